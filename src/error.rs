@@ -1,0 +1,56 @@
+//! One error type for the whole program. Every variant carries the context a user needs to
+//! act on it: the file and field for bad input, the time, iteration and residual for a
+//! failed solve.
+
+use std::path::Path;
+
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// Bad input: names the file, the field (a dotted path such as `bodies[1].length`) and
+    /// the problem.
+    #[error("{file}: {field}: {problem}")]
+    Input { file: String, field: String, problem: String },
+
+    /// Reading or writing a file failed at the operating-system level.
+    #[error("{file}: {source}")]
+    Io { file: String, #[source] source: std::io::Error },
+
+    /// An HDF5 file is missing, truncated, foreign or inconsistent.
+    #[error("{file}: {problem}")]
+    Hdf5 { file: String, problem: String },
+
+    /// Newton did not converge even after the allowed number of step halvings.
+    #[error(
+        "Newton failed at t = {t:.6} s (step {dt:.3e} s after {cuts} halvings): \
+         {iterations} iterations, last increment {increment:.3e}, residual {residual:.3e}"
+    )]
+    NewtonFailed { t: f64, dt: f64, cuts: u32, iterations: usize, increment: f64, residual: f64 },
+
+    /// The iteration matrix could not be factored (singular system).
+    #[error("linear solve failed at t = {t:.6} s: {problem}")]
+    LinearSolve { t: f64, problem: String },
+
+    /// Anything else that is a usage error of the program (bad command-line values).
+    #[error("{0}")]
+    Usage(String),
+}
+
+pub type Result<T> = std::result::Result<T, Error>;
+
+impl Error {
+    pub fn input(file: impl AsRef<Path>, field: impl Into<String>, problem: impl Into<String>) -> Self {
+        Error::Input {
+            file: file.as_ref().display().to_string(),
+            field: field.into(),
+            problem: problem.into(),
+        }
+    }
+
+    pub fn io(file: impl AsRef<Path>, source: std::io::Error) -> Self {
+        Error::Io { file: file.as_ref().display().to_string(), source }
+    }
+
+    pub fn hdf5(file: impl AsRef<Path>, problem: impl std::fmt::Display) -> Self {
+        Error::Hdf5 { file: file.as_ref().display().to_string(), problem: problem.to_string() }
+    }
+}

@@ -1,0 +1,3 @@
+//! HDF5 input and output.
+pub mod h5;
+pub mod result_file;

@@ -1,0 +1,46 @@
+//! The result file of `simulate` (and, later, of reduced runs). Fixed layout, read by
+//! scripts outside the project:
+//!
+//! ```text
+//! /t                      (n_t)          time, s
+//! /q                      (n_dof, n_t)   column k = all coordinates at t_k
+//! /multipliers            (n_c, n_t)     Lagrange multipliers (N for pins)
+//! /probes/<name>          (n_t, 2)       x, y of each probe, m
+//! attributes on /: model (TOML text), model_path, load_scale, dt, t_end, rho_inf,
+//!   linear_solver, newton_iterations, factorizations, step_cuts, steps,
+//!   max_iterations_in_a_step, wall_seconds, program_version
+//! ```
+
+use super::h5::{attr_f64, attr_str, attr_u64, write_atomically};
+use crate::error::{Error, Result};
+use crate::simulate::SimulationResult;
+use std::path::Path;
+
+pub fn write_result(path: &Path, r: &SimulationResult) -> Result<()> {
+    write_atomically(path, |f| {
+        let e = |err: hdf5::Error| Error::hdf5(path, err);
+        f.new_dataset_builder().with_data(&r.t).create("t").map_err(e)?;
+        f.new_dataset_builder().with_data(&r.q).create("q").map_err(e)?;
+        f.new_dataset_builder().with_data(&r.multipliers).create("multipliers").map_err(e)?;
+        let g = f.create_group("probes").map_err(e)?;
+        for (name, xy) in &r.probes {
+            g.new_dataset_builder().with_data(xy).create(name.as_str()).map_err(e)?;
+        }
+        let s = &r.settings;
+        attr_str(f, "model", &r.model_text).map_err(e)?;
+        attr_str(f, "model_path", &r.model_path).map_err(e)?;
+        attr_f64(f, "load_scale", s.load_scale).map_err(e)?;
+        attr_f64(f, "dt", s.dt).map_err(e)?;
+        attr_f64(f, "t_end", s.t_end).map_err(e)?;
+        attr_f64(f, "rho_inf", s.rho_inf).map_err(e)?;
+        attr_str(f, "linear_solver", &format!("{:?}", s.solver).to_lowercase()).map_err(e)?;
+        attr_u64(f, "steps", r.stats.steps as u64).map_err(e)?;
+        attr_u64(f, "newton_iterations", r.stats.newton_iterations as u64).map_err(e)?;
+        attr_u64(f, "factorizations", r.stats.factorizations as u64).map_err(e)?;
+        attr_u64(f, "step_cuts", r.stats.step_cuts as u64).map_err(e)?;
+        attr_u64(f, "max_iterations_in_a_step", r.stats.max_iterations_in_a_step as u64).map_err(e)?;
+        attr_f64(f, "wall_seconds", r.wall_seconds).map_err(e)?;
+        attr_str(f, "program_version", env!("CARGO_PKG_VERSION")).map_err(e)?;
+        Ok(())
+    })
+}

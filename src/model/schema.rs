@@ -1,0 +1,130 @@
+//! The TOML schema of a model file (`data/models/*.toml`). Every table refuses unknown keys.
+
+use crate::physics::time_function::TimeFunction;
+use serde::Deserialize;
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelFile {
+    /// free text shown in reports
+    #[serde(default)]
+    pub description: String,
+    pub time: TimeSettings,
+    #[serde(default)]
+    pub damping: Option<DampingSpec>,
+    pub bodies: Vec<BodySpec>,
+    #[serde(default)]
+    pub joints: Vec<JointSpec>,
+    #[serde(default)]
+    pub loads: Vec<LoadSpec>,
+    #[serde(default)]
+    pub probes: Vec<ProbeSpec>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimeSettings {
+    pub t_end: f64,
+    pub dt: f64,
+    /// spectral radius of generalized-α at infinite frequency (1 = trapezoidal rule)
+    pub rho_inf: f64,
+    /// Newton tolerance on ‖Δq‖∞ relative to the longest body
+    #[serde(default)]
+    pub newton_tolerance: Option<f64>,
+    #[serde(default)]
+    pub max_iterations: Option<i64>,
+    #[serde(default)]
+    pub max_step_cuts: Option<i64>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DampingSpec {
+    /// a in C = a M + b K_t
+    #[serde(default)]
+    pub mass: f64,
+    /// b in C = a M + b K_t
+    #[serde(default)]
+    pub stiffness: f64,
+}
+
+/// A straight beam: `start` and either `angle` (rad) with `length`, or `end` (then
+/// `length`, if given, must agree with it and is used as the exact length).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec {
+    pub name: String,
+    pub start: [f64; 2],
+    #[serde(default)]
+    pub angle: Option<f64>,
+    #[serde(default)]
+    pub end: Option<[f64; 2]>,
+    #[serde(default)]
+    pub length: Option<f64>,
+    pub elements: i64,
+    pub density: f64,
+    pub area: f64,
+    pub inertia: f64,
+    pub youngs_modulus: f64,
+}
+
+/// A node of a body: its index (0 = start) or `"start"` / `"end"`.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum NodeRef {
+    Index(i64),
+    Name(String),
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NodeSpec {
+    pub body: String,
+    pub node: NodeRef,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum JointSpec {
+    /// the node's position is fixed at `point` (default: where it starts)
+    GroundPin { body: String, node: NodeRef, #[serde(default)] point: Option<[f64; 2]> },
+    /// two bodies' nodes share their position
+    Pin { a: NodeSpec, b: NodeSpec },
+    /// position and slope of the node fixed at their initial values
+    Clamp { body: String, node: NodeRef },
+}
+
+fn yes() -> bool {
+    true
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum LoadSpec {
+    /// gravity acceleration vector, m/s²; `scaled` = multiplied by the load scale
+    Gravity { g: [f64; 2], #[serde(default)] scaled: bool },
+    /// moment (N·m) at a node, `function` of time
+    Moment { body: String, node: NodeRef, function: TimeFunction, #[serde(default = "yes")] scaled: bool },
+    /// force (N) at a node, times `function` of time if given
+    Force {
+        body: String,
+        node: NodeRef,
+        value: [f64; 2],
+        #[serde(default)]
+        function: Option<TimeFunction>,
+        #[serde(default = "yes")]
+        scaled: bool,
+    },
+}
+
+/// A recorded point: a `node` of a body, or the point at fraction `at` ∈ [0, 1] of its length.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProbeSpec {
+    pub name: String,
+    pub body: String,
+    #[serde(default)]
+    pub node: Option<NodeRef>,
+    #[serde(default)]
+    pub at: Option<f64>,
+}

@@ -1,0 +1,6 @@
+//! The mechanics: element, loads, time functions and the assembled system. Knows nothing of
+//! reduction.
+pub mod element;
+pub mod loads;
+pub mod system;
+pub mod time_function;

@@ -1,0 +1,438 @@
+//! A planar flexible multibody system: straight ANCF beams meshed into equal elements,
+//! linear joints on nodal coordinates, external loads. Implements [`DynamicModel`].
+//!
+//! Coordinates: node `k` (numbered body after body) owns `q[4k..4k+4] = (x, y, x', y')`.
+
+use super::element::{BeamElement, Mat8, Section, Vec8};
+use super::loads::{moment_force, moment_jacobian};
+use super::time_function::TimeFunction;
+use crate::solver::kkt::{make_solver, KktPattern, KktSolver, LinearSolverKind};
+use crate::solver::model::{DynamicModel, IterationCoefficients};
+
+/// A straight beam in its undeformed configuration.
+#[derive(Clone, Debug)]
+pub struct BeamBody {
+    pub name: String,
+    pub start: [f64; 2],
+    /// angle of the beam axis to +x, rad
+    pub angle: f64,
+    pub length: f64,
+    pub n_elements: usize,
+    pub section: Section,
+}
+
+/// A node is addressed by body index and node index within the body (0..=n_elements).
+pub type NodeId = (usize, usize);
+
+#[derive(Clone, Debug)]
+pub enum Joint {
+    /// `r_node − point = 0`
+    GroundPin { node: NodeId, point: [f64; 2] },
+    /// `r_a − r_b = 0`
+    Pin { a: NodeId, b: NodeId },
+    /// `r_node − point = 0`, `r'_node − slope = 0`
+    Clamp { node: NodeId, point: [f64; 2], slope: [f64; 2] },
+}
+
+#[derive(Clone, Debug)]
+pub enum Load {
+    /// body force `ρA g` on every element
+    Gravity { g: [f64; 2], scaled: bool },
+    /// moment `M(t)` at a node, acting on its slope
+    Moment { node: NodeId, function: TimeFunction, scaled: bool },
+    /// force `F f(t)` at a node (f = 1 without a function)
+    Force { node: NodeId, value: [f64; 2], function: Option<TimeFunction>, scaled: bool },
+}
+
+/// A material point whose position is recorded: element index and `ξ` in [0, 1].
+#[derive(Clone, Debug)]
+pub struct Probe {
+    pub name: String,
+    pub element: usize,
+    pub xi: f64,
+}
+
+/// Rayleigh damping `C = a M + b K_t` on the constant parts of the element matrices.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Rayleigh {
+    pub mass: f64,
+    pub stiffness: f64,
+}
+
+/// One scalar constraint `Σ coef · q[dof] = rhs`.
+#[derive(Clone, Debug)]
+pub struct Constraint {
+    pub terms: Vec<(usize, f64)>,
+    pub rhs: f64,
+}
+
+struct MomentLoad {
+    slope_dofs: [usize; 2],
+    element: usize,
+    local: usize,
+    function: TimeFunction,
+    scaled: bool,
+}
+
+struct ForceLoad {
+    dofs: [usize; 2],
+    value: [f64; 2],
+    function: Option<TimeFunction>,
+    scaled: bool,
+}
+
+pub struct FlexibleSystem {
+    pub bodies: Vec<BeamBody>,
+    /// first node of each body
+    first_node: Vec<usize>,
+    /// element → (body, dofs)
+    elements: Vec<(usize, [usize; 8])>,
+    /// one element prototype per body
+    prototypes: Vec<BeamElement>,
+    pub constraints: Vec<Constraint>,
+    pub probes: Vec<Probe>,
+    damping: Rayleigh,
+    load_scale: f64,
+    gravity_fixed: Vec<f64>,
+    gravity_scaled: Vec<f64>,
+    moments: Vec<MomentLoad>,
+    forces: Vec<ForceLoad>,
+    n_dof: usize,
+    kkt: Box<dyn KktSolver>,
+    blocks: Vec<Mat8>,
+    length_scale: f64,
+}
+
+impl FlexibleSystem {
+    /// Builds the system. Indices in joints, loads and probes must be valid (the model-file
+    /// layer checks them and reports errors against the file).
+    pub fn new(
+        bodies: Vec<BeamBody>,
+        joints: &[Joint],
+        loads: &[Load],
+        probes: Vec<Probe>,
+        damping: Rayleigh,
+        solver: LinearSolverKind,
+    ) -> Self {
+        let mut first_node = Vec::new();
+        let mut elements = Vec::new();
+        let mut prototypes = Vec::new();
+        let mut node = 0;
+        for (b, body) in bodies.iter().enumerate() {
+            first_node.push(node);
+            prototypes.push(BeamElement::new(body.length / body.n_elements as f64, body.section));
+            for k in 0..body.n_elements {
+                let d0 = 4 * (node + k);
+                elements.push((b, std::array::from_fn(|i| d0 + i)));
+            }
+            node += body.n_elements + 1;
+        }
+        let n_dof = 4 * node;
+        let gnode = |(b, k): NodeId| first_node[b] + k;
+
+        let mut constraints = Vec::new();
+        let mut fix = |dof: usize, value: f64| constraints.push(Constraint { terms: vec![(dof, 1.0)], rhs: value });
+        let mut pins = Vec::new();
+        for joint in joints {
+            match *joint {
+                Joint::GroundPin { node, point } => {
+                    let n = gnode(node);
+                    fix(4 * n, point[0]);
+                    fix(4 * n + 1, point[1]);
+                }
+                Joint::Clamp { node, point, slope } => {
+                    let n = gnode(node);
+                    fix(4 * n, point[0]);
+                    fix(4 * n + 1, point[1]);
+                    fix(4 * n + 2, slope[0]);
+                    fix(4 * n + 3, slope[1]);
+                }
+                Joint::Pin { a, b } => pins.push((gnode(a), gnode(b))),
+            }
+        }
+        for (a, b) in pins {
+            for c in 0..2 {
+                constraints.push(Constraint { terms: vec![(4 * a + c, 1.0), (4 * b + c, -1.0)], rhs: 0.0 });
+            }
+        }
+
+        let mut gravity_fixed = vec![0.0; n_dof];
+        let mut gravity_scaled = vec![0.0; n_dof];
+        let mut moments = Vec::new();
+        let mut forces = Vec::new();
+        // the element that holds a node: the one it starts, or the last of its body
+        let element_of = |(b, k): NodeId| -> (usize, usize) {
+            let first_el: usize = bodies[..b].iter().map(|x| x.n_elements).sum();
+            if k < bodies[b].n_elements { (first_el + k, 0) } else { (first_el + k - 1, 4) }
+        };
+        for load in loads {
+            match load {
+                Load::Gravity { g, scaled } => {
+                    let target = if *scaled { &mut gravity_scaled } else { &mut gravity_fixed };
+                    for (b, dofs) in &elements {
+                        let qg = prototypes[*b].gravity_force(*g);
+                        for i in 0..8 {
+                            target[dofs[i]] += qg[i];
+                        }
+                    }
+                }
+                Load::Moment { node, function, scaled } => {
+                    let n = gnode(*node);
+                    let (element, local) = element_of(*node);
+                    moments.push(MomentLoad {
+                        slope_dofs: [4 * n + 2, 4 * n + 3],
+                        element,
+                        local: local + 2,
+                        function: function.clone(),
+                        scaled: *scaled,
+                    });
+                }
+                Load::Force { node, value, function, scaled } => {
+                    let n = gnode(*node);
+                    forces.push(ForceLoad { dofs: [4 * n, 4 * n + 1], value: *value, function: function.clone(), scaled: *scaled });
+                }
+            }
+        }
+        let pattern = KktPattern {
+            n_dof,
+            element_dofs: elements.iter().map(|(_, d)| *d).collect(),
+            constraint_rows: constraints.iter().map(|c| c.terms.clone()).collect(),
+        };
+        let length_scale = bodies.iter().map(|b| b.length).fold(0.0, f64::max);
+        let n_el = elements.len();
+        FlexibleSystem {
+            bodies,
+            first_node,
+            elements,
+            prototypes,
+            constraints,
+            probes,
+            damping,
+            load_scale: 1.0,
+            gravity_fixed,
+            gravity_scaled,
+            moments,
+            forces,
+            n_dof,
+            kkt: make_solver(solver, pattern),
+            blocks: vec![Mat8::zeros(); n_el],
+            length_scale,
+        }
+    }
+
+    pub fn n_elements(&self) -> usize {
+        self.elements.len()
+    }
+
+    /// Global dof indices of element `e`.
+    pub fn element_dofs(&self, e: usize) -> &[usize; 8] {
+        &self.elements[e].1
+    }
+
+    /// The element object (constant matrices, force, tangent) of element `e`.
+    pub fn element(&self, e: usize) -> &BeamElement {
+        &self.prototypes[self.elements[e].0]
+    }
+
+    /// Global node index of node `k` of body `b`.
+    pub fn node_index(&self, b: usize, k: usize) -> usize {
+        self.first_node[b] + k
+    }
+
+    pub fn load_scale(&self) -> f64 {
+        self.load_scale
+    }
+
+    /// Multiplies every load marked `scaled` (the λ of SPEC §4).
+    pub fn set_load_scale(&mut self, x: f64) {
+        self.load_scale = x;
+    }
+
+    fn gather(&self, e: usize, q: &[f64]) -> Vec8 {
+        let d = &self.elements[e].1;
+        Vec8::from_fn(|i, _| q[d[i]])
+    }
+
+    /// The straight, undeformed configuration of every body (SPEC §1).
+    pub fn initial_state(&self) -> Vec<f64> {
+        let mut q = vec![0.0; self.n_dof];
+        for (b, body) in self.bodies.iter().enumerate() {
+            let (c, s) = (body.angle.cos(), body.angle.sin());
+            let h = body.length / body.n_elements as f64;
+            for k in 0..=body.n_elements {
+                let n = self.first_node[b] + k;
+                let d = k as f64 * h;
+                q[4 * n..4 * n + 4].copy_from_slice(&[body.start[0] + d * c, body.start[1] + d * s, c, s]);
+            }
+        }
+        q
+    }
+
+    /// Smallest (weighted) change of `q` that satisfies `B q = b` exactly; used to remove
+    /// round-off gaps in joints given with finitely many digits. Returns the largest change.
+    pub fn make_consistent(&mut self, q: &mut [f64]) -> Result<f64, String> {
+        let n = self.n_dof;
+        self.blocks.iter_mut().for_each(|b| *b = Mat8::identity());
+        self.kkt.factor(&self.blocks, 1.0)?;
+        let mut rhs = vec![0.0; n + self.constraints.len()];
+        self.constraint_residual(q, &mut rhs[n..]);
+        rhs[n..].iter_mut().for_each(|r| *r = -*r);
+        self.kkt.solve(&mut rhs)?;
+        let mut change = 0.0_f64;
+        for i in 0..n {
+            q[i] += rhs[i];
+            change = change.max(rhs[i].abs());
+        }
+        Ok(change)
+    }
+
+    /// Position of a probe.
+    pub fn probe_position(&self, probe: &Probe, q: &[f64]) -> [f64; 2] {
+        self.element(probe.element).position(&self.gather(probe.element, q), probe.xi)
+    }
+
+    /// Kinetic energy `½ q̇ᵀ M q̇`.
+    pub fn kinetic_energy(&self, v: &[f64]) -> f64 {
+        let mut mv = vec![0.0; self.n_dof];
+        self.mass_mul(v, &mut mv);
+        0.5 * v.iter().zip(&mv).map(|(a, b)| a * b).sum::<f64>()
+    }
+
+    /// Potential energy: strain energy plus that of the (constant) gravity loads.
+    pub fn potential_energy(&self, q: &[f64]) -> f64 {
+        let strain: f64 = (0..self.elements.len()).map(|e| self.element(e).strain_energy(&self.gather(e, q))).sum();
+        let grav: f64 = (0..self.n_dof).map(|i| (self.gravity_fixed[i] + self.load_scale * self.gravity_scaled[i]) * q[i]).sum();
+        strain - grav
+    }
+
+    /// Dense global mass matrix and tangent stiffness at `q` (row-major n×n), for modal
+    /// analysis and tests.
+    pub fn dense_mass_and_stiffness(&self, q: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        let n = self.n_dof;
+        let (mut m, mut k) = (vec![0.0; n * n], vec![0.0; n * n]);
+        for e in 0..self.elements.len() {
+            let el = self.element(e);
+            let (_, kt) = el.force_and_tangent(&self.gather(e, q));
+            let d = &self.elements[e].1;
+            for i in 0..8 {
+                for j in 0..8 {
+                    m[d[i] * n + d[j]] += el.mass()[(i, j)];
+                    k[d[i] * n + d[j]] += kt[(i, j)];
+                }
+            }
+        }
+        (m, k)
+    }
+
+    fn load_factor(&self, scaled: bool) -> f64 {
+        if scaled { self.load_scale } else { 1.0 }
+    }
+}
+
+impl DynamicModel for FlexibleSystem {
+    fn n_dof(&self) -> usize {
+        self.n_dof
+    }
+
+    fn n_constraints(&self) -> usize {
+        self.constraints.len()
+    }
+
+    fn mass_mul(&self, a: &[f64], out: &mut [f64]) {
+        out.iter_mut().for_each(|x| *x = 0.0);
+        for e in 0..self.elements.len() {
+            let f = self.element(e).mass() * self.gather(e, a);
+            for (i, &d) in self.elements[e].1.iter().enumerate() {
+                out[d] += f[i];
+            }
+        }
+    }
+
+    fn force(&mut self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
+        let s = self.load_scale;
+        for i in 0..self.n_dof {
+            out[i] = -(self.gravity_fixed[i] + s * self.gravity_scaled[i]);
+        }
+        let damped = self.damping != Rayleigh::default();
+        for e in 0..self.elements.len() {
+            let el = self.element(e);
+            let mut f = el.elastic_force(&self.gather(e, q));
+            if damped {
+                let ve = self.gather(e, v);
+                f += (el.mass() * self.damping.mass + el.bending_stiffness() * self.damping.stiffness) * ve;
+            }
+            for (i, &d) in self.elements[e].1.iter().enumerate() {
+                out[d] += f[i];
+            }
+        }
+        for m in &self.moments {
+            let mt = self.load_factor(m.scaled) * m.function.eval(t);
+            let qm = moment_force(mt, [q[m.slope_dofs[0]], q[m.slope_dofs[1]]]);
+            out[m.slope_dofs[0]] -= qm[0];
+            out[m.slope_dofs[1]] -= qm[1];
+        }
+        for f in &self.forces {
+            let ft = self.load_factor(f.scaled) * f.function.as_ref().map_or(1.0, |func| func.eval(t));
+            out[f.dofs[0]] -= ft * f.value[0];
+            out[f.dofs[1]] -= ft * f.value[1];
+        }
+    }
+
+    fn constraint_residual(&self, q: &[f64], out: &mut [f64]) {
+        for (o, c) in out.iter_mut().zip(&self.constraints) {
+            *o = c.terms.iter().map(|&(d, k)| k * q[d]).sum::<f64>() - c.rhs;
+        }
+    }
+
+    fn add_constraint_force(&self, lambda: &[f64], out: &mut [f64]) {
+        for (l, c) in lambda.iter().zip(&self.constraints) {
+            for &(d, k) in &c.terms {
+                out[d] += k * l;
+            }
+        }
+    }
+
+    fn factor(&mut self, q: &[f64], _v: &[f64], t: f64, coef: IterationCoefficients) -> Result<f64, String> {
+        let damp_m = coef.mass + coef.damping * self.damping.mass;
+        let damp_k = coef.damping * self.damping.stiffness;
+        let mut diag_max = 0.0_f64;
+        for e in 0..self.elements.len() {
+            let el = &self.prototypes[self.elements[e].0];
+            let mut blk = el.mass() * damp_m;
+            if coef.stiffness != 0.0 {
+                let (_, kt) = el.force_and_tangent(&self.gather(e, q));
+                blk += kt * coef.stiffness;
+            }
+            if damp_k != 0.0 {
+                blk += el.bending_stiffness() * damp_k;
+            }
+            for i in 0..8 {
+                diag_max = diag_max.max(blk[(i, i)].abs());
+            }
+            self.blocks[e] = blk;
+        }
+        if coef.stiffness != 0.0 {
+            for m in &self.moments {
+                let mt = self.load_factor(m.scaled) * m.function.eval(t);
+                let j = moment_jacobian(mt, [q[m.slope_dofs[0]], q[m.slope_dofs[1]]]);
+                for r in 0..2 {
+                    for c in 0..2 {
+                        // residual carries −Q_ext, so its Jacobian enters with a minus sign
+                        self.blocks[m.element][(m.local + r, m.local + c)] -= coef.stiffness * j[r][c];
+                    }
+                }
+            }
+        }
+        let scale = if diag_max > 0.0 { diag_max } else { 1.0 };
+        self.kkt.factor(&self.blocks, scale)?;
+        Ok(scale)
+    }
+
+    fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+        self.kkt.solve(rhs)
+    }
+
+    fn length_scale(&self) -> f64 {
+        self.length_scale
+    }
+}

@@ -1,0 +1,4 @@
+//! Time integration and linear algebra, generic over [`model::DynamicModel`].
+pub mod generalized_alpha;
+pub mod kkt;
+pub mod model;
