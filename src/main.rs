@@ -30,7 +30,7 @@ struct RunArgs {
     #[arg(long)]
     load_scale: Option<f64>,
     /// linear solver of the full model
-    #[arg(long, value_enum, default_value_t = LinearSolverKind::Sparse)]
+    #[arg(long, value_enum, default_value_t = LinearSolverKind::Banded)]
     solver: LinearSolverKind,
 }
 
@@ -81,11 +81,12 @@ fn run(cli: Cli) -> flexrom::Result<()> {
             let r = simulate(&model, &run.overrides())?;
             write_result(&output, &r)?;
             eprintln!(
-                "{}: {} steps in {:.3} s ({} Newton iterations, {} step cuts) -> {}",
+                "{}: {} steps in {:.3} s ({} Newton iterations, {} factorizations, {} step cuts) -> {}",
                 model.path.display(),
                 r.stats.steps,
                 r.wall_seconds,
                 r.stats.newton_iterations,
+                r.stats.factorizations,
                 r.stats.step_cuts,
                 output.display()
             );

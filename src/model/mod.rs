@@ -124,7 +124,7 @@ impl Model {
                 section: Section { density: b.density, area: b.area, inertia: b.inertia, youngs_modulus: b.youngs_modulus },
             });
         }
-        let q0 = FlexibleSystem::new(self.bodies.clone(), &[], &[], vec![], Rayleigh::default(), LinearSolverKind::Sparse).initial_state();
+        let q0 = FlexibleSystem::new(self.bodies.clone(), &[], &[], vec![], Rayleigh::default(), LinearSolverKind::Dense).initial_state();
         let lmax = self.bodies.iter().map(|b| b.length).fold(0.0, f64::max);
         let node_pos = |(b, k): NodeId, bodies: &[BeamBody]| -> [f64; 2] {
             let first: usize = bodies[..b].iter().map(|x| x.n_elements + 1).sum();

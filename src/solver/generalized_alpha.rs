@@ -164,7 +164,14 @@ impl GeneralizedAlpha {
             Some(b) => b.clone_from(state),
             None => self.backup = Some(state.clone()),
         }
-        match self.try_step(model, state, h) {
+        let mut result = self.try_step(model, state, h, self.params.reuse_factorization);
+        if result.is_err() && self.params.reuse_factorization {
+            // a stale matrix may be what failed: retry once with full Newton before halving
+            state.clone_from(self.backup.as_ref().expect("backup taken"));
+            self.factored = None;
+            result = self.try_step(model, state, h, false);
+        }
+        match result {
             Ok(()) => Ok(()),
             Err(fail) => {
                 state.clone_from(self.backup.as_ref().expect("backup taken"));
@@ -186,7 +193,7 @@ impl GeneralizedAlpha {
         }
     }
 
-    fn try_step<M: DynamicModel>(&mut self, model: &mut M, st: &mut State, h: f64) -> std::result::Result<(), Failure> {
+    fn try_step<M: DynamicModel>(&mut self, model: &mut M, st: &mut State, h: f64, reuse_allowed: bool) -> std::result::Result<(), Failure> {
         let (am, af, g, b) = (self.alpha_m, self.alpha_f, self.gamma, self.beta);
         let n = model.n_dof();
         let beta_p = (1.0 - am) / (b * h * h * (1.0 - af));
@@ -217,7 +224,7 @@ impl GeneralizedAlpha {
             if !residual.is_finite() {
                 return Err(Failure { iterations: it, increment: last_increment, residual });
             }
-            let reuse = self.params.reuse_factorization && self.factored.is_some_and(|(fh, _)| fh == h);
+            let reuse = reuse_allowed && self.factored.is_some_and(|(fh, _)| fh == h);
             let s = if reuse {
                 self.factored.expect("checked").1
             } else {
@@ -255,8 +262,9 @@ impl GeneralizedAlpha {
                 self.stats.max_iterations_in_a_step = self.stats.max_iterations_in_a_step.max(it);
                 return Ok(());
             }
-            // a reused matrix that contracts slowly is refreshed at the next iteration
-            if self.params.reuse_factorization && it > 1 && inc > 0.25 * last_increment {
+            // modified Newton: refresh the matrix when the contraction is slow (a fresh
+            // tangent gives quadratic convergence) or when the step needs many iterations
+            if !reuse_allowed || (it > 1 && inc > 0.1 * last_increment) || it >= 4 {
                 self.factored = None;
             }
             last_increment = inc;

@@ -1,4 +1,5 @@
 //! Time integration and linear algebra, generic over [`model::DynamicModel`].
+pub mod banded;
 pub mod generalized_alpha;
 pub mod kkt;
 pub mod model;

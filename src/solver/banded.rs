@@ -1,0 +1,303 @@
+//! Band LU for the KKT matrix: reverse Cuthill–McKee ordering of the fixed pattern, then an
+//! LU with partial pivoting in LAPACK band storage (partial pivoting, so the zero constraint
+//! diagonal is fine).
+//!
+//! A chain of beam elements has a half-bandwidth of 7 after ordering and the four-bar loop 8,
+//! so one factorization costs `O(n b²)`: linear in the number of elements. The factorization
+//! is LAPACK's `dgbtf2` algorithm written out in Rust: at these bandwidths OpenBLAS's
+//! `dgbtrf` spends most of its time in the per-column BLAS calls (measured with callgrind:
+//! ~350k instructions per 206-row factorization against ~60k here).
+
+use super::kkt::{Block, KktPattern, KktSolver};
+use std::collections::VecDeque;
+
+/// Reverse Cuthill–McKee (Cuthill & McKee 1969; George & Liu 1981, §4.3): a breadth-first
+/// numbering from a low-degree start node, neighbours taken in increasing degree, reversed.
+/// `adj[i]` lists the neighbours of i. Returns `order[new] = old`.
+pub fn reverse_cuthill_mckee(adj: &[Vec<usize>]) -> Vec<usize> {
+    let n = adj.len();
+    let degree: Vec<usize> = adj.iter().map(|a| a.len()).collect();
+    let mut visited = vec![false; n];
+    let mut order = Vec::with_capacity(n);
+    let mut by_degree: Vec<usize> = (0..n).collect();
+    by_degree.sort_by_key(|&i| degree[i]);
+    for &seed in &by_degree {
+        if visited[seed] {
+            continue;
+        }
+        // move the start to a pseudo-peripheral node: the last node reached by a BFS
+        let start = last_reached(adj, seed, &degree);
+        let mut queue = VecDeque::from([start]);
+        visited[start] = true;
+        while let Some(i) = queue.pop_front() {
+            order.push(i);
+            let mut next: Vec<usize> = adj[i].iter().copied().filter(|&j| !visited[j]).collect();
+            next.sort_by_key(|&j| degree[j]);
+            for j in next {
+                if !visited[j] {
+                    visited[j] = true;
+                    queue.push_back(j);
+                }
+            }
+        }
+    }
+    order.reverse();
+    order
+}
+
+fn last_reached(adj: &[Vec<usize>], seed: usize, degree: &[usize]) -> usize {
+    let mut seen = vec![false; adj.len()];
+    let mut queue = VecDeque::from([seed]);
+    seen[seed] = true;
+    let mut last = seed;
+    while let Some(i) = queue.pop_front() {
+        last = i;
+        let mut next: Vec<usize> = adj[i].iter().copied().filter(|&j| !seen[j]).collect();
+        next.sort_by_key(|&j| degree[j]);
+        for j in next {
+            if !seen[j] {
+                seen[j] = true;
+                queue.push_back(j);
+            }
+        }
+    }
+    last
+}
+
+pub struct BandedKkt {
+    n: usize,
+    band: usize,
+    ldab: usize,
+    /// position of each original row/column in the band ordering
+    new_of: Vec<usize>,
+    ab: Vec<f64>,
+    ipiv: Vec<usize>,
+    elem_slots: Vec<usize>,
+    cons_slots: Vec<(usize, usize, f64)>,
+    work: Vec<f64>,
+    factored: bool,
+}
+
+impl BandedKkt {
+    pub fn new(pattern: KktPattern) -> Self {
+        let n = pattern.size();
+        let nd = pattern.n_dof;
+        let mut adj: Vec<Vec<usize>> = vec![Vec::new(); n];
+        for dofs in &pattern.element_dofs {
+            for &i in dofs {
+                adj[i].extend(dofs.iter().copied().filter(|&j| j != i));
+            }
+        }
+        for (c, row) in pattern.constraint_rows.iter().enumerate() {
+            for &(d, _) in row {
+                adj[d].push(nd + c);
+                adj[nd + c].push(d);
+            }
+        }
+        for a in adj.iter_mut() {
+            a.sort_unstable();
+            a.dedup();
+        }
+        let order = reverse_cuthill_mckee(&adj);
+        let mut new_of = vec![0; n];
+        for (new, &old) in order.iter().enumerate() {
+            new_of[old] = new;
+        }
+        let band = adj
+            .iter()
+            .enumerate()
+            .flat_map(|(i, a)| a.iter().map(move |&j| (i, j)))
+            .map(|(i, j)| new_of[i].abs_diff(new_of[j]))
+            .max()
+            .unwrap_or(0);
+        let ldab = 3 * band + 1;
+        // A(i, j) lives at AB[kl + ku + i − j, j] (LAPACK band storage with room for fill)
+        let slot = |i: usize, j: usize| {
+            let (i, j) = (new_of[i], new_of[j]);
+            (2 * band + i - j) + j * ldab
+        };
+        let mut elem_slots = Vec::with_capacity(64 * pattern.element_dofs.len());
+        for dofs in &pattern.element_dofs {
+            for j in 0..8 {
+                for i in 0..8 {
+                    elem_slots.push(slot(dofs[i], dofs[j]));
+                }
+            }
+        }
+        let mut cons_slots = Vec::new();
+        for (c, row) in pattern.constraint_rows.iter().enumerate() {
+            for &(d, coef) in row {
+                cons_slots.push((slot(nd + c, d), slot(d, nd + c), coef));
+            }
+        }
+        BandedKkt {
+            n,
+            band,
+            ldab,
+            new_of,
+            ab: vec![0.0; ldab * n],
+            ipiv: vec![0; n],
+            elem_slots,
+            cons_slots,
+            work: vec![0.0; n],
+            factored: false,
+        }
+    }
+
+    /// Half-bandwidth after ordering.
+    pub fn bandwidth(&self) -> usize {
+        self.band
+    }
+}
+
+impl KktSolver for BandedKkt {
+    fn factor(&mut self, blocks: &[Block], scale: f64) -> Result<(), String> {
+        self.ab.iter_mut().for_each(|v| *v = 0.0);
+        for (e, block) in blocks.iter().enumerate() {
+            for (k, &s) in self.elem_slots[64 * e..64 * e + 64].iter().enumerate() {
+                self.ab[s] += block.as_slice()[k];
+            }
+        }
+        for &(a, b, coef) in &self.cons_slots {
+            self.ab[a] += scale * coef;
+            self.ab[b] += scale * coef;
+        }
+        self.factored = false;
+        band_lu(&mut self.ab, self.n, self.band, self.ldab, &mut self.ipiv)?;
+        self.factored = true;
+        Ok(())
+    }
+
+    fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+        if !self.factored {
+            return Err("solve called without a valid factorization".into());
+        }
+        for (old, &new) in self.new_of.iter().enumerate() {
+            self.work[new] = rhs[old];
+        }
+        band_lu_solve(&self.ab, self.n, self.band, self.ldab, &self.ipiv, &mut self.work);
+        for (old, &new) in self.new_of.iter().enumerate() {
+            rhs[old] = self.work[new];
+        }
+        if rhs.iter().all(|v| v.is_finite()) { Ok(()) } else { Err("the iteration matrix is singular (non-finite solution)".into()) }
+    }
+}
+
+/// LU with partial pivoting of a square band matrix with `kl = ku = b`, in place, in LAPACK
+/// band storage: `A(i, j)` at `ab[2b + i − j + j·ldab]`, `ldab ≥ 3b + 1`, rows `0..b` of each
+/// column zero on entry (room for fill from the row interchanges). Same algorithm and
+/// storage as LAPACK `dgbtf2`.
+pub fn band_lu(ab: &mut [f64], n: usize, b: usize, ldab: usize, ipiv: &mut [usize]) -> Result<(), String> {
+    let kv = 2 * b;
+    let mut ju = 0; // last column touched by the interchanges so far
+    for j in 0..n {
+        let km = b.min(n - 1 - j);
+        let (done, rest) = ab.split_at_mut((j + 1) * ldab);
+        let col = &mut done[j * ldab + kv..j * ldab + kv + km + 1];
+        let (mut jp, mut best) = (0, col[0].abs());
+        for (r, v) in col.iter().enumerate().skip(1) {
+            if v.abs() > best {
+                best = v.abs();
+                jp = r;
+            }
+        }
+        ipiv[j] = j + jp;
+        if best == 0.0 || !best.is_finite() {
+            return Err(format!("band LU: zero or non-finite pivot in column {j} (singular iteration matrix)"));
+        }
+        ju = ju.max((j + b + jp).min(n - 1));
+        col.swap(0, jp);
+        let inv = 1.0 / col[0];
+        let l = &mut col[1..];
+        l.iter_mut().for_each(|x| *x *= inv);
+        // columns c = j+1..=ju: entry (j, c) sits at offset kv + j − c of column c
+        for c in j + 1..=ju {
+            let off = (c - j - 1) * ldab + kv + j - c;
+            let tgt = &mut rest[off..off + km + 1];
+            tgt.swap(0, jp);
+            let u = tgt[0];
+            if u != 0.0 {
+                for (t, m) in tgt[1..].iter_mut().zip(l.iter()) {
+                    *t -= m * u;
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Solves `A x = rhs` in place with the factors of [`band_lu`] (LAPACK `dgbtrs`, no transpose).
+pub fn band_lu_solve(ab: &[f64], n: usize, b: usize, ldab: usize, ipiv: &[usize], x: &mut [f64]) {
+    let kv = 2 * b;
+    for j in 0..n {
+        x.swap(ipiv[j], j);
+        let xj = x[j];
+        let km = b.min(n - 1 - j);
+        if xj != 0.0 {
+            let l = &ab[j * ldab + kv + 1..j * ldab + kv + 1 + km];
+            for (t, m) in x[j + 1..j + 1 + km].iter_mut().zip(l) {
+                *t -= m * xj;
+            }
+        }
+    }
+    for j in (0..n).rev() {
+        let col = &ab[j * ldab..j * ldab + kv + 1];
+        x[j] /= col[kv];
+        let xj = x[j];
+        let i0 = j.saturating_sub(kv);
+        if xj != 0.0 {
+            // U(i, j) for i in i0..j sits at offset kv + i − j
+            for (t, u) in x[i0..j].iter_mut().zip(&col[kv + i0 - j..kv]) {
+                *t -= u * xj;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn band_lu_solves_a_system_that_needs_pivoting() {
+        // zero diagonal everywhere except the last: without row interchanges LU breaks down
+        let (n, b) = (30, 3);
+        let ldab = 3 * b + 1;
+        let a = |i: usize, j: usize| -> f64 {
+            if i.abs_diff(j) > b || (i == j && i + 1 != n) { 0.0 } else { 1.0 + ((i * 7 + j * 3) % 11) as f64 * 0.1 }
+        };
+        let mut ab = vec![0.0; ldab * n];
+        for j in 0..n {
+            for i in j.saturating_sub(b)..(j + b + 1).min(n) {
+                ab[2 * b + i - j + j * ldab] = a(i, j);
+            }
+        }
+        let x_true: Vec<f64> = (0..n).map(|i| (i as f64 * 0.3).cos()).collect();
+        let mut rhs: Vec<f64> = (0..n).map(|i| (0..n).map(|j| a(i, j) * x_true[j]).sum()).collect();
+        let mut ipiv = vec![0; n];
+        band_lu(&mut ab, n, b, ldab, &mut ipiv).unwrap();
+        band_lu_solve(&ab, n, b, ldab, &ipiv, &mut rhs);
+        for i in 0..n {
+            assert!((rhs[i] - x_true[i]).abs() < 1e-10, "{i}: {} vs {}", rhs[i], x_true[i]);
+        }
+    }
+
+    /// A path graph numbered at random has RCM bandwidth 1 (a path is its own best order).
+    #[test]
+    fn rcm_recovers_a_scrambled_path() {
+        let n = 40;
+        let label: Vec<usize> = (0..n).map(|i| (i * 17 + 5) % n).collect(); // 17 ⟂ 40: a permutation
+        let mut adj = vec![Vec::new(); n];
+        for i in 0..n - 1 {
+            adj[label[i]].push(label[i + 1]);
+            adj[label[i + 1]].push(label[i]);
+        }
+        let order = reverse_cuthill_mckee(&adj);
+        let mut pos = vec![0; n];
+        for (k, &o) in order.iter().enumerate() {
+            pos[o] = k;
+        }
+        let band = (0..n).flat_map(|i| adj[i].iter().map(move |&j| (i, j))).map(|(i, j)| pos[i].abs_diff(pos[j])).max();
+        assert_eq!(band, Some(1));
+    }
+}
