@@ -3,3 +3,4 @@ pub mod banded;
 pub mod generalized_alpha;
 pub mod kkt;
 pub mod model;
+pub mod statics;

@@ -1,0 +1,46 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use flexrom::model::Model;
+
+/// A model from TOML text (the path is only used in messages).
+pub fn model(text: &str) -> Model {
+    Model::from_text(text, "test.toml").expect("valid test model")
+}
+
+/// A straight horizontal cantilever along +x, clamped at the origin, with a tip force
+/// `(0, −P)` (scaled by the load scale) and no gravity.
+pub fn cantilever(elements: usize, length: f64, e: f64, area: f64, inertia: f64, p: f64) -> Model {
+    model(&format!(
+        r#"
+        [time]
+        t_end = 1.0
+        dt = 0.01
+        rho_inf = 1.0
+        [[bodies]]
+        name = "beam"
+        start = [0.0, 0.0]
+        angle = 0.0
+        length = {length}
+        elements = {elements}
+        density = 7800.0
+        area = {area}
+        inertia = {inertia}
+        youngs_modulus = {e}
+        [[joints]]
+        type = "clamp"
+        body = "beam"
+        node = "start"
+        [[loads]]
+        type = "force"
+        body = "beam"
+        node = "end"
+        value = [0.0, {minus_p}]
+        [[probes]]
+        name = "tip"
+        body = "beam"
+        node = "end"
+        "#,
+        minus_p = -p
+    ))
+}
