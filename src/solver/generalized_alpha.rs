@@ -254,7 +254,11 @@ impl GeneralizedAlpha {
             if !inc.is_finite() {
                 return Err(Failure { iterations: it, increment: inc, residual });
             }
-            if inc <= tol {
+            // converged when the increment, or the error still left after it as estimated
+            // from the contraction θ = ‖Δq_k‖/‖Δq_{k−1}‖, is below tolerance: θ/(1−θ)‖Δq_k‖
+            // (Hairer & Wanner, Solving ODEs II, §IV.8); saves the confirming iteration
+            let theta = inc / last_increment;
+            if inc <= tol || (it > 1 && theta < 0.5 && theta / (1.0 - theta) * inc <= tol) {
                 for i in 0..n {
                     st.a[i] += (1.0 - af) / (1.0 - am) * st.qdd[i];
                 }

@@ -1,0 +1,119 @@
+//! The `flexrom simulate` command as a user meets it: the result-file layout that outside
+//! scripts read (issue 2, item 6), and bad input — a message naming the file, the field and
+//! the problem, a non-zero exit, and no output file.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn flexrom() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_flexrom"))
+}
+
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("data/models").join(name)
+}
+
+#[test]
+fn simulate_writes_the_documented_layout() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("p.h5");
+    let o = flexrom()
+        .args(["simulate", data("pendulum.toml").to_str().unwrap(), "-o", out.to_str().unwrap(), "--t-end", "0.05", "--csv"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = String::from_utf8(o.stdout).unwrap();
+    assert_eq!(csv.lines().next(), Some("t,tip_x,tip_y"));
+    assert_eq!(csv.lines().count(), 1 + 11, "header + t = 0 and 10 steps");
+    let f = hdf5::File::open(&out).unwrap();
+    let t = f.dataset("t").unwrap().read_1d::<f64>().unwrap();
+    assert_eq!(t.len(), 11);
+    assert!((t[10] - 0.05).abs() < 1e-12);
+    assert_eq!(f.dataset("q").unwrap().shape(), vec![204, 11]);
+    assert_eq!(f.dataset("multipliers").unwrap().shape(), vec![2, 11]);
+    let tip = f.dataset("probes/tip").unwrap().read_2d::<f64>().unwrap();
+    assert_eq!(tip.shape(), &[11, 2]);
+    // the tip probe is the last node's position, column 10 of /q
+    let q = f.dataset("q").unwrap().read_2d::<f64>().unwrap();
+    assert_eq!(tip[[10, 0]], q[[200, 10]]);
+    assert_eq!(tip[[10, 1]], q[[201, 10]]);
+    assert!(flexrom::io::h5::read_attr_str(&f, "model").unwrap().contains("[[bodies]]"));
+    assert_eq!(flexrom::io::h5::read_attr_f64(&f, "dt").unwrap(), 0.005);
+    assert_eq!(flexrom::io::h5::read_attr_f64(&f, "load_scale").unwrap(), 1.0);
+    assert!(f.attr("newton_iterations").unwrap().read_scalar::<u64>().unwrap() >= 10);
+    assert!(flexrom::io::h5::read_attr_f64(&f, "wall_seconds").unwrap() > 0.0);
+}
+
+/// Runs `simulate` on a broken copy of the pendulum file and returns stderr; asserts the
+/// exit is non-zero and that no output (nor temporary) file is left behind.
+fn broken(edit: impl Fn(&str) -> String) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("broken.toml");
+    std::fs::write(&model, edit(&std::fs::read_to_string(data("pendulum.toml")).unwrap())).unwrap();
+    let out = dir.path().join("out.h5");
+    let o = flexrom().args(["simulate", model.to_str().unwrap(), "-o", out.to_str().unwrap()]).output().unwrap();
+    assert!(!o.status.success());
+    assert!(!out.exists(), "no output file on error");
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "only the model file remains");
+    let err = String::from_utf8(o.stderr).unwrap();
+    assert!(err.contains("broken.toml"), "message names the file: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    err
+}
+
+#[test]
+fn bad_model_files_are_refused_with_file_field_and_problem() {
+    let cases: Vec<(Box<dyn Fn(&str) -> String>, &[&str])> = vec![
+        (Box::new(|s: &str| s.replace("length = 1.2", "length = 1.2\nlenght = 3")), &["lenght", "unknown field"]),
+        (Box::new(|s: &str| s.replace("density = 5540.0\n", "")), &["density", "missing"]),
+        (Box::new(|s: &str| s.replace("length = 1.2", "length = 0.0")), &["bodies[0].length", "positive"]),
+        (Box::new(|s: &str| s.replace("length = 1.2", "length = -1.2")), &["bodies[0].length", "positive"]),
+        (Box::new(|s: &str| s.replace("youngs_modulus = 0.7e9", "youngs_modulus = nan")), &["bodies[0].youngs_modulus", "finite"]),
+        (Box::new(|s: &str| s.replace("area = 1.8e-3", "area = inf")), &["bodies[0].area"]),
+        (Box::new(|s: &str| s.replace("inertia = 1.215e-8", "inertia = 0")), &["bodies[0].inertia"]),
+        (Box::new(|s: &str| s.replace("density = 5540.0", "density = -1.0")), &["bodies[0].density"]),
+        (Box::new(|s: &str| s.replace("elements = 50", "elements = 0")), &["bodies[0].elements", "positive"]),
+        (Box::new(|s: &str| s.replace("elements = 50", "elements = -3")), &["bodies[0].elements"]),
+        (Box::new(|s: &str| s.replace("dt = 0.005", "dt = 0.0")), &["time.dt", "positive"]),
+        (Box::new(|s: &str| s.replace("dt = 0.005", "dt = -0.005")), &["time.dt"]),
+        (Box::new(|s: &str| s.replace("rho_inf = 1.0", "rho_inf = 1.5")), &["time.rho_inf"]),
+        (Box::new(|s: &str| s.replace("body = \"beam\"\nnode = \"start\"", "body = \"bean\"\nnode = \"start\"")), &["joints[0].body", "bean"]),
+        (Box::new(|s: &str| s.replace("node = \"start\"", "node = 51")), &["joints[0].node", "outside"]),
+        (Box::new(|s: &str| s.replace("node = \"end\"", "node = 77")), &["probes[0].node", "outside"]),
+        (Box::new(|s: &str| s.replace("node = \"end\"", "at = 1.5")), &["probes[0].at", "outside"]),
+        (Box::new(|s: &str| s.replace("type = \"ground_pin\"", "type = \"ground_pin\"\npoint = [0.5, 0.0]")), &["joints[0].point"]),
+    ];
+    for (edit, needles) in cases {
+        let err = broken(edit);
+        for n in needles {
+            assert!(err.contains(n), "expected `{n}` in: {err}");
+        }
+    }
+}
+
+#[test]
+fn output_into_a_missing_directory_is_a_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("no/such/dir/out.h5");
+    let o = flexrom().args(["simulate", data("pendulum.toml").to_str().unwrap(), "-o", out.to_str().unwrap()]).output().unwrap();
+    assert!(!o.status.success());
+    let err = String::from_utf8(o.stderr).unwrap();
+    assert!(err.contains("does not exist") && !err.contains("panicked"), "{err}");
+}
+
+#[test]
+fn a_failed_run_keeps_the_previous_good_result() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("keep.h5");
+    std::fs::write(&out, b"previous good data").unwrap();
+    let o = flexrom().args(["simulate", data("pendulum.toml").to_str().unwrap(), "-o", out.to_str().unwrap(), "--dt", "-1"]).output().unwrap();
+    assert!(!o.status.success());
+    assert_eq!(std::fs::read(&out).unwrap(), b"previous good data");
+}
+
+#[test]
+fn missing_model_file_is_named() {
+    let o = flexrom().args(["simulate", "/no/such/model.toml", "-o", "/tmp/x.h5"]).output().unwrap();
+    assert!(!o.status.success());
+    assert!(String::from_utf8(o.stderr).unwrap().contains("/no/such/model.toml"));
+}
