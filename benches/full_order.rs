@@ -28,6 +28,7 @@ fn bench(model: &Model, solver: LinearSolverKind, runs: usize) -> (f64, usize, u
 }
 
 fn main() {
+    flexrom::single_threaded_blas();
     // `cargo bench` passes `--bench`; anything else named `quick` shortens the run
     let quick = std::env::args().any(|a| a == "quick");
     let root = env!("CARGO_MANIFEST_DIR");

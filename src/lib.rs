@@ -13,3 +13,14 @@ pub mod simulate;
 pub mod solver;
 
 pub use error::{Error, Result};
+
+extern "C" {
+    fn openblas_set_num_threads(n: std::os::raw::c_int);
+}
+
+/// Keeps OpenBLAS on one thread: the dense reference solver then measures one core, like
+/// everything else, and parallel sweeps do not oversubscribe the machine.
+pub fn single_threaded_blas() {
+    // SAFETY: plain setter of OpenBLAS's global thread count, linked through ndarray-linalg.
+    unsafe { openblas_set_num_threads(1) }
+}

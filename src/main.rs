@@ -64,6 +64,7 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    flexrom::single_threaded_blas();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
