@@ -11,28 +11,7 @@ use ndarray_linalg::{Eigh, UPLO};
 #[test]
 fn clamped_free_bending_frequencies_match_euler_bernoulli() {
     let (l, e, a, i, rho): (f64, f64, f64, f64, f64) = (1.2, 0.7e9, 1.8e-3, 1.215e-8, 5540.0);
-    let m = common::model(&format!(
-        r#"
-        [time]
-        t_end = 1.0
-        dt = 0.01
-        rho_inf = 1.0
-        [[bodies]]
-        name = "beam"
-        start = [0.0, 0.0]
-        angle = 0.0
-        length = {l}
-        elements = 20
-        density = {rho}
-        area = {a}
-        inertia = {i}
-        youngs_modulus = {e}
-        [[joints]]
-        type = "clamp"
-        body = "beam"
-        node = "start"
-        "#
-    ));
+    let m = common::cantilever_with_density(20, l, e, a, i, rho, 0.0);
     let sys = m.system(Default::default());
     let q0 = sys.initial_state();
     let n = q0.len();

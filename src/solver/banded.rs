@@ -8,7 +8,7 @@
 //! `dgbtrf` spends most of its time in the per-column BLAS calls (measured with callgrind:
 //! ~350k instructions per 206-row factorization against ~60k here).
 
-use super::kkt::{Block, KktPattern, KktSolver};
+use super::kkt::{Block, KktPattern, KktSolver, SlotMap};
 use std::collections::VecDeque;
 
 /// Reverse Cuthill–McKee (Cuthill & McKee 1969; George & Liu 1981, §4.3): a breadth-first
@@ -25,43 +25,31 @@ pub fn reverse_cuthill_mckee(adj: &[Vec<usize>]) -> Vec<usize> {
         if visited[seed] {
             continue;
         }
-        // move the start to a pseudo-peripheral node: the last node reached by a BFS
-        let start = last_reached(adj, seed, &degree);
-        let mut queue = VecDeque::from([start]);
-        visited[start] = true;
-        while let Some(i) = queue.pop_front() {
-            order.push(i);
-            let mut next: Vec<usize> = adj[i].iter().copied().filter(|&j| !visited[j]).collect();
-            next.sort_by_key(|&j| degree[j]);
-            for j in next {
-                if !visited[j] {
-                    visited[j] = true;
-                    queue.push_back(j);
-                }
-            }
-        }
+        // start from a pseudo-peripheral node: the last one a search from the seed reaches
+        let start = *breadth_first(adj, &degree, seed, &mut visited.clone()).last().expect("seed");
+        order.extend(breadth_first(adj, &degree, start, &mut visited));
     }
     order.reverse();
     order
 }
 
-fn last_reached(adj: &[Vec<usize>], seed: usize, degree: &[usize]) -> usize {
-    let mut seen = vec![false; adj.len()];
-    let mut queue = VecDeque::from([seed]);
-    seen[seed] = true;
-    let mut last = seed;
+/// Breadth-first order from `start` over unvisited nodes, neighbours by increasing degree.
+fn breadth_first(adj: &[Vec<usize>], degree: &[usize], start: usize, visited: &mut [bool]) -> Vec<usize> {
+    let mut out = Vec::new();
+    let mut queue = VecDeque::from([start]);
+    visited[start] = true;
     while let Some(i) = queue.pop_front() {
-        last = i;
-        let mut next: Vec<usize> = adj[i].iter().copied().filter(|&j| !seen[j]).collect();
+        out.push(i);
+        let mut next: Vec<usize> = adj[i].iter().copied().filter(|&j| !visited[j]).collect();
         next.sort_by_key(|&j| degree[j]);
         for j in next {
-            if !seen[j] {
-                seen[j] = true;
+            if !visited[j] {
+                visited[j] = true;
                 queue.push_back(j);
             }
         }
     }
-    last
+    out
 }
 
 pub struct BandedKkt {
@@ -74,8 +62,7 @@ pub struct BandedKkt {
     ipiv: Vec<usize>,
     /// upper bandwidth of the current U
     ubw: usize,
-    elem_slots: Vec<usize>,
-    cons_slots: Vec<(usize, usize, f64)>,
+    slots: SlotMap,
     work: Vec<f64>,
     factored: bool,
 }
@@ -114,24 +101,11 @@ impl BandedKkt {
             .unwrap_or(0);
         let ldab = 3 * band + 1;
         // A(i, j) lives at AB[kl + ku + i − j, j] (LAPACK band storage with room for fill)
-        let slot = |i: usize, j: usize| {
+        // A(i, j) lives at AB[kl + ku + i − j, j] (LAPACK band storage with room for fill)
+        let slots = SlotMap::new(&pattern, |i, j| {
             let (i, j) = (new_of[i], new_of[j]);
             (2 * band + i - j) + j * ldab
-        };
-        let mut elem_slots = Vec::with_capacity(64 * pattern.element_dofs.len());
-        for dofs in &pattern.element_dofs {
-            for j in 0..8 {
-                for i in 0..8 {
-                    elem_slots.push(slot(dofs[i], dofs[j]));
-                }
-            }
-        }
-        let mut cons_slots = Vec::new();
-        for (c, row) in pattern.constraint_rows.iter().enumerate() {
-            for &(d, coef) in row {
-                cons_slots.push((slot(nd + c, d), slot(d, nd + c), coef));
-            }
-        }
+        });
         BandedKkt {
             n,
             band,
@@ -140,8 +114,7 @@ impl BandedKkt {
             ab: vec![0.0; ldab * n],
             ipiv: vec![0; n],
             ubw: 2 * band,
-            elem_slots,
-            cons_slots,
+            slots,
             work: vec![0.0; n],
             factored: false,
         }
@@ -155,16 +128,7 @@ impl BandedKkt {
 
 impl KktSolver for BandedKkt {
     fn factor(&mut self, blocks: &[Block], scale: f64) -> Result<(), String> {
-        self.ab.iter_mut().for_each(|v| *v = 0.0);
-        for (e, block) in blocks.iter().enumerate() {
-            for (k, &s) in self.elem_slots[64 * e..64 * e + 64].iter().enumerate() {
-                self.ab[s] += block.as_slice()[k];
-            }
-        }
-        for &(a, b, coef) in &self.cons_slots {
-            self.ab[a] += scale * coef;
-            self.ab[b] += scale * coef;
-        }
+        self.slots.scatter(&mut self.ab, blocks, scale);
         self.factored = false;
         self.ubw = band_lu(&mut self.ab, self.n, self.band, self.ldab, &mut self.ipiv)?;
         self.factored = true;

@@ -48,6 +48,52 @@ pub enum LinearSolverKind {
     Dense,
 }
 
+/// Where each entry of the element blocks and of the scaled constraint rows lands in a
+/// solver's value array; shared by the sparse and band storages.
+pub(crate) struct SlotMap {
+    /// for element e, entry (i, j) of its block lands at `elem[64 e + 8 j + i]`
+    elem: Vec<usize>,
+    /// per constraint entry: the slots of (row c, dof) and (dof, row c), and the coefficient
+    cons: Vec<(usize, usize, f64)>,
+}
+
+impl SlotMap {
+    /// `slot(i, j)` gives the storage index of matrix entry (i, j).
+    pub(crate) fn new(pattern: &KktPattern, slot: impl Fn(usize, usize) -> usize) -> Self {
+        let mut elem = Vec::with_capacity(64 * pattern.element_dofs.len());
+        for dofs in &pattern.element_dofs {
+            for j in 0..8 {
+                for i in 0..8 {
+                    elem.push(slot(dofs[i], dofs[j]));
+                }
+            }
+        }
+        let nd = pattern.n_dof;
+        let mut cons = Vec::new();
+        for (c, row) in pattern.constraint_rows.iter().enumerate() {
+            for &(dof, coef) in row {
+                cons.push((slot(nd + c, dof), slot(dof, nd + c), coef));
+            }
+        }
+        SlotMap { elem, cons }
+    }
+
+    /// Adds the blocks and `scale ×` the constraint entries into `values` (zeroed first).
+    pub(crate) fn scatter(&self, values: &mut [f64], blocks: &[Block], scale: f64) {
+        values.iter_mut().for_each(|v| *v = 0.0);
+        for (block, slots) in blocks.iter().zip(self.elem.chunks_exact(64)) {
+            // nalgebra storage is column-major: k = 8 j + i
+            for (&s, &v) in slots.iter().zip(block.as_slice()) {
+                values[s] += v;
+            }
+        }
+        for &(a, b, coef) in &self.cons {
+            values[a] += scale * coef;
+            values[b] += scale * coef;
+        }
+    }
+}
+
 pub trait KktSolver: Send {
     /// Assembles `[Σ P_eᵀ blocks[e] P_e, s Bᵀ; s B, 0]` and factors it.
     fn factor(&mut self, blocks: &[Block], scale: f64) -> Result<(), String>;
@@ -69,10 +115,7 @@ pub struct SparseKkt {
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
     values: Vec<f64>,
-    /// for element e, entry (i, j) of its block lands at `values[elem_slots[64 e + 8 j + i]]`
-    elem_slots: Vec<usize>,
-    /// for constraint entry k (row-major over `constraint_rows`): slots of (c, dof) and (dof, c)
-    cons_slots: Vec<(usize, usize, f64)>,
+    slots: SlotMap,
     symbolic: SymbolicLu<usize>,
     numeric: NumericLu<usize, f64>,
     factor_mem: MemBuffer,
@@ -106,24 +149,10 @@ impl SparseKkt {
             row_idx.extend_from_slice(col);
             col_ptr.push(row_idx.len());
         }
-        let slot = |i: usize, j: usize| -> usize {
+        let slots = SlotMap::new(&pattern, |i, j| {
             let r = &row_idx[col_ptr[j]..col_ptr[j + 1]];
             col_ptr[j] + r.binary_search(&i).expect("entry in pattern")
-        };
-        let mut elem_slots = Vec::with_capacity(64 * pattern.element_dofs.len());
-        for dofs in &pattern.element_dofs {
-            for j in 0..8 {
-                for i in 0..8 {
-                    elem_slots.push(slot(dofs[i], dofs[j]));
-                }
-            }
-        }
-        let mut cons_slots = Vec::new();
-        for (c, row) in pattern.constraint_rows.iter().enumerate() {
-            for &(dof, coef) in row {
-                cons_slots.push((slot(nd + c, dof), slot(dof, nd + c), coef));
-            }
-        }
+        });
         let symbolic = {
             let sym = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
             factorize_symbolic_lu(sym, Default::default()).expect("symbolic LU of a valid pattern")
@@ -136,8 +165,7 @@ impl SparseKkt {
             col_ptr,
             row_idx,
             values,
-            elem_slots,
-            cons_slots,
+            slots,
             symbolic,
             numeric: NumericLu::new(),
             factor_mem,
@@ -150,18 +178,7 @@ impl SparseKkt {
 impl KktSolver for SparseKkt {
     fn factor(&mut self, blocks: &[Block], scale: f64) -> Result<(), String> {
         debug_assert_eq!(blocks.len(), self.pattern.element_dofs.len());
-        self.values.iter_mut().for_each(|v| *v = 0.0);
-        for (e, block) in blocks.iter().enumerate() {
-            let slots = &self.elem_slots[64 * e..64 * e + 64];
-            for (k, &s) in slots.iter().enumerate() {
-                // nalgebra storage is column-major: k = 8 j + i
-                self.values[s] += block.as_slice()[k];
-            }
-        }
-        for &(a, b, coef) in &self.cons_slots {
-            self.values[a] += scale * coef;
-            self.values[b] += scale * coef;
-        }
+        self.slots.scatter(&mut self.values, blocks, scale);
         let n = self.pattern.size();
         let sym = SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx);
         let mat = SparseColMatRef::new(sym, &self.values);

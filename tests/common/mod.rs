@@ -8,9 +8,13 @@ pub fn model(text: &str) -> Model {
     Model::from_text(text, "test.toml").expect("valid test model")
 }
 
-/// A straight horizontal cantilever along +x, clamped at the origin, with a tip force
-/// `(0, −P)` (scaled by the load scale) and no gravity.
+/// A straight horizontal steel-density cantilever along +x, clamped at the origin, with a
+/// tip force `(0, −P)` (scaled by the load scale) and no gravity.
 pub fn cantilever(elements: usize, length: f64, e: f64, area: f64, inertia: f64, p: f64) -> Model {
+    cantilever_with_density(elements, length, e, area, inertia, 7800.0, p)
+}
+
+pub fn cantilever_with_density(elements: usize, length: f64, e: f64, area: f64, inertia: f64, density: f64, p: f64) -> Model {
     model(&format!(
         r#"
         [time]
@@ -23,7 +27,7 @@ pub fn cantilever(elements: usize, length: f64, e: f64, area: f64, inertia: f64,
         angle = 0.0
         length = {length}
         elements = {elements}
-        density = 7800.0
+        density = {density}
         area = {area}
         inertia = {inertia}
         youngs_modulus = {e}
