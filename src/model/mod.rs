@@ -124,11 +124,10 @@ impl Model {
                 section: Section { density: b.density, area: b.area, inertia: b.inertia, youngs_modulus: b.youngs_modulus },
             });
         }
-        let q0 = FlexibleSystem::new(self.bodies.clone(), &[], &[], vec![], Rayleigh::default(), LinearSolverKind::Dense).initial_state();
         let lmax = self.bodies.iter().map(|b| b.length).fold(0.0, f64::max);
         let node_pos = |(b, k): NodeId, bodies: &[BeamBody]| -> [f64; 2] {
-            let first: usize = bodies[..b].iter().map(|x| x.n_elements + 1).sum();
-            [q0[4 * (first + k)], q0[4 * (first + k) + 1]]
+            let r = bodies[b].undeformed_node(k);
+            [r[0], r[1]]
         };
         for (i, j) in f.joints.iter().enumerate() {
             let p = |k: &str| format!("joints[{i}].{k}");

@@ -21,6 +21,15 @@ pub struct BeamBody {
     pub section: Section,
 }
 
+impl BeamBody {
+    /// Position and slope `(x, y, x', y')` of node `k` in the straight, undeformed body.
+    pub fn undeformed_node(&self, k: usize) -> [f64; 4] {
+        let (c, s) = (self.angle.cos(), self.angle.sin());
+        let d = k as f64 * self.length / self.n_elements as f64;
+        [self.start[0] + d * c, self.start[1] + d * s, c, s]
+    }
+}
+
 /// A node is addressed by body index and node index within the body (0..=n_elements).
 pub type NodeId = (usize, usize);
 
@@ -257,12 +266,9 @@ impl FlexibleSystem {
     pub fn initial_state(&self) -> Vec<f64> {
         let mut q = vec![0.0; self.n_dof];
         for (b, body) in self.bodies.iter().enumerate() {
-            let (c, s) = (body.angle.cos(), body.angle.sin());
-            let h = body.length / body.n_elements as f64;
             for k in 0..=body.n_elements {
                 let n = self.first_node[b] + k;
-                let d = k as f64 * h;
-                q[4 * n..4 * n + 4].copy_from_slice(&[body.start[0] + d * c, body.start[1] + d * s, c, s]);
+                q[4 * n..4 * n + 4].copy_from_slice(&body.undeformed_node(k));
             }
         }
         q
@@ -312,7 +318,7 @@ impl FlexibleSystem {
         let (mut m, mut k) = (vec![0.0; n * n], vec![0.0; n * n]);
         for e in 0..self.elements.len() {
             let el = self.element(e);
-            let (_, kt) = el.force_and_tangent(&self.gather(e, q));
+            let kt = el.tangent(&self.gather(e, q));
             let d = &self.elements[e].1;
             for i in 0..8 {
                 for j in 0..8 {
@@ -400,8 +406,7 @@ impl DynamicModel for FlexibleSystem {
             let el = &self.prototypes[self.elements[e].0];
             let mut blk = el.mass() * damp_m;
             if coef.stiffness != 0.0 {
-                let (_, kt) = el.force_and_tangent(&self.gather(e, q));
-                blk += kt * coef.stiffness;
+                blk += el.tangent(&self.gather(e, q)) * coef.stiffness;
             }
             if damp_k != 0.0 {
                 blk += el.bending_stiffness() * damp_k;
