@@ -9,6 +9,8 @@ pub mod error;
 pub mod io;
 pub mod model;
 pub mod physics;
+pub mod pipeline;
+pub mod reduction;
 pub mod simulate;
 pub mod solver;
 

@@ -1,7 +1,9 @@
 //! The `flexrom` command line.
 
 use clap::{Parser, Subcommand};
-use flexrom::io::result_file::write_result;
+use flexrom::io::result_file::{write_result, write_result_with};
+use flexrom::pipeline::online::{load_basis, run_reduced};
+use flexrom::pipeline::Pipeline;
 use flexrom::model::Model;
 use flexrom::simulate::{simulate, Overrides};
 use flexrom::solver::kkt::LinearSolverKind;
@@ -55,6 +57,67 @@ enum Command {
         #[arg(long)]
         csv: bool,
     },
+    /// Run the full model at the pipeline's training load scales and write the POD basis (HDF5).
+    Train {
+        /// pipeline file (TOML)
+        pipeline: PathBuf,
+        /// basis file to write (default: the pipeline's `basis`)
+        #[arg(long)]
+        basis: Option<PathBuf>,
+    },
+    /// Run the reduced model at one load scale and write a result file.
+    Online {
+        /// pipeline file (TOML)
+        pipeline: PathBuf,
+        /// multiplies every load marked `scaled` in the model file
+        #[arg(long)]
+        load_scale: f64,
+        /// result file (HDF5)
+        #[arg(short, long)]
+        output: PathBuf,
+        /// basis file (default: the pipeline's `basis`)
+        #[arg(long)]
+        basis: Option<PathBuf>,
+    },
+    /// Run full and reduced models at one load scale and report errors and timings.
+    Validate {
+        /// pipeline file (TOML)
+        pipeline: PathBuf,
+        /// multiplies every load marked `scaled` in the model file
+        #[arg(long)]
+        load_scale: f64,
+        /// print one JSON object on stdout
+        #[arg(long)]
+        json: bool,
+        /// basis file (default: the pipeline's `basis`)
+        #[arg(long)]
+        basis: Option<PathBuf>,
+        /// skip the dense-LU full run (its time and speedup are then null)
+        #[arg(long)]
+        no_dense: bool,
+    },
+    /// Reduced runs at many load scales, in parallel, into one HDF5 file and a table.
+    Sweep {
+        /// pipeline file (TOML)
+        pipeline: PathBuf,
+        /// `A:B:N`: N load scales from A to B (default: the pipeline's [online] list)
+        #[arg(long)]
+        load_scales: Option<String>,
+        /// also run the full model at each load scale and report errors
+        #[arg(long)]
+        validate: bool,
+        /// sweep file (default: sweep.h5 in the pipeline's report folder)
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// basis file (default: the pipeline's `basis`)
+        #[arg(long)]
+        basis: Option<PathBuf>,
+    },
+    /// Train, sweep, validate and write a report folder (Markdown and SVG plots).
+    Run {
+        /// pipeline file (TOML)
+        pipeline: PathBuf,
+    },
     /// Run each model and print its probe positions at a few times.
     Demo {
         /// model files (TOML)
@@ -96,6 +159,97 @@ fn run(cli: Cli) -> flexrom::Result<()> {
             }
             Ok(())
         }
+        Command::Train { pipeline, basis } => {
+            let p = Pipeline::load(&pipeline)?;
+            let out = basis.unwrap_or_else(|| p.basis_path.clone());
+            let s = flexrom::pipeline::train::train_and_write(&p, &out)?;
+            let b = &s.trained.basis;
+            eprintln!(
+                "{}: {} snapshots from {} full run(s) ({:.3} s); {} basis, {} snapshots, {} POD modes{} (captured energy 1 − {:.2e}) -> {}",
+                p.path.display(),
+                s.n_snapshots,
+                p.file.train.load_scales.len(),
+                s.full_seconds,
+                b.variant.name(),
+                b.snapshots.name(),
+                b.n_pod_modes,
+                if b.kept.is_empty() { String::new() } else { format!(" + {} joint coordinates", b.kept.len()) },
+                1.0 - s.trained.pod.energy[b.n_pod_modes - 1],
+                out.display()
+            );
+            Ok(())
+        }
+        Command::Online { pipeline, load_scale, output, basis } => {
+            let p = Pipeline::load(&pipeline)?;
+            check_output_dir(&output)?;
+            check_scale(load_scale)?;
+            let path = basis.unwrap_or_else(|| p.basis_path.clone());
+            let stored = load_basis(&p, &path)?;
+            let run = run_reduced(&p.model, &stored.basis, load_scale)?;
+            let basis_name = path.display().to_string();
+            write_result_with(&output, &run.result, |f| {
+                let e = |err: hdf5::Error| flexrom::Error::hdf5(&output, err);
+                let g = f.create_group("reduced").map_err(e)?;
+                g.new_dataset_builder().with_data(&run.reduced_q).create("q").map_err(e)?;
+                flexrom::io::h5::attr_str(f, "basis", &basis_name).map_err(e)?;
+                flexrom::io::h5::attr_str(f, "variant", stored.basis.variant.name()).map_err(e)?;
+                flexrom::io::h5::attr_u64(f, "n_modes", stored.basis.n_reduced() as u64).map_err(e)
+            })?;
+            let st = &run.result.stats;
+            eprintln!(
+                "{}: reduced run ({} modes) at load scale {load_scale}: {} steps in {:.4} s ({} Newton iterations, {} step cuts) -> {}",
+                p.path.display(),
+                stored.basis.n_reduced(),
+                st.steps,
+                run.result.wall_seconds,
+                st.newton_iterations,
+                st.step_cuts,
+                output.display()
+            );
+            Ok(())
+        }
+        Command::Validate { pipeline, load_scale, json, basis, no_dense } => {
+            let p = Pipeline::load(&pipeline)?;
+            check_scale(load_scale)?;
+            let path = basis.unwrap_or_else(|| p.basis_path.clone());
+            let stored = load_basis(&p, &path)?;
+            let (v, _, _) = flexrom::pipeline::validate::validate(&p.model, &stored.basis, load_scale, !no_dense)?;
+            if json {
+                println!("{}", serde_json::to_string(&v).expect("serializable"));
+            } else {
+                println!("{}", v.describe());
+            }
+            Ok(())
+        }
+        Command::Sweep { pipeline, load_scales, validate, output, basis } => {
+            let p = Pipeline::load(&pipeline)?;
+            let scales = match load_scales {
+                Some(s) => flexrom::pipeline::config::parse_range(&s).map_err(|e| flexrom::Error::Usage(format!("--load-scales: {e}")))?,
+                None => p.online_scales(),
+            };
+            let out = match output {
+                Some(o) => o,
+                None => {
+                    std::fs::create_dir_all(&p.report_dir).map_err(|e| flexrom::Error::io(&p.report_dir, e))?;
+                    p.report_dir.join("sweep.h5")
+                }
+            };
+            check_output_dir(&out)?;
+            let path = basis.unwrap_or_else(|| p.basis_path.clone());
+            let stored = load_basis(&p, &path)?;
+            let sw = flexrom::pipeline::sweep::sweep(&p.model, &stored.basis, &scales, validate, true)?;
+            flexrom::pipeline::sweep::write_sweep(&out, &sw, &stored.basis, &path)?;
+            print!("{}", flexrom::pipeline::sweep::table(&sw));
+            eprintln!("{} load scales on {} threads in {:.3} s -> {}", scales.len(), sw.threads, sw.wall_seconds, out.display());
+            Ok(())
+        }
+        Command::Run { pipeline } => {
+            let p = Pipeline::load(&pipeline)?;
+            let dir = flexrom::pipeline::report::run(&p, true)?;
+            println!("{}", std::fs::read_to_string(dir.join("summary.md")).map_err(|e| flexrom::Error::io(&dir, e))?);
+            eprintln!("report: {}", dir.display());
+            Ok(())
+        }
         Command::Demo { models } => {
             for path in models {
                 let model = Model::load(&path)?;
@@ -118,6 +272,14 @@ fn run(cli: Cli) -> flexrom::Result<()> {
             }
             Ok(())
         }
+    }
+}
+
+fn check_scale(x: f64) -> flexrom::Result<()> {
+    if x.is_finite() {
+        Ok(())
+    } else {
+        Err(flexrom::Error::Usage(format!("--load-scale must be finite, got {x}")))
     }
 }
 

@@ -1,4 +1,4 @@
-//! The result file of `simulate` (and, later, of reduced runs). Fixed layout, read by
+//! The result file of `simulate` and of reduced runs (`online`). Fixed layout, read by
 //! scripts outside the project:
 //!
 //! ```text
@@ -17,6 +17,12 @@ use crate::simulate::SimulationResult;
 use std::path::Path;
 
 pub fn write_result(path: &Path, r: &SimulationResult) -> Result<()> {
+    write_result_with(path, r, |_| Ok(()))
+}
+
+/// Writes the common layout, then lets `extra` add datasets and attributes (reduced runs
+/// add `/reduced/q` and the basis they used), all in the same atomic write.
+pub fn write_result_with(path: &Path, r: &SimulationResult, extra: impl FnOnce(&hdf5::File) -> Result<()>) -> Result<()> {
     write_atomically(path, |f| {
         let e = |err: hdf5::Error| Error::hdf5(path, err);
         f.new_dataset_builder().with_data(&r.t).create("t").map_err(e)?;
@@ -41,6 +47,6 @@ pub fn write_result(path: &Path, r: &SimulationResult) -> Result<()> {
         attr_u64(f, "max_iterations_in_a_step", r.stats.max_iterations_in_a_step as u64).map_err(e)?;
         attr_f64(f, "wall_seconds", r.wall_seconds).map_err(e)?;
         attr_str(f, "program_version", env!("CARGO_PKG_VERSION")).map_err(e)?;
-        Ok(())
+        extra(f)
     })
 }

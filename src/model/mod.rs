@@ -249,6 +249,17 @@ impl Model {
     }
 
     /// Integrator parameters from the `[time]` table.
+    /// SHA-256 of the model's canonical form: the parsed file as JSON, without the free
+    /// `description`. Comments, layout, key order and number spelling do not change it;
+    /// any change of geometry, material, mesh, joints, loads, probes or time settings does.
+    pub fn fingerprint(&self) -> String {
+        use sha2::{Digest, Sha256};
+        let mut canonical = self.file.clone();
+        canonical.description.clear();
+        let json = serde_json::to_string(&canonical).expect("the schema serializes");
+        Sha256::digest(json.as_bytes()).iter().map(|b| format!("{b:02x}")).collect()
+    }
+
     pub fn integrator_params(&self) -> IntegratorParams {
         self.params_from(&self.file.time).expect("validated at load")
     }
@@ -301,7 +312,7 @@ impl Model {
 }
 
 /// The dotted key path (or line) at byte `pos` of a TOML text, for error messages.
-fn locate(text: &str, pos: usize) -> String {
+pub(crate) fn locate(text: &str, pos: usize) -> String {
     let line = text[..pos.min(text.len())].matches('\n').count() + 1;
     let mut table = String::new();
     let mut counts: std::collections::HashMap<String, usize> = Default::default();

@@ -1,9 +1,9 @@
 //! The TOML schema of a model file (`data/models/*.toml`). Every table refuses unknown keys.
 
 use crate::physics::time_function::TimeFunction;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ModelFile {
     /// free text shown in reports
@@ -21,7 +21,7 @@ pub struct ModelFile {
     pub probes: Vec<ProbeSpec>,
 }
 
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct TimeSettings {
     pub t_end: f64,
@@ -37,7 +37,7 @@ pub struct TimeSettings {
     pub max_step_cuts: Option<i64>,
 }
 
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct DampingSpec {
     /// a in C = a M + b K_t
@@ -50,7 +50,7 @@ pub struct DampingSpec {
 
 /// A straight beam: `start` and either `angle` (rad) with `length`, or `end` (then
 /// `length`, if given, must agree with it and is used as the exact length).
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct BodySpec {
     pub name: String,
@@ -69,21 +69,21 @@ pub struct BodySpec {
 }
 
 /// A node of a body: its index (0 = start) or `"start"` / `"end"`.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(untagged)]
 pub enum NodeRef {
     Index(i64),
     Name(String),
 }
 
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct NodeSpec {
     pub body: String,
     pub node: NodeRef,
 }
 
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum JointSpec {
     /// the node's position is fixed at `point` (default: where it starts)
@@ -98,7 +98,7 @@ fn yes() -> bool {
     true
 }
 
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum LoadSpec {
     /// gravity acceleration vector, m/s²; `scaled` = multiplied by the load scale
@@ -118,7 +118,7 @@ pub enum LoadSpec {
 }
 
 /// A recorded point: a `node` of a body, or the point at fraction `at` ∈ [0, 1] of its length.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ProbeSpec {
     pub name: String,

@@ -7,7 +7,7 @@ use super::element::{BeamElement, Mat8, Section, Vec8};
 use super::loads::{moment_force, moment_jacobian};
 use super::time_function::TimeFunction;
 use crate::solver::kkt::{make_solver, KktPattern, KktSolver, LinearSolverKind};
-use crate::solver::model::{DynamicModel, IterationCoefficients};
+use crate::solver::model::{DynamicModel, ElementModel, IterationCoefficients};
 
 /// A straight beam in its undeformed configuration.
 #[derive(Clone, Debug)]
@@ -106,6 +106,8 @@ pub struct FlexibleSystem {
     gravity_scaled: Vec<f64>,
     moments: Vec<MomentLoad>,
     forces: Vec<ForceLoad>,
+    /// the dofs that moments and nodal forces act on, sorted
+    load_dofs: Vec<usize>,
     n_dof: usize,
     kkt: Box<dyn KktSolver>,
     blocks: Vec<Mat8>,
@@ -209,6 +211,10 @@ impl FlexibleSystem {
         };
         let length_scale = bodies.iter().map(|b| b.length).fold(0.0, f64::max);
         let n_el = elements.len();
+        let mut load_dofs: Vec<usize> =
+            moments.iter().flat_map(|m| m.slope_dofs).chain(forces.iter().flat_map(|f| f.dofs)).collect();
+        load_dofs.sort_unstable();
+        load_dofs.dedup();
         FlexibleSystem {
             bodies,
             first_node,
@@ -222,6 +228,7 @@ impl FlexibleSystem {
             gravity_scaled,
             moments,
             forces,
+            load_dofs,
             n_dof,
             kkt: make_solver(solver, pattern),
             blocks: vec![Mat8::zeros(); n_el],
@@ -333,6 +340,103 @@ impl FlexibleSystem {
     fn load_factor(&self, scaled: bool) -> f64 {
         if scaled { self.load_scale } else { 1.0 }
     }
+
+    /// `fₑ = Cₑ q̇ₑ + Qₑ(qₑ)` with Rayleigh `Cₑ = a Mₑ + b K_bending,ₑ`.
+    fn element_force_vec(&self, e: usize, qe: &Vec8, ve: &Vec8) -> Vec8 {
+        let el = self.element(e);
+        let mut f = el.elastic_force(qe);
+        if self.damping != Rayleigh::default() {
+            f += (el.mass() * self.damping.mass + el.bending_stiffness() * self.damping.stiffness) * ve;
+        }
+        f
+    }
+
+    /// `c Cₑ + k Kₑ(qₑ)`.
+    fn element_matrix_mat(&self, e: usize, qe: &Vec8, coef: IterationCoefficients) -> Mat8 {
+        let el = self.element(e);
+        let mut blk = Mat8::zeros();
+        if coef.stiffness != 0.0 {
+            blk += el.tangent(qe) * coef.stiffness;
+        }
+        if coef.damping != 0.0 && self.damping != Rayleigh::default() {
+            blk += (el.mass() * self.damping.mass + el.bending_stiffness() * self.damping.stiffness) * coef.damping;
+        }
+        blk
+    }
+
+    /// Jacobian of the moment's contribution `−Q_M` to `g`.
+    fn moment_load_jacobian(&self, m: &MomentLoad, t: f64, slope: [f64; 2]) -> [[f64; 2]; 2] {
+        let j = moment_jacobian(self.load_factor(m.scaled) * m.function.eval(t), slope);
+        // g carries −Q_ext, so its Jacobian enters with a minus sign
+        [[-j[0][0], -j[0][1]], [-j[1][0], -j[1][1]]]
+    }
+
+    /// Calls `add(dof, value)` with the contributions `−Q_ext` of moments and nodal forces;
+    /// `q(dof)` reads the coordinates they depend on.
+    fn add_nodal_loads(&self, t: f64, q: impl Fn(usize) -> f64, mut add: impl FnMut(usize, f64)) {
+        for m in &self.moments {
+            let qm = moment_force(self.load_factor(m.scaled) * m.function.eval(t), [q(m.slope_dofs[0]), q(m.slope_dofs[1])]);
+            add(m.slope_dofs[0], -qm[0]);
+            add(m.slope_dofs[1], -qm[1]);
+        }
+        for f in &self.forces {
+            let ft = self.load_factor(f.scaled) * f.function.as_ref().map_or(1.0, |func| func.eval(t));
+            add(f.dofs[0], -ft * f.value[0]);
+            add(f.dofs[1], -ft * f.value[1]);
+        }
+    }
+
+    fn local_load_index(&self, dof: usize) -> usize {
+        self.load_dofs.binary_search(&dof).expect("load dof listed")
+    }
+}
+
+impl ElementModel for FlexibleSystem {
+    fn n_elements(&self) -> usize {
+        self.elements.len()
+    }
+
+    fn element_dofs(&self, e: usize) -> &[usize] {
+        &self.elements[e].1
+    }
+
+    fn element_force(&self, e: usize, qe: &[f64], ve: &[f64], out: &mut [f64]) {
+        let f = self.element_force_vec(e, &Vec8::from_column_slice(qe), &Vec8::from_column_slice(ve));
+        out.copy_from_slice(f.as_slice());
+    }
+
+    fn element_matrix(&self, e: usize, qe: &[f64], coef: IterationCoefficients, out: &mut [f64]) {
+        out.copy_from_slice(self.element_matrix_mat(e, &Vec8::from_column_slice(qe), coef).as_slice());
+    }
+
+    fn constant_force(&self, out: &mut [f64]) {
+        for (o, (gf, gs)) in out.iter_mut().zip(self.gravity_fixed.iter().zip(&self.gravity_scaled)) {
+            *o = -(gf + self.load_scale * gs);
+        }
+    }
+
+    fn load_dofs(&self) -> Vec<usize> {
+        self.load_dofs.clone()
+    }
+
+    fn load_force(&self, ql: &[f64], t: f64, out: &mut [f64]) {
+        out.iter_mut().for_each(|x| *x = 0.0);
+        self.add_nodal_loads(t, |d| ql[self.local_load_index(d)], |d, v| out[self.local_load_index(d)] += v);
+    }
+
+    fn load_jacobian(&self, ql: &[f64], t: f64, out: &mut [f64]) {
+        let nl = self.load_dofs.len();
+        out.iter_mut().for_each(|x| *x = 0.0);
+        for m in &self.moments {
+            let idx = m.slope_dofs.map(|d| self.local_load_index(d));
+            let j = self.moment_load_jacobian(m, t, [ql[idx[0]], ql[idx[1]]]);
+            for r in 0..2 {
+                for c in 0..2 {
+                    out[idx[c] * nl + idx[r]] += j[r][c];
+                }
+            }
+        }
+    }
 }
 
 impl DynamicModel for FlexibleSystem {
@@ -355,33 +459,14 @@ impl DynamicModel for FlexibleSystem {
     }
 
     fn force(&mut self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
-        let s = self.load_scale;
-        for i in 0..self.n_dof {
-            out[i] = -(self.gravity_fixed[i] + s * self.gravity_scaled[i]);
-        }
-        let damped = self.damping != Rayleigh::default();
+        self.constant_force(out);
         for e in 0..self.elements.len() {
-            let el = self.element(e);
-            let mut f = el.elastic_force(&self.gather(e, q));
-            if damped {
-                let ve = self.gather(e, v);
-                f += (el.mass() * self.damping.mass + el.bending_stiffness() * self.damping.stiffness) * ve;
-            }
+            let f = self.element_force_vec(e, &self.gather(e, q), &self.gather(e, v));
             for (i, &d) in self.elements[e].1.iter().enumerate() {
                 out[d] += f[i];
             }
         }
-        for m in &self.moments {
-            let mt = self.load_factor(m.scaled) * m.function.eval(t);
-            let qm = moment_force(mt, [q[m.slope_dofs[0]], q[m.slope_dofs[1]]]);
-            out[m.slope_dofs[0]] -= qm[0];
-            out[m.slope_dofs[1]] -= qm[1];
-        }
-        for f in &self.forces {
-            let ft = self.load_factor(f.scaled) * f.function.as_ref().map_or(1.0, |func| func.eval(t));
-            out[f.dofs[0]] -= ft * f.value[0];
-            out[f.dofs[1]] -= ft * f.value[1];
-        }
+        self.add_nodal_loads(t, |d| q[d], |d, value| out[d] += value);
     }
 
     fn constraint_residual(&self, q: &[f64], out: &mut [f64]) {
@@ -399,31 +484,21 @@ impl DynamicModel for FlexibleSystem {
     }
 
     fn factor(&mut self, q: &[f64], _v: &[f64], t: f64, coef: IterationCoefficients) -> Result<f64, String> {
-        let damp_m = coef.mass + coef.damping * self.damping.mass;
-        let damp_k = coef.damping * self.damping.stiffness;
         let mut diag_max = 0.0_f64;
         for e in 0..self.elements.len() {
             let el = &self.prototypes[self.elements[e].0];
-            let mut blk = el.mass() * damp_m;
-            if coef.stiffness != 0.0 {
-                blk += el.tangent(&self.gather(e, q)) * coef.stiffness;
-            }
-            if damp_k != 0.0 {
-                blk += el.bending_stiffness() * damp_k;
-            }
+            let mut blk = el.mass() * coef.mass + self.element_matrix_mat(e, &self.gather(e, q), coef);
             for i in 0..8 {
                 diag_max = diag_max.max(blk[(i, i)].abs());
             }
-            self.blocks[e] = blk;
+            std::mem::swap(&mut self.blocks[e], &mut blk);
         }
         if coef.stiffness != 0.0 {
             for m in &self.moments {
-                let mt = self.load_factor(m.scaled) * m.function.eval(t);
-                let j = moment_jacobian(mt, [q[m.slope_dofs[0]], q[m.slope_dofs[1]]]);
+                let j = self.moment_load_jacobian(m, t, [q[m.slope_dofs[0]], q[m.slope_dofs[1]]]);
                 for r in 0..2 {
                     for c in 0..2 {
-                        // residual carries −Q_ext, so its Jacobian enters with a minus sign
-                        self.blocks[m.element][(m.local + r, m.local + c)] -= coef.stiffness * j[r][c];
+                        self.blocks[m.element][(m.local + r, m.local + c)] += coef.stiffness * j[r][c];
                     }
                 }
             }

@@ -1,8 +1,8 @@
 //! Scalar functions of time that drive loads (model files name them with `type = ...`).
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum TimeFunction {
     /// `f(t) = value`
@@ -17,7 +17,7 @@ pub enum TimeFunction {
     Piecewise { pieces: Vec<Piece> },
 }
 
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Piece {
     pub until: Option<f64>,

@@ -38,3 +38,32 @@ pub trait DynamicModel {
     /// A length that sets the absolute scale of coordinate increments (for convergence tests).
     fn length_scale(&self) -> f64;
 }
+
+/// A model assembled from elements with fixed dof lists and a few nodal loads, opened up so
+/// that a reduction can project it element by element (and hyper-reduction can visit only
+/// some elements). The physics implements it; the reduction knows nothing else about it.
+///
+/// ```text
+///     g(q, q̇, t) = Σ_e Aₑᵀ fₑ(qₑ, q̇ₑ) + g₀ + A_lᵀ g_l(q_l, t)
+/// ```
+///
+/// with `fₑ` the element forces (internal and damping), `g₀` the constant applied loads
+/// (gravity, entering with a minus sign) and `g_l` the state- or time-dependent nodal loads
+/// on the dofs `load_dofs()`.
+pub trait ElementModel: DynamicModel {
+    fn n_elements(&self) -> usize;
+    /// Global dofs of element `e`; every element has the same number of them.
+    fn element_dofs(&self, e: usize) -> &[usize];
+    /// `fₑ = Cₑ q̇ₑ + Qₑ(qₑ)` from the element's own coordinates.
+    fn element_force(&self, e: usize, qe: &[f64], ve: &[f64], out: &mut [f64]);
+    /// `c Cₑ + k ∂Qₑ/∂qₑ` (no mass term), column-major.
+    fn element_matrix(&self, e: usize, qe: &[f64], coef: IterationCoefficients, out: &mut [f64]);
+    /// `g₀`: the part of `g` that depends on neither `q`, `q̇` nor `t`.
+    fn constant_force(&self, out: &mut [f64]);
+    /// The dofs the state- or time-dependent loads act on (and depend on).
+    fn load_dofs(&self) -> Vec<usize>;
+    /// `g_l(q_l, t)` on `load_dofs()`, given `q` on the same dofs.
+    fn load_force(&self, ql: &[f64], t: f64, out: &mut [f64]);
+    /// `∂g_l/∂q_l` (column-major, `load_dofs().len()` square).
+    fn load_jacobian(&self, ql: &[f64], t: f64, out: &mut [f64]);
+}

@@ -1,0 +1,167 @@
+//! The basis file written by `train` and read by `online`, `validate`, `sweep`:
+//!
+//! ```text
+//! /snapshots                 (n_dof, m)   column k = all coordinates at one time of one run
+//! /snapshot_multipliers      (n_c, m)     Lagrange multipliers at the same instants
+//! /snapshot_load_scale       (m)          load scale of the run each column comes from
+//! /snapshot_t                (m)          time of each column, s
+//! /basis/modes               (n_dof, r)   V: orthonormal columns (whole-system: the
+//!                                         coordinate rows of the joint POD)
+//! /basis/singular_values     (k)          all singular values of the POD, non-increasing
+//! /basis/energy              (k)          cumulative captured fraction Σ_{i≤j} σᵢ² / Σ σᵢ²
+//! /basis/reference           (n_dof)      x_ref (zeros for raw snapshots)
+//! /basis/reduced_dofs        (n_f)        coordinates whose rows entered the POD
+//! /basis/kept_dofs           (n_k)        coordinates kept unreduced (last n_k columns of V)
+//! /basis/multiplier_modes    (n_c, r)     whole-system only: λ ≈ w V_λ q
+//! attributes on /: schema_version, model (TOML text), model_path, model_fingerprint,
+//!   pipeline (TOML text), variant, snapshots, mode_rule, n_modes (= r), n_pod_modes,
+//!   multiplier_scale (w), n_dof, creation_time (RFC 3339, UTC), program_version
+//! ```
+
+use super::h5::{attr_f64, attr_str, attr_u64, read_attr_f64, read_attr_str, write_atomically};
+use crate::error::{Error, Result};
+use crate::reduction::{Basis, SnapshotKind, Trained, Variant};
+use ndarray::{Array1, Array2};
+use std::path::Path;
+
+pub const SCHEMA_VERSION: u64 = 1;
+
+/// The training data the snapshots come from.
+#[derive(Clone, Debug)]
+pub struct TrainingData {
+    pub x: Array2<f64>,
+    pub multipliers: Array2<f64>,
+    pub load_scale: Array1<f64>,
+    pub t: Array1<f64>,
+}
+
+/// Provenance written with a basis.
+#[derive(Clone, Debug)]
+pub struct BasisMeta {
+    pub model_text: String,
+    pub model_path: String,
+    pub model_fingerprint: String,
+    pub pipeline_text: String,
+    pub mode_rule: String,
+}
+
+/// A basis as read back, with its provenance.
+#[derive(Clone, Debug)]
+pub struct StoredBasis {
+    pub basis: Basis,
+    pub singular_values: Array1<f64>,
+    pub energy: Array1<f64>,
+    pub model_fingerprint: String,
+    pub mode_rule: String,
+    pub creation_time: String,
+}
+
+/// Chunked, shuffled and deflated (when the HDF5 library has zlib): snapshots compress well.
+fn compressible(b: hdf5::DatasetBuilderEmpty, rows: usize, cols: usize) -> hdf5::DatasetBuilderEmpty {
+    let mut b = b.chunk((rows.clamp(1, 1024), cols.clamp(1, 64)));
+    if hdf5::filters::deflate_available() {
+        b = b.shuffle().deflate(4);
+    }
+    b
+}
+
+pub fn write_basis(path: &Path, data: &TrainingData, trained: &Trained, meta: &BasisMeta) -> Result<()> {
+    write_atomically(path, |f| {
+        let e = |err: hdf5::Error| Error::hdf5(path, err);
+        let big = |name: &str, a: &Array2<f64>| -> Result<()> {
+            let (r, c) = a.dim();
+            if r == 0 || c == 0 {
+                f.new_dataset_builder().with_data(&a.as_standard_layout()).create(name).map_err(e)?;
+            } else {
+                compressible(f.new_dataset::<f64>(), r, c).shape((r, c)).create(name).map_err(e)?.write(&a.as_standard_layout()).map_err(e)?;
+            }
+            Ok(())
+        };
+        big("snapshots", &data.x)?;
+        big("snapshot_multipliers", &data.multipliers)?;
+        f.new_dataset_builder().with_data(&data.load_scale).create("snapshot_load_scale").map_err(e)?;
+        f.new_dataset_builder().with_data(&data.t).create("snapshot_t").map_err(e)?;
+        let g = f.create_group("basis").map_err(e)?;
+        let b = &trained.basis;
+        g.new_dataset_builder().with_data(&b.modes.as_standard_layout()).create("modes").map_err(e)?;
+        g.new_dataset_builder().with_data(&trained.pod.singular_values).create("singular_values").map_err(e)?;
+        g.new_dataset_builder().with_data(&trained.pod.energy).create("energy").map_err(e)?;
+        g.new_dataset_builder().with_data(&b.reference).create("reference").map_err(e)?;
+        let idx = |v: &[usize]| Array1::from_iter(v.iter().map(|&d| d as u64));
+        g.new_dataset_builder().with_data(&idx(&trained.reduced_dofs)).create("reduced_dofs").map_err(e)?;
+        g.new_dataset_builder().with_data(&idx(&b.kept)).create("kept_dofs").map_err(e)?;
+        if let Some(vl) = &b.multiplier_modes {
+            g.new_dataset_builder().with_data(&vl.as_standard_layout()).create("multiplier_modes").map_err(e)?;
+        }
+        attr_u64(f, "schema_version", SCHEMA_VERSION).map_err(e)?;
+        attr_str(f, "model", &meta.model_text).map_err(e)?;
+        attr_str(f, "model_path", &meta.model_path).map_err(e)?;
+        attr_str(f, "model_fingerprint", &meta.model_fingerprint).map_err(e)?;
+        attr_str(f, "pipeline", &meta.pipeline_text).map_err(e)?;
+        attr_str(f, "variant", b.variant.name()).map_err(e)?;
+        attr_str(f, "snapshots", b.snapshots.name()).map_err(e)?;
+        attr_str(f, "mode_rule", &meta.mode_rule).map_err(e)?;
+        attr_u64(f, "n_modes", b.n_reduced() as u64).map_err(e)?;
+        attr_u64(f, "n_pod_modes", b.n_pod_modes as u64).map_err(e)?;
+        attr_f64(f, "multiplier_scale", b.multiplier_scale).map_err(e)?;
+        attr_u64(f, "n_dof", b.n_dof() as u64).map_err(e)?;
+        attr_str(f, "creation_time", &humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string()).map_err(e)?;
+        attr_str(f, "program_version", env!("CARGO_PKG_VERSION")).map_err(e)?;
+        Ok(())
+    })
+}
+
+/// Reads a basis file; every missing or malformed part is reported with the file and the
+/// dataset or attribute it concerns.
+pub fn read_basis(path: &Path) -> Result<StoredBasis> {
+    if !path.is_file() {
+        return Err(Error::input(path, "(file)", "does not exist; run `flexrom train` first"));
+    }
+    let f = hdf5::File::open(path).map_err(|_| Error::input(path, "(file)", "is not a readable HDF5 file (truncated or of another format?)"))?;
+    let field = |name: &str, problem: String| Error::input(path, name, problem);
+    let version = f
+        .attr("schema_version")
+        .and_then(|a| a.read_scalar::<u64>())
+        .map_err(|_| field("schema_version", "is missing: this is not a flexrom basis file".into()))?;
+    if version != SCHEMA_VERSION {
+        return Err(field("schema_version", format!("is {version}; this program reads version {SCHEMA_VERSION}")));
+    }
+    let text = |name: &str| read_attr_str(&f, name).map_err(|err| field(name, format!("cannot be read: {err}")));
+    let num = |name: &str| read_attr_f64(&f, name).map_err(|err| field(name, format!("cannot be read: {err}")));
+    let count = |name: &str| {
+        f.attr(name).and_then(|a| a.read_scalar::<u64>()).map(|v| v as usize).map_err(|err| field(name, format!("cannot be read: {err}")))
+    };
+    let mat = |name: &str| f.dataset(name).and_then(|d| d.read_2d::<f64>()).map_err(|err| field(name, format!("cannot be read: {err}")));
+    let vec = |name: &str| f.dataset(name).and_then(|d| d.read_1d::<f64>()).map_err(|err| field(name, format!("cannot be read: {err}")));
+    let idx = |name: &str| -> Result<Vec<usize>> {
+        Ok(f.dataset(name).and_then(|d| d.read_1d::<u64>()).map_err(|err| field(name, format!("cannot be read: {err}")))?.iter().map(|&d| d as usize).collect())
+    };
+    let variant_name = text("variant")?;
+    let variant = Variant::parse(&variant_name).ok_or_else(|| field("variant", format!("`{variant_name}` is not a known variant")))?;
+    let kind_name = text("snapshots")?;
+    let snapshots = SnapshotKind::parse(&kind_name).ok_or_else(|| field("snapshots", format!("`{kind_name}` is not raw or reference")))?;
+    let multiplier_modes = if variant == Variant::WholeSystem { Some(mat("basis/multiplier_modes")?) } else { None };
+    let basis = Basis {
+        variant,
+        snapshots,
+        reference: vec("basis/reference")?,
+        modes: mat("basis/modes")?,
+        kept: idx("basis/kept_dofs")?,
+        multiplier_modes,
+        multiplier_scale: num("multiplier_scale")?,
+        n_pod_modes: count("n_pod_modes")?,
+    };
+    let singular_values = vec("basis/singular_values")?;
+    let energy = vec("basis/energy")?;
+    if basis.n_pod_modes == 0 || basis.n_pod_modes > singular_values.len() {
+        return Err(field("n_pod_modes", format!("is {} but the POD has {} singular values", basis.n_pod_modes, singular_values.len())));
+    }
+    Ok(StoredBasis {
+        basis,
+        singular_values,
+        energy,
+        model_fingerprint: text("model_fingerprint")?,
+        mode_rule: text("mode_rule")?,
+        creation_time: text("creation_time")?,
+    })
+}

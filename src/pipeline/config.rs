@@ -1,0 +1,185 @@
+//! Pipeline files (`pipelines/*.toml`): which model, how to train, which reduction, which
+//! load scales to run and validate. Paths inside are relative to the pipeline file.
+//!
+//! ```toml
+//! model = "../data/models/pendulum.toml"
+//! basis = "../data/bases/pendulum.h5"       # default: ../data/bases/<pipeline name>.h5
+//! report = "../reports/pendulum"            # default: ../reports/<pipeline name>
+//! [train]
+//! load_scales = [1.0]
+//! snapshots = "reference"                   # or "raw" (the thesis)
+//! [reduction]
+//! variant = "galerkin"                      # or "constraint-preserving", "whole-system"
+//! modes = { ratio = 0.1 }                   # or { count = 20 }, { energy = 1e-6 }
+//! [online]
+//! load_scales = "0.5:1.5:21"                # or a list
+//! [validate]
+//! load_scales = [0.8, 1.0, 1.2]
+//! ```
+
+use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::reduction::{ModeRule, SnapshotKind, Variant};
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PipelineFile {
+    #[serde(default)]
+    pub description: String,
+    pub model: PathBuf,
+    #[serde(default)]
+    pub basis: Option<PathBuf>,
+    #[serde(default)]
+    pub report: Option<PathBuf>,
+    pub train: TrainSpec,
+    pub reduction: ReductionSpec,
+    #[serde(default)]
+    pub online: Option<ScalesSpec>,
+    #[serde(default)]
+    pub validate: Option<ScalesSpec>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrainSpec {
+    pub load_scales: Vec<f64>,
+    #[serde(default = "default_snapshots")]
+    pub snapshots: SnapshotKind,
+}
+
+fn default_snapshots() -> SnapshotKind {
+    SnapshotKind::Reference
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReductionSpec {
+    /// default: constraint-preserving when the model has joints that the basis cannot
+    /// hold by itself, galerkin otherwise (see `Pipeline::variant`)
+    #[serde(default)]
+    pub variant: Option<Variant>,
+    pub modes: ModeRule,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScalesSpec {
+    pub load_scales: Scales,
+}
+
+/// A list of load scales, or `"A:B:N"`: N evenly spaced values from A to B.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(untagged)]
+pub enum Scales {
+    List(Vec<f64>),
+    Range(String),
+}
+
+impl Scales {
+    pub fn values(&self) -> std::result::Result<Vec<f64>, String> {
+        let v = match self {
+            Scales::List(v) => v.clone(),
+            Scales::Range(s) => parse_range(s)?,
+        };
+        check_scales(&v)?;
+        Ok(v)
+    }
+}
+
+/// `"A:B:N"` → N evenly spaced values from A to B (N ≥ 1; N = 1 gives A).
+pub fn parse_range(s: &str) -> std::result::Result<Vec<f64>, String> {
+    let parts: Vec<&str> = s.split(':').collect();
+    if parts.len() != 3 {
+        return Err(format!("`{s}` is not of the form A:B:N"));
+    }
+    let num = |p: &str| p.trim().parse::<f64>().map_err(|_| format!("`{p}` in `{s}` is not a number"));
+    let (a, b) = (num(parts[0])?, num(parts[1])?);
+    let n: usize = parts[2].trim().parse().map_err(|_| format!("`{}` in `{s}` is not a whole number", parts[2]))?;
+    if n == 0 {
+        return Err(format!("`{s}` asks for no load scales (N = 0)"));
+    }
+    let v = if n == 1 { vec![a] } else { (0..n).map(|i| a + (b - a) * i as f64 / (n - 1) as f64).collect() };
+    check_scales(&v)?;
+    Ok(v)
+}
+
+fn check_scales(v: &[f64]) -> std::result::Result<(), String> {
+    if v.is_empty() {
+        return Err("the list of load scales is empty".into());
+    }
+    if let Some(x) = v.iter().find(|x| !x.is_finite()) {
+        return Err(format!("load scale {x} is not finite"));
+    }
+    Ok(())
+}
+
+/// A loaded, checked pipeline with its model.
+#[derive(Clone, Debug)]
+pub struct Pipeline {
+    pub path: PathBuf,
+    pub text: String,
+    pub file: PipelineFile,
+    pub model: Model,
+    pub basis_path: PathBuf,
+    pub report_dir: PathBuf,
+}
+
+impl Pipeline {
+    pub fn load(path: impl AsRef<Path>) -> Result<Pipeline> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let file: PipelineFile = toml::from_str(&text).map_err(|e| {
+            let field = e.span().map(|s| crate::model::locate(&text, s.start)).unwrap_or_else(|| "(file)".into());
+            Error::input(path, field, e.message().to_string())
+        })?;
+        let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        let stem = path.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_else(|| "pipeline".into());
+        let model = Model::load(dir.join(&file.model)).map_err(|e| match e {
+            Error::Io { .. } => Error::input(path, "model", format!("cannot read `{}`: {e}", file.model.display())),
+            other => other,
+        })?;
+        let basis_path = dir.join(file.basis.clone().unwrap_or_else(|| PathBuf::from(format!("../data/bases/{stem}.h5"))));
+        let report_dir = dir.join(file.report.clone().unwrap_or_else(|| PathBuf::from(format!("../reports/{stem}"))));
+        let p = Pipeline { path: path.to_path_buf(), text, file, model, basis_path, report_dir };
+        p.check()?;
+        Ok(p)
+    }
+
+    fn check(&self) -> Result<()> {
+        let bad = |field: &str, problem: String| Err(Error::input(&self.path, field, problem));
+        if let Err(e) = check_scales(&self.file.train.load_scales) {
+            return bad("train.load_scales", e);
+        }
+        if let Err(e) = self.file.reduction.modes.validate() {
+            return bad("reduction.modes", e);
+        }
+        for (name, spec) in [("online", &self.file.online), ("validate", &self.file.validate)] {
+            if let Some(s) = spec {
+                if let Err(e) = s.load_scales.values() {
+                    return bad(&format!("{name}.load_scales"), e);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The reduction variant: the file's, or constraint-preserving when the model has
+    /// joints between bodies, galerkin when it has none or only ground joints.
+    pub fn variant(&self) -> Variant {
+        self.file.reduction.variant.unwrap_or(if self.model.file.joints.iter().any(|j| matches!(j, crate::model::schema::JointSpec::Pin { .. })) {
+            Variant::ConstraintPreserving
+        } else {
+            Variant::Galerkin
+        })
+    }
+
+    pub fn online_scales(&self) -> Vec<f64> {
+        self.file.online.as_ref().map_or_else(|| self.file.train.load_scales.clone(), |s| s.load_scales.values().expect("checked"))
+    }
+
+    pub fn validate_scales(&self) -> Vec<f64> {
+        self.file.validate.as_ref().map_or_else(|| self.file.train.load_scales.clone(), |s| s.load_scales.values().expect("checked"))
+    }
+}

@@ -1,0 +1,14 @@
+//! The offline/online workflow on top of the full solver and the reduction:
+//! pipeline file → `train` (full runs, snapshots, POD basis in HDF5) → `online` (reduced
+//! runs) → `validate` (error norms, timings) → `sweep` (many load scales) → `run` (all of
+//! it, with a report).
+
+pub mod config;
+pub mod online;
+pub mod plot;
+pub mod report;
+pub mod sweep;
+pub mod train;
+pub mod validate;
+
+pub use config::Pipeline;

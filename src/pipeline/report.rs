@@ -1,0 +1,148 @@
+//! `run`: train → online sweep (validated) → validation with timings at chosen points →
+//! a report folder: `summary.md`, `validation.json`, `sweep.h5` and SVG plots.
+//! The folder is built beside the target and renamed into place at the end.
+
+use super::config::Pipeline;
+use super::online::load_basis;
+use super::plot::{line_chart, Series};
+use super::sweep::{sweep, table, write_sweep};
+use super::train::train_and_write;
+use super::validate::{validate, Validation};
+use crate::error::{Error, Result};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+pub fn run(p: &Pipeline, progress: bool) -> Result<PathBuf> {
+    let dir = p.report_dir.clone();
+    let parent = dir.parent().map(Path::to_path_buf).unwrap_or_else(|| PathBuf::from("."));
+    std::fs::create_dir_all(&parent).map_err(|e| Error::io(&parent, e))?;
+    if let Some(b) = p.basis_path.parent() {
+        std::fs::create_dir_all(b).map_err(|e| Error::io(b, e))?;
+    }
+    let name = dir.file_name().map(|s| s.to_string_lossy().to_string()).unwrap_or_else(|| "report".into());
+    let tmp = parent.join(format!(".{name}.tmp-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&tmp);
+    std::fs::create_dir_all(&tmp).map_err(|e| Error::io(&tmp, e))?;
+    let result = build(p, &tmp, progress);
+    if result.is_err() {
+        let _ = std::fs::remove_dir_all(&tmp);
+        return result.map(|_| dir);
+    }
+    if dir.exists() {
+        std::fs::remove_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+    }
+    std::fs::rename(&tmp, &dir).map_err(|e| Error::io(&dir, e))?;
+    Ok(dir)
+}
+
+fn build(p: &Pipeline, out: &Path, progress: bool) -> Result<()> {
+    let plot_err = |e: String| Error::io(out, std::io::Error::other(e));
+    eprintln!("[1/3] train: {} full run(s)", p.file.train.load_scales.len());
+    let trained = train_and_write(p, &p.basis_path)?;
+    let stored = load_basis(p, &p.basis_path)?;
+    let basis = &stored.basis;
+
+    let scales = p.online_scales();
+    eprintln!("[2/3] sweep: {} reduced and full runs", scales.len());
+    let sw = sweep(&p.model, basis, &scales, true, progress)?;
+    write_sweep(&out.join("sweep.h5"), &sw, basis, &p.basis_path)?;
+
+    let vscales = p.validate_scales();
+    eprintln!("[3/3] validate at {} load scale(s), with the dense full solve", vscales.len());
+    let mut validations: Vec<Validation> = Vec::new();
+    for (i, &x) in vscales.iter().enumerate() {
+        let (v, full, rom) = validate(&p.model, basis, x, true)?;
+        let mut series = Vec::new();
+        for ((name, a), (_, b)) in full.probes.iter().zip(&rom.result.probes) {
+            series.push(Series { name: format!("{name} y, full"), points: full.t.iter().zip(a.column(1)).map(|(t, y)| (*t, *y)).collect(), dashed: false });
+            series.push(Series { name: format!("{name} y, reduced"), points: full.t.iter().zip(b.column(1)).map(|(t, y)| (*t, *y)).collect(), dashed: true });
+        }
+        line_chart(&out.join(format!("probes_{i}.svg")), &format!("Probe y, full vs reduced, load scale {x}"), "t (s)", "y (m)", &series, false).map_err(plot_err)?;
+        validations.push(v);
+    }
+    let sv = &stored.singular_values;
+    line_chart(
+        &out.join("singular_values.svg"),
+        "POD singular values",
+        "index",
+        "σ",
+        &[Series { name: "σ_i".into(), points: sv.iter().enumerate().map(|(i, s)| ((i + 1) as f64, *s)).collect(), dashed: false }],
+        true,
+    )
+    .map_err(plot_err)?;
+    let pts = |f: &dyn Fn(&Validation) -> f64| -> Vec<(f64, f64)> {
+        sw.points.iter().filter_map(|q| q.validation.as_ref()).map(|v| (v.load_scale, f(v))).collect()
+    };
+    line_chart(
+        &out.join("error_vs_load.svg"),
+        "Reduced vs full model",
+        "load scale",
+        "error",
+        &[
+            Series { name: "rel_error".into(), points: pts(&|v| v.rel_error), dashed: false },
+            Series { name: "max probe error (m)".into(), points: pts(&|v| v.max_probe_error), dashed: true },
+        ],
+        true,
+    )
+    .map_err(plot_err)?;
+    line_chart(
+        &out.join("speedup_vs_load.svg"),
+        "Speedup of the reduced time loop over the full one (banded solver)",
+        "load scale",
+        "speedup",
+        &[Series { name: "speedup".into(), points: pts(&|v| v.speedup), dashed: false }],
+        false,
+    )
+    .map_err(plot_err)?;
+    let json = serde_json::to_string_pretty(&validations).expect("serializable");
+    std::fs::write(out.join("validation.json"), json).map_err(|e| Error::io(out, e))?;
+
+    let b = &trained.trained.basis;
+    let mut md = String::new();
+    let _ = writeln!(md, "# flexrom report: {}\n", p.path.display());
+    if !p.file.description.is_empty() {
+        let _ = writeln!(md, "{}\n", p.file.description);
+    }
+    let _ = writeln!(md, "- model: `{}` ({} coordinates), fingerprint `{}`", p.model.path.display(), b.n_dof(), &p.model.fingerprint()[..12]);
+    let _ = writeln!(
+        md,
+        "- basis: `{}`: {} reduction, {} snapshots, rule `{}` → {} POD modes{}, {} snapshots from load scales {:?}",
+        p.basis_path.display(),
+        b.variant.name(),
+        b.snapshots.name(),
+        stored.mode_rule,
+        b.n_pod_modes,
+        if b.kept.is_empty() { String::new() } else { format!(" + {} joint coordinates", b.kept.len()) },
+        trained.n_snapshots,
+        p.file.train.load_scales
+    );
+    let _ = writeln!(md, "- sweep: {} load scales on {} threads in {:.3} s (whole sweep, reduced and full runs)\n", sw.points.len(), sw.threads, sw.wall_seconds);
+    let _ = writeln!(md, "## Validation (time loops only; one run each)\n");
+    let _ = writeln!(md, "| load scale | rel_error | max probe error (m) | at | max constraint violation | full (s) | full dense (s) | reduced (s) | speedup | vs dense |");
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|");
+    for v in &validations {
+        let _ = writeln!(
+            md,
+            "| {} | {:.3e} | {:.3e} | {} t = {:.3} s | {:.2e} | {:.4} | {:.4} | {:.4} | {:.2} | {:.2} |",
+            v.load_scale,
+            v.rel_error,
+            v.max_probe_error,
+            v.max_probe_error_probe,
+            v.max_probe_error_t,
+            v.max_constraint_violation,
+            v.full_seconds,
+            v.full_dense_seconds.unwrap_or(f64::NAN),
+            v.rom_seconds,
+            v.speedup,
+            v.speedup_vs_dense.unwrap_or(f64::NAN)
+        );
+    }
+    let _ = writeln!(md, "\n## Sweep\n\n```text\n{}```\n", table(&sw));
+    let _ = writeln!(md, "## Plots\n");
+    for (i, x) in vscales.iter().enumerate() {
+        let _ = writeln!(md, "![probes at {x}](probes_{i}.svg)");
+    }
+    let _ = writeln!(md, "![singular values](singular_values.svg)\n![error](error_vs_load.svg)\n![speedup](speedup_vs_load.svg)");
+    std::fs::write(out.join("summary.md"), md).map_err(|e| Error::io(out, e))?;
+    Ok(())
+}

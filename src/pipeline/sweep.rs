@@ -1,0 +1,125 @@
+//! `sweep`: reduced runs at many load scales, in parallel across cores (rayon; BLAS stays
+//! on one thread inside each run), optionally validated against full runs.
+//!
+//! The sweep file:
+//!
+//! ```text
+//! /load_scales        (N)
+//! /t                  (n_t)
+//! /probes/<name>      (N, n_t, 2)    reduced-model probe positions, m
+//! /reduced_q          (N, r, n_t)    reduced coordinates
+//! /rom_seconds        (N)            reduced time loop of each run
+//! /newton_iterations  (N)
+//! with --validate:    /rel_error, /max_probe_error, /max_constraint_violation,
+//!                     /full_seconds, /speedup  (N each)
+//! attributes on /: basis, variant, n_modes, wall_seconds (whole sweep), threads,
+//!   program_version
+//! ```
+
+use super::online::{run_reduced, ReducedRun};
+use super::validate::{compare, Validation};
+use crate::error::{Error, Result};
+use crate::io::h5::{attr_f64, attr_str, attr_u64, write_atomically};
+use crate::model::Model;
+use crate::reduction::Basis;
+use crate::simulate::{simulate, Overrides};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use ndarray::{Array1, Array3};
+use rayon::prelude::*;
+use std::path::Path;
+
+pub struct SweepPoint {
+    pub rom: ReducedRun,
+    pub validation: Option<Validation>,
+}
+
+pub struct Sweep {
+    pub points: Vec<SweepPoint>,
+    pub wall_seconds: f64,
+    pub threads: usize,
+}
+
+/// Runs the reduced model at every scale (in parallel); with `validate`, also the full one.
+pub fn sweep(model: &Model, basis: &Basis, scales: &[f64], validate: bool, progress: bool) -> Result<Sweep> {
+    let bar = ProgressBar::with_draw_target(Some(scales.len() as u64), if progress { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() });
+    bar.set_style(ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} load scales, {elapsed} elapsed, ETA {eta}").expect("valid template").progress_chars("=> "));
+    bar.set_prefix(if validate { "sweep + validate" } else { "sweep" });
+    let start = std::time::Instant::now();
+    let points: Result<Vec<SweepPoint>> = scales
+        .par_iter()
+        .map(|&x| {
+            let rom = run_reduced(model, basis, x)?;
+            let validation = if validate {
+                let full = simulate(model, &Overrides { load_scale: Some(x), ..Default::default() })?;
+                Some(compare(model, &full, &rom, None, basis.n_reduced(), basis.variant.name()))
+            } else {
+                None
+            };
+            bar.inc(1);
+            Ok(SweepPoint { rom, validation })
+        })
+        .collect();
+    bar.finish_and_clear();
+    Ok(Sweep { points: points?, wall_seconds: start.elapsed().as_secs_f64(), threads: rayon::current_num_threads() })
+}
+
+pub fn write_sweep(path: &Path, s: &Sweep, basis: &Basis, basis_path: &Path) -> Result<()> {
+    let first = &s.points.first().ok_or_else(|| Error::Usage("the sweep has no load scales".into()))?.rom;
+    let (n, nt, r) = (s.points.len(), first.result.t.len(), first.reduced_q.nrows());
+    write_atomically(path, |f| {
+        let e = |err: hdf5::Error| Error::hdf5(path, err);
+        let col = |g: &dyn Fn(&SweepPoint) -> f64| Array1::from_iter(s.points.iter().map(g));
+        f.new_dataset_builder().with_data(&col(&|p| p.rom.result.settings.load_scale)).create("load_scales").map_err(e)?;
+        f.new_dataset_builder().with_data(&first.result.t).create("t").map_err(e)?;
+        let g = f.create_group("probes").map_err(e)?;
+        for (i, (name, _)) in first.result.probes.iter().enumerate() {
+            let a = Array3::from_shape_fn((n, nt, 2), |(k, j, c)| s.points[k].rom.result.probes[i].1[[j, c]]);
+            g.new_dataset_builder().with_data(&a).create(name.as_str()).map_err(e)?;
+        }
+        let zq = Array3::from_shape_fn((n, r, nt), |(k, i, j)| s.points[k].rom.reduced_q[[i, j]]);
+        let mut b = f.new_dataset_builder().chunk((1, r.max(1), nt.max(1)));
+        if hdf5::filters::deflate_available() {
+            b = b.deflate(4);
+        }
+        b.with_data(&zq).create("reduced_q").map_err(e)?;
+        f.new_dataset_builder().with_data(&col(&|p| p.rom.result.wall_seconds)).create("rom_seconds").map_err(e)?;
+        f.new_dataset_builder()
+            .with_data(&Array1::from_iter(s.points.iter().map(|p| p.rom.result.stats.newton_iterations as u64)))
+            .create("newton_iterations")
+            .map_err(e)?;
+        if s.points.iter().all(|p| p.validation.is_some()) {
+            let v = |g: &dyn Fn(&Validation) -> f64| col(&|p: &SweepPoint| g(p.validation.as_ref().expect("checked")));
+            f.new_dataset_builder().with_data(&v(&|x| x.rel_error)).create("rel_error").map_err(e)?;
+            f.new_dataset_builder().with_data(&v(&|x| x.max_probe_error)).create("max_probe_error").map_err(e)?;
+            f.new_dataset_builder().with_data(&v(&|x| x.max_constraint_violation)).create("max_constraint_violation").map_err(e)?;
+            f.new_dataset_builder().with_data(&v(&|x| x.full_seconds)).create("full_seconds").map_err(e)?;
+            f.new_dataset_builder().with_data(&v(&|x| x.speedup)).create("speedup").map_err(e)?;
+        }
+        attr_str(f, "basis", &basis_path.display().to_string()).map_err(e)?;
+        attr_str(f, "variant", basis.variant.name()).map_err(e)?;
+        attr_u64(f, "n_modes", basis.n_reduced() as u64).map_err(e)?;
+        attr_f64(f, "wall_seconds", s.wall_seconds).map_err(e)?;
+        attr_u64(f, "threads", s.threads as u64).map_err(e)?;
+        attr_str(f, "program_version", env!("CARGO_PKG_VERSION")).map_err(e)
+    })
+}
+
+/// The table printed on stdout.
+pub fn table(s: &Sweep) -> String {
+    let mut out = String::new();
+    let validated = s.points.iter().all(|p| p.validation.is_some());
+    out.push_str("load_scale  rom_ms  newton");
+    if validated {
+        out.push_str("   rel_error  probe_err_m  full_ms  speedup");
+    }
+    out.push('\n');
+    for p in &s.points {
+        let r = &p.rom.result;
+        out.push_str(&format!("{:>10.4}  {:>6.2}  {:>6}", r.settings.load_scale, 1e3 * r.wall_seconds, r.stats.newton_iterations));
+        if let Some(v) = &p.validation {
+            out.push_str(&format!("  {:>10.3e}  {:>11.3e}  {:>7.2}  {:>7.2}", v.rel_error, v.max_probe_error, 1e3 * v.full_seconds, v.speedup));
+        }
+        out.push('\n');
+    }
+    out
+}

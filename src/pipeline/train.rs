@@ -1,0 +1,82 @@
+//! `train`: full runs at the training load scales → snapshot matrix → POD basis → HDF5.
+
+use super::config::Pipeline;
+use crate::error::{Error, Result};
+use crate::io::basis_file::{write_basis, BasisMeta, TrainingData};
+use crate::reduction::{train_basis, Trained};
+use crate::simulate::{simulate, Overrides};
+use crate::solver::kkt::LinearSolverKind;
+use ndarray::{concatenate, Array1, Axis};
+use std::path::Path;
+
+pub struct TrainSummary {
+    pub trained: Trained,
+    pub n_snapshots: usize,
+    pub full_seconds: f64,
+}
+
+/// The coordinates that appear in any joint, sorted.
+pub fn joint_dofs(p: &Pipeline) -> Vec<usize> {
+    let sys = p.model.system(LinearSolverKind::Banded);
+    let mut d: Vec<usize> = sys.constraints.iter().flat_map(|c| c.terms.iter().map(|&(dof, _)| dof)).collect();
+    d.sort_unstable();
+    d.dedup();
+    d
+}
+
+/// Runs the training simulations and builds the basis (nothing is written).
+pub fn train(p: &Pipeline) -> Result<(TrainingData, TrainSummary)> {
+    let scales = &p.file.train.load_scales;
+    if scales.is_empty() {
+        return Err(Error::input(&p.path, "train.load_scales", "is empty: no training run, no snapshots"));
+    }
+    let mut runs = Vec::new();
+    let mut full_seconds = 0.0;
+    for &s in scales {
+        let r = simulate(&p.model, &Overrides { load_scale: Some(s), ..Default::default() })?;
+        full_seconds += r.wall_seconds;
+        runs.push(r);
+    }
+    let cat = |f: &dyn Fn(&crate::simulate::SimulationResult) -> ndarray::ArrayView2<f64>| {
+        concatenate(Axis(1), &runs.iter().map(f).collect::<Vec<_>>()).expect("same row counts")
+    };
+    let data = TrainingData {
+        x: cat(&|r| r.q.view()),
+        multipliers: cat(&|r| r.multipliers.view()),
+        load_scale: Array1::from_iter(runs.iter().flat_map(|r| std::iter::repeat_n(r.settings.load_scale, r.t.len()))),
+        t: Array1::from_iter(runs.iter().flat_map(|r| r.t.iter().copied())),
+    };
+    // every run starts from the same consistent, undeformed state
+    let x_ref = runs[0].q.column(0).to_owned();
+    // whole-system: scale the multipliers so both blocks weigh alike in the POD
+    let dx = (&data.x - &x_ref.view().insert_axis(Axis(1))).mapv(|v| v * v).sum().sqrt();
+    let dl = data.multipliers.mapv(|v| v * v).sum().sqrt();
+    let w = if dx > 0.0 && dl > 0.0 { dl / dx } else { 1.0 };
+    let trained = train_basis(
+        data.x.view(),
+        data.multipliers.view(),
+        &joint_dofs(p),
+        x_ref.view(),
+        p.variant(),
+        p.file.train.snapshots,
+        p.file.reduction.modes,
+        w,
+    )
+    .map_err(|e| Error::input(&p.path, "reduction.modes", e))?;
+    let n_snapshots = data.x.ncols();
+    Ok((data, TrainSummary { trained, n_snapshots, full_seconds }))
+}
+
+/// Trains and writes the basis file atomically (a failed run keeps the previous file).
+pub fn train_and_write(p: &Pipeline, out: &Path) -> Result<TrainSummary> {
+    let (data, summary) = train(p)?;
+    let meta = BasisMeta {
+        model_text: p.model.text.clone(),
+        model_path: p.model.path.display().to_string(),
+        model_fingerprint: p.model.fingerprint(),
+        pipeline_text: p.text.clone(),
+        mode_rule: p.file.reduction.modes.to_string(),
+    };
+    write_basis(out, &data, &summary.trained, &meta)?;
+    Ok(summary)
+}
