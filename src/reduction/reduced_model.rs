@@ -21,7 +21,8 @@
 use super::basis::{Basis, Variant};
 use crate::solver::model::{DynamicModel, ElementModel, IterationCoefficients};
 use ndarray::{linalg::general_mat_mul, s, Array1, Array2, ArrayView1, Axis};
-use ndarray_linalg::{FactorizeInto, LUFactorized, Solve, SVD};
+use crate::solver::kkt::dense_lu_solve;
+use ndarray_linalg::{FactorizeInto, LUFactorized, SVD};
 
 pub struct ReducedModel<M: ElementModel> {
     full: M,
@@ -360,14 +361,7 @@ impl<M: ElementModel> DynamicModel for ReducedModel<M> {
     }
 
     fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {
-        let lu = self.lu.as_ref().ok_or("solve called without a valid factorization")?;
-        let mut b = ndarray::ArrayViewMut1::from(rhs);
-        let x = lu.solve(&b.view()).map_err(|e| format!("reduced solve failed: {e}"))?;
-        if x.iter().any(|v| !v.is_finite()) {
-            return Err("the reduced iteration matrix is singular (non-finite solution)".into());
-        }
-        b.assign(&x);
-        Ok(())
+        dense_lu_solve(self.lu.as_ref(), rhs)
     }
 
     fn length_scale(&self) -> f64 {

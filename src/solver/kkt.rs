@@ -248,16 +248,22 @@ impl KktSolver for DenseKkt {
     }
 
     fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {
-        use ndarray_linalg::Solve;
-        let lu = self.lu.as_ref().ok_or("solve called without a valid factorization")?;
-        let mut b = ndarray::ArrayViewMut1::from(rhs);
-        let x = lu.solve(&b.view()).map_err(|e| format!("dense solve failed: {e}"))?;
-        if x.iter().any(|v| !v.is_finite()) {
-            return Err("the iteration matrix is singular (non-finite solution)".into());
-        }
-        b.assign(&x);
-        Ok(())
+        dense_lu_solve(self.lu.as_ref(), rhs)
     }
+}
+
+/// Solves in place with a LAPACK LU factorization (getrs); a non-finite solution means the
+/// matrix was singular. Shared by the dense KKT solver and the reduced models.
+pub fn dense_lu_solve(lu: Option<&ndarray_linalg::LUFactorized<ndarray::OwnedRepr<f64>>>, rhs: &mut [f64]) -> Result<(), String> {
+    use ndarray_linalg::Solve;
+    let lu = lu.ok_or("solve called without a valid factorization")?;
+    let mut b = ndarray::ArrayViewMut1::from(rhs);
+    let x = lu.solve(&b.view()).map_err(|e| format!("dense solve failed: {e}"))?;
+    if x.iter().any(|v| !v.is_finite()) {
+        return Err("the iteration matrix is singular (non-finite solution)".into());
+    }
+    b.assign(&x);
+    Ok(())
 }
 
 #[cfg(test)]
