@@ -36,10 +36,7 @@ impl Model {
 
     pub fn from_text(text: &str, path: impl AsRef<Path>) -> Result<Model> {
         let path = path.as_ref();
-        let file: ModelFile = toml::from_str(text).map_err(|e| {
-            let field = e.span().map(|s| locate(text, s.start)).unwrap_or_else(|| "(file)".into());
-            Error::input(path, field, e.message().to_string())
-        })?;
+        let file: ModelFile = parse_toml(text, path)?;
         let mut model = Model { path: path.to_path_buf(), text: text.to_string(), file, bodies: vec![], joints: vec![], loads: vec![], probes: vec![] };
         model.check()?;
         Ok(model)
@@ -312,7 +309,16 @@ impl Model {
 }
 
 /// The dotted key path (or line) at byte `pos` of a TOML text, for error messages.
-pub(crate) fn locate(text: &str, pos: usize) -> String {
+/// Parses a TOML file into its schema; an error names the file, the field path (with its
+/// line) and the problem. Shared by model and pipeline files.
+pub(crate) fn parse_toml<T: serde::de::DeserializeOwned>(text: &str, path: &Path) -> Result<T> {
+    toml::from_str(text).map_err(|e| {
+        let field = e.span().map(|s| locate(text, s.start)).unwrap_or_else(|| "(file)".into());
+        Error::input(path, field, e.message().to_string())
+    })
+}
+
+fn locate(text: &str, pos: usize) -> String {
     let line = text[..pos.min(text.len())].matches('\n').count() + 1;
     let mut table = String::new();
     let mut counts: std::collections::HashMap<String, usize> = Default::default();

@@ -130,10 +130,7 @@ impl Pipeline {
     pub fn load(path: impl AsRef<Path>) -> Result<Pipeline> {
         let path = path.as_ref();
         let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-        let file: PipelineFile = toml::from_str(&text).map_err(|e| {
-            let field = e.span().map(|s| crate::model::locate(&text, s.start)).unwrap_or_else(|| "(file)".into());
-            Error::input(path, field, e.message().to_string())
-        })?;
+        let file: PipelineFile = crate::model::parse_toml(&text, path)?;
         let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
         let stem = path.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_else(|| "pipeline".into());
         let model = Model::load(dir.join(&file.model)).map_err(|e| match e {
