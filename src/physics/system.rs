@@ -7,7 +7,7 @@ use super::element::{BeamElement, Mat8, Section, Vec8};
 use super::loads::{moment_force, moment_jacobian};
 use super::time_function::TimeFunction;
 use crate::solver::kkt::{make_solver, KktPattern, KktSolver, LinearSolverKind};
-use crate::solver::model::{DynamicModel, ElementModel, IterationCoefficients};
+use crate::solver::model::{DynamicModel, ElementModel, InvariantElementModel, IterationCoefficients};
 
 /// A straight beam in its undeformed configuration.
 #[derive(Clone, Debug)]
@@ -439,6 +439,32 @@ impl ElementModel for FlexibleSystem {
     }
 }
 
+/// Berzeri–Shabana in invariant form (SPEC §1): `L = K_t`, `C = a M + b K_t`, one invariant
+/// `s = eᵀS_l e` with `Û = ½ EA l ε̄²`, `ε̄ = s/(2l) − ½`, so `ψ = EA ε̄/2`, `ψ' = EA/(4l)`.
+impl InvariantElementModel for FlexibleSystem {
+    fn n_invariants(&self) -> usize {
+        1
+    }
+
+    fn element_linear(&self, e: usize, stiffness: &mut [f64], damping: &mut [f64]) {
+        let el = self.element(e);
+        stiffness.copy_from_slice(el.bending_stiffness().as_slice());
+        let c = el.mass() * self.damping.mass + el.bending_stiffness() * self.damping.stiffness;
+        damping.copy_from_slice(c.as_slice());
+    }
+
+    fn element_invariant_matrix(&self, e: usize, _j: usize, out: &mut [f64]) {
+        out.copy_from_slice(self.element(e).axial_matrix().as_slice());
+    }
+
+    fn invariant_derivatives(&self, e: usize, s: &[f64], d1: &mut [f64], d2: &mut [f64]) {
+        let el = self.element(e);
+        let (ea, l) = (el.section.ea(), el.length);
+        d1[0] = 0.5 * ea * (s[0] / (2.0 * l) - 0.5);
+        d2[0] = ea / (4.0 * l);
+    }
+}
+
 impl DynamicModel for FlexibleSystem {
     fn n_dof(&self) -> usize {
         self.n_dof
@@ -514,5 +540,45 @@ impl DynamicModel for FlexibleSystem {
 
     fn length_scale(&self) -> f64 {
         self.length_scale
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The invariant form (`InvariantElementModel`) must rebuild the element force and
+    /// tangent of `ElementModel` exactly: both implement SPEC §1, one directly, one as
+    /// `L e + C ė + 2ψ S_l e` and `L + 2ψ S_l + 4ψ' (S_l e)(S_l e)ᵀ`.
+    #[test]
+    fn invariant_form_rebuilds_element_force_and_tangent() {
+        let section = Section { density: 2700.0, area: 1e-3, inertia: 1e-7, youngs_modulus: 7e9 };
+        let body = BeamBody { name: "b".into(), start: [0.0, 0.0], angle: 0.3, length: 1.0, n_elements: 2, section };
+        let sys = FlexibleSystem::new(vec![body], &[], &[], vec![], Rayleigh { mass: 0.3, stiffness: 2e-3 }, LinearSolverKind::Banded);
+        // a stretched and bent element with an arbitrary velocity
+        let qe: Vec<f64> = (0..8).map(|i| [0.1, -0.05, 0.95, 0.31, 0.62, 0.2, 1.02, 0.4][i]).collect();
+        let ve: Vec<f64> = (0..8).map(|i| 0.1 * i as f64 - 0.3).collect();
+        let (mut l, mut c, mut s) = ([0.0; 64], [0.0; 64], [0.0; 64]);
+        sys.element_linear(1, &mut l, &mut c);
+        sys.element_invariant_matrix(1, 0, &mut s);
+        let (l, c, s) = (Mat8::from_column_slice(&l), Mat8::from_column_slice(&c), Mat8::from_column_slice(&s));
+        let (e, v) = (Vec8::from_column_slice(&qe), Vec8::from_column_slice(&ve));
+        let se = s * e;
+        let (mut d1, mut d2) = ([0.0], [0.0]);
+        sys.invariant_derivatives(1, &[e.dot(&se)], &mut d1, &mut d2);
+        let f = l * e + c * v + se * (2.0 * d1[0]);
+        let k = l + s * (2.0 * d1[0]) + se * se.transpose() * (4.0 * d2[0]);
+        let mut f_ref = [0.0; 8];
+        sys.element_force(1, &qe, &ve, &mut f_ref);
+        let mut k_ref = [0.0; 64];
+        sys.element_matrix(1, &qe, IterationCoefficients { mass: 0.0, damping: 0.0, stiffness: 1.0 }, &mut k_ref);
+        let scale_f = f.amax();
+        for i in 0..8 {
+            assert!((f[i] - f_ref[i]).abs() <= 1e-13 * scale_f, "force {i}: {} vs {}", f[i], f_ref[i]);
+        }
+        let scale_k = k.amax();
+        for (a, b) in k.as_slice().iter().zip(&k_ref) {
+            assert!((a - b).abs() <= 1e-13 * scale_k, "tangent {a} vs {b}");
+        }
     }
 }

@@ -6,6 +6,7 @@
 
 pub mod basis;
 pub mod pod;
+pub(crate) mod projection;
 pub mod reduced_model;
 
 pub use basis::{train_basis, Basis, SnapshotKind, Trained, Variant};

@@ -67,3 +67,26 @@ pub trait ElementModel: DynamicModel {
     /// `∂g_l/∂q_l` (column-major, `load_dofs().len()` square).
     fn load_jacobian(&self, ql: &[f64], t: f64, out: &mut [f64]);
 }
+
+/// An [`ElementModel`] whose element forces are a constant linear part plus a part that
+/// depends on the coordinates only through a few quadratic invariants `s_j = qₑᵀ Sⱼ qₑ`
+/// (constant symmetric `Sⱼ`) of an energy `Û(s)`:
+///
+/// ```text
+///     fₑ(qₑ, q̇ₑ) = Cₑ q̇ₑ + Lₑ qₑ + Σ_j 2ψⱼ Sⱼ qₑ,          ψⱼ = ∂Û/∂s_j,
+///     ∂fₑ/∂qₑ   = Lₑ + Σ_j 2ψⱼ Sⱼ + Σ_jk 4ψⱼₖ (Sⱼ qₑ)(Sₖ qₑ)ᵀ,   ψⱼₖ = ∂²Û/∂s_j∂s_k.
+/// ```
+///
+/// A reduction can then project `Lₑ`, `Cₑ` once and precompute `Vₑᵀ Sⱼ Vₑ` per element,
+/// so that the reduced tangent of an element costs O(r²) instead of O(8 r²) (SPEC §1:
+/// Berzeri–Shabana has `L = K_t`, one invariant `s = eᵀS_l e`, `Û = ½EAl(s/(2l) − ½)²`).
+pub trait InvariantElementModel: ElementModel {
+    /// Number of invariants per element (the same for every element).
+    fn n_invariants(&self) -> usize;
+    /// `Lₑ` and `Cₑ`, column-major.
+    fn element_linear(&self, e: usize, stiffness: &mut [f64], damping: &mut [f64]);
+    /// `Sⱼ` of element `e`, column-major.
+    fn element_invariant_matrix(&self, e: usize, j: usize, out: &mut [f64]);
+    /// `ψⱼ` and `ψⱼₖ` (column-major, `n_invariants()` square) at the invariants `s`.
+    fn invariant_derivatives(&self, e: usize, s: &[f64], d1: &mut [f64], d2: &mut [f64]);
+}

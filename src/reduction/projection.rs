@@ -1,0 +1,284 @@
+//! What every reduced model shares: the parts of the full model that are projected once
+//! (mass, constant loads, joints), the few state- or time-dependent nodal loads, and the
+//! reduced KKT matrix with its allocation-free LU. The element terms are left to the
+//! model (all elements in [`super::ReducedModel`], a sampled set in
+//! [`super::HyperReducedModel`]). With `x = x_ref + V q`:
+//!
+//! ```text
+//!     M_r = VᵀMV,  g₀,r = Vᵀg₀,  g_l,r = V_lᵀ g_l(x_ref,l + V_l q, t),  J_l,r = V_lᵀ J_l V_l
+//! ```
+//!
+//! Joints: *constraint-preserving* keeps `B V q = b − B x_ref` with exact multipliers
+//! (`B V = [0, B_c]`); *galerkin* keeps the independent combinations of the projected
+//! joint equations (none when the basis cannot move the joint's coordinates, as for a
+//! ground pin whose rows are zero in every snapshot); *whole-system* has no separate multipliers:
+//! `λ = w V_λ q` and the projected saddle point adds `Vᵀ Bᵀ λ + w V_λᵀ (B x − b)`, i.e.
+//! `(P + Pᵀ) q + c₀` with `P = w V_λᵀ B V`, `c₀ = w V_λᵀ (B x_ref − b)`.
+
+use super::basis::{Basis, Variant};
+use crate::solver::dense_lu::DenseLu;
+use crate::solver::model::{ElementModel, IterationCoefficients};
+use ndarray::{s, Array1, Array2, ArrayView1, Axis};
+use ndarray_linalg::SVD;
+
+pub(crate) struct Projection {
+    pub variant: Variant,
+    pub r: usize,
+    /// constraint rows kept in reduced form
+    pub nc: usize,
+    pub mass: Array2<f64>,
+    g0: Array1<f64>,
+    /// B V and B x_ref − b (reduced rows)
+    b_r: Array2<f64>,
+    c_r: Array1<f64>,
+    /// whole-system: P + Pᵀ and c₀
+    coupling: Option<(Array2<f64>, Array1<f64>)>,
+    /// whole-system: w V_λ (λ = w V_λ q); galerkin: Uₖ (λ = Uₖ λ̃), to recover the multipliers
+    multiplier_map: Option<Array2<f64>>,
+    load_dofs: Vec<usize>,
+    /// rows of V and x_ref on the load dofs
+    v_load: Array2<f64>,
+    x_ref_load: Array1<f64>,
+    xl: Vec<f64>,
+    gl: Vec<f64>,
+    jl: Vec<f64>,
+    jv: Vec<f64>,
+    pub lu: DenseLu,
+}
+
+impl Projection {
+    pub fn new<M: ElementModel>(full: &M, basis: &Basis) -> Result<Self, String> {
+        let (n, nc_full) = (full.n_dof(), full.n_constraints());
+        basis.validate(n, nc_full).map_err(|(field, problem)| format!("{field} {problem}"))?;
+        let v = &basis.modes;
+        let r = v.ncols();
+        let load_dofs = full.load_dofs();
+        let v_load = v.select(Axis(0), &load_dofs);
+        let x_ref_load = basis.reference.select(Axis(0), &load_dofs);
+
+        // constant parts, projected once
+        let mut mv = Array2::zeros((n, r));
+        let mut col = vec![0.0; n];
+        for j in 0..r {
+            full.mass_mul(&v.column(j).to_vec(), &mut col);
+            mv.column_mut(j).assign(&ArrayView1::from(&col));
+        }
+        let mass = v.t().dot(&mv);
+        full.constant_force(&mut col);
+        let g0 = v.t().dot(&ArrayView1::from(&col));
+
+        // constraints are linear: B y − b, so B V_j = res(V_j) − res(0)
+        let mut res0 = vec![0.0; nc_full];
+        full.constraint_residual(&vec![0.0; n], &mut res0);
+        let mut bv = Array2::<f64>::zeros((nc_full, r));
+        let mut res = vec![0.0; nc_full];
+        for j in 0..r {
+            full.constraint_residual(&v.column(j).to_vec(), &mut res);
+            for c in 0..nc_full {
+                bv[[c, j]] = res[c] - res0[c];
+            }
+        }
+        full.constraint_residual(basis.reference.as_slice().expect("contiguous"), &mut res);
+        let mut c_ref = Array1::from(res);
+
+        let (nc, coupling, multiplier_map) = match basis.variant {
+            Variant::ConstraintPreserving => (nc_full, None, None),
+            Variant::Galerkin => {
+                // keep the combinations of joint equations the basis can move: B V = U Σ Wᵀ,
+                // rows Uₖᵀ(B V q + B x_ref − b) for σ > 1e-8 (B has unit entries, V is
+                // orthonormal, so σ ≤ √2); the rest hold as well as the basis represents them
+                let (u, sigma, _) = if nc_full > 0 { bv.svd(true, false).map_err(|e| format!("SVD of B V failed: {e}"))? } else { (None, Array1::zeros(0), None) };
+                let k = sigma.iter().filter(|&&x| x > 1e-8).count();
+                if k > 0 {
+                    let uk = u.expect("requested").slice(s![.., ..k]).to_owned();
+                    bv = uk.t().dot(&bv);
+                    c_ref = uk.t().dot(&c_ref);
+                    (k, None, Some(uk))
+                } else {
+                    (0, None, None)
+                }
+            }
+            Variant::WholeSystem => {
+                let w = basis.multiplier_scale;
+                let vl = basis.multiplier_modes.as_ref().expect("validated") * w;
+                let p = vl.t().dot(&bv);
+                let c0 = vl.t().dot(&c_ref);
+                (0, Some((&p + &p.t(), c0)), Some(vl))
+            }
+        };
+        let (b_r, c_r) = if nc > 0 { (bv, c_ref) } else { (Array2::zeros((0, r)), Array1::zeros(0)) };
+        let nl = load_dofs.len();
+        Ok(Projection {
+            variant: basis.variant,
+            r,
+            nc,
+            mass,
+            g0,
+            b_r,
+            c_r,
+            coupling,
+            multiplier_map,
+            load_dofs,
+            v_load,
+            x_ref_load,
+            xl: vec![0.0; nl],
+            gl: vec![0.0; nl],
+            jl: vec![0.0; nl * nl],
+            jv: vec![0.0; nl * r],
+            lu: DenseLu::new(r + nc),
+        })
+    }
+
+    /// Physical multipliers of the full model's constraints, when this variant has them:
+    /// constraint-preserving returns the integrator's own, whole-system `w V_λ q`.
+    pub fn multipliers(&self, q: &[f64], lambda: &[f64]) -> Option<Array1<f64>> {
+        match self.variant {
+            Variant::ConstraintPreserving => Some(Array1::from(lambda.to_vec())),
+            Variant::WholeSystem => Some(self.multiplier_map.as_ref().expect("set").dot(&ArrayView1::from(q))),
+            Variant::Galerkin => self.multiplier_map.as_ref().map(|uk| uk.dot(&ArrayView1::from(lambda))),
+        }
+    }
+
+    /// `out = M_r a`
+    pub fn mass_mul(&self, a: &[f64], out: &mut [f64]) {
+        mat_vec(&self.mass, a, out, false);
+    }
+
+    /// `out = g₀,r + g_l,r(q, t)` (+ the whole-system coupling `(P + Pᵀ) q + c₀`)
+    pub fn constant_and_load_force<M: ElementModel>(&mut self, full: &M, q: &[f64], t: f64, out: &mut [f64]) {
+        out.copy_from_slice(self.g0.as_slice().expect("contiguous"));
+        if !self.load_dofs.is_empty() {
+            expand(&self.v_load, Some(&self.x_ref_load), 0, q, &mut self.xl);
+            full.load_force(&self.xl, t, &mut self.gl);
+            project_add(&self.v_load, 0, &self.gl, out);
+        }
+        if let Some((pp, c0)) = &self.coupling {
+            mat_vec(pp, q, out, true);
+            out.iter_mut().zip(c0).for_each(|(o, c)| *o += c);
+        }
+    }
+
+    /// `out = B_r q + c_r`
+    pub fn constraint_residual(&self, q: &[f64], out: &mut [f64]) {
+        mat_vec(&self.b_r, q, out, false);
+        out.iter_mut().zip(&self.c_r).for_each(|(o, c)| *o += c);
+    }
+
+    /// `out += B_rᵀ λ`
+    pub fn add_constraint_force(&self, lambda: &[f64], out: &mut [f64]) {
+        for (row, l) in self.b_r.rows().into_iter().zip(lambda) {
+            row.iter().zip(out.iter_mut()).for_each(|(b, o)| *o += b * l);
+        }
+    }
+
+    /// Starts the reduced iteration matrix: clears it and writes
+    /// `m M_r + k (J_l,r + P + Pᵀ)` into its r×r block; the model adds its element terms.
+    pub fn start_matrix<M: ElementModel>(&mut self, full: &M, q: &[f64], t: f64, coef: IterationCoefficients) {
+        let r = self.r;
+        let mut a = self.lu.matrix_mut();
+        a.fill(0.0);
+        for j in 0..r {
+            for i in 0..r {
+                a[(i, j)] = coef.mass * self.mass[[i, j]];
+            }
+        }
+        if coef.stiffness != 0.0 && !self.load_dofs.is_empty() {
+            let nl = self.load_dofs.len();
+            expand(&self.v_load, Some(&self.x_ref_load), 0, q, &mut self.xl);
+            full.load_jacobian(&self.xl, t, &mut self.jl);
+            // J V_l (nl × r, row-major), then V_lᵀ (J V_l)
+            for a_ in 0..nl {
+                let row = &mut self.jv[a_ * r..(a_ + 1) * r];
+                row.fill(0.0);
+                for b in 0..nl {
+                    axpy(self.jl[b * nl + a_], self.v_load.row(b).as_slice().expect("standard layout"), row);
+                }
+            }
+            for j in 0..r {
+                for i in 0..r {
+                    let mut sum = 0.0;
+                    for a_ in 0..nl {
+                        sum += self.v_load[[a_, i]] * self.jv[a_ * r + j];
+                    }
+                    a[(i, j)] += coef.stiffness * sum;
+                }
+            }
+        }
+        if let Some((pp, _)) = &self.coupling {
+            for j in 0..r {
+                for i in 0..r {
+                    a[(i, j)] += coef.stiffness * pp[[i, j]];
+                }
+            }
+        }
+    }
+
+    /// Completes the matrix with the scaled constraint rows `s B_r`, `s B_rᵀ` (s = the largest
+    /// diagonal entry, so both block rows are of one magnitude) and factors it; returns `s`.
+    pub fn finish_matrix(&mut self) -> Result<f64, String> {
+        let (r, nc) = (self.r, self.nc);
+        let mut a = self.lu.matrix_mut();
+        let scale = (0..r).map(|i| a[(i, i)].abs()).fold(0.0, f64::max);
+        let scale = if scale > 0.0 && scale.is_finite() { scale } else { 1.0 };
+        for c in 0..nc {
+            for j in 0..r {
+                let b = scale * self.b_r[[c, j]];
+                a[(r + c, j)] = b;
+                a[(j, r + c)] = b;
+            }
+        }
+        self.lu.factor().map_err(|e| format!("reduced LU: {e}"))?;
+        Ok(scale)
+    }
+}
+
+/// `out (+)= A x`
+pub(crate) fn mat_vec(a: &Array2<f64>, x: &[f64], out: &mut [f64], accumulate: bool) {
+    for (o, row) in out.iter_mut().zip(a.rows()) {
+        let d = match row.as_slice() {
+            Some(rs) => dot(rs, x),
+            None => row.iter().zip(x).map(|(p, q)| p * q).sum(),
+        };
+        *o = if accumulate { *o + d } else { d };
+    }
+}
+
+/// `out_i = x_ref[first + i] + V[first + i, :] · q` (pass no `x_ref` for velocities).
+pub(crate) fn expand(v: &Array2<f64>, x_ref: Option<&Array1<f64>>, first: usize, q: &[f64], out: &mut [f64]) {
+    let r = q.len();
+    let rows = &v.as_slice().expect("standard layout")[first * r..(first + out.len()) * r];
+    for (i, (o, row)) in out.iter_mut().zip(rows.chunks_exact(r)).enumerate() {
+        *o = x_ref.map_or(0.0, |x| x[first + i]) + dot(row, q);
+    }
+}
+
+/// `out += Σ_i f_i V[first + i, :]`
+pub(crate) fn project_add(v: &Array2<f64>, first: usize, f: &[f64], out: &mut [f64]) {
+    let r = out.len();
+    let rows = &v.as_slice().expect("standard layout")[first * r..(first + f.len()) * r];
+    for (fi, row) in f.iter().zip(rows.chunks_exact(r)) {
+        axpy(*fi, row, out);
+    }
+}
+
+/// Dot product with four independent partial sums, so that it vectorizes (a single
+/// running sum is a chain of dependent additions).
+#[inline]
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut acc = [0.0; 4];
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let tail: f64 = ca.remainder().iter().zip(cb.remainder()).map(|(x, y)| x * y).sum();
+    for (x, y) in ca.zip(cb) {
+        for k in 0..4 {
+            acc[k] += x[k] * y[k];
+        }
+    }
+    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
+}
+
+#[inline]
+pub(crate) fn axpy(alpha: f64, x: &[f64], y: &mut [f64]) {
+    for (yi, xi) in y.iter_mut().zip(x) {
+        *yi += alpha * xi;
+    }
+}
