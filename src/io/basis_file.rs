@@ -13,6 +13,10 @@
 //! /basis/reduced_dofs        (n_f)        coordinates whose rows entered the POD
 //! /basis/kept_dofs           (n_k)        coordinates kept unreduced (last n_k columns of V)
 //! /basis/multiplier_modes    (n_c, r)     whole-system only: λ ≈ w V_λ q
+//! /hyper/elements            (|E|)        hyper-reduction only: sampled element indices,
+//!                                         increasing (elements numbered body by body)
+//! /hyper/weights             (|E|)        their ECSW weights, positive
+//!   attributes on /hyper: tolerance (τ), training_residual (‖Cw − b‖/‖b‖), n_training
 //! attributes on /: schema_version, model (TOML text), model_path, model_fingerprint,
 //!   pipeline (TOML text), variant, snapshots, mode_rule, n_modes (= r), n_pod_modes,
 //!   multiplier_scale (w), n_dof, creation_time (RFC 3339, UTC), program_version
@@ -20,7 +24,7 @@
 
 use super::h5::{attr_f64, attr_str, attr_u64, read_attr_f64, read_attr_str, write_atomically};
 use crate::error::{Error, Result};
-use crate::reduction::{Basis, SnapshotKind, Trained, Variant};
+use crate::reduction::{Basis, Hyper, SnapshotKind, Trained, Variant};
 use ndarray::{Array1, Array2};
 use std::path::Path;
 
@@ -93,6 +97,14 @@ pub fn write_basis(path: &Path, data: &TrainingData, trained: &Trained, meta: &B
         if let Some(vl) = &b.multiplier_modes {
             g.new_dataset_builder().with_data(&vl.as_standard_layout()).create("multiplier_modes").map_err(e)?;
         }
+        if let Some(h) = &b.hyper {
+            let g = f.create_group("hyper").map_err(e)?;
+            g.new_dataset_builder().with_data(&idx(&h.elements)).create("elements").map_err(e)?;
+            g.new_dataset_builder().with_data(&Array1::from(h.weights.clone())).create("weights").map_err(e)?;
+            attr_f64(&g, "tolerance", h.tolerance).map_err(e)?;
+            attr_f64(&g, "training_residual", h.training_residual).map_err(e)?;
+            attr_u64(&g, "n_training", h.n_training as u64).map_err(e)?;
+        }
         attr_u64(f, "schema_version", SCHEMA_VERSION).map_err(e)?;
         attr_str(f, "model", &meta.model_text).map_err(e)?;
         attr_str(f, "model_path", &meta.model_path).map_err(e)?;
@@ -150,6 +162,7 @@ pub fn read_basis(path: &Path) -> Result<StoredBasis> {
         multiplier_modes,
         multiplier_scale: num("multiplier_scale")?,
         n_pod_modes: count("n_pod_modes")?,
+        hyper: read_hyper(&f, path)?,
     };
     let singular_values = vec("basis/singular_values")?;
     let energy = vec("basis/energy")?;
@@ -164,4 +177,24 @@ pub fn read_basis(path: &Path) -> Result<StoredBasis> {
         mode_rule: text("mode_rule")?,
         creation_time: text("creation_time")?,
     })
+}
+
+/// `/hyper`, when present; its sizes and weights are checked here, its element indices
+/// against the model by the caller (`Hyper::validate`).
+fn read_hyper(f: &hdf5::File, path: &Path) -> Result<Option<Hyper>> {
+    let Ok(g) = f.group("hyper") else { return Ok(None) };
+    let field = |name: &str, problem: String| Error::input(path, name, problem);
+    let elements: Vec<usize> = g
+        .dataset("elements")
+        .and_then(|d| d.read_1d::<u64>())
+        .map_err(|err| field("hyper/elements", format!("cannot be read: {err}")))?
+        .iter()
+        .map(|&e| e as usize)
+        .collect();
+    let weights = g.dataset("weights").and_then(|d| d.read_1d::<f64>()).map_err(|err| field("hyper/weights", format!("cannot be read: {err}")))?.to_vec();
+    let num = |name: &str| read_attr_f64(&g, name).map_err(|err| field(&format!("hyper/{name}"), format!("cannot be read: {err}")));
+    let n_training = g.attr("n_training").and_then(|a| a.read_scalar::<u64>()).map_err(|err| field("hyper/n_training", format!("cannot be read: {err}")))? as usize;
+    let h = Hyper { elements, weights, tolerance: num("tolerance")?, training_residual: num("training_residual")?, n_training };
+    h.validate(usize::MAX).map_err(|(f, p)| field(&f, p))?;
+    Ok(Some(h))
 }

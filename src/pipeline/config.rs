@@ -11,6 +11,7 @@
 //! [reduction]
 //! variant = "galerkin"                      # or "constraint-preserving", "whole-system"
 //! modes = { ratio = 0.1 }                   # or { count = 20 }, { energy = 1e-6 }
+//! hyper = { tolerance = 1e-3 }              # ECSW element sampling; omit for plain Galerkin
 //! [online]
 //! load_scales = "0.5:1.5:21"                # or a list
 //! [validate]
@@ -61,6 +62,17 @@ pub struct ReductionSpec {
     #[serde(default)]
     pub variant: Option<Variant>,
     pub modes: ModeRule,
+    /// hyper-reduction by ECSW; absent: every element is evaluated (plain Galerkin)
+    #[serde(default)]
+    pub hyper: Option<HyperSpec>,
+}
+
+/// `[reduction.hyper]`: ECSW element sampling trained to a relative tolerance τ on the
+/// training snapshots (‖C w − b‖ ≤ τ ‖b‖; smaller τ: more elements, closer to Galerkin).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HyperSpec {
+    pub tolerance: f64,
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -151,6 +163,11 @@ impl Pipeline {
         }
         if let Err(e) = self.file.reduction.modes.validate() {
             return bad("reduction.modes", e);
+        }
+        if let Some(h) = &self.file.reduction.hyper {
+            if !(h.tolerance.is_finite() && h.tolerance > 0.0 && h.tolerance < 1.0) {
+                return bad("reduction.hyper.tolerance", format!("is {}; it must lie strictly between 0 and 1", h.tolerance));
+            }
         }
         for (name, spec) in [("online", &self.file.online), ("validate", &self.file.validate)] {
             if let Some(s) = spec {

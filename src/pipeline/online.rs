@@ -4,7 +4,9 @@ use super::config::Pipeline;
 use crate::error::{Error, Result};
 use crate::io::basis_file::{read_basis, StoredBasis};
 use crate::model::Model;
-use crate::reduction::{Basis, ReducedModel};
+use crate::physics::element::Vec8;
+use crate::physics::system::FlexibleSystem;
+use crate::reduction::{Basis, HyperReducedModel, Reduced, ReducedModel};
 use crate::simulate::{integrate, prepare, Overrides, Settings, SimulationResult};
 use crate::solver::model::DynamicModel;
 use ndarray::{Array1, Array2, ArrayView1};
@@ -38,6 +40,9 @@ pub fn load_basis(p: &Pipeline, path: &Path) -> Result<StoredBasis> {
     }
     let sys = p.model.system(Default::default());
     stored.basis.validate(sys.n_dof(), sys.n_constraints()).map_err(|(field, problem)| Error::input(path, field, problem))?;
+    if let Some(h) = &stored.basis.hyper {
+        h.validate(sys.n_elements()).map_err(|(field, problem)| Error::input(path, field, problem))?;
+    }
     Ok(stored)
 }
 
@@ -45,40 +50,78 @@ fn short(h: &str) -> &str {
     &h[..h.len().min(12)]
 }
 
-/// Runs the reduced model of `basis` at `load_scale` with the model's time settings.
+/// What the run writes: the full coordinates (`online`, `validate`) or only the reduced
+/// ones and the probes (`sweep`: nothing of size n_dof, probes from their own rows of V).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Output {
+    Full,
+    ReducedAndProbes,
+}
+
+/// Runs the reduced model of `basis` at `load_scale` with the model's time settings; the
+/// hyper-reduced model when the basis carries a sampled element set.
 pub fn run_reduced(model: &Model, basis: &Basis, load_scale: f64) -> Result<ReducedRun> {
+    run_reduced_with(model, basis, load_scale, Output::Full)
+}
+
+pub fn run_reduced_with(model: &Model, basis: &Basis, load_scale: f64, output: Output) -> Result<ReducedRun> {
     let s = Settings::resolve(model, &Overrides { load_scale: Some(load_scale), ..Default::default() })?;
     let (sys, x0) = prepare(model, &s)?;
-    let probes = sys.probes.clone();
-    let n_c = sys.n_constraints();
-    let mut rom = ReducedModel::new(sys, basis).map_err(|e| Error::Usage(format!("cannot build the reduced model: {e}")))?;
-    let q0 = basis.reduce(ArrayView1::from(&x0)).to_vec();
+    let cannot = |e: String| Error::Usage(format!("cannot build the reduced model: {e}"));
+    match &basis.hyper {
+        Some(h) => {
+            let mut rom = HyperReducedModel::new(sys, basis, h).map_err(cannot)?;
+            run(&mut rom, model, basis, s, &x0, output)
+        }
+        None => {
+            let mut rom = ReducedModel::new(sys, basis).map_err(cannot)?;
+            run(&mut rom, model, basis, s, &x0, output)
+        }
+    }
+}
+
+fn run<R: Reduced<FlexibleSystem>>(rom: &mut R, model: &Model, basis: &Basis, s: Settings, x0: &[f64], output: Output) -> Result<ReducedRun> {
+    let q0 = basis.reduce(ArrayView1::from(x0)).to_vec();
     let (r, nt) = (rom.n_dof(), s.n_steps + 1);
     let mut zq = Array2::zeros((r, nt));
     let mut lam = Array2::<f64>::zeros((rom.n_constraints(), nt));
     let mut t = Array1::zeros(nt);
     let start = std::time::Instant::now();
-    let stats = integrate(&mut rom, &s.params, q0, s.dt, s.n_steps, |k, st| {
+    let stats = integrate(rom, &s.params, q0, s.dt, s.n_steps, |k, st| {
         t[k] = st.t;
         zq.column_mut(k).assign(&ArrayView1::from(&st.q));
         lam.column_mut(k).assign(&ArrayView1::from(&st.lambda));
     })?;
     let wall_seconds = start.elapsed().as_secs_f64();
     // reconstruct only what is written out
-    let q = basis.reference.view().insert_axis(ndarray::Axis(1)).to_owned() + basis.modes.dot(&zq);
-    let mut multipliers = Array2::from_elem((n_c, nt), f64::NAN);
-    for k in 0..nt {
-        if let Some(l) = rom.multipliers(&zq.column(k).to_vec(), &lam.column(k).to_vec()) {
-            multipliers.column_mut(k).assign(&l);
-        }
-    }
     let full = rom.full();
-    let probes = probes
+    let n_c = full.n_constraints();
+    let (q, multipliers) = match output {
+        Output::Full => {
+            let q = basis.reference.view().insert_axis(ndarray::Axis(1)).to_owned() + basis.modes.dot(&zq);
+            let mut multipliers = Array2::from_elem((n_c, nt), f64::NAN);
+            for k in 0..nt {
+                if let Some(l) = rom.multipliers(&zq.column(k).to_vec(), &lam.column(k).to_vec()) {
+                    multipliers.column_mut(k).assign(&l);
+                }
+            }
+            (q, multipliers)
+        }
+        Output::ReducedAndProbes => (Array2::zeros((0, nt)), Array2::zeros((0, nt))),
+    };
+    // probes from the rows of V on their element: x_e = x_ref,e + V_e q
+    let probes = full
+        .probes
         .iter()
         .map(|p| {
+            let dofs = full.element_dofs(p.element);
+            let ve = basis.modes.select(ndarray::Axis(0), dofs);
+            let xe_ref = basis.reference.select(ndarray::Axis(0), dofs);
+            let xe = ve.dot(&zq) + &xe_ref.insert_axis(ndarray::Axis(1));
+            let el = full.element(p.element);
             let mut xy = Array2::zeros((nt, 2));
             for k in 0..nt {
-                let r = full.probe_position(p, &q.column(k).to_vec());
+                let r = el.position(&Vec8::from_iterator(xe.column(k).iter().copied()), p.xi);
                 xy[[k, 0]] = r[0];
                 xy[[k, 1]] = r[1];
             }

@@ -16,7 +16,7 @@
 //!   program_version
 //! ```
 
-use super::online::{run_reduced, ReducedRun};
+use super::online::{run_reduced_with, Output, ReducedRun};
 use super::validate::{compare, Validation};
 use crate::error::{Error, Result};
 use crate::io::h5::{attr_f64, attr_str, attr_u64, write_atomically};
@@ -48,7 +48,8 @@ pub fn sweep(model: &Model, basis: &Basis, scales: &[f64], validate: bool, progr
     let points: Result<Vec<SweepPoint>> = scales
         .par_iter()
         .map(|&x| {
-            let rom = run_reduced(model, basis, x)?;
+            // without validation nothing of full size is reconstructed
+            let rom = run_reduced_with(model, basis, x, if validate { Output::Full } else { Output::ReducedAndProbes })?;
             let validation = if validate {
                 let full = simulate(model, &Overrides { load_scale: Some(x), ..Default::default() })?;
                 Some(compare(model, &full, &rom, None, basis.n_reduced(), basis.variant.name()))

@@ -3,7 +3,7 @@
 use super::config::Pipeline;
 use crate::error::{Error, Result};
 use crate::io::basis_file::{write_basis, BasisMeta, TrainingData};
-use crate::reduction::{train_basis, Trained};
+use crate::reduction::{ecsw, train_basis, Trained};
 use crate::simulate::{simulate, Overrides};
 use crate::solver::kkt::LinearSolverKind;
 use ndarray::{concatenate, Array1, Axis};
@@ -63,6 +63,12 @@ pub fn train(p: &Pipeline) -> Result<(TrainingData, TrainSummary)> {
         w,
     )
     .map_err(|e| Error::input(&p.path, "reduction.modes", e))?;
+    let mut trained = trained;
+    if let Some(h) = &p.file.reduction.hyper {
+        let sys = p.model.system(LinearSolverKind::Banded);
+        let hyper = ecsw(&sys, &trained.basis, data.x.view(), h.tolerance).map_err(|e| Error::input(&p.path, "reduction.hyper", format!("ECSW training failed: {e}")))?;
+        trained.basis.hyper = Some(hyper);
+    }
     let n_snapshots = data.x.ncols();
     Ok((data, TrainSummary { trained, n_snapshots, full_seconds }))
 }

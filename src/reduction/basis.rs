@@ -8,6 +8,7 @@
 //!     whole-system:          [x; λ/w] ≈ [x_ref; 0] + [V; V_λ] q (eqs. 18–19)
 //! ```
 
+use super::ecsw::Hyper;
 use super::pod::{pod, ModeRule, Pod};
 use ndarray::{s, Array1, Array2, ArrayView1, ArrayView2, Axis};
 
@@ -79,6 +80,8 @@ pub struct Basis {
     pub multiplier_scale: f64,
     /// how many columns of `V` come from the POD
     pub n_pod_modes: usize,
+    /// the sampled elements of hyper-reduction (ECSW), when trained
+    pub hyper: Option<Hyper>,
 }
 
 /// The POD and the basis built from it.
@@ -143,7 +146,7 @@ pub fn train_basis(
             (v, kept, None)
         }
     };
-    let basis = Basis { variant, snapshots: kind, reference, modes, kept, multiplier_modes, multiplier_scale, n_pod_modes: r };
+    let basis = Basis { variant, snapshots: kind, reference, modes, kept, multiplier_modes, multiplier_scale, n_pod_modes: r, hyper: None };
     Ok(Trained { basis, pod: p, reduced_dofs })
 }
 

@@ -1,14 +1,48 @@
-//! Model reduction by POD (SPEC §3), knowing nothing of beams: it sees the physics only
-//! through [`crate::solver::model::ElementModel`].
+//! Model reduction by POD (SPEC §3) and hyper-reduction by ECSW, knowing nothing of beams:
+//! it sees the physics only through [`crate::solver::model::ElementModel`] and
+//! [`crate::solver::model::InvariantElementModel`].
 //!
 //! `pod` (modes and singular values) → `basis` (the reductor: `train_basis`, `reduce`,
-//! `reconstruct`) → `reduced_model` (the projected [`crate::solver::model::DynamicModel`]).
+//! `reconstruct`) → `reduced_model` (Galerkin over every element) or `ecsw` (a weighted
+//! element sample, by `nnls`) → `hyper_model` (the sampled model); both reduced models are
+//! [`crate::solver::model::DynamicModel`]s and share `projection`.
 
 pub mod basis;
+pub mod ecsw;
+pub mod hyper_model;
+pub mod nnls;
 pub mod pod;
 pub(crate) mod projection;
 pub mod reduced_model;
 
 pub use basis::{train_basis, Basis, SnapshotKind, Trained, Variant};
 pub use pod::{pod, ModeRule, Pod};
+pub use ecsw::{ecsw, Hyper};
+pub use hyper_model::HyperReducedModel;
 pub use reduced_model::ReducedModel;
+
+/// What the online stage needs of a reduced model besides the dynamics.
+pub trait Reduced<M>: crate::solver::model::DynamicModel {
+    /// The full model it was projected from.
+    fn full(&self) -> &M;
+    /// Physical multipliers of the full model's constraints, when the variant has them.
+    fn multipliers(&self, q: &[f64], lambda: &[f64]) -> Option<ndarray::Array1<f64>>;
+}
+
+impl<M: crate::solver::model::ElementModel> Reduced<M> for ReducedModel<M> {
+    fn full(&self) -> &M {
+        ReducedModel::full(self)
+    }
+    fn multipliers(&self, q: &[f64], lambda: &[f64]) -> Option<ndarray::Array1<f64>> {
+        ReducedModel::multipliers(self, q, lambda)
+    }
+}
+
+impl<M: crate::solver::model::InvariantElementModel> Reduced<M> for HyperReducedModel<M> {
+    fn full(&self) -> &M {
+        HyperReducedModel::full(self)
+    }
+    fn multipliers(&self, q: &[f64], lambda: &[f64]) -> Option<ndarray::Array1<f64>> {
+        HyperReducedModel::multipliers(self, q, lambda)
+    }
+}

@@ -43,6 +43,11 @@ pub(crate) struct Projection {
     gl: Vec<f64>,
     jl: Vec<f64>,
     jv: Vec<f64>,
+    /// constant r×r stiffness and damping terms of the model, if any
+    linear: (Option<Array2<f64>>, Option<Array2<f64>>),
+    /// the constant part of the iteration matrix, for `base_coef`
+    base: Vec<f64>,
+    base_coef: Option<IterationCoefficients>,
     pub lu: DenseLu,
 }
 
@@ -125,6 +130,9 @@ impl Projection {
             gl: vec![0.0; nl],
             jl: vec![0.0; nl * nl],
             jv: vec![0.0; nl * r],
+            linear: (None, None),
+            base: vec![0.0; (r + nc) * (r + nc)],
+            base_coef: None,
             lu: DenseLu::new(r + nc),
         })
     }
@@ -171,17 +179,43 @@ impl Projection {
         }
     }
 
-    /// Starts the reduced iteration matrix: clears it and writes
-    /// `m M_r + k (J_l,r + P + Pᵀ)` into its r×r block; the model adds its element terms.
+    /// Adds constant r×r terms to the iteration matrix: `stiffness` enters with `k`,
+    /// `damping` with `c` (the hyper-reduced model's projected linear element parts).
+    pub fn set_linear_terms(&mut self, stiffness: Option<Array2<f64>>, damping: Option<Array2<f64>>) {
+        self.linear = (stiffness, damping);
+        self.base_coef = None;
+    }
+
+    /// Starts the reduced iteration matrix (column-major, (r + nc)²): the constant part
+    /// `m M_r + k (L_r + P + Pᵀ) + c C_r` (kept for the last coefficients, since they change
+    /// only with the step size) plus `k J_l,r(q, t)`; the model adds its element terms.
     pub fn start_matrix<M: ElementModel>(&mut self, full: &M, q: &[f64], t: f64, coef: IterationCoefficients) {
-        let r = self.r;
-        let mut a = self.lu.matrix_mut();
-        a.fill(0.0);
-        for j in 0..r {
-            for i in 0..r {
-                a[(i, j)] = coef.mass * self.mass[[i, j]];
+        let (r, n) = (self.r, self.r + self.nc);
+        if self.base_coef != Some(coef) {
+            self.base.fill(0.0);
+            let mut add = |m: &Array2<f64>, f: f64| {
+                if f != 0.0 {
+                    for j in 0..r {
+                        for i in 0..r {
+                            self.base[i + n * j] += f * m[[i, j]];
+                        }
+                    }
+                }
+            };
+            add(&self.mass, coef.mass);
+            if let Some((pp, _)) = &self.coupling {
+                add(pp, coef.stiffness);
             }
+            if let Some(l) = &self.linear.0 {
+                add(l, coef.stiffness);
+            }
+            if let Some(c) = &self.linear.1 {
+                add(c, coef.damping);
+            }
+            self.base_coef = Some(coef);
         }
+        let a = self.lu.matrix_mut();
+        a.copy_from_slice(&self.base);
         if coef.stiffness != 0.0 && !self.load_dofs.is_empty() {
             let nl = self.load_dofs.len();
             expand(&self.v_load, Some(&self.x_ref_load), 0, q, &mut self.xl);
@@ -194,21 +228,43 @@ impl Projection {
                     axpy(self.jl[b * nl + a_], self.v_load.row(b).as_slice().expect("standard layout"), row);
                 }
             }
-            for j in 0..r {
+            for a_ in 0..nl {
+                let jv = &self.jv[a_ * r..(a_ + 1) * r];
                 for i in 0..r {
-                    let mut sum = 0.0;
-                    for a_ in 0..nl {
-                        sum += self.v_load[[a_, i]] * self.jv[a_ * r + j];
+                    let vi = coef.stiffness * self.v_load[[a_, i]];
+                    if vi != 0.0 {
+                        for (j, x) in jv.iter().enumerate() {
+                            a[i + n * j] += vi * x;
+                        }
                     }
-                    a[(i, j)] += coef.stiffness * sum;
                 }
             }
         }
-        if let Some((pp, _)) = &self.coupling {
+    }
+
+    /// Adds the symmetric r×r block given by its upper triangle (row-major `upper[i r + j]`,
+    /// j ≥ i) times `f` to the iteration matrix.
+    pub fn add_symmetric_upper(&mut self, upper: &[f64], f: f64) {
+        let (r, n) = (self.r, self.r + self.nc);
+        let a = self.lu.matrix_mut();
+        for i in 0..r {
+            let row = &upper[i * r..(i + 1) * r];
+            a[i + n * i] += f * row[i];
+            for j in i + 1..r {
+                let v = f * row[j];
+                a[i + n * j] += v;
+                a[j + n * i] += v;
+            }
+        }
+    }
+
+    /// Adds the r×r matrix `m` (row-major) to the iteration matrix.
+    pub fn add_block(&mut self, m: &[f64]) {
+        let (r, n) = (self.r, self.r + self.nc);
+        let a = self.lu.matrix_mut();
+        for i in 0..r {
             for j in 0..r {
-                for i in 0..r {
-                    a[(i, j)] += coef.stiffness * pp[[i, j]];
-                }
+                a[i + n * j] += m[i * r + j];
             }
         }
     }
@@ -216,15 +272,15 @@ impl Projection {
     /// Completes the matrix with the scaled constraint rows `s B_r`, `s B_rᵀ` (s = the largest
     /// diagonal entry, so both block rows are of one magnitude) and factors it; returns `s`.
     pub fn finish_matrix(&mut self) -> Result<f64, String> {
-        let (r, nc) = (self.r, self.nc);
-        let mut a = self.lu.matrix_mut();
-        let scale = (0..r).map(|i| a[(i, i)].abs()).fold(0.0, f64::max);
+        let (r, nc, n) = (self.r, self.nc, self.r + self.nc);
+        let a = self.lu.matrix_mut();
+        let scale = (0..r).map(|i| a[i + n * i].abs()).fold(0.0, f64::max);
         let scale = if scale > 0.0 && scale.is_finite() { scale } else { 1.0 };
         for c in 0..nc {
             for j in 0..r {
                 let b = scale * self.b_r[[c, j]];
-                a[(r + c, j)] = b;
-                a[(j, r + c)] = b;
+                a[(r + c) + n * j] = b;
+                a[j + n * (r + c)] = b;
             }
         }
         self.lu.factor().map_err(|e| format!("reduced LU: {e}"))?;

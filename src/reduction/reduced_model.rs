@@ -173,12 +173,7 @@ impl<M: ElementModel> DynamicModel for ReducedModel<M> {
                 }
             }
             general_mat_mul(1.0, &self.v.t(), &self.y, 0.0, &mut self.vty);
-            let mut a = self.p.lu.matrix_mut();
-            for j in 0..r {
-                for i in 0..r {
-                    a[(i, j)] += self.vty[[i, j]];
-                }
-            }
+            self.p.add_block(self.vty.as_slice().expect("standard layout"));
         }
         self.p.finish_matrix()
     }

@@ -7,11 +7,12 @@
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::lu::partial_pivoting::{factor, solve};
 use faer::perm::PermRef;
-use faer::{Conj, Mat, MatMut, Par};
+use faer::{Conj, MatMut, MatRef, Par};
 
 pub struct DenseLu {
-    /// the matrix to factor (filled by the caller), then its L and U factors
-    a: Mat<f64>,
+    /// the matrix to factor (filled by the caller, column-major), then its L and U factors
+    a: Vec<f64>,
+    n: usize,
     perm: Vec<usize>,
     perm_inv: Vec<usize>,
     mem: MemBuffer,
@@ -24,29 +25,29 @@ impl DenseLu {
             factor::lu_in_place_scratch::<usize, f64>(n, n, Par::Seq, Default::default()),
             solve::solve_in_place_scratch::<usize, f64>(n, 1, Par::Seq),
         ]);
-        DenseLu { a: Mat::zeros(n, n), perm: vec![0; n], perm_inv: vec![0; n], mem: MemBuffer::new(req), factored: false }
+        DenseLu { a: vec![0.0; n * n], n, perm: vec![0; n], perm_inv: vec![0; n], mem: MemBuffer::new(req), factored: false }
     }
 
     pub fn dim(&self) -> usize {
-        self.a.nrows()
+        self.n
     }
 
-    /// The matrix to be factored next; writing to it invalidates the last factorization.
-    pub fn matrix_mut(&mut self) -> MatMut<'_, f64> {
+    /// The matrix to be factored next, column-major (entry (i, j) at `i + n j`); writing
+    /// to it invalidates the last factorization.
+    pub fn matrix_mut(&mut self) -> &mut [f64] {
         self.factored = false;
-        self.a.as_mut()
+        &mut self.a
     }
 
     /// Factors the matrix in place; refuses non-finite entries and exact zero pivots.
     pub fn factor(&mut self) -> Result<(), String> {
-        let n = self.dim();
-        for j in 0..n {
-            if self.a.col(j).iter().any(|x| !x.is_finite()) {
-                return Err(format!("the iteration matrix holds non-finite values (column {j})"));
-            }
+        let n = self.n;
+        if let Some(k) = self.a.iter().position(|x| !x.is_finite()) {
+            return Err(format!("the iteration matrix holds non-finite values (column {})", k / n.max(1)));
         }
-        factor::lu_in_place(self.a.as_mut(), &mut self.perm, &mut self.perm_inv, Par::Seq, MemStack::new(&mut self.mem), Default::default());
-        if let Some(i) = (0..n).find(|&i| self.a[(i, i)] == 0.0) {
+        let a = MatMut::from_column_major_slice_mut(&mut self.a, n, n);
+        factor::lu_in_place(a, &mut self.perm, &mut self.perm_inv, Par::Seq, MemStack::new(&mut self.mem), Default::default());
+        if let Some(i) = (0..n).find(|&i| self.a[i + n * i] == 0.0) {
             return Err(format!("the iteration matrix is singular (zero pivot {i} of {n})"));
         }
         self.factored = true;
@@ -64,7 +65,7 @@ impl DenseLu {
         }
         let perm = PermRef::new_checked(&self.perm, &self.perm_inv, n);
         let b = MatMut::from_column_major_slice_mut(rhs, n, 1);
-        let a = self.a.as_ref();
+        let a = MatRef::from_column_major_slice(&self.a, n, n);
         solve::solve_in_place_with_conj(a, a, perm, Conj::No, b, Par::Seq, MemStack::new(&mut self.mem));
         Ok(())
     }
@@ -83,10 +84,10 @@ mod tests {
         let mut b: Vec<f64> = a.iter().map(|row| row.iter().zip(&x).map(|(p, q)| p * q).sum()).collect();
         let mut lu = DenseLu::new(3);
         {
-            let mut m = lu.matrix_mut();
+            let m = lu.matrix_mut();
             for i in 0..3 {
                 for j in 0..3 {
-                    m[(i, j)] = a[i][j];
+                    m[i + 3 * j] = a[i][j];
                 }
             }
         }
@@ -100,9 +101,9 @@ mod tests {
     #[test]
     fn refuses_singular_and_non_finite_matrices() {
         let mut lu = DenseLu::new(2);
-        lu.matrix_mut()[(0, 0)] = 1.0; // second row and column stay zero
+        lu.matrix_mut()[0] = 1.0; // second row and column stay zero
         assert!(lu.factor().unwrap_err().contains("singular"));
-        lu.matrix_mut()[(1, 1)] = f64::NAN;
+        lu.matrix_mut()[3] = f64::NAN;
         assert!(lu.factor().unwrap_err().contains("non-finite"));
         assert!(lu.solve(&mut [1.0, 1.0]).is_err());
     }

@@ -1,0 +1,116 @@
+//! Energy-conserving sampling and weighting (ECSW; Farhat, Avery, Chapman & Cortial 2014,
+//! IJNME 98:625–662; Farhat, Chapman & Avery 2015, IJNME 102:1077–1110): pick a few
+//! elements and positive weights so that, on the training snapshots, the weighted sum of
+//! their reduced forces reproduces the sum over all elements:
+//!
+//! ```text
+//!     c_{k,e} = Vₑᵀ f̂ₑ(x_ref,ₑ + Vₑ q_k)            (r entries per snapshot k),
+//!     b = Σ_e c_{·,e},      min ‖C w − b‖₂, w ≥ 0,  stopped at ‖C w − b‖ ≤ τ ‖b‖,
+//! ```
+//!
+//! with `q_k` the reduced coordinates of snapshot `k` (the training trajectory as the basis
+//! sees it) and `f̂ₑ = fₑ − Lₑ xₑ` the part of the element force that is not linear in the
+//! coordinates: the linear part (bending, damping), the mass and the loads are projected
+//! exactly over every element and need no sampling. Positive weights keep each sampled
+//! term a true element force, so the hyper-reduced model keeps the energy structure
+//! (symmetric tangent, conservative internal forces).
+
+use super::basis::Basis;
+use super::nnls::{nnls, NnlsParams};
+use crate::solver::model::InvariantElementModel;
+use ndarray::{Array1, Array2, ArrayView2};
+
+/// A sampled set of elements: what the basis file stores under `/hyper`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Hyper {
+    /// element indices, increasing
+    pub elements: Vec<usize>,
+    /// their positive weights
+    pub weights: Vec<f64>,
+    /// the relative tolerance τ the set was trained to
+    pub tolerance: f64,
+    /// `‖C w − b‖ / ‖b‖` reached on the training snapshots
+    pub training_residual: f64,
+    /// snapshots used
+    pub n_training: usize,
+}
+
+impl Hyper {
+    /// Every element with weight 1: plain Galerkin.
+    pub fn all(n_elements: usize) -> Hyper {
+        Hyper { elements: (0..n_elements).collect(), weights: vec![1.0; n_elements], tolerance: 0.0, training_residual: 0.0, n_training: 0 }
+    }
+
+    /// Checks the set against a model of `n_elements`; `Err((dataset, problem))`.
+    pub fn validate(&self, n_elements: usize) -> Result<(), (String, String)> {
+        let bad = |f: &str, p: String| Err((format!("hyper/{f}"), p));
+        if self.elements.len() != self.weights.len() {
+            return bad("weights", format!("has {} entries but hyper/elements has {}", self.weights.len(), self.elements.len()));
+        }
+        if self.elements.is_empty() {
+            return bad("elements", "is empty: a hyper-reduced model needs at least one element".into());
+        }
+        if let Some(&e) = self.elements.iter().find(|&&e| e >= n_elements) {
+            return bad("elements", format!("names element {e}, but the model has {n_elements} elements (0..{})", n_elements));
+        }
+        if self.elements.windows(2).any(|w| w[0] >= w[1]) {
+            return bad("elements", "must be strictly increasing (each element once)".into());
+        }
+        if let Some((k, w)) = self.weights.iter().enumerate().find(|(_, w)| !(w.is_finite() && **w > 0.0)) {
+            return bad("weights", format!("entry {k} is {w}; weights must be positive and finite"));
+        }
+        if !(self.tolerance.is_finite() && (0.0..1.0).contains(&self.tolerance)) {
+            return bad("tolerance", format!("is {}; it must lie in [0, 1)", self.tolerance));
+        }
+        Ok(())
+    }
+}
+
+/// The ECSW training matrix `C` (n_snapshots·r × n_elements) of the module documentation.
+pub fn training_matrix<M: InvariantElementModel>(full: &M, basis: &Basis, snapshots: ArrayView2<f64>) -> Array2<f64> {
+    let (r, ns, n_el) = (basis.n_reduced(), snapshots.ncols(), full.n_elements());
+    let ne = if n_el > 0 { full.element_dofs(0).len() } else { 0 };
+    let v = basis.modes.as_standard_layout();
+    let mut c = Array2::zeros((ns * r, n_el));
+    let (mut xe, ve, mut fe, mut l, mut d) = (vec![0.0; ne], vec![0.0; ne], vec![0.0; ne], vec![0.0; ne * ne], vec![0.0; ne * ne]);
+    for k in 0..ns {
+        // the snapshot as the basis represents it
+        let x = basis.reconstruct(basis.reduce(snapshots.column(k)).view());
+        for e in 0..n_el {
+            let dofs = full.element_dofs(e);
+            for (i, &d) in dofs.iter().enumerate() {
+                xe[i] = x[d];
+            }
+            full.element_force(e, &xe, &ve, &mut fe);
+            full.element_linear(e, &mut l, &mut d);
+            for j in 0..ne {
+                for i in 0..ne {
+                    fe[i] -= l[j * ne + i] * xe[j];
+                }
+            }
+            for (i, &dof) in dofs.iter().enumerate() {
+                for a in 0..r {
+                    c[[k * r + a, e]] += v[[dof, a]] * fe[i];
+                }
+            }
+        }
+    }
+    c
+}
+
+/// Trains the sampled set on `snapshots` (n_dof × n_snapshots) with relative tolerance τ.
+pub fn ecsw<M: InvariantElementModel>(full: &M, basis: &Basis, snapshots: ArrayView2<f64>, tolerance: f64) -> Result<Hyper, String> {
+    if snapshots.ncols() == 0 {
+        return Err("no training snapshots".into());
+    }
+    let c = training_matrix(full, basis, snapshots);
+    let b: Array1<f64> = c.sum_axis(ndarray::Axis(1));
+    let sol = nnls(c.view(), b.view(), &NnlsParams { tolerance, max_iterations: full.n_elements().max(1) })?;
+    let elements: Vec<usize> = (0..sol.x.len()).filter(|&e| sol.x[e] > 0.0).collect();
+    let weights = elements.iter().map(|&e| sol.x[e]).collect();
+    if elements.is_empty() {
+        // b = 0: the snapshots never strain the elements; keep one so the model is defined
+        return Ok(Hyper { elements: vec![0], weights: vec![1.0], tolerance, training_residual: 0.0, n_training: snapshots.ncols() });
+    }
+    Ok(Hyper { elements, weights, tolerance, training_residual: sol.relative_residual, n_training: snapshots.ncols() })
+}
