@@ -32,7 +32,9 @@ test: deps
 	cargo test --release
 
 bench: deps
+	cargo build --release
 	cargo bench --bench full_order
+	cargo bench --bench online
 
 # the README's thesis table
 thesis: deps

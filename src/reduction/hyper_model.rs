@@ -35,6 +35,8 @@ pub struct HyperReducedModel<M: InvariantElementModel> {
     /// rows of V and x_ref on the sampled elements' dofs, stacked
     v_el: Array2<f64>,
     x_ref_el: Array1<f64>,
+    /// for 8-dof elements: column a of `Vₑ` (8 entries) for every sampled element and mode
+    vt8: Vec<[f64; 8]>,
     /// `Sⱼ` per sampled element and invariant (ne × ne, column-major)
     s_el: Vec<f64>,
     /// `Gₑⱼ` per sampled element and invariant (r × r, row-major, symmetric)
@@ -104,7 +106,13 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
                 g_el[(k * nj + j) * r * r..(k * nj + j + 1) * r * r].copy_from_slice(g.as_standard_layout().as_slice().expect("standard"));
             }
         }
+        let vt8 = if ne == 8 {
+            (0..m * r).map(|ka| std::array::from_fn(|i| v_el[[(ka / r) * 8 + i, ka % r]])).collect()
+        } else {
+            Vec::new()
+        };
         Ok(HyperReducedModel {
+            vt8,
             ne,
             nj,
             l_r,
@@ -153,6 +161,12 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
             return;
         }
         let (ne, nj, r) = (self.ne, self.nj, self.p.r);
+        if ne == 8 {
+            self.update_8(q);
+            self.at.copy_from_slice(q);
+            self.valid = true;
+            return;
+        }
         expand(&self.v_el, Some(&self.x_ref_el), 0, q, &mut self.x_el);
         for (k, &e) in self.elements.iter().enumerate() {
             let xe = &self.x_el[k * ne..(k + 1) * ne];
@@ -179,6 +193,48 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
         }
         self.at.copy_from_slice(q);
         self.valid = true;
+    }
+
+    /// `update` for 8-dof elements (the planar ANCF beam) with fixed-size kernels over the
+    /// element's columns of `Vₑᵀ` (`vt8`): the same sums, unrolled and vectorized.
+    fn update_8(&mut self, q: &[f64]) {
+        let (nj, r) = (self.nj, self.p.r);
+        for (k, &e) in self.elements.iter().enumerate() {
+            let cols = &self.vt8[k * r..(k + 1) * r];
+            let mut x = [0.0; 8];
+            x.copy_from_slice(&self.x_ref_el.as_slice().expect("contiguous")[k * 8..(k + 1) * 8]);
+            for (c, &qa) in cols.iter().zip(q) {
+                for i in 0..8 {
+                    x[i] += qa * c[i];
+                }
+            }
+            self.x_el[k * 8..(k + 1) * 8].copy_from_slice(&x);
+            for j in 0..nj {
+                let s = &self.s_el[(k * nj + j) * 64..(k * nj + j + 1) * 64];
+                let mut y = [0.0; 8];
+                for c in 0..8 {
+                    for i in 0..8 {
+                        y[i] += s[c * 8 + i] * x[c];
+                    }
+                }
+                self.y_el[(k * nj + j) * 8..(k * nj + j + 1) * 8].copy_from_slice(&y);
+                self.s_val[k * nj + j] = (0..8).map(|i| x[i] * y[i]).sum();
+                let u = &mut self.u_el[(k * nj + j) * r..(k * nj + j + 1) * r];
+                for (ua, c) in u.iter_mut().zip(cols) {
+                    let mut acc = 0.0;
+                    for i in 0..8 {
+                        acc += c[i] * y[i];
+                    }
+                    *ua = acc;
+                }
+            }
+            self.full.invariant_derivatives(
+                e,
+                &self.s_val[k * nj..(k + 1) * nj],
+                &mut self.psi[k * nj..(k + 1) * nj],
+                &mut self.psi2[k * nj * nj..(k + 1) * nj * nj],
+            );
+        }
     }
 }
 
