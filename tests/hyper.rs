@@ -16,7 +16,7 @@ use flexrom::pipeline::train::train;
 use flexrom::pipeline::validate::validate;
 use flexrom::pipeline::Pipeline;
 use flexrom::reduction::ecsw::training_matrix;
-use flexrom::reduction::{ecsw, Hyper, HyperReducedModel, ReducedModel};
+use flexrom::reduction::{ecsw, Hyper, HyperReducedModel, Reduced, ReducedModel};
 use flexrom::simulate::{integrate, prepare, Overrides, Settings};
 use flexrom::solver::model::{DynamicModel, InvariantElementModel, IterationCoefficients};
 use ndarray::{Array1, Array2, ArrayView1};

@@ -16,7 +16,7 @@
 //! `G_e = Φ_eᵀ S_l Φ_e` suggests. Work space is allocated once: the time loop does not
 //! touch the heap, and nothing of size n_dof is visited.
 
-use super::basis::{Basis, Variant};
+use super::basis::Basis;
 use super::ecsw::Hyper;
 use super::projection::{axpy, dot, expand, mat_vec, project_add, Projection};
 use crate::solver::model::{DynamicModel, InvariantElementModel, IterationCoefficients};
@@ -136,22 +136,6 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
             full,
             p,
         })
-    }
-
-    pub fn full(&self) -> &M {
-        &self.full
-    }
-
-    pub fn variant(&self) -> Variant {
-        self.p.variant
-    }
-
-    pub fn elements(&self) -> (&[usize], &[f64]) {
-        (&self.elements, &self.weights)
-    }
-
-    pub fn multipliers(&self, q: &[f64], lambda: &[f64]) -> Option<Array1<f64>> {
-        self.p.multipliers(q, lambda)
     }
 
     /// xₑ, yⱼ = Sⱼ xₑ, s_j, ψⱼ, ψⱼₖ, uⱼ = Vₑᵀ yⱼ of every sampled element at `q` (once per q:
@@ -314,5 +298,14 @@ impl<M: InvariantElementModel> DynamicModel for HyperReducedModel<M> {
 
     fn length_scale(&self) -> f64 {
         self.full.length_scale()
+    }
+}
+
+impl<M: InvariantElementModel> super::Reduced<M> for HyperReducedModel<M> {
+    fn full(&self) -> &M {
+        &self.full
+    }
+    fn multipliers(&self, q: &[f64], lambda: &[f64]) -> Option<Array1<f64>> {
+        self.p.multipliers(q, lambda)
     }
 }

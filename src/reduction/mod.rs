@@ -28,21 +28,3 @@ pub trait Reduced<M>: crate::solver::model::DynamicModel {
     /// Physical multipliers of the full model's constraints, when the variant has them.
     fn multipliers(&self, q: &[f64], lambda: &[f64]) -> Option<ndarray::Array1<f64>>;
 }
-
-impl<M: crate::solver::model::ElementModel> Reduced<M> for ReducedModel<M> {
-    fn full(&self) -> &M {
-        ReducedModel::full(self)
-    }
-    fn multipliers(&self, q: &[f64], lambda: &[f64]) -> Option<ndarray::Array1<f64>> {
-        ReducedModel::multipliers(self, q, lambda)
-    }
-}
-
-impl<M: crate::solver::model::InvariantElementModel> Reduced<M> for HyperReducedModel<M> {
-    fn full(&self) -> &M {
-        HyperReducedModel::full(self)
-    }
-    fn multipliers(&self, q: &[f64], lambda: &[f64]) -> Option<ndarray::Array1<f64>> {
-        HyperReducedModel::multipliers(self, q, lambda)
-    }
-}

@@ -14,7 +14,7 @@
 //!
 //! Joints, mass and nodal loads: see [`super::projection`].
 
-use super::basis::{Basis, Variant};
+use super::basis::Basis;
 use super::projection::{axpy, expand, project_add, Projection};
 use crate::solver::model::{DynamicModel, ElementModel, IterationCoefficients};
 use ndarray::{linalg::general_mat_mul, Array1, Array2, Axis};
@@ -81,24 +81,6 @@ impl<M: ElementModel> ReducedModel<M> {
             elements,
             weights,
         })
-    }
-
-    pub fn full(&self) -> &M {
-        &self.full
-    }
-
-    pub fn variant(&self) -> Variant {
-        self.p.variant
-    }
-
-    /// The visited elements and their weights.
-    pub fn elements(&self) -> (&[usize], &[f64]) {
-        (&self.elements, &self.weights)
-    }
-
-    /// Physical multipliers of the full model's constraints, when this variant has them.
-    pub fn multipliers(&self, q: &[f64], lambda: &[f64]) -> Option<Array1<f64>> {
-        self.p.multipliers(q, lambda)
     }
 
     /// Element coordinates `x_ref,ₑ + Vₑ q` of every visited element, computed once per `q`.
@@ -184,5 +166,14 @@ impl<M: ElementModel> DynamicModel for ReducedModel<M> {
 
     fn length_scale(&self) -> f64 {
         self.full.length_scale()
+    }
+}
+
+impl<M: ElementModel> super::Reduced<M> for ReducedModel<M> {
+    fn full(&self) -> &M {
+        &self.full
+    }
+    fn multipliers(&self, q: &[f64], lambda: &[f64]) -> Option<Array1<f64>> {
+        self.p.multipliers(q, lambda)
     }
 }
