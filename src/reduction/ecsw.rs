@@ -71,18 +71,22 @@ pub fn training_matrix<M: InvariantElementModel>(full: &M, basis: &Basis, snapsh
     let (r, ns, n_el) = (basis.n_reduced(), snapshots.ncols(), full.n_elements());
     let ne = if n_el > 0 { full.element_dofs(0).len() } else { 0 };
     let v = basis.modes.as_standard_layout();
+    // the snapshots as the basis represents them: x_ref + V q_k, all at once
+    let mut q = Array2::zeros((r, ns));
+    for k in 0..ns {
+        q.column_mut(k).assign(&basis.reduce(snapshots.column(k)));
+    }
+    let x = v.dot(&q) + &basis.reference.view().insert_axis(ndarray::Axis(1));
     let mut c = Array2::zeros((ns * r, n_el));
     let (mut xe, ve, mut fe, mut l, mut d) = (vec![0.0; ne], vec![0.0; ne], vec![0.0; ne], vec![0.0; ne * ne], vec![0.0; ne * ne]);
-    for k in 0..ns {
-        // the snapshot as the basis represents it
-        let x = basis.reconstruct(basis.reduce(snapshots.column(k)).view());
-        for e in 0..n_el {
-            let dofs = full.element_dofs(e);
-            for (i, &d) in dofs.iter().enumerate() {
-                xe[i] = x[d];
+    for e in 0..n_el {
+        let dofs = full.element_dofs(e);
+        full.element_linear(e, &mut l, &mut d);
+        for k in 0..ns {
+            for (i, &dof) in dofs.iter().enumerate() {
+                xe[i] = x[[dof, k]];
             }
             full.element_force(e, &xe, &ve, &mut fe);
-            full.element_linear(e, &mut l, &mut d);
             for j in 0..ne {
                 for i in 0..ne {
                     fe[i] -= l[j * ne + i] * xe[j];
