@@ -73,20 +73,27 @@ fn main() {
     let basis = dir.join("fourbar.h5");
     train_and_write(&p, &basis).expect("training");
     let exe = format!("{root}/target/release/flexrom");
-    let mut times = Vec::new();
-    for _ in 0..3 {
-        let start = std::time::Instant::now();
-        let out = Command::new(&exe)
-            .args(["sweep", &format!("{root}/pipelines/fourbar.toml"), "--load-scales", "0.85:1.0:100", "--basis"])
-            .arg(&basis)
-            .arg("-o")
-            .arg(dir.join("sweep.h5"))
-            .output()
-            .expect("flexrom sweep (build it first: cargo build --release)");
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-        times.push(start.elapsed().as_secs_f64());
-    }
     println!();
-    println!("`flexrom sweep pipelines/fourbar.toml --load-scales 0.85:1.0:100`, whole process, median of 3: {:.2} s", median(times));
+    for extra in [None, Some("--continuation")] {
+        let mut times = Vec::new();
+        for _ in 0..3 {
+            let start = std::time::Instant::now();
+            let out = Command::new(&exe)
+                .args(["sweep", &format!("{root}/pipelines/fourbar.toml"), "--load-scales", "0.85:1.0:100", "--basis"])
+                .arg(&basis)
+                .arg("-o")
+                .arg(dir.join("sweep.h5"))
+                .args(extra)
+                .output()
+                .expect("flexrom sweep (build it first: cargo build --release)");
+            assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+            times.push(start.elapsed().as_secs_f64());
+        }
+        println!(
+            "`flexrom sweep pipelines/fourbar.toml --load-scales 0.85:1.0:100{}`, whole process, median of 3: {:.2} s",
+            extra.map_or(String::new(), |e| format!(" {e}")),
+            median(times)
+        );
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }

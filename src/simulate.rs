@@ -85,14 +85,30 @@ pub fn integrate<M: DynamicModel>(
     q0: Vec<f64>,
     dt: f64,
     n_steps: usize,
+    record: impl FnMut(usize, &State),
+) -> Result<Stats> {
+    integrate_guided(model, params, q0, dt, n_steps, |_, _| false, record)
+}
+
+/// [`integrate`] with a guess of each step's increment: `guess(k, out)` fills `out` with
+/// `q_k − q_{k−1}` and returns true, or returns false for the default predictor.
+pub fn integrate_guided<M: DynamicModel>(
+    model: &mut M,
+    params: &IntegratorParams,
+    q0: Vec<f64>,
+    dt: f64,
+    n_steps: usize,
+    mut guess: impl FnMut(usize, &mut [f64]) -> bool,
     mut record: impl FnMut(usize, &State),
 ) -> Result<Stats> {
     let mut integ = GeneralizedAlpha::new(params.clone()).map_err(Error::Usage)?;
     let v0 = vec![0.0; q0.len()];
     let mut state = integ.initialize(model, q0, v0, 0.0)?;
+    let mut increment = vec![0.0; state.q.len()];
     record(0, &state);
     for k in 1..=n_steps {
-        integ.step(model, &mut state, dt)?;
+        let guessed = guess(k, &mut increment);
+        integ.step_guided(model, &mut state, dt, guessed.then_some(increment.as_slice()))?;
         // keep t on the nominal grid despite round-off in sub-steps
         state.t = k as f64 * dt;
         record(k, &state);

@@ -129,7 +129,7 @@ pub fn read_basis(path: &Path) -> Result<StoredBasis> {
     if !path.is_file() {
         return Err(Error::input(path, "(file)", "does not exist; run `flexrom train` first"));
     }
-    let f = hdf5::File::open(path).map_err(|_| Error::input(path, "(file)", "is not a readable HDF5 file (truncated or of another format?)"))?;
+    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", format!("is not a readable HDF5 file (truncated or of another format?): {e}")))?;
     let field = |name: &str, problem: String| Error::input(path, name, problem);
     let version = f
         .attr("schema_version")

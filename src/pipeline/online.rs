@@ -7,7 +7,8 @@ use crate::model::Model;
 use crate::physics::element::Vec8;
 use crate::physics::system::FlexibleSystem;
 use crate::reduction::{Basis, HyperReducedModel, Reduced, ReducedModel};
-use crate::simulate::{integrate, prepare, Overrides, Settings, SimulationResult};
+use crate::simulate::{integrate_guided, prepare, Overrides, Settings, SimulationResult};
+use crate::solver::generalized_alpha::JacobianReuse;
 use crate::solver::model::DynamicModel;
 use ndarray::{Array1, Array2, ArrayView1};
 use std::path::Path;
@@ -61,33 +62,78 @@ pub enum Output {
 /// Runs the reduced model of `basis` at `load_scale` with the model's time settings; the
 /// hyper-reduced model when the basis carries a sampled element set.
 pub fn run_reduced(model: &Model, basis: &Basis, load_scale: f64) -> Result<ReducedRun> {
-    run_reduced_with(model, basis, load_scale, Output::Full)
+    run_reduced_with(model, basis, load_scale, Output::Full, &[])
 }
 
-pub fn run_reduced_with(model: &Model, basis: &Basis, load_scale: f64, output: Output) -> Result<ReducedRun> {
-    let s = Settings::resolve(model, &Overrides { load_scale: Some(load_scale), ..Default::default() })?;
+/// [`run_reduced`] with a choice of output and, in `previous`, up to two earlier runs of
+/// the same basis at nearby load scales (nearest last): a continuation in the load scale.
+/// Each step's Newton solve then starts from their increment of that step, extrapolated
+/// linearly in the load scale,
+///
+/// ```text
+///     Δq_k(λ) ≈ Δq_k(λ₁) + (λ − λ₁)/(λ₁ − λ₂) · (Δq_k(λ₁) − Δq_k(λ₂)),
+/// ```
+///
+/// and keeps its factorized matrix while Newton contracts fast
+/// ([`JacobianReuse::WithinStep`]). Only the starting point changes: every step stops on
+/// the same tolerance as a run on its own.
+pub fn run_reduced_with(model: &Model, basis: &Basis, load_scale: f64, output: Output, previous: &[&ReducedRun]) -> Result<ReducedRun> {
+    let mut s = Settings::resolve(model, &Overrides { load_scale: Some(load_scale), ..Default::default() })?;
+    let previous = &previous[previous.len().saturating_sub(2)..];
+    if !previous.is_empty() {
+        s.params.reuse = JacobianReuse::WithinStep;
+    }
     let (sys, x0) = prepare(model, &s)?;
     let cannot = |e: String| Error::Usage(format!("cannot build the reduced model: {e}"));
     match &basis.hyper {
         Some(h) => {
             let mut rom = HyperReducedModel::new(sys, basis, h).map_err(cannot)?;
-            run(&mut rom, model, basis, s, &x0, output)
+            run(&mut rom, model, basis, s, &x0, output, previous)
         }
         None => {
             let mut rom = ReducedModel::new(sys, basis).map_err(cannot)?;
-            run(&mut rom, model, basis, s, &x0, output)
+            run(&mut rom, model, basis, s, &x0, output, previous)
         }
     }
 }
 
-fn run<R: Reduced<FlexibleSystem>>(rom: &mut R, model: &Model, basis: &Basis, s: Settings, x0: &[f64], output: Output) -> Result<ReducedRun> {
+fn run<R: Reduced<FlexibleSystem>>(
+    rom: &mut R,
+    model: &Model,
+    basis: &Basis,
+    s: Settings,
+    x0: &[f64],
+    output: Output,
+    previous: &[&ReducedRun],
+) -> Result<ReducedRun> {
     let q0 = basis.reduce(ArrayView1::from(x0)).to_vec();
     let (r, nt) = (rom.n_dof(), s.n_steps + 1);
     let mut zq = Array2::zeros((r, nt));
     let mut lam = Array2::<f64>::zeros((rom.n_constraints(), nt));
     let mut t = Array1::zeros(nt);
+    // (λᵢ, trajectory) of the earlier runs that fit this one, nearest last
+    let known: Vec<(f64, &Array2<f64>)> =
+        previous.iter().filter(|p| p.reduced_q.dim() == (r, nt)).map(|p| (p.result.settings.load_scale, &p.reduced_q)).collect();
+    let x = s.load_scale;
+    let guess = |k: usize, out: &mut [f64]| match known.as_slice() {
+        [] => false,
+        [.., (l2, z2), (l1, z1)] if l1 != l2 => {
+            let f = (x - l1) / (l1 - l2);
+            for (i, o) in out.iter_mut().enumerate() {
+                let (d1, d2) = (z1[[i, k]] - z1[[i, k - 1]], z2[[i, k]] - z2[[i, k - 1]]);
+                *o = d1 + f * (d1 - d2);
+            }
+            true
+        }
+        [.., (_, z1)] => {
+            for (i, o) in out.iter_mut().enumerate() {
+                *o = z1[[i, k]] - z1[[i, k - 1]];
+            }
+            true
+        }
+    };
     let start = std::time::Instant::now();
-    let stats = integrate(rom, &s.params, q0, s.dt, s.n_steps, |k, st| {
+    let stats = integrate_guided(rom, &s.params, q0, s.dt, s.n_steps, guess, |k, st| {
         t[k] = st.t;
         zq.column_mut(k).assign(&ArrayView1::from(&st.q));
         lam.column_mut(k).assign(&ArrayView1::from(&st.lambda));

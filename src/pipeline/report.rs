@@ -5,7 +5,7 @@
 use super::config::Pipeline;
 use super::online::load_basis;
 use super::plot::{line_chart, Series};
-use super::sweep::{sweep, table, write_sweep};
+use super::sweep::{sweep, table, write_sweep, SweepOptions};
 use super::train::train_and_write;
 use super::validate::{validate, Validation};
 use crate::error::{Error, Result};
@@ -44,7 +44,7 @@ fn build(p: &Pipeline, out: &Path, progress: bool) -> Result<()> {
 
     let scales = p.online_scales();
     eprintln!("[2/3] sweep: {} reduced and full runs", scales.len());
-    let sw = sweep(&p.model, basis, &scales, true, progress)?;
+    let sw = sweep(&p.model, basis, &scales, SweepOptions { validate: true, continuation: false, progress })?;
     write_sweep(&out.join("sweep.h5"), &sw, basis, &p.basis_path)?;
 
     let vscales = p.validate_scales();

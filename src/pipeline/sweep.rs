@@ -10,10 +10,11 @@
 //! /reduced_q          (N, r, n_t)    reduced coordinates
 //! /rom_seconds        (N)            reduced time loop of each run
 //! /newton_iterations  (N)
+//! /factorizations     (N)            iteration matrices factorized
 //! with --validate:    /rel_error, /max_probe_error, /max_constraint_violation,
 //!                     /full_seconds, /speedup  (N each)
 //! attributes on /: basis, variant, n_modes, wall_seconds (whole sweep), threads,
-//!   program_version
+//!   continuation (1 when the runs were continued from their neighbours), program_version
 //! ```
 
 use super::online::{run_reduced_with, Output, ReducedRun};
@@ -37,31 +38,56 @@ pub struct Sweep {
     pub points: Vec<SweepPoint>,
     pub wall_seconds: f64,
     pub threads: usize,
+    pub continuation: bool,
 }
 
-/// Runs the reduced model at every scale (in parallel); with `validate`, also the full one.
-pub fn sweep(model: &Model, basis: &Basis, scales: &[f64], validate: bool, progress: bool) -> Result<Sweep> {
-    let bar = ProgressBar::with_draw_target(Some(scales.len() as u64), if progress { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() });
+/// How a sweep runs (default: independent runs, no validation, no progress bar).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SweepOptions {
+    /// also run the full model at every load scale and compare
+    pub validate: bool,
+    /// continuation in the load scale: each thread takes a contiguous part of the list and
+    /// starts every Newton solve from the previous points' increments
+    /// ([`run_reduced_with`]); off (the default): every load scale on its own, exactly as
+    /// `online` runs it
+    pub continuation: bool,
+    /// a progress bar on stderr
+    pub progress: bool,
+}
+
+/// Runs the reduced model at every scale, in parallel; with `validate`, also the full one.
+pub fn sweep(model: &Model, basis: &Basis, scales: &[f64], o: SweepOptions) -> Result<Sweep> {
+    let bar = ProgressBar::with_draw_target(Some(scales.len() as u64), if o.progress { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() });
     bar.set_style(ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} load scales, {elapsed} elapsed, ETA {eta}").expect("valid template").progress_chars("=> "));
-    bar.set_prefix(if validate { "sweep + validate" } else { "sweep" });
+    bar.set_prefix(if o.validate { "sweep + validate" } else { "sweep" });
     let start = std::time::Instant::now();
-    let points: Result<Vec<SweepPoint>> = scales
-        .par_iter()
-        .map(|&x| {
-            // without validation nothing of full size is reconstructed
-            let rom = run_reduced_with(model, basis, x, if validate { Output::Full } else { Output::ReducedAndProbes })?;
-            let validation = if validate {
-                let full = simulate(model, &Overrides { load_scale: Some(x), ..Default::default() })?;
-                Some(compare(model, &full, &rom, None, basis.n_reduced(), basis.variant.name()))
-            } else {
-                None
-            };
-            bar.inc(1);
-            Ok(SweepPoint { rom, validation })
+    let threads = rayon::current_num_threads().max(1);
+    // continuation: one contiguous part per thread; otherwise one point per task
+    let part = if o.continuation { scales.len().div_ceil(threads).max(1) } else { 1 };
+    let parts: Result<Vec<Vec<SweepPoint>>> = scales
+        .par_chunks(part)
+        .map(|xs| {
+            let mut done: Vec<SweepPoint> = Vec::with_capacity(xs.len());
+            for &x in xs {
+                let previous: Vec<&ReducedRun> = done.iter().rev().take(2).rev().map(|p| &p.rom).collect();
+                // without validation nothing of full size is reconstructed
+                let output = if o.validate { Output::Full } else { Output::ReducedAndProbes };
+                let rom = run_reduced_with(model, basis, x, output, &previous)?;
+                let validation = if o.validate {
+                    let full = simulate(model, &Overrides { load_scale: Some(x), ..Default::default() })?;
+                    Some(compare(model, &full, &rom, None, basis.n_reduced(), basis.variant.name()))
+                } else {
+                    None
+                };
+                bar.inc(1);
+                done.push(SweepPoint { rom, validation });
+            }
+            Ok(done)
         })
         .collect();
     bar.finish_and_clear();
-    Ok(Sweep { points: points?, wall_seconds: start.elapsed().as_secs_f64(), threads: rayon::current_num_threads() })
+    let points = parts?.into_iter().flatten().collect();
+    Ok(Sweep { points, wall_seconds: start.elapsed().as_secs_f64(), threads, continuation: o.continuation })
 }
 
 pub fn write_sweep(path: &Path, s: &Sweep, basis: &Basis, basis_path: &Path) -> Result<()> {
@@ -88,6 +114,10 @@ pub fn write_sweep(path: &Path, s: &Sweep, basis: &Basis, basis_path: &Path) -> 
             .with_data(&Array1::from_iter(s.points.iter().map(|p| p.rom.result.stats.newton_iterations as u64)))
             .create("newton_iterations")
             .map_err(e)?;
+        f.new_dataset_builder()
+            .with_data(&Array1::from_iter(s.points.iter().map(|p| p.rom.result.stats.factorizations as u64)))
+            .create("factorizations")
+            .map_err(e)?;
         if s.points.iter().all(|p| p.validation.is_some()) {
             let v = |g: &dyn Fn(&Validation) -> f64| col(&|p: &SweepPoint| g(p.validation.as_ref().expect("checked")));
             f.new_dataset_builder().with_data(&v(&|x| x.rel_error)).create("rel_error").map_err(e)?;
@@ -101,6 +131,7 @@ pub fn write_sweep(path: &Path, s: &Sweep, basis: &Basis, basis_path: &Path) -> 
         attr_u64(f, "n_modes", basis.n_reduced() as u64).map_err(e)?;
         attr_f64(f, "wall_seconds", s.wall_seconds).map_err(e)?;
         attr_u64(f, "threads", s.threads as u64).map_err(e)?;
+        attr_u64(f, "continuation", s.continuation as u64).map_err(e)?;
         attr_str(f, "program_version", env!("CARGO_PKG_VERSION")).map_err(e)
     })
 }

@@ -34,14 +34,27 @@ pub struct IntegratorParams {
     pub max_iterations: usize,
     /// how many times a failing step may be halved
     pub max_cuts: u32,
-    /// keep the factorized iteration matrix across iterations and steps while Newton
-    /// contracts fast (modified Newton); refactor when it does not
-    pub reuse_factorization: bool,
+    /// when the factorized iteration matrix may be kept instead of refreshed
+    pub reuse: JacobianReuse,
+}
+
+/// How long a factorized iteration matrix is kept (modified Newton). Only the convergence
+/// path changes: every step still stops on the same tolerance.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum JacobianReuse {
+    /// a fresh matrix at every iteration (full Newton)
+    Never,
+    /// within a step, once an iteration contracted fast (θ = ‖Δq_k‖/‖Δq_{k−1}‖ < 0.1), keep
+    /// the matrix until the contraction slows (θ > 0.3); the first iteration of every step
+    /// refactors. Pays off when the predictor is good (continuation sweeps).
+    WithinStep,
+    /// also across steps while Newton contracts fast; refresh when it does not
+    AcrossSteps,
 }
 
 impl Default for IntegratorParams {
     fn default() -> Self {
-        IntegratorParams { rho_inf: 0.9, tolerance: 1e-10, max_iterations: 25, max_cuts: 8, reuse_factorization: false }
+        IntegratorParams { rho_inf: 0.9, tolerance: 1e-10, max_iterations: 25, max_cuts: 8, reuse: JacobianReuse::Never }
     }
 }
 
@@ -154,22 +167,31 @@ impl GeneralizedAlpha {
 
     /// Advances `state` by `h`, halving the step on Newton failure.
     pub fn step<M: DynamicModel>(&mut self, model: &mut M, state: &mut State, h: f64) -> Result<()> {
-        self.advance(model, state, h, 0)?;
+        self.step_guided(model, state, h, None)
+    }
+
+    /// [`Self::step`] with a guess of the step's increment `q_{n+1} − q_n` (e.g. the same
+    /// step of a run at a nearby load scale) as Newton's starting point instead of the
+    /// zero-acceleration predictor. The guess only moves the start: the step still stops on
+    /// the same tolerance. Halved sub-steps, if any, use the default predictor.
+    pub fn step_guided<M: DynamicModel>(&mut self, model: &mut M, state: &mut State, h: f64, guess: Option<&[f64]>) -> Result<()> {
+        self.advance(model, state, h, 0, guess)?;
         self.stats.steps += 1;
         Ok(())
     }
 
-    fn advance<M: DynamicModel>(&mut self, model: &mut M, state: &mut State, h: f64, depth: u32) -> Result<()> {
+    fn advance<M: DynamicModel>(&mut self, model: &mut M, state: &mut State, h: f64, depth: u32, guess: Option<&[f64]>) -> Result<()> {
         match &mut self.backup {
             Some(b) => b.clone_from(state),
             None => self.backup = Some(state.clone()),
         }
-        let mut result = self.try_step(model, state, h, self.params.reuse_factorization);
-        if result.is_err() && self.params.reuse_factorization {
+        let reuse = self.params.reuse;
+        let mut result = self.try_step(model, state, h, reuse, guess);
+        if result.is_err() && reuse != JacobianReuse::Never {
             // a stale matrix may be what failed: retry once with full Newton before halving
             state.clone_from(self.backup.as_ref().expect("backup taken"));
             self.factored = None;
-            result = self.try_step(model, state, h, false);
+            result = self.try_step(model, state, h, JacobianReuse::Never, guess);
         }
         match result {
             Ok(()) => Ok(()),
@@ -187,26 +209,36 @@ impl GeneralizedAlpha {
                     });
                 }
                 self.stats.step_cuts += 1;
-                self.advance(model, state, 0.5 * h, depth + 1)?;
-                self.advance(model, state, 0.5 * h, depth + 1)
+                self.advance(model, state, 0.5 * h, depth + 1, None)?;
+                self.advance(model, state, 0.5 * h, depth + 1, None)
             }
         }
     }
 
-    fn try_step<M: DynamicModel>(&mut self, model: &mut M, st: &mut State, h: f64, reuse_allowed: bool) -> std::result::Result<(), Failure> {
+    fn try_step<M: DynamicModel>(&mut self, model: &mut M, st: &mut State, h: f64, policy: JacobianReuse, guess: Option<&[f64]>) -> std::result::Result<(), Failure> {
         let (am, af, g, b) = (self.alpha_m, self.alpha_f, self.gamma, self.beta);
         let n = model.n_dof();
         let beta_p = (1.0 - am) / (b * h * h * (1.0 - af));
         let gamma_p = g / (b * h);
         let coef = IterationCoefficients { mass: 1.0, damping: gamma_p / beta_p, stiffness: 1.0 / beta_p };
         let t = st.t + h;
-        // predictor: q̈_{n+1} = 0 and a_{n+1} from the α relation
+        // predictor: q̈_{n+1} = 0 and a_{n+1} from the α relation; with a guessed increment,
+        // the q̈_{n+1} that puts q_{n+1} there (a_{n+1} = a₀ + c q̈_{n+1}, c = (1−α_f)/(1−α_m))
+        let c = (1.0 - af) / (1.0 - am);
+        assert!(guess.is_none_or(|d| d.len() == n), "a guessed increment needs {n} entries");
         for i in 0..n {
-            let a_new = (af * st.qdd[i] - am * st.a[i]) / (1.0 - am);
-            st.q[i] += h * st.v[i] + h * h * ((0.5 - b) * st.a[i] + b * a_new);
-            st.v[i] += h * ((1.0 - g) * st.a[i] + g * a_new);
-            st.a[i] = a_new;
-            st.qdd[i] = 0.0;
+            // a₀: the part of a_{n+1} that does not depend on q̈_{n+1}; st.a holds it while
+            // Newton runs and gets c q̈_{n+1} added at convergence
+            let a0 = (af * st.qdd[i] - am * st.a[i]) / (1.0 - am);
+            let dq0 = h * st.v[i] + h * h * ((0.5 - b) * st.a[i] + b * a0);
+            let qdd = guess.map_or(0.0, |d| (d[i] - dq0) / (h * h * b * c));
+            st.q[i] += dq0 + h * h * b * c * qdd;
+            st.v[i] += h * ((1.0 - g) * st.a[i] + g * (a0 + c * qdd));
+            st.a[i] = a0;
+            st.qdd[i] = qdd;
+        }
+        if policy != JacobianReuse::AcrossSteps {
+            self.factored = None;
         }
         let tol = self.params.tolerance * model.length_scale();
         let mut last_increment = f64::INFINITY;
@@ -224,7 +256,7 @@ impl GeneralizedAlpha {
             if !residual.is_finite() {
                 return Err(Failure { iterations: it, increment: last_increment, residual });
             }
-            let reuse = reuse_allowed && self.factored.is_some_and(|(fh, _)| fh == h);
+            let reuse = policy != JacobianReuse::Never && self.factored.is_some_and(|(fh, _)| fh == h);
             let s = if reuse {
                 self.factored.expect("checked").1
             } else {
@@ -267,8 +299,24 @@ impl GeneralizedAlpha {
                 return Ok(());
             }
             // modified Newton: refresh the matrix when the contraction is slow (a fresh
-            // tangent gives quadratic convergence) or when the step needs many iterations
-            if !reuse_allowed || (it > 1 && inc > 0.1 * last_increment) || it >= 4 {
+            // tangent gives quadratic convergence)
+            let refresh = match policy {
+                JacobianReuse::Never => true,
+                // a fresh matrix until one contracted fast; a kept one while it still does
+                JacobianReuse::WithinStep => {
+                    if reuse {
+                        theta > 0.3
+                    } else if it == 1 {
+                        // keep the first matrix only when the guess was good: its
+                        // correction small next to the step it guessed
+                        guess.is_none_or(|d| inc > 0.05 * d.iter().fold(0.0_f64, |m, x| m.max(x.abs())))
+                    } else {
+                        theta >= 0.1
+                    }
+                }
+                JacobianReuse::AcrossSteps => (it > 1 && theta > 0.1) || it >= 4,
+            };
+            if refresh {
                 self.factored = None;
             }
             last_increment = inc;
