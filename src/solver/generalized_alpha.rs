@@ -46,7 +46,8 @@ pub enum JacobianReuse {
     Never,
     /// within a step, once an iteration contracted fast (θ = ‖Δq_k‖/‖Δq_{k−1}‖ < 0.1), keep
     /// the matrix until the contraction slows (θ > 0.3); the first iteration of every step
-    /// refactors. Pays off when the predictor is good (continuation sweeps).
+    /// refactors, and its matrix is kept at once when a guessed increment needed a
+    /// correction below 5 % of itself. Pays off with good guesses (continuation sweeps).
     WithinStep,
     /// also across steps while Newton contracts fast; refresh when it does not
     AcrossSteps,
