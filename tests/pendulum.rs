@@ -97,10 +97,10 @@ fn every_step_satisfies_the_equations_of_motion() {
     assert!(worst < 1e-2 * g_node, "largest residual {worst:.3e} N against nodal weight {g_node:.3} N");
 }
 
-/// Modified Newton (factorization kept across iterations and steps while it contracts fast)
-/// solves the same step equations as full Newton, so the trajectories may differ only at the
-/// level of the Newton tolerance (1e-10 × 1.2 m per step; bound 1e-7 m over 220 steps), and
-/// it must factor less often per iteration.
+/// Modified Newton (factorization kept within a step, or across steps too, while Newton
+/// contracts fast) solves the same step equations as full Newton, so the trajectories may
+/// differ only at the level of the Newton tolerance (1e-10 × 1.2 m per step; bound 1e-7 m
+/// over 220 steps), and it must factor less often per iteration.
 #[test]
 fn factorization_reuse_reaches_the_same_solution() {
     use flexrom::solver::generalized_alpha::{IntegratorParams, JacobianReuse};

@@ -69,7 +69,7 @@ pub fn sweep(model: &Model, basis: &Basis, scales: &[f64], o: SweepOptions) -> R
         .map(|xs| {
             let mut done: Vec<SweepPoint> = Vec::with_capacity(xs.len());
             for &x in xs {
-                let previous: Vec<&ReducedRun> = done.iter().rev().take(2).rev().map(|p| &p.rom).collect();
+                let previous: Vec<&ReducedRun> = done[done.len().saturating_sub(2)..].iter().map(|p| &p.rom).collect();
                 // without validation nothing of full size is reconstructed
                 let output = if o.validate { Output::Full } else { Output::ReducedAndProbes };
                 let rom = run_reduced_with(model, basis, x, output, &previous)?;
