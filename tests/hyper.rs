@@ -4,7 +4,7 @@
 //! - with every element sampled at weight 1 the hyper-reduced model is plain Galerkin: its
 //!   force equals the Galerkin force to round-off (1e-12 relative: the same sums in another
 //!   order; the scale is the sum of the element terms, which cancel), its Newton step to
-//!   1e-10, and its trajectory follows the Galerkin one to 1e-8 relative (43 steps, each
+//!   1e-6 (Gₑ is kept in single precision, unit round-off 6e-8), and its trajectory follows the Galerkin one to 1e-8 relative (43 steps, each
 //!   Newton solve stopping within 1e-10 · L on its own);
 //! - the ECSW set meets its training tolerance ‖C w − b‖ ≤ τ ‖b‖ (the definition of the
 //!   stopping rule, Farhat et al. 2015), recomputed here from the training matrix;
@@ -94,7 +94,10 @@ fn every_element_at_weight_one_equals_plain_galerkin() {
     let (mut x1, mut x2) = (rhs.clone(), rhs.clone());
     galerkin.solve(&mut x1).unwrap();
     hyper.solve(&mut x2).unwrap();
-    assert!(rel(&x2, &x1) < 1e-10, "Newton steps differ by {:e}", rel(&x2, &x1));
+    // Gₑ is stored in single precision (it only steers Newton): the matrices differ by
+    // ~6e-8 (f32's unit round-off) relative to the Gₑ terms, so the steps by about that
+    // times the condition of the step; a modelling difference would show at O(1)
+    assert!(rel(&x2, &x1) < 1e-6, "Newton steps differ by {:e}", rel(&x2, &x1));
 
     // whole trajectories through the shared integrator: each step's Newton solve stops
     // within 1e-10 · L of its solution, independently in the two models, so over 43 steps
