@@ -16,7 +16,11 @@ pub fn write_atomically(path: &Path, fill: impl FnOnce(&hdf5::File) -> Result<()
         return Err(Error::input(path, "output path", format!("directory `{}` does not exist", dir.display())));
     }
     let name = path.file_name().ok_or_else(|| Error::input(path, "output path", "is not a file name"))?;
-    let tmp = dir.join(format!(".{}.tmp-{}", name.to_string_lossy(), std::process::id()));
+    // unique per process and call: two writes of one path in one process (threads, or a
+    // test that trains twice) never share a temporary file
+    static CALLS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let tmp = dir.join(format!(".{}.tmp-{}-{call}", name.to_string_lossy(), std::process::id()));
     let result = (|| {
         let file = hdf5::File::create(&tmp).map_err(|e| Error::hdf5(path, format!("cannot create: {e}")))?;
         fill(&file)?;

@@ -95,9 +95,12 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
             let lm = Array2::from_shape_fn((ne, ne), |(i, j)| le[j * ne + i]);
             let cm = Array2::from_shape_fn((ne, ne), |(i, j)| ce[j * ne + i]);
             ndarray::linalg::general_mat_mul(1.0, &lm, &ve, 0.0, &mut lv);
-            ndarray::linalg::general_mat_mul(1.0, &cm, &ve, 0.0, &mut cv);
             ndarray::linalg::general_mat_mul(1.0, &ve.t(), &lv, 1.0, &mut l_r);
-            ndarray::linalg::general_mat_mul(1.0, &ve.t(), &cv, 1.0, &mut c_r);
+            // undamped models (both benchmarks) skip half the work of every run's set-up
+            if ce.iter().any(|&x| x != 0.0) {
+                ndarray::linalg::general_mat_mul(1.0, &cm, &ve, 0.0, &mut cv);
+                ndarray::linalg::general_mat_mul(1.0, &ve.t(), &cv, 1.0, &mut c_r);
+            }
             l0 += &ve.t().dot(&lm.dot(&xe));
         }
         let c_r = if c_r.iter().any(|&x| x != 0.0) { Some(c_r) } else { None };
