@@ -228,14 +228,13 @@ impl Projection {
                     axpy(self.jl[b * nl + a_], self.v_load.row(b).as_slice().expect("standard layout"), row);
                 }
             }
+            // column by column (contiguous in the column-major matrix)
             for a_ in 0..nl {
-                let jv = &self.jv[a_ * r..(a_ + 1) * r];
-                for i in 0..r {
-                    let vi = coef.stiffness * self.v_load[[a_, i]];
-                    if vi != 0.0 {
-                        for (j, x) in jv.iter().enumerate() {
-                            a[i + n * j] += vi * x;
-                        }
+                let (jv, vl) = (&self.jv[a_ * r..(a_ + 1) * r], self.v_load.row(a_));
+                let vl = vl.as_slice().expect("standard layout");
+                for (j, &x) in jv.iter().enumerate() {
+                    if x != 0.0 {
+                        axpy(coef.stiffness * x, vl, &mut a[n * j..n * j + r]);
                     }
                 }
             }

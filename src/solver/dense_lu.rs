@@ -42,7 +42,18 @@ impl DenseLu {
     /// Factors the matrix in place; refuses non-finite entries and exact zero pivots.
     pub fn factor(&mut self) -> Result<(), String> {
         let n = self.n;
-        if let Some(k) = self.a.iter().position(|x| !x.is_finite()) {
+        // x·0 is NaN exactly for infinite or NaN x; eight independent sums vectorize (a
+        // position() scan with early exit does not), and the column is found only on failure
+        let mut acc = [0.0_f64; 8];
+        let chunks = self.a.chunks_exact(8);
+        let tail = chunks.remainder().iter().fold(0.0, |s, x| s + x * 0.0);
+        for c in chunks {
+            for (s, x) in acc.iter_mut().zip(c) {
+                *s += x * 0.0;
+            }
+        }
+        if (acc.iter().sum::<f64>() + tail).is_nan() {
+            let k = self.a.iter().position(|x| !x.is_finite()).unwrap_or(0);
             return Err(format!("the iteration matrix holds non-finite values (column {})", k / n.max(1)));
         }
         let a = MatMut::from_column_major_slice_mut(&mut self.a, n, n);
