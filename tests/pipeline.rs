@@ -9,7 +9,8 @@
 //! - the HDF5 basis file round trip is exact;
 //! - a small pendulum pipeline end to end: rel_error ≤ 1e-3 with 10 % of the coordinates
 //!   as modes (the target), the constraint-preserving four-bar keeps every joint to
-//!   round-off (its joint coordinates are unreduced);
+//!   round-off (its joint coordinates are unreduced) and its multipliers follow the full
+//!   ones (5e-2 relative, measured 2.4e-2);
 //! - bad input: a basis of another model, a missing, truncated or foreign file, too many or
 //!   zero modes, a non-finite load scale, an empty training set — a clear message and a
 //!   non-zero exit, and a failed train keeps the previous good basis.
@@ -191,11 +192,18 @@ modes = { ratio = 0.1 }
     let b = &s.trained.basis;
     assert_eq!(b.kept.len(), 12, "x, y of the 6 joined nodes (2 ground pins, 2 pins of two nodes each; SPEC §4)");
     assert_eq!(b.n_pod_modes, 45, "10 % of 452, rounded");
-    let (v, _, rom) = validate(&p.model, b, 0.935, false).unwrap();
+    let (v, full, rom) = validate(&p.model, b, 0.935, false).unwrap();
     // the reference implementation: 10 % with reference snapshots ≈ 2.6e-4 to t = 0.9 s
     assert!(v.rel_error < 1e-3, "rel_error {}", v.rel_error);
     assert!(v.max_constraint_violation < 1e-12, "joint coordinates are unreduced: {}", v.max_constraint_violation);
-    assert!(rom.result.multipliers.iter().all(|m| m.is_finite()), "exact multipliers");
+    // the multipliers are the reduced model's own (solved in the joints' null space), not a
+    // projection, and follow the full ones: measured 2.4e-2 relative (joint forces carry the
+    // stiff axial terms, so they are less accurate than the motion), the same to 1e-10 with
+    // the KKT solve; a wrong multiplier solve (e.g. the constraint scale s, the largest
+    // diagonal entry of the iteration matrix, missed) would be off by orders of magnitude
+    let lf = &full.multipliers;
+    let dl = (&rom.result.multipliers - lf).mapv(|x| x * x).sum().sqrt() / lf.mapv(|x| x * x).sum().sqrt();
+    assert!(dl < 5e-2, "multipliers differ by {dl:e} relative");
 }
 
 fn fails_with(args: &[&str], needles: &[&str]) {

@@ -343,7 +343,7 @@ impl<M: InvariantElementModel> DynamicModel for HyperReducedModel<M> {
     }
 
     fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {
-        self.p.lu.solve(rhs)
+        self.p.solve(rhs)
     }
 
     fn length_scale(&self) -> f64 {

@@ -10,6 +10,7 @@
 pub mod basis;
 pub mod ecsw;
 pub mod hyper_model;
+pub(crate) mod joint_elimination;
 pub mod nnls;
 pub mod pod;
 pub(crate) mod projection;

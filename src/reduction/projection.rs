@@ -9,13 +9,15 @@
 //! ```
 //!
 //! Joints: *constraint-preserving* keeps `B V q = b − B x_ref` with exact multipliers
-//! (`B V = [0, B_c]`); *galerkin* keeps the independent combinations of the projected
+//! (`B V = [0, B_c]`), and solves each Newton system in the null space of its joint rows
+//! ([`super::joint_elimination`]: an LU of r − nc instead of r + nc); *galerkin* keeps the independent combinations of the projected
 //! joint equations (none when the basis cannot move the joint's coordinates, as for a
 //! ground pin whose rows are zero in every snapshot); *whole-system* has no separate multipliers:
 //! `λ = w V_λ q` and the projected saddle point adds `Vᵀ Bᵀ λ + w V_λᵀ (B x − b)`, i.e.
 //! `(P + Pᵀ) q + c₀` with `P = w V_λᵀ B V`, `c₀ = w V_λᵀ (B x_ref − b)`.
 
 use super::basis::{Basis, Variant};
+use super::joint_elimination::JointElimination;
 use crate::solver::dense_lu::DenseLu;
 use crate::solver::model::{ElementModel, IterationCoefficients};
 use ndarray::{s, Array1, Array2, ArrayView1, Axis};
@@ -48,7 +50,10 @@ pub(crate) struct Projection {
     /// the constant part of the iteration matrix, for `base_coef`
     base: Vec<f64>,
     base_coef: Option<IterationCoefficients>,
-    pub lu: DenseLu,
+    /// constraint-preserving: the Newton system solved in the null space of the joint rows
+    /// (`S` is assembled in it, the LU holds `Pᵀ S P`); otherwise the LU holds the KKT matrix
+    elim: Option<JointElimination>,
+    lu: DenseLu,
 }
 
 impl Projection {
@@ -113,6 +118,11 @@ impl Projection {
         };
         let (b_r, c_r) = if nc > 0 { (bv, c_ref) } else { (Array2::zeros((0, r)), Array1::zeros(0)) };
         let nl = load_dofs.len();
+        let elim = if basis.variant == Variant::ConstraintPreserving { JointElimination::new(&b_r) } else { None };
+        let (ld, dim) = match &elim {
+            Some(e) => (r, e.dim()),
+            None => (r + nc, r + nc),
+        };
         Ok(Projection {
             variant: basis.variant,
             r,
@@ -131,9 +141,10 @@ impl Projection {
             jl: vec![0.0; nl * nl],
             jv: vec![0.0; nl * r],
             linear: (None, None),
-            base: vec![0.0; (r + nc) * (r + nc)],
+            base: vec![0.0; ld * ld],
             base_coef: None,
-            lu: DenseLu::new(r + nc),
+            elim,
+            lu: DenseLu::new(dim),
         })
     }
 
@@ -186,11 +197,29 @@ impl Projection {
         self.base_coef = None;
     }
 
+    /// The buffer the iteration matrix is assembled in (column-major) and its leading
+    /// dimension: `S` (r × r) when the joints are eliminated, else the KKT matrix.
+    fn matrix(&mut self) -> (&mut [f64], usize) {
+        match &mut self.elim {
+            Some(e) => (&mut e.s, self.r),
+            None => (self.lu.matrix_mut(), self.r + self.nc),
+        }
+    }
+
+    /// Solves the Newton system `[S, s Bᵀ; s B, 0] [Δq; Δμ] = rhs` in place with the last
+    /// factorization (in the joints' null space when they are eliminated).
+    pub fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+        match &mut self.elim {
+            Some(e) => e.solve(&mut self.lu, rhs),
+            None => self.lu.solve(rhs),
+        }
+    }
+
     /// Starts the reduced iteration matrix (column-major, (r + nc)²): the constant part
     /// `m M_r + k (L_r + P + Pᵀ) + c C_r` (kept for the last coefficients, since they change
     /// only with the step size) plus `k J_l,r(q, t)`; the model adds its element terms.
     pub fn start_matrix<M: ElementModel>(&mut self, full: &M, q: &[f64], t: f64, coef: IterationCoefficients) {
-        let (r, n) = (self.r, self.r + self.nc);
+        let (r, n) = (self.r, if self.elim.is_some() { self.r } else { self.r + self.nc });
         if self.base_coef != Some(coef) {
             self.base.fill(0.0);
             let mut add = |m: &Array2<f64>, f: f64| {
@@ -214,8 +243,13 @@ impl Projection {
             }
             self.base_coef = Some(coef);
         }
-        let a = self.lu.matrix_mut();
-        a.copy_from_slice(&self.base);
+        let base = std::mem::take(&mut self.base);
+        self.matrix().0.copy_from_slice(&base);
+        self.base = base;
+        let a = match &mut self.elim {
+            Some(e) => &mut e.s[..],
+            None => self.lu.matrix_mut(),
+        };
         if coef.stiffness != 0.0 && !self.load_dofs.is_empty() {
             let nl = self.load_dofs.len();
             expand(&self.v_load, Some(&self.x_ref_load), 0, q, &mut self.xl);
@@ -244,8 +278,8 @@ impl Projection {
     /// Adds the symmetric r×r block given by its upper triangle (row-major `upper[i r + j]`,
     /// j ≥ i) times `f` to the iteration matrix.
     pub fn add_symmetric_upper(&mut self, upper: &[f64], f: f64) {
-        let (r, n) = (self.r, self.r + self.nc);
-        let a = self.lu.matrix_mut();
+        let r = self.r;
+        let (a, n) = self.matrix();
         for i in 0..r {
             let row = &upper[i * r..(i + 1) * r];
             a[i + n * i] += f * row[i];
@@ -259,8 +293,8 @@ impl Projection {
 
     /// Adds the r×r matrix `m` (row-major) to the iteration matrix.
     pub fn add_block(&mut self, m: &[f64]) {
-        let (r, n) = (self.r, self.r + self.nc);
-        let a = self.lu.matrix_mut();
+        let r = self.r;
+        let (a, n) = self.matrix();
         for i in 0..r {
             for j in 0..r {
                 a[i + n * j] += m[i * r + j];
@@ -270,11 +304,18 @@ impl Projection {
 
     /// Completes the matrix with the scaled constraint rows `s B_r`, `s B_rᵀ` (s = the largest
     /// diagonal entry, so both block rows are of one magnitude) and factors it; returns `s`.
+    /// With the joints eliminated it factors `Pᵀ S P` instead.
     pub fn finish_matrix(&mut self) -> Result<f64, String> {
-        let (r, nc, n) = (self.r, self.nc, self.r + self.nc);
-        let a = self.lu.matrix_mut();
+        let (r, nc) = (self.r, self.nc);
+        let (a, n) = self.matrix();
         let scale = (0..r).map(|i| a[i + n * i].abs()).fold(0.0, f64::max);
         let scale = if scale > 0.0 && scale.is_finite() { scale } else { 1.0 };
+        if let Some(e) = &mut self.elim {
+            e.reduce(scale, self.lu.matrix_mut());
+            self.lu.factor().map_err(|e| format!("reduced LU: {e}"))?;
+            return Ok(scale);
+        }
+        let a = self.lu.matrix_mut();
         for c in 0..nc {
             for j in 0..r {
                 let b = scale * self.b_r[[c, j]];

@@ -161,7 +161,7 @@ impl<M: ElementModel> DynamicModel for ReducedModel<M> {
     }
 
     fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {
-        self.p.lu.solve(rhs)
+        self.p.solve(rhs)
     }
 
     fn length_scale(&self) -> f64 {
