@@ -217,6 +217,9 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
     fn accumulate_tangent(&mut self) {
         let (r, nj) = (self.p.r, self.nj);
         self.acc.fill(0.0);
+        if nj == 1 {
+            return self.accumulate_tangent_pairs();
+        }
         for (k, &w) in self.weights.iter().enumerate() {
             let me = self.m_el[k];
             for j in 0..nj {
@@ -243,6 +246,50 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
                         axpy(b * uj[i], &ujj[i..], &mut self.acc[i * r + i..i * r + me]);
                     }
                 }
+            }
+        }
+    }
+
+    /// [`Self::accumulate_tangent`] for one invariant per element: two consecutive elements
+    /// that see the same modes share one pass over the rows, so `acc` is read and written
+    /// half as often (four at a time measured no faster).
+    #[inline(always)]
+    fn accumulate_tangent_pairs(&mut self) {
+        let r = self.p.r;
+        let n = self.weights.len();
+        let coefs = |k: usize| (2.0 * self.weights[k] * self.psi[k], 4.0 * self.weights[k] * self.psi2[k]);
+        let mut k = 0;
+        while k < n {
+            let me = self.m_el[k];
+            let same = (k..n.min(k + 2)).take_while(|&kk| self.m_el[kk] == me).count();
+            let g = |kk: usize| &self.g_el[self.g_off[kk]..self.g_off[kk] + me * (me + 1) / 2];
+            let u = |kk: usize| &self.u_el[kk * r..kk * r + me];
+            let mut p = 0;
+            if same >= 2 {
+                let ((a1, b1), (a2, b2)) = (coefs(k), coefs(k + 1));
+                let (g1, g2, u1, u2) = (g(k), g(k + 1), u(k), u(k + 1));
+                for i in 0..me {
+                    let len = me - i;
+                    let (c1, c2) = (b1 * u1[i], b2 * u2[i]);
+                    let rows = g1[p..p + len].iter().zip(&g2[p..p + len]).zip(u1[i..].iter().zip(&u2[i..]));
+                    for (o, ((&x1, &x2), (&v1, &v2))) in self.acc[i * r + i..i * r + me].iter_mut().zip(rows) {
+                        *o += (a1 * f64::from(x1) + c1 * v1) + (a2 * f64::from(x2) + c2 * v2);
+                    }
+                    p += len;
+                }
+                k += 2;
+            } else {
+                let (a1, b1) = coefs(k);
+                let (g1, u1) = (g(k), u(k));
+                for i in 0..me {
+                    let len = me - i;
+                    let c1 = b1 * u1[i];
+                    for ((o, &x1), &v1) in self.acc[i * r + i..i * r + me].iter_mut().zip(&g1[p..p + len]).zip(&u1[i..]) {
+                        *o += a1 * f64::from(x1) + c1 * v1;
+                    }
+                    p += len;
+                }
+                k += 1;
             }
         }
     }
