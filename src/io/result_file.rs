@@ -8,7 +8,7 @@
 //! /probes/<name>          (n_t, 2)       x, y of each probe, m
 //! attributes on /: model (TOML text), model_path, load_scale, dt, t_end, rho_inf,
 //!   linear_solver, newton_iterations, factorizations, step_cuts, steps,
-//!   max_iterations_in_a_step, wall_seconds, program_version
+//!   max_iterations_in_a_step, steps_at_round_off, wall_seconds, program_version
 //! ```
 
 use super::h5::{attr_f64, attr_str, attr_u64, write_atomically};
@@ -45,6 +45,7 @@ pub fn write_result_with(path: &Path, r: &SimulationResult, extra: impl FnOnce(&
         attr_u64(f, "factorizations", r.stats.factorizations as u64).map_err(e)?;
         attr_u64(f, "step_cuts", r.stats.step_cuts as u64).map_err(e)?;
         attr_u64(f, "max_iterations_in_a_step", r.stats.max_iterations_in_a_step as u64).map_err(e)?;
+        attr_u64(f, "steps_at_round_off", r.stats.steps_at_round_off as u64).map_err(e)?;
         attr_f64(f, "wall_seconds", r.wall_seconds).map_err(e)?;
         attr_str(f, "program_version", env!("CARGO_PKG_VERSION")).map_err(e)?;
         extra(f)

@@ -230,6 +230,12 @@ impl Model {
             self.positive("time.newton_tolerance", tol)?;
             p.tolerance = tol;
         }
+        if let Some(x) = t.newton_stagnation {
+            if !(x.is_finite() && x >= 0.0) {
+                return Err(self.err("time.newton_stagnation", format!("must be zero or positive, got {x}")));
+            }
+            p.stagnation = x;
+        }
         if let Some(m) = t.max_iterations {
             if m <= 0 {
                 return Err(self.err("time.max_iterations", format!("must be a positive integer, got {m}")));

@@ -31,6 +31,10 @@ pub struct TimeSettings {
     /// Newton tolerance on ‖Δq‖∞ relative to the longest body
     #[serde(default)]
     pub newton_tolerance: Option<f64>,
+    /// Newton increments (relative to the longest body) accepted when Newton has stopped
+    /// contracting: the round-off floor (default 1e-6, 0 = never)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub newton_stagnation: Option<f64>,
     #[serde(default)]
     pub max_iterations: Option<i64>,
     #[serde(default)]
