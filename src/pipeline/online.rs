@@ -6,7 +6,7 @@ use crate::io::basis_file::{read_basis, StoredBasis};
 use crate::model::Model;
 use crate::physics::element::Vec8;
 use crate::physics::system::FlexibleSystem;
-use crate::reduction::{Basis, HyperReducedModel, Reduced, ReducedModel};
+use crate::reduction::{Basis, Hyper, HyperReducedModel, Reduced, ReducedModel};
 use crate::simulate::{integrate_guided, prepare, Overrides, Settings, SimulationResult};
 use crate::solver::generalized_alpha::JacobianReuse;
 use crate::solver::model::DynamicModel;
@@ -60,7 +60,8 @@ pub enum Output {
 }
 
 /// Runs the reduced model of `basis` at `load_scale` with the model's time settings; the
-/// hyper-reduced model when the basis carries a sampled element set.
+/// hyper-reduced model when the basis carries a sampled element set, else the same model
+/// over every element at weight 1 (plain Galerkin).
 pub fn run_reduced(model: &Model, basis: &Basis, load_scale: f64) -> Result<ReducedRun> {
     run_reduced_with(model, basis, load_scale, Output::Full, &[])
 }
@@ -85,16 +86,23 @@ pub fn run_reduced_with(model: &Model, basis: &Basis, load_scale: f64, output: O
     }
     let (sys, x0) = prepare(model, &s)?;
     let cannot = |e: String| Error::Usage(format!("cannot build the reduced model: {e}"));
-    match &basis.hyper {
-        Some(h) => {
-            let mut rom = HyperReducedModel::new(sys, basis, h).map_err(cannot)?;
-            run(&mut rom, model, basis, s, &x0, output, previous)
+    // without a sampled set: every element at weight 1, which is plain Galerkin (to
+    // round-off, tests/hyper.rs) through the cheaper per-element Gₑ route; the generic
+    // element-by-element projection only for elements that route does not support
+    let all;
+    let hyper = match &basis.hyper {
+        Some(h) => h,
+        None if HyperReducedModel::<FlexibleSystem>::supports(&sys) => {
+            all = Hyper::all(sys.n_elements());
+            &all
         }
         None => {
             let mut rom = ReducedModel::new(sys, basis).map_err(cannot)?;
-            run(&mut rom, model, basis, s, &x0, output, previous)
+            return run(&mut rom, model, basis, s, &x0, output, previous);
         }
-    }
+    };
+    let mut rom = HyperReducedModel::new(sys, basis, hyper).map_err(cannot)?;
+    run(&mut rom, model, basis, s, &x0, output, previous)
 }
 
 fn run<R: Reduced<FlexibleSystem>>(

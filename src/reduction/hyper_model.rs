@@ -68,6 +68,11 @@ pub struct HyperReducedModel<M: InvariantElementModel> {
 }
 
 impl<M: InvariantElementModel> HyperReducedModel<M> {
+    /// Whether `full` has elements this model supports (4, 6, 8 or 12 dofs).
+    pub fn supports(full: &M) -> bool {
+        full.n_elements() > 0 && [4, 6, 8, 12].contains(&full.element_dofs(0).len())
+    }
+
     pub fn new(full: M, basis: &Basis, hyper: &Hyper) -> Result<Self, String> {
         hyper.validate(full.n_elements()).map_err(|(f, p)| format!("{f} {p}"))?;
         let mut p = Projection::new(&full, basis)?;
