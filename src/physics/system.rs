@@ -284,9 +284,9 @@ impl FlexibleSystem {
     /// Closes the joints of `q` (given to finitely many digits in a model file): first by
     /// the smallest rigid motion of each body (translation `t` and rotation `θ` about its
     /// start), which strains no element; then whatever is left (round-off, or a gap no rigid
-    /// motion closes) by the smallest change of the joint coordinates. Moving the joint nodes alone would bend the end
-    /// elements: a gap `g` costs ~12 EI g / l³, 10 N for g = 2e-10 m on the four-bar
-    /// refined 10×. Returns the largest change of a coordinate.
+    /// motion closes) by the smallest change of the joint coordinates. Moving the joint
+    /// nodes alone would bend the end elements: a gap `g` costs ~12 EI g / l³, 10 N for
+    /// g = 2e-10 m on the four-bar refined 10×. Returns the largest change of a coordinate.
     pub fn make_consistent(&mut self, q: &mut [f64]) -> Result<f64, String> {
         use nalgebra::{DMatrix, DVector};
         let (n, nb, nc) = (self.n_dof, self.bodies.len(), self.constraints.len());
