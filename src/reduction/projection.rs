@@ -200,10 +200,7 @@ impl Projection {
     /// The buffer the iteration matrix is assembled in (column-major) and its leading
     /// dimension: `S` (r × r) when the joints are eliminated, else the KKT matrix.
     fn matrix(&mut self) -> (&mut [f64], usize) {
-        match &mut self.elim {
-            Some(e) => (&mut e.s, self.r),
-            None => (self.lu.matrix_mut(), self.r + self.nc),
-        }
+        matrix_of(&mut self.elim, &mut self.lu, self.r, self.nc)
     }
 
     /// Solves the Newton system `[S, s Bᵀ; s B, 0] [Δq; Δμ] = rhs` in place with the last
@@ -243,13 +240,8 @@ impl Projection {
             }
             self.base_coef = Some(coef);
         }
-        let base = std::mem::take(&mut self.base);
-        self.matrix().0.copy_from_slice(&base);
-        self.base = base;
-        let a = match &mut self.elim {
-            Some(e) => &mut e.s[..],
-            None => self.lu.matrix_mut(),
-        };
+        let (a, _) = matrix_of(&mut self.elim, &mut self.lu, r, self.nc);
+        a.copy_from_slice(&self.base);
         if coef.stiffness != 0.0 && !self.load_dofs.is_empty() {
             let nl = self.load_dofs.len();
             expand(&self.v_load, Some(&self.x_ref_load), 0, q, &mut self.xl);
@@ -325,6 +317,15 @@ impl Projection {
         }
         self.lu.factor().map_err(|e| format!("reduced LU: {e}"))?;
         Ok(scale)
+    }
+}
+
+/// [`Projection::matrix`] on the two fields it needs, so that the rest of the projection
+/// can be read while the matrix is written.
+fn matrix_of<'a>(elim: &'a mut Option<JointElimination>, lu: &'a mut DenseLu, r: usize, nc: usize) -> (&'a mut [f64], usize) {
+    match elim {
+        Some(e) => (&mut e.s, r),
+        None => (lu.matrix_mut(), r + nc),
     }
 }
 
