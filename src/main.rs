@@ -106,9 +106,9 @@ enum Command {
         /// also run the full model at each load scale and report errors
         #[arg(long)]
         validate: bool,
-        /// continuation in the load scale: each thread takes a contiguous part of the list
-        /// and every run starts its Newton solves from its neighbours' steps (about 2× fewer
-        /// iterations on the pendulum). Same step equations and tolerance, but where the
+        /// continuation in the load scale: each thread takes two contiguous parts of the list
+        /// (one from each end) and every run starts its Newton solves from its neighbours'
+        /// steps (about 2× fewer iterations on the pendulum). Same step equations and tolerance, but where the
         /// dynamics are sensitive (the four-bar after t ≈ 0.6 s) Newton may settle on
         /// another nearby solution than `online` does; without it every load scale runs on
         /// its own, exactly as `online`
