@@ -17,7 +17,7 @@
 //!   continuation (1 when the runs were continued from their neighbours), program_version
 //! ```
 
-use super::online::{run_reduced_with, Output, ReducedRun};
+use super::online::{Output, ReducedRun, ReducedRunner};
 use super::validate::{compare, Validation};
 use crate::error::{Error, Result};
 use crate::io::h5::{attr_f64, attr_str, attr_u64, write_atomically};
@@ -49,7 +49,7 @@ pub struct SweepOptions {
     /// continuation in the load scale: each thread takes two contiguous parts of the list
     /// (one from each end) and starts every Newton solve from the previous points'
     /// increments
-    /// ([`run_reduced_with`]); off (the default): every load scale on its own, exactly as
+    /// ([`super::online::ReducedRunner::run`]); off (the default): every load scale on its own, exactly as
     /// `online` runs it
     pub continuation: bool,
     /// a progress bar on stderr
@@ -80,7 +80,12 @@ pub fn sweep(model: &Model, basis: &Basis, scales: &[f64], o: SweepOptions) -> R
     let lanes = if o.continuation { continuation_lanes(scales.len(), threads) } else { (0..scales.len()).map(|i| vec![i..i + 1]).collect() };
     let parts: Result<Vec<Vec<(usize, SweepPoint)>>> = lanes
         .par_iter()
-        .map(|chains| {
+        // one reduced model per worker, built at its first lane, its loads changed per scale
+        .map_init(|| None, |slot: &mut Option<ReducedRunner>, chains| {
+            let runner = match slot {
+                Some(r) => r,
+                None => slot.insert(ReducedRunner::new(model, basis)?),
+            };
             let mut done: Vec<(usize, SweepPoint)> = Vec::new();
             for chain in chains {
                 let first = done.len();
@@ -90,7 +95,7 @@ pub fn sweep(model: &Model, basis: &Basis, scales: &[f64], o: SweepOptions) -> R
                     let previous: Vec<&ReducedRun> = done[first.max(done.len().saturating_sub(2))..].iter().map(|p| &p.1.rom).collect();
                     // without validation nothing of full size is reconstructed
                     let output = if o.validate { Output::Full } else { Output::ReducedAndProbes };
-                    let rom = run_reduced_with(model, basis, x, output, &previous)?;
+                    let rom = runner.run(x, output, &previous)?;
                     let validation = if o.validate {
                         let full = simulate(model, &Overrides { load_scale: Some(x), ..Default::default() })?;
                         Some(compare(model, &full, &rom, None, basis.n_reduced(), basis.variant.name()))

@@ -28,4 +28,8 @@ pub trait Reduced<M>: crate::solver::model::DynamicModel {
     fn full(&self) -> &M;
     /// Physical multipliers of the full model's constraints, when the variant has them.
     fn multipliers(&self, q: &[f64], lambda: &[f64]) -> Option<ndarray::Array1<f64>>;
+    /// Changes the full model's loads (`change`, e.g. a new load scale) and projects again
+    /// what was projected once from them, the constant force `Vᵀg₀`: a sweep then reuses
+    /// one reduced model for every load scale instead of building it again.
+    fn change_loads(&mut self, basis: &Basis, change: &mut dyn FnMut(&mut M));
 }

@@ -148,6 +148,13 @@ impl Projection {
         })
     }
 
+    /// `g₀,r = Vᵀg₀` again, after the full model's constant loads changed.
+    pub fn project_constant_force<M: ElementModel>(&mut self, full: &M, basis: &Basis) {
+        let mut col = vec![0.0; full.n_dof()];
+        full.constant_force(&mut col);
+        self.g0 = basis.modes.t().dot(&ArrayView1::from(&col));
+    }
+
     /// Physical multipliers of the full model's constraints, when this variant has them:
     /// constraint-preserving returns the integrator's own, whole-system `w V_λ q`.
     pub fn multipliers(&self, q: &[f64], lambda: &[f64]) -> Option<Array1<f64>> {

@@ -176,4 +176,8 @@ impl<M: ElementModel> super::Reduced<M> for ReducedModel<M> {
     fn multipliers(&self, q: &[f64], lambda: &[f64]) -> Option<Array1<f64>> {
         self.p.multipliers(q, lambda)
     }
+    fn change_loads(&mut self, basis: &Basis, change: &mut dyn FnMut(&mut M)) {
+        change(&mut self.full);
+        self.p.project_constant_force(&self.full, basis);
+    }
 }
