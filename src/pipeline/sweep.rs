@@ -77,7 +77,7 @@ pub fn sweep(model: &Model, basis: &Basis, scales: &[f64], o: SweepOptions) -> R
     let start = std::time::Instant::now();
     let threads = rayon::current_num_threads().max(1);
     // continuation: a few chains of neighbouring scales per thread; otherwise one point per task
-    let lanes = if o.continuation { continuation_lanes(scales.len(), threads) } else { (0..scales.len()).map(|i| vec![i..i + 1]).collect() };
+    let lanes = if o.continuation { continuation_lanes(scales.len(), threads) } else { (0..scales.len()).map(|i| std::iter::once(i..i + 1).collect()).collect() };
     let parts: Result<Vec<Vec<(usize, SweepPoint)>>> = lanes
         .par_iter()
         // one reduced model per worker, built at its first lane, its loads changed per scale
