@@ -25,7 +25,7 @@
 
 use super::basis::Basis;
 use super::ecsw::Hyper;
-use super::projection::{axpy, mat_vec, Projection};
+use super::projection::{axpy, forward_to_projection, impl_reduced, mat_vec, Projection};
 use crate::solver::model::{DynamicModel, InvariantElementModel, IterationCoefficients};
 use ndarray::{Array1, Array2, Axis};
 
@@ -346,17 +346,7 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
 }
 
 impl<M: InvariantElementModel> DynamicModel for HyperReducedModel<M> {
-    fn n_dof(&self) -> usize {
-        self.p.r
-    }
-
-    fn n_constraints(&self) -> usize {
-        self.p.nc
-    }
-
-    fn mass_mul(&self, a: &[f64], out: &mut [f64]) {
-        self.p.mass_mul(a, out);
-    }
+    forward_to_projection!();
 
     fn force(&mut self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
         self.p.constant_and_load_force(&self.full, q, t, out);
@@ -375,14 +365,6 @@ impl<M: InvariantElementModel> DynamicModel for HyperReducedModel<M> {
         }
     }
 
-    fn constraint_residual(&self, q: &[f64], out: &mut [f64]) {
-        self.p.constraint_residual(q, out);
-    }
-
-    fn add_constraint_force(&self, lambda: &[f64], out: &mut [f64]) {
-        self.p.add_constraint_force(lambda, out);
-    }
-
     fn factor(&mut self, q: &[f64], _v: &[f64], t: f64, coef: IterationCoefficients) -> Result<f64, String> {
         // m M_r + k (L_r + J_l,r) + c C_r
         self.p.start_matrix(&self.full, q, t, coef);
@@ -393,25 +375,6 @@ impl<M: InvariantElementModel> DynamicModel for HyperReducedModel<M> {
         }
         self.p.finish_matrix()
     }
-
-    fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {
-        self.p.solve(rhs)
-    }
-
-    fn length_scale(&self) -> f64 {
-        self.full.length_scale()
-    }
 }
 
-impl<M: InvariantElementModel> super::Reduced<M> for HyperReducedModel<M> {
-    fn full(&self) -> &M {
-        &self.full
-    }
-    fn multipliers(&self, q: &[f64], lambda: &[f64]) -> Option<Array1<f64>> {
-        self.p.multipliers(q, lambda)
-    }
-    fn change_loads(&mut self, basis: &Basis, change: &mut dyn FnMut(&mut M)) {
-        change(&mut self.full);
-        self.p.project_constant_force(&self.full, basis);
-    }
-}
+impl_reduced!(HyperReducedModel, InvariantElementModel);

@@ -23,6 +23,56 @@ use crate::solver::model::{ElementModel, IterationCoefficients};
 use ndarray::{s, Array1, Array2, ArrayView1, Axis};
 use ndarray_linalg::SVD;
 
+/// The [`crate::solver::model::DynamicModel`] methods a reduced model with fields
+/// `p: Projection` and `full: M` forwards unchanged (mass, joints, Newton solve, length
+/// scale); the model writes `force` and `factor` itself.
+macro_rules! forward_to_projection {
+    () => {
+        fn n_dof(&self) -> usize {
+            self.p.r
+        }
+        fn n_constraints(&self) -> usize {
+            self.p.nc
+        }
+        fn mass_mul(&self, a: &[f64], out: &mut [f64]) {
+            self.p.mass_mul(a, out);
+        }
+        fn constraint_residual(&self, q: &[f64], out: &mut [f64]) {
+            self.p.constraint_residual(q, out);
+        }
+        fn add_constraint_force(&self, lambda: &[f64], out: &mut [f64]) {
+            self.p.add_constraint_force(lambda, out);
+        }
+        fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+            self.p.solve(rhs)
+        }
+        fn length_scale(&self) -> f64 {
+            self.full.length_scale()
+        }
+    };
+}
+pub(crate) use forward_to_projection;
+
+/// [`super::Reduced`] for a reduced model `$t<M>` with fields `p: Projection` and
+/// `full: M` (`M: $bound`): all of it is the projection's.
+macro_rules! impl_reduced {
+    ($t:ident, $bound:path) => {
+        impl<M: $bound> super::Reduced<M> for $t<M> {
+            fn full(&self) -> &M {
+                &self.full
+            }
+            fn multipliers(&self, q: &[f64], lambda: &[f64]) -> Option<ndarray::Array1<f64>> {
+                self.p.multipliers(q, lambda)
+            }
+            fn change_loads(&mut self, basis: &super::Basis, change: &mut dyn FnMut(&mut M)) {
+                change(&mut self.full);
+                self.p.project_constant_force(&self.full, basis);
+            }
+        }
+    };
+}
+pub(crate) use impl_reduced;
+
 pub(crate) struct Projection {
     pub variant: Variant,
     pub r: usize,

@@ -15,7 +15,7 @@
 //! Joints, mass and nodal loads: see [`super::projection`].
 
 use super::basis::Basis;
-use super::projection::{axpy, expand, project_add, Projection};
+use super::projection::{axpy, expand, forward_to_projection, impl_reduced, project_add, Projection};
 use crate::solver::model::{DynamicModel, ElementModel, IterationCoefficients};
 use ndarray::{linalg::general_mat_mul, Array1, Array2, Axis};
 
@@ -96,17 +96,7 @@ impl<M: ElementModel> ReducedModel<M> {
 }
 
 impl<M: ElementModel> DynamicModel for ReducedModel<M> {
-    fn n_dof(&self) -> usize {
-        self.p.r
-    }
-
-    fn n_constraints(&self) -> usize {
-        self.p.nc
-    }
-
-    fn mass_mul(&self, a: &[f64], out: &mut [f64]) {
-        self.p.mass_mul(a, out);
-    }
+    forward_to_projection!();
 
     fn force(&mut self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
         self.p.constant_and_load_force(&self.full, q, t, out);
@@ -118,14 +108,6 @@ impl<M: ElementModel> DynamicModel for ReducedModel<M> {
             self.fe.iter_mut().for_each(|f| *f *= w);
             project_add(&self.v_el, k * ne, &self.fe, out);
         }
-    }
-
-    fn constraint_residual(&self, q: &[f64], out: &mut [f64]) {
-        self.p.constraint_residual(q, out);
-    }
-
-    fn add_constraint_force(&self, lambda: &[f64], out: &mut [f64]) {
-        self.p.add_constraint_force(lambda, out);
     }
 
     fn factor(&mut self, q: &[f64], _v: &[f64], t: f64, coef: IterationCoefficients) -> Result<f64, String> {
@@ -159,25 +141,6 @@ impl<M: ElementModel> DynamicModel for ReducedModel<M> {
         }
         self.p.finish_matrix()
     }
-
-    fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {
-        self.p.solve(rhs)
-    }
-
-    fn length_scale(&self) -> f64 {
-        self.full.length_scale()
-    }
 }
 
-impl<M: ElementModel> super::Reduced<M> for ReducedModel<M> {
-    fn full(&self) -> &M {
-        &self.full
-    }
-    fn multipliers(&self, q: &[f64], lambda: &[f64]) -> Option<Array1<f64>> {
-        self.p.multipliers(q, lambda)
-    }
-    fn change_loads(&mut self, basis: &Basis, change: &mut dyn FnMut(&mut M)) {
-        change(&mut self.full);
-        self.p.project_constant_force(&self.full, basis);
-    }
-}
+impl_reduced!(ReducedModel, ElementModel);
