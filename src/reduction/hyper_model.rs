@@ -110,6 +110,8 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
         }
         let c_r = if c_r.iter().any(|&x| x != 0.0) { Some(c_r) } else { None };
         p.set_linear_terms(Some(l_r.clone()), c_r.clone());
+        // invariant-based element forces derive from an energy: symmetric tangents
+        p.symmetric_newton_matrix();
 
         // sampled elements: stacked rows, Sⱼ and Gₑⱼ = Vₑᵀ Sⱼ Vₑ
         let rows: Vec<usize> = hyper.elements.iter().flat_map(|&e| full.element_dofs(e).to_vec()).collect();

@@ -83,7 +83,8 @@ pub trait ElementModel: DynamicModel {
 pub trait InvariantElementModel: ElementModel {
     /// Number of invariants per element (the same for every element).
     fn n_invariants(&self) -> usize;
-    /// `Lₑ` and `Cₑ`, column-major.
+    /// `Lₑ` and `Cₑ`, column-major; both symmetric (elastic stiffness from an energy,
+    /// Rayleigh damping), so that the reduced Newton matrix is.
     fn element_linear(&self, e: usize, stiffness: &mut [f64], damping: &mut [f64]);
     /// `Sⱼ` of element `e`, column-major.
     fn element_invariant_matrix(&self, e: usize, j: usize, out: &mut [f64]);
