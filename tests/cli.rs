@@ -77,6 +77,7 @@ fn bad_model_files_are_refused_with_file_field_and_problem() {
         (Box::new(|s: &str| s.replace("dt = 0.005", "dt = 0.0")), &["time.dt", "positive"]),
         (Box::new(|s: &str| s.replace("dt = 0.005", "dt = -0.005")), &["time.dt"]),
         (Box::new(|s: &str| s.replace("rho_inf = 1.0", "rho_inf = 1.5")), &["time.rho_inf"]),
+        (Box::new(|s: &str| s.replace("rho_inf = 1.0", "rho_inf = 1.0\njacobian_reuse = \"always\"")), &["time.jacobian_reuse", "within-step"]),
         (Box::new(|s: &str| s.replace("body = \"beam\"\nnode = \"start\"", "body = \"bean\"\nnode = \"start\"")), &["joints[0].body", "bean"]),
         (Box::new(|s: &str| s.replace("node = \"start\"", "node = 51")), &["joints[0].node", "outside"]),
         (Box::new(|s: &str| s.replace("node = \"end\"", "node = 77")), &["probes[0].node", "outside"]),

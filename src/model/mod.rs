@@ -6,7 +6,7 @@ pub mod schema;
 use crate::error::{Error, Result};
 use crate::physics::element::Section;
 use crate::physics::system::{BeamBody, FlexibleSystem, Joint, Load, NodeId, Probe, Rayleigh};
-use crate::solver::generalized_alpha::IntegratorParams;
+use crate::solver::generalized_alpha::{IntegratorParams, JacobianReuse};
 use crate::solver::kkt::LinearSolverKind;
 use schema::*;
 use std::path::{Path, PathBuf};
@@ -247,6 +247,13 @@ impl Model {
                 return Err(self.err("time.max_step_cuts", format!("must be in 0..=30, got {m}")));
             }
             p.max_cuts = m as u32;
+        }
+        if let Some(r) = &t.jacobian_reuse {
+            p.reuse = match r.as_str() {
+                "within-step" => JacobianReuse::WithinStep,
+                "never" => JacobianReuse::Never,
+                _ => return Err(self.err("time.jacobian_reuse", format!("must be \"within-step\" or \"never\", got \"{r}\""))),
+            };
         }
         Ok(p)
     }

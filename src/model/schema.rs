@@ -39,6 +39,10 @@ pub struct TimeSettings {
     pub max_iterations: Option<i64>,
     #[serde(default)]
     pub max_step_cuts: Option<i64>,
+    /// "within-step" (the default: keep a factorized Newton matrix while Newton contracts
+    /// fast) or "never" (a fresh matrix at every iteration: full Newton)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub jacobian_reuse: Option<String>,
 }
 
 #[derive(Clone, Debug, Deserialize, Serialize)]

@@ -8,7 +8,6 @@ use crate::physics::element::Vec8;
 use crate::physics::system::FlexibleSystem;
 use crate::reduction::{Basis, Hyper, HyperReducedModel, Reduced, ReducedModel};
 use crate::simulate::{integrate_guided, prepare, Overrides, Settings, SimulationResult};
-use crate::solver::generalized_alpha::JacobianReuse;
 use crate::solver::model::DynamicModel;
 use ndarray::{Array1, Array2, ArrayView1};
 use std::path::Path;
@@ -114,15 +113,12 @@ impl<'a> ReducedRunner<'a> {
     ///     Δq_k(λ) ≈ Δq_k(λ₁) + (λ − λ₁)/(λ₁ − λ₂) · (Δq_k(λ₁) − Δq_k(λ₂)),
     /// ```
     ///
-    /// and keeps its factorized matrix while Newton contracts fast
-    /// ([`JacobianReuse::WithinStep`]). Only the starting point changes: every step stops
-    /// on the same tolerance as a run on its own.
+    /// and, with the default [`WithinStep`](crate::solver::generalized_alpha::JacobianReuse::WithinStep), keeps the factorized matrix of
+    /// a good guess. Only the starting point changes: every step stops on the same
+    /// tolerance as a run on its own.
     pub fn run(&mut self, load_scale: f64, output: Output, previous: &[&ReducedRun]) -> Result<ReducedRun> {
-        let mut s = Settings::resolve(self.model, &Overrides { load_scale: Some(load_scale), ..Default::default() })?;
+        let s = Settings::resolve(self.model, &Overrides { load_scale: Some(load_scale), ..Default::default() })?;
         let previous = &previous[previous.len().saturating_sub(2)..];
-        if !previous.is_empty() {
-            s.params.reuse = JacobianReuse::WithinStep;
-        }
         let (model, basis, x0) = (self.model, self.basis, &self.x0);
         let mut scale = |sys: &mut FlexibleSystem| sys.set_load_scale(load_scale);
         match &mut self.rom {

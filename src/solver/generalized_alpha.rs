@@ -52,7 +52,9 @@ pub enum JacobianReuse {
     /// within a step, once an iteration contracted fast (θ = ‖Δq_k‖/‖Δq_{k−1}‖ < 0.1), keep
     /// the matrix until the contraction slows (θ > 0.3); the first iteration of every step
     /// refactors, and its matrix is kept at once when a guessed increment needed a
-    /// correction below 5 % of itself. Pays off with good guesses (continuation sweeps).
+    /// correction below 5 % of itself. The default: on every shipped model, full and
+    /// reduced, 15–25 % faster than full Newton for the same tolerance, and more so with
+    /// good guesses (continuation sweeps).
     WithinStep,
     /// also across steps while Newton contracts fast; refresh when it does not
     AcrossSteps,
@@ -60,7 +62,9 @@ pub enum JacobianReuse {
 
 impl Default for IntegratorParams {
     fn default() -> Self {
-        IntegratorParams { rho_inf: 0.9, tolerance: 1e-10, stagnation: 1e-6, max_iterations: 25, max_cuts: 8, reuse: JacobianReuse::Never }
+        // within-step reuse: the same tolerance at 15–25 % less time on every shipped model,
+        // full and reduced (README, benchmark)
+        IntegratorParams { rho_inf: 0.9, tolerance: 1e-10, stagnation: 1e-6, max_iterations: 25, max_cuts: 8, reuse: JacobianReuse::WithinStep }
     }
 }
 
