@@ -308,8 +308,10 @@ impl GeneralizedAlpha {
             let theta = inc / last_increment;
             let converged = inc <= tol || (it > 1 && theta < 0.5 && theta / (1.0 - theta) * inc <= tol);
             // no longer contracting, far below any increment that matters: the round-off
-            // floor of the residual, where more iterations only shuffle round-off
-            let stagnated = !converged && it > 3 && theta > 0.5 && inc <= floor;
+            // floor of the residual, where more iterations only shuffle round-off. Only
+            // with a fresh matrix: a kept one that stopped contracting is stale, not at the
+            // floor (it is refreshed below)
+            let stagnated = !converged && !reuse && it > 3 && theta > 0.5 && inc <= floor;
             if converged || stagnated {
                 self.stats.steps_at_round_off += stagnated as usize;
                 for i in 0..n {
