@@ -386,7 +386,7 @@ impl Projection {
         let scale = if scale > 0.0 && scale.is_finite() { scale } else { 1.0 };
         if let Some(e) = &mut self.elim {
             e.reduce(scale, self.lu.matrix_mut());
-            self.factor_lu()?;
+            self.factor_matrix()?;
             return Ok(scale);
         }
         let a = self.lu.matrix_mut();
@@ -397,11 +397,11 @@ impl Projection {
                 a[j + n * (r + c)] = b;
             }
         }
-        self.factor_lu()?;
+        self.factor_matrix()?;
         Ok(scale)
     }
 
-    fn factor_lu(&mut self) -> Result<(), String> {
+    fn factor_matrix(&mut self) -> Result<(), String> {
         let done = if self.symmetric { self.lu.factor_symmetric() } else { self.lu.factor() };
         done.map_err(|e| format!("reduced Newton matrix: {e}"))
     }

@@ -67,8 +67,9 @@ impl DenseLu {
         &mut self.a
     }
 
-    /// Factors a symmetric matrix (only its lower triangle is read by Cholesky) as `L Lᵀ`
-    /// when it is positive definite, else by LU like [`Self::factor`].
+    /// Factors a symmetric matrix as `L Lᵀ` when it is positive definite, else by LU like
+    /// [`Self::factor`] (from a copy: faer's Cholesky may write the upper triangle too, so
+    /// the failed attempt cannot be undone from the matrix itself).
     pub fn factor_symmetric(&mut self) -> Result<(), String> {
         self.check_finite()?;
         if self.skip_cholesky > 0 {
