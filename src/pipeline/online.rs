@@ -113,9 +113,10 @@ impl<'a> ReducedRunner<'a> {
     ///     Δq_k(λ) ≈ Δq_k(λ₁) + (λ − λ₁)/(λ₁ − λ₂) · (Δq_k(λ₁) − Δq_k(λ₂)),
     /// ```
     ///
-    /// and, with the default [`WithinStep`](crate::solver::generalized_alpha::JacobianReuse::WithinStep), keeps the factorized matrix of
-    /// a good guess. Only the starting point changes: every step stops on the same
-    /// tolerance as a run on its own.
+    /// and, with the default within-step reuse
+    /// ([`JacobianReuse`](crate::solver::generalized_alpha::JacobianReuse)), keeps the
+    /// factorized matrix of a good guess. Only the starting point changes: every step
+    /// stops on the same tolerance as a run on its own.
     pub fn run(&mut self, load_scale: f64, output: Output, previous: &[&ReducedRun]) -> Result<ReducedRun> {
         let s = Settings::resolve(self.model, &Overrides { load_scale: Some(load_scale), ..Default::default() })?;
         let previous = &previous[previous.len().saturating_sub(2)..];

@@ -355,66 +355,21 @@ impl GeneralizedAlpha {
 mod tests {
     use super::*;
 
-    /// One mass on a spring, `q̈ + k q + A sin(10¹² q) = 0`: the last term stands for the
-    /// round-off of a residual summed from large terms that cancel (chaotic in q, of size A).
-    struct NoisySpring {
-        k: f64,
-        noise: f64,
-        s: f64,
-    }
-
-    impl DynamicModel for NoisySpring {
-        fn n_dof(&self) -> usize {
-            1
-        }
-        fn n_constraints(&self) -> usize {
-            0
-        }
-        fn mass_mul(&self, a: &[f64], out: &mut [f64]) {
-            out[0] = a[0];
-        }
-        fn force(&mut self, q: &[f64], _v: &[f64], _t: f64, out: &mut [f64]) {
-            out[0] = self.k * q[0] + self.noise * (1e12 * q[0]).sin();
-        }
-        fn constraint_residual(&self, _q: &[f64], _out: &mut [f64]) {}
-        fn add_constraint_force(&self, _lambda: &[f64], _out: &mut [f64]) {}
-        fn factor(&mut self, _q: &[f64], _v: &[f64], _t: f64, c: IterationCoefficients) -> std::result::Result<f64, String> {
-            self.s = c.mass + c.stiffness * self.k;
-            Ok(1.0)
-        }
-        fn solve(&mut self, rhs: &mut [f64]) -> std::result::Result<(), String> {
-            rhs[0] /= self.s;
-            Ok(())
-        }
-        fn length_scale(&self) -> f64 {
-            1.0
-        }
-    }
-
-    fn run(noise: f64, stagnation: f64) -> (Vec<f64>, Stats) {
-        let params = IntegratorParams { stagnation, ..IntegratorParams::default() };
-        let mut m = NoisySpring { k: 100.0, noise, s: 1.0 };
-        let mut integ = GeneralizedAlpha::new(params).unwrap();
-        let mut st = integ.initialize(&mut m, vec![1.0], vec![0.0], 0.0).unwrap();
-        let mut q = Vec::new();
-        for _ in 0..50 {
-            integ.step(&mut m, &mut st, 0.01).unwrap();
-            q.push(st.q[0]);
-        }
-        (q, integ.stats)
-    }
-
-    /// A hardening spring `q̈ + k q + c q³ = 0` whose factorization goes stale when kept: the
-    /// first solve after each `factor` uses the exact tangent, later ones a tangent 2.5×
-    /// too stiff (a kept matrix contracting at θ = 0.6, like one from far back).
-    struct StaleSpring {
+    /// One mass on a spring, `q̈ + k q + c q³ + A sin(10¹² q) = 0`. The noise term stands
+    /// for the round-off of a residual summed from large terms that cancel (chaotic in q, of
+    /// size A). With `stale` ≠ 1 the factorization goes stale when kept: the first solve
+    /// after each `factor` uses the exact tangent, later ones a tangent `stale` times too
+    /// stiff (a kept matrix contracting at θ = 1 − 1/stale, like one from far back).
+    struct Spring {
         k: f64,
         c: f64,
+        noise: f64,
+        stale: f64,
         s: f64,
         fresh: bool,
     }
 
-    impl DynamicModel for StaleSpring {
+    impl DynamicModel for Spring {
         fn n_dof(&self) -> usize {
             1
         }
@@ -425,7 +380,7 @@ mod tests {
             out[0] = a[0];
         }
         fn force(&mut self, q: &[f64], _v: &[f64], _t: f64, out: &mut [f64]) {
-            out[0] = self.k * q[0] + self.c * q[0].powi(3);
+            out[0] = self.k * q[0] + self.c * q[0].powi(3) + self.noise * (1e12 * q[0]).sin();
         }
         fn constraint_residual(&self, _q: &[f64], _out: &mut [f64]) {}
         fn add_constraint_force(&self, _lambda: &[f64], _out: &mut [f64]) {}
@@ -435,12 +390,24 @@ mod tests {
             Ok(1.0)
         }
         fn solve(&mut self, rhs: &mut [f64]) -> std::result::Result<(), String> {
-            rhs[0] /= if std::mem::take(&mut self.fresh) { self.s } else { 2.5 * self.s };
+            rhs[0] /= if std::mem::take(&mut self.fresh) { self.s } else { self.stale * self.s };
             Ok(())
         }
         fn length_scale(&self) -> f64 {
             1.0
         }
+    }
+
+    /// 50 steps of `h` from q = q₀ at rest; the positions after each step and the stats.
+    fn run(mut m: Spring, q0: f64, h: f64, params: IntegratorParams) -> (Vec<f64>, Stats) {
+        let mut integ = GeneralizedAlpha::new(params).unwrap();
+        let mut st = integ.initialize(&mut m, vec![q0], vec![0.0], 0.0).unwrap();
+        let mut q = Vec::new();
+        for _ in 0..50 {
+            integ.step(&mut m, &mut st, h).unwrap();
+            q.push(st.q[0]);
+        }
+        (q, integ.stats)
     }
 
     /// A kept matrix that stops contracting (θ = 0.6 > ½) is stale, not at the round-off
@@ -450,14 +417,8 @@ mod tests {
     #[test]
     fn a_stale_kept_matrix_is_refreshed_not_taken_for_the_floor() {
         for reuse in [JacobianReuse::WithinStep, JacobianReuse::Never] {
-            let params = IntegratorParams { reuse, ..IntegratorParams::default() };
-            let mut m = StaleSpring { k: 100.0, c: 1e4, s: 1.0, fresh: false };
-            let mut integ = GeneralizedAlpha::new(params).unwrap();
-            let mut st = integ.initialize(&mut m, vec![0.5], vec![0.0], 0.0).unwrap();
-            for _ in 0..50 {
-                integ.step(&mut m, &mut st, 0.05).unwrap();
-            }
-            let stats = integ.stats;
+            let spring = Spring { k: 100.0, c: 1e4, noise: 0.0, stale: 2.5, s: 1.0, fresh: false };
+            let (_, stats) = run(spring, 0.5, 0.05, IntegratorParams { reuse, ..IntegratorParams::default() });
             assert_eq!((stats.steps_at_round_off, stats.step_cuts), (0, 0), "{reuse:?}: {stats:?}");
             if reuse == JacobianReuse::WithinStep {
                 assert!(stats.factorizations < stats.newton_iterations, "matrices were kept: {stats:?}");
@@ -472,6 +433,10 @@ mod tests {
     /// floor, and the trajectory stays closer to the noise-free one than the halved run.
     #[test]
     fn stagnation_at_the_round_off_floor_is_accepted() {
+        let run = |noise: f64, stagnation: f64| {
+            let spring = Spring { k: 100.0, c: 0.0, noise, stale: 1.0, s: 1.0, fresh: false };
+            run(spring, 1.0, 0.01, IntegratorParams { stagnation, ..IntegratorParams::default() })
+        };
         let (exact, clean) = run(0.0, 1e-6);
         assert_eq!((clean.step_cuts, clean.steps_at_round_off), (0, 0), "{clean:?}");
         let (cut, strict) = run(0.02, 0.0);
