@@ -182,7 +182,7 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                 b.snapshots.name(),
                 b.n_pod_modes,
                 if b.kept.is_empty() { String::new() } else { format!(" + {} joint coordinates", b.kept.len()) },
-                1.0 - s.trained.pod.energy[b.n_pod_modes - 1],
+                s.trained.uncaptured_energy(),
                 out.display()
             );
             Ok(())

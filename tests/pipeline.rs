@@ -75,9 +75,9 @@ fn pod_basis_is_orthonormal_and_round_trips_through_hdf5() {
     let gram = b.modes.t().dot(&b.modes);
     let eye = Array2::<f64>::eye(b.n_reduced());
     assert!(frob(&(&gram - &eye)) < 1e-12);
-    let sv = &s.trained.pod.singular_values;
+    let sv = &s.trained.pods[0].singular_values;
     assert!(sv.windows(2).into_iter().all(|w| w[0] >= w[1]), "singular values must not increase");
-    assert!((s.trained.pod.energy[sv.len() - 1] - 1.0).abs() < 1e-12);
+    assert!((s.trained.pods[0].energy[sv.len() - 1] - 1.0).abs() < 1e-12);
 
     let back = read_basis(&p.basis_path).unwrap();
     assert_eq!(back.basis.modes, b.modes);

@@ -8,7 +8,13 @@
 //! /basis/modes               (n_dof, r)   V: orthonormal columns (whole-system: the
 //!                                         coordinate rows of the joint POD)
 //! /basis/singular_values     (k)          all singular values of the POD, non-increasing
+//!                                         (a block basis: those of each block's POD in turn)
 //! /basis/energy              (k)          cumulative captured fraction Σ_{i≤j} σᵢ² / Σ σᵢ²
+//!                                         (a block basis: within each block)
+//! /basis/block_modes         (n_b)        modes kept from each block's POD (columns of V in
+//!                                         this order; one block without reduction.blocks;
+//!                                         absent in older files: one block)
+//! /basis/block_values        (n_b)        singular values of each block's POD
 //! /basis/reference           (n_dof)      x_ref (zeros for raw snapshots)
 //! /basis/reduced_dofs        (n_f)        coordinates whose rows entered the POD
 //! /basis/kept_dofs           (n_k)        coordinates kept unreduced (last n_k columns of V)
@@ -55,6 +61,9 @@ pub struct StoredBasis {
     pub basis: Basis,
     pub singular_values: Array1<f64>,
     pub energy: Array1<f64>,
+    /// modes kept from each block's POD, and how many singular values each has
+    pub block_modes: Vec<usize>,
+    pub block_values: Vec<usize>,
     pub model_fingerprint: String,
     pub mode_rule: String,
     pub creation_time: String,
@@ -88,10 +97,14 @@ pub fn write_basis(path: &Path, data: &TrainingData, trained: &Trained, meta: &B
         let g = f.create_group("basis").map_err(e)?;
         let b = &trained.basis;
         g.new_dataset_builder().with_data(&b.modes.as_standard_layout()).create("modes").map_err(e)?;
-        g.new_dataset_builder().with_data(&trained.pod.singular_values).create("singular_values").map_err(e)?;
-        g.new_dataset_builder().with_data(&trained.pod.energy).create("energy").map_err(e)?;
+        let cat = |f: &dyn Fn(&crate::reduction::Pod) -> &Array1<f64>| Array1::from_iter(trained.pods.iter().flat_map(|p| f(p).iter().copied()));
+        g.new_dataset_builder().with_data(&cat(&|p| &p.singular_values)).create("singular_values").map_err(e)?;
+        g.new_dataset_builder().with_data(&cat(&|p| &p.energy)).create("energy").map_err(e)?;
         g.new_dataset_builder().with_data(&b.reference).create("reference").map_err(e)?;
         let idx = |v: &[usize]| Array1::from_iter(v.iter().map(|&d| d as u64));
+        g.new_dataset_builder().with_data(&idx(&trained.block_modes)).create("block_modes").map_err(e)?;
+        let values: Vec<usize> = trained.pods.iter().map(|p| p.singular_values.len()).collect();
+        g.new_dataset_builder().with_data(&idx(&values)).create("block_values").map_err(e)?;
         g.new_dataset_builder().with_data(&idx(&trained.reduced_dofs)).create("reduced_dofs").map_err(e)?;
         g.new_dataset_builder().with_data(&idx(&b.kept)).create("kept_dofs").map_err(e)?;
         if let Some(vl) = &b.multiplier_modes {
@@ -169,10 +182,24 @@ pub fn read_basis(path: &Path) -> Result<StoredBasis> {
     if basis.n_pod_modes == 0 || basis.n_pod_modes > singular_values.len() {
         return Err(field("n_pod_modes", format!("is {} but the POD has {} singular values", basis.n_pod_modes, singular_values.len())));
     }
+    // files written before block bases have one block
+    let (block_modes, block_values) = if f.link_exists("basis/block_modes") {
+        (idx("basis/block_modes")?, idx("basis/block_values")?)
+    } else {
+        (vec![basis.n_pod_modes], vec![singular_values.len()])
+    };
+    if block_modes.iter().sum::<usize>() != basis.n_pod_modes {
+        return Err(field("basis/block_modes", format!("{block_modes:?} do not add up to the {} POD modes (n_pod_modes)", basis.n_pod_modes)));
+    }
+    if block_values.len() != block_modes.len() || block_values.iter().sum::<usize>() != singular_values.len() {
+        return Err(field("basis/block_values", format!("{block_values:?} do not split the {} singular values into {} blocks", singular_values.len(), block_modes.len())));
+    }
     Ok(StoredBasis {
         basis,
         singular_values,
         energy,
+        block_modes,
+        block_values,
         model_fingerprint: text("model_fingerprint")?,
         mode_rule: text("mode_rule")?,
         creation_time: text("creation_time")?,

@@ -255,6 +255,12 @@ impl FlexibleSystem {
         self.first_node[b] + k
     }
 
+    /// The coordinates of body `b` (4 per node, its nodes numbered consecutively).
+    pub fn body_dofs(&self, b: usize) -> std::ops::Range<usize> {
+        let first = self.first_node[b];
+        4 * first..4 * (first + self.bodies[b].n_elements + 1)
+    }
+
     pub fn load_scale(&self) -> f64 {
         self.load_scale
     }

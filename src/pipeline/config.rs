@@ -11,6 +11,8 @@
 //! [reduction]
 //! variant = "galerkin"                      # or "constraint-preserving", "whole-system"
 //! modes = { ratio = 0.1 }                   # or { count = 20 }, { energy = 1e-6 }
+//! blocks = "bodies"                         # one POD per body (modes = { counts = [..] }
+//!                                           # gives each its own); default: one POD
 //! hyper = { tolerance = 1e-3 }              # ECSW element sampling; omit for plain Galerkin
 //! [online]
 //! load_scales = "0.5:1.5:21"                # or a list
@@ -62,9 +64,21 @@ pub struct ReductionSpec {
     #[serde(default)]
     pub variant: Option<Variant>,
     pub modes: ModeRule,
+    /// `"bodies"`: a block basis, one POD per body (`modes` applies to each body, or
+    /// `counts` gives each its own); absent: one POD of all coordinates
+    #[serde(default)]
+    pub blocks: Option<Blocks>,
     /// hyper-reduction by ECSW; absent: every element is evaluated (plain Galerkin)
     #[serde(default)]
     pub hyper: Option<HyperSpec>,
+}
+
+/// How the coordinates are split into blocks with a POD each.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Blocks {
+    /// one block per body: each mode moves one body only
+    Bodies,
 }
 
 /// `[reduction.hyper]`: ECSW element sampling trained to a relative tolerance τ on the
@@ -161,8 +175,19 @@ impl Pipeline {
         if let Err(e) = check_scales(&self.file.train.load_scales) {
             return bad("train.load_scales", e);
         }
-        if let Err(e) = self.file.reduction.modes.validate() {
+        let red = &self.file.reduction;
+        if let Err(e) = red.modes.validate() {
             return bad("reduction.modes", e);
+        }
+        match (&red.modes, red.blocks) {
+            (ModeRule::Counts(_), None) => return bad("reduction.modes", "gives one count per block, but there are no blocks (set reduction.blocks = \"bodies\")".into()),
+            (ModeRule::Counts(c), Some(Blocks::Bodies)) if c.len() != self.model.file.bodies.len() => {
+                return bad("reduction.modes", format!("gives {} counts, the model has {} bodies", c.len(), self.model.file.bodies.len()))
+            }
+            _ => {}
+        }
+        if red.blocks.is_some() && self.variant() == Variant::WholeSystem {
+            return bad("reduction.blocks", "needs the galerkin or the constraint-preserving variant, not whole-system".into());
         }
         if let Some(h) = &self.file.reduction.hyper {
             if !(h.tolerance.is_finite() && h.tolerance > 0.0 && h.tolerance < 1.0) {

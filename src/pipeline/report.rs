@@ -60,15 +60,19 @@ fn build(p: &Pipeline, out: &Path, progress: bool) -> Result<()> {
         line_chart(&out.join(format!("probes_{i}.svg")), &format!("Probe y, full vs reduced, load scale {x}"), "t (s)", "y (m)", &series, false).map_err(plot_err)?;
         validations.push(v);
     }
-    let sv = &stored.singular_values;
-    line_chart(
-        &out.join("singular_values.svg"),
-        "POD singular values",
-        "index",
-        "σ",
-        &[Series { name: "σ_i".into(), points: sv.iter().enumerate().map(|(i, s)| ((i + 1) as f64, *s)).collect(), dashed: false }],
-        true,
-    )
+    // one curve per block of a block basis (per body), each indexed from 1
+    let mut sv = stored.singular_values.iter();
+    let blocks: Vec<Series> = stored
+        .block_values
+        .iter()
+        .enumerate()
+        .map(|(b, &k)| Series {
+            name: if stored.block_values.len() == 1 { "σ_i".into() } else { format!("σ_i, block {}", b + 1) },
+            points: sv.by_ref().take(k).enumerate().map(|(i, s)| ((i + 1) as f64, *s)).collect(),
+            dashed: false,
+        })
+        .collect();
+    line_chart(&out.join("singular_values.svg"), "POD singular values", "index", "σ", &blocks, true)
     .map_err(plot_err)?;
     let pts = |f: &dyn Fn(&Validation) -> f64| -> Vec<(f64, f64)> {
         sw.points.iter().filter_map(|q| q.validation.as_ref()).map(|v| (v.load_scale, f(v))).collect()

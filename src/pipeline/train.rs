@@ -1,9 +1,9 @@
 //! `train`: full runs at the training load scales → snapshot matrix → POD basis → HDF5.
 
-use super::config::Pipeline;
+use super::config::{Blocks, Pipeline};
 use crate::error::{Error, Result};
 use crate::io::basis_file::{write_basis, BasisMeta, TrainingData};
-use crate::reduction::{ecsw, train_basis, Trained};
+use crate::reduction::{ecsw, train_basis, BasisSpec, Trained};
 use crate::simulate::{simulate, Overrides};
 use crate::solver::kkt::LinearSolverKind;
 use ndarray::{concatenate, Array1, Axis};
@@ -52,17 +52,15 @@ pub fn train(p: &Pipeline) -> Result<(TrainingData, TrainSummary)> {
     let dx = (&data.x - &x_ref.view().insert_axis(Axis(1))).mapv(|v| v * v).sum().sqrt();
     let dl = data.multipliers.mapv(|v| v * v).sum().sqrt();
     let w = if dx > 0.0 && dl > 0.0 { dl / dx } else { 1.0 };
-    let trained = train_basis(
-        data.x.view(),
-        data.multipliers.view(),
-        &joint_dofs(p),
-        x_ref.view(),
-        p.variant(),
-        p.file.train.snapshots,
-        p.file.reduction.modes,
-        w,
-    )
-    .map_err(|e| Error::input(&p.path, "reduction.modes", e))?;
+    let blocks = match p.file.reduction.blocks {
+        Some(Blocks::Bodies) => {
+            let sys = p.model.system(LinearSolverKind::Banded);
+            (0..sys.bodies.len()).map(|b| sys.body_dofs(b).collect()).collect()
+        }
+        None => Vec::new(),
+    };
+    let spec = BasisSpec { variant: p.variant(), snapshots: p.file.train.snapshots, modes: p.file.reduction.modes.clone(), multiplier_scale: w, blocks };
+    let trained = train_basis(data.x.view(), data.multipliers.view(), &joint_dofs(p), x_ref.view(), &spec).map_err(|e| Error::input(&p.path, "reduction.modes", e))?;
     let mut trained = trained;
     if let Some(h) = &p.file.reduction.hyper {
         let sys = p.model.system(LinearSolverKind::Banded);

@@ -84,33 +84,53 @@ pub struct Basis {
     pub hyper: Option<Hyper>,
 }
 
-/// The POD and the basis built from it.
+/// The POD(s) and the basis built from them.
 pub struct Trained {
     pub basis: Basis,
-    /// the decomposition the modes come from (of the rows the variant reduces)
-    pub pod: Pod,
+    /// the decompositions the modes come from (of the rows the variant reduces), one per
+    /// block of the basis (one for a basis without blocks)
+    pub pods: Vec<Pod>,
+    /// how many modes each block keeps (columns of `V` in this order, then the kept ones)
+    pub block_modes: Vec<usize>,
     /// the dofs whose snapshot rows entered the POD
     pub reduced_dofs: Vec<usize>,
 }
 
+impl Trained {
+    /// `1 − Σ_{i≤r} σᵢ² / Σ σᵢ²` of the worst block: the energy fraction the basis misses.
+    pub fn uncaptured_energy(&self) -> f64 {
+        self.pods.iter().zip(&self.block_modes).map(|(p, &r)| 1.0 - p.energy[r - 1]).fold(0.0, f64::max)
+    }
+}
+
+/// How to build a basis from snapshots.
+#[derive(Clone, Debug)]
+pub struct BasisSpec {
+    pub variant: Variant,
+    pub snapshots: SnapshotKind,
+    pub modes: ModeRule,
+    /// `w` of the whole-system variant (its multipliers' snapshots are `λ/w`)
+    pub multiplier_scale: f64,
+    /// groups of coordinates with a POD of their own each (a block-diagonal basis whose
+    /// modes each move one group only, e.g. one body; the variant's kept coordinates are
+    /// left out of them); empty: one POD of all coordinates
+    pub blocks: Vec<Vec<usize>>,
+}
+
 /// Builds a basis from snapshots `x` (n × m) and, for whole-system, multipliers `λ`
 /// (n_c × m). `joint_dofs` are the coordinates that appear in a joint; `x_ref` is used
-/// when `kind` is `Reference`.
-pub fn train_basis(
-    x: ArrayView2<f64>,
-    lambda: ArrayView2<f64>,
-    joint_dofs: &[usize],
-    x_ref: ArrayView1<f64>,
-    variant: Variant,
-    kind: SnapshotKind,
-    rule: ModeRule,
-    multiplier_scale: f64,
-) -> Result<Trained, String> {
+/// when the snapshots are `Reference`.
+///
+/// With blocks, `V = [blockdiag(Φ₁, …, Φ_B), kept]`: the rows of block b's coordinates
+/// get the leading modes of their own POD, so that an element sees its own block's modes
+/// only and the Newton matrix is block-diagonal apart from the kept coordinates.
+pub fn train_basis(x: ArrayView2<f64>, lambda: ArrayView2<f64>, joint_dofs: &[usize], x_ref: ArrayView1<f64>, spec: &BasisSpec) -> Result<Trained, String> {
+    let (variant, multiplier_scale) = (spec.variant, spec.multiplier_scale);
     let n = x.nrows();
     if x.ncols() == 0 {
         return Err("the training set is empty (no snapshots)".into());
     }
-    let reference = match kind {
+    let reference = match spec.snapshots {
         SnapshotKind::Raw => Array1::zeros(n),
         SnapshotKind::Reference => x_ref.to_owned(),
     };
@@ -119,6 +139,12 @@ pub fn train_basis(
         Variant::ConstraintPreserving => (0..n).filter(|d| !joint_dofs.contains(d)).collect(),
         _ => (0..n).collect(),
     };
+    if !spec.blocks.is_empty() {
+        return train_blocks(centred, reference, joint_dofs, reduced_dofs, spec);
+    }
+    if let ModeRule::Counts(_) = spec.modes {
+        return Err(format!("{} gives one count per block, and the basis has no blocks", spec.modes));
+    }
     let rows = match variant {
         Variant::WholeSystem => {
             if !(multiplier_scale.is_finite() && multiplier_scale > 0.0) {
@@ -129,28 +155,80 @@ pub fn train_basis(
         _ => centred.select(Axis(0), &reduced_dofs),
     };
     let p = pod(rows.view())?;
-    let r = rule.count(n, p.energy.as_slice().expect("contiguous"))?;
+    let r = spec.modes.count(n, p.energy.as_slice().expect("contiguous"))?;
     let lead = p.leading(r);
     let (modes, kept, multiplier_modes) = match variant {
         Variant::Galerkin => (lead, Vec::new(), None),
         Variant::WholeSystem => (lead.slice(s![..n, ..]).to_owned(), Vec::new(), Some(lead.slice(s![n.., ..]).to_owned())),
         Variant::ConstraintPreserving => {
-            let kept: Vec<usize> = joint_dofs.to_vec();
-            let mut v = Array2::zeros((n, r + kept.len()));
+            let mut v = Array2::zeros((n, r + joint_dofs.len()));
             for (i, &d) in reduced_dofs.iter().enumerate() {
                 v.slice_mut(s![d, ..r]).assign(&lead.row(i));
             }
-            for (k, &d) in kept.iter().enumerate() {
-                v[[d, r + k]] = 1.0;
-            }
-            (v, kept, None)
+            (v, joint_dofs.to_vec(), None)
         }
     };
-    let basis = Basis { variant, snapshots: kind, reference, modes, kept, multiplier_modes, multiplier_scale, n_pod_modes: r, hyper: None };
-    Ok(Trained { basis, pod: p, reduced_dofs })
+    let mut basis = Basis { variant, snapshots: spec.snapshots, reference, modes, kept, multiplier_modes, multiplier_scale, n_pod_modes: r, hyper: None };
+    basis.set_kept_columns();
+    Ok(Trained { basis, pods: vec![p], block_modes: vec![r], reduced_dofs })
+}
+
+/// [`train_basis`] with blocks (galerkin or constraint-preserving).
+fn train_blocks(centred: Array2<f64>, reference: Array1<f64>, joint_dofs: &[usize], reduced_dofs: Vec<usize>, spec: &BasisSpec) -> Result<Trained, String> {
+    let n = centred.nrows();
+    if spec.variant == Variant::WholeSystem {
+        return Err("a basis with blocks needs the galerkin or the constraint-preserving variant".into());
+    }
+    if let ModeRule::Counts(c) = &spec.modes {
+        if c.len() != spec.blocks.len() {
+            return Err(format!("{} gives {} counts for {} blocks", spec.modes, c.len(), spec.blocks.len()));
+        }
+    }
+    let mut owner = vec![None; n];
+    for (b, block) in spec.blocks.iter().enumerate() {
+        for &d in block {
+            match owner.get(d) {
+                None => return Err(format!("block {} holds coordinate {d}, the model has {n}", b + 1)),
+                Some(Some(o)) => return Err(format!("coordinate {d} is in blocks {} and {}", o + 1, b + 1)),
+                Some(None) => owner[d] = Some(b),
+            }
+        }
+    }
+    if let Some(d) = reduced_dofs.iter().find(|&&d| owner[d].is_none()) {
+        return Err(format!("coordinate {d} is in no block"));
+    }
+    let kept = if spec.variant == Variant::ConstraintPreserving { joint_dofs.to_vec() } else { Vec::new() };
+    let (mut pods, mut block_modes, mut columns) = (Vec::new(), Vec::new(), Vec::new());
+    for (b, block) in spec.blocks.iter().enumerate() {
+        let rows: Vec<usize> = block.iter().copied().filter(|d| !kept.contains(d)).collect();
+        let p = pod(centred.select(Axis(0), &rows).view()).map_err(|e| format!("block {}: {e}", b + 1))?;
+        let r = spec.modes.count_in_block(b, block.len(), p.energy.as_slice().expect("contiguous")).map_err(|e| format!("block {}: {e}", b + 1))?;
+        columns.push((rows, p.leading(r)));
+        pods.push(p);
+        block_modes.push(r);
+    }
+    let r: usize = block_modes.iter().sum();
+    let mut v = Array2::zeros((n, r + kept.len()));
+    let mut c0 = 0;
+    for (rows, lead) in &columns {
+        for (i, &d) in rows.iter().enumerate() {
+            v.slice_mut(s![d, c0..c0 + lead.ncols()]).assign(&lead.row(i));
+        }
+        c0 += lead.ncols();
+    }
+    let mut basis = Basis { variant: spec.variant, snapshots: spec.snapshots, reference, modes: v, kept, multiplier_modes: None, multiplier_scale: spec.multiplier_scale, n_pod_modes: r, hyper: None };
+    basis.set_kept_columns();
+    Ok(Trained { basis, pods, block_modes, reduced_dofs })
 }
 
 impl Basis {
+    /// Writes the unit columns of the kept coordinates (the last `kept.len()` columns).
+    fn set_kept_columns(&mut self) {
+        for (k, &d) in self.kept.iter().enumerate() {
+            self.modes[[d, self.n_pod_modes + k]] = 1.0;
+        }
+    }
+
     pub fn n_dof(&self) -> usize {
         self.modes.nrows()
     }
@@ -225,7 +303,8 @@ mod tests {
         let lam = Array2::zeros((0, m));
         let xref = x.column(0).to_owned();
         for (variant, joints) in [(Variant::Galerkin, vec![]), (Variant::ConstraintPreserving, vec![0, 3])] {
-            let t = train_basis(x.view(), lam.view(), &joints, xref.view(), variant, SnapshotKind::Reference, ModeRule::Energy(1e-14), 1.0).unwrap();
+            let spec = BasisSpec { variant, snapshots: SnapshotKind::Reference, modes: ModeRule::Energy(1e-14), multiplier_scale: 1.0, blocks: vec![] };
+            let t = train_basis(x.view(), lam.view(), &joints, xref.view(), &spec).unwrap();
             let b = &t.basis;
             let gram = b.modes.t().dot(&b.modes);
             let eye = Array2::<f64>::eye(b.n_reduced());

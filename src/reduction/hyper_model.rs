@@ -39,20 +39,21 @@ pub struct HyperReducedModel<M: InvariantElementModel> {
     l_r: Array2<f64>,
     l0: Array1<f64>,
     c_r: Option<Array2<f64>>,
-    /// columns of `V` that are nonzero on each sampled element: all columns after the
-    /// last nonzero one are skipped (unreduced joint coordinates touch a few elements only)
-    m_el: Vec<usize>,
-    /// `Vₑ` of every sampled element by columns, its first `mₑ` columns only: column a of
-    /// element k is the `ne` entries at `vt_off[k] + a ne`, so the per-element kernels run
-    /// over contiguous short vectors
+    /// the columns of `V` that are nonzero on each sampled element, as two runs (a basis
+    /// with a block of modes per body, its unreduced joint coordinates last, gives an
+    /// element its body's block and the few joint columns of its nodes)
+    cols: Vec<Cols>,
+    /// `Vₑ` of every sampled element by columns, its `mₑ` columns of `cols` only: local
+    /// column a of element k is the `ne` entries at `vt_off[k] + a ne`, so the per-element
+    /// kernels run over contiguous short vectors
     vt_el: Vec<f64>,
     vt_off: Vec<usize>,
     x_ref_el: Array1<f64>,
     /// `Sⱼ` per sampled element and invariant (ne × ne, column-major)
     s_el: Vec<f64>,
-    /// `Gₑⱼ` per sampled element and invariant: upper triangle of its leading mₑ × mₑ
-    /// block packed by rows (the rest is zero), at `g_off[k nj + j]`; single precision, as
-    /// it only enters the Newton matrix
+    /// `Gₑⱼ` per sampled element and invariant: upper triangle of its mₑ × mₑ block on the
+    /// element's columns packed by rows (the rest is zero), at `g_off[k nj + j]`; single
+    /// precision, as it only enters the Newton matrix
     g_el: Vec<f32>,
     g_off: Vec<usize>,
     // cache at `at` (valid when `valid`): s_j, ψⱼ, ψⱼₖ, uⱼ
@@ -61,10 +62,63 @@ pub struct HyperReducedModel<M: InvariantElementModel> {
     s_val: Vec<f64>,
     psi: Vec<f64>,
     psi2: Vec<f64>,
-    /// uⱼ = Vₑᵀ yⱼ per sampled element and invariant (r each)
+    /// uⱼ = Vₑᵀ yⱼ per sampled element and invariant, on the element's columns (the first
+    /// mₑ of r each)
     u_el: Vec<f64>,
     /// tangent accumulator: upper triangle, row-major r × r
     acc: Vec<f64>,
+    /// the runs `(row, first, end)` of `acc` that any sampled element reaches
+    runs: Vec<(usize, usize, usize)>,
+}
+
+/// The columns of `V` an element sees: the runs `a` and `b` (`b` empty when one will do).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Cols {
+    a: (usize, usize),
+    b: (usize, usize),
+}
+
+impl Cols {
+    /// The nonzero columns of `ve` (ne × r): from the first to the last one, less the
+    /// longest run of zero columns between them.
+    fn of(ve: ndarray::ArrayView2<f64>) -> Cols {
+        let nz: Vec<usize> = (0..ve.ncols()).filter(|&c| ve.column(c).iter().any(|&x| x != 0.0)).collect();
+        let (Some(&first), Some(&last)) = (nz.first(), nz.last()) else {
+            return Cols { a: (0, 0), b: (0, 0) };
+        };
+        let gap = nz.windows(2).max_by_key(|w| w[1] - w[0]).filter(|w| w[1] - w[0] > 1);
+        match gap {
+            Some(w) => Cols { a: (first, w[0] + 1), b: (w[1], last + 1) },
+            None => Cols { a: (first, last + 1), b: (last + 1, last + 1) },
+        }
+    }
+
+    fn n1(&self) -> usize {
+        self.a.1 - self.a.0
+    }
+
+    fn len(&self) -> usize {
+        self.n1() + self.b.1 - self.b.0
+    }
+
+    /// The global columns, in local order.
+    fn iter(&self) -> impl Iterator<Item = usize> {
+        (self.a.0..self.a.1).chain(self.b.0..self.b.1)
+    }
+
+    /// Local row `l` of the packed upper triangle as at most two contiguous pieces of the
+    /// row-major r × r matrix: `(offset in it, offset in the packed row, length)`.
+    #[inline(always)]
+    fn row_pieces(&self, l: usize, r: usize) -> [(usize, usize, usize); 2] {
+        let (n1, me) = (self.n1(), self.len());
+        if l < n1 {
+            let i = self.a.0 + l;
+            [(i * r + i, 0, n1 - l), (i * r + self.b.0, n1 - l, me - n1)]
+        } else {
+            let i = self.b.0 + l - n1;
+            [(i * r + i, 0, me - l), (0, 0, 0)]
+        }
+    }
 }
 
 impl<M: InvariantElementModel> HyperReducedModel<M> {
@@ -119,17 +173,18 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
         let x_ref_el = basis.reference.select(Axis(0), &rows);
         let m = hyper.elements.len();
         let mut s_el = vec![0.0; m * nj * ne * ne];
-        let (mut m_el, mut vt_el, mut vt_off) = (Vec::with_capacity(m), Vec::new(), Vec::with_capacity(m));
+        let (mut cols, mut vt_el, mut vt_off) = (Vec::with_capacity(m), Vec::new(), Vec::with_capacity(m));
         let (mut g_el, mut g_off) = (Vec::new(), Vec::with_capacity(m * nj));
         for (k, &e) in hyper.elements.iter().enumerate() {
             let ve = v_el.slice(ndarray::s![k * ne..(k + 1) * ne, ..]);
-            let me = (0..r).rev().find(|&a| ve.column(a).iter().any(|&x| x != 0.0)).map_or(0, |a| a + 1);
-            m_el.push(me);
+            let c = Cols::of(ve);
+            let me = c.len();
+            cols.push(c);
             vt_off.push(vt_el.len());
-            for a in 0..me {
+            for a in c.iter() {
                 vt_el.extend(ve.column(a).iter());
             }
-            let ve = ve.slice(ndarray::s![.., ..me]);
+            let ve = ve.select(Axis(1), &c.iter().collect::<Vec<_>>());
             for j in 0..nj {
                 let s = &mut s_el[(k * nj + j) * ne * ne..(k * nj + j + 1) * ne * ne];
                 full.element_invariant_matrix(e, j, s);
@@ -141,8 +196,31 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
                 }
             }
         }
+        // the parts of the accumulator any element reaches, row by row
+        let mut reached = vec![false; r * r];
+        for c in &cols {
+            for l in 0..c.len() {
+                for (at, _, len) in c.row_pieces(l, r) {
+                    reached[at..at + len].iter_mut().for_each(|x| *x = true);
+                }
+            }
+        }
+        let mut runs = Vec::new();
+        for i in 0..r {
+            let mut j = i;
+            while j < r {
+                if reached[i * r + j] {
+                    let end = (j..r).find(|&jj| !reached[i * r + jj]).unwrap_or(r);
+                    runs.push((i, j, end));
+                    j = end;
+                } else {
+                    j += 1;
+                }
+            }
+        }
         Ok(HyperReducedModel {
-            m_el,
+            cols,
+            runs,
             vt_el,
             vt_off,
             g_off,
@@ -219,16 +297,19 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
     }
 
     /// `acc` = the upper triangle of Σ_E wₑ [Σⱼ 2ψⱼ Gₑⱼ + Σⱼₖ 4ψⱼₖ uⱼ uₖᵀ] at the cached point
-    /// (both terms are symmetric).
+    /// (both terms are symmetric), on the runs that elements reach (the rest stays zero).
     #[inline(always)]
     fn accumulate_tangent(&mut self) {
         let (r, nj) = (self.p.r, self.nj);
-        self.acc.fill(0.0);
+        for &(i, j0, j1) in &self.runs {
+            self.acc[i * r + j0..i * r + j1].fill(0.0);
+        }
         if nj == 1 {
             return self.accumulate_tangent_pairs();
         }
         for (k, &w) in self.weights.iter().enumerate() {
-            let me = self.m_el[k];
+            let c = self.cols[k];
+            let me = c.len();
             for j in 0..nj {
                 let a = 2.0 * w * self.psi[k * nj + j];
                 let b = 4.0 * w * self.psi2[k * nj * nj + j * nj + j];
@@ -236,21 +317,24 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
                 let uj = &self.u_el[(k * nj + j) * r..(k * nj + j) * r + me];
                 // one pass per row: a Gₑⱼ + b uⱼ uⱼᵀ (packed rows of Gₑⱼ follow each other)
                 let mut p = 0;
-                for i in 0..me {
-                    let len = me - i;
-                    let (grow, urow) = (&g[p..p + len], &uj[i..]);
-                    let c = b * uj[i];
-                    for ((o, &gv), &uv) in self.acc[i * r + i..i * r + me].iter_mut().zip(grow).zip(urow) {
-                        *o += a * f64::from(gv) + c * uv;
+                for l in 0..me {
+                    let cu = b * uj[l];
+                    for (at, off, len) in c.row_pieces(l, r) {
+                        let (grow, urow) = (&g[p + off..p + off + len], &uj[l + off..l + off + len]);
+                        for ((o, &gv), &uv) in self.acc[at..at + len].iter_mut().zip(grow).zip(urow) {
+                            *o += a * f64::from(gv) + cu * uv;
+                        }
                     }
-                    p += len;
+                    p += me - l;
                 }
                 // the mixed terms of models with several invariants
                 for jj in (0..nj).filter(|&jj| jj != j) {
                     let b = 4.0 * w * self.psi2[k * nj * nj + jj * nj + j];
                     let ujj = &self.u_el[(k * nj + jj) * r..(k * nj + jj) * r + me];
-                    for i in 0..me {
-                        axpy(b * uj[i], &ujj[i..], &mut self.acc[i * r + i..i * r + me]);
+                    for l in 0..me {
+                        for (at, off, len) in c.row_pieces(l, r) {
+                            axpy(b * uj[l], &ujj[l + off..l + off + len], &mut self.acc[at..at + len]);
+                        }
                     }
                 }
             }
@@ -258,8 +342,8 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
     }
 
     /// [`Self::accumulate_tangent`] for one invariant per element: two consecutive elements
-    /// that see the same modes share one pass over the rows, so `acc` is read and written
-    /// half as often (four at a time measured no faster).
+    /// that see the same columns share one pass over the rows, so `acc` is read and
+    /// written half as often (four at a time measured no faster).
     #[inline(always)]
     fn accumulate_tangent_pairs(&mut self) {
         let r = self.p.r;
@@ -267,34 +351,38 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
         let coefs = |k: usize| (2.0 * self.weights[k] * self.psi[k], 4.0 * self.weights[k] * self.psi2[k]);
         let mut k = 0;
         while k < n {
-            let me = self.m_el[k];
-            let same = (k..n.min(k + 2)).take_while(|&kk| self.m_el[kk] == me).count();
+            let c = self.cols[k];
+            let me = c.len();
             let g = |kk: usize| &self.g_el[self.g_off[kk]..self.g_off[kk] + me * (me + 1) / 2];
             let u = |kk: usize| &self.u_el[kk * r..kk * r + me];
             let mut p = 0;
-            if same >= 2 {
+            if k + 1 < n && self.cols[k + 1] == c {
                 let ((a1, b1), (a2, b2)) = (coefs(k), coefs(k + 1));
                 let (g1, g2, u1, u2) = (g(k), g(k + 1), u(k), u(k + 1));
-                for i in 0..me {
-                    let len = me - i;
-                    let (c1, c2) = (b1 * u1[i], b2 * u2[i]);
-                    let rows = g1[p..p + len].iter().zip(&g2[p..p + len]).zip(u1[i..].iter().zip(&u2[i..]));
-                    for (o, ((&x1, &x2), (&v1, &v2))) in self.acc[i * r + i..i * r + me].iter_mut().zip(rows) {
-                        *o += (a1 * f64::from(x1) + c1 * v1) + (a2 * f64::from(x2) + c2 * v2);
+                for l in 0..me {
+                    let (c1, c2) = (b1 * u1[l], b2 * u2[l]);
+                    for (at, off, len) in c.row_pieces(l, r) {
+                        let (q, v) = (p + off, l + off);
+                        let rows = g1[q..q + len].iter().zip(&g2[q..q + len]).zip(u1[v..v + len].iter().zip(&u2[v..v + len]));
+                        for (o, ((&x1, &x2), (&v1, &v2))) in self.acc[at..at + len].iter_mut().zip(rows) {
+                            *o += (a1 * f64::from(x1) + c1 * v1) + (a2 * f64::from(x2) + c2 * v2);
+                        }
                     }
-                    p += len;
+                    p += me - l;
                 }
                 k += 2;
             } else {
                 let (a1, b1) = coefs(k);
                 let (g1, u1) = (g(k), u(k));
-                for i in 0..me {
-                    let len = me - i;
-                    let c1 = b1 * u1[i];
-                    for ((o, &x1), &v1) in self.acc[i * r + i..i * r + me].iter_mut().zip(&g1[p..p + len]).zip(&u1[i..]) {
-                        *o += a1 * f64::from(x1) + c1 * v1;
+                for l in 0..me {
+                    let c1 = b1 * u1[l];
+                    for (at, off, len) in c.row_pieces(l, r) {
+                        let (q, v) = (p + off, l + off);
+                        for ((o, &x1), &v1) in self.acc[at..at + len].iter_mut().zip(&g1[q..q + len]).zip(&u1[v..v + len]) {
+                            *o += a1 * f64::from(x1) + c1 * v1;
+                        }
                     }
-                    p += len;
+                    p += me - l;
                 }
                 k += 1;
             }
@@ -315,10 +403,12 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
         let (nj, r) = (self.nj, self.p.r);
         let x_ref = self.x_ref_el.as_slice().expect("contiguous");
         for (k, &e) in self.elements.iter().enumerate() {
-            let me = self.m_el[k];
+            let ce = self.cols[k];
+            let me = ce.len();
             let cols = &self.vt_el[self.vt_off[k]..self.vt_off[k] + me * N];
             let mut x: [f64; N] = x_ref[k * N..(k + 1) * N].try_into().expect("N entries");
-            for (c, &qa) in cols.chunks_exact(N).zip(q) {
+            let qe = q[ce.a.0..ce.a.1].iter().chain(&q[ce.b.0..ce.b.1]);
+            for (c, &qa) in cols.chunks_exact(N).zip(qe) {
                 for i in 0..N {
                     x[i] += qa * c[i];
                 }
@@ -360,9 +450,13 @@ impl<M: InvariantElementModel> DynamicModel for HyperReducedModel<M> {
         self.update(q);
         let (nj, r) = (self.nj, self.p.r);
         for (k, &w) in self.weights.iter().enumerate() {
-            let me = self.m_el[k];
+            let c = self.cols[k];
+            let (n1, me) = (c.n1(), c.len());
             for j in 0..nj {
-                axpy(2.0 * w * self.psi[k * nj + j], &self.u_el[(k * nj + j) * r..(k * nj + j) * r + me], &mut out[..me]);
+                let f = 2.0 * w * self.psi[k * nj + j];
+                let u = &self.u_el[(k * nj + j) * r..(k * nj + j) * r + me];
+                axpy(f, &u[..n1], &mut out[c.a.0..c.a.1]);
+                axpy(f, &u[n1..], &mut out[c.b.0..c.b.1]);
             }
         }
     }
@@ -373,7 +467,7 @@ impl<M: InvariantElementModel> DynamicModel for HyperReducedModel<M> {
         if coef.stiffness != 0.0 {
             self.update(q);
             self.tangent();
-            self.p.add_symmetric_upper(&self.acc, coef.stiffness);
+            self.p.add_symmetric_upper(&self.acc, coef.stiffness, &self.runs);
         }
         self.p.finish_matrix()
     }

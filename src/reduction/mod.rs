@@ -16,7 +16,7 @@ pub mod pod;
 pub(crate) mod projection;
 pub mod reduced_model;
 
-pub use basis::{train_basis, Basis, SnapshotKind, Trained, Variant};
+pub use basis::{train_basis, Basis, BasisSpec, SnapshotKind, Trained, Variant};
 pub use pod::{pod, ModeRule, Pod};
 pub use ecsw::{ecsw, Hyper};
 pub use hyper_model::HyperReducedModel;

@@ -9,11 +9,13 @@ use ndarray::{s, Array1, Array2, ArrayView2};
 use ndarray_linalg::{JobSvd, SVDDC};
 
 /// How many POD modes to keep.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum ModeRule {
-    /// exactly this many
+    /// exactly this many (per block, when the basis has blocks)
     Count(usize),
+    /// this many in each block of a block basis, in block order
+    Counts(Vec<usize>),
     /// this fraction of the full model's coordinate count, rounded (the thesis's
     /// "reduction ratio": 0.1 for the pendulum, 0.3 for the four-bar)
     Ratio(f64),
@@ -25,6 +27,7 @@ impl ModeRule {
     pub fn validate(&self) -> Result<(), String> {
         match *self {
             ModeRule::Count(0) => Err("count must be at least 1".into()),
+            ModeRule::Counts(ref c) if c.is_empty() || c.contains(&0) => Err(format!("counts must be at least 1 each, got {c:?}")),
             ModeRule::Ratio(x) if !(x.is_finite() && x > 0.0 && x <= 1.0) => Err(format!("ratio must lie in (0, 1], got {x}")),
             ModeRule::Energy(t) if !(t.is_finite() && t > 0.0 && t < 1.0) => Err(format!("energy tolerance must lie in (0, 1), got {t}")),
             _ => Ok(()),
@@ -34,10 +37,17 @@ impl ModeRule {
     /// The number of modes this rule keeps, given the full model's dof count and the
     /// captured-energy curve; an error when it asks for more modes than the snapshots hold.
     pub fn count(&self, n_dof: usize, energy: &[f64]) -> Result<usize, String> {
+        self.count_in_block(0, n_dof, energy)
+    }
+
+    /// [`Self::count`] for block `b` of a block basis whose block has `n_dof` coordinates
+    /// (`counts` gives each block its own number).
+    pub fn count_in_block(&self, b: usize, n_dof: usize, energy: &[f64]) -> Result<usize, String> {
         self.validate()?;
         let available = energy.len();
         let r = match *self {
             ModeRule::Count(n) => n,
+            ModeRule::Counts(ref c) => *c.get(b).ok_or_else(|| format!("{self} has no count for block {}", b + 1))?,
             ModeRule::Ratio(x) => ((x * n_dof as f64).round() as usize).max(1),
             ModeRule::Energy(tol) => energy.iter().position(|&e| e >= 1.0 - tol).map_or(available, |i| i + 1),
         };
@@ -52,6 +62,7 @@ impl std::fmt::Display for ModeRule {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             ModeRule::Count(n) => write!(f, "count = {n}"),
+            ModeRule::Counts(c) => write!(f, "counts = {c:?}"),
             ModeRule::Ratio(x) => write!(f, "ratio = {x}"),
             ModeRule::Energy(t) => write!(f, "energy = {t:e}"),
         }

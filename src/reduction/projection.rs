@@ -19,6 +19,7 @@
 use super::basis::{Basis, Variant};
 use super::joint_elimination::JointElimination;
 use crate::solver::dense_lu::DenseLu;
+pub(crate) use crate::solver::vec_ops::{axpy, dot};
 use crate::solver::model::{ElementModel, IterationCoefficients};
 use ndarray::{s, Array1, Array2, ArrayView1, Axis};
 use ndarray_linalg::SVD;
@@ -350,17 +351,19 @@ impl Projection {
     }
 
     /// Adds the symmetric r×r block given by its upper triangle (row-major `upper[i r + j]`,
-    /// j ≥ i) times `f` to the iteration matrix.
-    pub fn add_symmetric_upper(&mut self, upper: &[f64], f: f64) {
+    /// j ≥ i) times `f` to the iteration matrix, where it is nonzero: on the `runs`
+    /// `(i, first, end)`, columns `first..end` of row i.
+    pub fn add_symmetric_upper(&mut self, upper: &[f64], f: f64, runs: &[(usize, usize, usize)]) {
         let r = self.r;
         let (a, n) = self.matrix();
-        for i in 0..r {
+        for &(i, j0, j1) in runs {
             let row = &upper[i * r..(i + 1) * r];
-            a[i + n * i] += f * row[i];
-            for j in i + 1..r {
+            for j in j0..j1 {
                 let v = f * row[j];
                 a[i + n * j] += v;
-                a[j + n * i] += v;
+                if j != i {
+                    a[j + n * i] += v;
+                }
             }
         }
     }
@@ -442,27 +445,5 @@ pub(crate) fn project_add(v: &Array2<f64>, first: usize, f: &[f64], out: &mut [f
     let rows = &v.as_slice().expect("standard layout")[first * r..(first + f.len()) * r];
     for (fi, row) in f.iter().zip(rows.chunks_exact(r)) {
         axpy(*fi, row, out);
-    }
-}
-
-/// Dot product with four independent partial sums, so that it vectorizes (a single
-/// running sum is a chain of dependent additions).
-#[inline]
-pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let mut acc = [0.0; 4];
-    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
-    let tail: f64 = ca.remainder().iter().zip(cb.remainder()).map(|(x, y)| x * y).sum();
-    for (x, y) in ca.zip(cb) {
-        for k in 0..4 {
-            acc[k] += x[k] * y[k];
-        }
-    }
-    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
-}
-
-#[inline]
-pub(crate) fn axpy(alpha: f64, x: &[f64], y: &mut [f64]) {
-    for (yi, xi) in y.iter_mut().zip(x) {
-        *yi += alpha * xi;
     }
 }

@@ -5,3 +5,4 @@ pub mod generalized_alpha;
 pub mod kkt;
 pub mod model;
 pub mod statics;
+pub(crate) mod vec_ops;
