@@ -25,7 +25,8 @@
 
 use super::basis::Basis;
 use super::ecsw::Hyper;
-use super::projection::{axpy, forward_to_projection, impl_reduced, mat_vec, Projection};
+use super::projection::{axpy, forward_to_projection, impl_reduced, Projection};
+use super::sparse_rows::SparseRows;
 use crate::solver::model::{DynamicModel, InvariantElementModel, IterationCoefficients};
 use ndarray::{Array1, Array2, Axis};
 
@@ -36,9 +37,10 @@ pub struct HyperReducedModel<M: InvariantElementModel> {
     nj: usize,
     elements: Vec<usize>,
     weights: Vec<f64>,
-    l_r: Array2<f64>,
+    /// `L_r` and `C_r` by runs of nonzeros (the projection keeps them dense for the matrix)
+    l_rows: SparseRows,
     l0: Array1<f64>,
-    c_r: Option<Array2<f64>>,
+    c_rows: Option<SparseRows>,
     /// the columns of `V` that are nonzero on each sampled element, as two runs (a basis
     /// with a block of modes per body, its unreduced joint coordinates last, gives an
     /// element its body's block and the few joint columns of its nodes)
@@ -163,7 +165,8 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
             l0 += &ve.t().dot(&lm.dot(&xe));
         }
         let c_r = if c_r.iter().any(|&x| x != 0.0) { Some(c_r) } else { None };
-        p.set_linear_terms(Some(l_r.clone()), c_r.clone());
+        let (l_rows, c_rows) = (SparseRows::new(&l_r), c_r.as_ref().map(SparseRows::new));
+        p.set_linear_terms(Some(l_r), c_r);
         // invariant-based element forces derive from an energy: symmetric tangents
         p.symmetric_newton_matrix();
 
@@ -226,9 +229,9 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
             g_off,
             ne,
             nj,
-            l_r,
+            l_rows,
             l0,
-            c_r,
+            c_rows,
             x_ref_el,
             s_el,
             g_el,
@@ -442,10 +445,10 @@ impl<M: InvariantElementModel> DynamicModel for HyperReducedModel<M> {
 
     fn force(&mut self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
         self.p.constant_and_load_force(&self.full, q, t, out);
-        mat_vec(&self.l_r, q, out, true);
+        self.l_rows.mul(q, out, true);
         out.iter_mut().zip(&self.l0).for_each(|(o, l)| *o += l);
-        if let Some(c) = &self.c_r {
-            mat_vec(c, v, out, true);
+        if let Some(c) = &self.c_rows {
+            c.mul(v, out, true);
         }
         self.update(q);
         let (nj, r) = (self.nj, self.p.r);

@@ -14,6 +14,7 @@ pub(crate) mod joint_elimination;
 pub mod nnls;
 pub mod pod;
 pub(crate) mod projection;
+mod sparse_rows;
 pub mod reduced_model;
 
 pub use basis::{train_basis, Basis, BasisSpec, SnapshotKind, Trained, Variant};

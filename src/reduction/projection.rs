@@ -18,6 +18,7 @@
 
 use super::basis::{Basis, Variant};
 use super::joint_elimination::JointElimination;
+use super::sparse_rows::SparseRows;
 use crate::solver::dense_lu::DenseLu;
 pub(crate) use crate::solver::vec_ops::{axpy, dot};
 use crate::solver::model::{ElementModel, IterationCoefficients};
@@ -80,6 +81,8 @@ pub(crate) struct Projection {
     /// constraint rows kept in reduced form
     pub nc: usize,
     pub mass: Array2<f64>,
+    /// `mass` by runs of nonzeros, for products
+    mass_rows: SparseRows,
     g0: Array1<f64>,
     /// B V and B x_ref − b (reduced rows)
     b_r: Array2<f64>,
@@ -181,6 +184,7 @@ impl Projection {
             variant: basis.variant,
             r,
             nc,
+            mass_rows: SparseRows::new(&mass),
             mass,
             g0,
             b_r,
@@ -234,7 +238,7 @@ impl Projection {
 
     /// `out = M_r a`
     pub fn mass_mul(&self, a: &[f64], out: &mut [f64]) {
-        mat_vec(&self.mass, a, out, false);
+        self.mass_rows.mul(a, out, false);
     }
 
     /// `out = g₀,r + g_l,r(q, t)` (+ the whole-system coupling `(P + Pᵀ) q + c₀`)

@@ -348,8 +348,8 @@ fn cholesky_lower(a: &mut [f64], inv_diag: &mut [f64], ld: usize, s: usize, m: u
         while k + 4 <= j {
             let (c0, c1, c2, c3) = (col(k), col(k + 1), col(k + 2), col(k + 3));
             let (f0, f1, f2, f3) = (c0[0], c1[0], c2[0], c3[0]);
-            for (i, o) in colj.iter_mut().enumerate() {
-                *o -= (f0 * c0[i] + f1 * c1[i]) + (f2 * c2[i] + f3 * c3[i]);
+            for (o, ((x0, x1), (x2, x3))) in colj.iter_mut().zip(c0.iter().zip(c1).zip(c2.iter().zip(c3))) {
+                *o -= (f0 * x0 + f1 * x1) + (f2 * x2 + f3 * x3);
             }
             k += 4;
         }
