@@ -12,8 +12,9 @@
 //!   round-off (its joint coordinates are unreduced) and its multipliers follow the full
 //!   ones (5e-2 relative, measured 2.4e-2);
 //! - bad input: a basis of another model, a missing, truncated or foreign file, too many or
-//!   zero modes, a non-finite load scale, an empty training set — a clear message and a
-//!   non-zero exit, and a failed train keeps the previous good basis.
+//!   zero modes, per-block counts that do not fit the blocks, a non-finite load scale, an
+//!   empty training set — a clear message and a non-zero exit, and a failed train keeps
+//!   the previous good basis.
 
 use flexrom::io::basis_file::read_basis;
 
@@ -268,6 +269,12 @@ fn bad_input_is_refused_clearly() {
     for (body, needles) in [
         (PENDULUM_PIPE.replace("{ ratio = 0.1 }", "{ count = 500 }"), vec!["reduction.modes", "500 modes"]),
         (PENDULUM_PIPE.replace("{ ratio = 0.1 }", "{ count = 0 }"), vec!["reduction.modes", "at least 1"]),
+        // counts are per block: none without blocks, one per body with them
+        (PENDULUM_PIPE.replace("{ ratio = 0.1 }", "{ counts = [3] }"), vec!["reduction.modes", "no blocks", "reduction.blocks"]),
+        (PENDULUM_PIPE.replace("{ ratio = 0.1 }", "{ counts = [3, 4] }\nblocks = \"bodies\""), vec!["reduction.modes", "2 counts", "1 bodies"]),
+        (PENDULUM_PIPE.replace("{ ratio = 0.1 }", "{ counts = [3, 0] }\nblocks = \"bodies\""), vec!["reduction.modes", "at least 1"]),
+        (PENDULUM_PIPE.replace("\"galerkin\"", "\"whole-system\"\nblocks = \"bodies\""), vec!["reduction.blocks", "whole-system"]),
+        (PENDULUM_PIPE.replace("{ ratio = 0.1 }", "{ ratio = 0.1 }\nblocks = \"elements\""), vec!["pipe.toml", "elements"]),
         (PENDULUM_PIPE.replace("load_scales = [0.9, 1.1]", "load_scales = []"), vec!["train.load_scales", "empty"]),
         (PENDULUM_PIPE.replace("load_scales = [0.9, 1.1]", "load_scales = [1.0]\nfoo = 1"), vec!["pipe.toml", "foo"]),
     ] {
@@ -299,6 +306,7 @@ assert V.shape == (44, int(f.attrs["n_modes"])), V.shape
 assert f["snapshots"].shape[0] == 44
 assert np.abs(V.T @ V - np.eye(V.shape[1])).max() < 1e-12
 assert np.all(np.diff(sv) <= 0)
+assert f["basis/block_modes"][:].sum() == f.attrs["n_pod_modes"] and f["basis/block_values"][:].sum() == len(sv)
 assert f.attrs["variant"] == "galerkin" and len(f.attrs["model_fingerprint"]) == 64
 print("ok")
 "#;

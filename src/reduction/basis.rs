@@ -320,4 +320,46 @@ mod tests {
             }
         }
     }
+
+    /// A block basis of two blocks (coordinates 0–4 and 5–9, joints 4 and 5 kept): each
+    /// block's modes vanish outside its rows, the kept coordinates have their unit columns,
+    /// the columns are orthonormal (blocks are disjoint), every snapshot is reproduced
+    /// when the blocks keep all their modes (energy 1e-14), and counts that do not fit
+    /// the blocks, or blocks that overlap, are refused.
+    #[test]
+    fn block_basis_keeps_each_block_to_its_rows() {
+        let (n, m) = (10, 6);
+        let x = Array2::from_shape_fn((n, m), |(i, j)| ((i + 1) as f64 * 0.37 * (j + 1) as f64).sin() + 0.1 * i as f64 * j as f64);
+        let lam = Array2::zeros((0, m));
+        let xref = x.column(0).to_owned();
+        let blocks = vec![(0..5).collect::<Vec<_>>(), (5..10).collect()];
+        let spec = BasisSpec { variant: Variant::ConstraintPreserving, snapshots: SnapshotKind::Reference, modes: ModeRule::Energy(1e-14), multiplier_scale: 1.0, blocks: blocks.clone() };
+        let t = train_basis(x.view(), lam.view(), &[4, 5], xref.view(), &spec).unwrap();
+        let b = &t.basis;
+        assert_eq!(t.pods.len(), 2);
+        assert_eq!(t.block_modes.iter().sum::<usize>(), b.n_pod_modes);
+        let gram = b.modes.t().dot(&b.modes);
+        assert!((&gram - &Array2::<f64>::eye(b.n_reduced())).iter().all(|v| v.abs() < 1e-12), "VᵀV = I");
+        let r1 = t.block_modes[0];
+        assert!(b.modes.slice(s![5.., ..r1]).iter().all(|&v| v == 0.0), "block 1 modes on block 2 rows");
+        assert!(b.modes.slice(s![..5, r1..b.n_pod_modes]).iter().all(|&v| v == 0.0), "block 2 modes on block 1 rows");
+        assert!(b.modes.slice(s![4..6, ..b.n_pod_modes]).iter().all(|&v| v == 0.0), "modes on kept rows");
+        assert_eq!((b.modes[[4, b.n_pod_modes]], b.modes[[5, b.n_pod_modes + 1]]), (1.0, 1.0));
+        for j in 0..m {
+            let back = b.reconstruct(b.reduce(x.column(j)).view());
+            let err = (&back - &x.column(j)).iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+            assert!(err < 1e-10, "column {j} error {err}");
+        }
+        let counts = BasisSpec { modes: ModeRule::Counts(vec![2, 3]), ..spec.clone() };
+        assert_eq!(train_basis(x.view(), lam.view(), &[4, 5], xref.view(), &counts).unwrap().block_modes, vec![2, 3]);
+        for (bad, needle) in [
+            (BasisSpec { modes: ModeRule::Counts(vec![2]), ..spec.clone() }, "1 counts for 2 blocks"),
+            (BasisSpec { blocks: vec![(0..6).collect(), (5..10).collect()], ..spec.clone() }, "in blocks 1 and 2"),
+            (BasisSpec { blocks: vec![(0..5).collect()], ..spec.clone() }, "in no block"),
+            (BasisSpec { blocks: vec![], ..counts.clone() }, "no blocks"),
+        ] {
+            let err = train_basis(x.view(), lam.view(), &[4, 5], xref.view(), &bad).err().expect("refused");
+            assert!(err.contains(needle), "{err}");
+        }
+    }
 }
