@@ -108,18 +108,36 @@ impl Cols {
         (self.a.0..self.a.1).chain(self.b.0..self.b.1)
     }
 
-    /// Local row `l` of the packed upper triangle as at most two contiguous pieces of the
-    /// row-major r × r matrix: `(offset in it, offset in the packed row, length)`.
+    /// Local row `l` of the packed upper triangle in the row-major r × r matrix: its first
+    /// piece starts on the diagonal at `at` and has `len` entries; the second, when
+    /// `len2 > 0`, starts at `at2` and takes the next `len2` packed entries.
     #[inline(always)]
-    fn row_pieces(&self, l: usize, r: usize) -> [(usize, usize, usize); 2] {
-        let (n1, me) = (self.n1(), self.len());
+    fn row(&self, l: usize, r: usize) -> (usize, usize, usize, usize) {
+        let (n1, n2) = (self.n1(), self.b.1 - self.b.0);
         if l < n1 {
             let i = self.a.0 + l;
-            [(i * r + i, 0, n1 - l), (i * r + self.b.0, n1 - l, me - n1)]
+            (i * r + i, n1 - l, i * r + self.b.0, n2)
         } else {
             let i = self.b.0 + l - n1;
-            [(i * r + i, 0, me - l), (0, 0, 0)]
+            (i * r + i, n1 + n2 - l, 0, 0)
         }
+    }
+}
+
+/// `o += a g + c u` (a row of the tangent: one element's `Gₑ` row and rank-one term).
+#[inline(always)]
+fn add_row(o: &mut [f64], g: &[f32], u: &[f64], a: f64, c: f64) {
+    for ((o, &x), &v) in o.iter_mut().zip(g).zip(u) {
+        *o += a * f64::from(x) + c * v;
+    }
+}
+
+/// [`add_row`] for two elements at once.
+#[inline(always)]
+fn add_row_pair(o: &mut [f64], g: (&[f32], &[f32]), u: (&[f64], &[f64]), a: (f64, f64), c: (f64, f64)) {
+    let rows = g.0.iter().zip(g.1).zip(u.0.iter().zip(u.1));
+    for (o, ((&x1, &x2), (&v1, &v2))) in o.iter_mut().zip(rows) {
+        *o += (a.0 * f64::from(x1) + c.0 * v1) + (a.1 * f64::from(x2) + c.1 * v2);
     }
 }
 
@@ -203,9 +221,9 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
         let mut reached = vec![false; r * r];
         for c in &cols {
             for l in 0..c.len() {
-                for (at, _, len) in c.row_pieces(l, r) {
-                    reached[at..at + len].iter_mut().for_each(|x| *x = true);
-                }
+                let (at, len, at2, len2) = c.row(l, r);
+                reached[at..at + len].iter_mut().for_each(|x| *x = true);
+                reached[at2..at2 + len2].iter_mut().for_each(|x| *x = true);
             }
         }
         let mut runs = Vec::new();
@@ -321,23 +339,21 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
                 // one pass per row: a Gₑⱼ + b uⱼ uⱼᵀ (packed rows of Gₑⱼ follow each other)
                 let mut p = 0;
                 for l in 0..me {
-                    let cu = b * uj[l];
-                    for (at, off, len) in c.row_pieces(l, r) {
-                        let (grow, urow) = (&g[p + off..p + off + len], &uj[l + off..l + off + len]);
-                        for ((o, &gv), &uv) in self.acc[at..at + len].iter_mut().zip(grow).zip(urow) {
-                            *o += a * f64::from(gv) + cu * uv;
-                        }
+                    let (at, len, at2, len2) = c.row(l, r);
+                    add_row(&mut self.acc[at..at + len], &g[p..p + len], &uj[l..l + len], a, b * uj[l]);
+                    if len2 > 0 {
+                        add_row(&mut self.acc[at2..at2 + len2], &g[p + len..p + len + len2], &uj[me - len2..me], a, b * uj[l]);
                     }
-                    p += me - l;
+                    p += len + len2;
                 }
                 // the mixed terms of models with several invariants
                 for jj in (0..nj).filter(|&jj| jj != j) {
                     let b = 4.0 * w * self.psi2[k * nj * nj + jj * nj + j];
                     let ujj = &self.u_el[(k * nj + jj) * r..(k * nj + jj) * r + me];
                     for l in 0..me {
-                        for (at, off, len) in c.row_pieces(l, r) {
-                            axpy(b * uj[l], &ujj[l + off..l + off + len], &mut self.acc[at..at + len]);
-                        }
+                        let (at, len, at2, len2) = c.row(l, r);
+                        axpy(b * uj[l], &ujj[l..l + len], &mut self.acc[at..at + len]);
+                        axpy(b * uj[l], &ujj[me - len2..me], &mut self.acc[at2..at2 + len2]);
                     }
                 }
             }
@@ -360,32 +376,29 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
             let u = |kk: usize| &self.u_el[kk * r..kk * r + me];
             let mut p = 0;
             if k + 1 < n && self.cols[k + 1] == c {
-                let ((a1, b1), (a2, b2)) = (coefs(k), coefs(k + 1));
+                let (ab1, ab2) = (coefs(k), coefs(k + 1));
                 let (g1, g2, u1, u2) = (g(k), g(k + 1), u(k), u(k + 1));
                 for l in 0..me {
-                    let (c1, c2) = (b1 * u1[l], b2 * u2[l]);
-                    for (at, off, len) in c.row_pieces(l, r) {
-                        let (q, v) = (p + off, l + off);
-                        let rows = g1[q..q + len].iter().zip(&g2[q..q + len]).zip(u1[v..v + len].iter().zip(&u2[v..v + len]));
-                        for (o, ((&x1, &x2), (&v1, &v2))) in self.acc[at..at + len].iter_mut().zip(rows) {
-                            *o += (a1 * f64::from(x1) + c1 * v1) + (a2 * f64::from(x2) + c2 * v2);
-                        }
+                    let (a, cu) = ((ab1.0, ab2.0), (ab1.1 * u1[l], ab2.1 * u2[l]));
+                    let (at, len, at2, len2) = c.row(l, r);
+                    add_row_pair(&mut self.acc[at..at + len], (&g1[p..p + len], &g2[p..p + len]), (&u1[l..l + len], &u2[l..l + len]), a, cu);
+                    if len2 > 0 {
+                        let (q, v) = (p + len, me - len2);
+                        add_row_pair(&mut self.acc[at2..at2 + len2], (&g1[q..q + len2], &g2[q..q + len2]), (&u1[v..me], &u2[v..me]), a, cu);
                     }
-                    p += me - l;
+                    p += len + len2;
                 }
                 k += 2;
             } else {
                 let (a1, b1) = coefs(k);
                 let (g1, u1) = (g(k), u(k));
                 for l in 0..me {
-                    let c1 = b1 * u1[l];
-                    for (at, off, len) in c.row_pieces(l, r) {
-                        let (q, v) = (p + off, l + off);
-                        for ((o, &x1), &v1) in self.acc[at..at + len].iter_mut().zip(&g1[q..q + len]).zip(&u1[v..v + len]) {
-                            *o += a1 * f64::from(x1) + c1 * v1;
-                        }
+                    let (at, len, at2, len2) = c.row(l, r);
+                    add_row(&mut self.acc[at..at + len], &g1[p..p + len], &u1[l..l + len], a1, b1 * u1[l]);
+                    if len2 > 0 {
+                        add_row(&mut self.acc[at2..at2 + len2], &g1[p + len..p + len + len2], &u1[me - len2..me], a1, b1 * u1[l]);
                     }
-                    p += me - l;
+                    p += len + len2;
                 }
                 k += 1;
             }
@@ -410,8 +423,14 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
             let me = ce.len();
             let cols = &self.vt_el[self.vt_off[k]..self.vt_off[k] + me * N];
             let mut x: [f64; N] = x_ref[k * N..(k + 1) * N].try_into().expect("N entries");
-            let qe = q[ce.a.0..ce.a.1].iter().chain(&q[ce.b.0..ce.b.1]);
-            for (c, &qa) in cols.chunks_exact(N).zip(qe) {
+            let (c1, c2) = cols.split_at(ce.n1() * N);
+            for (c, &qa) in c1.chunks_exact(N).zip(&q[ce.a.0..ce.a.1]) {
+                for i in 0..N {
+                    x[i] += qa * c[i];
+                }
+            }
+            // the second run, when there is one (a chained iterator would branch per column)
+            for (c, &qa) in c2.chunks_exact(N).zip(&q[ce.b.0..ce.b.1]) {
                 for i in 0..N {
                     x[i] += qa * c[i];
                 }
@@ -459,7 +478,9 @@ impl<M: InvariantElementModel> DynamicModel for HyperReducedModel<M> {
                 let f = 2.0 * w * self.psi[k * nj + j];
                 let u = &self.u_el[(k * nj + j) * r..(k * nj + j) * r + me];
                 axpy(f, &u[..n1], &mut out[c.a.0..c.a.1]);
-                axpy(f, &u[n1..], &mut out[c.b.0..c.b.1]);
+                if me > n1 {
+                    axpy(f, &u[n1..], &mut out[c.b.0..c.b.1]);
+                }
             }
         }
     }

@@ -362,12 +362,16 @@ impl Projection {
         let (a, n) = self.matrix();
         for &(i, j0, j1) in runs {
             let row = &upper[i * r..(i + 1) * r];
+            let j0 = if j0 == i {
+                a[i + n * i] += f * row[i];
+                i + 1
+            } else {
+                j0
+            };
             for j in j0..j1 {
                 let v = f * row[j];
                 a[i + n * j] += v;
-                if j != i {
-                    a[j + n * i] += v;
-                }
+                a[j + n * i] += v;
             }
         }
     }

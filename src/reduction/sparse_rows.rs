@@ -2,13 +2,15 @@
 //! linear stiffness of a block basis are block-diagonal apart from the kept coordinates'
 //! rows and columns, and their products with a vector run in every Newton iteration.
 
-use super::projection::dot;
+use super::projection::{dot, mat_vec};
 use ndarray::Array2;
 
 pub(crate) struct SparseRows {
     /// `(row, first column, offset in values, length)` of each run
     runs: Vec<(usize, usize, usize, usize)>,
     values: Vec<f64>,
+    /// the matrix itself when it has no zero runs worth skipping (a global basis)
+    dense: Option<Array2<f64>>,
 }
 
 impl SparseRows {
@@ -28,11 +30,16 @@ impl SparseRows {
                 j = end;
             }
         }
-        SparseRows { runs, values }
+        // below ~3/4 of the entries the runs pay for their bookkeeping
+        let dense = (4 * values.len() > 3 * a.len()).then(|| a.as_standard_layout().to_owned());
+        SparseRows { runs, values, dense }
     }
 
     /// `out (+)= A x`
     pub fn mul(&self, x: &[f64], out: &mut [f64], accumulate: bool) {
+        if let Some(a) = &self.dense {
+            return mat_vec(a, x, out, accumulate);
+        }
         if !accumulate {
             out.fill(0.0);
         }
@@ -47,7 +54,8 @@ mod tests {
     use super::*;
 
     /// A block matrix with zero blocks, a zero row and an isolated entry: the product
-    /// equals the dense one (ndarray's `dot`) to round-off, with and without accumulation.
+    /// equals the dense one (ndarray's `dot`) to round-off, with and without accumulation;
+    /// and so does that of a matrix without zeros, kept dense.
     #[test]
     fn product_equals_the_dense_one() {
         let a = Array2::from_shape_fn((7, 7), |(i, j)| {
@@ -66,5 +74,13 @@ mod tests {
         for (o, d) in out.iter().zip(&dense) {
             assert!((o - 2.0 * d).abs() < 1e-12);
         }
+        assert!(m.dense.is_none(), "stored by runs");
+        // a dense matrix is kept as it is, with the same product
+        let full = a.mapv(|v| v + 0.5);
+        let m = SparseRows::new(&full);
+        assert!(m.dense.is_some());
+        m.mul(&x, &mut out, false);
+        let d = full.dot(&ndarray::ArrayView1::from(&x));
+        assert!(out.iter().zip(&d).all(|(o, d)| (o - d).abs() < 1e-12));
     }
 }
