@@ -132,6 +132,22 @@ fn add_row(o: &mut [f64], g: &[f32], u: &[f64], a: f64, c: f64) {
     }
 }
 
+/// `acc += a Gₑ + b u uᵀ` on the element's columns `c`: one pass per row (the packed rows
+/// of `Gₑ`, upper triangle, follow each other).
+#[inline(always)]
+fn add_element(acc: &mut [f64], c: &Cols, r: usize, g: &[f32], u: &[f64], a: f64, b: f64) {
+    let me = c.len();
+    let mut p = 0;
+    for l in 0..me {
+        let (at, len, at2, len2) = c.row(l, r);
+        add_row(&mut acc[at..at + len], &g[p..p + len], &u[l..l + len], a, b * u[l]);
+        if len2 > 0 {
+            add_row(&mut acc[at2..at2 + len2], &g[p + len..p + len + len2], &u[me - len2..me], a, b * u[l]);
+        }
+        p += len + len2;
+    }
+}
+
 /// [`add_row`] for two elements at once.
 #[inline(always)]
 fn add_row_pair(o: &mut [f64], g: (&[f32], &[f32]), u: (&[f64], &[f64]), a: (f64, f64), c: (f64, f64)) {
@@ -336,16 +352,7 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
                 let b = 4.0 * w * self.psi2[k * nj * nj + j * nj + j];
                 let g = &self.g_el[self.g_off[k * nj + j]..];
                 let uj = &self.u_el[(k * nj + j) * r..(k * nj + j) * r + me];
-                // one pass per row: a Gₑⱼ + b uⱼ uⱼᵀ (packed rows of Gₑⱼ follow each other)
-                let mut p = 0;
-                for l in 0..me {
-                    let (at, len, at2, len2) = c.row(l, r);
-                    add_row(&mut self.acc[at..at + len], &g[p..p + len], &uj[l..l + len], a, b * uj[l]);
-                    if len2 > 0 {
-                        add_row(&mut self.acc[at2..at2 + len2], &g[p + len..p + len + len2], &uj[me - len2..me], a, b * uj[l]);
-                    }
-                    p += len + len2;
-                }
+                add_element(&mut self.acc, &c, r, g, uj, a, b);
                 // the mixed terms of models with several invariants
                 for jj in (0..nj).filter(|&jj| jj != j) {
                     let b = 4.0 * w * self.psi2[k * nj * nj + jj * nj + j];
@@ -391,15 +398,7 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
                 k += 2;
             } else {
                 let (a1, b1) = coefs(k);
-                let (g1, u1) = (g(k), u(k));
-                for l in 0..me {
-                    let (at, len, at2, len2) = c.row(l, r);
-                    add_row(&mut self.acc[at..at + len], &g1[p..p + len], &u1[l..l + len], a1, b1 * u1[l]);
-                    if len2 > 0 {
-                        add_row(&mut self.acc[at2..at2 + len2], &g1[p + len..p + len + len2], &u1[me - len2..me], a1, b1 * u1[l]);
-                    }
-                    p += len + len2;
-                }
+                add_element(&mut self.acc, &c, r, g(k), u(k), a1, b1);
                 k += 1;
             }
         }

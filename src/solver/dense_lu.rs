@@ -358,6 +358,8 @@ fn cholesky_lower(a: &mut [f64], inv_diag: &mut [f64], ld: usize, s: usize, m: u
             axpy(-c[0], c, colj);
         }
         let d = colj[0];
+        // written so that a NaN pivot fails too
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
         if !(d > 0.0) {
             return false;
         }
