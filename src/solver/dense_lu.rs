@@ -445,39 +445,45 @@ mod tests {
         }
     }
 
-    /// A block-diagonal matrix with a coupling border (blocks of 9, 7, 8 and 8, then 2 rows
-    /// coupled to all, like a per-body basis's Newton matrix with its joints) goes through
-    /// the bordered block Cholesky; it is diagonally dominant, hence positive definite; with one
-    /// diagonal entry made negative it is not, and the LU fallback takes it. Both give the
-    /// x that b was built from. Bound: round-off of a 34 × 34 solve, 1e-12.
+    /// A block-diagonal matrix (blocks of 9, 7, 8 and 8) with a coupling border of k = 2
+    /// rows, like a block basis's Newton matrix with its joints, and without one (k = 0):
+    /// the blocks and the border are found from the zero pattern and factored block by
+    /// block; the matrix is diagonally dominant, hence positive definite. With one diagonal
+    /// entry made negative it is not: the LU fallback takes the matrix restored from its
+    /// upper triangle. All give the x that b was built from. Bound: round-off of a 34 × 34
+    /// solve, 1e-12.
     #[test]
-    fn block_arrow_systems_by_the_envelope_cholesky_or_the_lu_fallback() {
-        let (n, blocks) = (34, [0usize, 9, 16, 24, 32]);
-        let block = |i: usize| blocks.iter().rposition(|&b| i >= b).expect("in a block");
-        let entry = |i: usize, j: usize| -> f64 {
-            let coupled = block(i) == block(j) || i >= 32 || j >= 32;
-            match (i == j, coupled) {
-                (true, _) => 20.0 + i as f64,
-                (false, true) => ((i * j + 3 * (i + j)) % 7) as f64 / 7.0 - 0.4,
-                (false, false) => 0.0,
-            }
-        };
-        let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.9).cos() + 0.1).collect();
-        for (flip, kind) in [(false, Factors::Bordered), (true, Factors::Lu)] {
-            let a = |i: usize, j: usize| if flip && i == 7 && j == 7 { -entry(i, j) } else { entry(i, j) };
-            let mut lu = DenseLu::new(n);
-            let m = lu.matrix_mut();
-            for j in 0..n {
-                for i in 0..n {
-                    m[i + n * j] = a(i, j);
+    fn bordered_block_systems_by_blocks_or_the_lu_fallback() {
+        let blocks = [0usize, 9, 16, 24, 32];
+        for k in [2, 0] {
+            let n = 32 + k;
+            let block = |i: usize| blocks.iter().rposition(|&b| i >= b).expect("in a block");
+            let entry = |i: usize, j: usize| -> f64 {
+                let coupled = block(i) == block(j) || i >= 32 || j >= 32;
+                match (i == j, coupled) {
+                    (true, _) => 20.0 + i as f64,
+                    (false, true) => ((i * j + 3 * (i + j)) % 7) as f64 / 7.0 - 0.4,
+                    (false, false) => 0.0,
                 }
-            }
-            let mut b: Vec<f64> = (0..n).map(|i| (0..n).map(|j| a(i, j) * x[j]).sum()).collect();
-            lu.factor_symmetric().unwrap();
-            assert_eq!(lu.factored, Some(kind));
-            lu.solve(&mut b).unwrap();
-            for (bi, xi) in b.iter().zip(&x) {
-                assert!((bi - xi).abs() < 1e-12, "{kind:?}: {b:?}");
+            };
+            let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.9).cos() + 0.1).collect();
+            for (flip, kind) in [(false, Factors::Bordered), (true, Factors::Lu)] {
+                let a = |i: usize, j: usize| if flip && i == 7 && j == 7 { -entry(i, j) } else { entry(i, j) };
+                let mut lu = DenseLu::new(n);
+                let m = lu.matrix_mut();
+                for j in 0..n {
+                    for i in 0..n {
+                        m[i + n * j] = a(i, j);
+                    }
+                }
+                let mut b: Vec<f64> = (0..n).map(|i| (0..n).map(|j| a(i, j) * x[j]).sum()).collect();
+                lu.factor_symmetric().unwrap();
+                assert_eq!(lu.factored, Some(kind), "k = {k}");
+                assert_eq!((&lu.blocks[..], lu.border), (&blocks[..], 32), "k = {k}");
+                lu.solve(&mut b).unwrap();
+                for (bi, xi) in b.iter().zip(&x) {
+                    assert!((bi - xi).abs() < 1e-12, "k = {k}, {kind:?}: {b:?}");
+                }
             }
         }
     }
