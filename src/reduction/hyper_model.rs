@@ -13,10 +13,11 @@
 //!
 //! The force takes the element route (4 ne r flops per element and invariant); the tangent
 //! takes the `Gₑⱼ` route (r² instead of the 16 r² of `Vₑᵀ Kₑ Vₑ`), as the issue's
-//! `G_e = Φ_eᵀ S_l Φ_e` suggests. Each element keeps only the columns of `V` it sees
-//! (unreduced joint coordinates are unit columns that touch one or two elements) and the
-//! upper triangle of `Gₑⱼ`, packed: on the thesis four-bar that is 1275 instead of 3844
-//! numbers per element, read once per tangent. `Gₑⱼ` is stored in single precision: it
+//! `G_e = Φ_eᵀ S_l Φ_e` suggests. Each element keeps only the columns of `V` it sees, as at
+//! most two runs (unreduced joint coordinates are unit columns that touch one or two
+//! elements; a block basis gives an element its own block's modes) and the upper triangle
+//! of `Gₑⱼ`, packed: on the thesis four-bar with a global basis that is 1275 instead of 3844
+//! numbers per element, with one block per body ~700 on the coupler, read once per tangent. `Gₑⱼ` is stored in single precision: it
 //! enters only the Newton matrix, where a relative error of 6e-8 changes how Newton gets
 //! to the solution, not where it stops (the force is summed in double precision); it halves
 //! the tangent's memory traffic (four-bar at 30 %: 7 → 3.5 MB per tangent). Work space is

@@ -56,7 +56,6 @@ const BORDERED_SHARE: f64 = 0.6;
 /// What one more diagonal block costs beyond its flops (calls, short loops), in flops.
 const BLOCK_OVERHEAD: f64 = 400.0;
 
-
 impl DenseLu {
     pub fn new(n: usize) -> Self {
         let req = StackReq::any_of(&[
@@ -95,7 +94,7 @@ impl DenseLu {
 
     /// Factors a symmetric matrix as `L Lᵀ` when it is positive definite, else by LU like
     /// [`Self::factor`]; in bordered block form when that saves flops. Every matrix is
-    /// tried by Cholesky first: on the block-basis four-bar, 44 of its ~900 Newton
+    /// tried by Cholesky first: on the block-basis four-bar, 44 of its ~620 Newton
     /// matrices are indefinite, one at a time, so going on with LU after a failure (16 in
     /// a row was tried) cost more than the failed attempts. A dense attempt works on a
     /// copy: faer's Cholesky may write the upper triangle too.
