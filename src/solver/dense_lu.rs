@@ -27,7 +27,9 @@ pub struct DenseLu {
     perm_inv: Vec<usize>,
     mem: MemBuffer,
     factored: Option<Factors>,
-    /// the matrix as filled, kept while a Cholesky factorization is tried
+    /// the matrix as filled, kept while a dense Cholesky factorization is tried; the
+    /// bordered one keeps only the diagonal here (its first n entries), as it leaves the
+    /// upper triangle as filled
     copy: Vec<f64>,
     /// the first nonzero column of each row's lower triangle
     first: Vec<usize>,
