@@ -32,7 +32,7 @@ fn main() {
         let path = Path::new(dir).join(file);
         if !path.exists() {
             panic!(
-                "{} not found: install the Debian packages libopenblas-dev and libhdf5-dev (`make deps` does)",
+                "{} not found: install the Debian packages libopenblas-dev (with its default libopenblas-pthread-dev) and libhdf5-dev (`make deps` does)",
                 path.display()
             );
         }
