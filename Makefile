@@ -3,13 +3,15 @@
 #               systems, writing reports/pendulum and reports/fourbar (installs packages first)
 #   make test   the whole test suite, release build
 # The system libraries (HDF5, OpenBLAS) are installed through apt when missing, as root or
-# through sudo. h5py (for the Python read-back test and the README's plotting example) is
-# installed with pip when python3 is there and h5py is not; without network it is skipped.
+# through sudo; they are linked statically (build.rs, docs/startup.md), and gfortran brings
+# libgfortran.a for OpenBLAS's LAPACK (without it the shared libgfortran.so.5 is linked).
+# h5py (for the Python read-back test and the README's plotting example) is installed with
+# pip when python3 is there and h5py is not; without network it is skipped.
 
-SYSTEM_PACKAGES := libhdf5-dev libopenblas-dev pkg-config
+SYSTEM_PACKAGES := libhdf5-dev libopenblas-dev pkg-config gfortran
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: run test bench deps thesis
+.PHONY: run test bench bench-exudyn deps thesis
 
 deps:
 	@missing=""; \
@@ -35,6 +37,12 @@ bench: deps
 	cargo build --release
 	cargo bench --bench full_order
 	cargo bench --bench online
+
+# the pendulum in Exudyn (in-process) and flexrom (whole process), side by side
+bench-exudyn: deps
+	cargo build --release
+	@python3 -c "import exudyn, h5py" 2>/dev/null || python3 -m pip install --quiet exudyn==1.13.6 h5py numpy
+	python3 benches/exudyn/pendulum.py
 
 # the README's thesis table
 thesis: deps
