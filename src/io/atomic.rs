@@ -108,10 +108,18 @@ fn unique_sibling(dir: &Path, name: &str, tag: &str) -> PathBuf {
     }
 }
 
+/// False for a path whose last segment is `.`, `..`, empty or the root (`Path::components`
+/// drops a trailing `.`, so the text is split here).
+pub fn names_an_entry(p: &Path) -> bool {
+    use std::os::unix::ffi::OsStrExt;
+    let last = p.as_os_str().as_bytes().split(|&b| b == b'/').rfind(|seg| !seg.is_empty());
+    !matches!(last, None | Some(b".") | Some(b".."))
+}
+
 /// The folder and file name of a target path (`""` parent → `.`).
 fn split(target: &Path) -> Result<(PathBuf, String)> {
     let name = match target.file_name() {
-        Some(n) if !matches!(target.components().next_back(), Some(std::path::Component::ParentDir | std::path::Component::CurDir)) => n,
+        Some(n) if names_an_entry(target) => n,
         _ => return Err(Error::input(target, "output path", "does not end in a file name")),
     };
     let dir = match target.parent() {

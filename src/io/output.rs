@@ -8,7 +8,7 @@
 //! its mark lists (and flexrom's own temporary files); anything else is the user's and is
 //! refused with an error naming the folder and the pipeline key `report`.
 
-use super::atomic::{kind_of, swap_in_dir, write_bytes_atomically, write_new, TempPath};
+use super::atomic::{kind_of, names_an_entry, swap_in_dir, write_bytes_atomically, write_new, TempPath};
 use crate::error::{Error, Result};
 use std::os::unix::fs::MetadataExt;
 use std::path::{Component, Path, PathBuf};
@@ -71,7 +71,7 @@ fn identity(p: &Path) -> Option<(u64, u64)> {
 /// path whose nearest existing ancestor is not a folder. Missing folders are created at
 /// write time ([`super::atomic::TempPath::file_for`]), for every command alike.
 pub fn check_output(output: &Path, origin: Origin, inputs: &[(&Path, &str)]) -> Result<()> {
-    if output.as_os_str().is_empty() || matches!(output.components().next_back(), None | Some(Component::CurDir | Component::ParentDir | Component::RootDir)) {
+    if !names_an_entry(output) {
         return Err(origin.error(output, "does not name a file"));
     }
     match std::fs::symlink_metadata(output) {
@@ -120,7 +120,7 @@ fn contains(a: &Path, b: &Path) -> bool {
 /// its mark does not list.
 pub fn check_report_dir(report: &Path, pipeline: &Path, inputs: &[(&Path, &str)]) -> Result<()> {
     let origin = Origin::Key { pipeline, key: "report" };
-    if report.as_os_str().is_empty() || matches!(report.components().next_back(), None | Some(Component::CurDir | Component::ParentDir | Component::RootDir)) {
+    if !names_an_entry(report) {
         return Err(origin.error(report, "names `.`, `..` or `/`, not a folder of its own; flexrom replaces the report folder as a whole"));
     }
     let r = resolve(report);
