@@ -3,7 +3,7 @@
 //! in a temporary folder, on a tiny copy of data/models/pendulum.toml (t_end shortened) and
 //! a pipeline written here; nothing is compared with stored numbers. The expected outcome of
 //! every case is the guarantee itself:
-//! - refused report folders (`.`, `..`, the pipeline's folder, a folder holding user files,
+//! - refused report folders (`.`, `..`, `/`, `/usr`, the pipeline's folder, a folder holding user files,
 //!   unmarked or marked): non-zero exit, an error naming the pipeline key `report`, and
 //!   every file of the temporary tree (listing and bytes) exactly as before;
 //! - outputs that are an input (the same path, through `..`, a symlink, a hard link) or not a
@@ -59,10 +59,6 @@ fn run(args: &[&Path]) -> Output {
         c.arg(a);
     }
     c.output().unwrap()
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
 }
 
 /// Every entry below `root`: path → bytes (files), `<dir>` / `<link …>` / `<other>`.
@@ -131,6 +127,7 @@ fn report_folders_that_are_not_flexroms_own_are_refused_and_nothing_is_deleted()
         ("../link", "symbolic link"),
         ("../file.txt", "not a folder"),
         ("/", "`/`"),
+        ("/usr", "top-level"),
         ("../proj/..", "names `.`"),
     ] {
         let p = project(root, report, "[1.0]", &model);

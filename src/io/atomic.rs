@@ -129,6 +129,29 @@ fn split(target: &Path) -> Result<(PathBuf, String)> {
     Ok((dir, name.to_string_lossy().into_owned()))
 }
 
+/// Creates `dir` and its missing ancestors, `fsync`ing the parent of each one made so the
+/// new entries survive a power cut.
+pub fn create_dirs(dir: &Path) -> Result<()> {
+    if dir.is_dir() {
+        return Ok(());
+    }
+    let mut missing = Vec::new();
+    let mut a = Some(dir);
+    while let Some(d) = a.filter(|d| !d.as_os_str().is_empty() && std::fs::symlink_metadata(d).is_err()) {
+        missing.push(d.to_path_buf());
+        a = d.parent();
+    }
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    for d in missing.iter().rev() {
+        let parent = match d.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
+        };
+        sync_path(parent)?;
+    }
+    Ok(())
+}
+
 /// `fsync` of a file or folder: its data and metadata are on disk when this returns.
 pub fn sync_path(p: &Path) -> Result<()> {
     std::fs::File::open(p).and_then(|f| f.sync_all()).map_err(|e| Error::io(p, e))
@@ -183,7 +206,7 @@ impl TempPath {
         let target = follow_symlink(target)?;
         check_replaceable(&target)?;
         let (dir, name) = split(&target)?;
-        std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+        create_dirs(&dir)?;
         let mut v = live();
         let tmp = unique_sibling(&dir, &name, "flexrom-tmp");
         v.push(Live::File(tmp.clone()));
@@ -193,7 +216,7 @@ impl TempPath {
     /// Creates a temporary folder beside `target` (whose parent is created when missing).
     pub fn dir_for(target: &Path) -> Result<TempPath> {
         let (dir, name) = split(target)?;
-        std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+        create_dirs(&dir)?;
         let mut v = live();
         let tmp = unique_sibling(&dir, &name, "flexrom-tmp");
         // registered before it exists: a signal between the two steps still removes it

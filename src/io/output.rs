@@ -142,6 +142,9 @@ pub fn check_report_dir(report: &Path, pipeline: &Path, inputs: &[(&Path, &str)]
             return Err(origin.error(report, format!("{rel} {what}; flexrom replaces the report folder as a whole, so it must be a folder of its own")));
         }
     }
+    if r.components().filter(|c| matches!(c, Component::Normal(_))).count() < 2 {
+        return Err(origin.error(report, format!("is the top-level folder `{}`; a report folder must be a folder of its own", r.display())));
+    }
     match std::fs::symlink_metadata(report) {
         Err(_) => Ok(()),
         Ok(m) if m.file_type().is_symlink() => Err(origin.error(report, "is a symbolic link; flexrom only replaces report folders it made itself")),
