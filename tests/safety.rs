@@ -126,6 +126,7 @@ fn report_folders_that_are_not_flexroms_own_are_refused_and_nothing_is_deleted()
         ("../marked", "mine.txt"),
         ("../link", "symbolic link"),
         ("../file.txt", "not a folder"),
+        ("../file.txt/sub", "cannot be created"),
         ("/", "`/`"),
         ("/usr", "top-level"),
         ("../proj/..", "names `.`"),

@@ -49,7 +49,13 @@ fn clean_up(v: &mut Vec<Live>) {
                 let _ = std::fs::remove_file(p);
             }
             Live::Dir(p) => {
-                let _ = std::fs::remove_dir_all(p);
+                // the interrupted thread may still be creating a file in it (ENOTEMPTY)
+                for _ in 0..50 {
+                    if std::fs::remove_dir_all(&p).is_ok() || std::fs::symlink_metadata(&p).is_err() {
+                        break;
+                    }
+                    std::thread::sleep(std::time::Duration::from_millis(2));
+                }
             }
             Live::Aside { aside, target } => {
                 if std::fs::symlink_metadata(&target).is_err() {
@@ -206,8 +212,10 @@ impl TempPath {
         let target = follow_symlink(target)?;
         check_replaceable(&target)?;
         let (dir, name) = split(&target)?;
-        create_dirs(&dir)?;
+        // the lock first: after a signal's clean-up (which keeps the lock until the exit) no
+        // folder is made again
         let mut v = live();
+        create_dirs(&dir)?;
         let tmp = unique_sibling(&dir, &name, "flexrom-tmp");
         v.push(Live::File(tmp.clone()));
         Ok(TempPath { live: Live::File(tmp), target, armed: true })
@@ -216,15 +224,15 @@ impl TempPath {
     /// Creates a temporary folder beside `target` (whose parent is created when missing).
     pub fn dir_for(target: &Path) -> Result<TempPath> {
         let (dir, name) = split(target)?;
-        create_dirs(&dir)?;
         let mut v = live();
+        create_dirs(&dir)?;
         let tmp = unique_sibling(&dir, &name, "flexrom-tmp");
         // registered before it exists: a signal between the two steps still removes it
         v.push(Live::Dir(tmp.clone()));
+        let made = std::fs::create_dir(&tmp).map_err(|e| Error::io(&tmp, e));
         drop(v);
         let t = TempPath { live: Live::Dir(tmp.clone()), target: target.to_path_buf(), armed: true };
-        std::fs::create_dir(&tmp).map_err(|e| Error::io(&tmp, e))?;
-        Ok(t)
+        made.map(|_| t)
     }
 
     /// The temporary path to write.
@@ -339,35 +347,45 @@ pub fn swap_in_dir(mut tmp: TempPath, may_replace: impl Fn(&Path) -> Result<()>)
     };
     let (parent, name) = split(&target)?;
     sync_tree(&src)?;
-    let old = match std::fs::symlink_metadata(&target) {
+    if std::fs::symlink_metadata(&target).is_ok() {
+        // checked again now, right before it is moved: it may have changed during the run
+        may_replace(&target)?;
+    }
+    // the renames happen under the registry lock, so a signal's clean-up sees either the old
+    // folder in place or the new one with the old one registered as moved aside
+    let mut v = live();
+    let aside = match std::fs::symlink_metadata(&target) {
         Ok(_) => {
-            // checked again now, right before it is moved: it may have changed during the run
-            may_replace(&target)?;
-            let mut v = live();
             let aside = unique_sibling(&parent, &name, "flexrom-old");
-            let l = Live::Aside { aside: aside.clone(), target: target.clone() };
             std::fs::rename(&target, &aside).map_err(|e| Error::io(&target, e))?;
-            v.push(l.clone());
-            Some(l)
+            Some(aside)
         }
         Err(_) => None,
     };
     if let Err(e) = std::fs::rename(&src, &target) {
         // put the old one back; the new one is removed by tmp's Drop
-        if let Some(l @ Live::Aside { aside, .. }) = &old {
-            let _ = std::fs::rename(aside, &target);
-            unregister(l);
+        if let Some(a) = &aside {
+            let _ = std::fs::rename(a, &target);
         }
+        drop(v);
         return Err(Error::io(&target, e));
     }
-    tmp.disarm();
-    sync_path(&parent)?;
+    if let Some(i) = v.iter().position(|x| x == &tmp.live) {
+        v.swap_remove(i);
+    }
+    tmp.armed = false;
+    let old = aside.map(|a| Live::Aside { aside: a, target: target.clone() });
+    if let Some(l) = &old {
+        v.push(l.clone());
+    }
+    drop(v);
+    let synced = sync_path(&parent);
     if let Some(l @ Live::Aside { aside, .. }) = &old {
         let r = std::fs::remove_dir_all(aside).map_err(|e| Error::io(aside, e));
         unregister(l);
         r?;
     }
-    Ok(())
+    synced
 }
 
 #[cfg(test)]

@@ -82,17 +82,7 @@ pub fn check_output(output: &Path, origin: Origin, inputs: &[(&Path, &str)]) -> 
         },
         Ok(m) if !m.is_file() => return Err(origin.error(output, format!("exists and is {}, not a regular file; flexrom only replaces regular files", kind_of(&m)))),
         Ok(_) => {}
-        Err(_) => {
-            // the nearest existing ancestor must be a folder for the missing ones to be made
-            let mut a = resolve(output);
-            while a.pop() {
-                match std::fs::metadata(&a) {
-                    Ok(m) if m.is_dir() => break,
-                    Ok(m) => return Err(origin.error(output, format!("cannot be created: `{}` is {}, not a folder", a.display(), kind_of(&m)))),
-                    Err(_) => {}
-                }
-            }
-        }
+        Err(_) => creatable(output, origin)?,
     }
     let out_id = identity(output);
     let out_path = resolve(output);
@@ -103,6 +93,20 @@ pub fn check_output(output: &Path, origin: Origin, inputs: &[(&Path, &str)]) -> 
         };
         if same {
             return Err(origin.error(output, format!("is the {what} `{}` (the same file); flexrom never writes over a command's input", input.display())));
+        }
+    }
+    Ok(())
+}
+
+/// The nearest existing ancestor of a missing `path` must be a folder for the missing
+/// ones to be made.
+fn creatable(path: &Path, origin: Origin) -> Result<()> {
+    let mut a = resolve(path);
+    while a.pop() {
+        match std::fs::metadata(&a) {
+            Ok(m) if m.is_dir() => return Ok(()),
+            Ok(m) => return Err(origin.error(path, format!("cannot be created: `{}` is {}, not a folder", a.display(), kind_of(&m)))),
+            Err(_) => {}
         }
     }
     Ok(())
@@ -146,7 +150,7 @@ pub fn check_report_dir(report: &Path, pipeline: &Path, inputs: &[(&Path, &str)]
         return Err(origin.error(report, format!("is the top-level folder `{}`; a report folder must be a folder of its own", r.display())));
     }
     match std::fs::symlink_metadata(report) {
-        Err(_) => Ok(()),
+        Err(_) => creatable(report, origin),
         Ok(m) if m.file_type().is_symlink() => Err(origin.error(report, "is a symbolic link; flexrom only replaces report folders it made itself")),
         Ok(m) if !m.is_dir() => Err(origin.error(report, format!("exists and is {}, not a folder", kind_of(&m)))),
         Ok(_) => check_marked(report, origin),
