@@ -11,8 +11,10 @@
 //! - missing output folders are created by every writing command;
 //! - SIGTERM / SIGINT during `run`: exit 143 / 130, no temporary file or folder left, the
 //!   previous basis and report unchanged;
+//! - SIGTERM during a long `simulate`: exit 143, the previous result file unchanged;
 //! - a `run` whose sweep stage fails (Newton limited to 4 iterations without step cuts, at
-//!   load scale 100 after training at 0.1) keeps the previous basis and report.
+//!   load scale 100 after training at 0.1) keeps the previous basis and report, and so does
+//!   a `train` that fails.
 
 use std::collections::BTreeMap;
 use std::io::{BufRead, BufReader};
@@ -178,6 +180,12 @@ fn a_marked_report_is_replaced_and_a_failed_later_stage_keeps_the_previous_basis
     let err = fails_with(&o, &["Newton failed"]);
     assert!(err.contains("[2/3]"), "the training stage passed: {err}");
     assert_eq!(snapshot(root), expected, "basis or report changed by a failed run");
+    // `train` whose training run fails (load scale 100) keeps the previous basis too
+    let text = std::fs::read_to_string(&p).unwrap().replace("load_scales = [0.1]\n[reduction]", "load_scales = [100.0]\n[reduction]");
+    std::fs::write(&p, &text).unwrap();
+    expected.insert(p.clone(), text.into_bytes());
+    fails_with(&run(&[Path::new("train"), &p]), &["Newton failed"]);
+    assert_eq!(snapshot(root), expected, "basis changed by a failed train");
 }
 
 #[test]
@@ -209,6 +217,7 @@ fn outputs_that_are_inputs_or_not_regular_files_are_refused() {
         (sim(&root.join("to_dir.h5")), &["symbolic link to a directory"]),
         (sim(&root.join("dangling.h5")), &["dangling"]),
         (sim(Path::new("/dev/null")), &["character device"]),
+        (sim(&root.join("newdir/")), &["names a folder"]),
         (sim(&root.join("hard.h5/x.h5")), &["not a folder"]),
         (online(&basis), &["basis file"]),
         (online(&root.join("to_basis.h5")), &["basis file"]),
@@ -322,5 +331,24 @@ fn a_killed_run_leaves_no_temporary_files_and_the_previous_outputs_unchanged() {
     let (code, err) = kill_run(root, &p, "[1/3]", &[".rep.flexrom-tmp-"], "INT");
     assert_eq!(code, Some(130), "{err}");
     assert!(leftovers(root).is_empty(), "{:?}", leftovers(root));
+    assert_eq!(snapshot(root), before);
+}
+
+#[test]
+fn a_killed_simulate_keeps_the_previous_result() {
+    let d = tempfile::tempdir().unwrap();
+    let root = d.path();
+    let model = root.join("m.toml");
+    // 10 000 steps: seconds of work, stopped after 300 ms
+    std::fs::write(&model, model_text(50.0, "")).unwrap();
+    let out = root.join("out.h5");
+    std::fs::write(&out, b"previous result").unwrap();
+    let before = snapshot(root);
+    let mut child = flexrom().arg("simulate").arg(&model).arg("-o").arg(&out).stderr(Stdio::piped()).spawn().unwrap();
+    std::thread::sleep(Duration::from_millis(300));
+    assert!(child.try_wait().unwrap().is_none(), "simulate ended before it could be stopped");
+    assert!(Command::new("kill").arg("-TERM").arg(child.id().to_string()).status().unwrap().success());
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(143), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(snapshot(root), before);
 }

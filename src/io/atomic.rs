@@ -79,14 +79,14 @@ pub fn live_paths() -> Vec<PathBuf> {
         .collect()
 }
 
-/// Installs the SIGINT/SIGTERM handler: a thread (signal-hook) that, on the first signal,
+/// Installs the SIGINT/SIGTERM (and SIGHUP: a closed terminal) handler: a thread (signal-hook) that, on the first signal,
 /// takes the registry lock (so no new temporary path can be registered), removes every live
 /// temporary path and ends the process with `_exit(128 + signal)`. `_exit` skips the HDF5
 /// library's exit handlers, which could wait for a lock held by the interrupted writer.
 pub fn install_signal_handler() -> Result<()> {
-    use signal_hook::consts::{SIGINT, SIGTERM};
-    let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM])
-        .map_err(|e| Error::Usage(format!("cannot install the SIGINT/SIGTERM handler: {e}")))?;
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP])
+        .map_err(|e| Error::Usage(format!("cannot install the SIGINT/SIGTERM/SIGHUP handler: {e}")))?;
     std::thread::Builder::new()
         .name("flexrom-signals".into())
         .spawn(move || {
@@ -94,7 +94,11 @@ pub fn install_signal_handler() -> Result<()> {
                 let mut v = live();
                 let n = v.len();
                 clean_up(&mut v);
-                let name = if sig == SIGINT { "SIGINT" } else { "SIGTERM" };
+                let name = match sig {
+                    SIGINT => "SIGINT",
+                    SIGHUP => "SIGHUP",
+                    _ => "SIGTERM",
+                };
                 eprintln!("flexrom: stopped by {name}; {n} temporary path(s) removed, previous outputs left as they were");
                 signal_hook::low_level::exit(128 + sig);
             }

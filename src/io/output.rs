@@ -74,6 +74,9 @@ pub fn check_output(output: &Path, origin: Origin, inputs: &[(&Path, &str)]) -> 
     if !names_an_entry(output) {
         return Err(origin.error(output, "does not name a file"));
     }
+    if output.as_os_str().to_string_lossy().ends_with('/') {
+        return Err(origin.error(output, "ends in `/`, which names a folder, not a file"));
+    }
     match std::fs::symlink_metadata(output) {
         Ok(m) if m.file_type().is_symlink() => match std::fs::metadata(output) {
             Ok(t) if !t.is_file() => return Err(origin.error(output, format!("is a symbolic link to {}, not to a regular file; flexrom only replaces regular files", kind_of(&t)))),
