@@ -7,6 +7,8 @@ use flexrom::pipeline::Pipeline;
 use flexrom::model::Model;
 use flexrom::simulate::{simulate, Overrides};
 use flexrom::solver::kkt::LinearSolverKind;
+use flexrom::io::atomic::TempPath;
+use flexrom::io::output::{check_output, check_report_dir, claim_in_report, Origin};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -135,6 +137,11 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // from here on SIGINT/SIGTERM remove flexrom's temporary files and exit with 130/143
+    if let Err(e) = flexrom::io::atomic::install_signal_handler() {
+        eprintln!("error: {e}");
+        return ExitCode::FAILURE;
+    }
     flexrom::single_threaded_blas();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
@@ -148,8 +155,8 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> flexrom::Result<()> {
     match cli.command {
         Command::Simulate { model, output, run, csv } => {
+            check_output(&output, Origin::Flag("-o"), &[(&model, "model file")])?;
             let model = Model::load(&model)?;
-            check_output_dir(&output)?;
             let r = simulate(&model, &run.overrides())?;
             write_result(&output, &r)?;
             eprintln!(
@@ -169,8 +176,15 @@ fn run(cli: Cli) -> flexrom::Result<()> {
         }
         Command::Train { pipeline, basis } => {
             let p = Pipeline::load(&pipeline)?;
-            let out = basis.unwrap_or_else(|| p.basis_path.clone());
-            let s = flexrom::pipeline::train::train_and_write(&p, &out)?;
+            let origin = if basis.is_some() { Origin::Flag("--basis") } else { Origin::Key { pipeline: &p.path, key: "basis" } };
+            let out = basis.clone().unwrap_or_else(|| p.basis_path.clone());
+            check_output(&out, origin, &[(&p.path, "pipeline file"), (&p.model.path, "model file")])?;
+            // trained into a temporary file, read back and checked, and only then renamed over
+            // the previous basis
+            let staged = TempPath::file_for(&out)?;
+            let s = flexrom::pipeline::train::train_and_write(&p, staged.path())?;
+            load_basis(&p, staged.path())?;
+            staged.commit()?;
             let b = &s.trained.basis;
             eprintln!(
                 "{}: {} snapshots from {} full run(s) ({:.3} s); {} basis, {} snapshots, {} POD modes{} (captured energy 1 − {:.2e}) -> {}",
@@ -189,9 +203,9 @@ fn run(cli: Cli) -> flexrom::Result<()> {
         }
         Command::Online { pipeline, load_scale, output, basis } => {
             let p = Pipeline::load(&pipeline)?;
-            check_output_dir(&output)?;
             check_scale(load_scale)?;
             let path = basis.unwrap_or_else(|| p.basis_path.clone());
+            check_output(&output, Origin::Flag("-o"), &[(&p.path, "pipeline file"), (&p.model.path, "model file"), (&path, "basis file")])?;
             let stored = load_basis(&p, &path)?;
             let run = run_reduced(&p.model, &stored.basis, load_scale)?;
             let basis_name = path.display().to_string();
@@ -235,18 +249,23 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                 Some(s) => flexrom::pipeline::config::parse_range(&s).map_err(|e| flexrom::Error::Usage(format!("--load-scales: {e}")))?,
                 None => p.online_scales(),
             };
-            let out = match output {
-                Some(o) => o,
-                None => {
-                    std::fs::create_dir_all(&p.report_dir).map_err(|e| flexrom::Error::io(&p.report_dir, e))?;
-                    p.report_dir.join("sweep.h5")
-                }
-            };
-            check_output_dir(&out)?;
             let path = basis.unwrap_or_else(|| p.basis_path.clone());
+            let inputs = [(p.path.as_path(), "pipeline file"), (p.model.path.as_path(), "model file"), (path.as_path(), "basis file")];
+            // the default goes into the pipeline's report folder, which must then be flexrom's
+            let in_report = output.is_none();
+            let out = output.unwrap_or_else(|| p.report_dir.join("sweep.h5"));
+            if in_report {
+                check_report_dir(&p.report_dir, &p.path, &inputs)?;
+                check_output(&out, Origin::Key { pipeline: &p.path, key: "report" }, &inputs)?;
+            } else {
+                check_output(&out, Origin::Flag("-o"), &inputs)?;
+            }
             let stored = load_basis(&p, &path)?;
             let options = flexrom::pipeline::sweep::SweepOptions { validate, continuation, progress: true };
             let sw = flexrom::pipeline::sweep::sweep(&p.model, &stored.basis, &scales, options)?;
+            if in_report {
+                claim_in_report(&p.report_dir, &p.path, "sweep.h5")?;
+            }
             flexrom::pipeline::sweep::write_sweep(&out, &sw, &stored.basis, &path)?;
             print!("{}", flexrom::pipeline::sweep::table(&sw));
             eprintln!("{} load scales on {} threads in {:.3} s -> {}", scales.len(), sw.threads, sw.wall_seconds, out.display());
@@ -290,15 +309,6 @@ fn check_scale(x: f64) -> flexrom::Result<()> {
     } else {
         Err(flexrom::Error::Usage(format!("--load-scale must be finite, got {x}")))
     }
-}
-
-fn check_output_dir(output: &std::path::Path) -> flexrom::Result<()> {
-    if let Some(d) = output.parent() {
-        if !d.as_os_str().is_empty() && !d.is_dir() {
-            return Err(flexrom::Error::input(output, "-o", format!("directory `{}` does not exist", d.display())));
-        }
-    }
-    Ok(())
 }
 
 fn print_csv(r: &flexrom::simulate::SimulationResult) {

@@ -2,36 +2,22 @@
 
 use crate::error::{Error, Result};
 use hdf5::types::VarLenUnicode;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-/// Creates `path` atomically: `fill` writes into a temporary file beside it, which is renamed
-/// over `path` only when `fill` succeeds, so a failed run never leaves a half-written file
-/// nor destroys a previous good one.
+/// Creates `path` atomically and durably: `fill` writes into a temporary file beside it
+/// (unique name, created exclusively, registered for removal on SIGINT/SIGTERM), which is
+/// closed, `fsync`ed and renamed over `path` only when `fill` succeeds, then the folder is
+/// `fsync`ed ([`super::atomic`]). A failed run never leaves a half-written file nor destroys a
+/// previous good one; a missing folder is created.
 pub fn write_atomically(path: &Path, fill: impl FnOnce(&hdf5::File) -> Result<()>) -> Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    if !dir.is_dir() {
-        return Err(Error::input(path, "output path", format!("directory `{}` does not exist", dir.display())));
-    }
-    let name = path.file_name().ok_or_else(|| Error::input(path, "output path", "is not a file name"))?;
-    // unique per process and call: two writes of one path in one process (threads, or a
-    // test that trains twice) never share a temporary file
-    static CALLS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let tmp = dir.join(format!(".{}.tmp-{}-{call}", name.to_string_lossy(), std::process::id()));
-    let result = (|| {
-        let file = hdf5::File::create(&tmp).map_err(|e| Error::hdf5(path, format!("cannot create: {e}")))?;
+    super::atomic::write_file_atomically(path, |tmp| {
+        let file = hdf5::File::create_excl(tmp).map_err(|e| Error::hdf5(path, format!("cannot create: {e}")))?;
         fill(&file)?;
         file.flush().map_err(|e| Error::hdf5(path, e))?;
+        // closed before the fsync and the rename (the last handle closes the file)
         drop(file);
-        std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e))
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
+        Ok(())
+    })
 }
 
 pub fn attr_str(loc: &hdf5::Location, name: &str, value: &str) -> hdf5::Result<()> {

@@ -1,4 +1,6 @@
 //! HDF5 input and output.
+pub mod atomic;
 pub mod h5;
+pub mod output;
 pub mod result_file;
 pub mod basis_file;

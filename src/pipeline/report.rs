@@ -1,6 +1,7 @@
 //! `run`: train → online sweep (validated) → validation with timings at chosen points →
 //! a report folder: `summary.md`, `validation.json`, `sweep.h5` and SVG plots.
-//! The folder is built beside the target and renamed into place at the end.
+//! The folder is built beside the target and renamed into place at the end, the basis
+//! written under a temporary name and renamed into place only when every stage succeeded.
 
 use super::config::Pipeline;
 use super::online::load_basis;
@@ -9,37 +10,50 @@ use super::sweep::{sweep, table, write_sweep, SweepOptions};
 use super::train::train_and_write;
 use super::validate::{validate, Validation};
 use crate::error::{Error, Result};
+use crate::io::atomic::TempPath;
+use crate::io::output::{check_output, check_report_dir, mark_new_report, swap_in_report, Origin};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+/// The files `run` reads, for the checks of its outputs.
+fn inputs(p: &Pipeline) -> [(&Path, &'static str); 2] {
+    [(p.path.as_path(), "pipeline file"), (p.model.path.as_path(), "model file")]
+}
+
+/// Checks, before any work, that `run` may write the pipeline's basis and replace its
+/// report folder (see [`crate::io::output`]).
+pub fn check_outputs(p: &Pipeline) -> Result<()> {
+    let [a, b] = inputs(p);
+    check_output(&p.basis_path, Origin::Key { pipeline: &p.path, key: "basis" }, &[a, b])?;
+    check_report_dir(&p.report_dir, &p.path, &[a, b, (p.basis_path.as_path(), "basis file")])
+}
+
+/// Trains, sweeps and validates, building the report in a temporary folder beside the
+/// target and the basis under a temporary name beside the pipeline's `basis`. Only when
+/// every stage succeeded is the basis renamed into place and the report folder swapped in
+/// (the previous one, flexrom's own, removed after); on any failure both are left as they
+/// were and the temporary ones removed.
 pub fn run(p: &Pipeline, progress: bool) -> Result<PathBuf> {
+    check_outputs(p)?;
     let dir = p.report_dir.clone();
-    let parent = dir.parent().map(Path::to_path_buf).unwrap_or_else(|| PathBuf::from("."));
-    std::fs::create_dir_all(&parent).map_err(|e| Error::io(&parent, e))?;
-    if let Some(b) = p.basis_path.parent() {
-        std::fs::create_dir_all(b).map_err(|e| Error::io(b, e))?;
-    }
-    let name = dir.file_name().map(|s| s.to_string_lossy().to_string()).unwrap_or_else(|| "report".into());
-    let tmp = parent.join(format!(".{name}.tmp-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&tmp);
-    std::fs::create_dir_all(&tmp).map_err(|e| Error::io(&tmp, e))?;
-    let result = build(p, &tmp, progress);
-    if result.is_err() {
-        let _ = std::fs::remove_dir_all(&tmp);
-        return result.map(|_| dir);
-    }
-    if dir.exists() {
-        std::fs::remove_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
-    }
-    std::fs::rename(&tmp, &dir).map_err(|e| Error::io(&dir, e))?;
+    let report = TempPath::dir_for(&dir)?;
+    let basis = TempPath::file_for(&p.basis_path)?;
+    build(p, report.path(), basis.path(), progress)?;
+    mark_new_report(report.path())?;
+    // checked again: the folder or the basis path may have changed during a long run
+    check_outputs(p)?;
+    basis.commit()?;
+    swap_in_report(report, &p.path)?;
     Ok(dir)
 }
 
-fn build(p: &Pipeline, out: &Path, progress: bool) -> Result<()> {
+/// Every stage, writing the basis to `basis_path` (a temporary name) and the report files
+/// into `out` (a temporary folder); the files are `fsync`ed when the folder is swapped in.
+fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool) -> Result<()> {
     let plot_err = |e: String| Error::io(out, std::io::Error::other(e));
     eprintln!("[1/3] train: {} full run(s)", p.file.train.load_scales.len());
-    let trained = train_and_write(p, &p.basis_path)?;
-    let stored = load_basis(p, &p.basis_path)?;
+    let trained = train_and_write(p, basis_path)?;
+    let stored = load_basis(p, basis_path)?;
     let basis = &stored.basis;
 
     let scales = p.online_scales();

@@ -1,0 +1,354 @@
+//! Issue 16, items 1 and 2: flexrom never deletes or overwrites what it did not create, and
+//! writes atomically (docs/guarantees.md). Each test runs the release binary as a user would,
+//! in a temporary folder, on a tiny copy of data/models/pendulum.toml (t_end shortened) and
+//! a pipeline written here; nothing is compared with stored numbers. The expected outcome of
+//! every case is the guarantee itself:
+//! - refused report folders (`.`, `..`, `/`, `/usr`, the pipeline's folder, a folder holding user files,
+//!   unmarked or marked): non-zero exit, an error naming the pipeline key `report`, and
+//!   every file of the temporary tree (listing and bytes) exactly as before;
+//! - outputs that are an input (the same path, through `..`, a symlink, a hard link) or not a
+//!   regular file (fifo, folder, /dev/null): refused, the inputs byte for byte unchanged;
+//! - missing output folders are created by every writing command;
+//! - SIGTERM / SIGINT during `run`: exit 143 / 130, no temporary file or folder left, the
+//!   previous basis and report unchanged;
+//! - SIGTERM during a long `simulate`: exit 143, the previous result file unchanged;
+//! - a `run` whose sweep stage fails (Newton limited to 4 iterations without step cuts, at
+//!   load scale 100 after training at 0.1) keeps the previous basis and report, and so does
+//!   a `train` that fails.
+
+use std::collections::BTreeMap;
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+fn flexrom() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_flexrom"))
+}
+
+fn pendulum_text() -> String {
+    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("data/models/pendulum.toml")).unwrap()
+}
+
+/// The pendulum model with end time `t_end` (and extra `[time]` lines).
+fn model_text(t_end: f64, extra_time: &str) -> String {
+    let t = pendulum_text();
+    assert!(t.contains("t_end = 1.1"));
+    t.replace("t_end = 1.1", &format!("t_end = {t_end}\n{extra_time}"))
+}
+
+/// `proj/m.toml` and `proj/pipe.toml` in `root`, with the given `report`, online scales and
+/// model; returns the pipeline path.
+fn project(root: &Path, report: &str, online: &str, model: &str) -> PathBuf {
+    let proj = root.join("proj");
+    std::fs::create_dir_all(&proj).unwrap();
+    std::fs::write(proj.join("m.toml"), model).unwrap();
+    let p = proj.join("pipe.toml");
+    std::fs::write(
+        &p,
+        format!(
+            "model = \"m.toml\"\nbasis = \"b.h5\"\nreport = \"{report}\"\n[train]\nload_scales = [1.0]\n[reduction]\nvariant = \"galerkin\"\nmodes = {{ count = 4 }}\n\
+             [online]\nload_scales = {online}\n[validate]\nload_scales = [1.0]\n"
+        ),
+    )
+    .unwrap();
+    p
+}
+
+fn run(args: &[&Path]) -> Output {
+    let mut c = flexrom();
+    for a in args {
+        c.arg(a);
+    }
+    c.output().unwrap()
+}
+
+/// Every entry below `root`: path → bytes (files), `<dir>` / `<link …>` / `<other>`.
+fn snapshot(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
+    let mut m = BTreeMap::new();
+    fn walk(d: &Path, m: &mut BTreeMap<PathBuf, Vec<u8>>) {
+        for e in std::fs::read_dir(d).unwrap() {
+            let p = e.unwrap().path();
+            let t = std::fs::symlink_metadata(&p).unwrap().file_type();
+            if t.is_symlink() {
+                m.insert(p.clone(), format!("<link {}>", std::fs::read_link(&p).unwrap().display()).into_bytes());
+            } else if t.is_dir() {
+                m.insert(p.clone(), b"<dir>".to_vec());
+                walk(&p, m);
+            } else if t.is_file() {
+                m.insert(p.clone(), std::fs::read(&p).unwrap());
+            } else {
+                m.insert(p.clone(), b"<other>".to_vec());
+            }
+        }
+    }
+    walk(root, &mut m);
+    m
+}
+
+/// Entries below `root` whose name says they are flexrom's temporary or moved-aside paths.
+fn leftovers(root: &Path) -> Vec<PathBuf> {
+    snapshot(root).into_keys().filter(|p| p.file_name().unwrap().to_string_lossy().contains(".flexrom-")).filter(|p| !p.ends_with(".flexrom-report")).collect()
+}
+
+fn fails_with(o: &Output, words: &[&str]) -> String {
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert!(!o.status.success(), "expected a failure, got success: {err}");
+    assert_eq!(o.status.code(), Some(1), "exit code: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    for w in words {
+        assert!(err.contains(w), "`{w}` missing from: {err}");
+    }
+    err
+}
+
+#[test]
+fn report_folders_that_are_not_flexroms_own_are_refused_and_nothing_is_deleted() {
+    let d = tempfile::tempdir().unwrap();
+    let root = d.path();
+    let model = model_text(0.05, "");
+    // the user's files: a data folder, a marked report folder the user added a note to
+    std::fs::create_dir_all(root.join("data/sub")).unwrap();
+    std::fs::write(root.join("data/results.csv"), b"1,2,3\n").unwrap();
+    std::fs::write(root.join("data/sub/notes.txt"), b"keep me").unwrap();
+    std::fs::create_dir_all(root.join("marked")).unwrap();
+    std::fs::write(root.join("marked/.flexrom-report"), "flexrom report folder: made by flexrom and replaced as a whole by `flexrom run`; files:\nsummary.md\n").unwrap();
+    std::fs::write(root.join("marked/summary.md"), b"old").unwrap();
+    std::fs::write(root.join("marked/mine.txt"), b"the user's").unwrap();
+    std::fs::write(root.join("file.txt"), b"a file").unwrap();
+    // a symlink to the user's data folder
+    std::os::unix::fs::symlink(root.join("data"), root.join("link")).unwrap();
+    for (report, why) in [
+        (".", "names `.`"),
+        ("..", "names `.`"),
+        ("", "pipeline's own folder"),
+        ("../proj", "pipeline's own folder"),
+        ("../data", "without flexrom's mark"),
+        ("../data/sub", "without flexrom's mark"),
+        ("../marked", "mine.txt"),
+        ("../link", "symbolic link"),
+        ("../file.txt", "not a folder"),
+        ("../file.txt/sub", "cannot be created"),
+        ("/", "`/`"),
+        ("/usr", "top-level"),
+        ("../proj/..", "names `.`"),
+    ] {
+        let p = project(root, report, "[1.0]", &model);
+        let before = snapshot(root);
+        let o = run(&[Path::new("run"), &p]);
+        let err = fails_with(&o, &["pipe.toml", "report", why]);
+        assert!(err.lines().count() <= 2, "{report}: {err}");
+        assert_eq!(snapshot(root), before, "report = {report:?}: files changed");
+        // `sweep` writes into the report folder by default: the same refusal
+        let o = run(&[Path::new("sweep"), &p]);
+        fails_with(&o, &["report"]);
+        assert_eq!(snapshot(root), before, "sweep, report = {report:?}: files changed");
+    }
+}
+
+#[test]
+fn a_marked_report_is_replaced_and_a_failed_later_stage_keeps_the_previous_basis_and_report() {
+    let d = tempfile::tempdir().unwrap();
+    let root = d.path();
+    let p = project(root, "rep", "[0.9, 1.0]", &model_text(0.05, ""));
+    let o = run(&[Path::new("run"), &p]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let rep = root.join("proj/rep");
+    let mark = std::fs::read_to_string(rep.join(".flexrom-report")).unwrap();
+    for f in ["summary.md", "sweep.h5", "validation.json", "singular_values.svg"] {
+        assert!(rep.join(f).is_file() && mark.lines().any(|l| l == f), "{f}: {mark}");
+    }
+    // a second run replaces flexrom's own folder; files of a removed kind go with it
+    std::fs::write(rep.join("probes_7.svg"), b"stale").unwrap();
+    std::fs::write(rep.join(".flexrom-report"), format!("{mark}probes_7.svg\n")).unwrap();
+    let o = run(&[Path::new("run"), &p]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(!rep.join("probes_7.svg").exists() && rep.join("summary.md").is_file());
+    assert!(leftovers(root).is_empty(), "{:?}", leftovers(root));
+
+    // now a pipeline whose training passes (load 0.1) but whose sweep must fail: Newton gets
+    // 4 iterations and no step cut, not enough at load scale 100
+    let before = snapshot(root);
+    let model = model_text(0.05, "max_iterations = 4\nmax_step_cuts = 0");
+    std::fs::write(root.join("proj/m.toml"), &model).unwrap();
+    let text = std::fs::read_to_string(&p).unwrap().replace("load_scales = [1.0]\n[reduction]", "load_scales = [0.1]\n[reduction]").replace("[0.9, 1.0]", "[0.1, 100.0]");
+    std::fs::write(&p, &text).unwrap();
+    let mut expected = before.clone();
+    expected.insert(root.join("proj/m.toml"), model.into_bytes());
+    expected.insert(p.clone(), text.into_bytes());
+    let o = run(&[Path::new("run"), &p]);
+    let err = fails_with(&o, &["Newton failed"]);
+    assert!(err.contains("[2/3]"), "the training stage passed: {err}");
+    assert_eq!(snapshot(root), expected, "basis or report changed by a failed run");
+    // `train` whose training run fails (load scale 100) keeps the previous basis too
+    let text = std::fs::read_to_string(&p).unwrap().replace("load_scales = [0.1]\n[reduction]", "load_scales = [100.0]\n[reduction]");
+    std::fs::write(&p, &text).unwrap();
+    expected.insert(p.clone(), text.into_bytes());
+    fails_with(&run(&[Path::new("train"), &p]), &["Newton failed"]);
+    assert_eq!(snapshot(root), expected, "basis changed by a failed train");
+}
+
+#[test]
+fn outputs_that_are_inputs_or_not_regular_files_are_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let root = d.path();
+    let p = project(root, "rep", "[1.0]", &model_text(0.05, ""));
+    let proj = root.join("proj");
+    let (model, basis) = (proj.join("m.toml"), proj.join("b.h5"));
+    let o = run(&[Path::new("train"), &p]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    std::os::unix::fs::symlink(&model, root.join("to_model.h5")).unwrap();
+    std::os::unix::fs::symlink("proj/b.h5", root.join("to_basis.h5")).unwrap();
+    std::os::unix::fs::symlink(root.join("data"), root.join("to_dir.h5")).unwrap();
+    std::os::unix::fs::symlink(root.join("nothing"), root.join("dangling.h5")).unwrap();
+    std::fs::hard_link(&model, root.join("hard.h5")).unwrap();
+    std::fs::create_dir(root.join("data")).unwrap();
+    assert!(Command::new("mkfifo").arg(root.join("fifo")).status().unwrap().success());
+    let before = snapshot(root);
+    let sim = |out: &Path| run(&[Path::new("simulate"), &model, Path::new("-o"), out]);
+    let online = |out: &Path| run(&[Path::new("online"), &p, Path::new("--load-scale"), Path::new("1"), Path::new("-o"), out]);
+    let cases: Vec<(Output, &[&str])> = vec![
+        (sim(&model), &["-o", "model file"]),
+        (sim(&proj.join("../proj/./m.toml")), &["model file"]),
+        (sim(&root.join("to_model.h5")), &["model file"]),
+        (sim(&root.join("hard.h5")), &["model file"]),
+        (sim(&root.join("fifo")), &["a fifo"]),
+        (sim(&root.join("data")), &["a directory"]),
+        (sim(&root.join("to_dir.h5")), &["symbolic link to a directory"]),
+        (sim(&root.join("dangling.h5")), &["dangling"]),
+        (sim(Path::new("/dev/null")), &["character device"]),
+        (sim(&root.join("newdir/")), &["names a folder"]),
+        (sim(&root.join("hard.h5/x.h5")), &["not a folder"]),
+        (online(&basis), &["basis file"]),
+        (online(&root.join("to_basis.h5")), &["basis file"]),
+        (online(&p), &["pipeline file"]),
+        (online(&model), &["model file"]),
+        (run(&[Path::new("sweep"), &p, Path::new("-o"), &root.join("to_basis.h5")]), &["basis file"]),
+        (run(&[Path::new("train"), &p, Path::new("--basis"), &model]), &["--basis", "model file"]),
+        (run(&[Path::new("train"), &p, Path::new("--basis"), &root.join("fifo")]), &["a fifo"]),
+    ];
+    for (i, (o, words)) in cases.iter().enumerate() {
+        let err = fails_with(o, words);
+        assert!(err.lines().count() <= 2, "case {i}: {err}");
+    }
+    assert_eq!(snapshot(root), before, "an input or another file changed");
+    // a basis path in the pipeline that is the model file
+    std::fs::write(&p, std::fs::read_to_string(&p).unwrap().replace("basis = \"b.h5\"", "basis = \"m.toml\"")).unwrap();
+    let before = snapshot(root);
+    for cmd in ["train", "run"] {
+        fails_with(&run(&[Path::new(cmd), &p]), &["pipe.toml", "basis", "model file"]);
+        assert_eq!(snapshot(root), before);
+    }
+}
+
+#[test]
+fn every_command_creates_missing_output_folders_and_follows_a_symlink_to_a_regular_file() {
+    let d = tempfile::tempdir().unwrap();
+    let root = d.path();
+    let p = project(root, "../reports/r", "[1.0]", &model_text(0.05, ""));
+    let model = root.join("proj/m.toml");
+    let new = |s: &str| root.join("new").join(s).join("out.h5");
+    let b = new("basis");
+    assert!(run(&[Path::new("train"), &p, Path::new("--basis"), &b]).status.success());
+    assert!(run(&[Path::new("simulate"), &model, Path::new("-o"), &new("sim")]).status.success());
+    assert!(run(&[Path::new("online"), &p, Path::new("--basis"), &b, Path::new("--load-scale"), Path::new("1"), Path::new("-o"), &new("online")]).status.success());
+    assert!(run(&[Path::new("sweep"), &p, Path::new("--basis"), &b, Path::new("-o"), &new("sweep")]).status.success());
+    for k in ["basis", "sim", "online", "sweep"] {
+        assert!(hdf5::File::open(new(k)).is_ok(), "{k}");
+    }
+    // the default sweep output makes the report folder, marked, and `run` may replace it
+    assert!(run(&[Path::new("sweep"), &p, Path::new("--basis"), &b]).status.success());
+    assert!(root.join("reports/r/.flexrom-report").is_file() && root.join("reports/r/sweep.h5").is_file());
+    let o = run(&[Path::new("run"), &p]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // a symlink to a regular file: the file it points to is replaced, the link stays
+    let link = root.join("link.h5");
+    std::os::unix::fs::symlink(new("sim"), &link).unwrap();
+    assert!(run(&[Path::new("simulate"), &model, Path::new("-o"), &link, Path::new("--t-end"), Path::new("0.02")]).status.success());
+    assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+    let t = hdf5::File::open(new("sim")).unwrap().dataset("t").unwrap().read_1d::<f64>().unwrap();
+    assert_eq!(t.len(), 5, "0.02 s in steps of 0.005 s: the new result is behind the link");
+    assert!(leftovers(root).is_empty(), "{:?}", leftovers(root));
+}
+
+/// Starts `flexrom run` on `p`, waits until stderr shows `stage` and the temporary paths
+/// `wanted` (name fragments) exist below `root`, sends `signal` and returns the exit status
+/// and stderr.
+fn kill_run(root: &Path, p: &Path, stage: &str, wanted: &[&str], signal: &str) -> (Option<i32>, String) {
+    let mut child = flexrom().arg("run").arg(p).stdout(Stdio::null()).stderr(Stdio::piped()).spawn().unwrap();
+    let stderr = child.stderr.take().unwrap();
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+            let _ = tx.send(line);
+        }
+    });
+    let start = Instant::now();
+    let mut err = String::new();
+    loop {
+        while let Ok(l) = rx.try_recv() {
+            err.push_str(&l);
+            err.push('\n');
+        }
+        let names: Vec<String> = leftovers(root).iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
+        if err.contains(stage) && wanted.iter().all(|w| names.iter().any(|n| n.contains(w))) {
+            break;
+        }
+        assert!(child.try_wait().unwrap().is_none(), "the run ended before it could be stopped: {err}");
+        assert!(start.elapsed() < Duration::from_secs(120), "no temporary files seen: {err}");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    assert!(Command::new("kill").arg(format!("-{signal}")).arg(child.id().to_string()).status().unwrap().success());
+    let status = child.wait().unwrap();
+    std::thread::sleep(Duration::from_millis(100));
+    while let Ok(l) = rx.try_recv() {
+        err.push_str(&l);
+        err.push('\n');
+    }
+    (status.code(), err)
+}
+
+#[test]
+fn a_killed_run_leaves_no_temporary_files_and_the_previous_outputs_unchanged() {
+    let d = tempfile::tempdir().unwrap();
+    let root = d.path();
+    let p = project(root, "rep", "[1.0]", &model_text(0.05, ""));
+    let o = run(&[Path::new("run"), &p]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // a long run: 1000 validated sweep points of 0.2 s (each a full and a reduced run)
+    let p = project(root, "rep", "\"0.5:1.5:1000\"", &model_text(0.2, ""));
+    let before = snapshot(root);
+    // SIGTERM in the sweep: the temporary report folder and the new basis (renamed into its
+    // temporary name) both exist
+    let (code, err) = kill_run(root, &p, "[2/3]", &[".rep.flexrom-tmp-", ".b.h5.flexrom-tmp-"], "TERM");
+    assert_eq!(code, Some(143), "{err}");
+    assert!(err.contains("SIGTERM") && !err.contains("panicked"), "{err}");
+    assert!(leftovers(root).is_empty(), "{:?}", leftovers(root));
+    assert_eq!(snapshot(root), before, "the previous basis and report are unchanged");
+    // SIGINT during training: only the temporary report folder exists yet
+    let p = project(root, "rep", "[1.0]", &model_text(20.0, ""));
+    let before = snapshot(root);
+    let (code, err) = kill_run(root, &p, "[1/3]", &[".rep.flexrom-tmp-"], "INT");
+    assert_eq!(code, Some(130), "{err}");
+    assert!(leftovers(root).is_empty(), "{:?}", leftovers(root));
+    assert_eq!(snapshot(root), before);
+}
+
+#[test]
+fn a_killed_simulate_keeps_the_previous_result() {
+    let d = tempfile::tempdir().unwrap();
+    let root = d.path();
+    let model = root.join("m.toml");
+    // 10 000 steps: seconds of work, stopped after 300 ms
+    std::fs::write(&model, model_text(50.0, "")).unwrap();
+    let out = root.join("out.h5");
+    std::fs::write(&out, b"previous result").unwrap();
+    let before = snapshot(root);
+    let mut child = flexrom().arg("simulate").arg(&model).arg("-o").arg(&out).stderr(Stdio::piped()).spawn().unwrap();
+    std::thread::sleep(Duration::from_millis(300));
+    assert!(child.try_wait().unwrap().is_none(), "simulate ended before it could be stopped");
+    assert!(Command::new("kill").arg("-TERM").arg(child.id().to_string()).status().unwrap().success());
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(143), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(snapshot(root), before);
+}
