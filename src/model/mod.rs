@@ -11,6 +11,15 @@ use crate::solver::kkt::LinearSolverKind;
 use schema::*;
 use std::path::{Path, PathBuf};
 
+/// Sizes of a model's system (see [`Model::sizes`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sizes {
+    pub n_dof: f64,
+    pub n_constraints: f64,
+    pub n_elements: f64,
+    pub n_probes: f64,
+}
+
 /// A validated model file.
 #[derive(Clone, Debug)]
 pub struct Model {
@@ -77,9 +86,8 @@ impl Model {
             if b.elements <= 0 {
                 return Err(self.err(p("elements"), format!("must be a positive integer, got {}", b.elements)));
             }
-            if b.elements > 1_000_000 {
-                return Err(self.err(p("elements"), format!("{} elements is more than this program supports (1e6)", b.elements)));
-            }
+            let total: f64 = f.bodies[..=i].iter().map(|b| b.elements.max(0) as f64).sum();
+            crate::limits::check_elements(total).map_err(|e| self.err(p("elements"), e))?;
             for (k, v) in [("density", b.density), ("area", b.area), ("inertia", b.inertia), ("youngs_modulus", b.youngs_modulus)] {
                 self.positive(&p(k), v)?;
             }
@@ -248,6 +256,16 @@ impl Model {
             }
             p.max_cuts = m as u32;
         }
+        if let Some(x) = t.max_strain {
+            self.positive("time.max_strain", x)?;
+            p.max_strain = x;
+        }
+        if let Some(m) = t.max_total_step_cuts {
+            if m < 0 {
+                return Err(self.err("time.max_total_step_cuts", format!("must be zero or a positive integer, got {m}")));
+            }
+            p.max_total_cuts = usize::try_from(m).unwrap_or(usize::MAX);
+        }
         if let Some(r) = &t.jacobian_reuse {
             p.reuse = match r.as_str() {
                 "within-step" => JacobianReuse::WithinStep,
@@ -278,6 +296,33 @@ impl Model {
     pub fn system(&self, solver: LinearSolverKind) -> FlexibleSystem {
         let damping = self.file.damping.as_ref().map_or(Rayleigh::default(), |d| Rayleigh { mass: d.mass, stiffness: d.stiffness });
         FlexibleSystem::new(self.bodies.clone(), &self.joints, &self.loads, self.probes.clone(), damping, solver)
+    }
+
+    /// The sizes of the system this model builds, from the file alone (nothing is
+    /// assembled), as floats so that estimates from them cannot overflow.
+    pub fn sizes(&self) -> Sizes {
+        let n_elements: f64 = self.bodies.iter().map(|b| b.n_elements as f64).sum();
+        let n_dof = 4.0 * self.bodies.iter().map(|b| b.n_elements as f64 + 1.0).sum::<f64>();
+        let n_constraints = self.joints.iter().map(|j| if matches!(j, Joint::Clamp { .. }) { 4.0 } else { 2.0 }).sum();
+        Sizes { n_dof, n_constraints, n_elements, n_probes: self.probes.len() as f64 }
+    }
+
+    /// Refuses a full run of `n_steps` whose arrays (plus, with `dense`, the dense LU of
+    /// the KKT matrix) would not fit the memory bound ([`crate::limits`]).
+    pub fn check_full_run_memory(&self, n_steps: usize, dense: bool) -> Result<()> {
+        let z = self.sizes();
+        let nt = n_steps as f64 + 1.0;
+        let arrays = 8.0 * nt * (z.n_dof + z.n_constraints + 2.0 * z.n_probes + 1.0);
+        let system = z.n_elements * crate::limits::BYTES_PER_ELEMENT;
+        let n_kkt = z.n_dof + z.n_constraints;
+        let lu = if dense { 2.0 * 8.0 * n_kkt * n_kkt } else { 0.0 };
+        let what = format!(
+            "a full run of {} steps × {} coordinates{}",
+            n_steps,
+            z.n_dof,
+            if dense { format!(" with a dense {n_kkt} × {n_kkt} LU") } else { String::new() }
+        );
+        crate::limits::check_memory(&what, arrays + system + lu)
     }
 
     pub fn probe_names(&self) -> Vec<String> {
