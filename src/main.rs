@@ -148,7 +148,21 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        // --help, --version: clap's text on stdout (a closed pipe there is not worth a word)
+        Err(e) if !e.use_stderr() => {
+            let _ = e.print();
+            return ExitCode::SUCCESS;
+        }
+        // a usage error in two lines: clap's first (what is wrong), and where to look
+        Err(e) => {
+            let text = e.render().to_string();
+            note(text.lines().find(|l| !l.trim().is_empty()).unwrap_or("error: bad arguments"));
+            note("run `flexrom --help` (or `flexrom <command> --help`) for usage");
+            return ExitCode::from(2);
+        }
+    };
     flexrom::single_threaded_blas();
     let limits = flexrom::limits::from_env(cli.max_memory.as_deref(), cli.max_steps.as_deref(), cli.max_elements.as_deref(), cli.allow_blowup);
     match limits.and_then(|l| {

@@ -45,7 +45,7 @@ impl Model {
 
     pub fn from_text(text: &str, path: impl AsRef<Path>) -> Result<Model> {
         let path = path.as_ref();
-        let file: ModelFile = parse_toml(text, path)?;
+        let file: ModelFile = parse_toml(text, path).map_err(|e| entry_error(text, path).unwrap_or(e))?;
         let mut model = Model { path: path.to_path_buf(), text: text.to_string(), file, bodies: vec![], joints: vec![], loads: vec![], probes: vec![] };
         model.check()?;
         Ok(model)
@@ -174,6 +174,7 @@ impl Model {
             };
             self.joints.push(joint);
         }
+        self.check_joint_rank()?;
         for (i, l) in f.loads.iter().enumerate() {
             let p = |k: &str| format!("loads[{i}].{k}");
             let load = match l {
@@ -227,6 +228,83 @@ impl Model {
             self.probes.push(Probe { name: pr.name.clone(), element, xi });
         }
         Ok(())
+    }
+
+    /// Refuses joints whose constraint rows `B` are linearly dependent (a node pinned twice,
+    /// a clamp plus a pin on its node, a loop of pins closing on one point): the KKT matrix
+    /// is then singular. Elimination row by row in joint order (B has entries ±1, so it is
+    /// exact); each row keeps the set of joints it was combined from, so a row that
+    /// reduces to zero names exactly the joints whose constraints it repeats.
+    fn check_joint_rank(&self) -> Result<()> {
+        use std::collections::{BTreeMap, BTreeSet, HashMap};
+        let mut first = Vec::with_capacity(self.bodies.len());
+        let mut n = 0;
+        for b in &self.bodies {
+            first.push(n);
+            n += b.n_elements + 1;
+        }
+        let g = |(b, k): NodeId| first[b] + k;
+        // reduced rows with their pivot column and the joints they combine
+        let mut basis: Vec<(BTreeMap<usize, f64>, BTreeSet<usize>)> = Vec::new();
+        let mut pivot_of: HashMap<usize, usize> = HashMap::new();
+        for (j, joint) in self.joints.iter().enumerate() {
+            let rows: Vec<Vec<(usize, f64)>> = match *joint {
+                Joint::GroundPin { node, .. } => (0..2).map(|c| vec![(4 * g(node) + c, 1.0)]).collect(),
+                Joint::Clamp { node, .. } => (0..4).map(|c| vec![(4 * g(node) + c, 1.0)]).collect(),
+                Joint::Pin { a, b } => (0..2).map(|c| vec![(4 * g(a) + c, 1.0), (4 * g(b) + c, -1.0)]).collect(),
+            };
+            for row in rows {
+                let mut r: BTreeMap<usize, f64> = row.into_iter().collect();
+                let mut used = BTreeSet::from([j]);
+                // eliminate the earliest basis row first: a basis row holds only pivot
+                // columns of later rows, so this ends
+                while let Some((c, bi)) = r.keys().filter_map(|c| pivot_of.get(c).map(|&bi| (*c, bi))).min_by_key(|x| x.1) {
+                    let (brow, bj) = &basis[bi];
+                    let f = r[&c] / brow[&c];
+                    for (&cc, &bv) in brow {
+                        *r.entry(cc).or_insert(0.0) -= f * bv;
+                    }
+                    r.remove(&c);
+                    r.retain(|_, v| v.abs() > 1e-9);
+                    used.extend(bj.iter().copied());
+                }
+                match r.keys().next() {
+                    Some(&c) => {
+                        pivot_of.insert(c, basis.len());
+                        basis.push((r, used));
+                    }
+                    None => {
+                        let others: Vec<String> = used.iter().filter(|&&i| i != j).map(|&i| format!("joints[{i}] ({})", self.describe_joint(i))).collect();
+                        let field = match entry_line(&self.text, "joints", j) {
+                            Some(l) => format!("joints[{j}] (line {l})"),
+                            None => format!("joints[{j}]"),
+                        };
+                        return Err(self.err(
+                            field,
+                            format!(
+                                "{} constrains what {} already fix{}: the joint equations are dependent (over-constrained, singular); remove or change one of them",
+                                self.describe_joint(j),
+                                others.join(" and "),
+                                if others.len() == 1 { "es" } else { "" }
+                            ),
+                        ));
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn describe_joint(&self, i: usize) -> String {
+        let node = |n: &NodeRef| match n {
+            NodeRef::Index(k) => format!("node {k}"),
+            NodeRef::Name(s) => format!("node \"{s}\""),
+        };
+        match &self.file.joints[i] {
+            JointSpec::GroundPin { body, node: n, .. } => format!("ground_pin on `{body}` {}", node(n)),
+            JointSpec::Clamp { body, node: n } => format!("clamp on `{body}` {}", node(n)),
+            JointSpec::Pin { a, b } => format!("pin `{}` {} – `{}` {}", a.body, node(&a.node), b.body, node(&b.node)),
+        }
     }
 
     fn params_from(&self, t: &TimeSettings) -> Result<IntegratorParams> {
@@ -364,6 +442,68 @@ impl Model {
         };
         Ok((b, k))
     }
+}
+
+/// The entry of an array of tables (`[[bodies]]`, `[[joints]]`, `[[loads]]`, `[[probes]]`)
+/// that fails to parse, with the key at fault and its line: serde reports errors inside
+/// internally tagged or untagged entries against the whole entry, so each entry is parsed
+/// on its own, and the key at fault is the one whose removal changes the error (the
+/// `type` tag last: removing it always does). `None` when every entry parses by itself.
+fn entry_error(text: &str, path: &Path) -> Option<Error> {
+    fn first_error<T: serde::de::DeserializeOwned>(v: &toml::Value) -> Option<String> {
+        v.clone().try_into::<T>().err().map(|e| e.message().to_string())
+    }
+    let doc: toml::Table = toml::from_str(text).ok()?;
+    let kinds: [(&str, fn(&toml::Value) -> Option<String>); 4] = [
+        ("bodies", first_error::<BodySpec>),
+        ("joints", first_error::<JointSpec>),
+        ("loads", first_error::<LoadSpec>),
+        ("probes", first_error::<ProbeSpec>),
+    ];
+    for (name, parse) in kinds {
+        let Some(toml::Value::Array(items)) = doc.get(name) else { continue };
+        for (i, item) in items.iter().enumerate() {
+            let Some(message) = parse(item) else { continue };
+            let key = item.as_table().and_then(|t| {
+                let changes = |k: &String| {
+                    let mut rest = t.clone();
+                    rest.remove(k);
+                    parse(&toml::Value::Table(rest)).as_deref() != Some(message.as_str())
+                };
+                t.keys().filter(|k| k.as_str() != "type").find(|k| changes(k)).or_else(|| t.keys().find(|k| changes(k))).cloned()
+            });
+            let line = entry_line(text, name, i).map(|l| key.as_deref().and_then(|k| key_line(text, l, k)).unwrap_or(l));
+            let field = match (&key, line) {
+                (Some(k), Some(l)) => format!("{name}[{i}].{k} (line {l})"),
+                (Some(k), None) => format!("{name}[{i}].{k}"),
+                (None, Some(l)) => format!("{name}[{i}] (line {l})"),
+                (None, None) => format!("{name}[{i}]"),
+            };
+            return Some(Error::input(path, field, message));
+        }
+    }
+    None
+}
+
+/// The line (1-based) of the `[[name]]` header of entry `i`, if written that way.
+fn entry_line(text: &str, name: &str, i: usize) -> Option<usize> {
+    let is_header = |l: &str| l.trim().strip_prefix("[[").and_then(|r| r.split("]]").next()).is_some_and(|n| n.trim() == name);
+    text.lines().enumerate().filter(|(_, l)| is_header(l)).nth(i).map(|(k, _)| k + 1)
+}
+
+/// The line of `key = …` in the table whose header is on line `header`.
+fn key_line(text: &str, header: usize, key: &str) -> Option<usize> {
+    for (k, l) in text.lines().enumerate().skip(header) {
+        let l = l.trim();
+        if l.starts_with('[') {
+            return None;
+        }
+        let lhs = l.split('=').next().unwrap_or("").trim().trim_matches('"');
+        if l.contains('=') && (lhs == key || lhs.starts_with(&format!("{key}."))) {
+            return Some(k + 1);
+        }
+    }
+    None
 }
 
 /// The dotted key path (or line) at byte `pos` of a TOML text, for error messages.
