@@ -46,7 +46,7 @@ pub enum Error {
 
     /// A numerical failure with the stage (simulate, train, online, validate, sweep) and
     /// the load scale it happened at; the time is in `source`.
-    #[error("{stage} at load scale {load_scale}: {source}")]
+    #[error("{stage} at load scale {}: {source}", crate::limits::show_number(*.load_scale))]
     Stage { stage: String, load_scale: f64, #[source] source: Box<Error> },
 
     /// Standard output was closed by the reader (`| head`): not an error of the run, the
