@@ -33,6 +33,26 @@ pub enum Error {
     /// Anything else that is a usage error of the program (bad command-line values).
     #[error("{0}")]
     Usage(String),
+
+    /// A run or an allocation would exceed a resource bound (memory, step count): names
+    /// the estimated figure, the bound and the option or key that raises it.
+    #[error("{0}")]
+    Resource(String),
+
+    /// A run left plausible bounds (strain, step cuts): names what, when, and the key or
+    /// option that relaxes the check.
+    #[error("blow-up at t = {t:.6} s: {problem}")]
+    BlowUp { t: f64, problem: String },
+
+    /// A numerical failure with the stage (simulate, train, online, validate, sweep) and
+    /// the load scale it happened at; the time is in `source`.
+    #[error("{stage} at load scale {}: {source}", crate::limits::show_number(*.load_scale))]
+    Stage { stage: String, load_scale: f64, #[source] source: Box<Error> },
+
+    /// Standard output was closed by the reader (`| head`): not an error of the run, the
+    /// program ends quietly.
+    #[error("standard output closed")]
+    StdoutClosed,
 }
 
 pub type Result<T> = std::result::Result<T, Error>;
@@ -48,6 +68,17 @@ impl Error {
 
     pub fn io(file: impl AsRef<Path>, source: std::io::Error) -> Self {
         Error::Io { file: file.as_ref().display().to_string(), source }
+    }
+
+    /// Adds the stage and the load scale to a numerical failure (Newton, linear solve,
+    /// blow-up); other errors already name their file or option and pass unchanged.
+    pub fn at_stage(self, stage: &str, load_scale: f64) -> Self {
+        match self {
+            Error::NewtonFailed { .. } | Error::LinearSolve { .. } | Error::BlowUp { .. } => {
+                Error::Stage { stage: stage.to_string(), load_scale, source: Box::new(self) }
+            }
+            other => other,
+        }
     }
 
     pub fn hdf5(file: impl AsRef<Path>, problem: impl std::fmt::Display) -> Self {

@@ -7,7 +7,9 @@
 
 pub mod error;
 pub mod io;
+pub mod limits;
 pub mod model;
+pub mod output;
 pub mod physics;
 pub mod pipeline;
 pub mod reduction;

@@ -5,6 +5,7 @@ use flexrom::io::result_file::{write_result, write_result_with};
 use flexrom::pipeline::online::{load_basis, run_reduced};
 use flexrom::pipeline::Pipeline;
 use flexrom::model::Model;
+use flexrom::output::{self, note};
 use flexrom::simulate::{simulate, Overrides};
 use flexrom::solver::kkt::LinearSolverKind;
 use flexrom::io::atomic::TempPath;
@@ -17,6 +18,19 @@ use std::process::ExitCode;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// memory bound for a stage's big arrays, e.g. 8G, 512M (default: env
+    /// FLEXROM_MAX_MEMORY, else half of the machine's memory)
+    #[arg(long, global = true, value_name = "SIZE")]
+    max_memory: Option<String>,
+    /// most time steps a run may take (default: env FLEXROM_MAX_STEPS, else 10000000)
+    #[arg(long, global = true, value_name = "N")]
+    max_steps: Option<String>,
+    /// most elements a model may have (default: env FLEXROM_MAX_ELEMENTS, else 200000)
+    #[arg(long, global = true, value_name = "N")]
+    max_elements: Option<String>,
+    /// a run whose strain or step cuts leave plausible bounds warns instead of failing
+    #[arg(long, global = true)]
+    allow_blowup: bool,
 }
 
 #[derive(clap::Args)]
@@ -136,17 +150,37 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        // --help, --version: clap's text on stdout (a closed pipe there is not worth a word)
+        Err(e) if !e.use_stderr() => {
+            let _ = e.print();
+            return ExitCode::SUCCESS;
+        }
+        // a usage error in two lines: clap's first (what is wrong), and where to look
+        Err(e) => {
+            let text = e.render().to_string();
+            note(text.lines().find(|l| !l.trim().is_empty()).unwrap_or("error: bad arguments"));
+            note("run `flexrom --help` (or `flexrom <command> --help`) for usage");
+            return ExitCode::from(2);
+        }
+    };
     // from here on SIGINT/SIGTERM remove flexrom's temporary files and exit with 130/143
     if let Err(e) = flexrom::io::atomic::install_signal_handler() {
-        eprintln!("error: {e}");
+        note(&format!("error: {e}"));
         return ExitCode::FAILURE;
     }
     flexrom::single_threaded_blas();
-    match run(cli) {
+    let limits = flexrom::limits::from_env(cli.max_memory.as_deref(), cli.max_steps.as_deref(), cli.max_elements.as_deref(), cli.allow_blowup);
+    match limits.and_then(|l| {
+        flexrom::limits::set(l);
+        run(cli)
+    }) {
         Ok(()) => ExitCode::SUCCESS,
+        // the reader of stdout went away (`| head`): nothing to say, and no one to say it to
+        Err(flexrom::Error::StdoutClosed) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            note(&format!("error: {e}"));
             ExitCode::FAILURE
         }
     }
@@ -157,9 +191,9 @@ fn run(cli: Cli) -> flexrom::Result<()> {
         Command::Simulate { model, output, run, csv } => {
             check_output(&output, Origin::Flag("-o"), &[(&model, "model file")])?;
             let model = Model::load(&model)?;
-            let r = simulate(&model, &run.overrides())?;
+            let r = simulate(&model, &run.overrides()).map_err(|e| e.at_stage("simulate", run.load_scale.unwrap_or(1.0)))?;
             write_result(&output, &r)?;
-            eprintln!(
+            note(&format!(
                 "{}: {} steps in {:.3} s ({} Newton iterations, {} factorizations, {} step cuts) -> {}",
                 model.path.display(),
                 r.stats.steps,
@@ -168,9 +202,9 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                 r.stats.factorizations,
                 r.stats.step_cuts,
                 output.display()
-            );
+            ));
             if csv {
-                print_csv(&r);
+                print_csv(&r)?;
             }
             Ok(())
         }
@@ -186,7 +220,7 @@ fn run(cli: Cli) -> flexrom::Result<()> {
             load_basis(&p, staged.path())?;
             staged.commit()?;
             let b = &s.trained.basis;
-            eprintln!(
+            note(&format!(
                 "{}: {} snapshots from {} full run(s) ({:.3} s); {} basis, {} snapshots, {} POD modes{} (captured energy 1 − {:.2e}) -> {}",
                 p.path.display(),
                 s.n_snapshots,
@@ -198,7 +232,7 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                 if b.kept.is_empty() { String::new() } else { format!(" + {} joint coordinates", b.kept.len()) },
                 s.trained.uncaptured_energy(),
                 out.display()
-            );
+            ));
             Ok(())
         }
         Command::Online { pipeline, load_scale, output, basis } => {
@@ -207,7 +241,7 @@ fn run(cli: Cli) -> flexrom::Result<()> {
             let path = basis.unwrap_or_else(|| p.basis_path.clone());
             check_output(&output, Origin::Flag("-o"), &[(&p.path, "pipeline file"), (&p.model.path, "model file"), (&path, "basis file")])?;
             let stored = load_basis(&p, &path)?;
-            let run = run_reduced(&p.model, &stored.basis, load_scale)?;
+            let run = run_reduced(&p.model, &stored.basis, load_scale).map_err(|e| e.at_stage("online", load_scale))?;
             let basis_name = path.display().to_string();
             write_result_with(&output, &run.result, |f| {
                 let e = |err: hdf5::Error| flexrom::Error::hdf5(&output, err);
@@ -218,7 +252,7 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                 flexrom::io::h5::attr_u64(f, "n_modes", stored.basis.n_reduced() as u64).map_err(e)
             })?;
             let st = &run.result.stats;
-            eprintln!(
+            note(&format!(
                 "{}: reduced run ({} modes) at load scale {load_scale}: {} steps in {:.4} s ({} Newton iterations, {} step cuts) -> {}",
                 p.path.display(),
                 stored.basis.n_reduced(),
@@ -227,7 +261,7 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                 st.newton_iterations,
                 st.step_cuts,
                 output.display()
-            );
+            ));
             Ok(())
         }
         Command::Validate { pipeline, load_scale, json, basis, no_dense } => {
@@ -237,11 +271,11 @@ fn run(cli: Cli) -> flexrom::Result<()> {
             let stored = load_basis(&p, &path)?;
             let (v, _, _) = flexrom::pipeline::validate::validate(&p.model, &stored.basis, load_scale, !no_dense)?;
             if json {
-                println!("{}", serde_json::to_string(&v).expect("serializable"));
+                let text = serde_json::to_string(&v).map_err(|e| flexrom::Error::Usage(format!("cannot write the JSON: {e}")))?;
+                output::println(&text)
             } else {
-                println!("{}", v.describe());
+                output::println(&v.describe())
             }
-            Ok(())
         }
         Command::Sweep { pipeline, load_scales, validate, continuation, output, basis } => {
             let p = Pipeline::load(&pipeline)?;
@@ -267,22 +301,22 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                 claim_in_report(&p.report_dir, &p.path, "sweep.h5")?;
             }
             flexrom::pipeline::sweep::write_sweep(&out, &sw, &stored.basis, &path)?;
-            print!("{}", flexrom::pipeline::sweep::table(&sw));
-            eprintln!("{} load scales on {} threads in {:.3} s -> {}", scales.len(), sw.threads, sw.wall_seconds, out.display());
+            output::print(&flexrom::pipeline::sweep::table(&sw))?;
+            note(&format!("{} load scales on {} threads in {:.3} s -> {}", scales.len(), sw.threads, sw.wall_seconds, out.display()));
             Ok(())
         }
         Command::Run { pipeline } => {
             let p = Pipeline::load(&pipeline)?;
             let dir = flexrom::pipeline::report::run(&p, true)?;
-            println!("{}", std::fs::read_to_string(dir.join("summary.md")).map_err(|e| flexrom::Error::io(&dir, e))?);
-            eprintln!("report: {}", dir.display());
+            output::println(&std::fs::read_to_string(dir.join("summary.md")).map_err(|e| flexrom::Error::io(&dir, e))?)?;
+            note(&format!("report: {}", dir.display()));
             Ok(())
         }
         Command::Demo { models } => {
             for path in models {
                 let model = Model::load(&path)?;
-                let r = simulate(&model, &Overrides::default())?;
-                println!(
+                let r = simulate(&model, &Overrides::default()).map_err(|e| e.at_stage("demo", 1.0))?;
+                output::println(&format!(
                     "{} ({} coordinates, {} steps of {} s, {:.1} ms, {} Newton iterations)",
                     path.display(),
                     r.q.nrows(),
@@ -290,12 +324,12 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                     r.settings.dt,
                     1e3 * r.wall_seconds,
                     r.stats.newton_iterations
-                );
+                ))?;
                 let nt = r.t.len();
                 for k in [0, nt / 4, nt / 2, 3 * nt / 4, nt - 1] {
                     let cells: Vec<String> =
                         r.probes.iter().map(|(n, xy)| format!("{n} = ({:+.5}, {:+.5})", xy[[k, 0]], xy[[k, 1]])).collect();
-                    println!("  t = {:.4} s: {}", r.t[k], cells.join("  "));
+                    output::println(&format!("  t = {:.4} s: {}", r.t[k], cells.join("  ")))?;
                 }
             }
             Ok(())
@@ -311,19 +345,24 @@ fn check_scale(x: f64) -> flexrom::Result<()> {
     }
 }
 
-fn print_csv(r: &flexrom::simulate::SimulationResult) {
+/// The probe positions as CSV on stdout, buffered; a closed pipe or a full disk is an
+/// error value (see `flexrom::output`), never a panic.
+fn print_csv(r: &flexrom::simulate::SimulationResult) -> flexrom::Result<()> {
+    use std::io::Write;
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     let mut header = vec!["t".to_string()];
     for (n, _) in &r.probes {
         header.push(format!("{n}_x"));
         header.push(format!("{n}_y"));
     }
-    println!("{}", header.join(","));
+    writeln!(out, "{}", header.join(",")).map_err(output::stdout_error)?;
     for k in 0..r.t.len() {
         let mut row = vec![format!("{}", r.t[k])];
         for (_, xy) in &r.probes {
             row.push(format!("{}", xy[[k, 0]]));
             row.push(format!("{}", xy[[k, 1]]));
         }
-        println!("{}", row.join(","));
+        writeln!(out, "{}", row.join(",")).map_err(output::stdout_error)?;
     }
+    out.flush().map_err(output::stdout_error)
 }

@@ -50,8 +50,12 @@ impl Settings {
         }
         let params = IntegratorParams { rho_inf, ..model.integrator_params() };
         params.validate().map_err(|e| Error::Usage(format!("--rho-inf: {e}")))?;
-        // the number of whole steps that fit (SPEC §4: 1.1 s at 0.007 s is 157 steps)
-        let n_steps = (t_end / dt + 1e-9).floor() as usize;
+        // the number of whole steps that fit (SPEC §4: 1.1 s at 0.007 s is 157 steps),
+        // bounded in floating point before the cast (t_end = 1e300 or dt = 1e-300 would
+        // saturate it and overflow n_t = n_steps + 1)
+        let steps = (t_end / dt + 1e-9).floor();
+        crate::limits::check_steps(steps, dt, t_end)?;
+        let n_steps = steps as usize;
         if n_steps == 0 {
             return Err(Error::Usage(format!("dt = {dt} is longer than t_end = {t_end}")));
         }
@@ -105,15 +109,70 @@ pub fn integrate_guided<M: DynamicModel>(
     let v0 = vec![0.0; q0.len()];
     let mut state = integ.initialize(model, q0, v0, 0.0)?;
     let mut increment = vec![0.0; state.q.len()];
+    let mut watch = BlowUpWatch::new(params, crate::limits::get().allow_blowup);
     record(0, &state);
     for k in 1..=n_steps {
         let guessed = guess(k, &mut increment);
         integ.step_guided(model, &mut state, dt, guessed.then_some(increment.as_slice()))?;
         // keep t on the nominal grid despite round-off in sub-steps
         state.t = k as f64 * dt;
+        watch.check(model, &state, &integ.stats, k == n_steps || k % STRAIN_CHECK_EVERY == 0)?;
         record(k, &state);
     }
     Ok(integ.stats)
+}
+
+/// The strain check runs every this many steps (and at the last): a full model pays one
+/// pass over its elements for it (~a quarter of a force evaluation), and a blow-up that
+/// grows for four steps is still caught long before the end of a run.
+const STRAIN_CHECK_EVERY: usize = 4;
+
+/// Blow-up detection: a run whose largest mean axial strain |ε̄| exceeds `max_strain` or
+/// whose step halvings exceed `max_total_cuts` stops with [`Error::BlowUp`], naming what,
+/// when, and the key that relaxes it; with `--allow-blowup` each check warns once instead.
+struct BlowUpWatch {
+    max_strain: f64,
+    max_cuts: usize,
+    warn_only: bool,
+    warned_strain: bool,
+    warned_cuts: bool,
+}
+
+impl BlowUpWatch {
+    fn new(p: &IntegratorParams, warn_only: bool) -> Self {
+        BlowUpWatch { max_strain: p.max_strain, max_cuts: p.max_total_cuts, warn_only, warned_strain: false, warned_cuts: false }
+    }
+
+    fn check<M: DynamicModel>(&mut self, model: &M, st: &State, stats: &Stats, strain_now: bool) -> Result<()> {
+        if stats.step_cuts > self.max_cuts && !self.warned_cuts {
+            let problem = format!(
+                "{} step halvings so far, over the budget of {} per run (`[time] max_total_step_cuts` in the model file raises it; --allow-blowup only warns)",
+                stats.step_cuts, self.max_cuts
+            );
+            self.report(st.t, problem, true)?;
+        }
+        if strain_now && !self.warned_strain {
+            if let Some((eps, e)) = model.max_strain(&st.q) {
+                if !(eps <= self.max_strain) {
+                    let problem = format!(
+                        "mean axial strain |ε̄| = {eps:.3e} in element {e}, over the plausible bound {} (`[time] max_strain` in the model file raises it; --allow-blowup only warns)",
+                        self.max_strain
+                    );
+                    self.report(st.t, problem, false)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn report(&mut self, t: f64, problem: String, cuts: bool) -> Result<()> {
+        if !self.warn_only {
+            return Err(Error::BlowUp { t, problem });
+        }
+        crate::output::note(&format!("warning: blow-up at t = {t:.6} s: {problem}"));
+        if cuts { self.warned_cuts = true } else { self.warned_strain = true }
+        Ok(())
+    }
 }
 
 /// Builds the model's system at the run's load scale and its consistent initial state.
@@ -127,6 +186,7 @@ pub fn prepare(model: &Model, s: &Settings) -> Result<(FlexibleSystem, Vec<f64>)
 
 pub fn simulate(model: &Model, overrides: &Overrides) -> Result<SimulationResult> {
     let s = Settings::resolve(model, overrides)?;
+    model.check_full_run_memory(s.n_steps, s.solver == LinearSolverKind::Dense)?;
     let (mut sys, q0) = prepare(model, &s)?;
     let (n, nc, nt) = (sys.n_dof(), sys.n_constraints(), s.n_steps + 1);
     let mut q = Array2::zeros((n, nt));

@@ -11,6 +11,15 @@ use crate::solver::kkt::LinearSolverKind;
 use schema::*;
 use std::path::{Path, PathBuf};
 
+/// Sizes of a model's system (see [`Model::sizes`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sizes {
+    pub n_dof: f64,
+    pub n_constraints: f64,
+    pub n_elements: f64,
+    pub n_probes: f64,
+}
+
 /// A validated model file.
 #[derive(Clone, Debug)]
 pub struct Model {
@@ -36,7 +45,7 @@ impl Model {
 
     pub fn from_text(text: &str, path: impl AsRef<Path>) -> Result<Model> {
         let path = path.as_ref();
-        let file: ModelFile = parse_toml(text, path)?;
+        let file: ModelFile = parse_toml(text, path).map_err(|e| entry_error(text, path).unwrap_or(e))?;
         let mut model = Model { path: path.to_path_buf(), text: text.to_string(), file, bodies: vec![], joints: vec![], loads: vec![], probes: vec![] };
         model.check()?;
         Ok(model)
@@ -77,9 +86,8 @@ impl Model {
             if b.elements <= 0 {
                 return Err(self.err(p("elements"), format!("must be a positive integer, got {}", b.elements)));
             }
-            if b.elements > 1_000_000 {
-                return Err(self.err(p("elements"), format!("{} elements is more than this program supports (1e6)", b.elements)));
-            }
+            let total: f64 = f.bodies[..=i].iter().map(|b| b.elements.max(0) as f64).sum();
+            crate::limits::check_elements(total).map_err(|e| self.err(p("elements"), e))?;
             for (k, v) in [("density", b.density), ("area", b.area), ("inertia", b.inertia), ("youngs_modulus", b.youngs_modulus)] {
                 self.positive(&p(k), v)?;
             }
@@ -166,6 +174,7 @@ impl Model {
             };
             self.joints.push(joint);
         }
+        self.check_joint_rank()?;
         for (i, l) in f.loads.iter().enumerate() {
             let p = |k: &str| format!("loads[{i}].{k}");
             let load = match l {
@@ -221,6 +230,83 @@ impl Model {
         Ok(())
     }
 
+    /// Refuses joints whose constraint rows `B` are linearly dependent (a node pinned twice,
+    /// a clamp plus a pin on its node, a loop of pins closing on one point): the KKT matrix
+    /// is then singular. Elimination row by row in joint order (B has entries ±1, so it is
+    /// exact); each row keeps the set of joints it was combined from, so a row that
+    /// reduces to zero names exactly the joints whose constraints it repeats.
+    fn check_joint_rank(&self) -> Result<()> {
+        use std::collections::{BTreeMap, BTreeSet, HashMap};
+        let mut first = Vec::with_capacity(self.bodies.len());
+        let mut n = 0;
+        for b in &self.bodies {
+            first.push(n);
+            n += b.n_elements + 1;
+        }
+        let g = |(b, k): NodeId| first[b] + k;
+        // reduced rows with their pivot column and the joints they combine
+        let mut basis: Vec<(BTreeMap<usize, f64>, BTreeSet<usize>)> = Vec::new();
+        let mut pivot_of: HashMap<usize, usize> = HashMap::new();
+        for (j, joint) in self.joints.iter().enumerate() {
+            let rows: Vec<Vec<(usize, f64)>> = match *joint {
+                Joint::GroundPin { node, .. } => (0..2).map(|c| vec![(4 * g(node) + c, 1.0)]).collect(),
+                Joint::Clamp { node, .. } => (0..4).map(|c| vec![(4 * g(node) + c, 1.0)]).collect(),
+                Joint::Pin { a, b } => (0..2).map(|c| vec![(4 * g(a) + c, 1.0), (4 * g(b) + c, -1.0)]).collect(),
+            };
+            for row in rows {
+                let mut r: BTreeMap<usize, f64> = row.into_iter().collect();
+                let mut used = BTreeSet::from([j]);
+                // eliminate the earliest basis row first: a basis row holds only pivot
+                // columns of later rows, so this ends
+                while let Some((c, bi)) = r.keys().filter_map(|c| pivot_of.get(c).map(|&bi| (*c, bi))).min_by_key(|x| x.1) {
+                    let (brow, bj) = &basis[bi];
+                    let f = r[&c] / brow[&c];
+                    for (&cc, &bv) in brow {
+                        *r.entry(cc).or_insert(0.0) -= f * bv;
+                    }
+                    r.remove(&c);
+                    r.retain(|_, v| v.abs() > 1e-9);
+                    used.extend(bj.iter().copied());
+                }
+                match r.keys().next() {
+                    Some(&c) => {
+                        pivot_of.insert(c, basis.len());
+                        basis.push((r, used));
+                    }
+                    None => {
+                        let others: Vec<String> = used.iter().filter(|&&i| i != j).map(|&i| format!("joints[{i}] ({})", self.describe_joint(i))).collect();
+                        let field = match entry_line(&self.text, "joints", j) {
+                            Some(l) => format!("joints[{j}] (line {l})"),
+                            None => format!("joints[{j}]"),
+                        };
+                        return Err(self.err(
+                            field,
+                            format!(
+                                "{} constrains what {} already fix{}: the joint equations are dependent (over-constrained, singular); remove or change one of them",
+                                self.describe_joint(j),
+                                others.join(" and "),
+                                if others.len() == 1 { "es" } else { "" }
+                            ),
+                        ));
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn describe_joint(&self, i: usize) -> String {
+        let node = |n: &NodeRef| match n {
+            NodeRef::Index(k) => format!("node {k}"),
+            NodeRef::Name(s) => format!("node \"{s}\""),
+        };
+        match &self.file.joints[i] {
+            JointSpec::GroundPin { body, node: n, .. } => format!("ground_pin on `{body}` {}", node(n)),
+            JointSpec::Clamp { body, node: n } => format!("clamp on `{body}` {}", node(n)),
+            JointSpec::Pin { a, b } => format!("pin `{}` {} – `{}` {}", a.body, node(&a.node), b.body, node(&b.node)),
+        }
+    }
+
     fn params_from(&self, t: &TimeSettings) -> Result<IntegratorParams> {
         let mut p = IntegratorParams { rho_inf: t.rho_inf, ..IntegratorParams::default() };
         if !(t.rho_inf.is_finite() && (0.0..=1.0).contains(&t.rho_inf)) {
@@ -247,6 +333,16 @@ impl Model {
                 return Err(self.err("time.max_step_cuts", format!("must be in 0..=30, got {m}")));
             }
             p.max_cuts = m as u32;
+        }
+        if let Some(x) = t.max_strain {
+            self.positive("time.max_strain", x)?;
+            p.max_strain = x;
+        }
+        if let Some(m) = t.max_total_step_cuts {
+            if m < 0 {
+                return Err(self.err("time.max_total_step_cuts", format!("must be zero or a positive integer, got {m}")));
+            }
+            p.max_total_cuts = usize::try_from(m).unwrap_or(usize::MAX);
         }
         if let Some(r) = &t.jacobian_reuse {
             p.reuse = match r.as_str() {
@@ -278,6 +374,33 @@ impl Model {
     pub fn system(&self, solver: LinearSolverKind) -> FlexibleSystem {
         let damping = self.file.damping.as_ref().map_or(Rayleigh::default(), |d| Rayleigh { mass: d.mass, stiffness: d.stiffness });
         FlexibleSystem::new(self.bodies.clone(), &self.joints, &self.loads, self.probes.clone(), damping, solver)
+    }
+
+    /// The sizes of the system this model builds, from the file alone (nothing is
+    /// assembled), as floats so that estimates from them cannot overflow.
+    pub fn sizes(&self) -> Sizes {
+        let n_elements: f64 = self.bodies.iter().map(|b| b.n_elements as f64).sum();
+        let n_dof = 4.0 * self.bodies.iter().map(|b| b.n_elements as f64 + 1.0).sum::<f64>();
+        let n_constraints = self.joints.iter().map(|j| if matches!(j, Joint::Clamp { .. }) { 4.0 } else { 2.0 }).sum();
+        Sizes { n_dof, n_constraints, n_elements, n_probes: self.probes.len() as f64 }
+    }
+
+    /// Refuses a full run of `n_steps` whose arrays (plus, with `dense`, the dense LU of
+    /// the KKT matrix) would not fit the memory bound ([`crate::limits`]).
+    pub fn check_full_run_memory(&self, n_steps: usize, dense: bool) -> Result<()> {
+        let z = self.sizes();
+        let nt = n_steps as f64 + 1.0;
+        let arrays = 8.0 * nt * (z.n_dof + z.n_constraints + 2.0 * z.n_probes + 1.0);
+        let system = z.n_elements * crate::limits::BYTES_PER_ELEMENT;
+        let n_kkt = z.n_dof + z.n_constraints;
+        let lu = if dense { 2.0 * 8.0 * n_kkt * n_kkt } else { 0.0 };
+        let what = format!(
+            "a full run of {} steps × {} coordinates{}",
+            n_steps,
+            z.n_dof,
+            if dense { format!(" with a dense {n_kkt} × {n_kkt} LU") } else { String::new() }
+        );
+        crate::limits::check_memory(&what, arrays + system + lu)
     }
 
     pub fn probe_names(&self) -> Vec<String> {
@@ -319,6 +442,68 @@ impl Model {
         };
         Ok((b, k))
     }
+}
+
+/// The entry of an array of tables (`[[bodies]]`, `[[joints]]`, `[[loads]]`, `[[probes]]`)
+/// that fails to parse, with the key at fault and its line: serde reports errors inside
+/// internally tagged or untagged entries against the whole entry, so each entry is parsed
+/// on its own, and the key at fault is the one whose removal changes the error (the
+/// `type` tag last: removing it always does). `None` when every entry parses by itself.
+fn entry_error(text: &str, path: &Path) -> Option<Error> {
+    fn first_error<T: serde::de::DeserializeOwned>(v: &toml::Value) -> Option<String> {
+        v.clone().try_into::<T>().err().map(|e| e.message().to_string())
+    }
+    let doc: toml::Table = toml::from_str(text).ok()?;
+    let kinds: [(&str, fn(&toml::Value) -> Option<String>); 4] = [
+        ("bodies", first_error::<BodySpec>),
+        ("joints", first_error::<JointSpec>),
+        ("loads", first_error::<LoadSpec>),
+        ("probes", first_error::<ProbeSpec>),
+    ];
+    for (name, parse) in kinds {
+        let Some(toml::Value::Array(items)) = doc.get(name) else { continue };
+        for (i, item) in items.iter().enumerate() {
+            let Some(message) = parse(item) else { continue };
+            let key = item.as_table().and_then(|t| {
+                let changes = |k: &String| {
+                    let mut rest = t.clone();
+                    rest.remove(k);
+                    parse(&toml::Value::Table(rest)).as_deref() != Some(message.as_str())
+                };
+                t.keys().filter(|k| k.as_str() != "type").find(|k| changes(k)).or_else(|| t.keys().find(|k| changes(k))).cloned()
+            });
+            let line = entry_line(text, name, i).map(|l| key.as_deref().and_then(|k| key_line(text, l, k)).unwrap_or(l));
+            let field = match (&key, line) {
+                (Some(k), Some(l)) => format!("{name}[{i}].{k} (line {l})"),
+                (Some(k), None) => format!("{name}[{i}].{k}"),
+                (None, Some(l)) => format!("{name}[{i}] (line {l})"),
+                (None, None) => format!("{name}[{i}]"),
+            };
+            return Some(Error::input(path, field, message));
+        }
+    }
+    None
+}
+
+/// The line (1-based) of the `[[name]]` header of entry `i`, if written that way.
+fn entry_line(text: &str, name: &str, i: usize) -> Option<usize> {
+    let is_header = |l: &str| l.trim().strip_prefix("[[").and_then(|r| r.split("]]").next()).is_some_and(|n| n.trim() == name);
+    text.lines().enumerate().filter(|(_, l)| is_header(l)).nth(i).map(|(k, _)| k + 1)
+}
+
+/// The line of `key = …` in the table whose header is on line `header`.
+fn key_line(text: &str, header: usize, key: &str) -> Option<usize> {
+    for (k, l) in text.lines().enumerate().skip(header) {
+        let l = l.trim();
+        if l.starts_with('[') {
+            return None;
+        }
+        let lhs = l.split('=').next().unwrap_or("").trim().trim_matches('"');
+        if l.contains('=') && (lhs == key || lhs.starts_with(&format!("{key}."))) {
+            return Some(k + 1);
+        }
+    }
+    None
 }
 
 /// The dotted key path (or line) at byte `pos` of a TOML text, for error messages.

@@ -43,6 +43,12 @@ pub struct TimeSettings {
     /// fast) or "never" (a fresh matrix at every iteration: full Newton)
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub jacobian_reuse: Option<String>,
+    /// blow-up check: the largest mean axial strain |ε̄| a run may reach (default 0.5)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_strain: Option<f64>,
+    /// blow-up check: step halvings a whole run may take (default 50)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_total_step_cuts: Option<i64>,
 }
 
 #[derive(Clone, Debug, Deserialize, Serialize)]

@@ -511,6 +511,11 @@ impl InvariantElementModel for FlexibleSystem {
         d1[0] = 0.5 * ea * (s[0] / (2.0 * l) - 0.5);
         d2[0] = ea / (4.0 * l);
     }
+
+    /// ε̄ = s/(2l) − ½ with s = eᵀS_l e (SPEC §1)
+    fn invariant_strain(&self, e: usize, s: &[f64]) -> Option<f64> {
+        Some(s[0] / (2.0 * self.element(e).length) - 0.5)
+    }
 }
 
 impl DynamicModel for FlexibleSystem {
@@ -588,6 +593,18 @@ impl DynamicModel for FlexibleSystem {
 
     fn length_scale(&self) -> f64 {
         self.length_scale
+    }
+
+    fn max_strain(&self, q: &[f64]) -> Option<(f64, usize)> {
+        let mut worst = (0.0_f64, 0);
+        for e in 0..self.elements.len() {
+            let eps = self.element(e).mean_axial_strain(&self.gather(e, q)).abs();
+            // NaN counts as the worst
+            if !(eps <= worst.0) {
+                worst = (eps, e);
+            }
+        }
+        Some(worst)
     }
 }
 

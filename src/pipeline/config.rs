@@ -114,6 +114,10 @@ impl Scales {
     }
 }
 
+/// The most load scales one range may list (each is a reduced run whose trajectory is kept
+/// until the sweep file is written; the memory check in `sweep` bounds them further).
+pub const MAX_LOAD_SCALES: usize = 1_000_000;
+
 /// `"A:B:N"` → N evenly spaced values from A to B (N ≥ 1; N = 1 gives A).
 pub fn parse_range(s: &str) -> std::result::Result<Vec<f64>, String> {
     let parts: Vec<&str> = s.split(':').collect();
@@ -125,6 +129,9 @@ pub fn parse_range(s: &str) -> std::result::Result<Vec<f64>, String> {
     let n: usize = parts[2].trim().parse().map_err(|_| format!("`{}` in `{s}` is not a whole number", parts[2]))?;
     if n == 0 {
         return Err(format!("`{s}` asks for no load scales (N = 0)"));
+    }
+    if n > MAX_LOAD_SCALES {
+        return Err(format!("`{s}` asks for {n} load scales, more than the {MAX_LOAD_SCALES} one sweep takes; split the range into several sweeps"));
     }
     let v = if n == 1 { vec![a] } else { (0..n).map(|i| a + (b - a) * i as f64 / (n - 1) as f64).collect() };
     check_scales(&v)?;

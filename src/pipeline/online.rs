@@ -135,6 +135,22 @@ impl<'a> ReducedRunner<'a> {
     }
 }
 
+/// Refuses `runs` reduced runs of `r` coordinates over `n_steps` whose kept arrays would
+/// not fit the memory bound: `8 n_t (r + n_c + 2 n_probes + 1)` each, plus the full
+/// coordinates `8 n_t (n_dof + n_c)` when they are reconstructed ([`crate::limits`]).
+pub fn check_reduced_memory(model: &Model, r: usize, n_steps: usize, output: Output, runs: f64) -> Result<()> {
+    let z = model.sizes();
+    let nt = n_steps as f64 + 1.0;
+    let full = if output == Output::Full { z.n_dof + z.n_constraints } else { 0.0 };
+    let bytes = runs * 8.0 * nt * (r as f64 + z.n_constraints + 2.0 * z.n_probes + 1.0 + full);
+    let what = if runs > 1.0 {
+        format!("{runs} reduced runs of {n_steps} steps × {r} modes{}", if full > 0.0 { " with their full coordinates" } else { "" })
+    } else {
+        format!("a reduced run of {n_steps} steps × {r} modes")
+    };
+    crate::limits::check_memory(&what, bytes)
+}
+
 fn run<R: Reduced<FlexibleSystem>>(
     rom: &mut R,
     model: &Model,
@@ -146,6 +162,7 @@ fn run<R: Reduced<FlexibleSystem>>(
 ) -> Result<ReducedRun> {
     let q0 = basis.reduce(ArrayView1::from(x0)).to_vec();
     let (r, nt) = (rom.n_dof(), s.n_steps + 1);
+    check_reduced_memory(model, r, s.n_steps, output, 1.0)?;
     let mut zq = Array2::zeros((r, nt));
     let mut lam = Array2::<f64>::zeros((rom.n_constraints(), nt));
     let mut t = Array1::zeros(nt);

@@ -51,18 +51,18 @@ pub fn run(p: &Pipeline, progress: bool) -> Result<PathBuf> {
 /// into `out` (a temporary folder); the files are `fsync`ed when the folder is swapped in.
 fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool) -> Result<()> {
     let plot_err = |e: String| Error::io(out, std::io::Error::other(e));
-    eprintln!("[1/3] train: {} full run(s)", p.file.train.load_scales.len());
+    crate::output::note(&format!("[1/3] train: {} full run(s)", p.file.train.load_scales.len()));
     let trained = train_and_write(p, basis_path)?;
     let stored = load_basis(p, basis_path)?;
     let basis = &stored.basis;
 
     let scales = p.online_scales();
-    eprintln!("[2/3] sweep: {} reduced and full runs", scales.len());
+    crate::output::note(&format!("[2/3] sweep: {} reduced and full runs", scales.len()));
     let sw = sweep(&p.model, basis, &scales, SweepOptions { validate: true, continuation: false, progress })?;
     write_sweep(&out.join("sweep.h5"), &sw, basis, &p.basis_path)?;
 
     let vscales = p.validate_scales();
-    eprintln!("[3/3] validate at {} load scale(s), with the dense full solve", vscales.len());
+    crate::output::note(&format!("[3/3] validate at {} load scale(s), with the dense full solve", vscales.len()));
     let mut validations: Vec<Validation> = Vec::new();
     for (i, &x) in vscales.iter().enumerate() {
         let (v, full, rom) = validate(&p.model, basis, x, true)?;

@@ -74,6 +74,10 @@ pub fn sweep(model: &Model, basis: &Basis, scales: &[f64], o: SweepOptions) -> R
     let bar = ProgressBar::with_draw_target(Some(scales.len() as u64), if o.progress { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() });
     bar.set_style(ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} load scales, {elapsed} elapsed, ETA {eta}").expect("valid template").progress_chars("=> "));
     bar.set_prefix(if o.validate { "sweep + validate" } else { "sweep" });
+    // every point's trajectories are kept until the file is written
+    let n_steps = crate::simulate::Settings::resolve(model, &Overrides::default())?.n_steps;
+    let output = if o.validate { Output::Full } else { Output::ReducedAndProbes };
+    super::online::check_reduced_memory(model, basis.n_reduced(), n_steps, output, scales.len() as f64)?;
     let start = std::time::Instant::now();
     let threads = rayon::current_num_threads().max(1);
     // continuation: a few chains of neighbouring scales per thread; otherwise one point per task
@@ -95,9 +99,9 @@ pub fn sweep(model: &Model, basis: &Basis, scales: &[f64], o: SweepOptions) -> R
                     let previous: Vec<&ReducedRun> = done[first.max(done.len().saturating_sub(2))..].iter().map(|p| &p.1.rom).collect();
                     // without validation nothing of full size is reconstructed
                     let output = if o.validate { Output::Full } else { Output::ReducedAndProbes };
-                    let rom = runner.run(x, output, &previous)?;
+                    let rom = runner.run(x, output, &previous).map_err(|e| e.at_stage("sweep (reduced run)", x))?;
                     let validation = if o.validate {
-                        let full = simulate(model, &Overrides { load_scale: Some(x), ..Default::default() })?;
+                        let full = simulate(model, &Overrides { load_scale: Some(x), ..Default::default() }).map_err(|e| e.at_stage("sweep (full run)", x))?;
                         Some(compare(model, &full, &rom, None, basis.n_reduced(), basis.variant.name()))
                     } else {
                         None

@@ -30,10 +30,18 @@ pub fn train(p: &Pipeline) -> Result<(TrainingData, TrainSummary)> {
     if scales.is_empty() {
         return Err(Error::input(&p.path, "train.load_scales", "is empty: no training run, no snapshots"));
     }
+    // the runs, their concatenated snapshots and the POD's working copy
+    let n_steps = crate::simulate::Settings::resolve(&p.model, &Overrides::default())?.n_steps;
+    let z = p.model.sizes();
+    let snapshots = scales.len() as f64 * (n_steps as f64 + 1.0);
+    crate::limits::check_memory(
+        &format!("training on {} snapshots × {} coordinates", snapshots, z.n_dof),
+        3.0 * 8.0 * snapshots * (z.n_dof + z.n_constraints) + z.n_elements * crate::limits::BYTES_PER_ELEMENT,
+    )?;
     let mut runs = Vec::new();
     let mut full_seconds = 0.0;
     for &s in scales {
-        let r = simulate(&p.model, &Overrides { load_scale: Some(s), ..Default::default() })?;
+        let r = simulate(&p.model, &Overrides { load_scale: Some(s), ..Default::default() }).map_err(|e| e.at_stage("train (full run)", s))?;
         full_seconds += r.wall_seconds;
         runs.push(r);
     }

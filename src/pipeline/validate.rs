@@ -84,9 +84,14 @@ pub fn compare(model: &Model, full: &SimulationResult, rom: &ReducedRun, dense_s
 /// Runs full (banded, and dense LU when `with_dense`) and reduced at `load_scale`.
 pub fn validate(model: &Model, basis: &Basis, load_scale: f64, with_dense: bool) -> Result<(Validation, SimulationResult, ReducedRun)> {
     let o = Overrides { load_scale: Some(load_scale), ..Default::default() };
-    let full = simulate(model, &o)?;
-    let dense = if with_dense { Some(simulate(model, &Overrides { solver: LinearSolverKind::Dense, ..o })?.wall_seconds) } else { None };
-    let rom = run_reduced(model, basis, load_scale)?;
+    let stage = |what: &'static str| move |e: crate::Error| e.at_stage(what, load_scale);
+    let full = simulate(model, &o).map_err(stage("validate (full run)"))?;
+    let dense = if with_dense {
+        Some(simulate(model, &Overrides { solver: LinearSolverKind::Dense, ..o }).map_err(stage("validate (dense full run)"))?.wall_seconds)
+    } else {
+        None
+    };
+    let rom = run_reduced(model, basis, load_scale).map_err(stage("validate (reduced run)"))?;
     let v = compare(model, &full, &rom, dense, basis.n_reduced(), basis.variant.name());
     Ok((v, full, rom))
 }

@@ -495,6 +495,23 @@ impl<M: InvariantElementModel> DynamicModel for HyperReducedModel<M> {
         }
         self.p.finish_matrix()
     }
+
+    /// From the invariants cached at the last force or matrix evaluation: at a converged
+    /// step the last Newton iterate, within the tolerance of the final state, at no cost.
+    fn max_strain(&self, _q: &[f64]) -> Option<(f64, usize)> {
+        if !self.valid {
+            return None;
+        }
+        let nj = self.nj;
+        let mut worst: Option<(f64, usize)> = None;
+        for (k, &e) in self.elements.iter().enumerate() {
+            let eps = self.full.invariant_strain(e, &self.s_val[k * nj..(k + 1) * nj])?.abs();
+            if !worst.is_some_and(|w| eps <= w.0) {
+                worst = Some((eps, e));
+            }
+        }
+        worst
+    }
 }
 
 impl_reduced!(HyperReducedModel, InvariantElementModel);

@@ -41,6 +41,11 @@ pub struct IntegratorParams {
     pub max_cuts: u32,
     /// when the factorized iteration matrix may be kept instead of refreshed
     pub reuse: JacobianReuse,
+    /// blow-up check: the largest mean axial strain |ε̄| a run may reach (`[time]
+    /// max_strain`, default 0.5 = 50 %; infinity disables it)
+    pub max_strain: f64,
+    /// blow-up check: step halvings a whole run may take (`[time] max_total_step_cuts`)
+    pub max_total_cuts: usize,
 }
 
 /// How long a factorized iteration matrix is kept (modified Newton). Only the convergence
@@ -64,7 +69,7 @@ impl Default for IntegratorParams {
     fn default() -> Self {
         // within-step reuse: the same tolerance at 15–25 % less time on every shipped model,
         // full and reduced (README, benchmark)
-        IntegratorParams { rho_inf: 0.9, tolerance: 1e-10, stagnation: 1e-6, max_iterations: 25, max_cuts: 8, reuse: JacobianReuse::WithinStep }
+        IntegratorParams { rho_inf: 0.9, tolerance: 1e-10, stagnation: 1e-6, max_iterations: 25, max_cuts: 8, reuse: JacobianReuse::WithinStep, max_strain: 0.5, max_total_cuts: 50 }
     }
 }
 
@@ -78,6 +83,9 @@ impl IntegratorParams {
         }
         if !(self.stagnation.is_finite() && self.stagnation >= 0.0) {
             return Err(format!("the Newton stagnation bound must be zero or positive, got {}", self.stagnation));
+        }
+        if !(self.max_strain > 0.0) {
+            return Err(format!("max_strain must be positive, got {}", self.max_strain));
         }
         if self.max_iterations == 0 {
             return Err("max_iterations must be at least 1".into());

@@ -37,6 +37,12 @@ pub trait DynamicModel {
     fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String>;
     /// A length that sets the absolute scale of coordinate increments (for convergence tests).
     fn length_scale(&self) -> f64;
+    /// The largest mean axial strain `max_e |ε̄ₑ|` (SPEC §1) at `q` and its element, over
+    /// the elements the model evaluates (a hyper-reduced model: its sampled ones, at the
+    /// last Newton iterate); `None` when the model cannot tell. Feeds the blow-up check.
+    fn max_strain(&self, _q: &[f64]) -> Option<(f64, usize)> {
+        None
+    }
 }
 
 /// A model assembled from elements with fixed dof lists and a few nodal loads, opened up so
@@ -90,4 +96,9 @@ pub trait InvariantElementModel: ElementModel {
     fn element_invariant_matrix(&self, e: usize, j: usize, out: &mut [f64]);
     /// `ψⱼ` and `ψⱼₖ` (column-major, `n_invariants()` square) at the invariants `s`.
     fn invariant_derivatives(&self, e: usize, s: &[f64], d1: &mut [f64], d2: &mut [f64]);
+    /// The element's mean axial strain from its invariants, when the model defines one
+    /// (the blow-up check); `None` by default.
+    fn invariant_strain(&self, _e: usize, _s: &[f64]) -> Option<f64> {
+        None
+    }
 }

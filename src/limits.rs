@@ -1,0 +1,187 @@
+//! Resource bounds checked before anything large is allocated, and the switch that turns
+//! blow-up errors into warnings. The command line sets them once (`--max-memory`,
+//! `--max-steps`, `--allow-blowup`); without it they come from the environment
+//! (`FLEXROM_MAX_MEMORY`, `FLEXROM_MAX_STEPS`) or the defaults: half of the machine's
+//! memory (`MemTotal` in /proc/meminfo, 4 GiB when unreadable) and 10⁷ time steps.
+//!
+//! Estimates count only the big arrays a stage keeps (8 bytes per f64):
+//!
+//! ```text
+//!     full run      (n_t) (n_dof + n_c + 2 n_probes + 1) · 8  +  n_el · 2 KiB (system, banded KKT)
+//!     dense LU      n_kkt² · 8 · 2                               (n_kkt = n_dof + n_c)
+//!     training      Σ runs + 3 · n_dof · n_snapshots · 8          (snapshot matrix, POD copies)
+//!     sweep         N · n_t · (r + 2 n_probes) · 8  (+ N · n_t · n_dof · 8 with --validate)
+//! ```
+
+use crate::error::{Error, Result};
+use std::sync::OnceLock;
+
+/// The bounds in force.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Limits {
+    /// bytes a stage may allocate for its big arrays
+    pub max_memory: u64,
+    /// where `max_memory` came from, for messages
+    pub memory_source: String,
+    /// time steps a run may take
+    pub max_steps: u64,
+    /// elements a model may have, over all bodies (the full model's cost per step grows
+    /// with them; 10⁵ elements already take minutes per step to set up)
+    pub max_elements: u64,
+    /// blow-up checks warn instead of failing
+    pub allow_blowup: bool,
+}
+
+/// Bytes assumed per element for the assembled system (element lists, 8×8 blocks, the
+/// banded KKT storage of bandwidth ~12 for each of the element's 4 coordinates).
+pub const BYTES_PER_ELEMENT: f64 = 2048.0;
+pub const DEFAULT_MAX_STEPS: u64 = 10_000_000;
+pub const DEFAULT_MAX_ELEMENTS: u64 = 200_000;
+
+static LIMITS: OnceLock<Limits> = OnceLock::new();
+
+/// Sets the bounds for the rest of the process (the first call wins).
+pub fn set(l: Limits) {
+    let _ = LIMITS.set(l);
+}
+
+/// The bounds in force: those given to [`set`], else the environment's, else the defaults.
+pub fn get() -> &'static Limits {
+    LIMITS.get_or_init(|| from_env(None, None, None, false).unwrap_or_else(|_| defaults()))
+}
+
+fn defaults() -> Limits {
+    let (max_memory, memory_source) = default_memory();
+    Limits { max_memory, memory_source, max_steps: DEFAULT_MAX_STEPS, max_elements: DEFAULT_MAX_ELEMENTS, allow_blowup: false }
+}
+
+fn default_memory() -> (u64, String) {
+    let total = std::fs::read_to_string("/proc/meminfo").ok().and_then(|s| {
+        s.lines().find(|l| l.starts_with("MemTotal:")).and_then(|l| l.split_whitespace().nth(1)?.parse::<u64>().ok())
+    });
+    match total {
+        Some(kib) => (kib.saturating_mul(1024) / 2, "half of MemTotal".into()),
+        None => (4 << 30, "the default 4 GiB".into()),
+    }
+}
+
+/// The bounds from the command-line values (`None`: not given), else the environment,
+/// else the defaults. A malformed value is a usage error naming the option.
+pub fn from_env(max_memory: Option<&str>, max_steps: Option<&str>, max_elements: Option<&str>, allow_blowup: bool) -> Result<Limits> {
+    let mut l = defaults();
+    l.allow_blowup = allow_blowup;
+    let env_mem = std::env::var("FLEXROM_MAX_MEMORY").ok();
+    if let Some((v, name)) = max_memory.map(|v| (v.to_string(), "--max-memory")).or(env_mem.map(|v| (v, "FLEXROM_MAX_MEMORY"))) {
+        l.max_memory = parse_bytes(&v).map_err(|e| Error::Usage(format!("{name}: {e}")))?;
+        l.memory_source = name.to_string();
+    }
+    let env_steps = std::env::var("FLEXROM_MAX_STEPS").ok();
+    if let Some((v, name)) = max_steps.map(|v| (v.to_string(), "--max-steps")).or(env_steps.map(|v| (v, "FLEXROM_MAX_STEPS"))) {
+        l.max_steps = positive_count(&v, name)?;
+    }
+    let env_el = std::env::var("FLEXROM_MAX_ELEMENTS").ok();
+    if let Some((v, name)) = max_elements.map(|v| (v.to_string(), "--max-elements")).or(env_el.map(|v| (v, "FLEXROM_MAX_ELEMENTS"))) {
+        l.max_elements = positive_count(&v, name)?;
+    }
+    Ok(l)
+}
+
+fn positive_count(v: &str, name: &str) -> Result<u64> {
+    v.trim().parse::<u64>().ok().filter(|&n| n > 0).ok_or_else(|| Error::Usage(format!("{name}: `{v}` is not a positive whole number")))
+}
+
+/// `"8G"`, `"512M"`, `"1.5GiB"`, `"1000000"` → bytes (K, M, G, T are powers of 1024).
+pub fn parse_bytes(s: &str) -> std::result::Result<u64, String> {
+    let t = s.trim();
+    let split = t.find(|c: char| c.is_ascii_alphabetic()).unwrap_or(t.len());
+    let (num, unit) = t.split_at(split);
+    let x: f64 = num.trim().parse().map_err(|_| format!("`{s}` is not a size (e.g. 8G, 512M, 1000000)"))?;
+    let mult = match unit.trim().to_ascii_uppercase().as_str() {
+        "" | "B" => 1.0,
+        "K" | "KB" | "KIB" => 1024.0,
+        "M" | "MB" | "MIB" => 1024.0 * 1024.0,
+        "G" | "GB" | "GIB" => 1024.0 * 1024.0 * 1024.0,
+        "T" | "TB" | "TIB" => 1024.0_f64.powi(4),
+        u => return Err(format!("unknown unit `{u}` in `{s}` (use K, M, G or T)")),
+    };
+    let b = x * mult;
+    if !(b.is_finite() && b >= 1.0 && b < 1.8e19) {
+        return Err(format!("`{s}` is not a positive size below 16 EiB"));
+    }
+    Ok(b as u64)
+}
+
+/// A number as written by hand: plain in [1e-4, 1e6), else in exponent form (1e300 is
+/// not 301 digits).
+pub fn show_number(x: f64) -> String {
+    if x == 0.0 || (1e-4..1e6).contains(&x.abs()) { format!("{x}") } else { format!("{x:e}") }
+}
+
+/// Human-readable bytes.
+pub fn show_bytes(b: f64) -> String {
+    const UNITS: [&str; 6] = ["B", "KiB", "MiB", "GiB", "TiB", "PiB"];
+    let mut x = b;
+    let mut u = 0;
+    while x >= 1024.0 && u + 1 < UNITS.len() {
+        x /= 1024.0;
+        u += 1;
+    }
+    if u == 0 { format!("{x:.0} {}", UNITS[0]) } else { format!("{x:.1} {}", UNITS[u]) }
+}
+
+/// Refuses an allocation estimated at `bytes` (computed in f64, so it cannot overflow)
+/// above the memory bound; `what` says what it is for.
+pub fn check_memory(what: &str, bytes: f64) -> Result<()> {
+    let l = get();
+    if bytes.is_finite() && bytes <= l.max_memory as f64 {
+        return Ok(());
+    }
+    Err(Error::Resource(format!(
+        "{what} would need about {} of memory, over the limit of {} ({}); raise it with --max-memory or FLEXROM_MAX_MEMORY, or use fewer steps, elements or load scales",
+        show_bytes(bytes),
+        show_bytes(l.max_memory as f64),
+        l.memory_source
+    )))
+}
+
+/// Refuses a model of `n` elements above the element bound.
+pub fn check_elements(n: f64) -> std::result::Result<(), String> {
+    let l = get();
+    if n <= l.max_elements as f64 {
+        return Ok(());
+    }
+    Err(format!(
+        "{n:.0} elements in all, over the limit of {} (raise it with --max-elements or FLEXROM_MAX_ELEMENTS)",
+        l.max_elements
+    ))
+}
+
+/// Refuses a run of `steps` (a float, so 1e300 / 1e-300 cannot overflow) above the step bound.
+pub fn check_steps(steps: f64, dt: f64, t_end: f64) -> Result<()> {
+    let l = get();
+    if steps.is_finite() && steps <= l.max_steps as f64 {
+        return Ok(());
+    }
+    Err(Error::Resource(format!(
+        "t_end = {} s at dt = {} s is {steps:.3e} steps, over the limit of {} steps; raise it with --max-steps or FLEXROM_MAX_STEPS, or use a larger dt",
+        show_number(t_end),
+        show_number(dt),
+        l.max_steps
+    )))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_parse_with_binary_units_and_refuse_nonsense() {
+        assert_eq!(parse_bytes("1000").unwrap(), 1000);
+        assert_eq!(parse_bytes("2K").unwrap(), 2048);
+        assert_eq!(parse_bytes("1.5GiB").unwrap(), 3 << 29);
+        assert_eq!(parse_bytes(" 8 g ").unwrap(), 8 << 30);
+        for bad in ["", "x", "-1G", "0", "nan", "inf", "1e300", "3Q"] {
+            assert!(parse_bytes(bad).is_err(), "{bad}");
+        }
+    }
+}

@@ -1,0 +1,225 @@
+//! Issue 16, items 3, 4, 6, 7: resource bounds refused before allocating, errors that say
+//! where (TOML entry lines, dependent joints, stage and load scale), blow-up detection, and
+//! a closed or full standard output.
+//!
+//! Where the expected figures come from:
+//! - memory of a full pendulum run (src/limits.rs): n_t = 221 instants (1.1 s / 0.005 s + 1)
+//!   × (204 coordinates + 2 multipliers + 2 probe columns + 1 time) × 8 B = 369 512 B, plus
+//!   50 elements × 2048 B = 102 400 B: 471 912 B = 460.9 KiB, so a 400 KiB bound refuses it
+//!   and a 500 KiB bound admits it;
+//! - steps: 1.1 s / 1e-9 s = 1.1e9 steps > the default 10⁷; 1e12 s / 0.005 s = 2e14;
+//! - a 10⁶-element body is over the default 2·10⁵ elements; with the element bound raised
+//!   its run needs 221 × (4 000 004 + 2 + 2 + 1) × 8 B ≈ 6.6 GiB, over a 1 GiB bound;
+//! - blow-up: the pendulum with E = 1e3 Pa instead of 0.7e9 (EA = 1.8 N for a 12 kg beam)
+//!   cannot carry its own weight: it stretches past 50 % within 0.1 s (seen: |ε̄| = 0.52
+//!   at t = 0.06 s); at load scale 1e4 (98 100 m/s²) the stiff beam stretches past it too
+//!   (seen: 2.25 at 0.06 s), and its Newton solves need step halvings, so a budget of 0
+//!   cuts is exceeded (seen: the first halving at t = 0.04 s).
+//!   Lines of TOML entries are found by searching the test's own text.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::Instant;
+
+fn flexrom() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_flexrom"))
+}
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).to_path_buf()
+}
+
+fn pendulum() -> String {
+    std::fs::read_to_string(root().join("data/models/pendulum.toml")).unwrap()
+}
+
+/// Runs `flexrom args…`; returns (exit code, stderr).
+fn run(args: &[&str]) -> (i32, String) {
+    let o = flexrom().args(args).output().unwrap();
+    (o.status.code().expect("exited, no signal"), String::from_utf8_lossy(&o.stderr).into_owned())
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p.display().to_string()
+}
+
+#[test]
+fn runs_that_would_not_fit_are_refused_quickly_with_the_figure_and_the_option() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o.h5");
+    let (o, m) = (out.to_str().unwrap(), root().join("data/models/pendulum.toml"));
+    let m = m.to_str().unwrap();
+    for (flag, value, figure) in [("--dt", "1e-9", "1.100e9 steps"), ("--t-end", "1e12", "2.000e14 steps")] {
+        let start = Instant::now();
+        let (code, err) = run(&["simulate", m, "-o", o, flag, value]);
+        assert_eq!(code, 1, "{flag} {value}: {err}");
+        assert!(err.contains(figure) && err.contains("--max-steps"), "{flag} {value}: {err}");
+        assert!(start.elapsed().as_secs_f64() < 5.0, "{flag} {value} took {:?}", start.elapsed());
+        assert!(!out.exists());
+    }
+    // the memory estimate: 460.9 KiB (header)
+    let (code, err) = run(&["simulate", m, "-o", o, "--max-memory", "400K"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("460.9 KiB") && err.contains("--max-memory") && err.contains("FLEXROM_MAX_MEMORY"), "{err}");
+    assert!(!out.exists());
+    let (code, err) = run(&["simulate", m, "-o", o, "--max-memory", "500K"]);
+    assert_eq!(code, 0, "{err}");
+    // the same bound through the environment
+    let e = flexrom().args(["simulate", m, "-o", o]).env("FLEXROM_MAX_MEMORY", "400K").output().unwrap();
+    assert_eq!(e.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&e.stderr).contains("FLEXROM_MAX_MEMORY"));
+
+    // 10⁶ elements: refused by the element bound, then (bound raised) by the memory one
+    let huge = write(dir.path(), "huge.toml", &pendulum().replace("elements = 50", "elements = 1000000"));
+    let start = Instant::now();
+    let (code, err) = run(&["simulate", &huge, "-o", o]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("bodies[0].elements") && err.contains("--max-elements"), "{err}");
+    let (code, err) = run(&["simulate", &huge, "-o", o, "--max-elements", "2000000", "--max-memory", "1G"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("4000004 coordinates") && err.contains("--max-memory"), "{err}");
+    assert!(start.elapsed().as_secs_f64() < 5.0, "took {:?}", start.elapsed());
+}
+
+#[test]
+fn errors_inside_array_of_tables_entries_name_the_key_and_its_line() {
+    let text = pendulum() + "\n[[loads]]\ntype = \"force\"\nbody = \"beam\"\nnode = \"end\"\nvalue = \"up\"\n";
+    let err = flexrom::model::Model::from_text(&text, "m.toml").unwrap_err().to_string();
+    let line = text.lines().position(|l| l.starts_with("value = \"up\"")).unwrap() + 1;
+    assert!(err.contains(&format!("loads[1].value (line {line})")), "{err}");
+    // an untagged node reference of the wrong kind, in the first joint
+    let text = pendulum().replace("node = \"start\"", "node = 1.5");
+    let err = flexrom::model::Model::from_text(&text, "m.toml").unwrap_err().to_string();
+    let line = text.lines().position(|l| l.starts_with("node = 1.5")).unwrap() + 1;
+    assert!(err.contains(&format!("joints[0].node (line {line})")), "{err}");
+    // an unknown key, and an unknown type tag
+    let text = pendulum().replace("scaled = true", "scaled = true\nscale = 2");
+    let err = flexrom::model::Model::from_text(&text, "m.toml").unwrap_err().to_string();
+    let line = text.lines().position(|l| l.starts_with("scale = 2")).unwrap() + 1;
+    assert!(err.contains(&format!("loads[0].scale (line {line})")), "{err}");
+    let text = pendulum().replace("type = \"gravity\"", "type = \"gravitation\"");
+    let err = flexrom::model::Model::from_text(&text, "m.toml").unwrap_err().to_string();
+    let line = text.lines().position(|l| l.contains("\"gravitation\"")).unwrap() + 1;
+    assert!(err.contains(&format!("loads[0].type (line {line})")), "{err}");
+}
+
+/// Three beams from one point, with a joint list to append.
+fn star(joints: &str) -> String {
+    let mut t = String::from("[time]\nt_end = 0.1\ndt = 0.01\nrho_inf = 0.9\n");
+    for (name, angle) in [("a", 0.0), ("b", 2.0), ("c", 4.0)] {
+        t += &format!(
+            "[[bodies]]\nname = \"{name}\"\nstart = [0.0, 0.0]\nangle = {angle}\nlength = 1.0\nelements = 2\ndensity = 7800.0\narea = 1e-4\ninertia = 1e-9\nyoungs_modulus = 2e11\n"
+        );
+    }
+    t + joints
+}
+
+fn pin(a: &str, b: &str) -> String {
+    format!("[[joints]]\ntype = \"pin\"\na = {{ body = \"{a}\", node = 0 }}\nb = {{ body = \"{b}\", node = 0 }}\n")
+}
+
+fn ground(kind: &str, body: &str) -> String {
+    format!("[[joints]]\ntype = \"{kind}\"\nbody = \"{body}\"\nnode = 0\n")
+}
+
+#[test]
+fn dependent_joints_are_refused_naming_them() {
+    let load = |j: &str| flexrom::model::Model::from_text(&star(j), "m.toml").map(|_| ()).map_err(|e| e.to_string());
+    // independent sets load
+    load(&(ground("ground_pin", "a") + &pin("a", "b") + &pin("b", "c"))).unwrap();
+    load(&(ground("clamp", "a") + &pin("a", "b"))).unwrap();
+    // a node pinned to ground twice
+    let e = load(&(ground("ground_pin", "a") + &ground("ground_pin", "a"))).unwrap_err();
+    assert!(e.contains("joints[1]") && e.contains("joints[0] (ground_pin on `a` node 0)") && e.contains("dependent"), "{e}");
+    // a clamp and a ground pin on the same node
+    let e = load(&(ground("clamp", "a") + &ground("ground_pin", "a"))).unwrap_err();
+    assert!(e.contains("joints[1]") && e.contains("joints[0] (clamp on `a` node 0)"), "{e}");
+    // a loop of pins closing on one point: the third repeats the first two
+    let e = load(&(pin("a", "b") + &pin("b", "c") + &pin("c", "a"))).unwrap_err();
+    assert!(e.contains("joints[2]") && e.contains("joints[0]") && e.contains("joints[1]"), "{e}");
+    // two ground pins on bodies already pinned together: the second names the chain
+    let e = load(&(ground("ground_pin", "a") + &pin("a", "b") + &ground("ground_pin", "b"))).unwrap_err();
+    assert!(e.contains("joints[2]") && e.contains("joints[0]") && e.contains("joints[1]"), "{e}");
+    // the line of the offending entry
+    let text = star(&(ground("ground_pin", "a") + &ground("ground_pin", "a")));
+    let line = text.lines().enumerate().filter(|(_, l)| *l == "[[joints]]").nth(1).unwrap().0 + 1;
+    assert!(load(&(ground("ground_pin", "a") + &ground("ground_pin", "a"))).unwrap_err().contains(&format!("joints[1] (line {line})")));
+}
+
+#[test]
+fn blow_ups_stop_the_run_unless_allowed() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o.h5");
+    let o = out.to_str().unwrap();
+    let soft = write(dir.path(), "soft.toml", &pendulum().replace("youngs_modulus = 0.7e9", "youngs_modulus = 1e3"));
+    let (code, err) = run(&["simulate", &soft, "-o", o, "--t-end", "0.1"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("simulate at load scale 1") && err.contains("max_strain") && err.contains("--allow-blowup"), "{err}");
+    assert!(!out.exists(), "a blown-up run writes nothing");
+    let (code, err) = run(&["simulate", &soft, "-o", o, "--t-end", "0.1", "--allow-blowup"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("warning: blow-up") && err.contains("max_strain"), "{err}");
+    assert!(out.exists());
+    // raising the key instead
+    let relaxed = write(dir.path(), "relaxed.toml", &pendulum().replace("youngs_modulus = 0.7e9", "youngs_modulus = 1e3").replace("rho_inf = 1.0", "rho_inf = 1.0\nmax_strain = 1e6"));
+    let (code, err) = run(&["simulate", &relaxed, "-o", o, "--t-end", "0.1"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!err.contains("blow-up"), "{err}");
+
+    // the load scale 1e4: the strain bound fires (naming the scale); with it relaxed and no
+    // step cuts allowed, the cut budget does
+    let (code, err) = run(&["simulate", &root().join("data/models/pendulum.toml").display().to_string(), "-o", o, "--load-scale", "1e4", "--t-end", "0.3"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("load scale 10000") && err.contains("max_strain"), "{err}");
+    let cuts = write(dir.path(), "cuts.toml", &pendulum().replace("rho_inf = 1.0", "rho_inf = 1.0\nmax_strain = 1e9\nmax_total_step_cuts = 0"));
+    let (code, err) = run(&["simulate", &cuts, "-o", o, "--load-scale", "1e4", "--t-end", "0.3"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("step halvings") && err.contains("max_total_step_cuts"), "{err}");
+    // a bad key value is an input error
+    let bad = write(dir.path(), "bad.toml", &pendulum().replace("rho_inf = 1.0", "rho_inf = 1.0\nmax_strain = -1"));
+    let (code, err) = run(&["simulate", &bad, "-o", o]);
+    assert_eq!(code, 1);
+    assert!(err.contains("time.max_strain"), "{err}");
+}
+
+/// Runs `args` with stdout a pipe whose reading end is closed at once.
+fn into_closed_pipe(args: &[&str]) -> (Option<i32>, String) {
+    let mut child = flexrom().args(args).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+    drop(child.stdout.take());
+    let o = child.wait_with_output().unwrap();
+    (o.status.code(), String::from_utf8_lossy(&o.stderr).into_owned())
+}
+
+#[test]
+fn a_closed_or_full_stdout_is_not_a_panic() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o.h5");
+    let (o, m) = (out.to_str().unwrap(), root().join("data/models/pendulum.toml"));
+    let m = m.to_str().unwrap();
+    let (code, err) = into_closed_pipe(&["simulate", m, "-o", o, "--t-end", "0.05", "--csv"]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(!err.contains("panicked") && !err.contains("error"), "{err}");
+    // a full disk is an ordinary error with its message
+    let full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+    let r = flexrom().args(["simulate", m, "-o", o, "--t-end", "0.05", "--csv"]).stdout(full).output().unwrap();
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(1), "{err}");
+    assert!(err.contains("standard output") && err.contains("No space left"), "{err}");
+
+    // validate --json and sweep into a closed pipe, with a basis trained here
+    let basis = dir.path().join("b.h5");
+    let b = basis.to_str().unwrap();
+    let p = root().join("pipelines/pendulum.toml");
+    let p = p.to_str().unwrap();
+    let (code, err) = run(&["train", p, "--basis", b]);
+    assert_eq!(code, 0, "{err}");
+    let (code, err) = into_closed_pipe(&["validate", p, "--load-scale", "1.0", "--json", "--no-dense", "--basis", b]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    let sw = dir.path().join("s.h5");
+    let (code, err) = into_closed_pipe(&["sweep", p, "--load-scales", "0.9:1.1:3", "--basis", b, "-o", sw.to_str().unwrap()]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+}
