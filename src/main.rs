@@ -120,6 +120,10 @@ enum Command {
         /// basis file (default: the pipeline's `basis`)
         #[arg(long)]
         basis: Option<PathBuf>,
+        /// take the load scales that the sweep file already holds as finished (same basis
+        /// and model) from it and run only the others; failed ones run again
+        #[arg(long)]
+        resume: bool,
     },
     /// Train, sweep, validate and write a report folder (Markdown and SVG plots).
     Run {
@@ -140,7 +144,7 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e}");
-            ExitCode::FAILURE
+            ExitCode::from(e.exit_code())
         }
     }
 }
@@ -229,7 +233,7 @@ fn run(cli: Cli) -> flexrom::Result<()> {
             }
             Ok(())
         }
-        Command::Sweep { pipeline, load_scales, validate, continuation, output, basis } => {
+        Command::Sweep { pipeline, load_scales, validate, continuation, output, basis, resume } => {
             let p = Pipeline::load(&pipeline)?;
             let scales = match load_scales {
                 Some(s) => flexrom::pipeline::config::parse_range(&s).map_err(|e| flexrom::Error::Usage(format!("--load-scales: {e}")))?,
@@ -246,11 +250,11 @@ fn run(cli: Cli) -> flexrom::Result<()> {
             let path = basis.unwrap_or_else(|| p.basis_path.clone());
             let stored = load_basis(&p, &path)?;
             let options = flexrom::pipeline::sweep::SweepOptions { validate, continuation, progress: true };
-            let sw = flexrom::pipeline::sweep::sweep(&p.model, &stored.basis, &scales, options)?;
-            flexrom::pipeline::sweep::write_sweep(&out, &sw, &stored.basis, &path)?;
+            let sw = flexrom::pipeline::sweep::sweep_to_file(&p.model, &stored, &path, &scales, options, &out, resume)?;
             print!("{}", flexrom::pipeline::sweep::table(&sw));
-            eprintln!("{} load scales on {} threads in {:.3} s -> {}", scales.len(), sw.threads, sw.wall_seconds, out.display());
-            Ok(())
+            eprintln!("{} load scales ({} resumed) on {} threads in {:.3} s -> {}", scales.len(), sw.resumed, sw.threads, sw.wall_seconds, out.display());
+            // the good runs are written; the exit code (3) says that some failed
+            sw.failure_summary().map_or(Ok(()), |s| Err(flexrom::Error::PartlyFailed(format!("{s} (the others are in {}; /status and /message say which)", out.display()))))
         }
         Command::Run { pipeline } => {
             let p = Pipeline::load(&pipeline)?;
