@@ -11,7 +11,8 @@
 //!   (below the 1e-8 floor; trained pendulum weights are 0.93–5.2), an element index out of
 //!   range and a repeated one, a content hash copied from another basis of the same model,
 //!   a model fingerprint copied from a basis of another model, an external link, a soft link,
-//!   a dataset in external storage, a version-1 file;
+//!   a dataset in external storage, a version-1 file, a declared shape of 29 GB (refused
+//!   before reading);
 //! - a pipeline whose [reduction] changed since training still runs, with one warning line;
 //! - whole-system bases (orthonormal only as the stacked [V; V_λ]) pass the library check.
 
@@ -144,6 +145,14 @@ fn crafted_basis_files_are_refused_naming_file_and_dataset() {
         replace(f, "basis/modes", &m);
     });
     refused(&pipe, &bad, &["basis/modes", "orthonormal"]);
+
+    // a shape that would need 36 × 10⁸ × 8 bytes = 29 GB to read: refused before reading
+    let bad = craft(&good, "huge.h5", |f| {
+        let rows = read2(f, "basis/modes").nrows();
+        f.unlink("basis/modes").unwrap();
+        f.new_dataset::<f64>().chunk((1, 1024)).shape((rows, 100_000_000)).create("basis/modes").unwrap();
+    });
+    refused(&pipe, &bad, &["basis/modes", "shape"]);
 
     let bad = craft(&good, "nan.h5", |f| {
         let mut m = read2(f, "basis/modes");

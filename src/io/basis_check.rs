@@ -62,8 +62,38 @@ const MAX_LINKS: usize = 10_000;
 /// Reads the basis at `path` and checks it against `model`; `settings_hash` is the
 /// pipeline's [`settings_hash`] (a mismatch only warns). The only way commands read a basis.
 pub fn check(path: &Path, model: &Model, settings_hash: Option<&str>) -> Result<StoredBasis> {
-    let stored = read_basis(path)?;
     let bad = |field: &str, problem: String| Error::input(path, field, problem);
+    // sizes before anything is read: a crafted shape must not make us allocate terabytes
+    // (after the link walk: opening a dataset follows its link)
+    let ours = |f: &hdf5::File| f.attr("schema_version").and_then(|a| a.read_scalar::<u64>()).is_ok_and(|v| v == super::basis_file::SCHEMA_VERSION);
+    if let Some(f) = hdf5::File::open(path).ok().filter(ours) {
+        check_file(&f, path)?;
+        let sys = model.system(LinearSolverKind::Banded);
+        let (n, nc, ne) = (sys.n_dof(), sys.n_constraints(), sys.n_elements());
+        let (cols, values) = (n + nc, n + nc);
+        let limits: [(&str, &[usize]); 11] = [
+            ("basis/modes", &[n, cols]),
+            ("basis/reference", &[n]),
+            ("basis/multiplier_modes", &[nc, cols]),
+            ("basis/singular_values", &[values]),
+            ("basis/energy", &[values]),
+            ("basis/block_modes", &[values]),
+            ("basis/block_values", &[values]),
+            ("basis/reduced_dofs", &[n]),
+            ("basis/kept_dofs", &[n]),
+            ("hyper/elements", &[ne]),
+            ("hyper/weights", &[ne]),
+        ];
+        for (name, max) in limits {
+            let Ok(d) = f.dataset(name) else { continue };
+            let shape = d.shape();
+            if shape.len() != max.len() || shape.iter().zip(max).any(|(s, m)| s > m) {
+                let want = max.iter().map(|m| format!("≤ {m}")).collect::<Vec<_>>().join(" × ");
+                return Err(bad(name, format!("has shape {shape:?}; for this model ({n} coordinates, {nc} constraints, {ne} elements) it must be {want}")));
+            }
+        }
+    }
+    let stored = read_basis(path)?;
     // the model first: a basis of another model is the commonest mistake, and the shape
     // checks below would otherwise report its symptoms
     let mine = model.fingerprint();
