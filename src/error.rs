@@ -53,11 +53,25 @@ pub enum Error {
     /// program ends quietly.
     #[error("standard output closed")]
     StdoutClosed,
+
+    /// Some of many independent runs failed (a sweep's load scales); the others were
+    /// written. Exit code 3.
+    #[error("{0}")]
+    PartlyFailed(String),
 }
 
 pub type Result<T> = std::result::Result<T, Error>;
 
 impl Error {
+    /// The process exit code for this error: 3 when only part of the work failed
+    /// ([`Error::PartlyFailed`]), 1 otherwise.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            Error::PartlyFailed(_) => 3,
+            _ => 1,
+        }
+    }
+
     pub fn input(file: impl AsRef<Path>, field: impl Into<String>, problem: impl Into<String>) -> Self {
         Error::Input {
             file: file.as_ref().display().to_string(),

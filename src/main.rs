@@ -136,6 +136,10 @@ enum Command {
         /// basis file (default: the pipeline's `basis`)
         #[arg(long)]
         basis: Option<PathBuf>,
+        /// take the load scales that the sweep file already holds as finished (same basis
+        /// and model) from it and run only the others; failed ones run again
+        #[arg(long)]
+        resume: bool,
     },
     /// Train, sweep, validate and write a report folder (Markdown and SVG plots).
     Run {
@@ -181,7 +185,7 @@ fn main() -> ExitCode {
         Err(flexrom::Error::StdoutClosed) => ExitCode::SUCCESS,
         Err(e) => {
             note(&format!("error: {e}"));
-            ExitCode::FAILURE
+            ExitCode::from(e.exit_code())
         }
     }
 }
@@ -277,7 +281,7 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                 output::println(&v.describe())
             }
         }
-        Command::Sweep { pipeline, load_scales, validate, continuation, output, basis } => {
+        Command::Sweep { pipeline, load_scales, validate, continuation, output, basis, resume } => {
             let p = Pipeline::load(&pipeline)?;
             let scales = match load_scales {
                 Some(s) => flexrom::pipeline::config::parse_range(&s).map_err(|e| flexrom::Error::Usage(format!("--load-scales: {e}")))?,
@@ -296,14 +300,14 @@ fn run(cli: Cli) -> flexrom::Result<()> {
             }
             let stored = load_basis(&p, &path)?;
             let options = flexrom::pipeline::sweep::SweepOptions { validate, continuation, progress: true };
-            let sw = flexrom::pipeline::sweep::sweep(&p.model, &stored.basis, &scales, options)?;
             if in_report {
                 claim_in_report(&p.report_dir, &p.path, "sweep.h5")?;
             }
-            flexrom::pipeline::sweep::write_sweep(&out, &sw, &stored.basis, &path)?;
+            let sw = flexrom::pipeline::sweep::sweep_to_file(&p.model, &stored, &path, &scales, options, &out, resume)?;
             output::print(&flexrom::pipeline::sweep::table(&sw))?;
-            note(&format!("{} load scales on {} threads in {:.3} s -> {}", scales.len(), sw.threads, sw.wall_seconds, out.display()));
-            Ok(())
+            note(&format!("{} load scales ({} resumed) on {} threads in {:.3} s -> {}", scales.len(), sw.resumed, sw.threads, sw.wall_seconds, out.display()));
+            // the good runs are written; the exit code (3) says that some failed
+            sw.failure_summary().map_or(Ok(()), |s| Err(flexrom::Error::PartlyFailed(format!("{s} (the others are in {}; /status and /message say which)", out.display()))))
         }
         Command::Run { pipeline } => {
             let p = Pipeline::load(&pipeline)?;

@@ -24,17 +24,20 @@
 //! /hyper/weights             (|E|)        their ECSW weights, positive
 //!   attributes on /hyper: tolerance (τ), training_residual (‖Cw − b‖/‖b‖), n_training
 //! attributes on /: schema_version, model (TOML text), model_path, model_fingerprint,
+//!   settings_hash, content_hash (SHA-256 of the content: src/io/basis_check.rs),
 //!   pipeline (TOML text), variant, snapshots, mode_rule, n_modes (= r), n_pod_modes,
 //!   multiplier_scale (w), n_dof, creation_time (RFC 3339, UTC), program_version
 //! ```
 
+use super::basis_check::{check_file, content_hash, HashInput};
 use super::h5::{attr_f64, attr_str, attr_u64, read_attr_f64, read_attr_str, write_atomically};
 use crate::error::{Error, Result};
 use crate::reduction::{Basis, Hyper, SnapshotKind, Trained, Variant};
 use ndarray::{Array1, Array2};
 use std::path::Path;
 
-pub const SCHEMA_VERSION: u64 = 1;
+/// 2: adds `content_hash` and `settings_hash` (version-1 files are refused: retrain).
+pub const SCHEMA_VERSION: u64 = 2;
 
 /// The training data the snapshots come from.
 #[derive(Clone, Debug)]
@@ -53,6 +56,8 @@ pub struct BasisMeta {
     pub model_fingerprint: String,
     pub pipeline_text: String,
     pub mode_rule: String,
+    /// [`super::basis_check::settings_hash`] of the pipeline that trained the basis
+    pub settings_hash: String,
 }
 
 /// A basis as read back, with its provenance.
@@ -64,7 +69,13 @@ pub struct StoredBasis {
     /// modes kept from each block's POD, and how many singular values each has
     pub block_modes: Vec<usize>,
     pub block_values: Vec<usize>,
+    /// coordinates whose rows entered the POD
+    pub reduced_dofs: Vec<usize>,
     pub model_fingerprint: String,
+    /// the training pipeline's `[train]`/`[reduction]` settings, hashed
+    pub settings_hash: String,
+    /// SHA-256 of the content as written ([`super::basis_check::content_hash`])
+    pub content_hash: String,
     pub mode_rule: String,
     pub creation_time: String,
 }
@@ -122,6 +133,19 @@ pub fn write_basis(path: &Path, data: &TrainingData, trained: &Trained, meta: &B
         attr_str(f, "model", &meta.model_text).map_err(e)?;
         attr_str(f, "model_path", &meta.model_path).map_err(e)?;
         attr_str(f, "model_fingerprint", &meta.model_fingerprint).map_err(e)?;
+        attr_str(f, "settings_hash", &meta.settings_hash).map_err(e)?;
+        let (sv, en) = (cat(&|p| &p.singular_values), cat(&|p| &p.energy));
+        let content = content_hash(&HashInput {
+            basis: b,
+            singular_values: sv.as_slice().expect("contiguous"),
+            energy: en.as_slice().expect("contiguous"),
+            block_modes: &trained.block_modes,
+            block_values: &values,
+            reduced_dofs: &trained.reduced_dofs,
+            model_fingerprint: &meta.model_fingerprint,
+            settings_hash: &meta.settings_hash,
+        });
+        attr_str(f, "content_hash", &content).map_err(e)?;
         attr_str(f, "pipeline", &meta.pipeline_text).map_err(e)?;
         attr_str(f, "variant", b.variant.name()).map_err(e)?;
         attr_str(f, "snapshots", b.snapshots.name()).map_err(e)?;
@@ -148,9 +172,14 @@ pub fn read_basis(path: &Path) -> Result<StoredBasis> {
         .attr("schema_version")
         .and_then(|a| a.read_scalar::<u64>())
         .map_err(|_| field("schema_version", "is missing: this is not a flexrom basis file".into()))?;
+    if version == 1 {
+        return Err(field("schema_version", format!("is 1 (an older flexrom's basis, without a content hash); this program reads version {SCHEMA_VERSION}: run `flexrom train` again")));
+    }
     if version != SCHEMA_VERSION {
         return Err(field("schema_version", format!("is {version}; this program reads version {SCHEMA_VERSION}")));
     }
+    // links, external storage and dataset types, before any dataset is read
+    check_file(&f, path)?;
     let text = |name: &str| read_attr_str(&f, name).map_err(|err| field(name, format!("cannot be read: {err}")));
     let num = |name: &str| read_attr_f64(&f, name).map_err(|err| field(name, format!("cannot be read: {err}")));
     let count = |name: &str| {
@@ -200,14 +229,16 @@ pub fn read_basis(path: &Path) -> Result<StoredBasis> {
         energy,
         block_modes,
         block_values,
+        reduced_dofs: idx("basis/reduced_dofs")?,
         model_fingerprint: text("model_fingerprint")?,
+        settings_hash: text("settings_hash")?,
+        content_hash: text("content_hash")?,
         mode_rule: text("mode_rule")?,
         creation_time: text("creation_time")?,
     })
 }
 
-/// `/hyper`, when present; its sizes and weights are checked here, its element indices
-/// against the model by the caller (`Hyper::validate`).
+/// `/hyper`, when present (checked by [`super::basis_check::check`]).
 fn read_hyper(f: &hdf5::File, path: &Path) -> Result<Option<Hyper>> {
     let Ok(g) = f.group("hyper") else { return Ok(None) };
     let field = |name: &str, problem: String| Error::input(path, name, problem);
@@ -221,7 +252,5 @@ fn read_hyper(f: &hdf5::File, path: &Path) -> Result<Option<Hyper>> {
     let weights = g.dataset("weights").and_then(|d| d.read_1d::<f64>()).map_err(|err| field("hyper/weights", format!("cannot be read: {err}")))?.to_vec();
     let num = |name: &str| read_attr_f64(&g, name).map_err(|err| field(&format!("hyper/{name}"), format!("cannot be read: {err}")));
     let n_training = g.attr("n_training").and_then(|a| a.read_scalar::<u64>()).map_err(|err| field("hyper/n_training", format!("cannot be read: {err}")))? as usize;
-    let h = Hyper { elements, weights, tolerance: num("tolerance")?, training_residual: num("training_residual")?, n_training };
-    h.validate(usize::MAX).map_err(|(f, p)| field(&f, p))?;
-    Ok(Some(h))
+    Ok(Some(Hyper { elements, weights, tolerance: num("tolerance")?, training_residual: num("training_residual")?, n_training }))
 }

@@ -4,3 +4,4 @@ pub mod h5;
 pub mod output;
 pub mod result_file;
 pub mod basis_file;
+pub mod basis_check;

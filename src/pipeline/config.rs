@@ -44,7 +44,7 @@ pub struct PipelineFile {
     pub validate: Option<ScalesSpec>,
 }
 
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct TrainSpec {
     pub load_scales: Vec<f64>,
@@ -56,7 +56,7 @@ fn default_snapshots() -> SnapshotKind {
     SnapshotKind::Reference
 }
 
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ReductionSpec {
     /// default: constraint-preserving when the model has joints that the basis cannot
@@ -74,7 +74,7 @@ pub struct ReductionSpec {
 }
 
 /// How the coordinates are split into blocks with a POD each.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Blocks {
     /// one block per body: each mode moves one body only
@@ -83,7 +83,7 @@ pub enum Blocks {
 
 /// `[reduction.hyper]`: ECSW element sampling trained to a relative tolerance τ on the
 /// training snapshots (‖C w − b‖ ≤ τ ‖b‖; smaller τ: more elements, closer to Galerkin).
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct HyperSpec {
     pub tolerance: f64,

@@ -2,7 +2,7 @@
 
 use super::config::Pipeline;
 use crate::error::{Error, Result};
-use crate::io::basis_file::{read_basis, StoredBasis};
+use crate::io::basis_file::StoredBasis;
 use crate::model::Model;
 use crate::physics::element::Vec8;
 use crate::physics::system::FlexibleSystem;
@@ -21,33 +21,10 @@ pub struct ReducedRun {
     pub reduced_q: Array2<f64>,
 }
 
-/// Reads the pipeline's basis (or `path`) and refuses one trained on another model.
+/// Reads the pipeline's basis (or `path`) and checks it against the pipeline's model and
+/// settings ([`crate::io::basis_check::check`]).
 pub fn load_basis(p: &Pipeline, path: &Path) -> Result<StoredBasis> {
-    let stored = read_basis(path)?;
-    let mine = p.model.fingerprint();
-    if stored.model_fingerprint != mine {
-        return Err(Error::input(
-            path,
-            "model_fingerprint",
-            format!(
-                "the basis was trained on a different model than `{}` (fingerprint {} ≠ {}); run `flexrom train {}` again",
-                p.model.path.display(),
-                short(&stored.model_fingerprint),
-                short(&mine),
-                p.path.display()
-            ),
-        ));
-    }
-    let sys = p.model.system(Default::default());
-    stored.basis.validate(sys.n_dof(), sys.n_constraints()).map_err(|(field, problem)| Error::input(path, field, problem))?;
-    if let Some(h) = &stored.basis.hyper {
-        h.validate(sys.n_elements()).map_err(|(field, problem)| Error::input(path, field, problem))?;
-    }
-    Ok(stored)
-}
-
-fn short(h: &str) -> &str {
-    &h[..h.len().min(12)]
+    crate::io::basis_check::check(path, &p.model, Some(&crate::io::basis_check::settings_hash(p)))
 }
 
 /// What the run writes: the full coordinates (`online`, `validate`) or only the reduced

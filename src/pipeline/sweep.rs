@@ -1,10 +1,19 @@
 //! `sweep`: reduced runs at many load scales, in parallel across cores (rayon; BLAS stays
 //! on one thread inside each run), optionally validated against full runs.
 //!
-//! The sweep file:
+//! One load scale that fails (Newton, a singular matrix) does not stop the sweep: its status
+//! and message are stored and the others run on. The file is written as the sweep goes
+//! (rewritten whole, atomically, at most every [`CHECKPOINT_SECONDS`] and at the end), so a
+//! killed sweep leaves a valid file of the finished scales at the final path; `--resume`
+//! ([`sweep_to_file`]) takes the finished scales from it and runs the rest.
+//!
+//! The sweep file (N load scales; rows of scales that failed or did not run yet hold NaN,
+//! and 0 in the counters):
 //!
 //! ```text
 //! /load_scales        (N)
+//! /status             (N)            0 = ok, 1 = failed, 2 = not run yet
+//! /message            (N)            why it failed ("" when ok)
 //! /t                  (n_t)
 //! /probes/<name>      (N, n_t, 2)    reduced-model probe positions, m
 //! /reduced_q          (N, r, n_t)    reduced coordinates
@@ -13,32 +22,116 @@
 //! /factorizations     (N)            iteration matrices factorized
 //! with --validate:    /rel_error, /max_probe_error, /max_constraint_violation,
 //!                     /full_seconds, /speedup  (N each)
-//! attributes on /: basis, variant, n_modes, wall_seconds (whole sweep), threads,
-//!   continuation (1 when the runs were continued from their neighbours), program_version
+//! attributes on /: basis, basis_content_hash, model_fingerprint, variant, n_modes,
+//!   validated (0/1), wall_seconds (whole sweep), threads, continuation (1 when the runs
+//!   were continued from their neighbours), n_failed, n_pending, program_version
 //! ```
 
 use super::online::{Output, ReducedRun, ReducedRunner};
 use super::validate::{compare, Validation};
 use crate::error::{Error, Result};
-use crate::io::h5::{attr_f64, attr_str, attr_u64, write_atomically};
+use crate::io::basis_file::StoredBasis;
+use crate::io::h5::{attr_f64, attr_str, attr_u64, read_attr_str, write_atomically};
 use crate::model::Model;
 use crate::reduction::Basis;
-use crate::simulate::{simulate, Overrides};
+use crate::simulate::{simulate, Overrides, Settings, SimulationResult};
+use crate::solver::generalized_alpha::Stats;
+use hdf5::types::VarLenUnicode;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use ndarray::{Array1, Array3};
+use ndarray::{Array1, Array2, Array3};
 use rayon::prelude::*;
 use std::path::Path;
+use std::sync::Mutex;
+
+/// The sweep file is rewritten at most this often while the sweep runs.
+pub const CHECKPOINT_SECONDS: f64 = 2.0;
+
+/// Status codes of `/status`.
+pub const STATUS_OK: u8 = 0;
+pub const STATUS_FAILED: u8 = 1;
+pub const STATUS_PENDING: u8 = 2;
 
 pub struct SweepPoint {
     pub rom: ReducedRun,
     pub validation: Option<Validation>,
 }
 
+/// What became of one load scale.
+pub enum Outcome {
+    Done(SweepPoint),
+    /// the error message of its run
+    Failed(String),
+    /// not run (yet)
+    Pending,
+}
+
+pub struct ScaleResult {
+    pub load_scale: f64,
+    pub outcome: Outcome,
+}
+
+impl ScaleResult {
+    pub fn point(&self) -> Option<&SweepPoint> {
+        match &self.outcome {
+            Outcome::Done(p) => Some(p),
+            _ => None,
+        }
+    }
+
+    pub fn status(&self) -> u8 {
+        match self.outcome {
+            Outcome::Done(_) => STATUS_OK,
+            Outcome::Failed(_) => STATUS_FAILED,
+            Outcome::Pending => STATUS_PENDING,
+        }
+    }
+
+    pub fn message(&self) -> &str {
+        match &self.outcome {
+            Outcome::Done(_) => "",
+            Outcome::Failed(m) => m,
+            Outcome::Pending => "not run yet",
+        }
+    }
+}
+
 pub struct Sweep {
-    pub points: Vec<SweepPoint>,
+    /// every requested load scale, in the order asked for
+    pub scales: Vec<ScaleResult>,
+    /// the time grid and probe names every run shares (from the model)
+    pub t: Array1<f64>,
+    pub probe_names: Vec<String>,
+    /// reduced coordinates r
+    pub n_reduced: usize,
+    pub validated: bool,
     pub wall_seconds: f64,
     pub threads: usize,
     pub continuation: bool,
+    /// scales taken from an earlier sweep file (`--resume`)
+    pub resumed: usize,
+}
+
+impl Sweep {
+    /// The load scales that ran to the end, in order.
+    pub fn done(&self) -> impl Iterator<Item = &SweepPoint> {
+        self.scales.iter().filter_map(ScaleResult::point)
+    }
+
+    pub fn n_failed(&self) -> usize {
+        self.scales.iter().filter(|s| s.status() == STATUS_FAILED).count()
+    }
+
+    /// One line when some load scale failed, naming the first few and their errors:
+    /// "2 of 100 load scales failed: load scale 1e20: Newton failed at …; …".
+    pub fn failure_summary(&self) -> Option<String> {
+        let failed: Vec<&ScaleResult> = self.scales.iter().filter(|s| s.status() == STATUS_FAILED).collect();
+        if failed.is_empty() {
+            return None;
+        }
+        let shown: Vec<String> = failed.iter().take(3).map(|s| format!("load scale {}: {}", s.load_scale, s.message())).collect();
+        let more = if failed.len() > 3 { format!("; and {} more", failed.len() - 3) } else { String::new() };
+        Some(format!("{} of {} load scales failed: {}{more}", failed.len(), self.scales.len(), shown.join("; ")))
+    }
 }
 
 /// How a sweep runs (default: independent runs, no validation, no progress bar).
@@ -70,7 +163,73 @@ fn continuation_lanes(n: usize, threads: usize) -> Vec<Vec<std::ops::Range<usize
 }
 
 /// Runs the reduced model at every scale, in parallel; with `validate`, also the full one.
+/// A scale whose run fails is recorded as failed and the others go on.
 pub fn sweep(model: &Model, basis: &Basis, scales: &[f64], o: SweepOptions) -> Result<Sweep> {
+    let start = pending(model, basis, scales, o)?;
+    run_pending(model, basis, start, o, None)
+}
+
+/// [`sweep`] writing `out` as it goes (see the module documentation); with `resume`, the
+/// scales that `out` already holds as finished (same basis content and model) are taken
+/// from it, and only the others run. The returned sweep is written to `out`.
+pub fn sweep_to_file(model: &Model, stored: &StoredBasis, basis_path: &Path, scales: &[f64], o: SweepOptions, out: &Path, resume: bool) -> Result<Sweep> {
+    let basis = &stored.basis;
+    let mut start = pending(model, basis, scales, o)?;
+    if resume {
+        if out.exists() {
+            let old = read_sweep(out, model, stored, o.validate)?;
+            let mut reused = 0;
+            for s in start.scales.iter_mut() {
+                if let Some(i) = old.iter().position(|(x, _)| *x == s.load_scale) {
+                    if let Some(p) = old[i].1.as_ref() {
+                        s.outcome = Outcome::Done(clone_point(p));
+                        reused += 1;
+                    }
+                }
+            }
+            start.resumed = reused;
+            let dropped = old.iter().filter(|(x, p)| p.is_some() && !scales.contains(x)).count();
+            eprintln!(
+                "resuming {}: {reused} of {} load scales already finished, running {}{}",
+                out.display(),
+                scales.len(),
+                scales.len() - reused,
+                if dropped > 0 { format!(" ({dropped} finished load scales of the file are not in the list and are left out)") } else { String::new() }
+            );
+        } else {
+            eprintln!("resuming {}: no such file yet, running all {} load scales", out.display(), scales.len());
+        }
+    }
+    let write = |s: &Sweep| write_sweep(out, s, stored, basis_path);
+    let sw = run_pending(model, basis, start, o, Some(&write))?;
+    write(&sw)?;
+    Ok(sw)
+}
+
+/// Every scale pending, with the model's time grid and probe names.
+fn pending(model: &Model, basis: &Basis, scales: &[f64], o: SweepOptions) -> Result<Sweep> {
+    let s = Settings::resolve(model, &Overrides::default())?;
+    let t = Array1::from_iter((0..=s.n_steps).map(|k| k as f64 * s.dt));
+    Ok(Sweep {
+        scales: scales.iter().map(|&x| ScaleResult { load_scale: x, outcome: Outcome::Pending }).collect(),
+        t,
+        probe_names: model.probe_names(),
+        n_reduced: basis.n_reduced(),
+        validated: o.validate,
+        wall_seconds: 0.0,
+        threads: rayon::current_num_threads().max(1),
+        continuation: o.continuation,
+        resumed: 0,
+    })
+}
+
+type Checkpoint<'a> = &'a (dyn Fn(&Sweep) -> Result<()> + Sync);
+
+/// Runs the pending scales of `state`; after each one, `checkpoint` (when given, and at
+/// most every [`CHECKPOINT_SECONDS`]) writes what is done so far.
+fn run_pending(model: &Model, basis: &Basis, state: Sweep, o: SweepOptions, checkpoint: Option<Checkpoint>) -> Result<Sweep> {
+    let todo: Vec<usize> = (0..state.scales.len()).filter(|&i| state.scales[i].status() != STATUS_OK).collect();
+    let scales: Vec<f64> = todo.iter().map(|&i| state.scales[i].load_scale).collect();
     let bar = ProgressBar::with_draw_target(Some(scales.len() as u64), if o.progress { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() });
     bar.set_style(ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} load scales, {elapsed} elapsed, ETA {eta}").expect("valid template").progress_chars("=> "));
     bar.set_prefix(if o.validate { "sweep + validate" } else { "sweep" });
@@ -79,10 +238,26 @@ pub fn sweep(model: &Model, basis: &Basis, scales: &[f64], o: SweepOptions) -> R
     let output = if o.validate { Output::Full } else { Output::ReducedAndProbes };
     super::online::check_reduced_memory(model, basis.n_reduced(), n_steps, output, scales.len() as f64)?;
     let start = std::time::Instant::now();
-    let threads = rayon::current_num_threads().max(1);
+    let threads = state.threads;
     // continuation: a few chains of neighbouring scales per thread; otherwise one point per task
     let lanes = if o.continuation { continuation_lanes(scales.len(), threads) } else { (0..scales.len()).map(|i| std::iter::once(i..i + 1).collect()).collect() };
-    let parts: Result<Vec<Vec<(usize, SweepPoint)>>> = lanes
+    // the sweep so far, and when it was last written (None: never, so the first finished
+    // scale is written at once)
+    let shared = Mutex::new((state, None::<std::time::Instant>));
+    let record = |i: usize, outcome: Outcome| -> Result<()> {
+        let mut guard = shared.lock().unwrap_or_else(|e| e.into_inner());
+        let (sw, last) = &mut *guard;
+        sw.scales[todo[i]].outcome = outcome;
+        if let Some(write) = checkpoint {
+            if last.is_none_or(|l| l.elapsed().as_secs_f64() >= CHECKPOINT_SECONDS) {
+                sw.wall_seconds = start.elapsed().as_secs_f64();
+                write(sw)?;
+                *last = Some(std::time::Instant::now());
+            }
+        }
+        Ok(())
+    };
+    let results: Result<Vec<()>> = lanes
         .par_iter()
         // one reduced model per worker, built at its first lane, its loads changed per scale
         .map_init(|| None, |slot: &mut Option<ReducedRunner>, chains| {
@@ -90,64 +265,94 @@ pub fn sweep(model: &Model, basis: &Basis, scales: &[f64], o: SweepOptions) -> R
                 Some(r) => r,
                 None => slot.insert(ReducedRunner::new(model, basis)?),
             };
-            let mut done: Vec<(usize, SweepPoint)> = Vec::new();
             for chain in chains {
-                let first = done.len();
+                // the last two good runs of this chain (continuation only)
+                let mut previous: Vec<ReducedRun> = Vec::new();
                 for i in chain.clone() {
                     let x = scales[i];
-                    // the last two runs of this chain
-                    let previous: Vec<&ReducedRun> = done[first.max(done.len().saturating_sub(2))..].iter().map(|p| &p.1.rom).collect();
                     // without validation nothing of full size is reconstructed
                     let output = if o.validate { Output::Full } else { Output::ReducedAndProbes };
-                    let rom = runner.run(x, output, &previous).map_err(|e| e.at_stage("sweep (reduced run)", x))?;
-                    let validation = if o.validate {
-                        let full = simulate(model, &Overrides { load_scale: Some(x), ..Default::default() }).map_err(|e| e.at_stage("sweep (full run)", x))?;
-                        Some(compare(model, &full, &rom, None, basis.n_reduced(), basis.variant.name()))
-                    } else {
-                        None
-                    };
+                    let run = (|| -> Result<SweepPoint> {
+                        let rom = runner.run(x, output, &previous.iter().collect::<Vec<_>>()).map_err(|e| e.at_stage("sweep (reduced run)", x))?;
+                        let validation = if o.validate {
+                            let full = simulate(model, &Overrides { load_scale: Some(x), ..Default::default() }).map_err(|e| e.at_stage("sweep (full run)", x))?;
+                            Some(compare(model, &full, &rom, None, basis.n_reduced(), basis.variant.name()))
+                        } else {
+                            None
+                        };
+                        Ok(SweepPoint { rom, validation })
+                    })();
                     bar.inc(1);
-                    done.push((i, SweepPoint { rom, validation }));
+                    match run {
+                        Ok(p) => {
+                            if o.continuation {
+                                previous.push(p.rom.clone());
+                                if previous.len() > 2 {
+                                    previous.remove(0);
+                                }
+                            }
+                            record(i, Outcome::Done(p))?;
+                        }
+                        Err(e) => record(i, Outcome::Failed(e.to_string()))?,
+                    }
                 }
             }
-            Ok(done)
+            Ok(())
         })
         .collect();
     bar.finish_and_clear();
-    let mut points: Vec<(usize, SweepPoint)> = parts?.into_iter().flatten().collect();
-    points.sort_by_key(|p| p.0);
-    let points = points.into_iter().map(|p| p.1).collect();
-    Ok(Sweep { points, wall_seconds: start.elapsed().as_secs_f64(), threads, continuation: o.continuation })
+    results?;
+    let (mut sw, _) = shared.into_inner().unwrap_or_else(|e| e.into_inner());
+    sw.wall_seconds = start.elapsed().as_secs_f64();
+    Ok(sw)
 }
 
-pub fn write_sweep(path: &Path, s: &Sweep, basis: &Basis, basis_path: &Path) -> Result<()> {
-    let first = &s.points.first().ok_or_else(|| Error::Usage("the sweep has no load scales".into()))?.rom;
-    let (n, nt, r) = (s.points.len(), first.result.t.len(), first.reduced_q.nrows());
+fn clone_point(p: &SweepPoint) -> SweepPoint {
+    SweepPoint { rom: p.rom.clone(), validation: p.validation.clone() }
+}
+
+/// Writes the sweep file (atomically: a temporary file renamed over `path`).
+pub fn write_sweep(path: &Path, s: &Sweep, stored: &StoredBasis, basis_path: &Path) -> Result<()> {
+    let basis = &stored.basis;
+    let (n, nt, r) = (s.scales.len(), s.t.len(), s.n_reduced);
+    if n == 0 {
+        return Err(Error::Usage("the sweep has no load scales".into()));
+    }
     write_atomically(path, |f| {
         let e = |err: hdf5::Error| Error::hdf5(path, err);
-        let col = |g: &dyn Fn(&SweepPoint) -> f64| Array1::from_iter(s.points.iter().map(g));
-        f.new_dataset_builder().with_data(&col(&|p| p.rom.result.settings.load_scale)).create("load_scales").map_err(e)?;
-        f.new_dataset_builder().with_data(&first.result.t).create("t").map_err(e)?;
+        // one value per load scale: NaN where it did not run to the end
+        let col = |g: &dyn Fn(&SweepPoint) -> f64| Array1::from_iter(s.scales.iter().map(|x| x.point().map_or(f64::NAN, g)));
+        let count = |g: &dyn Fn(&SweepPoint) -> usize| Array1::from_iter(s.scales.iter().map(|x| x.point().map_or(0, g) as u64));
+        f.new_dataset_builder().with_data(&Array1::from_iter(s.scales.iter().map(|x| x.load_scale))).create("load_scales").map_err(e)?;
+        f.new_dataset_builder().with_data(&Array1::from_iter(s.scales.iter().map(ScaleResult::status))).create("status").map_err(e)?;
+        let messages: Vec<VarLenUnicode> =
+            s.scales.iter().map(|x| x.message().replace('\0', " ").parse::<VarLenUnicode>().unwrap_or_default()).collect();
+        f.new_dataset_builder().with_data(&Array1::from(messages)).create("message").map_err(e)?;
+        f.new_dataset_builder().with_data(&s.t).create("t").map_err(e)?;
         let g = f.create_group("probes").map_err(e)?;
-        for (i, (name, _)) in first.result.probes.iter().enumerate() {
-            let a = Array3::from_shape_fn((n, nt, 2), |(k, j, c)| s.points[k].rom.result.probes[i].1[[j, c]]);
+        for (i, name) in s.probe_names.iter().enumerate() {
+            let mut a = Array3::from_elem((n, nt, 2), f64::NAN);
+            for (k, x) in s.scales.iter().enumerate() {
+                if let Some(p) = x.point() {
+                    a.index_axis_mut(ndarray::Axis(0), k).assign(&p.rom.result.probes[i].1);
+                }
+            }
             g.new_dataset_builder().with_data(&a).create(name.as_str()).map_err(e)?;
         }
-        let zq = Array3::from_shape_fn((n, r, nt), |(k, i, j)| s.points[k].rom.reduced_q[[i, j]]);
+        let mut zq = Array3::from_elem((n, r, nt), f64::NAN);
+        for (k, x) in s.scales.iter().enumerate() {
+            if let Some(p) = x.point() {
+                zq.index_axis_mut(ndarray::Axis(0), k).assign(&p.rom.reduced_q);
+            }
+        }
         // one chunk per run, not compressed: deflate took 15 % off the size of these
         // trajectories for 0.15 s of a 1.5 s four-bar sweep
         f.new_dataset_builder().chunk((1, r.max(1), nt.max(1))).with_data(&zq).create("reduced_q").map_err(e)?;
         f.new_dataset_builder().with_data(&col(&|p| p.rom.result.wall_seconds)).create("rom_seconds").map_err(e)?;
-        f.new_dataset_builder()
-            .with_data(&Array1::from_iter(s.points.iter().map(|p| p.rom.result.stats.newton_iterations as u64)))
-            .create("newton_iterations")
-            .map_err(e)?;
-        f.new_dataset_builder()
-            .with_data(&Array1::from_iter(s.points.iter().map(|p| p.rom.result.stats.factorizations as u64)))
-            .create("factorizations")
-            .map_err(e)?;
-        if s.points.iter().all(|p| p.validation.is_some()) {
-            let v = |g: &dyn Fn(&Validation) -> f64| col(&|p: &SweepPoint| g(p.validation.as_ref().expect("checked")));
+        f.new_dataset_builder().with_data(&count(&|p| p.rom.result.stats.newton_iterations)).create("newton_iterations").map_err(e)?;
+        f.new_dataset_builder().with_data(&count(&|p| p.rom.result.stats.factorizations)).create("factorizations").map_err(e)?;
+        if s.validated {
+            let v = |g: &dyn Fn(&Validation) -> f64| col(&|p: &SweepPoint| p.validation.as_ref().map_or(f64::NAN, g));
             f.new_dataset_builder().with_data(&v(&|x| x.rel_error)).create("rel_error").map_err(e)?;
             f.new_dataset_builder().with_data(&v(&|x| x.max_probe_error)).create("max_probe_error").map_err(e)?;
             f.new_dataset_builder().with_data(&v(&|x| x.max_constraint_violation)).create("max_constraint_violation").map_err(e)?;
@@ -155,33 +360,139 @@ pub fn write_sweep(path: &Path, s: &Sweep, basis: &Basis, basis_path: &Path) -> 
             f.new_dataset_builder().with_data(&v(&|x| x.speedup)).create("speedup").map_err(e)?;
         }
         attr_str(f, "basis", &basis_path.display().to_string()).map_err(e)?;
+        attr_str(f, "basis_content_hash", &stored.content_hash).map_err(e)?;
+        attr_str(f, "model_fingerprint", &stored.model_fingerprint).map_err(e)?;
         attr_str(f, "variant", basis.variant.name()).map_err(e)?;
         attr_u64(f, "n_modes", basis.n_reduced() as u64).map_err(e)?;
+        attr_u64(f, "validated", s.validated as u64).map_err(e)?;
         attr_f64(f, "wall_seconds", s.wall_seconds).map_err(e)?;
         attr_u64(f, "threads", s.threads as u64).map_err(e)?;
         attr_u64(f, "continuation", s.continuation as u64).map_err(e)?;
+        attr_u64(f, "n_failed", s.n_failed() as u64).map_err(e)?;
+        attr_u64(f, "n_pending", s.scales.iter().filter(|x| x.status() == STATUS_PENDING).count() as u64).map_err(e)?;
         attr_str(f, "program_version", env!("CARGO_PKG_VERSION")).map_err(e)
     })
+}
+
+/// Reads an earlier sweep file for `--resume`: (load scale, the finished run) for every
+/// scale it holds, `None` for those that failed or did not run. Refuses a file of another
+/// basis or model, and one without the validation a `--validate` sweep needs.
+fn read_sweep(path: &Path, model: &Model, stored: &StoredBasis, validate: bool) -> Result<Vec<(f64, Option<SweepPoint>)>> {
+    let cannot = |field: &str, problem: String| Error::input(path, field, format!("{problem}; cannot resume from it (remove it, or run without --resume)"));
+    let f = hdf5::File::open(path).map_err(|e| cannot("(file)", format!("is not a readable HDF5 file: {e}")))?;
+    let text = |name: &str| read_attr_str(&f, name).map_err(|e| cannot(name, format!("cannot be read ({e}): not a flexrom sweep file?")));
+    if text("basis_content_hash")? != stored.content_hash {
+        return Err(cannot("basis_content_hash", "comes from another basis than the one given".into()));
+    }
+    if text("model_fingerprint")? != model.fingerprint() {
+        return Err(cannot("model_fingerprint", "comes from another model than the pipeline's".into()));
+    }
+    let vec = |name: &str| f.dataset(name).and_then(|d| d.read_1d::<f64>()).map_err(|e| cannot(name, format!("cannot be read: {e}")));
+    let ints = |name: &str| f.dataset(name).and_then(|d| d.read_1d::<u64>()).map_err(|e| cannot(name, format!("cannot be read: {e}")));
+    let scales = vec("load_scales")?;
+    let status = f.dataset("status").and_then(|d| d.read_1d::<u8>()).map_err(|e| cannot("status", format!("cannot be read: {e}")))?;
+    let t = vec("t")?;
+    let s = Settings::resolve(model, &Overrides::default())?;
+    let (n, nt, r) = (scales.len(), s.n_steps + 1, stored.basis.n_reduced());
+    if status.len() != n || t.len() != nt {
+        return Err(cannot("status", format!("has {} entries for {n} load scales, or /t {} for {nt} instants", status.len(), t.len())));
+    }
+    let zq = f.dataset("reduced_q").and_then(|d| d.read::<f64, ndarray::Ix3>()).map_err(|e| cannot("reduced_q", format!("cannot be read: {e}")))?;
+    if zq.dim() != (n, r, nt) {
+        return Err(cannot("reduced_q", format!("is {:?}, expected ({n}, {r}, {nt})", zq.dim())));
+    }
+    let mut probes = Vec::new();
+    for name in model.probe_names() {
+        let a = f.dataset(&format!("probes/{name}")).and_then(|d| d.read::<f64, ndarray::Ix3>()).map_err(|e| cannot(&format!("probes/{name}"), format!("cannot be read: {e}")))?;
+        if a.dim() != (n, nt, 2) {
+            return Err(cannot(&format!("probes/{name}"), format!("is {:?}, expected ({n}, {nt}, 2)", a.dim())));
+        }
+        probes.push((name, a));
+    }
+    let rom_seconds = vec("rom_seconds")?;
+    let (newton, factorizations) = (ints("newton_iterations")?, ints("factorizations")?);
+    let validation = if validate && f.link_exists("rel_error") {
+        Some([vec("rel_error")?, vec("max_probe_error")?, vec("max_constraint_violation")?, vec("full_seconds")?, vec("speedup")?])
+    } else {
+        None
+    };
+    for a in [&rom_seconds].into_iter().chain(validation.iter().flatten()) {
+        if a.len() != n {
+            return Err(cannot("rom_seconds", format!("a per-scale dataset has {} entries for {n} load scales", a.len())));
+        }
+    }
+    let mut out = Vec::new();
+    for k in 0..n {
+        let x = scales[k];
+        // a finished run counts only when it has what this sweep writes
+        if status[k] != STATUS_OK || (validate && validation.is_none()) {
+            out.push((x, None));
+            continue;
+        }
+        let settings = Settings::resolve(model, &Overrides { load_scale: Some(x), ..Default::default() })?;
+        let stats = Stats { steps: settings.n_steps, newton_iterations: newton[k] as usize, factorizations: factorizations[k] as usize, ..Default::default() };
+        let result = SimulationResult {
+            model_text: model.text.clone(),
+            model_path: model.path.display().to_string(),
+            settings,
+            t: t.clone(),
+            q: Array2::zeros((0, nt)),
+            multipliers: Array2::zeros((0, nt)),
+            probes: probes.iter().map(|(name, a)| (name.clone(), a.index_axis(ndarray::Axis(0), k).to_owned())).collect(),
+            stats,
+            wall_seconds: rom_seconds[k],
+        };
+        let v = validation.as_ref().map(|c| Validation {
+            load_scale: x,
+            variant: stored.basis.variant.name().to_string(),
+            n_dof: stored.basis.n_dof(),
+            n_modes: r,
+            rel_error: c[0][k],
+            max_probe_error: c[1][k],
+            max_probe_error_probe: String::new(),
+            max_probe_error_t: f64::NAN,
+            max_constraint_violation: c[2][k],
+            full_seconds: c[3][k],
+            full_dense_seconds: None,
+            rom_seconds: rom_seconds[k],
+            speedup: c[4][k],
+            speedup_vs_dense: None,
+            full_newton_iterations: 0,
+            rom_newton_iterations: newton[k] as usize,
+            rom_step_cuts: 0,
+        });
+        out.push((x, Some(SweepPoint { rom: ReducedRun { result, reduced_q: zq.index_axis(ndarray::Axis(0), k).to_owned() }, validation: v })));
+    }
+    Ok(out)
 }
 
 /// The table printed on stdout.
 pub fn table(s: &Sweep) -> String {
     let mut out = String::new();
-    let validated = s.points.iter().all(|p| p.validation.is_some());
     out.push_str("load_scale  rom_ms  newton");
-    if validated {
+    if s.validated {
         out.push_str("   rel_error  probe_err_m  full_ms  speedup");
     }
     out.push('\n');
-    for p in &s.points {
+    for x in &s.scales {
+        let Some(p) = x.point() else {
+            out.push_str(&format!("{}  {}: {}\n", scale(x.load_scale), if x.status() == STATUS_FAILED { "failed" } else { "not run" }, x.message()));
+            continue;
+        };
         let r = &p.rom.result;
-        out.push_str(&format!("{:>10.4}  {:>6.2}  {:>6}", r.settings.load_scale, 1e3 * r.wall_seconds, r.stats.newton_iterations));
+        out.push_str(&format!("{}  {:>6.2}  {:>6}", scale(r.settings.load_scale), 1e3 * r.wall_seconds, r.stats.newton_iterations));
         if let Some(v) = &p.validation {
             out.push_str(&format!("  {:>10.3e}  {:>11.3e}  {:>7.2}  {:>7.2}", v.rel_error, v.max_probe_error, 1e3 * v.full_seconds, v.speedup));
         }
         out.push('\n');
     }
     out
+}
+
+/// A load scale in the table's first column: fixed point, or exponent form when that would
+/// not fit (|x| ≥ 1e6) or show nothing (|x| < 1e-3).
+fn scale(x: f64) -> String {
+    if x != 0.0 && !(1e-3..1e6).contains(&x.abs()) { format!("{x:>10.3e}") } else { format!("{x:>10.4}") }
 }
 
 #[cfg(test)]

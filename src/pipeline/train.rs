@@ -88,6 +88,7 @@ pub fn train_and_write(p: &Pipeline, out: &Path) -> Result<TrainSummary> {
         model_fingerprint: p.model.fingerprint(),
         pipeline_text: p.text.clone(),
         mode_rule: p.file.reduction.modes.to_string(),
+        settings_hash: crate::io::basis_check::settings_hash(p),
     };
     write_basis(out, &data, &summary.trained, &meta)?;
     Ok(summary)

@@ -1,0 +1,186 @@
+//! Sweeps survive a bad load (issue 16, item 8), through the `flexrom sweep` command.
+//!
+//! Checks, and where each expectation comes from:
+//! - a load scale that makes Newton fail (1e20 × gravity on a coarse pendulum: measured to
+//!   fail at the first step after 8 halvings; 1e12 still runs) does not stop the sweep: the
+//!   good scales are written, `/status` is 0 for them and 1 for the failed ones with the
+//!   error in `/message`, their rows are NaN, the exit code is 3 and stderr ends with one
+//!   line "2 of 5 load scales failed: …";
+//! - a good scale's probe trajectory in the sweep file is bit-for-bit the one `online`
+//!   writes at the same load scale (without --continuation a sweep runs each scale exactly
+//!   as `online` does);
+//! - `--resume` on a file of 3 finished scales runs only the 2 missing of 5 (stderr says so,
+//!   and the 3 reused rows keep their `/rom_seconds` bit for bit: a rerun would measure a
+//!   new time), reruns failed scales, and refuses a file of another basis;
+//! - a sweep killed (SIGKILL) while it runs leaves a valid file at the final path (statuses
+//!   0 and 2 only), from which `--resume` finishes the sweep.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// One test at a time: a `flexrom` child forked while another test has an HDF5 file open
+/// inherits that descriptor and HDF5's lock on it, and the file cannot be opened again
+/// until the child exits.
+static SERIAL: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+fn flexrom() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_flexrom"))
+}
+
+fn pendulum_text(elements: usize, t_end: f64) -> String {
+    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("data/models/pendulum.toml"))
+        .unwrap()
+        .replace("elements = 50", &format!("elements = {elements}"))
+        .replace("t_end = 1.1", &format!("t_end = {t_end}"))
+}
+
+/// A pendulum pipeline in `dir` with `modes` POD modes and the given [online] list; trained.
+fn setup(dir: &Path, elements: usize, t_end: f64, modes: usize, online: &str) -> PathBuf {
+    std::fs::write(dir.join("model.toml"), pendulum_text(elements, t_end)).unwrap();
+    let p = dir.join("pipe.toml");
+    std::fs::write(
+        &p,
+        format!(
+            "model = \"model.toml\"\nbasis = \"basis.h5\"\nreport = \"report\"\n[train]\nload_scales = [1.0]\n[reduction]\nvariant = \"galerkin\"\nmodes = {{ count = {modes} }}\n[online]\nload_scales = {online}\n"
+        ),
+    )
+    .unwrap();
+    let o = flexrom().args(["train", p.to_str().unwrap()]).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    p
+}
+
+fn run(args: &[&str]) -> (Output, String) {
+    let o = flexrom().args(args).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert_ne!(o.status.code(), Some(101), "panic: {err}");
+    assert!(o.status.code().is_some(), "killed by a signal: {err}");
+    (o, err)
+}
+
+fn status(f: &Path) -> Vec<u8> {
+    hdf5::File::open(f).unwrap().dataset("status").unwrap().read_raw::<u8>().unwrap()
+}
+
+fn column(f: &Path, name: &str) -> Vec<f64> {
+    hdf5::File::open(f).unwrap().dataset(name).unwrap().read_raw::<f64>().unwrap()
+}
+
+#[test]
+fn a_failing_load_scale_is_recorded_and_the_others_written() {
+    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let p = setup(d, 8, 0.1, 4, "[0.9, 1e20, 1.0, 1.1, 5e19]");
+    let out = d.join("s.h5");
+    let (o, err) = run(&["sweep", p.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(3), "{err}");
+    let last = err.trim().lines().last().unwrap();
+    assert!(last.starts_with("error: 2 of 5 load scales failed: load scale 100000000000000000000: Newton failed"), "{err}");
+    assert!(last.contains("s.h5"), "{err}");
+    assert_eq!(status(&out), vec![0, 1, 0, 0, 1]);
+    let f = hdf5::File::open(&out).unwrap();
+    let messages: Vec<String> = f.dataset("message").unwrap().read_raw::<hdf5::types::VarLenUnicode>().unwrap().iter().map(|m| m.to_string()).collect();
+    assert_eq!(messages[0], "");
+    assert!(messages[1].starts_with("Newton failed at t = "), "{messages:?}");
+    assert!(messages[4].starts_with("Newton failed"), "{messages:?}");
+    assert_eq!(f.attr("n_failed").unwrap().read_scalar::<u64>().unwrap(), 2);
+    let tip = f.dataset("probes/tip").unwrap().read::<f64, ndarray::Ix3>().unwrap();
+    let rom_seconds = column(&out, "rom_seconds");
+    for (k, ok) in [true, false, true, true, false].into_iter().enumerate() {
+        let row = tip.index_axis(ndarray::Axis(0), k);
+        assert_eq!(row.iter().all(|v| v.is_finite()), ok, "row {k}");
+        assert_eq!(row.iter().all(|v| v.is_nan()), !ok, "row {k}");
+        assert_eq!(rom_seconds[k].is_finite(), ok);
+    }
+    // the stdout table names the failures too
+    let table = String::from_utf8_lossy(&o.stdout).to_string();
+    assert_eq!(table.lines().filter(|l| l.contains("failed: Newton failed")).count(), 2, "{table}");
+    // a good row is exactly what `online` computes at that load scale
+    let single = d.join("online.h5");
+    let (o, err) = run(&["online", p.to_str().unwrap(), "--load-scale", "1.0", "-o", single.to_str().unwrap()]);
+    assert!(o.status.success(), "{err}");
+    let alone = hdf5::File::open(&single).unwrap().dataset("probes/tip").unwrap().read_2d::<f64>().unwrap();
+    assert_eq!(tip.index_axis(ndarray::Axis(0), 2), alone);
+
+    // --resume reruns the failed scales only (they fail again: exit 3 again)
+    let before = column(&out, "rom_seconds");
+    let (o, err) = run(&["sweep", p.to_str().unwrap(), "-o", out.to_str().unwrap(), "--resume"]);
+    assert_eq!(o.status.code(), Some(3), "{err}");
+    assert!(err.contains("3 of 5 load scales already finished, running 2"), "{err}");
+    let after = column(&out, "rom_seconds");
+    for k in [0, 2, 3] {
+        assert_eq!(before[k].to_bits(), after[k].to_bits(), "row {k} was not rerun");
+    }
+    assert_eq!(status(&out), vec![0, 1, 0, 0, 1]);
+}
+
+#[test]
+fn resume_runs_only_the_missing_scales_of_the_same_basis() {
+    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let p = setup(d, 8, 0.1, 4, "\"0.8:1.2:5\"");
+    let (ps, out) = (p.to_str().unwrap(), d.join("s.h5"));
+    let os = out.to_str().unwrap();
+    let (o, err) = run(&["sweep", ps, "-o", os, "--load-scales", "0.8:1.2:3"]);
+    assert!(o.status.success(), "{err}");
+    let first = column(&out, "rom_seconds");
+    assert_eq!(column(&out, "load_scales"), vec![0.8, 1.0, 1.2]);
+    // the pipeline's list of 5 holds the 3 finished ones
+    let (o, err) = run(&["sweep", ps, "-o", os, "--resume"]);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("resuming") && err.contains("3 of 5 load scales already finished, running 2"), "{err}");
+    assert_eq!(column(&out, "load_scales"), vec![0.8, 0.9, 1.0, 1.1, 1.2]);
+    assert_eq!(status(&out), vec![0; 5]);
+    let merged = column(&out, "rom_seconds");
+    for (k, j) in [(0, 0), (1, 2), (2, 4)] {
+        assert_eq!(first[k].to_bits(), merged[j].to_bits(), "scale {k} was taken from the file");
+    }
+    assert!(merged.iter().all(|v| v.is_finite()));
+    // everything finished: nothing runs
+    let (o, err) = run(&["sweep", ps, "-o", os, "--resume"]);
+    assert!(o.status.success() && err.contains("5 of 5 load scales already finished, running 0"), "{err}");
+    // a file of another basis is refused, and left as it was
+    let bytes = std::fs::read(&out).unwrap();
+    let other = d.join("other.h5");
+    let text = std::fs::read_to_string(&p).unwrap().replace("count = 4", "count = 3").replace("basis.h5", "other.h5");
+    let p2 = d.join("pipe2.toml");
+    std::fs::write(&p2, text).unwrap();
+    assert!(run(&["train", p2.to_str().unwrap()]).0.status.success());
+    let (o, err) = run(&["sweep", ps, "-o", os, "--resume", "--basis", other.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    // (the other basis was trained with other settings than pipe.toml has: one warning line first)
+    let errors: Vec<&str> = err.lines().filter(|l| !l.starts_with("warning:")).collect();
+    assert_eq!(errors.len(), 1, "{err}");
+    assert!(err.contains("s.h5") && err.contains("basis_content_hash") && err.contains("another basis"), "{err}");
+    assert_eq!(std::fs::read(&out).unwrap(), bytes);
+}
+
+#[test]
+fn a_killed_sweep_leaves_a_valid_file_to_resume_from() {
+    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    // ~10 ms per reduced run: 300 of them take seconds, long enough to be killed midway
+    let p = setup(d, 50, 1.1, 14, "\"0.5:1.5:300\"");
+    let out = d.join("s.h5");
+    let mut child = flexrom().args(["sweep", p.to_str().unwrap(), "-o", out.to_str().unwrap()]).stdout(std::process::Stdio::null()).stderr(std::process::Stdio::null()).spawn().unwrap();
+    let start = std::time::Instant::now();
+    while !out.exists() && start.elapsed().as_secs() < 120 {
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(out.exists(), "the first finished scale is written at once");
+    let st = status(&out);
+    assert_eq!(st.len(), 300);
+    assert!(st.iter().all(|&s| s == 0 || s == 2), "{st:?}");
+    let finished = st.iter().filter(|&&s| s == 0).count();
+    assert!(finished >= 1 && finished < 300, "killed midway: {finished} finished");
+    let (o, err) = run(&["sweep", p.to_str().unwrap(), "-o", out.to_str().unwrap(), "--resume"]);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains(&format!("{finished} of 300 load scales already finished, running {}", 300 - finished)), "{err}");
+    assert_eq!(status(&out), vec![0; 300]);
+    assert!(column(&out, "rom_seconds").iter().all(|v| v.is_finite()));
+}
