@@ -137,7 +137,7 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    // from here on SIGINT/SIGTERM remove flexrom's temporary files and exit with 130/143
+    // from here on SIGINT/SIGTERM/SIGHUP remove flexrom's temporary files and exit with 130/143/129
     if let Err(e) = flexrom::io::atomic::install_signal_handler() {
         eprintln!("error: {e}");
         return ExitCode::FAILURE;
