@@ -169,7 +169,7 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    // from here on SIGINT/SIGTERM remove flexrom's temporary files and exit with 130/143
+    // from here on SIGINT/SIGTERM/SIGHUP remove flexrom's temporary files and exit with 130/143/129
     if let Err(e) = flexrom::io::atomic::install_signal_handler() {
         note(&format!("error: {e}"));
         return ExitCode::FAILURE;

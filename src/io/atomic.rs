@@ -439,6 +439,34 @@ mod tests {
         assert_eq!(std::fs::read_dir(d.path()).unwrap().count(), 1);
     }
 
+    /// What the signal handler does: temporary paths removed, a report folder moved aside put
+    /// back when the new one is not in place yet, removed when it is.
+    #[test]
+    fn the_clean_up_removes_temporaries_and_puts_back_a_folder_moved_aside() {
+        let d = tempfile::tempdir().unwrap();
+        let p = |n: &str| d.path().join(n);
+        std::fs::create_dir(p("tmpdir")).unwrap();
+        std::fs::write(p("tmpdir/f"), b"x").unwrap();
+        std::fs::write(p("tmpfile"), b"x").unwrap();
+        for n in ["old1", "old2", "rep2"] {
+            std::fs::create_dir(p(n)).unwrap();
+            std::fs::write(p(n).join("summary.md"), n).unwrap();
+        }
+        let mut v = vec![
+            Live::Dir(p("tmpdir")),
+            Live::File(p("tmpfile")),
+            Live::Aside { aside: p("old1"), target: p("rep1") },
+            Live::Aside { aside: p("old2"), target: p("rep2") },
+        ];
+        clean_up(&mut v);
+        assert!(v.is_empty());
+        let mut left: Vec<String> = std::fs::read_dir(d.path()).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        left.sort();
+        assert_eq!(left, ["rep1", "rep2"]);
+        assert_eq!(std::fs::read(p("rep1/summary.md")).unwrap(), b"old1", "put back");
+        assert_eq!(std::fs::read(p("rep2/summary.md")).unwrap(), b"rep2", "the new one kept");
+    }
+
     #[test]
     fn non_regular_targets_are_refused() {
         let d = tempfile::tempdir().unwrap();

@@ -18,6 +18,22 @@ pub fn write_atomically(path: &Path, fill: impl FnOnce(&hdf5::File) -> Result<()
         drop(file);
         Ok(())
     })
+    .map_err(|e| match e {
+        Error::Hdf5 { file, problem } => Error::Hdf5 { file, problem: short_write_error(&problem) },
+        other => other,
+    })
+}
+
+/// HDF5's write errors span lines (time, temporary file name, buffer address, …); the
+/// system's message is what the user can act on: "cannot write: No space left on device
+/// (errno 28)".
+fn short_write_error(problem: &str) -> String {
+    let field = |key: &str| problem.split(key).nth(1).and_then(|r| r.split(['\'', ',']).find(|s| !s.trim().is_empty())).map(|s| s.trim().to_string());
+    match (field("error message = '"), field("errno = ")) {
+        (Some(msg), Some(errno)) => format!("cannot write: {msg} (errno {errno})"),
+        (Some(msg), None) => format!("cannot write: {msg}"),
+        _ => problem.split_whitespace().collect::<Vec<_>>().join(" "),
+    }
 }
 
 pub fn attr_str(loc: &hdf5::Location, name: &str, value: &str) -> hdf5::Result<()> {
@@ -39,4 +55,14 @@ pub fn read_attr_str(loc: &hdf5::Location, name: &str) -> hdf5::Result<String> {
 
 pub fn read_attr_f64(loc: &hdf5::Location, name: &str) -> hdf5::Result<f64> {
     loc.attr(name)?.read_scalar::<f64>()
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn hdf5_write_errors_are_one_line_with_the_system_message() {
+        let p = "H5Dwrite(): can't write data: file write failed: time = Wed Nov 25 02:33:25 2026\n, filename = '/tmp/x/.out.h5.flexrom-tmp-1-0', file descriptor = 5, errno = 28, error message = 'No space left on device', buf = 0x55, total write size = 32424";
+        assert_eq!(super::short_write_error(p), "cannot write: No space left on device (errno 28)");
+        assert_eq!(super::short_write_error("a\n b"), "a b");
+    }
 }

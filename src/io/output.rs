@@ -121,7 +121,7 @@ fn contains(a: &Path, b: &Path) -> bool {
 }
 
 /// Refuses a report folder that flexrom must not replace: one named `.` or `..`, the root,
-/// the home folder, the current folder, the pipeline's own folder, or a folder holding any
+/// a top-level folder, the home folder, the current folder, the pipeline's own folder, or a folder holding any
 /// of `inputs` (the pipeline file, the model file, the basis file); a symlink; an existing
 /// non-folder; a non-empty folder without flexrom's mark; a marked folder holding a file
 /// its mark does not list.
