@@ -292,6 +292,79 @@ pub fn load_trust(p: &super::Pipeline, path: &std::path::Path, stored: &crate::i
     Ok(TrustInfo { estimator, range: read_training_range(path)?, tolerance })
 }
 
+/// One line for stderr: the estimate, whether calibrated, and its cost against the reduced run.
+pub fn describe(e: &Estimate, rom_seconds: f64) -> String {
+    format!(
+        "error_estimate {:.3e} ({}, c = {:.3}), estimator {:.4} s ({:.0} % of the reduced run)",
+        e.error_estimate,
+        if e.calibrated { "calibrated" } else { "uncalibrated" },
+        e.factor,
+        e.seconds,
+        100.0 * e.seconds / rom_seconds
+    )
+}
+
+/// Attributes of an `online` result file: `error_estimate` (NaN without an estimator),
+/// `error_estimate_raw`, `error_estimate_factor`, `error_estimate_calibrated` (0/1),
+/// `extrapolated` (0/1), `training_range` ([min, max]), `tolerance` (when set).
+pub fn write_run_attributes(f: &hdf5::File, e: Option<&Estimate>, trust: &TrustInfo, extrapolated: bool) -> hdf5::Result<()> {
+    use crate::io::h5::{attr_f64, attr_u64};
+    attr_f64(f, "error_estimate", e.map_or(f64::NAN, |e| e.error_estimate))?;
+    attr_f64(f, "error_estimate_raw", e.map_or(f64::NAN, |e| e.raw))?;
+    attr_f64(f, "error_estimate_factor", e.map_or(f64::NAN, |e| e.factor))?;
+    attr_u64(f, "error_estimate_calibrated", e.is_some_and(|e| e.calibrated) as u64)?;
+    attr_u64(f, "extrapolated", extrapolated as u64)?;
+    f.new_attr::<f64>().shape(2).create("training_range")?.write(&[trust.range.0, trust.range.1])?;
+    if let Some(t) = trust.tolerance {
+        attr_f64(f, "tolerance", t)?;
+    }
+    Ok(())
+}
+
+/// The exit code of `--strict` when an estimate exceeds the tolerance.
+pub const STRICT_EXIT_CODE: u8 = 4;
+
+/// Prints one warning line on stderr for extrapolated load scales and one for estimates
+/// above the tolerance (or for a basis without an estimator); `runs` are
+/// `(load scale, error_estimate)`. With `strict`, an estimate above the tolerance (or none
+/// at all when a tolerance is set) is an [`crate::Error::Strict`], for after the output is
+/// written.
+pub fn check_runs(trust: &TrustInfo, runs: &[(f64, Option<f64>)], strict: bool) -> Result<()> {
+    let (a, b) = trust.range;
+    let out: Vec<String> = runs.iter().filter(|r| is_extrapolated(trust.range, r.0)).map(|r| format!("{}", r.0)).collect();
+    if !out.is_empty() {
+        let what = if runs.len() == 1 { format!("load scale {}", out[0]) } else { format!("{} of {} load scales ({})", out.len(), runs.len(), out.join(", ")) };
+        eprintln!("warning: {what} outside the basis's training range [{a}, {b}]: extrapolated, the reduced model was never trained there");
+    }
+    if trust.estimator.is_none() {
+        eprintln!("warning: the basis file has no error estimator (/estimator; written by `flexrom train` since this version): no error_estimate; train again");
+    }
+    let Some(tol) = trust.tolerance else {
+        if strict {
+            eprintln!("warning: --strict: no tolerance to hold the estimates to (set [online] tolerance in the pipeline)");
+        }
+        return Ok(());
+    };
+    let over: Vec<String> = runs
+        .iter()
+        .filter(|r| r.1.is_none_or(|e| !(e <= tol)))
+        .map(|r| match r.1 {
+            Some(e) => format!("{} ({e:.2e})", r.0),
+            None => format!("{} (no estimate)", r.0),
+        })
+        .collect();
+    if over.is_empty() {
+        return Ok(());
+    }
+    let what = if runs.len() == 1 { format!("load scale {}", over[0]) } else { format!("{} of {} load scales: {}", over.len(), runs.len(), over.join(", ")) };
+    let msg = format!("error estimate above the tolerance {tol:e} at {what}");
+    if strict {
+        return Err(crate::Error::Strict(format!("--strict: {msg}")));
+    }
+    eprintln!("warning: {msg}");
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
