@@ -44,7 +44,20 @@ fn main() -> flexrom::Result<()> {
     let mut p = Pipeline::load(&args[1])?;
     p.file.train.load_scales = list(&args[2]);
     let tests = list(&args[3]);
-    let (_, summary) = train(&p)?;
+    let (data, mut summary) = train(&p)?;
+    // experiments (not the default): ESTIMATE_HYPER=none runs the enriched model over every
+    // element; ESTIMATE_HYPER=<τ> retrains its ECSW set at τ
+    if let Ok(h) = std::env::var("ESTIMATE_HYPER") {
+        let est = summary.estimator.as_mut().expect("estimator");
+        if h == "none" {
+            est.enriched.hyper = None;
+        } else {
+            let tol: f64 = h.parse().expect("ESTIMATE_HYPER: none or a tolerance");
+            let sys = p.model.system(Default::default());
+            est.enriched.hyper = Some(flexrom::reduction::ecsw(&sys, &est.enriched, data.x.view(), tol).expect("ECSW"));
+        }
+        println!("experiment: ESTIMATE_HYPER={h}");
+    }
     let basis = &summary.trained.basis;
     let est = summary.estimator.as_ref().expect("train builds an estimator");
     let lo = p.file.train.load_scales.iter().copied().fold(f64::INFINITY, f64::min);
