@@ -274,6 +274,8 @@ pub struct TrustInfo {
     pub range: (f64, f64),
     /// `[online] tolerance`, else greedy training's tolerance, else none
     pub tolerance: Option<f64>,
+    /// the user asked for no estimate (`--no-estimate`): no warnings about its absence
+    pub skipped: bool,
 }
 
 /// Reads the estimator (checked against the model), the training range and tolerance of
@@ -295,7 +297,7 @@ pub fn load_trust(p: &super::Pipeline, path: &std::path::Path, stored: &crate::i
         Some(t) => Some(t),
         None => read_training_tolerance(path)?,
     };
-    Ok(TrustInfo { estimator, range: read_training_range(path)?, tolerance })
+    Ok(TrustInfo { estimator, range: read_training_range(path)?, tolerance, skipped: false })
 }
 
 /// One line for stderr: the estimate, whether calibrated, and its cost against the reduced run.
@@ -327,6 +329,15 @@ pub fn write_run_attributes(f: &hdf5::File, e: Option<&Estimate>, trust: &TrustI
     Ok(())
 }
 
+/// At most five entries of a list for a one-line message, then "…".
+fn few(v: &[String]) -> String {
+    if v.len() <= 5 {
+        v.join(", ")
+    } else {
+        format!("{}, …, {}", v[..4].join(", "), v[v.len() - 1])
+    }
+}
+
 /// The exit code of `--strict` when an estimate exceeds the tolerance.
 pub const STRICT_EXIT_CODE: u8 = 4;
 
@@ -337,15 +348,15 @@ pub const STRICT_EXIT_CODE: u8 = 4;
 /// written.
 pub fn check_runs(trust: &TrustInfo, runs: &[(f64, Option<f64>)], strict: bool) -> Result<()> {
     let (a, b) = trust.range;
-    let out: Vec<String> = runs.iter().filter(|r| is_extrapolated(trust.range, r.0)).map(|r| format!("{}", r.0)).collect();
+    let out: Vec<String> = runs.iter().filter(|r| is_extrapolated(trust.range, r.0)).map(|r| format!("{:.4}", r.0).trim_end_matches('0').trim_end_matches('.').to_string()).collect();
     if !out.is_empty() {
-        let what = if runs.len() == 1 { format!("load scale {}", out[0]) } else { format!("{} of {} load scales ({})", out.len(), runs.len(), out.join(", ")) };
+        let what = if runs.len() == 1 { format!("load scale {}", out[0]) } else { format!("{} of {} load scales ({})", out.len(), runs.len(), few(&out)) };
         eprintln!("warning: {what} outside the basis's training range [{a}, {b}]: extrapolated, the reduced model was never trained there");
     }
-    if trust.estimator.is_none() {
+    if trust.estimator.is_none() && runs.iter().all(|r| r.1.is_none()) && !trust.skipped {
         eprintln!("warning: the basis file has no error estimator (/estimator; written by `flexrom train` since this version): no error_estimate; train again");
     }
-    let Some(tol) = trust.tolerance else {
+    let Some(tol) = trust.tolerance.filter(|_| !trust.skipped) else {
         if strict {
             eprintln!("warning: --strict: no tolerance to hold the estimates to (set [online] tolerance in the pipeline)");
         }
@@ -355,14 +366,14 @@ pub fn check_runs(trust: &TrustInfo, runs: &[(f64, Option<f64>)], strict: bool) 
         .iter()
         .filter(|r| r.1.is_none_or(|e| !(e <= tol)))
         .map(|r| match r.1 {
-            Some(e) => format!("{} ({e:.2e})", r.0),
-            None => format!("{} (no estimate)", r.0),
+            Some(e) => format!("{:.4} ({e:.2e})", r.0),
+            None => format!("{:.4} (no estimate)", r.0),
         })
         .collect();
     if over.is_empty() {
         return Ok(());
     }
-    let what = if runs.len() == 1 { format!("load scale {}", over[0]) } else { format!("{} of {} load scales: {}", over.len(), runs.len(), over.join(", ")) };
+    let what = if runs.len() == 1 { format!("load scale {}", over[0]) } else { format!("{} of {} load scales: {}", over.len(), runs.len(), few(&over)) };
     let msg = format!("error estimate above the tolerance {tol:e} at {what}");
     if strict {
         return Err(crate::Error::Strict(format!("--strict: {msg}")));
