@@ -161,20 +161,19 @@ pub fn build_estimator(
     Ok(Estimator { enriched: richer.basis, block_modes: richer.block_modes, extra_modes: extra, calibration: Calibration::default() })
 }
 
-/// `η_raw = ‖X_r − X⁺‖_F / ‖X⁺‖_F` of two finished runs of the same load: from the reduced
-/// coordinates when both bases are orthonormal (module documentation), else from the
-/// full coordinates (whole-system; needs `Output::Full` runs).
+/// `η_raw = ‖X_r − X⁺‖_F / ‖X⁺‖_F` of two finished runs of the same load, from their
+/// reduced coordinates: by the module documentation's identities when both bases are
+/// orthonormal, by reconstructing `x_ref + V q` otherwise (whole-system).
 pub fn raw_estimate(basis: &Basis, est: &Estimator, rom: &ReducedRun, enriched: &ReducedRun) -> f64 {
     let (q, qp) = (&rom.reduced_q, &enriched.reduced_q);
     if q.ncols() != qp.ncols() {
         return f64::INFINITY;
     }
     if basis.variant == Variant::WholeSystem {
-        let (a, b) = (&rom.result.q, &enriched.result.q);
-        if a.dim() != b.dim() || a.is_empty() {
-            return f64::NAN;
-        }
-        return (a - b).mapv(|v| v * v).sum().sqrt() / b.mapv(|v| v * v).sum().sqrt();
+        // V is not orthonormal: reconstruct x_ref + V q of both
+        let full = |b: &Basis, z: &Array2<f64>| b.modes.dot(z) + &b.reference.view().insert_axis(Axis(1));
+        let (a, b) = (full(basis, q), full(&est.enriched, qp));
+        return (&a - &b).mapv(|v| v * v).sum().sqrt() / b.mapv(|v| v * v).sum().sqrt();
     }
     raw_estimate_reduced(basis, &est.enriched, q, qp)
 }
@@ -224,16 +223,9 @@ impl<'a> EstimatingRunner<'a> {
         let run = self.rom.run(load_scale, output, previous)?;
         let Some((est, runner)) = &mut self.est else { return Ok((run, None)) };
         let start = std::time::Instant::now();
-        // the norms need full coordinates only for whole-system
-        let out = if self.basis.variant == Variant::WholeSystem { Output::Full } else { Output::ReducedAndProbes };
-        let raw = match runner.run(load_scale, out, &[]) {
-            Ok(richer) => {
-                if self.basis.variant == Variant::WholeSystem && output != Output::Full {
-                    f64::NAN
-                } else {
-                    raw_estimate(self.basis, est, &run, &richer)
-                }
-            }
+        // the norms come from the reduced coordinates: nothing of full size is written
+        let raw = match runner.run(load_scale, Output::ReducedAndProbes, &[]) {
+            Ok(richer) => raw_estimate(self.basis, est, &run, &richer),
             Err(_) => f64::INFINITY,
         };
         let c = &est.calibration;
