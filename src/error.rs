@@ -30,6 +30,11 @@ pub enum Error {
     #[error("linear solve failed at t = {t:.6} s: {problem}")]
     LinearSolve { t: f64, problem: String },
 
+    /// `--strict`: a run's error estimate exceeds the tolerance (its output is written;
+    /// the program exits with code 4).
+    #[error("{0}")]
+    Strict(String),
+
     /// Anything else that is a usage error of the program (bad command-line values).
     #[error("{0}")]
     Usage(String),
@@ -64,10 +69,12 @@ pub type Result<T> = std::result::Result<T, Error>;
 
 impl Error {
     /// The process exit code for this error: 3 when only part of the work failed
-    /// ([`Error::PartlyFailed`]), 1 otherwise.
+    /// ([`Error::PartlyFailed`]), 4 when an error estimate exceeded the tolerance under
+    /// `--strict` ([`Error::Strict`]), 1 otherwise.
     pub fn exit_code(&self) -> u8 {
         match self {
             Error::PartlyFailed(_) => 3,
+            Error::Strict(_) => crate::pipeline::estimate::STRICT_EXIT_CODE,
             _ => 1,
         }
     }

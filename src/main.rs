@@ -2,7 +2,7 @@
 
 use clap::{Parser, Subcommand};
 use flexrom::io::result_file::{write_result, write_result_with};
-use flexrom::pipeline::online::{load_basis, run_reduced};
+use flexrom::pipeline::online::load_basis;
 use flexrom::pipeline::Pipeline;
 use flexrom::model::Model;
 use flexrom::output::{self, note};
@@ -94,6 +94,10 @@ enum Command {
         /// basis file (default: the pipeline's `basis`)
         #[arg(long)]
         basis: Option<PathBuf>,
+        /// exit with code 4 (after writing the output) when an error estimate exceeds the
+        /// tolerance ([online] tolerance, default the training tolerance)
+        #[arg(long)]
+        strict: bool,
     },
     /// Run full and reduced models at one load scale and report errors and timings.
     Validate {
@@ -111,6 +115,10 @@ enum Command {
         /// skip the dense-LU full run (its time and speedup are then null)
         #[arg(long)]
         no_dense: bool,
+        /// exit with code 4 (after writing the output) when an error estimate exceeds the
+        /// tolerance ([online] tolerance, default the training tolerance)
+        #[arg(long)]
+        strict: bool,
     },
     /// Reduced runs at many load scales, in parallel, into one HDF5 file and a table.
     Sweep {
@@ -130,6 +138,9 @@ enum Command {
         /// its own, exactly as `online`
         #[arg(long)]
         continuation: bool,
+        /// skip the error estimate (about 2× faster; `/error_estimate` is then NaN)
+        #[arg(long)]
+        no_estimate: bool,
         /// sweep file (default: sweep.h5 in the pipeline's report folder)
         #[arg(short, long)]
         output: Option<PathBuf>,
@@ -140,11 +151,19 @@ enum Command {
         /// and model) from it and run only the others; failed ones run again
         #[arg(long)]
         resume: bool,
+        /// exit with code 4 (after writing the output) when an error estimate exceeds the
+        /// tolerance ([online] tolerance, default the training tolerance)
+        #[arg(long)]
+        strict: bool,
     },
     /// Train, sweep, validate and write a report folder (Markdown and SVG plots).
     Run {
         /// pipeline file (TOML)
         pipeline: PathBuf,
+        /// exit with code 4 (after writing the output) when an error estimate exceeds the
+        /// tolerance ([online] tolerance, default the training tolerance)
+        #[arg(long)]
+        strict: bool,
     },
     /// Run each model and print its probe positions at a few times.
     Demo {
@@ -239,13 +258,16 @@ fn run(cli: Cli) -> flexrom::Result<()> {
             ));
             Ok(())
         }
-        Command::Online { pipeline, load_scale, output, basis } => {
+        Command::Online { pipeline, load_scale, output, basis, strict } => {
             let p = Pipeline::load(&pipeline)?;
             check_scale(load_scale)?;
             let path = basis.unwrap_or_else(|| p.basis_path.clone());
             check_output(&output, Origin::Flag("-o"), &[(&p.path, "pipeline file"), (&p.model.path, "model file"), (&path, "basis file")])?;
             let stored = load_basis(&p, &path)?;
-            let run = run_reduced(&p.model, &stored.basis, load_scale).map_err(|e| e.at_stage("online", load_scale))?;
+            let trust = flexrom::pipeline::estimate::load_trust(&p, &path, &stored)?;
+            let mut runner = flexrom::pipeline::estimate::EstimatingRunner::new(&p.model, &stored.basis, trust.estimator.as_ref())?;
+            let (run, estimate) = runner.run(load_scale, flexrom::pipeline::online::Output::Full).map_err(|e| e.at_stage("online", load_scale))?;
+            let extrapolated = flexrom::pipeline::estimate::is_extrapolated(trust.range, load_scale);
             let basis_name = path.display().to_string();
             write_result_with(&output, &run.result, |f| {
                 let e = |err: hdf5::Error| flexrom::Error::hdf5(&output, err);
@@ -253,7 +275,8 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                 g.new_dataset_builder().with_data(&run.reduced_q).create("q").map_err(e)?;
                 flexrom::io::h5::attr_str(f, "basis", &basis_name).map_err(e)?;
                 flexrom::io::h5::attr_str(f, "variant", stored.basis.variant.name()).map_err(e)?;
-                flexrom::io::h5::attr_u64(f, "n_modes", stored.basis.n_reduced() as u64).map_err(e)
+                flexrom::io::h5::attr_u64(f, "n_modes", stored.basis.n_reduced() as u64).map_err(e)?;
+                flexrom::pipeline::estimate::write_run_attributes(f, estimate.as_ref(), &trust, extrapolated).map_err(e)
             })?;
             let st = &run.result.stats;
             note(&format!(
@@ -266,22 +289,27 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                 st.step_cuts,
                 output.display()
             ));
-            Ok(())
+            if let Some(e) = &estimate {
+                note(&format!("  {}", flexrom::pipeline::estimate::describe(e, run.result.wall_seconds)));
+            }
+            flexrom::pipeline::estimate::check_runs(&trust, &[(load_scale, estimate.map(|e| e.error_estimate))], strict)
         }
-        Command::Validate { pipeline, load_scale, json, basis, no_dense } => {
+        Command::Validate { pipeline, load_scale, json, basis, no_dense, strict } => {
             let p = Pipeline::load(&pipeline)?;
             check_scale(load_scale)?;
             let path = basis.unwrap_or_else(|| p.basis_path.clone());
             let stored = load_basis(&p, &path)?;
-            let (v, _, _) = flexrom::pipeline::validate::validate(&p.model, &stored.basis, load_scale, !no_dense)?;
+            let trust = flexrom::pipeline::estimate::load_trust(&p, &path, &stored)?;
+            let (v, _, _) = flexrom::pipeline::validate::validate_with(&p.model, &stored.basis, Some(&trust), load_scale, !no_dense)?;
             if json {
                 let text = serde_json::to_string(&v).map_err(|e| flexrom::Error::Usage(format!("cannot write the JSON: {e}")))?;
-                output::println(&text)
+                output::println(&text)?;
             } else {
-                output::println(&v.describe())
+                output::println(&v.describe())?;
             }
+            flexrom::pipeline::estimate::check_runs(&trust, &[(load_scale, v.error_estimate)], strict)
         }
-        Command::Sweep { pipeline, load_scales, validate, continuation, output, basis, resume } => {
+        Command::Sweep { pipeline, load_scales, validate, continuation, no_estimate, output, basis, resume, strict } => {
             let p = Pipeline::load(&pipeline)?;
             let scales = match load_scales {
                 Some(s) => flexrom::pipeline::config::parse_range(&s).map_err(|e| flexrom::Error::Usage(format!("--load-scales: {e}")))?,
@@ -300,21 +328,33 @@ fn run(cli: Cli) -> flexrom::Result<()> {
             }
             let stored = load_basis(&p, &path)?;
             let options = flexrom::pipeline::sweep::SweepOptions { validate, continuation, progress: true };
+            let mut trust = flexrom::pipeline::estimate::load_trust(&p, &path, &stored)?;
+            if no_estimate {
+                if strict {
+                    return Err(flexrom::Error::Usage("--strict needs the error estimate; drop --no-estimate".into()));
+                }
+                trust.estimator = None;
+                trust.skipped = true;
+            }
             if in_report {
                 claim_in_report(&p.report_dir, &p.path, "sweep.h5")?;
             }
-            let sw = flexrom::pipeline::sweep::sweep_to_file(&p.model, &stored, &path, &scales, options, &out, resume)?;
+            let sw = flexrom::pipeline::sweep::sweep_to_file(&p.model, &stored, Some(&trust), &path, &scales, options, &out, resume)?;
             output::print(&flexrom::pipeline::sweep::table(&sw))?;
             note(&format!("{} load scales ({} resumed) on {} threads in {:.3} s -> {}", scales.len(), sw.resumed, sw.threads, sw.wall_seconds, out.display()));
             // the good runs are written; the exit code (3) says that some failed
-            sw.failure_summary().map_or(Ok(()), |s| Err(flexrom::Error::PartlyFailed(format!("{s} (the others are in {}; /status and /message say which)", out.display()))))
+            if let Some(s) = sw.failure_summary() {
+                return Err(flexrom::Error::PartlyFailed(format!("{s} (the others are in {}; /status and /message say which)", out.display())));
+            }
+            let runs: Vec<(f64, Option<f64>)> = sw.scales.iter().filter_map(|x| x.point()).map(|q| (q.rom.result.settings.load_scale, q.estimate.map(|e| e.error_estimate))).collect();
+            flexrom::pipeline::estimate::check_runs(&trust, &runs, strict)
         }
-        Command::Run { pipeline } => {
+        Command::Run { pipeline, strict } => {
             let p = Pipeline::load(&pipeline)?;
             let dir = flexrom::pipeline::report::run(&p, true)?;
             output::println(&std::fs::read_to_string(dir.join("summary.md")).map_err(|e| flexrom::Error::io(&dir, e))?)?;
             note(&format!("report: {}", dir.display()));
-            Ok(())
+            flexrom::pipeline::report::check_report(&p, &dir, strict)
         }
         Command::Demo { models } => {
             for path in models {

@@ -5,3 +5,4 @@ pub mod output;
 pub mod result_file;
 pub mod basis_file;
 pub mod basis_check;
+pub mod estimator_file;

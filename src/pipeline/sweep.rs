@@ -20,6 +20,9 @@
 //! /rom_seconds        (N)            reduced time loop of each run
 //! /newton_iterations  (N)
 //! /factorizations     (N)            iteration matrices factorized
+//! /error_estimate     (N)            the estimate of rel_error of each run (NaN: no estimator)
+//! /extrapolated       (N)            1 where the load scale is outside the training range
+//! /estimate_seconds   (N)            the estimator's enriched run and norms, s
 //! with --validate:    /rel_error, /max_probe_error, /max_constraint_violation,
 //!                     /full_seconds, /speedup  (N each)
 //! attributes on /: basis, basis_content_hash, model_fingerprint, variant, n_modes,
@@ -27,7 +30,8 @@
 //!   were continued from their neighbours), n_failed, n_pending, program_version
 //! ```
 
-use super::online::{Output, ReducedRun, ReducedRunner};
+use super::estimate::{is_extrapolated, Estimate, EstimatingRunner, TrustInfo};
+use super::online::{Output, ReducedRun};
 use super::validate::{compare, Validation};
 use crate::error::{Error, Result};
 use crate::io::basis_file::StoredBasis;
@@ -54,6 +58,10 @@ pub const STATUS_PENDING: u8 = 2;
 pub struct SweepPoint {
     pub rom: ReducedRun,
     pub validation: Option<Validation>,
+    /// the run's error estimate (None: no estimator)
+    pub estimate: Option<Estimate>,
+    /// outside the training range
+    pub extrapolated: bool,
 }
 
 /// What became of one load scale.
@@ -165,14 +173,30 @@ fn continuation_lanes(n: usize, threads: usize) -> Vec<Vec<std::ops::Range<usize
 /// Runs the reduced model at every scale, in parallel; with `validate`, also the full one.
 /// A scale whose run fails is recorded as failed and the others go on.
 pub fn sweep(model: &Model, basis: &Basis, scales: &[f64], o: SweepOptions) -> Result<Sweep> {
+    sweep_with(model, basis, None, scales, o)
+}
+
+/// [`sweep`] with the basis's estimator and training range: every point gets its error
+/// estimate and extrapolation flag.
+pub fn sweep_with(model: &Model, basis: &Basis, trust: Option<&TrustInfo>, scales: &[f64], o: SweepOptions) -> Result<Sweep> {
     let start = pending(model, basis, scales, o)?;
-    run_pending(model, basis, start, o, None)
+    run_pending(model, basis, trust, start, o, None)
 }
 
 /// [`sweep`] writing `out` as it goes (see the module documentation); with `resume`, the
 /// scales that `out` already holds as finished (same basis content and model) are taken
 /// from it, and only the others run. The returned sweep is written to `out`.
-pub fn sweep_to_file(model: &Model, stored: &StoredBasis, basis_path: &Path, scales: &[f64], o: SweepOptions, out: &Path, resume: bool) -> Result<Sweep> {
+#[allow(clippy::too_many_arguments)]
+pub fn sweep_to_file(
+    model: &Model,
+    stored: &StoredBasis,
+    trust: Option<&TrustInfo>,
+    basis_path: &Path,
+    scales: &[f64],
+    o: SweepOptions,
+    out: &Path,
+    resume: bool,
+) -> Result<Sweep> {
     let basis = &stored.basis;
     let mut start = pending(model, basis, scales, o)?;
     if resume {
@@ -201,7 +225,7 @@ pub fn sweep_to_file(model: &Model, stored: &StoredBasis, basis_path: &Path, sca
         }
     }
     let write = |s: &Sweep| write_sweep(out, s, stored, basis_path);
-    let sw = run_pending(model, basis, start, o, Some(&write))?;
+    let sw = run_pending(model, basis, trust, start, o, Some(&write))?;
     write(&sw)?;
     Ok(sw)
 }
@@ -227,7 +251,8 @@ type Checkpoint<'a> = &'a (dyn Fn(&Sweep) -> Result<()> + Sync);
 
 /// Runs the pending scales of `state`; after each one, `checkpoint` (when given, and at
 /// most every [`CHECKPOINT_SECONDS`]) writes what is done so far.
-fn run_pending(model: &Model, basis: &Basis, state: Sweep, o: SweepOptions, checkpoint: Option<Checkpoint>) -> Result<Sweep> {
+fn run_pending(model: &Model, basis: &Basis, trust: Option<&TrustInfo>, state: Sweep, o: SweepOptions, checkpoint: Option<Checkpoint>) -> Result<Sweep> {
+    let est = trust.and_then(|t| t.estimator.as_ref());
     let todo: Vec<usize> = (0..state.scales.len()).filter(|&i| state.scales[i].status() != STATUS_OK).collect();
     let scales: Vec<f64> = todo.iter().map(|&i| state.scales[i].load_scale).collect();
     let bar = ProgressBar::with_draw_target(Some(scales.len() as u64), if o.progress { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() });
@@ -260,10 +285,10 @@ fn run_pending(model: &Model, basis: &Basis, state: Sweep, o: SweepOptions, chec
     let results: Result<Vec<()>> = lanes
         .par_iter()
         // one reduced model per worker, built at its first lane, its loads changed per scale
-        .map_init(|| None, |slot: &mut Option<ReducedRunner>, chains| {
+        .map_init(|| None, |slot: &mut Option<EstimatingRunner>, chains| {
             let runner = match slot {
                 Some(r) => r,
-                None => slot.insert(ReducedRunner::new(model, basis)?),
+                None => slot.insert(EstimatingRunner::new(model, basis, est)?),
             };
             for chain in chains {
                 // the last two good runs of this chain (continuation only)
@@ -273,14 +298,15 @@ fn run_pending(model: &Model, basis: &Basis, state: Sweep, o: SweepOptions, chec
                     // without validation nothing of full size is reconstructed
                     let output = if o.validate { Output::Full } else { Output::ReducedAndProbes };
                     let run = (|| -> Result<SweepPoint> {
-                        let rom = runner.run(x, output, &previous.iter().collect::<Vec<_>>()).map_err(|e| e.at_stage("sweep (reduced run)", x))?;
+                        let (rom, estimate) = runner.run_with(x, output, &previous.iter().collect::<Vec<_>>()).map_err(|e| e.at_stage("sweep (reduced run)", x))?;
                         let validation = if o.validate {
                             let full = simulate(model, &Overrides { load_scale: Some(x), ..Default::default() }).map_err(|e| e.at_stage("sweep (full run)", x))?;
-                            Some(compare(model, &full, &rom, None, basis.n_reduced(), basis.variant.name()))
+                            Some(compare(model, &full, &rom, None, basis.n_reduced(), basis.variant.name()).with_trust(estimate.as_ref(), trust))
                         } else {
                             None
                         };
-                        Ok(SweepPoint { rom, validation })
+                        let extrapolated = trust.is_some_and(|t| is_extrapolated(t.range, x));
+                        Ok(SweepPoint { rom, validation, estimate, extrapolated })
                     })();
                     bar.inc(1);
                     match run {
@@ -308,7 +334,7 @@ fn run_pending(model: &Model, basis: &Basis, state: Sweep, o: SweepOptions, chec
 }
 
 fn clone_point(p: &SweepPoint) -> SweepPoint {
-    SweepPoint { rom: p.rom.clone(), validation: p.validation.clone() }
+    SweepPoint { rom: p.rom.clone(), validation: p.validation.clone(), estimate: p.estimate, extrapolated: p.extrapolated }
 }
 
 /// Writes the sweep file (atomically: a temporary file renamed over `path`).
@@ -351,6 +377,9 @@ pub fn write_sweep(path: &Path, s: &Sweep, stored: &StoredBasis, basis_path: &Pa
         f.new_dataset_builder().with_data(&col(&|p| p.rom.result.wall_seconds)).create("rom_seconds").map_err(e)?;
         f.new_dataset_builder().with_data(&count(&|p| p.rom.result.stats.newton_iterations)).create("newton_iterations").map_err(e)?;
         f.new_dataset_builder().with_data(&count(&|p| p.rom.result.stats.factorizations)).create("factorizations").map_err(e)?;
+        f.new_dataset_builder().with_data(&col(&|p| p.estimate.map_or(f64::NAN, |e| e.error_estimate))).create("error_estimate").map_err(e)?;
+        f.new_dataset_builder().with_data(&col(&|p| p.estimate.map_or(f64::NAN, |e| e.seconds))).create("estimate_seconds").map_err(e)?;
+        f.new_dataset_builder().with_data(&Array1::from_iter(s.scales.iter().map(|x| x.point().is_some_and(|p| p.extrapolated) as u8))).create("extrapolated").map_err(e)?;
         if s.validated {
             let v = |g: &dyn Fn(&Validation) -> f64| col(&|p: &SweepPoint| p.validation.as_ref().map_or(f64::NAN, g));
             f.new_dataset_builder().with_data(&v(&|x| x.rel_error)).create("rel_error").map_err(e)?;
@@ -410,13 +439,16 @@ fn read_sweep(path: &Path, model: &Model, stored: &StoredBasis, validate: bool) 
         probes.push((name, a));
     }
     let rom_seconds = vec("rom_seconds")?;
+    // the estimate columns of the file (absent in files written before them: no estimate)
+    let optional = |name: &str| if f.link_exists(name) { vec(name).map(Some) } else { Ok(None) };
+    let (estimates, estimate_seconds, extrapolated) = (optional("error_estimate")?, optional("estimate_seconds")?, if f.link_exists("extrapolated") { Some(f.dataset("extrapolated").and_then(|d| d.read_1d::<u8>()).map_err(|e| cannot("extrapolated", format!("cannot be read: {e}")))?) } else { None });
     let (newton, factorizations) = (ints("newton_iterations")?, ints("factorizations")?);
     let validation = if validate && f.link_exists("rel_error") {
         Some([vec("rel_error")?, vec("max_probe_error")?, vec("max_constraint_violation")?, vec("full_seconds")?, vec("speedup")?])
     } else {
         None
     };
-    for a in [&rom_seconds].into_iter().chain(validation.iter().flatten()) {
+    for a in [&rom_seconds].into_iter().chain(validation.iter().flatten()).chain(estimates.iter()).chain(estimate_seconds.iter()) {
         if a.len() != n {
             return Err(cannot("rom_seconds", format!("a per-scale dataset has {} entries for {n} load scales", a.len())));
         }
@@ -460,8 +492,36 @@ fn read_sweep(path: &Path, model: &Model, stored: &StoredBasis, validate: bool) 
             full_newton_iterations: 0,
             rom_newton_iterations: newton[k] as usize,
             rom_step_cuts: 0,
+            // the estimate and the flags are set below from the file's columns
+            error_estimate: None,
+            effectivity: None,
+            estimate_calibrated: None,
+            estimate_seconds: None,
+            extrapolated: false,
+            training_range: None,
+            sensitivity: None,
+            rel_error_by_time: Vec::new(),
         });
-        out.push((x, Some(SweepPoint { rom: ReducedRun { result, reduced_q: zq.index_axis(ndarray::Axis(0), k).to_owned() }, validation: v })));
+        // the stored estimate: its value and cost (the factor it was made with is the basis's)
+        let estimate = estimates.as_ref().map(|a| a[k]).filter(|e| !e.is_nan()).map(|error_estimate| Estimate {
+            error_estimate,
+            raw: f64::NAN,
+            factor: f64::NAN,
+            calibrated: false,
+            seconds: estimate_seconds.as_ref().map_or(f64::NAN, |a| a[k]),
+        });
+        let extrapolated = extrapolated.as_ref().is_some_and(|a| a.get(k).is_some_and(|&v| v != 0));
+        let v = v.map(|mut v| {
+            if let Some(e) = &estimate {
+                v.error_estimate = Some(e.error_estimate);
+                v.effectivity = Some(e.error_estimate / v.rel_error);
+                v.estimate_seconds = Some(e.seconds);
+            }
+            v.extrapolated = extrapolated;
+            v
+        });
+        let rom = ReducedRun { result, reduced_q: zq.index_axis(ndarray::Axis(0), k).to_owned() };
+        out.push((x, Some(SweepPoint { rom, validation: v, estimate, extrapolated })));
     }
     Ok(out)
 }
@@ -469,7 +529,7 @@ fn read_sweep(path: &Path, model: &Model, stored: &StoredBasis, validate: bool) 
 /// The table printed on stdout.
 pub fn table(s: &Sweep) -> String {
     let mut out = String::new();
-    out.push_str("load_scale  rom_ms  newton");
+    out.push_str("load_scale  rom_ms  newton  error_estimate  est_ms  extrap");
     if s.validated {
         out.push_str("   rel_error  probe_err_m  full_ms  speedup");
     }
@@ -481,6 +541,11 @@ pub fn table(s: &Sweep) -> String {
         };
         let r = &p.rom.result;
         out.push_str(&format!("{}  {:>6.2}  {:>6}", scale(r.settings.load_scale), 1e3 * r.wall_seconds, r.stats.newton_iterations));
+        match &p.estimate {
+            Some(e) => out.push_str(&format!("  {:>14.3e}  {:>6.2}", e.error_estimate, 1e3 * e.seconds)),
+            None => out.push_str(&format!("  {:>14}  {:>6}", "-", "-")),
+        }
+        out.push_str(if p.extrapolated { "     yes" } else { "      no" });
         if let Some(v) = &p.validation {
             out.push_str(&format!("  {:>10.3e}  {:>11.3e}  {:>7.2}  {:>7.2}", v.rel_error, v.max_probe_error, 1e3 * v.full_seconds, v.speedup));
         }

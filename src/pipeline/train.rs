@@ -2,7 +2,8 @@
 
 use super::config::{Blocks, Pipeline};
 use crate::error::{Error, Result};
-use crate::io::basis_file::{write_basis, BasisMeta, TrainingData};
+use super::estimate::{build_estimator, Estimator, DEFAULT_EXTRA_MODES};
+use crate::io::basis_file::{write_basis_with, BasisMeta, TrainingData};
 use crate::reduction::{ecsw, train_basis, BasisSpec, Trained};
 use crate::simulate::{simulate, Overrides};
 use crate::solver::kkt::LinearSolverKind;
@@ -13,6 +14,8 @@ pub struct TrainSummary {
     pub trained: Trained,
     pub n_snapshots: usize,
     pub full_seconds: f64,
+    /// the error estimator (uncalibrated: `load_scales` training has no held-out runs)
+    pub estimator: Option<Estimator>,
 }
 
 /// The coordinates that appear in any joint, sorted.
@@ -75,8 +78,12 @@ pub fn train(p: &Pipeline) -> Result<(TrainingData, TrainSummary)> {
         let hyper = ecsw(&sys, &trained.basis, data.x.view(), h.tolerance).map_err(|e| Error::input(&p.path, "reduction.hyper", format!("ECSW training failed: {e}")))?;
         trained.basis.hyper = Some(hyper);
     }
+    let sys = p.model.system(LinearSolverKind::Banded);
+    let tol = p.file.reduction.hyper.as_ref().map(|h| h.tolerance);
+    let estimator = build_estimator(&sys, &trained, &spec, data.x.view(), data.multipliers.view(), &joint_dofs(p), x_ref.view(), tol, DEFAULT_EXTRA_MODES)
+        .map_err(|e| Error::input(&p.path, "reduction", format!("cannot build the error estimator: {e}")))?;
     let n_snapshots = data.x.ncols();
-    Ok((data, TrainSummary { trained, n_snapshots, full_seconds }))
+    Ok((data, TrainSummary { trained, n_snapshots, full_seconds, estimator: Some(estimator) }))
 }
 
 /// Trains and writes the basis file atomically (a failed run keeps the previous file).
@@ -90,6 +97,9 @@ pub fn train_and_write(p: &Pipeline, out: &Path) -> Result<TrainSummary> {
         mode_rule: p.file.reduction.modes.to_string(),
         settings_hash: crate::io::basis_check::settings_hash(p),
     };
-    write_basis(out, &data, &summary.trained, &meta)?;
+    write_basis_with(out, &data, &summary.trained, &meta, |f| match &summary.estimator {
+        Some(est) => crate::io::estimator_file::write_estimator(f, est).map_err(|e| Error::hdf5(out, e)),
+        None => Ok(()),
+    })?;
     Ok(summary)
 }
