@@ -88,8 +88,14 @@ pub fn check(path: &Path, model: &Model, settings_hash: Option<&str>) -> Result<
             let Ok(d) = f.dataset(name) else { continue };
             let shape = d.shape();
             if shape.len() != max.len() || shape.iter().zip(max).any(|(s, m)| s > m) {
-                let want = max.iter().map(|m| format!("≤ {m}")).collect::<Vec<_>>().join(" × ");
-                return Err(bad(name, format!("has shape {shape:?}; for this model ({n} coordinates, {nc} constraints, {ne} elements) it must be {want}")));
+                let model = format!("for this model ({n} coordinates, {nc} constraints, {ne} elements)");
+                return Err(bad(
+                    name,
+                    match (shape.as_slice(), max) {
+                        ([len], [m]) => format!("has {len} entries; {model} it holds at most {m}"),
+                        _ => format!("has shape {shape:?}; {model} it must be {}", max.iter().map(|m| format!("≤ {m}")).collect::<Vec<_>>().join(" × ")),
+                    },
+                ));
             }
         }
     }
