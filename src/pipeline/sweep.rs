@@ -88,7 +88,8 @@ pub fn sweep(model: &Model, basis: &Basis, scales: &[f64], o: SweepOptions) -> R
         .map_init(|| None, |slot: &mut Option<ReducedRunner>, chains| {
             let runner = match slot {
                 Some(r) => r,
-                None => slot.insert(ReducedRunner::new(model, basis)?),
+                // built at the model's own load scale, 1
+                None => slot.insert(ReducedRunner::new(model, basis).map_err(|e| e.at_stage("sweep (building the reduced model)", 1.0))?),
             };
             let mut done: Vec<(usize, SweepPoint)> = Vec::new();
             for chain in chains {
