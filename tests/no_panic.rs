@@ -1,5 +1,6 @@
-//! No input makes flexrom panic (issue 16, item 3): a table of hostile command-line values
-//! and model-file values, each run through the release binary. Every case must end with an
+//! No input makes flexrom panic (issue 16, item 3): tables of hostile command-line values
+//! (71), model-file values (182) and pipeline-file values (19), each run through the
+//! release binary. Every case must end with an
 //! exit code (no signal), never 101 (Rust's panic exit), and a failing case must explain
 //! itself in one or two lines of stderr. The expected outcome of each case is not
 //! hard-coded beyond that: which of them are refused is the program's business, that none
@@ -123,4 +124,46 @@ fn hostile_model_values_never_panic() {
     }
     assert!(cases > 150, "{cases} cases");
     assert!(bad.is_empty(), "{} of {cases} cases misbehaved:\n{}", bad.len(), bad.join("\n"));
+}
+
+/// Pipeline values (the mode rule, the ECSW tolerance, the load-scale lists, the variant)
+/// through `train`, which runs the full pendulum (shortened to 0.05 s by the model's copy
+/// below) and the reduction; any outcome but a panic or a signal is the program's choice.
+#[test]
+fn hostile_pipeline_values_never_panic() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = std::fs::read_to_string(root().join("data/models/pendulum.toml")).unwrap().replace("t_end = 1.1", "t_end = 0.05");
+    std::fs::write(dir.path().join("m.toml"), model).unwrap();
+    let text = std::fs::read_to_string(root().join("pipelines/pendulum.toml")).unwrap().replace("../data/models/pendulum.toml", "m.toml");
+    let edits: &[(&str, &str)] = &[
+        ("modes = { count = 14 }", "modes = { count = 0 }"),
+        ("modes = { count = 14 }", "modes = { count = 99999999999 }"),
+        ("modes = { count = 14 }", "modes = { count = -3 }"),
+        ("modes = { count = 14 }", "modes = { ratio = 1e300 }"),
+        ("modes = { count = 14 }", "modes = { ratio = nan }"),
+        ("modes = { count = 14 }", "modes = { energy = 1e-300 }"),
+        ("modes = { count = 14 }", "modes = { counts = [1, 2] }"),
+        ("modes = { count = 14 }", "modes = \"all\""),
+        ("hyper = { tolerance = 1e-2 }", "hyper = { tolerance = 1e-300 }"),
+        ("hyper = { tolerance = 1e-2 }", "hyper = { tolerance = nan }"),
+        ("load_scales = [1.0]", "load_scales = [1e300]"),
+        ("load_scales = [1.0]", "load_scales = [0.0]"),
+        ("load_scales = [1.0]", "load_scales = [nan]"),
+        ("load_scales = [1.0]", "load_scales = []"),
+        ("load_scales = [1.0]", "load_scales = [1.0, 1.0]"),
+        ("\"0.8:1.2:21\"", "\"0.8:1.2:99999999999999999999\""),
+        ("variant = \"galerkin\"", "variant = \"whole-system\""),
+        ("variant = \"galerkin\"", "variant = \"constraint-preserving\""),
+        ("snapshots = \"reference\"", "snapshots = \"raw\""),
+    ];
+    let mut bad = Vec::new();
+    for (from, to) in edits {
+        assert!(text.contains(from), "pipelines/pendulum.toml has no `{from}`");
+        let path = dir.path().join("p.toml");
+        std::fs::write(&path, text.replacen(from, to, 1)).unwrap();
+        let basis = dir.path().join("b.h5");
+        let o = flexrom().args(["train", path.to_str().unwrap(), "--basis", basis.to_str().unwrap()]).output().unwrap();
+        bad.extend(violation(&format!("pipeline {to}"), &o));
+    }
+    assert!(bad.is_empty(), "{} of {} cases misbehaved:\n{}", bad.len(), edits.len(), bad.join("\n"));
 }

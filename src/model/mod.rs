@@ -517,7 +517,8 @@ pub(crate) fn parse_toml<T: serde::de::DeserializeOwned>(text: &str, path: &Path
 }
 
 fn locate(text: &str, pos: usize) -> String {
-    let line = text[..pos.min(text.len())].matches('\n').count() + 1;
+    // counted on bytes: a span that is not on a char boundary must not panic
+    let line = text.as_bytes()[..pos.min(text.len())].iter().filter(|&&b| b == b'\n').count() + 1;
     let mut table = String::new();
     let mut counts: std::collections::HashMap<String, usize> = Default::default();
     for l in text.lines().take(line) {

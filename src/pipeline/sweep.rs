@@ -294,7 +294,8 @@ fn run_pending(model: &Model, basis: &Basis, trust: Option<&TrustInfo>, state: S
         .map_init(|| None, |slot: &mut Option<EstimatingRunner>, chains| {
             let runner = match slot {
                 Some(r) => r,
-                None => slot.insert(EstimatingRunner::new(model, basis, est)?),
+                // built at the model's own load scale, 1
+                None => slot.insert(EstimatingRunner::new(model, basis, est).map_err(|e| e.at_stage("sweep (building the reduced model)", 1.0))?),
             };
             for chain in chains {
                 // the last two good runs of this chain (continuation only)
