@@ -13,12 +13,32 @@ const EXE: &str = env!("CARGO_BIN_EXE_flexrom");
 
 #[test]
 fn no_shared_hdf5_blas_or_network_libraries() {
-    let out = Command::new("ldd").arg(EXE).output().expect("ldd runs (Debian's libc-bin)");
-    assert!(out.status.success(), "ldd {EXE} failed: {}", String::from_utf8_lossy(&out.stderr));
+    let out = Command::new("ldd")
+        .arg(EXE)
+        .output()
+        .expect("ldd runs (Debian's libc-bin)");
+    assert!(
+        out.status.success(),
+        "ldd {EXE} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = String::from_utf8_lossy(&out.stdout);
     // the listing is real: glibc is there
     assert!(text.contains("libc.so.6"), "ldd output without libc:\n{text}");
-    for name in ["libhdf5", "libopenblas", "libcurl", "libssl", "libcrypto", "libgnutls", "libkrb5", "libgssapi", "libldap", "libsz", "libaec", "libz.so"] {
+    for name in [
+        "libhdf5",
+        "libopenblas",
+        "libcurl",
+        "libssl",
+        "libcrypto",
+        "libgnutls",
+        "libkrb5",
+        "libgssapi",
+        "libldap",
+        "libsz",
+        "libaec",
+        "libz.so",
+    ] {
         assert!(!text.contains(name), "{EXE} still loads {name}:\n{text}");
     }
 }
