@@ -37,7 +37,10 @@ pub fn run(p: &Pipeline, progress: bool) -> Result<PathBuf> {
 
 fn build(p: &Pipeline, out: &Path, progress: bool) -> Result<()> {
     let plot_err = |e: String| Error::io(out, std::io::Error::other(e));
-    eprintln!("[1/3] train: {} full run(s)", p.file.train.load_scales.len());
+    match &p.file.train.greedy {
+        Some(g) => eprintln!("[1/3] train: greedy over [{}, {}]", g.range().0, g.range().1),
+        None => eprintln!("[1/3] train: {} full run(s)", p.training_scales().len()),
+    }
     let trained = train_and_write(p, &p.basis_path)?;
     let stored = load_basis(p, &p.basis_path)?;
     let basis = &stored.basis;
@@ -118,7 +121,7 @@ fn build(p: &Pipeline, out: &Path, progress: bool) -> Result<()> {
         b.n_pod_modes,
         if b.kept.is_empty() { String::new() } else { format!(" + {} joint coordinates", b.kept.len()) },
         trained.n_snapshots,
-        p.file.train.load_scales
+        trained.greedy.as_ref().map_or_else(|| p.training_scales(), |g| g.load_scales.clone())
     );
     let _ = writeln!(md, "- sweep: {} load scales on {} threads in {:.3} s (whole sweep, reduced and full runs)\n", sw.points.len(), sw.threads, sw.wall_seconds);
     let _ = writeln!(md, "## Validation (time loops only; one run each)\n");
