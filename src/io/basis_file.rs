@@ -86,6 +86,12 @@ fn compressible(b: hdf5::DatasetBuilderEmpty, rows: usize, cols: usize) -> hdf5:
 }
 
 pub fn write_basis(path: &Path, data: &TrainingData, trained: &Trained, meta: &BasisMeta) -> Result<()> {
+    write_basis_with(path, data, trained, meta, |_| Ok(()))
+}
+
+/// [`write_basis`], then `extra` adds groups (the estimator, greedy's `/training`) in the
+/// same atomic write.
+pub fn write_basis_with(path: &Path, data: &TrainingData, trained: &Trained, meta: &BasisMeta, extra: impl FnOnce(&hdf5::File) -> Result<()>) -> Result<()> {
     write_atomically(path, |f| {
         let e = |err: hdf5::Error| Error::hdf5(path, err);
         let big = |name: &str, a: &Array2<f64>| -> Result<()> {
@@ -139,7 +145,7 @@ pub fn write_basis(path: &Path, data: &TrainingData, trained: &Trained, meta: &B
         attr_u64(f, "n_dof", b.n_dof() as u64).map_err(e)?;
         attr_str(f, "creation_time", &humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string()).map_err(e)?;
         attr_str(f, "program_version", env!("CARGO_PKG_VERSION")).map_err(e)?;
-        Ok(())
+        extra(f)
     })
 }
 

@@ -18,6 +18,8 @@
 //! hyper = { tolerance = 1e-3 }              # ECSW element sampling; omit for plain Galerkin
 //! [online]
 //! load_scales = "0.5:1.5:21"                # or a list
+//! tolerance = 1e-3                          # error estimates above it warn (--strict: exit 4);
+//!                                           # default: greedy training's tolerance, if any
 //! [validate]
 //! load_scales = [0.8, 1.0, 1.2]
 //! ```
@@ -43,7 +45,7 @@ pub struct PipelineFile {
     #[serde(default)]
     pub reduction: ReductionSpec,
     #[serde(default)]
-    pub online: Option<ScalesSpec>,
+    pub online: Option<OnlineSpec>,
     #[serde(default)]
     pub validate: Option<ScalesSpec>,
 }
@@ -151,6 +153,16 @@ pub enum Blocks {
 #[serde(deny_unknown_fields)]
 pub struct HyperSpec {
     pub tolerance: f64,
+}
+
+/// `[online]`: the load scales of `sweep` and `run`, and the tolerance every reduced run's
+/// error estimate is held to (a warning, or exit code 4 with `--strict`, above it).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OnlineSpec {
+    pub load_scales: Scales,
+    #[serde(default)]
+    pub tolerance: Option<f64>,
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -272,11 +284,16 @@ impl Pipeline {
                 return bad("reduction.hyper.tolerance", format!("is {}; it must lie strictly between 0 and 1", h.tolerance));
             }
         }
-        for (name, spec) in [("online", &self.file.online), ("validate", &self.file.validate)] {
-            if let Some(s) = spec {
-                if let Err(e) = s.load_scales.values() {
+        for (name, scales) in [("online", self.file.online.as_ref().map(|o| &o.load_scales)), ("validate", self.file.validate.as_ref().map(|v| &v.load_scales))] {
+            if let Some(s) = scales {
+                if let Err(e) = s.values() {
                     return bad(&format!("{name}.load_scales"), e);
                 }
+            }
+        }
+        if let Some(t) = self.online_tolerance() {
+            if !(t.is_finite() && t > 0.0) {
+                return bad("online.tolerance", format!("is {t}; it must be positive and finite"));
             }
         }
         Ok(())
@@ -314,6 +331,11 @@ impl Pipeline {
 
     pub fn online_scales(&self) -> Vec<f64> {
         self.file.online.as_ref().map_or_else(|| self.training_scales(), |s| s.load_scales.values().expect("checked"))
+    }
+
+    /// `[online] tolerance`, when given.
+    pub fn online_tolerance(&self) -> Option<f64> {
+        self.file.online.as_ref().and_then(|o| o.tolerance)
     }
 
     pub fn validate_scales(&self) -> Vec<f64> {

@@ -156,7 +156,7 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
     let mut full_runs = runs.len();
     let mut points: Vec<CalibrationPoint> = Vec::new();
     let mut iterations: Vec<Iteration> = Vec::new();
-    let mut converged = false;
+    let converged;
     let chosen = loop {
         let data = training_data(&runs);
         let level = search(p, g, &data, &candidates, &points, iterations.len() + 1)?;

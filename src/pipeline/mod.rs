@@ -4,6 +4,7 @@
 //! it, with a report).
 
 pub mod config;
+pub mod estimate;
 pub mod greedy;
 pub mod online;
 pub mod plot;

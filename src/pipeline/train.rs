@@ -2,7 +2,8 @@
 
 use super::config::{Blocks, Pipeline};
 use crate::error::{Error, Result};
-use crate::io::basis_file::{write_basis, BasisMeta, TrainingData};
+use super::estimate::{build_estimator, Estimator, DEFAULT_EXTRA_MODES};
+use crate::io::basis_file::{write_basis_with, BasisMeta, TrainingData};
 use crate::reduction::{ecsw, train_basis, BasisSpec, ModeRule, Trained};
 use crate::simulate::{simulate, Overrides, SimulationResult};
 use crate::solver::kkt::LinearSolverKind;
@@ -17,6 +18,9 @@ pub struct TrainSummary {
     pub n_runs: usize,
     /// what the greedy loop did (`/training` in the basis file); `None` for `load_scales`
     pub greedy: Option<super::greedy::GreedyRecord>,
+    /// the error estimator (uncalibrated for `load_scales` training: no held-out runs;
+    /// greedy training calibrates it on its held-out full runs)
+    pub estimator: Option<Estimator>,
 }
 
 /// The coordinates that appear in any joint, sorted.
@@ -47,9 +51,14 @@ pub fn train(p: &Pipeline) -> Result<(TrainingData, TrainSummary)> {
     }
     let data = training_data(&runs);
     let modes = p.file.reduction.modes.clone().ok_or_else(|| Error::input(&p.path, "reduction.modes", "is missing"))?;
-    let (trained, _) = build_basis(p, &data, modes, p.file.reduction.hyper.as_ref().map(|h| h.tolerance)).map_err(|(f, e)| Error::input(&p.path, f, e))?;
+    let tol = p.file.reduction.hyper.as_ref().map(|h| h.tolerance);
+    let (trained, spec) = build_basis(p, &data, modes, tol).map_err(|(f, e)| Error::input(&p.path, f, e))?;
+    let sys = p.model.system(LinearSolverKind::Banded);
+    let x_ref = data.x.column(0);
+    let estimator = build_estimator(&sys, &trained, &spec, data.x.view(), data.multipliers.view(), &joint_dofs(p), x_ref, tol, DEFAULT_EXTRA_MODES)
+        .map_err(|e| Error::input(&p.path, "reduction", format!("cannot build the error estimator: {e}")))?;
     let n_snapshots = data.x.ncols();
-    Ok((data, TrainSummary { trained, n_snapshots, full_seconds, n_runs: scales.len(), greedy: None }))
+    Ok((data, TrainSummary { trained, n_snapshots, full_seconds, n_runs: scales.len(), greedy: None, estimator: Some(estimator) }))
 }
 
 /// The snapshots of full runs, side by side in run order.
@@ -102,6 +111,14 @@ pub fn train_and_write(p: &Pipeline, out: &Path) -> Result<TrainSummary> {
             None => p.file.reduction.modes.as_ref().map(|m| m.to_string()).unwrap_or_default(),
         },
     };
-    write_basis(out, &data, &summary.trained, &meta)?;
+    write_basis_with(out, &data, &summary.trained, &meta, |f| {
+        if let Some(est) = &summary.estimator {
+            crate::io::estimator_file::write_estimator(f, est).map_err(|e| Error::hdf5(out, e))?;
+        }
+        if let Some(g) = &summary.greedy {
+            super::greedy::write_training(f, g).map_err(|e| Error::hdf5(out, e))?;
+        }
+        Ok(())
+    })?;
     Ok(summary)
 }

@@ -1,0 +1,177 @@
+//! The error estimator's part of the basis file (see [`crate::pipeline::estimate`]), and
+//! the training range and tolerance the online tools compare against:
+//!
+//! ```text
+//! /estimator/modes            (n_dof, r⁺)  V⁺: the same POD with k more modes per block
+//!                                          (POD columns block by block, then the kept unit columns)
+//! /estimator/block_modes      (n_b)        POD modes per block of V⁺
+//! /estimator/multiplier_modes (n_c, r⁺)    whole-system only
+//! /estimator/hyper/elements, /estimator/hyper/weights   V⁺'s ECSW set (hyper-reduced bases)
+//!   attributes on /estimator/hyper: tolerance, training_residual, n_training
+//! /estimator/calibration/load_scale, raw_estimate, rel_error   (m) held-out calibration pairs
+//!   attributes on /estimator: method ("enriched"), extra_modes (k), factor (c),
+//!   calibrated (1: c from calibration pairs, 0: the default), n_modes (r⁺)
+//! /training/range             (2)          [min, max] training load scale (greedy training;
+//!                                          otherwise min/max of /snapshot_load_scale)
+//! /training/tolerance or attribute `tolerance` on /training: greedy's tolerance
+//! ```
+
+use super::h5::{attr_f64, attr_str, attr_u64, read_attr_f64, read_attr_str};
+use crate::error::{Error, Result};
+use crate::pipeline::estimate::{Calibration, CalibrationPoint, Estimator};
+use crate::reduction::{Basis, Hyper};
+use ndarray::Array1;
+use std::path::Path;
+
+/// Writes `/estimator` into an open basis file (inside `write_basis_with`'s closure).
+pub fn write_estimator(f: &hdf5::File, est: &Estimator) -> hdf5::Result<()> {
+    let g = f.create_group("estimator")?;
+    let b = &est.enriched;
+    g.new_dataset_builder().with_data(&b.modes.as_standard_layout()).create("modes")?;
+    let idx = |v: &[usize]| Array1::from_iter(v.iter().map(|&d| d as u64));
+    g.new_dataset_builder().with_data(&idx(&est.block_modes)).create("block_modes")?;
+    if let Some(vl) = &b.multiplier_modes {
+        g.new_dataset_builder().with_data(&vl.as_standard_layout()).create("multiplier_modes")?;
+    }
+    if let Some(h) = &b.hyper {
+        let hg = g.create_group("hyper")?;
+        hg.new_dataset_builder().with_data(&idx(&h.elements)).create("elements")?;
+        hg.new_dataset_builder().with_data(&Array1::from(h.weights.clone())).create("weights")?;
+        attr_f64(&hg, "tolerance", h.tolerance)?;
+        attr_f64(&hg, "training_residual", h.training_residual)?;
+        attr_u64(&hg, "n_training", h.n_training as u64)?;
+    }
+    let c = &est.calibration;
+    let cg = g.create_group("calibration")?;
+    let col = |f: &dyn Fn(&CalibrationPoint) -> f64| Array1::from_iter(c.points.iter().map(f));
+    cg.new_dataset_builder().with_data(&col(&|p| p.load_scale)).create("load_scale")?;
+    cg.new_dataset_builder().with_data(&col(&|p| p.raw_estimate)).create("raw_estimate")?;
+    cg.new_dataset_builder().with_data(&col(&|p| p.rel_error)).create("rel_error")?;
+    attr_str(&g, "method", "enriched")?;
+    attr_u64(&g, "extra_modes", est.extra_modes as u64)?;
+    attr_f64(&g, "factor", c.factor)?;
+    attr_u64(&g, "calibrated", c.calibrated as u64)?;
+    attr_u64(&g, "n_modes", b.n_reduced() as u64)?;
+    Ok(())
+}
+
+/// Reads `/estimator` of the basis file at `path`, completing it from `basis` (variant,
+/// reference, kept coordinates are the basis's). `None` when the file has none (trained
+/// before the estimator existed).
+pub fn read_estimator(path: &Path, basis: &Basis) -> Result<Option<Estimator>> {
+    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", format!("is not a readable HDF5 file: {e}")))?;
+    let Ok(g) = f.group("estimator") else { return Ok(None) };
+    let field = |name: &str, problem: String| Error::input(path, format!("estimator/{name}"), problem);
+    let modes = g.dataset("modes").and_then(|d| d.read_2d::<f64>()).map_err(|e| field("modes", format!("cannot be read: {e}")))?;
+    let idx = |g: &hdf5::Group, name: &str, prefix: &str| -> Result<Vec<usize>> {
+        Ok(g.dataset(name)
+            .and_then(|d| d.read_1d::<u64>())
+            .map_err(|e| field(&format!("{prefix}{name}"), format!("cannot be read: {e}")))?
+            .iter()
+            .map(|&v| v as usize)
+            .collect())
+    };
+    let vec = |g: &hdf5::Group, name: &str| -> Result<Vec<f64>> {
+        Ok(g.dataset(name).and_then(|d| d.read_1d::<f64>()).map_err(|e| field(&format!("calibration/{name}"), format!("cannot be read: {e}")))?.to_vec())
+    };
+    let block_modes = idx(&g, "block_modes", "")?;
+    let num = |name: &str| read_attr_f64(&g, name).map_err(|e| field(name, format!("cannot be read: {e}")));
+    let count = |name: &str| g.attr(name).and_then(|a| a.read_scalar::<u64>()).map_err(|e| field(name, format!("cannot be read: {e}")));
+    let method = read_attr_str(&g, "method").map_err(|e| field("method", format!("cannot be read: {e}")))?;
+    if method != "enriched" {
+        return Err(field("method", format!("is `{method}`; this program knows `enriched`")));
+    }
+    let multiplier_modes = match g.dataset("multiplier_modes") {
+        Ok(d) => Some(d.read_2d::<f64>().map_err(|e| field("multiplier_modes", format!("cannot be read: {e}")))?),
+        Err(_) => None,
+    };
+    let hyper = match g.group("hyper") {
+        Ok(hg) => {
+            let hnum = |name: &str| read_attr_f64(&hg, name).map_err(|e| field(&format!("hyper/{name}"), format!("cannot be read: {e}")));
+            let weights = hg.dataset("weights").and_then(|d| d.read_1d::<f64>()).map_err(|e| field("hyper/weights", format!("cannot be read: {e}")))?.to_vec();
+            let n_training =
+                hg.attr("n_training").and_then(|a| a.read_scalar::<u64>()).map_err(|e| field("hyper/n_training", format!("cannot be read: {e}")))? as usize;
+            let h = Hyper { elements: idx(&hg, "elements", "hyper/")?, weights, tolerance: hnum("tolerance")?, training_residual: hnum("training_residual")?, n_training };
+            h.validate(usize::MAX).map_err(|(f, p)| field(&f, p))?;
+            Some(h)
+        }
+        Err(_) => None,
+    };
+    let cg = g.group("calibration").map_err(|e| field("calibration", format!("cannot be read: {e}")))?;
+    let (ls, raw, err) = (vec(&cg, "load_scale")?, vec(&cg, "raw_estimate")?, vec(&cg, "rel_error")?);
+    if raw.len() != ls.len() || err.len() != ls.len() {
+        return Err(field("calibration", format!("load_scale, raw_estimate, rel_error have {}, {}, {} entries", ls.len(), raw.len(), err.len())));
+    }
+    let points = (0..ls.len()).map(|i| CalibrationPoint { load_scale: ls[i], raw_estimate: raw[i], rel_error: err[i] }).collect();
+    let factor = num("factor")?;
+    if !(factor.is_finite() && factor > 0.0) {
+        return Err(field("factor", format!("is {factor}; it must be positive and finite")));
+    }
+    let kept = basis.kept.clone();
+    let n_pod_modes = block_modes.iter().sum();
+    let enriched = Basis {
+        variant: basis.variant,
+        snapshots: basis.snapshots,
+        reference: basis.reference.clone(),
+        modes,
+        kept,
+        multiplier_modes,
+        multiplier_scale: basis.multiplier_scale,
+        n_pod_modes,
+        hyper,
+    };
+    if enriched.modes.nrows() != basis.n_dof() || n_pod_modes + enriched.kept.len() != enriched.modes.ncols() {
+        return Err(field(
+            "modes",
+            format!("is {:?}; expected {} rows and {} POD + {} kept columns (block_modes)", enriched.modes.dim(), basis.n_dof(), n_pod_modes, enriched.kept.len()),
+        ));
+    }
+    Ok(Some(Estimator {
+        enriched,
+        block_modes,
+        extra_modes: count("extra_modes")? as usize,
+        calibration: Calibration { factor, calibrated: count("calibrated")? != 0, points },
+    }))
+}
+
+/// `[min, max]` of the training load scales: `/training/range` when present (greedy
+/// training), else the extremes of `/snapshot_load_scale`.
+pub fn read_training_range(path: &Path) -> Result<(f64, f64)> {
+    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", format!("is not a readable HDF5 file: {e}")))?;
+    if let Ok(d) = f.dataset("training/range") {
+        let r = d.read_1d::<f64>().map_err(|e| Error::input(path, "training/range", format!("cannot be read: {e}")))?;
+        if r.len() != 2 || !(r[0].is_finite() && r[1].is_finite() && r[0] <= r[1]) {
+            return Err(Error::input(path, "training/range", format!("is {r}; expected [A, B] with A ≤ B finite")));
+        }
+        return Ok((r[0], r[1]));
+    }
+    let s = f
+        .dataset("snapshot_load_scale")
+        .and_then(|d| d.read_1d::<f64>())
+        .map_err(|e| Error::input(path, "snapshot_load_scale", format!("cannot be read: {e}")))?;
+    let lo = s.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = s.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if !(lo.is_finite() && hi.is_finite()) {
+        return Err(Error::input(path, "snapshot_load_scale", "is empty or not finite"));
+    }
+    Ok((lo, hi))
+}
+
+/// Greedy training's tolerance: the dataset `/training/tolerance` or the attribute
+/// `tolerance` on `/training`; `None` without greedy training.
+pub fn read_training_tolerance(path: &Path) -> Result<Option<f64>> {
+    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", format!("is not a readable HDF5 file: {e}")))?;
+    let Ok(g) = f.group("training") else { return Ok(None) };
+    let t = if let Ok(d) = g.dataset("tolerance") {
+        d.read_scalar::<f64>().or_else(|_| d.read_1d::<f64>().map(|a| a.first().copied().unwrap_or(f64::NAN)))
+    } else if g.attr("tolerance").is_ok() {
+        read_attr_f64(&g, "tolerance")
+    } else {
+        return Ok(None);
+    };
+    let t = t.map_err(|e| Error::input(path, "training/tolerance", format!("cannot be read: {e}")))?;
+    if !(t.is_finite() && t > 0.0) {
+        return Err(Error::input(path, "training/tolerance", format!("is {t}; it must be positive and finite")));
+    }
+    Ok(Some(t))
+}
