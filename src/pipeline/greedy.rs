@@ -10,7 +10,7 @@
 //!             ECSW at τ = √ε, and the estimator of V_ε (k more modes, its own ECSW);
 //!             η_ε(λ) = the estimate of rel_error at every λ ∈ Λ (reduced runs, rayon);
 //!             keep the first ε with max_Λ η_ε ≤ T / 2, else the one with the least max;
-//!         λ* = argmax_Λ η(λ);  stop when |S| = K;
+//!         λ* = argmax η(λ) over the candidates without a full run;  stop when |S| = K;
 //!         full run at λ*  →  e* = true rel_error of V at λ*   (V never saw λ*: held out)
 //!         calibration pair (raw estimate at λ*, e*);  c = calibrate(all pairs so far)
 //!         stop when max_Λ η ≤ T and e* ≤ T  (V is kept, the run at λ* stays held out)
@@ -51,6 +51,9 @@ use rayon::prelude::*;
 pub const MARGIN: f64 = 2.0;
 /// Energy tolerances ε tried, loose to tight: 10⁻², 10⁻³, …, 10⁻¹⁰.
 pub const ENERGY_LADDER: [f64; 9] = [1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10];
+/// ECSW tolerances τ tried with the chosen modes, loose to tight: 10^(−1 − i/2), down to 10⁻⁶
+/// (also the τ with given modes and no given τ).
+pub const TAU_LADDER: [f64; 11] = [1e-1, 3.162e-2, 1e-2, 3.162e-3, 1e-3, 3.162e-4, 1e-4, 3.162e-5, 1e-5, 3.162e-6, 1e-6];
 
 /// One pass of the loop: the basis it chose and where its estimate was worst.
 #[derive(Clone, Debug)]
@@ -69,8 +72,11 @@ pub struct Iteration {
     pub estimates: Vec<f64>,
     pub worst_load: f64,
     pub worst_estimate: f64,
-    /// the true rel_error of this iteration's basis at `worst_load`, from the full run
-    /// there (NaN when the budget allowed no run)
+    /// where this iteration ran the full model: the worst candidate without a full run yet
+    /// (NaN when no run was made)
+    pub run_load: f64,
+    /// the true rel_error of this iteration's basis at `run_load`, from the full run there
+    /// (NaN when no run was made)
     pub true_error: f64,
 }
 
@@ -123,11 +129,16 @@ struct Level {
 impl Level {
     /// The candidate with the largest estimate and that estimate (NaN counts as ∞).
     fn worst(&self) -> (usize, f64) {
-        let mut w = (0, f64::NEG_INFINITY);
-        for (i, &e) in self.estimates.iter().enumerate() {
+        self.worst_where(|_| true).expect("at least two candidates")
+    }
+
+    /// [`Self::worst`] among the candidates `keep` accepts.
+    fn worst_where(&self, keep: impl Fn(usize) -> bool) -> Option<(usize, f64)> {
+        let mut w: Option<(usize, f64)> = None;
+        for (i, &e) in self.estimates.iter().enumerate().filter(|(i, _)| keep(*i)) {
             let e = if e.is_nan() { f64::INFINITY } else { e };
-            if e > w.1 {
-                w = (i, e);
+            if w.is_none_or(|w| e > w.1) {
+                w = Some((i, e));
             }
         }
         w
@@ -161,6 +172,10 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         let data = training_data(&runs);
         let level = search(p, g, &data, &candidates, &points, iterations.len() + 1)?;
         let (wi, worst) = level.worst();
+        // where to run the full model: the worst candidate whose load has no full run yet
+        // (a training load's own run is already in the snapshots)
+        let fresh = |i: usize| runs.iter().all(|r| (r.settings.load_scale - candidates[i]).abs() > 1e-12 * candidates[i].abs().max(1.0));
+        let next = level.worst_where(fresh);
         let b = &level.trained.basis;
         let mut it = Iteration {
             energy: level.energy,
@@ -171,33 +186,35 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
             estimates: level.estimates.clone(),
             worst_load: candidates[wi],
             worst_estimate: worst,
+            run_load: f64::NAN,
             true_error: f64::NAN,
         };
         let shape = format!("{}{}, {} elements", modes_text(&it.block_modes), if b.kept.is_empty() { String::new() } else { format!(" + {} joint coordinates", b.kept.len()) }, it.n_elements);
         let n = iterations.len() + 1;
         let cmp = if worst <= g.tolerance { "≤" } else { ">" };
-        if full_runs >= g.max_runs {
-            eprintln!("iteration {n}: no full run left (max_runs = {}), worst estimate {worst:.2e} {cmp} {:e} at λ = {}, {shape}", g.max_runs, g.tolerance, it.worst_load);
+        let Some((ni, next_estimate)) = next.filter(|_| full_runs < g.max_runs) else {
+            let why = if full_runs >= g.max_runs { format!("no full run left (max_runs = {})", g.max_runs) } else { "every candidate has a full run".into() };
+            eprintln!("iteration {n}: {why}, worst estimate {worst:.2e} {cmp} {:e} at λ = {}, {shape}", g.tolerance, it.worst_load);
             converged = worst <= g.tolerance;
             iterations.push(it);
             break level;
-        }
+        };
         // the full run at the worst candidate: snapshots for the next basis, and the true
         // error of this one there (it never saw that load)
-        let at = candidates[wi];
+        let at = candidates[ni];
         let truth = full(at)?;
         full_seconds += truth.wall_seconds;
         full_runs += 1;
         let e = true_error(&p.model, &level.trained.basis, &level.estimator, &truth, at);
-        it.true_error = e;
-        if level.raws[wi].is_finite() && e.is_finite() {
-            points.push(CalibrationPoint { load_scale: at, raw_estimate: level.raws[wi], rel_error: e });
+        (it.run_load, it.true_error) = (at, e);
+        if level.raws[ni].is_finite() && e.is_finite() {
+            points.push(CalibrationPoint { load_scale: at, raw_estimate: level.raws[ni], rel_error: e });
         }
         let done = worst <= g.tolerance && e <= g.tolerance;
         if done {
-            eprintln!("iteration {n}: worst estimate {worst:.2e} ≤ {:e}; held-out check at λ = {at}: rel_error {e:.2e}; {shape}", g.tolerance);
+            eprintln!("iteration {n}: worst estimate {worst:.2e} ≤ {:e}; held-out check at λ = {at} (estimate {next_estimate:.2e}): rel_error {e:.2e}; {shape}", g.tolerance);
         } else {
-            eprintln!("iteration {n}: full run at λ = {at} (worst estimate {worst:.2e} {cmp} {:e}, true error there {e:.2e}), {shape}", g.tolerance);
+            eprintln!("iteration {n}: full run at λ = {at} (worst estimate {worst:.2e} {cmp} {:e}; {next_estimate:.2e} there, true error {e:.2e}), {shape}", g.tolerance);
         }
         iterations.push(it);
         if done {
@@ -240,36 +257,80 @@ fn true_error(model: &Model, basis: &Basis, est: &Estimator, truth: &SimulationR
     }
 }
 
-/// The mode search of one iteration (module documentation): the given modes and τ when the
-/// pipeline fixes them, else the energy ladder loose → tight.
+/// The mode and hyper-reduction search of one iteration (module documentation): the modes
+/// the pipeline gives, or the energy ladder loose → tight with τ = √ε (and a half step
+/// before the first accepted rung); then, unless the pipeline gives τ, the loosest τ that
+/// still meets T / 2 with those modes.
 fn search(p: &Pipeline, g: &GreedySpec, data: &TrainingData, candidates: &[f64], points: &[CalibrationPoint], n: usize) -> Result<Level> {
     let given_hyper = p.file.reduction.hyper.as_ref().map(|h| h.tolerance);
-    if let Some(m) = &p.file.reduction.modes {
-        return level(p, data, candidates, points, m.clone(), f64::NAN, given_hyper, n).map_err(|(f, e)| Error::input(&p.path, f, e));
-    }
-    let mut best: Option<Level> = None;
-    let mut last_error = None;
-    for &eps in &ENERGY_LADDER {
-        let tau = given_hyper.unwrap_or(eps.sqrt());
-        let l = match level(p, data, candidates, points, ModeRule::Energy(eps), eps, Some(tau), n) {
-            Ok(l) => l,
+    let debug = std::env::var_os("FLEXROM_GREEDY_DEBUG").is_some();
+    let accepts = |l: &Level| l.worst().1 <= g.tolerance / MARGIN;
+    let mut last_error: Option<(&'static str, String)> = None;
+    let mut attempt = |modes: ModeRule, eps: f64, tau: f64| -> Option<Level> {
+        match level(p, data, candidates, points, modes, eps, Some(tau), n) {
+            Ok(l) => {
+                if debug {
+                    let (wi, w) = l.worst();
+                    let h = l.trained.basis.hyper.as_ref().map_or(0, |h| h.elements.len());
+                    eprintln!("  rung ε = {eps:.1e}, τ = {tau:.1e}: {}, {h} elements, estimator {:?}, worst estimate {w:.3e} at λ = {}", modes_text(&l.trained.block_modes), l.estimator.block_modes, candidates[wi]);
+                }
+                Some(l)
+            }
             Err(e) => {
                 last_error = Some(e);
-                continue;
+                None
             }
-        };
-        if !l.fully_enriched && best.is_some() {
-            // the snapshots span too little for a tighter basis with an honest estimate
-            break;
         }
-        let w = l.worst().1;
-        let accept = w <= g.tolerance / MARGIN;
-        let enriched = l.fully_enriched;
-        if best.as_ref().is_none_or(|b| w < b.worst().1) {
-            best = Some(l);
+    };
+    let better = |best: &Option<Level>, l: &Level| best.as_ref().is_none_or(|b| l.worst().1 < b.worst().1);
+    let mut best: Option<Level> = None;
+    if let Some(m) = &p.file.reduction.modes {
+        best = attempt(m.clone(), f64::NAN, given_hyper.unwrap_or(TAU_LADDER[TAU_LADDER.len() - 1]));
+    } else {
+        let mut failed_eps: Option<f64> = None;
+        for &eps in &ENERGY_LADDER {
+            let Some(l) = attempt(ModeRule::Energy(eps), eps, given_hyper.unwrap_or(eps.sqrt())) else { continue };
+            if !l.fully_enriched && best.is_some() {
+                // the snapshots span too little for a tighter basis with an honest estimate
+                break;
+            }
+            let (ok, enriched) = (accepts(&l), l.fully_enriched);
+            if ok {
+                // a half step back towards the last rung that failed: fewer modes may do
+                if let Some(f) = failed_eps {
+                    let half = (f * eps).sqrt();
+                    if let Some(h) = attempt(ModeRule::Energy(half), half, given_hyper.unwrap_or(half.sqrt())) {
+                        if accepts(&h) && h.fully_enriched && h.trained.basis.n_reduced() < l.trained.basis.n_reduced() {
+                            best = Some(h);
+                            break;
+                        }
+                    }
+                }
+                best = Some(l);
+                break;
+            }
+            failed_eps = Some(eps);
+            if better(&best, &l) {
+                best = Some(l);
+            }
+            if !enriched {
+                break;
+            }
         }
-        if accept || !enriched {
-            break;
+    }
+    // the cheapest hyper-reduction that keeps the accepted modes within T / 2
+    if let (Some(b), None) = (&best, given_hyper) {
+        if accepts(b) {
+            let modes = if p.blocks().is_some() { ModeRule::Counts(b.trained.block_modes.clone()) } else { ModeRule::Count(b.trained.block_modes[0]) };
+            let (eps, tau0) = (b.energy, b.hyper_tolerance.unwrap_or(0.0));
+            for &tau in TAU_LADDER.iter().filter(|&&t| t > tau0 * (1.0 + 1e-9)) {
+                if let Some(l) = attempt(modes.clone(), eps, tau) {
+                    if accepts(&l) {
+                        best = Some(l);
+                        break;
+                    }
+                }
+            }
         }
     }
     best.ok_or_else(|| {
@@ -342,6 +403,7 @@ pub fn write_training(f: &hdf5::File, r: &GreedyRecord) -> hdf5::Result<()> {
     g.new_dataset_builder().with_data(&Array1::from(r.candidates.clone())).create("candidates")?;
     g.new_dataset_builder().with_data(&col(&|i| i.worst_estimate)).create("worst_estimate")?;
     g.new_dataset_builder().with_data(&col(&|i| i.worst_load)).create("worst_load")?;
+    g.new_dataset_builder().with_data(&col(&|i| i.run_load)).create("run_load")?;
     g.new_dataset_builder().with_data(&col(&|i| i.true_error)).create("true_error")?;
     g.new_dataset_builder().with_data(&col(&|i| i.energy)).create("energy_tolerance")?;
     g.new_dataset_builder().with_data(&col(&|i| i.hyper_tolerance)).create("hyper_tolerance")?;
