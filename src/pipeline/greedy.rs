@@ -30,6 +30,9 @@
 //!   iteration's estimates, so an estimator that read low at one full run reads higher at
 //!   the next iteration.
 //!
+//! - from the second iteration on, the ladder starts two rungs looser than the rung chosen
+//!   the iteration before (more snapshots need as many modes or more for the same error).
+//!
 //! Nothing here is fitted to a model: the ladder, √ε and the factor 2 are the same for
 //! every model; a reduced run that fails (Newton diverges) counts as an infinite estimate.
 
@@ -170,7 +173,8 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
     let converged;
     let chosen = loop {
         let data = training_data(&runs);
-        let level = search(p, g, &data, &candidates, &points, iterations.len() + 1)?;
+        let previous_energy = iterations.last().map(|i: &Iteration| i.energy);
+        let level = search(p, g, &data, &candidates, &points, iterations.len() + 1, previous_energy)?;
         let (wi, worst) = level.worst();
         // where to run the full model: the worst candidate whose load has no full run yet
         // (a training load's own run is already in the snapshots)
@@ -261,7 +265,7 @@ fn true_error(model: &Model, basis: &Basis, est: &Estimator, truth: &SimulationR
 /// the pipeline gives, or the energy ladder loose → tight with τ = √ε (and a half step
 /// before the first accepted rung); then, unless the pipeline gives τ, the loosest τ that
 /// still meets T / 2 with those modes.
-fn search(p: &Pipeline, g: &GreedySpec, data: &TrainingData, candidates: &[f64], points: &[CalibrationPoint], n: usize) -> Result<Level> {
+fn search(p: &Pipeline, g: &GreedySpec, data: &TrainingData, candidates: &[f64], points: &[CalibrationPoint], n: usize, previous_energy: Option<f64>) -> Result<Level> {
     let given_hyper = p.file.reduction.hyper.as_ref().map(|h| h.tolerance);
     let debug = std::env::var_os("FLEXROM_GREEDY_DEBUG").is_some();
     let accepts = |l: &Level| l.worst().1 <= g.tolerance / MARGIN;
@@ -288,7 +292,11 @@ fn search(p: &Pipeline, g: &GreedySpec, data: &TrainingData, candidates: &[f64],
         best = attempt(m.clone(), f64::NAN, given_hyper.unwrap_or(TAU_LADDER[TAU_LADDER.len() - 1]));
     } else {
         let mut failed_eps: Option<f64> = None;
-        for &eps in &ENERGY_LADDER {
+        // after the first iteration the ladder starts two rungs looser than the rung chosen
+        // last time: more snapshots need as many modes or more for the same error, and the
+        // rungs far looser than that were already far off
+        let start = previous_energy.and_then(|e| ENERGY_LADDER.iter().position(|&x| x <= e * (1.0 + 1e-9))).map_or(0, |i| i.saturating_sub(2));
+        for &eps in &ENERGY_LADDER[start..] {
             let Some(l) = attempt(ModeRule::Energy(eps), eps, given_hyper.unwrap_or(eps.sqrt())) else { continue };
             if !l.fully_enriched && best.is_some() {
                 // the snapshots span too little for a tighter basis with an honest estimate
