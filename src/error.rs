@@ -30,6 +30,11 @@ pub enum Error {
     #[error("linear solve failed at t = {t:.6} s: {problem}")]
     LinearSolve { t: f64, problem: String },
 
+    /// `--strict`: a run's error estimate exceeds the tolerance (its output is written;
+    /// the program exits with code 4).
+    #[error("{0}")]
+    Strict(String),
+
     /// Anything else that is a usage error of the program (bad command-line values).
     #[error("{0}")]
     Usage(String),

@@ -2,7 +2,7 @@
 
 use clap::{Parser, Subcommand};
 use flexrom::io::result_file::{write_result, write_result_with};
-use flexrom::pipeline::online::{load_basis, run_reduced};
+use flexrom::pipeline::online::load_basis;
 use flexrom::pipeline::Pipeline;
 use flexrom::model::Model;
 use flexrom::simulate::{simulate, Overrides};
@@ -78,6 +78,10 @@ enum Command {
         /// basis file (default: the pipeline's `basis`)
         #[arg(long)]
         basis: Option<PathBuf>,
+        /// exit with code 4 (after writing the output) when an error estimate exceeds the
+        /// tolerance ([online] tolerance, default the training tolerance)
+        #[arg(long)]
+        strict: bool,
     },
     /// Run full and reduced models at one load scale and report errors and timings.
     Validate {
@@ -95,6 +99,10 @@ enum Command {
         /// skip the dense-LU full run (its time and speedup are then null)
         #[arg(long)]
         no_dense: bool,
+        /// exit with code 4 (after writing the output) when an error estimate exceeds the
+        /// tolerance ([online] tolerance, default the training tolerance)
+        #[arg(long)]
+        strict: bool,
     },
     /// Reduced runs at many load scales, in parallel, into one HDF5 file and a table.
     Sweep {
@@ -120,11 +128,19 @@ enum Command {
         /// basis file (default: the pipeline's `basis`)
         #[arg(long)]
         basis: Option<PathBuf>,
+        /// exit with code 4 (after writing the output) when an error estimate exceeds the
+        /// tolerance ([online] tolerance, default the training tolerance)
+        #[arg(long)]
+        strict: bool,
     },
     /// Train, sweep, validate and write a report folder (Markdown and SVG plots).
     Run {
         /// pipeline file (TOML)
         pipeline: PathBuf,
+        /// exit with code 4 (after writing the output) when an error estimate exceeds the
+        /// tolerance ([online] tolerance, default the training tolerance)
+        #[arg(long)]
+        strict: bool,
     },
     /// Run each model and print its probe positions at a few times.
     Demo {
@@ -138,6 +154,10 @@ fn main() -> ExitCode {
     flexrom::single_threaded_blas();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e @ flexrom::Error::Strict(_)) => {
+            eprintln!("error: {e}");
+            ExitCode::from(flexrom::pipeline::estimate::STRICT_EXIT_CODE)
+        }
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::FAILURE
@@ -187,13 +207,16 @@ fn run(cli: Cli) -> flexrom::Result<()> {
             );
             Ok(())
         }
-        Command::Online { pipeline, load_scale, output, basis } => {
+        Command::Online { pipeline, load_scale, output, basis, strict } => {
             let p = Pipeline::load(&pipeline)?;
             check_output_dir(&output)?;
             check_scale(load_scale)?;
             let path = basis.unwrap_or_else(|| p.basis_path.clone());
             let stored = load_basis(&p, &path)?;
-            let run = run_reduced(&p.model, &stored.basis, load_scale)?;
+            let trust = flexrom::pipeline::estimate::load_trust(&p, &path, &stored)?;
+            let mut runner = flexrom::pipeline::estimate::EstimatingRunner::new(&p.model, &stored.basis, trust.estimator.as_ref())?;
+            let (run, estimate) = runner.run(load_scale, flexrom::pipeline::online::Output::Full)?;
+            let extrapolated = flexrom::pipeline::estimate::is_extrapolated(trust.range, load_scale);
             let basis_name = path.display().to_string();
             write_result_with(&output, &run.result, |f| {
                 let e = |err: hdf5::Error| flexrom::Error::hdf5(&output, err);
@@ -201,7 +224,8 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                 g.new_dataset_builder().with_data(&run.reduced_q).create("q").map_err(e)?;
                 flexrom::io::h5::attr_str(f, "basis", &basis_name).map_err(e)?;
                 flexrom::io::h5::attr_str(f, "variant", stored.basis.variant.name()).map_err(e)?;
-                flexrom::io::h5::attr_u64(f, "n_modes", stored.basis.n_reduced() as u64).map_err(e)
+                flexrom::io::h5::attr_u64(f, "n_modes", stored.basis.n_reduced() as u64).map_err(e)?;
+                flexrom::pipeline::estimate::write_run_attributes(f, estimate.as_ref(), &trust, extrapolated).map_err(e)
             })?;
             let st = &run.result.stats;
             eprintln!(
@@ -214,22 +238,26 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                 st.step_cuts,
                 output.display()
             );
-            Ok(())
+            if let Some(e) = &estimate {
+                eprintln!("  {}", flexrom::pipeline::estimate::describe(e, run.result.wall_seconds));
+            }
+            flexrom::pipeline::estimate::check_runs(&trust, &[(load_scale, estimate.map(|e| e.error_estimate))], strict)
         }
-        Command::Validate { pipeline, load_scale, json, basis, no_dense } => {
+        Command::Validate { pipeline, load_scale, json, basis, no_dense, strict } => {
             let p = Pipeline::load(&pipeline)?;
             check_scale(load_scale)?;
             let path = basis.unwrap_or_else(|| p.basis_path.clone());
             let stored = load_basis(&p, &path)?;
-            let (v, _, _) = flexrom::pipeline::validate::validate(&p.model, &stored.basis, load_scale, !no_dense)?;
+            let trust = flexrom::pipeline::estimate::load_trust(&p, &path, &stored)?;
+            let (v, _, _) = flexrom::pipeline::validate::validate_with(&p.model, &stored.basis, Some(&trust), load_scale, !no_dense)?;
             if json {
                 println!("{}", serde_json::to_string(&v).expect("serializable"));
             } else {
                 println!("{}", v.describe());
             }
-            Ok(())
+            flexrom::pipeline::estimate::check_runs(&trust, &[(load_scale, v.error_estimate)], strict)
         }
-        Command::Sweep { pipeline, load_scales, validate, continuation, output, basis } => {
+        Command::Sweep { pipeline, load_scales, validate, continuation, output, basis, strict } => {
             let p = Pipeline::load(&pipeline)?;
             let scales = match load_scales {
                 Some(s) => flexrom::pipeline::config::parse_range(&s).map_err(|e| flexrom::Error::Usage(format!("--load-scales: {e}")))?,
@@ -246,18 +274,20 @@ fn run(cli: Cli) -> flexrom::Result<()> {
             let path = basis.unwrap_or_else(|| p.basis_path.clone());
             let stored = load_basis(&p, &path)?;
             let options = flexrom::pipeline::sweep::SweepOptions { validate, continuation, progress: true };
-            let sw = flexrom::pipeline::sweep::sweep(&p.model, &stored.basis, &scales, options)?;
+            let trust = flexrom::pipeline::estimate::load_trust(&p, &path, &stored)?;
+            let sw = flexrom::pipeline::sweep::sweep_with(&p.model, &stored.basis, Some(&trust), &scales, options)?;
             flexrom::pipeline::sweep::write_sweep(&out, &sw, &stored.basis, &path)?;
             print!("{}", flexrom::pipeline::sweep::table(&sw));
             eprintln!("{} load scales on {} threads in {:.3} s -> {}", scales.len(), sw.threads, sw.wall_seconds, out.display());
-            Ok(())
+            let runs: Vec<(f64, Option<f64>)> = sw.points.iter().map(|q| (q.rom.result.settings.load_scale, q.estimate.map(|e| e.error_estimate))).collect();
+            flexrom::pipeline::estimate::check_runs(&trust, &runs, strict)
         }
-        Command::Run { pipeline } => {
+        Command::Run { pipeline, strict } => {
             let p = Pipeline::load(&pipeline)?;
             let dir = flexrom::pipeline::report::run(&p, true)?;
             println!("{}", std::fs::read_to_string(dir.join("summary.md")).map_err(|e| flexrom::Error::io(&dir, e))?);
             eprintln!("report: {}", dir.display());
-            Ok(())
+            flexrom::pipeline::report::check_report(&p, &dir, strict)
         }
         Command::Demo { models } => {
             for path in models {

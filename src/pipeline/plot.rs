@@ -59,3 +59,60 @@ pub fn line_chart(path: &Path, title: &str, x_label: &str, y_label: &str, series
     root.present().map_err(|e| err(&e))?;
     Ok(())
 }
+
+/// The error estimate against the load scale (a line, log scale), the true errors where
+/// validated (circles), and the training loads (vertical grey lines): the report's
+/// `estimate_vs_load.svg`.
+pub fn estimate_chart(path: &Path, title: &str, estimates: &[(f64, f64)], errors: &[(f64, f64)], training: &[f64]) -> Result<(), String> {
+    let ok = |&(x, y): &(f64, f64)| x.is_finite() && y.is_finite() && y > 0.0;
+    let est: Vec<(f64, f64)> = estimates.iter().copied().filter(ok).collect();
+    let err_pts: Vec<(f64, f64)> = errors.iter().copied().filter(ok).collect();
+    let all: Vec<(f64, f64)> = est.iter().chain(&err_pts).copied().collect();
+    if all.is_empty() {
+        return Err(format!("{}: nothing to plot", path.display()));
+    }
+    let xs = all.iter().map(|p| p.0).chain(training.iter().copied().filter(|x| x.is_finite()));
+    let (mut x0, mut x1) = xs.fold((f64::MAX, f64::MIN), |(a, b), x| (a.min(x), b.max(x)));
+    if x1 <= x0 {
+        (x0, x1) = (x0 - 0.5, x1 + 0.5);
+    }
+    let pad = 0.03 * (x1 - x0);
+    (x0, x1) = (x0 - pad, x1 + pad);
+    let (y0, y1) = all.iter().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
+    let (y0, y1) = (y0 / 3.0, y1 * 3.0);
+    let root = SVGBackend::new(path, (900, 520)).into_drawing_area();
+    let err = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(42)
+        .y_label_area_size(78)
+        .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
+        .map_err(|e| err(&e))?;
+    chart.configure_mesh().x_desc("load scale").y_desc("relative error").draw().map_err(|e| err(&e))?;
+    let grey = RGBColor(150, 150, 150);
+    for (i, &x) in training.iter().filter(|x| x.is_finite()).enumerate() {
+        let a = chart.draw_series(LineSeries::new(vec![(x, y0), (x, y1)], ShapeStyle { color: grey.to_rgba(), filled: false, stroke_width: 1 })).map_err(|e| err(&e))?;
+        if i == 0 {
+            a.label("training load").legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey));
+        }
+    }
+    if !est.is_empty() {
+        chart
+            .draw_series(LineSeries::new(est.clone(), ShapeStyle { color: BLUE.to_rgba(), filled: false, stroke_width: 2 }))
+            .map_err(|e| err(&e))?
+            .label("error_estimate")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE));
+    }
+    if !err_pts.is_empty() {
+        chart
+            .draw_series(err_pts.iter().map(|&p| Circle::new(p, 4, RED.filled())))
+            .map_err(|e| err(&e))?
+            .label("rel_error (validated)")
+            .legend(|(x, y)| Circle::new((x + 10, y), 4, RED.filled()));
+    }
+    chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(|e| err(&e))?;
+    root.present().map_err(|e| err(&e))?;
+    Ok(())
+}

@@ -4,10 +4,11 @@
 
 use super::config::Pipeline;
 use super::online::load_basis;
-use super::plot::{line_chart, Series};
-use super::sweep::{sweep, table, write_sweep, SweepOptions};
+use super::estimate::{check_runs, load_trust};
+use super::plot::{estimate_chart, line_chart, Series};
+use super::sweep::{sweep_with, table, write_sweep, SweepOptions};
 use super::train::train_and_write;
-use super::validate::{validate, Validation};
+use super::validate::{validate_with, Validation};
 use crate::error::{Error, Result};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -44,17 +45,18 @@ fn build(p: &Pipeline, out: &Path, progress: bool) -> Result<()> {
     let trained = train_and_write(p, &p.basis_path)?;
     let stored = load_basis(p, &p.basis_path)?;
     let basis = &stored.basis;
+    let trust = load_trust(p, &p.basis_path, &stored)?;
 
     let scales = p.online_scales();
     eprintln!("[2/3] sweep: {} reduced and full runs", scales.len());
-    let sw = sweep(&p.model, basis, &scales, SweepOptions { validate: true, continuation: false, progress })?;
+    let sw = sweep_with(&p.model, basis, Some(&trust), &scales, SweepOptions { validate: true, continuation: false, progress })?;
     write_sweep(&out.join("sweep.h5"), &sw, basis, &p.basis_path)?;
 
     let vscales = p.validate_scales();
     eprintln!("[3/3] validate at {} load scale(s), with the dense full solve", vscales.len());
     let mut validations: Vec<Validation> = Vec::new();
     for (i, &x) in vscales.iter().enumerate() {
-        let (v, full, rom) = validate(&p.model, basis, x, true)?;
+        let (v, full, rom) = validate_with(&p.model, basis, Some(&trust), x, true)?;
         let mut series = Vec::new();
         for ((name, a), (_, b)) in full.probes.iter().zip(&rom.result.probes) {
             series.push(Series { name: format!("{name} y, full"), points: full.t.iter().zip(a.column(1)).map(|(t, y)| (*t, *y)).collect(), dashed: false });
@@ -101,6 +103,28 @@ fn build(p: &Pipeline, out: &Path, progress: bool) -> Result<()> {
         false,
     )
     .map_err(plot_err)?;
+    // the estimate over the sweep, the true errors of the sweep and of the validation runs
+    let estimates: Vec<(f64, f64)> = sw.points.iter().filter_map(|q| q.estimate.map(|e| (q.rom.result.settings.load_scale, e.error_estimate))).collect();
+    let mut errors = pts(&|v| v.rel_error);
+    errors.extend(validations.iter().map(|v| (v.load_scale, v.rel_error)));
+    let training: Vec<f64> = {
+        let f = hdf5::File::open(&p.basis_path).map_err(|e| Error::hdf5(&p.basis_path, e))?;
+        let mut l: Vec<f64> = match f.dataset("training/load_scales") {
+            Ok(d) => d.read_1d::<f64>().map_err(|e| Error::input(&p.basis_path, "training/load_scales", e.to_string()))?.to_vec(),
+            Err(_) => f.dataset("snapshot_load_scale").and_then(|d| d.read_1d::<f64>()).map_err(|e| Error::input(&p.basis_path, "snapshot_load_scale", e.to_string()))?.to_vec(),
+        };
+        l.sort_by(f64::total_cmp);
+        l.dedup();
+        l
+    };
+    if !estimates.is_empty() {
+        estimate_chart(&out.join("estimate_vs_load.svg"), "Error estimate (no full run) and true error", &estimates, &errors, &training).map_err(plot_err)?;
+    }
+    let by_time: Vec<Series> = validations
+        .iter()
+        .map(|v| Series { name: format!("load scale {}", v.load_scale), points: v.rel_error_by_time.iter().enumerate().map(|(i, e)| ((i + 1) as f64 / 5.0, *e)).collect(), dashed: false })
+        .collect();
+    line_chart(&out.join("error_by_time.svg"), "rel_error up to a fraction of the run", "fraction of the run", "rel_error", &by_time, true).map_err(plot_err)?;
     let json = serde_json::to_string_pretty(&validations).expect("serializable");
     std::fs::write(out.join("validation.json"), json).map_err(|e| Error::io(out, e))?;
 
@@ -144,12 +168,55 @@ fn build(p: &Pipeline, out: &Path, progress: bool) -> Result<()> {
             v.speedup_vs_dense.unwrap_or(f64::NAN)
         );
     }
+    let _ = writeln!(md, "\n## Error estimate, extrapolation, sensitivity\n");
+    let _ = writeln!(
+        md,
+        "Training range [{}, {}]; tolerance {}. The estimate predicts rel_error without a full run (docs/error-estimate.md); effectivity = estimate / rel_error (≥ 1: bounded). Sensitivity: the full model's own change for a 0.1 % change of the load.\n",
+        trust.range.0,
+        trust.range.1,
+        trust.tolerance.map_or("none".to_string(), |t| format!("{t:e}"))
+    );
+    let _ = writeln!(md, "| load scale | rel_error | error_estimate | effectivity | calibrated | extrapolated | sensitivity | rel_error by fifth of the run |");
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|");
+    for v in &validations {
+        let by: Vec<String> = v.rel_error_by_time.iter().map(|e| format!("{e:.2e}")).collect();
+        let o = |x: Option<f64>, f: &dyn Fn(f64) -> String| x.map_or("–".to_string(), f);
+        let _ = writeln!(
+            md,
+            "| {} | {:.3e} | {} | {} | {} | {} | {} | {} |",
+            v.load_scale,
+            v.rel_error,
+            o(v.error_estimate, &|x| format!("{x:.3e}")),
+            o(v.effectivity, &|x| format!("{x:.2}")),
+            v.estimate_calibrated.map_or("–", |c| if c { "yes" } else { "no" }),
+            if v.extrapolated { "yes" } else { "no" },
+            o(v.sensitivity, &|x| format!("{x:.2e}")),
+            by.join(", ")
+        );
+    }
     let _ = writeln!(md, "\n## Sweep\n\n```text\n{}```\n", table(&sw));
     let _ = writeln!(md, "## Plots\n");
     for (i, x) in vscales.iter().enumerate() {
         let _ = writeln!(md, "![probes at {x}](probes_{i}.svg)");
     }
     let _ = writeln!(md, "![singular values](singular_values.svg)\n![error](error_vs_load.svg)\n![speedup](speedup_vs_load.svg)");
+    if !estimates.is_empty() {
+        let _ = writeln!(md, "![error estimate](estimate_vs_load.svg)");
+    }
+    let _ = writeln!(md, "![error by time](error_by_time.svg)");
     std::fs::write(out.join("summary.md"), md).map_err(|e| Error::io(out, e))?;
     Ok(())
+}
+
+/// After `run`: the extrapolation and tolerance warnings of the report's sweep (read back
+/// from its `sweep.h5`), and `--strict`'s error when an estimate exceeds the tolerance.
+pub fn check_report(p: &Pipeline, dir: &Path, strict: bool) -> Result<()> {
+    let stored = load_basis(p, &p.basis_path)?;
+    let trust = load_trust(p, &p.basis_path, &stored)?;
+    let path = dir.join("sweep.h5");
+    let f = hdf5::File::open(&path).map_err(|e| Error::hdf5(&path, e))?;
+    let read = |name: &str| f.dataset(name).and_then(|d| d.read_1d::<f64>()).map_err(|e| Error::input(&path, name, format!("cannot be read: {e}")));
+    let (scales, est) = (read("load_scales")?, read("error_estimate")?);
+    let runs: Vec<(f64, Option<f64>)> = scales.iter().zip(&est).map(|(&x, &e)| (x, if e.is_nan() { None } else { Some(e) })).collect();
+    check_runs(&trust, &runs, strict)
 }

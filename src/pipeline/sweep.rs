@@ -11,13 +11,17 @@
 //! /rom_seconds        (N)            reduced time loop of each run
 //! /newton_iterations  (N)
 //! /factorizations     (N)            iteration matrices factorized
+//! /error_estimate     (N)            the estimate of rel_error of each run (NaN: no estimator)
+//! /extrapolated       (N)            1 where the load scale is outside the training range
+//! /estimate_seconds   (N)            the estimator's enriched run and norms, s
 //! with --validate:    /rel_error, /max_probe_error, /max_constraint_violation,
 //!                     /full_seconds, /speedup  (N each)
 //! attributes on /: basis, variant, n_modes, wall_seconds (whole sweep), threads,
 //!   continuation (1 when the runs were continued from their neighbours), program_version
 //! ```
 
-use super::online::{Output, ReducedRun, ReducedRunner};
+use super::estimate::{is_extrapolated, Estimate, EstimatingRunner, TrustInfo};
+use super::online::{Output, ReducedRun};
 use super::validate::{compare, Validation};
 use crate::error::{Error, Result};
 use crate::io::h5::{attr_f64, attr_str, attr_u64, write_atomically};
@@ -32,6 +36,10 @@ use std::path::Path;
 pub struct SweepPoint {
     pub rom: ReducedRun,
     pub validation: Option<Validation>,
+    /// the run's error estimate (None: no estimator)
+    pub estimate: Option<Estimate>,
+    /// outside the training range
+    pub extrapolated: bool,
 }
 
 pub struct Sweep {
@@ -71,6 +79,13 @@ fn continuation_lanes(n: usize, threads: usize) -> Vec<Vec<std::ops::Range<usize
 
 /// Runs the reduced model at every scale, in parallel; with `validate`, also the full one.
 pub fn sweep(model: &Model, basis: &Basis, scales: &[f64], o: SweepOptions) -> Result<Sweep> {
+    sweep_with(model, basis, None, scales, o)
+}
+
+/// [`sweep`] with the basis's estimator and training range: every point gets its error
+/// estimate and extrapolation flag.
+pub fn sweep_with(model: &Model, basis: &Basis, trust: Option<&TrustInfo>, scales: &[f64], o: SweepOptions) -> Result<Sweep> {
+    let est = trust.and_then(|t| t.estimator.as_ref());
     let bar = ProgressBar::with_draw_target(Some(scales.len() as u64), if o.progress { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() });
     bar.set_style(ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} load scales, {elapsed} elapsed, ETA {eta}").expect("valid template").progress_chars("=> "));
     bar.set_prefix(if o.validate { "sweep + validate" } else { "sweep" });
@@ -81,10 +96,10 @@ pub fn sweep(model: &Model, basis: &Basis, scales: &[f64], o: SweepOptions) -> R
     let parts: Result<Vec<Vec<(usize, SweepPoint)>>> = lanes
         .par_iter()
         // one reduced model per worker, built at its first lane, its loads changed per scale
-        .map_init(|| None, |slot: &mut Option<ReducedRunner>, chains| {
+        .map_init(|| None, |slot: &mut Option<EstimatingRunner>, chains| {
             let runner = match slot {
                 Some(r) => r,
-                None => slot.insert(ReducedRunner::new(model, basis)?),
+                None => slot.insert(EstimatingRunner::new(model, basis, est)?),
             };
             let mut done: Vec<(usize, SweepPoint)> = Vec::new();
             for chain in chains {
@@ -95,15 +110,16 @@ pub fn sweep(model: &Model, basis: &Basis, scales: &[f64], o: SweepOptions) -> R
                     let previous: Vec<&ReducedRun> = done[first.max(done.len().saturating_sub(2))..].iter().map(|p| &p.1.rom).collect();
                     // without validation nothing of full size is reconstructed
                     let output = if o.validate { Output::Full } else { Output::ReducedAndProbes };
-                    let rom = runner.run(x, output, &previous)?;
+                    let (rom, estimate) = runner.run_with(x, output, &previous)?;
                     let validation = if o.validate {
                         let full = simulate(model, &Overrides { load_scale: Some(x), ..Default::default() })?;
-                        Some(compare(model, &full, &rom, None, basis.n_reduced(), basis.variant.name()))
+                        Some(compare(model, &full, &rom, None, basis.n_reduced(), basis.variant.name()).with_trust(estimate.as_ref(), trust))
                     } else {
                         None
                     };
+                    let extrapolated = trust.is_some_and(|t| is_extrapolated(t.range, x));
                     bar.inc(1);
-                    done.push((i, SweepPoint { rom, validation }));
+                    done.push((i, SweepPoint { rom, validation, estimate, extrapolated }));
                 }
             }
             Ok(done)
@@ -142,6 +158,9 @@ pub fn write_sweep(path: &Path, s: &Sweep, basis: &Basis, basis_path: &Path) -> 
             .with_data(&Array1::from_iter(s.points.iter().map(|p| p.rom.result.stats.factorizations as u64)))
             .create("factorizations")
             .map_err(e)?;
+        f.new_dataset_builder().with_data(&col(&|p| p.estimate.map_or(f64::NAN, |e| e.error_estimate))).create("error_estimate").map_err(e)?;
+        f.new_dataset_builder().with_data(&col(&|p| p.estimate.map_or(f64::NAN, |e| e.seconds))).create("estimate_seconds").map_err(e)?;
+        f.new_dataset_builder().with_data(&Array1::from_iter(s.points.iter().map(|p| p.extrapolated as u8))).create("extrapolated").map_err(e)?;
         if s.points.iter().all(|p| p.validation.is_some()) {
             let v = |g: &dyn Fn(&Validation) -> f64| col(&|p: &SweepPoint| g(p.validation.as_ref().expect("checked")));
             f.new_dataset_builder().with_data(&v(&|x| x.rel_error)).create("rel_error").map_err(e)?;
@@ -164,7 +183,7 @@ pub fn write_sweep(path: &Path, s: &Sweep, basis: &Basis, basis_path: &Path) -> 
 pub fn table(s: &Sweep) -> String {
     let mut out = String::new();
     let validated = s.points.iter().all(|p| p.validation.is_some());
-    out.push_str("load_scale  rom_ms  newton");
+    out.push_str("load_scale  rom_ms  newton  error_estimate  est_ms  extrap");
     if validated {
         out.push_str("   rel_error  probe_err_m  full_ms  speedup");
     }
@@ -172,6 +191,11 @@ pub fn table(s: &Sweep) -> String {
     for p in &s.points {
         let r = &p.rom.result;
         out.push_str(&format!("{:>10.4}  {:>6.2}  {:>6}", r.settings.load_scale, 1e3 * r.wall_seconds, r.stats.newton_iterations));
+        match &p.estimate {
+            Some(e) => out.push_str(&format!("  {:>14.3e}  {:>6.2}", e.error_estimate, 1e3 * e.seconds)),
+            None => out.push_str(&format!("  {:>14}  {:>6}", "-", "-")),
+        }
+        out.push_str(if p.extrapolated { "     yes" } else { "      no" });
         if let Some(v) = &p.validation {
             out.push_str(&format!("  {:>10.3e}  {:>11.3e}  {:>7.2}  {:>7.2}", v.rel_error, v.max_probe_error, 1e3 * v.full_seconds, v.speedup));
         }

@@ -4,9 +4,17 @@
 //!     rel_error = ‖X_rom − X_full‖_F / ‖X_full‖_F      (all coordinates, all instants)
 //!     max_probe_error = max_{probe, k} |r_rom(t_k) − r_full(t_k)|
 //!     max_constraint_violation = max_k ‖B x_rom(t_k) − b‖∞
+//!     error_estimate = c ‖X_r − X_{r+k}‖_F / ‖X_{r+k}‖_F   (no full run: super::estimate)
+//!     effectivity = error_estimate / rel_error               (≥ 1: the estimate bounds the error)
+//!     sensitivity = ‖X_full(1.001 λ) − X_full(λ)‖_F / ‖X_full(λ)‖_F
+//!     rel_error_by_time[i] = rel_error over t ≤ the end of fifth i + 1 of the run
 //! ```
+//!
+//! `sensitivity` puts the error in context: how much the full model's own answer moves for
+//! a 0.1 % change of the load.
 
-use super::online::{run_reduced, ReducedRun};
+use super::estimate::{is_extrapolated, rel_error_by_time, EstimatingRunner, TrustInfo};
+use super::online::{Output, ReducedRun};
 use crate::error::Result;
 use crate::model::Model;
 use crate::reduction::Basis;
@@ -37,6 +45,22 @@ pub struct Validation {
     pub full_newton_iterations: usize,
     pub rom_newton_iterations: usize,
     pub rom_step_cuts: usize,
+    /// the estimate of `rel_error` without a full run (null: the basis has no estimator)
+    pub error_estimate: Option<f64>,
+    /// `error_estimate / rel_error`
+    pub effectivity: Option<f64>,
+    /// whether the estimate's factor was calibrated on held-out full runs
+    pub estimate_calibrated: Option<bool>,
+    /// the estimator's extra cost: its enriched reduced run and norms, s
+    pub estimate_seconds: Option<f64>,
+    /// the load scale lies outside the basis's training range
+    pub extrapolated: bool,
+    /// `[min, max]` training load scale (null when unknown)
+    pub training_range: Option<[f64; 2]>,
+    /// relative difference of full runs at λ and 1.001 λ (null when not measured)
+    pub sensitivity: Option<f64>,
+    /// rel_error up to the end of each fifth of the run (the last is rel_error)
+    pub rel_error_by_time: Vec<f64>,
 }
 
 /// Compares a reduced run with a full run of the same model, load scale and Δt.
@@ -78,16 +102,51 @@ pub fn compare(model: &Model, full: &SimulationResult, rom: &ReducedRun, dense_s
         full_newton_iterations: full.stats.newton_iterations,
         rom_newton_iterations: r.stats.newton_iterations,
         rom_step_cuts: r.stats.step_cuts,
+        error_estimate: None,
+        effectivity: None,
+        estimate_calibrated: None,
+        estimate_seconds: None,
+        extrapolated: false,
+        training_range: None,
+        sensitivity: None,
+        rel_error_by_time: rel_error_by_time(&r.q, &full.q),
+    }
+}
+
+impl Validation {
+    /// Adds the estimate and the extrapolation flag of a run.
+    pub fn with_trust(mut self, estimate: Option<&super::estimate::Estimate>, trust: Option<&TrustInfo>) -> Self {
+        if let Some(e) = estimate {
+            self.error_estimate = Some(e.error_estimate);
+            self.effectivity = Some(e.error_estimate / self.rel_error);
+            self.estimate_calibrated = Some(e.calibrated);
+            self.estimate_seconds = Some(e.seconds);
+        }
+        if let Some(t) = trust {
+            self.extrapolated = is_extrapolated(t.range, self.load_scale);
+            self.training_range = Some([t.range.0, t.range.1]);
+        }
+        self
     }
 }
 
 /// Runs full (banded, and dense LU when `with_dense`) and reduced at `load_scale`.
 pub fn validate(model: &Model, basis: &Basis, load_scale: f64, with_dense: bool) -> Result<(Validation, SimulationResult, ReducedRun)> {
+    validate_with(model, basis, None, load_scale, with_dense)
+}
+
+/// [`validate`] with the basis's estimator, training range and tolerance (`trust`), and the
+/// full model's sensitivity (one more full run at 1.001 λ).
+pub fn validate_with(model: &Model, basis: &Basis, trust: Option<&TrustInfo>, load_scale: f64, with_dense: bool) -> Result<(Validation, SimulationResult, ReducedRun)> {
     let o = Overrides { load_scale: Some(load_scale), ..Default::default() };
     let full = simulate(model, &o)?;
-    let dense = if with_dense { Some(simulate(model, &Overrides { solver: LinearSolverKind::Dense, ..o })?.wall_seconds) } else { None };
-    let rom = run_reduced(model, basis, load_scale)?;
-    let v = compare(model, &full, &rom, dense, basis.n_reduced(), basis.variant.name());
+    let dense = if with_dense { Some(simulate(model, &Overrides { solver: LinearSolverKind::Dense, ..o.clone() })?.wall_seconds) } else { None };
+    let nearby = simulate(model, &Overrides { load_scale: Some(1.001 * load_scale), ..o })?;
+    let mut runner = EstimatingRunner::new(model, basis, trust.and_then(|t| t.estimator.as_ref()))?;
+    let (rom, estimate) = runner.run(load_scale, Output::Full)?;
+    let mut v = compare(model, &full, &rom, dense, basis.n_reduced(), basis.variant.name()).with_trust(estimate.as_ref(), trust);
+    let norm = full.q.mapv(|x| x * x).sum().sqrt();
+    v.sensitivity = Some((&nearby.q - &full.q).mapv(|x| x * x).sum().sqrt() / norm);
     Ok((v, full, rom))
 }
 
@@ -99,7 +158,7 @@ impl Validation {
             _ => String::new(),
         };
         format!(
-            "load scale {}: {} reduction, {} of {} coordinates\n  rel_error {:.3e}, max probe error {:.3e} m ({} at t = {:.4} s), max constraint violation {:.3e}\n  full {:.4} s, reduced {:.4} s, speedup {:.2}×{}",
+            "load scale {}: {} reduction, {} of {} coordinates\n  rel_error {:.3e}, max probe error {:.3e} m ({} at t = {:.4} s), max constraint violation {:.3e}\n  full {:.4} s, reduced {:.4} s, speedup {:.2}×{}{}",
             self.load_scale,
             self.variant,
             self.n_modes,
@@ -112,7 +171,32 @@ impl Validation {
             self.full_seconds,
             self.rom_seconds,
             self.speedup,
-            dense
+            dense,
+            self.trust_lines()
         )
+    }
+
+    /// The estimate, extrapolation, sensitivity and error-by-time lines of `describe`.
+    fn trust_lines(&self) -> String {
+        let mut s = String::new();
+        match (self.error_estimate, self.effectivity) {
+            (Some(e), Some(f)) => s.push_str(&format!(
+                "\n  error_estimate {:.3e} ({}), effectivity {:.2}{}",
+                e,
+                if self.estimate_calibrated == Some(true) { "calibrated" } else { "uncalibrated" },
+                f,
+                self.estimate_seconds.map_or(String::new(), |t| format!(", estimator {:.4} s ({:.0} % of the reduced run)", t, 100.0 * t / self.rom_seconds))
+            )),
+            _ => s.push_str("\n  error_estimate: none (the basis file has no /estimator; train again)"),
+        }
+        if let Some([a, b]) = self.training_range {
+            s.push_str(&format!("\n  training range [{a}, {b}]{}", if self.extrapolated { ": EXTRAPOLATED" } else { "" }));
+        }
+        if let Some(x) = self.sensitivity {
+            s.push_str(&format!("\n  sensitivity {x:.3e} (full runs at λ and 1.001 λ)"));
+        }
+        let by: Vec<String> = self.rel_error_by_time.iter().map(|e| format!("{e:.2e}")).collect();
+        s.push_str(&format!("\n  rel_error up to each fifth of the run: {}", by.join(", ")));
+        s
     }
 }

@@ -1,0 +1,111 @@
+//! Measures the error estimator (docs/error-estimate.md): trains a pipeline's basis at the
+//! given training loads (in memory, nothing written but the basis under /tmp), then at
+//! every test load runs the full model and the reduced model with its estimate, and prints
+//! one row per load and a summary: coverage (estimate ≥ rel_error), median and max
+//! effectivity (estimate / rel_error) inside and outside the training range, and the
+//! estimator's cost relative to the reduced run (time loops only, median).
+//!
+//! ```text
+//! cargo run --release --example estimate_table -- PIPELINE TRAIN_LOADS TEST_LOADS
+//! cargo run --release --example estimate_table -- pipelines/pendulum.toml 0.5,1.0,1.5 0.4:1.6:15
+//! ```
+
+use flexrom::pipeline::config::parse_range;
+use flexrom::pipeline::estimate::{is_extrapolated, EstimatingRunner};
+use flexrom::pipeline::online::Output;
+use flexrom::pipeline::train::train;
+use flexrom::pipeline::Pipeline;
+use flexrom::simulate::{simulate, Overrides};
+
+fn list(s: &str) -> Vec<f64> {
+    if s.contains(':') {
+        parse_range(s).expect("A:B:N")
+    } else {
+        s.split(',').map(|x| x.trim().parse().expect("number")).collect()
+    }
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    if v.is_empty() {
+        f64::NAN
+    } else {
+        v[v.len() / 2]
+    }
+}
+
+fn main() -> flexrom::Result<()> {
+    flexrom::single_threaded_blas();
+    let args: Vec<String> = std::env::args().collect();
+    if args.len() != 4 {
+        eprintln!("usage: estimate_table PIPELINE TRAIN_LOADS(a,b,c) TEST_LOADS(a,b,.. or A:B:N)");
+        std::process::exit(2);
+    }
+    let mut p = Pipeline::load(&args[1])?;
+    p.file.train.load_scales = list(&args[2]);
+    let tests = list(&args[3]);
+    let (data, mut summary) = train(&p)?;
+    // experiments (not the default): ESTIMATE_HYPER=none runs the enriched model over every
+    // element; ESTIMATE_HYPER=<τ> retrains its ECSW set at τ
+    if let Ok(h) = std::env::var("ESTIMATE_HYPER") {
+        let est = summary.estimator.as_mut().expect("estimator");
+        if h == "none" {
+            est.enriched.hyper = None;
+        } else {
+            let tol: f64 = h.parse().expect("ESTIMATE_HYPER: none or a tolerance");
+            let sys = p.model.system(Default::default());
+            est.enriched.hyper = Some(flexrom::reduction::ecsw(&sys, &est.enriched, data.x.view(), tol).expect("ECSW"));
+        }
+        println!("experiment: ESTIMATE_HYPER={h}");
+    }
+    let basis = &summary.trained.basis;
+    let est = summary.estimator.as_ref().expect("train builds an estimator");
+    let lo = p.file.train.load_scales.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = p.file.train.load_scales.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    println!(
+        "{}: training loads {:?}, {} modes (+{} in the estimator's basis, {} elements sampled / {} in the estimator's)",
+        p.path.display(),
+        p.file.train.load_scales,
+        basis.n_reduced(),
+        est.enriched.n_reduced() - basis.n_reduced(),
+        basis.hyper.as_ref().map_or("all".into(), |h| h.elements.len().to_string()),
+        est.enriched.hyper.as_ref().map_or("all".into(), |h| h.elements.len().to_string()),
+    );
+    println!("| load scale | inside | rel_error | error_estimate | effectivity | reduced (s) | estimator (s) | cost |");
+    println!("|---|---|---|---|---|---|---|---|");
+    let mut runner = EstimatingRunner::new(&p.model, basis, Some(est))?;
+    let mut rows = Vec::new();
+    for &x in &tests {
+        let full = simulate(&p.model, &Overrides { load_scale: Some(x), ..Default::default() })?;
+        let (rom, e) = runner.run(x, Output::Full)?;
+        let e = e.expect("estimator");
+        let err = (&rom.result.q - &full.q).mapv(|v| v * v).sum().sqrt() / full.q.mapv(|v| v * v).sum().sqrt();
+        let inside = !is_extrapolated((lo, hi), x);
+        let cost = e.seconds / rom.result.wall_seconds;
+        println!(
+            "| {x:.4} | {} | {err:.3e} | {:.3e} | {:.2} | {:.4} | {:.4} | {:.0} % |",
+            if inside { "yes" } else { "no" },
+            e.error_estimate,
+            e.error_estimate / err,
+            rom.result.wall_seconds,
+            e.seconds,
+            100.0 * cost
+        );
+        rows.push((inside, err, e.error_estimate, cost));
+    }
+    println!("\n| loads | n | coverage | median effectivity | max effectivity | min effectivity |\n|---|---|---|---|---|---|");
+    for (name, pick) in [("inside", Some(true)), ("outside", Some(false)), ("all", None)] {
+        let sel: Vec<_> = rows.iter().filter(|r| pick.is_none_or(|i| r.0 == i)).collect();
+        if sel.is_empty() {
+            continue;
+        }
+        let covered = sel.iter().filter(|r| r.2 >= r.1).count();
+        let mut eff: Vec<f64> = sel.iter().map(|r| r.2 / r.1).collect();
+        let max = eff.iter().copied().fold(0.0, f64::max);
+        let min = eff.iter().copied().fold(f64::INFINITY, f64::min);
+        println!("| {name} | {} | {}/{} | {:.2} | {:.2} | {:.2} |", sel.len(), covered, sel.len(), median(&mut eff), max, min);
+    }
+    let mut costs: Vec<f64> = rows.iter().map(|r| r.3).collect();
+    println!("\nestimator cost / reduced run: median {:.0} %", 100.0 * median(&mut costs));
+    Ok(())
+}

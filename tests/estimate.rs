@@ -1,0 +1,162 @@
+//! The error estimate, the extrapolation flag and `--strict` (issue 15 items 2–4), through
+//! the command line as a user meets them, on the pendulum of data/models/pendulum.toml
+//! shortened to t_end = 0.5 s for speed (100 steps), with the shipped pipeline's reduction
+//! (14 POD modes, ECSW at τ = 1e-2) trained at load scales 0.8 and 1.2.
+//!
+//! - `estimate_bounds_the_error_at_held_out_loads`: at loads the basis never saw (0.9, 1.1
+//!   inside the training range, 1.5 outside it) `validate --json` reports an
+//!   `error_estimate` ≥ the measured `rel_error` (the issue's coverage requirement), its
+//!   `effectivity` = estimate / rel_error (recomputed here from the two numbers) at most 30
+//!   (the issue's overestimate bound), `extrapolated` false, false, true, a positive
+//!   `sensitivity`, and five `rel_error_by_time` values, non-decreasing in the sense of
+//!   prefixes being covered and the last one equal to `rel_error` (both are ‖·‖_F over the
+//!   whole run).
+//! - `extrapolation_warns_once_and_is_flagged`: `online` outside the range prints exactly
+//!   one warning line naming the training range and writes `extrapolated` = 1 and a finite
+//!   `error_estimate` attribute; inside the range no warning and `extrapolated` = 0; a sweep
+//!   over 0.9, 1.15, 1.4 writes `/extrapolated` = [0, 0, 1] and finite `/error_estimate`.
+//! - `strict_exits_4_after_writing_its_output`: with `[online] tolerance = 1e-12` (below any
+//!   estimate) `online --strict` exits with code 4 and the result file exists; without
+//!   `--strict` it exits 0 and warns; with tolerance 0.5 (above any estimate: the reduced
+//!   pendulum is ~1e-3 off) `--strict` exits 0. `validate --strict` and `sweep --strict`
+//!   exit 4 too.
+//! - `basis_file_stores_an_uncalibrated_estimator`: `/estimator` holds V⁺ with 10 more
+//!   modes than the basis (24 × 204), `factor` 1.5 and `calibrated` 0 (load_scales training
+//!   has no held-out runs).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn flexrom() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_flexrom"))
+}
+
+fn repo(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
+}
+
+/// A folder with the shortened pendulum, a pipeline (online tolerance `tol`, or none) and
+/// its trained basis.
+fn setup(tol: Option<f64>) -> (tempfile::TempDir, PathBuf, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let model = std::fs::read_to_string(repo("data/models/pendulum.toml")).unwrap().replace("t_end = 1.1", "t_end = 0.5");
+    assert!(model.contains("t_end = 0.5"));
+    std::fs::write(dir.path().join("pendulum.toml"), model).unwrap();
+    let tolerance = tol.map_or(String::new(), |t| format!("tolerance = {t:e}\n"));
+    let pipeline = format!(
+        "model = \"pendulum.toml\"\nbasis = \"basis.h5\"\nreport = \"report\"\n[train]\nload_scales = [0.8, 1.2]\n[reduction]\nvariant = \"galerkin\"\nmodes = {{ count = 14 }}\nhyper = {{ tolerance = 1e-2 }}\n[online]\nload_scales = \"0.9:1.4:3\"\n{tolerance}"
+    );
+    let p = dir.path().join("pipeline.toml");
+    std::fs::write(&p, pipeline).unwrap();
+    let o = flexrom().args(["train", p.to_str().unwrap()]).output().unwrap();
+    assert!(o.status.success(), "train: {}", String::from_utf8_lossy(&o.stderr));
+    let basis = dir.path().join("basis.h5");
+    (dir, p, basis)
+}
+
+fn run(args: &[&str]) -> Output {
+    flexrom().args(args).output().unwrap()
+}
+
+fn warnings(o: &Output) -> Vec<String> {
+    String::from_utf8_lossy(&o.stderr).lines().filter(|l| l.starts_with("warning:")).map(str::to_string).collect()
+}
+
+#[test]
+fn estimate_bounds_the_error_at_held_out_loads() {
+    let (_dir, p, _) = setup(None);
+    for (x, outside) in [(0.9, false), (1.1, false), (1.5, true)] {
+        let o = run(&["validate", p.to_str().unwrap(), "--load-scale", &x.to_string(), "--json", "--no-dense"]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        let err = v["rel_error"].as_f64().unwrap();
+        let est = v["error_estimate"].as_f64().expect("error_estimate reported");
+        let eff = v["effectivity"].as_f64().expect("effectivity reported");
+        assert!(err > 0.0 && err.is_finite());
+        assert!(est >= err, "λ = {x}: estimate {est:e} below the true error {err:e}");
+        assert!((eff - est / err).abs() <= 1e-12 * eff, "λ = {x}: effectivity {eff} ≠ {est:e}/{err:e}");
+        assert!(eff <= 30.0, "λ = {x}: effectivity {eff} above 30");
+        assert_eq!(v["extrapolated"].as_bool(), Some(outside), "λ = {x}");
+        assert_eq!(v["estimate_calibrated"].as_bool(), Some(false));
+        let s = v["sensitivity"].as_f64().expect("sensitivity reported");
+        assert!(s > 0.0 && s.is_finite(), "λ = {x}: sensitivity {s}");
+        let by: Vec<f64> = v["rel_error_by_time"].as_array().unwrap().iter().map(|e| e.as_f64().unwrap()).collect();
+        assert_eq!(by.len(), 5);
+        assert!((by[4] - err).abs() <= 1e-12 * err, "{by:?} vs {err}");
+        // the text output shows the same figures
+        let t = run(&["validate", p.to_str().unwrap(), "--load-scale", &x.to_string(), "--no-dense"]);
+        let text = String::from_utf8_lossy(&t.stdout);
+        for needle in ["error_estimate", "effectivity", "sensitivity", "rel_error up to each fifth"] {
+            assert!(text.contains(needle), "λ = {x}: `{needle}` missing from\n{text}");
+        }
+    }
+}
+
+#[test]
+fn extrapolation_warns_once_and_is_flagged() {
+    let (dir, p, _) = setup(None);
+    let out = dir.path().join("r.h5");
+    let o = run(&["online", p.to_str().unwrap(), "--load-scale", "1.5", "-o", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let w = warnings(&o);
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(w[0].contains("training range [0.8, 1.2]") && w[0].contains("extrapolated"), "{}", w[0]);
+    let f = hdf5::File::open(&out).unwrap();
+    assert_eq!(f.attr("extrapolated").unwrap().read_scalar::<u64>().unwrap(), 1);
+    let e = f.attr("error_estimate").unwrap().read_scalar::<f64>().unwrap();
+    assert!(e.is_finite() && e > 0.0, "{e}");
+    let o = run(&["online", p.to_str().unwrap(), "--load-scale", "1.0", "-o", out.to_str().unwrap()]);
+    assert!(o.status.success());
+    assert!(warnings(&o).is_empty(), "{:?}", warnings(&o));
+    let f = hdf5::File::open(&out).unwrap();
+    assert_eq!(f.attr("extrapolated").unwrap().read_scalar::<u64>().unwrap(), 0);
+
+    let sw = dir.path().join("s.h5");
+    let o = run(&["sweep", p.to_str().unwrap(), "--load-scales", "0.9:1.4:3", "-o", sw.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(warnings(&o).len(), 1, "{:?}", warnings(&o));
+    let f = hdf5::File::open(&sw).unwrap();
+    assert_eq!(f.dataset("extrapolated").unwrap().read_1d::<u8>().unwrap().to_vec(), vec![0, 0, 1]);
+    let e = f.dataset("error_estimate").unwrap().read_1d::<f64>().unwrap();
+    assert!(e.iter().all(|v| v.is_finite() && *v > 0.0), "{e}");
+    assert!(String::from_utf8_lossy(&o.stdout).contains("error_estimate"));
+}
+
+#[test]
+fn strict_exits_4_after_writing_its_output() {
+    let (dir, p, _) = setup(Some(1e-12));
+    let out = dir.path().join("r.h5");
+    let o = run(&["online", p.to_str().unwrap(), "--load-scale", "1.0", "-o", out.to_str().unwrap(), "--strict"]);
+    assert_eq!(o.status.code(), Some(4), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.is_file(), "the result is written before the strict exit");
+    assert!(String::from_utf8_lossy(&o.stderr).contains("above the tolerance"));
+    std::fs::remove_file(&out).unwrap();
+    let o = run(&["online", p.to_str().unwrap(), "--load-scale", "1.0", "-o", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0));
+    assert!(warnings(&o).iter().any(|w| w.contains("above the tolerance")), "{:?}", warnings(&o));
+    assert!(out.is_file());
+    let o = run(&["validate", p.to_str().unwrap(), "--load-scale", "1.0", "--no-dense", "--json", "--strict"]);
+    assert_eq!(o.status.code(), Some(4), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(serde_json::from_slice::<serde_json::Value>(&o.stdout).is_ok(), "validate printed its JSON before exiting");
+    let sw = dir.path().join("s.h5");
+    let o = run(&["sweep", p.to_str().unwrap(), "-o", sw.to_str().unwrap(), "--strict"]);
+    assert_eq!(o.status.code(), Some(4), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(sw.is_file());
+
+    let (dir, p, _) = setup(Some(0.5));
+    let out = dir.path().join("r.h5");
+    let o = run(&["online", p.to_str().unwrap(), "--load-scale", "1.0", "-o", out.to_str().unwrap(), "--strict"]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+#[test]
+fn basis_file_stores_an_uncalibrated_estimator() {
+    let (_dir, _, basis) = setup(None);
+    let f = hdf5::File::open(&basis).unwrap();
+    let g = f.group("estimator").unwrap();
+    assert_eq!(g.dataset("modes").unwrap().shape(), vec![204, 24]);
+    assert_eq!(g.attr("factor").unwrap().read_scalar::<f64>().unwrap(), 1.5);
+    assert_eq!(g.attr("calibrated").unwrap().read_scalar::<u64>().unwrap(), 0);
+    assert!(g.group("hyper").is_ok(), "the estimator of a hyper-reduced basis has its own ECSW set");
+    assert_eq!(g.dataset("calibration/rel_error").unwrap().shape(), vec![0]);
+}
