@@ -115,7 +115,9 @@ impl GreedySpec {
     pub fn candidate_loads(&self) -> Vec<f64> {
         let (a, b) = self.range();
         let n = self.candidates;
-        (0..n).map(|i| if i + 1 == n { b } else { a + (b - a) * i as f64 / (n - 1) as f64 }).collect()
+        // rounded to 12 significant digits: 0.7 + 0.5 · 19/20 prints as 1.175, not 1.1749999999999998
+        let round = |x: f64| if x == 0.0 { x } else { let k = 10f64.powi(11 - x.abs().log10().floor() as i32); (x * k).round() / k };
+        (0..n).map(|i| if i + 1 == n { b } else { round(a + (b - a) * i as f64 / (n - 1) as f64) }).collect()
     }
 }
 
