@@ -23,6 +23,7 @@
 //! - `basis_file_stores_an_uncalibrated_estimator`: `/estimator` holds V⁺ with 10 more
 //!   modes than the basis (24 × 204), `factor` 1.5 and `calibrated` 0 (load_scales training
 //!   has no held-out runs).
+//! - `a_bad_online_tolerance_is_refused`: `[online] tolerance = -1` is a clear input error.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -159,4 +160,23 @@ fn basis_file_stores_an_uncalibrated_estimator() {
     assert_eq!(g.attr("calibrated").unwrap().read_scalar::<u64>().unwrap(), 0);
     assert!(g.group("hyper").is_ok(), "the estimator of a hyper-reduced basis has its own ECSW set");
     assert_eq!(g.dataset("calibration/rel_error").unwrap().shape(), vec![0]);
+}
+
+/// `[online] tolerance` must be positive: a pipeline with -1 is refused, naming the file and
+/// the field, with a non-zero exit (before any full run).
+#[test]
+fn a_bad_online_tolerance_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("bad.toml");
+    let model = repo("data/models/pendulum.toml");
+    std::fs::write(
+        &p,
+        format!("model = \"{}\"\n[train]\nload_scales = [1.0]\n[reduction]\nmodes = {{ count = 4 }}\n[online]\nload_scales = [1.0]\ntolerance = -1.0\n", model.display()),
+    )
+    .unwrap();
+    let o = run(&["train", p.to_str().unwrap(), "--basis", dir.path().join("b.h5").to_str().unwrap()]);
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("bad.toml") && err.contains("online.tolerance") && err.contains("positive"), "{err}");
+    assert!(!dir.path().join("b.h5").exists());
 }

@@ -161,20 +161,19 @@ pub fn build_estimator(
     Ok(Estimator { enriched: richer.basis, block_modes: richer.block_modes, extra_modes: extra, calibration: Calibration::default() })
 }
 
-/// `η_raw = ‖X_r − X⁺‖_F / ‖X⁺‖_F` of two finished runs of the same load: from the reduced
-/// coordinates when both bases are orthonormal (module documentation), else from the
-/// full coordinates (whole-system; needs `Output::Full` runs).
+/// `η_raw = ‖X_r − X⁺‖_F / ‖X⁺‖_F` of two finished runs of the same load, from their
+/// reduced coordinates: by the module documentation's identities when both bases are
+/// orthonormal, by reconstructing `x_ref + V q` otherwise (whole-system).
 pub fn raw_estimate(basis: &Basis, est: &Estimator, rom: &ReducedRun, enriched: &ReducedRun) -> f64 {
     let (q, qp) = (&rom.reduced_q, &enriched.reduced_q);
     if q.ncols() != qp.ncols() {
         return f64::INFINITY;
     }
     if basis.variant == Variant::WholeSystem {
-        let (a, b) = (&rom.result.q, &enriched.result.q);
-        if a.dim() != b.dim() || a.is_empty() {
-            return f64::NAN;
-        }
-        return (a - b).mapv(|v| v * v).sum().sqrt() / b.mapv(|v| v * v).sum().sqrt();
+        // V is not orthonormal: reconstruct x_ref + V q of both
+        let full = |b: &Basis, z: &Array2<f64>| b.modes.dot(z) + &b.reference.view().insert_axis(Axis(1));
+        let (a, b) = (full(basis, q), full(&est.enriched, qp));
+        return (&a - &b).mapv(|v| v * v).sum().sqrt() / b.mapv(|v| v * v).sum().sqrt();
     }
     raw_estimate_reduced(basis, &est.enriched, q, qp)
 }
@@ -224,16 +223,9 @@ impl<'a> EstimatingRunner<'a> {
         let run = self.rom.run(load_scale, output, previous)?;
         let Some((est, runner)) = &mut self.est else { return Ok((run, None)) };
         let start = std::time::Instant::now();
-        // the norms need full coordinates only for whole-system
-        let out = if self.basis.variant == Variant::WholeSystem { Output::Full } else { Output::ReducedAndProbes };
-        let raw = match runner.run(load_scale, out, &[]) {
-            Ok(richer) => {
-                if self.basis.variant == Variant::WholeSystem && output != Output::Full {
-                    f64::NAN
-                } else {
-                    raw_estimate(self.basis, est, &run, &richer)
-                }
-            }
+        // the norms come from the reduced coordinates: nothing of full size is written
+        let raw = match runner.run(load_scale, Output::ReducedAndProbes, &[]) {
+            Ok(richer) => raw_estimate(self.basis, est, &run, &richer),
             Err(_) => f64::INFINITY,
         };
         let c = &est.calibration;
@@ -274,6 +266,8 @@ pub struct TrustInfo {
     pub range: (f64, f64),
     /// `[online] tolerance`, else greedy training's tolerance, else none
     pub tolerance: Option<f64>,
+    /// the user asked for no estimate (`--no-estimate`): no warnings about its absence
+    pub skipped: bool,
 }
 
 /// Reads the estimator (checked against the model), the training range and tolerance of
@@ -295,7 +289,7 @@ pub fn load_trust(p: &super::Pipeline, path: &std::path::Path, stored: &crate::i
         Some(t) => Some(t),
         None => read_training_tolerance(path)?,
     };
-    Ok(TrustInfo { estimator, range: read_training_range(path)?, tolerance })
+    Ok(TrustInfo { estimator, range: read_training_range(path)?, tolerance, skipped: false })
 }
 
 /// One line for stderr: the estimate, whether calibrated, and its cost against the reduced run.
@@ -327,6 +321,15 @@ pub fn write_run_attributes(f: &hdf5::File, e: Option<&Estimate>, trust: &TrustI
     Ok(())
 }
 
+/// At most five entries of a list for a one-line message, then "…".
+fn few(v: &[String]) -> String {
+    if v.len() <= 5 {
+        v.join(", ")
+    } else {
+        format!("{}, …, {}", v[..4].join(", "), v[v.len() - 1])
+    }
+}
+
 /// The exit code of `--strict` when an estimate exceeds the tolerance.
 pub const STRICT_EXIT_CODE: u8 = 4;
 
@@ -337,15 +340,15 @@ pub const STRICT_EXIT_CODE: u8 = 4;
 /// written.
 pub fn check_runs(trust: &TrustInfo, runs: &[(f64, Option<f64>)], strict: bool) -> Result<()> {
     let (a, b) = trust.range;
-    let out: Vec<String> = runs.iter().filter(|r| is_extrapolated(trust.range, r.0)).map(|r| format!("{}", r.0)).collect();
+    let out: Vec<String> = runs.iter().filter(|r| is_extrapolated(trust.range, r.0)).map(|r| format!("{:.4}", r.0).trim_end_matches('0').trim_end_matches('.').to_string()).collect();
     if !out.is_empty() {
-        let what = if runs.len() == 1 { format!("load scale {}", out[0]) } else { format!("{} of {} load scales ({})", out.len(), runs.len(), out.join(", ")) };
+        let what = if runs.len() == 1 { format!("load scale {}", out[0]) } else { format!("{} of {} load scales ({})", out.len(), runs.len(), few(&out)) };
         eprintln!("warning: {what} outside the basis's training range [{a}, {b}]: extrapolated, the reduced model was never trained there");
     }
-    if trust.estimator.is_none() {
+    if trust.estimator.is_none() && runs.iter().all(|r| r.1.is_none()) && !trust.skipped {
         eprintln!("warning: the basis file has no error estimator (/estimator; written by `flexrom train` since this version): no error_estimate; train again");
     }
-    let Some(tol) = trust.tolerance else {
+    let Some(tol) = trust.tolerance.filter(|_| !trust.skipped) else {
         if strict {
             eprintln!("warning: --strict: no tolerance to hold the estimates to (set [online] tolerance in the pipeline)");
         }
@@ -355,14 +358,14 @@ pub fn check_runs(trust: &TrustInfo, runs: &[(f64, Option<f64>)], strict: bool) 
         .iter()
         .filter(|r| r.1.is_none_or(|e| !(e <= tol)))
         .map(|r| match r.1 {
-            Some(e) => format!("{} ({e:.2e})", r.0),
-            None => format!("{} (no estimate)", r.0),
+            Some(e) => format!("{:.4} ({e:.2e})", r.0),
+            None => format!("{:.4} (no estimate)", r.0),
         })
         .collect();
     if over.is_empty() {
         return Ok(());
     }
-    let what = if runs.len() == 1 { format!("load scale {}", over[0]) } else { format!("{} of {} load scales: {}", over.len(), runs.len(), over.join(", ")) };
+    let what = if runs.len() == 1 { format!("load scale {}", over[0]) } else { format!("{} of {} load scales: {}", over.len(), runs.len(), few(&over)) };
     let msg = format!("error estimate above the tolerance {tol:e} at {what}");
     if strict {
         return Err(crate::Error::Strict(format!("--strict: {msg}")));
