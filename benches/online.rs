@@ -35,8 +35,12 @@ fn main() {
         let p = Pipeline::load(format!("{root}/pipelines/{name}.toml")).expect("shipped pipeline");
         let (_, summary) = train(&p).expect("training");
         let basis = summary.trained.basis;
-        // the thesis load: the (first) training load scale of each shipped pipeline
-        let x = p.file.train.load_scales[0];
+        // the thesis load: the (first) training load scale of each shipped pipeline; for a
+        // greedy pipeline the middle of its range
+        let x = match &p.file.train.load_scales {
+            Some(s) => s[0],
+            None => p.training_scales()[1],
+        };
         let (mut tf, mut tr) = (Vec::new(), Vec::new());
         let mut last = None;
         for _ in 0..runs {

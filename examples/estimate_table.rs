@@ -7,7 +7,7 @@
 //!
 //! ```text
 //! cargo run --release --example estimate_table -- PIPELINE TRAIN_LOADS TEST_LOADS
-//! cargo run --release --example estimate_table -- pipelines/pendulum.toml 0.5,1.0,1.5 0.4:1.6:15
+//! cargo run --release --example estimate_table -- pipelines/thesis/pendulum_hyper.toml 0.5,1.0,1.5 0.4:1.6:15
 //! ```
 
 use flexrom::pipeline::config::parse_range;
@@ -42,7 +42,11 @@ fn main() -> flexrom::Result<()> {
         std::process::exit(2);
     }
     let mut p = Pipeline::load(&args[1])?;
-    p.file.train.load_scales = list(&args[2]);
+    // the pipeline's reduction with these training loads (a greedy pipeline needs its
+    // [reduction] modes given: e.g. pipelines/thesis/pendulum_hyper.toml)
+    let train_loads = list(&args[2]);
+    p.file.train.load_scales = Some(train_loads.clone());
+    p.file.train.greedy = None;
     let tests = list(&args[3]);
     let (data, mut summary) = train(&p)?;
     // experiments (not the default): ESTIMATE_HYPER=none runs the enriched model over every
@@ -60,12 +64,12 @@ fn main() -> flexrom::Result<()> {
     }
     let basis = &summary.trained.basis;
     let est = summary.estimator.as_ref().expect("train builds an estimator");
-    let lo = p.file.train.load_scales.iter().copied().fold(f64::INFINITY, f64::min);
-    let hi = p.file.train.load_scales.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let lo = train_loads.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = train_loads.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     println!(
         "{}: training loads {:?}, {} modes (+{} in the estimator's basis, {} elements sampled / {} in the estimator's)",
         p.path.display(),
-        p.file.train.load_scales,
+        train_loads,
         basis.n_reduced(),
         est.enriched.n_reduced() - basis.n_reduced(),
         basis.hyper.as_ref().map_or("all".into(), |h| h.elements.len().to_string()),

@@ -247,7 +247,7 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                 "{}: {} snapshots from {} full run(s) ({:.3} s); {} basis, {} snapshots, {} POD modes{} (captured energy 1 − {:.2e}) -> {}",
                 p.path.display(),
                 s.n_snapshots,
-                p.file.train.load_scales.len(),
+                s.n_runs,
                 s.full_seconds,
                 b.variant.name(),
                 b.snapshots.name(),

@@ -23,6 +23,14 @@
 //!                                         increasing (elements numbered body by body)
 //! /hyper/weights             (|E|)        their ECSW weights, positive
 //!   attributes on /hyper: tolerance (τ), training_residual (‖Cw − b‖/‖b‖), n_training
+//! /training/...                          greedy training only (src/pipeline/greedy.rs):
+//!   range (2) [A, B]; tolerance (scalar) T; load_scales (n_runs) the loads whose
+//!   snapshots the basis holds, in run order; candidates (N); per iteration i:
+//!   worst_estimate, worst_load, run_load (where its full run was: the worst candidate
+//!   without a run yet), true_error (rel_error of that iteration's basis at run_load from
+//!   the full run there; both NaN without a run), energy_tolerance ε,
+//!   hyper_tolerance τ, n_modes, n_elements; estimates (iterations, N) every candidate's
+//!   estimate; attributes: method = "greedy", iterations, max_runs, full_runs, converged
 //! attributes on /: schema_version, model (TOML text), model_path, model_fingerprint,
 //!   settings_hash, content_hash (SHA-256 of the content: src/io/basis_check.rs),
 //!   pipeline (TOML text), variant, snapshots, mode_rule, n_modes (= r), n_pod_modes,

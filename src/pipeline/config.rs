@@ -6,9 +6,11 @@
 //! basis = "../data/bases/pendulum.h5"       # default: ../data/bases/<pipeline name>.h5
 //! report = "../reports/pendulum"            # default: ../reports/<pipeline name>
 //! [train]
-//! load_scales = [1.0]
+//! load_scales = [1.0]                       # or, over a load range (docs/greedy-training.md):
+//!                                           # greedy = { range = [0.5, 1.5], tolerance = 1e-3,
+//!                                           #            max_runs = 8, candidates = 33 }
 //! snapshots = "reference"                   # or "raw" (the thesis)
-//! [reduction]
+//! [reduction]                               # with greedy: optional, or partial
 //! variant = "galerkin"                      # or "constraint-preserving", "whole-system"
 //! modes = { ratio = 0.1 }                   # or { count = 20 }, { energy = 1e-6 }
 //! blocks = "bodies"                         # one POD per body (modes = { counts = [..] }
@@ -39,6 +41,8 @@ pub struct PipelineFile {
     #[serde(default)]
     pub report: Option<PathBuf>,
     pub train: TrainSpec,
+    /// may be omitted or partial with `train.greedy` (the rest is chosen by the greedy loop)
+    #[serde(default)]
     pub reduction: ReductionSpec,
     #[serde(default)]
     pub online: Option<OnlineSpec>,
@@ -49,7 +53,12 @@ pub struct PipelineFile {
 #[derive(Clone, Debug, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct TrainSpec {
-    pub load_scales: Vec<f64>,
+    /// the training loads; exactly one of `load_scales` and `greedy`
+    #[serde(default)]
+    pub load_scales: Option<Vec<f64>>,
+    /// greedy training over a load range (src/pipeline/greedy.rs)
+    #[serde(default)]
+    pub greedy: Option<GreedySpec>,
     #[serde(default = "default_snapshots")]
     pub snapshots: SnapshotKind,
 }
@@ -58,16 +67,73 @@ fn default_snapshots() -> SnapshotKind {
     SnapshotKind::Reference
 }
 
+/// `[train] greedy = { range = [A, B], tolerance = T, max_runs = K, candidates = N }`:
+/// full runs where the error estimate over N evenly spaced loads of [A, B] is worst, until
+/// every estimate is ≤ T or K full runs were made.
 #[derive(Clone, Debug, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct GreedySpec {
+    pub range: Vec<f64>,
+    pub tolerance: f64,
+    pub max_runs: usize,
+    #[serde(default = "default_candidates")]
+    pub candidates: usize,
+}
+
+fn default_candidates() -> usize {
+    33
+}
+
+impl GreedySpec {
+    /// `Err((field, problem))` with the field under `train.greedy`.
+    pub fn validate(&self) -> std::result::Result<(), (String, String)> {
+        let bad = |f: &str, p: String| Err((format!("train.greedy.{f}"), p));
+        match self.range[..] {
+            [a, b] if !(a.is_finite() && b.is_finite()) => return bad("range", format!("[{a}, {b}] must be two finite numbers")),
+            [a, b] if a >= b => return bad("range", format!("[{a}, {b}]: the first end must be less than the second")),
+            [_, _] => {}
+            _ => return bad("range", format!("has {} entries; it must be [A, B] with A < B", self.range.len())),
+        }
+        if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
+            return bad("tolerance", format!("is {}; it must be positive and finite (a relative error, e.g. 1e-3)", self.tolerance));
+        }
+        if self.max_runs == 0 {
+            return bad("max_runs", "is 0; at least one full run is needed".into());
+        }
+        if self.candidates < 2 {
+            return bad("candidates", format!("is {}; at least 2 (the range ends) are needed", self.candidates));
+        }
+        Ok(())
+    }
+
+    /// `(A, B)`; call after [`Self::validate`].
+    pub fn range(&self) -> (f64, f64) {
+        (self.range[0], self.range[1])
+    }
+
+    /// The N evenly spaced candidate loads `A + (B − A) i/(N − 1)`.
+    pub fn candidate_loads(&self) -> Vec<f64> {
+        let (a, b) = self.range();
+        let n = self.candidates;
+        // rounded to 12 significant digits: 0.7 + 0.5 · 19/20 prints as 1.175, not 1.1749999999999998
+        let round = |x: f64| if x == 0.0 { x } else { let k = 10f64.powi(11 - x.abs().log10().floor() as i32); (x * k).round() / k };
+        (0..n).map(|i| if i + 1 == n { b } else { round(a + (b - a) * i as f64 / (n - 1) as f64) }).collect()
+    }
+}
+
+#[derive(Clone, Debug, Default, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ReductionSpec {
     /// default: constraint-preserving when the model has joints that the basis cannot
     /// hold by itself, galerkin otherwise (see `Pipeline::variant`)
     #[serde(default)]
     pub variant: Option<Variant>,
-    pub modes: ModeRule,
+    /// required with `train.load_scales`; with `train.greedy`, absent: chosen by the loop
+    #[serde(default)]
+    pub modes: Option<ModeRule>,
     /// `"bodies"`: a block basis, one POD per body (`modes` applies to each body, or
-    /// `counts` gives each its own); absent: one POD of all coordinates
+    /// `counts` gives each its own); absent: one POD of all coordinates (with
+    /// `train.greedy`, absent: "bodies" when the model has more than one body)
     #[serde(default)]
     pub blocks: Option<Blocks>,
     /// hyper-reduction by ECSW; absent: every element is evaluated (plain Galerkin)
@@ -191,21 +257,35 @@ impl Pipeline {
 
     fn check(&self) -> Result<()> {
         let bad = |field: &str, problem: String| Err(Error::input(&self.path, field, problem));
-        if let Err(e) = check_scales(&self.file.train.load_scales) {
-            return bad("train.load_scales", e);
-        }
         let red = &self.file.reduction;
-        if let Err(e) = red.modes.validate() {
+        match (&self.file.train.load_scales, &self.file.train.greedy) {
+            (Some(_), Some(_)) => return bad("train", "has both load_scales and greedy; give exactly one".into()),
+            (None, None) => return bad("train", "needs load_scales = [..] or greedy = { range = [A, B], tolerance = T, max_runs = K }".into()),
+            (Some(s), None) => {
+                if let Err(e) = check_scales(s) {
+                    return bad("train.load_scales", e);
+                }
+                if red.modes.is_none() {
+                    return bad("reduction.modes", "is missing: with train.load_scales the mode count must be given (or train greedily, which chooses it)".into());
+                }
+            }
+            (None, Some(g)) => {
+                if let Err((f, p)) = g.validate() {
+                    return bad(&f, p);
+                }
+            }
+        }
+        if let Err(e) = red.modes.as_ref().map_or(Ok(()), |m| m.validate()) {
             return bad("reduction.modes", e);
         }
-        match (&red.modes, red.blocks) {
-            (ModeRule::Counts(_), None) => return bad("reduction.modes", "gives one count per block, but there are no blocks (set reduction.blocks = \"bodies\")".into()),
-            (ModeRule::Counts(c), Some(Blocks::Bodies)) if c.len() != self.model.file.bodies.len() => {
+        match (&red.modes, self.blocks()) {
+            (Some(ModeRule::Counts(_)), None) => return bad("reduction.modes", "gives one count per block, but there are no blocks (set reduction.blocks = \"bodies\")".into()),
+            (Some(ModeRule::Counts(c)), Some(Blocks::Bodies)) if c.len() != self.model.file.bodies.len() => {
                 return bad("reduction.modes", format!("gives {} counts, the model has {} bodies", c.len(), self.model.file.bodies.len()))
             }
             _ => {}
         }
-        if red.blocks.is_some() && self.variant() == Variant::WholeSystem {
+        if self.blocks().is_some() && self.variant() == Variant::WholeSystem {
             return bad("reduction.blocks", "needs the galerkin or the constraint-preserving variant, not whole-system".into());
         }
         if let Some(h) = &self.file.reduction.hyper {
@@ -238,8 +318,28 @@ impl Pipeline {
         })
     }
 
+    /// The block split: the file's; with `train.greedy` and none given, one block per body
+    /// when the model has several bodies (each body's modes then move that body only).
+    pub fn blocks(&self) -> Option<Blocks> {
+        let multi_body = self.model.file.bodies.len() > 1 && self.variant() != Variant::WholeSystem;
+        self.file.reduction.blocks.or(if self.file.train.greedy.is_some() && multi_body { Some(Blocks::Bodies) } else { None })
+    }
+
+    /// The given training loads, or for greedy training the ends and middle of its range
+    /// (what `online` and `validate` default to without their own lists).
+    pub fn training_scales(&self) -> Vec<f64> {
+        match (&self.file.train.load_scales, &self.file.train.greedy) {
+            (Some(s), _) => s.clone(),
+            (None, Some(g)) => {
+                let (a, b) = g.range();
+                vec![a, 0.5 * (a + b), b]
+            }
+            (None, None) => Vec::new(),
+        }
+    }
+
     pub fn online_scales(&self) -> Vec<f64> {
-        self.file.online.as_ref().map_or_else(|| self.file.train.load_scales.clone(), |s| s.load_scales.values().expect("checked"))
+        self.file.online.as_ref().map_or_else(|| self.training_scales(), |s| s.load_scales.values().expect("checked"))
     }
 
     /// `[online] tolerance`, when given.
@@ -248,6 +348,6 @@ impl Pipeline {
     }
 
     pub fn validate_scales(&self) -> Vec<f64> {
-        self.file.validate.as_ref().map_or_else(|| self.file.train.load_scales.clone(), |s| s.load_scales.values().expect("checked"))
+        self.file.validate.as_ref().map_or_else(|| self.training_scales(), |s| s.load_scales.values().expect("checked"))
     }
 }

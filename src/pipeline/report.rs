@@ -52,7 +52,10 @@ pub fn run(p: &Pipeline, progress: bool) -> Result<PathBuf> {
 /// into `out` (a temporary folder); the files are `fsync`ed when the folder is swapped in.
 fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool) -> Result<()> {
     let plot_err = |e: String| Error::io(out, std::io::Error::other(e));
-    crate::output::note(&format!("[1/3] train: {} full run(s)", p.file.train.load_scales.len()));
+    match &p.file.train.greedy {
+        Some(g) => crate::output::note(&format!("[1/3] train: greedy over [{}, {}]", g.range().0, g.range().1)),
+        None => crate::output::note(&format!("[1/3] train: {} full run(s)", p.training_scales().len())),
+    }
     let trained = train_and_write(p, basis_path)?;
     let stored = load_basis(p, basis_path)?;
     let basis = &stored.basis;
@@ -160,7 +163,7 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool) -> Result<
         b.n_pod_modes,
         if b.kept.is_empty() { String::new() } else { format!(" + {} joint coordinates", b.kept.len()) },
         trained.n_snapshots,
-        p.file.train.load_scales
+        trained.greedy.as_ref().map_or_else(|| p.training_scales(), |g| g.load_scales.clone())
     );
     let _ = writeln!(md, "- sweep: {} load scales on {} threads in {:.3} s (whole sweep, reduced and full runs)\n", sw.scales.len(), sw.threads, sw.wall_seconds);
     let _ = writeln!(md, "## Validation (time loops only; one run each)\n");

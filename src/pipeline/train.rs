@@ -4,8 +4,8 @@ use super::config::{Blocks, Pipeline};
 use crate::error::{Error, Result};
 use super::estimate::{build_estimator, Estimator, DEFAULT_EXTRA_MODES};
 use crate::io::basis_file::{write_basis_with, BasisMeta, TrainingData};
-use crate::reduction::{ecsw, train_basis, BasisSpec, Trained};
-use crate::simulate::{simulate, Overrides};
+use crate::reduction::{ecsw, train_basis, BasisSpec, ModeRule, Trained};
+use crate::simulate::{simulate, Overrides, SimulationResult};
 use crate::solver::kkt::LinearSolverKind;
 use ndarray::{concatenate, Array1, Axis};
 use std::path::Path;
@@ -14,7 +14,12 @@ pub struct TrainSummary {
     pub trained: Trained,
     pub n_snapshots: usize,
     pub full_seconds: f64,
-    /// the error estimator (uncalibrated: `load_scales` training has no held-out runs)
+    /// full runs made (greedy: with the last, held-out check run)
+    pub n_runs: usize,
+    /// what the greedy loop did (`/training` in the basis file); `None` for `load_scales`
+    pub greedy: Option<super::greedy::GreedyRecord>,
+    /// the error estimator (uncalibrated for `load_scales` training: no held-out runs;
+    /// greedy training calibrates it on its held-out full runs)
     pub estimator: Option<Estimator>,
 }
 
@@ -27,9 +32,13 @@ pub fn joint_dofs(p: &Pipeline) -> Vec<usize> {
     d
 }
 
-/// Runs the training simulations and builds the basis (nothing is written).
+/// Runs the training simulations and builds the basis (nothing is written); greedy
+/// training (`train.greedy`) is [`super::greedy::train`].
 pub fn train(p: &Pipeline) -> Result<(TrainingData, TrainSummary)> {
-    let scales = &p.file.train.load_scales;
+    if let Some(g) = &p.file.train.greedy {
+        return super::greedy::train(p, g);
+    }
+    let scales = p.file.train.load_scales.clone().unwrap_or_default();
     if scales.is_empty() {
         return Err(Error::input(&p.path, "train.load_scales", "is empty: no training run, no snapshots"));
     }
@@ -43,47 +52,58 @@ pub fn train(p: &Pipeline) -> Result<(TrainingData, TrainSummary)> {
     )?;
     let mut runs = Vec::new();
     let mut full_seconds = 0.0;
-    for &s in scales {
+    for &s in &scales {
         let r = simulate(&p.model, &Overrides { load_scale: Some(s), ..Default::default() }).map_err(|e| e.at_stage("train (full run)", s))?;
         full_seconds += r.wall_seconds;
         runs.push(r);
     }
-    let cat = |f: &dyn Fn(&crate::simulate::SimulationResult) -> ndarray::ArrayView2<f64>| {
-        concatenate(Axis(1), &runs.iter().map(f).collect::<Vec<_>>()).expect("same row counts")
-    };
-    let data = TrainingData {
+    let data = training_data(&runs);
+    let modes = p.file.reduction.modes.clone().ok_or_else(|| Error::input(&p.path, "reduction.modes", "is missing"))?;
+    let tol = p.file.reduction.hyper.as_ref().map(|h| h.tolerance);
+    let (trained, spec) = build_basis(p, &data, modes, tol).map_err(|(f, e)| Error::input(&p.path, f, e))?;
+    let sys = p.model.system(LinearSolverKind::Banded);
+    let x_ref = data.x.column(0);
+    let estimator = build_estimator(&sys, &trained, &spec, data.x.view(), data.multipliers.view(), &joint_dofs(p), x_ref, tol, DEFAULT_EXTRA_MODES)
+        .map_err(|e| Error::input(&p.path, "reduction", format!("cannot build the error estimator: {e}")))?;
+    let n_snapshots = data.x.ncols();
+    Ok((data, TrainSummary { trained, n_snapshots, full_seconds, n_runs: scales.len(), greedy: None, estimator: Some(estimator) }))
+}
+
+/// The snapshots of full runs, side by side in run order.
+pub fn training_data(runs: &[SimulationResult]) -> TrainingData {
+    let cat = |f: &dyn Fn(&SimulationResult) -> ndarray::ArrayView2<f64>| concatenate(Axis(1), &runs.iter().map(f).collect::<Vec<_>>()).expect("same row counts");
+    TrainingData {
         x: cat(&|r| r.q.view()),
         multipliers: cat(&|r| r.multipliers.view()),
         load_scale: Array1::from_iter(runs.iter().flat_map(|r| std::iter::repeat_n(r.settings.load_scale, r.t.len()))),
         t: Array1::from_iter(runs.iter().flat_map(|r| r.t.iter().copied())),
-    };
+    }
+}
+
+/// The basis of the pipeline's variant and blocks from `data` with `modes`, hyper-reduced
+/// by ECSW at `hyper_tolerance` when given; `Err((pipeline field, problem))`.
+pub fn build_basis(p: &Pipeline, data: &TrainingData, modes: ModeRule, hyper_tolerance: Option<f64>) -> std::result::Result<(Trained, BasisSpec), (&'static str, String)> {
     // every run starts from the same consistent, undeformed state
-    let x_ref = runs[0].q.column(0).to_owned();
+    let x_ref = data.x.column(0).to_owned();
     // whole-system: scale the multipliers so both blocks weigh alike in the POD
     let dx = (&data.x - &x_ref.view().insert_axis(Axis(1))).mapv(|v| v * v).sum().sqrt();
     let dl = data.multipliers.mapv(|v| v * v).sum().sqrt();
     let w = if dx > 0.0 && dl > 0.0 { dl / dx } else { 1.0 };
-    let blocks = match p.file.reduction.blocks {
+    let blocks = match p.blocks() {
         Some(Blocks::Bodies) => {
             let sys = p.model.system(LinearSolverKind::Banded);
             (0..sys.bodies.len()).map(|b| sys.body_dofs(b).collect()).collect()
         }
         None => Vec::new(),
     };
-    let spec = BasisSpec { variant: p.variant(), snapshots: p.file.train.snapshots, modes: p.file.reduction.modes.clone(), multiplier_scale: w, blocks };
-    let trained = train_basis(data.x.view(), data.multipliers.view(), &joint_dofs(p), x_ref.view(), &spec).map_err(|e| Error::input(&p.path, "reduction.modes", e))?;
-    let mut trained = trained;
-    if let Some(h) = &p.file.reduction.hyper {
+    let spec = BasisSpec { variant: p.variant(), snapshots: p.file.train.snapshots, modes, multiplier_scale: w, blocks };
+    let mut trained = train_basis(data.x.view(), data.multipliers.view(), &joint_dofs(p), x_ref.view(), &spec).map_err(|e| ("reduction.modes", e))?;
+    if let Some(tol) = hyper_tolerance {
         let sys = p.model.system(LinearSolverKind::Banded);
-        let hyper = ecsw(&sys, &trained.basis, data.x.view(), h.tolerance).map_err(|e| Error::input(&p.path, "reduction.hyper", format!("ECSW training failed: {e}")))?;
+        let hyper = ecsw(&sys, &trained.basis, data.x.view(), tol).map_err(|e| ("reduction.hyper", format!("ECSW training failed: {e}")))?;
         trained.basis.hyper = Some(hyper);
     }
-    let sys = p.model.system(LinearSolverKind::Banded);
-    let tol = p.file.reduction.hyper.as_ref().map(|h| h.tolerance);
-    let estimator = build_estimator(&sys, &trained, &spec, data.x.view(), data.multipliers.view(), &joint_dofs(p), x_ref.view(), tol, DEFAULT_EXTRA_MODES)
-        .map_err(|e| Error::input(&p.path, "reduction", format!("cannot build the error estimator: {e}")))?;
-    let n_snapshots = data.x.ncols();
-    Ok((data, TrainSummary { trained, n_snapshots, full_seconds, estimator: Some(estimator) }))
+    Ok((trained, spec))
 }
 
 /// Trains and writes the basis file atomically (a failed run keeps the previous file).
@@ -94,12 +114,20 @@ pub fn train_and_write(p: &Pipeline, out: &Path) -> Result<TrainSummary> {
         model_path: p.model.path.display().to_string(),
         model_fingerprint: p.model.fingerprint(),
         pipeline_text: p.text.clone(),
-        mode_rule: p.file.reduction.modes.to_string(),
+        mode_rule: match &summary.greedy {
+            Some(g) => g.mode_rule(),
+            None => p.file.reduction.modes.as_ref().map(|m| m.to_string()).unwrap_or_default(),
+        },
         settings_hash: crate::io::basis_check::settings_hash(p),
     };
-    write_basis_with(out, &data, &summary.trained, &meta, |f| match &summary.estimator {
-        Some(est) => crate::io::estimator_file::write_estimator(f, est).map_err(|e| Error::hdf5(out, e)),
-        None => Ok(()),
+    write_basis_with(out, &data, &summary.trained, &meta, |f| {
+        if let Some(est) = &summary.estimator {
+            crate::io::estimator_file::write_estimator(f, est).map_err(|e| Error::hdf5(out, e))?;
+        }
+        if let Some(g) = &summary.greedy {
+            super::greedy::write_training(f, g).map_err(|e| Error::hdf5(out, e))?;
+        }
+        Ok(())
     })?;
     Ok(summary)
 }
