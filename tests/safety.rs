@@ -94,7 +94,8 @@ fn leftovers(root: &Path) -> Vec<PathBuf> {
 fn fails_with(o: &Output, words: &[&str]) -> String {
     let err = String::from_utf8_lossy(&o.stderr).to_string();
     assert!(!o.status.success(), "expected a failure, got success: {err}");
-    assert_eq!(o.status.code(), Some(1), "exit code: {err}");
+    // 1: an error; 3: some load scales of a sweep failed (here the sweep stage of `run`)
+    assert!(matches!(o.status.code(), Some(1) | Some(3)), "exit code: {err}");
     assert!(!err.contains("panicked"), "{err}");
     for w in words {
         assert!(err.contains(w), "`{w}` missing from: {err}");

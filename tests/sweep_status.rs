@@ -76,14 +76,14 @@ fn a_failing_load_scale_is_recorded_and_the_others_written() {
     let (o, err) = run(&["sweep", p.to_str().unwrap(), "-o", out.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(3), "{err}");
     let last = err.trim().lines().last().unwrap();
-    assert!(last.starts_with("error: 2 of 5 load scales failed: load scale 100000000000000000000: Newton failed"), "{err}");
+    assert!(last.starts_with("error: 2 of 5 load scales failed: sweep (reduced run) at load scale 1e20: Newton failed"), "{err}");
     assert!(last.contains("s.h5"), "{err}");
     assert_eq!(status(&out), vec![0, 1, 0, 0, 1]);
     let f = hdf5::File::open(&out).unwrap();
     let messages: Vec<String> = f.dataset("message").unwrap().read_raw::<hdf5::types::VarLenUnicode>().unwrap().iter().map(|m| m.to_string()).collect();
     assert_eq!(messages[0], "");
-    assert!(messages[1].starts_with("Newton failed at t = "), "{messages:?}");
-    assert!(messages[4].starts_with("Newton failed"), "{messages:?}");
+    assert!(messages[1].starts_with("sweep (reduced run) at load scale 1e20: Newton failed at t = "), "{messages:?}");
+    assert!(messages[4].starts_with("sweep (reduced run) at load scale 5e19: Newton failed"), "{messages:?}");
     assert_eq!(f.attr("n_failed").unwrap().read_scalar::<u64>().unwrap(), 2);
     let tip = f.dataset("probes/tip").unwrap().read::<f64, ndarray::Ix3>().unwrap();
     let rom_seconds = column(&out, "rom_seconds");
@@ -95,7 +95,7 @@ fn a_failing_load_scale_is_recorded_and_the_others_written() {
     }
     // the stdout table names the failures too
     let table = String::from_utf8_lossy(&o.stdout).to_string();
-    assert_eq!(table.lines().filter(|l| l.contains("failed: Newton failed")).count(), 2, "{table}");
+    assert_eq!(table.lines().filter(|l| l.contains("failed: sweep (reduced run) at load scale")).count(), 2, "{table}");
     // a good row is exactly what `online` computes at that load scale
     let single = d.join("online.h5");
     let (o, err) = run(&["online", p.to_str().unwrap(), "--load-scale", "1.0", "-o", single.to_str().unwrap()]);

@@ -162,7 +162,7 @@ pub fn initial_loads(range: (f64, f64), max_runs: usize) -> Vec<f64> {
 pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary)> {
     let range = g.range();
     let candidates = g.candidate_loads();
-    let full = |x: f64| simulate(&p.model, &Overrides { load_scale: Some(x), ..Default::default() });
+    let full = |x: f64| simulate(&p.model, &Overrides { load_scale: Some(x), ..Default::default() }).map_err(|e| e.at_stage("train (greedy full run)", x));
     let first = initial_loads(range, g.max_runs);
     eprintln!("greedy training over [{}, {}], tolerance {:e}, {} candidates: full runs at {:?}", range.0, range.1, g.tolerance, candidates.len(), first);
     let mut runs: Vec<SimulationResult> = first.par_iter().map(|&x| full(x)).collect::<Result<_>>()?;

@@ -140,7 +140,8 @@ impl Sweep {
         if failed.is_empty() {
             return None;
         }
-        let shown: Vec<String> = failed.iter().take(3).map(|s| format!("load scale {}: {}", s.load_scale, s.message())).collect();
+        // each message names its stage and load scale already (`Error::at_stage`)
+        let shown: Vec<String> = failed.iter().take(3).map(|s| s.message().to_string()).collect();
         let more = if failed.len() > 3 { format!("; and {} more", failed.len() - 3) } else { String::new() };
         Some(format!("{} of {} load scales failed: {}{more}", failed.len(), self.scales.len(), shown.join("; ")))
     }
