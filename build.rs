@@ -28,12 +28,9 @@ fn main() {
         println!("cargo::warning=flexrom's build.rs knows only Debian's x86_64 library layout; BLAS/LAPACK and HDF5 dependencies are not linked");
         return;
     }
-    for (dir, file) in [
-        (OPENBLAS_DIR, "libopenblas.a"),
-        (LIB_DIR, "libz.a"),
-        (LIB_DIR, "libsz.a"),
-        (LIB_DIR, "libaec.a"),
-    ] {
+    for (dir, file) in
+        [(OPENBLAS_DIR, "libopenblas.a"), (LIB_DIR, "libz.a"), (LIB_DIR, "libsz.a"), (LIB_DIR, "libaec.a")]
+    {
         let path = Path::new(dir).join(file);
         if !path.exists() {
             panic!(
@@ -68,10 +65,7 @@ fn main() {
 /// The path of a file in the C compiler's library search path, if it is there
 /// (`cc -print-file-name` echoes the bare name when it is not).
 fn gcc_file(name: &str) -> Option<String> {
-    let out = Command::new("cc")
-        .arg(format!("-print-file-name={name}"))
-        .output()
-        .ok()?;
+    let out = Command::new("cc").arg(format!("-print-file-name={name}")).output().ok()?;
     let path = String::from_utf8(out.stdout).ok()?.trim().to_string();
     (Path::new(&path).is_absolute() && Path::new(&path).exists()).then_some(path)
 }

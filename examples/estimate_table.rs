@@ -107,7 +107,15 @@ fn main() -> flexrom::Result<()> {
         let mut eff: Vec<f64> = sel.iter().map(|r| r.2 / r.1).collect();
         let max = eff.iter().copied().fold(0.0, f64::max);
         let min = eff.iter().copied().fold(f64::INFINITY, f64::min);
-        println!("| {name} | {} | {}/{} | {:.2} | {:.2} | {:.2} |", sel.len(), covered, sel.len(), median(&mut eff), max, min);
+        println!(
+            "| {name} | {} | {}/{} | {:.2} | {:.2} | {:.2} |",
+            sel.len(),
+            covered,
+            sel.len(),
+            median(&mut eff),
+            max,
+            min
+        );
     }
     let mut costs: Vec<f64> = rows.iter().map(|r| r.3).collect();
     println!("\nestimator cost / reduced run: median {:.0} %", 100.0 * median(&mut costs));

@@ -13,7 +13,11 @@ pub enum Error {
 
     /// Reading or writing a file failed at the operating-system level.
     #[error("{file}: {source}")]
-    Io { file: String, #[source] source: std::io::Error },
+    Io {
+        file: String,
+        #[source]
+        source: std::io::Error,
+    },
 
     /// An HDF5 file is missing, truncated, foreign or inconsistent.
     #[error("{file}: {problem}")]
@@ -52,7 +56,12 @@ pub enum Error {
     /// A numerical failure with the stage (simulate, train, online, validate, sweep) and
     /// the load scale it happened at; the time is in `source`.
     #[error("{stage} at load scale {}: {source}", crate::limits::show_number(*.load_scale))]
-    Stage { stage: String, load_scale: f64, #[source] source: Box<Error> },
+    Stage {
+        stage: String,
+        load_scale: f64,
+        #[source]
+        source: Box<Error>,
+    },
 
     /// Standard output was closed by the reader (`| head`): not an error of the run, the
     /// program ends quietly.
@@ -80,11 +89,7 @@ impl Error {
     }
 
     pub fn input(file: impl AsRef<Path>, field: impl Into<String>, problem: impl Into<String>) -> Self {
-        Error::Input {
-            file: file.as_ref().display().to_string(),
-            field: field.into(),
-            problem: problem.into(),
-        }
+        Error::Input { file: file.as_ref().display().to_string(), field: field.into(), problem: problem.into() }
     }
 
     pub fn io(file: impl AsRef<Path>, source: std::io::Error) -> Self {

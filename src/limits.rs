@@ -52,7 +52,13 @@ pub fn get() -> &'static Limits {
 
 fn defaults() -> Limits {
     let (max_memory, memory_source) = default_memory();
-    Limits { max_memory, memory_source, max_steps: DEFAULT_MAX_STEPS, max_elements: DEFAULT_MAX_ELEMENTS, allow_blowup: false }
+    Limits {
+        max_memory,
+        memory_source,
+        max_steps: DEFAULT_MAX_STEPS,
+        max_elements: DEFAULT_MAX_ELEMENTS,
+        allow_blowup: false,
+    }
 }
 
 fn default_memory() -> (u64, String) {
@@ -67,27 +73,42 @@ fn default_memory() -> (u64, String) {
 
 /// The bounds from the command-line values (`None`: not given), else the environment,
 /// else the defaults. A malformed value is a usage error naming the option.
-pub fn from_env(max_memory: Option<&str>, max_steps: Option<&str>, max_elements: Option<&str>, allow_blowup: bool) -> Result<Limits> {
+pub fn from_env(
+    max_memory: Option<&str>,
+    max_steps: Option<&str>,
+    max_elements: Option<&str>,
+    allow_blowup: bool,
+) -> Result<Limits> {
     let mut l = defaults();
     l.allow_blowup = allow_blowup;
     let env_mem = std::env::var("FLEXROM_MAX_MEMORY").ok();
-    if let Some((v, name)) = max_memory.map(|v| (v.to_string(), "--max-memory")).or(env_mem.map(|v| (v, "FLEXROM_MAX_MEMORY"))) {
+    if let Some((v, name)) =
+        max_memory.map(|v| (v.to_string(), "--max-memory")).or(env_mem.map(|v| (v, "FLEXROM_MAX_MEMORY")))
+    {
         l.max_memory = parse_bytes(&v).map_err(|e| Error::Usage(format!("{name}: {e}")))?;
         l.memory_source = name.to_string();
     }
     let env_steps = std::env::var("FLEXROM_MAX_STEPS").ok();
-    if let Some((v, name)) = max_steps.map(|v| (v.to_string(), "--max-steps")).or(env_steps.map(|v| (v, "FLEXROM_MAX_STEPS"))) {
+    if let Some((v, name)) =
+        max_steps.map(|v| (v.to_string(), "--max-steps")).or(env_steps.map(|v| (v, "FLEXROM_MAX_STEPS")))
+    {
         l.max_steps = positive_count(&v, name)?;
     }
     let env_el = std::env::var("FLEXROM_MAX_ELEMENTS").ok();
-    if let Some((v, name)) = max_elements.map(|v| (v.to_string(), "--max-elements")).or(env_el.map(|v| (v, "FLEXROM_MAX_ELEMENTS"))) {
+    if let Some((v, name)) =
+        max_elements.map(|v| (v.to_string(), "--max-elements")).or(env_el.map(|v| (v, "FLEXROM_MAX_ELEMENTS")))
+    {
         l.max_elements = positive_count(&v, name)?;
     }
     Ok(l)
 }
 
 fn positive_count(v: &str, name: &str) -> Result<u64> {
-    v.trim().parse::<u64>().ok().filter(|&n| n > 0).ok_or_else(|| Error::Usage(format!("{name}: `{v}` is not a positive whole number")))
+    v.trim()
+        .parse::<u64>()
+        .ok()
+        .filter(|&n| n > 0)
+        .ok_or_else(|| Error::Usage(format!("{name}: `{v}` is not a positive whole number")))
 }
 
 /// `"8G"`, `"512M"`, `"1.5GiB"`, `"1000000"` → bytes (K, M, G, T are powers of 1024).
@@ -114,7 +135,11 @@ pub fn parse_bytes(s: &str) -> std::result::Result<u64, String> {
 /// A number as written by hand: plain in [1e-4, 1e6), else in exponent form (1e300 is
 /// not 301 digits).
 pub fn show_number(x: f64) -> String {
-    if x == 0.0 || (1e-4..1e6).contains(&x.abs()) { format!("{x}") } else { format!("{x:e}") }
+    if x == 0.0 || (1e-4..1e6).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
 }
 
 /// Human-readable bytes.
@@ -126,7 +151,11 @@ pub fn show_bytes(b: f64) -> String {
         x /= 1024.0;
         u += 1;
     }
-    if u == 0 { format!("{x:.0} {}", UNITS[0]) } else { format!("{x:.1} {}", UNITS[u]) }
+    if u == 0 {
+        format!("{x:.0} {}", UNITS[0])
+    } else {
+        format!("{x:.1} {}", UNITS[u])
+    }
 }
 
 /// Refuses an allocation estimated at `bytes` (computed in f64, so it cannot overflow)

@@ -1,20 +1,24 @@
 //! The `flexrom` command line.
 
 use clap::{Parser, Subcommand};
-use flexrom::io::result_file::{write_result, write_result_with};
-use flexrom::pipeline::online::load_basis;
-use flexrom::pipeline::Pipeline;
-use flexrom::model::Model;
-use flexrom::output::{self, note};
-use flexrom::simulate::{simulate, Overrides};
-use flexrom::solver::kkt::LinearSolverKind;
 use flexrom::io::atomic::TempPath;
 use flexrom::io::output::{check_output, check_report_dir, claim_in_report, Origin};
+use flexrom::io::result_file::{write_result, write_result_with};
+use flexrom::model::Model;
+use flexrom::output::{self, note};
+use flexrom::pipeline::online::load_basis;
+use flexrom::pipeline::Pipeline;
+use flexrom::simulate::{simulate, Overrides};
+use flexrom::solver::kkt::LinearSolverKind;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "flexrom", version, about = "Planar flexible multibody dynamics (ANCF beams) with POD reduced-order models")]
+#[command(
+    name = "flexrom",
+    version,
+    about = "Planar flexible multibody dynamics (ANCF beams) with POD reduced-order models"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -54,7 +58,13 @@ struct RunArgs {
 
 impl RunArgs {
     fn overrides(&self) -> Overrides {
-        Overrides { dt: self.dt, t_end: self.t_end, rho_inf: self.rho_inf, load_scale: self.load_scale, solver: self.solver }
+        Overrides {
+            dt: self.dt,
+            t_end: self.t_end,
+            rho_inf: self.rho_inf,
+            load_scale: self.load_scale,
+            solver: self.solver,
+        }
     }
 }
 
@@ -194,7 +204,12 @@ fn main() -> ExitCode {
         return ExitCode::FAILURE;
     }
     flexrom::single_threaded_blas();
-    let limits = flexrom::limits::from_env(cli.max_memory.as_deref(), cli.max_steps.as_deref(), cli.max_elements.as_deref(), cli.allow_blowup);
+    let limits = flexrom::limits::from_env(
+        cli.max_memory.as_deref(),
+        cli.max_steps.as_deref(),
+        cli.max_elements.as_deref(),
+        cli.allow_blowup,
+    );
     match limits.and_then(|l| {
         flexrom::limits::set(l);
         run(cli)
@@ -214,7 +229,8 @@ fn run(cli: Cli) -> flexrom::Result<()> {
         Command::Simulate { model, output, run, csv } => {
             check_output(&output, Origin::Flag("-o"), &[(&model, "model file")])?;
             let model = Model::load(&model)?;
-            let r = simulate(&model, &run.overrides()).map_err(|e| e.at_stage("simulate", run.load_scale.unwrap_or(1.0)))?;
+            let r = simulate(&model, &run.overrides())
+                .map_err(|e| e.at_stage("simulate", run.load_scale.unwrap_or(1.0)))?;
             write_result(&output, &r)?;
             note(&format!(
                 "{}: {} steps in {:.3} s ({} Newton iterations, {} factorizations, {} step cuts) -> {}",
@@ -233,7 +249,8 @@ fn run(cli: Cli) -> flexrom::Result<()> {
         }
         Command::Train { pipeline, basis } => {
             let p = Pipeline::load(&pipeline)?;
-            let origin = if basis.is_some() { Origin::Flag("--basis") } else { Origin::Key { pipeline: &p.path, key: "basis" } };
+            let origin =
+                if basis.is_some() { Origin::Flag("--basis") } else { Origin::Key { pipeline: &p.path, key: "basis" } };
             let out = basis.clone().unwrap_or_else(|| p.basis_path.clone());
             check_output(&out, origin, &[(&p.path, "pipeline file"), (&p.model.path, "model file")])?;
             // trained into a temporary file, read back and checked, and only then renamed over
@@ -262,11 +279,18 @@ fn run(cli: Cli) -> flexrom::Result<()> {
             let p = Pipeline::load(&pipeline)?;
             check_scale(load_scale)?;
             let path = basis.unwrap_or_else(|| p.basis_path.clone());
-            check_output(&output, Origin::Flag("-o"), &[(&p.path, "pipeline file"), (&p.model.path, "model file"), (&path, "basis file")])?;
+            check_output(
+                &output,
+                Origin::Flag("-o"),
+                &[(&p.path, "pipeline file"), (&p.model.path, "model file"), (&path, "basis file")],
+            )?;
             let stored = load_basis(&p, &path)?;
             let trust = flexrom::pipeline::estimate::load_trust(&p, &path, &stored)?;
-            let mut runner = flexrom::pipeline::estimate::EstimatingRunner::new(&p.model, &stored.basis, trust.estimator.as_ref())?;
-            let (run, estimate) = runner.run(load_scale, flexrom::pipeline::online::Output::Full).map_err(|e| e.at_stage("online", load_scale))?;
+            let mut runner =
+                flexrom::pipeline::estimate::EstimatingRunner::new(&p.model, &stored.basis, trust.estimator.as_ref())?;
+            let (run, estimate) = runner
+                .run(load_scale, flexrom::pipeline::online::Output::Full)
+                .map_err(|e| e.at_stage("online", load_scale))?;
             let extrapolated = flexrom::pipeline::estimate::is_extrapolated(trust.range, load_scale);
             let basis_name = path.display().to_string();
             write_result_with(&output, &run.result, |f| {
@@ -300,23 +324,45 @@ fn run(cli: Cli) -> flexrom::Result<()> {
             let path = basis.unwrap_or_else(|| p.basis_path.clone());
             let stored = load_basis(&p, &path)?;
             let trust = flexrom::pipeline::estimate::load_trust(&p, &path, &stored)?;
-            let (v, _, _) = flexrom::pipeline::validate::validate_with(&p.model, &stored.basis, Some(&trust), load_scale, !no_dense)?;
+            let (v, _, _) = flexrom::pipeline::validate::validate_with(
+                &p.model,
+                &stored.basis,
+                Some(&trust),
+                load_scale,
+                !no_dense,
+            )?;
             if json {
-                let text = serde_json::to_string(&v).map_err(|e| flexrom::Error::Usage(format!("cannot write the JSON: {e}")))?;
+                let text = serde_json::to_string(&v)
+                    .map_err(|e| flexrom::Error::Usage(format!("cannot write the JSON: {e}")))?;
                 output::println(&text)?;
             } else {
                 output::println(&v.describe())?;
             }
             flexrom::pipeline::estimate::check_runs(&trust, &[(load_scale, v.error_estimate)], strict)
         }
-        Command::Sweep { pipeline, load_scales, validate, continuation, no_estimate, output, basis, resume, strict } => {
+        Command::Sweep {
+            pipeline,
+            load_scales,
+            validate,
+            continuation,
+            no_estimate,
+            output,
+            basis,
+            resume,
+            strict,
+        } => {
             let p = Pipeline::load(&pipeline)?;
             let scales = match load_scales {
-                Some(s) => flexrom::pipeline::config::parse_range(&s).map_err(|e| flexrom::Error::Usage(format!("--load-scales: {e}")))?,
+                Some(s) => flexrom::pipeline::config::parse_range(&s)
+                    .map_err(|e| flexrom::Error::Usage(format!("--load-scales: {e}")))?,
                 None => p.online_scales(),
             };
             let path = basis.unwrap_or_else(|| p.basis_path.clone());
-            let inputs = [(p.path.as_path(), "pipeline file"), (p.model.path.as_path(), "model file"), (path.as_path(), "basis file")];
+            let inputs = [
+                (p.path.as_path(), "pipeline file"),
+                (p.model.path.as_path(), "model file"),
+                (path.as_path(), "basis file"),
+            ];
             // the default goes into the pipeline's report folder, which must then be flexrom's
             let in_report = output.is_none();
             let out = output.unwrap_or_else(|| p.report_dir.join("sweep.h5"));
@@ -339,20 +385,46 @@ fn run(cli: Cli) -> flexrom::Result<()> {
             if in_report {
                 claim_in_report(&p.report_dir, &p.path, "sweep.h5")?;
             }
-            let sw = flexrom::pipeline::sweep::sweep_to_file(&p.model, &stored, Some(&trust), &path, &scales, options, &out, resume)?;
+            let sw = flexrom::pipeline::sweep::sweep_to_file(
+                &p.model,
+                &stored,
+                Some(&trust),
+                &path,
+                &scales,
+                options,
+                &out,
+                resume,
+            )?;
             output::print(&flexrom::pipeline::sweep::table(&sw))?;
-            note(&format!("{} load scales ({} resumed) on {} threads in {:.3} s -> {}", scales.len(), sw.resumed, sw.threads, sw.wall_seconds, out.display()));
+            note(&format!(
+                "{} load scales ({} resumed) on {} threads in {:.3} s -> {}",
+                scales.len(),
+                sw.resumed,
+                sw.threads,
+                sw.wall_seconds,
+                out.display()
+            ));
             // the good runs are written; the exit code (3) says that some failed
             if let Some(s) = sw.failure_summary() {
-                return Err(flexrom::Error::PartlyFailed(format!("{s} (the others are in {}; /status and /message say which)", out.display())));
+                return Err(flexrom::Error::PartlyFailed(format!(
+                    "{s} (the others are in {}; /status and /message say which)",
+                    out.display()
+                )));
             }
-            let runs: Vec<(f64, Option<f64>)> = sw.scales.iter().filter_map(|x| x.point()).map(|q| (q.rom.result.settings.load_scale, q.estimate.map(|e| e.error_estimate))).collect();
+            let runs: Vec<(f64, Option<f64>)> = sw
+                .scales
+                .iter()
+                .filter_map(|x| x.point())
+                .map(|q| (q.rom.result.settings.load_scale, q.estimate.map(|e| e.error_estimate)))
+                .collect();
             flexrom::pipeline::estimate::check_runs(&trust, &runs, strict)
         }
         Command::Run { pipeline, strict } => {
             let p = Pipeline::load(&pipeline)?;
             let dir = flexrom::pipeline::report::run(&p, true)?;
-            output::println(&std::fs::read_to_string(dir.join("summary.md")).map_err(|e| flexrom::Error::io(&dir, e))?)?;
+            output::println(
+                &std::fs::read_to_string(dir.join("summary.md")).map_err(|e| flexrom::Error::io(&dir, e))?,
+            )?;
             note(&format!("report: {}", dir.display()));
             flexrom::pipeline::report::check_report(&p, &dir, strict)
         }
@@ -371,8 +443,11 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                 ))?;
                 let nt = r.t.len();
                 for k in [0, nt / 4, nt / 2, 3 * nt / 4, nt - 1] {
-                    let cells: Vec<String> =
-                        r.probes.iter().map(|(n, xy)| format!("{n} = ({:+.5}, {:+.5})", xy[[k, 0]], xy[[k, 1]])).collect();
+                    let cells: Vec<String> = r
+                        .probes
+                        .iter()
+                        .map(|(n, xy)| format!("{n} = ({:+.5}, {:+.5})", xy[[k, 0]], xy[[k, 1]]))
+                        .collect();
                     output::println(&format!("  t = {:.4} s: {}", r.t[k], cells.join("  ")))?;
                 }
             }

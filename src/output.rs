@@ -20,7 +20,11 @@ pub fn println(text: &str) -> Result<()> {
 
 /// The error for a failed write to standard output.
 pub fn stdout_error(e: std::io::Error) -> Error {
-    if e.kind() == std::io::ErrorKind::BrokenPipe { Error::StdoutClosed } else { Error::io("standard output", e) }
+    if e.kind() == std::io::ErrorKind::BrokenPipe {
+        Error::StdoutClosed
+    } else {
+        Error::io("standard output", e)
+    }
 }
 
 /// A line on standard error; a closed or full stderr is ignored (messages are a courtesy,

@@ -140,7 +140,13 @@ struct BlowUpWatch {
 
 impl BlowUpWatch {
     fn new(p: &IntegratorParams, warn_only: bool) -> Self {
-        BlowUpWatch { max_strain: p.max_strain, max_cuts: p.max_total_cuts, warn_only, warned_strain: false, warned_cuts: false }
+        BlowUpWatch {
+            max_strain: p.max_strain,
+            max_cuts: p.max_total_cuts,
+            warn_only,
+            warned_strain: false,
+            warned_cuts: false,
+        }
     }
 
     fn check<M: DynamicModel>(&mut self, model: &M, st: &State, stats: &Stats, strain_now: bool) -> Result<()> {
@@ -170,7 +176,11 @@ impl BlowUpWatch {
             return Err(Error::BlowUp { t, problem });
         }
         crate::output::note(&format!("warning: blow-up at t = {t:.6} s: {problem}"));
-        if cuts { self.warned_cuts = true } else { self.warned_strain = true }
+        if cuts {
+            self.warned_cuts = true
+        } else {
+            self.warned_strain = true
+        }
         Ok(())
     }
 }
@@ -180,7 +190,8 @@ pub fn prepare(model: &Model, s: &Settings) -> Result<(FlexibleSystem, Vec<f64>)
     let mut sys = model.system(s.solver);
     sys.set_load_scale(s.load_scale);
     let mut q0 = sys.initial_state();
-    sys.make_consistent(&mut q0).map_err(|p| Error::LinearSolve { t: 0.0, problem: format!("initial joint projection: {p}") })?;
+    sys.make_consistent(&mut q0)
+        .map_err(|p| Error::LinearSolve { t: 0.0, problem: format!("initial joint projection: {p}") })?;
     Ok((sys, q0))
 }
 
@@ -192,7 +203,8 @@ pub fn simulate(model: &Model, overrides: &Overrides) -> Result<SimulationResult
     let mut q = Array2::zeros((n, nt));
     let mut mult = Array2::zeros((nc, nt));
     let mut t = Array1::zeros(nt);
-    let mut probes: Vec<(String, Array2<f64>)> = sys.probes.iter().map(|p| (p.name.clone(), Array2::zeros((nt, 2)))).collect();
+    let mut probes: Vec<(String, Array2<f64>)> =
+        sys.probes.iter().map(|p| (p.name.clone(), Array2::zeros((nt, 2)))).collect();
     let probe_defs = sys.probes.clone();
     let start = std::time::Instant::now();
     // the probes are evaluated after the loop, from the stored coordinates

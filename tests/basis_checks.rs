@@ -54,7 +54,11 @@ hyper = { tolerance = 1e-2 }
 fn trained(dir: &Path, tag: &str, density: f64, pipe: &str) -> PathBuf {
     std::fs::write(dir.join(format!("{tag}_model.toml")), pendulum_text(8, 0.1, density)).unwrap();
     let p = dir.join(format!("{tag}.toml"));
-    std::fs::write(&p, format!("model = \"{tag}_model.toml\"\nbasis = \"{tag}.h5\"\nreport = \"{tag}_report\"\n{pipe}")).unwrap();
+    std::fs::write(
+        &p,
+        format!("model = \"{tag}_model.toml\"\nbasis = \"{tag}.h5\"\nreport = \"{tag}_report\"\n{pipe}"),
+    )
+    .unwrap();
     train_and_write(&Pipeline::load(&p).unwrap(), &dir.join(format!("{tag}.h5"))).unwrap();
     p
 }
@@ -87,7 +91,19 @@ fn read1(f: &hdf5::File, name: &str) -> Array1<f64> {
 fn online(pipe: &Path, basis: &Path) -> (bool, String) {
     let out = basis.with_extension("out.h5");
     let _ = std::fs::remove_file(&out);
-    let o = flexrom().args(["online", pipe.to_str().unwrap(), "--load-scale", "1", "-o", out.to_str().unwrap(), "--basis", basis.to_str().unwrap()]).output().unwrap();
+    let o = flexrom()
+        .args([
+            "online",
+            pipe.to_str().unwrap(),
+            "--load-scale",
+            "1",
+            "-o",
+            out.to_str().unwrap(),
+            "--basis",
+            basis.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
     let err = String::from_utf8_lossy(&o.stderr).to_string();
     assert_ne!(o.status.code(), Some(101), "panic: {err}");
     assert!(o.status.code().is_some(), "killed by a signal: {err}");
@@ -192,7 +208,8 @@ fn crafted_basis_files_are_refused_naming_file_and_dataset() {
 
     // another basis of the same model (5 modes): its content hash does not fit this content
     let other = trained(d, "b", 5540.0, &PIPE.replace("count = 4", "count = 5"));
-    let other_hash = flexrom::io::h5::read_attr_str(&hdf5::File::open(other.with_extension("h5")).unwrap(), "content_hash").unwrap();
+    let other_hash =
+        flexrom::io::h5::read_attr_str(&hdf5::File::open(other.with_extension("h5")).unwrap(), "content_hash").unwrap();
     let bad = craft(&good, "copied_hash.h5", |f| {
         f.delete_attr("content_hash").unwrap();
         flexrom::io::h5::attr_str(f, "content_hash", &other_hash).unwrap();
@@ -221,14 +238,20 @@ fn crafted_basis_files_are_refused_naming_file_and_dataset() {
         f.group("hyper").unwrap().link_soft("/snapshot_t", "weights").unwrap();
     });
     refused(&pipe, &bad, &["hyper/weights", "soft link"]);
-    let bad = craft(&good, "extra_link.h5", |f| f.link_external(outside.to_str().unwrap(), "/snapshots", "notes").unwrap());
+    let bad =
+        craft(&good, "extra_link.h5", |f| f.link_external(outside.to_str().unwrap(), "/snapshots", "notes").unwrap());
     refused(&pipe, &bad, &["notes", "external"]);
     // a dataset whose data lives in an external raw file
     let bad = craft(&good, "external_storage.h5", |f| {
         let r = read1(f, "basis/reference");
         f.unlink("basis/reference").unwrap();
         let raw = d.join("reference.bin");
-        let ds = f.new_dataset::<f64>().shape(r.len()).external(raw.to_str().unwrap(), 0, 8 * r.len()).create("basis/reference").unwrap();
+        let ds = f
+            .new_dataset::<f64>()
+            .shape(r.len())
+            .external(raw.to_str().unwrap(), 0, 8 * r.len())
+            .create("basis/reference")
+            .unwrap();
         ds.write(&r).unwrap();
     });
     refused(&pipe, &bad, &["basis/reference", "external file"]);
@@ -248,7 +271,11 @@ fn crafted_basis_files_are_refused_naming_file_and_dataset() {
     assert_eq!(warnings.len(), 1, "{err}");
     assert!(warnings[0].contains("a.h5") && warnings[0].contains("settings"), "{err}");
     // comments and number spelling do not count as a change
-    std::fs::write(&pipe, text.replace("tolerance = 1e-2", "tolerance = 0.01").replace("[train]", "# same settings\n[train]")).unwrap();
+    std::fs::write(
+        &pipe,
+        text.replace("tolerance = 1e-2", "tolerance = 0.01").replace("[train]", "# same settings\n[train]"),
+    )
+    .unwrap();
     let (ok, err) = online(&pipe, &good);
     assert!(ok && !err.contains("warning"), "{err}");
 }
@@ -261,17 +288,25 @@ fn whole_system_and_raw_bases_pass_the_check() {
     let tmp = tempfile::tempdir().unwrap();
     let d = tmp.path();
     for (tag, pipe) in [
-        ("ws", PIPE.replace("variant = \"galerkin\"", "variant = \"whole-system\"").replace("hyper = { tolerance = 1e-2 }", "")),
+        (
+            "ws",
+            PIPE.replace("variant = \"galerkin\"", "variant = \"whole-system\"")
+                .replace("hyper = { tolerance = 1e-2 }", ""),
+        ),
         ("raw", PIPE.replace("[reduction]", "snapshots = \"raw\"\n[reduction]")),
     ] {
         let p = Pipeline::load(trained(d, tag, 5540.0, &pipe)).unwrap();
-        let s = basis_check::check(&d.join(format!("{tag}.h5")), &p.model, Some(&basis_check::settings_hash(&p))).unwrap();
+        let s =
+            basis_check::check(&d.join(format!("{tag}.h5")), &p.model, Some(&basis_check::settings_hash(&p))).unwrap();
         assert_eq!(s.content_hash.len(), 64);
         assert_eq!(s.settings_hash, basis_check::settings_hash(&p));
         if tag == "ws" {
             // V alone is not orthonormal: the check must use the stacked matrix
             let g = s.basis.modes.t().dot(&s.basis.modes);
-            assert!((&g - &Array2::<f64>::eye(g.nrows())).iter().any(|v| v.abs() > 1e-8), "V alone should not be orthonormal here");
+            assert!(
+                (&g - &Array2::<f64>::eye(g.nrows())).iter().any(|v| v.abs() > 1e-8),
+                "V alone should not be orthonormal here"
+            );
         } else {
             assert!(s.basis.reference.iter().all(|v| *v == 0.0));
         }

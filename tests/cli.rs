@@ -18,7 +18,15 @@ fn simulate_writes_the_documented_layout() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("p.h5");
     let o = flexrom()
-        .args(["simulate", data("pendulum.toml").to_str().unwrap(), "-o", out.to_str().unwrap(), "--t-end", "0.05", "--csv"])
+        .args([
+            "simulate",
+            data("pendulum.toml").to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--t-end",
+            "0.05",
+            "--csv",
+        ])
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -68,7 +76,10 @@ fn bad_model_files_are_refused_with_file_field_and_problem() {
         (Box::new(|s: &str| s.replace("density = 5540.0\n", "")), &["density", "missing"]),
         (Box::new(|s: &str| s.replace("length = 1.2", "length = 0.0")), &["bodies[0].length", "positive"]),
         (Box::new(|s: &str| s.replace("length = 1.2", "length = -1.2")), &["bodies[0].length", "positive"]),
-        (Box::new(|s: &str| s.replace("youngs_modulus = 0.7e9", "youngs_modulus = nan")), &["bodies[0].youngs_modulus", "finite"]),
+        (
+            Box::new(|s: &str| s.replace("youngs_modulus = 0.7e9", "youngs_modulus = nan")),
+            &["bodies[0].youngs_modulus", "finite"],
+        ),
         (Box::new(|s: &str| s.replace("area = 1.8e-3", "area = inf")), &["bodies[0].area"]),
         (Box::new(|s: &str| s.replace("inertia = 1.215e-8", "inertia = 0")), &["bodies[0].inertia"]),
         (Box::new(|s: &str| s.replace("density = 5540.0", "density = -1.0")), &["bodies[0].density"]),
@@ -77,12 +88,21 @@ fn bad_model_files_are_refused_with_file_field_and_problem() {
         (Box::new(|s: &str| s.replace("dt = 0.005", "dt = 0.0")), &["time.dt", "positive"]),
         (Box::new(|s: &str| s.replace("dt = 0.005", "dt = -0.005")), &["time.dt"]),
         (Box::new(|s: &str| s.replace("rho_inf = 1.0", "rho_inf = 1.5")), &["time.rho_inf"]),
-        (Box::new(|s: &str| s.replace("rho_inf = 1.0", "rho_inf = 1.0\njacobian_reuse = \"always\"")), &["time.jacobian_reuse", "within-step"]),
-        (Box::new(|s: &str| s.replace("body = \"beam\"\nnode = \"start\"", "body = \"bean\"\nnode = \"start\"")), &["joints[0].body", "bean"]),
+        (
+            Box::new(|s: &str| s.replace("rho_inf = 1.0", "rho_inf = 1.0\njacobian_reuse = \"always\"")),
+            &["time.jacobian_reuse", "within-step"],
+        ),
+        (
+            Box::new(|s: &str| s.replace("body = \"beam\"\nnode = \"start\"", "body = \"bean\"\nnode = \"start\"")),
+            &["joints[0].body", "bean"],
+        ),
         (Box::new(|s: &str| s.replace("node = \"start\"", "node = 51")), &["joints[0].node", "outside"]),
         (Box::new(|s: &str| s.replace("node = \"end\"", "node = 77")), &["probes[0].node", "outside"]),
         (Box::new(|s: &str| s.replace("node = \"end\"", "at = 1.5")), &["probes[0].at", "outside"]),
-        (Box::new(|s: &str| s.replace("type = \"ground_pin\"", "type = \"ground_pin\"\npoint = [0.5, 0.0]")), &["joints[0].point"]),
+        (
+            Box::new(|s: &str| s.replace("type = \"ground_pin\"", "type = \"ground_pin\"\npoint = [0.5, 0.0]")),
+            &["joints[0].point"],
+        ),
     ];
     for (edit, needles) in cases {
         let err = broken(edit);
@@ -97,7 +117,10 @@ fn bad_model_files_are_refused_with_file_field_and_problem() {
 fn output_into_a_missing_directory_creates_it() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("no/such/dir/out.h5");
-    let o = flexrom().args(["simulate", data("pendulum.toml").to_str().unwrap(), "-o", out.to_str().unwrap(), "--t-end", "0.01"]).output().unwrap();
+    let o = flexrom()
+        .args(["simulate", data("pendulum.toml").to_str().unwrap(), "-o", out.to_str().unwrap(), "--t-end", "0.01"])
+        .output()
+        .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(hdf5::File::open(&out).is_ok());
 }
@@ -107,7 +130,10 @@ fn a_failed_run_keeps_the_previous_good_result() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("keep.h5");
     std::fs::write(&out, b"previous good data").unwrap();
-    let o = flexrom().args(["simulate", data("pendulum.toml").to_str().unwrap(), "-o", out.to_str().unwrap(), "--dt", "-1"]).output().unwrap();
+    let o = flexrom()
+        .args(["simulate", data("pendulum.toml").to_str().unwrap(), "-o", out.to_str().unwrap(), "--dt", "-1"])
+        .output()
+        .unwrap();
     assert!(!o.status.success());
     assert_eq!(std::fs::read(&out).unwrap(), b"previous good data");
 }

@@ -40,7 +40,8 @@ fn repo(rel: &str) -> PathBuf {
 /// its trained basis.
 fn setup(tol: Option<f64>) -> (tempfile::TempDir, PathBuf, PathBuf) {
     let dir = tempfile::tempdir().unwrap();
-    let model = std::fs::read_to_string(repo("data/models/pendulum.toml")).unwrap().replace("t_end = 1.1", "t_end = 0.5");
+    let model =
+        std::fs::read_to_string(repo("data/models/pendulum.toml")).unwrap().replace("t_end = 1.1", "t_end = 0.5");
     assert!(model.contains("t_end = 0.5"));
     std::fs::write(dir.path().join("pendulum.toml"), model).unwrap();
     let tolerance = tol.map_or(String::new(), |t| format!("tolerance = {t:e}\n"));

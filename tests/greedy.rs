@@ -93,7 +93,8 @@ fn greedy_pendulum_meets_its_tolerance() {
     let sl = f.dataset("snapshot_load_scale").unwrap().read_raw::<f64>().unwrap();
     assert!(sl.iter().all(|x| g.load_scales.contains(x)));
 
-    let has_h5py = Command::new("python3").args(["-c", "import h5py, numpy"]).status().map(|s| s.success()).unwrap_or(false);
+    let has_h5py =
+        Command::new("python3").args(["-c", "import h5py, numpy"]).status().map(|s| s.success()).unwrap_or(false);
     if has_h5py {
         let script = r#"
 import sys, h5py, numpy as np
@@ -148,7 +149,9 @@ fn bad_greedy_tables_are_refused() {
 fn greedy_defaults_follow_the_model() {
     let dir = tempfile::tempdir().unwrap();
     let body = "[train]\ngreedy = { range = [0.7, 1.2], tolerance = 1e-3, max_runs = 4 }\n";
-    let fourbar = Pipeline::load(setup(dir.path(), &std::fs::read_to_string(repo("data/models/fourbar.toml")).unwrap(), body)).unwrap();
+    let fourbar =
+        Pipeline::load(setup(dir.path(), &std::fs::read_to_string(repo("data/models/fourbar.toml")).unwrap(), body))
+            .unwrap();
     assert_eq!(fourbar.variant(), Variant::ConstraintPreserving);
     assert_eq!(fourbar.blocks(), Some(flexrom::pipeline::config::Blocks::Bodies));
     let pendulum = Pipeline::load(setup(dir.path(), &pendulum_text(6, 0.1), body)).unwrap();

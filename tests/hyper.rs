@@ -33,7 +33,8 @@ fn repo(rel: &str) -> PathBuf {
 fn setup(dir: &Path, model: &str, pipeline_body: &str) -> PathBuf {
     std::fs::write(dir.join("model.toml"), model).unwrap();
     let p = dir.join("pipe.toml");
-    std::fs::write(&p, format!("model = \"model.toml\"\nbasis = \"basis.h5\"\nreport = \"report\"\n{pipeline_body}")).unwrap();
+    std::fs::write(&p, format!("model = \"model.toml\"\nbasis = \"basis.h5\"\nreport = \"report\"\n{pipeline_body}"))
+        .unwrap();
     p
 }
 
@@ -118,9 +119,13 @@ fn every_element_at_weight_one_equals_plain_galerkin_with(modes: &str) {
     let params = s.params.clone();
     let q0 = basis.reduce(data.x.column(0)).to_vec();
     let mut a = Array2::zeros((r, s.n_steps + 1));
-    integrate(&mut galerkin, &params, q0.clone(), s.dt, s.n_steps, |k, st| a.column_mut(k).assign(&ArrayView1::from(&st.q))).unwrap();
+    integrate(&mut galerkin, &params, q0.clone(), s.dt, s.n_steps, |k, st| {
+        a.column_mut(k).assign(&ArrayView1::from(&st.q))
+    })
+    .unwrap();
     let mut b = Array2::zeros((r, s.n_steps + 1));
-    integrate(&mut hyper, &params, q0, s.dt, s.n_steps, |k, st| b.column_mut(k).assign(&ArrayView1::from(&st.q))).unwrap();
+    integrate(&mut hyper, &params, q0, s.dt, s.n_steps, |k, st| b.column_mut(k).assign(&ArrayView1::from(&st.q)))
+        .unwrap();
     let e = rel(b.as_slice().unwrap(), a.as_slice().unwrap());
     assert!(e < 1e-8, "trajectories differ by {e:e}");
 }
@@ -128,7 +133,8 @@ fn every_element_at_weight_one_equals_plain_galerkin_with(modes: &str) {
 #[test]
 fn ecsw_meets_its_training_tolerance() {
     let dir = tempfile::tempdir().unwrap();
-    let model = std::fs::read_to_string(repo("data/models/pendulum.toml")).unwrap().replace("t_end = 1.1", "t_end = 0.6");
+    let model =
+        std::fs::read_to_string(repo("data/models/pendulum.toml")).unwrap().replace("t_end = 1.1", "t_end = 0.6");
     let body = "[train]\nload_scales = [1.0]\n[reduction]\nvariant = \"galerkin\"\nmodes = { count = 12 }\n";
     let p = Pipeline::load(setup(dir.path(), &model, body)).unwrap();
     let (data, summary) = train(&p).unwrap();
@@ -193,7 +199,10 @@ fn flexrom() -> Command {
 #[test]
 fn bad_hyper_data_is_refused_naming_the_dataset() {
     let dir = tempfile::tempdir().unwrap();
-    let model = std::fs::read_to_string(repo("data/models/pendulum.toml")).unwrap().replace("elements = 50", "elements = 10").replace("t_end = 1.1", "t_end = 0.2");
+    let model = std::fs::read_to_string(repo("data/models/pendulum.toml"))
+        .unwrap()
+        .replace("elements = 50", "elements = 10")
+        .replace("t_end = 1.1", "t_end = 0.2");
     let body = "[train]\nload_scales = [1.0]\n[reduction]\nvariant = \"galerkin\"\nmodes = { count = 6 }\nhyper = { tolerance = 1e-2 }\n";
     let pipe = setup(dir.path(), &model, body);
     let out = flexrom().arg("train").arg(&pipe).output().unwrap();
@@ -201,14 +210,32 @@ fn bad_hyper_data_is_refused_naming_the_dataset() {
     let basis = dir.path().join("basis.h5");
     let good = std::fs::read(&basis).unwrap();
     let cases: [(&str, Box<dyn Fn(&hdf5::Group)>, &str); 3] = [
-        ("hyper/weights", Box::new(|g| {
-            let n = g.dataset("elements").unwrap().size();
-            let mut w = vec![1.0; n];
-            w[n - 1] = -1.0;
-            g.new_dataset_builder().with_data(&w).create("weights").map(|_| ()).unwrap()
-        }), "positive"),
-        ("hyper/elements", Box::new(|g| g.new_dataset_builder().with_data(&[99u64]).create("elements").map(|_| ()).unwrap()), "10 elements"),
-        ("hyper/weights", Box::new(|g| g.new_dataset_builder().with_data(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0, 10.0, 11.0]).create("weights").map(|_| ()).unwrap()), "entries"),
+        (
+            "hyper/weights",
+            Box::new(|g| {
+                let n = g.dataset("elements").unwrap().size();
+                let mut w = vec![1.0; n];
+                w[n - 1] = -1.0;
+                g.new_dataset_builder().with_data(&w).create("weights").map(|_| ()).unwrap()
+            }),
+            "positive",
+        ),
+        (
+            "hyper/elements",
+            Box::new(|g| g.new_dataset_builder().with_data(&[99u64]).create("elements").map(|_| ()).unwrap()),
+            "10 elements",
+        ),
+        (
+            "hyper/weights",
+            Box::new(|g| {
+                g.new_dataset_builder()
+                    .with_data(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0, 10.0, 11.0])
+                    .create("weights")
+                    .map(|_| ())
+                    .unwrap()
+            }),
+            "entries",
+        ),
     ];
     for (dataset, corrupt, needle) in cases {
         std::fs::write(&basis, &good).unwrap();
@@ -225,7 +252,11 @@ fn bad_hyper_data_is_refused_naming_the_dataset() {
             g.unlink(name).unwrap();
             corrupt(&g);
         }
-        let out = flexrom().args(["online", pipe.to_str().unwrap(), "--load-scale", "1.0", "-o"]).arg(dir.path().join("out.h5")).output().unwrap();
+        let out = flexrom()
+            .args(["online", pipe.to_str().unwrap(), "--load-scale", "1.0", "-o"])
+            .arg(dir.path().join("out.h5"))
+            .output()
+            .unwrap();
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(!out.status.success(), "{dataset}: accepted");
         assert!(err.contains("basis.h5") && err.contains(dataset) && err.contains(needle), "{dataset}: {err}");

@@ -24,7 +24,8 @@ fn clamped_free_bending_frequencies_match_euler_bernoulli() {
             assert!(kk[r * n + c].abs() < 1e-9 * kk[r * n + r].abs(), "bending–axial coupling at ({r}, {c})");
         }
     }
-    let pick = |src: &[f64]| Array2::from_shape_fn((bending.len(), bending.len()), |(r, c)| src[bending[r] * n + bending[c]]);
+    let pick =
+        |src: &[f64]| Array2::from_shape_fn((bending.len(), bending.len()), |(r, c)| src[bending[r] * n + bending[c]]);
     let (w2, _) = (pick(&kk), pick(&mm)).eigh(UPLO::Lower).expect("generalized symmetric eigenproblem");
     let scale = (e * i / (rho * a * l.powi(4))).sqrt();
     for (k, bl) in [1.8751_f64, 4.6941, 7.8548].iter().enumerate() {

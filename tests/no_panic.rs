@@ -28,7 +28,9 @@ fn violation(case: &str, o: &Output) -> Option<String> {
         Some(101) => Some(format!("{case}: panicked (exit 101)\n{stderr}")),
         _ if stderr.contains("panicked") => Some(format!("{case}: panic message on stderr\n{stderr}")),
         Some(0) => None,
-        Some(_) if lines == 0 || lines > 2 => Some(format!("{case}: failed with {lines} lines of stderr (want 1 or 2)\n{stderr}")),
+        Some(_) if lines == 0 || lines > 2 => {
+            Some(format!("{case}: failed with {lines} lines of stderr (want 1 or 2)\n{stderr}"))
+        }
         Some(_) => None,
     }
 }
@@ -45,7 +47,8 @@ fn hostile_command_line_values_never_panic() {
     for flag in ["--dt", "--t-end", "--load-scale", "--rho-inf"] {
         for v in values {
             // the run is kept short unless the flag under test is the end time
-            let mut args: Vec<String> = vec!["simulate".into(), model.display().to_string(), "-o".into(), out.display().to_string()];
+            let mut args: Vec<String> =
+                vec!["simulate".into(), model.display().to_string(), "-o".into(), out.display().to_string()];
             if flag != "--t-end" {
                 args.extend(["--t-end".into(), "0.02".into()]);
             }
@@ -58,9 +61,29 @@ fn hostile_command_line_values_never_panic() {
     // sweep ranges: N = 0, N beyond usize, N as a float, words, an overflowing span, N at
     // the maximum of u64; parsing comes before the basis is read, and no basis is shipped,
     // so valid ranges end on the missing basis file (an ordinary error)
-    for range in ["1:2:0", "1:2:99999999999999999999", "1:2:18446744073709551615", "1:2:1e3", "a:b:c", "1e308:-1e308:3", "nan:1:2", "1:2", "1:2:3:4", "1:1:1"] {
+    for range in [
+        "1:2:0",
+        "1:2:99999999999999999999",
+        "1:2:18446744073709551615",
+        "1:2:1e3",
+        "a:b:c",
+        "1e308:-1e308:3",
+        "nan:1:2",
+        "1:2",
+        "1:2:3:4",
+        "1:1:1",
+    ] {
         let o = flexrom()
-            .args(["sweep", pipeline.to_str().unwrap(), "--load-scales", range, "-o", out.to_str().unwrap(), "--basis", dir.path().join("none.h5").to_str().unwrap()])
+            .args([
+                "sweep",
+                pipeline.to_str().unwrap(),
+                "--load-scales",
+                range,
+                "-o",
+                out.to_str().unwrap(),
+                "--basis",
+                dir.path().join("none.h5").to_str().unwrap(),
+            ])
             .output()
             .unwrap();
         cases += 1;
@@ -78,8 +101,17 @@ fn hostile_command_line_values_never_panic() {
         }
     }
     // bounds given badly
-    for (flag, v) in [("--max-memory", "0"), ("--max-memory", "-5G"), ("--max-memory", "1e400"), ("--max-steps", "0"), ("--max-elements", "x")] {
-        let o = flexrom().args(["simulate", model.to_str().unwrap(), "-o", out.to_str().unwrap(), "--t-end", "0.02", flag, v]).output().unwrap();
+    for (flag, v) in [
+        ("--max-memory", "0"),
+        ("--max-memory", "-5G"),
+        ("--max-memory", "1e400"),
+        ("--max-steps", "0"),
+        ("--max-elements", "x"),
+    ] {
+        let o = flexrom()
+            .args(["simulate", model.to_str().unwrap(), "-o", out.to_str().unwrap(), "--t-end", "0.02", flag, v])
+            .output()
+            .unwrap();
         cases += 1;
         bad.extend(violation(&format!("simulate {flag} {v}"), &o));
     }
@@ -108,8 +140,37 @@ fn hostile_model_values_never_panic() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("o.h5");
     let text = std::fs::read_to_string(root().join("data/models/pendulum.toml")).unwrap();
-    let keys = ["t_end", "dt", "rho_inf", "length", "angle", "elements", "density", "area", "inertia", "youngs_modulus", "start", "g", "node"];
-    let values = ["0", "-1", "1e300", "1e-300", "nan", "inf", "-inf", "9223372036854775807", "-9223372036854775808", "\"x\"", "true", "[1, 2]", "[nan, 0.0]", "{}"];
+    let keys = [
+        "t_end",
+        "dt",
+        "rho_inf",
+        "length",
+        "angle",
+        "elements",
+        "density",
+        "area",
+        "inertia",
+        "youngs_modulus",
+        "start",
+        "g",
+        "node",
+    ];
+    let values = [
+        "0",
+        "-1",
+        "1e300",
+        "1e-300",
+        "nan",
+        "inf",
+        "-inf",
+        "9223372036854775807",
+        "-9223372036854775808",
+        "\"x\"",
+        "true",
+        "[1, 2]",
+        "[nan, 0.0]",
+        "{}",
+    ];
     let mut bad = Vec::new();
     let mut cases = 0;
     for key in keys {
@@ -117,7 +178,10 @@ fn hostile_model_values_never_panic() {
         for v in values {
             let path = dir.path().join("m.toml");
             std::fs::write(&path, with_value(&text, key, v)).unwrap();
-            let o = flexrom().args(["simulate", path.to_str().unwrap(), "-o", out.to_str().unwrap(), "--t-end", "0.02"]).output().unwrap();
+            let o = flexrom()
+                .args(["simulate", path.to_str().unwrap(), "-o", out.to_str().unwrap(), "--t-end", "0.02"])
+                .output()
+                .unwrap();
             cases += 1;
             bad.extend(violation(&format!("{key} = {v}"), &o));
         }
@@ -132,11 +196,15 @@ fn hostile_model_values_never_panic() {
 #[test]
 fn hostile_pipeline_values_never_panic() {
     let dir = tempfile::tempdir().unwrap();
-    let model = std::fs::read_to_string(root().join("data/models/pendulum.toml")).unwrap().replace("t_end = 1.1", "t_end = 0.05");
+    let model = std::fs::read_to_string(root().join("data/models/pendulum.toml"))
+        .unwrap()
+        .replace("t_end = 1.1", "t_end = 0.05");
     std::fs::write(dir.path().join("m.toml"), model).unwrap();
     // the pendulum pipeline with fixed training loads and mode count (the shipped one trains
     // greedily, tests/greedy.rs refuses its bad tables)
-    let text = std::fs::read_to_string(root().join("pipelines/thesis/pendulum_hyper.toml")).unwrap().replace("../../data/models/pendulum.toml", "m.toml");
+    let text = std::fs::read_to_string(root().join("pipelines/thesis/pendulum_hyper.toml"))
+        .unwrap()
+        .replace("../../data/models/pendulum.toml", "m.toml");
     let edits: &[(&str, &str)] = &[
         ("modes = { count = 14 }", "modes = { count = 0 }"),
         ("modes = { count = 14 }", "modes = { count = 99999999999 }"),

@@ -56,7 +56,8 @@ fn tip_trajectory_converges_at_second_order_in_dt() {
         (0..=220).map(|k| [xy[[k * every, 0]], xy[[k * every, 1]]]).collect::<Vec<_>>()
     };
     let rms = |a: &[[f64; 2]], b: &[[f64; 2]]| {
-        (a.iter().zip(b).map(|(p, q)| (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sum::<f64>() / a.len() as f64).sqrt()
+        (a.iter().zip(b).map(|(p, q)| (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sum::<f64>() / a.len() as f64)
+            .sqrt()
     };
     let (a, b, c) = (tip(0.005), tip(0.0025), tip(0.00125));
     let (d1, d2) = (rms(&a, &b), rms(&b, &c));
@@ -149,13 +150,19 @@ fn a_guessed_increment_moves_only_the_start_of_newton() {
     // exact than the tolerance, so a guide from it is exact
     let newton = IntegratorParams { reuse: JacobianReuse::Never, ..s.params.clone() };
     let (plain, plain_stats) = run(&newton, 1.0, None);
-    let (same, same_stats) = run(&IntegratorParams { reuse: JacobianReuse::WithinStep, ..s.params.clone() }, 1.0, Some(&plain));
+    let (same, same_stats) =
+        run(&IntegratorParams { reuse: JacobianReuse::WithinStep, ..s.params.clone() }, 1.0, Some(&plain));
     let (other, _) = run(&newton, 0.5, None);
     let (wrong, _) = run(&newton, 1.0, Some(&other));
-    let diff = |a: &Vec<Vec<f64>>| a.last().unwrap().iter().zip(plain.last().unwrap()).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+    let diff = |a: &Vec<Vec<f64>>| {
+        a.last().unwrap().iter().zip(plain.last().unwrap()).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+    };
     assert!(diff(&same) < 1e-7 && diff(&wrong) < 1e-7, "{:.3e} {:.3e}", diff(&same), diff(&wrong));
     assert!(same_stats.max_iterations_in_a_step <= 2, "{same_stats:?}");
-    assert!(same_stats.factorizations <= s.n_steps + 1 && plain_stats.newton_iterations > 2 * same_stats.newton_iterations, "{plain_stats:?} {same_stats:?}");
+    assert!(
+        same_stats.factorizations <= s.n_steps + 1 && plain_stats.newton_iterations > 2 * same_stats.newton_iterations,
+        "{plain_stats:?} {same_stats:?}"
+    );
     // the other run really is another trajectory
     assert!(other.last().unwrap().iter().zip(plain.last().unwrap()).any(|(a, b)| (a - b).abs() > 1e-3));
 }

@@ -45,7 +45,8 @@ fn pendulum_text(elements: usize, t_end: f64) -> String {
 fn setup(dir: &Path, model: &str, pipeline_body: &str) -> PathBuf {
     std::fs::write(dir.join("model.toml"), model).unwrap();
     let p = dir.join("pipe.toml");
-    std::fs::write(&p, format!("model = \"model.toml\"\nbasis = \"basis.h5\"\nreport = \"report\"\n{pipeline_body}")).unwrap();
+    std::fs::write(&p, format!("model = \"model.toml\"\nbasis = \"basis.h5\"\nreport = \"report\"\n{pipeline_body}"))
+        .unwrap();
     p
 }
 
@@ -135,7 +136,10 @@ fn pendulum_pipeline_end_to_end_within_the_error_bound() {
     let o = flexrom().args(["train", pipe.to_str().unwrap()]).output().unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let out = dir.path().join("rom.h5");
-    let o = flexrom().args(["online", pipe.to_str().unwrap(), "--load-scale", "1.0", "-o", out.to_str().unwrap()]).output().unwrap();
+    let o = flexrom()
+        .args(["online", pipe.to_str().unwrap(), "--load-scale", "1.0", "-o", out.to_str().unwrap()])
+        .output()
+        .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let f = hdf5::File::open(&out).unwrap();
     assert_eq!(f.dataset("q").unwrap().shape(), vec![84, 121]);
@@ -145,7 +149,19 @@ fn pendulum_pipeline_end_to_end_within_the_error_bound() {
     let o = flexrom().args(["validate", pipe.to_str().unwrap(), "--load-scale", "1.0", "--json"]).output().unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    for key in ["load_scale", "n_dof", "n_modes", "rel_error", "max_probe_error", "max_constraint_violation", "full_seconds", "full_dense_seconds", "rom_seconds", "speedup", "speedup_vs_dense"] {
+    for key in [
+        "load_scale",
+        "n_dof",
+        "n_modes",
+        "rel_error",
+        "max_probe_error",
+        "max_constraint_violation",
+        "full_seconds",
+        "full_dense_seconds",
+        "rom_seconds",
+        "speedup",
+        "speedup_vs_dense",
+    ] {
         assert!(j.get(key).is_some(), "key {key} missing in {j}");
     }
     assert_eq!(j["n_dof"], 84);
@@ -154,7 +170,18 @@ fn pendulum_pipeline_end_to_end_within_the_error_bound() {
     assert!(j["max_constraint_violation"].as_f64().unwrap() < 1e-12, "{j}");
 
     let sweep = dir.path().join("sweep.h5");
-    let o = flexrom().args(["sweep", pipe.to_str().unwrap(), "--load-scales", "0.9:1.1:3", "--validate", "-o", sweep.to_str().unwrap()]).output().unwrap();
+    let o = flexrom()
+        .args([
+            "sweep",
+            pipe.to_str().unwrap(),
+            "--load-scales",
+            "0.9:1.1:3",
+            "--validate",
+            "-o",
+            sweep.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(String::from_utf8_lossy(&o.stdout).lines().count(), 4, "header and three rows");
     let f = hdf5::File::open(&sweep).unwrap();
@@ -168,7 +195,8 @@ fn pendulum_pipeline_end_to_end_within_the_error_bound() {
     // guesses, so each step keeps its first matrix), and the file says how it was run
     let run = |extra: &[&str], name: &str| {
         let out = dir.path().join(name);
-        let mut args = vec!["sweep", pipe.to_str().unwrap(), "--load-scales", "0.9:1.1:21", "-o", out.to_str().unwrap()];
+        let mut args =
+            vec!["sweep", pipe.to_str().unwrap(), "--load-scales", "0.9:1.1:21", "-o", out.to_str().unwrap()];
         args.extend_from_slice(extra);
         let o = flexrom().args(&args).output().unwrap();
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -192,7 +220,15 @@ fn run_writes_a_report() {
     let pipe = setup(dir.path(), &pendulum_text(10, 0.3), PENDULUM_PIPE);
     let o = flexrom().args(["run", pipe.to_str().unwrap()]).output().unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    for f in ["summary.md", "validation.json", "sweep.h5", "probes_0.svg", "singular_values.svg", "error_vs_load.svg", "speedup_vs_load.svg"] {
+    for f in [
+        "summary.md",
+        "validation.json",
+        "sweep.h5",
+        "probes_0.svg",
+        "singular_values.svg",
+        "error_vs_load.svg",
+        "speedup_vs_load.svg",
+    ] {
         assert!(dir.path().join("report").join(f).is_file(), "{f} missing");
     }
     let svg = std::fs::read_to_string(dir.path().join("report/singular_values.svg")).unwrap();
@@ -202,7 +238,8 @@ fn run_writes_a_report() {
 #[test]
 fn constraint_preserving_fourbar_keeps_the_joints() {
     let dir = tempfile::tempdir().unwrap();
-    let model = std::fs::read_to_string(repo("data/models/fourbar.toml")).unwrap().replace("t_end = 1.1", "t_end = 0.9");
+    let model =
+        std::fs::read_to_string(repo("data/models/fourbar.toml")).unwrap().replace("t_end = 1.1", "t_end = 0.9");
     let body = r#"
 [train]
 load_scales = [0.935]
@@ -254,15 +291,29 @@ fn bad_input_is_refused_clearly() {
 
     fails_with(&["online", ps, "--load-scale", "nan", "-o", os], &["load-scale", "finite"]);
     // a basis of another model: the same pipeline after the model changed
-    std::fs::write(d.join("model.toml"), pendulum_text(6, 0.1).replace("youngs_modulus = 0.7e9", "youngs_modulus = 0.8e9")).unwrap();
+    std::fs::write(
+        d.join("model.toml"),
+        pendulum_text(6, 0.1).replace("youngs_modulus = 0.7e9", "youngs_modulus = 0.8e9"),
+    )
+    .unwrap();
     fails_with(&["online", ps, "--load-scale", "1", "-o", os], &["basis.h5", "model_fingerprint", "different model"]);
     std::fs::write(d.join("model.toml"), pendulum_text(6, 0.1)).unwrap();
     // truncated and foreign files
     std::fs::write(d.join("cut.h5"), &good[..good.len() / 2]).unwrap();
-    fails_with(&["online", ps, "--load-scale", "1", "-o", os, "--basis", d.join("cut.h5").to_str().unwrap()], &["cut.h5", "HDF5"]);
+    fails_with(
+        &["online", ps, "--load-scale", "1", "-o", os, "--basis", d.join("cut.h5").to_str().unwrap()],
+        &["cut.h5", "HDF5"],
+    );
     let foreign = d.join("foreign.h5");
-    assert!(flexrom().args(["simulate", d.join("model.toml").to_str().unwrap(), "-o", foreign.to_str().unwrap()]).status().unwrap().success());
-    fails_with(&["online", ps, "--load-scale", "1", "-o", os, "--basis", foreign.to_str().unwrap()], &["foreign.h5", "schema_version", "not a flexrom basis"]);
+    assert!(flexrom()
+        .args(["simulate", d.join("model.toml").to_str().unwrap(), "-o", foreign.to_str().unwrap()])
+        .status()
+        .unwrap()
+        .success());
+    fails_with(
+        &["online", ps, "--load-scale", "1", "-o", os, "--basis", foreign.to_str().unwrap()],
+        &["foreign.h5", "schema_version", "not a flexrom basis"],
+    );
     assert!(!out.exists(), "no output from failed runs");
 
     // too many modes, zero modes, an empty training set: a failed train keeps the good basis
@@ -270,11 +321,26 @@ fn bad_input_is_refused_clearly() {
         (PENDULUM_PIPE.replace("{ ratio = 0.1 }", "{ count = 500 }"), vec!["reduction.modes", "500 modes"]),
         (PENDULUM_PIPE.replace("{ ratio = 0.1 }", "{ count = 0 }"), vec!["reduction.modes", "at least 1"]),
         // counts are per block: none without blocks, one per body with them
-        (PENDULUM_PIPE.replace("{ ratio = 0.1 }", "{ counts = [3] }"), vec!["reduction.modes", "no blocks", "reduction.blocks"]),
-        (PENDULUM_PIPE.replace("{ ratio = 0.1 }", "{ counts = [3, 4] }\nblocks = \"bodies\""), vec!["reduction.modes", "2 counts", "1 bodies"]),
-        (PENDULUM_PIPE.replace("{ ratio = 0.1 }", "{ counts = [3, 0] }\nblocks = \"bodies\""), vec!["reduction.modes", "at least 1"]),
-        (PENDULUM_PIPE.replace("\"galerkin\"", "\"whole-system\"\nblocks = \"bodies\""), vec!["reduction.blocks", "whole-system"]),
-        (PENDULUM_PIPE.replace("{ ratio = 0.1 }", "{ ratio = 0.1 }\nblocks = \"elements\""), vec!["pipe.toml", "elements"]),
+        (
+            PENDULUM_PIPE.replace("{ ratio = 0.1 }", "{ counts = [3] }"),
+            vec!["reduction.modes", "no blocks", "reduction.blocks"],
+        ),
+        (
+            PENDULUM_PIPE.replace("{ ratio = 0.1 }", "{ counts = [3, 4] }\nblocks = \"bodies\""),
+            vec!["reduction.modes", "2 counts", "1 bodies"],
+        ),
+        (
+            PENDULUM_PIPE.replace("{ ratio = 0.1 }", "{ counts = [3, 0] }\nblocks = \"bodies\""),
+            vec!["reduction.modes", "at least 1"],
+        ),
+        (
+            PENDULUM_PIPE.replace("\"galerkin\"", "\"whole-system\"\nblocks = \"bodies\""),
+            vec!["reduction.blocks", "whole-system"],
+        ),
+        (
+            PENDULUM_PIPE.replace("{ ratio = 0.1 }", "{ ratio = 0.1 }\nblocks = \"elements\""),
+            vec!["pipe.toml", "elements"],
+        ),
         (PENDULUM_PIPE.replace("load_scales = [0.9, 1.1]", "load_scales = []"), vec!["train.load_scales", "empty"]),
         (PENDULUM_PIPE.replace("load_scales = [0.9, 1.1]", "load_scales = [1.0]\nfoo = 1"), vec!["pipe.toml", "foo"]),
     ] {
@@ -282,14 +348,19 @@ fn bad_input_is_refused_clearly() {
         fails_with(&["train", ps], &needles);
         assert_eq!(std::fs::read(d.join("basis.h5")).unwrap(), good, "the previous basis survives");
     }
-    let leftovers: Vec<_> = std::fs::read_dir(d).unwrap().filter_map(|e| e.ok()).filter(|e| e.file_name().to_string_lossy().contains(".tmp-")).collect();
+    let leftovers: Vec<_> = std::fs::read_dir(d)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains(".tmp-"))
+        .collect();
     assert!(leftovers.is_empty(), "no temporary files left behind");
 }
 
 /// Reads a basis from Python, as users do, when python3 with h5py is installed.
 #[test]
 fn basis_file_reads_from_python_h5py() {
-    let has_h5py = Command::new("python3").args(["-c", "import h5py, numpy"]).status().map(|s| s.success()).unwrap_or(false);
+    let has_h5py =
+        Command::new("python3").args(["-c", "import h5py, numpy"]).status().map(|s| s.success()).unwrap_or(false);
     if !has_h5py {
         eprintln!("skipped: python3 with h5py and numpy is not installed");
         return;
@@ -318,7 +389,8 @@ print("ok")
 fn shipped_pipelines_load() {
     for name in ["pipelines/pendulum.toml", "pipelines/fourbar.toml"] {
         let p = Pipeline::load(repo(name)).unwrap();
-        assert!(p.basis_path.ends_with(format!("data/bases/{}.h5", Path::new(name).file_stem().unwrap().to_string_lossy())));
+        assert!(p
+            .basis_path
+            .ends_with(format!("data/bases/{}.h5", Path::new(name).file_stem().unwrap().to_string_lossy())));
     }
 }
-

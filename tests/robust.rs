@@ -132,7 +132,10 @@ fn dependent_joints_are_refused_naming_them() {
     load(&(ground("clamp", "a") + &pin("a", "b"))).unwrap();
     // a node pinned to ground twice
     let e = load(&(ground("ground_pin", "a") + &ground("ground_pin", "a"))).unwrap_err();
-    assert!(e.contains("joints[1]") && e.contains("joints[0] (ground_pin on `a` node 0)") && e.contains("dependent"), "{e}");
+    assert!(
+        e.contains("joints[1]") && e.contains("joints[0] (ground_pin on `a` node 0)") && e.contains("dependent"),
+        "{e}"
+    );
     // a clamp and a ground pin on the same node
     let e = load(&(ground("clamp", "a") + &ground("ground_pin", "a"))).unwrap_err();
     assert!(e.contains("joints[1]") && e.contains("joints[0] (clamp on `a` node 0)"), "{e}");
@@ -145,7 +148,9 @@ fn dependent_joints_are_refused_naming_them() {
     // the line of the offending entry
     let text = star(&(ground("ground_pin", "a") + &ground("ground_pin", "a")));
     let line = text.lines().enumerate().filter(|(_, l)| *l == "[[joints]]").nth(1).unwrap().0 + 1;
-    assert!(load(&(ground("ground_pin", "a") + &ground("ground_pin", "a"))).unwrap_err().contains(&format!("joints[1] (line {line})")));
+    assert!(load(&(ground("ground_pin", "a") + &ground("ground_pin", "a")))
+        .unwrap_err()
+        .contains(&format!("joints[1] (line {line})")));
 }
 
 #[test]
@@ -156,24 +161,46 @@ fn blow_ups_stop_the_run_unless_allowed() {
     let soft = write(dir.path(), "soft.toml", &pendulum().replace("youngs_modulus = 0.7e9", "youngs_modulus = 1e3"));
     let (code, err) = run(&["simulate", &soft, "-o", o, "--t-end", "0.1"]);
     assert_eq!(code, 1, "{err}");
-    assert!(err.contains("simulate at load scale 1") && err.contains("max_strain") && err.contains("--allow-blowup"), "{err}");
+    assert!(
+        err.contains("simulate at load scale 1") && err.contains("max_strain") && err.contains("--allow-blowup"),
+        "{err}"
+    );
     assert!(!out.exists(), "a blown-up run writes nothing");
     let (code, err) = run(&["simulate", &soft, "-o", o, "--t-end", "0.1", "--allow-blowup"]);
     assert_eq!(code, 0, "{err}");
     assert!(err.contains("warning: blow-up") && err.contains("max_strain"), "{err}");
     assert!(out.exists());
     // raising the key instead
-    let relaxed = write(dir.path(), "relaxed.toml", &pendulum().replace("youngs_modulus = 0.7e9", "youngs_modulus = 1e3").replace("rho_inf = 1.0", "rho_inf = 1.0\nmax_strain = 1e6"));
+    let relaxed = write(
+        dir.path(),
+        "relaxed.toml",
+        &pendulum()
+            .replace("youngs_modulus = 0.7e9", "youngs_modulus = 1e3")
+            .replace("rho_inf = 1.0", "rho_inf = 1.0\nmax_strain = 1e6"),
+    );
     let (code, err) = run(&["simulate", &relaxed, "-o", o, "--t-end", "0.1"]);
     assert_eq!(code, 0, "{err}");
     assert!(!err.contains("blow-up"), "{err}");
 
     // the load scale 1e4: the strain bound fires (naming the scale); with it relaxed and no
     // step cuts allowed, the cut budget does
-    let (code, err) = run(&["simulate", &root().join("data/models/pendulum.toml").display().to_string(), "-o", o, "--load-scale", "1e4", "--t-end", "0.3"]);
+    let (code, err) = run(&[
+        "simulate",
+        &root().join("data/models/pendulum.toml").display().to_string(),
+        "-o",
+        o,
+        "--load-scale",
+        "1e4",
+        "--t-end",
+        "0.3",
+    ]);
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("load scale 10000") && err.contains("max_strain"), "{err}");
-    let cuts = write(dir.path(), "cuts.toml", &pendulum().replace("rho_inf = 1.0", "rho_inf = 1.0\nmax_strain = 1e9\nmax_total_step_cuts = 0"));
+    let cuts = write(
+        dir.path(),
+        "cuts.toml",
+        &pendulum().replace("rho_inf = 1.0", "rho_inf = 1.0\nmax_strain = 1e9\nmax_total_step_cuts = 0"),
+    );
     let (code, err) = run(&["simulate", &cuts, "-o", o, "--load-scale", "1e4", "--t-end", "0.3"]);
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("step halvings") && err.contains("max_total_step_cuts"), "{err}");
@@ -219,7 +246,8 @@ fn a_closed_or_full_stdout_is_not_a_panic() {
     assert_eq!(code, Some(0), "{err}");
     assert!(!err.contains("panicked"), "{err}");
     let sw = dir.path().join("s.h5");
-    let (code, err) = into_closed_pipe(&["sweep", p, "--load-scales", "0.9:1.1:3", "--basis", b, "-o", sw.to_str().unwrap()]);
+    let (code, err) =
+        into_closed_pipe(&["sweep", p, "--load-scales", "0.9:1.1:3", "--basis", b, "-o", sw.to_str().unwrap()]);
     assert_eq!(code, Some(0), "{err}");
     assert!(!err.contains("panicked"), "{err}");
 }

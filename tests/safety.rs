@@ -88,7 +88,11 @@ fn snapshot(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
 
 /// Entries below `root` whose name says they are flexrom's temporary or moved-aside paths.
 fn leftovers(root: &Path) -> Vec<PathBuf> {
-    snapshot(root).into_keys().filter(|p| p.file_name().unwrap().to_string_lossy().contains(".flexrom-")).filter(|p| !p.ends_with(".flexrom-report")).collect()
+    snapshot(root)
+        .into_keys()
+        .filter(|p| p.file_name().unwrap().to_string_lossy().contains(".flexrom-"))
+        .filter(|p| !p.ends_with(".flexrom-report"))
+        .collect()
 }
 
 fn fails_with(o: &Output, words: &[&str]) -> String {
@@ -113,7 +117,11 @@ fn report_folders_that_are_not_flexroms_own_are_refused_and_nothing_is_deleted()
     std::fs::write(root.join("data/results.csv"), b"1,2,3\n").unwrap();
     std::fs::write(root.join("data/sub/notes.txt"), b"keep me").unwrap();
     std::fs::create_dir_all(root.join("marked")).unwrap();
-    std::fs::write(root.join("marked/.flexrom-report"), "flexrom report folder: made by flexrom and replaced as a whole by `flexrom run`; files:\nsummary.md\n").unwrap();
+    std::fs::write(
+        root.join("marked/.flexrom-report"),
+        "flexrom report folder: made by flexrom and replaced as a whole by `flexrom run`; files:\nsummary.md\n",
+    )
+    .unwrap();
     std::fs::write(root.join("marked/summary.md"), b"old").unwrap();
     std::fs::write(root.join("marked/mine.txt"), b"the user's").unwrap();
     std::fs::write(root.join("file.txt"), b"a file").unwrap();
@@ -172,7 +180,10 @@ fn a_marked_report_is_replaced_and_a_failed_later_stage_keeps_the_previous_basis
     let before = snapshot(root);
     let model = model_text(0.05, "max_iterations = 4\nmax_step_cuts = 0");
     std::fs::write(root.join("proj/m.toml"), &model).unwrap();
-    let text = std::fs::read_to_string(&p).unwrap().replace("load_scales = [1.0]\n[reduction]", "load_scales = [0.1]\n[reduction]").replace("[0.9, 1.0]", "[0.1, 100.0]");
+    let text = std::fs::read_to_string(&p)
+        .unwrap()
+        .replace("load_scales = [1.0]\n[reduction]", "load_scales = [0.1]\n[reduction]")
+        .replace("[0.9, 1.0]", "[0.1, 100.0]");
     std::fs::write(&p, &text).unwrap();
     let mut expected = before.clone();
     expected.insert(root.join("proj/m.toml"), model.into_bytes());
@@ -182,7 +193,9 @@ fn a_marked_report_is_replaced_and_a_failed_later_stage_keeps_the_previous_basis
     assert!(err.contains("[2/3]"), "the training stage passed: {err}");
     assert_eq!(snapshot(root), expected, "basis or report changed by a failed run");
     // `train` whose training run fails (load scale 100) keeps the previous basis too
-    let text = std::fs::read_to_string(&p).unwrap().replace("load_scales = [0.1]\n[reduction]", "load_scales = [100.0]\n[reduction]");
+    let text = std::fs::read_to_string(&p)
+        .unwrap()
+        .replace("load_scales = [0.1]\n[reduction]", "load_scales = [100.0]\n[reduction]");
     std::fs::write(&p, &text).unwrap();
     expected.insert(p.clone(), text.into_bytes());
     fails_with(&run(&[Path::new("train"), &p]), &["Newton failed"]);
@@ -207,7 +220,8 @@ fn outputs_that_are_inputs_or_not_regular_files_are_refused() {
     assert!(Command::new("mkfifo").arg(root.join("fifo")).status().unwrap().success());
     let before = snapshot(root);
     let sim = |out: &Path| run(&[Path::new("simulate"), &model, Path::new("-o"), out]);
-    let online = |out: &Path| run(&[Path::new("online"), &p, Path::new("--load-scale"), Path::new("1"), Path::new("-o"), out]);
+    let online =
+        |out: &Path| run(&[Path::new("online"), &p, Path::new("--load-scale"), Path::new("1"), Path::new("-o"), out]);
     let cases: Vec<(Output, &[&str])> = vec![
         (sim(&model), &["-o", "model file"]),
         (sim(&proj.join("../proj/./m.toml")), &["model file"]),
@@ -252,7 +266,18 @@ fn every_command_creates_missing_output_folders_and_follows_a_symlink_to_a_regul
     let b = new("basis");
     assert!(run(&[Path::new("train"), &p, Path::new("--basis"), &b]).status.success());
     assert!(run(&[Path::new("simulate"), &model, Path::new("-o"), &new("sim")]).status.success());
-    assert!(run(&[Path::new("online"), &p, Path::new("--basis"), &b, Path::new("--load-scale"), Path::new("1"), Path::new("-o"), &new("online")]).status.success());
+    assert!(run(&[
+        Path::new("online"),
+        &p,
+        Path::new("--basis"),
+        &b,
+        Path::new("--load-scale"),
+        Path::new("1"),
+        Path::new("-o"),
+        &new("online")
+    ])
+    .status
+    .success());
     assert!(run(&[Path::new("sweep"), &p, Path::new("--basis"), &b, Path::new("-o"), &new("sweep")]).status.success());
     for k in ["basis", "sim", "online", "sweep"] {
         assert!(hdf5::File::open(new(k)).is_ok(), "{k}");
@@ -265,7 +290,9 @@ fn every_command_creates_missing_output_folders_and_follows_a_symlink_to_a_regul
     // a symlink to a regular file: the file it points to is replaced, the link stays
     let link = root.join("link.h5");
     std::os::unix::fs::symlink(new("sim"), &link).unwrap();
-    assert!(run(&[Path::new("simulate"), &model, Path::new("-o"), &link, Path::new("--t-end"), Path::new("0.02")]).status.success());
+    assert!(run(&[Path::new("simulate"), &model, Path::new("-o"), &link, Path::new("--t-end"), Path::new("0.02")])
+        .status
+        .success());
     assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
     let t = hdf5::File::open(new("sim")).unwrap().dataset("t").unwrap().read_1d::<f64>().unwrap();
     assert_eq!(t.len(), 5, "0.02 s in steps of 0.005 s: the new result is behind the link");
@@ -291,7 +318,8 @@ fn kill_run(root: &Path, p: &Path, stage: &str, wanted: &[&str], signal: &str) -
             err.push_str(&l);
             err.push('\n');
         }
-        let names: Vec<String> = leftovers(root).iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
+        let names: Vec<String> =
+            leftovers(root).iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
         if err.contains(stage) && wanted.iter().all(|w| names.iter().any(|n| n.contains(w))) {
             break;
         }

@@ -13,15 +13,8 @@ const EXE: &str = env!("CARGO_BIN_EXE_flexrom");
 
 #[test]
 fn no_shared_hdf5_blas_or_network_libraries() {
-    let out = Command::new("ldd")
-        .arg(EXE)
-        .output()
-        .expect("ldd runs (Debian's libc-bin)");
-    assert!(
-        out.status.success(),
-        "ldd {EXE} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = Command::new("ldd").arg(EXE).output().expect("ldd runs (Debian's libc-bin)");
+    assert!(out.status.success(), "ldd {EXE} failed: {}", String::from_utf8_lossy(&out.stderr));
     let text = String::from_utf8_lossy(&out.stdout);
     // the listing is real: glibc is there
     assert!(text.contains("libc.so.6"), "ldd output without libc:\n{text}");
@@ -65,7 +58,10 @@ fn openblas_starts_no_worker_thread() {
     // every thread's name; the one flexrom starts on purpose, `flexrom-signals` (the SIGINT/
     // SIGTERM/SIGHUP clean-up, src/io/atomic.rs), is not OpenBLAS's
     let names: Option<Vec<String>> = std::fs::read_dir(format!("/proc/{}/task", child.id())).ok().map(|d| {
-        d.filter_map(|e| e.ok()).filter_map(|e| std::fs::read_to_string(e.path().join("comm")).ok()).map(|c| c.trim().to_string()).collect()
+        d.filter_map(|e| e.ok())
+            .filter_map(|e| std::fs::read_to_string(e.path().join("comm")).ok())
+            .map(|c| c.trim().to_string())
+            .collect()
     });
     child.kill().ok();
     child.wait().ok();

@@ -76,11 +76,21 @@ fn a_failing_load_scale_is_recorded_and_the_others_written() {
     let (o, err) = run(&["sweep", p.to_str().unwrap(), "-o", out.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(3), "{err}");
     let last = err.trim().lines().last().unwrap();
-    assert!(last.starts_with("error: 2 of 5 load scales failed: sweep (reduced run) at load scale 1e20: Newton failed"), "{err}");
+    assert!(
+        last.starts_with("error: 2 of 5 load scales failed: sweep (reduced run) at load scale 1e20: Newton failed"),
+        "{err}"
+    );
     assert!(last.contains("s.h5"), "{err}");
     assert_eq!(status(&out), vec![0, 1, 0, 0, 1]);
     let f = hdf5::File::open(&out).unwrap();
-    let messages: Vec<String> = f.dataset("message").unwrap().read_raw::<hdf5::types::VarLenUnicode>().unwrap().iter().map(|m| m.to_string()).collect();
+    let messages: Vec<String> = f
+        .dataset("message")
+        .unwrap()
+        .read_raw::<hdf5::types::VarLenUnicode>()
+        .unwrap()
+        .iter()
+        .map(|m| m.to_string())
+        .collect();
     assert_eq!(messages[0], "");
     assert!(messages[1].starts_with("sweep (reduced run) at load scale 1e20: Newton failed at t = "), "{messages:?}");
     assert!(messages[4].starts_with("sweep (reduced run) at load scale 5e19: Newton failed"), "{messages:?}");
@@ -165,7 +175,12 @@ fn a_killed_sweep_leaves_a_valid_file_to_resume_from() {
     // ~10 ms per reduced run: 300 of them take seconds, long enough to be killed midway
     let p = setup(d, 50, 1.1, 14, "\"0.5:1.5:300\"");
     let out = d.join("s.h5");
-    let mut child = flexrom().args(["sweep", p.to_str().unwrap(), "-o", out.to_str().unwrap()]).stdout(std::process::Stdio::null()).stderr(std::process::Stdio::null()).spawn().unwrap();
+    let mut child = flexrom()
+        .args(["sweep", p.to_str().unwrap(), "-o", out.to_str().unwrap()])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
     let start = std::time::Instant::now();
     while !out.exists() && start.elapsed().as_secs() < 120 {
         std::thread::sleep(std::time::Duration::from_millis(5));
@@ -180,7 +195,10 @@ fn a_killed_sweep_leaves_a_valid_file_to_resume_from() {
     assert!(finished >= 1 && finished < 300, "killed midway: {finished} finished");
     let (o, err) = run(&["sweep", p.to_str().unwrap(), "-o", out.to_str().unwrap(), "--resume"]);
     assert!(o.status.success(), "{err}");
-    assert!(err.contains(&format!("{finished} of 300 load scales already finished, running {}", 300 - finished)), "{err}");
+    assert!(
+        err.contains(&format!("{finished} of 300 load scales already finished, running {}", 300 - finished)),
+        "{err}"
+    );
     assert_eq!(status(&out), vec![0; 300]);
     assert!(column(&out, "rom_seconds").iter().all(|v| v.is_finite()));
 }

@@ -99,7 +99,9 @@ pub fn install_signal_handler() -> Result<()> {
                     SIGHUP => "SIGHUP",
                     _ => "SIGTERM",
                 };
-                eprintln!("flexrom: stopped by {name}; {n} temporary path(s) removed, previous outputs left as they were");
+                eprintln!(
+                    "flexrom: stopped by {name}; {n} temporary path(s) removed, previous outputs left as they were"
+                );
                 signal_hook::low_level::exit(128 + sig);
             }
         })
@@ -172,7 +174,11 @@ pub fn sync_path(p: &Path) -> Result<()> {
 /// folder.
 pub fn check_replaceable(target: &Path) -> Result<()> {
     match std::fs::metadata(target) {
-        Ok(m) if !m.is_file() => Err(Error::input(target, "output path", format!("exists and is {}, not a regular file; flexrom only replaces regular files", kind_of(&m)))),
+        Ok(m) if !m.is_file() => Err(Error::input(
+            target,
+            "output path",
+            format!("exists and is {}, not a regular file; flexrom only replaces regular files", kind_of(&m)),
+        )),
         _ => Ok(()),
     }
 }
@@ -257,7 +263,10 @@ impl TempPath {
     pub fn commit(mut self) -> Result<()> {
         let tmp = self.path().to_path_buf();
         if matches!(self.live, Live::Dir(_)) {
-            return Err(Error::Usage(format!("internal: {} is a folder; it is swapped in, not committed", tmp.display())));
+            return Err(Error::Usage(format!(
+                "internal: {} is a folder; it is swapped in, not committed",
+                tmp.display()
+            )));
         }
         sync_path(&tmp)?;
         // checked again right before the rename: something may have appeared meanwhile
@@ -298,7 +307,11 @@ fn follow_symlink(target: &Path) -> Result<PathBuf> {
     match std::fs::symlink_metadata(target) {
         Ok(m) if m.file_type().is_symlink() => match std::fs::canonicalize(target) {
             Ok(p) => Ok(p),
-            Err(_) => Err(Error::input(target, "output path", "is a symbolic link to nothing (dangling); flexrom does not create files through it")),
+            Err(_) => Err(Error::input(
+                target,
+                "output path",
+                "is a symbolic link to nothing (dangling); flexrom does not create files through it",
+            )),
         },
         _ => Ok(target.to_path_buf()),
     }
@@ -460,7 +473,10 @@ mod tests {
         ];
         clean_up(&mut v);
         assert!(v.is_empty());
-        let mut left: Vec<String> = std::fs::read_dir(d.path()).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        let mut left: Vec<String> = std::fs::read_dir(d.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
         left.sort();
         assert_eq!(left, ["rep1", "rep2"]);
         assert_eq!(std::fs::read(p("rep1/summary.md")).unwrap(), b"old1", "put back");

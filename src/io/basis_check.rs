@@ -52,9 +52,17 @@ pub const MIN_WEIGHT: f64 = 1e-8;
 pub const MAX_WEIGHT_PER_ELEMENT: f64 = 1e4;
 
 /// Datasets read as `f64` (the basis proper); anything else than 8-byte floats is refused.
-const FLOAT_DATASETS: [&str; 6] = ["basis/modes", "basis/reference", "basis/singular_values", "basis/energy", "basis/multiplier_modes", "hyper/weights"];
+const FLOAT_DATASETS: [&str; 6] = [
+    "basis/modes",
+    "basis/reference",
+    "basis/singular_values",
+    "basis/energy",
+    "basis/multiplier_modes",
+    "hyper/weights",
+];
 /// Datasets read as indices; floating-point ones are refused.
-const INDEX_DATASETS: [&str; 5] = ["basis/block_modes", "basis/block_values", "basis/reduced_dofs", "basis/kept_dofs", "hyper/elements"];
+const INDEX_DATASETS: [&str; 5] =
+    ["basis/block_modes", "basis/block_values", "basis/reduced_dofs", "basis/kept_dofs", "hyper/elements"];
 /// Links deeper than this, or more than [`MAX_LINKS`] of them, are not a basis file.
 const MAX_DEPTH: usize = 8;
 const MAX_LINKS: usize = 10_000;
@@ -65,7 +73,11 @@ pub fn check(path: &Path, model: &Model, settings_hash: Option<&str>) -> Result<
     let bad = |field: &str, problem: String| Error::input(path, field, problem);
     // sizes before anything is read: a crafted shape must not make us allocate terabytes
     // (after the link walk: opening a dataset follows its link)
-    let ours = |f: &hdf5::File| f.attr("schema_version").and_then(|a| a.read_scalar::<u64>()).is_ok_and(|v| v == super::basis_file::SCHEMA_VERSION);
+    let ours = |f: &hdf5::File| {
+        f.attr("schema_version")
+            .and_then(|a| a.read_scalar::<u64>())
+            .is_ok_and(|v| v == super::basis_file::SCHEMA_VERSION)
+    };
     if let Some(f) = hdf5::File::open(path).ok().filter(ours) {
         check_file(&f, path)?;
         let sys = model.system(LinearSolverKind::Banded);
@@ -93,7 +105,10 @@ pub fn check(path: &Path, model: &Model, settings_hash: Option<&str>) -> Result<
                     name,
                     match (shape.as_slice(), max) {
                         ([len], [m]) => format!("has {len} entries; {model} it holds at most {m}"),
-                        _ => format!("has shape {shape:?}; {model} it must be {}", max.iter().map(|m| format!("≤ {m}")).collect::<Vec<_>>().join(" × ")),
+                        _ => format!(
+                            "has shape {shape:?}; {model} it must be {}",
+                            max.iter().map(|m| format!("≤ {m}")).collect::<Vec<_>>().join(" × ")
+                        ),
                     },
                 ));
             }
@@ -155,13 +170,28 @@ pub fn check_file(f: &hdf5::File, path: &Path) -> Result<()> {
             continue;
         }
         let Ok(d) = f.dataset(name) else { return Err(Error::input(path, *name, "is not a dataset")) };
-        let ty = d.dtype().and_then(|t| t.to_descriptor()).map_err(|e| Error::input(path, *name, format!("has an unreadable type: {e}")))?;
+        let ty = d
+            .dtype()
+            .and_then(|t| t.to_descriptor())
+            .map_err(|e| Error::input(path, *name, format!("has an unreadable type: {e}")))?;
         let float = FLOAT_DATASETS.contains(name);
         match (&ty, float) {
             (TypeDescriptor::Float(FloatSize::U8), true) => {}
-            (_, true) => return Err(Error::input(path, *name, format!("has type {}; it must hold 8-byte floats (f64)", describe(&ty)))),
+            (_, true) => {
+                return Err(Error::input(
+                    path,
+                    *name,
+                    format!("has type {}; it must hold 8-byte floats (f64)", describe(&ty)),
+                ))
+            }
             (TypeDescriptor::Unsigned(_) | TypeDescriptor::Integer(_), false) => {}
-            (_, false) => return Err(Error::input(path, *name, format!("has type {}; it must hold integer indices", describe(&ty)))),
+            (_, false) => {
+                return Err(Error::input(
+                    path,
+                    *name,
+                    format!("has type {}; it must hold integer indices", describe(&ty)),
+                ))
+            }
         }
     }
     Ok(())
@@ -180,28 +210,52 @@ fn describe(t: &TypeDescriptor) -> String {
 fn walk(g: &hdf5::Group, prefix: &str, depth: usize, seen: &mut usize, path: &Path) -> Result<()> {
     let here = if prefix.is_empty() { "/" } else { prefix };
     if depth > MAX_DEPTH {
-        return Err(Error::input(path, here, format!("is nested deeper than {MAX_DEPTH} groups: not a flexrom basis file")));
+        return Err(Error::input(
+            path,
+            here,
+            format!("is nested deeper than {MAX_DEPTH} groups: not a flexrom basis file"),
+        ));
     }
-    let links = g.links(hdf5::IndexType::Name, hdf5::IterationOrder::Native).map_err(|e| Error::input(path, here, format!("cannot list its links: {e}")))?;
+    let links = g
+        .links(hdf5::IndexType::Name, hdf5::IterationOrder::Native)
+        .map_err(|e| Error::input(path, here, format!("cannot list its links: {e}")))?;
     for (name, info) in links {
         let full = if prefix.is_empty() { name.clone() } else { format!("{prefix}/{name}") };
         *seen += 1;
         if *seen > MAX_LINKS {
-            return Err(Error::input(path, "(file)", format!("holds more than {MAX_LINKS} links: not a flexrom basis file")));
+            return Err(Error::input(
+                path,
+                "(file)",
+                format!("holds more than {MAX_LINKS} links: not a flexrom basis file"),
+            ));
         }
         if info.link_type != hdf5::LinkType::Hard {
-            let kind = if info.link_type == hdf5::LinkType::Soft { "a soft link" } else { "an external or user-defined link" };
-            return Err(Error::input(path, &full, format!("is {kind}; a basis file must hold its data itself (hard links only)")));
+            let kind =
+                if info.link_type == hdf5::LinkType::Soft { "a soft link" } else { "an external or user-defined link" };
+            return Err(Error::input(
+                path,
+                &full,
+                format!("is {kind}; a basis file must hold its data itself (hard links only)"),
+            ));
         }
         if let Ok(sub) = g.group(&name) {
             walk(&sub, &full, depth + 1, seen, path)?;
         } else if let Ok(d) = g.dataset(&name) {
-            let dcpl = d.dcpl().map_err(|e| Error::input(path, &full, format!("cannot read its storage properties: {e}")))?;
+            let dcpl =
+                d.dcpl().map_err(|e| Error::input(path, &full, format!("cannot read its storage properties: {e}")))?;
             if !dcpl.external().is_empty() {
-                return Err(Error::input(path, &full, "is stored in an external file; a basis file must hold its data itself"));
+                return Err(Error::input(
+                    path,
+                    &full,
+                    "is stored in an external file; a basis file must hold its data itself",
+                ));
             }
             if matches!(dcpl.layout(), hdf5::dataset::Layout::Virtual) {
-                return Err(Error::input(path, &full, "is a virtual dataset (data in other files); a basis file must hold its data itself"));
+                return Err(Error::input(
+                    path,
+                    &full,
+                    "is a virtual dataset (data in other files); a basis file must hold its data itself",
+                ));
             }
         }
     }
@@ -213,9 +267,17 @@ fn walk(g: &hdf5::Group, prefix: &str, depth: usize, seen: &mut usize, path: &Pa
 pub fn check_content(s: &StoredBasis) -> std::result::Result<(), (String, String)> {
     let b = &s.basis;
     let bad = |f: &str, p: String| Err((f.to_string(), p));
-    let first_bad = |a: &mut dyn Iterator<Item = &f64>| a.enumerate().find(|(_, v)| !v.is_finite()).map(|(i, v)| (i, *v));
+    let first_bad =
+        |a: &mut dyn Iterator<Item = &f64>| a.enumerate().find(|(_, v)| !v.is_finite()).map(|(i, v)| (i, *v));
     if let Some((i, v)) = first_bad(&mut b.modes.iter()) {
-        return bad("basis/modes", format!("entry ({}, {}) is {v}; every entry must be finite", i / b.modes.ncols().max(1), i % b.modes.ncols().max(1)));
+        return bad(
+            "basis/modes",
+            format!(
+                "entry ({}, {}) is {v}; every entry must be finite",
+                i / b.modes.ncols().max(1),
+                i % b.modes.ncols().max(1)
+            ),
+        );
     }
     if let Some((i, v)) = first_bad(&mut b.reference.iter()) {
         return bad("basis/reference", format!("entry {i} is {v}; every entry must be finite"));
@@ -225,7 +287,10 @@ pub fn check_content(s: &StoredBasis) -> std::result::Result<(), (String, String
             return bad("basis/multiplier_modes", format!("entry {i} is {v}; every entry must be finite"));
         }
         if vl.ncols() != b.modes.ncols() {
-            return bad("basis/multiplier_modes", format!("has {} columns, basis/modes has {}", vl.ncols(), b.modes.ncols()));
+            return bad(
+                "basis/multiplier_modes",
+                format!("has {} columns, basis/modes has {}", vl.ncols(), b.modes.ncols()),
+            );
         }
     }
     if b.variant == Variant::WholeSystem && !(b.multiplier_scale.is_finite() && b.multiplier_scale > 0.0) {
@@ -235,34 +300,68 @@ pub fn check_content(s: &StoredBasis) -> std::result::Result<(), (String, String
         return bad("basis/modes", "has no columns (r = 0)".into());
     }
     if b.n_pod_modes + b.kept.len() != b.modes.ncols() {
-        return bad("basis/kept_dofs", format!("{} POD modes and {} kept coordinates do not make the {} columns of basis/modes", b.n_pod_modes, b.kept.len(), b.modes.ncols()));
+        return bad(
+            "basis/kept_dofs",
+            format!(
+                "{} POD modes and {} kept coordinates do not make the {} columns of basis/modes",
+                b.n_pod_modes,
+                b.kept.len(),
+                b.modes.ncols()
+            ),
+        );
     }
     // singular values: finite, non-negative, non-increasing within each block
     let mut at = 0;
     for (blk, &k) in s.block_values.iter().enumerate() {
         let sv = s.singular_values.slice(s![at..at + k]);
         if let Some((i, v)) = sv.iter().enumerate().find(|(_, v)| !(v.is_finite() && **v >= 0.0)) {
-            return bad("basis/singular_values", format!("entry {} is {v}; singular values are finite and non-negative", at + i));
+            return bad(
+                "basis/singular_values",
+                format!("entry {} is {v}; singular values are finite and non-negative", at + i),
+            );
         }
         if let Some(i) = (1..k).find(|&i| sv[i] > sv[i - 1] * (1.0 + 1e-12)) {
-            return bad("basis/singular_values", format!("increase at entry {} (block {}): {} after {}; a POD's singular values never increase", at + i, blk + 1, sv[i], sv[i - 1]));
+            return bad(
+                "basis/singular_values",
+                format!(
+                    "increase at entry {} (block {}): {} after {}; a POD's singular values never increase",
+                    at + i,
+                    blk + 1,
+                    sv[i],
+                    sv[i - 1]
+                ),
+            );
         }
         at += k;
     }
     if s.energy.len() != s.singular_values.len() {
-        return bad("basis/energy", format!("has {} entries, basis/singular_values has {}", s.energy.len(), s.singular_values.len()));
+        return bad(
+            "basis/energy",
+            format!("has {} entries, basis/singular_values has {}", s.energy.len(), s.singular_values.len()),
+        );
     }
-    if let Some((i, v)) = s.energy.iter().enumerate().find(|(_, v)| !(v.is_finite() && (-1e-12..=1.0 + 1e-12).contains(*v))) {
+    if let Some((i, v)) =
+        s.energy.iter().enumerate().find(|(_, v)| !(v.is_finite() && (-1e-12..=1.0 + 1e-12).contains(*v)))
+    {
         return bad("basis/energy", format!("entry {i} is {v}; captured energy fractions lie in [0, 1]"));
     }
     // the kept coordinates' unit columns
     for (k, &d) in b.kept.iter().enumerate() {
         if d >= b.modes.nrows() {
-            return bad("basis/kept_dofs", format!("coordinate {d} does not exist (basis/modes has {} rows)", b.modes.nrows()));
+            return bad(
+                "basis/kept_dofs",
+                format!("coordinate {d} does not exist (basis/modes has {} rows)", b.modes.nrows()),
+            );
         }
         let c = b.n_pod_modes + k;
         if (b.modes[[d, c]] - 1.0).abs() > ORTHONORMALITY_TOLERANCE {
-            return bad("basis/modes", format!("column {c} must be the unit column of kept coordinate {d}, but holds {} there", b.modes[[d, c]]));
+            return bad(
+                "basis/modes",
+                format!(
+                    "column {c} must be the unit column of kept coordinate {d}, but holds {} there",
+                    b.modes[[d, c]]
+                ),
+            );
         }
     }
     // VᵀV = I (whole-system: the stacked [V; V_λ])
@@ -273,16 +372,23 @@ pub fn check_content(s: &StoredBasis) -> std::result::Result<(), (String, String
     let (worst, (i, j)) = max_off_identity(&gram);
     if !(worst <= ORTHONORMALITY_TOLERANCE) {
         let name = if b.variant == Variant::WholeSystem { "[V; V_λ]ᵀ[V; V_λ]" } else { "VᵀV" };
-        let dataset = if b.variant == Variant::WholeSystem { "basis/modes, basis/multiplier_modes" } else { "basis/modes" };
+        let dataset =
+            if b.variant == Variant::WholeSystem { "basis/modes, basis/multiplier_modes" } else { "basis/modes" };
         return bad(dataset, format!("are not orthonormal: {name} − I is {:.3e} at columns ({i}, {j}) ({}); the limit is {ORTHONORMALITY_TOLERANCE:e}", gram[[i, j]] - if i == j { 1.0 } else { 0.0 }, block_of(s, i, j)));
     }
     if let Some(h) = &s.basis.hyper {
         h.validate(usize::MAX)?;
         if let Some((k, w)) = h.weights.iter().enumerate().find(|(_, w)| **w < MIN_WEIGHT) {
-            return bad("hyper/weights", format!("entry {k} is {w:e}; ECSW weights below {MIN_WEIGHT:e} are not trained ones"));
+            return bad(
+                "hyper/weights",
+                format!("entry {k} is {w:e}; ECSW weights below {MIN_WEIGHT:e} are not trained ones"),
+            );
         }
         if !(h.training_residual.is_finite() && h.training_residual >= 0.0) {
-            return bad("hyper/training_residual", format!("is {}; it must be finite and non-negative", h.training_residual));
+            return bad(
+                "hyper/training_residual",
+                format!("is {}; it must be finite and non-negative", h.training_residual),
+            );
         }
     }
     Ok(())
@@ -316,7 +422,11 @@ fn block_of(s: &StoredBasis, i: usize, j: usize) -> String {
         "kept coordinates".into()
     };
     let (a, b) = (which(i), which(j));
-    if a == b { a } else { format!("{a} and {b}") }
+    if a == b {
+        a
+    } else {
+        format!("{a} and {b}")
+    }
 }
 
 /// Checks that need the model: sizes, the reference state, kept coordinates, elements.
@@ -337,20 +447,39 @@ fn check_against_model(s: &StoredBasis, model: &Model) -> std::result::Result<()
         joints.sort_unstable();
         joints.dedup();
         if b.kept != joints {
-            return bad("basis/kept_dofs", format!("are not the model's {} joint coordinates (constraint-preserving keeps exactly those)", joints.len()));
+            return bad(
+                "basis/kept_dofs",
+                format!(
+                    "are not the model's {} joint coordinates (constraint-preserving keeps exactly those)",
+                    joints.len()
+                ),
+            );
         }
     }
     match b.snapshots {
         SnapshotKind::Raw => {
             if let Some((i, v)) = b.reference.iter().enumerate().find(|(_, v)| **v != 0.0) {
-                return bad("basis/reference", format!("entry {i} is {v}; a basis of raw snapshots has a zero reference"));
+                return bad(
+                    "basis/reference",
+                    format!("entry {i} is {v}; a basis of raw snapshots has a zero reference"),
+                );
             }
         }
         SnapshotKind::Reference => {
-            let settings = Settings::resolve(model, &Overrides::default()).map_err(|e| ("basis/reference".to_string(), format!("cannot compute the model's initial state: {e}")))?;
-            let (_, x0) = prepare(model, &settings).map_err(|e| ("basis/reference".to_string(), format!("cannot compute the model's initial state: {e}")))?;
+            let settings = Settings::resolve(model, &Overrides::default()).map_err(|e| {
+                ("basis/reference".to_string(), format!("cannot compute the model's initial state: {e}"))
+            })?;
+            let (_, x0) = prepare(model, &settings).map_err(|e| {
+                ("basis/reference".to_string(), format!("cannot compute the model's initial state: {e}"))
+            })?;
             let scale = x0.iter().fold(1.0_f64, |a, v| a.max(v.abs()));
-            let (i, d) = b.reference.iter().zip(&x0).map(|(r, x)| (r - x).abs()).enumerate().fold((0, 0.0), |a, (i, d)| if d > a.1 { (i, d) } else { a });
+            let (i, d) = b
+                .reference
+                .iter()
+                .zip(&x0)
+                .map(|(r, x)| (r - x).abs())
+                .enumerate()
+                .fold((0, 0.0), |a, (i, d)| if d > a.1 { (i, d) } else { a });
             if d > REFERENCE_TOLERANCE * scale {
                 return bad(
                     "basis/reference",
@@ -363,7 +492,10 @@ fn check_against_model(s: &StoredBasis, model: &Model) -> std::result::Result<()
         h.validate(ne)?;
         let max = MAX_WEIGHT_PER_ELEMENT * ne as f64;
         if let Some((k, w)) = h.weights.iter().enumerate().find(|(_, w)| **w > max) {
-            return bad("hyper/weights", format!("entry {k} is {w:e}; with {ne} elements an ECSW weight above {max:e} is not a trained one"));
+            return bad(
+                "hyper/weights",
+                format!("entry {k} is {w:e}; with {ne} elements an ECSW weight above {max:e} is not a trained one"),
+            );
         }
     }
     Ok(())
@@ -437,7 +569,12 @@ pub fn content_hash(c: &HashInput) -> String {
         part("hyper/n_training", &[], &mut std::iter::once((hy.n_training as u64).to_le_bytes()));
     }
     drop(part);
-    for (name, text) in [("variant", b.variant.name()), ("snapshots", b.snapshots.name()), ("model_fingerprint", c.model_fingerprint), ("settings_hash", c.settings_hash)] {
+    for (name, text) in [
+        ("variant", b.variant.name()),
+        ("snapshots", b.snapshots.name()),
+        ("model_fingerprint", c.model_fingerprint),
+        ("settings_hash", c.settings_hash),
+    ] {
         h.update((name.len() as u64).to_le_bytes());
         h.update(name.as_bytes());
         h.update((text.len() as u64).to_le_bytes());

@@ -103,7 +103,13 @@ pub fn write_basis(path: &Path, data: &TrainingData, trained: &Trained, meta: &B
 
 /// [`write_basis`], then `extra` adds groups (the estimator, greedy's `/training`) in the
 /// same atomic write.
-pub fn write_basis_with(path: &Path, data: &TrainingData, trained: &Trained, meta: &BasisMeta, extra: impl FnOnce(&hdf5::File) -> Result<()>) -> Result<()> {
+pub fn write_basis_with(
+    path: &Path,
+    data: &TrainingData,
+    trained: &Trained,
+    meta: &BasisMeta,
+    extra: impl FnOnce(&hdf5::File) -> Result<()>,
+) -> Result<()> {
     write_atomically(path, |f| {
         let e = |err: hdf5::Error| Error::hdf5(path, err);
         let big = |name: &str, a: &Array2<f64>| -> Result<()> {
@@ -111,7 +117,12 @@ pub fn write_basis_with(path: &Path, data: &TrainingData, trained: &Trained, met
             if r == 0 || c == 0 {
                 f.new_dataset_builder().with_data(&a.as_standard_layout()).create(name).map_err(e)?;
             } else {
-                compressible(f.new_dataset::<f64>(), r, c).shape((r, c)).create(name).map_err(e)?.write(&a.as_standard_layout()).map_err(e)?;
+                compressible(f.new_dataset::<f64>(), r, c)
+                    .shape((r, c))
+                    .create(name)
+                    .map_err(e)?
+                    .write(&a.as_standard_layout())
+                    .map_err(e)?;
             }
             Ok(())
         };
@@ -122,7 +133,9 @@ pub fn write_basis_with(path: &Path, data: &TrainingData, trained: &Trained, met
         let g = f.create_group("basis").map_err(e)?;
         let b = &trained.basis;
         g.new_dataset_builder().with_data(&b.modes.as_standard_layout()).create("modes").map_err(e)?;
-        let cat = |f: &dyn Fn(&crate::reduction::Pod) -> &Array1<f64>| Array1::from_iter(trained.pods.iter().flat_map(|p| f(p).iter().copied()));
+        let cat = |f: &dyn Fn(&crate::reduction::Pod) -> &Array1<f64>| {
+            Array1::from_iter(trained.pods.iter().flat_map(|p| f(p).iter().copied()))
+        };
         g.new_dataset_builder().with_data(&cat(&|p| &p.singular_values)).create("singular_values").map_err(e)?;
         g.new_dataset_builder().with_data(&cat(&|p| &p.energy)).create("energy").map_err(e)?;
         g.new_dataset_builder().with_data(&b.reference).create("reference").map_err(e)?;
@@ -168,7 +181,8 @@ pub fn write_basis_with(path: &Path, data: &TrainingData, trained: &Trained, met
         attr_u64(f, "n_pod_modes", b.n_pod_modes as u64).map_err(e)?;
         attr_f64(f, "multiplier_scale", b.multiplier_scale).map_err(e)?;
         attr_u64(f, "n_dof", b.n_dof() as u64).map_err(e)?;
-        attr_str(f, "creation_time", &humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string()).map_err(e)?;
+        attr_str(f, "creation_time", &humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string())
+            .map_err(e)?;
         attr_str(f, "program_version", env!("CARGO_PKG_VERSION")).map_err(e)?;
         extra(f)
     })
@@ -180,7 +194,9 @@ pub fn read_basis(path: &Path) -> Result<StoredBasis> {
     if !path.is_file() {
         return Err(Error::input(path, "(file)", "does not exist; run `flexrom train` first"));
     }
-    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", format!("is not a readable HDF5 file (truncated or of another format?): {e}")))?;
+    let f = hdf5::File::open(path).map_err(|e| {
+        Error::input(path, "(file)", format!("is not a readable HDF5 file (truncated or of another format?): {e}"))
+    })?;
     let field = |name: &str, problem: String| Error::input(path, name, problem);
     let version = f
         .attr("schema_version")
@@ -197,17 +213,31 @@ pub fn read_basis(path: &Path) -> Result<StoredBasis> {
     let text = |name: &str| read_attr_str(&f, name).map_err(|err| field(name, format!("cannot be read: {err}")));
     let num = |name: &str| read_attr_f64(&f, name).map_err(|err| field(name, format!("cannot be read: {err}")));
     let count = |name: &str| {
-        f.attr(name).and_then(|a| a.read_scalar::<u64>()).map(|v| v as usize).map_err(|err| field(name, format!("cannot be read: {err}")))
+        f.attr(name)
+            .and_then(|a| a.read_scalar::<u64>())
+            .map(|v| v as usize)
+            .map_err(|err| field(name, format!("cannot be read: {err}")))
     };
-    let mat = |name: &str| f.dataset(name).and_then(|d| d.read_2d::<f64>()).map_err(|err| field(name, format!("cannot be read: {err}")));
-    let vec = |name: &str| f.dataset(name).and_then(|d| d.read_1d::<f64>()).map_err(|err| field(name, format!("cannot be read: {err}")));
+    let mat = |name: &str| {
+        f.dataset(name).and_then(|d| d.read_2d::<f64>()).map_err(|err| field(name, format!("cannot be read: {err}")))
+    };
+    let vec = |name: &str| {
+        f.dataset(name).and_then(|d| d.read_1d::<f64>()).map_err(|err| field(name, format!("cannot be read: {err}")))
+    };
     let idx = |name: &str| -> Result<Vec<usize>> {
-        Ok(f.dataset(name).and_then(|d| d.read_1d::<u64>()).map_err(|err| field(name, format!("cannot be read: {err}")))?.iter().map(|&d| d as usize).collect())
+        Ok(f.dataset(name)
+            .and_then(|d| d.read_1d::<u64>())
+            .map_err(|err| field(name, format!("cannot be read: {err}")))?
+            .iter()
+            .map(|&d| d as usize)
+            .collect())
     };
     let variant_name = text("variant")?;
-    let variant = Variant::parse(&variant_name).ok_or_else(|| field("variant", format!("`{variant_name}` is not a known variant")))?;
+    let variant = Variant::parse(&variant_name)
+        .ok_or_else(|| field("variant", format!("`{variant_name}` is not a known variant")))?;
     let kind_name = text("snapshots")?;
-    let snapshots = SnapshotKind::parse(&kind_name).ok_or_else(|| field("snapshots", format!("`{kind_name}` is not raw or reference")))?;
+    let snapshots = SnapshotKind::parse(&kind_name)
+        .ok_or_else(|| field("snapshots", format!("`{kind_name}` is not raw or reference")))?;
     let multiplier_modes = if variant == Variant::WholeSystem { Some(mat("basis/multiplier_modes")?) } else { None };
     let basis = Basis {
         variant,
@@ -223,7 +253,10 @@ pub fn read_basis(path: &Path) -> Result<StoredBasis> {
     let singular_values = vec("basis/singular_values")?;
     let energy = vec("basis/energy")?;
     if basis.n_pod_modes == 0 || basis.n_pod_modes > singular_values.len() {
-        return Err(field("n_pod_modes", format!("is {} but the POD has {} singular values", basis.n_pod_modes, singular_values.len())));
+        return Err(field(
+            "n_pod_modes",
+            format!("is {} but the POD has {} singular values", basis.n_pod_modes, singular_values.len()),
+        ));
     }
     // files written before block bases have one block
     let (block_modes, block_values) = if f.link_exists("basis/block_modes") {
@@ -232,10 +265,20 @@ pub fn read_basis(path: &Path) -> Result<StoredBasis> {
         (vec![basis.n_pod_modes], vec![singular_values.len()])
     };
     if block_modes.iter().sum::<usize>() != basis.n_pod_modes {
-        return Err(field("basis/block_modes", format!("{block_modes:?} do not add up to the {} POD modes (n_pod_modes)", basis.n_pod_modes)));
+        return Err(field(
+            "basis/block_modes",
+            format!("{block_modes:?} do not add up to the {} POD modes (n_pod_modes)", basis.n_pod_modes),
+        ));
     }
     if block_values.len() != block_modes.len() || block_values.iter().sum::<usize>() != singular_values.len() {
-        return Err(field("basis/block_values", format!("{block_values:?} do not split the {} singular values into {} blocks", singular_values.len(), block_modes.len())));
+        return Err(field(
+            "basis/block_values",
+            format!(
+                "{block_values:?} do not split the {} singular values into {} blocks",
+                singular_values.len(),
+                block_modes.len()
+            ),
+        ));
     }
     Ok(StoredBasis {
         basis,
@@ -263,8 +306,23 @@ fn read_hyper(f: &hdf5::File, path: &Path) -> Result<Option<Hyper>> {
         .iter()
         .map(|&e| e as usize)
         .collect();
-    let weights = g.dataset("weights").and_then(|d| d.read_1d::<f64>()).map_err(|err| field("hyper/weights", format!("cannot be read: {err}")))?.to_vec();
-    let num = |name: &str| read_attr_f64(&g, name).map_err(|err| field(&format!("hyper/{name}"), format!("cannot be read: {err}")));
-    let n_training = g.attr("n_training").and_then(|a| a.read_scalar::<u64>()).map_err(|err| field("hyper/n_training", format!("cannot be read: {err}")))? as usize;
-    Ok(Some(Hyper { elements, weights, tolerance: num("tolerance")?, training_residual: num("training_residual")?, n_training }))
+    let weights = g
+        .dataset("weights")
+        .and_then(|d| d.read_1d::<f64>())
+        .map_err(|err| field("hyper/weights", format!("cannot be read: {err}")))?
+        .to_vec();
+    let num = |name: &str| {
+        read_attr_f64(&g, name).map_err(|err| field(&format!("hyper/{name}"), format!("cannot be read: {err}")))
+    };
+    let n_training = g
+        .attr("n_training")
+        .and_then(|a| a.read_scalar::<u64>())
+        .map_err(|err| field("hyper/n_training", format!("cannot be read: {err}")))? as usize;
+    Ok(Some(Hyper {
+        elements,
+        weights,
+        tolerance: num("tolerance")?,
+        training_residual: num("training_residual")?,
+        n_training,
+    }))
 }

@@ -59,10 +59,14 @@ pub fn write_estimator(f: &hdf5::File, est: &Estimator) -> hdf5::Result<()> {
 /// reference, kept coordinates are the basis's). `None` when the file has none (trained
 /// before the estimator existed).
 pub fn read_estimator(path: &Path, basis: &Basis) -> Result<Option<Estimator>> {
-    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", format!("is not a readable HDF5 file: {e}")))?;
+    let f = hdf5::File::open(path)
+        .map_err(|e| Error::input(path, "(file)", format!("is not a readable HDF5 file: {e}")))?;
     let Ok(g) = f.group("estimator") else { return Ok(None) };
     let field = |name: &str, problem: String| Error::input(path, format!("estimator/{name}"), problem);
-    let modes = g.dataset("modes").and_then(|d| d.read_2d::<f64>()).map_err(|e| field("modes", format!("cannot be read: {e}")))?;
+    let modes = g
+        .dataset("modes")
+        .and_then(|d| d.read_2d::<f64>())
+        .map_err(|e| field("modes", format!("cannot be read: {e}")))?;
     let idx = |g: &hdf5::Group, name: &str, prefix: &str| -> Result<Vec<usize>> {
         Ok(g.dataset(name)
             .and_then(|d| d.read_1d::<u64>())
@@ -72,11 +76,16 @@ pub fn read_estimator(path: &Path, basis: &Basis) -> Result<Option<Estimator>> {
             .collect())
     };
     let vec = |g: &hdf5::Group, name: &str| -> Result<Vec<f64>> {
-        Ok(g.dataset(name).and_then(|d| d.read_1d::<f64>()).map_err(|e| field(&format!("calibration/{name}"), format!("cannot be read: {e}")))?.to_vec())
+        Ok(g.dataset(name)
+            .and_then(|d| d.read_1d::<f64>())
+            .map_err(|e| field(&format!("calibration/{name}"), format!("cannot be read: {e}")))?
+            .to_vec())
     };
     let block_modes = idx(&g, "block_modes", "")?;
     let num = |name: &str| read_attr_f64(&g, name).map_err(|e| field(name, format!("cannot be read: {e}")));
-    let count = |name: &str| g.attr(name).and_then(|a| a.read_scalar::<u64>()).map_err(|e| field(name, format!("cannot be read: {e}")));
+    let count = |name: &str| {
+        g.attr(name).and_then(|a| a.read_scalar::<u64>()).map_err(|e| field(name, format!("cannot be read: {e}")))
+    };
     let method = read_attr_str(&g, "method").map_err(|e| field("method", format!("cannot be read: {e}")))?;
     if method != "enriched" {
         return Err(field("method", format!("is `{method}`; this program knows `enriched`")));
@@ -87,11 +96,25 @@ pub fn read_estimator(path: &Path, basis: &Basis) -> Result<Option<Estimator>> {
     };
     let hyper = match g.group("hyper") {
         Ok(hg) => {
-            let hnum = |name: &str| read_attr_f64(&hg, name).map_err(|e| field(&format!("hyper/{name}"), format!("cannot be read: {e}")));
-            let weights = hg.dataset("weights").and_then(|d| d.read_1d::<f64>()).map_err(|e| field("hyper/weights", format!("cannot be read: {e}")))?.to_vec();
+            let hnum = |name: &str| {
+                read_attr_f64(&hg, name).map_err(|e| field(&format!("hyper/{name}"), format!("cannot be read: {e}")))
+            };
+            let weights = hg
+                .dataset("weights")
+                .and_then(|d| d.read_1d::<f64>())
+                .map_err(|e| field("hyper/weights", format!("cannot be read: {e}")))?
+                .to_vec();
             let n_training =
-                hg.attr("n_training").and_then(|a| a.read_scalar::<u64>()).map_err(|e| field("hyper/n_training", format!("cannot be read: {e}")))? as usize;
-            let h = Hyper { elements: idx(&hg, "elements", "hyper/")?, weights, tolerance: hnum("tolerance")?, training_residual: hnum("training_residual")?, n_training };
+                hg.attr("n_training")
+                    .and_then(|a| a.read_scalar::<u64>())
+                    .map_err(|e| field("hyper/n_training", format!("cannot be read: {e}")))? as usize;
+            let h = Hyper {
+                elements: idx(&hg, "elements", "hyper/")?,
+                weights,
+                tolerance: hnum("tolerance")?,
+                training_residual: hnum("training_residual")?,
+                n_training,
+            };
             h.validate(usize::MAX).map_err(|(f, p)| field(&f, p))?;
             Some(h)
         }
@@ -100,9 +123,14 @@ pub fn read_estimator(path: &Path, basis: &Basis) -> Result<Option<Estimator>> {
     let cg = g.group("calibration").map_err(|e| field("calibration", format!("cannot be read: {e}")))?;
     let (ls, raw, err) = (vec(&cg, "load_scale")?, vec(&cg, "raw_estimate")?, vec(&cg, "rel_error")?);
     if raw.len() != ls.len() || err.len() != ls.len() {
-        return Err(field("calibration", format!("load_scale, raw_estimate, rel_error have {}, {}, {} entries", ls.len(), raw.len(), err.len())));
+        return Err(field(
+            "calibration",
+            format!("load_scale, raw_estimate, rel_error have {}, {}, {} entries", ls.len(), raw.len(), err.len()),
+        ));
     }
-    let points = (0..ls.len()).map(|i| CalibrationPoint { load_scale: ls[i], raw_estimate: raw[i], rel_error: err[i] }).collect();
+    let points = (0..ls.len())
+        .map(|i| CalibrationPoint { load_scale: ls[i], raw_estimate: raw[i], rel_error: err[i] })
+        .collect();
     let factor = num("factor")?;
     if !(factor.is_finite() && factor > 0.0) {
         return Err(field("factor", format!("is {factor}; it must be positive and finite")));
@@ -123,7 +151,13 @@ pub fn read_estimator(path: &Path, basis: &Basis) -> Result<Option<Estimator>> {
     if enriched.modes.nrows() != basis.n_dof() || n_pod_modes + enriched.kept.len() != enriched.modes.ncols() {
         return Err(field(
             "modes",
-            format!("is {:?}; expected {} rows and {} POD + {} kept columns (block_modes)", enriched.modes.dim(), basis.n_dof(), n_pod_modes, enriched.kept.len()),
+            format!(
+                "is {:?}; expected {} rows and {} POD + {} kept columns (block_modes)",
+                enriched.modes.dim(),
+                basis.n_dof(),
+                n_pod_modes,
+                enriched.kept.len()
+            ),
         ));
     }
     Ok(Some(Estimator {
@@ -137,7 +171,8 @@ pub fn read_estimator(path: &Path, basis: &Basis) -> Result<Option<Estimator>> {
 /// `[min, max]` of the training load scales: `/training/range` when present (greedy
 /// training), else the extremes of `/snapshot_load_scale`.
 pub fn read_training_range(path: &Path) -> Result<(f64, f64)> {
-    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", format!("is not a readable HDF5 file: {e}")))?;
+    let f = hdf5::File::open(path)
+        .map_err(|e| Error::input(path, "(file)", format!("is not a readable HDF5 file: {e}")))?;
     if let Ok(d) = f.dataset("training/range") {
         let r = d.read_1d::<f64>().map_err(|e| Error::input(path, "training/range", format!("cannot be read: {e}")))?;
         if r.len() != 2 || !(r[0].is_finite() && r[1].is_finite() && r[0] <= r[1]) {
@@ -160,7 +195,8 @@ pub fn read_training_range(path: &Path) -> Result<(f64, f64)> {
 /// Greedy training's tolerance: the dataset `/training/tolerance` or the attribute
 /// `tolerance` on `/training`; `None` without greedy training.
 pub fn read_training_tolerance(path: &Path) -> Result<Option<f64>> {
-    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", format!("is not a readable HDF5 file: {e}")))?;
+    let f = hdf5::File::open(path)
+        .map_err(|e| Error::input(path, "(file)", format!("is not a readable HDF5 file: {e}")))?;
     let Ok(g) = f.group("training") else { return Ok(None) };
     let t = if let Ok(d) = g.dataset("tolerance") {
         d.read_scalar::<f64>().or_else(|_| d.read_1d::<f64>().map(|a| a.first().copied().unwrap_or(f64::NAN)))

@@ -28,7 +28,13 @@ pub fn write_atomically(path: &Path, fill: impl FnOnce(&hdf5::File) -> Result<()
 /// system's message is what the user can act on: "cannot write: No space left on device
 /// (errno 28)".
 fn short_write_error(problem: &str) -> String {
-    let field = |key: &str| problem.split(key).nth(1).and_then(|r| r.split(['\'', ',']).find(|s| !s.trim().is_empty())).map(|s| s.trim().to_string());
+    let field = |key: &str| {
+        problem
+            .split(key)
+            .nth(1)
+            .and_then(|r| r.split(['\'', ',']).find(|s| !s.trim().is_empty()))
+            .map(|s| s.trim().to_string())
+    };
     match (field("error message = '"), field("errno = ")) {
         (Some(msg), Some(errno)) => format!("cannot write: {msg} (errno {errno})"),
         (Some(msg), None) => format!("cannot write: {msg}"),

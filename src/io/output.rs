@@ -39,7 +39,11 @@ impl Origin<'_> {
 /// `p` made absolute with its longest existing prefix canonicalized (symlinks and `..`
 /// resolved by the file system) and the rest applied lexically.
 pub fn resolve(p: &Path) -> PathBuf {
-    let abs = if p.is_absolute() { p.to_path_buf() } else { std::env::current_dir().unwrap_or_else(|_| PathBuf::from("/")).join(p) };
+    let abs = if p.is_absolute() {
+        p.to_path_buf()
+    } else {
+        std::env::current_dir().unwrap_or_else(|_| PathBuf::from("/")).join(p)
+    };
     let comps: Vec<Component> = abs.components().collect();
     for k in (0..=comps.len()).rev() {
         let prefix: PathBuf = comps[..k].iter().collect();
@@ -79,11 +83,29 @@ pub fn check_output(output: &Path, origin: Origin, inputs: &[(&Path, &str)]) -> 
     }
     match std::fs::symlink_metadata(output) {
         Ok(m) if m.file_type().is_symlink() => match std::fs::metadata(output) {
-            Ok(t) if !t.is_file() => return Err(origin.error(output, format!("is a symbolic link to {}, not to a regular file; flexrom only replaces regular files", kind_of(&t)))),
+            Ok(t) if !t.is_file() => {
+                return Err(origin.error(
+                    output,
+                    format!(
+                        "is a symbolic link to {}, not to a regular file; flexrom only replaces regular files",
+                        kind_of(&t)
+                    ),
+                ))
+            }
             Ok(_) => {}
-            Err(_) => return Err(origin.error(output, "is a symbolic link to nothing (dangling); flexrom does not create files through it")),
+            Err(_) => {
+                return Err(origin.error(
+                    output,
+                    "is a symbolic link to nothing (dangling); flexrom does not create files through it",
+                ))
+            }
         },
-        Ok(m) if !m.is_file() => return Err(origin.error(output, format!("exists and is {}, not a regular file; flexrom only replaces regular files", kind_of(&m)))),
+        Ok(m) if !m.is_file() => {
+            return Err(origin.error(
+                output,
+                format!("exists and is {}, not a regular file; flexrom only replaces regular files", kind_of(&m)),
+            ))
+        }
         Ok(_) => {}
         Err(_) => creatable(output, origin)?,
     }
@@ -95,7 +117,13 @@ pub fn check_output(output: &Path, origin: Origin, inputs: &[(&Path, &str)]) -> 
             _ => out_path == resolve(input),
         };
         if same {
-            return Err(origin.error(output, format!("is the {what} `{}` (the same file); flexrom never writes over a command's input", input.display())));
+            return Err(origin.error(
+                output,
+                format!(
+                    "is the {what} `{}` (the same file); flexrom never writes over a command's input",
+                    input.display()
+                ),
+            ));
         }
     }
     Ok(())
@@ -108,7 +136,10 @@ fn creatable(path: &Path, origin: Origin) -> Result<()> {
     while a.pop() {
         match std::fs::metadata(&a) {
             Ok(m) if m.is_dir() => return Ok(()),
-            Ok(m) => return Err(origin.error(path, format!("cannot be created: `{}` is {}, not a folder", a.display(), kind_of(&m)))),
+            Ok(m) => {
+                return Err(origin
+                    .error(path, format!("cannot be created: `{}` is {}, not a folder", a.display(), kind_of(&m))))
+            }
             Err(_) => {}
         }
     }
@@ -128,7 +159,10 @@ fn contains(a: &Path, b: &Path) -> bool {
 pub fn check_report_dir(report: &Path, pipeline: &Path, inputs: &[(&Path, &str)]) -> Result<()> {
     let origin = Origin::Key { pipeline, key: "report" };
     if !names_an_entry(report) {
-        return Err(origin.error(report, "names `.`, `..` or `/`, not a folder of its own; flexrom replaces the report folder as a whole"));
+        return Err(origin.error(
+            report,
+            "names `.`, `..` or `/`, not a folder of its own; flexrom replaces the report folder as a whole",
+        ));
     }
     let r = resolve(report);
     let mut forbidden: Vec<(PathBuf, String)> = vec![(PathBuf::from("/"), "the root folder".into())];
@@ -146,15 +180,25 @@ pub fn check_report_dir(report: &Path, pipeline: &Path, inputs: &[(&Path, &str)]
     for (f, what) in &forbidden {
         if contains(&r, f) {
             let rel = if &r == f { "is" } else { "holds" };
-            return Err(origin.error(report, format!("{rel} {what}; flexrom replaces the report folder as a whole, so it must be a folder of its own")));
+            return Err(origin.error(
+                report,
+                format!(
+                    "{rel} {what}; flexrom replaces the report folder as a whole, so it must be a folder of its own"
+                ),
+            ));
         }
     }
     if r.components().filter(|c| matches!(c, Component::Normal(_))).count() < 2 {
-        return Err(origin.error(report, format!("is the top-level folder `{}`; a report folder must be a folder of its own", r.display())));
+        return Err(origin.error(
+            report,
+            format!("is the top-level folder `{}`; a report folder must be a folder of its own", r.display()),
+        ));
     }
     match std::fs::symlink_metadata(report) {
         Err(_) => creatable(report, origin),
-        Ok(m) if m.file_type().is_symlink() => Err(origin.error(report, "is a symbolic link; flexrom only replaces report folders it made itself")),
+        Ok(m) if m.file_type().is_symlink() => {
+            Err(origin.error(report, "is a symbolic link; flexrom only replaces report folders it made itself"))
+        }
         Ok(m) if !m.is_dir() => Err(origin.error(report, format!("exists and is {}, not a folder", kind_of(&m)))),
         Ok(_) => check_marked(report, origin),
     }
@@ -187,7 +231,8 @@ fn check_marked(dir: &Path, origin: Origin) -> Result<()> {
             format!("is a non-empty folder without flexrom's mark `{MARKER}`: flexrom did not make it and will not replace it (move it away or choose another `report`)"),
         ));
     };
-    let ours = |n: &str| n == MARKER || listed.iter().any(|l| l == n) || (n.starts_with('.') && n.contains(".flexrom-tmp-"));
+    let ours =
+        |n: &str| n == MARKER || listed.iter().any(|l| l == n) || (n.starts_with('.') && n.contains(".flexrom-tmp-"));
     if let Some(foreign) = entries.iter().find(|n| !ours(n)) {
         return Err(origin.error(
             dir,

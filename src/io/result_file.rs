@@ -22,7 +22,11 @@ pub fn write_result(path: &Path, r: &SimulationResult) -> Result<()> {
 
 /// Writes the common layout, then lets `extra` add datasets and attributes (reduced runs
 /// add `/reduced/q` and the basis they used), all in the same atomic write.
-pub fn write_result_with(path: &Path, r: &SimulationResult, extra: impl FnOnce(&hdf5::File) -> Result<()>) -> Result<()> {
+pub fn write_result_with(
+    path: &Path,
+    r: &SimulationResult,
+    extra: impl FnOnce(&hdf5::File) -> Result<()>,
+) -> Result<()> {
     write_atomically(path, |f| {
         let e = |err: hdf5::Error| Error::hdf5(path, err);
         f.new_dataset_builder().with_data(&r.t).create("t").map_err(e)?;

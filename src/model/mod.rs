@@ -46,7 +46,15 @@ impl Model {
     pub fn from_text(text: &str, path: impl AsRef<Path>) -> Result<Model> {
         let path = path.as_ref();
         let file: ModelFile = parse_toml(text, path).map_err(|e| entry_error(text, path).unwrap_or(e))?;
-        let mut model = Model { path: path.to_path_buf(), text: text.to_string(), file, bodies: vec![], joints: vec![], loads: vec![], probes: vec![] };
+        let mut model = Model {
+            path: path.to_path_buf(),
+            text: text.to_string(),
+            file,
+            bodies: vec![],
+            joints: vec![],
+            loads: vec![],
+            probes: vec![],
+        };
         model.check()?;
         Ok(model)
     }
@@ -88,7 +96,9 @@ impl Model {
             }
             let total: f64 = f.bodies[..=i].iter().map(|b| b.elements.max(0) as f64).sum();
             crate::limits::check_elements(total).map_err(|e| self.err(p("elements"), e))?;
-            for (k, v) in [("density", b.density), ("area", b.area), ("inertia", b.inertia), ("youngs_modulus", b.youngs_modulus)] {
+            for (k, v) in
+                [("density", b.density), ("area", b.area), ("inertia", b.inertia), ("youngs_modulus", b.youngs_modulus)]
+            {
                 self.positive(&p(k), v)?;
             }
             let (angle, length) = match (b.angle, b.end) {
@@ -126,7 +136,12 @@ impl Model {
                 angle,
                 length,
                 n_elements: b.elements as usize,
-                section: Section { density: b.density, area: b.area, inertia: b.inertia, youngs_modulus: b.youngs_modulus },
+                section: Section {
+                    density: b.density,
+                    area: b.area,
+                    inertia: b.inertia,
+                    youngs_modulus: b.youngs_modulus,
+                },
             });
         }
         let lmax = self.bodies.iter().map(|b| b.length).fold(0.0, f64::max);
@@ -169,7 +184,11 @@ impl Model {
                 JointSpec::Clamp { body, node } => {
                     let id = self.node_id(&p("body"), &p("node"), body, node)?;
                     let bd = &self.bodies[id.0];
-                    Joint::Clamp { node: id, point: node_pos(id, &self.bodies), slope: [bd.angle.cos(), bd.angle.sin()] }
+                    Joint::Clamp {
+                        node: id,
+                        point: node_pos(id, &self.bodies),
+                        slope: [bd.angle.cos(), bd.angle.sin()],
+                    }
                 }
             };
             self.joints.push(joint);
@@ -214,7 +233,11 @@ impl Model {
                 (None, None) => return Err(self.err(p("node"), "missing: give `node` or `at`")),
                 (Some(node), None) => {
                     let (_, k) = self.node_id(&p("body"), &p("node"), &pr.body, node)?;
-                    if k < n_el { (first_el + k, 0.0) } else { (first_el + n_el - 1, 1.0) }
+                    if k < n_el {
+                        (first_el + k, 0.0)
+                    } else {
+                        (first_el + n_el - 1, 1.0)
+                    }
                 }
                 (None, Some(at)) => {
                     if !(at.is_finite() && (0.0..=1.0).contains(&at)) {
@@ -258,7 +281,9 @@ impl Model {
                 let mut used = BTreeSet::from([j]);
                 // eliminate the earliest basis row first: a basis row holds only pivot
                 // columns of later rows, so this ends
-                while let Some((c, bi)) = r.keys().filter_map(|c| pivot_of.get(c).map(|&bi| (*c, bi))).min_by_key(|x| x.1) {
+                while let Some((c, bi)) =
+                    r.keys().filter_map(|c| pivot_of.get(c).map(|&bi| (*c, bi))).min_by_key(|x| x.1)
+                {
                     let (brow, bj) = &basis[bi];
                     let f = r[&c] / brow[&c];
                     for (&cc, &bv) in brow {
@@ -274,7 +299,11 @@ impl Model {
                         basis.push((r, used));
                     }
                     None => {
-                        let others: Vec<String> = used.iter().filter(|&&i| i != j).map(|&i| format!("joints[{i}] ({})", self.describe_joint(i))).collect();
+                        let others: Vec<String> = used
+                            .iter()
+                            .filter(|&&i| i != j)
+                            .map(|&i| format!("joints[{i}] ({})", self.describe_joint(i)))
+                            .collect();
                         let field = match entry_line(&self.text, "joints", j) {
                             Some(l) => format!("joints[{j}] (line {l})"),
                             None => format!("joints[{j}]"),
@@ -340,7 +369,9 @@ impl Model {
         }
         if let Some(m) = t.max_total_step_cuts {
             if m < 0 {
-                return Err(self.err("time.max_total_step_cuts", format!("must be zero or a positive integer, got {m}")));
+                return Err(
+                    self.err("time.max_total_step_cuts", format!("must be zero or a positive integer, got {m}"))
+                );
             }
             p.max_total_cuts = usize::try_from(m).unwrap_or(usize::MAX);
         }
@@ -348,7 +379,11 @@ impl Model {
             p.reuse = match r.as_str() {
                 "within-step" => JacobianReuse::WithinStep,
                 "never" => JacobianReuse::Never,
-                _ => return Err(self.err("time.jacobian_reuse", format!("must be \"within-step\" or \"never\", got \"{r}\""))),
+                _ => {
+                    return Err(
+                        self.err("time.jacobian_reuse", format!("must be \"within-step\" or \"never\", got \"{r}\""))
+                    )
+                }
             };
         }
         Ok(p)
@@ -372,7 +407,11 @@ impl Model {
 
     /// Builds the physical system with the given linear solver.
     pub fn system(&self, solver: LinearSolverKind) -> FlexibleSystem {
-        let damping = self.file.damping.as_ref().map_or(Rayleigh::default(), |d| Rayleigh { mass: d.mass, stiffness: d.stiffness });
+        let damping = self
+            .file
+            .damping
+            .as_ref()
+            .map_or(Rayleigh::default(), |d| Rayleigh { mass: d.mass, stiffness: d.stiffness });
         FlexibleSystem::new(self.bodies.clone(), &self.joints, &self.loads, self.probes.clone(), damping, solver)
     }
 
@@ -416,11 +455,19 @@ impl Model {
     }
 
     fn finite(&self, field: &str, v: f64) -> Result<()> {
-        if v.is_finite() { Ok(()) } else { Err(self.err(field, format!("must be finite, got {v}"))) }
+        if v.is_finite() {
+            Ok(())
+        } else {
+            Err(self.err(field, format!("must be finite, got {v}")))
+        }
     }
 
     fn finite2(&self, field: &str, v: [f64; 2]) -> Result<()> {
-        if v.iter().all(|x| x.is_finite()) { Ok(()) } else { Err(self.err(field, format!("must be finite, got {v:?}"))) }
+        if v.iter().all(|x| x.is_finite()) {
+            Ok(())
+        } else {
+            Err(self.err(field, format!("must be finite, got {v:?}")))
+        }
     }
 
     fn body_index(&self, field: &str, name: &str) -> Result<usize> {
@@ -435,10 +482,16 @@ impl Model {
         let n = self.bodies[b].n_elements;
         let k = match node {
             NodeRef::Index(k) if (0..=n as i64).contains(k) => *k as usize,
-            NodeRef::Index(k) => return Err(self.err(node_field, format!("node {k} is outside body `{body}` (nodes 0..={n})"))),
+            NodeRef::Index(k) => {
+                return Err(self.err(node_field, format!("node {k} is outside body `{body}` (nodes 0..={n})")))
+            }
             NodeRef::Name(s) if s == "start" => 0,
             NodeRef::Name(s) if s == "end" => n,
-            NodeRef::Name(s) => return Err(self.err(node_field, format!("`{s}` is not a node: use an index 0..={n}, \"start\" or \"end\""))),
+            NodeRef::Name(s) => {
+                return Err(
+                    self.err(node_field, format!("`{s}` is not a node: use an index 0..={n}, \"start\" or \"end\""))
+                )
+            }
         };
         Ok((b, k))
     }
@@ -470,9 +523,14 @@ fn entry_error(text: &str, path: &Path) -> Option<Error> {
                     rest.remove(k);
                     parse(&toml::Value::Table(rest)).as_deref() != Some(message.as_str())
                 };
-                t.keys().filter(|k| k.as_str() != "type").find(|k| changes(k)).or_else(|| t.keys().find(|k| changes(k))).cloned()
+                t.keys()
+                    .filter(|k| k.as_str() != "type")
+                    .find(|k| changes(k))
+                    .or_else(|| t.keys().find(|k| changes(k)))
+                    .cloned()
             });
-            let line = entry_line(text, name, i).map(|l| key.as_deref().and_then(|k| key_line(text, l, k)).unwrap_or(l));
+            let line =
+                entry_line(text, name, i).map(|l| key.as_deref().and_then(|k| key_line(text, l, k)).unwrap_or(l));
             let field = match (&key, line) {
                 (Some(k), Some(l)) => format!("{name}[{i}].{k} (line {l})"),
                 (Some(k), None) => format!("{name}[{i}].{k}"),
@@ -487,7 +545,8 @@ fn entry_error(text: &str, path: &Path) -> Option<Error> {
 
 /// The line (1-based) of the `[[name]]` header of entry `i`, if written that way.
 fn entry_line(text: &str, name: &str, i: usize) -> Option<usize> {
-    let is_header = |l: &str| l.trim().strip_prefix("[[").and_then(|r| r.split("]]").next()).is_some_and(|n| n.trim() == name);
+    let is_header =
+        |l: &str| l.trim().strip_prefix("[[").and_then(|r| r.split("]]").next()).is_some_and(|n| n.trim() == name);
     text.lines().enumerate().filter(|(_, l)| is_header(l)).nth(i).map(|(k, _)| k + 1)
 }
 

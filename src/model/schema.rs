@@ -101,7 +101,12 @@ pub struct NodeSpec {
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum JointSpec {
     /// the node's position is fixed at `point` (default: where it starts)
-    GroundPin { body: String, node: NodeRef, #[serde(default)] point: Option<[f64; 2]> },
+    GroundPin {
+        body: String,
+        node: NodeRef,
+        #[serde(default)]
+        point: Option<[f64; 2]>,
+    },
     /// two bodies' nodes share their position
     Pin { a: NodeSpec, b: NodeSpec },
     /// position and slope of the node fixed at their initial values
@@ -116,9 +121,19 @@ fn yes() -> bool {
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum LoadSpec {
     /// gravity acceleration vector, m/s²; `scaled` = multiplied by the load scale
-    Gravity { g: [f64; 2], #[serde(default)] scaled: bool },
+    Gravity {
+        g: [f64; 2],
+        #[serde(default)]
+        scaled: bool,
+    },
     /// moment (N·m) at a node, `function` of time
-    Moment { body: String, node: NodeRef, function: TimeFunction, #[serde(default = "yes")] scaled: bool },
+    Moment {
+        body: String,
+        node: NodeRef,
+        function: TimeFunction,
+        #[serde(default = "yes")]
+        scaled: bool,
+    },
     /// force (N) at a node, times `function` of time if given
     Force {
         body: String,

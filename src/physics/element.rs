@@ -93,14 +93,7 @@ impl BeamElement {
             [-6.0 / (5.0 * l), -0.1, 6.0 / (5.0 * l), -0.1],
             [0.1, -l / 30.0, -0.1, 2.0 * l / 15.0],
         ];
-        BeamElement {
-            length,
-            section,
-            sl,
-            mass: kron_i2(&mass),
-            bending: kron_i2(&bending),
-            axial: kron_i2(&sl),
-        }
+        BeamElement { length, section, sl, mass: kron_i2(&mass), bending: kron_i2(&bending), axial: kron_i2(&sl) }
     }
 
     /// Constant mass matrix `M = ρA ∫ SᵀS ds`.
@@ -198,13 +191,24 @@ mod tests {
     /// 5-point Gauss–Legendre on [0, 1] (exact for degree ≤ 9; every integrand here is ≤ 6).
     fn gauss5() -> [(f64, f64); 5] {
         let p = [0.0, -0.538_469_310_105_683_1, 0.538_469_310_105_683_1, -0.906_179_845_938_664, 0.906_179_845_938_664];
-        let w = [0.568_888_888_888_888_9, 0.478_628_670_499_366_5, 0.478_628_670_499_366_5, 0.236_926_885_056_189_1, 0.236_926_885_056_189_1];
+        let w = [
+            0.568_888_888_888_888_9,
+            0.478_628_670_499_366_5,
+            0.478_628_670_499_366_5,
+            0.236_926_885_056_189_1,
+            0.236_926_885_056_189_1,
+        ];
         std::array::from_fn(|i| (0.5 * (p[i] + 1.0), 0.5 * w[i]))
     }
 
     /// dS/dξ and d²S/dξ² of the shape functions, derived by hand from `shape_functions`.
     fn dshape(xi: f64, l: f64) -> ([f64; 4], [f64; 4]) {
-        let d1 = [-6.0 * xi + 6.0 * xi * xi, l * (1.0 - 4.0 * xi + 3.0 * xi * xi), 6.0 * xi - 6.0 * xi * xi, l * (3.0 * xi * xi - 2.0 * xi)];
+        let d1 = [
+            -6.0 * xi + 6.0 * xi * xi,
+            l * (1.0 - 4.0 * xi + 3.0 * xi * xi),
+            6.0 * xi - 6.0 * xi * xi,
+            l * (3.0 * xi * xi - 2.0 * xi),
+        ];
         let d2 = [-6.0 + 12.0 * xi, l * (-4.0 + 6.0 * xi), 6.0 - 12.0 * xi, l * (6.0 * xi - 2.0)];
         (d1, d2)
     }

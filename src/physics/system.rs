@@ -174,7 +174,11 @@ impl FlexibleSystem {
         // the element that holds a node: the one it starts, or the last of its body
         let element_of = |(b, k): NodeId| -> (usize, usize) {
             let first_el: usize = bodies[..b].iter().map(|x| x.n_elements).sum();
-            if k < bodies[b].n_elements { (first_el + k, 0) } else { (first_el + k - 1, 4) }
+            if k < bodies[b].n_elements {
+                (first_el + k, 0)
+            } else {
+                (first_el + k - 1, 4)
+            }
         };
         for load in loads {
             match load {
@@ -200,7 +204,12 @@ impl FlexibleSystem {
                 }
                 Load::Force { node, value, function, scaled } => {
                     let n = gnode(*node);
-                    forces.push(ForceLoad { dofs: [4 * n, 4 * n + 1], value: *value, function: function.clone(), scaled: *scaled });
+                    forces.push(ForceLoad {
+                        dofs: [4 * n, 4 * n + 1],
+                        value: *value,
+                        function: function.clone(),
+                        scaled: *scaled,
+                    });
                 }
             }
         }
@@ -301,7 +310,8 @@ impl FlexibleSystem {
         let mut change = 0.0_f64;
         if res.iter().any(|r| *r != 0.0) {
             // ∂q_d/∂(t_x, t_y, θ̂) with θ = θ̂/L: all three in metres
-            let body_of = |node: usize| (0..nb).rev().find(|&b| self.first_node[b] <= node).expect("node 0 is in body 0");
+            let body_of =
+                |node: usize| (0..nb).rev().find(|&b| self.first_node[b] <= node).expect("node 0 is in body 0");
             let motion = |d: usize, q: &[f64]| -> (usize, [f64; 3]) {
                 let node = d / 4;
                 let b = body_of(node);
@@ -362,7 +372,8 @@ impl FlexibleSystem {
     /// Potential energy: strain energy plus that of the (constant) gravity loads.
     pub fn potential_energy(&self, q: &[f64]) -> f64 {
         let strain: f64 = (0..self.elements.len()).map(|e| self.element(e).strain_energy(&self.gather(e, q))).sum();
-        let grav: f64 = (0..self.n_dof).map(|i| (self.gravity_fixed[i] + self.load_scale * self.gravity_scaled[i]) * q[i]).sum();
+        let grav: f64 =
+            (0..self.n_dof).map(|i| (self.gravity_fixed[i] + self.load_scale * self.gravity_scaled[i]) * q[i]).sum();
         strain - grav
     }
 
@@ -386,7 +397,11 @@ impl FlexibleSystem {
     }
 
     fn load_factor(&self, scaled: bool) -> f64 {
-        if scaled { self.load_scale } else { 1.0 }
+        if scaled {
+            self.load_scale
+        } else {
+            1.0
+        }
     }
 
     /// `fₑ = Cₑ q̇ₑ + Qₑ(qₑ)` with Rayleigh `Cₑ = a Mₑ + b K_bending,ₑ`.
@@ -423,7 +438,8 @@ impl FlexibleSystem {
     /// `q(dof)` reads the coordinates they depend on.
     fn add_nodal_loads(&self, t: f64, q: impl Fn(usize) -> f64, mut add: impl FnMut(usize, f64)) {
         for m in &self.moments {
-            let qm = moment_force(self.load_factor(m.scaled) * m.function.eval(t), [q(m.slope_dofs[0]), q(m.slope_dofs[1])]);
+            let qm =
+                moment_force(self.load_factor(m.scaled) * m.function.eval(t), [q(m.slope_dofs[0]), q(m.slope_dofs[1])]);
             add(m.slope_dofs[0], -qm[0]);
             add(m.slope_dofs[1], -qm[1]);
         }
@@ -619,7 +635,14 @@ mod tests {
     fn invariant_form_rebuilds_element_force_and_tangent() {
         let section = Section { density: 2700.0, area: 1e-3, inertia: 1e-7, youngs_modulus: 7e9 };
         let body = BeamBody { name: "b".into(), start: [0.0, 0.0], angle: 0.3, length: 1.0, n_elements: 2, section };
-        let sys = FlexibleSystem::new(vec![body], &[], &[], vec![], Rayleigh { mass: 0.3, stiffness: 2e-3 }, LinearSolverKind::Banded);
+        let sys = FlexibleSystem::new(
+            vec![body],
+            &[],
+            &[],
+            vec![],
+            Rayleigh { mass: 0.3, stiffness: 2e-3 },
+            LinearSolverKind::Banded,
+        );
         // a stretched and bent element with an arbitrary velocity
         let qe: Vec<f64> = (0..8).map(|i| [0.1, -0.05, 0.95, 0.31, 0.62, 0.2, 1.02, 0.4][i]).collect();
         let ve: Vec<f64> = (0..8).map(|i| 0.1 * i as f64 - 0.3).collect();

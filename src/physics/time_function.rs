@@ -8,7 +8,12 @@ pub enum TimeFunction {
     /// `f(t) = value`
     Constant { value: f64 },
     /// `f(t) = amplitude · sin(2π · frequency · t + phase)`, frequency in Hz, phase in rad.
-    Sine { amplitude: f64, frequency: f64, #[serde(default)] phase: f64 },
+    Sine {
+        amplitude: f64,
+        frequency: f64,
+        #[serde(default)]
+        phase: f64,
+    },
     /// `f(t) = amplitude · exp(rate · t)`
     Exponential { amplitude: f64, rate: f64 },
     /// `f(t) = amplitude · min(t / duration, 1)`: a ramp that then holds.
@@ -43,7 +48,8 @@ impl TimeFunction {
 
     /// Checks that every number is finite and the pieces are ordered; returns the problem.
     pub fn check(&self) -> Result<(), String> {
-        let finite = |name: &str, v: f64| if v.is_finite() { Ok(()) } else { Err(format!("{name} must be finite, got {v}")) };
+        let finite =
+            |name: &str, v: f64| if v.is_finite() { Ok(()) } else { Err(format!("{name} must be finite, got {v}")) };
         match self {
             TimeFunction::Constant { value } => finite("value", *value),
             TimeFunction::Sine { amplitude, frequency, phase } => {

@@ -89,13 +89,18 @@ impl GreedySpec {
     pub fn validate(&self) -> std::result::Result<(), (String, String)> {
         let bad = |f: &str, p: String| Err((format!("train.greedy.{f}"), p));
         match self.range[..] {
-            [a, b] if !(a.is_finite() && b.is_finite()) => return bad("range", format!("[{a}, {b}] must be two finite numbers")),
+            [a, b] if !(a.is_finite() && b.is_finite()) => {
+                return bad("range", format!("[{a}, {b}] must be two finite numbers"))
+            }
             [a, b] if a >= b => return bad("range", format!("[{a}, {b}]: the first end must be less than the second")),
             [_, _] => {}
             _ => return bad("range", format!("has {} entries; it must be [A, B] with A < B", self.range.len())),
         }
         if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
-            return bad("tolerance", format!("is {}; it must be positive and finite (a relative error, e.g. 1e-3)", self.tolerance));
+            return bad(
+                "tolerance",
+                format!("is {}; it must be positive and finite (a relative error, e.g. 1e-3)", self.tolerance),
+            );
         }
         if self.max_runs == 0 {
             return bad("max_runs", "is 0; at least one full run is needed".into());
@@ -116,7 +121,14 @@ impl GreedySpec {
         let (a, b) = self.range();
         let n = self.candidates;
         // rounded to 12 significant digits: 0.7 + 0.5 · 19/20 prints as 1.175, not 1.1749999999999998
-        let round = |x: f64| if x == 0.0 { x } else { let k = 10f64.powi(11 - x.abs().log10().floor() as i32); (x * k).round() / k };
+        let round = |x: f64| {
+            if x == 0.0 {
+                x
+            } else {
+                let k = 10f64.powi(11 - x.abs().log10().floor() as i32);
+                (x * k).round() / k
+            }
+        };
         (0..n).map(|i| if i + 1 == n { b } else { round(a + (b - a) * i as f64 / (n - 1) as f64) }).collect()
     }
 }
@@ -248,7 +260,8 @@ impl Pipeline {
             Error::Io { .. } => Error::input(path, "model", format!("cannot read `{}`: {e}", file.model.display())),
             other => other,
         })?;
-        let basis_path = dir.join(file.basis.clone().unwrap_or_else(|| PathBuf::from(format!("../data/bases/{stem}.h5"))));
+        let basis_path =
+            dir.join(file.basis.clone().unwrap_or_else(|| PathBuf::from(format!("../data/bases/{stem}.h5"))));
         let report_dir = dir.join(file.report.clone().unwrap_or_else(|| PathBuf::from(format!("../reports/{stem}"))));
         let p = Pipeline { path: path.to_path_buf(), text, file, model, basis_path, report_dir };
         p.check()?;
@@ -260,7 +273,12 @@ impl Pipeline {
         let red = &self.file.reduction;
         match (&self.file.train.load_scales, &self.file.train.greedy) {
             (Some(_), Some(_)) => return bad("train", "has both load_scales and greedy; give exactly one".into()),
-            (None, None) => return bad("train", "needs load_scales = [..] or greedy = { range = [A, B], tolerance = T, max_runs = K }".into()),
+            (None, None) => {
+                return bad(
+                    "train",
+                    "needs load_scales = [..] or greedy = { range = [A, B], tolerance = T, max_runs = K }".into(),
+                )
+            }
             (Some(s), None) => {
                 if let Err(e) = check_scales(s) {
                     return bad("train.load_scales", e);
@@ -279,21 +297,38 @@ impl Pipeline {
             return bad("reduction.modes", e);
         }
         match (&red.modes, self.blocks()) {
-            (Some(ModeRule::Counts(_)), None) => return bad("reduction.modes", "gives one count per block, but there are no blocks (set reduction.blocks = \"bodies\")".into()),
+            (Some(ModeRule::Counts(_)), None) => {
+                return bad(
+                    "reduction.modes",
+                    "gives one count per block, but there are no blocks (set reduction.blocks = \"bodies\")".into(),
+                )
+            }
             (Some(ModeRule::Counts(c)), Some(Blocks::Bodies)) if c.len() != self.model.file.bodies.len() => {
-                return bad("reduction.modes", format!("gives {} counts, the model has {} bodies", c.len(), self.model.file.bodies.len()))
+                return bad(
+                    "reduction.modes",
+                    format!("gives {} counts, the model has {} bodies", c.len(), self.model.file.bodies.len()),
+                )
             }
             _ => {}
         }
         if self.blocks().is_some() && self.variant() == Variant::WholeSystem {
-            return bad("reduction.blocks", "needs the galerkin or the constraint-preserving variant, not whole-system".into());
+            return bad(
+                "reduction.blocks",
+                "needs the galerkin or the constraint-preserving variant, not whole-system".into(),
+            );
         }
         if let Some(h) = &self.file.reduction.hyper {
             if !(h.tolerance.is_finite() && h.tolerance > 0.0 && h.tolerance < 1.0) {
-                return bad("reduction.hyper.tolerance", format!("is {}; it must lie strictly between 0 and 1", h.tolerance));
+                return bad(
+                    "reduction.hyper.tolerance",
+                    format!("is {}; it must lie strictly between 0 and 1", h.tolerance),
+                );
             }
         }
-        for (name, scales) in [("online", self.file.online.as_ref().map(|o| &o.load_scales)), ("validate", self.file.validate.as_ref().map(|v| &v.load_scales))] {
+        for (name, scales) in [
+            ("online", self.file.online.as_ref().map(|o| &o.load_scales)),
+            ("validate", self.file.validate.as_ref().map(|v| &v.load_scales)),
+        ] {
             if let Some(s) = scales {
                 if let Err(e) = s.values() {
                     return bad(&format!("{name}.load_scales"), e);
@@ -311,18 +346,24 @@ impl Pipeline {
     /// The reduction variant: the file's, or constraint-preserving when the model has
     /// joints between bodies, galerkin when it has none or only ground joints.
     pub fn variant(&self) -> Variant {
-        self.file.reduction.variant.unwrap_or(if self.model.file.joints.iter().any(|j| matches!(j, crate::model::schema::JointSpec::Pin { .. })) {
-            Variant::ConstraintPreserving
-        } else {
-            Variant::Galerkin
-        })
+        self.file.reduction.variant.unwrap_or(
+            if self.model.file.joints.iter().any(|j| matches!(j, crate::model::schema::JointSpec::Pin { .. })) {
+                Variant::ConstraintPreserving
+            } else {
+                Variant::Galerkin
+            },
+        )
     }
 
     /// The block split: the file's; with `train.greedy` and none given, one block per body
     /// when the model has several bodies (each body's modes then move that body only).
     pub fn blocks(&self) -> Option<Blocks> {
         let multi_body = self.model.file.bodies.len() > 1 && self.variant() != Variant::WholeSystem;
-        self.file.reduction.blocks.or(if self.file.train.greedy.is_some() && multi_body { Some(Blocks::Bodies) } else { None })
+        self.file.reduction.blocks.or(if self.file.train.greedy.is_some() && multi_body {
+            Some(Blocks::Bodies)
+        } else {
+            None
+        })
     }
 
     /// The given training loads, or for greedy training the ends and middle of its range

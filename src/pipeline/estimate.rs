@@ -154,11 +154,20 @@ pub fn build_estimator(
     extra: usize,
 ) -> std::result::Result<Estimator, String> {
     let spec = BasisSpec { modes: enriched_rule(trained, !spec.blocks.is_empty(), extra), ..spec.clone() };
-    let mut richer = train_basis(x, multipliers, joint_dofs, x_ref, &spec).map_err(|e| format!("enriched basis: {e}"))?;
+    let mut richer =
+        train_basis(x, multipliers, joint_dofs, x_ref, &spec).map_err(|e| format!("enriched basis: {e}"))?;
     if let Some(tol) = hyper_tolerance {
-        richer.basis.hyper = Some(ecsw(sys, &richer.basis, x, ENRICHED_HYPER_FACTOR * tol).map_err(|e| format!("ECSW of the enriched basis: {e}"))?);
+        richer.basis.hyper = Some(
+            ecsw(sys, &richer.basis, x, ENRICHED_HYPER_FACTOR * tol)
+                .map_err(|e| format!("ECSW of the enriched basis: {e}"))?,
+        );
     }
-    Ok(Estimator { enriched: richer.basis, block_modes: richer.block_modes, extra_modes: extra, calibration: Calibration::default() })
+    Ok(Estimator {
+        enriched: richer.basis,
+        block_modes: richer.block_modes,
+        extra_modes: extra,
+        calibration: Calibration::default(),
+    })
 }
 
 /// `η_raw = ‖X_r − X⁺‖_F / ‖X⁺‖_F` of two finished runs of the same load, from their
@@ -219,7 +228,12 @@ impl<'a> EstimatingRunner<'a> {
 
     /// [`Self::run`] with continuation from `previous` runs of the main model (see
     /// [`ReducedRunner::run`]); the enriched model runs on its own.
-    pub fn run_with(&mut self, load_scale: f64, output: Output, previous: &[&ReducedRun]) -> Result<(ReducedRun, Option<Estimate>)> {
+    pub fn run_with(
+        &mut self,
+        load_scale: f64,
+        output: Output,
+        previous: &[&ReducedRun],
+    ) -> Result<(ReducedRun, Option<Estimate>)> {
         let run = self.rom.run(load_scale, output, previous)?;
         let Some((est, runner)) = &mut self.est else { return Ok((run, None)) };
         let start = std::time::Instant::now();
@@ -229,7 +243,13 @@ impl<'a> EstimatingRunner<'a> {
             Err(_) => f64::INFINITY,
         };
         let c = &est.calibration;
-        let e = Estimate { error_estimate: c.factor * raw, raw, factor: c.factor, calibrated: c.calibrated, seconds: start.elapsed().as_secs_f64() };
+        let e = Estimate {
+            error_estimate: c.factor * raw,
+            raw,
+            factor: c.factor,
+            calibrated: c.calibrated,
+            seconds: start.elapsed().as_secs_f64(),
+        };
         Ok((run, Some(e)))
     }
 }
@@ -272,7 +292,11 @@ pub struct TrustInfo {
 
 /// Reads the estimator (checked against the model), the training range and tolerance of
 /// the basis file `path` already read as `stored`.
-pub fn load_trust(p: &super::Pipeline, path: &std::path::Path, stored: &crate::io::basis_file::StoredBasis) -> Result<TrustInfo> {
+pub fn load_trust(
+    p: &super::Pipeline,
+    path: &std::path::Path,
+    stored: &crate::io::basis_file::StoredBasis,
+) -> Result<TrustInfo> {
     use crate::error::Error;
     use crate::io::estimator_file::{read_estimator, read_training_range, read_training_tolerance};
     use crate::solver::model::DynamicModel;
@@ -307,7 +331,12 @@ pub fn describe(e: &Estimate, rom_seconds: f64) -> String {
 /// Attributes of an `online` result file: `error_estimate` (NaN without an estimator),
 /// `error_estimate_raw`, `error_estimate_factor`, `error_estimate_calibrated` (0/1),
 /// `extrapolated` (0/1), `training_range` ([min, max]), `tolerance` (when set).
-pub fn write_run_attributes(f: &hdf5::File, e: Option<&Estimate>, trust: &TrustInfo, extrapolated: bool) -> hdf5::Result<()> {
+pub fn write_run_attributes(
+    f: &hdf5::File,
+    e: Option<&Estimate>,
+    trust: &TrustInfo,
+    extrapolated: bool,
+) -> hdf5::Result<()> {
     use crate::io::h5::{attr_f64, attr_u64};
     attr_f64(f, "error_estimate", e.map_or(f64::NAN, |e| e.error_estimate))?;
     attr_f64(f, "error_estimate_raw", e.map_or(f64::NAN, |e| e.raw))?;
@@ -340,9 +369,17 @@ pub const STRICT_EXIT_CODE: u8 = 4;
 /// written.
 pub fn check_runs(trust: &TrustInfo, runs: &[(f64, Option<f64>)], strict: bool) -> Result<()> {
     let (a, b) = trust.range;
-    let out: Vec<String> = runs.iter().filter(|r| is_extrapolated(trust.range, r.0)).map(|r| format!("{:.4}", r.0).trim_end_matches('0').trim_end_matches('.').to_string()).collect();
+    let out: Vec<String> = runs
+        .iter()
+        .filter(|r| is_extrapolated(trust.range, r.0))
+        .map(|r| format!("{:.4}", r.0).trim_end_matches('0').trim_end_matches('.').to_string())
+        .collect();
     if !out.is_empty() {
-        let what = if runs.len() == 1 { format!("load scale {}", out[0]) } else { format!("{} of {} load scales ({})", out.len(), runs.len(), few(&out)) };
+        let what = if runs.len() == 1 {
+            format!("load scale {}", out[0])
+        } else {
+            format!("{} of {} load scales ({})", out.len(), runs.len(), few(&out))
+        };
         eprintln!("warning: {what} outside the basis's training range [{a}, {b}]: extrapolated, the reduced model was never trained there");
     }
     if trust.estimator.is_none() && runs.iter().all(|r| r.1.is_none()) && !trust.skipped {
@@ -350,7 +387,9 @@ pub fn check_runs(trust: &TrustInfo, runs: &[(f64, Option<f64>)], strict: bool) 
     }
     let Some(tol) = trust.tolerance.filter(|_| !trust.skipped) else {
         if strict {
-            eprintln!("warning: --strict: no tolerance to hold the estimates to (set [online] tolerance in the pipeline)");
+            eprintln!(
+                "warning: --strict: no tolerance to hold the estimates to (set [online] tolerance in the pipeline)"
+            );
         }
         return Ok(());
     };
@@ -365,7 +404,11 @@ pub fn check_runs(trust: &TrustInfo, runs: &[(f64, Option<f64>)], strict: bool) 
     if over.is_empty() {
         return Ok(());
     }
-    let what = if runs.len() == 1 { format!("load scale {}", over[0]) } else { format!("{} of {} load scales: {}", over.len(), runs.len(), few(&over)) };
+    let what = if runs.len() == 1 {
+        format!("load scale {}", over[0])
+    } else {
+        format!("{} of {} load scales: {}", over.len(), runs.len(), few(&over))
+    };
     let msg = format!("error estimate above the tolerance {tol:e} at {what}");
     if strict {
         return Err(crate::Error::Strict(format!("--strict: {msg}")));
@@ -399,7 +442,8 @@ mod tests {
     fn reduced_norms_match_full_reconstruction() {
         let n = 7;
         let nt = 4;
-        let a = Array2::from_shape_fn((n, 5), |(i, j)| ((i * 5 + j) as f64 * 0.37).sin() + if i == j { 2.0 } else { 0.0 });
+        let a =
+            Array2::from_shape_fn((n, 5), |(i, j)| ((i * 5 + j) as f64 * 0.37).sin() + if i == j { 2.0 } else { 0.0 });
         let (qf, _) = ndarray_linalg::QR::qr(&a).unwrap();
         let vp = qf.slice(ndarray::s![.., ..5]).to_owned();
         let reference = Array1::from_shape_fn(n, |i| 0.1 * i as f64 + 1.0);
@@ -415,18 +459,26 @@ mod tests {
             hyper: None,
         };
         let plus = mk(vp.clone());
-        let est = Estimator { enriched: plus.clone(), block_modes: vec![5], extra_modes: 2, calibration: Calibration::default() };
+        let est = Estimator {
+            enriched: plus.clone(),
+            block_modes: vec![5],
+            extra_modes: 2,
+            calibration: Calibration::default(),
+        };
         // nested (first 3 columns) and not nested (mixing columns 2..5)
         let nested = vp.slice(ndarray::s![.., ..3]).to_owned();
         let mixed = {
-            let (q, _) = ndarray_linalg::QR::qr(&(&vp.slice(ndarray::s![.., 1..4]) + &(0.3 * &qf.slice(ndarray::s![.., 4..5])))).unwrap();
+            let (q, _) =
+                ndarray_linalg::QR::qr(&(&vp.slice(ndarray::s![.., 1..4]) + &(0.3 * &qf.slice(ndarray::s![.., 4..5]))))
+                    .unwrap();
             q
         };
         for small in [nested, mixed] {
             let b = mk(small);
             let q = Array2::from_shape_fn((b.n_reduced(), nt), |(i, k)| (i as f64 + 1.0) * (k as f64 * 0.5).cos());
             let qp = Array2::from_shape_fn((5, nt), |(i, k)| (i as f64 - 1.0) * (k as f64 * 0.3).sin());
-            let full = |basis: &Basis, z: &Array2<f64>| basis.modes.dot(z) + &basis.reference.view().insert_axis(Axis(1));
+            let full =
+                |basis: &Basis, z: &Array2<f64>| basis.modes.dot(z) + &basis.reference.view().insert_axis(Axis(1));
             let (x1, x2) = (full(&b, &q), full(&plus, &qp));
             let want = (&x1 - &x2).mapv(|v| v * v).sum().sqrt() / x2.mapv(|v| v * v).sum().sqrt();
             let got = raw_estimate_reduced(&b, &est.enriched, &q, &qp);
@@ -444,6 +496,8 @@ mod tests {
         assert!(r[..4].iter().all(|&v| v == 0.0), "{r:?}");
         let whole = (&a - &b).mapv(|v| v * v).sum().sqrt() / b.mapv(|v| v * v).sum().sqrt();
         assert!((r[4] - whole).abs() < 1e-15);
-        assert!(is_extrapolated((0.5, 1.5), 1.6) && is_extrapolated((0.5, 1.5), 0.49) && !is_extrapolated((0.5, 1.5), 1.5));
+        assert!(
+            is_extrapolated((0.5, 1.5), 1.6) && is_extrapolated((0.5, 1.5), 0.49) && !is_extrapolated((0.5, 1.5), 1.5)
+        );
     }
 }

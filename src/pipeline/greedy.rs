@@ -56,7 +56,8 @@ pub const MARGIN: f64 = 2.0;
 pub const ENERGY_LADDER: [f64; 9] = [1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10];
 /// ECSW tolerances τ tried with the chosen modes, loose to tight: 10^(−1 − i/2), down to 10⁻⁶
 /// (also the τ with given modes and no given τ).
-pub const TAU_LADDER: [f64; 11] = [1e-1, 3.162e-2, 1e-2, 3.162e-3, 1e-3, 3.162e-4, 1e-4, 3.162e-5, 1e-5, 3.162e-6, 1e-6];
+pub const TAU_LADDER: [f64; 11] =
+    [1e-1, 3.162e-2, 1e-2, 3.162e-3, 1e-3, 3.162e-4, 1e-4, 3.162e-5, 1e-5, 3.162e-6, 1e-6];
 
 /// One pass of the loop: the basis it chose and where its estimate was worst.
 #[derive(Clone, Debug)]
@@ -104,7 +105,12 @@ impl GreedyRecord {
     pub fn mode_rule(&self) -> String {
         match self.iterations.last() {
             Some(it) if it.energy.is_finite() => {
-                format!("greedy: energy = {:e} per block ({}), hyper tolerance {:e}", it.energy, modes_text(&it.block_modes), it.hyper_tolerance)
+                format!(
+                    "greedy: energy = {:e} per block ({}), hyper tolerance {:e}",
+                    it.energy,
+                    modes_text(&it.block_modes),
+                    it.hyper_tolerance
+                )
             }
             Some(it) => format!("greedy: {}", modes_text(&it.block_modes)),
             None => "greedy".into(),
@@ -162,9 +168,19 @@ pub fn initial_loads(range: (f64, f64), max_runs: usize) -> Vec<f64> {
 pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary)> {
     let range = g.range();
     let candidates = g.candidate_loads();
-    let full = |x: f64| simulate(&p.model, &Overrides { load_scale: Some(x), ..Default::default() }).map_err(|e| e.at_stage("train (greedy full run)", x));
+    let full = |x: f64| {
+        simulate(&p.model, &Overrides { load_scale: Some(x), ..Default::default() })
+            .map_err(|e| e.at_stage("train (greedy full run)", x))
+    };
     let first = initial_loads(range, g.max_runs);
-    eprintln!("greedy training over [{}, {}], tolerance {:e}, {} candidates: full runs at {:?}", range.0, range.1, g.tolerance, candidates.len(), first);
+    eprintln!(
+        "greedy training over [{}, {}], tolerance {:e}, {} candidates: full runs at {:?}",
+        range.0,
+        range.1,
+        g.tolerance,
+        candidates.len(),
+        first
+    );
     let mut runs: Vec<SimulationResult> = first.par_iter().map(|&x| full(x)).collect::<Result<_>>()?;
     let mut full_seconds: f64 = runs.iter().map(|r| r.wall_seconds).sum();
     let mut full_runs = runs.len();
@@ -178,7 +194,9 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         let (wi, worst) = level.worst();
         // where to run the full model: the worst candidate whose load has no full run yet
         // (a training load's own run is already in the snapshots)
-        let fresh = |i: usize| runs.iter().all(|r| (r.settings.load_scale - candidates[i]).abs() > 1e-12 * candidates[i].abs().max(1.0));
+        let fresh = |i: usize| {
+            runs.iter().all(|r| (r.settings.load_scale - candidates[i]).abs() > 1e-12 * candidates[i].abs().max(1.0))
+        };
         let next = level.worst_where(fresh);
         let b = &level.trained.basis;
         let mut it = Iteration {
@@ -186,19 +204,34 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
             hyper_tolerance: level.hyper_tolerance.unwrap_or(f64::NAN),
             block_modes: level.trained.block_modes.clone(),
             n_modes: b.n_reduced(),
-            n_elements: b.hyper.as_ref().map_or_else(|| p.model.system(LinearSolverKind::Banded).n_elements(), |h| h.elements.len()),
+            n_elements: b
+                .hyper
+                .as_ref()
+                .map_or_else(|| p.model.system(LinearSolverKind::Banded).n_elements(), |h| h.elements.len()),
             estimates: level.estimates.clone(),
             worst_load: candidates[wi],
             worst_estimate: worst,
             run_load: f64::NAN,
             true_error: f64::NAN,
         };
-        let shape = format!("{}{}, {} elements", modes_text(&it.block_modes), if b.kept.is_empty() { String::new() } else { format!(" + {} joint coordinates", b.kept.len()) }, it.n_elements);
+        let shape = format!(
+            "{}{}, {} elements",
+            modes_text(&it.block_modes),
+            if b.kept.is_empty() { String::new() } else { format!(" + {} joint coordinates", b.kept.len()) },
+            it.n_elements
+        );
         let n = iterations.len() + 1;
         let cmp = if worst <= g.tolerance { "≤" } else { ">" };
         let Some((ni, next_estimate)) = next.filter(|_| full_runs < g.max_runs) else {
-            let why = if full_runs >= g.max_runs { format!("no full run left (max_runs = {})", g.max_runs) } else { "every candidate has a full run".into() };
-            eprintln!("iteration {n}: {why}, worst estimate {worst:.2e} {cmp} {:e} at λ = {}, {shape}", g.tolerance, it.worst_load);
+            let why = if full_runs >= g.max_runs {
+                format!("no full run left (max_runs = {})", g.max_runs)
+            } else {
+                "every candidate has a full run".into()
+            };
+            eprintln!(
+                "iteration {n}: {why}, worst estimate {worst:.2e} {cmp} {:e} at λ = {}, {shape}",
+                g.tolerance, it.worst_load
+            );
             converged = worst <= g.tolerance;
             iterations.push(it);
             break level;
@@ -249,7 +282,17 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         full_runs,
     };
     let n_snapshots = data.x.ncols();
-    Ok((data, TrainSummary { trained, n_snapshots, full_seconds, n_runs: full_runs, greedy: Some(record), estimator: Some(estimator) }))
+    Ok((
+        data,
+        TrainSummary {
+            trained,
+            n_snapshots,
+            full_seconds,
+            n_runs: full_runs,
+            greedy: Some(record),
+            estimator: Some(estimator),
+        },
+    ))
 }
 
 /// rel_error of `basis` at `load` against the full run `truth` (∞ when the reduced run fails).
@@ -265,7 +308,15 @@ fn true_error(model: &Model, basis: &Basis, est: &Estimator, truth: &SimulationR
 /// the pipeline gives, or the energy ladder loose → tight with τ = √ε (and a half step
 /// before the first accepted rung); then, unless the pipeline gives τ, the loosest τ that
 /// still meets T / 2 with those modes.
-fn search(p: &Pipeline, g: &GreedySpec, data: &TrainingData, candidates: &[f64], points: &[CalibrationPoint], n: usize, previous_energy: Option<f64>) -> Result<Level> {
+fn search(
+    p: &Pipeline,
+    g: &GreedySpec,
+    data: &TrainingData,
+    candidates: &[f64],
+    points: &[CalibrationPoint],
+    n: usize,
+    previous_energy: Option<f64>,
+) -> Result<Level> {
     let given_hyper = p.file.reduction.hyper.as_ref().map(|h| h.tolerance);
     let debug = std::env::var_os("FLEXROM_GREEDY_DEBUG").is_some();
     let accepts = |l: &Level| l.worst().1 <= g.tolerance / MARGIN;
@@ -295,7 +346,9 @@ fn search(p: &Pipeline, g: &GreedySpec, data: &TrainingData, candidates: &[f64],
         // after the first iteration the ladder starts two rungs looser than the rung chosen
         // last time: more snapshots need as many modes or more for the same error, and the
         // rungs far looser than that were already far off
-        let start = previous_energy.and_then(|e| ENERGY_LADDER.iter().position(|&x| x <= e * (1.0 + 1e-9))).map_or(0, |i| i.saturating_sub(2));
+        let start = previous_energy
+            .and_then(|e| ENERGY_LADDER.iter().position(|&x| x <= e * (1.0 + 1e-9)))
+            .map_or(0, |i| i.saturating_sub(2));
         for &eps in &ENERGY_LADDER[start..] {
             let Some(l) = attempt(ModeRule::Energy(eps), eps, given_hyper.unwrap_or(eps.sqrt())) else { continue };
             if !l.fully_enriched && best.is_some() {
@@ -308,7 +361,8 @@ fn search(p: &Pipeline, g: &GreedySpec, data: &TrainingData, candidates: &[f64],
                 if let Some(f) = failed_eps {
                     let half = (f * eps).sqrt();
                     if let Some(h) = attempt(ModeRule::Energy(half), half, given_hyper.unwrap_or(half.sqrt())) {
-                        if accepts(&h) && h.fully_enriched && h.trained.basis.n_reduced() < l.trained.basis.n_reduced() {
+                        if accepts(&h) && h.fully_enriched && h.trained.basis.n_reduced() < l.trained.basis.n_reduced()
+                        {
                             best = Some(h);
                             break;
                         }
@@ -329,7 +383,11 @@ fn search(p: &Pipeline, g: &GreedySpec, data: &TrainingData, candidates: &[f64],
     // the cheapest hyper-reduction that keeps the accepted modes within T / 2
     if let (Some(b), None) = (&best, given_hyper) {
         if accepts(b) {
-            let modes = if p.blocks().is_some() { ModeRule::Counts(b.trained.block_modes.clone()) } else { ModeRule::Count(b.trained.block_modes[0]) };
+            let modes = if p.blocks().is_some() {
+                ModeRule::Counts(b.trained.block_modes.clone())
+            } else {
+                ModeRule::Count(b.trained.block_modes[0])
+            };
             let (eps, tau0) = (b.energy, b.hyper_tolerance.unwrap_or(0.0));
             for &tau in TAU_LADDER.iter().filter(|&&t| t > tau0 * (1.0 + 1e-9)) {
                 if let Some(l) = attempt(modes.clone(), eps, tau) {
@@ -362,11 +420,23 @@ fn level(
     let (trained, spec) = build_basis(p, data, modes, hyper_tolerance)?;
     let sys = p.model.system(LinearSolverKind::Banded);
     let x_ref = data.x.column(0);
-    let mut estimator = build_estimator(&sys, &trained, &spec, data.x.view(), data.multipliers.view(), &joint_dofs(p), x_ref, hyper_tolerance, DEFAULT_EXTRA_MODES)
-        .map_err(|e| ("reduction", format!("cannot build the error estimator: {e}")))?;
+    let mut estimator = build_estimator(
+        &sys,
+        &trained,
+        &spec,
+        data.x.view(),
+        data.multipliers.view(),
+        &joint_dofs(p),
+        x_ref,
+        hyper_tolerance,
+        DEFAULT_EXTRA_MODES,
+    )
+    .map_err(|e| ("reduction", format!("cannot build the error estimator: {e}")))?;
     estimator.calibration = calibrate(points.to_vec());
-    let fully_enriched = estimator.block_modes.iter().zip(&trained.block_modes).all(|(&e, &r)| e >= r + DEFAULT_EXTRA_MODES);
-    let label = if energy.is_finite() { format!("iteration {n}, energy {energy:.0e}") } else { format!("iteration {n}") };
+    let fully_enriched =
+        estimator.block_modes.iter().zip(&trained.block_modes).all(|(&e, &r)| e >= r + DEFAULT_EXTRA_MODES);
+    let label =
+        if energy.is_finite() { format!("iteration {n}, energy {energy:.0e}") } else { format!("iteration {n}") };
     let (estimates, raws) = estimate_candidates(&p.model, &trained.basis, &estimator, candidates, &label);
     Ok(Level { energy, hyper_tolerance, trained, estimator, estimates, raws, fully_enriched })
 }
@@ -374,9 +444,19 @@ fn level(
 /// The seam to the error estimator: `(error_estimate, raw estimate)` of `basis` at every
 /// load, reduced runs in parallel (one reduced model and its estimator's per worker, as
 /// `sweep` does); a run that fails gives ∞.
-fn estimate_candidates(model: &Model, basis: &Basis, est: &Estimator, loads: &[f64], label: &str) -> (Vec<f64>, Vec<f64>) {
+fn estimate_candidates(
+    model: &Model,
+    basis: &Basis,
+    est: &Estimator,
+    loads: &[f64],
+    label: &str,
+) -> (Vec<f64>, Vec<f64>) {
     let bar = ProgressBar::with_draw_target(Some(loads.len() as u64), ProgressDrawTarget::stderr());
-    bar.set_style(ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} candidates, {elapsed}").expect("valid template").progress_chars("=> "));
+    bar.set_style(
+        ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} candidates, {elapsed}")
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
     bar.set_prefix(label.to_string());
     let out: Vec<(f64, f64)> = loads
         .par_iter()
@@ -415,8 +495,12 @@ pub fn write_training(f: &hdf5::File, r: &GreedyRecord) -> hdf5::Result<()> {
     g.new_dataset_builder().with_data(&col(&|i| i.true_error)).create("true_error")?;
     g.new_dataset_builder().with_data(&col(&|i| i.energy)).create("energy_tolerance")?;
     g.new_dataset_builder().with_data(&col(&|i| i.hyper_tolerance)).create("hyper_tolerance")?;
-    g.new_dataset_builder().with_data(&Array1::from_iter(r.iterations.iter().map(|i| i.n_modes as u64))).create("n_modes")?;
-    g.new_dataset_builder().with_data(&Array1::from_iter(r.iterations.iter().map(|i| i.n_elements as u64))).create("n_elements")?;
+    g.new_dataset_builder()
+        .with_data(&Array1::from_iter(r.iterations.iter().map(|i| i.n_modes as u64)))
+        .create("n_modes")?;
+    g.new_dataset_builder()
+        .with_data(&Array1::from_iter(r.iterations.iter().map(|i| i.n_elements as u64)))
+        .create("n_elements")?;
     let (ni, nc) = (r.iterations.len(), r.candidates.len());
     let est = Array2::from_shape_fn((ni, nc), |(i, j)| r.iterations[i].estimates.get(j).copied().unwrap_or(f64::NAN));
     g.new_dataset_builder().with_data(&est).create("estimates")?;

@@ -44,7 +44,13 @@ pub fn run_reduced(model: &Model, basis: &Basis, load_scale: f64) -> Result<Redu
 
 /// [`run_reduced`] with a choice of output and, in `previous`, up to two earlier runs of
 /// the same basis at nearby load scales (nearest last): see [`ReducedRunner::run`].
-pub fn run_reduced_with(model: &Model, basis: &Basis, load_scale: f64, output: Output, previous: &[&ReducedRun]) -> Result<ReducedRun> {
+pub fn run_reduced_with(
+    model: &Model,
+    basis: &Basis,
+    load_scale: f64,
+    output: Output,
+    previous: &[&ReducedRun],
+) -> Result<ReducedRun> {
     ReducedRunner::new(model, basis)?.run(load_scale, output, previous)
 }
 
@@ -121,7 +127,10 @@ pub fn check_reduced_memory(model: &Model, r: usize, n_steps: usize, output: Out
     let full = if output == Output::Full { z.n_dof + z.n_constraints } else { 0.0 };
     let bytes = runs * 8.0 * nt * (r as f64 + z.n_constraints + 2.0 * z.n_probes + 1.0 + full);
     let what = if runs > 1.0 {
-        format!("{runs} reduced runs of {n_steps} steps × {r} modes{}", if full > 0.0 { " with their full coordinates" } else { "" })
+        format!(
+            "{runs} reduced runs of {n_steps} steps × {r} modes{}",
+            if full > 0.0 { " with their full coordinates" } else { "" }
+        )
     } else {
         format!("a reduced run of {n_steps} steps × {r} modes")
     };
@@ -144,8 +153,11 @@ fn run<R: Reduced<FlexibleSystem>>(
     let mut lam = Array2::<f64>::zeros((rom.n_constraints(), nt));
     let mut t = Array1::zeros(nt);
     // (λᵢ, trajectory) of the earlier runs that fit this one, nearest last
-    let known: Vec<(f64, &Array2<f64>)> =
-        previous.iter().filter(|p| p.reduced_q.dim() == (r, nt)).map(|p| (p.result.settings.load_scale, &p.reduced_q)).collect();
+    let known: Vec<(f64, &Array2<f64>)> = previous
+        .iter()
+        .filter(|p| p.reduced_q.dim() == (r, nt))
+        .map(|p| (p.result.settings.load_scale, &p.reduced_q))
+        .collect();
     let x = s.load_scale;
     let guess = |k: usize, out: &mut [f64]| match known.as_slice() {
         [] => false,

@@ -10,9 +10,17 @@ pub struct Series {
 }
 
 /// One chart with any number of line series; `log_y` for decays and errors.
-pub fn line_chart(path: &Path, title: &str, x_label: &str, y_label: &str, series: &[Series], log_y: bool) -> Result<(), String> {
+pub fn line_chart(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series],
+    log_y: bool,
+) -> Result<(), String> {
     let finite = |v: f64| v.is_finite() && (!log_y || v > 0.0);
-    let pts: Vec<(f64, f64)> = series.iter().flat_map(|s| s.points.iter().copied()).filter(|&(x, y)| x.is_finite() && finite(y)).collect();
+    let pts: Vec<(f64, f64)> =
+        series.iter().flat_map(|s| s.points.iter().copied()).filter(|&(x, y)| x.is_finite() && finite(y)).collect();
     if pts.is_empty() {
         return Err(format!("{}: nothing to plot", path.display()));
     }
@@ -39,8 +47,10 @@ pub fn line_chart(path: &Path, title: &str, x_label: &str, y_label: &str, series
             chart.configure_mesh().x_desc(x_label).y_desc(y_label).draw().map_err(|e| err(&e))?;
             for (i, s) in series.iter().enumerate() {
                 let c = colors[i % colors.len()];
-                let data: Vec<(f64, f64)> = s.points.iter().copied().filter(|&(x, y)| x.is_finite() && finite(y)).collect();
-                let style = ShapeStyle { color: c.to_rgba(), filled: false, stroke_width: if s.dashed { 1 } else { 2 } };
+                let data: Vec<(f64, f64)> =
+                    s.points.iter().copied().filter(|&(x, y)| x.is_finite() && finite(y)).collect();
+                let style =
+                    ShapeStyle { color: c.to_rgba(), filled: false, stroke_width: if s.dashed { 1 } else { 2 } };
                 let anno = if s.dashed {
                     chart.draw_series(DashedLineSeries::new(data, 6, 4, style)).map_err(|e| err(&e))?
                 } else {
@@ -48,7 +58,12 @@ pub fn line_chart(path: &Path, title: &str, x_label: &str, y_label: &str, series
                 };
                 anno.label(s.name.clone()).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c));
             }
-            chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(|e| err(&e))?;
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .draw()
+                .map_err(|e| err(&e))?;
         }};
     }
     if log_y {
@@ -63,7 +78,13 @@ pub fn line_chart(path: &Path, title: &str, x_label: &str, y_label: &str, series
 /// The error estimate against the load scale (a line, log scale), the true errors where
 /// validated (circles), and the training loads (vertical grey lines): the report's
 /// `estimate_vs_load.svg`.
-pub fn estimate_chart(path: &Path, title: &str, estimates: &[(f64, f64)], errors: &[(f64, f64)], training: &[f64]) -> Result<(), String> {
+pub fn estimate_chart(
+    path: &Path,
+    title: &str,
+    estimates: &[(f64, f64)],
+    errors: &[(f64, f64)],
+    training: &[f64],
+) -> Result<(), String> {
     let ok = |&(x, y): &(f64, f64)| x.is_finite() && y.is_finite() && y > 0.0;
     let est: Vec<(f64, f64)> = estimates.iter().copied().filter(ok).collect();
     let err_pts: Vec<(f64, f64)> = errors.iter().copied().filter(ok).collect();
@@ -93,14 +114,22 @@ pub fn estimate_chart(path: &Path, title: &str, estimates: &[(f64, f64)], errors
     chart.configure_mesh().x_desc("load scale").y_desc("relative error").draw().map_err(|e| err(&e))?;
     let grey = RGBColor(150, 150, 150);
     for (i, &x) in training.iter().filter(|x| x.is_finite()).enumerate() {
-        let a = chart.draw_series(LineSeries::new(vec![(x, y0), (x, y1)], ShapeStyle { color: grey.to_rgba(), filled: false, stroke_width: 1 })).map_err(|e| err(&e))?;
+        let a = chart
+            .draw_series(LineSeries::new(
+                vec![(x, y0), (x, y1)],
+                ShapeStyle { color: grey.to_rgba(), filled: false, stroke_width: 1 },
+            ))
+            .map_err(|e| err(&e))?;
         if i == 0 {
             a.label("training load").legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey));
         }
     }
     if !est.is_empty() {
         chart
-            .draw_series(LineSeries::new(est.clone(), ShapeStyle { color: BLUE.to_rgba(), filled: false, stroke_width: 2 }))
+            .draw_series(LineSeries::new(
+                est.clone(),
+                ShapeStyle { color: BLUE.to_rgba(), filled: false, stroke_width: 2 },
+            ))
             .map_err(|e| err(&e))?
             .label("error_estimate")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE));

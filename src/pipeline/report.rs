@@ -4,8 +4,8 @@
 //! written under a temporary name and renamed into place only when every stage succeeded.
 
 use super::config::Pipeline;
-use super::online::load_basis;
 use super::estimate::{check_runs, load_trust};
+use super::online::load_basis;
 use super::plot::{estimate_chart, line_chart, Series};
 use super::sweep::{sweep_with, table, write_sweep, SweepOptions};
 use super::train::train_and_write;
@@ -63,7 +63,13 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool) -> Result<
 
     let scales = p.online_scales();
     crate::output::note(&format!("[2/3] sweep: {} reduced and full runs", scales.len()));
-    let sw = sweep_with(&p.model, basis, Some(&trust), &scales, SweepOptions { validate: true, continuation: false, progress })?;
+    let sw = sweep_with(
+        &p.model,
+        basis,
+        Some(&trust),
+        &scales,
+        SweepOptions { validate: true, continuation: false, progress },
+    )?;
     write_sweep(&out.join("sweep.h5"), &sw, &stored, &p.basis_path)?;
     // the plots and tables below need every load scale
     if let Some(s) = sw.failure_summary() {
@@ -77,10 +83,26 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool) -> Result<
         let (v, full, rom) = validate_with(&p.model, basis, Some(&trust), x, true)?;
         let mut series = Vec::new();
         for ((name, a), (_, b)) in full.probes.iter().zip(&rom.result.probes) {
-            series.push(Series { name: format!("{name} y, full"), points: full.t.iter().zip(a.column(1)).map(|(t, y)| (*t, *y)).collect(), dashed: false });
-            series.push(Series { name: format!("{name} y, reduced"), points: full.t.iter().zip(b.column(1)).map(|(t, y)| (*t, *y)).collect(), dashed: true });
+            series.push(Series {
+                name: format!("{name} y, full"),
+                points: full.t.iter().zip(a.column(1)).map(|(t, y)| (*t, *y)).collect(),
+                dashed: false,
+            });
+            series.push(Series {
+                name: format!("{name} y, reduced"),
+                points: full.t.iter().zip(b.column(1)).map(|(t, y)| (*t, *y)).collect(),
+                dashed: true,
+            });
         }
-        line_chart(&out.join(format!("probes_{i}.svg")), &format!("Probe y, full vs reduced, load scale {x}"), "t (s)", "y (m)", &series, false).map_err(plot_err)?;
+        line_chart(
+            &out.join(format!("probes_{i}.svg")),
+            &format!("Probe y, full vs reduced, load scale {x}"),
+            "t (s)",
+            "y (m)",
+            &series,
+            false,
+        )
+        .map_err(plot_err)?;
         validations.push(v);
     }
     // one curve per block of a block basis (per body), each indexed from 1
@@ -96,7 +118,7 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool) -> Result<
         })
         .collect();
     line_chart(&out.join("singular_values.svg"), "POD singular values", "index", "σ", &blocks, true)
-    .map_err(plot_err)?;
+        .map_err(plot_err)?;
     let pts = |f: &dyn Fn(&Validation) -> f64| -> Vec<(f64, f64)> {
         sw.done().filter_map(|q| q.validation.as_ref()).map(|v| (v.load_scale, f(v))).collect()
     };
@@ -122,27 +144,58 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool) -> Result<
     )
     .map_err(plot_err)?;
     // the estimate over the sweep, the true errors of the sweep and of the validation runs
-    let estimates: Vec<(f64, f64)> = sw.scales.iter().filter_map(|x| x.point()).filter_map(|q| q.estimate.map(|e| (q.rom.result.settings.load_scale, e.error_estimate))).collect();
+    let estimates: Vec<(f64, f64)> = sw
+        .scales
+        .iter()
+        .filter_map(|x| x.point())
+        .filter_map(|q| q.estimate.map(|e| (q.rom.result.settings.load_scale, e.error_estimate)))
+        .collect();
     let mut errors = pts(&|v| v.rel_error);
     errors.extend(validations.iter().map(|v| (v.load_scale, v.rel_error)));
     let training: Vec<f64> = {
         let f = hdf5::File::open(basis_path).map_err(|e| Error::hdf5(basis_path, e))?;
         let mut l: Vec<f64> = match f.dataset("training/load_scales") {
-            Ok(d) => d.read_1d::<f64>().map_err(|e| Error::input(basis_path, "training/load_scales", e.to_string()))?.to_vec(),
-            Err(_) => f.dataset("snapshot_load_scale").and_then(|d| d.read_1d::<f64>()).map_err(|e| Error::input(basis_path, "snapshot_load_scale", e.to_string()))?.to_vec(),
+            Ok(d) => d
+                .read_1d::<f64>()
+                .map_err(|e| Error::input(basis_path, "training/load_scales", e.to_string()))?
+                .to_vec(),
+            Err(_) => f
+                .dataset("snapshot_load_scale")
+                .and_then(|d| d.read_1d::<f64>())
+                .map_err(|e| Error::input(basis_path, "snapshot_load_scale", e.to_string()))?
+                .to_vec(),
         };
         l.sort_by(f64::total_cmp);
         l.dedup();
         l
     };
     if !estimates.is_empty() {
-        estimate_chart(&out.join("estimate_vs_load.svg"), "Error estimate (no full run) and true error", &estimates, &errors, &training).map_err(plot_err)?;
+        estimate_chart(
+            &out.join("estimate_vs_load.svg"),
+            "Error estimate (no full run) and true error",
+            &estimates,
+            &errors,
+            &training,
+        )
+        .map_err(plot_err)?;
     }
     let by_time: Vec<Series> = validations
         .iter()
-        .map(|v| Series { name: format!("load scale {}", v.load_scale), points: v.rel_error_by_time.iter().enumerate().map(|(i, e)| ((i + 1) as f64 / 5.0, *e)).collect(), dashed: false })
+        .map(|v| Series {
+            name: format!("load scale {}", v.load_scale),
+            points: v.rel_error_by_time.iter().enumerate().map(|(i, e)| ((i + 1) as f64 / 5.0, *e)).collect(),
+            dashed: false,
+        })
         .collect();
-    line_chart(&out.join("error_by_time.svg"), "rel_error up to a fraction of the run", "fraction of the run", "rel_error", &by_time, true).map_err(plot_err)?;
+    line_chart(
+        &out.join("error_by_time.svg"),
+        "rel_error up to a fraction of the run",
+        "fraction of the run",
+        "rel_error",
+        &by_time,
+        true,
+    )
+    .map_err(plot_err)?;
     let json = serde_json::to_string_pretty(&validations).expect("serializable");
     std::fs::write(out.join("validation.json"), json).map_err(|e| Error::io(out, e))?;
 
@@ -152,7 +205,13 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool) -> Result<
     if !p.file.description.is_empty() {
         let _ = writeln!(md, "{}\n", p.file.description);
     }
-    let _ = writeln!(md, "- model: `{}` ({} coordinates), fingerprint `{}`", p.model.path.display(), b.n_dof(), &p.model.fingerprint()[..12]);
+    let _ = writeln!(
+        md,
+        "- model: `{}` ({} coordinates), fingerprint `{}`",
+        p.model.path.display(),
+        b.n_dof(),
+        &p.model.fingerprint()[..12]
+    );
     let _ = writeln!(
         md,
         "- basis: `{}`: {} reduction, {} snapshots, rule `{}` → {} POD modes{}, {} snapshots from load scales {:?}",
@@ -165,7 +224,13 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool) -> Result<
         trained.n_snapshots,
         trained.greedy.as_ref().map_or_else(|| p.training_scales(), |g| g.load_scales.clone())
     );
-    let _ = writeln!(md, "- sweep: {} load scales on {} threads in {:.3} s (whole sweep, reduced and full runs)\n", sw.scales.len(), sw.threads, sw.wall_seconds);
+    let _ = writeln!(
+        md,
+        "- sweep: {} load scales on {} threads in {:.3} s (whole sweep, reduced and full runs)\n",
+        sw.scales.len(),
+        sw.threads,
+        sw.wall_seconds
+    );
     let _ = writeln!(md, "## Validation (time loops only; one run each)\n");
     let _ = writeln!(md, "| load scale | rel_error | max probe error (m) | at | max constraint violation | full (s) | full dense (s) | reduced (s) | speedup | vs dense |");
     let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|");
@@ -217,7 +282,10 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool) -> Result<
     for (i, x) in vscales.iter().enumerate() {
         let _ = writeln!(md, "![probes at {x}](probes_{i}.svg)");
     }
-    let _ = writeln!(md, "![singular values](singular_values.svg)\n![error](error_vs_load.svg)\n![speedup](speedup_vs_load.svg)");
+    let _ = writeln!(
+        md,
+        "![singular values](singular_values.svg)\n![error](error_vs_load.svg)\n![speedup](speedup_vs_load.svg)"
+    );
     if !estimates.is_empty() {
         let _ = writeln!(md, "![error estimate](estimate_vs_load.svg)");
     }
@@ -233,8 +301,13 @@ pub fn check_report(p: &Pipeline, dir: &Path, strict: bool) -> Result<()> {
     let trust = load_trust(p, &p.basis_path, &stored)?;
     let path = dir.join("sweep.h5");
     let f = hdf5::File::open(&path).map_err(|e| Error::hdf5(&path, e))?;
-    let read = |name: &str| f.dataset(name).and_then(|d| d.read_1d::<f64>()).map_err(|e| Error::input(&path, name, format!("cannot be read: {e}")));
+    let read = |name: &str| {
+        f.dataset(name)
+            .and_then(|d| d.read_1d::<f64>())
+            .map_err(|e| Error::input(&path, name, format!("cannot be read: {e}")))
+    };
     let (scales, est) = (read("load_scales")?, read("error_estimate")?);
-    let runs: Vec<(f64, Option<f64>)> = scales.iter().zip(&est).map(|(&x, &e)| (x, if e.is_nan() { None } else { Some(e) })).collect();
+    let runs: Vec<(f64, Option<f64>)> =
+        scales.iter().zip(&est).map(|(&x, &e)| (x, if e.is_nan() { None } else { Some(e) })).collect();
     check_runs(&trust, &runs, strict)
 }

@@ -172,7 +172,15 @@ fn continuation_lanes(n: usize, threads: usize) -> Vec<Vec<std::ops::Range<usize
     let part = n.div_ceil(2 * threads.max(1)).max(1);
     let blocks: Vec<std::ops::Range<usize>> = (0..n).step_by(part).map(|a| a..(a + part).min(n)).collect();
     let nb = blocks.len();
-    (0..nb.div_ceil(2)).map(|t| if t == nb - 1 - t { vec![blocks[t].clone()] } else { vec![blocks[t].clone(), blocks[nb - 1 - t].clone()] }).collect()
+    (0..nb.div_ceil(2))
+        .map(|t| {
+            if t == nb - 1 - t {
+                vec![blocks[t].clone()]
+            } else {
+                vec![blocks[t].clone(), blocks[nb - 1 - t].clone()]
+            }
+        })
+        .collect()
 }
 
 /// Runs the reduced model at every scale, in parallel; with `validate`, also the full one.
@@ -183,7 +191,13 @@ pub fn sweep(model: &Model, basis: &Basis, scales: &[f64], o: SweepOptions) -> R
 
 /// [`sweep`] with the basis's estimator and training range: every point gets its error
 /// estimate and extrapolation flag.
-pub fn sweep_with(model: &Model, basis: &Basis, trust: Option<&TrustInfo>, scales: &[f64], o: SweepOptions) -> Result<Sweep> {
+pub fn sweep_with(
+    model: &Model,
+    basis: &Basis,
+    trust: Option<&TrustInfo>,
+    scales: &[f64],
+    o: SweepOptions,
+) -> Result<Sweep> {
     let start = pending(model, basis, scales, o)?;
     run_pending(model, basis, trust, start, o, None)
 }
@@ -223,7 +237,11 @@ pub fn sweep_to_file(
                 out.display(),
                 scales.len(),
                 scales.len() - reused,
-                if dropped > 0 { format!(" ({dropped} finished load scales of the file are not in the list and are left out)") } else { String::new() }
+                if dropped > 0 {
+                    format!(" ({dropped} finished load scales of the file are not in the list and are left out)")
+                } else {
+                    String::new()
+                }
             );
         } else {
             eprintln!("resuming {}: no such file yet, running all {} load scales", out.display(), scales.len());
@@ -256,12 +274,26 @@ type Checkpoint<'a> = &'a (dyn Fn(&Sweep) -> Result<()> + Sync);
 
 /// Runs the pending scales of `state`; after each one, `checkpoint` (when given, and at
 /// most every [`CHECKPOINT_SECONDS`]) writes what is done so far.
-fn run_pending(model: &Model, basis: &Basis, trust: Option<&TrustInfo>, state: Sweep, o: SweepOptions, checkpoint: Option<Checkpoint>) -> Result<Sweep> {
+fn run_pending(
+    model: &Model,
+    basis: &Basis,
+    trust: Option<&TrustInfo>,
+    state: Sweep,
+    o: SweepOptions,
+    checkpoint: Option<Checkpoint>,
+) -> Result<Sweep> {
     let est = trust.and_then(|t| t.estimator.as_ref());
     let todo: Vec<usize> = (0..state.scales.len()).filter(|&i| state.scales[i].status() != STATUS_OK).collect();
     let scales: Vec<f64> = todo.iter().map(|&i| state.scales[i].load_scale).collect();
-    let bar = ProgressBar::with_draw_target(Some(scales.len() as u64), if o.progress { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() });
-    bar.set_style(ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} load scales, {elapsed} elapsed, ETA {eta}").expect("valid template").progress_chars("=> "));
+    let bar = ProgressBar::with_draw_target(
+        Some(scales.len() as u64),
+        if o.progress { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() },
+    );
+    bar.set_style(
+        ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} load scales, {elapsed} elapsed, ETA {eta}")
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
     bar.set_prefix(if o.validate { "sweep + validate" } else { "sweep" });
     // every point's trajectories are kept until the file is written
     let n_steps = crate::simulate::Settings::resolve(model, &Overrides::default())?.n_steps;
@@ -270,7 +302,11 @@ fn run_pending(model: &Model, basis: &Basis, trust: Option<&TrustInfo>, state: S
     let start = std::time::Instant::now();
     let threads = state.threads;
     // continuation: a few chains of neighbouring scales per thread; otherwise one point per task
-    let lanes = if o.continuation { continuation_lanes(scales.len(), threads) } else { (0..scales.len()).map(|i| std::iter::once(i..i + 1).collect()).collect() };
+    let lanes = if o.continuation {
+        continuation_lanes(scales.len(), threads)
+    } else {
+        (0..scales.len()).map(|i| std::iter::once(i..i + 1).collect()).collect()
+    };
     // the sweep so far, and when the next write is due (None: now, so the first finished
     // scale is written at once)
     let shared = Mutex::new((state, None::<std::time::Instant>));
@@ -292,47 +328,59 @@ fn run_pending(model: &Model, basis: &Basis, trust: Option<&TrustInfo>, state: S
     let results: Result<Vec<()>> = lanes
         .par_iter()
         // one reduced model per worker, built at its first lane, its loads changed per scale
-        .map_init(|| None, |slot: &mut Option<EstimatingRunner>, chains| {
-            let runner = match slot {
-                Some(r) => r,
-                // built at the model's own load scale, 1
-                None => slot.insert(EstimatingRunner::new(model, basis, est).map_err(|e| e.at_stage("sweep (building the reduced model)", 1.0))?),
-            };
-            for chain in chains {
-                // the last two good runs of this chain (continuation only)
-                let mut previous: Vec<ReducedRun> = Vec::new();
-                for i in chain.clone() {
-                    let x = scales[i];
-                    // without validation nothing of full size is reconstructed
-                    let output = if o.validate { Output::Full } else { Output::ReducedAndProbes };
-                    let run = (|| -> Result<SweepPoint> {
-                        let (rom, estimate) = runner.run_with(x, output, &previous.iter().collect::<Vec<_>>()).map_err(|e| e.at_stage("sweep (reduced run)", x))?;
-                        let validation = if o.validate {
-                            let full = simulate(model, &Overrides { load_scale: Some(x), ..Default::default() }).map_err(|e| e.at_stage("sweep (full run)", x))?;
-                            Some(compare(model, &full, &rom, None, basis.n_reduced(), basis.variant.name()).with_trust(estimate.as_ref(), trust))
-                        } else {
-                            None
-                        };
-                        let extrapolated = trust.is_some_and(|t| is_extrapolated(t.range, x));
-                        Ok(SweepPoint { rom, validation, estimate, extrapolated })
-                    })();
-                    bar.inc(1);
-                    match run {
-                        Ok(p) => {
-                            if o.continuation {
-                                previous.push(p.rom.clone());
-                                if previous.len() > 2 {
-                                    previous.remove(0);
+        .map_init(
+            || None,
+            |slot: &mut Option<EstimatingRunner>, chains| {
+                let runner = match slot {
+                    Some(r) => r,
+                    // built at the model's own load scale, 1
+                    None => slot.insert(
+                        EstimatingRunner::new(model, basis, est)
+                            .map_err(|e| e.at_stage("sweep (building the reduced model)", 1.0))?,
+                    ),
+                };
+                for chain in chains {
+                    // the last two good runs of this chain (continuation only)
+                    let mut previous: Vec<ReducedRun> = Vec::new();
+                    for i in chain.clone() {
+                        let x = scales[i];
+                        // without validation nothing of full size is reconstructed
+                        let output = if o.validate { Output::Full } else { Output::ReducedAndProbes };
+                        let run = (|| -> Result<SweepPoint> {
+                            let (rom, estimate) = runner
+                                .run_with(x, output, &previous.iter().collect::<Vec<_>>())
+                                .map_err(|e| e.at_stage("sweep (reduced run)", x))?;
+                            let validation = if o.validate {
+                                let full = simulate(model, &Overrides { load_scale: Some(x), ..Default::default() })
+                                    .map_err(|e| e.at_stage("sweep (full run)", x))?;
+                                Some(
+                                    compare(model, &full, &rom, None, basis.n_reduced(), basis.variant.name())
+                                        .with_trust(estimate.as_ref(), trust),
+                                )
+                            } else {
+                                None
+                            };
+                            let extrapolated = trust.is_some_and(|t| is_extrapolated(t.range, x));
+                            Ok(SweepPoint { rom, validation, estimate, extrapolated })
+                        })();
+                        bar.inc(1);
+                        match run {
+                            Ok(p) => {
+                                if o.continuation {
+                                    previous.push(p.rom.clone());
+                                    if previous.len() > 2 {
+                                        previous.remove(0);
+                                    }
                                 }
+                                record(i, Outcome::Done(p))?;
                             }
-                            record(i, Outcome::Done(p))?;
+                            Err(e) => record(i, Outcome::Failed(e.to_string()))?,
                         }
-                        Err(e) => record(i, Outcome::Failed(e.to_string()))?,
                     }
                 }
-            }
-            Ok(())
-        })
+                Ok(())
+            },
+        )
         .collect();
     bar.finish_and_clear();
     results?;
@@ -342,7 +390,12 @@ fn run_pending(model: &Model, basis: &Basis, trust: Option<&TrustInfo>, state: S
 }
 
 fn clone_point(p: &SweepPoint) -> SweepPoint {
-    SweepPoint { rom: p.rom.clone(), validation: p.validation.clone(), estimate: p.estimate, extrapolated: p.extrapolated }
+    SweepPoint {
+        rom: p.rom.clone(),
+        validation: p.validation.clone(),
+        estimate: p.estimate,
+        extrapolated: p.extrapolated,
+    }
 }
 
 /// Writes the sweep file (atomically: a temporary file renamed over `path`).
@@ -355,12 +408,24 @@ pub fn write_sweep(path: &Path, s: &Sweep, stored: &StoredBasis, basis_path: &Pa
     write_atomically(path, |f| {
         let e = |err: hdf5::Error| Error::hdf5(path, err);
         // one value per load scale: NaN where it did not run to the end
-        let col = |g: &dyn Fn(&SweepPoint) -> f64| Array1::from_iter(s.scales.iter().map(|x| x.point().map_or(f64::NAN, g)));
-        let count = |g: &dyn Fn(&SweepPoint) -> usize| Array1::from_iter(s.scales.iter().map(|x| x.point().map_or(0, g) as u64));
-        f.new_dataset_builder().with_data(&Array1::from_iter(s.scales.iter().map(|x| x.load_scale))).create("load_scales").map_err(e)?;
-        f.new_dataset_builder().with_data(&Array1::from_iter(s.scales.iter().map(ScaleResult::status))).create("status").map_err(e)?;
-        let messages: Vec<VarLenUnicode> =
-            s.scales.iter().map(|x| x.message().replace('\0', " ").parse::<VarLenUnicode>().unwrap_or_default()).collect();
+        let col =
+            |g: &dyn Fn(&SweepPoint) -> f64| Array1::from_iter(s.scales.iter().map(|x| x.point().map_or(f64::NAN, g)));
+        let count = |g: &dyn Fn(&SweepPoint) -> usize| {
+            Array1::from_iter(s.scales.iter().map(|x| x.point().map_or(0, g) as u64))
+        };
+        f.new_dataset_builder()
+            .with_data(&Array1::from_iter(s.scales.iter().map(|x| x.load_scale)))
+            .create("load_scales")
+            .map_err(e)?;
+        f.new_dataset_builder()
+            .with_data(&Array1::from_iter(s.scales.iter().map(ScaleResult::status)))
+            .create("status")
+            .map_err(e)?;
+        let messages: Vec<VarLenUnicode> = s
+            .scales
+            .iter()
+            .map(|x| x.message().replace('\0', " ").parse::<VarLenUnicode>().unwrap_or_default())
+            .collect();
         f.new_dataset_builder().with_data(&Array1::from(messages)).create("message").map_err(e)?;
         f.new_dataset_builder().with_data(&s.t).create("t").map_err(e)?;
         let g = f.create_group("probes").map_err(e)?;
@@ -383,16 +448,34 @@ pub fn write_sweep(path: &Path, s: &Sweep, stored: &StoredBasis, basis_path: &Pa
         // trajectories for 0.15 s of a 1.5 s four-bar sweep
         f.new_dataset_builder().chunk((1, r.max(1), nt.max(1))).with_data(&zq).create("reduced_q").map_err(e)?;
         f.new_dataset_builder().with_data(&col(&|p| p.rom.result.wall_seconds)).create("rom_seconds").map_err(e)?;
-        f.new_dataset_builder().with_data(&count(&|p| p.rom.result.stats.newton_iterations)).create("newton_iterations").map_err(e)?;
-        f.new_dataset_builder().with_data(&count(&|p| p.rom.result.stats.factorizations)).create("factorizations").map_err(e)?;
-        f.new_dataset_builder().with_data(&col(&|p| p.estimate.map_or(f64::NAN, |e| e.error_estimate))).create("error_estimate").map_err(e)?;
-        f.new_dataset_builder().with_data(&col(&|p| p.estimate.map_or(f64::NAN, |e| e.seconds))).create("estimate_seconds").map_err(e)?;
-        f.new_dataset_builder().with_data(&Array1::from_iter(s.scales.iter().map(|x| x.point().is_some_and(|p| p.extrapolated) as u8))).create("extrapolated").map_err(e)?;
+        f.new_dataset_builder()
+            .with_data(&count(&|p| p.rom.result.stats.newton_iterations))
+            .create("newton_iterations")
+            .map_err(e)?;
+        f.new_dataset_builder()
+            .with_data(&count(&|p| p.rom.result.stats.factorizations))
+            .create("factorizations")
+            .map_err(e)?;
+        f.new_dataset_builder()
+            .with_data(&col(&|p| p.estimate.map_or(f64::NAN, |e| e.error_estimate)))
+            .create("error_estimate")
+            .map_err(e)?;
+        f.new_dataset_builder()
+            .with_data(&col(&|p| p.estimate.map_or(f64::NAN, |e| e.seconds)))
+            .create("estimate_seconds")
+            .map_err(e)?;
+        f.new_dataset_builder()
+            .with_data(&Array1::from_iter(s.scales.iter().map(|x| x.point().is_some_and(|p| p.extrapolated) as u8)))
+            .create("extrapolated")
+            .map_err(e)?;
         if s.validated {
             let v = |g: &dyn Fn(&Validation) -> f64| col(&|p: &SweepPoint| p.validation.as_ref().map_or(f64::NAN, g));
             f.new_dataset_builder().with_data(&v(&|x| x.rel_error)).create("rel_error").map_err(e)?;
             f.new_dataset_builder().with_data(&v(&|x| x.max_probe_error)).create("max_probe_error").map_err(e)?;
-            f.new_dataset_builder().with_data(&v(&|x| x.max_constraint_violation)).create("max_constraint_violation").map_err(e)?;
+            f.new_dataset_builder()
+                .with_data(&v(&|x| x.max_constraint_violation))
+                .create("max_constraint_violation")
+                .map_err(e)?;
             f.new_dataset_builder().with_data(&v(&|x| x.full_seconds)).create("full_seconds").map_err(e)?;
             f.new_dataset_builder().with_data(&v(&|x| x.speedup)).create("speedup").map_err(e)?;
         }
@@ -414,33 +497,58 @@ pub fn write_sweep(path: &Path, s: &Sweep, stored: &StoredBasis, basis_path: &Pa
 /// Reads an earlier sweep file for `--resume`: (load scale, the finished run) for every
 /// scale it holds, `None` for those that failed or did not run. Refuses a file of another
 /// basis or model, and one without the validation a `--validate` sweep needs.
-fn read_sweep(path: &Path, model: &Model, stored: &StoredBasis, validate: bool) -> Result<Vec<(f64, Option<SweepPoint>)>> {
-    let cannot = |field: &str, problem: String| Error::input(path, field, format!("{problem}; cannot resume from it (remove it, or run without --resume)"));
+fn read_sweep(
+    path: &Path,
+    model: &Model,
+    stored: &StoredBasis,
+    validate: bool,
+) -> Result<Vec<(f64, Option<SweepPoint>)>> {
+    let cannot = |field: &str, problem: String| {
+        Error::input(path, field, format!("{problem}; cannot resume from it (remove it, or run without --resume)"))
+    };
     let f = hdf5::File::open(path).map_err(|e| cannot("(file)", format!("is not a readable HDF5 file: {e}")))?;
-    let text = |name: &str| read_attr_str(&f, name).map_err(|e| cannot(name, format!("cannot be read ({e}): not a flexrom sweep file?")));
+    let text = |name: &str| {
+        read_attr_str(&f, name).map_err(|e| cannot(name, format!("cannot be read ({e}): not a flexrom sweep file?")))
+    };
     if text("basis_content_hash")? != stored.content_hash {
         return Err(cannot("basis_content_hash", "comes from another basis than the one given".into()));
     }
     if text("model_fingerprint")? != model.fingerprint() {
         return Err(cannot("model_fingerprint", "comes from another model than the pipeline's".into()));
     }
-    let vec = |name: &str| f.dataset(name).and_then(|d| d.read_1d::<f64>()).map_err(|e| cannot(name, format!("cannot be read: {e}")));
-    let ints = |name: &str| f.dataset(name).and_then(|d| d.read_1d::<u64>()).map_err(|e| cannot(name, format!("cannot be read: {e}")));
+    let vec = |name: &str| {
+        f.dataset(name).and_then(|d| d.read_1d::<f64>()).map_err(|e| cannot(name, format!("cannot be read: {e}")))
+    };
+    let ints = |name: &str| {
+        f.dataset(name).and_then(|d| d.read_1d::<u64>()).map_err(|e| cannot(name, format!("cannot be read: {e}")))
+    };
     let scales = vec("load_scales")?;
-    let status = f.dataset("status").and_then(|d| d.read_1d::<u8>()).map_err(|e| cannot("status", format!("cannot be read: {e}")))?;
+    let status = f
+        .dataset("status")
+        .and_then(|d| d.read_1d::<u8>())
+        .map_err(|e| cannot("status", format!("cannot be read: {e}")))?;
     let t = vec("t")?;
     let s = Settings::resolve(model, &Overrides::default())?;
     let (n, nt, r) = (scales.len(), s.n_steps + 1, stored.basis.n_reduced());
     if status.len() != n || t.len() != nt {
-        return Err(cannot("status", format!("has {} entries for {n} load scales, or /t {} for {nt} instants", status.len(), t.len())));
+        return Err(cannot(
+            "status",
+            format!("has {} entries for {n} load scales, or /t {} for {nt} instants", status.len(), t.len()),
+        ));
     }
-    let zq = f.dataset("reduced_q").and_then(|d| d.read::<f64, ndarray::Ix3>()).map_err(|e| cannot("reduced_q", format!("cannot be read: {e}")))?;
+    let zq = f
+        .dataset("reduced_q")
+        .and_then(|d| d.read::<f64, ndarray::Ix3>())
+        .map_err(|e| cannot("reduced_q", format!("cannot be read: {e}")))?;
     if zq.dim() != (n, r, nt) {
         return Err(cannot("reduced_q", format!("is {:?}, expected ({n}, {r}, {nt})", zq.dim())));
     }
     let mut probes = Vec::new();
     for name in model.probe_names() {
-        let a = f.dataset(&format!("probes/{name}")).and_then(|d| d.read::<f64, ndarray::Ix3>()).map_err(|e| cannot(&format!("probes/{name}"), format!("cannot be read: {e}")))?;
+        let a = f
+            .dataset(&format!("probes/{name}"))
+            .and_then(|d| d.read::<f64, ndarray::Ix3>())
+            .map_err(|e| cannot(&format!("probes/{name}"), format!("cannot be read: {e}")))?;
         if a.dim() != (n, nt, 2) {
             return Err(cannot(&format!("probes/{name}"), format!("is {:?}, expected ({n}, {nt}, 2)", a.dim())));
         }
@@ -449,16 +557,42 @@ fn read_sweep(path: &Path, model: &Model, stored: &StoredBasis, validate: bool) 
     let rom_seconds = vec("rom_seconds")?;
     // the estimate columns of the file (absent in files written before them: no estimate)
     let optional = |name: &str| if f.link_exists(name) { vec(name).map(Some) } else { Ok(None) };
-    let (estimates, estimate_seconds, extrapolated) = (optional("error_estimate")?, optional("estimate_seconds")?, if f.link_exists("extrapolated") { Some(f.dataset("extrapolated").and_then(|d| d.read_1d::<u8>()).map_err(|e| cannot("extrapolated", format!("cannot be read: {e}")))?) } else { None });
+    let (estimates, estimate_seconds, extrapolated) = (
+        optional("error_estimate")?,
+        optional("estimate_seconds")?,
+        if f.link_exists("extrapolated") {
+            Some(
+                f.dataset("extrapolated")
+                    .and_then(|d| d.read_1d::<u8>())
+                    .map_err(|e| cannot("extrapolated", format!("cannot be read: {e}")))?,
+            )
+        } else {
+            None
+        },
+    );
     let (newton, factorizations) = (ints("newton_iterations")?, ints("factorizations")?);
     let validation = if validate && f.link_exists("rel_error") {
-        Some([vec("rel_error")?, vec("max_probe_error")?, vec("max_constraint_violation")?, vec("full_seconds")?, vec("speedup")?])
+        Some([
+            vec("rel_error")?,
+            vec("max_probe_error")?,
+            vec("max_constraint_violation")?,
+            vec("full_seconds")?,
+            vec("speedup")?,
+        ])
     } else {
         None
     };
-    for a in [&rom_seconds].into_iter().chain(validation.iter().flatten()).chain(estimates.iter()).chain(estimate_seconds.iter()) {
+    for a in [&rom_seconds]
+        .into_iter()
+        .chain(validation.iter().flatten())
+        .chain(estimates.iter())
+        .chain(estimate_seconds.iter())
+    {
         if a.len() != n {
-            return Err(cannot("rom_seconds", format!("a per-scale dataset has {} entries for {n} load scales", a.len())));
+            return Err(cannot(
+                "rom_seconds",
+                format!("a per-scale dataset has {} entries for {n} load scales", a.len()),
+            ));
         }
     }
     let mut out = Vec::new();
@@ -470,7 +604,12 @@ fn read_sweep(path: &Path, model: &Model, stored: &StoredBasis, validate: bool) 
             continue;
         }
         let settings = Settings::resolve(model, &Overrides { load_scale: Some(x), ..Default::default() })?;
-        let stats = Stats { steps: settings.n_steps, newton_iterations: newton[k] as usize, factorizations: factorizations[k] as usize, ..Default::default() };
+        let stats = Stats {
+            steps: settings.n_steps,
+            newton_iterations: newton[k] as usize,
+            factorizations: factorizations[k] as usize,
+            ..Default::default()
+        };
         let result = SimulationResult {
             model_text: model.text.clone(),
             model_path: model.path.display().to_string(),
@@ -478,7 +617,10 @@ fn read_sweep(path: &Path, model: &Model, stored: &StoredBasis, validate: bool) 
             t: t.clone(),
             q: Array2::zeros((0, nt)),
             multipliers: Array2::zeros((0, nt)),
-            probes: probes.iter().map(|(name, a)| (name.clone(), a.index_axis(ndarray::Axis(0), k).to_owned())).collect(),
+            probes: probes
+                .iter()
+                .map(|(name, a)| (name.clone(), a.index_axis(ndarray::Axis(0), k).to_owned()))
+                .collect(),
             stats,
             wall_seconds: rom_seconds[k],
         };
@@ -544,18 +686,34 @@ pub fn table(s: &Sweep) -> String {
     out.push('\n');
     for x in &s.scales {
         let Some(p) = x.point() else {
-            out.push_str(&format!("{}  {}: {}\n", scale(x.load_scale), if x.status() == STATUS_FAILED { "failed" } else { "not run" }, x.message()));
+            out.push_str(&format!(
+                "{}  {}: {}\n",
+                scale(x.load_scale),
+                if x.status() == STATUS_FAILED { "failed" } else { "not run" },
+                x.message()
+            ));
             continue;
         };
         let r = &p.rom.result;
-        out.push_str(&format!("{}  {:>6.2}  {:>6}", scale(r.settings.load_scale), 1e3 * r.wall_seconds, r.stats.newton_iterations));
+        out.push_str(&format!(
+            "{}  {:>6.2}  {:>6}",
+            scale(r.settings.load_scale),
+            1e3 * r.wall_seconds,
+            r.stats.newton_iterations
+        ));
         match &p.estimate {
             Some(e) => out.push_str(&format!("  {:>14.3e}  {:>6.2}", e.error_estimate, 1e3 * e.seconds)),
             None => out.push_str(&format!("  {:>14}  {:>6}", "-", "-")),
         }
         out.push_str(if p.extrapolated { "     yes" } else { "      no" });
         if let Some(v) = &p.validation {
-            out.push_str(&format!("  {:>10.3e}  {:>11.3e}  {:>7.2}  {:>7.2}", v.rel_error, v.max_probe_error, 1e3 * v.full_seconds, v.speedup));
+            out.push_str(&format!(
+                "  {:>10.3e}  {:>11.3e}  {:>7.2}  {:>7.2}",
+                v.rel_error,
+                v.max_probe_error,
+                1e3 * v.full_seconds,
+                v.speedup
+            ));
         }
         out.push('\n');
     }
@@ -565,7 +723,11 @@ pub fn table(s: &Sweep) -> String {
 /// A load scale in the table's first column: fixed point, or exponent form when that would
 /// not fit (|x| ≥ 1e6) or show nothing (|x| < 1e-3).
 fn scale(x: f64) -> String {
-    if x != 0.0 && !(1e-3..1e6).contains(&x.abs()) { format!("{x:>10.3e}") } else { format!("{x:>10.4}") }
+    if x != 0.0 && !(1e-3..1e6).contains(&x.abs()) {
+        format!("{x:>10.3e}")
+    } else {
+        format!("{x:>10.4}")
+    }
 }
 
 #[cfg(test)]

@@ -1,8 +1,8 @@
 //! `train`: full runs at the training load scales → snapshot matrix → POD basis → HDF5.
 
 use super::config::{Blocks, Pipeline};
-use crate::error::{Error, Result};
 use super::estimate::{build_estimator, Estimator, DEFAULT_EXTRA_MODES};
+use crate::error::{Error, Result};
 use crate::io::basis_file::{write_basis_with, BasisMeta, TrainingData};
 use crate::reduction::{ecsw, train_basis, BasisSpec, ModeRule, Trained};
 use crate::simulate::{simulate, Overrides, SimulationResult};
@@ -53,7 +53,8 @@ pub fn train(p: &Pipeline) -> Result<(TrainingData, TrainSummary)> {
     let mut runs = Vec::new();
     let mut full_seconds = 0.0;
     for &s in &scales {
-        let r = simulate(&p.model, &Overrides { load_scale: Some(s), ..Default::default() }).map_err(|e| e.at_stage("train (full run)", s))?;
+        let r = simulate(&p.model, &Overrides { load_scale: Some(s), ..Default::default() })
+            .map_err(|e| e.at_stage("train (full run)", s))?;
         full_seconds += r.wall_seconds;
         runs.push(r);
     }
@@ -63,15 +64,37 @@ pub fn train(p: &Pipeline) -> Result<(TrainingData, TrainSummary)> {
     let (trained, spec) = build_basis(p, &data, modes, tol).map_err(|(f, e)| Error::input(&p.path, f, e))?;
     let sys = p.model.system(LinearSolverKind::Banded);
     let x_ref = data.x.column(0);
-    let estimator = build_estimator(&sys, &trained, &spec, data.x.view(), data.multipliers.view(), &joint_dofs(p), x_ref, tol, DEFAULT_EXTRA_MODES)
-        .map_err(|e| Error::input(&p.path, "reduction", format!("cannot build the error estimator: {e}")))?;
+    let estimator = build_estimator(
+        &sys,
+        &trained,
+        &spec,
+        data.x.view(),
+        data.multipliers.view(),
+        &joint_dofs(p),
+        x_ref,
+        tol,
+        DEFAULT_EXTRA_MODES,
+    )
+    .map_err(|e| Error::input(&p.path, "reduction", format!("cannot build the error estimator: {e}")))?;
     let n_snapshots = data.x.ncols();
-    Ok((data, TrainSummary { trained, n_snapshots, full_seconds, n_runs: scales.len(), greedy: None, estimator: Some(estimator) }))
+    Ok((
+        data,
+        TrainSummary {
+            trained,
+            n_snapshots,
+            full_seconds,
+            n_runs: scales.len(),
+            greedy: None,
+            estimator: Some(estimator),
+        },
+    ))
 }
 
 /// The snapshots of full runs, side by side in run order.
 pub fn training_data(runs: &[SimulationResult]) -> TrainingData {
-    let cat = |f: &dyn Fn(&SimulationResult) -> ndarray::ArrayView2<f64>| concatenate(Axis(1), &runs.iter().map(f).collect::<Vec<_>>()).expect("same row counts");
+    let cat = |f: &dyn Fn(&SimulationResult) -> ndarray::ArrayView2<f64>| {
+        concatenate(Axis(1), &runs.iter().map(f).collect::<Vec<_>>()).expect("same row counts")
+    };
     TrainingData {
         x: cat(&|r| r.q.view()),
         multipliers: cat(&|r| r.multipliers.view()),
@@ -82,7 +105,12 @@ pub fn training_data(runs: &[SimulationResult]) -> TrainingData {
 
 /// The basis of the pipeline's variant and blocks from `data` with `modes`, hyper-reduced
 /// by ECSW at `hyper_tolerance` when given; `Err((pipeline field, problem))`.
-pub fn build_basis(p: &Pipeline, data: &TrainingData, modes: ModeRule, hyper_tolerance: Option<f64>) -> std::result::Result<(Trained, BasisSpec), (&'static str, String)> {
+pub fn build_basis(
+    p: &Pipeline,
+    data: &TrainingData,
+    modes: ModeRule,
+    hyper_tolerance: Option<f64>,
+) -> std::result::Result<(Trained, BasisSpec), (&'static str, String)> {
     // every run starts from the same consistent, undeformed state
     let x_ref = data.x.column(0).to_owned();
     // whole-system: scale the multipliers so both blocks weigh alike in the POD
@@ -96,11 +124,14 @@ pub fn build_basis(p: &Pipeline, data: &TrainingData, modes: ModeRule, hyper_tol
         }
         None => Vec::new(),
     };
-    let spec = BasisSpec { variant: p.variant(), snapshots: p.file.train.snapshots, modes, multiplier_scale: w, blocks };
-    let mut trained = train_basis(data.x.view(), data.multipliers.view(), &joint_dofs(p), x_ref.view(), &spec).map_err(|e| ("reduction.modes", e))?;
+    let spec =
+        BasisSpec { variant: p.variant(), snapshots: p.file.train.snapshots, modes, multiplier_scale: w, blocks };
+    let mut trained = train_basis(data.x.view(), data.multipliers.view(), &joint_dofs(p), x_ref.view(), &spec)
+        .map_err(|e| ("reduction.modes", e))?;
     if let Some(tol) = hyper_tolerance {
         let sys = p.model.system(LinearSolverKind::Banded);
-        let hyper = ecsw(&sys, &trained.basis, data.x.view(), tol).map_err(|e| ("reduction.hyper", format!("ECSW training failed: {e}")))?;
+        let hyper = ecsw(&sys, &trained.basis, data.x.view(), tol)
+            .map_err(|e| ("reduction.hyper", format!("ECSW training failed: {e}")))?;
         trained.basis.hyper = Some(hyper);
     }
     Ok((trained, spec))

@@ -64,7 +64,14 @@ pub struct Validation {
 }
 
 /// Compares a reduced run with a full run of the same model, load scale and Δt.
-pub fn compare(model: &Model, full: &SimulationResult, rom: &ReducedRun, dense_seconds: Option<f64>, n_modes: usize, variant: &str) -> Validation {
+pub fn compare(
+    model: &Model,
+    full: &SimulationResult,
+    rom: &ReducedRun,
+    dense_seconds: Option<f64>,
+    n_modes: usize,
+    variant: &str,
+) -> Validation {
     let r = &rom.result;
     let diff = (&r.q - &full.q).mapv(|v| v * v).sum().sqrt();
     let norm = full.q.mapv(|v| v * v).sum().sqrt();
@@ -131,25 +138,42 @@ impl Validation {
 }
 
 /// Runs full (banded, and dense LU when `with_dense`) and reduced at `load_scale`.
-pub fn validate(model: &Model, basis: &Basis, load_scale: f64, with_dense: bool) -> Result<(Validation, SimulationResult, ReducedRun)> {
+pub fn validate(
+    model: &Model,
+    basis: &Basis,
+    load_scale: f64,
+    with_dense: bool,
+) -> Result<(Validation, SimulationResult, ReducedRun)> {
     validate_with(model, basis, None, load_scale, with_dense)
 }
 
 /// [`validate`] with the basis's estimator, training range and tolerance (`trust`), and the
 /// full model's sensitivity (one more full run at 1.001 λ).
-pub fn validate_with(model: &Model, basis: &Basis, trust: Option<&TrustInfo>, load_scale: f64, with_dense: bool) -> Result<(Validation, SimulationResult, ReducedRun)> {
+pub fn validate_with(
+    model: &Model,
+    basis: &Basis,
+    trust: Option<&TrustInfo>,
+    load_scale: f64,
+    with_dense: bool,
+) -> Result<(Validation, SimulationResult, ReducedRun)> {
     let o = Overrides { load_scale: Some(load_scale), ..Default::default() };
     let stage = |what: &'static str| move |e: crate::Error| e.at_stage(what, load_scale);
     let full = simulate(model, &o).map_err(stage("validate (full run)"))?;
     let dense = if with_dense {
-        Some(simulate(model, &Overrides { solver: LinearSolverKind::Dense, ..o.clone() }).map_err(stage("validate (dense full run)"))?.wall_seconds)
+        Some(
+            simulate(model, &Overrides { solver: LinearSolverKind::Dense, ..o.clone() })
+                .map_err(stage("validate (dense full run)"))?
+                .wall_seconds,
+        )
     } else {
         None
     };
-    let nearby = simulate(model, &Overrides { load_scale: Some(1.001 * load_scale), ..o }).map_err(stage("validate (full run at 1.001 λ)"))?;
+    let nearby = simulate(model, &Overrides { load_scale: Some(1.001 * load_scale), ..o })
+        .map_err(stage("validate (full run at 1.001 λ)"))?;
     let mut runner = EstimatingRunner::new(model, basis, trust.and_then(|t| t.estimator.as_ref()))?;
     let (rom, estimate) = runner.run(load_scale, Output::Full).map_err(stage("validate (reduced run)"))?;
-    let mut v = compare(model, &full, &rom, dense, basis.n_reduced(), basis.variant.name()).with_trust(estimate.as_ref(), trust);
+    let mut v = compare(model, &full, &rom, dense, basis.n_reduced(), basis.variant.name())
+        .with_trust(estimate.as_ref(), trust);
     let norm = full.q.mapv(|x| x * x).sum().sqrt();
     v.sensitivity = Some((&nearby.q - &full.q).mapv(|x| x * x).sum().sqrt() / norm);
     Ok((v, full, rom))
@@ -190,12 +214,19 @@ impl Validation {
                 e,
                 if self.estimate_calibrated == Some(true) { "calibrated" } else { "uncalibrated" },
                 f,
-                self.estimate_seconds.map_or(String::new(), |t| format!(", estimator {:.4} s ({:.0} % of the reduced run)", t, 100.0 * t / self.rom_seconds))
+                self.estimate_seconds.map_or(String::new(), |t| format!(
+                    ", estimator {:.4} s ({:.0} % of the reduced run)",
+                    t,
+                    100.0 * t / self.rom_seconds
+                ))
             )),
             _ => s.push_str("\n  error_estimate: none (the basis file has no /estimator; train again)"),
         }
         if let Some([a, b]) = self.training_range {
-            s.push_str(&format!("\n  training range [{a}, {b}]{}", if self.extrapolated { ": EXTRAPOLATED" } else { "" }));
+            s.push_str(&format!(
+                "\n  training range [{a}, {b}]{}",
+                if self.extrapolated { ": EXTRAPOLATED" } else { "" }
+            ));
         }
         if let Some(x) = self.sensitivity {
             s.push_str(&format!("\n  sensitivity {x:.3e} (full runs at λ and 1.001 λ)"));

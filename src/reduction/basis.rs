@@ -124,7 +124,13 @@ pub struct BasisSpec {
 /// With blocks, `V = [blockdiag(Φ₁, …, Φ_B), kept]`: the rows of block b's coordinates
 /// get the leading modes of their own POD, so that an element sees its own block's modes
 /// only and the Newton matrix is block-diagonal apart from the kept coordinates.
-pub fn train_basis(x: ArrayView2<f64>, lambda: ArrayView2<f64>, joint_dofs: &[usize], x_ref: ArrayView1<f64>, spec: &BasisSpec) -> Result<Trained, String> {
+pub fn train_basis(
+    x: ArrayView2<f64>,
+    lambda: ArrayView2<f64>,
+    joint_dofs: &[usize],
+    x_ref: ArrayView1<f64>,
+    spec: &BasisSpec,
+) -> Result<Trained, String> {
     let (variant, multiplier_scale) = (spec.variant, spec.multiplier_scale);
     let n = x.nrows();
     if x.ncols() == 0 {
@@ -150,7 +156,8 @@ pub fn train_basis(x: ArrayView2<f64>, lambda: ArrayView2<f64>, joint_dofs: &[us
             if !(multiplier_scale.is_finite() && multiplier_scale > 0.0) {
                 return Err(format!("the multiplier scale must be positive, got {multiplier_scale}"));
             }
-            ndarray::concatenate(Axis(0), &[centred.view(), (&lambda / multiplier_scale).view()]).map_err(|e| e.to_string())?
+            ndarray::concatenate(Axis(0), &[centred.view(), (&lambda / multiplier_scale).view()])
+                .map_err(|e| e.to_string())?
         }
         _ => centred.select(Axis(0), &reduced_dofs),
     };
@@ -159,7 +166,9 @@ pub fn train_basis(x: ArrayView2<f64>, lambda: ArrayView2<f64>, joint_dofs: &[us
     let lead = p.leading(r);
     let (modes, kept, multiplier_modes) = match variant {
         Variant::Galerkin => (lead, Vec::new(), None),
-        Variant::WholeSystem => (lead.slice(s![..n, ..]).to_owned(), Vec::new(), Some(lead.slice(s![n.., ..]).to_owned())),
+        Variant::WholeSystem => {
+            (lead.slice(s![..n, ..]).to_owned(), Vec::new(), Some(lead.slice(s![n.., ..]).to_owned()))
+        }
         Variant::ConstraintPreserving => {
             let mut v = Array2::zeros((n, r + joint_dofs.len()));
             for (i, &d) in reduced_dofs.iter().enumerate() {
@@ -168,13 +177,29 @@ pub fn train_basis(x: ArrayView2<f64>, lambda: ArrayView2<f64>, joint_dofs: &[us
             (v, joint_dofs.to_vec(), None)
         }
     };
-    let mut basis = Basis { variant, snapshots: spec.snapshots, reference, modes, kept, multiplier_modes, multiplier_scale, n_pod_modes: r, hyper: None };
+    let mut basis = Basis {
+        variant,
+        snapshots: spec.snapshots,
+        reference,
+        modes,
+        kept,
+        multiplier_modes,
+        multiplier_scale,
+        n_pod_modes: r,
+        hyper: None,
+    };
     basis.set_kept_columns();
     Ok(Trained { basis, pods: vec![p], block_modes: vec![r], reduced_dofs })
 }
 
 /// [`train_basis`] with blocks (galerkin or constraint-preserving).
-fn train_blocks(centred: Array2<f64>, reference: Array1<f64>, joint_dofs: &[usize], reduced_dofs: Vec<usize>, spec: &BasisSpec) -> Result<Trained, String> {
+fn train_blocks(
+    centred: Array2<f64>,
+    reference: Array1<f64>,
+    joint_dofs: &[usize],
+    reduced_dofs: Vec<usize>,
+    spec: &BasisSpec,
+) -> Result<Trained, String> {
     let n = centred.nrows();
     if spec.variant == Variant::WholeSystem {
         return Err("a basis with blocks needs the galerkin or the constraint-preserving variant".into());
@@ -202,7 +227,10 @@ fn train_blocks(centred: Array2<f64>, reference: Array1<f64>, joint_dofs: &[usiz
     for (b, block) in spec.blocks.iter().enumerate() {
         let rows: Vec<usize> = block.iter().copied().filter(|d| !kept.contains(d)).collect();
         let p = pod(centred.select(Axis(0), &rows).view()).map_err(|e| format!("block {}: {e}", b + 1))?;
-        let r = spec.modes.count_in_block(b, block.len(), p.energy.as_slice().expect("contiguous")).map_err(|e| format!("block {}: {e}", b + 1))?;
+        let r = spec
+            .modes
+            .count_in_block(b, block.len(), p.energy.as_slice().expect("contiguous"))
+            .map_err(|e| format!("block {}: {e}", b + 1))?;
         columns.push((rows, p.leading(r)));
         pods.push(p);
         block_modes.push(r);
@@ -216,7 +244,17 @@ fn train_blocks(centred: Array2<f64>, reference: Array1<f64>, joint_dofs: &[usiz
         }
         c0 += lead.ncols();
     }
-    let mut basis = Basis { variant: spec.variant, snapshots: spec.snapshots, reference, modes: v, kept, multiplier_modes: None, multiplier_scale: spec.multiplier_scale, n_pod_modes: r, hyper: None };
+    let mut basis = Basis {
+        variant: spec.variant,
+        snapshots: spec.snapshots,
+        reference,
+        modes: v,
+        kept,
+        multiplier_modes: None,
+        multiplier_scale: spec.multiplier_scale,
+        n_pod_modes: r,
+        hyper: None,
+    };
     basis.set_kept_columns();
     Ok(Trained { basis, pods, block_modes, reduced_dofs })
 }
@@ -268,20 +306,34 @@ impl Basis {
             return bad("basis/modes", "has no columns (r = 0)".into());
         }
         if self.reference.len() != n_dof {
-            return bad("basis/reference", format!("has {} entries, the model has {n_dof} coordinates", self.reference.len()));
+            return bad(
+                "basis/reference",
+                format!("has {} entries, the model has {n_dof} coordinates", self.reference.len()),
+            );
         }
         if self.modes.iter().chain(self.reference.iter()).any(|x| !x.is_finite()) {
             return bad("basis/modes", "holds non-finite values".into());
         }
         if self.n_pod_modes + self.kept.len() != self.modes.ncols() {
-            return bad("basis/kept_dofs", format!("{} POD modes and {} kept coordinates do not make {} columns", self.n_pod_modes, self.kept.len(), self.modes.ncols()));
+            return bad(
+                "basis/kept_dofs",
+                format!(
+                    "{} POD modes and {} kept coordinates do not make {} columns",
+                    self.n_pod_modes,
+                    self.kept.len(),
+                    self.modes.ncols()
+                ),
+            );
         }
         if let Some(&d) = self.kept.iter().find(|&&d| d >= n_dof) {
             return bad("basis/kept_dofs", format!("coordinate {d} does not exist (the model has {n_dof})"));
         }
         match (&self.multiplier_modes, self.variant) {
             (Some(vl), Variant::WholeSystem) if vl.dim() == (n_constraints, self.modes.ncols()) => Ok(()),
-            (Some(vl), Variant::WholeSystem) => bad("basis/multiplier_modes", format!("is {:?}, expected ({n_constraints}, {})", vl.dim(), self.modes.ncols())),
+            (Some(vl), Variant::WholeSystem) => bad(
+                "basis/multiplier_modes",
+                format!("is {:?}, expected ({n_constraints}, {})", vl.dim(), self.modes.ncols()),
+            ),
             (None, Variant::WholeSystem) => bad("basis/multiplier_modes", "is missing (whole-system variant)".into()),
             _ => Ok(()),
         }
@@ -299,11 +351,19 @@ mod tests {
     fn reduce_then_reconstruct_is_identity_on_the_span() {
         let n = 6;
         let m = 5;
-        let x = Array2::from_shape_fn((n, m), |(i, j)| (i as f64 + 1.0) * (j as f64 * 0.3).sin() + (i * i) as f64 * (j as f64 * 0.7).cos());
+        let x = Array2::from_shape_fn((n, m), |(i, j)| {
+            (i as f64 + 1.0) * (j as f64 * 0.3).sin() + (i * i) as f64 * (j as f64 * 0.7).cos()
+        });
         let lam = Array2::zeros((0, m));
         let xref = x.column(0).to_owned();
         for (variant, joints) in [(Variant::Galerkin, vec![]), (Variant::ConstraintPreserving, vec![0, 3])] {
-            let spec = BasisSpec { variant, snapshots: SnapshotKind::Reference, modes: ModeRule::Energy(1e-14), multiplier_scale: 1.0, blocks: vec![] };
+            let spec = BasisSpec {
+                variant,
+                snapshots: SnapshotKind::Reference,
+                modes: ModeRule::Energy(1e-14),
+                multiplier_scale: 1.0,
+                blocks: vec![],
+            };
             let t = train_basis(x.view(), lam.view(), &joints, xref.view(), &spec).unwrap();
             let b = &t.basis;
             let gram = b.modes.t().dot(&b.modes);
@@ -329,11 +389,19 @@ mod tests {
     #[test]
     fn block_basis_keeps_each_block_to_its_rows() {
         let (n, m) = (10, 6);
-        let x = Array2::from_shape_fn((n, m), |(i, j)| ((i + 1) as f64 * 0.37 * (j + 1) as f64).sin() + 0.1 * i as f64 * j as f64);
+        let x = Array2::from_shape_fn((n, m), |(i, j)| {
+            ((i + 1) as f64 * 0.37 * (j + 1) as f64).sin() + 0.1 * i as f64 * j as f64
+        });
         let lam = Array2::zeros((0, m));
         let xref = x.column(0).to_owned();
         let blocks = vec![(0..5).collect::<Vec<_>>(), (5..10).collect()];
-        let spec = BasisSpec { variant: Variant::ConstraintPreserving, snapshots: SnapshotKind::Reference, modes: ModeRule::Energy(1e-14), multiplier_scale: 1.0, blocks: blocks.clone() };
+        let spec = BasisSpec {
+            variant: Variant::ConstraintPreserving,
+            snapshots: SnapshotKind::Reference,
+            modes: ModeRule::Energy(1e-14),
+            multiplier_scale: 1.0,
+            blocks: blocks.clone(),
+        };
         let t = train_basis(x.view(), lam.view(), &[4, 5], xref.view(), &spec).unwrap();
         let b = &t.basis;
         assert_eq!(t.pods.len(), 2);

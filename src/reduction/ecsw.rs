@@ -38,20 +38,32 @@ pub struct Hyper {
 impl Hyper {
     /// Every element with weight 1: plain Galerkin.
     pub fn all(n_elements: usize) -> Hyper {
-        Hyper { elements: (0..n_elements).collect(), weights: vec![1.0; n_elements], tolerance: 0.0, training_residual: 0.0, n_training: 0 }
+        Hyper {
+            elements: (0..n_elements).collect(),
+            weights: vec![1.0; n_elements],
+            tolerance: 0.0,
+            training_residual: 0.0,
+            n_training: 0,
+        }
     }
 
     /// Checks the set against a model of `n_elements`; `Err((dataset, problem))`.
     pub fn validate(&self, n_elements: usize) -> Result<(), (String, String)> {
         let bad = |f: &str, p: String| Err((format!("hyper/{f}"), p));
         if self.elements.len() != self.weights.len() {
-            return bad("weights", format!("has {} entries but hyper/elements has {}", self.weights.len(), self.elements.len()));
+            return bad(
+                "weights",
+                format!("has {} entries but hyper/elements has {}", self.weights.len(), self.elements.len()),
+            );
         }
         if self.elements.is_empty() {
             return bad("elements", "is empty: a hyper-reduced model needs at least one element".into());
         }
         if let Some(&e) = self.elements.iter().find(|&&e| e >= n_elements) {
-            return bad("elements", format!("names element {e}, but the model has {n_elements} elements (0..{})", n_elements));
+            return bad(
+                "elements",
+                format!("names element {e}, but the model has {n_elements} elements (0..{})", n_elements),
+            );
         }
         if self.elements.windows(2).any(|w| w[0] >= w[1]) {
             return bad("elements", "must be strictly increasing (each element once)".into());
@@ -78,7 +90,8 @@ pub fn training_matrix<M: InvariantElementModel>(full: &M, basis: &Basis, snapsh
     }
     let x = v.dot(&q) + &basis.reference.view().insert_axis(ndarray::Axis(1));
     let mut c = Array2::zeros((ns * r, n_el));
-    let (mut xe, ve, mut fe, mut l, mut d) = (vec![0.0; ne], vec![0.0; ne], vec![0.0; ne], vec![0.0; ne * ne], vec![0.0; ne * ne]);
+    let (mut xe, ve, mut fe, mut l, mut d) =
+        (vec![0.0; ne], vec![0.0; ne], vec![0.0; ne], vec![0.0; ne * ne], vec![0.0; ne * ne]);
     for e in 0..n_el {
         let dofs = full.element_dofs(e);
         full.element_linear(e, &mut l, &mut d);
@@ -103,7 +116,12 @@ pub fn training_matrix<M: InvariantElementModel>(full: &M, basis: &Basis, snapsh
 }
 
 /// Trains the sampled set on `snapshots` (n_dof × n_snapshots) with relative tolerance τ.
-pub fn ecsw<M: InvariantElementModel>(full: &M, basis: &Basis, snapshots: ArrayView2<f64>, tolerance: f64) -> Result<Hyper, String> {
+pub fn ecsw<M: InvariantElementModel>(
+    full: &M,
+    basis: &Basis,
+    snapshots: ArrayView2<f64>,
+    tolerance: f64,
+) -> Result<Hyper, String> {
     if snapshots.ncols() == 0 {
         return Err("no training snapshots".into());
     }
@@ -114,7 +132,13 @@ pub fn ecsw<M: InvariantElementModel>(full: &M, basis: &Basis, snapshots: ArrayV
     let weights = elements.iter().map(|&e| sol.x[e]).collect();
     if elements.is_empty() {
         // b = 0: the snapshots never strain the elements; keep one so the model is defined
-        return Ok(Hyper { elements: vec![0], weights: vec![1.0], tolerance, training_residual: 0.0, n_training: snapshots.ncols() });
+        return Ok(Hyper {
+            elements: vec![0],
+            weights: vec![1.0],
+            tolerance,
+            training_residual: 0.0,
+            n_training: snapshots.ncols(),
+        });
     }
     Ok(Hyper { elements, weights, tolerance, training_residual: sol.relative_residual, n_training: snapshots.ncols() })
 }

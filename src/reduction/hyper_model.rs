@@ -389,10 +389,22 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
                 for l in 0..me {
                     let (a, cu) = ((ab1.0, ab2.0), (ab1.1 * u1[l], ab2.1 * u2[l]));
                     let (at, len, at2, len2) = c.row(l, r);
-                    add_row_pair(&mut self.acc[at..at + len], (&g1[p..p + len], &g2[p..p + len]), (&u1[l..l + len], &u2[l..l + len]), a, cu);
+                    add_row_pair(
+                        &mut self.acc[at..at + len],
+                        (&g1[p..p + len], &g2[p..p + len]),
+                        (&u1[l..l + len], &u2[l..l + len]),
+                        a,
+                        cu,
+                    );
                     if len2 > 0 {
                         let (q, v) = (p + len, me - len2);
-                        add_row_pair(&mut self.acc[at2..at2 + len2], (&g1[q..q + len2], &g2[q..q + len2]), (&u1[v..me], &u2[v..me]), a, cu);
+                        add_row_pair(
+                            &mut self.acc[at2..at2 + len2],
+                            (&g1[q..q + len2], &g2[q..q + len2]),
+                            (&u1[v..me], &u2[v..me]),
+                            a,
+                            cu,
+                        );
                     }
                     p += len + len2;
                 }

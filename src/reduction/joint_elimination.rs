@@ -68,7 +68,9 @@ impl JointElimination {
             return None;
         }
         let k = j - nc;
-        let col_major = |rows: usize, cols: usize, at: &dyn Fn(usize, usize) -> f64| -> Vec<f64> { (0..cols).flat_map(|c| (0..rows).map(move |i| (i, c))).map(|(i, c)| at(i, c)).collect() };
+        let col_major = |rows: usize, cols: usize, at: &dyn Fn(usize, usize) -> f64| -> Vec<f64> {
+            (0..cols).flat_map(|c| (0..rows).map(move |i| (i, c))).map(|(i, c)| at(i, c)).collect()
+        };
         Some(JointElimination {
             r,
             nc,
@@ -197,7 +199,13 @@ mod tests {
         b[[2, 9]] = 1.0;
         let mut el = JointElimination::new(&b).expect("eligible");
         assert_eq!(el.dim(), r - 3);
-        let s_mat = Array2::from_shape_fn((r, r), |(i, j)| if i == j { 5.0 + i as f64 } else { ((3 * i + 7 * j) % 5) as f64 / 7.0 - 0.3 });
+        let s_mat = Array2::from_shape_fn((r, r), |(i, j)| {
+            if i == j {
+                5.0 + i as f64
+            } else {
+                ((3 * i + 7 * j) % 5) as f64 / 7.0 - 0.3
+            }
+        });
         for j in 0..r {
             for i in 0..r {
                 el.s[i + r * j] = s_mat[[i, j]];

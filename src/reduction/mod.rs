@@ -14,13 +14,13 @@ pub(crate) mod joint_elimination;
 pub mod nnls;
 pub mod pod;
 pub(crate) mod projection;
-mod sparse_rows;
 pub mod reduced_model;
+mod sparse_rows;
 
 pub use basis::{train_basis, Basis, BasisSpec, SnapshotKind, Trained, Variant};
-pub use pod::{pod, ModeRule, Pod};
 pub use ecsw::{ecsw, Hyper};
 pub use hyper_model::HyperReducedModel;
+pub use pod::{pod, ModeRule, Pod};
 pub use reduced_model::ReducedModel;
 
 /// What the online stage needs of a reduced model besides the dynamics.

@@ -89,7 +89,10 @@ pub fn nnls(a: ArrayView2<f64>, b: ArrayView1<f64>, params: &NnlsParams) -> Resu
         }
         // the most promising column outside P
         let w = a.t().dot(&residual);
-        let best = (0..n).filter(|&j| !in_p[j] && !excluded[j]).map(|j| (j, w[j] / norms[j])).max_by(|p, q| p.1.total_cmp(&q.1));
+        let best = (0..n)
+            .filter(|&j| !in_p[j] && !excluded[j])
+            .map(|j| (j, w[j] / norms[j]))
+            .max_by(|p, q| p.1.total_cmp(&q.1));
         let Some((j, wj)) = best else { break };
         if wj <= 0.0 {
             break; // Kuhn–Tucker point: no column can lower the residual
@@ -212,7 +215,9 @@ mod tests {
     /// below 0.3 ‖b‖ and with fewer nonzero entries.
     #[test]
     fn meets_its_relative_tolerance_and_stops_early() {
-        let a = Array2::from_shape_fn((40, 12), |(i, j)| 1.0 + ((i * 7 + j * 13) % 11) as f64 / 5.0 + if i % 12 == j { 3.0 } else { 0.0 });
+        let a = Array2::from_shape_fn((40, 12), |(i, j)| {
+            1.0 + ((i * 7 + j * 13) % 11) as f64 / 5.0 + if i % 12 == j { 3.0 } else { 0.0 }
+        });
         let b = a.dot(&Array1::ones(12));
         let exact = nnls(a.view(), b.view(), &NnlsParams::default()).unwrap();
         assert!(exact.relative_residual < 1e-10, "{}", exact.relative_residual);

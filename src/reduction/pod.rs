@@ -27,9 +27,15 @@ impl ModeRule {
     pub fn validate(&self) -> Result<(), String> {
         match *self {
             ModeRule::Count(0) => Err("count must be at least 1".into()),
-            ModeRule::Counts(ref c) if c.is_empty() || c.contains(&0) => Err(format!("counts must be at least 1 each, got {c:?}")),
-            ModeRule::Ratio(x) if !(x.is_finite() && x > 0.0 && x <= 1.0) => Err(format!("ratio must lie in (0, 1], got {x}")),
-            ModeRule::Energy(t) if !(t.is_finite() && t > 0.0 && t < 1.0) => Err(format!("energy tolerance must lie in (0, 1), got {t}")),
+            ModeRule::Counts(ref c) if c.is_empty() || c.contains(&0) => {
+                Err(format!("counts must be at least 1 each, got {c:?}"))
+            }
+            ModeRule::Ratio(x) if !(x.is_finite() && x > 0.0 && x <= 1.0) => {
+                Err(format!("ratio must lie in (0, 1], got {x}"))
+            }
+            ModeRule::Energy(t) if !(t.is_finite() && t > 0.0 && t < 1.0) => {
+                Err(format!("energy tolerance must lie in (0, 1), got {t}"))
+            }
             _ => Ok(()),
         }
     }
@@ -105,7 +111,11 @@ pub fn pod(snapshots: ArrayView2<f64>) -> Result<Pod, String> {
         .iter()
         .map(|s| {
             acc += s * s;
-            if total > 0.0 { acc / total } else { 1.0 }
+            if total > 0.0 {
+                acc / total
+            } else {
+                1.0
+            }
         })
         .collect();
     Ok(Pod { modes: u, singular_values: sigma, energy })

@@ -20,8 +20,8 @@ use super::basis::{Basis, Variant};
 use super::joint_elimination::JointElimination;
 use super::sparse_rows::SparseRows;
 use crate::solver::dense_lu::DenseLu;
-pub(crate) use crate::solver::vec_ops::{axpy, dot};
 use crate::solver::model::{ElementModel, IterationCoefficients};
+pub(crate) use crate::solver::vec_ops::{axpy, dot};
 use ndarray::{s, Array1, Array2, ArrayView1, Axis};
 use ndarray_linalg::SVD;
 
@@ -154,7 +154,11 @@ impl Projection {
                 // keep the combinations of joint equations the basis can move: B V = U Σ Wᵀ,
                 // rows Uₖᵀ(B V q + B x_ref − b) for σ > 1e-8 (B has unit entries, V is
                 // orthonormal, so σ ≤ √2); the rest hold as well as the basis represents them
-                let (u, sigma, _) = if nc_full > 0 { bv.svd(true, false).map_err(|e| format!("SVD of B V failed: {e}"))? } else { (None, Array1::zeros(0), None) };
+                let (u, sigma, _) = if nc_full > 0 {
+                    bv.svd(true, false).map_err(|e| format!("SVD of B V failed: {e}"))?
+                } else {
+                    (None, Array1::zeros(0), None)
+                };
                 let k = sigma.iter().filter(|&&x| x > 1e-8).count();
                 if k > 0 {
                     let uk = u.expect("requested").slice(s![.., ..k]).to_owned();
@@ -420,7 +424,12 @@ impl Projection {
 
 /// [`Projection::matrix`] on the two fields it needs, so that the rest of the projection
 /// can be read while the matrix is written.
-fn matrix_of<'a>(elim: &'a mut Option<JointElimination>, lu: &'a mut DenseLu, r: usize, nc: usize) -> (&'a mut [f64], usize) {
+fn matrix_of<'a>(
+    elim: &'a mut Option<JointElimination>,
+    lu: &'a mut DenseLu,
+    r: usize,
+    nc: usize,
+) -> (&'a mut [f64], usize) {
     match elim {
         Some(e) => (&mut e.s, r),
         None => (lu.matrix_mut(), r + nc),

@@ -60,7 +60,11 @@ mod tests {
     fn product_equals_the_dense_one() {
         let a = Array2::from_shape_fn((7, 7), |(i, j)| {
             let block = |k: usize| if k < 3 { 0 } else { 1 };
-            if i == 5 || (block(i) != block(j) && j != 6) { 0.0 } else { 1.0 + (i * 7 + j) as f64 * 0.1 }
+            if i == 5 || (block(i) != block(j) && j != 6) {
+                0.0
+            } else {
+                1.0 + (i * 7 + j) as f64 * 0.1
+            }
         });
         let x: Vec<f64> = (0..7).map(|i| (i as f64).sin() + 0.3).collect();
         let dense = a.dot(&ndarray::ArrayView1::from(&x));

@@ -146,7 +146,11 @@ impl KktSolver for BandedKkt {
         for (old, &new) in self.new_of.iter().enumerate() {
             rhs[old] = self.work[new];
         }
-        if rhs.iter().all(|v| v.is_finite()) { Ok(()) } else { Err("the iteration matrix is singular (non-finite solution)".into()) }
+        if rhs.iter().all(|v| v.is_finite()) {
+            Ok(())
+        } else {
+            Err("the iteration matrix is singular (non-finite solution)".into())
+        }
     }
 }
 
@@ -176,7 +180,13 @@ pub fn band_lu(ab: &mut [f64], n: usize, b: usize, ldab: usize, ipiv: &mut [usiz
 }
 
 /// [`band_lu`] with `B = b` known at compile time (`B = 0`: any `b`).
-fn band_lu_impl<const B: usize>(ab: &mut [f64], n: usize, b: usize, ldab: usize, ipiv: &mut [usize]) -> Result<usize, String> {
+fn band_lu_impl<const B: usize>(
+    ab: &mut [f64],
+    n: usize,
+    b: usize,
+    ldab: usize,
+    ipiv: &mut [usize],
+) -> Result<usize, String> {
     let kv = 2 * b;
     let mut ju = 0; // last column touched by the interchanges so far
     let mut ubw = 0;
@@ -267,7 +277,11 @@ mod tests {
         let (n, b) = (30, 3);
         let ldab = 3 * b + 1;
         let a = |i: usize, j: usize| -> f64 {
-            if i.abs_diff(j) > b || (i == j && i + 1 != n) { 0.0 } else { 1.0 + ((i * 7 + j * 3) % 11) as f64 * 0.1 }
+            if i.abs_diff(j) > b || (i == j && i + 1 != n) {
+                0.0
+            } else {
+                1.0 + ((i * 7 + j * 3) % 11) as f64 * 0.1
+            }
         };
         let mut ab = vec![0.0; ldab * n];
         for j in 0..n {

@@ -123,7 +123,13 @@ impl DenseLu {
         }
         self.copy.copy_from_slice(&self.a);
         let a = MatMut::from_column_major_slice_mut(&mut self.a, n, n);
-        match llt::factor::cholesky_in_place(a, Default::default(), Par::Seq, MemStack::new(&mut self.mem), Default::default()) {
+        match llt::factor::cholesky_in_place(
+            a,
+            Default::default(),
+            Par::Seq,
+            MemStack::new(&mut self.mem),
+            Default::default(),
+        ) {
             Ok(_) => {
                 self.factored = Some(Factors::Cholesky);
                 Ok(())
@@ -278,7 +284,14 @@ impl DenseLu {
     fn factor_lu(&mut self) -> Result<(), String> {
         let n = self.n;
         let a = MatMut::from_column_major_slice_mut(&mut self.a, n, n);
-        factor::lu_in_place(a, &mut self.perm, &mut self.perm_inv, Par::Seq, MemStack::new(&mut self.mem), Default::default());
+        factor::lu_in_place(
+            a,
+            &mut self.perm,
+            &mut self.perm_inv,
+            Par::Seq,
+            MemStack::new(&mut self.mem),
+            Default::default(),
+        );
         if let Some(i) = (0..n).find(|&i| self.a[i + n * i] == 0.0) {
             return Err(format!("the iteration matrix is singular (zero pivot {i} of {n})"));
         }
@@ -325,7 +338,9 @@ impl DenseLu {
                 let perm = PermRef::new_checked(&self.perm, &self.perm_inv, n);
                 solve::solve_in_place_with_conj(a, a, perm, Conj::No, b, Par::Seq, MemStack::new(&mut self.mem));
             }
-            Factors::Cholesky => llt::solve::solve_in_place_with_conj(a, Conj::No, b, Par::Seq, MemStack::new(&mut self.mem)),
+            Factors::Cholesky => {
+                llt::solve::solve_in_place_with_conj(a, Conj::No, b, Par::Seq, MemStack::new(&mut self.mem))
+            }
             Factors::Bordered => unreachable!("solved above"),
         }
         Ok(())

@@ -69,7 +69,16 @@ impl Default for IntegratorParams {
     fn default() -> Self {
         // within-step reuse: the same tolerance at 15–25 % less time on every shipped model,
         // full and reduced (README, benchmark)
-        IntegratorParams { rho_inf: 0.9, tolerance: 1e-10, stagnation: 1e-6, max_iterations: 25, max_cuts: 8, reuse: JacobianReuse::WithinStep, max_strain: 0.5, max_total_cuts: 50 }
+        IntegratorParams {
+            rho_inf: 0.9,
+            tolerance: 1e-10,
+            stagnation: 1e-6,
+            max_iterations: 25,
+            max_cuts: 8,
+            reuse: JacobianReuse::WithinStep,
+            max_strain: 0.5,
+            max_total_cuts: 50,
+        }
     }
 }
 
@@ -197,13 +206,26 @@ impl GeneralizedAlpha {
     /// step of a run at a nearby load scale) as Newton's starting point instead of the
     /// zero-acceleration predictor. The guess only moves the start: the step still stops on
     /// the same tolerance. Halved sub-steps, if any, use the default predictor.
-    pub fn step_guided<M: DynamicModel>(&mut self, model: &mut M, state: &mut State, h: f64, guess: Option<&[f64]>) -> Result<()> {
+    pub fn step_guided<M: DynamicModel>(
+        &mut self,
+        model: &mut M,
+        state: &mut State,
+        h: f64,
+        guess: Option<&[f64]>,
+    ) -> Result<()> {
         self.advance(model, state, h, 0, guess)?;
         self.stats.steps += 1;
         Ok(())
     }
 
-    fn advance<M: DynamicModel>(&mut self, model: &mut M, state: &mut State, h: f64, depth: u32, guess: Option<&[f64]>) -> Result<()> {
+    fn advance<M: DynamicModel>(
+        &mut self,
+        model: &mut M,
+        state: &mut State,
+        h: f64,
+        depth: u32,
+        guess: Option<&[f64]>,
+    ) -> Result<()> {
         match &mut self.backup {
             Some(b) => b.clone_from(state),
             None => self.backup = Some(state.clone()),
@@ -238,7 +260,14 @@ impl GeneralizedAlpha {
         }
     }
 
-    fn try_step<M: DynamicModel>(&mut self, model: &mut M, st: &mut State, h: f64, policy: JacobianReuse, guess: Option<&[f64]>) -> std::result::Result<(), Failure> {
+    fn try_step<M: DynamicModel>(
+        &mut self,
+        model: &mut M,
+        st: &mut State,
+        h: f64,
+        policy: JacobianReuse,
+        guess: Option<&[f64]>,
+    ) -> std::result::Result<(), Failure> {
         let (am, af, g, b) = (self.alpha_m, self.alpha_f, self.gamma, self.beta);
         let n = model.n_dof();
         let beta_p = (1.0 - am) / (b * h * h * (1.0 - af));
@@ -285,9 +314,11 @@ impl GeneralizedAlpha {
             let s = if reuse {
                 self.factored.expect("checked").1
             } else {
-                let s = model
-                    .factor(&st.q, &st.v, t, coef)
-                    .map_err(|_| Failure { iterations: it, increment: last_increment, residual })?;
+                let s = model.factor(&st.q, &st.v, t, coef).map_err(|_| Failure {
+                    iterations: it,
+                    increment: last_increment,
+                    residual,
+                })?;
                 self.stats.factorizations += 1;
                 self.factored = Some((h, s));
                 s
@@ -392,7 +423,13 @@ mod tests {
         }
         fn constraint_residual(&self, _q: &[f64], _out: &mut [f64]) {}
         fn add_constraint_force(&self, _lambda: &[f64], _out: &mut [f64]) {}
-        fn factor(&mut self, q: &[f64], _v: &[f64], _t: f64, c: IterationCoefficients) -> std::result::Result<f64, String> {
+        fn factor(
+            &mut self,
+            q: &[f64],
+            _v: &[f64],
+            _t: f64,
+            c: IterationCoefficients,
+        ) -> std::result::Result<f64, String> {
             self.s = c.mass + c.stiffness * (self.k + 3.0 * self.c * q[0] * q[0]);
             self.fresh = true;
             Ok(1.0)

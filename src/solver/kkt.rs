@@ -254,7 +254,10 @@ impl KktSolver for DenseKkt {
 
 /// Solves in place with a LAPACK LU factorization (getrs); a non-finite solution means the
 /// matrix was singular. Shared by the dense KKT solver and the reduced models.
-pub fn dense_lu_solve(lu: Option<&ndarray_linalg::LUFactorized<ndarray::OwnedRepr<f64>>>, rhs: &mut [f64]) -> Result<(), String> {
+pub fn dense_lu_solve(
+    lu: Option<&ndarray_linalg::LUFactorized<ndarray::OwnedRepr<f64>>>,
+    rhs: &mut [f64],
+) -> Result<(), String> {
     use ndarray_linalg::Solve;
     let lu = lu.ok_or("solve called without a valid factorization")?;
     let mut b = ndarray::ArrayViewMut1::from(rhs);

@@ -6,7 +6,13 @@ use super::model::{DynamicModel, IterationCoefficients};
 use crate::error::{Error, Result};
 
 /// Solves in place from the guess `q`; returns the multipliers and the iteration count.
-pub fn solve_static<M: DynamicModel>(model: &mut M, q: &mut [f64], t: f64, tolerance: f64, max_iterations: usize) -> Result<(Vec<f64>, usize)> {
+pub fn solve_static<M: DynamicModel>(
+    model: &mut M,
+    q: &mut [f64],
+    t: f64,
+    tolerance: f64,
+    max_iterations: usize,
+) -> Result<(Vec<f64>, usize)> {
     let (n, nc) = (model.n_dof(), model.n_constraints());
     let zero = vec![0.0; n];
     let mut lambda = vec![0.0; nc];

@@ -14,7 +14,15 @@ pub fn cantilever(elements: usize, length: f64, e: f64, area: f64, inertia: f64,
     cantilever_with_density(elements, length, e, area, inertia, 7800.0, p)
 }
 
-pub fn cantilever_with_density(elements: usize, length: f64, e: f64, area: f64, inertia: f64, density: f64, p: f64) -> Model {
+pub fn cantilever_with_density(
+    elements: usize,
+    length: f64,
+    e: f64,
+    area: f64,
+    inertia: f64,
+    density: f64,
+    p: f64,
+) -> Model {
     model(&format!(
         r#"
         [time]
