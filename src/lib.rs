@@ -5,6 +5,11 @@
 //! `model` (files) → `physics` (element, system) → `solver` (integrator, linear solvers)
 //! → `simulate` (full runs) → `io` (HDF5).
 
+// `!(x > 0.0)` is how the input checks say "positive, and not NaN": the negated comparison is
+// the point, so clippy's preference for `partial_cmp` is off; index loops in the numeric
+// kernels follow the equations' indices (several arrays indexed alike)
+#![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
+
 pub mod error;
 pub mod io;
 pub mod limits;
@@ -26,7 +31,7 @@ extern "C" {
 /// Keeps OpenBLAS on one thread: the dense reference solver then measures one core, like
 /// everything else, and parallel sweeps do not oversubscribe the machine.
 ///
-/// Usually OpenBLAS has started no worker at all ([`BLAS_ONE_THREAD_AT_START`]). When the
+/// Usually OpenBLAS has started no worker at all (`BLAS_ONE_THREAD_AT_START`, below). When the
 /// user's `OPENBLAS_NUM_THREADS` asked for more, its constructor has started them before `main`;
 /// setting the count to 1 only stops handing them work, and each keeps polling its queue with
 /// `sched_yield` (about a third of a pendulum run's CPU time). `blas_thread_shutdown_` joins

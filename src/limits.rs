@@ -126,7 +126,7 @@ pub fn parse_bytes(s: &str) -> std::result::Result<u64, String> {
         u => return Err(format!("unknown unit `{u}` in `{s}` (use K, M, G or T)")),
     };
     let b = x * mult;
-    if !(b.is_finite() && b >= 1.0 && b < 1.8e19) {
+    if !(b.is_finite() && (1.0..1.8e19).contains(&b)) {
         return Err(format!("`{s}` is not a positive size below 16 EiB"));
     }
     Ok(b as u64)

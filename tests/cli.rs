@@ -70,6 +70,7 @@ fn broken(edit: impl Fn(&str) -> String) -> String {
 }
 
 #[test]
+#[allow(clippy::type_complexity)]
 fn bad_model_files_are_refused_with_file_field_and_problem() {
     let cases: Vec<(Box<dyn Fn(&str) -> String>, &[&str])> = vec![
         (Box::new(|s: &str| s.replace("length = 1.2", "length = 1.2\nlenght = 3")), &["lenght", "unknown field"]),

@@ -197,6 +197,7 @@ fn flexrom() -> Command {
 }
 
 #[test]
+#[allow(clippy::type_complexity)]
 fn bad_hyper_data_is_refused_naming_the_dataset() {
     let dir = tempfile::tempdir().unwrap();
     let model = std::fs::read_to_string(repo("data/models/pendulum.toml"))

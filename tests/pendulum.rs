@@ -11,7 +11,7 @@
 //!   observed order: measured on the RMS tip difference over 1.1 s, halvings from 0.01 s down
 //!   to 0.0003 s shrink it 3.6×, 3.5×, 3.2×, 3.1× (order 1.86 → 1.65). We require order
 //!   > 1.5 from dt = 0.005 (the thesis step) to 0.00125. A single instant is no good
-//!   measure: its bending-vibration phase makes the ratio erratic.
+//!   > measure: its bending-vibration phase makes the ratio erratic.
 
 mod common;
 

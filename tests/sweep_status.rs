@@ -192,7 +192,7 @@ fn a_killed_sweep_leaves_a_valid_file_to_resume_from() {
     assert_eq!(st.len(), 300);
     assert!(st.iter().all(|&s| s == 0 || s == 2), "{st:?}");
     let finished = st.iter().filter(|&&s| s == 0).count();
-    assert!(finished >= 1 && finished < 300, "killed midway: {finished} finished");
+    assert!((1..300).contains(&finished), "killed midway: {finished} finished");
     let (o, err) = run(&["sweep", p.to_str().unwrap(), "-o", out.to_str().unwrap(), "--resume"]);
     assert!(o.status.success(), "{err}");
     assert!(

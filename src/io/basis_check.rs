@@ -568,7 +568,6 @@ pub fn content_hash(c: &HashInput) -> String {
         part("hyper/training_residual", &[], &mut std::iter::once(hy.training_residual.to_le_bytes()));
         part("hyper/n_training", &[], &mut std::iter::once((hy.n_training as u64).to_le_bytes()));
     }
-    drop(part);
     for (name, text) in [
         ("variant", b.variant.name()),
         ("snapshots", b.snapshots.name()),

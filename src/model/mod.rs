@@ -507,7 +507,8 @@ fn entry_error(text: &str, path: &Path) -> Option<Error> {
         v.clone().try_into::<T>().err().map(|e| e.message().to_string())
     }
     let doc: toml::Table = toml::from_str(text).ok()?;
-    let kinds: [(&str, fn(&toml::Value) -> Option<String>); 4] = [
+    type FirstError = fn(&toml::Value) -> Option<String>;
+    let kinds: [(&str, FirstError); 4] = [
         ("bodies", first_error::<BodySpec>),
         ("joints", first_error::<JointSpec>),
         ("loads", first_error::<LoadSpec>),

@@ -180,7 +180,7 @@ pub fn raw_estimate(basis: &Basis, est: &Estimator, rom: &ReducedRun, enriched: 
     }
     if basis.variant == Variant::WholeSystem {
         // V is not orthonormal: reconstruct x_ref + V q of both
-        let full = |b: &Basis, z: &Array2<f64>| b.modes.dot(z) + &b.reference.view().insert_axis(Axis(1));
+        let full = |b: &Basis, z: &Array2<f64>| b.modes.dot(z) + b.reference.view().insert_axis(Axis(1));
         let (a, b) = (full(basis, q), full(&est.enriched, qp));
         return (&a - &b).mapv(|v| v * v).sum().sqrt() / b.mapv(|v| v * v).sum().sqrt();
     }
@@ -478,7 +478,7 @@ mod tests {
             let q = Array2::from_shape_fn((b.n_reduced(), nt), |(i, k)| (i as f64 + 1.0) * (k as f64 * 0.5).cos());
             let qp = Array2::from_shape_fn((5, nt), |(i, k)| (i as f64 - 1.0) * (k as f64 * 0.3).sin());
             let full =
-                |basis: &Basis, z: &Array2<f64>| basis.modes.dot(z) + &basis.reference.view().insert_axis(Axis(1));
+                |basis: &Basis, z: &Array2<f64>| basis.modes.dot(z) + basis.reference.view().insert_axis(Axis(1));
             let (x1, x2) = (full(&b, &q), full(&plus, &qp));
             let want = (&x1 - &x2).mapv(|v| v * v).sum().sqrt() / x2.mapv(|v| v * v).sum().sqrt();
             let got = raw_estimate_reduced(&b, &est.enriched, &q, &qp);

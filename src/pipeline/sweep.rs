@@ -69,6 +69,8 @@ pub struct SweepPoint {
 }
 
 /// What became of one load scale.
+// one per load scale, built once and moved into place: the size difference costs nothing
+#[allow(clippy::large_enum_variant)]
 pub enum Outcome {
     Done(SweepPoint),
     /// the error message of its run

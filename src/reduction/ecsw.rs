@@ -88,7 +88,7 @@ pub fn training_matrix<M: InvariantElementModel>(full: &M, basis: &Basis, snapsh
     for k in 0..ns {
         q.column_mut(k).assign(&basis.reduce(snapshots.column(k)));
     }
-    let x = v.dot(&q) + &basis.reference.view().insert_axis(ndarray::Axis(1));
+    let x = v.dot(&q) + basis.reference.view().insert_axis(ndarray::Axis(1));
     let mut c = Array2::zeros((ns * r, n_el));
     let (mut xe, ve, mut fe, mut l, mut d) =
         (vec![0.0; ne], vec![0.0; ne], vec![0.0; ne], vec![0.0; ne * ne], vec![0.0; ne * ne]);

@@ -1,5 +1,5 @@
 //! The hyper-reduced model: Galerkin projection on `x = x_ref + V q` with the element
-//! terms summed over a sampled set `E` with weights `wₑ` (ECSW, [`super::ecsw`]), built on
+//! terms summed over a sampled set `E` with weights `wₑ` (ECSW, [`mod@super::ecsw`]), built on
 //! an [`InvariantElementModel`] so that the online cost depends on r and |E| only:
 //!
 //! ```text

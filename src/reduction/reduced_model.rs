@@ -12,7 +12,7 @@
 //! touched per iteration except the tangent's `Vᵀ Y` (Y = Σ Aₑᵀ Sₑ Vₑ, n × r): plain Galerkin
 //! costs as much as the mesh. The element weights `wₑ` are 1 for plain Galerkin.
 //!
-//! Joints, mass and nodal loads: see [`super::projection`].
+//! Joints, mass and nodal loads: see `reduction::projection` (private).
 
 use super::basis::Basis;
 use super::projection::{axpy, expand, forward_to_projection, impl_reduced, project_add, Projection};
