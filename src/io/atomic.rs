@@ -215,34 +215,44 @@ pub struct TempPath {
 }
 
 impl TempPath {
-    /// Reserves a temporary file name beside `target` (the file is not created). The
-    /// target's folder is created when missing. A symlink at `target` is followed: the
-    /// file it points to is the one replaced, the link stays.
+    /// Creates an empty temporary file beside `target`, exclusively, so that what is removed
+    /// on failure is always flexrom's own file (the writer truncates it). The target's folder
+    /// is created when missing. A symlink at `target` is followed: the file it points to is
+    /// the one replaced, the link stays.
     pub fn file_for(target: &Path) -> Result<TempPath> {
         let target = follow_symlink(target)?;
         check_replaceable(&target)?;
         let (dir, name) = split(&target)?;
-        // the lock first: after a signal's clean-up (which keeps the lock until the exit) no
-        // folder is made again
-        let mut v = live();
-        create_dirs(&dir)?;
-        let tmp = unique_sibling(&dir, &name, "flexrom-tmp");
-        v.push(Live::File(tmp.clone()));
-        Ok(TempPath { live: Live::File(tmp), target, armed: true })
+        Self::create(&dir, &name, target.clone(), |p| {
+            std::fs::OpenOptions::new().write(true).create_new(true).open(p).map(|_| Live::File(p.to_path_buf()))
+        })
     }
 
     /// Creates a temporary folder beside `target` (whose parent is created when missing).
     pub fn dir_for(target: &Path) -> Result<TempPath> {
         let (dir, name) = split(target)?;
+        Self::create(&dir, &name, target.to_path_buf(), |p| std::fs::create_dir(p).map(|_| Live::Dir(p.to_path_buf())))
+    }
+
+    /// Makes a fresh sibling with `make` (which must fail if the path exists) and registers
+    /// it, both under the registry lock: a signal's clean-up (which takes the lock) sees it
+    /// registered only once it is flexrom's own, and after that clean-up (which keeps the
+    /// lock until the exit) nothing is made again. A name that turns out to be taken is not
+    /// touched; the next one is tried.
+    fn create(dir: &Path, name: &str, target: PathBuf, make: impl Fn(&Path) -> std::io::Result<Live>) -> Result<TempPath> {
         let mut v = live();
-        create_dirs(&dir)?;
-        let tmp = unique_sibling(&dir, &name, "flexrom-tmp");
-        // registered before it exists: a signal between the two steps still removes it
-        v.push(Live::Dir(tmp.clone()));
-        let made = std::fs::create_dir(&tmp).map_err(|e| Error::io(&tmp, e));
-        drop(v);
-        let t = TempPath { live: Live::Dir(tmp.clone()), target: target.to_path_buf(), armed: true };
-        made.map(|_| t)
+        create_dirs(dir)?;
+        loop {
+            let tmp = unique_sibling(dir, name, "flexrom-tmp");
+            match make(&tmp) {
+                Ok(l) => {
+                    v.push(l.clone());
+                    return Ok(TempPath { live: l, target, armed: true });
+                }
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+                Err(e) => return Err(Error::io(&tmp, e)),
+            }
+        }
     }
 
     /// The temporary path to write.
@@ -328,13 +338,18 @@ pub fn write_file_atomically(target: &Path, fill: impl FnOnce(&Path) -> Result<(
 
 /// Writes `bytes` to `target` atomically and durably.
 pub fn write_bytes_atomically(target: &Path, bytes: &[u8]) -> Result<()> {
-    write_file_atomically(target, |tmp| write_new(tmp, bytes))
+    // the temporary file exists (flexrom's own, empty): opened without create_new
+    write_file_atomically(target, |tmp| write_with(std::fs::OpenOptions::new().write(true).truncate(true), tmp, bytes))
 }
 
 /// Creates `path` (which must not exist) with `bytes` and `fsync`s it.
 pub fn write_new(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_with(std::fs::OpenOptions::new().write(true).create_new(true), path, bytes)
+}
+
+fn write_with(o: &std::fs::OpenOptions, path: &Path, bytes: &[u8]) -> Result<()> {
     use std::io::Write;
-    let mut f = std::fs::OpenOptions::new().write(true).create_new(true).open(path).map_err(|e| Error::io(path, e))?;
+    let mut f = o.open(path).map_err(|e| Error::io(path, e))?;
     f.write_all(bytes).and_then(|_| f.sync_all()).map_err(|e| Error::io(path, e))
 }
 
@@ -409,13 +424,39 @@ pub fn swap_in_dir(mut tmp: TempPath, may_replace: impl Fn(&Path) -> Result<()>)
 mod tests {
     use super::*;
 
+    /// Entries that already sit at the temporary names flexrom would pick next (same pid,
+    /// next counters) are skipped and survive the temporaries' removal.
+    #[test]
+    fn a_foreign_entry_at_a_temporary_name_is_never_removed() {
+        let d = tempfile::tempdir().unwrap();
+        let next = COUNTER.load(Ordering::Relaxed);
+        let foreign: Vec<PathBuf> =
+            (next..next + 8).map(|n| d.path().join(format!(".out.flexrom-tmp-{}-{n}", std::process::id()))).collect();
+        for (i, p) in foreign.iter().enumerate() {
+            if i % 2 == 0 {
+                std::fs::write(p, b"user data").unwrap();
+            } else {
+                std::fs::create_dir(p).unwrap();
+                std::fs::write(p.join("inside"), b"user data").unwrap();
+            }
+        }
+        for _ in 0..3 {
+            drop(TempPath::file_for(&d.path().join("out")).unwrap());
+            drop(TempPath::dir_for(&d.path().join("out")).unwrap());
+        }
+        for (i, p) in foreign.iter().enumerate() {
+            let kept = if i % 2 == 0 { std::fs::read(p) } else { std::fs::read(p.join("inside")) };
+            assert_eq!(kept.unwrap(), b"user data", "{}", p.display());
+        }
+    }
+
     #[test]
     fn a_dropped_temp_file_is_removed_and_a_committed_one_replaces_the_target() {
         let d = tempfile::tempdir().unwrap();
         let target = d.path().join("sub/out.txt");
         {
             let t = TempPath::file_for(&target).unwrap();
-            write_new(t.path(), b"half").unwrap();
+            std::fs::write(t.path(), b"half").unwrap();
             assert!(live_paths().contains(&t.path().to_path_buf()));
         }
         // the parent folder was made; nothing else is left in it
@@ -425,7 +466,7 @@ mod tests {
         assert_eq!(std::fs::read(&target).unwrap(), b"two");
         assert_eq!(std::fs::read_dir(d.path().join("sub")).unwrap().count(), 1);
         let r = write_file_atomically(&target, |tmp| {
-            write_new(tmp, b"three")?;
+            std::fs::write(tmp, b"three").map_err(|e| Error::io(tmp, e))?;
             Err(Error::Usage("later stage failed".into()))
         });
         assert!(r.is_err());

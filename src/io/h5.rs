@@ -5,13 +5,14 @@ use hdf5::types::VarLenUnicode;
 use std::path::Path;
 
 /// Creates `path` atomically and durably: `fill` writes into a temporary file beside it
-/// (unique name, created exclusively, registered for removal on SIGINT/SIGTERM), which is
+/// (unique name, created exclusively by flexrom, registered for removal on SIGINT/SIGTERM), which is
 /// closed, `fsync`ed and renamed over `path` only when `fill` succeeds, then the folder is
 /// `fsync`ed ([`super::atomic`]). A failed run never leaves a half-written file nor destroys a
 /// previous good one; a missing folder is created.
 pub fn write_atomically(path: &Path, fill: impl FnOnce(&hdf5::File) -> Result<()>) -> Result<()> {
     super::atomic::write_file_atomically(path, |tmp| {
-        let file = hdf5::File::create_excl(tmp).map_err(|e| Error::hdf5(path, format!("cannot create: {e}")))?;
+        // the empty temporary file is flexrom's own (created exclusively): truncated here
+        let file = hdf5::File::create(tmp).map_err(|e| Error::hdf5(path, format!("cannot create: {e}")))?;
         fill(&file)?;
         file.flush().map_err(|e| Error::hdf5(path, e))?;
         // closed before the fsync and the rename (the last handle closes the file)
