@@ -239,7 +239,12 @@ impl TempPath {
     /// registered only once it is flexrom's own, and after that clean-up (which keeps the
     /// lock until the exit) nothing is made again. A name that turns out to be taken is not
     /// touched; the next one is tried.
-    fn create(dir: &Path, name: &str, target: PathBuf, make: impl Fn(&Path) -> std::io::Result<Live>) -> Result<TempPath> {
+    fn create(
+        dir: &Path,
+        name: &str,
+        target: PathBuf,
+        make: impl Fn(&Path) -> std::io::Result<Live>,
+    ) -> Result<TempPath> {
         let mut v = live();
         create_dirs(dir)?;
         loop {

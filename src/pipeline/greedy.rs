@@ -37,9 +37,9 @@
 //! every model; a reduced run that fails (Newton diverges) counts as an infinite estimate.
 
 use super::config::{GreedySpec, Pipeline};
-use super::estimate::{build_estimator, calibrate, CalibrationPoint, EstimatingRunner, Estimator, DEFAULT_EXTRA_MODES};
+use super::estimate::{calibrate, CalibrationPoint, EstimatingRunner, Estimator, DEFAULT_EXTRA_MODES};
 use super::online::Output;
-use super::train::{build_basis, joint_dofs, training_data, TrainSummary};
+use super::train::{build_basis, training_data, TrainSummary};
 use super::validate::compare;
 use crate::error::{Error, Result};
 use crate::io::basis_file::TrainingData;
@@ -417,21 +417,7 @@ fn level(
     hyper_tolerance: Option<f64>,
     n: usize,
 ) -> std::result::Result<Level, (&'static str, String)> {
-    let (trained, spec) = build_basis(p, data, modes, hyper_tolerance)?;
-    let sys = p.model.system(LinearSolverKind::Banded);
-    let x_ref = data.x.column(0);
-    let mut estimator = build_estimator(
-        &sys,
-        &trained,
-        &spec,
-        data.x.view(),
-        data.multipliers.view(),
-        &joint_dofs(p),
-        x_ref,
-        hyper_tolerance,
-        DEFAULT_EXTRA_MODES,
-    )
-    .map_err(|e| ("reduction", format!("cannot build the error estimator: {e}")))?;
+    let (trained, mut estimator) = build_basis(p, data, modes, hyper_tolerance)?;
     estimator.calibration = calibrate(points.to_vec());
     let fully_enriched =
         estimator.block_modes.iter().zip(&trained.block_modes).all(|(&e, &r)| e >= r + DEFAULT_EXTRA_MODES);

@@ -4,6 +4,7 @@ use super::config::{Blocks, Pipeline};
 use super::estimate::{build_estimator, Estimator, DEFAULT_EXTRA_MODES};
 use crate::error::{Error, Result};
 use crate::io::basis_file::{write_basis_with, BasisMeta, TrainingData};
+use crate::physics::system::FlexibleSystem;
 use crate::reduction::{ecsw, train_basis, BasisSpec, ModeRule, Trained};
 use crate::simulate::{simulate, Overrides, SimulationResult};
 use crate::solver::kkt::LinearSolverKind;
@@ -25,7 +26,10 @@ pub struct TrainSummary {
 
 /// The coordinates that appear in any joint, sorted.
 pub fn joint_dofs(p: &Pipeline) -> Vec<usize> {
-    let sys = p.model.system(LinearSolverKind::Banded);
+    joint_dofs_of(&p.model.system(LinearSolverKind::Banded))
+}
+
+fn joint_dofs_of(sys: &FlexibleSystem) -> Vec<usize> {
     let mut d: Vec<usize> = sys.constraints.iter().flat_map(|c| c.terms.iter().map(|&(dof, _)| dof)).collect();
     d.sort_unstable();
     d.dedup();
@@ -61,21 +65,7 @@ pub fn train(p: &Pipeline) -> Result<(TrainingData, TrainSummary)> {
     let data = training_data(&runs);
     let modes = p.file.reduction.modes.clone().ok_or_else(|| Error::input(&p.path, "reduction.modes", "is missing"))?;
     let tol = p.file.reduction.hyper.as_ref().map(|h| h.tolerance);
-    let (trained, spec) = build_basis(p, &data, modes, tol).map_err(|(f, e)| Error::input(&p.path, f, e))?;
-    let sys = p.model.system(LinearSolverKind::Banded);
-    let x_ref = data.x.column(0);
-    let estimator = build_estimator(
-        &sys,
-        &trained,
-        &spec,
-        data.x.view(),
-        data.multipliers.view(),
-        &joint_dofs(p),
-        x_ref,
-        tol,
-        DEFAULT_EXTRA_MODES,
-    )
-    .map_err(|e| Error::input(&p.path, "reduction", format!("cannot build the error estimator: {e}")))?;
+    let (trained, estimator) = build_basis(p, &data, modes, tol).map_err(|(f, e)| Error::input(&p.path, f, e))?;
     let n_snapshots = data.x.ncols();
     Ok((
         data,
@@ -104,13 +94,16 @@ pub fn training_data(runs: &[SimulationResult]) -> TrainingData {
 }
 
 /// The basis of the pipeline's variant and blocks from `data` with `modes`, hyper-reduced
-/// by ECSW at `hyper_tolerance` when given; `Err((pipeline field, problem))`.
+/// by ECSW at `hyper_tolerance` when given, and its error estimator (uncalibrated: the same
+/// POD with [`DEFAULT_EXTRA_MODES`] more modes per block); `Err((pipeline field, problem))`.
 pub fn build_basis(
     p: &Pipeline,
     data: &TrainingData,
     modes: ModeRule,
     hyper_tolerance: Option<f64>,
-) -> std::result::Result<(Trained, BasisSpec), (&'static str, String)> {
+) -> std::result::Result<(Trained, Estimator), (&'static str, String)> {
+    // the physics, assembled once for the blocks, the joint rows, ECSW and the estimator
+    let sys = p.model.system(LinearSolverKind::Banded);
     // every run starts from the same consistent, undeformed state
     let x_ref = data.x.column(0).to_owned();
     // whole-system: scale the multipliers so both blocks weigh alike in the POD
@@ -118,23 +111,32 @@ pub fn build_basis(
     let dl = data.multipliers.mapv(|v| v * v).sum().sqrt();
     let w = if dx > 0.0 && dl > 0.0 { dl / dx } else { 1.0 };
     let blocks = match p.blocks() {
-        Some(Blocks::Bodies) => {
-            let sys = p.model.system(LinearSolverKind::Banded);
-            (0..sys.bodies.len()).map(|b| sys.body_dofs(b).collect()).collect()
-        }
+        Some(Blocks::Bodies) => (0..sys.bodies.len()).map(|b| sys.body_dofs(b).collect()).collect(),
         None => Vec::new(),
     };
     let spec =
         BasisSpec { variant: p.variant(), snapshots: p.file.train.snapshots, modes, multiplier_scale: w, blocks };
-    let mut trained = train_basis(data.x.view(), data.multipliers.view(), &joint_dofs(p), x_ref.view(), &spec)
+    let joints = joint_dofs_of(&sys);
+    let mut trained = train_basis(data.x.view(), data.multipliers.view(), &joints, x_ref.view(), &spec)
         .map_err(|e| ("reduction.modes", e))?;
     if let Some(tol) = hyper_tolerance {
-        let sys = p.model.system(LinearSolverKind::Banded);
         let hyper = ecsw(&sys, &trained.basis, data.x.view(), tol)
             .map_err(|e| ("reduction.hyper", format!("ECSW training failed: {e}")))?;
         trained.basis.hyper = Some(hyper);
     }
-    Ok((trained, spec))
+    let estimator = build_estimator(
+        &sys,
+        &trained,
+        &spec,
+        data.x.view(),
+        data.multipliers.view(),
+        &joints,
+        x_ref.view(),
+        hyper_tolerance,
+        DEFAULT_EXTRA_MODES,
+    )
+    .map_err(|e| ("reduction", format!("cannot build the error estimator: {e}")))?;
+    Ok((trained, estimator))
 }
 
 /// Trains and writes the basis file atomically (a failed run keeps the previous file).
