@@ -21,8 +21,8 @@ deps:
 		$(SUDO) apt-get update -qq && \
 		DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends $$missing; \
 	fi
-	@if command -v python3 >/dev/null && ! python3 -c "import h5py, numpy" 2>/dev/null; then \
-		python3 -m pip install --quiet h5py numpy 2>/dev/null || echo "note: h5py not installed; the h5py read-back test will be skipped"; \
+	@if command -v python3 >/dev/null && ! python3 -c "import h5py, numpy, matplotlib" 2>/dev/null; then \
+		python3 -m pip install --quiet h5py numpy matplotlib 2>/dev/null || echo "note: h5py/matplotlib not installed; the Python read-back tests will be skipped"; \
 	fi
 
 run: deps

@@ -228,11 +228,16 @@ fn run_writes_a_report() {
         "singular_values.svg",
         "error_vs_load.svg",
         "speedup_vs_load.svg",
+        "probes_0.png",
+        "estimate_vs_load.png",
     ] {
         assert!(dir.path().join("report").join(f).is_file(), "{f} missing");
     }
     let svg = std::fs::read_to_string(dir.path().join("report/singular_values.svg")).unwrap();
     assert!(svg.starts_with("<svg") && svg.contains("polyline"), "an SVG with a line in it");
+    // a PNG beside each figure (issue 18: SVG and PNG), starting with the PNG signature
+    let png = std::fs::read(dir.path().join("report/singular_values.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG\r\n\x1a\n"), "singular_values.png is not a PNG");
 }
 
 #[test]

@@ -1,147 +1,323 @@
-//! Line plots as SVG (plotters), for the report of `run`.
+//! The report's figures (plotters), each written as SVG (for the report and papers) and PNG
+//! (for slides and notebooks) from one description: panels stacked over a shared x axis,
+//! the legend in a strip to the right of the data (never over it), log axes labelled in
+//! powers of ten, and optional vertical markers (the training loads).
 
+use plotters::coord::Shift;
 use plotters::prelude::*;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+/// How a series is drawn.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Style {
+    Line,
+    Dashed,
+    /// filled circles, no line (measured points, e.g. validated errors)
+    Markers,
+}
 
 pub struct Series {
     pub name: String,
     pub points: Vec<(f64, f64)>,
-    pub dashed: bool,
+    pub style: Style,
 }
 
-/// One chart with any number of line series; `log_y` for decays and errors.
-pub fn line_chart(
-    path: &Path,
-    title: &str,
-    x_label: &str,
-    y_label: &str,
-    series: &[Series],
-    log_y: bool,
-) -> Result<(), String> {
-    let finite = |v: f64| v.is_finite() && (!log_y || v > 0.0);
-    let pts: Vec<(f64, f64)> =
-        series.iter().flat_map(|s| s.points.iter().copied()).filter(|&(x, y)| x.is_finite() && finite(y)).collect();
-    if pts.is_empty() {
-        return Err(format!("{}: nothing to plot", path.display()));
+impl Series {
+    pub fn new(name: impl Into<String>, points: Vec<(f64, f64)>, style: Style) -> Series {
+        Series { name: name.into(), points, style }
     }
-    let (mut x0, mut x1) = pts.iter().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
-    let (mut y0, mut y1) = pts.iter().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
-    if x1 <= x0 {
-        (x0, x1) = (x0 - 0.5, x1 + 0.5);
-    }
-    if log_y {
-        (y0, y1) = (y0 / 2.0, y1 * 2.0);
-    } else {
-        let pad = if y1 > y0 { 0.05 * (y1 - y0) } else { 0.5 * y0.abs().max(1e-12) };
-        (y0, y1) = (y0 - pad, y1 + pad);
-    }
-    let root = SVGBackend::new(path, (900, 520)).into_drawing_area();
-    let err = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
-    root.fill(&WHITE).map_err(|e| err(&e))?;
-    let mut b = ChartBuilder::on(&root);
-    b.caption(title, ("sans-serif", 20)).margin(12).x_label_area_size(42).y_label_area_size(78);
-    let colors = [BLUE, RED, GREEN, MAGENTA, CYAN, BLACK];
-    macro_rules! draw {
-        ($chart:expr) => {{
-            let mut chart = $chart;
-            chart.configure_mesh().x_desc(x_label).y_desc(y_label).draw().map_err(|e| err(&e))?;
-            for (i, s) in series.iter().enumerate() {
-                let c = colors[i % colors.len()];
-                let data: Vec<(f64, f64)> =
-                    s.points.iter().copied().filter(|&(x, y)| x.is_finite() && finite(y)).collect();
-                let style =
-                    ShapeStyle { color: c.to_rgba(), filled: false, stroke_width: if s.dashed { 1 } else { 2 } };
-                let anno = if s.dashed {
-                    chart.draw_series(DashedLineSeries::new(data, 6, 4, style)).map_err(|e| err(&e))?
-                } else {
-                    chart.draw_series(LineSeries::new(data, style)).map_err(|e| err(&e))?
-                };
-                anno.label(s.name.clone()).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c));
-            }
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.8))
-                .border_style(BLACK)
-                .draw()
-                .map_err(|e| err(&e))?;
-        }};
-    }
-    if log_y {
-        draw!(b.build_cartesian_2d(x0..x1, (y0..y1).log_scale()).map_err(|e| err(&e))?);
-    } else {
-        draw!(b.build_cartesian_2d(x0..x1, y0..y1).map_err(|e| err(&e))?);
-    }
-    root.present().map_err(|e| err(&e))?;
-    Ok(())
 }
 
-/// The error estimate against the load scale (a line, log scale), the true errors where
-/// validated (circles), and the training loads (vertical grey lines): the report's
-/// `estimate_vs_load.svg`.
-pub fn estimate_chart(
-    path: &Path,
-    title: &str,
-    estimates: &[(f64, f64)],
-    errors: &[(f64, f64)],
-    training: &[f64],
-) -> Result<(), String> {
-    let ok = |&(x, y): &(f64, f64)| x.is_finite() && y.is_finite() && y > 0.0;
-    let est: Vec<(f64, f64)> = estimates.iter().copied().filter(ok).collect();
-    let err_pts: Vec<(f64, f64)> = errors.iter().copied().filter(ok).collect();
-    let all: Vec<(f64, f64)> = est.iter().chain(&err_pts).copied().collect();
-    if all.is_empty() {
-        return Err(format!("{}: nothing to plot", path.display()));
-    }
-    let xs = all.iter().map(|p| p.0).chain(training.iter().copied().filter(|x| x.is_finite()));
-    let (mut x0, mut x1) = xs.fold((f64::MAX, f64::MIN), |(a, b), x| (a.min(x), b.max(x)));
-    if x1 <= x0 {
-        (x0, x1) = (x0 - 0.5, x1 + 0.5);
-    }
-    let pad = 0.03 * (x1 - x0);
-    (x0, x1) = (x0 - pad, x1 + pad);
-    let (y0, y1) = all.iter().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
-    let (y0, y1) = (y0 / 3.0, y1 * 3.0);
-    let root = SVGBackend::new(path, (900, 520)).into_drawing_area();
-    let err = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
-    root.fill(&WHITE).map_err(|e| err(&e))?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 20))
-        .margin(12)
-        .x_label_area_size(42)
-        .y_label_area_size(78)
-        .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
-        .map_err(|e| err(&e))?;
-    chart.configure_mesh().x_desc("load scale").y_desc("relative error").draw().map_err(|e| err(&e))?;
-    let grey = RGBColor(150, 150, 150);
-    for (i, &x) in training.iter().filter(|x| x.is_finite()).enumerate() {
-        let a = chart
-            .draw_series(LineSeries::new(
-                vec![(x, y0), (x, y1)],
-                ShapeStyle { color: grey.to_rgba(), filled: false, stroke_width: 1 },
-            ))
-            .map_err(|e| err(&e))?;
-        if i == 0 {
-            a.label("training load").legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey));
+/// One chart of a figure: its y axis and series.
+pub struct Panel {
+    pub y_label: String,
+    pub log_y: bool,
+    pub series: Vec<Series>,
+}
+
+/// Panels stacked over one x axis; `markers` are vertical lines drawn on every panel
+/// (labelled once in the legend as `marker_label`).
+pub struct Figure {
+    pub title: String,
+    pub x_label: String,
+    pub panels: Vec<Panel>,
+    pub markers: Vec<f64>,
+    pub marker_label: String,
+}
+
+const WIDTH: u32 = 960;
+const LEGEND: u32 = 210;
+const PANEL_HEIGHT: u32 = 300;
+/// Colour-blind-safe palette (Okabe & Ito 2008), in order of use.
+const COLORS: [RGBColor; 7] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+    RGBColor(86, 180, 233),
+    RGBColor(230, 159, 0),
+    RGBColor(0, 0, 0),
+];
+const MARKER_COLOR: RGBColor = RGBColor(120, 120, 120);
+
+fn register_font() {
+    // both backends measure (and the PNG one draws) text with this font, built into the
+    // binary: no system fonts needed on a fresh machine
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular());
+    });
+}
+
+fn usable(log_y: bool) -> impl Fn(&(f64, f64)) -> bool {
+    move |&(x, y)| x.is_finite() && y.is_finite() && (!log_y || y > 0.0)
+}
+
+/// `1e-4`, `3e-4`: a log axis's labels, short and never garbled.
+fn log_label(v: &f64) -> String {
+    let s = format!("{v:.0e}");
+    s.replace("e0", "").replace("e-0", "e-")
+}
+
+/// Linear labels with as many digits as the axis span `lo..hi` needs (scientific notation
+/// for spans below 1e-3, where fixed decimals would print every tick as 0).
+fn linear_labels(lo: f64, hi: f64) -> impl Fn(&f64) -> String {
+    let span = (hi - lo).abs();
+    move |v: &f64| {
+        if span > 0.0 && span < 1e-3 {
+            return log_label_precise(*v);
+        }
+        let digits = if span > 0.0 { (2.0 - (span / 5.0).log10().floor()).clamp(0.0, 6.0) as usize } else { 3 };
+        let s = format!("{v:.digits$}");
+        let s = if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.').to_string() } else { s };
+        if s == "-0" {
+            "0".into()
+        } else {
+            s
         }
     }
-    if !est.is_empty() {
-        chart
-            .draw_series(LineSeries::new(
-                est.clone(),
-                ShapeStyle { color: BLUE.to_rgba(), filled: false, stroke_width: 2 },
-            ))
-            .map_err(|e| err(&e))?
-            .label("error_estimate")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE));
+}
+
+/// `-1.5e-5`: two significant digits in scientific notation; 0 as `0`.
+fn log_label_precise(v: f64) -> String {
+    if v == 0.0 || v.abs() < 1e-300 {
+        return "0".into();
     }
-    if !err_pts.is_empty() {
-        chart
-            .draw_series(err_pts.iter().map(|&p| Circle::new(p, 4, RED.filled())))
-            .map_err(|e| err(&e))?
-            .label("rel_error (validated)")
-            .legend(|(x, y)| Circle::new((x + 10, y), 4, RED.filled()));
+    format!("{v:.1e}").replace(".0e", "e")
+}
+
+impl Figure {
+    fn x_range(&self) -> Option<(f64, f64)> {
+        let xs = self
+            .panels
+            .iter()
+            .flat_map(|p| p.series.iter().flat_map(move |s| s.points.iter().copied().filter(usable(p.log_y)).map(|q| q.0)))
+            .chain(self.markers.iter().copied().filter(|x| x.is_finite()));
+        let (a, b) = xs.fold((f64::MAX, f64::MIN), |(a, b), x| (a.min(x), b.max(x)));
+        if a > b {
+            return None;
+        }
+        Some(if b > a { (a, b) } else { (a - 0.5, b + 0.5) })
     }
-    chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(|e| err(&e))?;
-    root.present().map_err(|e| err(&e))?;
-    Ok(())
+
+    /// Writes `<stem>.svg` and `<stem>.png`; returns their paths.
+    pub fn save(&self, stem: &Path) -> Result<Vec<PathBuf>, String> {
+        let svg = stem.with_extension("svg");
+        let png = stem.with_extension("png");
+        let height = 70 + PANEL_HEIGHT * self.panels.len().max(1) as u32;
+        register_font();
+        {
+            let root = SVGBackend::new(&svg, (WIDTH, height)).into_drawing_area();
+            self.draw(&root).map_err(|e| format!("{}: {e}", svg.display()))?;
+            root.present().map_err(|e| format!("{}: {e}", svg.display()))?;
+        }
+        let mut buf = vec![0u8; (WIDTH * height * 3) as usize];
+        {
+            let root = BitMapBackend::with_buffer(&mut buf, (WIDTH, height)).into_drawing_area();
+            self.draw(&root).map_err(|e| format!("{}: {e}", png.display()))?;
+            root.present().map_err(|e| format!("{}: {e}", png.display()))?;
+        }
+        write_png(&png, &buf, WIDTH, height)?;
+        Ok(vec![svg, png])
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        let e = |x: &dyn std::fmt::Display| x.to_string();
+        let (x0, x1) = self.x_range().ok_or("nothing to plot")?;
+        let pad = 0.02 * (x1 - x0);
+        let (x0, x1) = (x0 - pad, x1 + pad);
+        let x_fmt = linear_labels(x0, x1);
+        root.fill(&WHITE).map_err(|x| e(&x))?;
+        let area = root.titled(&self.title, ("sans-serif", 22)).map_err(|x| e(&x))?;
+        let (plots, legend) = area.split_horizontally(WIDTH - LEGEND);
+        let n = self.panels.len().max(1);
+        let rows = plots.split_evenly((n, 1));
+        for (k, (panel, row)) in self.panels.iter().zip(&rows).enumerate() {
+            let last = k + 1 == n;
+            let pts: Vec<(f64, f64)> =
+                panel.series.iter().flat_map(|s| s.points.iter().copied()).filter(usable(panel.log_y)).collect();
+            let (mut y0, mut y1) = pts.iter().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
+            if pts.is_empty() {
+                (y0, y1) = if panel.log_y { (1e-16, 1.0) } else { (0.0, 1.0) };
+            }
+            let mut b = ChartBuilder::on(row);
+            b.margin_left(8).margin_right(12).margin_top(8).margin_bottom(if last { 4 } else { 8 });
+            b.x_label_area_size(if last { 48 } else { 22 }).y_label_area_size(84);
+            macro_rules! finish {
+                ($chart:expr, $ylo:expr, $yhi:expr, $fmt:expr) => {{
+                    let mut chart = $chart;
+                    let mut mesh = chart.configure_mesh();
+                    mesh.y_desc(panel.y_label.as_str())
+                        .y_label_formatter(&$fmt)
+                        .x_label_formatter(&x_fmt)
+                        .label_style(("sans-serif", 15))
+                        .axis_desc_style(("sans-serif", 16))
+                        .light_line_style(WHITE.mix(0.0))
+                        .bold_line_style(BLACK.mix(0.12));
+                    if last {
+                        mesh.x_desc(self.x_label.as_str());
+                    }
+                    mesh.draw().map_err(|x| e(&x))?;
+                    for &m in self.markers.iter().filter(|m| m.is_finite()) {
+                        chart
+                            .draw_series(DashedLineSeries::new(
+                                vec![(m, $ylo), (m, $yhi)],
+                                5,
+                                4,
+                                MARKER_COLOR.stroke_width(2),
+                            ))
+                            .map_err(|x| e(&x))?;
+                    }
+                    for (i, s) in panel.series.iter().enumerate() {
+                        let c = COLORS[i % COLORS.len()];
+                        let data: Vec<(f64, f64)> = s.points.iter().copied().filter(usable(panel.log_y)).collect();
+                        match s.style {
+                            Style::Line => chart.draw_series(LineSeries::new(data, c.stroke_width(2))).map(|_| ()),
+                            Style::Dashed => {
+                                chart.draw_series(DashedLineSeries::new(data, 7, 4, c.stroke_width(2))).map(|_| ())
+                            }
+                            Style::Markers => {
+                                chart.draw_series(data.into_iter().map(|p| Circle::new(p, 4, c.filled()))).map(|_| ())
+                            }
+                        }
+                        .map_err(|x| e(&x))?;
+                    }
+                }};
+            }
+            if panel.log_y {
+                let (y0, y1) = (y0 / 2.0, y1 * 2.0);
+                let chart = b.build_cartesian_2d(x0..x1, (y0..y1).log_scale()).map_err(|x| e(&x))?;
+                finish!(chart, y0, y1, log_label);
+            } else {
+                let p = if y1 > y0 { 0.06 * (y1 - y0) } else { 0.5 * y0.abs().max(1e-12) };
+                let (y0, y1) = (y0 - p, y1 + p);
+                let chart = b.build_cartesian_2d(x0..x1, y0..y1).map_err(|x| e(&x))?;
+                let y_fmt = linear_labels(y0, y1);
+                finish!(chart, y0, y1, y_fmt);
+            }
+        }
+        self.draw_legend(&legend)
+    }
+
+    /// The legend, in its own strip right of the panels: one entry per series name (the
+    /// colour of its first use), then the markers.
+    fn draw_legend<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        let e = |x: &dyn std::fmt::Display| x.to_string();
+        let mut entries: Vec<(String, Style, RGBColor)> = Vec::new();
+        for p in &self.panels {
+            for (i, s) in p.series.iter().enumerate() {
+                if !entries.iter().any(|(n, ..)| *n == s.name) {
+                    entries.push((s.name.clone(), s.style, COLORS[i % COLORS.len()]));
+                }
+            }
+        }
+        if !self.markers.is_empty() {
+            entries.push((self.marker_label.clone(), Style::Dashed, MARKER_COLOR));
+        }
+        let font = ("sans-serif", 15).into_font();
+        for (k, (name, style, c)) in entries.iter().enumerate() {
+            let y = 30 + 24 * k as i32;
+            match style {
+                Style::Markers => area.draw(&Circle::new((18, y), 4, c.filled())),
+                Style::Line => area.draw(&PathElement::new(vec![(6, y), (32, y)], c.stroke_width(2))),
+                Style::Dashed => {
+                    area.draw(&PathElement::new(vec![(6, y), (14, y)], c.stroke_width(2))).map_err(|x| e(&x))?;
+                    area.draw(&PathElement::new(vec![(20, y), (32, y)], c.stroke_width(2)))
+                }
+            }
+            .map_err(|x| e(&x))?;
+            area.draw(&Text::new(name.clone(), (40, y - 8), font.clone())).map_err(|x| e(&x))?;
+        }
+        Ok(())
+    }
+}
+
+fn write_png(path: &Path, rgb: &[u8], width: u32, height: u32) -> Result<(), String> {
+    let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut enc = png::Encoder::new(std::io::BufWriter::new(file), width, height);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    let mut w = enc.write_header().map_err(|e| format!("{}: {e}", path.display()))?;
+    w.write_image_data(rgb).map_err(|e| format!("{}: {e}", path.display()))?;
+    w.finish().map_err(|e| format!("{}: {e}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Log-axis labels are powers of ten in short form (the old default printed
+    /// "0.00000000000003" for 3e-4).
+    #[test]
+    fn log_labels_are_short() {
+        assert_eq!(log_label(&3e-4), "3e-4");
+        assert_eq!(log_label(&1e-10), "1e-10");
+        assert_eq!(log_label(&1.0), "1");
+        assert_eq!(log_label(&20.0), "2e1");
+        let f = linear_labels(-1.2, 1.2);
+        assert_eq!((f(&-0.0), f(&0.25), f(&-1.2)), ("0".into(), "0.25".into(), "-1.2".into()));
+        // a span of 2e-4 m: the old fixed 4 decimals printed 0 for every tick
+        let f = linear_labels(-1e-4, 1e-4);
+        assert_eq!((f(&2e-5), f(&-1.5e-5), f(&0.0)), ("2e-5".into(), "-1.5e-5".into(), "0".into()));
+    }
+
+    /// A figure writes a valid SVG and a PNG of the stated size (the PNG header's width and
+    /// height, read back by the png crate), for linear and log panels with markers.
+    #[test]
+    fn figure_writes_svg_and_png() {
+        let dir = tempfile::tempdir().unwrap();
+        let fig = Figure {
+            title: "t".into(),
+            x_label: "load scale".into(),
+            panels: vec![
+                Panel {
+                    y_label: "error".into(),
+                    log_y: true,
+                    series: vec![
+                        Series::new("estimate", vec![(0.5, 1e-4), (1.0, 2e-4), (1.5, 3e-4)], Style::Line),
+                        Series::new("true", vec![(0.5, 8e-5), (1.5, 2e-4)], Style::Markers),
+                    ],
+                },
+                Panel {
+                    y_label: "y".into(),
+                    log_y: false,
+                    series: vec![Series::new("a", vec![(0.5, -1.0), (1.5, 1.0)], Style::Dashed)],
+                },
+            ],
+            markers: vec![0.5, 1.0],
+            marker_label: "training load".into(),
+        };
+        let files = fig.save(&dir.path().join("fig")).unwrap();
+        let svg = std::fs::read_to_string(&files[0]).unwrap();
+        assert!(svg.starts_with("<svg") && svg.contains("training load") && svg.contains("3e-4"));
+        let dec = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&files[1]).unwrap()));
+        let reader = dec.read_info().unwrap();
+        assert_eq!((reader.info().width, reader.info().height), (WIDTH, 70 + 2 * PANEL_HEIGHT));
+    }
 }

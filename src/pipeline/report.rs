@@ -6,7 +6,7 @@
 use super::config::Pipeline;
 use super::estimate::{check_runs, load_trust};
 use super::online::load_basis;
-use super::plot::{estimate_chart, line_chart, Series};
+use super::plot::{Figure, Panel, Series, Style};
 use super::sweep::{sweep_with, table, write_sweep, SweepOptions};
 use super::train::train_and_write;
 use super::validate::{validate_with, Validation};
@@ -81,27 +81,50 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool) -> Result<
     let mut validations: Vec<Validation> = Vec::new();
     for (i, &x) in vscales.iter().enumerate() {
         let (v, full, rom) = validate_with(&p.model, basis, Some(&trust), x, true)?;
-        let mut series = Vec::new();
-        for ((name, a), (_, b)) in full.probes.iter().zip(&rom.result.probes) {
-            series.push(Series {
-                name: format!("{name} y, full"),
-                points: full.t.iter().zip(a.column(1)).map(|(t, y)| (*t, *y)).collect(),
-                dashed: false,
-            });
-            series.push(Series {
-                name: format!("{name} y, reduced"),
-                points: full.t.iter().zip(b.column(1)).map(|(t, y)| (*t, *y)).collect(),
-                dashed: true,
-            });
+        // x and y of every probe, full (line) and reduced (dashed), and their difference
+        let t = &full.t;
+        let mut panels: Vec<Panel> = ["x (m)", "y (m)"]
+            .iter()
+            .enumerate()
+            .map(|(c, label)| Panel {
+                y_label: label.to_string(),
+                log_y: false,
+                series: full
+                    .probes
+                    .iter()
+                    .zip(&rom.result.probes)
+                    .flat_map(|((name, a), (_, b))| {
+                        [
+                            Series::new(format!("{name}, full"), t.iter().zip(a.column(c)).map(|(t, v)| (*t, *v)).collect(), Style::Line),
+                            Series::new(format!("{name}, reduced"), t.iter().zip(b.column(c)).map(|(t, v)| (*t, *v)).collect(), Style::Dashed),
+                        ]
+                    })
+                    .collect(),
+            })
+            .collect();
+        panels.push(Panel {
+            y_label: "reduced − full (m)".into(),
+            log_y: false,
+            series: full
+                .probes
+                .iter()
+                .zip(&rom.result.probes)
+                .flat_map(|((name, a), (_, b))| {
+                    (0..2).map(move |c| {
+                        let d = t.iter().zip(a.column(c)).zip(b.column(c)).map(|((t, f), r)| (*t, r - f)).collect();
+                        Series::new(format!("{name} {}, error", ["x", "y"][c]), d, Style::Line)
+                    })
+                })
+                .collect(),
+        });
+        Figure {
+            title: format!("Probes, full and reduced, load scale {x}"),
+            x_label: "t (s)".into(),
+            panels,
+            markers: vec![],
+            marker_label: String::new(),
         }
-        line_chart(
-            &out.join(format!("probes_{i}.svg")),
-            &format!("Probe y, full vs reduced, load scale {x}"),
-            "t (s)",
-            "y (m)",
-            &series,
-            false,
-        )
+        .save(&out.join(format!("probes_{i}")))
         .map_err(plot_err)?;
         validations.push(v);
     }
@@ -111,47 +134,21 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool) -> Result<
         .block_values
         .iter()
         .enumerate()
-        .map(|(b, &k)| Series {
-            name: if stored.block_values.len() == 1 { "σ_i".into() } else { format!("σ_i, block {}", b + 1) },
-            points: sv.by_ref().take(k).enumerate().map(|(i, s)| ((i + 1) as f64, *s)).collect(),
-            dashed: false,
+        .map(|(b, &k)| {
+            let name = if stored.block_values.len() == 1 { "σᵢ".into() } else { format!("σᵢ, block {}", b + 1) };
+            Series::new(name, sv.by_ref().take(k).enumerate().map(|(i, s)| ((i + 1) as f64, *s)).collect(), Style::Line)
         })
         .collect();
-    line_chart(&out.join("singular_values.svg"), "POD singular values", "index", "σ", &blocks, true)
-        .map_err(plot_err)?;
+    let single = |title: &str, x_label: &str, panel: Panel, markers: Vec<f64>, stem: &str| {
+        Figure { title: title.into(), x_label: x_label.into(), panels: vec![panel], markers, marker_label: "training load".into() }
+            .save(&out.join(stem))
+            .map_err(plot_err)
+    };
+    single("POD singular values", "index", Panel { y_label: "σ".into(), log_y: true, series: blocks }, vec![], "singular_values")?;
     let pts = |f: &dyn Fn(&Validation) -> f64| -> Vec<(f64, f64)> {
         sw.done().filter_map(|q| q.validation.as_ref()).map(|v| (v.load_scale, f(v))).collect()
     };
-    line_chart(
-        &out.join("error_vs_load.svg"),
-        "Reduced vs full model",
-        "load scale",
-        "error",
-        &[
-            Series { name: "rel_error".into(), points: pts(&|v| v.rel_error), dashed: false },
-            Series { name: "max probe error (m)".into(), points: pts(&|v| v.max_probe_error), dashed: true },
-        ],
-        true,
-    )
-    .map_err(plot_err)?;
-    line_chart(
-        &out.join("speedup_vs_load.svg"),
-        "Speedup of the reduced time loop over the full one (banded solver)",
-        "load scale",
-        "speedup",
-        &[Series { name: "speedup".into(), points: pts(&|v| v.speedup), dashed: false }],
-        false,
-    )
-    .map_err(plot_err)?;
-    // the estimate over the sweep, the true errors of the sweep and of the validation runs
-    let estimates: Vec<(f64, f64)> = sw
-        .scales
-        .iter()
-        .filter_map(|x| x.point())
-        .filter_map(|q| q.estimate.map(|e| (q.rom.result.settings.load_scale, e.error_estimate)))
-        .collect();
-    let mut errors = pts(&|v| v.rel_error);
-    errors.extend(validations.iter().map(|v| (v.load_scale, v.rel_error)));
+    // the loads of the full runs the basis was trained on, marked on the plots against λ
     let training: Vec<f64> = {
         let f = hdf5::File::open(basis_path).map_err(|e| Error::hdf5(basis_path, e))?;
         let mut l: Vec<f64> = match f.dataset("training/load_scales") {
@@ -169,33 +166,70 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool) -> Result<
         l.dedup();
         l
     };
+    single(
+        "Reduced vs full model",
+        "load scale",
+        Panel {
+            y_label: "error".into(),
+            log_y: true,
+            series: vec![
+                Series::new("rel_error", pts(&|v| v.rel_error), Style::Line),
+                Series::new("max probe error (m)", pts(&|v| v.max_probe_error), Style::Dashed),
+            ],
+        },
+        training.clone(),
+        "error_vs_load",
+    )?;
+    single(
+        "Speedup of the reduced time loop over the full one",
+        "load scale",
+        Panel {
+            y_label: "speedup".into(),
+            log_y: false,
+            series: vec![Series::new("speedup (banded full solver)", pts(&|v| v.speedup), Style::Line)],
+        },
+        training.clone(),
+        "speedup_vs_load",
+    )?;
+    // the estimate over the sweep, the true errors of the sweep and of the validation runs
+    let estimates: Vec<(f64, f64)> = sw
+        .scales
+        .iter()
+        .filter_map(|x| x.point())
+        .filter_map(|q| q.estimate.map(|e| (q.rom.result.settings.load_scale, e.error_estimate)))
+        .collect();
+    let mut errors = pts(&|v| v.rel_error);
+    errors.extend(validations.iter().map(|v| (v.load_scale, v.rel_error)));
     if !estimates.is_empty() {
-        estimate_chart(
-            &out.join("estimate_vs_load.svg"),
-            "Error estimate (no full run) and true error",
-            &estimates,
-            &errors,
-            &training,
-        )
-        .map_err(plot_err)?;
+        single(
+            "Error estimate (no full run) and true error (full runs)",
+            "load scale",
+            Panel {
+                y_label: "relative error".into(),
+                log_y: true,
+                series: vec![
+                    Series::new("error_estimate", estimates.clone(), Style::Line),
+                    Series::new("rel_error (validated)", errors, Style::Markers),
+                ],
+            },
+            training.clone(),
+            "estimate_vs_load",
+        )?;
     }
     let by_time: Vec<Series> = validations
         .iter()
-        .map(|v| Series {
-            name: format!("load scale {}", v.load_scale),
-            points: v.rel_error_by_time.iter().enumerate().map(|(i, e)| ((i + 1) as f64 / 5.0, *e)).collect(),
-            dashed: false,
+        .map(|v| {
+            let pts = v.rel_error_by_time.iter().enumerate().map(|(i, e)| ((i + 1) as f64 / 5.0, *e)).collect();
+            Series::new(format!("load scale {}", v.load_scale), pts, Style::Line)
         })
         .collect();
-    line_chart(
-        &out.join("error_by_time.svg"),
+    single(
         "rel_error up to a fraction of the run",
         "fraction of the run",
-        "rel_error",
-        &by_time,
-        true,
-    )
-    .map_err(plot_err)?;
+        Panel { y_label: "rel_error".into(), log_y: true, series: by_time },
+        vec![],
+        "error_by_time",
+    )?;
     let json = serde_json::to_string_pretty(&validations).expect("serializable");
     std::fs::write(out.join("validation.json"), json).map_err(|e| Error::io(out, e))?;
 

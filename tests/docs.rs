@@ -1,0 +1,208 @@
+//! The documentation tells the truth about the repository (issue 18).
+//!
+//! Checks, with where each expected value comes from:
+//! - `relative_links_resolve`: every relative Markdown link `[..](path)` in README.md and
+//!   docs/*.md names a file or folder that exists in the repository (links to web
+//!   addresses and in-page anchors are left alone).
+//! - `every_model_key_has_a_unit`: every key of the model-file schema (the field names in
+//!   src/model/schema.rs and src/physics/time_function.rs, read from the source so a new
+//!   key cannot be forgotten) has a row `| \`key\` |` in the key table of
+//!   docs/model-format.md.
+//! - `readme_pipeline_snippet_is_the_shipped_file`: each key line of the README's pipeline
+//!   snippet is a line of pipelines/double_pendulum.toml, so the tutorial shows what runs.
+//! - `readme_tutorial_runs_as_written`: the commands between `<!-- tutorial:begin -->` and
+//!   `<!-- tutorial:end -->` run, as written (with `flexrom` the built binary), in a copy of
+//!   the tutorial's model and pipeline files; then the README's Python block runs there and
+//!   writes its figure when python3 has h5py, numpy and matplotlib (otherwise it says it
+//!   skipped). Every command must exit 0 and the files the README names must exist.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn markdown_files() -> Vec<PathBuf> {
+    let mut files = vec![root().join("README.md")];
+    let mut docs: Vec<PathBuf> = std::fs::read_dir(root().join("docs"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "md"))
+        .collect();
+    docs.sort();
+    files.extend(docs);
+    files
+}
+
+/// The targets of inline Markdown links `](target)` in `text`, outside code blocks.
+fn link_targets(text: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut in_code = false;
+    for line in text.lines() {
+        if line.trim_start().starts_with("```") {
+            in_code = !in_code;
+            continue;
+        }
+        if in_code {
+            continue;
+        }
+        let mut rest = line;
+        while let Some(i) = rest.find("](") {
+            let after = &rest[i + 2..];
+            let Some(j) = after.find(')') else { break };
+            out.push(after[..j].to_string());
+            rest = &after[j..];
+        }
+    }
+    out
+}
+
+#[test]
+fn relative_links_resolve() {
+    let mut broken = Vec::new();
+    let mut checked = 0;
+    for file in markdown_files() {
+        let text = std::fs::read_to_string(&file).unwrap();
+        for target in link_targets(&text) {
+            let target = target.split_whitespace().next().unwrap_or("").to_string();
+            if target.is_empty() || target.starts_with('#') || target.contains("://") || target.starts_with("mailto:")
+            {
+                continue;
+            }
+            let path = target.split('#').next().unwrap();
+            checked += 1;
+            if !file.parent().unwrap().join(path).exists() {
+                broken.push(format!("{}: {target}", file.strip_prefix(root()).unwrap().display()));
+            }
+        }
+    }
+    assert!(checked > 20, "only {checked} relative links found: is the link parser broken?");
+    assert!(broken.is_empty(), "broken relative links:\n{}", broken.join("\n"));
+}
+
+/// Field names of the serde structs and enum variants in a Rust source file: lines of the
+/// form `name: Type,` or `pub name: Type,` inside a struct or a variant's braces.
+fn schema_keys(source: &str) -> Vec<String> {
+    let mut keys = Vec::new();
+    for line in source.lines() {
+        let l = line.trim();
+        if l.starts_with("//") || l.starts_with('#') || l.contains("fn ") || l.contains("let ") || l.contains("=>") {
+            continue;
+        }
+        // one-line variants such as `Exponential { amplitude: f64, rate: f64 },` hold several
+        for part in l.split(['{', ',']) {
+            let part = part.trim();
+            let part = part.strip_prefix("pub ").unwrap_or(part);
+            let Some((name, _ty)) = part.split_once(": ") else { continue };
+            if !name.is_empty() && name.chars().all(|c| c.is_ascii_lowercase() || c == '_') {
+                keys.push(name.to_string());
+            }
+        }
+    }
+    keys.sort();
+    keys.dedup();
+    keys
+}
+
+#[test]
+fn every_model_key_has_a_unit() {
+    let table = std::fs::read_to_string(root().join("docs/model-format.md")).unwrap();
+    let table = &table[table.find("## Every key").expect("docs/model-format.md: no '## Every key' table")..];
+    let mut keys = schema_keys(&std::fs::read_to_string(root().join("src/model/schema.rs")).unwrap());
+    // TimeFunction's fields, up to its `impl` (the rest is code, not schema)
+    let tf = std::fs::read_to_string(root().join("src/physics/time_function.rs")).unwrap();
+    keys.extend(schema_keys(&tf[..tf.find("impl TimeFunction").unwrap()]));
+    // the schema's own top-level structure: tables, not keys with a unit
+    let tables = ["time", "damping", "bodies", "joints", "loads", "probes"];
+    keys.retain(|k| !tables.contains(&k.as_str()));
+    assert!(keys.len() >= 30, "only {} keys read from the schema: {keys:?}", keys.len());
+    for must in ["youngs_modulus", "rate", "phase", "frequency", "g", "scaled", "until"] {
+        assert!(keys.iter().any(|k| k == must), "the schema reader missed `{must}`: {keys:?}");
+    }
+    let missing: Vec<&String> = keys.iter().filter(|k| !table.contains(&format!("| `{k}` |"))).collect();
+    assert!(missing.is_empty(), "model keys without a row in docs/model-format.md's key table: {missing:?}");
+}
+
+/// The fenced block of `lang` that follows the marker `marker` in the README.
+fn readme_block(marker: &str) -> String {
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let at = readme.find(marker).unwrap_or_else(|| panic!("README.md has no {marker}"));
+    let rest = &readme[at..];
+    let open = rest.find("```").unwrap();
+    let body = &rest[open..];
+    let body = &body[body.find('\n').unwrap() + 1..];
+    body[..body.find("```").unwrap()].to_string()
+}
+
+#[test]
+fn readme_pipeline_snippet_is_the_shipped_file() {
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let at = readme.find("**2. A pipeline**").expect("README.md: no tutorial step 2");
+    let rest = &readme[at..];
+    let body = &rest[rest.find("```toml").unwrap() + 7..];
+    let body = &body[..body.find("```").unwrap()];
+    let shipped = std::fs::read_to_string(root().join("pipelines/double_pendulum.toml")).unwrap();
+    let mut n = 0;
+    for line in body.lines().map(str::trim).filter(|l| !l.is_empty()) {
+        n += 1;
+        assert!(shipped.lines().any(|s| s.trim() == line), "README pipeline line not in the shipped file: {line}");
+    }
+    assert!(n >= 5, "the README's pipeline snippet has only {n} lines");
+}
+
+fn copy_tutorial(dir: &Path) {
+    for f in ["data/models/double_pendulum.toml", "pipelines/double_pendulum.toml"] {
+        std::fs::create_dir_all(dir.join(f).parent().unwrap()).unwrap();
+        std::fs::copy(root().join(f), dir.join(f)).unwrap();
+    }
+}
+
+#[test]
+fn readme_tutorial_runs_as_written() {
+    let dir = tempfile::tempdir().unwrap();
+    copy_tutorial(dir.path());
+    let commands = readme_block("<!-- tutorial:begin -->");
+    let mut n = 0;
+    for line in commands.lines().map(str::trim).filter(|l| !l.is_empty() && !l.starts_with('#')) {
+        let words: Vec<&str> = line.split_whitespace().collect();
+        assert_eq!(words[0], "flexrom", "tutorial line does not start with flexrom: {line}");
+        let out = Command::new(env!("CARGO_BIN_EXE_flexrom"))
+            .args(&words[1..])
+            .current_dir(dir.path())
+            .env("HDF5_USE_FILE_LOCKING", "FALSE")
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "`{line}` failed ({}):\n{}",
+            out.status,
+            String::from_utf8_lossy(&out.stderr)
+        );
+        n += 1;
+    }
+    assert!(n >= 4, "the tutorial has only {n} commands");
+    for f in ["data/bases/double_pendulum.h5", "out/dp_1.3.h5", "out/dp_sweep.h5"] {
+        assert!(dir.path().join(f).is_file(), "the tutorial did not write {f}");
+    }
+
+    let python = readme_block("<!-- tutorial:python -->");
+    let has = Command::new("python3")
+        .args(["-c", "import h5py, numpy, matplotlib"])
+        .status()
+        .map(|s| s.success())
+        .unwrap_or(false);
+    if !has {
+        eprintln!("skipped: the README's Python block (python3 with h5py, numpy and matplotlib not found)");
+        return;
+    }
+    let out = Command::new("python3")
+        .args(["-c", &python])
+        .current_dir(dir.path())
+        .env("MPLBACKEND", "Agg")
+        .env("HDF5_USE_FILE_LOCKING", "FALSE")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "the README's Python block failed:\n{}", String::from_utf8_lossy(&out.stderr));
+    assert!(dir.path().join("out/dp.png").is_file(), "the README's Python block wrote no figure");
+}
