@@ -4,6 +4,8 @@
 pub mod banded;
 pub mod dense_lu;
 pub mod kkt;
+pub mod kkt_pattern;
 pub mod nnls;
+pub mod simd;
 pub(crate) mod sparse_rows;
 pub(crate) mod vec_ops;

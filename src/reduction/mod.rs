@@ -14,6 +14,7 @@ pub(crate) mod joint_elimination;
 pub mod pod;
 pub(crate) mod projection;
 pub mod reduced_model;
+pub mod sample;
 
 // transitional re-export (remove after merge)
 pub use crate::linalg::nnls;

@@ -6,4 +6,5 @@ pub mod statics;
 // transitional re-export (remove after merge)
 pub use crate::linalg::{banded, dense_lu, kkt};
 // transitional re-export (remove after merge)
+#[allow(unused_imports)]
 pub(crate) use crate::linalg::vec_ops;
