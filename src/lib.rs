@@ -13,6 +13,7 @@
 pub mod error;
 pub mod io;
 pub mod limits;
+pub mod linalg;
 pub mod model;
 pub mod output;
 pub mod physics;

@@ -27,15 +27,15 @@
 //! (`settings_hash`) is still used, with a one-line warning on stderr.
 
 use super::basis_file::{read_basis, StoredBasis};
+pub use super::basis_hash::{content_hash, settings_hash, HashInput};
+pub use super::basis_layout::check_file;
 use crate::error::{Error, Result};
 use crate::model::Model;
-use crate::reduction::{Basis, SnapshotKind, Variant};
+use crate::reduction::{SnapshotKind, Variant};
 use crate::simulate::{prepare, Overrides, Settings};
-use crate::solver::kkt::LinearSolverKind;
+use crate::linalg::kkt::LinearSolverKind;
 use crate::solver::model::DynamicModel;
-use hdf5::types::{FloatSize, TypeDescriptor};
 use ndarray::{s, Array2};
-use sha2::{Digest, Sha256};
 use std::path::Path;
 
 /// ‖VᵀV − I‖_max allowed: LAPACK's SVD gives orthonormal columns to ~1e-14; 1e-8 leaves
@@ -50,22 +50,6 @@ pub const MIN_WEIGHT: f64 = 1e-8;
 /// Largest ECSW weight accepted, per element of the model: the weights sum to about the
 /// number of elements, so a single weight above 1e4 × that is not a trained one.
 pub const MAX_WEIGHT_PER_ELEMENT: f64 = 1e4;
-
-/// Datasets read as `f64` (the basis proper); anything else than 8-byte floats is refused.
-const FLOAT_DATASETS: [&str; 6] = [
-    "basis/modes",
-    "basis/reference",
-    "basis/singular_values",
-    "basis/energy",
-    "basis/multiplier_modes",
-    "hyper/weights",
-];
-/// Datasets read as indices; floating-point ones are refused.
-const INDEX_DATASETS: [&str; 5] =
-    ["basis/block_modes", "basis/block_values", "basis/reduced_dofs", "basis/kept_dofs", "hyper/elements"];
-/// Links deeper than this, or more than [`MAX_LINKS`] of them, are not a basis file.
-const MAX_DEPTH: usize = 8;
-const MAX_LINKS: usize = 10_000;
 
 /// Reads the basis at `path` and checks it against `model`; `settings_hash` is the
 /// pipeline's [`settings_hash`] (a mismatch only warns). The only way commands read a basis.
@@ -158,108 +142,6 @@ pub fn check(path: &Path, model: &Model, settings_hash: Option<&str>) -> Result<
 
 fn short(h: &str) -> &str {
     h.get(..12).unwrap_or(h)
-}
-
-/// Refuses anything but hard links, external or virtual storage, and datasets of the wrong
-/// type. Runs on the open file before any dataset is read.
-pub fn check_file(f: &hdf5::File, path: &Path) -> Result<()> {
-    let mut seen = 0;
-    walk(f, "", 0, &mut seen, path)?;
-    for name in FLOAT_DATASETS.iter().chain(INDEX_DATASETS.iter()) {
-        if !f.link_exists(name) {
-            continue;
-        }
-        let Ok(d) = f.dataset(name) else { return Err(Error::input(path, *name, "is not a dataset")) };
-        let ty = d
-            .dtype()
-            .and_then(|t| t.to_descriptor())
-            .map_err(|e| Error::input(path, *name, format!("has an unreadable type: {e}")))?;
-        let float = FLOAT_DATASETS.contains(name);
-        match (&ty, float) {
-            (TypeDescriptor::Float(FloatSize::U8), true) => {}
-            (_, true) => {
-                return Err(Error::input(
-                    path,
-                    *name,
-                    format!("has type {}; it must hold 8-byte floats (f64)", describe(&ty)),
-                ))
-            }
-            (TypeDescriptor::Unsigned(_) | TypeDescriptor::Integer(_), false) => {}
-            (_, false) => {
-                return Err(Error::input(
-                    path,
-                    *name,
-                    format!("has type {}; it must hold integer indices", describe(&ty)),
-                ))
-            }
-        }
-    }
-    Ok(())
-}
-
-fn describe(t: &TypeDescriptor) -> String {
-    match t {
-        TypeDescriptor::Integer(s) => format!("{}-byte signed integer", *s as usize),
-        TypeDescriptor::Unsigned(s) => format!("{}-byte unsigned integer", *s as usize),
-        TypeDescriptor::Float(s) => format!("{}-byte float", *s as usize),
-        other => format!("{other}"),
-    }
-}
-
-/// Visits every link under `prefix`: only hard links; datasets stored in the file itself.
-fn walk(g: &hdf5::Group, prefix: &str, depth: usize, seen: &mut usize, path: &Path) -> Result<()> {
-    let here = if prefix.is_empty() { "/" } else { prefix };
-    if depth > MAX_DEPTH {
-        return Err(Error::input(
-            path,
-            here,
-            format!("is nested deeper than {MAX_DEPTH} groups: not a flexrom basis file"),
-        ));
-    }
-    let links = g
-        .links(hdf5::IndexType::Name, hdf5::IterationOrder::Native)
-        .map_err(|e| Error::input(path, here, format!("cannot list its links: {e}")))?;
-    for (name, info) in links {
-        let full = if prefix.is_empty() { name.clone() } else { format!("{prefix}/{name}") };
-        *seen += 1;
-        if *seen > MAX_LINKS {
-            return Err(Error::input(
-                path,
-                "(file)",
-                format!("holds more than {MAX_LINKS} links: not a flexrom basis file"),
-            ));
-        }
-        if info.link_type != hdf5::LinkType::Hard {
-            let kind =
-                if info.link_type == hdf5::LinkType::Soft { "a soft link" } else { "an external or user-defined link" };
-            return Err(Error::input(
-                path,
-                &full,
-                format!("is {kind}; a basis file must hold its data itself (hard links only)"),
-            ));
-        }
-        if let Ok(sub) = g.group(&name) {
-            walk(&sub, &full, depth + 1, seen, path)?;
-        } else if let Ok(d) = g.dataset(&name) {
-            let dcpl =
-                d.dcpl().map_err(|e| Error::input(path, &full, format!("cannot read its storage properties: {e}")))?;
-            if !dcpl.external().is_empty() {
-                return Err(Error::input(
-                    path,
-                    &full,
-                    "is stored in an external file; a basis file must hold its data itself",
-                ));
-            }
-            if matches!(dcpl.layout(), hdf5::dataset::Layout::Virtual) {
-                return Err(Error::input(
-                    path,
-                    &full,
-                    "is a virtual dataset (data in other files); a basis file must hold its data itself",
-                ));
-            }
-        }
-    }
-    Ok(())
 }
 
 /// Checks that need no model: values, orthonormality, the spectrum, the ECSW set's own
@@ -499,93 +381,4 @@ fn check_against_model(s: &StoredBasis, model: &Model) -> std::result::Result<()
         }
     }
     Ok(())
-}
-
-/// What the content hash covers.
-pub struct HashInput<'a> {
-    pub basis: &'a Basis,
-    pub singular_values: &'a [f64],
-    pub energy: &'a [f64],
-    pub block_modes: &'a [usize],
-    pub block_values: &'a [usize],
-    pub reduced_dofs: &'a [usize],
-    pub model_fingerprint: &'a str,
-    pub settings_hash: &'a str,
-}
-
-impl<'a> HashInput<'a> {
-    pub fn of_stored(s: &'a StoredBasis) -> Self {
-        HashInput {
-            basis: &s.basis,
-            singular_values: s.singular_values.as_slice().unwrap_or(&[]),
-            energy: s.energy.as_slice().unwrap_or(&[]),
-            block_modes: &s.block_modes,
-            block_values: &s.block_values,
-            reduced_dofs: &s.reduced_dofs,
-            model_fingerprint: &s.model_fingerprint,
-            settings_hash: &s.settings_hash,
-        }
-    }
-}
-
-/// SHA-256 (hex) of the basis content: every part prefixed by its name and shape, floats as
-/// little-endian IEEE bytes, so equal content gives equal hashes on every machine.
-pub fn content_hash(c: &HashInput) -> String {
-    let mut h = Sha256::new();
-    let mut part = |name: &str, shape: &[usize], bytes: &mut dyn Iterator<Item = [u8; 8]>| {
-        h.update((name.len() as u64).to_le_bytes());
-        h.update(name.as_bytes());
-        h.update((shape.len() as u64).to_le_bytes());
-        for &d in shape {
-            h.update((d as u64).to_le_bytes());
-        }
-        for b in bytes {
-            h.update(b);
-        }
-    };
-    let b = c.basis;
-    let f = |v: &f64| v.to_le_bytes();
-    let u = |v: &usize| (*v as u64).to_le_bytes();
-    let modes = b.modes.as_standard_layout();
-    part("modes", &[modes.nrows(), modes.ncols()], &mut modes.iter().map(f));
-    part("reference", &[b.reference.len()], &mut b.reference.iter().map(f));
-    part("singular_values", &[c.singular_values.len()], &mut c.singular_values.iter().map(f));
-    part("energy", &[c.energy.len()], &mut c.energy.iter().map(f));
-    part("block_modes", &[c.block_modes.len()], &mut c.block_modes.iter().map(u));
-    part("block_values", &[c.block_values.len()], &mut c.block_values.iter().map(u));
-    part("reduced_dofs", &[c.reduced_dofs.len()], &mut c.reduced_dofs.iter().map(u));
-    part("kept_dofs", &[b.kept.len()], &mut b.kept.iter().map(u));
-    if let Some(vl) = &b.multiplier_modes {
-        let vl = vl.as_standard_layout();
-        part("multiplier_modes", &[vl.nrows(), vl.ncols()], &mut vl.iter().map(f));
-    }
-    part("multiplier_scale", &[], &mut std::iter::once(b.multiplier_scale.to_le_bytes()));
-    part("n_pod_modes", &[], &mut std::iter::once((b.n_pod_modes as u64).to_le_bytes()));
-    if let Some(hy) = &b.hyper {
-        part("hyper/elements", &[hy.elements.len()], &mut hy.elements.iter().map(u));
-        part("hyper/weights", &[hy.weights.len()], &mut hy.weights.iter().map(f));
-        part("hyper/tolerance", &[], &mut std::iter::once(hy.tolerance.to_le_bytes()));
-        part("hyper/training_residual", &[], &mut std::iter::once(hy.training_residual.to_le_bytes()));
-        part("hyper/n_training", &[], &mut std::iter::once((hy.n_training as u64).to_le_bytes()));
-    }
-    for (name, text) in [
-        ("variant", b.variant.name()),
-        ("snapshots", b.snapshots.name()),
-        ("model_fingerprint", c.model_fingerprint),
-        ("settings_hash", c.settings_hash),
-    ] {
-        h.update((name.len() as u64).to_le_bytes());
-        h.update(name.as_bytes());
-        h.update((text.len() as u64).to_le_bytes());
-        h.update(text.as_bytes());
-    }
-    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
-}
-
-/// SHA-256 (hex) of a pipeline's `[train]` and `[reduction]` tables in canonical form (the
-/// parsed values as JSON): comments, layout and number spelling do not change it, any
-/// setting that changes the basis does.
-pub fn settings_hash(p: &crate::pipeline::Pipeline) -> String {
-    let json = serde_json::json!({ "train": p.file.train, "reduction": p.file.reduction });
-    Sha256::digest(json.to_string().as_bytes()).iter().map(|b| format!("{b:02x}")).collect()
 }

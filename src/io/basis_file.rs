@@ -37,7 +37,8 @@
 //!   multiplier_scale (w), n_dof, creation_time (RFC 3339, UTC), program_version
 //! ```
 
-use super::basis_check::{check_file, content_hash, HashInput};
+use super::basis_hash::{content_hash, HashInput};
+use super::basis_layout::check_file;
 use super::h5::{attr_f64, attr_str, attr_u64, read_attr_f64, read_attr_str, write_atomically};
 use crate::error::{Error, Result};
 use crate::reduction::{Basis, Hyper, SnapshotKind, Trained, Variant};
@@ -325,4 +326,20 @@ fn read_hyper(f: &hdf5::File, path: &Path) -> Result<Option<Hyper>> {
         training_residual: num("training_residual")?,
         n_training,
     }))
+}
+
+/// The hash input of a basis as read back, to check its `content_hash`.
+impl<'a> HashInput<'a> {
+    pub fn of_stored(s: &'a StoredBasis) -> Self {
+        HashInput {
+            basis: &s.basis,
+            singular_values: s.singular_values.as_slice().unwrap_or(&[]),
+            energy: s.energy.as_slice().unwrap_or(&[]),
+            block_modes: &s.block_modes,
+            block_values: &s.block_values,
+            reduced_dofs: &s.reduced_dofs,
+            model_fingerprint: &s.model_fingerprint,
+            settings_hash: &s.settings_hash,
+        }
+    }
 }

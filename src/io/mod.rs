@@ -2,6 +2,8 @@
 pub mod atomic;
 pub mod basis_check;
 pub mod basis_file;
+pub mod basis_hash;
+pub mod basis_layout;
 pub mod estimator_file;
 pub mod h5;
 pub mod output;

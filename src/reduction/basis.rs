@@ -8,7 +8,7 @@
 //!     whole-system:          [x; λ/w] ≈ [x_ref; 0] + [V; V_λ] q (eqs. 18–19)
 //! ```
 
-use super::ecsw::Hyper;
+use super::sample::Hyper;
 use super::pod::{pod, ModeRule, Pod};
 use ndarray::{s, Array1, Array2, ArrayView1, ArrayView2, Axis};
 

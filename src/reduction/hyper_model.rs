@@ -28,6 +28,7 @@ use super::basis::Basis;
 use super::ecsw::Hyper;
 use super::projection::{axpy, forward_to_projection, impl_reduced, Projection};
 use super::sparse_rows::SparseRows;
+use crate::linalg::simd::{dispatch, Kernel};
 use crate::solver::model::{DynamicModel, InvariantElementModel, IterationCoefficients};
 use ndarray::{Array1, Array2, Axis};
 
@@ -291,47 +292,39 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
         if self.valid && self.at == q {
             return;
         }
-        #[cfg(target_arch = "x86_64")]
-        let avx2 = std::arch::is_x86_feature_detected!("avx2");
-        #[cfg(not(target_arch = "x86_64"))]
-        let avx2 = false;
-        match (self.ne, avx2) {
-            (4, false) => self.update_with::<4>(q),
-            (6, false) => self.update_with::<6>(q),
-            (8, false) => self.update_with::<8>(q),
-            (12, false) => self.update_with::<12>(q),
-            // SAFETY (all four): the CPU has AVX2, checked above
-            #[cfg(target_arch = "x86_64")]
-            (4, true) => unsafe { self.update_avx2::<4>(q) },
-            #[cfg(target_arch = "x86_64")]
-            (6, true) => unsafe { self.update_avx2::<6>(q) },
-            #[cfg(target_arch = "x86_64")]
-            (8, true) => unsafe { self.update_avx2::<8>(q) },
-            #[cfg(target_arch = "x86_64")]
-            (12, true) => unsafe { self.update_avx2::<12>(q) },
+        // the kernel, inlined whole into the dispatched function (see crate::linalg::simd)
+        struct Update<'a, T: InvariantElementModel, const N: usize>(&'a mut HyperReducedModel<T>, &'a [f64]);
+        impl<T: InvariantElementModel, const N: usize> Kernel for Update<'_, T, N> {
+            type Output = ();
+            #[inline(always)]
+            fn run(self) {
+                self.0.update_with::<N>(self.1)
+            }
+        }
+        match self.ne {
+            4 => dispatch(Update::<M, 4>(self, q)),
+            6 => dispatch(Update::<M, 6>(self, q)),
+            8 => dispatch(Update::<M, 8>(self, q)),
+            12 => dispatch(Update::<M, 12>(self, q)),
             _ => unreachable!("element size checked in new()"),
         }
         self.at.copy_from_slice(q);
         self.valid = true;
     }
 
-    /// [`Self::accumulate_tangent`], compiled for AVX2 when the CPU has it: the row passes
-    /// are plain multiply-adds that the compiler vectorizes 4 wide instead of SSE2's 2 (no
-    /// FMA contraction, so the sums are the same to the last bit on either path). The
-    /// check is one cached load; `-C target-cpu` is not needed, so the binary stays portable.
+    /// [`Self::accumulate_tangent`], compiled for the CPU's best instruction set
+    /// ([`crate::linalg::simd`]): the row passes are plain multiply-adds that the compiler
+    /// vectorizes 4 wide with AVX2 instead of SSE2's 2, with the same sums to the last bit.
     fn tangent(&mut self) {
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2, checked just above
-            return unsafe { self.tangent_avx2() };
+        struct Tangent<'a, T: InvariantElementModel>(&'a mut HyperReducedModel<T>);
+        impl<T: InvariantElementModel> Kernel for Tangent<'_, T> {
+            type Output = ();
+            #[inline(always)]
+            fn run(self) {
+                self.0.accumulate_tangent()
+            }
         }
-        self.accumulate_tangent()
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn tangent_avx2(&mut self) {
-        self.accumulate_tangent()
+        dispatch(Tangent(self))
     }
 
     /// `acc` = the upper triangle of Σ_E wₑ [Σⱼ 2ψⱼ Gₑⱼ + Σⱼₖ 4ψⱼₖ uⱼ uₖᵀ] at the cached point
@@ -415,13 +408,6 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
                 k += 1;
             }
         }
-    }
-
-    /// [`Self::update_with`] compiled for AVX2 (see [`Self::tangent`]).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn update_avx2<const N: usize>(&mut self, q: &[f64]) {
-        self.update_with::<N>(q)
     }
 
     /// `update` for elements of `N` dofs: fixed-size kernels, unrolled and vectorized by the

@@ -23,8 +23,8 @@
 //! thesis four-bar: 54 instead of 70, an LU 40 % as costly), and forming it touches only the
 //! `j` joint rows and columns of `S`. The multipliers stay exact.
 
-use super::projection::{axpy, dot};
-use crate::solver::dense_lu::DenseLu;
+use crate::linalg::dense_lu::DenseLu;
+use crate::linalg::vec_ops::{axpy, dot};
 use ndarray::Array2;
 use ndarray_linalg::SVD;
 

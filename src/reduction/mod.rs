@@ -11,11 +11,15 @@ pub mod basis;
 pub mod ecsw;
 pub mod hyper_model;
 pub(crate) mod joint_elimination;
-pub mod nnls;
 pub mod pod;
 pub(crate) mod projection;
 pub mod reduced_model;
-mod sparse_rows;
+pub mod sample;
+
+// transitional re-export (remove after merge)
+pub use crate::linalg::nnls;
+// transitional re-export (remove after merge)
+use crate::linalg::sparse_rows;
 
 pub use basis::{train_basis, Basis, BasisSpec, SnapshotKind, Trained, Variant};
 pub use ecsw::{ecsw, Hyper};

@@ -18,10 +18,10 @@
 
 use super::basis::{Basis, Variant};
 use super::joint_elimination::JointElimination;
-use super::sparse_rows::SparseRows;
-use crate::solver::dense_lu::DenseLu;
+use crate::linalg::sparse_rows::SparseRows;
+use crate::linalg::dense_lu::DenseLu;
 use crate::solver::model::{ElementModel, IterationCoefficients};
-pub(crate) use crate::solver::vec_ops::{axpy, dot};
+pub(crate) use crate::linalg::vec_ops::{axpy, dot, mat_vec};
 use ndarray::{s, Array1, Array2, ArrayView1, Axis};
 use ndarray_linalg::SVD;
 
@@ -433,17 +433,6 @@ fn matrix_of<'a>(
     match elim {
         Some(e) => (&mut e.s, r),
         None => (lu.matrix_mut(), r + nc),
-    }
-}
-
-/// `out (+)= A x`
-pub(crate) fn mat_vec(a: &Array2<f64>, x: &[f64], out: &mut [f64], accumulate: bool) {
-    for (o, row) in out.iter_mut().zip(a.rows()) {
-        let d = match row.as_slice() {
-            Some(rs) => dot(rs, x),
-            None => row.iter().zip(x).map(|(p, q)| p * q).sum(),
-        };
-        *o = if accumulate { *o + d } else { d };
     }
 }
 

@@ -1,8 +1,10 @@
 //! Time integration and linear algebra, generic over [`model::DynamicModel`].
-pub mod banded;
-pub mod dense_lu;
 pub mod generalized_alpha;
-pub mod kkt;
 pub mod model;
 pub mod statics;
-pub(crate) mod vec_ops;
+
+// transitional re-export (remove after merge)
+pub use crate::linalg::{banded, dense_lu, kkt};
+// transitional re-export (remove after merge)
+#[allow(unused_imports)]
+pub(crate) use crate::linalg::vec_ops;

@@ -2,7 +2,7 @@
 //! linear stiffness of a block basis are block-diagonal apart from the kept coordinates'
 //! rows and columns, and their products with a vector run in every Newton iteration.
 
-use super::projection::{dot, mat_vec};
+use super::vec_ops::{dot, mat_vec};
 use ndarray::Array2;
 
 pub(crate) struct SparseRows {

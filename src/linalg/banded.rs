@@ -8,7 +8,7 @@
 //! `dgbtrf` spends most of its time in the per-column BLAS calls (measured with callgrind:
 //! ~350k instructions per 206-row factorization against ~60k here).
 
-use super::kkt::{Block, KktPattern, KktSolver, SlotMap};
+use super::kkt_pattern::{Block, KktPattern, KktSolver, SlotMap};
 use std::collections::VecDeque;
 
 /// Reverse Cuthill–McKee (Cuthill & McKee 1969; George & Liu 1981, §4.3): a breadth-first

@@ -15,91 +15,9 @@ use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::lu::{factorize_symbolic_lu, NumericLu, SymbolicLu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par};
-use nalgebra::SMatrix;
 
-pub type Block = SMatrix<f64, 8, 8>;
-
-/// Structure of a KKT system: element dof maps and constraint rows `Σ coef·q[dof]`.
-#[derive(Clone, Debug)]
-pub struct KktPattern {
-    pub n_dof: usize,
-    pub element_dofs: Vec<[usize; 8]>,
-    pub constraint_rows: Vec<Vec<(usize, f64)>>,
-}
-
-impl KktPattern {
-    pub fn size(&self) -> usize {
-        self.n_dof + self.constraint_rows.len()
-    }
-}
-
-/// Which linear solver the full-order model uses.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Deserialize, clap::ValueEnum)]
-#[serde(rename_all = "snake_case")]
-pub enum LinearSolverKind {
-    /// Band LU (LAPACK dgbtrf) after reverse Cuthill–McKee ordering: linear in the number
-    /// of elements for chains and loops, the fastest here.
-    #[default]
-    Banded,
-    /// faer general sparse LU (COLAMD + partial pivoting), symbolic analysis reused: for
-    /// topologies whose band after ordering is wide (trees with many branches).
-    Sparse,
-    /// Dense LU through LAPACK: the O(n³) reference the thesis's timings most likely had.
-    Dense,
-}
-
-/// Where each entry of the element blocks and of the scaled constraint rows lands in a
-/// solver's value array; shared by the sparse and band storages.
-pub(crate) struct SlotMap {
-    /// for element e, entry (i, j) of its block lands at `elem[64 e + 8 j + i]`
-    elem: Vec<usize>,
-    /// per constraint entry: the slots of (row c, dof) and (dof, row c), and the coefficient
-    cons: Vec<(usize, usize, f64)>,
-}
-
-impl SlotMap {
-    /// `slot(i, j)` gives the storage index of matrix entry (i, j).
-    pub(crate) fn new(pattern: &KktPattern, slot: impl Fn(usize, usize) -> usize) -> Self {
-        let mut elem = Vec::with_capacity(64 * pattern.element_dofs.len());
-        for dofs in &pattern.element_dofs {
-            for j in 0..8 {
-                for i in 0..8 {
-                    elem.push(slot(dofs[i], dofs[j]));
-                }
-            }
-        }
-        let nd = pattern.n_dof;
-        let mut cons = Vec::new();
-        for (c, row) in pattern.constraint_rows.iter().enumerate() {
-            for &(dof, coef) in row {
-                cons.push((slot(nd + c, dof), slot(dof, nd + c), coef));
-            }
-        }
-        SlotMap { elem, cons }
-    }
-
-    /// Adds the blocks and `scale ×` the constraint entries into `values` (zeroed first).
-    pub(crate) fn scatter(&self, values: &mut [f64], blocks: &[Block], scale: f64) {
-        values.iter_mut().for_each(|v| *v = 0.0);
-        for (block, slots) in blocks.iter().zip(self.elem.chunks_exact(64)) {
-            // nalgebra storage is column-major: k = 8 j + i
-            for (&s, &v) in slots.iter().zip(block.as_slice()) {
-                values[s] += v;
-            }
-        }
-        for &(a, b, coef) in &self.cons {
-            values[a] += scale * coef;
-            values[b] += scale * coef;
-        }
-    }
-}
-
-pub trait KktSolver: Send {
-    /// Assembles `[Σ P_eᵀ blocks[e] P_e, s Bᵀ; s B, 0]` and factors it.
-    fn factor(&mut self, blocks: &[Block], scale: f64) -> Result<(), String>;
-    /// Solves in place with the last factorization; `rhs` has `n_dof + n_c` entries.
-    fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String>;
-}
+pub use super::kkt_pattern::{Block, KktPattern, KktSolver, LinearSolverKind};
+pub(crate) use super::kkt_pattern::SlotMap;
 
 pub fn make_solver(kind: LinearSolverKind, pattern: KktPattern) -> Box<dyn KktSolver> {
     match kind {

@@ -1,0 +1,115 @@
+//! The process-wide registry of live temporary paths and the signal handler that removes
+//! them: every temporary path [`super::TempPath`] makes is registered while it lives, and
+//! on SIGINT, SIGTERM or SIGHUP the handler removes them all (putting back a report folder
+//! moved aside) before the process exits with 128 + the signal number.
+
+use crate::error::{Error, Result};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Mutex, MutexGuard};
+
+/// What the signal handler does with a registered path.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(super) enum Live {
+    /// a temporary file: removed
+    File(PathBuf),
+    /// a temporary folder flexrom made itself: removed with its contents
+    Dir(PathBuf),
+    /// a previous report folder moved aside while a new one is renamed in: renamed back to
+    /// `target` when the new one is not there yet, removed otherwise
+    Aside { aside: PathBuf, target: PathBuf },
+}
+
+static LIVE: Mutex<Vec<Live>> = Mutex::new(Vec::new());
+pub(super) static COUNTER: AtomicU64 = AtomicU64::new(0);
+
+/// The registry, also after a thread panicked while holding it (the list stays valid).
+pub(super) fn live() -> MutexGuard<'static, Vec<Live>> {
+    LIVE.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+pub(super) fn unregister(l: &Live) {
+    let mut v = live();
+    if let Some(i) = v.iter().position(|x| x == l) {
+        v.swap_remove(i);
+    }
+}
+
+/// Removes (or puts back) every registered path; used by the signal handler.
+pub(super) fn clean_up(v: &mut Vec<Live>) {
+    for l in v.drain(..) {
+        match l {
+            Live::File(p) => {
+                let _ = std::fs::remove_file(p);
+            }
+            Live::Dir(p) => {
+                // the interrupted thread may still be creating a file in it (ENOTEMPTY)
+                for _ in 0..50 {
+                    if std::fs::remove_dir_all(&p).is_ok() || std::fs::symlink_metadata(&p).is_err() {
+                        break;
+                    }
+                    std::thread::sleep(std::time::Duration::from_millis(2));
+                }
+            }
+            Live::Aside { aside, target } => {
+                if std::fs::symlink_metadata(&target).is_err() {
+                    let _ = std::fs::rename(&aside, &target);
+                } else {
+                    let _ = std::fs::remove_dir_all(&aside);
+                }
+            }
+        }
+    }
+}
+
+/// The temporary paths alive right now (for tests and diagnostics).
+pub fn live_paths() -> Vec<PathBuf> {
+    live()
+        .iter()
+        .map(|l| match l {
+            Live::File(p) | Live::Dir(p) => p.clone(),
+            Live::Aside { aside, .. } => aside.clone(),
+        })
+        .collect()
+}
+
+/// Installs the SIGINT/SIGTERM (and SIGHUP: a closed terminal) handler: a thread (signal-hook) that, on the first signal,
+/// takes the registry lock (so no new temporary path can be registered), removes every live
+/// temporary path and ends the process with `_exit(128 + signal)`. `_exit` skips the HDF5
+/// library's exit handlers, which could wait for a lock held by the interrupted writer.
+pub fn install_signal_handler() -> Result<()> {
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP])
+        .map_err(|e| Error::Usage(format!("cannot install the SIGINT/SIGTERM/SIGHUP handler: {e}")))?;
+    std::thread::Builder::new()
+        .name("flexrom-signals".into())
+        .spawn(move || {
+            if let Some(sig) = signals.forever().next() {
+                let mut v = live();
+                let n = v.len();
+                clean_up(&mut v);
+                let name = match sig {
+                    SIGINT => "SIGINT",
+                    SIGHUP => "SIGHUP",
+                    _ => "SIGTERM",
+                };
+                eprintln!(
+                    "flexrom: stopped by {name}; {n} temporary path(s) removed, previous outputs left as they were"
+                );
+                signal_hook::low_level::exit(128 + sig);
+            }
+        })
+        .map_err(|e| Error::Usage(format!("cannot start the signal thread: {e}")))?;
+    Ok(())
+}
+
+/// A unique, not yet existing name `.<name>.<tag>-<pid>-<n>` in `dir`.
+pub(super) fn unique_sibling(dir: &Path, name: &str, tag: &str) -> PathBuf {
+    loop {
+        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+        let p = dir.join(format!(".{name}.{tag}-{}-{n}", std::process::id()));
+        if std::fs::symlink_metadata(&p).is_err() {
+            return p;
+        }
+    }
+}

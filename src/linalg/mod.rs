@@ -1,0 +1,11 @@
+//! The linear-algebra floor under `solver` and `reduction`: sparse and banded KKT solvers,
+//! dense LU and bordered Cholesky, non-negative least squares, run-sparse matrices and the
+//! vector kernels. Knows nothing of the physics, the integrator or the reduction.
+pub mod banded;
+pub mod dense_lu;
+pub mod kkt;
+pub mod kkt_pattern;
+pub mod nnls;
+pub mod simd;
+pub(crate) mod sparse_rows;
+pub(crate) mod vec_ops;

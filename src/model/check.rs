@@ -1,0 +1,392 @@
+//! The checks of a model file beyond its syntax: every field in range, names and nodes that
+//! exist, joints that close and whose constraint rows are independent, time settings that
+//! make a run; the validated bodies, joints, loads and probes are kept on the [`Model`].
+
+use super::schema::*;
+use super::Model;
+use super::toml_errors::entry_line;
+use crate::error::Result;
+use crate::physics::element::Section;
+use crate::physics::system::{BeamBody, Joint, Load, NodeId, Probe};
+use crate::solver::generalized_alpha::{IntegratorParams, JacobianReuse};
+
+/// Relative tolerance for a joint to count as closed in the initial configuration.
+const CLOSURE_TOL: f64 = 1e-6;
+
+impl Model {
+    pub(super) fn check(&mut self) -> Result<()> {
+        let f = self.file.clone();
+        let t = &f.time;
+        self.positive("time.t_end", t.t_end)?;
+        self.positive("time.dt", t.dt)?;
+        if t.dt > t.t_end {
+            return Err(self.err("time.dt", format!("step {} is longer than t_end {}", t.dt, t.t_end)));
+        }
+        self.params_from(t)?;
+        if let Some(d) = &f.damping {
+            for (name, v) in [("damping.mass", d.mass), ("damping.stiffness", d.stiffness)] {
+                if !v.is_finite() || v < 0.0 {
+                    return Err(self.err(name, format!("must be finite and non-negative, got {v}")));
+                }
+            }
+        }
+        if f.bodies.is_empty() {
+            return Err(self.err("bodies", "a model needs at least one body"));
+        }
+        for (i, b) in f.bodies.iter().enumerate() {
+            let p = |k: &str| format!("bodies[{i}].{k}");
+            if b.name.trim().is_empty() {
+                return Err(self.err(p("name"), "must not be empty"));
+            }
+            if f.bodies[..i].iter().any(|o| o.name == b.name) {
+                return Err(self.err(p("name"), format!("body `{}` is defined twice", b.name)));
+            }
+            self.finite2(&p("start"), b.start)?;
+            if b.elements <= 0 {
+                return Err(self.err(p("elements"), format!("must be a positive integer, got {}", b.elements)));
+            }
+            let total: f64 = f.bodies[..=i].iter().map(|b| b.elements.max(0) as f64).sum();
+            crate::limits::check_elements(total).map_err(|e| self.err(p("elements"), e))?;
+            for (k, v) in
+                [("density", b.density), ("area", b.area), ("inertia", b.inertia), ("youngs_modulus", b.youngs_modulus)]
+            {
+                self.positive(&p(k), v)?;
+            }
+            let (angle, length) = match (b.angle, b.end) {
+                (Some(_), Some(_)) => return Err(self.err(p("end"), "give either `angle` or `end`, not both")),
+                (None, None) => return Err(self.err(p("angle"), "missing: give `angle` (rad) with `length`, or `end`")),
+                (Some(a), None) => {
+                    self.finite(&p("angle"), a)?;
+                    let l = b.length.ok_or_else(|| self.err(p("length"), "missing (required with `angle`)"))?;
+                    self.positive(&p("length"), l)?;
+                    (a, l)
+                }
+                (None, Some(end)) => {
+                    self.finite2(&p("end"), end)?;
+                    let (dx, dy) = (end[0] - b.start[0], end[1] - b.start[1]);
+                    let dist = dx.hypot(dy);
+                    if dist <= 0.0 {
+                        return Err(self.err(p("end"), "coincides with `start`: the body has zero length"));
+                    }
+                    let l = match b.length {
+                        Some(l) => {
+                            self.positive(&p("length"), l)?;
+                            if (l - dist).abs() > CLOSURE_TOL * l {
+                                return Err(self.err(p("length"), format!("{l} disagrees with |end − start| = {dist}")));
+                            }
+                            l
+                        }
+                        None => dist,
+                    };
+                    (dy.atan2(dx), l)
+                }
+            };
+            self.bodies.push(BeamBody {
+                name: b.name.clone(),
+                start: b.start,
+                angle,
+                length,
+                n_elements: b.elements as usize,
+                section: Section {
+                    density: b.density,
+                    area: b.area,
+                    inertia: b.inertia,
+                    youngs_modulus: b.youngs_modulus,
+                },
+            });
+        }
+        let lmax = self.bodies.iter().map(|b| b.length).fold(0.0, f64::max);
+        let node_pos = |(b, k): NodeId, bodies: &[BeamBody]| -> [f64; 2] {
+            let r = bodies[b].undeformed_node(k);
+            [r[0], r[1]]
+        };
+        for (i, j) in f.joints.iter().enumerate() {
+            let p = |k: &str| format!("joints[{i}].{k}");
+            let joint = match j {
+                JointSpec::GroundPin { body, node, point } => {
+                    let id = self.node_id(&p("body"), &p("node"), body, node)?;
+                    let at = node_pos(id, &self.bodies);
+                    let point = match point {
+                        Some(pt) => {
+                            self.finite2(&p("point"), *pt)?;
+                            let gap = (pt[0] - at[0]).hypot(pt[1] - at[1]);
+                            if gap > CLOSURE_TOL * lmax {
+                                return Err(self.err(p("point"), format!("{pt:?} is {gap:.3e} m from the node's initial position {at:?}; the initial configuration must satisfy every joint")));
+                            }
+                            *pt
+                        }
+                        None => at,
+                    };
+                    Joint::GroundPin { node: id, point }
+                }
+                JointSpec::Pin { a, b } => {
+                    let ia = self.node_id(&p("a.body"), &p("a.node"), &a.body, &a.node)?;
+                    let ib = self.node_id(&p("b.body"), &p("b.node"), &b.body, &b.node)?;
+                    if ia.0 == ib.0 {
+                        return Err(self.err(p("b.body"), "a pin joins two different bodies"));
+                    }
+                    let (pa, pb) = (node_pos(ia, &self.bodies), node_pos(ib, &self.bodies));
+                    let gap = (pa[0] - pb[0]).hypot(pa[1] - pb[1]);
+                    if gap > CLOSURE_TOL * lmax {
+                        return Err(self.err(p("b"), format!("the two nodes start {gap:.3e} m apart ({pa:?} and {pb:?}); the initial configuration must satisfy every joint")));
+                    }
+                    Joint::Pin { a: ia, b: ib }
+                }
+                JointSpec::Clamp { body, node } => {
+                    let id = self.node_id(&p("body"), &p("node"), body, node)?;
+                    let bd = &self.bodies[id.0];
+                    Joint::Clamp {
+                        node: id,
+                        point: node_pos(id, &self.bodies),
+                        slope: [bd.angle.cos(), bd.angle.sin()],
+                    }
+                }
+            };
+            self.joints.push(joint);
+        }
+        self.check_joint_rank()?;
+        for (i, l) in f.loads.iter().enumerate() {
+            let p = |k: &str| format!("loads[{i}].{k}");
+            let load = match l {
+                LoadSpec::Gravity { g, scaled } => {
+                    self.finite2(&p("g"), *g)?;
+                    Load::Gravity { g: *g, scaled: *scaled }
+                }
+                LoadSpec::Moment { body, node, function, scaled } => {
+                    let id = self.node_id(&p("body"), &p("node"), body, node)?;
+                    function.check().map_err(|e| self.err(p("function"), e))?;
+                    Load::Moment { node: id, function: function.clone(), scaled: *scaled }
+                }
+                LoadSpec::Force { body, node, value, function, scaled } => {
+                    let id = self.node_id(&p("body"), &p("node"), body, node)?;
+                    self.finite2(&p("value"), *value)?;
+                    if let Some(func) = function {
+                        func.check().map_err(|e| self.err(p("function"), e))?;
+                    }
+                    Load::Force { node: id, value: *value, function: function.clone(), scaled: *scaled }
+                }
+            };
+            self.loads.push(load);
+        }
+        for (i, pr) in f.probes.iter().enumerate() {
+            let p = |k: &str| format!("probes[{i}].{k}");
+            if f.probes[..i].iter().any(|o| o.name == pr.name) {
+                return Err(self.err(p("name"), format!("probe `{}` is defined twice", pr.name)));
+            }
+            if pr.name.is_empty() || pr.name.contains('/') {
+                return Err(self.err(p("name"), "must be non-empty and contain no `/` (it names an HDF5 dataset)"));
+            }
+            let b = self.body_index(&p("body"), &pr.body)?;
+            let n_el = self.bodies[b].n_elements;
+            let first_el: usize = self.bodies[..b].iter().map(|x| x.n_elements).sum();
+            let (element, xi) = match (&pr.node, pr.at) {
+                (Some(_), Some(_)) => return Err(self.err(p("at"), "give either `node` or `at`, not both")),
+                (None, None) => return Err(self.err(p("node"), "missing: give `node` or `at`")),
+                (Some(node), None) => {
+                    let (_, k) = self.node_id(&p("body"), &p("node"), &pr.body, node)?;
+                    if k < n_el {
+                        (first_el + k, 0.0)
+                    } else {
+                        (first_el + n_el - 1, 1.0)
+                    }
+                }
+                (None, Some(at)) => {
+                    if !(at.is_finite() && (0.0..=1.0).contains(&at)) {
+                        return Err(self.err(p("at"), format!("{at} lies outside the body (must be in [0, 1])")));
+                    }
+                    let s = at * n_el as f64;
+                    let k = (s.floor() as usize).min(n_el - 1);
+                    (first_el + k, s - k as f64)
+                }
+            };
+            self.probes.push(Probe { name: pr.name.clone(), element, xi });
+        }
+        Ok(())
+    }
+
+    /// Refuses joints whose constraint rows `B` are linearly dependent (a node pinned twice,
+    /// a clamp plus a pin on its node, a loop of pins closing on one point): the KKT matrix
+    /// is then singular. Elimination row by row in joint order (B has entries ±1, so it is
+    /// exact); each row keeps the set of joints it was combined from, so a row that
+    /// reduces to zero names exactly the joints whose constraints it repeats.
+    fn check_joint_rank(&self) -> Result<()> {
+        use std::collections::{BTreeMap, BTreeSet, HashMap};
+        let mut first = Vec::with_capacity(self.bodies.len());
+        let mut n = 0;
+        for b in &self.bodies {
+            first.push(n);
+            n += b.n_elements + 1;
+        }
+        let g = |(b, k): NodeId| first[b] + k;
+        // reduced rows with their pivot column and the joints they combine
+        let mut basis: Vec<(BTreeMap<usize, f64>, BTreeSet<usize>)> = Vec::new();
+        let mut pivot_of: HashMap<usize, usize> = HashMap::new();
+        for (j, joint) in self.joints.iter().enumerate() {
+            let rows: Vec<Vec<(usize, f64)>> = match *joint {
+                Joint::GroundPin { node, .. } => (0..2).map(|c| vec![(4 * g(node) + c, 1.0)]).collect(),
+                Joint::Clamp { node, .. } => (0..4).map(|c| vec![(4 * g(node) + c, 1.0)]).collect(),
+                Joint::Pin { a, b } => (0..2).map(|c| vec![(4 * g(a) + c, 1.0), (4 * g(b) + c, -1.0)]).collect(),
+            };
+            for row in rows {
+                let mut r: BTreeMap<usize, f64> = row.into_iter().collect();
+                let mut used = BTreeSet::from([j]);
+                // eliminate the earliest basis row first: a basis row holds only pivot
+                // columns of later rows, so this ends
+                while let Some((c, bi)) =
+                    r.keys().filter_map(|c| pivot_of.get(c).map(|&bi| (*c, bi))).min_by_key(|x| x.1)
+                {
+                    let (brow, bj) = &basis[bi];
+                    let f = r[&c] / brow[&c];
+                    for (&cc, &bv) in brow {
+                        *r.entry(cc).or_insert(0.0) -= f * bv;
+                    }
+                    r.remove(&c);
+                    r.retain(|_, v| v.abs() > 1e-9);
+                    used.extend(bj.iter().copied());
+                }
+                match r.keys().next() {
+                    Some(&c) => {
+                        pivot_of.insert(c, basis.len());
+                        basis.push((r, used));
+                    }
+                    None => {
+                        let others: Vec<String> = used
+                            .iter()
+                            .filter(|&&i| i != j)
+                            .map(|&i| format!("joints[{i}] ({})", self.describe_joint(i)))
+                            .collect();
+                        let field = match entry_line(&self.text, "joints", j) {
+                            Some(l) => format!("joints[{j}] (line {l})"),
+                            None => format!("joints[{j}]"),
+                        };
+                        return Err(self.err(
+                            field,
+                            format!(
+                                "{} constrains what {} already fix{}: the joint equations are dependent (over-constrained, singular); remove or change one of them",
+                                self.describe_joint(j),
+                                others.join(" and "),
+                                if others.len() == 1 { "es" } else { "" }
+                            ),
+                        ));
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn describe_joint(&self, i: usize) -> String {
+        let node = |n: &NodeRef| match n {
+            NodeRef::Index(k) => format!("node {k}"),
+            NodeRef::Name(s) => format!("node \"{s}\""),
+        };
+        match &self.file.joints[i] {
+            JointSpec::GroundPin { body, node: n, .. } => format!("ground_pin on `{body}` {}", node(n)),
+            JointSpec::Clamp { body, node: n } => format!("clamp on `{body}` {}", node(n)),
+            JointSpec::Pin { a, b } => format!("pin `{}` {} – `{}` {}", a.body, node(&a.node), b.body, node(&b.node)),
+        }
+    }
+
+    pub(super) fn params_from(&self, t: &TimeSettings) -> Result<IntegratorParams> {
+        let mut p = IntegratorParams { rho_inf: t.rho_inf, ..IntegratorParams::default() };
+        if !(t.rho_inf.is_finite() && (0.0..=1.0).contains(&t.rho_inf)) {
+            return Err(self.err("time.rho_inf", format!("must lie in [0, 1], got {}", t.rho_inf)));
+        }
+        if let Some(tol) = t.newton_tolerance {
+            self.positive("time.newton_tolerance", tol)?;
+            p.tolerance = tol;
+        }
+        if let Some(x) = t.newton_stagnation {
+            if !(x.is_finite() && x >= 0.0) {
+                return Err(self.err("time.newton_stagnation", format!("must be zero or positive, got {x}")));
+            }
+            p.stagnation = x;
+        }
+        if let Some(m) = t.max_iterations {
+            if m <= 0 {
+                return Err(self.err("time.max_iterations", format!("must be a positive integer, got {m}")));
+            }
+            p.max_iterations = m as usize;
+        }
+        if let Some(m) = t.max_step_cuts {
+            if !(0..=30).contains(&m) {
+                return Err(self.err("time.max_step_cuts", format!("must be in 0..=30, got {m}")));
+            }
+            p.max_cuts = m as u32;
+        }
+        if let Some(x) = t.max_strain {
+            self.positive("time.max_strain", x)?;
+            p.max_strain = x;
+        }
+        if let Some(m) = t.max_total_step_cuts {
+            if m < 0 {
+                return Err(
+                    self.err("time.max_total_step_cuts", format!("must be zero or a positive integer, got {m}"))
+                );
+            }
+            p.max_total_cuts = usize::try_from(m).unwrap_or(usize::MAX);
+        }
+        if let Some(r) = &t.jacobian_reuse {
+            p.reuse = match r.as_str() {
+                "within-step" => JacobianReuse::WithinStep,
+                "never" => JacobianReuse::Never,
+                _ => {
+                    return Err(
+                        self.err("time.jacobian_reuse", format!("must be \"within-step\" or \"never\", got \"{r}\""))
+                    )
+                }
+            };
+        }
+        Ok(p)
+    }
+
+    fn positive(&self, field: &str, v: f64) -> Result<()> {
+        if v.is_finite() && v > 0.0 {
+            Ok(())
+        } else {
+            Err(self.err(field, format!("must be positive and finite, got {v}")))
+        }
+    }
+
+    fn finite(&self, field: &str, v: f64) -> Result<()> {
+        if v.is_finite() {
+            Ok(())
+        } else {
+            Err(self.err(field, format!("must be finite, got {v}")))
+        }
+    }
+
+    fn finite2(&self, field: &str, v: [f64; 2]) -> Result<()> {
+        if v.iter().all(|x| x.is_finite()) {
+            Ok(())
+        } else {
+            Err(self.err(field, format!("must be finite, got {v:?}")))
+        }
+    }
+
+    fn body_index(&self, field: &str, name: &str) -> Result<usize> {
+        self.bodies.iter().position(|b| b.name == name).ok_or_else(|| {
+            let names: Vec<_> = self.bodies.iter().map(|b| b.name.as_str()).collect();
+            self.err(field, format!("no body named `{name}` (bodies: {})", names.join(", ")))
+        })
+    }
+
+    fn node_id(&self, body_field: &str, node_field: &str, body: &str, node: &NodeRef) -> Result<NodeId> {
+        let b = self.body_index(body_field, body)?;
+        let n = self.bodies[b].n_elements;
+        let k = match node {
+            NodeRef::Index(k) if (0..=n as i64).contains(k) => *k as usize,
+            NodeRef::Index(k) => {
+                return Err(self.err(node_field, format!("node {k} is outside body `{body}` (nodes 0..={n})")))
+            }
+            NodeRef::Name(s) if s == "start" => 0,
+            NodeRef::Name(s) if s == "end" => n,
+            NodeRef::Name(s) => {
+                return Err(
+                    self.err(node_field, format!("`{s}` is not a node: use an index 0..={n}, \"start\" or \"end\""))
+                )
+            }
+        };
+        Ok((b, k))
+    }
+}
