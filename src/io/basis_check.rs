@@ -32,7 +32,7 @@ use crate::model::Model;
 use crate::reduction::{Basis, SnapshotKind, Variant};
 use crate::simulate::{prepare, Overrides, Settings};
 use crate::solver::kkt::LinearSolverKind;
-use crate::solver::model::DynamicModel;
+use crate::solver::model::ParametricModel;
 use hdf5::types::{FloatSize, TypeDescriptor};
 use ndarray::{s, Array2};
 use sha2::{Digest, Sha256};

@@ -20,7 +20,7 @@ use crate::model::Model;
 use crate::reduction::Basis;
 use crate::simulate::{simulate, Overrides, SimulationResult};
 use crate::solver::kkt::LinearSolverKind;
-use crate::solver::model::DynamicModel;
+use crate::solver::model::ParametricModel;
 
 /// The fixed keys of `validate --json`.
 #[derive(Clone, Debug, serde::Serialize)]
