@@ -2,6 +2,8 @@
 //! the physical system.
 
 pub mod schema;
+pub mod shared;
+pub use shared::SharedPhysics;
 
 use crate::error::{Error, Result};
 use crate::physics::element::Section;
@@ -31,6 +33,8 @@ pub struct Model {
     joints: Vec<Joint>,
     loads: Vec<Load>,
     probes: Vec<Probe>,
+    /// the physics, assembled at the first [`Model::physics`] call ([`shared`])
+    physics: std::sync::OnceLock<SharedPhysics>,
 }
 
 /// Relative tolerance for a joint to count as closed in the initial configuration.
@@ -54,6 +58,7 @@ impl Model {
             joints: vec![],
             loads: vec![],
             probes: vec![],
+            physics: std::sync::OnceLock::new(),
         };
         model.check()?;
         Ok(model)

@@ -302,7 +302,7 @@ pub fn load_trust(
     use crate::solver::model::ParametricModel;
     let estimator = read_estimator(path, &stored.basis)?;
     if let Some(e) = &estimator {
-        let sys = p.model.system(Default::default());
+        let sys = &*p.model.physics()?.sys;
         let err = |(field, problem): (String, String)| Error::input(path, format!("estimator/{field}"), problem);
         e.enriched.validate(sys.n_dof(), sys.n_constraints()).map_err(err)?;
         if let Some(h) = &e.enriched.hyper {

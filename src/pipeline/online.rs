@@ -7,27 +7,13 @@ use crate::model::Model;
 use crate::physics::element::Vec8;
 use crate::physics::system::FlexibleSystem;
 use crate::reduction::{Basis, Hyper, HyperReducedModel, Reduced, ReducedModel};
-use crate::simulate::{prepare, Overrides, Settings, SimulationResult};
+use crate::simulate::{Overrides, Settings, SimulationResult};
 use crate::solver::model::{ParametricModel, Parameters};
 use ndarray::{Array1, Array2, ArrayView1};
 use std::path::Path;
 use std::sync::Arc;
 
-/// The physics of a model file, assembled once per command and shared (read only) by every
-/// reduced model built from it, on any thread: the system and its consistent initial state.
-#[derive(Clone)]
-pub struct SharedPhysics {
-    pub sys: Arc<FlexibleSystem>,
-    pub x0: Arc<Vec<f64>>,
-}
-
-impl SharedPhysics {
-    pub fn new(model: &Model) -> Result<Self> {
-        let s = Settings::resolve(model, &Overrides::default())?;
-        let (sys, x0) = prepare(model, &s)?;
-        Ok(SharedPhysics { sys: Arc::new(sys), x0: Arc::new(x0) })
-    }
-}
+pub use crate::model::SharedPhysics;
 
 /// A reduced run: the full-coordinate result (same layout as `simulate`) and the reduced
 /// trajectory. `result.wall_seconds` is the reduced time loop alone.
@@ -90,9 +76,10 @@ enum Rom {
 }
 
 impl<'a> ReducedRunner<'a> {
-    /// Assembles the physics of `model` and projects it on `basis`.
+    /// Projects the physics of `model` (assembled once per model: [`Model::physics`]) on
+    /// `basis`.
     pub fn new(model: &'a Model, basis: &'a Basis) -> Result<Self> {
-        Self::with_physics(model, basis, &SharedPhysics::new(model)?)
+        Self::with_physics(model, basis, model.physics()?)
     }
 
     /// Projects the already assembled physics of `model` on `basis`.
