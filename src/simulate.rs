@@ -259,7 +259,7 @@ pub fn simulate(model: &Model, overrides: &Overrides) -> Result<SimulationResult
 
 fn run_full(model: &Model, sys: &mut FlexibleSystem, q0: Vec<f64>, s: Settings) -> Result<SimulationResult> {
     model.check_full_run_memory(s.n_steps, s.solver == LinearSolverKind::Dense)?;
-    let (n, nc, nt) = (sys.n_dof(), sys.n_constraints(), s.n_steps + 1);
+    let (n, nc, nt) = (ParametricModel::n_dof(sys), ParametricModel::n_constraints(sys), s.n_steps + 1);
     let mut q = Array2::zeros((n, nt));
     let mut mult = Array2::zeros((nc, nt));
     let mut t = Array1::zeros(nt);
