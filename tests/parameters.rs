@@ -55,7 +55,7 @@ fn check(p: &Pipeline, l1: f64, l2: f64) {
         let m = fresh(model);
         let mut new = ReducedRunner::new(&m, &basis).unwrap();
         let reference = new.solve(&Parameters::new(x), Output::ReducedAndProbes, &[]).unwrap().reduced_q;
-        assert!(run == &reference, "reduced run at λ = {x} on a reused model differs from a fresh model's");
+        assert!(*run == reference, "reduced run at λ = {x} on a reused model differs from a fresh model's");
     }
     assert!(differ(&runs[0], &runs[1]) > 1e-6, "λ = {l1} and {l2} gave the same reduced trajectory");
 
