@@ -6,7 +6,7 @@ use crate::model::Model;
 use crate::physics::system::FlexibleSystem;
 use crate::solver::generalized_alpha::{GeneralizedAlpha, IntegratorParams, State, Stats};
 use crate::solver::kkt::LinearSolverKind;
-use crate::solver::model::DynamicModel;
+use crate::solver::model::{Bound, DynamicModel, ParametricModel, Parameters};
 use ndarray::{Array1, Array2};
 
 /// Run settings; `None` fields take the model file's values.
@@ -45,9 +45,7 @@ impl Settings {
         if !(t_end.is_finite() && t_end > 0.0) {
             return Err(bad("t-end", t_end));
         }
-        if !load_scale.is_finite() {
-            return Err(Error::Usage(format!("--load-scale must be finite, got {load_scale}")));
-        }
+        Parameters::new(load_scale).validate()?;
         let params = IntegratorParams { rho_inf, ..model.integrator_params() };
         params.validate().map_err(|e| Error::Usage(format!("--rho-inf: {e}")))?;
         // the number of whole steps that fit (SPEC §4: 1.1 s at 0.007 s is 157 steps),
@@ -60,6 +58,11 @@ impl Settings {
             return Err(Error::Usage(format!("dt = {dt} is longer than t_end = {t_end}")));
         }
         Ok(Settings { dt, t_end, rho_inf, load_scale, n_steps, solver: o.solver, params })
+    }
+
+    /// The parameters μ of the run.
+    pub fn parameters(&self) -> Parameters {
+        Parameters::new(self.load_scale)
     }
 }
 
@@ -81,8 +84,29 @@ pub struct SimulationResult {
     pub wall_seconds: f64,
 }
 
-/// Integrates any [`DynamicModel`] over `n_steps` steps of `dt`, calling `record` at t₀ and
-/// after every step. Returns the integrator statistics.
+/// The one solve of every run, full or reduced (`simulate`, `online`, `sweep`, `validate`,
+/// greedy training and the error estimate all come here): integrates `model` at the
+/// parameters `mu` over `n_steps` steps of `dt` from `q0` at rest, with the optional
+/// increment guess of [`integrate_guided`], calling `record` at t₀ and after every step.
+/// The model is not changed by the parameters: the same model runs at λ₁, λ₂, λ₁ and gives
+/// what three fresh models give (tests/parameters.rs).
+#[allow(clippy::too_many_arguments)]
+pub fn solve<M: ParametricModel + ?Sized>(
+    model: &mut M,
+    mu: &Parameters,
+    params: &IntegratorParams,
+    q0: Vec<f64>,
+    dt: f64,
+    n_steps: usize,
+    guess: impl FnMut(usize, &mut [f64]) -> bool,
+    record: impl FnMut(usize, &State),
+) -> Result<Stats> {
+    mu.validate()?;
+    integrate_guided(&mut Bound::new(model, mu), params, q0, dt, n_steps, guess, record)
+}
+
+/// Integrates any [`DynamicModel`] (a model bound to its parameters) over `n_steps` steps
+/// of `dt`, calling `record` at t₀ and after every step. Returns the integrator statistics.
 pub fn integrate<M: DynamicModel>(
     model: &mut M,
     params: &IntegratorParams,
@@ -185,21 +209,57 @@ impl BlowUpWatch {
     }
 }
 
-/// Builds the model's system at the run's load scale and its consistent initial state.
+/// Builds the model's system with the linear solver `s.solver` and its consistent initial
+/// state (neither depends on the load scale).
 pub fn prepare(model: &Model, s: &Settings) -> Result<(FlexibleSystem, Vec<f64>)> {
     let mut sys = model.system(s.solver);
-    sys.set_load_scale(s.load_scale);
     let mut q0 = sys.initial_state();
     sys.make_consistent(&mut q0)
         .map_err(|p| Error::LinearSolve { t: 0.0, problem: format!("initial joint projection: {p}") })?;
     Ok((sys, q0))
 }
 
+/// The full model of a model file, assembled once and run at as many parameters as wanted
+/// (training, validation): the system and its consistent initial state.
+pub struct FullModel<'a> {
+    model: &'a Model,
+    solver: LinearSolverKind,
+    sys: FlexibleSystem,
+    q0: Vec<f64>,
+}
+
+impl<'a> FullModel<'a> {
+    /// Assembles the system of `model` with the linear solver `solver`.
+    pub fn new(model: &'a Model, solver: LinearSolverKind) -> Result<Self> {
+        let s = Settings::resolve(model, &Overrides { solver, ..Default::default() })?;
+        let (sys, q0) = prepare(model, &s)?;
+        Ok(FullModel { model, solver, sys, q0 })
+    }
+
+    pub fn system(&self) -> &FlexibleSystem {
+        &self.sys
+    }
+
+    /// The full run with `overrides` (their `solver` is this model's): [`simulate`] without
+    /// assembling the system again.
+    pub fn simulate(&mut self, overrides: &Overrides) -> Result<SimulationResult> {
+        let s = Settings::resolve(self.model, &Overrides { solver: self.solver, ..overrides.clone() })?;
+        run_full(self.model, &mut self.sys, self.q0.clone(), s)
+    }
+}
+
+/// The full run of `model` with `overrides`: assembles the system and runs it once
+/// ([`FullModel`] keeps the system for more runs).
 pub fn simulate(model: &Model, overrides: &Overrides) -> Result<SimulationResult> {
     let s = Settings::resolve(model, overrides)?;
     model.check_full_run_memory(s.n_steps, s.solver == LinearSolverKind::Dense)?;
     let (mut sys, q0) = prepare(model, &s)?;
-    let (n, nc, nt) = (sys.n_dof(), sys.n_constraints(), s.n_steps + 1);
+    run_full(model, &mut sys, q0, s)
+}
+
+fn run_full(model: &Model, sys: &mut FlexibleSystem, q0: Vec<f64>, s: Settings) -> Result<SimulationResult> {
+    model.check_full_run_memory(s.n_steps, s.solver == LinearSolverKind::Dense)?;
+    let (n, nc, nt) = (ParametricModel::n_dof(sys), ParametricModel::n_constraints(sys), s.n_steps + 1);
     let mut q = Array2::zeros((n, nt));
     let mut mult = Array2::zeros((nc, nt));
     let mut t = Array1::zeros(nt);
@@ -208,7 +268,7 @@ pub fn simulate(model: &Model, overrides: &Overrides) -> Result<SimulationResult
     let probe_defs = sys.probes.clone();
     let start = std::time::Instant::now();
     // the probes are evaluated after the loop, from the stored coordinates
-    let stats = integrate(&mut sys, &s.params, q0, s.dt, s.n_steps, |k, st| {
+    let stats = solve(sys, &s.parameters(), &s.params, q0, s.dt, s.n_steps, |_, _| false, |k, st| {
         t[k] = st.t;
         q.column_mut(k).assign(&ndarray::ArrayView1::from(&st.q));
         mult.column_mut(k).assign(&ndarray::ArrayView1::from(&st.lambda));

@@ -20,8 +20,8 @@ use flexrom::pipeline::validate::validate;
 use flexrom::pipeline::Pipeline;
 use flexrom::reduction::ecsw::training_matrix;
 use flexrom::reduction::{ecsw, Hyper, HyperReducedModel, Reduced, ReducedModel};
-use flexrom::simulate::{integrate, prepare, Overrides, Settings};
-use flexrom::solver::model::{DynamicModel, InvariantElementModel, IterationCoefficients};
+use flexrom::simulate::{prepare, solve, Overrides, Settings};
+use flexrom::solver::model::{InvariantElementModel, IterationCoefficients, ParametricModel};
 use ndarray::{Array1, Array2, ArrayView1};
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -79,8 +79,9 @@ fn every_element_at_weight_one_equals_plain_galerkin_with(modes: &str) {
     let v: Vec<f64> = (0..q.len()).map(|i| 0.01 * (i as f64).sin()).collect();
     let r = q.len();
     let (mut f1, mut f2) = (vec![0.0; r], vec![0.0; r]);
-    galerkin.force(&q, &v, 0.2, &mut f1);
-    hyper.force(&q, &v, 0.2, &mut f2);
+    let mu = s.parameters();
+    galerkin.force(&mu, &q, &v, 0.2, &mut f1);
+    hyper.force(&mu, &q, &v, 0.2, &mut f2);
     // round-off is relative to the terms summed, not to their (much smaller) sum: the
     // bending forces K_t xₑ of a straight element cancel entry by entry (EI/l³ ≈ 1e8 on the
     // crank), so the scale is Σₑ ‖Lₑ‖_F ‖xₑ‖ + ‖Vₑᵀ f̂ₑ‖, and 64 ε of it is round-off of 8×8
@@ -99,8 +100,8 @@ fn every_element_at_weight_one_equals_plain_galerkin_with(modes: &str) {
     let diff = rel(&f2, &f1) * f1.iter().map(|x| x * x).sum::<f64>().sqrt();
     assert!(diff < 64.0 * f64::EPSILON * terms, "forces differ by {diff:e}, terms sum to {terms:e}");
     let coef = IterationCoefficients { mass: 1.0, damping: 30.0, stiffness: 1e-4 };
-    let s1 = galerkin.factor(&q, &v, 0.2, coef).unwrap();
-    let s2 = hyper.factor(&q, &v, 0.2, coef).unwrap();
+    let s1 = galerkin.factor(&mu, &q, &v, 0.2, coef).unwrap();
+    let s2 = hyper.factor(&mu, &q, &v, 0.2, coef).unwrap();
     assert!((s1 - s2).abs() <= 1e-12 * s1, "constraint scales {s1} vs {s2}");
     let nc = galerkin.n_constraints();
     let rhs: Vec<f64> = (0..r + nc).map(|i| 1.0 + (i as f64).cos()).collect();
@@ -119,12 +120,12 @@ fn every_element_at_weight_one_equals_plain_galerkin_with(modes: &str) {
     let params = s.params.clone();
     let q0 = basis.reduce(data.x.column(0)).to_vec();
     let mut a = Array2::zeros((r, s.n_steps + 1));
-    integrate(&mut galerkin, &params, q0.clone(), s.dt, s.n_steps, |k, st| {
+    solve(&mut galerkin, &mu, &params, q0.clone(), s.dt, s.n_steps, |_, _| false, |k, st| {
         a.column_mut(k).assign(&ArrayView1::from(&st.q))
     })
     .unwrap();
     let mut b = Array2::zeros((r, s.n_steps + 1));
-    integrate(&mut hyper, &params, q0, s.dt, s.n_steps, |k, st| b.column_mut(k).assign(&ArrayView1::from(&st.q)))
+    solve(&mut hyper, &mu, &params, q0, s.dt, s.n_steps, |_, _| false, |k, st| b.column_mut(k).assign(&ArrayView1::from(&st.q)))
         .unwrap();
     let e = rel(b.as_slice().unwrap(), a.as_slice().unwrap());
     assert!(e < 1e-8, "trajectories differ by {e:e}");

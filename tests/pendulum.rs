@@ -35,7 +35,7 @@ fn energy_is_conserved_and_the_pin_holds() {
     integrate(&mut sys, &s.params, q0, s.dt, s.n_steps, |_, st| {
         let t = probe_sys.kinetic_energy(&st.v);
         kinetic_peak = kinetic_peak.max(t);
-        energies.push(t + probe_sys.potential_energy(&st.q));
+        energies.push(t + probe_sys.potential_energy(&s.parameters(), &st.q));
         pin_error = pin_error.max(st.q[0].abs()).max(st.q[1].abs());
     })
     .unwrap();
@@ -135,7 +135,9 @@ fn a_guessed_increment_moves_only_the_start_of_newton() {
     let m = pendulum();
     let s = Settings::resolve(&m, &Overrides::default()).unwrap();
     let run = |params: &IntegratorParams, scale: f64, guide: Option<&Vec<Vec<f64>>>| {
-        let (mut sys, q0) = prepare(&m, &Settings { load_scale: scale, ..s.clone() }).unwrap();
+        let (mut sys, q0) = prepare(&m, &s).unwrap();
+        let mu = flexrom::solver::model::Parameters::new(scale);
+        let mut sys = flexrom::solver::model::Bound::new(&mut sys, &mu);
         let mut integ = GeneralizedAlpha::new(params.clone()).unwrap();
         let mut st = integ.initialize(&mut sys, q0.clone(), vec![0.0; q0.len()], 0.0).unwrap();
         let mut qs = vec![st.q.clone()];

@@ -10,7 +10,7 @@
 
 mod common;
 
-use flexrom::solver::model::DynamicModel;
+use flexrom::solver::model::{Bound, DynamicModel, Parameters};
 use flexrom::solver::statics::solve_static;
 
 const L: f64 = 1.0;
@@ -25,8 +25,8 @@ fn solve(elements: usize, p: f64, steps: usize) -> ([f64; 2], [f64; 2]) {
     let mut sys = m.system(Default::default());
     let mut q = sys.initial_state();
     for k in 1..=steps {
-        sys.set_load_scale(k as f64 / steps as f64);
-        solve_static(&mut sys, &mut q, 0.0, 1e-12, 30).expect("static Newton converges");
+        let mu = Parameters::new(k as f64 / steps as f64);
+        solve_static(&mut Bound::new(&mut sys, &mu), &mut q, 0.0, 1e-12, 30).expect("static Newton converges");
     }
     let n = sys.n_dof();
     ([q[n - 4], q[n - 3]], [q[n - 2], q[n - 1]])

@@ -32,9 +32,7 @@ pub use super::basis_layout::check_file;
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::reduction::{SnapshotKind, Variant};
-use crate::simulate::{prepare, Overrides, Settings};
-use crate::linalg::kkt::LinearSolverKind;
-use crate::solver::model::DynamicModel;
+use crate::solver::model::ParametricModel;
 use ndarray::{s, Array2};
 use std::path::Path;
 
@@ -64,7 +62,7 @@ pub fn check(path: &Path, model: &Model, settings_hash: Option<&str>) -> Result<
     };
     if let Some(f) = hdf5::File::open(path).ok().filter(ours) {
         check_file(&f, path)?;
-        let sys = model.system(LinearSolverKind::Banded);
+        let sys = &*model.physics()?.sys;
         let (n, nc, ne) = (sys.n_dof(), sys.n_constraints(), sys.n_elements());
         let (cols, values) = (n + nc, n + nc);
         let limits: [(&str, &[usize]); 11] = [
@@ -315,7 +313,10 @@ fn block_of(s: &StoredBasis, i: usize, j: usize) -> String {
 fn check_against_model(s: &StoredBasis, model: &Model) -> std::result::Result<(), (String, String)> {
     let b = &s.basis;
     let bad = |f: &str, p: String| Err((f.to_string(), p));
-    let sys = model.system(LinearSolverKind::Banded);
+    let physics = model.physics().map_err(|e| {
+        ("basis/reference".to_string(), format!("cannot compute the model's initial state: {e}"))
+    })?;
+    let sys = &*physics.sys;
     let (n, nc, ne) = (sys.n_dof(), sys.n_constraints(), sys.n_elements());
     b.validate(n, nc)?;
     if let Some(&d) = s.reduced_dofs.iter().find(|&&d| d >= n) {
@@ -348,17 +349,12 @@ fn check_against_model(s: &StoredBasis, model: &Model) -> std::result::Result<()
             }
         }
         SnapshotKind::Reference => {
-            let settings = Settings::resolve(model, &Overrides::default()).map_err(|e| {
-                ("basis/reference".to_string(), format!("cannot compute the model's initial state: {e}"))
-            })?;
-            let (_, x0) = prepare(model, &settings).map_err(|e| {
-                ("basis/reference".to_string(), format!("cannot compute the model's initial state: {e}"))
-            })?;
+            let x0: &[f64] = &physics.x0;
             let scale = x0.iter().fold(1.0_f64, |a, v| a.max(v.abs()));
             let (i, d) = b
                 .reference
                 .iter()
-                .zip(&x0)
+                .zip(x0.iter())
                 .map(|(r, x)| (r - x).abs())
                 .enumerate()
                 .fold((0, 0.0), |a, (i, d)| if d > a.1 { (i, d) } else { a });

@@ -81,7 +81,7 @@ impl SlotMap {
     }
 }
 
-pub trait KktSolver: Send {
+pub trait KktSolver: Send + Sync {
     /// Assembles `[Σ P_eᵀ blocks[e] P_e, s Bᵀ; s B, 0]` and factors it.
     fn factor(&mut self, blocks: &[Block], scale: f64) -> Result<(), String>;
     /// Solves in place with the last factorization; `rhs` has `n_dof + n_c` entries.

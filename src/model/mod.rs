@@ -4,6 +4,8 @@
 mod check;
 pub mod schema;
 mod toml_errors;
+pub mod shared;
+pub use shared::SharedPhysics;
 
 use crate::error::{Error, Result};
 use crate::physics::system::{BeamBody, FlexibleSystem, Joint, Load, Probe, Rayleigh};
@@ -34,6 +36,8 @@ pub struct Model {
     joints: Vec<Joint>,
     loads: Vec<Load>,
     probes: Vec<Probe>,
+    /// the physics, assembled at the first [`Model::physics`] call ([`shared`])
+    physics: std::sync::OnceLock<SharedPhysics>,
 }
 
 impl Model {
@@ -54,6 +58,7 @@ impl Model {
             joints: vec![],
             loads: vec![],
             probes: vec![],
+            physics: std::sync::OnceLock::new(),
         };
         model.check()?;
         Ok(model)

@@ -1,5 +1,6 @@
 //! A planar flexible multibody system: straight ANCF beams meshed into equal elements,
-//! linear joints on nodal coordinates, external loads. Implements [`DynamicModel`].
+//! linear joints on nodal coordinates, external loads. Implements [`ParametricModel`]: the
+//! load scale is an argument of each evaluation ([`Parameters`]), not part of the system.
 //!
 //! Coordinates: node `k` (numbered body after body) owns `q[4k..4k+4] = (x, y, x', y')`.
 
@@ -7,7 +8,7 @@ use super::element::{BeamElement, Mat8, Section, Vec8};
 use super::loads::{moment_force, moment_jacobian};
 use super::time_function::TimeFunction;
 use crate::solver::kkt::{make_solver, KktPattern, KktSolver, LinearSolverKind};
-use crate::solver::model::{DynamicModel, ElementModel, InvariantElementModel, IterationCoefficients};
+use crate::solver::model::{ElementModel, InvariantElementModel, IterationCoefficients, ParametricModel, Parameters};
 
 /// A straight beam in its undeformed configuration.
 #[derive(Clone, Debug)]
@@ -101,7 +102,6 @@ pub struct FlexibleSystem {
     pub constraints: Vec<Constraint>,
     pub probes: Vec<Probe>,
     damping: Rayleigh,
-    load_scale: f64,
     gravity_fixed: Vec<f64>,
     gravity_scaled: Vec<f64>,
     moments: Vec<MomentLoad>,
@@ -232,7 +232,6 @@ impl FlexibleSystem {
             constraints,
             probes,
             damping,
-            load_scale: 1.0,
             gravity_fixed,
             gravity_scaled,
             moments,
@@ -268,15 +267,6 @@ impl FlexibleSystem {
     pub fn body_dofs(&self, b: usize) -> std::ops::Range<usize> {
         let first = self.first_node[b];
         4 * first..4 * (first + self.bodies[b].n_elements + 1)
-    }
-
-    pub fn load_scale(&self) -> f64 {
-        self.load_scale
-    }
-
-    /// Multiplies every load marked `scaled` (the λ of SPEC §4).
-    pub fn set_load_scale(&mut self, x: f64) {
-        self.load_scale = x;
     }
 
     fn gather(&self, e: usize, q: &[f64]) -> Vec8 {
@@ -369,11 +359,12 @@ impl FlexibleSystem {
         0.5 * v.iter().zip(&mv).map(|(a, b)| a * b).sum::<f64>()
     }
 
-    /// Potential energy: strain energy plus that of the (constant) gravity loads.
-    pub fn potential_energy(&self, q: &[f64]) -> f64 {
+    /// Potential energy at the parameters `mu`: strain energy plus that of the (constant)
+    /// gravity loads.
+    pub fn potential_energy(&self, mu: &Parameters, q: &[f64]) -> f64 {
         let strain: f64 = (0..self.elements.len()).map(|e| self.element(e).strain_energy(&self.gather(e, q))).sum();
         let grav: f64 =
-            (0..self.n_dof).map(|i| (self.gravity_fixed[i] + self.load_scale * self.gravity_scaled[i]) * q[i]).sum();
+            (0..self.n_dof).map(|i| (self.gravity_fixed[i] + mu.load_scale * self.gravity_scaled[i]) * q[i]).sum();
         strain - grav
     }
 
@@ -394,14 +385,6 @@ impl FlexibleSystem {
             }
         }
         (m, k)
-    }
-
-    fn load_factor(&self, scaled: bool) -> f64 {
-        if scaled {
-            self.load_scale
-        } else {
-            1.0
-        }
     }
 
     /// `fₑ = Cₑ q̇ₑ + Qₑ(qₑ)` with Rayleigh `Cₑ = a Mₑ + b K_bending,ₑ`.
@@ -428,23 +411,23 @@ impl FlexibleSystem {
     }
 
     /// Jacobian of the moment's contribution `−Q_M` to `g`.
-    fn moment_load_jacobian(&self, m: &MomentLoad, t: f64, slope: [f64; 2]) -> [[f64; 2]; 2] {
-        let j = moment_jacobian(self.load_factor(m.scaled) * m.function.eval(t), slope);
+    fn moment_load_jacobian(mu: &Parameters, m: &MomentLoad, t: f64, slope: [f64; 2]) -> [[f64; 2]; 2] {
+        let j = moment_jacobian(mu.load_factor(m.scaled) * m.function.eval(t), slope);
         // g carries −Q_ext, so its Jacobian enters with a minus sign
         [[-j[0][0], -j[0][1]], [-j[1][0], -j[1][1]]]
     }
 
     /// Calls `add(dof, value)` with the contributions `−Q_ext` of moments and nodal forces;
     /// `q(dof)` reads the coordinates they depend on.
-    fn add_nodal_loads(&self, t: f64, q: impl Fn(usize) -> f64, mut add: impl FnMut(usize, f64)) {
+    fn add_nodal_loads(&self, mu: &Parameters, t: f64, q: impl Fn(usize) -> f64, mut add: impl FnMut(usize, f64)) {
         for m in &self.moments {
             let qm =
-                moment_force(self.load_factor(m.scaled) * m.function.eval(t), [q(m.slope_dofs[0]), q(m.slope_dofs[1])]);
+                moment_force(mu.load_factor(m.scaled) * m.function.eval(t), [q(m.slope_dofs[0]), q(m.slope_dofs[1])]);
             add(m.slope_dofs[0], -qm[0]);
             add(m.slope_dofs[1], -qm[1]);
         }
         for f in &self.forces {
-            let ft = self.load_factor(f.scaled) * f.function.as_ref().map_or(1.0, |func| func.eval(t));
+            let ft = mu.load_factor(f.scaled) * f.function.as_ref().map_or(1.0, |func| func.eval(t));
             add(f.dofs[0], -ft * f.value[0]);
             add(f.dofs[1], -ft * f.value[1]);
         }
@@ -473,9 +456,12 @@ impl ElementModel for FlexibleSystem {
         out.copy_from_slice(self.element_matrix_mat(e, &Vec8::from_column_slice(qe), coef).as_slice());
     }
 
-    fn constant_force(&self, out: &mut [f64]) {
-        for (o, (gf, gs)) in out.iter_mut().zip(self.gravity_fixed.iter().zip(&self.gravity_scaled)) {
-            *o = -(gf + self.load_scale * gs);
+    fn constant_force_parts(&self, fixed: &mut [f64], scaled: &mut [f64]) {
+        for (o, g) in fixed.iter_mut().zip(&self.gravity_fixed) {
+            *o = -g;
+        }
+        for (o, g) in scaled.iter_mut().zip(&self.gravity_scaled) {
+            *o = -g;
         }
     }
 
@@ -483,17 +469,17 @@ impl ElementModel for FlexibleSystem {
         self.load_dofs.clone()
     }
 
-    fn load_force(&self, ql: &[f64], t: f64, out: &mut [f64]) {
+    fn load_force(&self, mu: &Parameters, ql: &[f64], t: f64, out: &mut [f64]) {
         out.iter_mut().for_each(|x| *x = 0.0);
-        self.add_nodal_loads(t, |d| ql[self.local_load_index(d)], |d, v| out[self.local_load_index(d)] += v);
+        self.add_nodal_loads(mu, t, |d| ql[self.local_load_index(d)], |d, v| out[self.local_load_index(d)] += v);
     }
 
-    fn load_jacobian(&self, ql: &[f64], t: f64, out: &mut [f64]) {
+    fn load_jacobian(&self, mu: &Parameters, ql: &[f64], t: f64, out: &mut [f64]) {
         let nl = self.load_dofs.len();
         out.iter_mut().for_each(|x| *x = 0.0);
         for m in &self.moments {
             let idx = m.slope_dofs.map(|d| self.local_load_index(d));
-            let j = self.moment_load_jacobian(m, t, [ql[idx[0]], ql[idx[1]]]);
+            let j = Self::moment_load_jacobian(mu, m, t, [ql[idx[0]], ql[idx[1]]]);
             for r in 0..2 {
                 for c in 0..2 {
                     out[idx[c] * nl + idx[r]] += j[r][c];
@@ -534,7 +520,7 @@ impl InvariantElementModel for FlexibleSystem {
     }
 }
 
-impl DynamicModel for FlexibleSystem {
+impl ParametricModel for FlexibleSystem {
     fn n_dof(&self) -> usize {
         self.n_dof
     }
@@ -553,15 +539,17 @@ impl DynamicModel for FlexibleSystem {
         }
     }
 
-    fn force(&mut self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
-        self.constant_force(out);
+    fn force(&mut self, mu: &Parameters, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
+        for (o, (gf, gs)) in out.iter_mut().zip(self.gravity_fixed.iter().zip(&self.gravity_scaled)) {
+            *o = -(gf + mu.load_scale * gs);
+        }
         for e in 0..self.elements.len() {
             let f = self.element_force_vec(e, &self.gather(e, q), &self.gather(e, v));
             for (i, &d) in self.elements[e].1.iter().enumerate() {
                 out[d] += f[i];
             }
         }
-        self.add_nodal_loads(t, |d| q[d], |d, value| out[d] += value);
+        self.add_nodal_loads(mu, t, |d| q[d], |d, value| out[d] += value);
     }
 
     fn constraint_residual(&self, q: &[f64], out: &mut [f64]) {
@@ -578,7 +566,14 @@ impl DynamicModel for FlexibleSystem {
         }
     }
 
-    fn factor(&mut self, q: &[f64], _v: &[f64], t: f64, coef: IterationCoefficients) -> Result<f64, String> {
+    fn factor(
+        &mut self,
+        mu: &Parameters,
+        q: &[f64],
+        _v: &[f64],
+        t: f64,
+        coef: IterationCoefficients,
+    ) -> Result<f64, String> {
         let mut diag_max = 0.0_f64;
         for e in 0..self.elements.len() {
             let el = &self.prototypes[self.elements[e].0];
@@ -590,7 +585,7 @@ impl DynamicModel for FlexibleSystem {
         }
         if coef.stiffness != 0.0 {
             for m in &self.moments {
-                let j = self.moment_load_jacobian(m, t, [q[m.slope_dofs[0]], q[m.slope_dofs[1]]]);
+                let j = Self::moment_load_jacobian(mu, m, t, [q[m.slope_dofs[0]], q[m.slope_dofs[1]]]);
                 for r in 0..2 {
                     for c in 0..2 {
                         self.blocks[m.element][(m.local + r, m.local + c)] += coef.stiffness * j[r][c];
@@ -621,6 +616,42 @@ impl DynamicModel for FlexibleSystem {
             }
         }
         Some(worst)
+    }
+}
+
+/// The system at the model file's own loads (`λ = 1`, [`Parameters::default`]) as the
+/// integrator's model, for callers that run it only there (tests, tools); any other
+/// parameters go through [`crate::solver::model::Bound`] or [`crate::simulate::solve`].
+impl crate::solver::model::DynamicModel for FlexibleSystem {
+    fn n_dof(&self) -> usize {
+        self.n_dof
+    }
+    fn n_constraints(&self) -> usize {
+        self.constraints.len()
+    }
+    fn mass_mul(&self, a: &[f64], out: &mut [f64]) {
+        ParametricModel::mass_mul(self, a, out)
+    }
+    fn force(&mut self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
+        ParametricModel::force(self, &Parameters::default(), q, v, t, out)
+    }
+    fn constraint_residual(&self, q: &[f64], out: &mut [f64]) {
+        ParametricModel::constraint_residual(self, q, out)
+    }
+    fn add_constraint_force(&self, lambda: &[f64], out: &mut [f64]) {
+        ParametricModel::add_constraint_force(self, lambda, out)
+    }
+    fn factor(&mut self, q: &[f64], v: &[f64], t: f64, coef: IterationCoefficients) -> Result<f64, String> {
+        ParametricModel::factor(self, &Parameters::default(), q, v, t, coef)
+    }
+    fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+        ParametricModel::solve(self, rhs)
+    }
+    fn length_scale(&self) -> f64 {
+        self.length_scale
+    }
+    fn max_strain(&self, q: &[f64]) -> Option<(f64, usize)> {
+        ParametricModel::max_strain(self, q)
     }
 }
 

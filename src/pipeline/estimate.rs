@@ -299,10 +299,10 @@ pub fn load_trust(
 ) -> Result<TrustInfo> {
     use crate::error::Error;
     use crate::io::estimator_file::{read_estimator, read_training_range, read_training_tolerance};
-    use crate::solver::model::DynamicModel;
+    use crate::solver::model::ParametricModel;
     let estimator = read_estimator(path, &stored.basis)?;
     if let Some(e) = &estimator {
-        let sys = p.model.system(Default::default());
+        let sys = &*p.model.physics()?.sys;
         let err = |(field, problem): (String, String)| Error::input(path, format!("estimator/{field}"), problem);
         e.enriched.validate(sys.n_dof(), sys.n_constraints()).map_err(err)?;
         if let Some(h) = &e.enriched.hyper {

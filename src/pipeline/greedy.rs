@@ -46,7 +46,6 @@ use crate::io::basis_file::TrainingData;
 use crate::model::Model;
 use crate::reduction::{Basis, ModeRule, Trained};
 use crate::simulate::{simulate, Overrides, SimulationResult};
-use crate::solver::kkt::LinearSolverKind;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
@@ -182,6 +181,8 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         first
     );
     let mut runs: Vec<SimulationResult> = first.par_iter().map(|&x| full(x)).collect::<Result<_>>()?;
+    // the later full runs, one at a time, on one full model
+    let mut full_model = crate::simulate::FullModel::new(&p.model, crate::solver::kkt::LinearSolverKind::Banded)?;
     let mut full_seconds: f64 = runs.iter().map(|r| r.wall_seconds).sum();
     let mut full_runs = runs.len();
     let mut points: Vec<CalibrationPoint> = Vec::new();
@@ -207,7 +208,7 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
             n_elements: b
                 .hyper
                 .as_ref()
-                .map_or_else(|| p.model.system(LinearSolverKind::Banded).n_elements(), |h| h.elements.len()),
+                .map_or_else(|| p.model.physics().map_or(0, |ph| ph.sys.n_elements()), |h| h.elements.len()),
             estimates: level.estimates.clone(),
             worst_load: candidates[wi],
             worst_estimate: worst,
@@ -239,7 +240,9 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         // the full run at the worst candidate: snapshots for the next basis, and the true
         // error of this one there (it never saw that load)
         let at = candidates[ni];
-        let truth = full(at)?;
+        let truth = full_model
+            .simulate(&Overrides { load_scale: Some(at), ..Default::default() })
+            .map_err(|e| e.at_stage("train (greedy full run)", at))?;
         full_seconds += truth.wall_seconds;
         full_runs += 1;
         let e = true_error(&p.model, &level.trained.basis, &level.estimator, &truth, at);

@@ -7,10 +7,13 @@ use crate::model::Model;
 use crate::physics::element::Vec8;
 use crate::physics::system::FlexibleSystem;
 use crate::reduction::{Basis, Hyper, HyperReducedModel, Reduced, ReducedModel};
-use crate::simulate::{integrate_guided, prepare, Overrides, Settings, SimulationResult};
-use crate::solver::model::DynamicModel;
+use crate::simulate::{Overrides, Settings, SimulationResult};
+use crate::solver::model::{ParametricModel, Parameters};
 use ndarray::{Array1, Array2, ArrayView1};
 use std::path::Path;
+use std::sync::Arc;
+
+pub use crate::model::SharedPhysics;
 
 /// A reduced run: the full-coordinate result (same layout as `simulate`) and the reduced
 /// trajectory. `result.wall_seconds` is the reduced time loop alone.
@@ -60,7 +63,7 @@ pub struct ReducedRunner<'a> {
     model: &'a Model,
     basis: &'a Basis,
     rom: Rom,
-    x0: Vec<f64>,
+    x0: Arc<Vec<f64>>,
 }
 
 /// The hyper-reduced model when the basis carries a sampled set; without one, every element
@@ -73,9 +76,15 @@ enum Rom {
 }
 
 impl<'a> ReducedRunner<'a> {
+    /// Projects the physics of `model` (assembled once per model: [`Model::physics`]) on
+    /// `basis`.
     pub fn new(model: &'a Model, basis: &'a Basis) -> Result<Self> {
-        let s = Settings::resolve(model, &Overrides::default())?;
-        let (sys, x0) = prepare(model, &s)?;
+        Self::with_physics(model, basis, model.physics()?)
+    }
+
+    /// Projects the already assembled physics of `model` on `basis`.
+    pub fn with_physics(model: &'a Model, basis: &'a Basis, physics: &SharedPhysics) -> Result<Self> {
+        let (sys, x0) = (Arc::clone(&physics.sys), Arc::clone(&physics.x0));
         let cannot = |e: String| Error::Usage(format!("cannot build the reduced model: {e}"));
         let rom = match &basis.hyper {
             Some(h) => Rom::Invariant(Box::new(HyperReducedModel::new(sys, basis, h).map_err(cannot)?)),
@@ -101,19 +110,19 @@ impl<'a> ReducedRunner<'a> {
     /// factorized matrix of a good guess. Only the starting point changes: every step
     /// stops on the same tolerance as a run on its own.
     pub fn run(&mut self, load_scale: f64, output: Output, previous: &[&ReducedRun]) -> Result<ReducedRun> {
-        let s = Settings::resolve(self.model, &Overrides { load_scale: Some(load_scale), ..Default::default() })?;
+        self.solve(&Parameters::new(load_scale), output, previous)
+    }
+
+    /// [`Self::run`] at the parameters `mu`: the reduced model is not changed by them (it
+    /// keeps its projected loads unscaled), so runs at any sequence of parameters give
+    /// what fresh models give.
+    pub fn solve(&mut self, mu: &Parameters, output: Output, previous: &[&ReducedRun]) -> Result<ReducedRun> {
+        let s = Settings::resolve(self.model, &Overrides { load_scale: Some(mu.load_scale), ..Default::default() })?;
         let previous = &previous[previous.len().saturating_sub(2)..];
-        let (model, basis, x0) = (self.model, self.basis, &self.x0);
-        let mut scale = |sys: &mut FlexibleSystem| sys.set_load_scale(load_scale);
+        let (model, basis, x0) = (self.model, self.basis, &self.x0[..]);
         match &mut self.rom {
-            Rom::Invariant(rom) => {
-                rom.change_loads(basis, &mut scale);
-                run(rom.as_mut(), model, basis, s, x0, output, previous)
-            }
-            Rom::Generic(rom) => {
-                rom.change_loads(basis, &mut scale);
-                run(rom.as_mut(), model, basis, s, x0, output, previous)
-            }
+            Rom::Invariant(rom) => run(rom.as_mut(), model, basis, s, x0, output, previous),
+            Rom::Generic(rom) => run(rom.as_mut(), model, basis, s, x0, output, previous),
         }
     }
 }
@@ -177,7 +186,7 @@ fn run<R: Reduced<FlexibleSystem>>(
         }
     };
     let start = std::time::Instant::now();
-    let stats = integrate_guided(rom, &s.params, q0, s.dt, s.n_steps, guess, |k, st| {
+    let stats = crate::simulate::solve(rom, &s.parameters(), &s.params, q0, s.dt, s.n_steps, guess, |k, st| {
         t[k] = st.t;
         zq.column_mut(k).assign(&ArrayView1::from(&st.q));
         lam.column_mut(k).assign(&ArrayView1::from(&st.lambda));

@@ -6,7 +6,7 @@ use crate::error::{Error, Result};
 use crate::io::basis_file::{write_basis_with, BasisMeta, TrainingData};
 use crate::physics::system::FlexibleSystem;
 use crate::reduction::{ecsw, train_basis, BasisSpec, ModeRule, Trained};
-use crate::simulate::{simulate, Overrides, SimulationResult};
+use crate::simulate::{FullModel, Overrides, SimulationResult};
 use crate::solver::kkt::LinearSolverKind;
 use ndarray::{concatenate, Array1, Axis};
 use std::path::Path;
@@ -56,8 +56,10 @@ pub fn train(p: &Pipeline) -> Result<(TrainingData, TrainSummary)> {
     )?;
     let mut runs = Vec::new();
     let mut full_seconds = 0.0;
+    // the full model assembled once for every training load
+    let mut full = FullModel::new(&p.model, LinearSolverKind::Banded)?;
     for &s in &scales {
-        let r = simulate(&p.model, &Overrides { load_scale: Some(s), ..Default::default() })
+        let r = full.simulate(&Overrides { load_scale: Some(s), ..Default::default() })
             .map_err(|e| e.at_stage("train (full run)", s))?;
         full_seconds += r.wall_seconds;
         runs.push(r);
@@ -103,7 +105,7 @@ pub fn build_basis(
     hyper_tolerance: Option<f64>,
 ) -> std::result::Result<(Trained, Estimator), (&'static str, String)> {
     // the physics, assembled once for the blocks, the joint rows, ECSW and the estimator
-    let sys = p.model.system(LinearSolverKind::Banded);
+    let sys = &*p.model.physics().map_err(|e| ("model", e.to_string()))?.sys;
     // every run starts from the same consistent, undeformed state
     let x_ref = data.x.column(0).to_owned();
     // whole-system: scale the multipliers so both blocks weigh alike in the POD
@@ -116,16 +118,16 @@ pub fn build_basis(
     };
     let spec =
         BasisSpec { variant: p.variant(), snapshots: p.file.train.snapshots, modes, multiplier_scale: w, blocks };
-    let joints = joint_dofs_of(&sys);
+    let joints = joint_dofs_of(sys);
     let mut trained = train_basis(data.x.view(), data.multipliers.view(), &joints, x_ref.view(), &spec)
         .map_err(|e| ("reduction.modes", e))?;
     if let Some(tol) = hyper_tolerance {
-        let hyper = ecsw(&sys, &trained.basis, data.x.view(), tol)
+        let hyper = ecsw(sys, &trained.basis, data.x.view(), tol)
             .map_err(|e| ("reduction.hyper", format!("ECSW training failed: {e}")))?;
         trained.basis.hyper = Some(hyper);
     }
     let estimator = build_estimator(
-        &sys,
+        sys,
         &trained,
         &spec,
         data.x.view(),

@@ -18,9 +18,9 @@ use super::online::{Output, ReducedRun};
 use crate::error::Result;
 use crate::model::Model;
 use crate::reduction::Basis;
-use crate::simulate::{simulate, Overrides, SimulationResult};
+use crate::simulate::{simulate, FullModel, Overrides, SimulationResult};
 use crate::solver::kkt::LinearSolverKind;
-use crate::solver::model::DynamicModel;
+use crate::solver::model::ParametricModel;
 
 /// The fixed keys of `validate --json`.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -84,7 +84,14 @@ pub fn compare(
             }
         }
     }
-    let sys = model.system(LinearSolverKind::Banded);
+    let owned;
+    let sys = match model.physics() {
+        Ok(ph) => &*ph.sys,
+        Err(_) => {
+            owned = model.system(LinearSolverKind::Banded);
+            &owned
+        }
+    };
     let mut res = vec![0.0; sys.n_constraints()];
     let mut viol = 0.0_f64;
     for k in 0..r.q.ncols() {
@@ -158,7 +165,9 @@ pub fn validate_with(
 ) -> Result<(Validation, SimulationResult, ReducedRun)> {
     let o = Overrides { load_scale: Some(load_scale), ..Default::default() };
     let stage = |what: &'static str| move |e: crate::Error| e.at_stage(what, load_scale);
-    let full = simulate(model, &o).map_err(stage("validate (full run)"))?;
+    // the full model assembled once for the run at λ and the sensitivity run at 1.001 λ
+    let mut full_model = FullModel::new(model, LinearSolverKind::Banded).map_err(stage("validate (full run)"))?;
+    let full = full_model.simulate(&o).map_err(stage("validate (full run)"))?;
     let dense = if with_dense {
         Some(
             simulate(model, &Overrides { solver: LinearSolverKind::Dense, ..o.clone() })
@@ -168,7 +177,7 @@ pub fn validate_with(
     } else {
         None
     };
-    let nearby = simulate(model, &Overrides { load_scale: Some(1.001 * load_scale), ..o })
+    let nearby = full_model.simulate(&Overrides { load_scale: Some(1.001 * load_scale), ..o })
         .map_err(stage("validate (full run at 1.001 λ)"))?;
     let mut runner = EstimatingRunner::new(model, basis, trust.and_then(|t| t.estimator.as_ref()))?;
     let (rom, estimate) = runner.run(load_scale, Output::Full).map_err(stage("validate (reduced run)"))?;

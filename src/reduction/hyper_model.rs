@@ -29,11 +29,13 @@ use super::ecsw::Hyper;
 use super::projection::{axpy, forward_to_projection, impl_reduced, Projection};
 use super::sparse_rows::SparseRows;
 use crate::linalg::simd::{dispatch, Kernel};
-use crate::solver::model::{DynamicModel, InvariantElementModel, IterationCoefficients};
+use crate::solver::model::{InvariantElementModel, IterationCoefficients, ParametricModel, Parameters};
+use std::sync::Arc;
 use ndarray::{Array1, Array2, Axis};
 
 pub struct HyperReducedModel<M: InvariantElementModel> {
-    full: M,
+    /// the full model, shared (read only) with every other reduced model of it
+    full: Arc<M>,
     p: Projection,
     ne: usize,
     nj: usize,
@@ -165,9 +167,12 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
         full.n_elements() > 0 && [4, 6, 8, 12].contains(&full.element_dofs(0).len())
     }
 
-    pub fn new(full: M, basis: &Basis, hyper: &Hyper) -> Result<Self, String> {
+    /// Projects `full` (a model, or an `Arc` of one shared with other reduced models) on
+    /// `basis`, summing the element terms over the sample `hyper`.
+    pub fn new(full: impl Into<Arc<M>>, basis: &Basis, hyper: &Hyper) -> Result<Self, String> {
+        let full: Arc<M> = full.into();
         hyper.validate(full.n_elements()).map_err(|(f, p)| format!("{f} {p}"))?;
-        let mut p = Projection::new(&full, basis)?;
+        let mut p = Projection::new(&*full, basis)?;
         let v = basis.modes.as_standard_layout();
         let r = v.ncols();
         let n_el = full.n_elements();
@@ -457,11 +462,11 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
     }
 }
 
-impl<M: InvariantElementModel> DynamicModel for HyperReducedModel<M> {
+impl<M: InvariantElementModel> ParametricModel for HyperReducedModel<M> {
     forward_to_projection!();
 
-    fn force(&mut self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
-        self.p.constant_and_load_force(&self.full, q, t, out);
+    fn force(&mut self, mu: &Parameters, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
+        self.p.constant_and_load_force(&*self.full, mu, q, t, out);
         self.l_rows.mul(q, out, true);
         out.iter_mut().zip(&self.l0).for_each(|(o, l)| *o += l);
         if let Some(c) = &self.c_rows {
@@ -483,9 +488,16 @@ impl<M: InvariantElementModel> DynamicModel for HyperReducedModel<M> {
         }
     }
 
-    fn factor(&mut self, q: &[f64], _v: &[f64], t: f64, coef: IterationCoefficients) -> Result<f64, String> {
+    fn factor(
+        &mut self,
+        mu: &Parameters,
+        q: &[f64],
+        _v: &[f64],
+        t: f64,
+        coef: IterationCoefficients,
+    ) -> Result<f64, String> {
         // m M_r + k (L_r + J_l,r) + c C_r
-        self.p.start_matrix(&self.full, q, t, coef);
+        self.p.start_matrix(&*self.full, mu, q, t, coef);
         if coef.stiffness != 0.0 {
             self.update(q);
             self.tangent();

@@ -5,7 +5,9 @@
 //! `pod` (modes and singular values) → `basis` (the reductor: `train_basis`, `reduce`,
 //! `reconstruct`) → `reduced_model` (Galerkin over every element) or `ecsw` (a weighted
 //! element sample, by `nnls`) → `hyper_model` (the sampled model); both reduced models are
-//! [`crate::solver::model::DynamicModel`]s and share `projection`.
+//! [`crate::solver::model::ParametricModel`]s and share `projection`: they keep the
+//! projected constant forces unscaled and take the load scale in each evaluation, so one
+//! reduced model runs at any parameters without being projected again.
 
 pub mod basis;
 pub mod ecsw;
@@ -28,13 +30,9 @@ pub use pod::{pod, ModeRule, Pod};
 pub use reduced_model::ReducedModel;
 
 /// What the online stage needs of a reduced model besides the dynamics.
-pub trait Reduced<M>: crate::solver::model::DynamicModel {
+pub trait Reduced<M>: crate::solver::model::ParametricModel {
     /// The full model it was projected from.
     fn full(&self) -> &M;
     /// Physical multipliers of the full model's constraints, when the variant has them.
     fn multipliers(&self, q: &[f64], lambda: &[f64]) -> Option<ndarray::Array1<f64>>;
-    /// Changes the full model's loads (`change`, e.g. a new load scale) and projects again
-    /// what was projected once from them, the constant force `Vᵀg₀`: a sweep then reuses
-    /// one reduced model for every load scale instead of building it again.
-    fn change_loads(&mut self, basis: &Basis, change: &mut dyn FnMut(&mut M));
 }

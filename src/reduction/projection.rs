@@ -5,7 +5,14 @@
 //! [`super::HyperReducedModel`]). With `x = x_ref + V q`:
 //!
 //! ```text
-//!     M_r = VᵀMV,  g₀,r = Vᵀg₀,  g_l,r = V_lᵀ g_l(x_ref,l + V_l q, t),  J_l,r = V_lᵀ J_l V_l
+//!     M_r = VᵀMV,  g₀,r(μ) = Vᵀg₀,fixed + λ Vᵀg₀,scaled,
+//!     g_l,r = V_lᵀ g_l(x_ref,l + V_l q, t; μ),  J_l,r = V_lᵀ J_l V_l
+//! ```
+//!
+//! Both parts of the constant force are projected once, unscaled, and combined at the load
+//! scale `λ` of each evaluation's parameters μ: one reduced model runs at every load.
+//!
+//! ```text
 //! ```
 //!
 //! Joints: *constraint-preserving* keeps `B V q = b − B x_ref` with exact multipliers
@@ -18,14 +25,14 @@
 
 use super::basis::{Basis, Variant};
 use super::joint_elimination::JointElimination;
-use crate::linalg::sparse_rows::SparseRows;
 use crate::linalg::dense_lu::DenseLu;
-use crate::solver::model::{ElementModel, IterationCoefficients};
+use crate::linalg::sparse_rows::SparseRows;
+use crate::solver::model::{ElementModel, IterationCoefficients, Parameters};
 pub(crate) use crate::linalg::vec_ops::{axpy, dot, mat_vec};
 use ndarray::{s, Array1, Array2, ArrayView1, Axis};
 use ndarray_linalg::SVD;
 
-/// The [`crate::solver::model::DynamicModel`] methods a reduced model with fields
+/// The [`crate::solver::model::ParametricModel`] methods a reduced model with fields
 /// `p: Projection` and `full: M` forwards unchanged (mass, joints, Newton solve, length
 /// scale); the model writes `force` and `factor` itself.
 macro_rules! forward_to_projection {
@@ -66,10 +73,6 @@ macro_rules! impl_reduced {
             fn multipliers(&self, q: &[f64], lambda: &[f64]) -> Option<ndarray::Array1<f64>> {
                 self.p.multipliers(q, lambda)
             }
-            fn change_loads(&mut self, basis: &super::Basis, change: &mut dyn FnMut(&mut M)) {
-                change(&mut self.full);
-                self.p.project_constant_force(&self.full, basis);
-            }
         }
     };
 }
@@ -83,7 +86,9 @@ pub(crate) struct Projection {
     pub mass: Array2<f64>,
     /// `mass` by runs of nonzeros, for products
     mass_rows: SparseRows,
-    g0: Array1<f64>,
+    /// `Vᵀg₀,fixed` and `Vᵀg₀,scaled`: `g₀,r(μ) = g0_fixed + λ g0_scaled`
+    g0_fixed: Array1<f64>,
+    g0_scaled: Array1<f64>,
     /// B V and B x_ref − b (reduced rows)
     b_r: Array2<f64>,
     c_r: Array1<f64>,
@@ -131,8 +136,10 @@ impl Projection {
             mv.column_mut(j).assign(&ArrayView1::from(&col));
         }
         let mass = v.t().dot(&mv);
-        full.constant_force(&mut col);
-        let g0 = v.t().dot(&ArrayView1::from(&col));
+        let mut col_scaled = vec![0.0; n];
+        full.constant_force_parts(&mut col, &mut col_scaled);
+        let g0_fixed = v.t().dot(&ArrayView1::from(&col));
+        let g0_scaled = v.t().dot(&ArrayView1::from(&col_scaled));
 
         // constraints are linear: B y − b, so B V_j = res(V_j) − res(0)
         let mut res0 = vec![0.0; nc_full];
@@ -190,7 +197,8 @@ impl Projection {
             nc,
             mass_rows: SparseRows::new(&mass),
             mass,
-            g0,
+            g0_fixed,
+            g0_scaled,
             b_r,
             c_r,
             coupling,
@@ -223,13 +231,6 @@ impl Projection {
         self.symmetric = self.elim.is_some() || self.nc == 0;
     }
 
-    /// `g₀,r = Vᵀg₀` again, after the full model's constant loads changed.
-    pub fn project_constant_force<M: ElementModel>(&mut self, full: &M, basis: &Basis) {
-        let mut col = vec![0.0; full.n_dof()];
-        full.constant_force(&mut col);
-        self.g0 = basis.modes.t().dot(&ArrayView1::from(&col));
-    }
-
     /// Physical multipliers of the full model's constraints, when this variant has them:
     /// constraint-preserving returns the integrator's own, whole-system `w V_λ q`.
     pub fn multipliers(&self, q: &[f64], lambda: &[f64]) -> Option<Array1<f64>> {
@@ -245,12 +246,22 @@ impl Projection {
         self.mass_rows.mul(a, out, false);
     }
 
-    /// `out = g₀,r + g_l,r(q, t)` (+ the whole-system coupling `(P + Pᵀ) q + c₀`)
-    pub fn constant_and_load_force<M: ElementModel>(&mut self, full: &M, q: &[f64], t: f64, out: &mut [f64]) {
-        out.copy_from_slice(self.g0.as_slice().expect("contiguous"));
+    /// `out = g₀,r(μ) + g_l,r(q, t; μ)` (+ the whole-system coupling `(P + Pᵀ) q + c₀`)
+    pub fn constant_and_load_force<M: ElementModel>(
+        &mut self,
+        full: &M,
+        mu: &Parameters,
+        q: &[f64],
+        t: f64,
+        out: &mut [f64],
+    ) {
+        let x = mu.load_scale;
+        for (o, (f, s)) in out.iter_mut().zip(self.g0_fixed.iter().zip(&self.g0_scaled)) {
+            *o = f + x * s;
+        }
         if !self.load_dofs.is_empty() {
             expand(&self.v_load, Some(&self.x_ref_load), 0, q, &mut self.xl);
-            full.load_force(&self.xl, t, &mut self.gl);
+            full.load_force(mu, &self.xl, t, &mut self.gl);
             project_add(&self.v_load, 0, &self.gl, out);
         }
         if let Some((pp, c0)) = &self.coupling {
@@ -297,7 +308,14 @@ impl Projection {
     /// Starts the reduced iteration matrix (column-major, (r + nc)²): the constant part
     /// `m M_r + k (L_r + P + Pᵀ) + c C_r` (kept for the last coefficients, since they change
     /// only with the step size) plus `k J_l,r(q, t)`; the model adds its element terms.
-    pub fn start_matrix<M: ElementModel>(&mut self, full: &M, q: &[f64], t: f64, coef: IterationCoefficients) {
+    pub fn start_matrix<M: ElementModel>(
+        &mut self,
+        full: &M,
+        mu: &Parameters,
+        q: &[f64],
+        t: f64,
+        coef: IterationCoefficients,
+    ) {
         let (r, n) = (self.r, if self.elim.is_some() { self.r } else { self.r + self.nc });
         if self.base_coef != Some(coef) {
             self.base.fill(0.0);
@@ -327,7 +345,7 @@ impl Projection {
         if coef.stiffness != 0.0 && !self.load_dofs.is_empty() {
             let nl = self.load_dofs.len();
             expand(&self.v_load, Some(&self.x_ref_load), 0, q, &mut self.xl);
-            full.load_jacobian(&self.xl, t, &mut self.jl);
+            full.load_jacobian(mu, &self.xl, t, &mut self.jl);
             if self.symmetric {
                 for a_ in 0..nl {
                     for b in 0..a_ {

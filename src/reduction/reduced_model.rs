@@ -1,10 +1,10 @@
-//! The Galerkin-projected model: a [`DynamicModel`] in reduced coordinates `q`, built on
+//! The Galerkin-projected model: a [`ParametricModel`] in reduced coordinates `q`, built on
 //! any [`ElementModel`], so it shares the integrator (and its step halving) with the full
 //! model. With `x = x_ref + V q` (SPEC §3, thesis eqs. 11–12, 18–21):
 //!
 //! ```text
-//!     M_r = VᵀMV (once),   g₀,r = Vᵀg₀ (once),
-//!     g_r(q, q̇, t) = g₀,r + Σ_e wₑ Vₑᵀ fₑ(xₑ, ẋₑ) + V_lᵀ g_l(x_l, t),   xₑ = x_ref,ₑ + Vₑ q,
+//!     M_r = VᵀMV (once),   g₀,r(μ) = Vᵀg₀,fixed + λ Vᵀg₀,scaled (both parts once),
+//!     g_r(q, q̇, t; μ) = g₀,r(μ) + Σ_e wₑ Vₑᵀ fₑ(xₑ, ẋₑ) + V_lᵀ g_l(x_l, t),   xₑ = x_ref,ₑ + Vₑ q,
 //!     S_r = m M_r + Σ_e wₑ Vₑᵀ (c Cₑ + k Kₑ) Vₑ + k V_lᵀ J_l V_l,
 //! ```
 //!
@@ -16,11 +16,13 @@
 
 use super::basis::Basis;
 use super::projection::{axpy, expand, forward_to_projection, impl_reduced, project_add, Projection};
-use crate::solver::model::{DynamicModel, ElementModel, IterationCoefficients};
+use crate::solver::model::{ElementModel, IterationCoefficients, ParametricModel, Parameters};
+use std::sync::Arc;
 use ndarray::{linalg::general_mat_mul, Array1, Array2, Axis};
 
 pub struct ReducedModel<M: ElementModel> {
-    full: M,
+    /// the full model, shared (read only) with every other reduced model of it
+    full: Arc<M>,
     p: Projection,
     /// dofs per element
     ne: usize,
@@ -46,8 +48,10 @@ pub struct ReducedModel<M: ElementModel> {
 }
 
 impl<M: ElementModel> ReducedModel<M> {
-    /// Projects `full` on `basis`, visiting every element with weight 1.
-    pub fn new(full: M, basis: &Basis) -> Result<Self, String> {
+    /// Projects `full` (a model, or an `Arc` of one shared with other reduced models) on
+    /// `basis`, visiting every element with weight 1.
+    pub fn new(full: impl Into<Arc<M>>, basis: &Basis) -> Result<Self, String> {
+        let full = full.into();
         let all: Vec<usize> = (0..full.n_elements()).collect();
         let ones = vec![1.0; all.len()];
         Self::with_elements(full, basis, all, ones)
@@ -55,8 +59,14 @@ impl<M: ElementModel> ReducedModel<M> {
 
     /// Projects `full` on `basis`, summing the element terms over `elements` with
     /// `weights` only (the constant mass and loads stay exact).
-    pub fn with_elements(full: M, basis: &Basis, elements: Vec<usize>, weights: Vec<f64>) -> Result<Self, String> {
-        let p = Projection::new(&full, basis)?;
+    pub fn with_elements(
+        full: impl Into<Arc<M>>,
+        basis: &Basis,
+        elements: Vec<usize>,
+        weights: Vec<f64>,
+    ) -> Result<Self, String> {
+        let full: Arc<M> = full.into();
+        let p = Projection::new(&*full, basis)?;
         let v = &basis.modes;
         let (n, r) = (v.nrows(), v.ncols());
         let ne = if full.n_elements() > 0 { full.element_dofs(0).len() } else { 0 };
@@ -95,11 +105,11 @@ impl<M: ElementModel> ReducedModel<M> {
     }
 }
 
-impl<M: ElementModel> DynamicModel for ReducedModel<M> {
+impl<M: ElementModel> ParametricModel for ReducedModel<M> {
     forward_to_projection!();
 
-    fn force(&mut self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
-        self.p.constant_and_load_force(&self.full, q, t, out);
+    fn force(&mut self, mu: &Parameters, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
+        self.p.constant_and_load_force(&*self.full, mu, q, t, out);
         let ne = self.ne;
         self.update_element_coordinates(q);
         for (k, (&e, &w)) in self.elements.iter().zip(&self.weights).enumerate() {
@@ -110,9 +120,16 @@ impl<M: ElementModel> DynamicModel for ReducedModel<M> {
         }
     }
 
-    fn factor(&mut self, q: &[f64], _v: &[f64], t: f64, coef: IterationCoefficients) -> Result<f64, String> {
+    fn factor(
+        &mut self,
+        mu: &Parameters,
+        q: &[f64],
+        _v: &[f64],
+        t: f64,
+        coef: IterationCoefficients,
+    ) -> Result<f64, String> {
         let (r, ne) = (self.p.r, self.ne);
-        self.p.start_matrix(&self.full, q, t, coef);
+        self.p.start_matrix(&*self.full, mu, q, t, coef);
         if coef.stiffness != 0.0 || coef.damping != 0.0 {
             self.update_element_coordinates(q);
             let ecoef = IterationCoefficients { mass: 0.0, ..coef };

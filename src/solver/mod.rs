@@ -1,6 +1,7 @@
 //! Time integration and linear algebra, generic over [`model::DynamicModel`].
 pub mod generalized_alpha;
 pub mod model;
+pub mod parameters;
 pub mod statics;
 
 // transitional re-export (remove after merge)

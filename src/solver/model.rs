@@ -8,7 +8,11 @@
 //!     g(q, q̇, t) = C q̇ + Q_e(q) − Q_ext(q, t)
 //! ```
 //!
-//! with constant `M`, `B`, `b` (joints are linear in ANCF coordinates, SPEC §2).
+//! with constant `M`, `B`, `b` (joints are linear in ANCF coordinates, SPEC §2). A model's
+//! loads depend on the run's parameters μ ([`super::parameters`]): models implement
+//! [`ParametricModel`], and the integrator sees one bound to a run's μ.
+
+pub use super::parameters::Parameters;
 
 /// Coefficients of the iteration matrix `S = m·M + c·C_t + k·K_t`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -45,6 +49,89 @@ pub trait DynamicModel {
     }
 }
 
+/// The model side of the DAE of [`DynamicModel`] with the parameters an argument of the
+/// evaluations that depend on them (`force`, `factor`), so that one model runs at any
+/// parameters without being changed between runs. The full system and every reduced model
+/// implement it; [`Bound`] hands one, at fixed parameters, to the integrator.
+///
+/// The methods take `&mut self` where the model keeps its Newton work space (the KKT
+/// factorization, cached element coordinates): one model serves one run at a time, so a
+/// parallel sweep keeps one model per thread. No parameter-dependent value is cached
+/// between calls, so nothing of one run's parameters leaks into the next.
+pub trait ParametricModel {
+    fn n_dof(&self) -> usize;
+    fn n_constraints(&self) -> usize;
+    /// `out = M a`
+    fn mass_mul(&self, a: &[f64], out: &mut [f64]);
+    /// `out = g(q, q̇, t; μ)`
+    fn force(&mut self, mu: &Parameters, q: &[f64], v: &[f64], t: f64, out: &mut [f64]);
+    /// `out = B q − b`
+    fn constraint_residual(&self, q: &[f64], out: &mut [f64]);
+    /// `out += Bᵀ λ`
+    fn add_constraint_force(&self, lambda: &[f64], out: &mut [f64]);
+    /// [`DynamicModel::factor`] at the parameters `mu`.
+    fn factor(
+        &mut self,
+        mu: &Parameters,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+        coef: IterationCoefficients,
+    ) -> std::result::Result<f64, String>;
+    /// [`DynamicModel::solve`]
+    fn solve(&mut self, rhs: &mut [f64]) -> std::result::Result<(), String>;
+    fn length_scale(&self) -> f64;
+    /// [`DynamicModel::max_strain`]
+    fn max_strain(&self, _q: &[f64]) -> Option<(f64, usize)> {
+        None
+    }
+}
+
+/// A model bound to the parameters of one run: what the integrator sees.
+pub struct Bound<'a, M: ?Sized> {
+    pub model: &'a mut M,
+    pub mu: Parameters,
+}
+
+impl<'a, M: ParametricModel + ?Sized> Bound<'a, M> {
+    pub fn new(model: &'a mut M, mu: &Parameters) -> Self {
+        Bound { model, mu: *mu }
+    }
+}
+
+impl<M: ParametricModel + ?Sized> DynamicModel for Bound<'_, M> {
+    fn n_dof(&self) -> usize {
+        self.model.n_dof()
+    }
+    fn n_constraints(&self) -> usize {
+        self.model.n_constraints()
+    }
+    fn mass_mul(&self, a: &[f64], out: &mut [f64]) {
+        self.model.mass_mul(a, out)
+    }
+    fn force(&mut self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
+        self.model.force(&self.mu, q, v, t, out)
+    }
+    fn constraint_residual(&self, q: &[f64], out: &mut [f64]) {
+        self.model.constraint_residual(q, out)
+    }
+    fn add_constraint_force(&self, lambda: &[f64], out: &mut [f64]) {
+        self.model.add_constraint_force(lambda, out)
+    }
+    fn factor(&mut self, q: &[f64], v: &[f64], t: f64, coef: IterationCoefficients) -> std::result::Result<f64, String> {
+        self.model.factor(&self.mu, q, v, t, coef)
+    }
+    fn solve(&mut self, rhs: &mut [f64]) -> std::result::Result<(), String> {
+        self.model.solve(rhs)
+    }
+    fn length_scale(&self) -> f64 {
+        self.model.length_scale()
+    }
+    fn max_strain(&self, q: &[f64]) -> Option<(f64, usize)> {
+        self.model.max_strain(q)
+    }
+}
+
 /// A model assembled from elements with fixed dof lists and a few nodal loads, opened up so
 /// that a reduction can project it element by element (and hyper-reduction can visit only
 /// some elements). The physics implements it; the reduction knows nothing else about it.
@@ -55,8 +142,9 @@ pub trait DynamicModel {
 ///
 /// with `fₑ` the element forces (internal and damping), `g₀` the constant applied loads
 /// (gravity, entering with a minus sign) and `g_l` the state- or time-dependent nodal loads
-/// on the dofs `load_dofs()`.
-pub trait ElementModel: DynamicModel {
+/// on the dofs `load_dofs()`. Both are affine in the load scale `λ` of the parameters μ:
+/// `g₀(μ) = g₀,fixed + λ g₀,scaled`, and `g_l` takes μ.
+pub trait ElementModel: ParametricModel {
     fn n_elements(&self) -> usize;
     /// Global dofs of element `e`; every element has the same number of them.
     fn element_dofs(&self, e: usize) -> &[usize];
@@ -64,14 +152,15 @@ pub trait ElementModel: DynamicModel {
     fn element_force(&self, e: usize, qe: &[f64], ve: &[f64], out: &mut [f64]);
     /// `c Cₑ + k ∂Qₑ/∂qₑ` (no mass term), column-major.
     fn element_matrix(&self, e: usize, qe: &[f64], coef: IterationCoefficients, out: &mut [f64]);
-    /// `g₀`: the part of `g` that depends on neither `q`, `q̇` nor `t`.
-    fn constant_force(&self, out: &mut [f64]);
+    /// `g₀,fixed` and `g₀,scaled` of `g₀(μ) = g₀,fixed + λ g₀,scaled`, the part of `g`
+    /// that depends on neither `q`, `q̇` nor `t`: a reduction projects each once.
+    fn constant_force_parts(&self, fixed: &mut [f64], scaled: &mut [f64]);
     /// The dofs the state- or time-dependent loads act on (and depend on).
     fn load_dofs(&self) -> Vec<usize>;
-    /// `g_l(q_l, t)` on `load_dofs()`, given `q` on the same dofs.
-    fn load_force(&self, ql: &[f64], t: f64, out: &mut [f64]);
-    /// `∂g_l/∂q_l` (column-major, `load_dofs().len()` square).
-    fn load_jacobian(&self, ql: &[f64], t: f64, out: &mut [f64]);
+    /// `g_l(q_l, t; μ)` on `load_dofs()`, given `q` on the same dofs.
+    fn load_force(&self, mu: &Parameters, ql: &[f64], t: f64, out: &mut [f64]);
+    /// `∂g_l/∂q_l` at μ (column-major, `load_dofs().len()` square).
+    fn load_jacobian(&self, mu: &Parameters, ql: &[f64], t: f64, out: &mut [f64]);
 }
 
 /// An [`ElementModel`] whose element forces are a constant linear part plus a part that

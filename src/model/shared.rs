@@ -1,0 +1,46 @@
+//! The physics of a model, assembled once per loaded model (so once per command) and
+//! shared, read only, by every reduced model and check that needs it, on any thread.
+
+use super::Model;
+use crate::error::{Error, Result};
+use crate::physics::system::FlexibleSystem;
+use crate::solver::kkt::LinearSolverKind;
+use std::sync::Arc;
+
+/// The assembled system (banded KKT solver) and its consistent initial state `x₀`.
+#[derive(Clone)]
+pub struct SharedPhysics {
+    pub sys: Arc<FlexibleSystem>,
+    pub x0: Arc<Vec<f64>>,
+}
+
+impl std::fmt::Debug for SharedPhysics {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "SharedPhysics({} coordinates)", self.x0.len())
+    }
+}
+
+impl SharedPhysics {
+    /// Assembles the system of `model` and closes the joints of its initial state.
+    pub fn assemble(model: &Model) -> Result<Self> {
+        let mut sys = model.system(LinearSolverKind::Banded);
+        let mut x0 = sys.initial_state();
+        sys.make_consistent(&mut x0)
+            .map_err(|p| Error::LinearSolve { t: 0.0, problem: format!("initial joint projection: {p}") })?;
+        Ok(SharedPhysics { sys: Arc::new(sys), x0: Arc::new(x0) })
+    }
+}
+
+impl Model {
+    /// The model's physics, assembled at the first call and shared from then on (a clone
+    /// of the model shares it too).
+    pub fn physics(&self) -> Result<&SharedPhysics> {
+        if let Some(p) = self.physics.get() {
+            return Ok(p);
+        }
+        let built = SharedPhysics::assemble(self)?;
+        // another thread may have won the race: either value is the same physics
+        let _ = self.physics.set(built);
+        Ok(self.physics.get().expect("set above"))
+    }
+}
