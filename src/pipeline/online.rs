@@ -105,7 +105,7 @@ impl<'a> ReducedRunner<'a> {
         let previous = &previous[previous.len().saturating_sub(2)..];
         let (model, basis, x0) = (self.model, self.basis, &self.x0);
         let mut scale = |sys: &mut FlexibleSystem| sys.set_load_scale(load_scale);
-        match &mut self.rom {
+        let result = match &mut self.rom {
             Rom::Invariant(rom) => {
                 rom.change_loads(basis, &mut scale);
                 run(rom.as_mut(), model, basis, s, x0, output, previous)
@@ -114,7 +114,8 @@ impl<'a> ReducedRunner<'a> {
                 rom.change_loads(basis, &mut scale);
                 run(rom.as_mut(), model, basis, s, x0, output, previous)
             }
-        }
+        };
+        result.map_err(|e| crate::reduction::whole_system::explain_failure(e, basis.variant, load_scale))
     }
 }
 

@@ -140,6 +140,23 @@ pub(crate) fn train_stabilized(
     Ok(Trained { basis, pods: vec![p], block_modes: vec![r], reduced_dofs: (0..n).collect() })
 }
 
+/// A failed Newton solve (or singular matrix) of the plain whole-system variant, with the
+/// reason and the way out in the message; other errors and variants pass unchanged.
+pub fn explain_failure(e: crate::error::Error, variant: super::Variant, load_scale: f64) -> crate::error::Error {
+    use crate::error::Error;
+    match e {
+        Error::NewtonFailed { .. } | Error::LinearSolve { .. } if variant == super::Variant::WholeSystem => Error::Stage {
+            stage: "reduced run of the plain whole-system variant (its reduced saddle point is not inf-sup stable: \
+                    B V = 0 for POD modes of constraint-satisfying snapshots, docs/whole-system.md; \
+                    use variant = \"whole-system-stabilized\")"
+                .into(),
+            load_scale,
+            source: Box::new(e),
+        },
+        other => other,
+    }
+}
+
 /// The inf-sup constant of the reduced saddle point, `β = σ_min(Ψᵀ B V) / (‖Ψ‖ ‖V‖)` with
 /// orthonormal `Ψ`, `V` (the reduced constraint block's smallest singular value): zero
 /// means some reduced multiplier acts on nothing and the reduced Newton matrix is singular.
