@@ -41,6 +41,10 @@ use std::path::Path;
 pub const ORTHONORMALITY_TOLERANCE: f64 = 1e-8;
 /// ‖x_ref − x₀‖_∞ allowed, relative to max(1, ‖x₀‖_∞).
 pub const REFERENCE_TOLERANCE: f64 = 1e-9;
+/// Smallest inf-sup constant `σ_min(Ψᵀ B V)` accepted for a whole-system-stabilized basis:
+/// trained ones are O(0.1–1) (B has unit entries, Ψ and V orthonormal, and the supremizers
+/// are `Bᵀ Ψ` orthonormalized), a basis without supremizers has ~1e-15.
+pub const INF_SUP_MIN: f64 = 1e-6;
 /// Smallest ECSW weight accepted. A sampled element of weight w stands for w copies of
 /// itself; ECSW's NNLS keeps an element only when it matters (trained weights are O(0.1–10)),
 /// so 1e-8 and below is an edited or corrupted file.
@@ -166,7 +170,27 @@ pub fn check_content(s: &StoredBasis) -> std::result::Result<(), (String, String
         if let Some((i, v)) = first_bad(&mut vl.iter()) {
             return bad("basis/multiplier_modes", format!("entry {i} is {v}; every entry must be finite"));
         }
-        if vl.ncols() != b.modes.ncols() {
+        if b.variant == Variant::WholeSystemStabilized {
+            if vl.ncols() == 0 || vl.ncols() > vl.nrows() || b.n_pod_modes + vl.ncols() != b.modes.ncols() {
+                return bad(
+                    "basis/multiplier_modes",
+                    format!(
+                        "has {} columns; whole-system-stabilized needs 1 ≤ k ≤ {} and n_pod_modes ({}) + k = {} columns of basis/modes",
+                        vl.ncols(),
+                        vl.nrows(),
+                        b.n_pod_modes,
+                        b.modes.ncols()
+                    ),
+                );
+            }
+            let (worst, (i, j)) = max_off_identity(&vl.t().dot(vl));
+            if !(worst <= ORTHONORMALITY_TOLERANCE) {
+                return bad(
+                    "basis/multiplier_modes",
+                    format!("are not orthonormal: ΨᵀΨ − I is {worst:.3e} at columns ({i}, {j}); the limit is {ORTHONORMALITY_TOLERANCE:e}"),
+                );
+            }
+        } else if vl.ncols() != b.modes.ncols() {
             return bad(
                 "basis/multiplier_modes",
                 format!("has {} columns, basis/modes has {}", vl.ncols(), b.modes.ncols()),
@@ -179,7 +203,12 @@ pub fn check_content(s: &StoredBasis) -> std::result::Result<(), (String, String
     if b.modes.ncols() == 0 {
         return bad("basis/modes", "has no columns (r = 0)".into());
     }
-    if b.n_pod_modes + b.kept.len() != b.modes.ncols() {
+    // whole-system-stabilized: its k supremizer columns follow the POD modes (checked above)
+    let supremizers = match (&b.multiplier_modes, b.variant) {
+        (Some(psi), Variant::WholeSystemStabilized) => psi.ncols(),
+        _ => 0,
+    };
+    if b.n_pod_modes + supremizers + b.kept.len() != b.modes.ncols() {
         return bad(
             "basis/kept_dofs",
             format!(
@@ -324,6 +353,18 @@ fn check_against_model(s: &StoredBasis, model: &Model) -> std::result::Result<()
     }
     if s.reduced_dofs.windows(2).any(|w| w[0] >= w[1]) {
         return bad("basis/reduced_dofs", "must be strictly increasing (each coordinate once)".into());
+    }
+    if let (Variant::WholeSystemStabilized, Some(psi)) = (b.variant, &b.multiplier_modes) {
+        // the reduced saddle point must be inf-sup stable: the supremizers make β of order 1
+        let rows: Vec<Vec<(usize, f64)>> = sys.constraints.iter().map(|c| c.terms.clone()).collect();
+        let bm = crate::reduction::whole_system::constraint_matrix(n, &rows);
+        let beta = crate::reduction::whole_system::inf_sup(&bm, psi, &b.modes);
+        if !(beta >= INF_SUP_MIN) {
+            return bad(
+                "basis/modes, basis/multiplier_modes",
+                format!("give an inf-sup constant σ_min(Ψᵀ B V) = {beta:.3e} below {INF_SUP_MIN:e}: the supremizer columns are missing or edited, and the reduced saddle point would be singular"),
+            );
+        }
     }
     if b.variant == Variant::ConstraintPreserving {
         let mut joints: Vec<usize> = sys.constraints.iter().flat_map(|c| c.terms.iter().map(|&(dof, _)| dof)).collect();

@@ -19,6 +19,8 @@
 //! /basis/reduced_dofs        (n_f)        coordinates whose rows entered the POD
 //! /basis/kept_dofs           (n_k)        coordinates kept unreduced (last n_k columns of V)
 //! /basis/multiplier_modes    (n_c, r)     whole-system only: λ ≈ w V_λ q
+//!                            (n_c, k)     whole-system-stabilized: Ψ, λ ≈ Ψ μ (orthonormal);
+//!                                         then V = [Φ (n_pod_modes), S (k supremizers)]
 //! /hyper/elements            (|E|)        hyper-reduction only: sampled element indices,
 //!                                         increasing (elements numbered body by body)
 //! /hyper/weights             (|E|)        their ECSW weights, positive
@@ -239,7 +241,11 @@ pub fn read_basis(path: &Path) -> Result<StoredBasis> {
     let kind_name = text("snapshots")?;
     let snapshots = SnapshotKind::parse(&kind_name)
         .ok_or_else(|| field("snapshots", format!("`{kind_name}` is not raw or reference")))?;
-    let multiplier_modes = if variant == Variant::WholeSystem { Some(mat("basis/multiplier_modes")?) } else { None };
+    let multiplier_modes = if matches!(variant, Variant::WholeSystem | Variant::WholeSystemStabilized) {
+        Some(mat("basis/multiplier_modes")?)
+    } else {
+        None
+    };
     let basis = Basis {
         variant,
         snapshots,

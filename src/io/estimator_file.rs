@@ -148,11 +148,18 @@ pub fn read_estimator(path: &Path, basis: &Basis) -> Result<Option<Estimator>> {
         n_pod_modes,
         hyper,
     };
-    if enriched.modes.nrows() != basis.n_dof() || n_pod_modes + enriched.kept.len() != enriched.modes.ncols() {
+    // whole-system-stabilized: k supremizer columns follow the POD modes
+    let supremizers = match (&enriched.multiplier_modes, enriched.variant) {
+        (Some(psi), crate::reduction::Variant::WholeSystemStabilized) => psi.ncols(),
+        _ => 0,
+    };
+    if enriched.modes.nrows() != basis.n_dof()
+        || n_pod_modes + supremizers + enriched.kept.len() != enriched.modes.ncols()
+    {
         return Err(field(
             "modes",
             format!(
-                "is {:?}; expected {} rows and {} POD + {} kept columns (block_modes)",
+                "is {:?}; expected {} rows and {} POD + {supremizers} supremizer + {} kept columns (block_modes)",
                 enriched.modes.dim(),
                 basis.n_dof(),
                 n_pod_modes,

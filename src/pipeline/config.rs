@@ -11,7 +11,9 @@
 //!                                           #            max_runs = 8, candidates = 33 }
 //! snapshots = "reference"                   # or "raw" (the thesis)
 //! [reduction]                               # with greedy: optional, or partial
-//! variant = "galerkin"                      # or "constraint-preserving", "whole-system"
+//! variant = "galerkin"                      # or "constraint-preserving", "whole-system",
+//!                                           # "whole-system-stabilized" (docs/whole-system.md)
+//! multiplier_modes = { count = 4 }          # whole-system-stabilized only (default energy 1e-12)
 //! modes = { ratio = 0.1 }                   # or { count = 20 }, { energy = 1e-6 }
 //! blocks = "bodies"                         # one POD per body (modes = { counts = [..] }
 //!                                           # gives each its own); default: one POD
@@ -151,6 +153,10 @@ pub struct ReductionSpec {
     /// hyper-reduction by ECSW; absent: every element is evaluated (plain Galerkin)
     #[serde(default)]
     pub hyper: Option<HyperSpec>,
+    /// whole-system-stabilized only: how many multiplier modes (a ratio is of the joint
+    /// equations' count); absent: `whole_system::DEFAULT_MULTIPLIER_MODES`
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub multiplier_modes: Option<ModeRule>,
 }
 
 /// How the coordinates are split into blocks with a POD each.
@@ -311,11 +317,26 @@ impl Pipeline {
             }
             _ => {}
         }
-        if self.blocks().is_some() && self.variant() == Variant::WholeSystem {
+        if self.blocks().is_some() && matches!(self.variant(), Variant::WholeSystem | Variant::WholeSystemStabilized) {
             return bad(
                 "reduction.blocks",
-                "needs the galerkin or the constraint-preserving variant, not whole-system".into(),
+                format!("needs the galerkin or the constraint-preserving variant, not {}", self.variant().name()),
             );
+        }
+        if let Some(m) = &self.file.reduction.multiplier_modes {
+            if self.variant() != Variant::WholeSystemStabilized {
+                return bad(
+                    "reduction.multiplier_modes",
+                    format!("applies to the whole-system-stabilized variant only, not {}", self.variant().name()),
+                );
+            }
+            if let Err(e) = m.validate().and(if matches!(m, ModeRule::Counts(_)) {
+                Err("gives counts per block; use count, ratio or energy".to_string())
+            } else {
+                Ok(())
+            }) {
+                return bad("reduction.multiplier_modes", e);
+            }
         }
         if let Some(h) = &self.file.reduction.hyper {
             if !(h.tolerance.is_finite() && h.tolerance > 0.0 && h.tolerance < 1.0) {
@@ -358,7 +379,8 @@ impl Pipeline {
     /// The block split: the file's; with `train.greedy` and none given, one block per body
     /// when the model has several bodies (each body's modes then move that body only).
     pub fn blocks(&self) -> Option<Blocks> {
-        let multi_body = self.model.file.bodies.len() > 1 && self.variant() != Variant::WholeSystem;
+        let multi_body = self.model.file.bodies.len() > 1
+            && !matches!(self.variant(), Variant::WholeSystem | Variant::WholeSystemStabilized);
         self.file.reduction.blocks.or(if self.file.train.greedy.is_some() && multi_body {
             Some(Blocks::Bodies)
         } else {

@@ -120,10 +120,11 @@ impl<'a> ReducedRunner<'a> {
         let s = Settings::resolve(self.model, &Overrides { load_scale: Some(mu.load_scale), ..Default::default() })?;
         let previous = &previous[previous.len().saturating_sub(2)..];
         let (model, basis, x0) = (self.model, self.basis, &self.x0[..]);
-        match &mut self.rom {
+        let result = match &mut self.rom {
             Rom::Invariant(rom) => run(rom.as_mut(), model, basis, s, x0, output, previous),
             Rom::Generic(rom) => run(rom.as_mut(), model, basis, s, x0, output, previous),
-        }
+        };
+        result.map_err(|e| crate::reduction::whole_system::explain_failure(e, basis.variant, mu.load_scale))
     }
 }
 

@@ -36,6 +36,19 @@ fn joint_dofs_of(sys: &FlexibleSystem) -> Vec<usize> {
     d
 }
 
+/// The joint equations and multiplier mode rule of the whole-system-stabilized variant
+/// (`None` for the others).
+fn stabilization_for(p: &Pipeline, sys: &FlexibleSystem) -> Option<crate::reduction::Stabilization> {
+    use crate::reduction::whole_system::{constraint_matrix, DEFAULT_MULTIPLIER_MODES};
+    (p.variant() == crate::reduction::Variant::WholeSystemStabilized).then(|| {
+        let rows: Vec<Vec<(usize, f64)>> = sys.constraints.iter().map(|c| c.terms.clone()).collect();
+        crate::reduction::Stabilization {
+            constraints: constraint_matrix(crate::solver::model::DynamicModel::n_dof(sys), &rows),
+            multiplier_modes: p.file.reduction.multiplier_modes.clone().unwrap_or(DEFAULT_MULTIPLIER_MODES),
+        }
+    })
+}
+
 /// Runs the training simulations and builds the basis (nothing is written); greedy
 /// training (`train.greedy`) is [`super::greedy::train`].
 pub fn train(p: &Pipeline) -> Result<(TrainingData, TrainSummary)> {
@@ -116,8 +129,15 @@ pub fn build_basis(
         Some(Blocks::Bodies) => (0..sys.bodies.len()).map(|b| sys.body_dofs(b).collect()).collect(),
         None => Vec::new(),
     };
-    let spec =
-        BasisSpec { variant: p.variant(), snapshots: p.file.train.snapshots, modes, multiplier_scale: w, blocks };
+    let stabilization = stabilization_for(p, sys);
+    let spec = BasisSpec {
+        variant: p.variant(),
+        snapshots: p.file.train.snapshots,
+        modes,
+        multiplier_scale: w,
+        blocks,
+        stabilization,
+    };
     let joints = joint_dofs_of(sys);
     let mut trained = train_basis(data.x.view(), data.multipliers.view(), &joints, x_ref.view(), &spec)
         .map_err(|e| ("reduction.modes", e))?;

@@ -23,6 +23,9 @@ pub enum Variant {
     WholeSystem,
     /// keep the joint coordinates unreduced, multipliers exact (the thesis's method)
     ConstraintPreserving,
+    /// coordinates and multipliers each by a POD of their own, the coordinate basis
+    /// enriched by supremizers `Bᵀ Ψ` (inf-sup stable; `super::whole_system`)
+    WholeSystemStabilized,
 }
 
 impl Variant {
@@ -31,11 +34,14 @@ impl Variant {
             Variant::Galerkin => "galerkin",
             Variant::WholeSystem => "whole-system",
             Variant::ConstraintPreserving => "constraint-preserving",
+            Variant::WholeSystemStabilized => "whole-system-stabilized",
         }
     }
 
     pub fn parse(s: &str) -> Option<Variant> {
-        [Variant::Galerkin, Variant::WholeSystem, Variant::ConstraintPreserving].into_iter().find(|v| v.name() == s)
+        [Variant::Galerkin, Variant::WholeSystem, Variant::ConstraintPreserving, Variant::WholeSystemStabilized]
+            .into_iter()
+            .find(|v| v.name() == s)
     }
 }
 
@@ -115,6 +121,8 @@ pub struct BasisSpec {
     /// modes each move one group only, e.g. one body; the variant's kept coordinates are
     /// left out of them); empty: one POD of all coordinates
     pub blocks: Vec<Vec<usize>>,
+    /// whole-system-stabilized: the joint equations and the multiplier mode rule
+    pub stabilization: Option<super::whole_system::Stabilization>,
 }
 
 /// Builds a basis from snapshots `x` (n × m) and, for whole-system, multipliers `λ`
@@ -145,6 +153,12 @@ pub fn train_basis(
         Variant::ConstraintPreserving => (0..n).filter(|d| !joint_dofs.contains(d)).collect(),
         _ => (0..n).collect(),
     };
+    if variant == Variant::WholeSystemStabilized {
+        if !spec.blocks.is_empty() {
+            return Err("a basis with blocks needs the galerkin or the constraint-preserving variant".into());
+        }
+        return super::whole_system::train_stabilized(centred, lambda, reference, spec);
+    }
     if !spec.blocks.is_empty() {
         return train_blocks(centred, reference, joint_dofs, reduced_dofs, spec);
     }
@@ -169,6 +183,7 @@ pub fn train_basis(
         Variant::WholeSystem => {
             (lead.slice(s![..n, ..]).to_owned(), Vec::new(), Some(lead.slice(s![n.., ..]).to_owned()))
         }
+        Variant::WholeSystemStabilized => return Err("the stabilized variant is trained by whole_system".into()),
         Variant::ConstraintPreserving => {
             let mut v = Array2::zeros((n, r + joint_dofs.len()));
             for (i, &d) in reduced_dofs.iter().enumerate() {
@@ -201,7 +216,7 @@ fn train_blocks(
     spec: &BasisSpec,
 ) -> Result<Trained, String> {
     let n = centred.nrows();
-    if spec.variant == Variant::WholeSystem {
+    if matches!(spec.variant, Variant::WholeSystem | Variant::WholeSystemStabilized) {
         return Err("a basis with blocks needs the galerkin or the constraint-preserving variant".into());
     }
     if let ModeRule::Counts(c) = &spec.modes {
@@ -314,11 +329,15 @@ impl Basis {
         if self.modes.iter().chain(self.reference.iter()).any(|x| !x.is_finite()) {
             return bad("basis/modes", "holds non-finite values".into());
         }
-        if self.n_pod_modes + self.kept.len() != self.modes.ncols() {
+        let supremizers = match (&self.multiplier_modes, self.variant) {
+            (Some(psi), Variant::WholeSystemStabilized) => psi.ncols(),
+            _ => 0,
+        };
+        if self.n_pod_modes + supremizers + self.kept.len() != self.modes.ncols() {
             return bad(
                 "basis/kept_dofs",
                 format!(
-                    "{} POD modes and {} kept coordinates do not make {} columns",
+                    "{} POD modes, {supremizers} supremizers and {} kept coordinates do not make {} columns",
                     self.n_pod_modes,
                     self.kept.len(),
                     self.modes.ncols()
@@ -335,6 +354,14 @@ impl Basis {
                 format!("is {:?}, expected ({n_constraints}, {})", vl.dim(), self.modes.ncols()),
             ),
             (None, Variant::WholeSystem) => bad("basis/multiplier_modes", "is missing (whole-system variant)".into()),
+            (Some(psi), Variant::WholeSystemStabilized) if psi.nrows() == n_constraints && psi.ncols() >= 1 => Ok(()),
+            (Some(psi), Variant::WholeSystemStabilized) => bad(
+                "basis/multiplier_modes",
+                format!("is {:?}, expected ({n_constraints}, k) with k ≥ 1 multiplier modes", psi.dim()),
+            ),
+            (None, Variant::WholeSystemStabilized) => {
+                bad("basis/multiplier_modes", "is missing (whole-system-stabilized variant)".into())
+            }
             _ => Ok(()),
         }
     }
@@ -363,6 +390,7 @@ mod tests {
                 modes: ModeRule::Energy(1e-14),
                 multiplier_scale: 1.0,
                 blocks: vec![],
+                stabilization: None,
             };
             let t = train_basis(x.view(), lam.view(), &joints, xref.view(), &spec).unwrap();
             let b = &t.basis;
@@ -401,6 +429,7 @@ mod tests {
             modes: ModeRule::Energy(1e-14),
             multiplier_scale: 1.0,
             blocks: blocks.clone(),
+            stabilization: None,
         };
         let t = train_basis(x.view(), lam.view(), &[4, 5], xref.view(), &spec).unwrap();
         let b = &t.basis;

@@ -22,12 +22,14 @@ pub mod sample;
 pub use crate::linalg::nnls;
 // transitional re-export (remove after merge)
 use crate::linalg::sparse_rows;
+pub mod whole_system;
 
 pub use basis::{train_basis, Basis, BasisSpec, SnapshotKind, Trained, Variant};
 pub use ecsw::{ecsw, Hyper};
 pub use hyper_model::HyperReducedModel;
 pub use pod::{pod, ModeRule, Pod};
 pub use reduced_model::ReducedModel;
+pub use whole_system::Stabilization;
 
 /// What the online stage needs of a reduced model besides the dynamics.
 pub trait Reduced<M>: crate::solver::model::ParametricModel {

@@ -176,6 +176,13 @@ impl Projection {
                     (0, None, None)
                 }
             }
+            Variant::WholeSystemStabilized => {
+                // k reduced joint equations Ψᵀ(B V q + B x_ref − b) with multipliers λ = Ψ μ
+                let psi = basis.multiplier_modes.as_ref().expect("validated").clone();
+                bv = psi.t().dot(&bv);
+                c_ref = psi.t().dot(&c_ref);
+                (psi.ncols(), None, Some(psi))
+            }
             Variant::WholeSystem => {
                 let w = basis.multiplier_scale;
                 let vl = basis.multiplier_modes.as_ref().expect("validated") * w;
@@ -237,7 +244,9 @@ impl Projection {
         match self.variant {
             Variant::ConstraintPreserving => Some(Array1::from(lambda.to_vec())),
             Variant::WholeSystem => Some(self.multiplier_map.as_ref().expect("set").dot(&ArrayView1::from(q))),
-            Variant::Galerkin => self.multiplier_map.as_ref().map(|uk| uk.dot(&ArrayView1::from(lambda))),
+            Variant::Galerkin | Variant::WholeSystemStabilized => {
+                self.multiplier_map.as_ref().map(|uk| uk.dot(&ArrayView1::from(lambda)))
+            }
         }
     }
 
