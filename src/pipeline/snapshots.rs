@@ -93,8 +93,8 @@ pub fn write_snapshots(p: &Pipeline, scales: &[f64], out: &Path) -> Result<(usiz
     let pipeline = crate::io::output::resolve(&p.path).display().to_string();
     write_atomically(out, |f| {
         let e = |err: hdf5::Error| Error::hdf5(out, err);
-        f.new_dataset_builder().with_data(&data.x).create("x").map_err(e)?;
-        f.new_dataset_builder().with_data(&data.multipliers).create("multipliers").map_err(e)?;
+        f.new_dataset_builder().with_data(&data.x.as_standard_layout()).create("x").map_err(e)?;
+        f.new_dataset_builder().with_data(&data.multipliers.as_standard_layout()).create("multipliers").map_err(e)?;
         f.new_dataset_builder().with_data(&data.load_scale).create("load_scale").map_err(e)?;
         f.new_dataset_builder().with_data(&data.t).create("t").map_err(e)?;
         attr_str(f, "kind", KIND).map_err(e)?;
