@@ -73,12 +73,9 @@ fn values(d: &hdf5::Dataset) -> Vec<String> {
         }
         TypeDescriptor::Unsigned(IntSize::U1) => d.read_raw::<u8>().unwrap().iter().map(|x| x.to_string()).collect(),
         TypeDescriptor::Unsigned(IntSize::U8) => d.read_raw::<u64>().unwrap().iter().map(|x| x.to_string()).collect(),
-        TypeDescriptor::VarLenUnicode => d
-            .read_raw::<hdf5::types::VarLenUnicode>()
-            .unwrap()
-            .iter()
-            .map(|x| x.as_str().to_string())
-            .collect(),
+        TypeDescriptor::VarLenUnicode => {
+            d.read_raw::<hdf5::types::VarLenUnicode>().unwrap().iter().map(|x| x.as_str().to_string()).collect()
+        }
         other => panic!("{}: unexpected type {other:?}", d.name()),
     }
 }
@@ -128,13 +125,17 @@ fn assert_same_sweep(a: &Path, b: &Path) {
         assert_eq!(x.shape(), y.shape(), "{name}");
         let (vx, vy) = (values(x), values(y));
         if name.ends_with("_seconds") {
-            let nan = |v: &[String]| v.iter().map(|b| f64::from_bits(u64::from_str_radix(b, 16).unwrap()).is_nan()).collect::<Vec<_>>();
+            let nan = |v: &[String]| {
+                v.iter().map(|b| f64::from_bits(u64::from_str_radix(b, 16).unwrap()).is_nan()).collect::<Vec<_>>()
+            };
             assert_eq!(nan(&vx), nan(&vy), "{name}");
         } else {
             assert_eq!(vx, vy, "{name}");
         }
     }
-    let keep = |v: Vec<(String, String)>| v.into_iter().filter(|(n, _)| n != "wall_seconds" && n != "threads").collect::<Vec<_>>();
+    let keep = |v: Vec<(String, String)>| {
+        v.into_iter().filter(|(n, _)| n != "wall_seconds" && n != "threads").collect::<Vec<_>>()
+    };
     assert_eq!(keep(attrs(&fa)), keep(attrs(&fb)));
 }
 
@@ -159,7 +160,8 @@ fn four_shards_merged_equal_one_sweep_and_bad_parts_are_refused() {
         shard(&p, list, k + 1, 4, part);
     }
     let merged = d.join("merged.h5");
-    let (o, err) = run(flexrom().args(["merge", s(&parts[2]), s(&parts[0]), s(&parts[3]), s(&parts[1]), "-o", s(&merged)]));
+    let (o, err) =
+        run(flexrom().args(["merge", s(&parts[2]), s(&parts[0]), s(&parts[3]), s(&parts[1]), "-o", s(&merged)]));
     assert!(o.status.success(), "{err}");
     assert_same_sweep(&single, &merged);
     // a merged file is no part
@@ -169,15 +171,29 @@ fn four_shards_merged_equal_one_sweep_and_bad_parts_are_refused() {
     // another load list
     let other_list = d.join("other_list.h5");
     shard(&p, "0.8:1.2:10", 4, 4, &other_list);
-    let (o, err) =
-        run(flexrom().args(["merge", s(&parts[0]), s(&parts[1]), s(&parts[2]), s(&other_list), "-o", s(&d.join("x.h5"))]));
+    let (o, err) = run(flexrom().args([
+        "merge",
+        s(&parts[0]),
+        s(&parts[1]),
+        s(&parts[2]),
+        s(&other_list),
+        "-o",
+        s(&d.join("x.h5")),
+    ]));
     one_line_error(&o, &err, "another load list");
     // another basis (5 modes)
     let p5 = setup(d, 5, "basis5.h5");
     let other_basis = d.join("other_basis.h5");
     shard(&p5, list, 4, 4, &other_basis);
-    let (o, err) =
-        run(flexrom().args(["merge", s(&parts[0]), s(&parts[1]), s(&parts[2]), s(&other_basis), "-o", s(&d.join("x.h5"))]));
+    let (o, err) = run(flexrom().args([
+        "merge",
+        s(&parts[0]),
+        s(&parts[1]),
+        s(&parts[2]),
+        s(&other_basis),
+        "-o",
+        s(&d.join("x.h5")),
+    ]));
     one_line_error(&o, &err, "another basis");
     // a duplicate shard
     let (o, err) = run(flexrom().args([
@@ -213,7 +229,8 @@ fn four_shards_merged_equal_one_sweep_and_bad_parts_are_refused() {
     assert_same_sweep(&single, &partial);
 
     // a shard without loads
-    let (o, err) = run(flexrom().args(["sweep", s(&p), "--load-scales", list, "--shard", "10/10", "-o", s(&d.join("y.h5"))]));
+    let (o, err) =
+        run(flexrom().args(["sweep", s(&p), "--load-scales", list, "--shard", "10/10", "-o", s(&d.join("y.h5"))]));
     one_line_error(&o, &err, "has no load for shard 10");
 }
 
@@ -236,7 +253,8 @@ fn slurm_array_sweep_equals_local_sweep() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let tmp = tempfile::tempdir().unwrap();
     let d = tmp.path();
-    let model = std::fs::read_to_string(root.join("data/models/fourbar.toml")).unwrap().replace("t_end = 1.1", "t_end = 0.3");
+    let model =
+        std::fs::read_to_string(root.join("data/models/fourbar.toml")).unwrap().replace("t_end = 1.1", "t_end = 0.3");
     assert!(model.contains("t_end = 0.3"));
     std::fs::write(d.join("model.toml"), model).unwrap();
     let p = d.join("pipe.toml");
@@ -362,13 +380,15 @@ fn eight_snapshot_jobs_give_the_single_machine_basis() {
         assert!(o.status.success(), "{err}");
     }
     let sharded = d.join("sharded.h5");
-    let mut args = vec!["train".to_string(), s(&p).into(), "--basis".into(), s(&sharded).into(), "--from-snapshots".into()];
+    let mut args =
+        vec!["train".to_string(), s(&p).into(), "--basis".into(), s(&sharded).into(), "--from-snapshots".into()];
     args.extend([7, 2, 0, 5, 1, 6, 3, 4].iter().map(|&k| s(&snaps[k]).to_string()));
     let (o, err) = run(flexrom().args(&args));
     assert!(o.status.success(), "{err}");
     let worst = max_mode_difference(&d.join("single.h5"), &sharded);
     assert!(worst <= 1e-10, "modes differ by {worst:e}");
-    let sv = |f: &Path| hdf5::File::open(f).unwrap().dataset("basis/singular_values").unwrap().read_raw::<f64>().unwrap();
+    let sv =
+        |f: &Path| hdf5::File::open(f).unwrap().dataset("basis/singular_values").unwrap().read_raw::<f64>().unwrap();
     let (a, b) = (sv(&d.join("single.h5")), sv(&sharded));
     assert_eq!(a.len(), b.len());
     assert!(a.iter().zip(&b).all(|(x, y)| (x - y).abs() <= 1e-10 * a[0]), "{a:?} {b:?}");
@@ -378,15 +398,23 @@ fn eight_snapshot_jobs_give_the_single_machine_basis() {
     let (o, err) = run(flexrom().args(["train", s(&p), "--basis", s(&other), "--from-snapshots"]).args(&snaps[..7]));
     one_line_error(&o, &err, "training load(s) [1.5]");
     // a doubled load
-    let (o, err) = run(flexrom().args(["train", s(&p), "--basis", s(&other), "--from-snapshots"]).args(&snaps).arg(&snaps[2]));
+    let (o, err) =
+        run(flexrom().args(["train", s(&p), "--basis", s(&other), "--from-snapshots"]).args(&snaps).arg(&snaps[2]));
     one_line_error(&o, &err, "is also in");
     // another model (a longer run)
     std::fs::create_dir(d.join("long")).unwrap();
     std::fs::write(d.join("long/model.toml"), model.replace("t_end = 0.2", "t_end = 0.25")).unwrap();
     std::fs::copy(&p, d.join("long/pipe.toml")).unwrap();
     let foreign = d.join("foreign.h5");
-    let (o, err) =
-        run(flexrom().args(["train", s(&d.join("long/pipe.toml")), "--snapshots-only", "--load-scale", "1.5", "-o", s(&foreign)]));
+    let (o, err) = run(flexrom().args([
+        "train",
+        s(&d.join("long/pipe.toml")),
+        "--snapshots-only",
+        "--load-scale",
+        "1.5",
+        "-o",
+        s(&foreign),
+    ]));
     assert!(o.status.success(), "{err}");
     let (o, err) =
         run(flexrom().args(["train", s(&p), "--basis", s(&other), "--from-snapshots"]).args(&snaps[..7]).arg(&foreign));

@@ -14,8 +14,8 @@
 
 use super::config::Pipeline;
 use super::online::load_basis;
-use super::sweep::{read_sweep, write_sweep, Outcome, ScaleResult, Sweep, STATUS_FAILED, STATUS_OK};
 use super::shard::load_list_hash;
+use super::sweep::{read_sweep, write_sweep, Outcome, ScaleResult, Sweep, STATUS_FAILED, STATUS_OK};
 use crate::error::{Error, Result};
 use crate::io::h5::{read_attr_f64, read_attr_str};
 use crate::simulate::{Overrides, Settings};
@@ -48,7 +48,10 @@ fn read_part(path: &Path) -> Result<Part> {
     let bad = |field: &str, problem: String| Error::input(path, field, problem);
     let f = hdf5::File::open(path).map_err(|e| bad("(file)", format!("is not a readable HDF5 file: {e}")))?;
     let g = f.group("shard").map_err(|_| {
-        bad("shard", "is missing: not a part file of `flexrom sweep --shard K/N` (a merged or plain sweep file?)".into())
+        bad(
+            "shard",
+            "is missing: not a part file of `flexrom sweep --shard K/N` (a merged or plain sweep file?)".into(),
+        )
     })?;
     let u = |name: &str| -> Result<u64> {
         g.attr(name)
@@ -98,7 +101,12 @@ fn read_part(path: &Path) -> Result<Part> {
     if indices.len() != n || status.len() != n || message.len() != n {
         return Err(bad(
             "shard/indices",
-            format!("has {} entries, /status {}, /message {}, for {n} load scales", indices.len(), status.len(), message.len()),
+            format!(
+                "has {} entries, /status {}, /message {}, for {n} load scales",
+                indices.len(),
+                status.len(),
+                message.len()
+            ),
         ));
     }
     if indices != (index - 1..all.len()).step_by(count).collect::<Vec<_>>()
@@ -110,7 +118,10 @@ fn read_part(path: &Path) -> Result<Part> {
         ));
     }
     let flag = |name: &str| -> Result<bool> {
-        f.attr(name).and_then(|a| a.read_scalar::<u64>()).map(|v| v != 0).map_err(|e| bad(name, format!("cannot be read: {e}")))
+        f.attr(name)
+            .and_then(|a| a.read_scalar::<u64>())
+            .map(|v| v != 0)
+            .map_err(|e| bad(name, format!("cannot be read: {e}")))
     };
     Ok(Part {
         path: path.to_path_buf(),
@@ -175,7 +186,10 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool) -> Result<Merged> {
             return Err(differ("shard/load_list_hash", "comes from another load list"));
         }
         if p.count != first.count {
-            return Err(differ("shard/count", &format!("is one of {} shards, not of {}, (another split)", p.count, first.count)));
+            return Err(differ(
+                "shard/count",
+                &format!("is one of {} shards, not of {}, (another split)", p.count, first.count),
+            ));
         }
         if p.validated != first.validated {
             return Err(differ("validated", "was run with another --validate"));
@@ -206,8 +220,7 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool) -> Result<Merged> {
     let all = &first.all;
     let missing: Vec<usize> = (0..first.count).filter(|&k| holder[k].is_none()).collect();
     if !missing.is_empty() && !partial {
-        let loads: Vec<f64> =
-            (0..all.len()).filter(|i| missing.contains(&(i % first.count))).map(|i| all[i]).collect();
+        let loads: Vec<f64> = (0..all.len()).filter(|i| missing.contains(&(i % first.count))).map(|i| all[i]).collect();
         let names: Vec<String> = missing.iter().map(|k| format!("{}/{}", k + 1, first.count)).collect();
         return Err(Error::Usage(format!(
             "merge: shard(s) {} missing: load scales {} not in any part; give their parts, or --partial to merge the rest with these marked not run",
@@ -217,8 +230,10 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool) -> Result<Merged> {
     }
     if !partial {
         for p in &parts {
-            let not_run: Vec<f64> =
-                (0..p.status.len()).filter(|&j| p.status[j] != STATUS_OK && p.status[j] != STATUS_FAILED).map(|j| p.all[p.indices[j]]).collect();
+            let not_run: Vec<f64> = (0..p.status.len())
+                .filter(|&j| p.status[j] != STATUS_OK && p.status[j] != STATUS_FAILED)
+                .map(|j| p.all[p.indices[j]])
+                .collect();
             if !not_run.is_empty() {
                 return Err(Error::input(
                     &p.path,

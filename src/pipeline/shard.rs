@@ -159,8 +159,7 @@ mod tests {
     #[test]
     fn shards_partition_the_list() {
         for (n, count) in [(64, 4), (7, 3), (3, 3), (1, 1), (10, 4)] {
-            let mut seen: Vec<usize> =
-                (1..=count).flat_map(|index| Shard { index, count }.indices(n)).collect();
+            let mut seen: Vec<usize> = (1..=count).flat_map(|index| Shard { index, count }.indices(n)).collect();
             seen.sort();
             assert_eq!(seen, (0..n).collect::<Vec<_>>(), "{n} {count}");
         }

@@ -144,8 +144,12 @@ fn read_runs(p: &Pipeline, path: &Path, n_t: usize) -> Result<(Vec<Run>, f64)> {
     if sm != [n_c, cols] {
         return Err(bad("multipliers", format!("is {sm:?}, expected [{n_c}, {cols}]")));
     }
-    let read2 = |name: &str| f.dataset(name).and_then(|d| d.read_2d::<f64>()).map_err(|e| bad(name, format!("cannot be read: {e}")));
-    let read1 = |name: &str| f.dataset(name).and_then(|d| d.read_1d::<f64>()).map_err(|e| bad(name, format!("cannot be read: {e}")));
+    let read2 = |name: &str| {
+        f.dataset(name).and_then(|d| d.read_2d::<f64>()).map_err(|e| bad(name, format!("cannot be read: {e}")))
+    };
+    let read1 = |name: &str| {
+        f.dataset(name).and_then(|d| d.read_1d::<f64>()).map_err(|e| bad(name, format!("cannot be read: {e}")))
+    };
     let (x, mult, ls, t) = (read2("x")?, read2("multipliers")?, read1("load_scale")?, read1("t")?);
     if ls.len() != cols || t.len() != cols {
         return Err(bad("load_scale", format!("has {} entries and /t {}, for {cols} columns", ls.len(), t.len())));
@@ -229,6 +233,13 @@ pub fn train_from_snapshots(p: &Pipeline, files: &[PathBuf]) -> Result<(Training
     let n_snapshots = data.x.ncols();
     Ok((
         data,
-        TrainSummary { trained, n_snapshots, full_seconds, n_runs: scales.len(), greedy: None, estimator: Some(estimator) },
+        TrainSummary {
+            trained,
+            n_snapshots,
+            full_seconds,
+            n_runs: scales.len(),
+            greedy: None,
+            estimator: Some(estimator),
+        },
     ))
 }
