@@ -294,7 +294,11 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                 check_output(&out, Origin::Flag("-o"), &[(&p.path, "pipeline file"), (&p.model.path, "model file")])?;
                 let scales = flexrom::pipeline::snapshots::job_scales(&p, load_scale, shard)?;
                 let (n, secs) = flexrom::pipeline::snapshots::write_snapshots(&p, &scales, &out)?;
-                note(&format!("{}: {n} full run(s) at {scales:?} ({secs:.3} s) -> {}", p.path.display(), out.display()));
+                note(&format!(
+                    "{}: {n} full run(s) at {scales:?} ({secs:.3} s) -> {}",
+                    p.path.display(),
+                    out.display()
+                ));
                 return Ok(());
             }
             let origin =
@@ -413,7 +417,9 @@ fn run(cli: Cli) -> flexrom::Result<()> {
         } => {
             let p = Pipeline::load(&pipeline)?;
             if shard.is_some() && output.is_none() {
-                return Err(flexrom::Error::Usage("--shard needs -o PART.h5: every shard writes its own part file".into()));
+                return Err(flexrom::Error::Usage(
+                    "--shard needs -o PART.h5: every shard writes its own part file".into(),
+                ));
             }
             let scales = match load_scales {
                 Some(s) => flexrom::pipeline::config::parse_range(&s)
