@@ -35,6 +35,9 @@ struct Cli {
     /// a run whose strain or step cuts leave plausible bounds warns instead of failing
     #[arg(long, global = true)]
     allow_blowup: bool,
+    /// worker threads (default: env RAYON_NUM_THREADS, else SLURM_CPUS_PER_TASK, else one per core)
+    #[arg(long, global = true, value_name = "N")]
+    threads: Option<usize>,
 }
 
 #[derive(clap::Args)]
@@ -90,6 +93,22 @@ enum Command {
         /// basis file to write (default: the pipeline's `basis`)
         #[arg(long)]
         basis: Option<PathBuf>,
+        /// only run the full model (at --load-scale X, or at the --shard K/N part of
+        /// train.load_scales) and write its snapshots to -o; no basis
+        #[arg(long, requires = "output", conflicts_with_all = ["from_snapshots", "basis"])]
+        snapshots_only: bool,
+        /// the load scale of a --snapshots-only run
+        #[arg(long, requires = "snapshots_only", conflicts_with = "shard")]
+        load_scale: Option<f64>,
+        /// `K/N`: the --snapshots-only runs of loads K, K+N, … of train.load_scales
+        #[arg(long, value_name = "K/N", requires = "snapshots_only")]
+        shard: Option<flexrom::pipeline::shard::Shard>,
+        /// snapshot file of --snapshots-only
+        #[arg(short, long, requires = "snapshots_only")]
+        output: Option<PathBuf>,
+        /// build the basis from these snapshot files instead of running the full model
+        #[arg(long, num_args = 1.., value_name = "SNAPS.h5")]
+        from_snapshots: Vec<PathBuf>,
     },
     /// Run the reduced model at one load scale and write a result file.
     Online {
@@ -165,6 +184,23 @@ enum Command {
         /// tolerance ([online] tolerance, default the training tolerance)
         #[arg(long)]
         strict: bool,
+        /// `K/N`: run only the K-th (1-based) of N parts of the load list (loads K, K+N,
+        /// K+2N, …) into the part file given by -o; join the parts with `flexrom merge`
+        #[arg(long, value_name = "K/N")]
+        shard: Option<flexrom::pipeline::shard::Shard>,
+    },
+    /// Join the part files of `sweep --shard` into the file one `sweep` writes.
+    Merge {
+        /// part files (`sweep --shard K/N -o PART.h5`), one per shard, in any order
+        #[arg(required = true)]
+        parts: Vec<PathBuf>,
+        /// sweep file to write
+        #[arg(short, long)]
+        output: PathBuf,
+        /// merge the parts there are; loads of missing shards or not run are marked
+        /// `status` 2 (not run yet), which `sweep --resume` on the merged file runs
+        #[arg(long)]
+        partial: bool,
     },
     /// Train, sweep, validate and write a report folder (Markdown and SVG plots).
     Run {
@@ -204,6 +240,10 @@ fn main() -> ExitCode {
         return ExitCode::FAILURE;
     }
     flexrom::single_threaded_blas();
+    if let Err(e) = flexrom::pipeline::shard::configure_threads(cli.threads) {
+        note(&format!("error: {e}"));
+        return ExitCode::from(e.exit_code());
+    }
     let limits = flexrom::limits::from_env(
         cli.max_memory.as_deref(),
         cli.max_steps.as_deref(),
@@ -247,8 +287,20 @@ fn run(cli: Cli) -> flexrom::Result<()> {
             }
             Ok(())
         }
-        Command::Train { pipeline, basis } => {
+        Command::Train { pipeline, basis, snapshots_only, load_scale, shard, output, from_snapshots } => {
             let p = Pipeline::load(&pipeline)?;
+            if snapshots_only {
+                let out = output.expect("clap: --snapshots-only requires -o");
+                check_output(&out, Origin::Flag("-o"), &[(&p.path, "pipeline file"), (&p.model.path, "model file")])?;
+                let scales = flexrom::pipeline::snapshots::job_scales(&p, load_scale, shard)?;
+                let (n, secs) = flexrom::pipeline::snapshots::write_snapshots(&p, &scales, &out)?;
+                note(&format!(
+                    "{}: {n} full run(s) at {scales:?} ({secs:.3} s) -> {}",
+                    p.path.display(),
+                    out.display()
+                ));
+                return Ok(());
+            }
             let origin =
                 if basis.is_some() { Origin::Flag("--basis") } else { Origin::Key { pipeline: &p.path, key: "basis" } };
             let out = basis.clone().unwrap_or_else(|| p.basis_path.clone());
@@ -256,7 +308,18 @@ fn run(cli: Cli) -> flexrom::Result<()> {
             // trained into a temporary file, read back and checked, and only then renamed over
             // the previous basis
             let staged = TempPath::file_for(&out)?;
-            let s = flexrom::pipeline::train::train_and_write(&p, staged.path())?;
+            let s = if from_snapshots.is_empty() {
+                flexrom::pipeline::train::train_and_write(&p, staged.path())?
+            } else {
+                for f in &from_snapshots {
+                    if flexrom::io::output::resolve(f) == flexrom::io::output::resolve(&out) {
+                        return Err(flexrom::Error::input(&out, "--basis", "is one of the --from-snapshots files"));
+                    }
+                }
+                let (data, s) = flexrom::pipeline::snapshots::train_from_snapshots(&p, &from_snapshots)?;
+                flexrom::pipeline::train::write_trained(&p, staged.path(), &data, &s)?;
+                s
+            };
             load_basis(&p, staged.path())?;
             staged.commit()?;
             let b = &s.trained.basis;
@@ -350,8 +413,14 @@ fn run(cli: Cli) -> flexrom::Result<()> {
             basis,
             resume,
             strict,
+            shard,
         } => {
             let p = Pipeline::load(&pipeline)?;
+            if shard.is_some() && output.is_none() {
+                return Err(flexrom::Error::Usage(
+                    "--shard needs -o PART.h5: every shard writes its own part file".into(),
+                ));
+            }
             let scales = match load_scales {
                 Some(s) => flexrom::pipeline::config::parse_range(&s)
                     .map_err(|e| flexrom::Error::Usage(format!("--load-scales: {e}")))?,
@@ -385,20 +454,34 @@ fn run(cli: Cli) -> flexrom::Result<()> {
             if in_report {
                 claim_in_report(&p.report_dir, &p.path, "sweep.h5")?;
             }
-            let sw = flexrom::pipeline::sweep::sweep_to_file(
-                &p.model,
-                &stored,
-                Some(&trust),
-                &path,
-                &scales,
-                options,
-                &out,
-                resume,
-            )?;
+            let sw = match shard {
+                Some(k) => flexrom::pipeline::shard::sweep_shard(
+                    &p,
+                    &stored,
+                    Some(&trust),
+                    &path,
+                    &scales,
+                    k,
+                    options,
+                    &out,
+                    resume,
+                )?,
+                None => flexrom::pipeline::sweep::sweep_to_file(
+                    &p.model,
+                    &stored,
+                    Some(&trust),
+                    &path,
+                    &scales,
+                    options,
+                    &out,
+                    resume,
+                )?,
+            };
             output::print(&flexrom::pipeline::sweep::table(&sw))?;
             note(&format!(
-                "{} load scales ({} resumed) on {} threads in {:.3} s -> {}",
-                scales.len(),
+                "{}{} load scales ({} resumed) on {} threads in {:.3} s -> {}",
+                shard.map(|k| format!("shard {k}: ")).unwrap_or_default(),
+                sw.scales.len(),
                 sw.resumed,
                 sw.threads,
                 sw.wall_seconds,
@@ -418,6 +501,25 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                 .map(|q| (q.rom.result.settings.load_scale, q.estimate.map(|e| e.error_estimate)))
                 .collect();
             flexrom::pipeline::estimate::check_runs(&trust, &runs, strict)
+        }
+        Command::Merge { parts, output, partial } => {
+            let inputs: Vec<(&std::path::Path, &str)> = parts.iter().map(|p| (p.as_path(), "part file")).collect();
+            check_output(&output, Origin::Flag("-o"), &inputs)?;
+            let m = flexrom::pipeline::merge::merge(&parts, &output, partial)?;
+            note(&format!(
+                "{} parts, {} load scales ({} not run) -> {}",
+                m.parts,
+                m.sweep.scales.len(),
+                m.gaps,
+                output.display()
+            ));
+            if let Some(s) = m.sweep.failure_summary() {
+                return Err(flexrom::Error::PartlyFailed(format!(
+                    "{s} (the others are in {}; /status and /message say which)",
+                    output.display()
+                )));
+            }
+            Ok(())
         }
         Command::Run { pipeline, strict } => {
             let p = Pipeline::load(&pipeline)?;

@@ -6,9 +6,12 @@
 pub mod config;
 pub mod estimate;
 pub mod greedy;
+pub mod merge;
 pub mod online;
 pub mod plot;
 pub mod report;
+pub mod shard;
+pub mod snapshots;
 pub mod sweep;
 pub mod train;
 pub mod validate;

@@ -218,6 +218,25 @@ pub fn sweep_to_file(
     out: &Path,
     resume: bool,
 ) -> Result<Sweep> {
+    sweep_to_file_with(model, stored, trust, basis_path, scales, o, out, resume, &|_| Ok(()))
+}
+
+/// Extra content written into every version of a sweep file (a shard's `/shard` group).
+pub type Extra<'a> = &'a (dyn Fn(&hdf5::File) -> Result<()> + Sync);
+
+/// [`sweep_to_file`] with `extra` written into the file at every checkpoint.
+#[allow(clippy::too_many_arguments)]
+pub fn sweep_to_file_with(
+    model: &Model,
+    stored: &StoredBasis,
+    trust: Option<&TrustInfo>,
+    basis_path: &Path,
+    scales: &[f64],
+    o: SweepOptions,
+    out: &Path,
+    resume: bool,
+    extra: Extra,
+) -> Result<Sweep> {
     let basis = &stored.basis;
     let mut start = pending(model, basis, scales, o)?;
     if resume {
@@ -249,7 +268,7 @@ pub fn sweep_to_file(
             eprintln!("resuming {}: no such file yet, running all {} load scales", out.display(), scales.len());
         }
     }
-    let write = |s: &Sweep| write_sweep(out, s, stored, basis_path);
+    let write = |s: &Sweep| write_sweep_with(out, s, stored, basis_path, extra);
     let sw = run_pending(model, basis, trust, start, o, Some(&write))?;
     write(&sw)?;
     Ok(sw)
@@ -402,6 +421,11 @@ fn clone_point(p: &SweepPoint) -> SweepPoint {
 
 /// Writes the sweep file (atomically: a temporary file renamed over `path`).
 pub fn write_sweep(path: &Path, s: &Sweep, stored: &StoredBasis, basis_path: &Path) -> Result<()> {
+    write_sweep_with(path, s, stored, basis_path, &|_| Ok(()))
+}
+
+/// [`write_sweep`] with `extra` written into the file before it is renamed into place.
+pub fn write_sweep_with(path: &Path, s: &Sweep, stored: &StoredBasis, basis_path: &Path, extra: Extra) -> Result<()> {
     let basis = &stored.basis;
     let (n, nt, r) = (s.scales.len(), s.t.len(), s.n_reduced);
     if n == 0 {
@@ -492,14 +516,15 @@ pub fn write_sweep(path: &Path, s: &Sweep, stored: &StoredBasis, basis_path: &Pa
         attr_u64(f, "continuation", s.continuation as u64).map_err(e)?;
         attr_u64(f, "n_failed", s.n_failed() as u64).map_err(e)?;
         attr_u64(f, "n_pending", s.scales.iter().filter(|x| x.status() == STATUS_PENDING).count() as u64).map_err(e)?;
-        attr_str(f, "program_version", env!("CARGO_PKG_VERSION")).map_err(e)
+        attr_str(f, "program_version", env!("CARGO_PKG_VERSION")).map_err(e)?;
+        extra(f)
     })
 }
 
 /// Reads an earlier sweep file for `--resume`: (load scale, the finished run) for every
 /// scale it holds, `None` for those that failed or did not run. Refuses a file of another
 /// basis or model, and one without the validation a `--validate` sweep needs.
-fn read_sweep(
+pub fn read_sweep(
     path: &Path,
     model: &Model,
     stored: &StoredBasis,

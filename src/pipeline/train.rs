@@ -164,6 +164,12 @@ pub fn build_basis(
 /// Trains and writes the basis file atomically (a failed run keeps the previous file).
 pub fn train_and_write(p: &Pipeline, out: &Path) -> Result<TrainSummary> {
     let (data, summary) = train(p)?;
+    write_trained(p, out, &data, &summary)?;
+    Ok(summary)
+}
+
+/// Writes the basis file of a finished training atomically.
+pub fn write_trained(p: &Pipeline, out: &Path, data: &TrainingData, summary: &TrainSummary) -> Result<()> {
     let meta = BasisMeta {
         model_text: p.model.text.clone(),
         model_path: p.model.path.display().to_string(),
@@ -175,7 +181,7 @@ pub fn train_and_write(p: &Pipeline, out: &Path) -> Result<TrainSummary> {
         },
         settings_hash: crate::io::basis_check::settings_hash(p),
     };
-    write_basis_with(out, &data, &summary.trained, &meta, |f| {
+    write_basis_with(out, data, &summary.trained, &meta, |f| {
         if let Some(est) = &summary.estimator {
             crate::io::estimator_file::write_estimator(f, est).map_err(|e| Error::hdf5(out, e))?;
         }
@@ -183,6 +189,5 @@ pub fn train_and_write(p: &Pipeline, out: &Path) -> Result<TrainSummary> {
             super::greedy::write_training(f, g).map_err(|e| Error::hdf5(out, e))?;
         }
         Ok(())
-    })?;
-    Ok(summary)
+    })
 }

@@ -1,0 +1,289 @@
+//! `merge`: the part files of a sharded sweep ([`super::shard`]) joined into the file a
+//! single `sweep` over the whole list writes: the same datasets with the same values (the
+//! runs' rows are read back and written by the same writer, [`super::sweep::write_sweep`]).
+//! Only the whole-sweep attributes differ in meaning: `wall_seconds` is the longest part's
+//! (the parts ran side by side) and `threads` the sum of the parts' threads.
+//!
+//! Checks, each failing with one line that names the file: every part is a part file (has
+//! `/shard`), all come from the same load list (hash), the same shard count, the same basis
+//! content and model, and the same options (`--validate`, `--continuation`). Two parts of
+//! the same shard are refused (naming both files and the loads); a missing shard, or loads a
+//! part has not run yet (a killed shard), are refused naming the loads, unless `--partial`,
+//! which merges what is there and marks the gaps `status` 2 ("not run yet"), so that
+//! `sweep --resume` on the merged file runs exactly the gaps.
+
+use super::config::Pipeline;
+use super::online::load_basis;
+use super::shard::load_list_hash;
+use super::sweep::{read_sweep, write_sweep, Outcome, ScaleResult, Sweep, STATUS_FAILED, STATUS_OK};
+use crate::error::{Error, Result};
+use crate::io::h5::{read_attr_f64, read_attr_str};
+use crate::simulate::{Overrides, Settings};
+use hdf5::types::VarLenUnicode;
+use ndarray::Array1;
+use std::path::{Path, PathBuf};
+
+/// What one part file says about itself.
+struct Part {
+    path: PathBuf,
+    index: usize,
+    count: usize,
+    list_hash: String,
+    all: Vec<f64>,
+    indices: Vec<usize>,
+    status: Vec<u8>,
+    message: Vec<String>,
+    basis_hash: String,
+    model_fingerprint: String,
+    validated: bool,
+    continuation: bool,
+    wall_seconds: f64,
+    threads: u64,
+    pipeline: PathBuf,
+    basis: PathBuf,
+    basis_attr: String,
+}
+
+fn read_part(path: &Path) -> Result<Part> {
+    let bad = |field: &str, problem: String| Error::input(path, field, problem);
+    let f = hdf5::File::open(path).map_err(|e| bad("(file)", format!("is not a readable HDF5 file: {e}")))?;
+    let g = f.group("shard").map_err(|_| {
+        bad(
+            "shard",
+            "is missing: not a part file of `flexrom sweep --shard K/N` (a merged or plain sweep file?)".into(),
+        )
+    })?;
+    let u = |name: &str| -> Result<u64> {
+        g.attr(name)
+            .and_then(|a| a.read_scalar::<u64>())
+            .map_err(|e| bad(&format!("shard/{name}"), format!("cannot be read: {e}")))
+    };
+    let s = |loc: &hdf5::Location, name: &str| {
+        read_attr_str(loc, name).map_err(|e| bad(name, format!("cannot be read ({e}): not a flexrom part file?")))
+    };
+    let (index, count) = (u("index")? as usize, u("count")? as usize);
+    if index == 0 || index > count {
+        return Err(bad("shard/index", format!("is {index} of {count}: need 1 ≤ index ≤ count")));
+    }
+    let all = g
+        .dataset("all_load_scales")
+        .and_then(|d| d.read_1d::<f64>())
+        .map_err(|e| bad("shard/all_load_scales", format!("cannot be read: {e}")))?
+        .to_vec();
+    let list_hash = s(&g, "load_list_hash")?;
+    if load_list_hash(&all) != list_hash {
+        return Err(bad("shard/load_list_hash", "does not match shard/all_load_scales (a damaged file)".into()));
+    }
+    let indices: Vec<usize> = g
+        .dataset("indices")
+        .and_then(|d| d.read_1d::<u64>())
+        .map_err(|e| bad("shard/indices", format!("cannot be read: {e}")))?
+        .iter()
+        .map(|&i| i as usize)
+        .collect();
+    let scales = f
+        .dataset("load_scales")
+        .and_then(|d| d.read_1d::<f64>())
+        .map_err(|e| bad("load_scales", format!("cannot be read: {e}")))?;
+    let status = f
+        .dataset("status")
+        .and_then(|d| d.read_1d::<u8>())
+        .map_err(|e| bad("status", format!("cannot be read: {e}")))?
+        .to_vec();
+    let message: Vec<String> = f
+        .dataset("message")
+        .and_then(|d| d.read_1d::<VarLenUnicode>())
+        .map_err(|e| bad("message", format!("cannot be read: {e}")))?
+        .iter()
+        .map(|m| m.as_str().to_string())
+        .collect();
+    let n = scales.len();
+    if indices.len() != n || status.len() != n || message.len() != n {
+        return Err(bad(
+            "shard/indices",
+            format!(
+                "has {} entries, /status {}, /message {}, for {n} load scales",
+                indices.len(),
+                status.len(),
+                message.len()
+            ),
+        ));
+    }
+    if indices != (index - 1..all.len()).step_by(count).collect::<Vec<_>>()
+        || indices.iter().zip(scales.iter()).any(|(&i, &x)| all[i].to_bits() != x.to_bits())
+    {
+        return Err(bad(
+            "shard/indices",
+            format!("are not the loads of shard {index}/{count} of shard/all_load_scales (a damaged file)"),
+        ));
+    }
+    let flag = |name: &str| -> Result<bool> {
+        f.attr(name)
+            .and_then(|a| a.read_scalar::<u64>())
+            .map(|v| v != 0)
+            .map_err(|e| bad(name, format!("cannot be read: {e}")))
+    };
+    Ok(Part {
+        path: path.to_path_buf(),
+        index,
+        count,
+        list_hash,
+        all,
+        indices,
+        status,
+        message,
+        basis_hash: s(&f, "basis_content_hash")?,
+        model_fingerprint: s(&f, "model_fingerprint")?,
+        validated: flag("validated")?,
+        continuation: flag("continuation")?,
+        wall_seconds: read_attr_f64(&f, "wall_seconds").unwrap_or(f64::NAN),
+        threads: f.attr("threads").and_then(|a| a.read_scalar::<u64>()).unwrap_or(1),
+        pipeline: PathBuf::from(s(&g, "pipeline")?),
+        basis: PathBuf::from(s(&g, "basis")?),
+        basis_attr: s(&f, "basis")?,
+    })
+}
+
+/// A few load scales for a message: "0.5, 0.53, 0.56 and 13 more".
+fn some(xs: &[f64]) -> String {
+    let shown: Vec<String> = xs.iter().take(4).map(|x| x.to_string()).collect();
+    if xs.len() > 4 {
+        format!("{} and {} more", shown.join(", "), xs.len() - 4)
+    } else {
+        shown.join(", ")
+    }
+}
+
+pub struct Merged {
+    pub sweep: Sweep,
+    /// loads no part has run (`--partial` only)
+    pub gaps: usize,
+    pub parts: usize,
+}
+
+/// Joins `parts` into `out` (atomically; the caller has checked that `out` may be written).
+pub fn merge(parts: &[PathBuf], out: &Path, partial: bool) -> Result<Merged> {
+    if parts.is_empty() {
+        return Err(Error::Usage("merge: no part files given".into()));
+    }
+    let parts: Vec<Part> = parts.iter().map(|p| read_part(p)).collect::<Result<_>>()?;
+    let first = &parts[0];
+    for p in &parts[1..] {
+        let differ = |field: &str, what: &str| {
+            Error::input(
+                &p.path,
+                field,
+                format!("{what} than {}; parts of different sweeps cannot be merged", first.path.display()),
+            )
+        };
+        if p.basis_hash != first.basis_hash {
+            return Err(differ("basis_content_hash", "comes from another basis"));
+        }
+        if p.model_fingerprint != first.model_fingerprint {
+            return Err(differ("model_fingerprint", "comes from another model"));
+        }
+        if p.list_hash != first.list_hash {
+            return Err(differ("shard/load_list_hash", "comes from another load list"));
+        }
+        if p.count != first.count {
+            return Err(differ(
+                "shard/count",
+                &format!("is one of {} shards, not of {}, (another split)", p.count, first.count),
+            ));
+        }
+        if p.validated != first.validated {
+            return Err(differ("validated", "was run with another --validate"));
+        }
+        if p.continuation != first.continuation {
+            return Err(differ("continuation", "was run with another --continuation"));
+        }
+    }
+    // who holds each shard
+    let mut holder: Vec<Option<usize>> = vec![None; first.count];
+    for (j, p) in parts.iter().enumerate() {
+        if let Some(other) = holder[p.index - 1] {
+            let loads: Vec<f64> = p.indices.iter().map(|&i| p.all[i]).collect();
+            return Err(Error::input(
+                &p.path,
+                "shard/index",
+                format!(
+                    "is shard {}/{} again, as is {} (duplicate load scales {}); give each shard once",
+                    p.index,
+                    p.count,
+                    parts[other].path.display(),
+                    some(&loads)
+                ),
+            ));
+        }
+        holder[p.index - 1] = Some(j);
+    }
+    let all = &first.all;
+    let missing: Vec<usize> = (0..first.count).filter(|&k| holder[k].is_none()).collect();
+    if !missing.is_empty() && !partial {
+        let loads: Vec<f64> = (0..all.len()).filter(|i| missing.contains(&(i % first.count))).map(|i| all[i]).collect();
+        let names: Vec<String> = missing.iter().map(|k| format!("{}/{}", k + 1, first.count)).collect();
+        return Err(Error::Usage(format!(
+            "merge: shard(s) {} missing: load scales {} not in any part; give their parts, or --partial to merge the rest with these marked not run",
+            names.join(", "),
+            some(&loads)
+        )));
+    }
+    if !partial {
+        for p in &parts {
+            let not_run: Vec<f64> = (0..p.status.len())
+                .filter(|&j| p.status[j] != STATUS_OK && p.status[j] != STATUS_FAILED)
+                .map(|j| p.all[p.indices[j]])
+                .collect();
+            if !not_run.is_empty() {
+                return Err(Error::input(
+                    &p.path,
+                    "status",
+                    format!(
+                        "load scales {} were not run (the shard did not finish); rerun it with --resume, or merge --partial",
+                        some(&not_run)
+                    ),
+                ));
+            }
+        }
+    }
+    // the model and basis the parts were run with, checked against the parts' basis hash
+    let pipeline = Pipeline::load(&first.pipeline)?;
+    let stored = load_basis(&pipeline, &first.basis)?;
+    if stored.content_hash != first.basis_hash {
+        return Err(Error::input(
+            &first.basis,
+            "basis_content_hash",
+            format!(
+                "differs from the one the parts were swept with ({}): the basis changed since; rerun the sweep",
+                first.path.display()
+            ),
+        ));
+    }
+    let model = &pipeline.model;
+    let s = Settings::resolve(model, &Overrides::default())?;
+    let mut sweep = Sweep {
+        scales: all.iter().map(|&x| ScaleResult { load_scale: x, outcome: Outcome::Pending }).collect(),
+        t: Array1::from_iter((0..=s.n_steps).map(|k| k as f64 * s.dt)),
+        probe_names: model.probe_names(),
+        n_reduced: stored.basis.n_reduced(),
+        validated: first.validated,
+        wall_seconds: parts.iter().map(|p| p.wall_seconds).fold(0.0, f64::max),
+        threads: parts.iter().map(|p| p.threads as usize).sum(),
+        continuation: first.continuation,
+        resumed: 0,
+    };
+    for p in &parts {
+        let rows = read_sweep(&p.path, model, &stored, p.validated)?;
+        for (j, (_, point)) in rows.into_iter().enumerate() {
+            let i = p.indices[j];
+            sweep.scales[i].outcome = match (p.status[j], point) {
+                (STATUS_OK, Some(pt)) => Outcome::Done(pt),
+                (STATUS_FAILED, _) => Outcome::Failed(p.message[j].clone()),
+                _ => Outcome::Pending,
+            };
+        }
+    }
+    let gaps = sweep.scales.iter().filter(|x| matches!(x.outcome, Outcome::Pending)).count();
+    write_sweep(out, &sweep, &stored, Path::new(&first.basis_attr))?;
+    Ok(Merged { sweep, gaps, parts: parts.len() })
+}

@@ -1,0 +1,175 @@
+//! `sweep --shard K/N`: the K-th of N deterministic parts of a sweep's load list, written as
+//! a part file that `flexrom merge` ([`super::merge`]) joins into the file a single sweep
+//! writes.
+//!
+//! The parts are strided: load index i (0-based, in the order of the list) belongs to shard
+//! `(i mod N) + 1`. The cost of a run grows or falls with the load along the list, so
+//! striding gives every shard a like share of cheap and dear loads; the assignment depends
+//! on the list and N alone, so every job of an array computes the same parts.
+//!
+//! A part file is a sweep file of its own loads ([`super::sweep`]'s layout, rows in list
+//! order) plus the group `/shard`:
+//!
+//! ```text
+//! /shard/all_load_scales   (N_all)     the whole list, as the sweep was asked for
+//! /shard/indices           (n_part)    u64: row j of the part is load all_load_scales[indices[j]]
+//! attributes on /shard: index (K, 1-based), count (N), load_list_hash (SHA-256 hex of the
+//!   list: its length, then each value's IEEE-754 bits, little-endian), pipeline and basis
+//!   (absolute paths, for `merge`)
+//! ```
+
+use super::config::Pipeline;
+use super::estimate::TrustInfo;
+use super::sweep::{sweep_to_file_with, Sweep, SweepOptions};
+use crate::error::{Error, Result};
+use crate::io::basis_file::StoredBasis;
+use crate::io::h5::{attr_str, attr_u64};
+use ndarray::Array1;
+use sha2::{Digest, Sha256};
+use std::path::Path;
+
+/// One part of N (`index` 1-based).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Shard {
+    pub index: usize,
+    pub count: usize,
+}
+
+impl std::str::FromStr for Shard {
+    type Err = String;
+
+    /// `K/N` with 1 ≤ K ≤ N.
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        let (k, n) = s.split_once('/').ok_or_else(|| format!("`{s}` is not K/N (e.g. 2/8)"))?;
+        let k: usize = k.trim().parse().map_err(|_| format!("`{s}`: K is not a whole number"))?;
+        let n: usize = n.trim().parse().map_err(|_| format!("`{s}`: N is not a whole number"))?;
+        if n == 0 || k == 0 || k > n {
+            return Err(format!("`{s}`: need 1 ≤ K ≤ N (K counts from 1)"));
+        }
+        Ok(Shard { index: k, count: n })
+    }
+}
+
+impl std::fmt::Display for Shard {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
+impl Shard {
+    /// The indices into a list of `n` loads that belong to this shard, in order.
+    pub fn indices(&self, n: usize) -> Vec<usize> {
+        (0..n).filter(|i| i % self.count == self.index - 1).collect()
+    }
+}
+
+/// SHA-256 (hex) of a load list: its length, then each value's bits (little-endian), so
+/// that two lists hash alike only when they are the same values in the same order.
+pub fn load_list_hash(scales: &[f64]) -> String {
+    let mut h = Sha256::new();
+    h.update((scales.len() as u64).to_le_bytes());
+    for x in scales {
+        h.update(x.to_bits().to_le_bytes());
+    }
+    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// The loads of `shard` in `all`, or a usage error when it holds none.
+pub fn shard_scales(all: &[f64], shard: Shard) -> Result<(Vec<usize>, Vec<f64>)> {
+    let idx = shard.indices(all.len());
+    if idx.is_empty() {
+        return Err(Error::Usage(format!(
+            "--shard {shard}: a list of {} load scales has no load for shard {}; use at most {} shards",
+            all.len(),
+            shard.index,
+            all.len()
+        )));
+    }
+    let scales = idx.iter().map(|&i| all[i]).collect();
+    Ok((idx, scales))
+}
+
+/// Runs the loads of `shard` and writes the part file `out` (checkpointed like a sweep,
+/// every version with its `/shard` group, so a killed shard leaves a part that `--resume`
+/// finishes and `merge --partial` reads).
+#[allow(clippy::too_many_arguments)]
+pub fn sweep_shard(
+    p: &Pipeline,
+    stored: &StoredBasis,
+    trust: Option<&TrustInfo>,
+    basis_path: &Path,
+    all: &[f64],
+    shard: Shard,
+    o: SweepOptions,
+    out: &Path,
+    resume: bool,
+) -> Result<Sweep> {
+    let (idx, scales) = shard_scales(all, shard)?;
+    let hash = load_list_hash(all);
+    let pipeline = crate::io::output::resolve(&p.path).display().to_string();
+    let basis = crate::io::output::resolve(basis_path).display().to_string();
+    let extra = |f: &hdf5::File| -> Result<()> {
+        let e = |err: hdf5::Error| Error::hdf5(out, err);
+        let g = f.create_group("shard").map_err(e)?;
+        g.new_dataset_builder().with_data(&Array1::from(all.to_vec())).create("all_load_scales").map_err(e)?;
+        g.new_dataset_builder()
+            .with_data(&Array1::from_iter(idx.iter().map(|&i| i as u64)))
+            .create("indices")
+            .map_err(e)?;
+        attr_u64(&g, "index", shard.index as u64).map_err(e)?;
+        attr_u64(&g, "count", shard.count as u64).map_err(e)?;
+        attr_str(&g, "load_list_hash", &hash).map_err(e)?;
+        attr_str(&g, "pipeline", &pipeline).map_err(e)?;
+        attr_str(&g, "basis", &basis).map_err(e)
+    };
+    sweep_to_file_with(&p.model, stored, trust, basis_path, &scales, o, out, resume, &extra)
+}
+
+/// Sets the size of the worker pool: `--threads` when given, else `RAYON_NUM_THREADS` (read
+/// by rayon itself), else `SLURM_CPUS_PER_TASK` (a Slurm job step gets that many CPUs,
+/// however many the node has), else one per core. A bad value is a usage error naming it.
+pub fn configure_threads(flag: Option<usize>) -> Result<()> {
+    let from_env = |name: &str| -> Result<Option<usize>> {
+        match std::env::var(name) {
+            Ok(v) if !v.trim().is_empty() => match v.trim().parse::<usize>() {
+                Ok(n) if n > 0 => Ok(Some(n)),
+                _ => Err(Error::Usage(format!("environment variable {name}=`{v}` is not a positive whole number"))),
+            },
+            _ => Ok(None),
+        }
+    };
+    let n = match flag {
+        Some(0) => return Err(Error::Usage("--threads must be at least 1".into())),
+        Some(n) => Some(n),
+        None if std::env::var_os("RAYON_NUM_THREADS").is_some() => None,
+        None => from_env("SLURM_CPUS_PER_TASK")?,
+    };
+    if let Some(n) = n {
+        // fails only when the pool was built already (it is not: this runs first in main)
+        let _ = rayon::ThreadPoolBuilder::new().num_threads(n).build_global();
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every index in exactly one shard, strided, and K/N parsed with its bounds.
+    #[test]
+    fn shards_partition_the_list() {
+        for (n, count) in [(64, 4), (7, 3), (3, 3), (1, 1), (10, 4)] {
+            let mut seen: Vec<usize> = (1..=count).flat_map(|index| Shard { index, count }.indices(n)).collect();
+            seen.sort();
+            assert_eq!(seen, (0..n).collect::<Vec<_>>(), "{n} {count}");
+        }
+        assert_eq!(Shard { index: 2, count: 4 }.indices(10), vec![1, 5, 9]);
+        assert_eq!("3/8".parse::<Shard>(), Ok(Shard { index: 3, count: 8 }));
+        for bad in ["0/4", "5/4", "1/0", "2", "a/4", "1/b"] {
+            assert!(bad.parse::<Shard>().is_err(), "{bad}");
+        }
+        assert!(shard_scales(&[1.0, 2.0], Shard { index: 3, count: 3 }).is_err());
+        assert_ne!(load_list_hash(&[1.0, 2.0]), load_list_hash(&[2.0, 1.0]));
+        assert_ne!(load_list_hash(&[1.0]), load_list_hash(&[1.0, 1.0]));
+    }
+}
