@@ -380,7 +380,10 @@ pub fn load_trust(
     use crate::error::Error;
     use crate::io::estimator_file::{read_estimator, read_training_range, read_training_tolerance};
     use crate::solver::model::DynamicModel;
-    let estimator = read_estimator(path, &stored.basis)?;
+    let mut estimator = read_estimator(path, &stored.basis)?;
+    if let (Some(e), Some(m)) = (&mut estimator, p.file.online.as_ref().and_then(|o| o.estimate)) {
+        e.method = m;
+    }
     if let Some(e) = &estimator {
         let sys = p.model.system(Default::default());
         let err = |(field, problem): (String, String)| Error::input(path, format!("estimator/{field}"), problem);
