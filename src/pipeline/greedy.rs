@@ -580,3 +580,25 @@ pub fn write_training(f: &hdf5::File, r: &GreedyRecord) -> hdf5::Result<()> {
     attr_u64(&g, "full_runs", r.full_runs as u64)?;
     attr_u64(&g, "converged", r.converged as u64)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::score;
+
+    /// Where the sensitivity stays below T the score is the largest estimate; a window
+    /// whose sensitivity exceeds T holds its estimate to that sensitivity instead; NaN
+    /// counts as ∞.
+    #[test]
+    fn score_holds_sensitive_windows_to_their_sensitivity() {
+        let t = 1e-2;
+        let calm = [1e-4; 5];
+        assert_eq!(score(t, &[1e-3, 2e-3, 3e-3, 4e-3, 5e-3], &calm), 5e-3);
+        // the last two fifths are sensitive (s = 0.2): an estimate of 0.1 there scores
+        // T·0.1/0.2 = 5e-3, below the early windows' 6e-3
+        let s = [1e-4, 1e-4, 1e-3, 0.2, 0.2];
+        assert!((score(t, &[1e-3, 2e-3, 6e-3, 0.1, 0.1], &s) - 6e-3).abs() < 1e-15);
+        // above the sensitivity it still counts, scaled: 0.4 against 0.2 scores 2 T
+        assert!((score(t, &[1e-3, 2e-3, 6e-3, 0.1, 0.4], &s) - 2e-2).abs() < 1e-15);
+        assert!(score(t, &[f64::NAN, 0.0, 0.0, 0.0, 0.0], &calm).is_infinite());
+    }
+}
