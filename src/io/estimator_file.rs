@@ -172,6 +172,7 @@ pub fn read_estimator(path: &Path, basis: &Basis) -> Result<Option<Estimator>> {
         block_modes,
         extra_modes: count("extra_modes")? as usize,
         calibration: Calibration { factor, calibrated: count("calibrated")? != 0, points },
+        method: Default::default(),
     }))
 }
 

@@ -183,6 +183,10 @@ pub struct OnlineSpec {
     pub load_scales: Scales,
     #[serde(default)]
     pub tolerance: Option<f64>,
+    /// how every reduced run computes its error estimate: "corrected" (default) or
+    /// "enriched" (docs/error-estimate.md)
+    #[serde(default)]
+    pub estimate: Option<super::estimate::EstimateMethod>,
 }
 
 #[derive(Clone, Debug, Deserialize)]

@@ -25,6 +25,7 @@
 //!     ‖x_ref + V⁺ q⁺‖² = ‖x_ref‖² + 2 (V⁺ᵀx_ref)·q⁺ + ‖q⁺‖².
 //! ```
 
+use super::estimate_corrected::CorrectedRunner;
 use super::online::{Output, ReducedRun, ReducedRunner};
 use crate::error::Result;
 use crate::model::Model;
@@ -56,6 +57,38 @@ pub struct Estimator {
     /// `k` requested per block (capped by the rank of each block's snapshots)
     pub extra_modes: usize,
     pub calibration: Calibration,
+    /// how a run computes the estimate (not stored in the basis file: a run-time choice,
+    /// `[online] estimate` in the pipeline or `--estimate`)
+    pub method: EstimateMethod,
+}
+
+/// How the enriched model's trajectory `X⁺` is obtained (docs/error-estimate.md).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum EstimateMethod {
+    /// the default: one modified-Newton iteration of the enriched model per step, from the
+    /// reduced run's increments ([`super::estimate_corrected`])
+    #[default]
+    Corrected,
+    /// the enriched model integrated on its own to convergence (about 2× the reduced run)
+    Enriched,
+}
+
+impl EstimateMethod {
+    pub fn name(self) -> &'static str {
+        match self {
+            EstimateMethod::Corrected => "corrected",
+            EstimateMethod::Enriched => "enriched",
+        }
+    }
+
+    pub fn parse(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "corrected" => Ok(EstimateMethod::Corrected),
+            "enriched" => Ok(EstimateMethod::Enriched),
+            _ => Err(format!("is \"{s}\"; expected \"corrected\" (default) or \"enriched\"")),
+        }
+    }
 }
 
 /// One held-out load: the raw estimate of a basis there and its true `rel_error`.
@@ -92,6 +125,9 @@ pub struct Estimate {
     pub calibrated: bool,
     /// wall time of the enriched run's time loop and the norms, s
     pub seconds: f64,
+    /// `c · η_raw` over the instants up to the end of each fifth of the run (as
+    /// [`rel_error_by_time`] for the true error); NaN where unknown
+    pub by_time: [f64; 5],
 }
 
 /// The constant `c` from held-out pairs `(η_i, e_i)`:
@@ -167,6 +203,7 @@ pub fn build_estimator(
         block_modes: richer.block_modes,
         extra_modes: extra,
         calibration: Calibration::default(),
+        method: EstimateMethod::default(),
     })
 }
 
@@ -174,31 +211,46 @@ pub fn build_estimator(
 /// reduced coordinates: by the module documentation's identities when both bases are
 /// orthonormal, by reconstructing `x_ref + V q` otherwise (whole-system).
 pub fn raw_estimate(basis: &Basis, est: &Estimator, rom: &ReducedRun, enriched: &ReducedRun) -> f64 {
-    let (q, qp) = (&rom.reduced_q, &enriched.reduced_q);
-    if q.ncols() != qp.ncols() {
-        return f64::INFINITY;
-    }
-    if basis.variant == Variant::WholeSystem {
-        // V is not orthonormal: reconstruct x_ref + V q of both
-        let full = |b: &Basis, z: &Array2<f64>| b.modes.dot(z) + b.reference.view().insert_axis(Axis(1));
-        let (a, b) = (full(basis, q), full(&est.enriched, qp));
-        return (&a - &b).mapv(|v| v * v).sum().sqrt() / b.mapv(|v| v * v).sum().sqrt();
-    }
-    raw_estimate_reduced(basis, &est.enriched, q, qp)
+    raw_estimate_by_time(basis, &est.enriched, &rom.reduced_q, &enriched.reduced_q)[4]
 }
 
 /// [`raw_estimate`] from the reduced coordinates `q` (r × n_t) of `basis` and `qp`
 /// (r⁺ × n_t) of `enriched`, both with orthonormal columns and the same reference.
 pub fn raw_estimate_reduced(basis: &Basis, enriched: &Basis, q: &Array2<f64>, qp: &Array2<f64>) -> f64 {
-    let vp = &enriched.modes;
-    let m = vp.t().dot(&basis.modes); // r⁺ × r
-    let mq = m.dot(q);
-    let diff2 = (&mq - qp).mapv(|v| v * v).sum() + (q.mapv(|v| v * v).sum() - mq.mapv(|v| v * v).sum()).max(0.0);
-    let xr = &enriched.reference;
-    let vtx = vp.t().dot(xr);
-    let nt = qp.ncols() as f64;
-    let norm2 = nt * xr.dot(xr) + 2.0 * vtx.dot(&qp.sum_axis(Axis(1))) + qp.mapv(|v| v * v).sum();
-    diff2.sqrt() / norm2.max(0.0).sqrt()
+    raw_estimate_by_time(basis, enriched, q, qp)[4]
+}
+
+/// `η_raw` over the instants up to the end of each fifth of the run (the last entry is the
+/// whole run's), as [`rel_error_by_time`] splits the true error; ∞ when the shapes differ.
+pub fn raw_estimate_by_time(basis: &Basis, enriched: &Basis, q: &Array2<f64>, qp: &Array2<f64>) -> [f64; 5] {
+    let nt = qp.ncols();
+    if q.ncols() != nt || nt == 0 {
+        return [f64::INFINITY; 5];
+    }
+    let (diff2, norm2): (Array1<f64>, Array1<f64>) = if basis.variant == Variant::WholeSystem {
+        // V is not orthonormal: reconstruct x_ref + V q of both
+        let full = |b: &Basis, z: &Array2<f64>| b.modes.dot(z) + b.reference.view().insert_axis(Axis(1));
+        let (a, b) = (full(basis, q), full(enriched, qp));
+        ((&a - &b).mapv(|v| v * v).sum_axis(Axis(0)), b.mapv(|v| v * v).sum_axis(Axis(0)))
+    } else {
+        let vp = &enriched.modes;
+        let m = vp.t().dot(&basis.modes); // r⁺ × r
+        let mq = m.dot(q);
+        let q2 = q.mapv(|v| v * v).sum_axis(Axis(0));
+        let mq2 = mq.mapv(|v| v * v).sum_axis(Axis(0));
+        let d = (&mq - qp).mapv(|v| v * v).sum_axis(Axis(0)) + (&q2 - &mq2).mapv(|v| v.max(0.0));
+        let xr = &enriched.reference;
+        let vtx = vp.t().dot(xr);
+        let norm = xr.dot(xr) + 2.0 * vtx.dot(qp) + qp.mapv(|v| v * v).sum_axis(Axis(0));
+        (d, norm)
+    };
+    let mut out = [0.0; 5];
+    for (i, o) in out.iter_mut().enumerate() {
+        let end = ((nt as f64 * (i + 1) as f64 / 5.0).round() as usize).clamp(1, nt);
+        let (d, n) = (diff2.slice(ndarray::s![..end]).sum(), norm2.slice(ndarray::s![..end]).sum());
+        *o = d.max(0.0).sqrt() / n.max(0.0).sqrt();
+    }
+    out
 }
 
 /// A reduced model and its estimator's model, built once, run at many load scales (a sweep
@@ -206,28 +258,51 @@ pub fn raw_estimate_reduced(basis: &Basis, enriched: &Basis, q: &Array2<f64>, qp
 pub struct EstimatingRunner<'a> {
     basis: &'a Basis,
     rom: ReducedRunner<'a>,
-    est: Option<(&'a Estimator, ReducedRunner<'a>)>,
+    est: Option<(&'a Estimator, EstimatorModel<'a>)>,
+}
+
+/// The estimator's model: the enriched model corrected along the reduced run, or run on its
+/// own (the `enriched` method, and the fallback where the corrected one is not available).
+enum EstimatorModel<'a> {
+    Corrected(Box<CorrectedRunner<'a>>),
+    Enriched(ReducedRunner<'a>),
 }
 
 impl<'a> EstimatingRunner<'a> {
+    /// The estimator runs by `est.method`.
     pub fn new(model: &'a Model, basis: &'a Basis, est: Option<&'a Estimator>) -> Result<Self> {
         let rom = ReducedRunner::new(model, basis)?;
         let est = match est {
-            Some(e) => Some((e, ReducedRunner::new(model, &e.enriched)?)),
+            Some(e) => {
+                let corrected = match e.method {
+                    EstimateMethod::Corrected => CorrectedRunner::new(model, basis, &e.enriched)?,
+                    EstimateMethod::Enriched => None,
+                };
+                let m = match corrected {
+                    Some(c) => EstimatorModel::Corrected(Box::new(c)),
+                    None => EstimatorModel::Enriched(ReducedRunner::new(model, &e.enriched)?),
+                };
+                Some((e, m))
+            }
             None => None,
         };
         Ok(EstimatingRunner { basis, rom, est })
     }
 
+    /// The reduced model alone (no estimate), e.g. for the reduced model's own sensitivity.
+    pub fn reduced(&mut self) -> &mut ReducedRunner<'a> {
+        &mut self.rom
+    }
+
     /// The reduced run at `load_scale` and, when the basis has an estimator, its estimate.
-    /// A failure of the enriched model gives an infinite estimate, not an error: the
+    /// A failure of the estimator's model gives an infinite estimate, not an error: the
     /// reduced answer itself exists.
     pub fn run(&mut self, load_scale: f64, output: Output) -> Result<(ReducedRun, Option<Estimate>)> {
         self.run_with(load_scale, output, &[])
     }
 
     /// [`Self::run`] with continuation from `previous` runs of the main model (see
-    /// [`ReducedRunner::run`]); the enriched model runs on its own.
+    /// [`ReducedRunner::run`]); the estimator's model runs on its own.
     pub fn run_with(
         &mut self,
         load_scale: f64,
@@ -235,20 +310,25 @@ impl<'a> EstimatingRunner<'a> {
         previous: &[&ReducedRun],
     ) -> Result<(ReducedRun, Option<Estimate>)> {
         let run = self.rom.run(load_scale, output, previous)?;
-        let Some((est, runner)) = &mut self.est else { return Ok((run, None)) };
+        let Some((est, model)) = &mut self.est else { return Ok((run, None)) };
         let start = std::time::Instant::now();
         // the norms come from the reduced coordinates: nothing of full size is written
-        let raw = match runner.run(load_scale, Output::ReducedAndProbes, &[]) {
-            Ok(richer) => raw_estimate(self.basis, est, &run, &richer),
-            Err(_) => f64::INFINITY,
+        let qp = match model {
+            EstimatorModel::Corrected(c) => c.run(&run).ok(),
+            EstimatorModel::Enriched(r) => r.run(load_scale, Output::ReducedAndProbes, &[]).ok().map(|e| e.reduced_q),
+        };
+        let raw = match &qp {
+            Some(qp) => raw_estimate_by_time(self.basis, &est.enriched, &run.reduced_q, qp),
+            None => [f64::INFINITY; 5],
         };
         let c = &est.calibration;
         let e = Estimate {
-            error_estimate: c.factor * raw,
-            raw,
+            error_estimate: c.factor * raw[4],
+            raw: raw[4],
             factor: c.factor,
             calibrated: c.calibrated,
             seconds: start.elapsed().as_secs_f64(),
+            by_time: raw.map(|r| c.factor * r),
         };
         Ok((run, Some(e)))
     }
@@ -300,7 +380,10 @@ pub fn load_trust(
     use crate::error::Error;
     use crate::io::estimator_file::{read_estimator, read_training_range, read_training_tolerance};
     use crate::solver::model::ParametricModel;
-    let estimator = read_estimator(path, &stored.basis)?;
+    let mut estimator = read_estimator(path, &stored.basis)?;
+    if let (Some(e), Some(m)) = (&mut estimator, p.file.online.as_ref().and_then(|o| o.estimate)) {
+        e.method = m;
+    }
     if let Some(e) = &estimator {
         let sys = &*p.model.physics()?.sys;
         let err = |(field, problem): (String, String)| Error::input(path, format!("estimator/{field}"), problem);
@@ -464,6 +547,7 @@ mod tests {
             block_modes: vec![5],
             extra_modes: 2,
             calibration: Calibration::default(),
+            method: EstimateMethod::default(),
         };
         // nested (first 3 columns) and not nested (mixing columns 2..5)
         let nested = vp.slice(ndarray::s![.., ..3]).to_owned();

@@ -33,11 +33,31 @@
 //! - from the second iteration on, the ladder starts two rungs looser than the rung chosen
 //!   the iteration before (more snapshots need as many modes or more for the same error).
 //!
+//! - what the loop holds to T is the *score* of a candidate, not its whole-run estimate:
+//!
+//!   ```text
+//!       score(λ) = T · max_i η_i(λ) / max(T, s_i(λ)),     i = 1 … 5 (fifths of the run)
+//!   ```
+//!
+//!   with `η_i` the estimate and `s_i` the reduced model's own *sensitivity* over the run
+//!   up to the end of fifth `i`: `s_i(λ) = ‖X_r(λ(1 + δ)) − X_r(λ)‖ / ‖X_r(λ)‖` over those
+//!   instants, δ = [`SENSITIVITY_STEP`] (the issue's 0.1 %). Where the model is not
+//!   sensitive (`s_i ≤ T`) the score is the estimate itself. Where its answer changes by
+//!   more than T when the load changes by 0.1 % (the four-bar after t ≈ 0.7 s), the
+//!   estimate there is held to `s_i` instead: any estimate compares two trajectories of
+//!   the same chaotic dynamics, so below `s_i` it measures how the dynamics amplify small
+//!   differences (the estimator's own among them) more than the reduction error, and full
+//!   runs spent there do not make the basis better. The whole-run estimate is still what
+//!   every reduced run reports; `/training/whole_run_estimates` keeps it.
+//!
 //! Nothing here is fitted to a model: the ladder, √ε and the factor 2 are the same for
 //! every model; a reduced run that fails (Newton diverges) counts as an infinite estimate.
 
 use super::config::{GreedySpec, Pipeline};
-use super::estimate::{calibrate, CalibrationPoint, EstimatingRunner, Estimator, DEFAULT_EXTRA_MODES};
+use super::estimate::{
+    calibrate, raw_estimate_by_time, rel_error_by_time, CalibrationPoint, EstimatingRunner, Estimator,
+    DEFAULT_EXTRA_MODES,
+};
 use super::online::Output;
 use super::train::{build_basis, training_data, TrainSummary};
 use super::validate::compare;
@@ -57,6 +77,21 @@ pub const ENERGY_LADDER: [f64; 9] = [1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1
 /// (also the τ with given modes and no given τ).
 pub const TAU_LADDER: [f64; 11] =
     [1e-1, 3.162e-2, 1e-2, 3.162e-3, 1e-3, 3.162e-4, 1e-4, 3.162e-5, 1e-5, 3.162e-6, 1e-6];
+/// δ of the sensitivity `s(λ) = ‖X_r(λ(1 + δ)) − X_r(λ)‖ / ‖X_r(λ)‖` (the issue's
+/// definition of `sensitivity`, 0.1 %).
+pub const SENSITIVITY_STEP: f64 = 1e-3;
+
+/// The score of one candidate (module documentation): `T · max_i η_i / max(T, s_i)`; NaN
+/// counts as ∞.
+pub fn score(tolerance: f64, estimate_by_time: &[f64; 5], sensitivity_by_time: &[f64; 5]) -> f64 {
+    let mut worst = 0.0_f64;
+    for (&e, &s) in estimate_by_time.iter().zip(sensitivity_by_time) {
+        let e = if e.is_nan() { f64::INFINITY } else { e };
+        let s = if s.is_finite() { s } else { 0.0 };
+        worst = worst.max(tolerance * e / tolerance.max(s));
+    }
+    worst
+}
 
 /// One pass of the loop: the basis it chose and where its estimate was worst.
 #[derive(Clone, Debug)]
@@ -71,8 +106,12 @@ pub struct Iteration {
     pub n_modes: usize,
     /// sampled elements (all of them without hyper-reduction)
     pub n_elements: usize,
-    /// the estimate at every candidate (`GreedyRecord::candidates` order)
+    /// the score at every candidate (`GreedyRecord::candidates` order; module documentation)
     pub estimates: Vec<f64>,
+    /// the whole-run error estimate at every candidate
+    pub whole_run_estimates: Vec<f64>,
+    /// the reduced model's whole-run sensitivity at every candidate
+    pub sensitivity: Vec<f64>,
     pub worst_load: f64,
     pub worst_estimate: f64,
     /// where this iteration ran the full model: the worst candidate without a full run yet
@@ -81,6 +120,9 @@ pub struct Iteration {
     /// the true rel_error of this iteration's basis at `run_load`, from the full run there
     /// (NaN when no run was made)
     pub true_error: f64,
+    /// the true error's score at `run_load` (as the estimates': held to the sensitivity where
+    /// the model is sensitive; NaN when no run was made)
+    pub true_score: f64,
 }
 
 /// What the greedy loop did: written under `/training` in the basis file.
@@ -128,8 +170,11 @@ struct Level {
     hyper_tolerance: Option<f64>,
     trained: Trained,
     estimator: Estimator,
+    /// scores (module documentation)
     estimates: Vec<f64>,
+    whole: Vec<f64>,
     raws: Vec<f64>,
+    sensitivity: Vec<[f64; 5]>,
     /// the estimator got its `k` extra modes in every block
     fully_enriched: bool,
 }
@@ -210,10 +255,13 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
                 .as_ref()
                 .map_or_else(|| p.model.physics().map_or(0, |ph| ph.sys.n_elements()), |h| h.elements.len()),
             estimates: level.estimates.clone(),
+            whole_run_estimates: level.whole.clone(),
+            sensitivity: level.sensitivity.iter().map(|s| s[4]).collect(),
             worst_load: candidates[wi],
             worst_estimate: worst,
             run_load: f64::NAN,
             true_error: f64::NAN,
+            true_score: f64::NAN,
         };
         let shape = format!(
             "{}{}, {} elements",
@@ -245,16 +293,18 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
             .map_err(|e| e.at_stage("train (greedy full run)", at))?;
         full_seconds += truth.wall_seconds;
         full_runs += 1;
-        let e = true_error(&p.model, &level.trained.basis, &level.estimator, &truth, at);
-        (it.run_load, it.true_error) = (at, e);
+        let (e, e_by_time) = true_error(&p.model, &level.trained.basis, &level.estimator, &truth, at);
+        let e_score = score(g.tolerance, &e_by_time, &level.sensitivity[ni]);
+        (it.run_load, it.true_error, it.true_score) = (at, e, e_score);
         if level.raws[ni].is_finite() && e.is_finite() {
             points.push(CalibrationPoint { load_scale: at, raw_estimate: level.raws[ni], rel_error: e });
         }
-        let done = worst <= g.tolerance && e <= g.tolerance;
+        let done = worst <= g.tolerance && e_score <= g.tolerance;
+        let sens = level.sensitivity[ni][4];
         if done {
-            eprintln!("iteration {n}: worst estimate {worst:.2e} ≤ {:e}; held-out check at λ = {at} (estimate {next_estimate:.2e}): rel_error {e:.2e}; {shape}", g.tolerance);
+            eprintln!("iteration {n}: worst score {worst:.2e} ≤ {:e}; held-out check at λ = {at} (score {next_estimate:.2e}): rel_error {e:.2e} (score {e_score:.2e}, sensitivity {sens:.1e}); {shape}", g.tolerance);
         } else {
-            eprintln!("iteration {n}: full run at λ = {at} (worst estimate {worst:.2e} {cmp} {:e}; {next_estimate:.2e} there, true error {e:.2e}), {shape}", g.tolerance);
+            eprintln!("iteration {n}: full run at λ = {at} (worst score {worst:.2e} {cmp} {:e}; {next_estimate:.2e} there, true error {e:.2e}, its score {e_score:.2e}, sensitivity {sens:.1e}), {shape}", g.tolerance);
         }
         iterations.push(it);
         if done {
@@ -298,12 +348,18 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
     ))
 }
 
-/// rel_error of `basis` at `load` against the full run `truth` (∞ when the reduced run fails).
-fn true_error(model: &Model, basis: &Basis, est: &Estimator, truth: &SimulationResult, load: f64) -> f64 {
+/// rel_error of `basis` at `load` against the full run `truth`, whole and by fifth of the
+/// run (∞ when the reduced run fails).
+fn true_error(model: &Model, basis: &Basis, est: &Estimator, truth: &SimulationResult, load: f64) -> (f64, [f64; 5]) {
     let run = EstimatingRunner::new(model, basis, Some(est)).and_then(|mut r| r.run(load, Output::Full));
     match run {
-        Ok((rom, _)) => compare(model, truth, &rom, None, basis.n_reduced(), basis.variant.name()).rel_error,
-        Err(_) => f64::INFINITY,
+        Ok((rom, _)) => {
+            let by = rel_error_by_time(&rom.result.q, &truth.q);
+            let mut by_time = [f64::INFINITY; 5];
+            by_time.iter_mut().zip(&by).for_each(|(o, &v)| *o = v);
+            (compare(model, truth, &rom, None, basis.n_reduced(), basis.variant.name()).rel_error, by_time)
+        }
+        Err(_) => (f64::INFINITY, [f64::INFINITY; 5]),
     }
 }
 
@@ -426,20 +482,35 @@ fn level(
         estimator.block_modes.iter().zip(&trained.block_modes).all(|(&e, &r)| e >= r + DEFAULT_EXTRA_MODES);
     let label =
         if energy.is_finite() { format!("iteration {n}, energy {energy:.0e}") } else { format!("iteration {n}") };
-    let (estimates, raws) = estimate_candidates(&p.model, &trained.basis, &estimator, candidates, &label);
-    Ok(Level { energy, hyper_tolerance, trained, estimator, estimates, raws, fully_enriched })
+    let runs = estimate_candidates(&p.model, &trained.basis, &estimator, candidates, &label);
+    let estimates = runs.iter().map(|r| score(p_tolerance(p), &r.by_time, &r.sensitivity)).collect();
+    let whole = runs.iter().map(|r| r.by_time[4]).collect();
+    let raws = runs.iter().map(|r| r.raw).collect();
+    let sensitivity = runs.iter().map(|r| r.sensitivity).collect();
+    Ok(Level { energy, hyper_tolerance, trained, estimator, estimates, whole, raws, sensitivity, fully_enriched })
 }
 
-/// The seam to the error estimator: `(error_estimate, raw estimate)` of `basis` at every
-/// load, reduced runs in parallel (one reduced model and its estimator's per worker, as
-/// `sweep` does); a run that fails gives ∞.
-fn estimate_candidates(
-    model: &Model,
-    basis: &Basis,
-    est: &Estimator,
-    loads: &[f64],
-    label: &str,
-) -> (Vec<f64>, Vec<f64>) {
+/// What the loop knows of one candidate.
+#[derive(Clone, Copy)]
+struct CandidateRun {
+    /// the error estimate by fifth of the run (the last: the whole run's)
+    by_time: [f64; 5],
+    /// the whole run's raw estimate
+    raw: f64,
+    /// the reduced model's sensitivity by fifth of the run (module documentation)
+    sensitivity: [f64; 5],
+}
+
+/// The greedy tolerance of the pipeline (`[train] greedy`).
+fn p_tolerance(p: &Pipeline) -> f64 {
+    p.file.train.greedy.as_ref().map_or(f64::INFINITY, |g| g.tolerance)
+}
+
+/// The seam to the error estimator: the estimate and the reduced model's sensitivity of
+/// `basis` at every load, reduced runs in parallel (one reduced model and its estimator's
+/// per worker, as `sweep` does); a run that fails gives ∞ estimates (and sensitivity 0,
+/// which holds its estimate to T).
+fn estimate_candidates(model: &Model, basis: &Basis, est: &Estimator, loads: &[f64], label: &str) -> Vec<CandidateRun> {
     let bar = ProgressBar::with_draw_target(Some(loads.len() as u64), ProgressDrawTarget::stderr());
     bar.set_style(
         ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} candidates, {elapsed}")
@@ -447,17 +518,25 @@ fn estimate_candidates(
             .progress_chars("=> "),
     );
     bar.set_prefix(label.to_string());
-    let out: Vec<(f64, f64)> = loads
+    let failed = CandidateRun { by_time: [f64::INFINITY; 5], raw: f64::INFINITY, sensitivity: [0.0; 5] };
+    let out: Vec<CandidateRun> = loads
         .par_iter()
         .map_init(
             || EstimatingRunner::new(model, basis, Some(est)).ok(),
             |runner, &x| {
                 let r = match runner {
                     Some(r) => match r.run(x, Output::ReducedAndProbes) {
-                        Ok((_, Some(e))) => (e.error_estimate, e.raw),
-                        _ => (f64::INFINITY, f64::INFINITY),
+                        Ok((run, Some(e))) => {
+                            // the same reduced model at λ(1 + δ): how much its answer moves
+                            let sensitivity = match r.reduced().run(x * (1.0 + SENSITIVITY_STEP), Output::ReducedAndProbes, &[]) {
+                                Ok(moved) => raw_estimate_by_time(basis, basis, &moved.reduced_q, &run.reduced_q),
+                                Err(_) => [0.0; 5],
+                            };
+                            CandidateRun { by_time: e.by_time, raw: e.raw, sensitivity }
+                        }
+                        _ => failed,
                     },
-                    None => (f64::INFINITY, f64::INFINITY),
+                    None => failed,
                 };
                 bar.inc(1);
                 r
@@ -465,7 +544,7 @@ fn estimate_candidates(
         )
         .collect();
     bar.finish_and_clear();
-    out.into_iter().unzip()
+    out
 }
 
 /// Writes `/training` (the basis file's layout: src/io/basis_file.rs).
@@ -491,11 +570,38 @@ pub fn write_training(f: &hdf5::File, r: &GreedyRecord) -> hdf5::Result<()> {
         .with_data(&Array1::from_iter(r.iterations.iter().map(|i| i.n_elements as u64)))
         .create("n_elements")?;
     let (ni, nc) = (r.iterations.len(), r.candidates.len());
-    let est = Array2::from_shape_fn((ni, nc), |(i, j)| r.iterations[i].estimates.get(j).copied().unwrap_or(f64::NAN));
-    g.new_dataset_builder().with_data(&est).create("estimates")?;
+    let table = |get: &dyn Fn(&Iteration) -> &Vec<f64>| {
+        Array2::from_shape_fn((ni, nc), |(i, j)| get(&r.iterations[i]).get(j).copied().unwrap_or(f64::NAN))
+    };
+    g.new_dataset_builder().with_data(&table(&|i| &i.estimates)).create("estimates")?;
+    g.new_dataset_builder().with_data(&table(&|i| &i.whole_run_estimates)).create("whole_run_estimates")?;
+    g.new_dataset_builder().with_data(&table(&|i| &i.sensitivity)).create("sensitivity")?;
+    g.new_dataset_builder().with_data(&col(&|i| i.true_score)).create("true_score")?;
     attr_str(&g, "method", "greedy")?;
     attr_u64(&g, "iterations", ni as u64)?;
     attr_u64(&g, "max_runs", r.max_runs as u64)?;
     attr_u64(&g, "full_runs", r.full_runs as u64)?;
     attr_u64(&g, "converged", r.converged as u64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::score;
+
+    /// Where the sensitivity stays below T the score is the largest estimate; a window
+    /// whose sensitivity exceeds T holds its estimate to that sensitivity instead; NaN
+    /// counts as ∞.
+    #[test]
+    fn score_holds_sensitive_windows_to_their_sensitivity() {
+        let t = 1e-2;
+        let calm = [1e-4; 5];
+        assert_eq!(score(t, &[1e-3, 2e-3, 3e-3, 4e-3, 5e-3], &calm), 5e-3);
+        // the last two fifths are sensitive (s = 0.2): an estimate of 0.1 there scores
+        // T·0.1/0.2 = 5e-3, below the early windows' 6e-3
+        let s = [1e-4, 1e-4, 1e-3, 0.2, 0.2];
+        assert!((score(t, &[1e-3, 2e-3, 6e-3, 0.1, 0.1], &s) - 6e-3).abs() < 1e-15);
+        // above the sensitivity it still counts, scaled: 0.4 against 0.2 scores 2 T
+        assert!((score(t, &[1e-3, 2e-3, 6e-3, 0.1, 0.4], &s) - 2e-2).abs() < 1e-15);
+        assert!(score(t, &[f64::NAN, 0.0, 0.0, 0.0, 0.0], &calm).is_infinite());
+    }
 }

@@ -5,6 +5,7 @@
 
 pub mod config;
 pub mod estimate;
+pub mod estimate_corrected;
 pub mod greedy;
 pub mod merge;
 pub mod online;

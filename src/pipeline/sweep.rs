@@ -686,6 +686,7 @@ pub fn read_sweep(
             factor: f64::NAN,
             calibrated: false,
             seconds: estimate_seconds.as_ref().map_or(f64::NAN, |a| a[k]),
+            by_time: [f64::NAN; 5],
         });
         let extrapolated = extrapolated.as_ref().is_some_and(|a| a.get(k).is_some_and(|&v| v != 0));
         let v = v.map(|mut v| {
