@@ -330,9 +330,10 @@ impl Model {
             p.reuse = match r.as_str() {
                 "within-step" => JacobianReuse::WithinStep,
                 "never" => JacobianReuse::Never,
+                "across-steps" => JacobianReuse::AcrossSteps,
                 _ => {
                     return Err(
-                        self.err("time.jacobian_reuse", format!("must be \"within-step\" or \"never\", got \"{r}\""))
+                        self.err("time.jacobian_reuse", format!("must be \"within-step\", \"across-steps\" or \"never\", got \"{r}\""))
                     )
                 }
             };
