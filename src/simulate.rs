@@ -6,7 +6,7 @@ use crate::model::Model;
 use crate::physics::system::FlexibleSystem;
 use crate::solver::generalized_alpha::{GeneralizedAlpha, IntegratorParams, State, Stats};
 use crate::solver::kkt::LinearSolverKind;
-use crate::solver::model::{Bound, DynamicModel, ParametricModel, Parameters};
+use crate::solver::model::{Bound, DynamicModel, Parameters, ParametricModel};
 use ndarray::{Array1, Array2};
 
 /// Run settings; `None` fields take the model file's values.
@@ -268,11 +268,20 @@ fn run_full(model: &Model, sys: &mut FlexibleSystem, q0: Vec<f64>, s: Settings) 
     let probe_defs = sys.probes.clone();
     let start = std::time::Instant::now();
     // the probes are evaluated after the loop, from the stored coordinates
-    let stats = solve(sys, &s.parameters(), &s.params, q0, s.dt, s.n_steps, |_, _| false, |k, st| {
-        t[k] = st.t;
-        q.column_mut(k).assign(&ndarray::ArrayView1::from(&st.q));
-        mult.column_mut(k).assign(&ndarray::ArrayView1::from(&st.lambda));
-    })?;
+    let stats = solve(
+        sys,
+        &s.parameters(),
+        &s.params,
+        q0,
+        s.dt,
+        s.n_steps,
+        |_, _| false,
+        |k, st| {
+            t[k] = st.t;
+            q.column_mut(k).assign(&ndarray::ArrayView1::from(&st.q));
+            mult.column_mut(k).assign(&ndarray::ArrayView1::from(&st.lambda));
+        },
+    )?;
     let wall_seconds = start.elapsed().as_secs_f64();
     for (p, (_, xy)) in probe_defs.iter().zip(probes.iter_mut()) {
         for k in 0..nt {

@@ -66,8 +66,7 @@ fn relative_links_resolve() {
         let text = std::fs::read_to_string(&file).unwrap();
         for target in link_targets(&text) {
             let target = target.split_whitespace().next().unwrap_or("").to_string();
-            if target.is_empty() || target.starts_with('#') || target.contains("://") || target.starts_with("mailto:")
-            {
+            if target.is_empty() || target.starts_with('#') || target.contains("://") || target.starts_with("mailto:") {
                 continue;
             }
             let path = target.split('#').next().unwrap();
@@ -173,12 +172,7 @@ fn readme_tutorial_runs_as_written() {
             .env("HDF5_USE_FILE_LOCKING", "FALSE")
             .output()
             .unwrap();
-        assert!(
-            out.status.success(),
-            "`{line}` failed ({}):\n{}",
-            out.status,
-            String::from_utf8_lossy(&out.stderr)
-        );
+        assert!(out.status.success(), "`{line}` failed ({}):\n{}", out.status, String::from_utf8_lossy(&out.stderr));
         n += 1;
     }
     assert!(n >= 4, "the tutorial has only {n} commands");

@@ -120,13 +120,29 @@ fn every_element_at_weight_one_equals_plain_galerkin_with(modes: &str) {
     let params = s.params.clone();
     let q0 = basis.reduce(data.x.column(0)).to_vec();
     let mut a = Array2::zeros((r, s.n_steps + 1));
-    solve(&mut galerkin, &mu, &params, q0.clone(), s.dt, s.n_steps, |_, _| false, |k, st| {
-        a.column_mut(k).assign(&ArrayView1::from(&st.q))
-    })
+    solve(
+        &mut galerkin,
+        &mu,
+        &params,
+        q0.clone(),
+        s.dt,
+        s.n_steps,
+        |_, _| false,
+        |k, st| a.column_mut(k).assign(&ArrayView1::from(&st.q)),
+    )
     .unwrap();
     let mut b = Array2::zeros((r, s.n_steps + 1));
-    solve(&mut hyper, &mu, &params, q0, s.dt, s.n_steps, |_, _| false, |k, st| b.column_mut(k).assign(&ArrayView1::from(&st.q)))
-        .unwrap();
+    solve(
+        &mut hyper,
+        &mu,
+        &params,
+        q0,
+        s.dt,
+        s.n_steps,
+        |_, _| false,
+        |k, st| b.column_mut(k).assign(&ArrayView1::from(&st.q)),
+    )
+    .unwrap();
     let e = rel(b.as_slice().unwrap(), a.as_slice().unwrap());
     assert!(e < 1e-8, "trajectories differ by {e:e}");
 }

@@ -55,15 +55,23 @@ fn compare<M: DynamicModel>(
 }
 
 /// Checks the across-steps run of a model against full Newton and within-step reuse.
-fn check_model<M: DynamicModel>(name: &str, make: impl Fn() -> M, params: &IntegratorParams, q0: Vec<f64>, dt: f64, steps: usize) {
+fn check_model<M: DynamicModel>(
+    name: &str,
+    make: impl Fn() -> M,
+    params: &IntegratorParams,
+    q0: Vec<f64>,
+    dt: f64,
+    steps: usize,
+) {
     let bound = 10.0 * params.tolerance;
-    let (diff, across) =
-        compare(&mut make(), &mut make(), params, JacobianReuse::AcrossSteps, q0.clone(), dt, steps);
+    let (diff, across) = compare(&mut make(), &mut make(), params, JacobianReuse::AcrossSteps, q0.clone(), dt, steps);
     let (diff_within, within) =
         compare(&mut make(), &mut make(), params, JacobianReuse::WithinStep, q0.clone(), dt, steps);
     eprintln!("{name}: within-step largest step difference {diff_within:.3e} L");
     let (_, never) = compare(&mut make(), &mut make(), params, JacobianReuse::Never, q0, dt, steps);
-    eprintln!("{name}: across {across:?}\n  within {within:?}\n  never {never:?}\n  largest step difference {diff:.3e} L");
+    eprintln!(
+        "{name}: across {across:?}\n  within {within:?}\n  never {never:?}\n  largest step difference {diff:.3e} L"
+    );
     assert!(diff <= bound, "{name}: a kept matrix moved a step end by {diff:.3e} L > {bound:.1e} L");
     assert_eq!(across.step_cuts, 0, "{name}: {across:?}");
     assert!(
@@ -88,4 +96,3 @@ fn kept_matrices_end_every_full_order_step_where_full_newton_does() {
         check_model(model, || prepare(&m, &s).unwrap().0, &s.params, q0, s.dt, steps.min(s.n_steps));
     }
 }
-

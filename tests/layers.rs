@@ -69,7 +69,8 @@ fn module_of(rel: &Path) -> String {
 }
 
 fn read_tree(dir: &Path, root: &Path, out: &mut Vec<File>) {
-    let mut entries: Vec<_> = std::fs::read_dir(dir).expect("readable src dir").map(|e| e.expect("entry").path()).collect();
+    let mut entries: Vec<_> =
+        std::fs::read_dir(dir).expect("readable src dir").map(|e| e.expect("entry").path()).collect();
     entries.sort();
     for p in entries {
         if p.is_dir() {
@@ -111,7 +112,10 @@ fn strip(src: &str) -> String {
                 }
             }
             out.push(' ');
-        } else if c == 'r' && (next == Some('"') || (next == Some('#') && !prev_is_ident(&b, i))) && !prev_is_ident(&b, i) {
+        } else if c == 'r'
+            && (next == Some('"') || (next == Some('#') && !prev_is_ident(&b, i)))
+            && !prev_is_ident(&b, i)
+        {
             // raw string r"…" or r#"…"#
             let mut j = i + 1;
             let mut hashes = 0;
@@ -149,7 +153,13 @@ fn strip(src: &str) -> String {
             out.push(' ');
         } else if c == '\'' {
             // a char literal ('x', '\n', '\u{..}'); a lifetime ('a) is kept as it is
-            let close = if next == Some('\\') { (i + 2..b.len().min(i + 12)).find(|&j| b[j] == '\'') } else if b.get(i + 2) == Some(&'\'') { Some(i + 2) } else { None };
+            let close = if next == Some('\\') {
+                (i + 2..b.len().min(i + 12)).find(|&j| b[j] == '\'')
+            } else if b.get(i + 2) == Some(&'\'') {
+                Some(i + 2)
+            } else {
+                None
+            };
             match close {
                 Some(j) => {
                     i = j + 1;
@@ -356,11 +366,8 @@ fn join(p: &[String]) -> String {
 
 /// The absolute path (from the crate root) of a path written in `module`.
 fn absolute(module: &str, path: &[String], modules: &BTreeSet<String>) -> Option<Vec<String>> {
-    let mut base: Vec<String> = if module.is_empty() || module == "main" {
-        Vec::new()
-    } else {
-        module.split("::").map(String::from).collect()
-    };
+    let mut base: Vec<String> =
+        if module.is_empty() || module == "main" { Vec::new() } else { module.split("::").map(String::from).collect() };
     // a file `a/b.rs` is module a::b; `super` inside it is `a`
     let first = path.first()?;
     match first.as_str() {
@@ -496,7 +503,8 @@ fn cycles(edges: &BTreeSet<(String, String)>) -> Vec<Vec<String>> {
         }
     }
     let n = nodes.len();
-    let mut s = St { index: vec![None; n], low: vec![0; n], on: vec![false; n], stack: Vec::new(), next: 0, out: Vec::new() };
+    let mut s =
+        St { index: vec![None; n], low: vec![0; n], on: vec![false; n], stack: Vec::new(), next: 0, out: Vec::new() };
     for v in 0..n {
         if s.index[v].is_none() {
             visit(v, &adj, &mut s);

@@ -83,6 +83,7 @@ fn pendulum_runs_at_any_sequence_of_load_scales_as_fresh_models_do() {
 fn fourbar_runs_at_any_sequence_of_load_scales_as_fresh_models_do() {
     let dir = tempfile::tempdir().unwrap();
     let model = repo("data/models/fourbar.toml").replace("t_end = 1.1", "t_end = 0.2");
-    let body = "[train]\nload_scales = [0.935]\n[reduction]\nvariant = \"constraint-preserving\"\nmodes = { count = 20 }\n";
+    let body =
+        "[train]\nload_scales = [0.935]\n[reduction]\nvariant = \"constraint-preserving\"\nmodes = { count = 20 }\n";
     check(&pipeline(dir.path(), &model, body), 0.8, 1.1);
 }

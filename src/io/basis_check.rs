@@ -342,9 +342,9 @@ fn block_of(s: &StoredBasis, i: usize, j: usize) -> String {
 fn check_against_model(s: &StoredBasis, model: &Model) -> std::result::Result<(), (String, String)> {
     let b = &s.basis;
     let bad = |f: &str, p: String| Err((f.to_string(), p));
-    let physics = model.physics().map_err(|e| {
-        ("basis/reference".to_string(), format!("cannot compute the model's initial state: {e}"))
-    })?;
+    let physics = model
+        .physics()
+        .map_err(|e| ("basis/reference".to_string(), format!("cannot compute the model's initial state: {e}")))?;
     let sys = &*physics.sys;
     let (n, nc, ne) = (sys.n_dof(), sys.n_constraints(), sys.n_elements());
     b.validate(n, nc)?;

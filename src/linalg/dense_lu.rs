@@ -135,7 +135,6 @@ impl DenseLu {
         }
     }
 
-
     /// Factors the matrix in place; refuses non-finite entries and exact zero pivots.
     pub fn factor(&mut self) -> Result<(), String> {
         self.check_finite()?;
@@ -207,7 +206,6 @@ impl DenseLu {
         Ok(())
     }
 }
-
 
 #[cfg(test)]
 mod tests {

@@ -16,8 +16,8 @@ use faer::sparse::linalg::lu::{factorize_symbolic_lu, NumericLu, SymbolicLu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par};
 
-pub use super::kkt_pattern::{Block, KktPattern, KktSolver, LinearSolverKind};
 pub(crate) use super::kkt_pattern::SlotMap;
+pub use super::kkt_pattern::{Block, KktPattern, KktSolver, LinearSolverKind};
 
 pub fn make_solver(kind: LinearSolverKind, pattern: KktPattern) -> Box<dyn KktSolver> {
     match kind {

@@ -3,8 +3,8 @@
 //! make a run; the validated bodies, joints, loads and probes are kept on the [`Model`].
 
 use super::schema::*;
-use super::Model;
 use super::toml_errors::entry_line;
+use super::Model;
 use crate::error::Result;
 use crate::physics::element::Section;
 use crate::physics::system::{BeamBody, Joint, Load, NodeId, Probe};
@@ -332,9 +332,10 @@ impl Model {
                 "never" => JacobianReuse::Never,
                 "across-steps" => JacobianReuse::AcrossSteps,
                 _ => {
-                    return Err(
-                        self.err("time.jacobian_reuse", format!("must be \"within-step\", \"across-steps\" or \"never\", got \"{r}\""))
-                    )
+                    return Err(self.err(
+                        "time.jacobian_reuse",
+                        format!("must be \"within-step\", \"across-steps\" or \"never\", got \"{r}\""),
+                    ))
                 }
             };
         }

@@ -3,18 +3,18 @@
 
 mod check;
 pub mod schema;
-mod toml_errors;
 pub mod shared;
+mod toml_errors;
 pub use shared::SharedPhysics;
 
 use crate::error::{Error, Result};
+use crate::linalg::kkt::LinearSolverKind;
 use crate::physics::system::{BeamBody, FlexibleSystem, Joint, Load, Probe, Rayleigh};
 use crate::solver::generalized_alpha::IntegratorParams;
-use crate::linalg::kkt::LinearSolverKind;
 use schema::*;
-pub(crate) use toml_errors::parse_toml;
-use toml_errors::entry_error;
 use std::path::{Path, PathBuf};
+use toml_errors::entry_error;
+pub(crate) use toml_errors::parse_toml;
 
 /// Sizes of a model's system (see [`Model::sizes`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -67,7 +67,6 @@ impl Model {
     fn err(&self, field: impl Into<String>, problem: impl Into<String>) -> Error {
         Error::input(&self.path, field, problem)
     }
-
 
     /// SHA-256 of the model's canonical form: the parsed file as JSON, without the free
     /// `description`. Comments, layout, key order and number spelling do not change it;
@@ -125,5 +124,4 @@ impl Model {
     pub fn probe_names(&self) -> Vec<String> {
         self.probes.iter().map(|p| p.name.clone()).collect()
     }
-
 }

@@ -528,10 +528,11 @@ fn estimate_candidates(model: &Model, basis: &Basis, est: &Estimator, loads: &[f
                     Some(r) => match r.run(x, Output::ReducedAndProbes) {
                         Ok((run, Some(e))) => {
                             // the same reduced model at λ(1 + δ): how much its answer moves
-                            let sensitivity = match r.reduced().run(x * (1.0 + SENSITIVITY_STEP), Output::ReducedAndProbes, &[]) {
-                                Ok(moved) => raw_estimate_by_time(basis, basis, &moved.reduced_q, &run.reduced_q),
-                                Err(_) => [0.0; 5],
-                            };
+                            let sensitivity =
+                                match r.reduced().run(x * (1.0 + SENSITIVITY_STEP), Output::ReducedAndProbes, &[]) {
+                                    Ok(moved) => raw_estimate_by_time(basis, basis, &moved.reduced_q, &run.reduced_q),
+                                    Err(_) => [0.0; 5],
+                                };
                             CandidateRun { by_time: e.by_time, raw: e.raw, sensitivity }
                         }
                         _ => failed,

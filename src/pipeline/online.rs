@@ -8,7 +8,7 @@ use crate::physics::element::Vec8;
 use crate::physics::system::FlexibleSystem;
 use crate::reduction::{Basis, Hyper, HyperReducedModel, Reduced, ReducedModel};
 use crate::simulate::{Overrides, Settings, SimulationResult};
-use crate::solver::model::{ParametricModel, Parameters};
+use crate::solver::model::{Parameters, ParametricModel};
 use ndarray::{Array1, Array2, ArrayView1};
 use std::path::Path;
 use std::sync::Arc;

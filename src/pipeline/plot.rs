@@ -111,7 +111,9 @@ impl Figure {
         let xs = self
             .panels
             .iter()
-            .flat_map(|p| p.series.iter().flat_map(move |s| s.points.iter().copied().filter(usable(p.log_y)).map(|q| q.0)))
+            .flat_map(|p| {
+                p.series.iter().flat_map(move |s| s.points.iter().copied().filter(usable(p.log_y)).map(|q| q.0))
+            })
             .chain(self.markers.iter().copied().filter(|x| x.is_finite()));
         let (a, b) = xs.fold((f64::MAX, f64::MIN), |(a, b), x| (a.min(x), b.max(x)));
         if a > b {

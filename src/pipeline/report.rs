@@ -95,8 +95,16 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool) -> Result<
                     .zip(&rom.result.probes)
                     .flat_map(|((name, a), (_, b))| {
                         [
-                            Series::new(format!("{name}, full"), t.iter().zip(a.column(c)).map(|(t, v)| (*t, *v)).collect(), Style::Line),
-                            Series::new(format!("{name}, reduced"), t.iter().zip(b.column(c)).map(|(t, v)| (*t, *v)).collect(), Style::Dashed),
+                            Series::new(
+                                format!("{name}, full"),
+                                t.iter().zip(a.column(c)).map(|(t, v)| (*t, *v)).collect(),
+                                Style::Line,
+                            ),
+                            Series::new(
+                                format!("{name}, reduced"),
+                                t.iter().zip(b.column(c)).map(|(t, v)| (*t, *v)).collect(),
+                                Style::Dashed,
+                            ),
                         ]
                     })
                     .collect(),
@@ -140,11 +148,23 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool) -> Result<
         })
         .collect();
     let single = |title: &str, x_label: &str, panel: Panel, markers: Vec<f64>, stem: &str| {
-        Figure { title: title.into(), x_label: x_label.into(), panels: vec![panel], markers, marker_label: "training load".into() }
-            .save(&out.join(stem))
-            .map_err(plot_err)
+        Figure {
+            title: title.into(),
+            x_label: x_label.into(),
+            panels: vec![panel],
+            markers,
+            marker_label: "training load".into(),
+        }
+        .save(&out.join(stem))
+        .map_err(plot_err)
     };
-    single("POD singular values", "index", Panel { y_label: "σ".into(), log_y: true, series: blocks }, vec![], "singular_values")?;
+    single(
+        "POD singular values",
+        "index",
+        Panel { y_label: "σ".into(), log_y: true, series: blocks },
+        vec![],
+        "singular_values",
+    )?;
     let pts = |f: &dyn Fn(&Validation) -> f64| -> Vec<(f64, f64)> {
         sw.done().filter_map(|q| q.validation.as_ref()).map(|v| (v.load_scale, f(v))).collect()
     };

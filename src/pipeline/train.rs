@@ -72,7 +72,8 @@ pub fn train(p: &Pipeline) -> Result<(TrainingData, TrainSummary)> {
     // the full model assembled once for every training load
     let mut full = FullModel::new(&p.model, LinearSolverKind::Banded)?;
     for &s in &scales {
-        let r = full.simulate(&Overrides { load_scale: Some(s), ..Default::default() })
+        let r = full
+            .simulate(&Overrides { load_scale: Some(s), ..Default::default() })
             .map_err(|e| e.at_stage("train (full run)", s))?;
         full_seconds += r.wall_seconds;
         runs.push(r);

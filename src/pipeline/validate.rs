@@ -177,7 +177,8 @@ pub fn validate_with(
     } else {
         None
     };
-    let nearby = full_model.simulate(&Overrides { load_scale: Some(1.001 * load_scale), ..o })
+    let nearby = full_model
+        .simulate(&Overrides { load_scale: Some(1.001 * load_scale), ..o })
         .map_err(stage("validate (full run at 1.001 λ)"))?;
     let mut runner = EstimatingRunner::new(model, basis, trust.and_then(|t| t.estimator.as_ref()))?;
     let (rom, estimate) = runner.run(load_scale, Output::Full).map_err(stage("validate (reduced run)"))?;

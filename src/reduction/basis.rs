@@ -8,8 +8,8 @@
 //!     whole-system:          [x; λ/w] ≈ [x_ref; 0] + [V; V_λ] q (eqs. 18–19)
 //! ```
 
-use super::sample::Hyper;
 use super::pod::{pod, ModeRule, Pod};
+use super::sample::Hyper;
 use ndarray::{s, Array1, Array2, ArrayView1, ArrayView2, Axis};
 
 /// Which reduction (SPEC §3).

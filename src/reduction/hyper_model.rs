@@ -29,9 +29,9 @@ use super::ecsw::Hyper;
 use super::projection::{axpy, forward_to_projection, impl_reduced, Projection};
 use super::sparse_rows::SparseRows;
 use crate::linalg::simd::{dispatch, Kernel};
-use crate::solver::model::{InvariantElementModel, IterationCoefficients, ParametricModel, Parameters};
-use std::sync::Arc;
+use crate::solver::model::{InvariantElementModel, IterationCoefficients, Parameters, ParametricModel};
 use ndarray::{Array1, Array2, Axis};
+use std::sync::Arc;
 
 pub struct HyperReducedModel<M: InvariantElementModel> {
     /// the full model, shared (read only) with every other reduced model of it

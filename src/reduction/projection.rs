@@ -27,8 +27,8 @@ use super::basis::{Basis, Variant};
 use super::joint_elimination::JointElimination;
 use crate::linalg::dense_lu::DenseLu;
 use crate::linalg::sparse_rows::SparseRows;
-use crate::solver::model::{ElementModel, IterationCoefficients, Parameters};
 pub(crate) use crate::linalg::vec_ops::{axpy, dot, mat_vec};
+use crate::solver::model::{ElementModel, IterationCoefficients, Parameters};
 use ndarray::{s, Array1, Array2, ArrayView1, Axis};
 use ndarray_linalg::SVD;
 

@@ -16,9 +16,9 @@
 
 use super::basis::Basis;
 use super::projection::{axpy, expand, forward_to_projection, impl_reduced, project_add, Projection};
-use crate::solver::model::{ElementModel, IterationCoefficients, ParametricModel, Parameters};
-use std::sync::Arc;
+use crate::solver::model::{ElementModel, IterationCoefficients, Parameters, ParametricModel};
 use ndarray::{linalg::general_mat_mul, Array1, Array2, Axis};
+use std::sync::Arc;
 
 pub struct ReducedModel<M: ElementModel> {
     /// the full model, shared (read only) with every other reduced model of it

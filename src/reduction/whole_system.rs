@@ -95,7 +95,10 @@ pub(crate) fn train_stabilized(
     let b = &stab.constraints;
     let nc = b.nrows();
     if nc == 0 {
-        return Err("the model has no joints: the whole-system-stabilized variant has no multipliers to reduce; use galerkin".into());
+        return Err(
+            "the model has no joints: the whole-system-stabilized variant has no multipliers to reduce; use galerkin"
+                .into(),
+        );
     }
     if b.ncols() != n || lambda.nrows() != nc || lambda.ncols() != centred.ncols() {
         return Err(format!(
@@ -145,14 +148,17 @@ pub(crate) fn train_stabilized(
 pub fn explain_failure(e: crate::error::Error, variant: super::Variant, load_scale: f64) -> crate::error::Error {
     use crate::error::Error;
     match e {
-        Error::NewtonFailed { .. } | Error::LinearSolve { .. } if variant == super::Variant::WholeSystem => Error::Stage {
-            stage: "reduced run of the plain whole-system variant (its reduced saddle point is not inf-sup stable: \
+        Error::NewtonFailed { .. } | Error::LinearSolve { .. } if variant == super::Variant::WholeSystem => {
+            Error::Stage {
+                stage:
+                    "reduced run of the plain whole-system variant (its reduced saddle point is not inf-sup stable: \
                     B V = 0 for POD modes of constraint-satisfying snapshots, docs/whole-system.md; \
                     use variant = \"whole-system-stabilized\")"
-                .into(),
-            load_scale,
-            source: Box::new(e),
-        },
+                        .into(),
+                load_scale,
+                source: Box::new(e),
+            }
+        }
         other => other,
     }
 }
@@ -217,6 +223,9 @@ mod tests {
             assert!((&back - &x.column(j)).iter().all(|e| e.abs() < 1e-10));
         }
         let none = BasisSpec { stabilization: None, ..spec.clone() };
-        assert!(train_basis(x.view(), lam.view(), &[0, 2], x0.view(), &none).err().expect("refused").contains("joint equations"));
+        assert!(train_basis(x.view(), lam.view(), &[0, 2], x0.view(), &none)
+            .err()
+            .expect("refused")
+            .contains("joint equations"));
     }
 }

@@ -118,7 +118,13 @@ impl<M: ParametricModel + ?Sized> DynamicModel for Bound<'_, M> {
     fn add_constraint_force(&self, lambda: &[f64], out: &mut [f64]) {
         self.model.add_constraint_force(lambda, out)
     }
-    fn factor(&mut self, q: &[f64], v: &[f64], t: f64, coef: IterationCoefficients) -> std::result::Result<f64, String> {
+    fn factor(
+        &mut self,
+        q: &[f64],
+        v: &[f64],
+        t: f64,
+        coef: IterationCoefficients,
+    ) -> std::result::Result<f64, String> {
         self.model.factor(&self.mu, q, v, t, coef)
     }
     fn solve(&mut self, rhs: &mut [f64]) -> std::result::Result<(), String> {
