@@ -5,7 +5,6 @@ mod check;
 pub mod schema;
 pub mod shared;
 mod toml_errors;
-pub use shared::SharedPhysics;
 
 use crate::error::{Error, Result};
 use crate::linalg::kkt::LinearSolverKind;
@@ -123,5 +122,18 @@ impl Model {
 
     pub fn probe_names(&self) -> Vec<String> {
         self.probes.iter().map(|p| p.name.clone()).collect()
+    }
+}
+
+/// The assembled system (banded KKT solver) and its consistent initial state `x₀`.
+#[derive(Clone)]
+pub struct SharedPhysics {
+    pub sys: std::sync::Arc<FlexibleSystem>,
+    pub x0: std::sync::Arc<Vec<f64>>,
+}
+
+impl std::fmt::Debug for SharedPhysics {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "SharedPhysics({} coordinates)", self.x0.len())
     }
 }

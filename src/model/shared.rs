@@ -1,24 +1,10 @@
 //! The physics of a model, assembled once per loaded model (so once per command) and
 //! shared, read only, by every reduced model and check that needs it, on any thread.
 
-use super::Model;
+use super::{Model, SharedPhysics};
 use crate::error::{Error, Result};
-use crate::physics::system::FlexibleSystem;
 use crate::solver::kkt::LinearSolverKind;
 use std::sync::Arc;
-
-/// The assembled system (banded KKT solver) and its consistent initial state `x₀`.
-#[derive(Clone)]
-pub struct SharedPhysics {
-    pub sys: Arc<FlexibleSystem>,
-    pub x0: Arc<Vec<f64>>,
-}
-
-impl std::fmt::Debug for SharedPhysics {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "SharedPhysics({} coordinates)", self.x0.len())
-    }
-}
 
 impl SharedPhysics {
     /// Assembles the system of `model` and closes the joints of its initial state.

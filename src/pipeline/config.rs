@@ -186,7 +186,7 @@ pub struct OnlineSpec {
     /// how every reduced run computes its error estimate: "corrected" (default) or
     /// "enriched" (docs/error-estimate.md)
     #[serde(default)]
-    pub estimate: Option<super::estimate::EstimateMethod>,
+    pub estimate: Option<EstimateMethod>,
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -416,5 +416,34 @@ impl Pipeline {
 
     pub fn validate_scales(&self) -> Vec<f64> {
         self.file.validate.as_ref().map_or_else(|| self.training_scales(), |s| s.load_scales.values().expect("checked"))
+    }
+}
+
+/// How the enriched model's trajectory `X⁺` is obtained (docs/error-estimate.md).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum EstimateMethod {
+    /// the default: one modified-Newton iteration of the enriched model per step, from the
+    /// reduced run's increments (`pipeline::estimate_corrected`)
+    #[default]
+    Corrected,
+    /// the enriched model integrated on its own to convergence (about 2× the reduced run)
+    Enriched,
+}
+
+impl EstimateMethod {
+    pub fn name(self) -> &'static str {
+        match self {
+            EstimateMethod::Corrected => "corrected",
+            EstimateMethod::Enriched => "enriched",
+        }
+    }
+
+    pub fn parse(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "corrected" => Ok(EstimateMethod::Corrected),
+            "enriched" => Ok(EstimateMethod::Enriched),
+            _ => Err(format!("is \"{s}\"; expected \"corrected\" (default) or \"enriched\"")),
+        }
     }
 }

@@ -62,34 +62,7 @@ pub struct Estimator {
     pub method: EstimateMethod,
 }
 
-/// How the enriched model's trajectory `X⁺` is obtained (docs/error-estimate.md).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum EstimateMethod {
-    /// the default: one modified-Newton iteration of the enriched model per step, from the
-    /// reduced run's increments ([`super::estimate_corrected`])
-    #[default]
-    Corrected,
-    /// the enriched model integrated on its own to convergence (about 2× the reduced run)
-    Enriched,
-}
-
-impl EstimateMethod {
-    pub fn name(self) -> &'static str {
-        match self {
-            EstimateMethod::Corrected => "corrected",
-            EstimateMethod::Enriched => "enriched",
-        }
-    }
-
-    pub fn parse(s: &str) -> std::result::Result<Self, String> {
-        match s {
-            "corrected" => Ok(EstimateMethod::Corrected),
-            "enriched" => Ok(EstimateMethod::Enriched),
-            _ => Err(format!("is \"{s}\"; expected \"corrected\" (default) or \"enriched\"")),
-        }
-    }
-}
+pub use super::config::EstimateMethod;
 
 /// One held-out load: the raw estimate of a basis there and its true `rel_error`.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]

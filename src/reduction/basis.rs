@@ -122,7 +122,17 @@ pub struct BasisSpec {
     /// left out of them); empty: one POD of all coordinates
     pub blocks: Vec<Vec<usize>>,
     /// whole-system-stabilized: the joint equations and the multiplier mode rule
-    pub stabilization: Option<super::whole_system::Stabilization>,
+    pub stabilization: Option<Stabilization>,
+}
+
+/// What the stabilized variant needs besides the snapshots.
+#[derive(Clone, Debug)]
+pub struct Stabilization {
+    /// `B`, n_c × n: the (constant) joint equations `B x = b`
+    pub constraints: Array2<f64>,
+    /// how many multiplier modes `k` to keep (of the POD of the multiplier snapshots;
+    /// a ratio is of `n_c`)
+    pub multiplier_modes: ModeRule,
 }
 
 /// Builds a basis from snapshots `x` (n × m) and, for whole-system, multipliers `λ`
@@ -132,7 +142,7 @@ pub struct BasisSpec {
 /// With blocks, `V = [blockdiag(Φ₁, …, Φ_B), kept]`: the rows of block b's coordinates
 /// get the leading modes of their own POD, so that an element sees its own block's modes
 /// only and the Newton matrix is block-diagonal apart from the kept coordinates.
-pub fn train_basis(
+pub(crate) fn train_plain(
     x: ArrayView2<f64>,
     lambda: ArrayView2<f64>,
     joint_dofs: &[usize],
@@ -154,10 +164,7 @@ pub fn train_basis(
         _ => (0..n).collect(),
     };
     if variant == Variant::WholeSystemStabilized {
-        if !spec.blocks.is_empty() {
-            return Err("a basis with blocks needs the galerkin or the constraint-preserving variant".into());
-        }
-        return super::whole_system::train_stabilized(centred, lambda, reference, spec);
+        return Err("the stabilized variant is trained by reduction::train_basis".into());
     }
     if !spec.blocks.is_empty() {
         return train_blocks(centred, reference, joint_dofs, reduced_dofs, spec);
@@ -369,6 +376,7 @@ impl Basis {
 
 #[cfg(test)]
 mod tests {
+    use super::train_plain as train_basis;
     use super::*;
 
     /// Snapshots of a known 2-dimensional family: reconstruct∘reduce is the identity on the

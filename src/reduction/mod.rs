@@ -24,12 +24,11 @@ pub use crate::linalg::nnls;
 use crate::linalg::sparse_rows;
 pub mod whole_system;
 
-pub use basis::{train_basis, Basis, BasisSpec, SnapshotKind, Trained, Variant};
+pub use basis::{Basis, BasisSpec, SnapshotKind, Stabilization, Trained, Variant};
 pub use ecsw::{ecsw, Hyper};
 pub use hyper_model::HyperReducedModel;
 pub use pod::{pod, ModeRule, Pod};
 pub use reduced_model::ReducedModel;
-pub use whole_system::Stabilization;
 
 /// What the online stage needs of a reduced model besides the dynamics.
 pub trait Reduced<M>: crate::solver::model::ParametricModel {
@@ -37,4 +36,31 @@ pub trait Reduced<M>: crate::solver::model::ParametricModel {
     fn full(&self) -> &M;
     /// Physical multipliers of the full model's constraints, when the variant has them.
     fn multipliers(&self, q: &[f64], lambda: &[f64]) -> Option<ndarray::Array1<f64>>;
+}
+
+/// Builds a basis from snapshots `x` (n × m) and multipliers `λ` (n_c × m), for every
+/// variant: the stabilized whole-system one by [`whole_system`], the others by
+/// [`basis`] (so that `basis` need not know `whole_system`, which builds on it).
+pub fn train_basis(
+    x: ndarray::ArrayView2<f64>,
+    lambda: ndarray::ArrayView2<f64>,
+    joint_dofs: &[usize],
+    x_ref: ndarray::ArrayView1<f64>,
+    spec: &BasisSpec,
+) -> Result<Trained, String> {
+    if spec.variant != Variant::WholeSystemStabilized {
+        return basis::train_plain(x, lambda, joint_dofs, x_ref, spec);
+    }
+    if !spec.blocks.is_empty() {
+        return Err("a basis with blocks needs the galerkin or the constraint-preserving variant".into());
+    }
+    if x.ncols() == 0 {
+        return Err("the training set is empty (no snapshots)".into());
+    }
+    let reference = match spec.snapshots {
+        SnapshotKind::Raw => ndarray::Array1::zeros(x.nrows()),
+        SnapshotKind::Reference => x_ref.to_owned(),
+    };
+    let centred = &x - &reference.view().insert_axis(ndarray::Axis(1));
+    whole_system::train_stabilized(centred, lambda, reference, spec)
 }

@@ -23,19 +23,10 @@
 //! joint equations). The reduced multipliers `μ` are then the integrator's Lagrange
 //! multipliers (`k` of them instead of `n_c`), and `Ψ μ` gives physical ones back.
 
+pub use super::basis::Stabilization;
 use super::basis::{Basis, BasisSpec, Trained};
 use super::pod::{pod, ModeRule};
 use ndarray::{s, Array1, Array2, ArrayView2};
-
-/// What the stabilized variant needs besides the snapshots.
-#[derive(Clone, Debug)]
-pub struct Stabilization {
-    /// `B`, n_c × n: the (constant) joint equations `B x = b`
-    pub constraints: Array2<f64>,
-    /// how many multiplier modes `k` to keep (of the POD of the multiplier snapshots;
-    /// a ratio is of `n_c`)
-    pub multiplier_modes: ModeRule,
-}
 
 /// Default multiplier mode rule: all modes above 1e-12 of the energy (the multiplier
 /// snapshots of a mechanism span few directions; keeping them costs `2k` unknowns).
