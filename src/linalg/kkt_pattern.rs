@@ -1,6 +1,6 @@
 //! The KKT system's structure, independent of how it is solved: the 8×8 element blocks, the
 //! pattern (element dof maps and constraint rows), where each entry lands in a solver's
-//! storage ([`SlotMap`]), the choice of solver and the interface every solver implements.
+//! storage (`SlotMap`), the choice of solver and the interface every solver implements.
 
 use nalgebra::SMatrix;
 
