@@ -27,7 +27,7 @@
 
 use super::config::Pipeline;
 use super::shard::Shard;
-use super::train::{build_basis, TrainSummary};
+use super::train::{basis_from_snapshots, TrainSummary};
 use crate::error::{Error, Result};
 use crate::io::basis_file::TrainingData;
 use crate::io::h5::{attr_f64, attr_str, read_attr_f64, read_attr_str, write_atomically};
@@ -227,19 +227,5 @@ pub fn train_from_snapshots(p: &Pipeline, files: &[PathBuf]) -> Result<(Training
         load_scale: Array1::from_iter(ordered.iter().flat_map(|r| std::iter::repeat_n(r.load_scale, n_t))),
         t: Array1::from_iter(ordered.iter().flat_map(|r| r.t.iter().copied())),
     };
-    let modes = p.file.reduction.modes.clone().ok_or_else(|| Error::input(&p.path, "reduction.modes", "is missing"))?;
-    let tol = p.file.reduction.hyper.as_ref().map(|h| h.tolerance);
-    let (trained, estimator) = build_basis(p, &data, modes, tol).map_err(|(f, e)| Error::input(&p.path, f, e))?;
-    let n_snapshots = data.x.ncols();
-    Ok((
-        data,
-        TrainSummary {
-            trained,
-            n_snapshots,
-            full_seconds,
-            n_runs: scales.len(),
-            greedy: None,
-            estimator: Some(estimator),
-        },
-    ))
+    basis_from_snapshots(p, data, full_seconds, scales.len())
 }

@@ -78,22 +78,24 @@ pub fn train(p: &Pipeline) -> Result<(TrainingData, TrainSummary)> {
         full_seconds += r.wall_seconds;
         runs.push(r);
     }
-    let data = training_data(&runs);
+    basis_from_snapshots(p, training_data(&runs), full_seconds, scales.len())
+}
+
+/// The basis and estimator of fixed-load training (`train.load_scales`, the pipeline's
+/// `[reduction]` rule) from the snapshots of `n_runs` full runs, on one machine or gathered
+/// from sharded jobs ([`super::snapshots`]).
+pub(crate) fn basis_from_snapshots(
+    p: &Pipeline,
+    data: TrainingData,
+    full_seconds: f64,
+    n_runs: usize,
+) -> Result<(TrainingData, TrainSummary)> {
     let modes = p.file.reduction.modes.clone().ok_or_else(|| Error::input(&p.path, "reduction.modes", "is missing"))?;
     let tol = p.file.reduction.hyper.as_ref().map(|h| h.tolerance);
     let (trained, estimator) = build_basis(p, &data, modes, tol).map_err(|(f, e)| Error::input(&p.path, f, e))?;
     let n_snapshots = data.x.ncols();
-    Ok((
-        data,
-        TrainSummary {
-            trained,
-            n_snapshots,
-            full_seconds,
-            n_runs: scales.len(),
-            greedy: None,
-            estimator: Some(estimator),
-        },
-    ))
+    let summary = TrainSummary { trained, n_snapshots, full_seconds, n_runs, greedy: None, estimator: Some(estimator) };
+    Ok((data, summary))
 }
 
 /// The snapshots of full runs, side by side in run order.
