@@ -10,11 +10,19 @@
 //!   (the overestimate bound), `extrapolated` false, false, true, a positive
 //!   `sensitivity`, and five `rel_error_by_time` values, non-decreasing in the sense of
 //!   prefixes being covered and the last one equal to `rel_error` (both are ‖·‖_F over the
-//!   whole run).
+//!   whole run). Its `error_estimate_by_time` (the estimate over the same prefixes of the
+//!   run) has five values, the last one equal to `error_estimate` (same formula, same
+//!   instants), and bounds `rel_error_by_time` fifth by fifth at all three loads, as the
+//!   whole-run estimate bounds rel_error (the "good to 1e-3 up to 0.7 s" question).
+//!   The prefix values are ratios of two growing sums and need not be monotone; the unit
+//!   test in src/pipeline/estimate.rs checks the case where they must be (a growing error).
 //! - `extrapolation_warns_once_and_is_flagged`: `online` outside the range prints exactly
 //!   one warning line naming the training range and writes `extrapolated` = 1 and a finite
 //!   `error_estimate` attribute; inside the range no warning and `extrapolated` = 0; a sweep
 //!   over 0.9, 1.15, 1.4 writes `/extrapolated` = [0, 0, 1] and finite `/error_estimate`.
+//!   The result file's `error_estimate_by_time` attribute (5 values) ends with
+//!   `error_estimate`; the sweep's `/error_estimate_by_time` is 3 × 5, its last column equal
+//!   to `/error_estimate`, and `sweep --resume` on the finished file keeps it unchanged.
 //! - `strict_exits_4_after_writing_its_output`: with `[online] tolerance = 1e-12` (below any
 //!   estimate) `online --strict` exits with code 4 and the result file exists; without
 //!   `--strict` it exits 0 and warns; with tolerance 0.5 (above any estimate: the reduced
@@ -85,10 +93,17 @@ fn estimate_bounds_the_error_at_held_out_loads() {
         let by: Vec<f64> = v["rel_error_by_time"].as_array().unwrap().iter().map(|e| e.as_f64().unwrap()).collect();
         assert_eq!(by.len(), 5);
         assert!((by[4] - err).abs() <= 1e-12 * err, "{by:?} vs {err}");
+        let eby: Vec<f64> =
+            v["error_estimate_by_time"].as_array().expect("error_estimate_by_time reported").iter().map(|e| e.as_f64().unwrap()).collect();
+        assert_eq!(eby.len(), 5);
+        assert_eq!(eby[4], est, "λ = {x}: the last fifth's estimate is the whole run's");
+        for i in 0..5 {
+            assert!(eby[i].is_finite() && eby[i] >= by[i], "λ = {x}, fifth {}: estimate {eby:?} below the error {by:?}", i + 1);
+        }
         // the text output shows the same figures
         let t = run(&["validate", p.to_str().unwrap(), "--load-scale", &x.to_string(), "--no-dense"]);
         let text = String::from_utf8_lossy(&t.stdout);
-        for needle in ["error_estimate", "effectivity", "sensitivity", "rel_error up to each fifth"] {
+        for needle in ["error_estimate", "effectivity", "sensitivity", "rel_error up to each fifth", "error_estimate up to each fifth"] {
             assert!(text.contains(needle), "λ = {x}: `{needle}` missing from\n{text}");
         }
     }
@@ -107,6 +122,10 @@ fn extrapolation_warns_once_and_is_flagged() {
     assert_eq!(f.attr("extrapolated").unwrap().read_scalar::<u64>().unwrap(), 1);
     let e = f.attr("error_estimate").unwrap().read_scalar::<f64>().unwrap();
     assert!(e.is_finite() && e > 0.0, "{e}");
+    let by = f.attr("error_estimate_by_time").unwrap().read_1d::<f64>().unwrap();
+    assert_eq!(by.len(), 5);
+    assert_eq!(by[4], e, "{by}");
+    assert!(by.iter().all(|v| v.is_finite() && *v >= 0.0), "{by}");
     let o = run(&["online", p.to_str().unwrap(), "--load-scale", "1.0", "-o", out.to_str().unwrap()]);
     assert!(o.status.success());
     assert!(warnings(&o).is_empty(), "{:?}", warnings(&o));
@@ -122,6 +141,17 @@ fn extrapolation_warns_once_and_is_flagged() {
     let e = f.dataset("error_estimate").unwrap().read_1d::<f64>().unwrap();
     assert!(e.iter().all(|v| v.is_finite() && *v > 0.0), "{e}");
     assert!(String::from_utf8_lossy(&o.stdout).contains("error_estimate"));
+    let by = f.dataset("error_estimate_by_time").unwrap().read_2d::<f64>().unwrap();
+    assert_eq!(by.dim(), (3, 5));
+    for k in 0..3 {
+        assert_eq!(by[[k, 4]], e[k], "row {k}: {by}");
+        assert!(by.row(k).iter().all(|v| v.is_finite() && *v >= 0.0), "{by}");
+    }
+    drop(f);
+    let o = run(&["sweep", p.to_str().unwrap(), "--load-scales", "0.9:1.4:3", "-o", sw.to_str().unwrap(), "--resume"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let f = hdf5::File::open(&sw).unwrap();
+    assert_eq!(f.dataset("error_estimate_by_time").unwrap().read_2d::<f64>().unwrap(), by, "kept by --resume");
 }
 
 #[test]

@@ -249,6 +249,8 @@ impl<'a> EstimatingRunner<'a> {
             Some(e) => {
                 let corrected = match e.method {
                     EstimateMethod::Corrected => CorrectedRunner::new(model, basis, &e.enriched)?,
+                    EstimateMethod::CorrectedKept => CorrectedRunner::new(model, basis, &e.enriched)?
+                        .map(|c| c.with_matrix(super::estimate_corrected::MatrixUse::Kept)),
                     EstimateMethod::Enriched => None,
                 };
                 let m = match corrected {
@@ -385,7 +387,8 @@ pub fn describe(e: &Estimate, rom_seconds: f64) -> String {
 }
 
 /// Attributes of an `online` result file: `error_estimate` (NaN without an estimator),
-/// `error_estimate_raw`, `error_estimate_factor`, `error_estimate_calibrated` (0/1),
+/// `error_estimate_by_time` (5 values: the estimate up to the end of each fifth of the run,
+/// the last = `error_estimate`; NaN without an estimator), `error_estimate_raw`, `error_estimate_factor`, `error_estimate_calibrated` (0/1),
 /// `extrapolated` (0/1), `training_range` ([min, max]), `tolerance` (when set).
 pub fn write_run_attributes(
     f: &hdf5::File,
@@ -395,6 +398,10 @@ pub fn write_run_attributes(
 ) -> hdf5::Result<()> {
     use crate::io::h5::{attr_f64, attr_u64};
     attr_f64(f, "error_estimate", e.map_or(f64::NAN, |e| e.error_estimate))?;
+    f.new_attr::<f64>()
+        .shape(5)
+        .create("error_estimate_by_time")?
+        .write(&e.map_or([f64::NAN; 5], |e| e.by_time))?;
     attr_f64(f, "error_estimate_raw", e.map_or(f64::NAN, |e| e.raw))?;
     attr_f64(f, "error_estimate_factor", e.map_or(f64::NAN, |e| e.factor))?;
     attr_u64(f, "error_estimate_calibrated", e.is_some_and(|e| e.calibrated) as u64)?;
@@ -541,6 +548,45 @@ mod tests {
             let got = raw_estimate_reduced(&b, &est.enriched, &q, &qp);
             assert!((got - want).abs() < 1e-12 * want.max(1.0), "{got} vs {want}");
         }
+    }
+
+    /// The estimate over prefixes of the run: zero while the two runs agree; non-decreasing
+    /// when the distance per instant grows and the norm per instant is constant (then each
+    /// prefix value is the RMS of a growing sequence); the last is the whole run's.
+    #[test]
+    fn estimate_by_time_follows_a_growing_error() {
+        let (n, nt) = (4, 20);
+        let eye = Array2::from_shape_fn((n, n), |(i, j)| if i == j { 1.0 } else { 0.0 });
+        let mk = |modes: Array2<f64>| Basis {
+            variant: Variant::Galerkin,
+            snapshots: crate::reduction::SnapshotKind::Reference,
+            reference: Array1::zeros(n),
+            n_pod_modes: modes.ncols(),
+            modes,
+            kept: vec![],
+            multiplier_modes: None,
+            multiplier_scale: 1.0,
+            hyper: None,
+        };
+        let (b, plus) = (mk(eye.clone()), mk(eye));
+        // X⁺ rotates at unit norm; X_r lags it by nothing for 8 instants, then by a growing angle
+        let lag = |k: usize| if k < 8 { 0.0 } else { 0.01 * (k - 7) as f64 };
+        let qp = Array2::from_shape_fn((n, nt), |(i, k)| match i {
+            0 => (0.1 * k as f64).cos(),
+            1 => (0.1 * k as f64).sin(),
+            _ => 0.0,
+        });
+        let q = Array2::from_shape_fn((n, nt), |(i, k)| match i {
+            0 => (0.1 * k as f64 - lag(k)).cos(),
+            1 => (0.1 * k as f64 - lag(k)).sin(),
+            _ => 0.0,
+        });
+        let by = raw_estimate_by_time(&b, &plus, &q, &qp);
+        assert_eq!(&by[..2], &[0.0, 0.0], "{by:?}");
+        assert!(by.windows(2).all(|w| w[1] >= w[0]) && by[4] > by[2], "{by:?}");
+        let whole = (&q - &qp).mapv(|v| v * v).sum().sqrt() / qp.mapv(|v| v * v).sum().sqrt();
+        assert!((by[4] - whole).abs() < 1e-14, "{} vs {whole}", by[4]);
+        assert_eq!(by[4], raw_estimate_reduced(&b, &plus, &q, &qp));
     }
 
     /// rel_error over growing prefixes; the last one is the whole run's.

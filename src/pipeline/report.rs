@@ -236,15 +236,20 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool) -> Result<
             "estimate_vs_load",
         )?;
     }
+    // the true error (solid) and its estimate (dashed) up to each fifth of the run
+    let fifths = |v: &[f64]| v.iter().enumerate().map(|(i, e)| ((i + 1) as f64 / 5.0, *e)).collect::<Vec<_>>();
     let by_time: Vec<Series> = validations
         .iter()
-        .map(|v| {
-            let pts = v.rel_error_by_time.iter().enumerate().map(|(i, e)| ((i + 1) as f64 / 5.0, *e)).collect();
-            Series::new(format!("load scale {}", v.load_scale), pts, Style::Line)
+        .flat_map(|v| {
+            let truth = Series::new(format!("rel_error, load scale {}", v.load_scale), fifths(&v.rel_error_by_time), Style::Line);
+            let est = v.error_estimate_by_time.as_ref().map(|e| {
+                Series::new(format!("error_estimate, load scale {}", v.load_scale), fifths(e), Style::Dashed)
+            });
+            std::iter::once(truth).chain(est)
         })
         .collect();
     single(
-        "rel_error up to a fraction of the run",
+        "rel_error (solid) and error_estimate (dashed) up to a fraction of the run",
         "fraction of the run",
         Panel { y_label: "rel_error".into(), log_y: true, series: by_time },
         vec![],
@@ -313,14 +318,17 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool) -> Result<
         trust.range.1,
         trust.tolerance.map_or("none".to_string(), |t| format!("{t:e}"))
     );
-    let _ = writeln!(md, "| load scale | rel_error | error_estimate | effectivity | calibrated | extrapolated | sensitivity | rel_error by fifth of the run |");
-    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(md, "| load scale | rel_error | error_estimate | effectivity | calibrated | extrapolated | sensitivity | rel_error by fifth of the run | error_estimate by fifth of the run |");
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|");
     for v in &validations {
         let by: Vec<String> = v.rel_error_by_time.iter().map(|e| format!("{e:.2e}")).collect();
+        let est_by = v.error_estimate_by_time.as_ref().map_or("–".to_string(), |e| {
+            e.iter().map(|e| format!("{e:.2e}")).collect::<Vec<_>>().join(", ")
+        });
         let o = |x: Option<f64>, f: &dyn Fn(f64) -> String| x.map_or("–".to_string(), f);
         let _ = writeln!(
             md,
-            "| {} | {:.3e} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {:.3e} | {} | {} | {} | {} | {} | {} | {} |",
             v.load_scale,
             v.rel_error,
             o(v.error_estimate, &|x| format!("{x:.3e}")),
@@ -328,7 +336,8 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool) -> Result<
             v.estimate_calibrated.map_or("–", |c| if c { "yes" } else { "no" }),
             if v.extrapolated { "yes" } else { "no" },
             o(v.sensitivity, &|x| format!("{x:.2e}")),
-            by.join(", ")
+            by.join(", "),
+            est_by
         );
     }
     let _ = writeln!(md, "\n## Sweep\n\n```text\n{}```\n", table(&sw));

@@ -22,6 +22,8 @@
 //! /newton_iterations  (N)
 //! /factorizations     (N)            iteration matrices factorized
 //! /error_estimate     (N)            the estimate of rel_error of each run (NaN: no estimator)
+//! /error_estimate_by_time (N, 5)     the estimate up to the end of each fifth of the run (the
+//!                                    last column is /error_estimate; NaN: no estimator)
 //! /extrapolated       (N)            1 where the load scale is outside the training range
 //! /estimate_seconds   (N)            the estimator's enriched run and norms, s
 //! with --validate:    /rel_error, /max_probe_error, /max_constraint_violation,
@@ -486,6 +488,13 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, stored: &StoredBasis, basis_path
             .with_data(&col(&|p| p.estimate.map_or(f64::NAN, |e| e.error_estimate)))
             .create("error_estimate")
             .map_err(e)?;
+        let mut by_time = Array2::from_elem((n, 5), f64::NAN);
+        for (k, x) in s.scales.iter().enumerate() {
+            if let Some(est) = x.point().and_then(|p| p.estimate) {
+                by_time.row_mut(k).assign(&ndarray::ArrayView1::from(&est.by_time));
+            }
+        }
+        f.new_dataset_builder().with_data(&by_time).create("error_estimate_by_time").map_err(e)?;
         f.new_dataset_builder()
             .with_data(&col(&|p| p.estimate.map_or(f64::NAN, |e| e.seconds)))
             .create("estimate_seconds")
@@ -597,6 +606,18 @@ pub fn read_sweep(
             None
         },
     );
+    let by_time = if f.link_exists("error_estimate_by_time") {
+        let a = f
+            .dataset("error_estimate_by_time")
+            .and_then(|d| d.read::<f64, ndarray::Ix2>())
+            .map_err(|e| cannot("error_estimate_by_time", format!("cannot be read: {e}")))?;
+        if a.dim() != (n, 5) {
+            return Err(cannot("error_estimate_by_time", format!("is {:?}, expected ({n}, 5)", a.dim())));
+        }
+        Some(a)
+    } else {
+        None
+    };
     let (newton, factorizations) = (ints("newton_iterations")?, ints("factorizations")?);
     let validation = if validate && f.link_exists("rel_error") {
         Some([
@@ -678,6 +699,7 @@ pub fn read_sweep(
             training_range: None,
             sensitivity: None,
             rel_error_by_time: Vec::new(),
+            error_estimate_by_time: None,
         });
         // the stored estimate: its value and cost (the factor it was made with is the basis's)
         let estimate = estimates.as_ref().map(|a| a[k]).filter(|e| !e.is_nan()).map(|error_estimate| Estimate {
@@ -686,7 +708,7 @@ pub fn read_sweep(
             factor: f64::NAN,
             calibrated: false,
             seconds: estimate_seconds.as_ref().map_or(f64::NAN, |a| a[k]),
-            by_time: [f64::NAN; 5],
+            by_time: by_time.as_ref().map_or([f64::NAN; 5], |a| std::array::from_fn(|i| a[[k, i]])),
         });
         let extrapolated = extrapolated.as_ref().is_some_and(|a| a.get(k).is_some_and(|&v| v != 0));
         let v = v.map(|mut v| {
@@ -694,6 +716,7 @@ pub fn read_sweep(
                 v.error_estimate = Some(e.error_estimate);
                 v.effectivity = Some(e.error_estimate / v.rel_error);
                 v.estimate_seconds = Some(e.seconds);
+                v.error_estimate_by_time = Some(e.by_time.to_vec());
             }
             v.extrapolated = extrapolated;
             v

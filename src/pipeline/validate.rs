@@ -8,6 +8,7 @@
 //!     effectivity = error_estimate / rel_error               (≥ 1: the estimate bounds the error)
 //!     sensitivity = ‖X_full(1.001 λ) − X_full(λ)‖_F / ‖X_full(λ)‖_F
 //!     rel_error_by_time[i] = rel_error over t ≤ the end of fifth i + 1 of the run
+//!     error_estimate_by_time[i] = error_estimate over the same instants (the last is error_estimate)
 //! ```
 //!
 //! `sensitivity` puts the error in context: how much the full model's own answer moves for
@@ -61,6 +62,9 @@ pub struct Validation {
     pub sensitivity: Option<f64>,
     /// rel_error up to the end of each fifth of the run (the last is rel_error)
     pub rel_error_by_time: Vec<f64>,
+    /// error_estimate up to the end of each fifth of the run, the estimate of
+    /// `rel_error_by_time` (the last is error_estimate; null: no estimator)
+    pub error_estimate_by_time: Option<Vec<f64>>,
 }
 
 /// Compares a reduced run with a full run of the same model, load scale and Δt.
@@ -124,6 +128,7 @@ pub fn compare(
         training_range: None,
         sensitivity: None,
         rel_error_by_time: rel_error_by_time(&r.q, &full.q),
+        error_estimate_by_time: None,
     }
 }
 
@@ -135,6 +140,7 @@ impl Validation {
             self.effectivity = Some(e.error_estimate / self.rel_error);
             self.estimate_calibrated = Some(e.calibrated);
             self.estimate_seconds = Some(e.seconds);
+            self.error_estimate_by_time = Some(e.by_time.to_vec());
         }
         if let Some(t) = trust {
             self.extrapolated = is_extrapolated(t.range, self.load_scale);
@@ -243,6 +249,10 @@ impl Validation {
         }
         let by: Vec<String> = self.rel_error_by_time.iter().map(|e| format!("{e:.2e}")).collect();
         s.push_str(&format!("\n  rel_error up to each fifth of the run: {}", by.join(", ")));
+        if let Some(e) = &self.error_estimate_by_time {
+            let by: Vec<String> = e.iter().map(|e| format!("{e:.2e}")).collect();
+            s.push_str(&format!("\n  error_estimate up to each fifth of the run: {}", by.join(", ")));
+        }
         s
     }
 }
