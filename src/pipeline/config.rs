@@ -183,8 +183,8 @@ pub struct OnlineSpec {
     pub load_scales: Scales,
     #[serde(default)]
     pub tolerance: Option<f64>,
-    /// how every reduced run computes its error estimate: "corrected" (default),
-    /// "corrected-kept" or "enriched" (docs/error-estimate.md)
+    /// how every reduced run computes its error estimate: "corrected" (default) or
+    /// "enriched" (docs/error-estimate.md)
     #[serde(default)]
     pub estimate: Option<EstimateMethod>,
 }
@@ -429,9 +429,6 @@ pub enum EstimateMethod {
     Corrected,
     /// the enriched model integrated on its own to convergence (about 2× the reduced run)
     Enriched,
-    /// as `corrected`, the enriched matrix kept over steps and iterated with
-    /// (`pipeline::estimate_corrected::MatrixUse::Kept`)
-    CorrectedKept,
 }
 
 impl EstimateMethod {
@@ -439,7 +436,6 @@ impl EstimateMethod {
         match self {
             EstimateMethod::Corrected => "corrected",
             EstimateMethod::Enriched => "enriched",
-            EstimateMethod::CorrectedKept => "corrected-kept",
         }
     }
 
@@ -447,8 +443,7 @@ impl EstimateMethod {
         match s {
             "corrected" => Ok(EstimateMethod::Corrected),
             "enriched" => Ok(EstimateMethod::Enriched),
-            "corrected-kept" => Ok(EstimateMethod::CorrectedKept),
-            _ => Err(format!("is \"{s}\"; expected \"corrected\" (default), \"corrected-kept\" or \"enriched\"")),
+            _ => Err(format!("is \"{s}\"; expected \"corrected\" (default) or \"enriched\"")),
         }
     }
 }

@@ -36,15 +36,6 @@
 //! changes it by a fraction (the contraction of the kept matrix) of that: a 10–30 %
 //! change of an estimate that is read as an order of magnitude.
 
-//!
-//! The `corrected-kept` method ([`MatrixUse::Kept`]) keeps the enriched matrix over steps
-//! and makes up for it with more iterations: at each step it iterates with the kept matrix
-//! until the update is at most [`KEPT_TOLERANCE`] times the first one (the accuracy of a
-//! fresh-matrix iteration, within the 10–30 % said above), factorizes afresh when an update
-//! shrinks by less than [`KEPT_CONTRACTION`] over the previous one, and at most
-//! [`KEPT_MAX_ITERATIONS`] iterations per step (then the next step starts with a fresh
-//! matrix). A residual and a solve cost a fraction of a matrix and its factorization.
-
 use super::online::ReducedRun;
 use crate::error::{Error, Result};
 use crate::model::Model;
@@ -54,22 +45,6 @@ use crate::simulate::{Overrides, Settings};
 use crate::solver::model::{Bound, DynamicModel, IterationCoefficients};
 use ndarray::{Array2, ArrayView1};
 
-/// How the corrected estimator uses the enriched model's iteration matrix.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MatrixUse {
-    /// a fresh matrix and one iteration per step (`corrected`)
-    Fresh,
-    /// the matrix kept over steps, iterated to [`KEPT_TOLERANCE`] (`corrected-kept`)
-    Kept,
-}
-
-/// `corrected-kept`: iterate until `‖δ_i‖∞ ≤ KEPT_TOLERANCE · ‖δ_0‖∞`.
-pub const KEPT_TOLERANCE: f64 = 0.1;
-/// `corrected-kept`: a fresh matrix when `‖δ_i‖∞ > KEPT_CONTRACTION · ‖δ_{i−1}‖∞`.
-pub const KEPT_CONTRACTION: f64 = 0.5;
-/// `corrected-kept`: iterations per step at most (then a fresh matrix at the next step).
-pub const KEPT_MAX_ITERATIONS: usize = 4;
-
 /// The enriched model, built once, corrected along reduced runs at many load scales.
 pub struct CorrectedRunner<'a> {
     model: &'a Model,
@@ -78,9 +53,6 @@ pub struct CorrectedRunner<'a> {
     /// `M = V⁺ᵀ V` (r⁺ × r)
     lift: Array2<f64>,
     x0: Vec<f64>,
-    matrix: MatrixUse,
-    /// iteration matrices factorized in the last run (for measurements)
-    pub factorizations: usize,
 }
 
 impl<'a> CorrectedRunner<'a> {
@@ -106,13 +78,7 @@ impl<'a> CorrectedRunner<'a> {
         let rom = HyperReducedModel::new(sys, enriched, h)
             .map_err(|e| Error::Usage(format!("cannot build the estimator's reduced model: {e}")))?;
         let lift = enriched.modes.t().dot(&basis.modes);
-        Ok(Some(CorrectedRunner { model, enriched, rom: Box::new(rom), lift, x0, matrix: MatrixUse::Fresh, factorizations: 0 }))
-    }
-
-    /// The same runner with the matrix used as `m`.
-    pub fn with_matrix(mut self, m: MatrixUse) -> Self {
-        self.matrix = m;
-        self
+        Ok(Some(CorrectedRunner { model, enriched, rom: Box::new(rom), lift, x0 }))
     }
 
     /// The enriched trajectory `q⁺` (r⁺ × n_t) corrected along `run` (module documentation).
@@ -156,9 +122,6 @@ impl<'a> CorrectedRunner<'a> {
 
         let mut out = Array2::zeros((n, nt));
         out.column_mut(0).assign(&ArrayView1::from(&q));
-        self.factorizations = 0;
-        // kept: the matrix of the last factorization and its constraint scaling
-        let (mut fresh, mut sc) = (true, s0);
         let mut dz = vec![0.0; z.nrows()];
         let mut d = vec![0.0; n];
         for k in 1..nt {
@@ -183,54 +146,30 @@ impl<'a> CorrectedRunner<'a> {
                 a[i] = a0;
                 qdd[i] = qn;
             }
-            // Newton iterations on r_q = M q̈ + g + Bᵀλ, r_c = B q − b: one with a fresh
-            // matrix, or (kept) as many as the module documentation says
-            let (mut first, mut prev) = (0.0_f64, 0.0_f64);
-            for it in 0.. {
-                if self.matrix == MatrixUse::Fresh || fresh {
-                    sc = rom.factor(&q, &v, t, coef).map_err(|p| fail(t, p))?;
-                    self.factorizations += 1;
-                    fresh = false;
-                }
-                rom.mass_mul(&qdd, &mut work);
-                rom.force(&q, &v, t, &mut rhs[..n]);
-                rhs[..n].iter_mut().zip(&work).for_each(|(o, w)| *o += w);
-                rom.add_constraint_force(&lambda, &mut rhs[..n]);
-                let (rq, rc) = rhs.split_at_mut(n);
-                rq.iter_mut().for_each(|x| *x *= -1.0 / beta_p);
-                rom.constraint_residual(&q, rc);
-                rc.iter_mut().for_each(|x| *x *= -sc);
-                rom.solve(&mut rhs).map_err(|p| fail(t, p))?;
-                let mut inc = 0.0_f64;
-                for i in 0..n {
-                    let dq = rhs[i];
-                    q[i] += dq;
-                    v[i] += gamma_p * dq;
-                    qdd[i] += beta_p * dq;
-                    inc = inc.max(dq.abs());
-                }
-                for (l, m) in lambda.iter_mut().zip(&rhs[n..]) {
-                    *l += beta_p * sc * m;
-                }
-                if !inc.is_finite() {
-                    return Err(fail(t, "the corrected trajectory is no longer finite".into()));
-                }
-                if self.matrix == MatrixUse::Fresh {
-                    break;
-                }
-                if it == 0 {
-                    first = inc;
-                } else if inc > KEPT_CONTRACTION * prev {
-                    fresh = true;
-                }
-                if inc <= KEPT_TOLERANCE * first {
-                    break;
-                }
-                if it + 1 >= KEPT_MAX_ITERATIONS {
-                    fresh = true;
-                    break;
-                }
-                prev = inc;
+            // one Newton iteration on r_q = M q̈ + g + Bᵀλ, r_c = B q − b, fresh matrix
+            rom.mass_mul(&qdd, &mut work);
+            rom.force(&q, &v, t, &mut rhs[..n]);
+            rhs[..n].iter_mut().zip(&work).for_each(|(o, w)| *o += w);
+            rom.add_constraint_force(&lambda, &mut rhs[..n]);
+            let sc = rom.factor(&q, &v, t, coef).map_err(|p| fail(t, p))?;
+            let (rq, rc) = rhs.split_at_mut(n);
+            rq.iter_mut().for_each(|x| *x *= -1.0 / beta_p);
+            rom.constraint_residual(&q, rc);
+            rc.iter_mut().for_each(|x| *x *= -sc);
+            rom.solve(&mut rhs).map_err(|p| fail(t, p))?;
+            let mut inc = 0.0_f64;
+            for i in 0..n {
+                let dq = rhs[i];
+                q[i] += dq;
+                v[i] += gamma_p * dq;
+                qdd[i] += beta_p * dq;
+                inc = inc.max(dq.abs());
+            }
+            for (l, m) in lambda.iter_mut().zip(&rhs[n..]) {
+                *l += beta_p * sc * m;
+            }
+            if !inc.is_finite() {
+                return Err(fail(t, "the corrected trajectory is no longer finite".into()));
             }
             for i in 0..n {
                 a[i] += c * qdd[i];
