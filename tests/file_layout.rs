@@ -11,10 +11,10 @@
 //!   (n_t, r), with n_t the length of `/t`; a sweep's `/reduced_q` (N, n_t, r); snapshot and
 //!   mode matrices keep one column per snapshot/mode (dims "dof, snapshot", "dof, mode").
 //!   Sizes from the model: the coarse pendulum has 8 elements → 9 nodes → 36 coordinates,
-//!   one ground pin → 2 multipliers; t_end 0.1 s at dt 0.01 s → 11 instants;
-//! - `/labels`: 36 coordinate names, the first "pendulum node 0 x", the 6th "pendulum node 1 y";
-//!   the two constraint rows "joint 0 (ground_pin pendulum node 0) x" / "… y"
-//!   (data/models/pendulum.toml: body "pendulum", joints[0] a ground pin at its start);
+//!   one ground pin → 2 multipliers; t_end 0.1 s at dt 0.005 s → 21 instants;
+//! - `/labels`: 36 coordinate names, the first "beam node 0 x", the 6th "beam node 1 y";
+//!   the two constraint rows "joint 0 (ground_pin beam node 0) x" / "… y"
+//!   (data/models/pendulum.toml: body "beam", joints[0] a ground pin at its start);
 //! - a sweep file of layout 1 (the attribute removed, `/reduced_q` stored (N, r, n_t) as
 //!   before) is still read by `sweep --resume`, which writes the same `/reduced_q`; a basis,
 //!   a sweep and a snapshot file claiming layout 3 are refused with one line naming the
@@ -48,7 +48,7 @@ fn s(p: &Path) -> &str {
 }
 
 const N_DOF: usize = 36;
-const N_T: usize = 11;
+const N_T: usize = 21;
 
 /// The coarse pendulum (8 elements, 0.1 s) and two pipelines: fixed loads with ECSW, greedy.
 fn setup(dir: &Path) -> (PathBuf, PathBuf, PathBuf) {
@@ -126,12 +126,12 @@ fn texts(path: &Path, name: &str) -> Vec<String> {
 fn check_labels(path: &Path) {
     let dof = texts(path, "labels/dof");
     assert_eq!(dof.len(), N_DOF, "{}", path.display());
-    assert_eq!((dof[0].as_str(), dof[5].as_str()), ("pendulum node 0 x", "pendulum node 1 y"));
+    assert_eq!((dof[0].as_str(), dof[5].as_str()), ("beam node 0 x", "beam node 1 y"));
     assert_eq!(
         texts(path, "labels/multiplier"),
-        vec!["joint 0 (ground_pin pendulum node 0) x", "joint 0 (ground_pin pendulum node 0) y"]
+        vec!["joint 0 (ground_pin beam node 0) x", "joint 0 (ground_pin beam node 0) y"]
     );
-    assert_eq!(texts(path, "labels/body"), vec!["pendulum"]);
+    assert_eq!(texts(path, "labels/body"), vec!["beam"]);
 }
 
 #[test]
@@ -260,7 +260,7 @@ fn older_layouts_are_read_and_newer_ones_refused() {
     set_layout(&sweep3, Some(3));
     refused(&["sweep", s(&p), "--load-scales", "0.9:1.1:3", "--resume", "-o", s(&sweep3)], &sweep3, "flexrom sweep");
     let snaps = out("snaps.h5");
-    ok(&["train", s(&p), "--snapshots-only", "-o", s(&snaps)]);
+    ok(&["train", s(&p), "--snapshots-only", "--shard", "1/1", "-o", s(&snaps)]);
     set_layout(&snaps, Some(3));
     refused(&["train", s(&p), "--basis", s(&out("b2.h5")), "--from-snapshots", s(&snaps)], &snaps, "flexrom train --snapshots-only");
     let basis = out("basis.h5");
