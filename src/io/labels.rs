@@ -118,6 +118,7 @@ mod tests {
         [time]
         t_end = 0.1
         dt = 0.01
+        rho_inf = 0.8
         [[bodies]]
         name = "beam"
         start = [0.0, 0.0]

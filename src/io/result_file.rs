@@ -37,8 +37,8 @@ pub fn write_result_with(
         let e = |err: hdf5::Error| Error::hdf5(path, err);
         f.new_dataset_builder().with_data(&r.t).create("t").map_err(e)?;
         // time first: the solver's columns (one per instant) become rows
-        f.new_dataset_builder().with_data(&r.q.t().as_standard_layout()).create("q").map_err(e)?;
-        f.new_dataset_builder().with_data(&r.multipliers.t().as_standard_layout()).create("multipliers").map_err(e)?;
+        write_time_first(f, "q", &r.q).map_err(e)?;
+        write_time_first(f, "multipliers", &r.multipliers).map_err(e)?;
         let g = f.create_group("probes").map_err(e)?;
         for (name, xy) in &r.probes {
             g.new_dataset_builder().with_data(xy).create(name.as_str()).map_err(e)?;
@@ -64,10 +64,49 @@ pub fn write_result_with(
     })
 }
 
+/// Rows of the transposed copy written at a time: ≤ 8 MiB of it, whatever the run's size.
+const BLOCK_BYTES: usize = 8 << 20;
+
+/// Writes `a` (n × n_t: one column per instant, as the solver keeps it) as the dataset
+/// `name` of shape (n_t, n), time first, transposing a block of instants at a time so that
+/// a large run is not copied whole.
+pub fn write_time_first(g: &hdf5::Group, name: &str, a: &ndarray::Array2<f64>) -> hdf5::Result<()> {
+    write_in_blocks(g, name, a, (BLOCK_BYTES / (8 * a.nrows().max(1))).max(1))
+}
+
+fn write_in_blocks(g: &hdf5::Group, name: &str, a: &ndarray::Array2<f64>, rows: usize) -> hdf5::Result<()> {
+    let (n, nt) = a.dim();
+    if n == 0 || nt == 0 {
+        g.new_dataset_builder().with_data(&a.t().as_standard_layout()).create(name)?;
+        return Ok(());
+    }
+    let d = g.new_dataset::<f64>().shape((nt, n)).create(name)?;
+    for start in (0..nt).step_by(rows) {
+        let end = (start + rows).min(nt);
+        let block = a.slice(ndarray::s![.., start..end]).t().as_standard_layout().into_owned();
+        d.write_slice(&block, ndarray::s![start..end, ..])?;
+    }
+    Ok(())
+}
+
 /// Writes `/reduced/q`, time first, from the reduced coordinates `zq` (r × n_t, one column
 /// per instant as the solver keeps them).
 pub fn write_reduced(f: &hdf5::File, zq: &ndarray::Array2<f64>) -> hdf5::Result<()> {
-    let g = f.create_group("reduced")?;
-    g.new_dataset_builder().with_data(&zq.t().as_standard_layout()).create("q")?;
-    Ok(())
+    write_time_first(&f.create_group("reduced")?, "q", zq)
+}
+
+#[cfg(test)]
+mod tests {
+    /// Blocks of 3 instants (the last one short) and one block give the transpose.
+    #[test]
+    fn time_first_blocks_give_the_transpose() {
+        let dir = tempfile::tempdir().unwrap();
+        let f = hdf5::File::create(dir.path().join("t.h5")).unwrap();
+        let a = ndarray::Array2::from_shape_fn((4, 10), |(i, k)| (10 * i + k) as f64);
+        super::write_in_blocks(&f, "blocks", &a, 3).unwrap();
+        super::write_time_first(&f, "whole", &a).unwrap();
+        for name in ["blocks", "whole"] {
+            assert_eq!(f.dataset(name).unwrap().read_2d::<f64>().unwrap(), a.t(), "{name}");
+        }
+    }
 }
