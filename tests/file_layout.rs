@@ -152,7 +152,15 @@ fn every_dataset_of_every_file_has_units_and_time_comes_first() {
     ok(&["merge", s(&out("part1.h5")), s(&out("part2.h5")), "-o", s(&out("merged.h5"))]);
     ok(&["train", s(&p), "--snapshots-only", "--shard", "1/2", "-o", s(&out("snaps1.h5"))]);
     ok(&["train", s(&p), "--snapshots-only", "--shard", "2/2", "-o", s(&out("snaps2.h5"))]);
-    ok(&["train", s(&p), "--basis", s(&out("from_snaps.h5")), "--from-snapshots", s(&out("snaps1.h5")), s(&out("snaps2.h5"))]);
+    ok(&[
+        "train",
+        s(&p),
+        "--basis",
+        s(&out("from_snaps.h5")),
+        "--from-snapshots",
+        s(&out("snaps1.h5")),
+        s(&out("snaps2.h5")),
+    ]);
 
     // units everywhere
     for f in ["sim.h5", "online.h5"] {
@@ -262,7 +270,11 @@ fn older_layouts_are_read_and_newer_ones_refused() {
     let snaps = out("snaps.h5");
     ok(&["train", s(&p), "--snapshots-only", "--shard", "1/1", "-o", s(&snaps)]);
     set_layout(&snaps, Some(3));
-    refused(&["train", s(&p), "--basis", s(&out("b2.h5")), "--from-snapshots", s(&snaps)], &snaps, "flexrom train --snapshots-only");
+    refused(
+        &["train", s(&p), "--basis", s(&out("b2.h5")), "--from-snapshots", s(&snaps)],
+        &snaps,
+        "flexrom train --snapshots-only",
+    );
     let basis = out("basis.h5");
     set_layout(&basis, Some(3));
     refused(&["online", s(&p), "--load-scale", "1.0", "-o", s(&out("on.h5"))], &basis, "flexrom train");

@@ -42,9 +42,9 @@
 //!   multiplier_scale (w), n_dof, creation_time (RFC 3339, UTC), program_version
 //! ```
 
+use super::attrs::{check_layout, write_atomically_as, Kind};
 use super::basis_hash::{content_hash, HashInput};
 use super::basis_layout::check_file;
-use super::attrs::{check_layout, write_atomically_as, Kind};
 use super::h5::{attr_f64, attr_str, attr_u64, read_attr_f64, read_attr_str};
 use crate::error::{Error, Result};
 use crate::reduction::{Basis, Hyper, SnapshotKind, Trained, Variant};
