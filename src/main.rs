@@ -358,8 +358,7 @@ fn run(cli: Cli) -> flexrom::Result<()> {
             let basis_name = path.display().to_string();
             write_result_with(&output, &run.result, |f| {
                 let e = |err: hdf5::Error| flexrom::Error::hdf5(&output, err);
-                let g = f.create_group("reduced").map_err(e)?;
-                g.new_dataset_builder().with_data(&run.reduced_q).create("q").map_err(e)?;
+                flexrom::io::result_file::write_reduced(f, &run.reduced_q).map_err(e)?;
                 flexrom::io::h5::attr_str(f, "basis", &basis_name).map_err(e)?;
                 flexrom::io::h5::attr_str(f, "variant", stored.basis.variant.name()).map_err(e)?;
                 flexrom::io::h5::attr_u64(f, "n_modes", stored.basis.n_reduced() as u64).map_err(e)?;

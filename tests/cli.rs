@@ -37,14 +37,15 @@ fn simulate_writes_the_documented_layout() {
     let t = f.dataset("t").unwrap().read_1d::<f64>().unwrap();
     assert_eq!(t.len(), 11);
     assert!((t[10] - 0.05).abs() < 1e-12);
-    assert_eq!(f.dataset("q").unwrap().shape(), vec![204, 11]);
-    assert_eq!(f.dataset("multipliers").unwrap().shape(), vec![2, 11]);
+    // time first (layout 2, docs/file-formats.md)
+    assert_eq!(f.dataset("q").unwrap().shape(), vec![11, 204]);
+    assert_eq!(f.dataset("multipliers").unwrap().shape(), vec![11, 2]);
     let tip = f.dataset("probes/tip").unwrap().read_2d::<f64>().unwrap();
     assert_eq!(tip.shape(), &[11, 2]);
-    // the tip probe is the last node's position, column 10 of /q
+    // the tip probe is the last node's position: row 10, columns 200 and 201 of /q
     let q = f.dataset("q").unwrap().read_2d::<f64>().unwrap();
-    assert_eq!(tip[[10, 0]], q[[200, 10]]);
-    assert_eq!(tip[[10, 1]], q[[201, 10]]);
+    assert_eq!(tip[[10, 0]], q[[10, 200]]);
+    assert_eq!(tip[[10, 1]], q[[10, 201]]);
     assert!(flexrom::io::h5::read_attr_str(&f, "model").unwrap().contains("[[bodies]]"));
     assert_eq!(flexrom::io::h5::read_attr_f64(&f, "dt").unwrap(), 0.005);
     assert_eq!(flexrom::io::h5::read_attr_f64(&f, "load_scale").unwrap(), 1.0);

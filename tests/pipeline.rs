@@ -142,8 +142,8 @@ fn pendulum_pipeline_end_to_end_within_the_error_bound() {
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let f = hdf5::File::open(&out).unwrap();
-    assert_eq!(f.dataset("q").unwrap().shape(), vec![84, 121]);
-    assert_eq!(f.dataset("reduced/q").unwrap().shape(), vec![17, 121]);
+    assert_eq!(f.dataset("q").unwrap().shape(), vec![121, 84], "time first");
+    assert_eq!(f.dataset("reduced/q").unwrap().shape(), vec![121, 17], "time first");
     assert_eq!(f.dataset("probes/tip").unwrap().shape(), vec![121, 2]);
 
     let o = flexrom().args(["validate", pipe.to_str().unwrap(), "--load-scale", "1.0", "--json"]).output().unwrap();

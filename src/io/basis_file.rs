@@ -33,15 +33,19 @@
 //!   the full run there; both NaN without a run), energy_tolerance ε,
 //!   hyper_tolerance τ, n_modes, n_elements; estimates (iterations, N) every candidate's
 //!   estimate; attributes: method = "greedy", iterations, max_runs, full_runs, converged
-//! attributes on /: schema_version, model (TOML text), model_path, model_fingerprint,
-//!   settings_hash, content_hash (SHA-256 of the content: src/io/basis_check.rs),
+//! /labels/...                            names of the coordinates and constraint rows
+//!                                         (src/io/labels.rs)
+//! every dataset: attributes units, dims ("dof, snapshot", "dof, mode", …: src/io/attrs.rs)
+//! attributes on /: flexrom_layout, flexrom_file = "basis", schema_version, model (TOML
+//!   text), model_path, model_fingerprint, settings_hash, content_hash (SHA-256 of the content: src/io/basis_check.rs),
 //!   pipeline (TOML text), variant, snapshots, mode_rule, n_modes (= r), n_pod_modes,
 //!   multiplier_scale (w), n_dof, creation_time (RFC 3339, UTC), program_version
 //! ```
 
+use super::attrs::{check_layout, write_atomically_as, Kind};
 use super::basis_hash::{content_hash, HashInput};
 use super::basis_layout::check_file;
-use super::h5::{attr_f64, attr_str, attr_u64, read_attr_f64, read_attr_str, write_atomically};
+use super::h5::{attr_f64, attr_str, attr_u64, read_attr_f64, read_attr_str};
 use crate::error::{Error, Result};
 use crate::reduction::{Basis, Hyper, SnapshotKind, Trained, Variant};
 use ndarray::{Array1, Array2};
@@ -113,7 +117,7 @@ pub fn write_basis_with(
     meta: &BasisMeta,
     extra: impl FnOnce(&hdf5::File) -> Result<()>,
 ) -> Result<()> {
-    write_atomically(path, |f| {
+    write_atomically_as(path, Kind::Basis, |f| {
         let e = |err: hdf5::Error| Error::hdf5(path, err);
         let big = |name: &str, a: &Array2<f64>| -> Result<()> {
             let (r, c) = a.dim();
@@ -187,6 +191,7 @@ pub fn write_basis_with(
         attr_str(f, "creation_time", &humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string())
             .map_err(e)?;
         attr_str(f, "program_version", env!("CARGO_PKG_VERSION")).map_err(e)?;
+        super::labels::write_labels_of_text(f, &meta.model_text, &meta.model_path).map_err(e)?;
         extra(f)
     })
 }
@@ -201,6 +206,9 @@ pub fn read_basis(path: &Path) -> Result<StoredBasis> {
         Error::input(path, "(file)", format!("is not a readable HDF5 file (truncated or of another format?): {e}"))
     })?;
     let field = |name: &str, problem: String| Error::input(path, name, problem);
+    // layouts 1 and 2 store a basis alike (snapshots and modes one column each); a newer
+    // one is refused
+    check_layout(&f, path, "flexrom train")?;
     let version = f
         .attr("schema_version")
         .and_then(|a| a.read_scalar::<u64>())

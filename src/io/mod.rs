@@ -1,10 +1,12 @@
 //! HDF5 input and output.
 pub mod atomic;
+pub mod attrs;
 pub mod basis_check;
 pub mod basis_file;
 pub mod basis_hash;
 pub mod basis_layout;
 pub mod estimator_file;
 pub mod h5;
+pub mod labels;
 pub mod output;
 pub mod result_file;

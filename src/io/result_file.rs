@@ -1,17 +1,22 @@
-//! The result file of `simulate` and of reduced runs (`online`). Fixed layout, read by
-//! scripts outside the project:
+//! The result file of `simulate` and of reduced runs (`online`). Fixed layout (layout
+//! [`super::attrs::LAYOUT_VERSION`]: time first), read by scripts outside the project:
 //!
 //! ```text
 //! /t                      (n_t)          time, s
-//! /q                      (n_dof, n_t)   column k = all coordinates at t_k
-//! /multipliers            (n_c, n_t)     Lagrange multipliers (N for pins)
+//! /q                      (n_t, n_dof)   row k = all coordinates at t_k (m, slopes 1)
+//! /multipliers            (n_t, n_c)     Lagrange multipliers (N; N·m on clamp slope rows)
 //! /probes/<name>          (n_t, 2)       x, y of each probe, m
-//! attributes on /: model (TOML text), model_path, load_scale, dt, t_end, rho_inf,
-//!   linear_solver, newton_iterations, factorizations, step_cuts, steps,
-//!   max_iterations_in_a_step, steps_at_round_off, wall_seconds, program_version
+//! /reduced/q              (n_t, r)       `online` only: the reduced coordinates
+//! /labels/...                            names of the coordinates and constraint rows
+//! every dataset: attributes units, dims (src/io/attrs.rs)
+//! attributes on /: flexrom_layout, flexrom_file = "result", model (TOML text), model_path,
+//!   load_scale, dt, t_end, rho_inf, linear_solver, newton_iterations, factorizations,
+//!   step_cuts, steps, max_iterations_in_a_step, steps_at_round_off, wall_seconds,
+//!   program_version
 //! ```
 
-use super::h5::{attr_f64, attr_str, attr_u64, write_atomically};
+use super::attrs::{write_atomically_as, Kind};
+use super::h5::{attr_f64, attr_str, attr_u64};
 use crate::error::{Error, Result};
 use crate::simulate::SimulationResult;
 use std::path::Path;
@@ -21,17 +26,19 @@ pub fn write_result(path: &Path, r: &SimulationResult) -> Result<()> {
 }
 
 /// Writes the common layout, then lets `extra` add datasets and attributes (reduced runs
-/// add `/reduced/q` and the basis they used), all in the same atomic write.
+/// add `/reduced/q` ([`write_reduced`]) and the basis they used), all in the same atomic
+/// write; every dataset gets its `units` ([`super::attrs::annotate`]).
 pub fn write_result_with(
     path: &Path,
     r: &SimulationResult,
     extra: impl FnOnce(&hdf5::File) -> Result<()>,
 ) -> Result<()> {
-    write_atomically(path, |f| {
+    write_atomically_as(path, Kind::Result, |f| {
         let e = |err: hdf5::Error| Error::hdf5(path, err);
         f.new_dataset_builder().with_data(&r.t).create("t").map_err(e)?;
-        f.new_dataset_builder().with_data(&r.q).create("q").map_err(e)?;
-        f.new_dataset_builder().with_data(&r.multipliers).create("multipliers").map_err(e)?;
+        // time first: the solver's columns (one per instant) become rows
+        write_time_first(f, "q", &r.q).map_err(e)?;
+        write_time_first(f, "multipliers", &r.multipliers).map_err(e)?;
         let g = f.create_group("probes").map_err(e)?;
         for (name, xy) in &r.probes {
             g.new_dataset_builder().with_data(xy).create(name.as_str()).map_err(e)?;
@@ -52,6 +59,54 @@ pub fn write_result_with(
         attr_u64(f, "steps_at_round_off", r.stats.steps_at_round_off as u64).map_err(e)?;
         attr_f64(f, "wall_seconds", r.wall_seconds).map_err(e)?;
         attr_str(f, "program_version", env!("CARGO_PKG_VERSION")).map_err(e)?;
+        super::labels::write_labels_of_text(f, &r.model_text, &r.model_path).map_err(e)?;
         extra(f)
     })
+}
+
+/// Rows of the transposed copy written at a time: ≤ 8 MiB of it, whatever the run's size.
+const BLOCK_BYTES: usize = 8 << 20;
+
+/// Writes `a` (n × n_t: one column per instant, as the solver keeps it) as the dataset
+/// `name` of shape (n_t, n), time first, transposing a block of instants at a time so that
+/// a large run is not copied whole.
+pub fn write_time_first(g: &hdf5::Group, name: &str, a: &ndarray::Array2<f64>) -> hdf5::Result<()> {
+    write_in_blocks(g, name, a, (BLOCK_BYTES / (8 * a.nrows().max(1))).max(1))
+}
+
+fn write_in_blocks(g: &hdf5::Group, name: &str, a: &ndarray::Array2<f64>, rows: usize) -> hdf5::Result<()> {
+    let (n, nt) = a.dim();
+    if n == 0 || nt == 0 {
+        g.new_dataset_builder().with_data(&a.t().as_standard_layout()).create(name)?;
+        return Ok(());
+    }
+    let d = g.new_dataset::<f64>().shape((nt, n)).create(name)?;
+    for start in (0..nt).step_by(rows) {
+        let end = (start + rows).min(nt);
+        let block = a.slice(ndarray::s![.., start..end]).t().as_standard_layout().into_owned();
+        d.write_slice(&block, ndarray::s![start..end, ..])?;
+    }
+    Ok(())
+}
+
+/// Writes `/reduced/q`, time first, from the reduced coordinates `zq` (r × n_t, one column
+/// per instant as the solver keeps them).
+pub fn write_reduced(f: &hdf5::File, zq: &ndarray::Array2<f64>) -> hdf5::Result<()> {
+    write_time_first(&f.create_group("reduced")?, "q", zq)
+}
+
+#[cfg(test)]
+mod tests {
+    /// Blocks of 3 instants (the last one short) and one block give the transpose.
+    #[test]
+    fn time_first_blocks_give_the_transpose() {
+        let dir = tempfile::tempdir().unwrap();
+        let f = hdf5::File::create(dir.path().join("t.h5")).unwrap();
+        let a = ndarray::Array2::from_shape_fn((4, 10), |(i, k)| (10 * i + k) as f64);
+        super::write_in_blocks(&f, "blocks", &a, 3).unwrap();
+        super::write_time_first(&f, "whole", &a).unwrap();
+        for name in ["blocks", "whole"] {
+            assert_eq!(f.dataset(name).unwrap().read_2d::<f64>().unwrap(), a.t(), "{name}");
+        }
+    }
 }

@@ -120,6 +120,17 @@ impl Model {
         crate::limits::check_memory(&what, arrays + system + lu)
     }
 
+    /// The validated bodies, in file order (node `k` of body `b` is global node
+    /// Σ_{c<b}(n_elements_c + 1) + k; labels in src/io/labels.rs).
+    pub fn bodies(&self) -> &[BeamBody] {
+        &self.bodies
+    }
+
+    /// The validated joints, in file order, nodes resolved.
+    pub fn joints(&self) -> &[Joint] {
+        &self.joints
+    }
+
     pub fn probe_names(&self) -> Vec<String> {
         self.probes.iter().map(|p| p.name.clone()).collect()
     }

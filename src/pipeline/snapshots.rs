@@ -21,7 +21,9 @@
 //! /multipliers  (n_c, m n_t)       Lagrange multipliers
 //! /load_scale   (m n_t)            each column's load scale
 //! /t            (m n_t)            each column's time, s
-//! attributes on /: kind = "flexrom snapshots", model_fingerprint, settings_hash (of the
+//! /labels/...                      names of the coordinates and constraint rows
+//! every dataset: units, dims ("dof, snapshot": src/io/attrs.rs)
+//! attributes on /: flexrom_layout, flexrom_file = "snapshots", kind = "flexrom snapshots", model_fingerprint, settings_hash (of the
 //!   pipeline: [train] and [reduction]), pipeline, full_seconds, program_version
 //! ```
 
@@ -29,8 +31,9 @@ use super::config::Pipeline;
 use super::shard::Shard;
 use super::train::{basis_from_snapshots, TrainSummary};
 use crate::error::{Error, Result};
+use crate::io::attrs::{check_layout, write_atomically_as, Kind};
 use crate::io::basis_file::TrainingData;
-use crate::io::h5::{attr_f64, attr_str, read_attr_f64, read_attr_str, write_atomically};
+use crate::io::h5::{attr_f64, attr_str, read_attr_f64, read_attr_str};
 use crate::simulate::{simulate, Overrides, Settings};
 use ndarray::{concatenate, s, Array1, Array2, Axis};
 use std::path::{Path, PathBuf};
@@ -91,8 +94,9 @@ pub fn write_snapshots(p: &Pipeline, scales: &[f64], out: &Path) -> Result<(usiz
     let data = super::train::training_data(&runs);
     let settings_hash = crate::io::basis_check::settings_hash(p);
     let pipeline = crate::io::output::resolve(&p.path).display().to_string();
-    write_atomically(out, |f| {
+    write_atomically_as(out, Kind::Snapshots, |f| {
         let e = |err: hdf5::Error| Error::hdf5(out, err);
+        crate::io::labels::Labels::of(&p.model).write(f).map_err(e)?;
         f.new_dataset_builder().with_data(&data.x.as_standard_layout()).create("x").map_err(e)?;
         f.new_dataset_builder().with_data(&data.multipliers.as_standard_layout()).create("multipliers").map_err(e)?;
         f.new_dataset_builder().with_data(&data.load_scale).create("load_scale").map_err(e)?;
@@ -120,6 +124,8 @@ struct Run {
 fn read_runs(p: &Pipeline, path: &Path, n_t: usize) -> Result<(Vec<Run>, f64)> {
     let bad = |field: &str, problem: String| Error::input(path, field, problem);
     let f = hdf5::File::open(path).map_err(|e| bad("(file)", format!("is not a readable HDF5 file: {e}")))?;
+    // layouts 1 and 2 store snapshots alike (one column each)
+    check_layout(&f, path, "flexrom train --snapshots-only")?;
     let text = |name: &str| read_attr_str(&f, name).map_err(|e| bad(name, format!("cannot be read: {e}")));
     if text("kind").ok().as_deref() != Some(KIND) {
         return Err(bad("kind", "is not \"flexrom snapshots\": not a file of `train --snapshots-only`".into()));

@@ -17,7 +17,7 @@
 //! /message            (N)            why it failed ("" when ok)
 //! /t                  (n_t)
 //! /probes/<name>      (N, n_t, 2)    reduced-model probe positions, m
-//! /reduced_q          (N, r, n_t)    reduced coordinates
+//! /reduced_q          (N, n_t, r)    reduced coordinates (time first; layout 1: (N, r, n_t))
 //! /rom_seconds        (N)            reduced time loop of each run
 //! /newton_iterations  (N)
 //! /factorizations     (N)            iteration matrices factorized
@@ -28,7 +28,8 @@
 //! /estimate_seconds   (N)            the estimator's enriched run and norms, s
 //! with --validate:    /rel_error, /max_probe_error, /max_constraint_violation,
 //!                     /full_seconds, /speedup  (N each)
-//! attributes on /: basis, basis_content_hash, model_fingerprint, variant, n_modes,
+//! every dataset: units, dims (src/io/attrs.rs)
+//! attributes on /: flexrom_layout, flexrom_file = "sweep", basis, basis_content_hash, model_fingerprint, variant, n_modes,
 //!   validated (0/1), wall_seconds (whole sweep), threads, continuation (1 when the runs
 //!   were continued from their neighbours), n_failed, n_pending, program_version
 //! ```
@@ -37,8 +38,9 @@ use super::estimate::{is_extrapolated, Estimate, EstimatingRunner, TrustInfo};
 use super::online::{Output, ReducedRun};
 use super::validate::{compare, Validation};
 use crate::error::{Error, Result};
+use crate::io::attrs::{check_layout, write_atomically_as, Kind};
 use crate::io::basis_file::StoredBasis;
-use crate::io::h5::{attr_f64, attr_str, attr_u64, read_attr_str, write_atomically};
+use crate::io::h5::{attr_f64, attr_str, attr_u64, read_attr_str};
 use crate::model::Model;
 use crate::reduction::Basis;
 use crate::simulate::{simulate, Overrides, Settings, SimulationResult};
@@ -433,7 +435,7 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, stored: &StoredBasis, basis_path
     if n == 0 {
         return Err(Error::Usage("the sweep has no load scales".into()));
     }
-    write_atomically(path, |f| {
+    write_atomically_as(path, Kind::Sweep, |f| {
         let e = |err: hdf5::Error| Error::hdf5(path, err);
         // one value per load scale: NaN where it did not run to the end
         let col =
@@ -466,15 +468,16 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, stored: &StoredBasis, basis_path
             }
             g.new_dataset_builder().with_data(&a).create(name.as_str()).map_err(e)?;
         }
-        let mut zq = Array3::from_elem((n, r, nt), f64::NAN);
+        // time first: (load, time, mode); the runs keep r × n_t
+        let mut zq = Array3::from_elem((n, nt, r), f64::NAN);
         for (k, x) in s.scales.iter().enumerate() {
             if let Some(p) = x.point() {
-                zq.index_axis_mut(ndarray::Axis(0), k).assign(&p.rom.reduced_q);
+                zq.index_axis_mut(ndarray::Axis(0), k).assign(&p.rom.reduced_q.t());
             }
         }
         // one chunk per run, not compressed: deflate took 15 % off the size of these
         // trajectories for 0.15 s of a 1.5 s four-bar sweep
-        f.new_dataset_builder().chunk((1, r.max(1), nt.max(1))).with_data(&zq).create("reduced_q").map_err(e)?;
+        f.new_dataset_builder().chunk((1, nt.max(1), r.max(1))).with_data(&zq).create("reduced_q").map_err(e)?;
         f.new_dataset_builder().with_data(&col(&|p| p.rom.result.wall_seconds)).create("rom_seconds").map_err(e)?;
         f.new_dataset_builder()
             .with_data(&count(&|p| p.rom.result.stats.newton_iterations))
@@ -543,6 +546,8 @@ pub fn read_sweep(
         Error::input(path, field, format!("{problem}; cannot resume from it (remove it, or run without --resume)"))
     };
     let f = hdf5::File::open(path).map_err(|e| cannot("(file)", format!("is not a readable HDF5 file: {e}")))?;
+    // layout 1 stored /reduced_q as (N, r, n_t): converted below; newer layouts are refused
+    let layout = check_layout(&f, path, "flexrom sweep")?;
     let text = |name: &str| {
         read_attr_str(&f, name).map_err(|e| cannot(name, format!("cannot be read ({e}): not a flexrom sweep file?")))
     };
@@ -576,9 +581,18 @@ pub fn read_sweep(
         .dataset("reduced_q")
         .and_then(|d| d.read::<f64, ndarray::Ix3>())
         .map_err(|e| cannot("reduced_q", format!("cannot be read: {e}")))?;
-    if zq.dim() != (n, r, nt) {
-        return Err(cannot("reduced_q", format!("is {:?}, expected ({n}, {r}, {nt})", zq.dim())));
-    }
+    let zq = if layout == 1 {
+        if zq.dim() != (n, r, nt) {
+            return Err(cannot("reduced_q", format!("is {:?}, expected ({n}, {r}, {nt}) (layout 1)", zq.dim())));
+        }
+        zq
+    } else {
+        if zq.dim() != (n, nt, r) {
+            return Err(cannot("reduced_q", format!("is {:?}, expected ({n}, {nt}, {r})", zq.dim())));
+        }
+        // back to the runs' r × n_t
+        zq.permuted_axes([0, 2, 1]).as_standard_layout().to_owned()
+    };
     let mut probes = Vec::new();
     for name in model.probe_names() {
         let a = f

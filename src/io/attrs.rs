@@ -1,0 +1,276 @@
+//! What every file flexrom writes says about itself: the layout version on `/`
+//! ([`LAYOUT_ATTR`] = [`LAYOUT_VERSION`], [`KIND_ATTR`]), and on every dataset its `units`
+//! (SI; `1` for dimensionless numbers, counts and indices; `none (text)` for text) and its
+//! `dims` (axis names, comma-separated, first axis first; `""` for a scalar).
+//!
+//! Layout 2 (this one): every time series is time-first, `(n_t, …)` (a sweep's
+//! `(n_loads, n_t, …)`); snapshot and mode matrices keep the POD convention, one column per
+//! snapshot or mode (`dims = "dof, snapshot"`, `"dof, mode"`). Layout 1 (files without the
+//! attribute, flexrom ≤ 0.1 of 2026-11-24) stored `/q`, `/multipliers`, `/reduced/q` as
+//! `(n, n_t)` and a sweep's `/reduced_q` as `(n_loads, r, n_t)`; readers convert them
+//! ([`layout_version`]). A file of a newer layout is refused ([`check_layout`]).
+//!
+//! The units of each dataset live in one table per file kind ([`units_of`]); the writers
+//! call [`annotate`] (through [`write_atomically_as`]) after filling a file, which labels
+//! every dataset it finds from the table. docs/file-formats.md shows the same tables
+//! (a test checks every row of them against this one).
+
+use super::h5::{attr_str, attr_u64, write_atomically};
+use crate::error::{Error, Result};
+use std::path::Path;
+
+/// Root attribute holding the layout version.
+pub const LAYOUT_ATTR: &str = "flexrom_layout";
+/// The layout this program writes and reads.
+pub const LAYOUT_VERSION: u64 = 2;
+/// Root attribute naming the kind of file ([`Kind::name`]).
+pub const KIND_ATTR: &str = "flexrom_file";
+
+/// Coordinates `q`: node `k` owns `(x, y, x', y')`, positions in m, slopes dimensionless.
+pub const COORDINATE_UNITS: &str = "m (positions x, y), 1 (slopes x', y')";
+/// Lagrange multipliers: forces on position rows, moments (N·m, conjugate to a
+/// dimensionless slope) on the slope rows of clamps.
+pub const MULTIPLIER_UNITS: &str = "N (position rows), N·m (slope rows of clamps)";
+/// Reduced coordinates `z = Vᵀ(q − x_ref)` with orthonormal, dimensionless modes: each mixes
+/// the units of `q` in proportion to the mode's entries.
+pub const REDUCED_UNITS: &str = "m (positions) and 1 (slopes), mixed by the modes: z = Vᵀ(q − x_ref)";
+/// Singular values of a snapshot matrix with rows in m and in 1.
+pub const SINGULAR_VALUE_UNITS: &str = "m (positions) and 1 (slopes), mixed: singular values of /snapshots";
+/// Constraint residuals: position rows in m, clamp slope rows dimensionless.
+pub const VIOLATION_UNITS: &str = "m (position rows), 1 (slope rows of clamps)";
+/// Text datasets.
+pub const TEXT: &str = "none (text)";
+
+/// The kinds of file flexrom writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// `simulate`, `online`
+    Result,
+    /// `train` (with the estimator and greedy's `/training`)
+    Basis,
+    /// `sweep`, `run`'s sweep.h5, shard parts, `merge`
+    Sweep,
+    /// `train --snapshots-only`
+    Snapshots,
+}
+
+impl Kind {
+    pub fn name(self) -> &'static str {
+        match self {
+            Kind::Result => "result",
+            Kind::Basis => "basis",
+            Kind::Sweep => "sweep",
+            Kind::Snapshots => "snapshots",
+        }
+    }
+}
+
+/// (path, units, dims) of one dataset; `*` stands for one name (a probe's).
+pub type Entry = (&'static str, &'static str, &'static str);
+
+/// `/labels/*`, in result, basis and snapshot files (src/io/labels.rs).
+pub const LABELS: [Entry; 7] = [
+    ("labels/body", TEXT, "body"),
+    ("labels/dof", TEXT, "dof"),
+    ("labels/dof_body", "1", "dof"),
+    ("labels/dof_node", "1", "dof"),
+    ("labels/dof_coordinate", "1", "dof"),
+    ("labels/multiplier", TEXT, "constraint"),
+    ("labels/multiplier_joint", "1", "constraint"),
+];
+
+const RESULT: [Entry; 5] = [
+    ("t", "s", "time"),
+    ("q", COORDINATE_UNITS, "time, dof"),
+    ("multipliers", MULTIPLIER_UNITS, "time, constraint"),
+    ("probes/*", "m", "time, xy"),
+    ("reduced/q", REDUCED_UNITS, "time, mode"),
+];
+
+const BASIS: [Entry; 39] = [
+    ("snapshots", COORDINATE_UNITS, "dof, snapshot"),
+    ("snapshot_multipliers", MULTIPLIER_UNITS, "constraint, snapshot"),
+    ("snapshot_load_scale", "1", "snapshot"),
+    ("snapshot_t", "s", "snapshot"),
+    ("basis/modes", "1", "dof, mode"),
+    ("basis/singular_values", SINGULAR_VALUE_UNITS, "singular value"),
+    ("basis/energy", "1", "singular value"),
+    ("basis/block_modes", "1", "block"),
+    ("basis/block_values", "1", "block"),
+    ("basis/reference", COORDINATE_UNITS, "dof"),
+    ("basis/reduced_dofs", "1", "entry"),
+    ("basis/kept_dofs", "1", "entry"),
+    ("basis/multiplier_modes", "1", "constraint, mode"),
+    ("hyper/elements", "1", "sample"),
+    ("hyper/weights", "1", "sample"),
+    ("estimator/modes", "1", "dof, mode"),
+    ("estimator/block_modes", "1", "block"),
+    ("estimator/multiplier_modes", "1", "constraint, mode"),
+    ("estimator/hyper/elements", "1", "sample"),
+    ("estimator/hyper/weights", "1", "sample"),
+    ("estimator/calibration/load_scale", "1", "pair"),
+    ("estimator/calibration/raw_estimate", "1", "pair"),
+    ("estimator/calibration/rel_error", "1", "pair"),
+    ("training/range", "1", "bound"),
+    ("training/tolerance", "1", ""),
+    ("training/load_scales", "1", "run"),
+    ("training/candidates", "1", "candidate"),
+    ("training/worst_estimate", "1", "iteration"),
+    ("training/worst_load", "1", "iteration"),
+    ("training/run_load", "1", "iteration"),
+    ("training/true_error", "1", "iteration"),
+    ("training/energy_tolerance", "1", "iteration"),
+    ("training/hyper_tolerance", "1", "iteration"),
+    ("training/n_modes", "1", "iteration"),
+    ("training/n_elements", "1", "iteration"),
+    ("training/estimates", "1", "iteration, candidate"),
+    ("training/whole_run_estimates", "1", "iteration, candidate"),
+    ("training/sensitivity", "1", "iteration, candidate"),
+    ("training/true_score", "1", "iteration"),
+];
+
+const SWEEP: [Entry; 20] = [
+    ("load_scales", "1", "load"),
+    ("status", "1", "load"),
+    ("message", TEXT, "load"),
+    ("t", "s", "time"),
+    ("probes/*", "m", "load, time, xy"),
+    ("reduced_q", REDUCED_UNITS, "load, time, mode"),
+    ("rom_seconds", "s", "load"),
+    ("newton_iterations", "1", "load"),
+    ("factorizations", "1", "load"),
+    ("error_estimate", "1", "load"),
+    // the estimate per fifth of the run (issue 15)
+    ("error_estimate_by_time", "1", "load, fifth"),
+    ("estimate_seconds", "s", "load"),
+    ("extrapolated", "1", "load"),
+    ("rel_error", "1", "load"),
+    ("max_probe_error", "m", "load"),
+    ("max_constraint_violation", VIOLATION_UNITS, "load"),
+    ("full_seconds", "s", "load"),
+    ("speedup", "1", "load"),
+    ("shard/all_load_scales", "1", "all loads"),
+    ("shard/indices", "1", "load"),
+];
+
+const SNAPSHOTS: [Entry; 4] = [
+    ("x", COORDINATE_UNITS, "dof, snapshot"),
+    ("multipliers", MULTIPLIER_UNITS, "constraint, snapshot"),
+    ("load_scale", "1", "snapshot"),
+    ("t", "s", "snapshot"),
+];
+
+/// The table of a file kind (without `/labels`).
+pub fn table(kind: Kind) -> &'static [Entry] {
+    match kind {
+        Kind::Result => &RESULT,
+        Kind::Basis => &BASIS,
+        Kind::Sweep => &SWEEP,
+        Kind::Snapshots => &SNAPSHOTS,
+    }
+}
+
+/// `(units, dims)` of the dataset at `path` (no leading `/`) in a file of `kind`.
+pub fn units_of(kind: Kind, path: &str) -> Option<(&'static str, &'static str)> {
+    let labels: &[Entry] = if kind == Kind::Sweep { &[] } else { &LABELS };
+    let matches = |pattern: &str| match pattern.strip_suffix('*') {
+        Some(prefix) => path.strip_prefix(prefix).is_some_and(|rest| !rest.is_empty() && !rest.contains('/')),
+        None => pattern == path,
+    };
+    table(kind).iter().chain(labels).find(|e| matches(e.0)).map(|e| (e.1, e.2))
+}
+
+/// Writes `units` (and `dims`) on a dataset, replacing neither: a writer that set its own
+/// keeps them.
+pub fn write_units(d: &hdf5::Dataset, units: &str, dims: &str) -> hdf5::Result<()> {
+    if !d.attr_names()?.iter().any(|a| a == "units") {
+        attr_str(d, "units", units)?;
+    }
+    if !d.attr_names()?.iter().any(|a| a == "dims") {
+        attr_str(d, "dims", dims)?;
+    }
+    Ok(())
+}
+
+/// Labels a freshly written file: [`LAYOUT_ATTR`] and [`KIND_ATTR`] on `/`, `units` and
+/// `dims` on every dataset found in the table of `kind`. A dataset missing from the table
+/// keeps no `units` (tests/file_layout.rs fails on it: add it to the table and the docs).
+pub fn annotate(f: &hdf5::File, kind: Kind) -> hdf5::Result<()> {
+    fn walk(g: &hdf5::Group, prefix: &str, kind: Kind) -> hdf5::Result<()> {
+        for name in g.member_names()? {
+            let full = if prefix.is_empty() { name.clone() } else { format!("{prefix}/{name}") };
+            if let Ok(sub) = g.group(&name) {
+                walk(&sub, &full, kind)?;
+            } else if let Ok(d) = g.dataset(&name) {
+                if let Some((units, dims)) = units_of(kind, &full) {
+                    write_units(&d, units, dims)?;
+                }
+            }
+        }
+        Ok(())
+    }
+    walk(f, "", kind)?;
+    if !f.attr_names()?.iter().any(|a| a == LAYOUT_ATTR) {
+        attr_u64(f, LAYOUT_ATTR, LAYOUT_VERSION)?;
+        attr_str(f, KIND_ATTR, kind.name())?;
+    }
+    Ok(())
+}
+
+/// [`write_atomically`], then [`annotate`] as `kind`, in the same atomic write.
+pub fn write_atomically_as(path: &Path, kind: Kind, fill: impl FnOnce(&hdf5::File) -> Result<()>) -> Result<()> {
+    write_atomically(path, |f| {
+        fill(f)?;
+        annotate(f, kind).map_err(|e| Error::hdf5(path, e))
+    })
+}
+
+/// The layout version of an open file: [`LAYOUT_ATTR`], or 1 when the file has none (files
+/// written before layouts had a version).
+pub fn layout_version(f: &hdf5::File) -> std::result::Result<u64, String> {
+    match f.attr(LAYOUT_ATTR) {
+        Err(_) => Ok(1),
+        Ok(a) => a.read_scalar::<u64>().map_err(|e| format!("cannot be read as a whole number: {e}")),
+    }
+}
+
+/// The layout version of the file at `path`, refused when it is newer than this program's
+/// (or unreadable) with a message naming the file, both versions and what to do; `stage` is
+/// the command that writes such a file (`flexrom train`, …).
+pub fn check_layout(f: &hdf5::File, path: &Path, stage: &str) -> Result<u64> {
+    let v = layout_version(f).map_err(|p| Error::input(path, LAYOUT_ATTR, p))?;
+    if v > LAYOUT_VERSION {
+        return Err(Error::input(
+            path,
+            LAYOUT_ATTR,
+            format!(
+                "is {v}, a newer file layout than this flexrom ({}) reads (layout {LAYOUT_VERSION} and older): \
+                 use the newer flexrom that wrote it, or re-run `{stage}` with this one",
+                env!("CARGO_PKG_VERSION")
+            ),
+        ));
+    }
+    if v == 0 {
+        return Err(Error::input(
+            path,
+            LAYOUT_ATTR,
+            format!("is 0, not a layout version (1 to {LAYOUT_VERSION}); re-run `{stage}`"),
+        ));
+    }
+    Ok(v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn probe_patterns_match_one_name_only() {
+        assert_eq!(units_of(Kind::Result, "probes/tip").map(|u| u.0), Some("m"));
+        assert_eq!(units_of(Kind::Result, "probes/"), None);
+        assert_eq!(units_of(Kind::Result, "probes/a/b"), None);
+        assert_eq!(units_of(Kind::Sweep, "probes/tip").map(|u| u.1), Some("load, time, xy"));
+        assert_eq!(units_of(Kind::Sweep, "labels/dof"), None);
+        assert_eq!(units_of(Kind::Basis, "labels/dof").map(|u| u.0), Some(TEXT));
+    }
+}

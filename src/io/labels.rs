@@ -1,0 +1,190 @@
+//! Names of the rows of coordinate and multiplier arrays, written as `/labels/*` into every
+//! file that holds coordinates or multipliers (result, basis, snapshot files):
+//!
+//! ```text
+//! /labels/body              (n_b)    body names, in model-file order
+//! /labels/dof               (n_dof)  "crank node 3 x'": body, node within the body, coordinate
+//! /labels/dof_body          (n_dof)  index into /labels/body
+//! /labels/dof_node          (n_dof)  node within its body (0 = "start", n_elements = "end")
+//! /labels/dof_coordinate    (n_dof)  0 x, 1 y, 2 x', 3 y' (position m, slope 1)
+//! /labels/multiplier        (n_c)    "joint 0 (ground_pin crank node 0) x"
+//! /labels/multiplier_joint  (n_c)    the model file's joints[j] each row belongs to
+//! ```
+//!
+//! The rows follow [`crate::physics::system::FlexibleSystem::new`]: coordinates node by node,
+//! body after body, `(x, y, x', y')` per node; constraint rows first those of the ground
+//! pins (x, y) and clamps (x, y, x', y') in file order, then those of the pins (x, y) in file
+//! order (a unit test checks the labels against the assembled constraint rows).
+
+use crate::model::Model;
+use crate::physics::system::{Joint, NodeId};
+use hdf5::types::VarLenUnicode;
+use ndarray::Array1;
+
+/// Names of the four coordinates of a node.
+pub const COORDINATES: [&str; 4] = ["x", "y", "x'", "y'"];
+
+/// The row names of one model.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Labels {
+    pub bodies: Vec<String>,
+    /// per coordinate: (body, node within the body, coordinate 0..4)
+    pub dofs: Vec<(usize, usize, usize)>,
+    /// per constraint row: (joint index in the model file, text)
+    pub multipliers: Vec<(usize, String)>,
+}
+
+impl Labels {
+    pub fn of(model: &Model) -> Labels {
+        let bodies = model.bodies();
+        let dofs = bodies
+            .iter()
+            .enumerate()
+            .flat_map(|(b, body)| (0..=body.n_elements).flat_map(move |k| (0..4).map(move |c| (b, k, c))))
+            .collect();
+        let node = |(b, k): NodeId| format!("{} node {k}", bodies[b].name);
+        let mut multipliers = Vec::new();
+        let mut pins = Vec::new();
+        for (j, joint) in model.joints().iter().enumerate() {
+            match *joint {
+                Joint::GroundPin { node: n, .. } => {
+                    for c in &COORDINATES[..2] {
+                        multipliers.push((j, format!("joint {j} (ground_pin {}) {c}", node(n))));
+                    }
+                }
+                Joint::Clamp { node: n, .. } => {
+                    for c in &COORDINATES {
+                        multipliers.push((j, format!("joint {j} (clamp {}) {c}", node(n))));
+                    }
+                }
+                Joint::Pin { a, b } => pins.push((j, a, b)),
+            }
+        }
+        for (j, a, b) in pins {
+            for c in &COORDINATES[..2] {
+                multipliers.push((j, format!("joint {j} (pin {} – {}) {c}", node(a), node(b))));
+            }
+        }
+        Labels { bodies: bodies.iter().map(|b| b.name.clone()).collect(), dofs, multipliers }
+    }
+
+    /// "crank node 3 x'" for each coordinate.
+    pub fn dof_names(&self) -> Vec<String> {
+        self.dofs.iter().map(|&(b, k, c)| format!("{} node {k} {}", self.bodies[b], COORDINATES[c])).collect()
+    }
+
+    /// Writes `/labels` into `f`.
+    pub fn write(&self, f: &hdf5::File) -> hdf5::Result<()> {
+        let g = f.create_group("labels")?;
+        let text = |v: Vec<String>| -> hdf5::Result<Array1<VarLenUnicode>> {
+            v.iter()
+                .map(|s| s.parse::<VarLenUnicode>().map_err(|e| hdf5::Error::from(format!("label `{s}`: {e:?}"))))
+                .collect()
+        };
+        let idx = |v: Vec<usize>| Array1::from_iter(v.into_iter().map(|i| i as u64));
+        g.new_dataset_builder().with_data(&text(self.bodies.clone())?).create("body")?;
+        g.new_dataset_builder().with_data(&text(self.dof_names())?).create("dof")?;
+        g.new_dataset_builder().with_data(&idx(self.dofs.iter().map(|d| d.0).collect())).create("dof_body")?;
+        g.new_dataset_builder().with_data(&idx(self.dofs.iter().map(|d| d.1).collect())).create("dof_node")?;
+        g.new_dataset_builder().with_data(&idx(self.dofs.iter().map(|d| d.2).collect())).create("dof_coordinate")?;
+        let names = self.multipliers.iter().map(|m| m.1.clone()).collect();
+        g.new_dataset_builder().with_data(&text(names)?).create("multiplier")?;
+        g.new_dataset_builder()
+            .with_data(&idx(self.multipliers.iter().map(|m| m.0).collect()))
+            .create("multiplier_joint")?;
+        Ok(())
+    }
+}
+
+/// Writes `/labels` of the model whose file text is `model_text` (as stored with a result
+/// or basis): parsed again, which is cheap beside the run it labels. A text that does not
+/// parse (it did when the run started) writes no labels rather than failing the write.
+pub fn write_labels_of_text(f: &hdf5::File, model_text: &str, model_path: &str) -> hdf5::Result<()> {
+    match Model::from_text(model_text, model_path) {
+        Ok(m) => Labels::of(&m).write(f),
+        Err(_) => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::linalg::kkt::LinearSolverKind;
+    use crate::solver::model::ParametricModel;
+
+    /// A clamp, a pin listed before a ground pin (pins' rows come last): every joint kind
+    /// and the reordering.
+    const CLAMPED: &str = r#"
+        [time]
+        t_end = 0.1
+        dt = 0.01
+        rho_inf = 0.8
+        [[bodies]]
+        name = "beam"
+        start = [0.0, 0.0]
+        angle = 0.0
+        length = 1.0
+        elements = 2
+        density = 7800.0
+        area = 1e-4
+        inertia = 1e-9
+        youngs_modulus = 2e11
+        [[bodies]]
+        name = "link"
+        start = [1.0, 0.0]
+        angle = 0.0
+        length = 1.0
+        elements = 3
+        density = 7800.0
+        area = 1e-4
+        inertia = 1e-9
+        youngs_modulus = 2e11
+        [[joints]]
+        type = "clamp"
+        body = "beam"
+        node = "start"
+        [[joints]]
+        type = "pin"
+        a = { body = "beam", node = "end" }
+        b = { body = "link", node = 0 }
+        [[joints]]
+        type = "ground_pin"
+        body = "link"
+        node = "end"
+    "#;
+
+    /// The labels name exactly the coordinates each assembled constraint row couples:
+    /// one unit coefficient on the named node's coordinate (ground pins, clamps), or +1 on
+    /// the first and −1 on the second named node's (pins).
+    #[test]
+    fn labels_match_the_assembled_constraint_rows() {
+        let root = env!("CARGO_MANIFEST_DIR");
+        let clamped = Model::from_text(CLAMPED, "clamped.toml").unwrap();
+        let l = Labels::of(&clamped);
+        assert_eq!(l.multipliers[4].1, "joint 2 (ground_pin link node 3) x");
+        assert_eq!(l.multipliers[7].1, "joint 1 (pin beam node 2 – link node 0) y");
+        for name in ["clamped", "fourbar", "pendulum", "double_pendulum"] {
+            let model = match name {
+                "clamped" => clamped.clone(),
+                _ => Model::load(format!("{root}/data/models/{name}.toml")).unwrap(),
+            };
+            let sys = model.system(LinearSolverKind::Banded);
+            let l = Labels::of(&model);
+            assert_eq!(l.dofs.len(), sys.n_dof(), "{name}");
+            assert_eq!(l.multipliers.len(), sys.constraints.len(), "{name}");
+            let names = l.dof_names();
+            for (row, (c, (j, text))) in sys.constraints.iter().zip(&l.multipliers).enumerate() {
+                assert!(text.starts_with(&format!("joint {j} (")), "{name} row {row}: {text}");
+                // "joint j (kind A node k[ – B node m]) coord"
+                let coord = text.rsplit(' ').next().unwrap();
+                let inner = &text[text.find('(').unwrap() + 1..text.rfind(')').unwrap()];
+                let nodes: Vec<&str> = inner.split_once(' ').unwrap().1.split(" – ").collect();
+                assert_eq!(nodes.len(), c.terms.len(), "{name} row {row}: {text}");
+                for ((dof, coef), (k, n)) in c.terms.iter().zip(nodes.iter().enumerate()) {
+                    assert_eq!(names[*dof], format!("{n} {coord}"), "{name} row {row}");
+                    assert_eq!(*coef, if k == 0 { 1.0 } else { -1.0 }, "{name} row {row}");
+                }
+            }
+        }
+    }
+}
