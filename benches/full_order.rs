@@ -7,7 +7,7 @@
 
 use flexrom::model::Model;
 use flexrom::simulate::{simulate, Overrides};
-use flexrom::solver::kkt::LinearSolverKind;
+use flexrom::linalg::kkt::LinearSolverKind;
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(|a, b| a.partial_cmp(b).unwrap());

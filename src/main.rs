@@ -9,7 +9,7 @@ use flexrom::output::{self, note};
 use flexrom::pipeline::online::load_basis;
 use flexrom::pipeline::Pipeline;
 use flexrom::simulate::{simulate, Overrides};
-use flexrom::solver::kkt::LinearSolverKind;
+use flexrom::linalg::kkt::LinearSolverKind;
 use std::path::PathBuf;
 use std::process::ExitCode;
 

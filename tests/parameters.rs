@@ -15,7 +15,7 @@ use flexrom::pipeline::online::{Output, ReducedRunner};
 use flexrom::pipeline::train::train;
 use flexrom::pipeline::Pipeline;
 use flexrom::simulate::{simulate, FullModel, Overrides};
-use flexrom::solver::kkt::LinearSolverKind;
+use flexrom::linalg::kkt::LinearSolverKind;
 use flexrom::solver::model::Parameters;
 use ndarray::Array2;
 use std::path::Path;

@@ -20,7 +20,7 @@ use flexrom::pipeline::train::train;
 use flexrom::pipeline::validate::validate;
 use flexrom::pipeline::Pipeline;
 use flexrom::reduction::whole_system::{constraint_matrix, inf_sup};
-use flexrom::solver::kkt::LinearSolverKind;
+use flexrom::linalg::kkt::LinearSolverKind;
 use ndarray::Array2;
 use std::path::Path;
 

@@ -7,7 +7,7 @@
 use super::element::{BeamElement, Mat8, Section, Vec8};
 use super::loads::{moment_force, moment_jacobian};
 use super::time_function::TimeFunction;
-use crate::solver::kkt::{make_solver, KktPattern, KktSolver, LinearSolverKind};
+use crate::linalg::kkt::{make_solver, KktPattern, KktSolver, LinearSolverKind};
 use crate::solver::model::{ElementModel, InvariantElementModel, IterationCoefficients, Parameters, ParametricModel};
 
 /// A straight beam in its undeformed configuration.

@@ -7,7 +7,7 @@ use crate::io::basis_file::{write_basis_with, BasisMeta, TrainingData};
 use crate::physics::system::FlexibleSystem;
 use crate::reduction::{ecsw, train_basis, BasisSpec, ModeRule, Trained};
 use crate::simulate::{FullModel, Overrides, SimulationResult};
-use crate::solver::kkt::LinearSolverKind;
+use crate::linalg::kkt::LinearSolverKind;
 use ndarray::{concatenate, Array1, Axis};
 use std::path::Path;
 

@@ -19,7 +19,7 @@ use crate::error::Result;
 use crate::model::Model;
 use crate::reduction::Basis;
 use crate::simulate::{simulate, FullModel, Overrides, SimulationResult};
-use crate::solver::kkt::LinearSolverKind;
+use crate::linalg::kkt::LinearSolverKind;
 use crate::solver::model::ParametricModel;
 
 /// The fixed keys of `validate --json`.

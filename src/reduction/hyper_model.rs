@@ -25,9 +25,9 @@
 //! visited.
 
 use super::basis::Basis;
-use super::ecsw::Hyper;
 use super::projection::{axpy, forward_to_projection, impl_reduced, Projection};
-use super::sparse_rows::SparseRows;
+use super::sample::Hyper;
+use crate::linalg::sparse_rows::SparseRows;
 use crate::linalg::simd::{dispatch, Kernel};
 use crate::solver::model::{InvariantElementModel, IterationCoefficients, Parameters, ParametricModel};
 use ndarray::{Array1, Array2, Axis};

@@ -17,18 +17,14 @@ pub mod pod;
 pub(crate) mod projection;
 pub mod reduced_model;
 pub mod sample;
-
-// transitional re-export (remove after merge)
-pub use crate::linalg::nnls;
-// transitional re-export (remove after merge)
-use crate::linalg::sparse_rows;
 pub mod whole_system;
 
 pub use basis::{Basis, BasisSpec, SnapshotKind, Stabilization, Trained, Variant};
-pub use ecsw::{ecsw, Hyper};
+pub use ecsw::ecsw;
 pub use hyper_model::HyperReducedModel;
 pub use pod::{pod, ModeRule, Pod};
 pub use reduced_model::ReducedModel;
+pub use sample::Hyper;
 
 /// What the online stage needs of a reduced model besides the dynamics.
 pub trait Reduced<M>: crate::solver::model::ParametricModel {
