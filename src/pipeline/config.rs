@@ -28,6 +28,7 @@
 
 use crate::error::{Error, Result};
 use crate::model::Model;
+pub use crate::reduction::estimator::EstimateMethod;
 use crate::reduction::{ModeRule, SnapshotKind, Variant};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -417,33 +418,11 @@ impl Pipeline {
     pub fn validate_scales(&self) -> Vec<f64> {
         self.file.validate.as_ref().map_or_else(|| self.training_scales(), |s| s.load_scales.values().expect("checked"))
     }
-}
 
-/// How the enriched model's trajectory `X⁺` is obtained (docs/error-estimate.md).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum EstimateMethod {
-    /// the default: one modified-Newton iteration of the enriched model per step, from the
-    /// reduced run's increments (`pipeline::estimate_corrected`)
-    #[default]
-    Corrected,
-    /// the enriched model integrated on its own to convergence (about 2× the reduced run)
-    Enriched,
-}
-
-impl EstimateMethod {
-    pub fn name(self) -> &'static str {
-        match self {
-            EstimateMethod::Corrected => "corrected",
-            EstimateMethod::Enriched => "enriched",
-        }
-    }
-
-    pub fn parse(s: &str) -> std::result::Result<Self, String> {
-        match s {
-            "corrected" => Ok(EstimateMethod::Corrected),
-            "enriched" => Ok(EstimateMethod::Enriched),
-            _ => Err(format!("is \"{s}\"; expected \"corrected\" (default) or \"enriched\"")),
-        }
+    /// The hash of the `[train]` and `[reduction]` settings a basis file records
+    /// ([`crate::io::basis_hash::settings_hash`]): a basis trained with other settings is
+    /// flagged as stale.
+    pub fn settings_hash(&self) -> String {
+        crate::io::basis_hash::settings_hash(&self.file.train, &self.file.reduction)
     }
 }

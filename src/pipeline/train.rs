@@ -182,7 +182,7 @@ pub fn write_trained(p: &Pipeline, out: &Path, data: &TrainingData, summary: &Tr
             Some(g) => g.mode_rule(),
             None => p.file.reduction.modes.as_ref().map(|m| m.to_string()).unwrap_or_default(),
         },
-        settings_hash: crate::io::basis_check::settings_hash(p),
+        settings_hash: p.settings_hash(),
     };
     write_basis_with(out, data, &summary.trained, &meta, |f| {
         if let Some(est) = &summary.estimator {

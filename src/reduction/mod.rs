@@ -11,10 +11,12 @@
 
 pub mod basis;
 pub mod ecsw;
+pub mod estimator;
 pub mod hyper_model;
 pub(crate) mod joint_elimination;
 pub mod pod;
 pub(crate) mod projection;
+pub mod reduced;
 pub mod reduced_model;
 pub mod sample;
 pub mod whole_system;
@@ -23,16 +25,9 @@ pub use basis::{Basis, BasisSpec, SnapshotKind, Stabilization, Trained, Variant}
 pub use ecsw::ecsw;
 pub use hyper_model::HyperReducedModel;
 pub use pod::{pod, ModeRule, Pod};
+pub use reduced::Reduced;
 pub use reduced_model::ReducedModel;
 pub use sample::Hyper;
-
-/// What the online stage needs of a reduced model besides the dynamics.
-pub trait Reduced<M>: crate::solver::model::ParametricModel {
-    /// The full model it was projected from.
-    fn full(&self) -> &M;
-    /// Physical multipliers of the full model's constraints, when the variant has them.
-    fn multipliers(&self, q: &[f64], lambda: &[f64]) -> Option<ndarray::Array1<f64>>;
-}
 
 /// Builds a basis from snapshots `x` (n × m) and multipliers `λ` (n_c × m), for every
 /// variant: the stabilized whole-system one by [`whole_system`], the others by

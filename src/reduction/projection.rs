@@ -62,11 +62,11 @@ macro_rules! forward_to_projection {
 }
 pub(crate) use forward_to_projection;
 
-/// [`super::Reduced`] for a reduced model `$t<M>` with fields `p: Projection` and
+/// [`super::reduced::Reduced`] for a reduced model `$t<M>` with fields `p: Projection` and
 /// `full: M` (`M: $bound`): all of it is the projection's.
 macro_rules! impl_reduced {
     ($t:ident, $bound:path) => {
-        impl<M: $bound> super::Reduced<M> for $t<M> {
+        impl<M: $bound> super::reduced::Reduced<M> for $t<M> {
             fn full(&self) -> &M {
                 &self.full
             }
