@@ -296,8 +296,7 @@ fn whole_system_and_raw_bases_pass_the_check() {
         ("raw", PIPE.replace("[reduction]", "snapshots = \"raw\"\n[reduction]")),
     ] {
         let p = Pipeline::load(trained(d, tag, 5540.0, &pipe)).unwrap();
-        let s =
-            basis_check::check(&d.join(format!("{tag}.h5")), &p.model, Some(&p.settings_hash())).unwrap();
+        let s = basis_check::check(&d.join(format!("{tag}.h5")), &p.model, Some(&p.settings_hash())).unwrap();
         assert_eq!(s.content_hash.len(), 64);
         assert_eq!(s.settings_hash, p.settings_hash());
         if tag == "ws" {

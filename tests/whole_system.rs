@@ -16,11 +16,11 @@
 //!   10 %, ECSW τ = 1e-4): rel_error ≤ 1e-3 (issue 20), no kept coordinates.
 
 use flexrom::io::basis_check::INF_SUP_MIN;
+use flexrom::linalg::kkt::LinearSolverKind;
 use flexrom::pipeline::train::train;
 use flexrom::pipeline::validate::validate;
 use flexrom::pipeline::Pipeline;
 use flexrom::reduction::whole_system::{constraint_matrix, inf_sup};
-use flexrom::linalg::kkt::LinearSolverKind;
 use ndarray::Array2;
 use std::path::Path;
 

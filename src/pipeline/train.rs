@@ -4,10 +4,10 @@ use super::config::{Blocks, Pipeline};
 use super::estimate::{build_estimator, Estimator, DEFAULT_EXTRA_MODES};
 use crate::error::{Error, Result};
 use crate::io::basis_file::{write_basis_with, BasisMeta, TrainingData};
+use crate::linalg::kkt::LinearSolverKind;
 use crate::physics::system::FlexibleSystem;
 use crate::reduction::{ecsw, train_basis, BasisSpec, ModeRule, Trained};
 use crate::simulate::{FullModel, Overrides, SimulationResult};
-use crate::linalg::kkt::LinearSolverKind;
 use ndarray::{concatenate, Array1, Axis};
 use std::path::Path;
 
