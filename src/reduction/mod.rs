@@ -10,6 +10,7 @@
 //! reduced model runs at any parameters without being projected again.
 
 pub mod basis;
+mod basis_train;
 pub mod ecsw;
 pub mod estimator;
 pub mod hyper_model;
@@ -40,7 +41,7 @@ pub fn train_basis(
     spec: &BasisSpec,
 ) -> Result<Trained, String> {
     if spec.variant != Variant::WholeSystemStabilized {
-        return basis::train_plain(x, lambda, joint_dofs, x_ref, spec);
+        return basis_train::train_plain(x, lambda, joint_dofs, x_ref, spec);
     }
     if !spec.blocks.is_empty() {
         return Err("a basis with blocks needs the galerkin or the constraint-preserving variant".into());
