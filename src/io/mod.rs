@@ -1,6 +1,7 @@
 //! HDF5 input and output.
 pub mod atomic;
 pub mod basis_check;
+pub mod basis_content;
 pub mod basis_file;
 pub mod basis_hash;
 pub mod basis_layout;
