@@ -31,7 +31,7 @@ fn pipeline(name: &str) -> Pipeline {
 fn b_of(p: &Pipeline) -> Array2<f64> {
     let sys = p.model.system(LinearSolverKind::Banded);
     let rows: Vec<Vec<(usize, f64)>> = sys.constraints.iter().map(|c| c.terms.clone()).collect();
-    constraint_matrix(flexrom::solver::model::DynamicModel::n_dof(&sys), &rows)
+    constraint_matrix(flexrom::solver::model::ParametricModel::n_dof(&sys), &rows)
 }
 
 #[test]

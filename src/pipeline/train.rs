@@ -43,7 +43,7 @@ fn stabilization_for(p: &Pipeline, sys: &FlexibleSystem) -> Option<crate::reduct
     (p.variant() == crate::reduction::Variant::WholeSystemStabilized).then(|| {
         let rows: Vec<Vec<(usize, f64)>> = sys.constraints.iter().map(|c| c.terms.clone()).collect();
         crate::reduction::Stabilization {
-            constraints: constraint_matrix(crate::solver::model::DynamicModel::n_dof(sys), &rows),
+            constraints: constraint_matrix(crate::solver::model::ParametricModel::n_dof(sys), &rows),
             multiplier_modes: p.file.reduction.multiplier_modes.clone().unwrap_or(DEFAULT_MULTIPLIER_MODES),
         }
     })
