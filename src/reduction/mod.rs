@@ -2,12 +2,15 @@
 //! it sees the physics only through [`crate::solver::model::ElementModel`] and
 //! [`crate::solver::model::InvariantElementModel`].
 //!
-//! `pod` (modes and singular values) → `basis` (the reductor: `train_basis`, `reduce`,
+//! `pod` (modes and singular values) → [`train_basis`] (`basis_train` for the plain
+//! variants, `whole_system` for the stabilized one) → `basis` (the reductor: `reduce`,
 //! `reconstruct`) → `reduced_model` (Galerkin over every element) or `ecsw` (a weighted
-//! element sample, by `nnls`) → `hyper_model` (the sampled model); both reduced models are
-//! [`crate::solver::model::ParametricModel`]s and share `projection`: they keep the
-//! projected constant forces unscaled and take the load scale in each evaluation, so one
-//! reduced model runs at any parameters without being projected again.
+//! element sample, by `crate::linalg::nnls`) → `hyper_model` (the sampled model); both
+//! reduced models are [`crate::solver::model::ParametricModel`]s and [`Reduced`], and share
+//! `projection`: they keep the projected constant forces unscaled and take the load scale
+//! in each evaluation, so one reduced model runs at any parameters without being projected
+//! again. `estimator` holds the error estimator's data (the enriched basis and its
+//! calibration) that the basis file stores beside the basis.
 
 pub mod basis;
 mod basis_train;

@@ -1,6 +1,7 @@
 //! What every reduced model shares: the parts of the full model that are projected once
 //! (mass, constant loads, joints), the few state- or time-dependent nodal loads, and the
-//! reduced KKT matrix with its allocation-free LU. The element terms are left to the
+//! reduced KKT matrix with its allocation-free LU (assembled and factored in
+//! `projection/newton.rs`). The element terms are left to the
 //! model (all elements in [`super::ReducedModel`], a sampled set in
 //! [`super::HyperReducedModel`]). With `x = x_ref + V q`:
 //!
@@ -11,9 +12,6 @@
 //!
 //! Both parts of the constant force are projected once, unscaled, and combined at the load
 //! scale `λ` of each evaluation's parameters μ: one reduced model runs at every load.
-//!
-//! ```text
-//! ```
 //!
 //! Joints: *constraint-preserving* keeps `B V q = b − B x_ref` with exact multipliers
 //! (`B V = [0, B_c]`), and solves each Newton system in the null space of its joint rows
