@@ -5,9 +5,9 @@
 //!     cargo bench --bench full_order            # all sizes
 //!     cargo bench --bench full_order -- quick   # 50 elements and the four-bar only
 
+use flexrom::linalg::kkt::LinearSolverKind;
 use flexrom::model::Model;
 use flexrom::simulate::{simulate, Overrides};
-use flexrom::solver::kkt::LinearSolverKind;
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(|a, b| a.partial_cmp(b).unwrap());

@@ -55,7 +55,7 @@ pub enum Error {
 
     /// A numerical failure with the stage (simulate, train, online, validate, sweep) and
     /// the load scale it happened at; the time is in `source`.
-    #[error("{stage} at load scale {}: {source}", crate::limits::show_number(*.load_scale))]
+    #[error("{stage} at load scale {}: {source}", show_number(*.load_scale))]
     Stage {
         stage: String,
         load_scale: f64,
@@ -76,6 +76,20 @@ pub enum Error {
 
 pub type Result<T> = std::result::Result<T, Error>;
 
+/// The exit code of `--strict` when an error estimate exceeds the tolerance.
+pub const STRICT_EXIT_CODE: u8 = 4;
+
+/// A number as written by hand: plain in [1e-4, 1e6), else in exponent form (1e300 is
+/// not 301 digits). Every message that prints a user's number (a load scale, a bound)
+/// uses it, so it lives with the error type at the bottom of the layers.
+pub fn show_number(x: f64) -> String {
+    if x == 0.0 || (1e-4..1e6).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
 impl Error {
     /// The process exit code for this error: 3 when only part of the work failed
     /// ([`Error::PartlyFailed`]), 4 when an error estimate exceeded the tolerance under
@@ -83,7 +97,7 @@ impl Error {
     pub fn exit_code(&self) -> u8 {
         match self {
             Error::PartlyFailed(_) => 3,
-            Error::Strict(_) => crate::pipeline::estimate::STRICT_EXIT_CODE,
+            Error::Strict(_) => STRICT_EXIT_CODE,
             _ => 1,
         }
     }

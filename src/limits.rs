@@ -13,7 +13,7 @@
 //!     sweep         N · n_t · (r + 2 n_probes) · 8  (+ N · n_t · n_dof · 8 with --validate)
 //! ```
 
-use crate::error::{Error, Result};
+use crate::error::{show_number, Error, Result};
 use std::sync::OnceLock;
 
 /// The bounds in force.
@@ -130,16 +130,6 @@ pub fn parse_bytes(s: &str) -> std::result::Result<u64, String> {
         return Err(format!("`{s}` is not a positive size below 16 EiB"));
     }
     Ok(b as u64)
-}
-
-/// A number as written by hand: plain in [1e-4, 1e6), else in exponent form (1e300 is
-/// not 301 digits).
-pub fn show_number(x: f64) -> String {
-    if x == 0.0 || (1e-4..1e6).contains(&x.abs()) {
-        format!("{x}")
-    } else {
-        format!("{x:e}")
-    }
 }
 
 /// Human-readable bytes.

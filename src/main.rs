@@ -4,12 +4,12 @@ use clap::{Parser, Subcommand};
 use flexrom::io::atomic::TempPath;
 use flexrom::io::output::{check_output, check_report_dir, claim_in_report, Origin};
 use flexrom::io::result_file::{write_result, write_result_with};
+use flexrom::linalg::kkt::LinearSolverKind;
 use flexrom::model::Model;
 use flexrom::output::{self, note};
 use flexrom::pipeline::online::load_basis;
 use flexrom::pipeline::Pipeline;
 use flexrom::simulate::{simulate, Overrides};
-use flexrom::solver::kkt::LinearSolverKind;
 use std::path::PathBuf;
 use std::process::ExitCode;
 

@@ -2,10 +2,10 @@
 //! model file → full simulation → snapshots → POD basis → reduced runs → validation.
 
 use crate::error::{Error, Result};
+use crate::linalg::kkt::LinearSolverKind;
 use crate::model::Model;
 use crate::physics::system::FlexibleSystem;
 use crate::solver::generalized_alpha::{GeneralizedAlpha, IntegratorParams, State, Stats};
-use crate::solver::kkt::LinearSolverKind;
 use crate::solver::model::{Bound, DynamicModel, Parameters, ParametricModel};
 use ndarray::{Array1, Array2};
 

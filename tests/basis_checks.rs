@@ -296,10 +296,9 @@ fn whole_system_and_raw_bases_pass_the_check() {
         ("raw", PIPE.replace("[reduction]", "snapshots = \"raw\"\n[reduction]")),
     ] {
         let p = Pipeline::load(trained(d, tag, 5540.0, &pipe)).unwrap();
-        let s =
-            basis_check::check(&d.join(format!("{tag}.h5")), &p.model, Some(&basis_check::settings_hash(&p))).unwrap();
+        let s = basis_check::check(&d.join(format!("{tag}.h5")), &p.model, Some(&p.settings_hash())).unwrap();
         assert_eq!(s.content_hash.len(), 64);
-        assert_eq!(s.settings_hash, basis_check::settings_hash(&p));
+        assert_eq!(s.settings_hash, p.settings_hash());
         if tag == "ws" {
             // V alone is not orthonormal: the check must use the stacked matrix
             let g = s.basis.modes.t().dot(&s.basis.modes);

@@ -8,7 +8,7 @@
 
 use flexrom::model::Model;
 use flexrom::simulate::{prepare, simulate, Overrides, Settings};
-use flexrom::solver::model::DynamicModel;
+use flexrom::solver::model::{Parameters, ParametricModel};
 
 #[test]
 fn a_rounded_joint_position_is_closed_without_bending() {
@@ -20,7 +20,7 @@ fn a_rounded_joint_position_is_closed_without_bending() {
         let s = Settings::resolve(&m, &Overrides::default()).unwrap();
         let (mut sys, q0) = prepare(&m, &s).unwrap();
         let mut f = vec![0.0; q0.len()];
-        sys.force(&q0, &vec![0.0; q0.len()], 0.0, &mut f);
+        sys.force(&Parameters::default(), &q0, &vec![0.0; q0.len()], 0.0, &mut f);
         f
     };
     let (a, b) = (forces(&exact), forces(&rounded));

@@ -19,7 +19,7 @@
 use flexrom::model::Model;
 use flexrom::simulate::{prepare, Overrides, Settings};
 use flexrom::solver::generalized_alpha::{GeneralizedAlpha, IntegratorParams, JacobianReuse, Stats};
-use flexrom::solver::model::DynamicModel;
+use flexrom::solver::model::{Bound, DynamicModel, Parameters, ParametricModel};
 use std::path::Path;
 
 fn repo(rel: &str) -> String {
@@ -54,21 +54,26 @@ fn compare<M: DynamicModel>(
     (worst, integ.stats)
 }
 
-/// Checks the across-steps run of a model against full Newton and within-step reuse.
-fn check_model<M: DynamicModel>(
+/// Checks the across-steps run of a model at the parameters `mu` against full Newton and
+/// within-step reuse (each run on its own copy of the model).
+fn check_model<M: ParametricModel>(
     name: &str,
     make: impl Fn() -> M,
+    mu: &Parameters,
     params: &IntegratorParams,
     q0: Vec<f64>,
     dt: f64,
     steps: usize,
 ) {
     let bound = 10.0 * params.tolerance;
-    let (diff, across) = compare(&mut make(), &mut make(), params, JacobianReuse::AcrossSteps, q0.clone(), dt, steps);
-    let (diff_within, within) =
-        compare(&mut make(), &mut make(), params, JacobianReuse::WithinStep, q0.clone(), dt, steps);
+    let run = |policy: JacobianReuse, q0: Vec<f64>| {
+        let (mut a, mut b) = (make(), make());
+        compare(&mut Bound::new(&mut a, mu), &mut Bound::new(&mut b, mu), params, policy, q0, dt, steps)
+    };
+    let (diff, across) = run(JacobianReuse::AcrossSteps, q0.clone());
+    let (diff_within, within) = run(JacobianReuse::WithinStep, q0.clone());
     eprintln!("{name}: within-step largest step difference {diff_within:.3e} L");
-    let (_, never) = compare(&mut make(), &mut make(), params, JacobianReuse::Never, q0, dt, steps);
+    let (_, never) = run(JacobianReuse::Never, q0);
     eprintln!(
         "{name}: across {across:?}\n  within {within:?}\n  never {never:?}\n  largest step difference {diff:.3e} L"
     );
@@ -93,5 +98,6 @@ fn kept_matrices_end_every_full_order_step_where_full_newton_does() {
     let m = Model::load(repo(model)).unwrap();
     let s = settings(&m, scale);
     let q0 = prepare(&m, &s).unwrap().1;
-    check_model(model, || prepare(&m, &s).unwrap().0, &s.params, q0, s.dt, steps.min(s.n_steps));
+    let mu = Parameters::new(s.load_scale);
+    check_model(model, || prepare(&m, &s).unwrap().0, &mu, &s.params, q0, s.dt, steps.min(s.n_steps));
 }

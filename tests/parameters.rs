@@ -10,12 +10,12 @@
 //! a constant force, hyper-reduced basis) and the four-bar over 0.2 s (the crank moment is
 //! the scaled load, a state- and time-dependent nodal load; every element at weight 1).
 
+use flexrom::linalg::kkt::LinearSolverKind;
 use flexrom::model::Model;
 use flexrom::pipeline::online::{Output, ReducedRunner};
 use flexrom::pipeline::train::train;
 use flexrom::pipeline::Pipeline;
 use flexrom::simulate::{simulate, FullModel, Overrides};
-use flexrom::solver::kkt::LinearSolverKind;
 use flexrom::solver::model::Parameters;
 use ndarray::Array2;
 use std::path::Path;

@@ -17,6 +17,7 @@ mod common;
 
 use flexrom::model::Model;
 use flexrom::simulate::{integrate, prepare, simulate, Overrides, Settings};
+use flexrom::solver::model::Bound;
 
 fn pendulum() -> Model {
     Model::load(concat!(env!("CARGO_MANIFEST_DIR"), "/data/models/pendulum.toml")).unwrap()
@@ -32,7 +33,7 @@ fn energy_is_conserved_and_the_pin_holds() {
     let mut energies = Vec::new();
     let mut kinetic_peak = 0.0_f64;
     let mut pin_error = 0.0_f64;
-    integrate(&mut sys, &s.params, q0, s.dt, s.n_steps, |_, st| {
+    integrate(&mut Bound::new(&mut sys, &s.parameters()), &s.params, q0, s.dt, s.n_steps, |_, st| {
         let t = probe_sys.kinetic_energy(&st.v);
         kinetic_peak = kinetic_peak.max(t);
         energies.push(t + probe_sys.potential_energy(&s.parameters(), &st.q));
@@ -73,7 +74,7 @@ fn tip_trajectory_converges_at_second_order_in_dt() {
 /// after one Newton iteration leaves ≈ 40 N, measured).
 #[test]
 fn every_step_satisfies_the_equations_of_motion() {
-    use flexrom::solver::model::DynamicModel;
+    use flexrom::solver::model::ParametricModel;
     let m = pendulum();
     let s = Settings::resolve(&m, &Overrides::default()).unwrap();
     let (mut sys, q0) = prepare(&m, &s).unwrap();
@@ -81,13 +82,14 @@ fn every_step_satisfies_the_equations_of_motion() {
     let n = check.n_dof();
     let g_node = 5540.0 * 1.8e-3 * (1.2 / 50.0) * 9.81;
     let mut worst = 0.0_f64;
-    integrate(&mut sys, &s.params, q0, s.dt, s.n_steps, |k, st| {
+    let mu = s.parameters();
+    integrate(&mut Bound::new(&mut sys, &mu), &s.params, q0, s.dt, s.n_steps, |k, st| {
         if k == 0 {
             return;
         }
         let mut r = vec![0.0; n];
         let mut mq = vec![0.0; n];
-        check.force(&st.q, &st.v, st.t, &mut r);
+        check.force(&mu, &st.q, &st.v, st.t, &mut r);
         check.mass_mul(&st.qdd, &mut mq);
         check.add_constraint_force(&st.lambda, &mut r);
         for i in 0..n {
@@ -110,6 +112,7 @@ fn factorization_reuse_reaches_the_same_solution() {
     let run = |params: &IntegratorParams| {
         let (mut sys, q0) = prepare(&m, &s).unwrap();
         let mut last = Vec::new();
+        let mut sys = Bound::new(&mut sys, &s.parameters());
         let stats = integrate(&mut sys, params, q0, s.dt, s.n_steps, |_, st| last = st.q.clone()).unwrap();
         (last, stats)
     };

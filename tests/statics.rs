@@ -10,7 +10,7 @@
 
 mod common;
 
-use flexrom::solver::model::{Bound, DynamicModel, Parameters};
+use flexrom::solver::model::{Bound, Parameters, ParametricModel};
 use flexrom::solver::statics::solve_static;
 
 const L: f64 = 1.0;

@@ -16,11 +16,11 @@
 //!   10 %, ECSW τ = 1e-4): rel_error ≤ 1e-3 (issue 20), no kept coordinates.
 
 use flexrom::io::basis_check::INF_SUP_MIN;
+use flexrom::linalg::kkt::LinearSolverKind;
 use flexrom::pipeline::train::train;
 use flexrom::pipeline::validate::validate;
 use flexrom::pipeline::Pipeline;
 use flexrom::reduction::whole_system::{constraint_matrix, inf_sup};
-use flexrom::solver::kkt::LinearSolverKind;
 use ndarray::Array2;
 use std::path::Path;
 
@@ -31,7 +31,7 @@ fn pipeline(name: &str) -> Pipeline {
 fn b_of(p: &Pipeline) -> Array2<f64> {
     let sys = p.model.system(LinearSolverKind::Banded);
     let rows: Vec<Vec<(usize, f64)>> = sys.constraints.iter().map(|c| c.terms.clone()).collect();
-    constraint_matrix(flexrom::solver::model::DynamicModel::n_dof(&sys), &rows)
+    constraint_matrix(flexrom::solver::model::ParametricModel::n_dof(&sys), &rows)
 }
 
 #[test]

@@ -71,7 +71,7 @@ pub struct BasisMeta {
     pub model_fingerprint: String,
     pub pipeline_text: String,
     pub mode_rule: String,
-    /// [`super::basis_check::settings_hash`] of the pipeline that trained the basis
+    /// [`super::basis_hash::settings_hash`] of the pipeline that trained the basis
     pub settings_hash: String,
 }
 

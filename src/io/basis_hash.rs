@@ -73,8 +73,9 @@ pub fn content_hash(c: &HashInput) -> String {
 
 /// SHA-256 (hex) of a pipeline's `[train]` and `[reduction]` tables in canonical form (the
 /// parsed values as JSON): comments, layout and number spelling do not change it, any
-/// setting that changes the basis does.
-pub fn settings_hash(p: &crate::pipeline::Pipeline) -> String {
-    let json = serde_json::json!({ "train": p.file.train, "reduction": p.file.reduction });
+/// setting that changes the basis does. A pipeline's own is
+/// `crate::pipeline::Pipeline::settings_hash`.
+pub fn settings_hash(train: &impl serde::Serialize, reduction: &impl serde::Serialize) -> String {
+    let json = serde_json::json!({ "train": train, "reduction": reduction });
     Sha256::digest(json.to_string().as_bytes()).iter().map(|b| format!("{b:02x}")).collect()
 }

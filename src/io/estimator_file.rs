@@ -18,7 +18,7 @@
 
 use super::h5::{attr_f64, attr_str, attr_u64, read_attr_f64, read_attr_str};
 use crate::error::{Error, Result};
-use crate::pipeline::estimate::{Calibration, CalibrationPoint, Estimator};
+use crate::reduction::estimator::{Calibration, CalibrationPoint, Estimator};
 use crate::reduction::{Basis, Hyper};
 use ndarray::Array1;
 use std::path::Path;

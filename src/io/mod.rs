@@ -2,6 +2,7 @@
 pub mod atomic;
 pub mod attrs;
 pub mod basis_check;
+pub mod basis_content;
 pub mod basis_file;
 pub mod basis_hash;
 pub mod basis_layout;

@@ -3,7 +3,7 @@
 
 use super::{Model, SharedPhysics};
 use crate::error::{Error, Result};
-use crate::solver::kkt::LinearSolverKind;
+use crate::linalg::kkt::LinearSolverKind;
 use std::sync::Arc;
 
 impl SharedPhysics {

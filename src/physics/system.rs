@@ -7,7 +7,7 @@
 use super::element::{BeamElement, Mat8, Section, Vec8};
 use super::loads::{moment_force, moment_jacobian};
 use super::time_function::TimeFunction;
-use crate::solver::kkt::{make_solver, KktPattern, KktSolver, LinearSolverKind};
+use crate::linalg::kkt::{make_solver, KktPattern, KktSolver, LinearSolverKind};
 use crate::solver::model::{ElementModel, InvariantElementModel, IterationCoefficients, Parameters, ParametricModel};
 
 /// A straight beam in its undeformed configuration.
@@ -616,42 +616,6 @@ impl ParametricModel for FlexibleSystem {
             }
         }
         Some(worst)
-    }
-}
-
-/// The system at the model file's own loads (`λ = 1`, [`Parameters::default`]) as the
-/// integrator's model, for callers that run it only there (tests, tools); any other
-/// parameters go through [`crate::solver::model::Bound`] or [`crate::simulate::solve`].
-impl crate::solver::model::DynamicModel for FlexibleSystem {
-    fn n_dof(&self) -> usize {
-        self.n_dof
-    }
-    fn n_constraints(&self) -> usize {
-        self.constraints.len()
-    }
-    fn mass_mul(&self, a: &[f64], out: &mut [f64]) {
-        ParametricModel::mass_mul(self, a, out)
-    }
-    fn force(&mut self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
-        ParametricModel::force(self, &Parameters::default(), q, v, t, out)
-    }
-    fn constraint_residual(&self, q: &[f64], out: &mut [f64]) {
-        ParametricModel::constraint_residual(self, q, out)
-    }
-    fn add_constraint_force(&self, lambda: &[f64], out: &mut [f64]) {
-        ParametricModel::add_constraint_force(self, lambda, out)
-    }
-    fn factor(&mut self, q: &[f64], v: &[f64], t: f64, coef: IterationCoefficients) -> Result<f64, String> {
-        ParametricModel::factor(self, &Parameters::default(), q, v, t, coef)
-    }
-    fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {
-        ParametricModel::solve(self, rhs)
-    }
-    fn length_scale(&self) -> f64 {
-        self.length_scale
-    }
-    fn max_strain(&self, q: &[f64]) -> Option<(f64, usize)> {
-        ParametricModel::max_strain(self, q)
     }
 }
 

@@ -30,14 +30,12 @@ use super::online::{Output, ReducedRun, ReducedRunner};
 use crate::error::Result;
 use crate::model::Model;
 use crate::physics::system::FlexibleSystem;
+pub use crate::reduction::estimator::{Calibration, CalibrationPoint, EstimateMethod, Estimator, DEFAULT_FACTOR};
 use crate::reduction::{ecsw, train_basis, Basis, BasisSpec, ModeRule, Trained, Variant};
 use ndarray::{Array1, Array2, ArrayView1, ArrayView2, Axis};
 
 /// `k`: extra POD modes per block of the enriched basis.
 pub const DEFAULT_EXTRA_MODES: usize = 10;
-/// `c` without calibration data (the probe: 1.5 covered every test load on both
-/// benchmark models with effectivity 1.1–1.5).
-pub const DEFAULT_FACTOR: f64 = 1.5;
 /// The enriched model's ECSW tolerance relative to the basis's τ: its force integration
 /// must be more accurate than the error it measures. At τ itself the four-bar (trained at
 /// 0.7, 0.95, 1.2) gave effectivities of 312 and 9.7 at two of 13 loads (the enriched
@@ -45,47 +43,6 @@ pub const DEFAULT_FACTOR: f64 = 1.5;
 pub const ENRICHED_HYPER_FACTOR: f64 = 0.1;
 /// Safety margin over the largest ratio true/raw seen in calibration.
 pub const CALIBRATION_MARGIN: f64 = 1.25;
-
-/// What the basis file stores under `/estimator`.
-#[derive(Clone, Debug)]
-pub struct Estimator {
-    /// `V⁺`: same variant, reference and kept coordinates as the basis, `k` more POD modes
-    /// per block; its own ECSW set when the basis is hyper-reduced
-    pub enriched: Basis,
-    /// POD modes per block of `V⁺`
-    pub block_modes: Vec<usize>,
-    /// `k` requested per block (capped by the rank of each block's snapshots)
-    pub extra_modes: usize,
-    pub calibration: Calibration,
-    /// how a run computes the estimate (not stored in the basis file: a run-time choice,
-    /// `[online] estimate` in the pipeline or `--estimate`)
-    pub method: EstimateMethod,
-}
-
-pub use super::config::EstimateMethod;
-
-/// One held-out load: the raw estimate of a basis there and its true `rel_error`.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
-pub struct CalibrationPoint {
-    pub load_scale: f64,
-    pub raw_estimate: f64,
-    pub rel_error: f64,
-}
-
-#[derive(Clone, Debug, PartialEq)]
-pub struct Calibration {
-    /// `c`
-    pub factor: f64,
-    /// false: [`DEFAULT_FACTOR`], no usable held-out data
-    pub calibrated: bool,
-    pub points: Vec<CalibrationPoint>,
-}
-
-impl Default for Calibration {
-    fn default() -> Self {
-        Calibration { factor: DEFAULT_FACTOR, calibrated: false, points: Vec::new() }
-    }
-}
 
 /// One estimate.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -424,9 +381,6 @@ fn few(v: &[String]) -> String {
         format!("{}, …, {}", v[..4].join(", "), v[v.len() - 1])
     }
 }
-
-/// The exit code of `--strict` when an estimate exceeds the tolerance.
-pub const STRICT_EXIT_CODE: u8 = 4;
 
 /// Prints one warning line on stderr for extrapolated load scales and one for estimates
 /// above the tolerance (or for a basis without an estimator); `runs` are

@@ -227,7 +227,7 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
     );
     let mut runs: Vec<SimulationResult> = first.par_iter().map(|&x| full(x)).collect::<Result<_>>()?;
     // the later full runs, one at a time, on one full model
-    let mut full_model = crate::simulate::FullModel::new(&p.model, crate::solver::kkt::LinearSolverKind::Banded)?;
+    let mut full_model = crate::simulate::FullModel::new(&p.model, crate::linalg::kkt::LinearSolverKind::Banded)?;
     let mut full_seconds: f64 = runs.iter().map(|r| r.wall_seconds).sum();
     let mut full_runs = runs.len();
     let mut points: Vec<CalibrationPoint> = Vec::new();

@@ -27,7 +27,7 @@ pub struct ReducedRun {
 /// Reads the pipeline's basis (or `path`) and checks it against the pipeline's model and
 /// settings ([`crate::io::basis_check::check`]).
 pub fn load_basis(p: &Pipeline, path: &Path) -> Result<StoredBasis> {
-    crate::io::basis_check::check(path, &p.model, Some(&crate::io::basis_check::settings_hash(p)))
+    crate::io::basis_check::check(path, &p.model, Some(&p.settings_hash()))
 }
 
 /// What the run writes: the full coordinates (`online`, `validate`) or only the reduced

@@ -92,7 +92,7 @@ pub fn write_snapshots(p: &Pipeline, scales: &[f64], out: &Path) -> Result<(usiz
         runs.push(r);
     }
     let data = super::train::training_data(&runs);
-    let settings_hash = crate::io::basis_check::settings_hash(p);
+    let settings_hash = p.settings_hash();
     let pipeline = crate::io::output::resolve(&p.path).display().to_string();
     write_atomically_as(out, Kind::Snapshots, |f| {
         let e = |err: hdf5::Error| Error::hdf5(out, err);
@@ -133,7 +133,7 @@ fn read_runs(p: &Pipeline, path: &Path, n_t: usize) -> Result<(Vec<Run>, f64)> {
     if text("model_fingerprint")? != p.model.fingerprint() {
         return Err(bad("model_fingerprint", format!("comes from another model than {}'s", p.path.display())));
     }
-    if text("settings_hash")? != crate::io::basis_check::settings_hash(p) {
+    if text("settings_hash")? != p.settings_hash() {
         return Err(bad(
             "settings_hash",
             format!("comes from other [train]/[reduction] settings than {}'s", p.path.display()),

@@ -4,10 +4,10 @@ use super::config::{Blocks, Pipeline};
 use super::estimate::{build_estimator, Estimator, DEFAULT_EXTRA_MODES};
 use crate::error::{Error, Result};
 use crate::io::basis_file::{write_basis_with, BasisMeta, TrainingData};
+use crate::linalg::kkt::LinearSolverKind;
 use crate::physics::system::FlexibleSystem;
 use crate::reduction::{ecsw, train_basis, BasisSpec, ModeRule, Trained};
 use crate::simulate::{FullModel, Overrides, SimulationResult};
-use crate::solver::kkt::LinearSolverKind;
 use ndarray::{concatenate, Array1, Axis};
 use std::path::Path;
 
@@ -43,7 +43,7 @@ fn stabilization_for(p: &Pipeline, sys: &FlexibleSystem) -> Option<crate::reduct
     (p.variant() == crate::reduction::Variant::WholeSystemStabilized).then(|| {
         let rows: Vec<Vec<(usize, f64)>> = sys.constraints.iter().map(|c| c.terms.clone()).collect();
         crate::reduction::Stabilization {
-            constraints: constraint_matrix(crate::solver::model::DynamicModel::n_dof(sys), &rows),
+            constraints: constraint_matrix(crate::solver::model::ParametricModel::n_dof(sys), &rows),
             multiplier_modes: p.file.reduction.multiplier_modes.clone().unwrap_or(DEFAULT_MULTIPLIER_MODES),
         }
     })
@@ -182,7 +182,7 @@ pub fn write_trained(p: &Pipeline, out: &Path, data: &TrainingData, summary: &Tr
             Some(g) => g.mode_rule(),
             None => p.file.reduction.modes.as_ref().map(|m| m.to_string()).unwrap_or_default(),
         },
-        settings_hash: crate::io::basis_check::settings_hash(p),
+        settings_hash: p.settings_hash(),
     };
     write_basis_with(out, data, &summary.trained, &meta, |f| {
         if let Some(est) = &summary.estimator {

@@ -17,10 +17,10 @@
 use super::estimate::{is_extrapolated, rel_error_by_time, EstimatingRunner, TrustInfo};
 use super::online::{Output, ReducedRun};
 use crate::error::Result;
+use crate::linalg::kkt::LinearSolverKind;
 use crate::model::Model;
 use crate::reduction::Basis;
 use crate::simulate::{simulate, FullModel, Overrides, SimulationResult};
-use crate::solver::kkt::LinearSolverKind;
 use crate::solver::model::ParametricModel;
 
 /// The fixed keys of `validate --json`.

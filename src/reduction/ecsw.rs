@@ -16,10 +16,9 @@
 //! (symmetric tangent, conservative internal forces).
 
 use super::basis::Basis;
+use super::sample::Hyper;
 use crate::linalg::nnls::{nnls, NnlsParams};
 use crate::solver::model::InvariantElementModel;
-// transitional re-export (remove after merge)
-pub use super::sample::Hyper;
 use ndarray::{Array1, Array2, ArrayView2};
 
 /// The ECSW training matrix `C` (n_snapshots·r × n_elements) of the module documentation.

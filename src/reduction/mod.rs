@@ -2,41 +2,36 @@
 //! it sees the physics only through [`crate::solver::model::ElementModel`] and
 //! [`crate::solver::model::InvariantElementModel`].
 //!
-//! `pod` (modes and singular values) → `basis` (the reductor: `train_basis`, `reduce`,
+//! `pod` (modes and singular values) → [`train_basis`] (`basis_train` for the plain
+//! variants, `whole_system` for the stabilized one) → `basis` (the reductor: `reduce`,
 //! `reconstruct`) → `reduced_model` (Galerkin over every element) or `ecsw` (a weighted
-//! element sample, by `nnls`) → `hyper_model` (the sampled model); both reduced models are
-//! [`crate::solver::model::ParametricModel`]s and share `projection`: they keep the
-//! projected constant forces unscaled and take the load scale in each evaluation, so one
-//! reduced model runs at any parameters without being projected again.
+//! element sample, by `crate::linalg::nnls`) → `hyper_model` (the sampled model); both
+//! reduced models are [`crate::solver::model::ParametricModel`]s and [`Reduced`], and share
+//! `projection`: they keep the projected constant forces unscaled and take the load scale
+//! in each evaluation, so one reduced model runs at any parameters without being projected
+//! again. `estimator` holds the error estimator's data (the enriched basis and its
+//! calibration) that the basis file stores beside the basis.
 
 pub mod basis;
+mod basis_train;
 pub mod ecsw;
+pub mod estimator;
 pub mod hyper_model;
 pub(crate) mod joint_elimination;
 pub mod pod;
 pub(crate) mod projection;
+pub mod reduced;
 pub mod reduced_model;
 pub mod sample;
-
-// transitional re-export (remove after merge)
-pub use crate::linalg::nnls;
-// transitional re-export (remove after merge)
-use crate::linalg::sparse_rows;
 pub mod whole_system;
 
 pub use basis::{Basis, BasisSpec, SnapshotKind, Stabilization, Trained, Variant};
-pub use ecsw::{ecsw, Hyper};
+pub use ecsw::ecsw;
 pub use hyper_model::HyperReducedModel;
 pub use pod::{pod, ModeRule, Pod};
+pub use reduced::Reduced;
 pub use reduced_model::ReducedModel;
-
-/// What the online stage needs of a reduced model besides the dynamics.
-pub trait Reduced<M>: crate::solver::model::ParametricModel {
-    /// The full model it was projected from.
-    fn full(&self) -> &M;
-    /// Physical multipliers of the full model's constraints, when the variant has them.
-    fn multipliers(&self, q: &[f64], lambda: &[f64]) -> Option<ndarray::Array1<f64>>;
-}
+pub use sample::Hyper;
 
 /// Builds a basis from snapshots `x` (n × m) and multipliers `λ` (n_c × m), for every
 /// variant: the stabilized whole-system one by [`whole_system`], the others by
@@ -49,7 +44,7 @@ pub fn train_basis(
     spec: &BasisSpec,
 ) -> Result<Trained, String> {
     if spec.variant != Variant::WholeSystemStabilized {
-        return basis::train_plain(x, lambda, joint_dofs, x_ref, spec);
+        return basis_train::train_plain(x, lambda, joint_dofs, x_ref, spec);
     }
     if !spec.blocks.is_empty() {
         return Err("a basis with blocks needs the galerkin or the constraint-preserving variant".into());

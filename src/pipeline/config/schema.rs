@@ -1,0 +1,171 @@
+//! The tables of a pipeline file as they are parsed (`serde`, unknown keys refused): what
+//! [`super::Pipeline::load`] reads before it checks them against each other and the model.
+
+use super::scales::Scales;
+use crate::reduction::estimator::EstimateMethod;
+use crate::reduction::{ModeRule, SnapshotKind, Variant};
+use serde::Deserialize;
+use std::path::PathBuf;
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PipelineFile {
+    #[serde(default)]
+    pub description: String,
+    pub model: PathBuf,
+    #[serde(default)]
+    pub basis: Option<PathBuf>,
+    #[serde(default)]
+    pub report: Option<PathBuf>,
+    pub train: TrainSpec,
+    /// may be omitted or partial with `train.greedy` (the rest is chosen by the greedy loop)
+    #[serde(default)]
+    pub reduction: ReductionSpec,
+    #[serde(default)]
+    pub online: Option<OnlineSpec>,
+    #[serde(default)]
+    pub validate: Option<ScalesSpec>,
+}
+
+#[derive(Clone, Debug, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrainSpec {
+    /// the training loads; exactly one of `load_scales` and `greedy`
+    #[serde(default)]
+    pub load_scales: Option<Vec<f64>>,
+    /// greedy training over a load range (src/pipeline/greedy.rs)
+    #[serde(default)]
+    pub greedy: Option<GreedySpec>,
+    #[serde(default = "default_snapshots")]
+    pub snapshots: SnapshotKind,
+}
+
+fn default_snapshots() -> SnapshotKind {
+    SnapshotKind::Reference
+}
+
+/// `[train] greedy = { range = [A, B], tolerance = T, max_runs = K, candidates = N }`:
+/// full runs where the error estimate over N evenly spaced loads of [A, B] is worst, until
+/// every estimate is ≤ T or K full runs were made.
+#[derive(Clone, Debug, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct GreedySpec {
+    pub range: Vec<f64>,
+    pub tolerance: f64,
+    pub max_runs: usize,
+    #[serde(default = "default_candidates")]
+    pub candidates: usize,
+}
+
+fn default_candidates() -> usize {
+    33
+}
+
+impl GreedySpec {
+    /// `Err((field, problem))` with the field under `train.greedy`.
+    pub fn validate(&self) -> std::result::Result<(), (String, String)> {
+        let bad = |f: &str, p: String| Err((format!("train.greedy.{f}"), p));
+        match self.range[..] {
+            [a, b] if !(a.is_finite() && b.is_finite()) => {
+                return bad("range", format!("[{a}, {b}] must be two finite numbers"))
+            }
+            [a, b] if a >= b => return bad("range", format!("[{a}, {b}]: the first end must be less than the second")),
+            [_, _] => {}
+            _ => return bad("range", format!("has {} entries; it must be [A, B] with A < B", self.range.len())),
+        }
+        if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
+            return bad(
+                "tolerance",
+                format!("is {}; it must be positive and finite (a relative error, e.g. 1e-3)", self.tolerance),
+            );
+        }
+        if self.max_runs == 0 {
+            return bad("max_runs", "is 0; at least one full run is needed".into());
+        }
+        if self.candidates < 2 {
+            return bad("candidates", format!("is {}; at least 2 (the range ends) are needed", self.candidates));
+        }
+        Ok(())
+    }
+
+    /// `(A, B)`; call after [`Self::validate`].
+    pub fn range(&self) -> (f64, f64) {
+        (self.range[0], self.range[1])
+    }
+
+    /// The N evenly spaced candidate loads `A + (B − A) i/(N − 1)`.
+    pub fn candidate_loads(&self) -> Vec<f64> {
+        let (a, b) = self.range();
+        let n = self.candidates;
+        // rounded to 12 significant digits: 0.7 + 0.5 · 19/20 prints as 1.175, not 1.1749999999999998
+        let round = |x: f64| {
+            if x == 0.0 {
+                x
+            } else {
+                let k = 10f64.powi(11 - x.abs().log10().floor() as i32);
+                (x * k).round() / k
+            }
+        };
+        (0..n).map(|i| if i + 1 == n { b } else { round(a + (b - a) * i as f64 / (n - 1) as f64) }).collect()
+    }
+}
+
+#[derive(Clone, Debug, Default, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReductionSpec {
+    /// default: constraint-preserving when the model has joints that the basis cannot
+    /// hold by itself, galerkin otherwise (see `Pipeline::variant`)
+    #[serde(default)]
+    pub variant: Option<Variant>,
+    /// required with `train.load_scales`; with `train.greedy`, absent: chosen by the loop
+    #[serde(default)]
+    pub modes: Option<ModeRule>,
+    /// `"bodies"`: a block basis, one POD per body (`modes` applies to each body, or
+    /// `counts` gives each its own); absent: one POD of all coordinates (with
+    /// `train.greedy`, absent: "bodies" when the model has more than one body)
+    #[serde(default)]
+    pub blocks: Option<Blocks>,
+    /// hyper-reduction by ECSW; absent: every element is evaluated (plain Galerkin)
+    #[serde(default)]
+    pub hyper: Option<HyperSpec>,
+    /// whole-system-stabilized only: how many multiplier modes (a ratio is of the joint
+    /// equations' count); absent: `whole_system::DEFAULT_MULTIPLIER_MODES`
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub multiplier_modes: Option<ModeRule>,
+}
+
+/// How the coordinates are split into blocks with a POD each.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Blocks {
+    /// one block per body: each mode moves one body only
+    Bodies,
+}
+
+/// `[reduction.hyper]`: ECSW element sampling trained to a relative tolerance τ on the
+/// training snapshots (‖C w − b‖ ≤ τ ‖b‖; smaller τ: more elements, closer to Galerkin).
+#[derive(Clone, Debug, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct HyperSpec {
+    pub tolerance: f64,
+}
+
+/// `[online]`: the load scales of `sweep` and `run`, and the tolerance every reduced run's
+/// error estimate is held to (a warning, or exit code 4 with `--strict`, above it).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OnlineSpec {
+    pub load_scales: Scales,
+    #[serde(default)]
+    pub tolerance: Option<f64>,
+    /// how every reduced run computes its error estimate: "corrected" (default) or
+    /// "enriched" (docs/error-estimate.md)
+    #[serde(default)]
+    pub estimate: Option<EstimateMethod>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScalesSpec {
+    pub load_scales: Scales,
+}
