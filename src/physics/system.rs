@@ -111,6 +111,10 @@ pub struct FlexibleSystem {
     n_dof: usize,
     kkt: Box<dyn KktSolver>,
     blocks: Vec<Mat8>,
+    /// per body: the constant part `m M + c C + k K_t` of the iteration blocks for the
+    /// coefficients `iteration_coef` (recomputed when the integrator changes them)
+    iteration_constant: Vec<Mat8>,
+    iteration_coef: Option<IterationCoefficients>,
     length_scale: f64,
 }
 
@@ -240,6 +244,8 @@ impl FlexibleSystem {
             n_dof,
             kkt: make_solver(solver, pattern),
             blocks: vec![Mat8::zeros(); n_el],
+            iteration_constant: Vec::new(),
+            iteration_coef: None,
             length_scale,
         }
     }
@@ -532,7 +538,7 @@ impl ParametricModel for FlexibleSystem {
     fn mass_mul(&self, a: &[f64], out: &mut [f64]) {
         out.iter_mut().for_each(|x| *x = 0.0);
         for e in 0..self.elements.len() {
-            let f = self.element(e).mass() * self.gather(e, a);
+            let f = self.element(e).mass_product(&self.gather(e, a));
             for (i, &d) in self.elements[e].1.iter().enumerate() {
                 out[d] += f[i];
             }
@@ -574,14 +580,30 @@ impl ParametricModel for FlexibleSystem {
         t: f64,
         coef: IterationCoefficients,
     ) -> Result<f64, String> {
+        if self.iteration_coef != Some(coef) {
+            let damped = coef.damping != 0.0 && self.damping != Rayleigh::default();
+            self.iteration_constant = self
+                .prototypes
+                .iter()
+                .map(|el| {
+                    let mut c = el.mass() * coef.mass + el.bending_stiffness() * coef.stiffness;
+                    if damped {
+                        c += (el.mass() * self.damping.mass + el.bending_stiffness() * self.damping.stiffness)
+                            * coef.damping;
+                    }
+                    c
+                })
+                .collect();
+            self.iteration_coef = Some(coef);
+        }
         let mut diag_max = 0.0_f64;
         for e in 0..self.elements.len() {
-            let el = &self.prototypes[self.elements[e].0];
-            let mut blk = el.mass() * coef.mass + self.element_matrix_mat(e, &self.gather(e, q), coef);
+            let (b, _) = self.elements[e];
+            let blk = self.prototypes[b].iteration_block(&self.iteration_constant[b], coef.stiffness, &self.gather(e, q));
             for i in 0..8 {
                 diag_max = diag_max.max(blk[(i, i)].abs());
             }
-            std::mem::swap(&mut self.blocks[e], &mut blk);
+            self.blocks[e] = blk;
         }
         if coef.stiffness != 0.0 {
             for m in &self.moments {
