@@ -162,10 +162,11 @@ impl BeamElement {
         let ea = self.section.ea();
         let (a, b) = (k * ea * eps, k * ea / self.length);
         let mut out = *constant;
+        // (sᵢ sⱼ) b: the same rounding for (i, j) and (j, i), so a symmetric `constant`
+        // gives a block symmetric to the bit (the band LDLᵀ checks it)
         for j in 0..8 {
-            let bj = b * sle[j];
             for i in 0..8 {
-                out[(i, j)] += sle[i] * bj;
+                out[(i, j)] += sle[i] * sle[j] * b;
             }
         }
         for j in 0..4 {
@@ -386,7 +387,9 @@ mod tests {
         let damping = el.mass() * 0.2 + el.bending_stiffness() * 1e-3;
         let constant = el.mass() * m + damping * c + el.bending_stiffness() * k;
         let plain = el.mass() * m + damping * c + el.tangent(&e) * k;
-        assert_close(&el.iteration_block(&constant, k, &e), &plain, 1e-14);
+        let fused = el.iteration_block(&constant, k, &e);
+        assert_close(&fused, &plain, 1e-14);
+        assert_eq!(fused, fused.transpose(), "symmetric to the bit");
         let a = Vec8::from_fn(|i, _| (i as f64 * 1.3).cos());
         assert!((el.mass_product(&a) - el.mass() * a).amax() <= 1e-15 * (el.mass() * a).amax());
     }
