@@ -160,7 +160,8 @@ impl ParametricModel for FlexibleSystem {
         let mut diag_max = 0.0_f64;
         for e in 0..self.elements.len() {
             let (b, _) = self.elements[e];
-            let blk = self.prototypes[b].iteration_block(&self.iteration_constant[b], coef.stiffness, &self.gather(e, q));
+            let blk =
+                self.prototypes[b].iteration_block(&self.iteration_constant[b], coef.stiffness, &self.gather(e, q));
             for i in 0..8 {
                 diag_max = diag_max.max(blk[(i, i)].abs());
             }
