@@ -21,7 +21,7 @@ pub use super::kkt_pattern::{Block, KktPattern, KktSolver, LinearSolverKind};
 
 pub fn make_solver(kind: LinearSolverKind, pattern: KktPattern) -> Box<dyn KktSolver> {
     match kind {
-        LinearSolverKind::Banded => Box::new(super::banded::BandedKkt::new(pattern)),
+        LinearSolverKind::Banded => Box::new(super::banded_ldlt::BandedLdlt::new(pattern)),
         LinearSolverKind::Sparse => Box::new(SparseKkt::new(pattern)),
         LinearSolverKind::Dense => Box::new(DenseKkt::new(pattern)),
     }

@@ -24,8 +24,10 @@ impl KktPattern {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "snake_case")]
 pub enum LinearSolverKind {
-    /// Band LU (LAPACK dgbtrf) after reverse Cuthill–McKee ordering: linear in the number
-    /// of elements for chains and loops, the fastest here.
+    /// Symmetric band LDLᵀ after reverse Cuthill–McKee ordering (each constraint row behind
+    /// its coordinates), falling back to a band LU with threshold pivoting (LAPACK dgbtf2's
+    /// algorithm) when a pivot or the symmetry check fails: linear in the number of elements
+    /// for chains and loops, the fastest here.
     #[default]
     Banded,
     /// faer general sparse LU (COLAMD + partial pivoting), symbolic analysis reused: for

@@ -2,6 +2,8 @@
 //! dense LU and bordered Cholesky, non-negative least squares, run-sparse matrices and the
 //! vector kernels. Knows nothing of the physics, the integrator or the reduction.
 pub mod banded;
+pub mod banded_ldlt;
+pub mod banded_order;
 pub mod dense_lu;
 pub mod kkt;
 pub mod kkt_pattern;

@@ -2,5 +2,6 @@
 //! reduction.
 pub mod element;
 pub mod loads;
+pub mod parts;
 pub mod system;
 pub mod time_function;

@@ -1,0 +1,71 @@
+//! What a planar flexible multibody system is made of: beams, joints, loads, probes,
+//! damping and the scalar constraints the joints become.
+
+use super::element::Section;
+use super::time_function::TimeFunction;
+
+/// A straight beam in its undeformed configuration.
+#[derive(Clone, Debug)]
+pub struct BeamBody {
+    pub name: String,
+    pub start: [f64; 2],
+    /// angle of the beam axis to +x, rad
+    pub angle: f64,
+    pub length: f64,
+    pub n_elements: usize,
+    pub section: Section,
+}
+
+impl BeamBody {
+    /// Position and slope `(x, y, x', y')` of node `k` in the straight, undeformed body.
+    pub fn undeformed_node(&self, k: usize) -> [f64; 4] {
+        let (c, s) = (self.angle.cos(), self.angle.sin());
+        let d = k as f64 * self.length / self.n_elements as f64;
+        [self.start[0] + d * c, self.start[1] + d * s, c, s]
+    }
+}
+
+/// A node is addressed by body index and node index within the body (0..=n_elements).
+pub type NodeId = (usize, usize);
+
+#[derive(Clone, Debug)]
+pub enum Joint {
+    /// `r_node − point = 0`
+    GroundPin { node: NodeId, point: [f64; 2] },
+    /// `r_a − r_b = 0`
+    Pin { a: NodeId, b: NodeId },
+    /// `r_node − point = 0`, `r'_node − slope = 0`
+    Clamp { node: NodeId, point: [f64; 2], slope: [f64; 2] },
+}
+
+#[derive(Clone, Debug)]
+pub enum Load {
+    /// body force `ρA g` on every element
+    Gravity { g: [f64; 2], scaled: bool },
+    /// moment `M(t)` at a node, acting on its slope
+    Moment { node: NodeId, function: TimeFunction, scaled: bool },
+    /// force `F f(t)` at a node (f = 1 without a function)
+    Force { node: NodeId, value: [f64; 2], function: Option<TimeFunction>, scaled: bool },
+}
+
+/// A material point whose position is recorded: element index and `ξ` in [0, 1].
+#[derive(Clone, Debug)]
+pub struct Probe {
+    pub name: String,
+    pub element: usize,
+    pub xi: f64,
+}
+
+/// Rayleigh damping `C = a M + b K_t` on the constant parts of the element matrices.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Rayleigh {
+    pub mass: f64,
+    pub stiffness: f64,
+}
+
+/// One scalar constraint `Σ coef · q[dof] = rhs`.
+#[derive(Clone, Debug)]
+pub struct Constraint {
+    pub terms: Vec<(usize, f64)>,
+    pub rhs: f64,
+}
