@@ -253,7 +253,7 @@ pub fn sweep_to_file_with(
             }
             start.resumed = reused;
             let dropped = old.iter().filter(|(x, p)| p.is_some() && !scales.contains(x)).count();
-            eprintln!(
+            crate::output::info(&format!(
                 "resuming {}: {reused} of {} load scales already finished, running {}{}",
                 out.display(),
                 scales.len(),
@@ -263,9 +263,9 @@ pub fn sweep_to_file_with(
                 } else {
                     String::new()
                 }
-            );
+            ));
         } else {
-            eprintln!("resuming {}: no such file yet, running all {} load scales", out.display(), scales.len());
+            crate::output::info(&format!("resuming {}: no such file yet, running all {} load scales", out.display(), scales.len()));
         }
     }
     let write = |s: &Sweep| write_sweep_with(out, s, stored, basis_path, extra);
