@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Reproduces the thesis table (docs/thesis.md): trains every pipeline in this folder and
-# validates it at its [validate] load scale (full banded, full dense LU and reduced runs,
+# validates it at the middle of its [validate] load scales, the thesis load (full banded, full dense LU and reduced runs,
 # one each), printing one Markdown row per pipeline on stdout.
 # Usage: pipelines/thesis/reproduce.sh   (from the repository root, after `cargo build --release`)
 #
@@ -26,8 +26,11 @@ i=0
 for f in "${files[@]}"; do
   i=$((i + 1))
   name=$(basename "$f" .toml)
-  scale=$(grep -A1 '^\[validate\]' "$f" | tail -1 | sed -n 's/^load_scales *= *\[ *\([^],]*\).*/\1/p')
-  [ -n "$scale" ] || { : >"$err"; fail "$f: no [validate] load_scales = [X] line to take the load scale from"; }
+  # the middle of the [validate] list: the thesis load (0.935 of [0.9, 0.935, 1.0], 1.0 of [1.0])
+  list=$(grep -A1 '^\[validate\]' "$f" | tail -1 | sed -n 's/^load_scales *= *\[\(.*\)\].*/\1/p' | tr -d ' ')
+  IFS=, read -r -a loads <<<"$list"
+  [ "${#loads[@]}" -gt 0 ] || { : >"$err"; fail "$f: no [validate] load_scales = [...] line to take the load scale from"; }
+  scale=${loads[$(( ${#loads[@]} / 2 ))]}
   echo "[$i/${#files[@]}] $name: train, validate at load scale $scale" >&2
   "$bin" -q train "$f" 2>"$err" || fail "flexrom train $f (exit $?)"
   cat "$err" >&2

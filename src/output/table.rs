@@ -79,6 +79,9 @@ impl Cell {
     fn text(&self) -> String {
         match self {
             // ±∞ (a failed estimate) is written as `inf`/`-inf`, which CSV readers parse
+            // both forms are Rust's shortest round trip; the exponent form where the plain
+            // one would spell out many zeros
+            Cell::Num(x) if *x != 0.0 && x.is_finite() && !(1e-4..1e15).contains(&x.abs()) => format!("{x:e}"),
             Cell::Num(x) => format!("{x}"),
             Cell::Int(i) => i.to_string(),
             Cell::Text(s) => s.clone(),
@@ -271,6 +274,8 @@ mod tests {
         assert_eq!(rows[0][1], *"tip, end");
         assert_eq!(rows[0][2], *"");
         assert_eq!(rows[1][0].parse::<f64>().unwrap(), 1.0e-7);
+        assert_eq!(&rows[1][0], "1e-7", "small numbers in exponent form");
+        assert_eq!(&rows[0][0], "0.1");
         assert_eq!(rows[1][1], *"a \"quoted\" name");
         assert_eq!(rows[1][2].parse::<f64>().unwrap(), 2.5e-4);
     }
