@@ -10,6 +10,7 @@
 //! solver statistics: only under `-v`). Results go to standard output.
 
 pub mod table;
+pub mod ticker;
 mod verbosity;
 
 pub use verbosity::{detail, info, set_verbosity, show_progress, verbosity, Verbosity};

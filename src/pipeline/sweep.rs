@@ -316,6 +316,11 @@ fn run_pending(
             .progress_chars("=> "),
     );
     bar.set_prefix(if o.validate { "sweep + validate" } else { "sweep" });
+    let ticker = crate::output::ticker::Ticker::new(
+        if o.validate { "sweep + validate" } else { "sweep" },
+        scales.len() as u64,
+        o.progress,
+    );
     // every point's trajectories are kept until the file is written
     let n_steps = crate::simulate::Settings::resolve(model, &Overrides::default())?.n_steps;
     let output = if o.validate { Output::Full } else { Output::ReducedAndProbes };
@@ -385,6 +390,7 @@ fn run_pending(
                             Ok(SweepPoint { rom, validation, estimate, extrapolated })
                         })();
                         bar.inc(1);
+                        ticker.tick();
                         match run {
                             Ok(p) => {
                                 if o.continuation {
