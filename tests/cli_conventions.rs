@@ -18,8 +18,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn flexrom(args: &[&str]) -> Output {
-    let o = Command::new(env!("CARGO_BIN_EXE_flexrom")).args(args).env("HDF5_USE_FILE_LOCKING", "FALSE").output().unwrap();
-    o
+    Command::new(env!("CARGO_BIN_EXE_flexrom")).args(args).env("HDF5_USE_FILE_LOCKING", "FALSE").output().unwrap()
 }
 
 fn ok(args: &[&str]) -> Output {

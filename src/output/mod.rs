@@ -13,7 +13,7 @@ pub mod table;
 pub mod ticker;
 mod verbosity;
 
-pub use verbosity::{detail, info, set_verbosity, show_progress, verbosity, Verbosity};
+pub use verbosity::{detail, info, note, set_verbosity, show_progress, verbosity, Verbosity};
 
 use crate::error::{Error, Result};
 use std::io::Write;
@@ -37,11 +37,4 @@ pub fn stdout_error(e: std::io::Error) -> Error {
     } else {
         Error::io("standard output", e)
     }
-}
-
-/// A line on standard error that every verbosity shows (errors, warnings); a closed or full
-/// stderr is ignored (messages are a courtesy, never a reason to fail or panic).
-pub fn note(text: &str) {
-    let mut err = std::io::stderr().lock();
-    let _ = writeln!(err, "{text}");
 }

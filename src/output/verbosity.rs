@@ -2,6 +2,7 @@
 //! printing site: `-q` keeps errors and warnings only, `-v` adds timings and solver
 //! statistics.
 
+use std::io::Write;
 use std::sync::atomic::{AtomicU8, Ordering};
 
 /// How much flexrom says on standard error (results on standard output are not affected).
@@ -39,13 +40,20 @@ pub fn show_progress() -> bool {
 /// A progress or info line on standard error, left out under `-q`.
 pub fn info(text: &str) {
     if verbosity() >= Verbosity::Normal {
-        super::note(text);
+        note(text);
     }
 }
 
 /// A detail line (timings, solver statistics) on standard error, shown only under `-v`.
 pub fn detail(text: &str) {
     if verbosity() >= Verbosity::Verbose {
-        super::note(text);
+        note(text);
     }
+}
+
+/// A line on standard error that every verbosity shows (errors, warnings); a closed or full
+/// stderr is ignored (messages are a courtesy, never a reason to fail or panic).
+pub fn note(text: &str) {
+    let mut err = std::io::stderr().lock();
+    let _ = writeln!(err, "{text}");
 }
