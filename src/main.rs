@@ -6,22 +6,57 @@ use flexrom::io::output::{check_output, check_report_dir, claim_in_report, Origi
 use flexrom::io::result_file::{write_result, write_result_with};
 use flexrom::linalg::kkt::LinearSolverKind;
 use flexrom::model::Model;
-use flexrom::output::{self, note};
+use flexrom::output::table::{Cell, Format, Table};
+use flexrom::output::{self, detail, info, note, Verbosity};
+use flexrom::pipeline::dense::DenseChoice;
 use flexrom::pipeline::online::load_basis;
 use flexrom::pipeline::Pipeline;
 use flexrom::simulate::{simulate, Overrides};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+/// The exit codes, as `flexrom --help` and every command's `--help` list them (a macro so
+/// that `concat!` can put it into the help texts).
+macro_rules! exit_codes {
+    () => {
+        "Exit codes:
+  0        success
+  1        an error: one line on stderr naming the file and field, or the stage, load scale and time
+  2        the command line could not be parsed (unknown option, missing or malformed argument)
+  3        sweep, merge, run: some load scales failed; the others are written (/status says which)
+  4        --strict: an error estimate is above the tolerance (the output is written first)
+  129/130/143  stopped by SIGHUP/SIGINT/SIGTERM (temporary files removed, earlier outputs kept)"
+    };
+}
+
 #[derive(Parser)]
 #[command(
     name = "flexrom",
     version,
-    about = "Planar flexible multibody dynamics (ANCF beams) with POD reduced-order models"
+    about = "Planar flexible multibody dynamics (ANCF beams) with POD reduced-order models",
+    after_help = concat!(
+        "Examples:
+  flexrom simulate data/models/pendulum.toml -o out/pendulum.h5
+  flexrom run pipelines/pendulum.toml                     train, sweep, validate, report
+  flexrom train pipelines/double_pendulum.toml
+  flexrom sweep pipelines/double_pendulum.toml --load-scales 0.5:1.5:21 --csv > sweep.csv
+
+Results go to stdout (--csv or --json where a command prints them), messages to stderr
+(-q: errors and warnings only; -v: timings and Newton statistics too).
+
+",
+        exit_codes!()
+    )
 )]
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// only errors and warnings on stderr (no progress bars, no info lines)
+    #[arg(short, long, global = true, conflicts_with = "verbose")]
+    quiet: bool,
+    /// more detail on stderr: settings, Newton statistics and timings of each run
+    #[arg(short, long, global = true)]
+    verbose: bool,
     /// memory bound for a stage's big arrays, e.g. 8G, 512M (default: env
     /// FLEXROM_MAX_MEMORY, else half of the machine's memory)
     #[arg(long, global = true, value_name = "SIZE")]
@@ -59,6 +94,41 @@ struct RunArgs {
     solver: LinearSolverKind,
 }
 
+/// `--csv` / `--json`: how a command prints its results on stdout.
+#[derive(clap::Args, Clone, Copy)]
+struct FormatArgs {
+    /// print the results as CSV on stdout (one header line)
+    #[arg(long, conflicts_with = "json")]
+    csv: bool,
+    /// print the results as JSON on stdout
+    #[arg(long)]
+    json: bool,
+}
+
+impl FormatArgs {
+    fn format(self) -> Format {
+        Format::from_flags(self.csv, self.json)
+    }
+}
+
+/// `--dense` / `--no-dense` of `validate` and `run` ([`flexrom::pipeline::dense`]).
+#[derive(clap::Args, Clone, Copy)]
+struct DenseArgs {
+    /// skip the full run with a dense LU (its time and speedup are then empty)
+    #[arg(long, conflicts_with = "dense")]
+    no_dense: bool,
+    /// run the dense-LU comparison even when its matrix is above 256 MiB (skipped by
+    /// default there, with a line saying so)
+    #[arg(long)]
+    dense: bool,
+}
+
+impl DenseArgs {
+    fn choice(self) -> DenseChoice {
+        DenseChoice::from_flags(self.dense, self.no_dense)
+    }
+}
+
 impl RunArgs {
     fn overrides(&self) -> Overrides {
         Overrides {
@@ -74,6 +144,17 @@ impl RunArgs {
 #[derive(Subcommand)]
 enum Command {
     /// Run the full-order model and write an HDF5 result file.
+    #[command(after_help = concat!(
+        "Examples:
+  flexrom simulate data/models/pendulum.toml -o out/pendulum.h5
+  flexrom simulate data/models/fourbar.toml -o fourbar.h5 --t-end 0.5 --solver sparse
+  flexrom simulate data/models/pendulum.toml -o p.h5 --load-scale 1.2 --csv > probes.csv
+
+--csv/--json print every probe's position at every step: columns t (s), NAME_x, NAME_y (m).
+
+",
+        exit_codes!()
+    ))]
     Simulate {
         /// model file (TOML)
         model: PathBuf,
@@ -82,11 +163,22 @@ enum Command {
         output: PathBuf,
         #[command(flatten)]
         run: RunArgs,
-        /// also print the probe positions as CSV on stdout
-        #[arg(long)]
-        csv: bool,
+        #[command(flatten)]
+        format: FormatArgs,
     },
     /// Run the full model at the pipeline's training load scales and write the POD basis (HDF5).
+    #[command(after_help = concat!(
+        "Examples:
+  flexrom train pipelines/double_pendulum.toml                  greedy over its load range
+  flexrom train pipelines/pendulum_500.toml --basis bases/p500.h5 --json
+  flexrom train pipelines/pendulum_500.toml --snapshots-only --shard 1/2 -o snaps/s1.h5
+  flexrom train pipelines/pendulum_500.toml --from-snapshots snaps/s1.h5 snaps/s2.h5
+
+--csv/--json print one record: the basis (or snapshot file), its runs, snapshots, modes and times.
+
+",
+        exit_codes!()
+    ))]
     Train {
         /// pipeline file (TOML)
         pipeline: PathBuf,
@@ -109,8 +201,20 @@ enum Command {
         /// build the basis from these snapshot files instead of running the full model
         #[arg(long, num_args = 1.., value_name = "SNAPS.h5")]
         from_snapshots: Vec<PathBuf>,
+        #[command(flatten)]
+        format: FormatArgs,
     },
     /// Run the reduced model at one load scale and write a result file.
+    #[command(after_help = concat!(
+        "Examples:
+  flexrom online pipelines/double_pendulum.toml --load-scale 1.2 -o out/dp_1.2.h5
+  flexrom online pipelines/pendulum.toml --load-scale 0.8 -o p.h5 --strict --json
+
+--csv/--json print one record: load scale, modes, steps, time, Newton iterations, error estimate.
+
+",
+        exit_codes!()
+    ))]
     Online {
         /// pipeline file (TOML)
         pipeline: PathBuf,
@@ -127,29 +231,57 @@ enum Command {
         /// tolerance ([online] tolerance, default the training tolerance)
         #[arg(long)]
         strict: bool,
+        #[command(flatten)]
+        format: FormatArgs,
     },
     /// Run full and reduced models at one load scale and report errors and timings.
+    #[command(after_help = concat!(
+        "Examples:
+  flexrom validate pipelines/pendulum.toml --load-scale 1.0
+  flexrom validate pipelines/fourbar.toml --load-scale 0.935 --json
+  flexrom validate pipelines/pendulum_5000.toml --load-scale 1.0 --no-dense
+
+The full run with a dense LU (the thesis's reference timing) is skipped, with one line on
+stderr, when its matrix would exceed 256 MiB or the memory bound; --dense forces it.
+--json prints one object (null where not measured), --csv one header line and one row
+(arrays as NAME_1, NAME_2, ...).
+
+",
+        exit_codes!()
+    ))]
     Validate {
         /// pipeline file (TOML)
         pipeline: PathBuf,
         /// multiplies every load marked `scaled` in the model file
         #[arg(long)]
         load_scale: f64,
-        /// print one JSON object on stdout
-        #[arg(long)]
-        json: bool,
+        #[command(flatten)]
+        format: FormatArgs,
         /// basis file (default: the pipeline's `basis`)
         #[arg(long)]
         basis: Option<PathBuf>,
-        /// skip the dense-LU full run (its time and speedup are then null)
-        #[arg(long)]
-        no_dense: bool,
+        #[command(flatten)]
+        dense: DenseArgs,
         /// exit with code 4 (after writing the output) when an error estimate exceeds the
         /// tolerance ([online] tolerance, default the training tolerance)
         #[arg(long)]
         strict: bool,
     },
     /// Reduced runs at many load scales, in parallel, into one HDF5 file and a table.
+    #[command(after_help = concat!(
+        "Examples:
+  flexrom sweep pipelines/double_pendulum.toml --load-scales 0.5:1.5:21
+  flexrom sweep pipelines/pendulum.toml -o out/sweep.h5 --validate --csv > sweep.csv
+  flexrom sweep pipelines/fourbar.toml --load-scales 0.8:1.0:40 --shard 2/4 -o parts/part_2.h5
+  flexrom sweep pipelines/fourbar.toml -o out/sweep.h5 --resume
+
+--csv/--json print one row per load scale: load_scale, status (0 done, 1 failed, 2 not run),
+message, rom_seconds, newton_iterations, step_cuts, error_estimate, estimate_seconds,
+extrapolated (and rel_error, max_probe_error (m), full_seconds, speedup with --validate).
+
+",
+        exit_codes!()
+    ))]
     Sweep {
         /// pipeline file (TOML)
         pipeline: PathBuf,
@@ -188,8 +320,20 @@ enum Command {
         /// K+2N, …) into the part file given by -o; join the parts with `flexrom merge`
         #[arg(long, value_name = "K/N")]
         shard: Option<flexrom::pipeline::shard::Shard>,
+        #[command(flatten)]
+        format: FormatArgs,
     },
     /// Join the part files of `sweep --shard` into the file one `sweep` writes.
+    #[command(after_help = concat!(
+        "Examples:
+  flexrom merge parts/part_*.h5 -o out/sweep.h5
+  flexrom merge parts/part_1.h5 parts/part_3.h5 -o out/sweep.h5 --partial   then sweep --resume
+
+--csv/--json print the merged sweep's table, one row per load scale (as `sweep`).
+
+",
+        exit_codes!()
+    ))]
     Merge {
         /// part files (`sweep --shard K/N -o PART.h5`), one per shard, in any order
         #[arg(required = true)]
@@ -201,8 +345,23 @@ enum Command {
         /// `status` 2 (not run yet), which `sweep --resume` on the merged file runs
         #[arg(long)]
         partial: bool,
+        #[command(flatten)]
+        format: FormatArgs,
     },
     /// Train, sweep, validate and write a report folder (Markdown and SVG plots).
+    #[command(after_help = concat!(
+        "Examples:
+  flexrom run pipelines/pendulum.toml                 report in reports/pendulum
+  flexrom run pipelines/pendulum_5000.toml -q         the dense comparison is skipped (n > 5792)
+  flexrom run pipelines/fourbar.toml --no-dense --json > validation.json
+
+The summary (summary.md) is printed on stdout; --csv/--json print the validation rows
+instead (as the report's validation.json). The dense-LU timing is skipped, with one line on
+stderr, when its matrix would exceed 256 MiB or the memory bound; --dense forces it.
+
+",
+        exit_codes!()
+    ))]
     Run {
         /// pipeline file (TOML)
         pipeline: PathBuf,
@@ -210,11 +369,27 @@ enum Command {
         /// tolerance ([online] tolerance, default the training tolerance)
         #[arg(long)]
         strict: bool,
+        #[command(flatten)]
+        dense: DenseArgs,
+        #[command(flatten)]
+        format: FormatArgs,
     },
     /// Run each model and print its probe positions at a few times.
+    #[command(after_help = concat!(
+        "Examples:
+  flexrom demo data/models/pendulum.toml data/models/fourbar.toml
+  flexrom demo data/models/double_pendulum.toml --csv
+
+--csv/--json print one row per model, time and probe: model, t (s), probe, x, y (m).
+
+",
+        exit_codes!()
+    ))]
     Demo {
         /// model files (TOML)
         models: Vec<PathBuf>,
+        #[command(flatten)]
+        format: FormatArgs,
     },
 }
 
@@ -234,6 +409,11 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    output::set_verbosity(match (cli.quiet, cli.verbose) {
+        (true, _) => Verbosity::Quiet,
+        (_, true) => Verbosity::Verbose,
+        _ => Verbosity::Normal,
+    });
     // from here on SIGINT/SIGTERM/SIGHUP remove flexrom's temporary files and exit with 130/143/129
     if let Err(e) = flexrom::io::atomic::install_signal_handler() {
         note(&format!("error: {e}"));
@@ -250,10 +430,17 @@ fn main() -> ExitCode {
         cli.max_elements.as_deref(),
         cli.allow_blowup,
     );
-    match limits.and_then(|l| {
+    let start = std::time::Instant::now();
+    let outcome = limits.and_then(|l| {
         flexrom::limits::set(l);
         run(cli)
-    }) {
+    });
+    detail(&format!(
+        "flexrom: {:.3} s wall time on {} thread(s)",
+        start.elapsed().as_secs_f64(),
+        rayon::current_num_threads()
+    ));
+    match outcome {
         Ok(()) => ExitCode::SUCCESS,
         // the reader of stdout went away (`| head`): nothing to say, and no one to say it to
         Err(flexrom::Error::StdoutClosed) => ExitCode::SUCCESS,
@@ -266,13 +453,13 @@ fn main() -> ExitCode {
 
 fn run(cli: Cli) -> flexrom::Result<()> {
     match cli.command {
-        Command::Simulate { model, output, run, csv } => {
+        Command::Simulate { model, output, run, format } => {
             check_output(&output, Origin::Flag("-o"), &[(&model, "model file")])?;
             let model = Model::load(&model)?;
             let r = simulate(&model, &run.overrides())
                 .map_err(|e| e.at_stage("simulate", run.load_scale.unwrap_or(1.0)))?;
             write_result(&output, &r)?;
-            note(&format!(
+            info(&format!(
                 "{}: {} steps in {:.3} s ({} Newton iterations, {} factorizations, {} step cuts) -> {}",
                 model.path.display(),
                 r.stats.steps,
@@ -282,24 +469,27 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                 r.stats.step_cuts,
                 output.display()
             ));
-            if csv {
-                print_csv(&r)?;
-            }
-            Ok(())
+            run_details(&r);
+            print_table(&flexrom::pipeline::tables::probe_table(&r), format.format(), false)
         }
-        Command::Train { pipeline, basis, snapshots_only, load_scale, shard, output, from_snapshots } => {
+        Command::Train { pipeline, basis, snapshots_only, load_scale, shard, output, from_snapshots, format } => {
             let p = Pipeline::load(&pipeline)?;
             if snapshots_only {
                 let out = output.expect("clap: --snapshots-only requires -o");
                 check_output(&out, Origin::Flag("-o"), &[(&p.path, "pipeline file"), (&p.model.path, "model file")])?;
                 let scales = flexrom::pipeline::snapshots::job_scales(&p, load_scale, shard)?;
                 let (n, secs) = flexrom::pipeline::snapshots::write_snapshots(&p, &scales, &out)?;
-                note(&format!(
-                    "{}: {n} full run(s) at {scales:?} ({secs:.3} s) -> {}",
-                    p.path.display(),
-                    out.display()
-                ));
-                return Ok(());
+                info(&format!("{}: {n} full run(s) at {scales:?} ({secs:.3} s) -> {}", p.path.display(), out.display()));
+                let mut t = Table::new(&["pipeline", "output", "n_runs", "load_scales", "seconds"]);
+                let list: Vec<String> = scales.iter().map(|x| x.to_string()).collect();
+                t.push(vec![
+                    p.path.display().to_string().into(),
+                    out.display().to_string().into(),
+                    n.into(),
+                    list.join(" ").into(),
+                    secs.into(),
+                ]);
+                return print_table(&t, format.format(), true);
             }
             let origin =
                 if basis.is_some() { Origin::Flag("--basis") } else { Origin::Key { pipeline: &p.path, key: "basis" } };
@@ -323,7 +513,7 @@ fn run(cli: Cli) -> flexrom::Result<()> {
             load_basis(&p, staged.path())?;
             staged.commit()?;
             let b = &s.trained.basis;
-            note(&format!(
+            info(&format!(
                 "{}: {} snapshots from {} full run(s) ({:.3} s); {} basis, {} snapshots, {} POD modes{} (captured energy 1 − {:.2e}) -> {}",
                 p.path.display(),
                 s.n_snapshots,
@@ -336,9 +526,33 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                 s.trained.uncaptured_energy(),
                 out.display()
             ));
-            Ok(())
+            let mut t = Table::new(&[
+                "pipeline",
+                "basis",
+                "n_runs",
+                "n_snapshots",
+                "full_seconds",
+                "variant",
+                "snapshots",
+                "n_pod_modes",
+                "n_joint_coordinates",
+                "uncaptured_energy",
+            ]);
+            t.push(vec![
+                p.path.display().to_string().into(),
+                out.display().to_string().into(),
+                s.n_runs.into(),
+                s.n_snapshots.into(),
+                s.full_seconds.into(),
+                b.variant.name().into(),
+                b.snapshots.name().into(),
+                b.n_pod_modes.into(),
+                b.kept.len().into(),
+                s.trained.uncaptured_energy().into(),
+            ]);
+            print_table(&t, format.format(), true)
         }
-        Command::Online { pipeline, load_scale, output, basis, strict } => {
+        Command::Online { pipeline, load_scale, output, basis, strict, format } => {
             let p = Pipeline::load(&pipeline)?;
             check_scale(load_scale)?;
             let path = basis.unwrap_or_else(|| p.basis_path.clone());
@@ -365,7 +579,7 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                 flexrom::pipeline::estimate::write_run_attributes(f, estimate.as_ref(), &trust, extrapolated).map_err(e)
             })?;
             let st = &run.result.stats;
-            note(&format!(
+            info(&format!(
                 "{}: reduced run ({} modes) at load scale {load_scale}: {} steps in {:.4} s ({} Newton iterations, {} step cuts) -> {}",
                 p.path.display(),
                 stored.basis.n_reduced(),
@@ -376,29 +590,47 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                 output.display()
             ));
             if let Some(e) = &estimate {
-                note(&format!("  {}", flexrom::pipeline::estimate::describe(e, run.result.wall_seconds)));
+                info(&format!("  {}", flexrom::pipeline::estimate::describe(e, run.result.wall_seconds)));
             }
+            run_details(&run.result);
+            let mut cols = vec!["load_scale", "n_modes"];
+            cols.extend(flexrom::pipeline::tables::RUN_COLUMNS);
+            cols.extend(["error_estimate", "extrapolated", "output"]);
+            let mut t = Table::new(&cols);
+            let mut row: Vec<Cell> = vec![load_scale.into(), stored.basis.n_reduced().into()];
+            row.extend(flexrom::pipeline::tables::run_cells(&run.result));
+            row.extend([
+                estimate.as_ref().map(|e| e.error_estimate).into(),
+                extrapolated.into(),
+                output.display().to_string().into(),
+            ]);
+            t.push(row);
+            print_table(&t, format.format(), true)?;
             flexrom::pipeline::estimate::check_runs(&trust, &[(load_scale, estimate.map(|e| e.error_estimate))], strict)
         }
-        Command::Validate { pipeline, load_scale, json, basis, no_dense, strict } => {
+        Command::Validate { pipeline, load_scale, format, basis, dense, strict } => {
             let p = Pipeline::load(&pipeline)?;
             check_scale(load_scale)?;
             let path = basis.unwrap_or_else(|| p.basis_path.clone());
             let stored = load_basis(&p, &path)?;
             let trust = flexrom::pipeline::estimate::load_trust(&p, &path, &stored)?;
+            let with_dense = flexrom::pipeline::dense::decide(dense.choice(), &p.model)?;
             let (v, _, _) = flexrom::pipeline::validate::validate_with(
                 &p.model,
                 &stored.basis,
                 Some(&trust),
                 load_scale,
-                !no_dense,
+                with_dense,
             )?;
-            if json {
-                let text = serde_json::to_string(&v)
-                    .map_err(|e| flexrom::Error::Usage(format!("cannot write the JSON: {e}")))?;
-                output::println(&text)?;
-            } else {
-                output::println(&v.describe())?;
+            match format.format() {
+                // the record as serde writes it (arrays stay arrays): the keys scripts read
+                Format::Json => {
+                    let text = serde_json::to_string(&v)
+                        .map_err(|e| flexrom::Error::Usage(format!("cannot write the JSON: {e}")))?;
+                    output::println(&text)?;
+                }
+                Format::Csv => output::print(&Table::from_record(&v)?.to_csv()?)?,
+                Format::Text => output::println(&v.describe())?,
             }
             flexrom::pipeline::estimate::check_runs(&trust, &[(load_scale, v.error_estimate)], strict)
         }
@@ -413,6 +645,7 @@ fn run(cli: Cli) -> flexrom::Result<()> {
             resume,
             strict,
             shard,
+            format,
         } => {
             let p = Pipeline::load(&pipeline)?;
             if shard.is_some() && output.is_none() {
@@ -441,7 +674,8 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                 check_output(&out, Origin::Flag("-o"), &inputs)?;
             }
             let stored = load_basis(&p, &path)?;
-            let options = flexrom::pipeline::sweep::SweepOptions { validate, continuation, progress: true };
+            let options =
+                flexrom::pipeline::sweep::SweepOptions { validate, continuation, progress: output::show_progress() };
             let mut trust = flexrom::pipeline::estimate::load_trust(&p, &path, &stored)?;
             if no_estimate {
                 if strict {
@@ -476,8 +710,11 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                     resume,
                 )?,
             };
-            output::print(&flexrom::pipeline::sweep::table(&sw))?;
-            note(&format!(
+            match format.format() {
+                Format::Text => output::print(&flexrom::pipeline::sweep::table(&sw))?,
+                f => print_table(&flexrom::pipeline::tables::sweep_table(&sw), f, false)?,
+            }
+            info(&format!(
                 "{}{} load scales ({} resumed) on {} threads in {:.3} s -> {}",
                 shard.map(|k| format!("shard {k}: ")).unwrap_or_default(),
                 sw.scales.len(),
@@ -501,11 +738,12 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                 .collect();
             flexrom::pipeline::estimate::check_runs(&trust, &runs, strict)
         }
-        Command::Merge { parts, output, partial } => {
+        Command::Merge { parts, output, partial, format } => {
             let inputs: Vec<(&std::path::Path, &str)> = parts.iter().map(|p| (p.as_path(), "part file")).collect();
             check_output(&output, Origin::Flag("-o"), &inputs)?;
             let m = flexrom::pipeline::merge::merge(&parts, &output, partial)?;
-            note(&format!(
+            print_table(&flexrom::pipeline::tables::sweep_table(&m.sweep), format.format(), false)?;
+            info(&format!(
                 "{} parts, {} load scales ({} not run) -> {}",
                 m.parts,
                 m.sweep.scales.len(),
@@ -520,19 +758,36 @@ fn run(cli: Cli) -> flexrom::Result<()> {
             }
             Ok(())
         }
-        Command::Run { pipeline, strict } => {
+        Command::Run { pipeline, strict, dense, format } => {
             let p = Pipeline::load(&pipeline)?;
-            let dir = flexrom::pipeline::report::run(&p, true)?;
-            output::println(
-                &std::fs::read_to_string(dir.join("summary.md")).map_err(|e| flexrom::Error::io(&dir, e))?,
-            )?;
-            note(&format!("report: {}", dir.display()));
+            let dir = flexrom::pipeline::report::run_with(&p, output::show_progress(), dense.choice())?;
+            let read = |name: &str| {
+                let f = dir.join(name);
+                std::fs::read_to_string(&f).map_err(|e| flexrom::Error::io(&f, e))
+            };
+            match format.format() {
+                Format::Text => output::println(&read("summary.md")?)?,
+                f => print_table(&Table::from_json_records(&read("validation.json")?)?, f, false)?,
+            }
+            info(&format!("report: {}", dir.display()));
             flexrom::pipeline::report::check_report(&p, &dir, strict)
         }
-        Command::Demo { models } => {
+        Command::Demo { models, format } => {
+            let mut table = Table::new(&["model", "t", "probe", "x", "y"]);
             for path in models {
                 let model = Model::load(&path)?;
                 let r = simulate(&model, &Overrides::default()).map_err(|e| e.at_stage("demo", 1.0))?;
+                run_details(&r);
+                let nt = r.t.len();
+                if format.format() != Format::Text {
+                    for k in [0, nt / 4, nt / 2, 3 * nt / 4, nt - 1] {
+                        for (n, xy) in &r.probes {
+                            let name = path.display().to_string();
+                            table.push(vec![name.into(), r.t[k].into(), n.as_str().into(), xy[[k, 0]].into(), xy[[k, 1]].into()]);
+                        }
+                    }
+                    continue;
+                }
                 output::println(&format!(
                     "{} ({} coordinates, {} steps of {} s, {:.1} ms, {} Newton iterations)",
                     path.display(),
@@ -542,7 +797,6 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                     1e3 * r.wall_seconds,
                     r.stats.newton_iterations
                 ))?;
-                let nt = r.t.len();
                 for k in [0, nt / 4, nt / 2, 3 * nt / 4, nt - 1] {
                     let cells: Vec<String> = r
                         .probes
@@ -552,7 +806,7 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                     output::println(&format!("  t = {:.4} s: {}", r.t[k], cells.join("  ")))?;
                 }
             }
-            Ok(())
+            print_table(&table, format.format(), false)
         }
     }
 }
@@ -565,24 +819,37 @@ fn check_scale(x: f64) -> flexrom::Result<()> {
     }
 }
 
-/// The probe positions as CSV on stdout, buffered; a closed pipe or a full disk is an
-/// error value (see `flexrom::output`), never a panic.
-fn print_csv(r: &flexrom::simulate::SimulationResult) -> flexrom::Result<()> {
-    use std::io::Write;
-    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
-    let mut header = vec!["t".to_string()];
-    for (n, _) in &r.probes {
-        header.push(format!("{n}_x"));
-        header.push(format!("{n}_y"));
+/// Prints `t` on stdout as CSV or JSON; nothing in text mode (the command's own lines, on
+/// stderr or stdout, are its text form). `single`: the command's result is one record,
+/// printed in JSON as one object rather than an array of one.
+fn print_table(t: &Table, format: Format, single: bool) -> flexrom::Result<()> {
+    match format {
+        Format::Text => Ok(()),
+        Format::Csv => output::print(&t.to_csv()?),
+        Format::Json if single => output::println(&t.to_json_object()),
+        Format::Json => output::println(&t.to_json()),
     }
-    writeln!(out, "{}", header.join(",")).map_err(output::stdout_error)?;
-    for k in 0..r.t.len() {
-        let mut row = vec![format!("{}", r.t[k])];
-        for (_, xy) in &r.probes {
-            row.push(format!("{}", xy[[k, 0]]));
-            row.push(format!("{}", xy[[k, 1]]));
-        }
-        writeln!(out, "{}", row.join(",")).map_err(output::stdout_error)?;
-    }
-    out.flush().map_err(output::stdout_error)
+}
+
+/// `-v`: the settings and Newton statistics of one run.
+fn run_details(r: &flexrom::simulate::SimulationResult) {
+    let (s, st) = (&r.settings, &r.stats);
+    detail(&format!(
+        "  settings: dt {} s, t_end {} s, rho_inf {}, load scale {}, solver {:?}, {} coordinates",
+        s.dt,
+        s.t_end,
+        s.rho_inf,
+        s.load_scale,
+        s.solver,
+        r.q.nrows()
+    ));
+    detail(&format!(
+        "  Newton: {:.2} iterations per step (at most {} in one step), {} factorizations, {} step cuts, {} steps at the round-off floor; {:.3} ms per step",
+        st.newton_iterations as f64 / st.steps.max(1) as f64,
+        st.max_iterations_in_a_step,
+        st.factorizations,
+        st.step_cuts,
+        st.steps_at_round_off,
+        1e3 * r.wall_seconds / st.steps.max(1) as f64
+    ));
 }

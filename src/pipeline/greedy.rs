@@ -217,14 +217,14 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
             .map_err(|e| e.at_stage("train (greedy full run)", x))
     };
     let first = initial_loads(range, g.max_runs);
-    eprintln!(
+    crate::output::info(&format!(
         "greedy training over [{}, {}], tolerance {:e}, {} candidates: full runs at {:?}",
         range.0,
         range.1,
         g.tolerance,
         candidates.len(),
         first
-    );
+    ));
     let mut runs: Vec<SimulationResult> = first.par_iter().map(|&x| full(x)).collect::<Result<_>>()?;
     // the later full runs, one at a time, on one full model
     let mut full_model = crate::simulate::FullModel::new(&p.model, crate::linalg::kkt::LinearSolverKind::Banded)?;
@@ -277,10 +277,10 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
             } else {
                 "every candidate has a full run".into()
             };
-            eprintln!(
+            crate::output::info(&format!(
                 "iteration {n}: {why}, worst estimate {worst:.2e} {cmp} {:e} at λ = {}, {shape}",
                 g.tolerance, it.worst_load
-            );
+            ));
             converged = worst <= g.tolerance;
             iterations.push(it);
             break level;
@@ -302,9 +302,9 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         let done = worst <= g.tolerance && e_score <= g.tolerance;
         let sens = level.sensitivity[ni][4];
         if done {
-            eprintln!("iteration {n}: worst score {worst:.2e} ≤ {:e}; held-out check at λ = {at} (score {next_estimate:.2e}): rel_error {e:.2e} (score {e_score:.2e}, sensitivity {sens:.1e}); {shape}", g.tolerance);
+            crate::output::info(&format!("iteration {n}: worst score {worst:.2e} ≤ {:e}; held-out check at λ = {at} (score {next_estimate:.2e}): rel_error {e:.2e} (score {e_score:.2e}, sensitivity {sens:.1e}); {shape}", g.tolerance));
         } else {
-            eprintln!("iteration {n}: full run at λ = {at} (worst score {worst:.2e} {cmp} {:e}; {next_estimate:.2e} there, true error {e:.2e}, its score {e_score:.2e}, sensitivity {sens:.1e}), {shape}", g.tolerance);
+            crate::output::info(&format!("iteration {n}: full run at λ = {at} (worst score {worst:.2e} {cmp} {:e}; {next_estimate:.2e} there, true error {e:.2e}, its score {e_score:.2e}, sensitivity {sens:.1e}), {shape}", g.tolerance));
         }
         iterations.push(it);
         if done {
@@ -386,7 +386,7 @@ fn search(
                 if debug {
                     let (wi, w) = l.worst();
                     let h = l.trained.basis.hyper.as_ref().map_or(0, |h| h.elements.len());
-                    eprintln!("  rung ε = {eps:.1e}, τ = {tau:.1e}: {}, {h} elements, estimator {:?}, worst estimate {w:.3e} at λ = {}", modes_text(&l.trained.block_modes), l.estimator.block_modes, candidates[wi]);
+                    crate::output::info(&format!("  rung ε = {eps:.1e}, τ = {tau:.1e}: {}, {h} elements, estimator {:?}, worst estimate {w:.3e} at λ = {}", modes_text(&l.trained.block_modes), l.estimator.block_modes, candidates[wi]));
                 }
                 Some(l)
             }
@@ -511,7 +511,8 @@ fn p_tolerance(p: &Pipeline) -> f64 {
 /// per worker, as `sweep` does); a run that fails gives ∞ estimates (and sensitivity 0,
 /// which holds its estimate to T).
 fn estimate_candidates(model: &Model, basis: &Basis, est: &Estimator, loads: &[f64], label: &str) -> Vec<CandidateRun> {
-    let bar = ProgressBar::with_draw_target(Some(loads.len() as u64), ProgressDrawTarget::stderr());
+    let target = if crate::output::show_progress() { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() };
+    let bar = ProgressBar::with_draw_target(Some(loads.len() as u64), target);
     bar.set_style(
         ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} candidates, {elapsed}")
             .expect("valid template")

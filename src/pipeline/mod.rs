@@ -4,6 +4,7 @@
 //! it, with a report).
 
 pub mod config;
+pub mod dense;
 pub mod estimate;
 pub mod estimate_corrected;
 pub mod greedy;
@@ -14,6 +15,7 @@ pub mod report;
 pub mod shard;
 pub mod snapshots;
 pub mod sweep;
+pub mod tables;
 pub mod train;
 pub mod validate;
 

@@ -35,11 +35,18 @@ pub fn check_outputs(p: &Pipeline) -> Result<()> {
 /// (the previous one, flexrom's own, removed after); on any failure both are left as they
 /// were and the temporary ones removed.
 pub fn run(p: &Pipeline, progress: bool) -> Result<PathBuf> {
+    run_with(p, progress, super::dense::DenseChoice::Auto)
+}
+
+/// [`run`] with the choice of the dense-LU comparison ([`super::dense`]), decided before
+/// any work.
+pub fn run_with(p: &Pipeline, progress: bool, dense: super::dense::DenseChoice) -> Result<PathBuf> {
     check_outputs(p)?;
+    let dense = super::dense::decide(dense, &p.model)?;
     let dir = p.report_dir.clone();
     let report = TempPath::dir_for(&dir)?;
     let basis = TempPath::file_for(&p.basis_path)?;
-    build(p, report.path(), basis.path(), progress)?;
+    build(p, report.path(), basis.path(), progress, dense)?;
     mark_new_report(report.path())?;
     // checked again: the folder or the basis path may have changed during a long run
     check_outputs(p)?;
@@ -50,11 +57,11 @@ pub fn run(p: &Pipeline, progress: bool) -> Result<PathBuf> {
 
 /// Every stage, writing the basis to `basis_path` (a temporary name) and the report files
 /// into `out` (a temporary folder); the files are `fsync`ed when the folder is swapped in.
-fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool) -> Result<()> {
+fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: bool) -> Result<()> {
     let plot_err = |e: String| Error::io(out, std::io::Error::other(e));
     match &p.file.train.greedy {
-        Some(g) => crate::output::note(&format!("[1/3] train: greedy over [{}, {}]", g.range().0, g.range().1)),
-        None => crate::output::note(&format!("[1/3] train: {} full run(s)", p.training_scales().len())),
+        Some(g) => crate::output::info(&format!("[1/3] train: greedy over [{}, {}]", g.range().0, g.range().1)),
+        None => crate::output::info(&format!("[1/3] train: {} full run(s)", p.training_scales().len())),
     }
     let trained = train_and_write(p, basis_path)?;
     let stored = load_basis(p, basis_path)?;
@@ -62,7 +69,7 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool) -> Result<
     let trust = load_trust(p, basis_path, &stored)?;
 
     let scales = p.online_scales();
-    crate::output::note(&format!("[2/3] sweep: {} reduced and full runs", scales.len()));
+    crate::output::info(&format!("[2/3] sweep: {} reduced and full runs", scales.len()));
     let sw = sweep_with(
         &p.model,
         basis,
@@ -77,10 +84,11 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool) -> Result<
     }
 
     let vscales = p.validate_scales();
-    crate::output::note(&format!("[3/3] validate at {} load scale(s), with the dense full solve", vscales.len()));
+    let with = if dense { ", with the dense full solve" } else { "" };
+    crate::output::info(&format!("[3/3] validate at {} load scale(s){with}", vscales.len()));
     let mut validations: Vec<Validation> = Vec::new();
     for (i, &x) in vscales.iter().enumerate() {
-        let (v, full, rom) = validate_with(&p.model, basis, Some(&trust), x, true)?;
+        let (v, full, rom) = validate_with(&p.model, basis, Some(&trust), x, dense)?;
         // x and y of every probe, full (line) and reduced (dashed), and their difference
         let t = &full.t;
         let mut panels: Vec<Panel> = ["x (m)", "y (m)"]

@@ -257,7 +257,7 @@ pub fn sweep_to_file_with(
             }
             start.resumed = reused;
             let dropped = old.iter().filter(|(x, p)| p.is_some() && !scales.contains(x)).count();
-            eprintln!(
+            crate::output::info(&format!(
                 "resuming {}: {reused} of {} load scales already finished, running {}{}",
                 out.display(),
                 scales.len(),
@@ -267,9 +267,9 @@ pub fn sweep_to_file_with(
                 } else {
                     String::new()
                 }
-            );
+            ));
         } else {
-            eprintln!("resuming {}: no such file yet, running all {} load scales", out.display(), scales.len());
+            crate::output::info(&format!("resuming {}: no such file yet, running all {} load scales", out.display(), scales.len()));
         }
     }
     let write = |s: &Sweep| write_sweep_with(out, s, stored, basis_path, extra);
@@ -320,6 +320,11 @@ fn run_pending(
             .progress_chars("=> "),
     );
     bar.set_prefix(if o.validate { "sweep + validate" } else { "sweep" });
+    let ticker = crate::output::ticker::Ticker::new(
+        if o.validate { "sweep + validate" } else { "sweep" },
+        scales.len() as u64,
+        o.progress,
+    );
     // every point's trajectories are kept until the file is written
     let n_steps = crate::simulate::Settings::resolve(model, &Overrides::default())?.n_steps;
     let output = if o.validate { Output::Full } else { Output::ReducedAndProbes };
@@ -389,6 +394,7 @@ fn run_pending(
                             Ok(SweepPoint { rom, validation, estimate, extrapolated })
                         })();
                         bar.inc(1);
+                        ticker.tick();
                         match run {
                             Ok(p) => {
                                 if o.continuation {

@@ -1,0 +1,92 @@
+//! The results of the commands as [`Table`]s, for `--csv` and `--json` (one row per load
+//! scale, per time step or per run; units in the column names' documentation below and in
+//! docs/cli.md).
+
+use super::sweep::Sweep;
+use crate::output::table::{Cell, Table};
+use crate::simulate::SimulationResult;
+
+/// `sweep`, `merge`: one row per load scale, in the order asked for. `status` is 0 (done),
+/// 1 (failed, `message` says why) or 2 (not run yet), as `/status` of the sweep file;
+/// times in seconds, errors relative (`rel_error`, `error_estimate`) or in metres
+/// (`max_probe_error`). The validation columns are there only for `--validate` sweeps.
+pub fn sweep_table(s: &Sweep) -> Table {
+    let mut cols = vec![
+        "load_scale",
+        "status",
+        "message",
+        "rom_seconds",
+        "newton_iterations",
+        "step_cuts",
+        "error_estimate",
+        "estimate_seconds",
+        "extrapolated",
+    ];
+    if s.validated {
+        cols.extend(["rel_error", "max_probe_error", "full_seconds", "speedup"]);
+    }
+    let mut t = Table::new(&cols);
+    for x in &s.scales {
+        let mut row: Vec<Cell> = vec![x.load_scale.into(), (x.status() as u64).into(), x.message().into()];
+        match x.point() {
+            Some(p) => {
+                let r = &p.rom.result;
+                row.extend([
+                    r.wall_seconds.into(),
+                    r.stats.newton_iterations.into(),
+                    r.stats.step_cuts.into(),
+                    p.estimate.as_ref().map(|e| e.error_estimate).into(),
+                    p.estimate.as_ref().map(|e| e.seconds).into(),
+                    p.extrapolated.into(),
+                ]);
+                if s.validated {
+                    let v = p.validation.as_ref();
+                    row.extend([
+                        v.map(|v| v.rel_error).into(),
+                        v.map(|v| v.max_probe_error).into(),
+                        v.map(|v| v.full_seconds).into(),
+                        v.map(|v| v.speedup).into(),
+                    ]);
+                }
+            }
+            None => row.resize(cols.len(), Cell::Null),
+        }
+        t.push(row);
+    }
+    t
+}
+
+/// `simulate --csv/--json`: one row per instant, `t` (s) and every probe's `NAME_x`,
+/// `NAME_y` (m).
+pub fn probe_table(r: &SimulationResult) -> Table {
+    let mut cols = vec!["t".to_string()];
+    for (n, _) in &r.probes {
+        cols.push(format!("{n}_x"));
+        cols.push(format!("{n}_y"));
+    }
+    let mut t = Table { columns: cols, rows: Vec::new() };
+    for k in 0..r.t.len() {
+        let mut row = vec![Cell::from(r.t[k])];
+        for (_, xy) in &r.probes {
+            row.push(xy[[k, 0]].into());
+            row.push(xy[[k, 1]].into());
+        }
+        t.push(row);
+    }
+    t
+}
+
+/// One run's statistics as cells: `steps`, `seconds` (time loop), `newton_iterations`,
+/// `factorizations`, `step_cuts`, with the names [`RUN_COLUMNS`].
+pub fn run_cells(r: &SimulationResult) -> Vec<Cell> {
+    vec![
+        r.stats.steps.into(),
+        r.wall_seconds.into(),
+        r.stats.newton_iterations.into(),
+        r.stats.factorizations.into(),
+        r.stats.step_cuts.into(),
+    ]
+}
+
+/// The column names of [`run_cells`].
+pub const RUN_COLUMNS: [&str; 5] = ["steps", "seconds", "newton_iterations", "factorizations", "step_cuts"];

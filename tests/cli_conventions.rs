@@ -1,0 +1,212 @@
+//! The command-line conventions of issue 18 item 5, as a user meets them:
+//!
+//! * `--csv` and `--json` on every command that prints results (`simulate`, `train`,
+//!   `online`, `validate`, `sweep`, `merge`, `demo`) give stdout that the `csv` crate and
+//!   `serde_json` read back, with the documented columns; the expected values are not
+//!   numbers from a reference but the same run's own figures: the rows count the steps
+//!   (the pendulum's dt = 0.005 s, so `--t-end 0.02` is 4 steps + t = 0), the load scales
+//!   asked for (0.9:1.1:3 → 0.9, 1.0, 1.1), and the JSON and CSV of one command agree.
+//! * `-q` leaves stderr empty on success, `-v` adds the Newton statistics line.
+//! * `validate --no-dense` leaves `full_dense_seconds` null without a word; the automatic
+//!   skip (here forced by a memory bound, 800 KiB, between the banded run's ≈ 0.46 MiB and the
+//!   dense run's ≈ 1.1 MiB: `Model::check_full_run_memory`) prints exactly one line saying
+//!   so and how to force it; below both bounds the dense run is timed.
+//! * every command's `--help` has examples and the exit-code table.
+//! * every command creates the folders of its outputs.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn flexrom(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_flexrom")).args(args).env("HDF5_USE_FILE_LOCKING", "FALSE").output().unwrap()
+}
+
+fn ok(args: &[&str]) -> Output {
+    let o = flexrom(args);
+    assert!(o.status.success(), "flexrom {args:?}: {}", String::from_utf8_lossy(&o.stderr));
+    o
+}
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A pipeline in `dir` on the shipped pendulum, trained at the one load 1.0 with raw
+/// snapshots (one full run, seconds), its basis and report inside `dir`.
+fn pipeline(dir: &Path) -> String {
+    let p = dir.join("p.toml");
+    std::fs::write(
+        &p,
+        format!(
+            "model = \"{}\"\nbasis = \"{}\"\nreport = \"{}\"\n\n[train]\nload_scales = [1.0]\nsnapshots = \"raw\"\n\n[reduction]\nvariant = \"galerkin\"\nmodes = {{ ratio = 0.1 }}\n",
+            root().join("data/models/pendulum.toml").display(),
+            dir.join("bases/deep/b.h5").display(),
+            dir.join("reports/r").display()
+        ),
+    )
+    .unwrap();
+    p.to_str().unwrap().to_string()
+}
+
+fn csv_rows(o: &Output) -> (Vec<String>, Vec<csv::StringRecord>) {
+    let mut r = csv::Reader::from_reader(o.stdout.as_slice());
+    let head = r.headers().unwrap().iter().map(String::from).collect();
+    (head, r.records().map(|x| x.unwrap()).collect())
+}
+
+fn json(o: &Output) -> serde_json::Value {
+    serde_json::from_slice(&o.stdout).unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&o.stdout)))
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+#[test]
+fn every_result_prints_as_csv_and_json() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let p = pipeline(dir);
+    let model = root().join("data/models/pendulum.toml");
+
+    // simulate: one row per instant
+    let out = dir.join("sim/deep/p.h5");
+    let o = ok(&["simulate", s(&model), "-o", s(&out), "--t-end", "0.02", "--csv"]);
+    let (head, rows) = csv_rows(&o);
+    assert_eq!(head, ["t", "tip_x", "tip_y"]);
+    assert_eq!(rows.len(), 5, "t = 0 and 4 steps of 0.005 s");
+    let o = ok(&["simulate", s(&model), "-o", s(&out), "--t-end", "0.02", "--json"]);
+    let j = json(&o);
+    assert_eq!(j.as_array().unwrap().len(), 5);
+    assert_eq!(j[4]["t"].as_f64().unwrap(), rows[4][0].parse::<f64>().unwrap());
+    assert_eq!(j[4]["tip_y"].as_f64().unwrap(), rows[4][2].parse::<f64>().unwrap(), "JSON and CSV agree");
+    assert!(out.exists(), "simulate created sim/deep/");
+
+    // train: one record; the basis's folder bases/deep/ does not exist yet
+    let j = json(&ok(&["train", &p, "--json"]));
+    assert_eq!(j["n_runs"], 1);
+    assert!(j["n_pod_modes"].as_u64().unwrap() > 0);
+    assert!(dir.join("bases/deep/b.h5").exists());
+    let (head, rows) = csv_rows(&ok(&["train", &p, "--csv"]));
+    assert_eq!(rows.len(), 1);
+    assert_eq!(rows[0][head.iter().position(|h| h == "n_pod_modes").unwrap()], j["n_pod_modes"].to_string());
+
+    // online: one record
+    let on = dir.join("online/deep/o.h5");
+    let j = json(&ok(&["online", &p, "--load-scale", "1.0", "-o", s(&on), "--json"]));
+    assert_eq!(j["load_scale"].as_f64(), Some(1.0));
+    assert_eq!(j["steps"].as_u64(), Some(220), "t_end 1.1 s / dt 0.005 s");
+    assert!(j["error_estimate"].as_f64().unwrap() > 0.0);
+    let (head, rows) = csv_rows(&ok(&["online", &p, "--load-scale", "1.0", "-o", s(&on), "--csv"]));
+    assert_eq!(head[..3], ["load_scale", "n_modes", "steps"]);
+    assert_eq!(&rows[0][2], "220");
+
+    // validate: JSON object (arrays kept), CSV with one row and the arrays spread out
+    let j = json(&ok(&["validate", &p, "--load-scale", "1.0", "--json", "--no-dense"]));
+    assert_eq!(j["rel_error_by_time"].as_array().unwrap().len(), 5);
+    let (head, rows) = csv_rows(&ok(&["validate", &p, "--load-scale", "1.0", "--csv", "--no-dense"]));
+    assert_eq!(rows.len(), 1);
+    let col = |n: &str| head.iter().position(|h| h == n).unwrap_or_else(|| panic!("no column {n}: {head:?}"));
+    assert_eq!(rows[0][col("n_modes")], j["n_modes"].to_string());
+    assert_eq!(&rows[0][col("full_dense_seconds")], "", "not measured: empty cell");
+    let rel: f64 = rows[0][col("rel_error")].parse().unwrap();
+    assert!((rel - j["rel_error"].as_f64().unwrap()).abs() <= 1e-12, "the same deterministic run");
+    let _ = col("rel_error_by_time_5");
+
+    // sweep and merge: one row per load scale
+    let sw = dir.join("sweep/deep/s.h5");
+    let j = json(&ok(&["sweep", &p, "--load-scales", "0.9:1.1:3", "-o", s(&sw), "--json", "--no-estimate"]));
+    let scales: Vec<f64> = j.as_array().unwrap().iter().map(|r| r["load_scale"].as_f64().unwrap()).collect();
+    assert_eq!(scales, [0.9, 1.0, 1.1]);
+    assert!(j.as_array().unwrap().iter().all(|r| r["status"] == 0 && r["error_estimate"].is_null()));
+    let part = dir.join("parts/deep/p1.h5");
+    let (head, rows) = csv_rows(&ok(&[
+        "sweep", &p, "--load-scales", "0.9:1.1:3", "--shard", "1/1", "-o", s(&part), "--csv", "--no-estimate",
+    ]));
+    assert_eq!(head[0], "load_scale");
+    assert_eq!(rows.len(), 3);
+    let merged = dir.join("merged/deep/m.h5");
+    let (_, rows) = csv_rows(&ok(&["merge", s(&part), "-o", s(&merged), "--csv"]));
+    assert_eq!(rows.iter().map(|r| r[0].parse::<f64>().unwrap()).collect::<Vec<_>>(), [0.9, 1.0, 1.1]);
+    assert!(merged.exists());
+
+    // demo: model, t, probe, x, y at five times
+    let (head, rows) = csv_rows(&ok(&["demo", s(&model), "--csv"]));
+    assert_eq!(head, ["model", "t", "probe", "x", "y"]);
+    assert_eq!(rows.len(), 5);
+    assert_eq!(json(&ok(&["demo", s(&model), "--json"])).as_array().unwrap().len(), 5);
+
+    // --csv and --json together are a usage error (exit 2)
+    assert_eq!(flexrom(&["demo", s(&model), "--csv", "--json"]).status.code(), Some(2));
+}
+
+#[test]
+fn train_snapshots_only_creates_its_folder() {
+    let d = tempfile::tempdir().unwrap();
+    let p = pipeline(d.path());
+    let out = d.path().join("snaps/a/b/s.h5");
+    ok(&["train", &p, "--snapshots-only", "--load-scale", "1.0", "-o", s(&out)]);
+    assert!(out.exists());
+}
+
+#[test]
+fn quiet_and_verbose() {
+    let d = tempfile::tempdir().unwrap();
+    let model = root().join("data/models/pendulum.toml");
+    let out = d.path().join("p.h5");
+    let args = ["simulate", s(&model), "-o", s(&out), "--t-end", "0.02"];
+    let normal = String::from_utf8(ok(&args).stderr).unwrap();
+    assert!(normal.contains("4 steps"), "{normal}");
+    assert!(!normal.contains("Newton:"), "{normal}");
+    let quiet = ok(&[&["-q"], &args[..]].concat());
+    assert!(quiet.stderr.is_empty(), "-q: {}", String::from_utf8_lossy(&quiet.stderr));
+    let verbose = String::from_utf8(ok(&[&args[..], &["-v"]].concat()).stderr).unwrap();
+    assert!(verbose.contains("4 steps") && verbose.contains("Newton: 3.00 iterations per step"), "{verbose}");
+    assert!(verbose.contains("wall time"), "{verbose}");
+    // errors still reach stderr under -q
+    let bad = flexrom(&["-q", "simulate", s(&d.path().join("missing.toml")), "-o", s(&out)]);
+    assert_eq!(bad.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("missing.toml"));
+    assert_eq!(flexrom(&["-q", "-v", "demo"]).status.code(), Some(2), "-q and -v exclude each other");
+}
+
+#[test]
+fn dense_comparison_flags_and_auto_skip() {
+    let d = tempfile::tempdir().unwrap();
+    let p = pipeline(d.path());
+    ok(&["-q", "train", &p]);
+    let skip_lines = |o: &Output| String::from_utf8_lossy(&o.stderr).lines().filter(|l| l.contains("skipping the dense-LU")).count();
+
+    let o = ok(&["validate", &p, "--load-scale", "1.0", "--json", "--no-dense"]);
+    assert!(json(&o)["full_dense_seconds"].is_null());
+    assert_eq!(skip_lines(&o), 0, "--no-dense skips silently");
+
+    let o = ok(&["validate", &p, "--load-scale", "1.0", "--json", "--max-memory", "800K"]);
+    assert!(json(&o)["full_dense_seconds"].is_null());
+    assert!(json(&o)["speedup_vs_dense"].is_null());
+    assert_eq!(skip_lines(&o), 1, "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--dense forces it"));
+
+    // forced over the memory bound: the bound's error, exit 1
+    let o = flexrom(&["validate", &p, "--load-scale", "1.0", "--dense", "--max-memory", "800K"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("dense 206 × 206 LU"), "{}", String::from_utf8_lossy(&o.stderr));
+
+    let o = ok(&["validate", &p, "--load-scale", "1.0", "--json"]);
+    assert!(json(&o)["full_dense_seconds"].as_f64().unwrap() > 0.0, "small model: timed by default");
+    assert_eq!(skip_lines(&o), 0);
+}
+
+#[test]
+fn every_help_has_examples_and_exit_codes() {
+    let top = String::from_utf8(ok(&["--help"]).stdout).unwrap();
+    assert!(top.contains("Exit codes:") && top.contains("Examples:"), "{top}");
+    for cmd in ["simulate", "train", "online", "validate", "sweep", "merge", "run", "demo"] {
+        let h = String::from_utf8(ok(&[cmd, "--help"]).stdout).unwrap();
+        assert!(h.contains("Examples:\n  flexrom ") && h.contains(&format!("flexrom {cmd} ")), "{cmd}: {h}");
+        for code in ["  0 ", "  1 ", "  2 ", "  3 ", "  4 ", "129/130/143"] {
+            assert!(h.contains(code), "{cmd} --help lacks exit code {code}");
+        }
+        assert!(h.contains("--quiet") && h.contains("--verbose") && h.contains("--threads"), "{cmd}");
+    }
+}
