@@ -479,7 +479,11 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                 check_output(&out, Origin::Flag("-o"), &[(&p.path, "pipeline file"), (&p.model.path, "model file")])?;
                 let scales = flexrom::pipeline::snapshots::job_scales(&p, load_scale, shard)?;
                 let (n, secs) = flexrom::pipeline::snapshots::write_snapshots(&p, &scales, &out)?;
-                info(&format!("{}: {n} full run(s) at {scales:?} ({secs:.3} s) -> {}", p.path.display(), out.display()));
+                info(&format!(
+                    "{}: {n} full run(s) at {scales:?} ({secs:.3} s) -> {}",
+                    p.path.display(),
+                    out.display()
+                ));
                 let mut t = Table::new(&["pipeline", "output", "n_runs", "load_scales", "seconds"]);
                 let list: Vec<String> = scales.iter().map(|x| x.to_string()).collect();
                 t.push(vec![
@@ -783,7 +787,13 @@ fn run(cli: Cli) -> flexrom::Result<()> {
                     for k in [0, nt / 4, nt / 2, 3 * nt / 4, nt - 1] {
                         for (n, xy) in &r.probes {
                             let name = path.display().to_string();
-                            table.push(vec![name.into(), r.t[k].into(), n.as_str().into(), xy[[k, 0]].into(), xy[[k, 1]].into()]);
+                            table.push(vec![
+                                name.into(),
+                                r.t[k].into(),
+                                n.as_str().into(),
+                                xy[[k, 0]].into(),
+                                xy[[k, 1]].into(),
+                            ]);
                         }
                     }
                     continue;

@@ -121,7 +121,16 @@ fn every_result_prints_as_csv_and_json() {
     assert!(j.as_array().unwrap().iter().all(|r| r["status"] == 0 && r["error_estimate"].is_null()));
     let part = dir.join("parts/deep/p1.h5");
     let (head, rows) = csv_rows(&ok(&[
-        "sweep", &p, "--load-scales", "0.9:1.1:3", "--shard", "1/1", "-o", s(&part), "--csv", "--no-estimate",
+        "sweep",
+        &p,
+        "--load-scales",
+        "0.9:1.1:3",
+        "--shard",
+        "1/1",
+        "-o",
+        s(&part),
+        "--csv",
+        "--no-estimate",
     ]));
     assert_eq!(head[0], "load_scale");
     assert_eq!(rows.len(), 3);
@@ -175,7 +184,8 @@ fn dense_comparison_flags_and_auto_skip() {
     let d = tempfile::tempdir().unwrap();
     let p = pipeline(d.path());
     ok(&["-q", "train", &p]);
-    let skip_lines = |o: &Output| String::from_utf8_lossy(&o.stderr).lines().filter(|l| l.contains("skipping the dense-LU")).count();
+    let skip_lines =
+        |o: &Output| String::from_utf8_lossy(&o.stderr).lines().filter(|l| l.contains("skipping the dense-LU")).count();
 
     let o = ok(&["validate", &p, "--load-scale", "1.0", "--json", "--no-dense"]);
     assert!(json(&o)["full_dense_seconds"].is_null());
@@ -190,7 +200,11 @@ fn dense_comparison_flags_and_auto_skip() {
     // forced over the memory bound: the bound's error, exit 1
     let o = flexrom(&["validate", &p, "--load-scale", "1.0", "--dense", "--max-memory", "800K"]);
     assert_eq!(o.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("dense 206 × 206 LU"), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("dense 206 × 206 LU"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
 
     let o = ok(&["validate", &p, "--load-scale", "1.0", "--json"]);
     assert!(json(&o)["full_dense_seconds"].as_f64().unwrap() > 0.0, "small model: timed by default");

@@ -93,17 +93,31 @@ fn estimate_bounds_the_error_at_held_out_loads() {
         let by: Vec<f64> = v["rel_error_by_time"].as_array().unwrap().iter().map(|e| e.as_f64().unwrap()).collect();
         assert_eq!(by.len(), 5);
         assert!((by[4] - err).abs() <= 1e-12 * err, "{by:?} vs {err}");
-        let eby: Vec<f64> =
-            v["error_estimate_by_time"].as_array().expect("error_estimate_by_time reported").iter().map(|e| e.as_f64().unwrap()).collect();
+        let eby: Vec<f64> = v["error_estimate_by_time"]
+            .as_array()
+            .expect("error_estimate_by_time reported")
+            .iter()
+            .map(|e| e.as_f64().unwrap())
+            .collect();
         assert_eq!(eby.len(), 5);
         assert_eq!(eby[4], est, "λ = {x}: the last fifth's estimate is the whole run's");
         for i in 0..5 {
-            assert!(eby[i].is_finite() && eby[i] >= by[i], "λ = {x}, fifth {}: estimate {eby:?} below the error {by:?}", i + 1);
+            assert!(
+                eby[i].is_finite() && eby[i] >= by[i],
+                "λ = {x}, fifth {}: estimate {eby:?} below the error {by:?}",
+                i + 1
+            );
         }
         // the text output shows the same figures
         let t = run(&["validate", p.to_str().unwrap(), "--load-scale", &x.to_string(), "--no-dense"]);
         let text = String::from_utf8_lossy(&t.stdout);
-        for needle in ["error_estimate", "effectivity", "sensitivity", "rel_error up to each fifth", "error_estimate up to each fifth"] {
+        for needle in [
+            "error_estimate",
+            "effectivity",
+            "sensitivity",
+            "rel_error up to each fifth",
+            "error_estimate up to each fifth",
+        ] {
             assert!(text.contains(needle), "λ = {x}: `{needle}` missing from\n{text}");
         }
     }

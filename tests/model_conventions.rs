@@ -59,7 +59,10 @@ fn time_function_units_and_signs() {
     assert_eq!(row("phase", "sine")[2], "rad");
     assert!((eval("type = \"sine\"\namplitude = 1.0\nfrequency = 1.0", 0.25) - 1.0).abs() < 1e-12);
     let half_pi = std::f64::consts::FRAC_PI_2;
-    assert!((eval(&format!("type = \"sine\"\namplitude = 1.0\nfrequency = 1.0\nphase = {half_pi}"), 0.0) - 1.0).abs() < 1e-12);
+    assert!(
+        (eval(&format!("type = \"sine\"\namplitude = 1.0\nfrequency = 1.0\nphase = {half_pi}"), 0.0) - 1.0).abs()
+            < 1e-12
+    );
 
     let rate = row("rate", "exponential");
     assert_eq!(rate[2], "1/s");
@@ -79,7 +82,14 @@ fn run_tip(dir: &Path, name: &str, body: &str, extra: &str) -> (f64, f64, f64, f
     )
     .unwrap();
     let o = Command::new(env!("CARGO_BIN_EXE_flexrom"))
-        .args(["-q", "simulate", model.to_str().unwrap(), "-o", dir.join(format!("{name}.h5")).to_str().unwrap(), "--json"])
+        .args([
+            "-q",
+            "simulate",
+            model.to_str().unwrap(),
+            "-o",
+            dir.join(format!("{name}.h5")).to_str().unwrap(),
+            "--json",
+        ])
         .output()
         .unwrap();
     assert!(o.status.success(), "{name}: {}", String::from_utf8_lossy(&o.stderr));

@@ -179,15 +179,23 @@ impl Table {
     }
 
     fn row_json(&self, r: &[Cell]) -> String {
-        let fields: Vec<String> =
-            self.columns.iter().zip(r).map(|(k, c)| format!("{}:{}", serde_json::Value::from(k.as_str()), c.json())).collect();
+        let fields: Vec<String> = self
+            .columns
+            .iter()
+            .zip(r)
+            .map(|(k, c)| format!("{}:{}", serde_json::Value::from(k.as_str()), c.json()))
+            .collect();
         format!("{{{}}}", fields.join(","))
     }
 
     /// Aligned text columns (right-aligned, two spaces apart), a header line first.
     pub fn to_text(&self) -> String {
         let cells: Vec<Vec<String>> = std::iter::once(self.columns.clone())
-            .chain(self.rows.iter().map(|r| r.iter().map(|c| if *c == Cell::Null { "-".into() } else { c.text() }).collect()))
+            .chain(
+                self.rows
+                    .iter()
+                    .map(|r| r.iter().map(|c| if *c == Cell::Null { "-".into() } else { c.text() }).collect()),
+            )
             .collect();
         let widths: Vec<usize> =
             (0..self.columns.len()).map(|j| cells.iter().map(|r| r[j].chars().count()).max().unwrap_or(0)).collect();

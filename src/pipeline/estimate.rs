@@ -358,10 +358,7 @@ pub fn write_run_attributes(
 ) -> hdf5::Result<()> {
     use crate::io::h5::{attr_f64, attr_u64};
     attr_f64(f, "error_estimate", e.map_or(f64::NAN, |e| e.error_estimate))?;
-    f.new_attr::<f64>()
-        .shape(5)
-        .create("error_estimate_by_time")?
-        .write(&e.map_or([f64::NAN; 5], |e| e.by_time))?;
+    f.new_attr::<f64>().shape(5).create("error_estimate_by_time")?.write(&e.map_or([f64::NAN; 5], |e| e.by_time))?;
     attr_f64(f, "error_estimate_raw", e.map_or(f64::NAN, |e| e.raw))?;
     attr_f64(f, "error_estimate_factor", e.map_or(f64::NAN, |e| e.factor))?;
     attr_u64(f, "error_estimate_calibrated", e.is_some_and(|e| e.calibrated) as u64)?;

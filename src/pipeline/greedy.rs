@@ -511,7 +511,8 @@ fn p_tolerance(p: &Pipeline) -> f64 {
 /// per worker, as `sweep` does); a run that fails gives ∞ estimates (and sensitivity 0,
 /// which holds its estimate to T).
 fn estimate_candidates(model: &Model, basis: &Basis, est: &Estimator, loads: &[f64], label: &str) -> Vec<CandidateRun> {
-    let target = if crate::output::show_progress() { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() };
+    let target =
+        if crate::output::show_progress() { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() };
     let bar = ProgressBar::with_draw_target(Some(loads.len() as u64), target);
     bar.set_style(
         ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} candidates, {elapsed}")

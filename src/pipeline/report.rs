@@ -249,10 +249,15 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: boo
     let by_time: Vec<Series> = validations
         .iter()
         .flat_map(|v| {
-            let truth = Series::new(format!("rel_error, load scale {}", v.load_scale), fifths(&v.rel_error_by_time), Style::Line);
-            let est = v.error_estimate_by_time.as_ref().map(|e| {
-                Series::new(format!("error_estimate, load scale {}", v.load_scale), fifths(e), Style::Dashed)
-            });
+            let truth = Series::new(
+                format!("rel_error, load scale {}", v.load_scale),
+                fifths(&v.rel_error_by_time),
+                Style::Line,
+            );
+            let est = v
+                .error_estimate_by_time
+                .as_ref()
+                .map(|e| Series::new(format!("error_estimate, load scale {}", v.load_scale), fifths(e), Style::Dashed));
             std::iter::once(truth).chain(est)
         })
         .collect();
@@ -330,9 +335,10 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: boo
     let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|");
     for v in &validations {
         let by: Vec<String> = v.rel_error_by_time.iter().map(|e| format!("{e:.2e}")).collect();
-        let est_by = v.error_estimate_by_time.as_ref().map_or("–".to_string(), |e| {
-            e.iter().map(|e| format!("{e:.2e}")).collect::<Vec<_>>().join(", ")
-        });
+        let est_by = v
+            .error_estimate_by_time
+            .as_ref()
+            .map_or("–".to_string(), |e| e.iter().map(|e| format!("{e:.2e}")).collect::<Vec<_>>().join(", "));
         let o = |x: Option<f64>, f: &dyn Fn(f64) -> String| x.map_or("–".to_string(), f);
         let _ = writeln!(
             md,

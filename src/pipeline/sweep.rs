@@ -269,7 +269,11 @@ pub fn sweep_to_file_with(
                 }
             ));
         } else {
-            crate::output::info(&format!("resuming {}: no such file yet, running all {} load scales", out.display(), scales.len()));
+            crate::output::info(&format!(
+                "resuming {}: no such file yet, running all {} load scales",
+                out.display(),
+                scales.len()
+            ));
         }
     }
     let write = |s: &Sweep| write_sweep_with(out, s, stored, basis_path, extra);
