@@ -79,6 +79,27 @@ fn log_label(v: &f64) -> String {
     s.replace("e0", "").replace("e-0", "e-")
 }
 
+/// A log axis over `lo..hi` labels only ticks at whole mantissas (plotters also places ticks
+/// such as 9.5e-4, which `log_label` would print as a second "1e-3"), and over more than a
+/// factor of 10 only 1, 2 and 5 of each decade, so that the labels of the crowded top of a
+/// decade do not run into each other.
+fn log_labels(lo: f64, hi: f64) -> impl Fn(&f64) -> String {
+    let sparse = hi > 10.0 * lo;
+    move |v: &f64| {
+        if !(*v > 0.0) {
+            return String::new();
+        }
+        let m = v / 10f64.powf(v.log10().floor());
+        let whole = m.round();
+        let keep = (m - whole).abs() < 1e-6 * whole && (!sparse || [1.0, 2.0, 5.0, 10.0].contains(&whole));
+        if keep {
+            log_label(v)
+        } else {
+            String::new()
+        }
+    }
+}
+
 /// Linear labels with as many digits as the axis span `lo..hi` needs (scientific notation
 /// for spans below 1e-3, where fixed decimals would print every tick as 0).
 fn linear_labels(lo: f64, hi: f64) -> impl Fn(&f64) -> String {
@@ -212,7 +233,8 @@ impl Figure {
             if panel.log_y {
                 let (y0, y1) = (y0 / 2.0, y1 * 2.0);
                 let chart = b.build_cartesian_2d(x0..x1, (y0..y1).log_scale()).map_err(|x| e(&x))?;
-                finish!(chart, y0, y1, log_label);
+                let y_fmt = log_labels(y0, y1);
+                finish!(chart, y0, y1, y_fmt);
             } else {
                 let p = if y1 > y0 { 0.06 * (y1 - y0) } else { 0.5 * y0.abs().max(1e-12) };
                 let (y0, y1) = (y0 - p, y1 + p);
@@ -282,6 +304,13 @@ mod tests {
         assert_eq!(log_label(&1e-10), "1e-10");
         assert_eq!(log_label(&1.0), "1");
         assert_eq!(log_label(&20.0), "2e1");
+        // over several decades only 1, 2 and 5 are labelled; 9.5e-4 never prints a second 1e-3
+        let f = log_labels(1e-5, 1e-3);
+        assert_eq!((f(&2e-4), f(&5e-4), f(&1e-3)), ("2e-4".into(), "5e-4".into(), "1e-3".into()));
+        assert_eq!((f(&3e-4), f(&9e-4), f(&9.5e-4)), (String::new(), String::new(), String::new()));
+        // within a factor of ten every whole mantissa is labelled
+        let f = log_labels(2e-4, 1e-3);
+        assert_eq!((f(&3e-4), f(&9e-4), f(&9.5e-4)), ("3e-4".into(), "9e-4".into(), String::new()));
         let f = linear_labels(-1.2, 1.2);
         assert_eq!((f(&-0.0), f(&0.25), f(&-1.2)), ("0".into(), "0.25".into(), "-1.2".into()));
         // a span of 2e-4 m: the old fixed 4 decimals printed 0 for every tick
@@ -317,7 +346,9 @@ mod tests {
         };
         let files = fig.save(&dir.path().join("fig")).unwrap();
         let svg = std::fs::read_to_string(&files[0]).unwrap();
-        assert!(svg.starts_with("<svg") && svg.contains("training load") && svg.contains("3e-4"));
+        assert!(
+            svg.starts_with("<svg") && svg.contains("training load") && svg.contains("2e-4") && svg.contains("5e-4")
+        );
         let dec = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&files[1]).unwrap()));
         let reader = dec.read_info().unwrap();
         assert_eq!((reader.info().width, reader.info().height), (WIDTH, 70 + 2 * PANEL_HEIGHT));
