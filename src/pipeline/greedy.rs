@@ -53,15 +53,15 @@
 //! Nothing here is fitted to a model: the ladder, √ε and the factor 2 are the same for
 //! every model; a reduced run that fails (Newton diverges) counts as an infinite estimate.
 
+use super::basis_build::{build_basis, training_data};
 use super::config::{GreedySpec, Pipeline};
 use super::estimate::{
     calibrate, raw_estimate_by_time, rel_error_by_time, CalibrationPoint, EstimatingRunner, Estimator,
     DEFAULT_EXTRA_MODES,
 };
 use super::online::Output;
-use super::basis_build::{build_basis, training_data};
-pub use super::training_record::{write_training, GreedyRecord, Iteration};
 use super::training_record::{modes_text, TrainSummary};
+pub use super::training_record::{write_training, GreedyRecord, Iteration};
 use super::validate::compare;
 use crate::error::{Error, Result};
 use crate::io::basis_file::TrainingData;

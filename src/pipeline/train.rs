@@ -3,11 +3,11 @@
 use super::basis_build::joint_dofs_of;
 pub use super::basis_build::{build_basis, training_data};
 use super::config::Pipeline;
+pub use super::training_record::TrainSummary;
 use crate::error::{Error, Result};
 use crate::io::basis_file::{write_basis_with, BasisMeta, TrainingData};
 use crate::linalg::kkt::LinearSolverKind;
 use crate::simulate::{FullModel, Overrides};
-pub use super::training_record::TrainSummary;
 use std::path::Path;
 
 /// The coordinates that appear in any joint, sorted.
