@@ -53,13 +53,15 @@
 //! Nothing here is fitted to a model: the ladder, √ε and the factor 2 are the same for
 //! every model; a reduced run that fails (Newton diverges) counts as an infinite estimate.
 
+use super::basis_build::{build_basis, training_data};
 use super::config::{GreedySpec, Pipeline};
 use super::estimate::{
     calibrate, raw_estimate_by_time, rel_error_by_time, CalibrationPoint, EstimatingRunner, Estimator,
     DEFAULT_EXTRA_MODES,
 };
 use super::online::Output;
-use super::train::{build_basis, training_data, TrainSummary};
+use super::training_record::{modes_text, TrainSummary};
+pub use super::training_record::{write_training, GreedyRecord, Iteration};
 use super::validate::compare;
 use crate::error::{Error, Result};
 use crate::io::basis_file::TrainingData;
@@ -91,77 +93,6 @@ pub fn score(tolerance: f64, estimate_by_time: &[f64; 5], sensitivity_by_time: &
         worst = worst.max(tolerance * e / tolerance.max(s));
     }
     worst
-}
-
-/// One pass of the loop: the basis it chose and where its estimate was worst.
-#[derive(Clone, Debug)]
-pub struct Iteration {
-    /// the energy tolerance ε chosen (NaN when `reduction.modes` is given)
-    pub energy: f64,
-    /// ECSW τ (NaN without hyper-reduction)
-    pub hyper_tolerance: f64,
-    /// POD modes per block
-    pub block_modes: Vec<usize>,
-    /// reduced coordinates (POD modes and kept joint coordinates)
-    pub n_modes: usize,
-    /// sampled elements (all of them without hyper-reduction)
-    pub n_elements: usize,
-    /// the score at every candidate (`GreedyRecord::candidates` order; module documentation)
-    pub estimates: Vec<f64>,
-    /// the whole-run error estimate at every candidate
-    pub whole_run_estimates: Vec<f64>,
-    /// the reduced model's whole-run sensitivity at every candidate
-    pub sensitivity: Vec<f64>,
-    pub worst_load: f64,
-    pub worst_estimate: f64,
-    /// where this iteration ran the full model: the worst candidate without a full run yet
-    /// (NaN when no run was made)
-    pub run_load: f64,
-    /// the true rel_error of this iteration's basis at `run_load`, from the full run there
-    /// (NaN when no run was made)
-    pub true_error: f64,
-    /// the true error's score at `run_load` (as the estimates': held to the sensitivity where
-    /// the model is sensitive; NaN when no run was made)
-    pub true_score: f64,
-}
-
-/// What the greedy loop did: written under `/training` in the basis file.
-#[derive(Clone, Debug)]
-pub struct GreedyRecord {
-    pub range: (f64, f64),
-    pub tolerance: f64,
-    pub max_runs: usize,
-    pub candidates: Vec<f64>,
-    /// the loads whose snapshots the basis holds, in run order
-    pub load_scales: Vec<f64>,
-    pub iterations: Vec<Iteration>,
-    /// every candidate's estimate ≤ T and the held-out check run within T
-    pub converged: bool,
-    /// full runs made, the held-out check included
-    pub full_runs: usize,
-}
-
-impl GreedyRecord {
-    /// The `mode_rule` attribute of the basis file.
-    pub fn mode_rule(&self) -> String {
-        match self.iterations.last() {
-            Some(it) if it.energy.is_finite() => {
-                format!(
-                    "greedy: energy = {:e} per block ({}), hyper tolerance {:e}",
-                    it.energy,
-                    modes_text(&it.block_modes),
-                    it.hyper_tolerance
-                )
-            }
-            Some(it) => format!("greedy: {}", modes_text(&it.block_modes)),
-            None => "greedy".into(),
-        }
-    }
-}
-
-fn modes_text(block_modes: &[usize]) -> String {
-    let v: Vec<String> = block_modes.iter().map(|m| m.to_string()).collect();
-    format!("{} modes", v.join(" + "))
 }
 
 /// A basis of one rung of the ladder with its estimator and its estimates at the candidates.
@@ -548,43 +479,6 @@ fn estimate_candidates(model: &Model, basis: &Basis, est: &Estimator, loads: &[f
         .collect();
     bar.finish_and_clear();
     out
-}
-
-/// Writes `/training` (the basis file's layout: src/io/basis_file.rs).
-pub fn write_training(f: &hdf5::File, r: &GreedyRecord) -> hdf5::Result<()> {
-    use crate::io::h5::{attr_str, attr_u64};
-    use ndarray::{arr0, Array1, Array2};
-    let g = f.create_group("training")?;
-    let col = |get: &dyn Fn(&Iteration) -> f64| Array1::from_iter(r.iterations.iter().map(get));
-    g.new_dataset_builder().with_data(&Array1::from(vec![r.range.0, r.range.1])).create("range")?;
-    g.new_dataset_builder().with_data(&arr0(r.tolerance)).create("tolerance")?;
-    g.new_dataset_builder().with_data(&Array1::from(r.load_scales.clone())).create("load_scales")?;
-    g.new_dataset_builder().with_data(&Array1::from(r.candidates.clone())).create("candidates")?;
-    g.new_dataset_builder().with_data(&col(&|i| i.worst_estimate)).create("worst_estimate")?;
-    g.new_dataset_builder().with_data(&col(&|i| i.worst_load)).create("worst_load")?;
-    g.new_dataset_builder().with_data(&col(&|i| i.run_load)).create("run_load")?;
-    g.new_dataset_builder().with_data(&col(&|i| i.true_error)).create("true_error")?;
-    g.new_dataset_builder().with_data(&col(&|i| i.energy)).create("energy_tolerance")?;
-    g.new_dataset_builder().with_data(&col(&|i| i.hyper_tolerance)).create("hyper_tolerance")?;
-    g.new_dataset_builder()
-        .with_data(&Array1::from_iter(r.iterations.iter().map(|i| i.n_modes as u64)))
-        .create("n_modes")?;
-    g.new_dataset_builder()
-        .with_data(&Array1::from_iter(r.iterations.iter().map(|i| i.n_elements as u64)))
-        .create("n_elements")?;
-    let (ni, nc) = (r.iterations.len(), r.candidates.len());
-    let table = |get: &dyn Fn(&Iteration) -> &Vec<f64>| {
-        Array2::from_shape_fn((ni, nc), |(i, j)| get(&r.iterations[i]).get(j).copied().unwrap_or(f64::NAN))
-    };
-    g.new_dataset_builder().with_data(&table(&|i| &i.estimates)).create("estimates")?;
-    g.new_dataset_builder().with_data(&table(&|i| &i.whole_run_estimates)).create("whole_run_estimates")?;
-    g.new_dataset_builder().with_data(&table(&|i| &i.sensitivity)).create("sensitivity")?;
-    g.new_dataset_builder().with_data(&col(&|i| i.true_score)).create("true_score")?;
-    attr_str(&g, "method", "greedy")?;
-    attr_u64(&g, "iterations", ni as u64)?;
-    attr_u64(&g, "max_runs", r.max_runs as u64)?;
-    attr_u64(&g, "full_runs", r.full_runs as u64)?;
-    attr_u64(&g, "converged", r.converged as u64)
 }
 
 #[cfg(test)]

@@ -3,6 +3,7 @@
 //! runs) → `validate` (error norms, timings) → `sweep` (many load scales) → `run` (all of
 //! it, with a report).
 
+pub mod basis_build;
 pub mod config;
 pub mod dense;
 pub mod estimate;
@@ -17,6 +18,7 @@ pub mod snapshots;
 pub mod sweep;
 pub mod tables;
 pub mod train;
+pub mod training_record;
 pub mod validate;
 
 pub use config::Pipeline;
