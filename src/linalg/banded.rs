@@ -11,6 +11,53 @@
 use super::kkt_pattern::{Block, KktPattern, KktSolver, SlotMap};
 use std::collections::VecDeque;
 
+/// The graph of the KKT matrix `[S Bᵀ; B 0]`: coordinates coupled through an element, and
+/// each constraint row (numbered after the coordinates) with the coordinates it holds;
+/// sorted neighbour lists without duplicates.
+pub fn adjacency(pattern: &KktPattern) -> Vec<Vec<usize>> {
+    let nd = pattern.n_dof;
+    let mut adj: Vec<Vec<usize>> = vec![Vec::new(); pattern.size()];
+    for dofs in &pattern.element_dofs {
+        for &i in dofs {
+            adj[i].extend(dofs.iter().copied().filter(|&j| j != i));
+        }
+    }
+    for (c, row) in pattern.constraint_rows.iter().enumerate() {
+        for &(d, _) in row {
+            adj[d].push(nd + c);
+            adj[nd + c].push(d);
+        }
+    }
+    for a in adj.iter_mut() {
+        a.sort_unstable();
+        a.dedup();
+    }
+    adj
+}
+
+/// Solves in the band's own order: `rhs` is permuted into `work` (`new_of[old] = new`),
+/// solved there by `solve_band`, and permuted back; a non-finite result means a singular
+/// matrix.
+pub fn solve_permuted(
+    new_of: &[usize],
+    work: &mut [f64],
+    rhs: &mut [f64],
+    solve_band: impl FnOnce(&mut [f64]),
+) -> Result<(), String> {
+    for (old, &new) in new_of.iter().enumerate() {
+        work[new] = rhs[old];
+    }
+    solve_band(work);
+    for (old, &new) in new_of.iter().enumerate() {
+        rhs[old] = work[new];
+    }
+    if rhs.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err("the iteration matrix is singular (non-finite solution)".into())
+    }
+}
+
 /// Reverse Cuthill–McKee (Cuthill & McKee 1969; George & Liu 1981, §4.3): a breadth-first
 /// numbering from a low-degree start node, neighbours taken in increasing degree, reversed.
 /// `adj[i]` lists the neighbours of i. Returns `order[new] = old`.
@@ -70,23 +117,7 @@ pub struct BandedKkt {
 impl BandedKkt {
     pub fn new(pattern: KktPattern) -> Self {
         let n = pattern.size();
-        let nd = pattern.n_dof;
-        let mut adj: Vec<Vec<usize>> = vec![Vec::new(); n];
-        for dofs in &pattern.element_dofs {
-            for &i in dofs {
-                adj[i].extend(dofs.iter().copied().filter(|&j| j != i));
-            }
-        }
-        for (c, row) in pattern.constraint_rows.iter().enumerate() {
-            for &(d, _) in row {
-                adj[d].push(nd + c);
-                adj[nd + c].push(d);
-            }
-        }
-        for a in adj.iter_mut() {
-            a.sort_unstable();
-            a.dedup();
-        }
+        let adj = adjacency(&pattern);
         let order = reverse_cuthill_mckee(&adj);
         let mut new_of = vec![0; n];
         for (new, &old) in order.iter().enumerate() {
@@ -139,18 +170,8 @@ impl KktSolver for BandedKkt {
         if !self.factored {
             return Err("solve called without a valid factorization".into());
         }
-        for (old, &new) in self.new_of.iter().enumerate() {
-            self.work[new] = rhs[old];
-        }
-        band_lu_solve(&self.ab, self.n, self.band, self.ldab, &self.ipiv, self.ubw, &mut self.work);
-        for (old, &new) in self.new_of.iter().enumerate() {
-            rhs[old] = self.work[new];
-        }
-        if rhs.iter().all(|v| v.is_finite()) {
-            Ok(())
-        } else {
-            Err("the iteration matrix is singular (non-finite solution)".into())
-        }
+        let (ab, n, band, ldab, ipiv, ubw) = (&self.ab, self.n, self.band, self.ldab, &self.ipiv, self.ubw);
+        solve_permuted(&self.new_of, &mut self.work, rhs, |w| band_lu_solve(ab, n, band, ldab, ipiv, ubw, w))
     }
 }
 

@@ -23,7 +23,7 @@
 //! so nothing is assumed that a matrix does not satisfy (a stiff compressed configuration
 //! can make `S` indefinite).
 
-use super::banded::BandedKkt;
+use super::banded::{solve_permuted, BandedKkt};
 pub use super::banded_order::quasi_definite_order;
 use super::kkt_pattern::{Block, KktPattern, KktSolver};
 
@@ -195,18 +195,8 @@ impl KktSolver for BandedLdlt {
             Factored::Lu => return self.fallback.solve(rhs),
             Factored::Ldlt => {}
         }
-        for (old, &new) in self.new_of.iter().enumerate() {
-            self.work[new] = rhs[old];
-        }
-        band_ldlt_solve(&self.ab, self.n, self.band, &mut self.work);
-        for (old, &new) in self.new_of.iter().enumerate() {
-            rhs[old] = self.work[new];
-        }
-        if rhs.iter().all(|v| v.is_finite()) {
-            Ok(())
-        } else {
-            Err("the iteration matrix is singular (non-finite solution)".into())
-        }
+        let (ab, n, band) = (&self.ab, self.n, self.band);
+        solve_permuted(&self.new_of, &mut self.work, rhs, |w| band_ldlt_solve(ab, n, band, w))
     }
 }
 

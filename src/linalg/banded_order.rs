@@ -12,22 +12,7 @@ use super::kkt_pattern::KktPattern;
 /// costs nothing).
 pub fn quasi_definite_order(pattern: &KktPattern) -> Vec<usize> {
     let nd = pattern.n_dof;
-    let mut adj: Vec<Vec<usize>> = vec![Vec::new(); pattern.size()];
-    for dofs in &pattern.element_dofs {
-        for &i in dofs {
-            adj[i].extend(dofs.iter().copied().filter(|&j| j != i));
-        }
-    }
-    for (c, row) in pattern.constraint_rows.iter().enumerate() {
-        for &(d, _) in row {
-            adj[d].push(nd + c);
-            adj[nd + c].push(d);
-        }
-    }
-    for a in adj.iter_mut() {
-        a.sort_unstable();
-        a.dedup();
-    }
+    let adj = super::banded::adjacency(pattern);
     // coordinates alone; a constraint couples its coordinates as an element does
     let mut dof_adj: Vec<Vec<usize>> =
         adj[..nd].iter().map(|a| a.iter().copied().filter(|&j| j < nd).collect()).collect();
