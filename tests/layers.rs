@@ -7,10 +7,11 @@
 //! * an import running upward, or sideways between two top-level modules of one layer, in the
 //!   layer order, top to bottom:
 //!
-//!   `main` → `pipeline` → `io` → `simulate` → `model` → `reduction` | `physics` → `solver`
+//!   `main` → `cli` → `pipeline` → `io` → `simulate` → `model` → `reduction` | `physics` → `solver`
 //!   → `linalg` → `output` → `limits` → `error`
 //!
-//!   (`reduction` and `physics` share a layer and must not see each other: the reduction
+//!   (`cli` is the binary's command handlers, below `main.rs`'s parsing and dispatch;
+//!   `reduction` and `physics` share a layer and must not see each other: the reduction
 //!   knows the physics only through the traits of `solver::model`).
 //!
 //! Comments, string literals and `#[cfg(test)]` modules are left out (a unit test may reach
@@ -25,6 +26,7 @@ use std::path::Path;
 
 const LAYERS: &[&[&str]] = &[
     &["main"],
+    &["cli"],
     &["pipeline"],
     &["io"],
     &["simulate"],

@@ -1,0 +1,47 @@
+//! `flexrom merge`: the part files of `sweep --shard` joined into one sweep file.
+
+use super::{print_table, FormatArgs};
+use flexrom::io::output::{check_output, Origin};
+use flexrom::output::info;
+use std::path::PathBuf;
+
+/// The arguments of `flexrom merge`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// part files (`sweep --shard K/N -o PART.h5`), one per shard, in any order
+    #[arg(required = true)]
+    parts: Vec<PathBuf>,
+    /// sweep file to write
+    #[arg(short, long)]
+    output: PathBuf,
+    /// merge the parts there are; loads of missing shards or not run are marked
+    /// `status` 2 (not run yet), which `sweep --resume` on the merged file runs
+    #[arg(long)]
+    partial: bool,
+    #[command(flatten)]
+    format: FormatArgs,
+}
+
+impl Args {
+    pub fn run(self) -> flexrom::Result<()> {
+        let Args { parts, output, partial, format } = self;
+        let inputs: Vec<(&std::path::Path, &str)> = parts.iter().map(|p| (p.as_path(), "part file")).collect();
+        check_output(&output, Origin::Flag("-o"), &inputs)?;
+        let m = flexrom::pipeline::merge::merge(&parts, &output, partial)?;
+        print_table(&flexrom::pipeline::tables::sweep_table(&m.sweep), format.format(), false)?;
+        info(&format!(
+            "{} parts, {} load scales ({} not run) -> {}",
+            m.parts,
+            m.sweep.scales.len(),
+            m.gaps,
+            output.display()
+        ));
+        if let Some(s) = m.sweep.failure_summary() {
+            return Err(flexrom::Error::PartlyFailed(format!(
+                "{s} (the others are in {}; /status and /message say which)",
+                output.display()
+            )));
+        }
+        Ok(())
+    }
+}

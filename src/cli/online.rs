@@ -1,0 +1,92 @@
+//! `flexrom online`: one reduced run at one load scale, written to a result file.
+
+use super::{check_scale, print_table, run_details, FormatArgs};
+use flexrom::io::output::{check_output, Origin};
+use flexrom::io::result_file::write_result_with;
+use flexrom::output::info;
+use flexrom::output::table::{Cell, Table};
+use flexrom::pipeline::online::load_basis;
+use flexrom::pipeline::Pipeline;
+use std::path::PathBuf;
+
+/// The arguments of `flexrom online`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// pipeline file (TOML)
+    pipeline: PathBuf,
+    /// multiplies every load marked `scaled` in the model file
+    #[arg(long)]
+    load_scale: f64,
+    /// result file (HDF5)
+    #[arg(short, long)]
+    output: PathBuf,
+    /// basis file (default: the pipeline's `basis`)
+    #[arg(long)]
+    basis: Option<PathBuf>,
+    /// exit with code 4 (after writing the output) when an error estimate exceeds the
+    /// tolerance ([online] tolerance, default the training tolerance)
+    #[arg(long)]
+    strict: bool,
+    #[command(flatten)]
+    format: FormatArgs,
+}
+
+impl Args {
+    pub fn run(self) -> flexrom::Result<()> {
+        let Args { pipeline, load_scale, output, basis, strict, format } = self;
+        let p = Pipeline::load(&pipeline)?;
+        check_scale(load_scale)?;
+        let path = basis.unwrap_or_else(|| p.basis_path.clone());
+        check_output(
+            &output,
+            Origin::Flag("-o"),
+            &[(&p.path, "pipeline file"), (&p.model.path, "model file"), (&path, "basis file")],
+        )?;
+        let stored = load_basis(&p, &path)?;
+        let trust = flexrom::pipeline::estimate::load_trust(&p, &path, &stored)?;
+        let mut runner =
+            flexrom::pipeline::estimate::EstimatingRunner::new(&p.model, &stored.basis, trust.estimator.as_ref())?;
+        let (run, estimate) = runner
+            .run(load_scale, flexrom::pipeline::online::Output::Full)
+            .map_err(|e| e.at_stage("online", load_scale))?;
+        let extrapolated = flexrom::pipeline::estimate::is_extrapolated(trust.range, load_scale);
+        let basis_name = path.display().to_string();
+        write_result_with(&output, &run.result, |f| {
+            let e = |err: hdf5::Error| flexrom::Error::hdf5(&output, err);
+            flexrom::io::result_file::write_reduced(f, &run.reduced_q).map_err(e)?;
+            flexrom::io::h5::attr_str(f, "basis", &basis_name).map_err(e)?;
+            flexrom::io::h5::attr_str(f, "variant", stored.basis.variant.name()).map_err(e)?;
+            flexrom::io::h5::attr_u64(f, "n_modes", stored.basis.n_reduced() as u64).map_err(e)?;
+            flexrom::pipeline::estimate::write_run_attributes(f, estimate.as_ref(), &trust, extrapolated).map_err(e)
+        })?;
+        let st = &run.result.stats;
+        info(&format!(
+            "{}: reduced run ({} modes) at load scale {load_scale}: {} steps in {:.4} s ({} Newton iterations, {} step cuts) -> {}",
+            p.path.display(),
+            stored.basis.n_reduced(),
+            st.steps,
+            run.result.wall_seconds,
+            st.newton_iterations,
+            st.step_cuts,
+            output.display()
+        ));
+        if let Some(e) = &estimate {
+            info(&format!("  {}", flexrom::pipeline::estimate::describe(e, run.result.wall_seconds)));
+        }
+        run_details(&run.result);
+        let mut cols = vec!["load_scale", "n_modes"];
+        cols.extend(flexrom::pipeline::tables::RUN_COLUMNS);
+        cols.extend(["error_estimate", "extrapolated", "output"]);
+        let mut t = Table::new(&cols);
+        let mut row: Vec<Cell> = vec![load_scale.into(), stored.basis.n_reduced().into()];
+        row.extend(flexrom::pipeline::tables::run_cells(&run.result));
+        row.extend([
+            estimate.as_ref().map(|e| e.error_estimate).into(),
+            extrapolated.into(),
+            output.display().to_string().into(),
+        ]);
+        t.push(row);
+        print_table(&t, format.format(), true)?;
+        flexrom::pipeline::estimate::check_runs(&trust, &[(load_scale, estimate.map(|e| e.error_estimate))], strict)
+    }
+}

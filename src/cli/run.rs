@@ -1,0 +1,40 @@
+//! `flexrom run`: the whole pipeline (train, sweep, validate) and its report folder.
+
+use super::{print_table, DenseArgs, FormatArgs};
+use flexrom::output::table::{Format, Table};
+use flexrom::output::{self, info};
+use flexrom::pipeline::Pipeline;
+use std::path::PathBuf;
+
+/// The arguments of `flexrom run`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// pipeline file (TOML)
+    pipeline: PathBuf,
+    /// exit with code 4 (after writing the output) when an error estimate exceeds the
+    /// tolerance ([online] tolerance, default the training tolerance)
+    #[arg(long)]
+    strict: bool,
+    #[command(flatten)]
+    dense: DenseArgs,
+    #[command(flatten)]
+    format: FormatArgs,
+}
+
+impl Args {
+    pub fn run(self) -> flexrom::Result<()> {
+        let Args { pipeline, strict, dense, format } = self;
+        let p = Pipeline::load(&pipeline)?;
+        let dir = flexrom::pipeline::report::run_with(&p, output::show_progress(), dense.choice())?;
+        let read = |name: &str| {
+            let f = dir.join(name);
+            std::fs::read_to_string(&f).map_err(|e| flexrom::Error::io(&f, e))
+        };
+        match format.format() {
+            Format::Text => output::println(&read("summary.md")?)?,
+            f => print_table(&Table::from_json_records(&read("validation.json")?)?, f, false)?,
+        }
+        info(&format!("report: {}", dir.display()));
+        flexrom::pipeline::report::check_report(&p, &dir, strict)
+    }
+}

@@ -1,0 +1,78 @@
+//! `flexrom simulate`: one full-order run of a model file, written to an HDF5 result file.
+
+use super::{print_table, run_details, FormatArgs};
+use flexrom::io::output::{check_output, Origin};
+use flexrom::io::result_file::write_result;
+use flexrom::linalg::kkt::LinearSolverKind;
+use flexrom::model::Model;
+use flexrom::output::info;
+use flexrom::simulate::{simulate, Overrides};
+use std::path::PathBuf;
+
+/// The arguments of `flexrom simulate`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// model file (TOML)
+    model: PathBuf,
+    /// result file (HDF5)
+    #[arg(short, long)]
+    output: PathBuf,
+    #[command(flatten)]
+    run: RunArgs,
+    #[command(flatten)]
+    format: FormatArgs,
+}
+
+impl Args {
+    pub fn run(self) -> flexrom::Result<()> {
+        let Args { model, output, run, format } = self;
+        check_output(&output, Origin::Flag("-o"), &[(&model, "model file")])?;
+        let model = Model::load(&model)?;
+        let r =
+            simulate(&model, &run.overrides()).map_err(|e| e.at_stage("simulate", run.load_scale.unwrap_or(1.0)))?;
+        write_result(&output, &r)?;
+        info(&format!(
+            "{}: {} steps in {:.3} s ({} Newton iterations, {} factorizations, {} step cuts) -> {}",
+            model.path.display(),
+            r.stats.steps,
+            r.wall_seconds,
+            r.stats.newton_iterations,
+            r.stats.factorizations,
+            r.stats.step_cuts,
+            output.display()
+        ));
+        run_details(&r);
+        print_table(&flexrom::pipeline::tables::probe_table(&r), format.format(), false)
+    }
+}
+
+#[derive(clap::Args)]
+struct RunArgs {
+    /// time step, s (default: the model file's)
+    #[arg(long)]
+    dt: Option<f64>,
+    /// end time, s (default: the model file's)
+    #[arg(long)]
+    t_end: Option<f64>,
+    /// generalized-α spectral radius ρ∞ in [0, 1] (default: the model file's)
+    #[arg(long)]
+    rho_inf: Option<f64>,
+    /// multiplies every load marked `scaled` in the model file
+    #[arg(long)]
+    load_scale: Option<f64>,
+    /// linear solver of the full model
+    #[arg(long, value_enum, default_value_t = LinearSolverKind::Banded)]
+    solver: LinearSolverKind,
+}
+
+impl RunArgs {
+    fn overrides(&self) -> Overrides {
+        Overrides {
+            dt: self.dt,
+            t_end: self.t_end,
+            rho_inf: self.rho_inf,
+            load_scale: self.load_scale,
+            solver: self.solver,
+        }
+    }
+}

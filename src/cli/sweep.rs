@@ -1,0 +1,160 @@
+//! `flexrom sweep`: reduced runs at many load scales into one sweep file and a table
+//! (optionally one shard of the list, resumed, or validated).
+
+use super::{print_table, FormatArgs};
+use flexrom::io::output::{check_output, check_report_dir, claim_in_report, Origin};
+use flexrom::output::table::Format;
+use flexrom::output::{self, info};
+use flexrom::pipeline::online::load_basis;
+use flexrom::pipeline::Pipeline;
+use std::path::PathBuf;
+
+/// The arguments of `flexrom sweep`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// pipeline file (TOML)
+    pipeline: PathBuf,
+    /// `A:B:N`: N load scales from A to B (default: the pipeline's [online] list)
+    #[arg(long)]
+    load_scales: Option<String>,
+    /// also run the full model at each load scale and report errors
+    #[arg(long)]
+    validate: bool,
+    /// continuation in the load scale: each thread takes two contiguous parts of the list
+    /// (one from each end) and every run starts its Newton solves from its neighbours'
+    /// steps (about 2× fewer iterations on the pendulum). Same step equations and tolerance, but where the
+    /// dynamics are sensitive (the four-bar after t ≈ 0.6 s) Newton may settle on
+    /// another nearby solution than `online` does; without it every load scale runs on
+    /// its own, exactly as `online`
+    #[arg(long)]
+    continuation: bool,
+    /// skip the error estimate (about 2× faster; `/error_estimate` is then NaN)
+    #[arg(long)]
+    no_estimate: bool,
+    /// sweep file (default: sweep.h5 in the pipeline's report folder)
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// basis file (default: the pipeline's `basis`)
+    #[arg(long)]
+    basis: Option<PathBuf>,
+    /// take the load scales that the sweep file already holds as finished (same basis
+    /// and model) from it and run only the others; failed ones run again
+    #[arg(long)]
+    resume: bool,
+    /// exit with code 4 (after writing the output) when an error estimate exceeds the
+    /// tolerance ([online] tolerance, default the training tolerance)
+    #[arg(long)]
+    strict: bool,
+    /// `K/N`: run only the K-th (1-based) of N parts of the load list (loads K, K+N,
+    /// K+2N, …) into the part file given by -o; join the parts with `flexrom merge`
+    #[arg(long, value_name = "K/N")]
+    shard: Option<flexrom::pipeline::shard::Shard>,
+    #[command(flatten)]
+    format: FormatArgs,
+}
+
+impl Args {
+    pub fn run(self) -> flexrom::Result<()> {
+        let Args {
+            pipeline,
+            load_scales,
+            validate,
+            continuation,
+            no_estimate,
+            output,
+            basis,
+            resume,
+            strict,
+            shard,
+            format,
+        } = self;
+        let p = Pipeline::load(&pipeline)?;
+        if shard.is_some() && output.is_none() {
+            return Err(flexrom::Error::Usage("--shard needs -o PART.h5: every shard writes its own part file".into()));
+        }
+        let scales = match load_scales {
+            Some(s) => flexrom::pipeline::config::parse_range(&s)
+                .map_err(|e| flexrom::Error::Usage(format!("--load-scales: {e}")))?,
+            None => p.online_scales(),
+        };
+        let path = basis.unwrap_or_else(|| p.basis_path.clone());
+        let inputs = [
+            (p.path.as_path(), "pipeline file"),
+            (p.model.path.as_path(), "model file"),
+            (path.as_path(), "basis file"),
+        ];
+        // the default goes into the pipeline's report folder, which must then be flexrom's
+        let in_report = output.is_none();
+        let out = output.unwrap_or_else(|| p.report_dir.join("sweep.h5"));
+        if in_report {
+            check_report_dir(&p.report_dir, &p.path, &inputs)?;
+            check_output(&out, Origin::Key { pipeline: &p.path, key: "report" }, &inputs)?;
+        } else {
+            check_output(&out, Origin::Flag("-o"), &inputs)?;
+        }
+        let stored = load_basis(&p, &path)?;
+        let options =
+            flexrom::pipeline::sweep::SweepOptions { validate, continuation, progress: output::show_progress() };
+        let mut trust = flexrom::pipeline::estimate::load_trust(&p, &path, &stored)?;
+        if no_estimate {
+            if strict {
+                return Err(flexrom::Error::Usage("--strict needs the error estimate; drop --no-estimate".into()));
+            }
+            trust.estimator = None;
+            trust.skipped = true;
+        }
+        if in_report {
+            claim_in_report(&p.report_dir, &p.path, "sweep.h5")?;
+        }
+        let sw = match shard {
+            Some(k) => flexrom::pipeline::shard::sweep_shard(
+                &p,
+                &stored,
+                Some(&trust),
+                &path,
+                &scales,
+                k,
+                options,
+                &out,
+                resume,
+            )?,
+            None => flexrom::pipeline::sweep::sweep_to_file(
+                &p.model,
+                &stored,
+                Some(&trust),
+                &path,
+                &scales,
+                options,
+                &out,
+                resume,
+            )?,
+        };
+        match format.format() {
+            Format::Text => output::print(&flexrom::pipeline::sweep::table(&sw))?,
+            f => print_table(&flexrom::pipeline::tables::sweep_table(&sw), f, false)?,
+        }
+        info(&format!(
+            "{}{} load scales ({} resumed) on {} threads in {:.3} s -> {}",
+            shard.map(|k| format!("shard {k}: ")).unwrap_or_default(),
+            sw.scales.len(),
+            sw.resumed,
+            sw.threads,
+            sw.wall_seconds,
+            out.display()
+        ));
+        // the good runs are written; the exit code (3) says that some failed
+        if let Some(s) = sw.failure_summary() {
+            return Err(flexrom::Error::PartlyFailed(format!(
+                "{s} (the others are in {}; /status and /message say which)",
+                out.display()
+            )));
+        }
+        let runs: Vec<(f64, Option<f64>)> = sw
+            .scales
+            .iter()
+            .filter_map(|x| x.point())
+            .map(|q| (q.rom.result.settings.load_scale, q.estimate.map(|e| e.error_estimate)))
+            .collect();
+        flexrom::pipeline::estimate::check_runs(&trust, &runs, strict)
+    }
+}

@@ -1,0 +1,124 @@
+//! `flexrom train`: full runs at the training load scales (or greedy over a load range) and the
+//! POD basis written to HDF5; or, with `--snapshots-only` / `--from-snapshots`, the two halves of
+//! that apart.
+
+use super::{print_table, FormatArgs};
+use flexrom::io::atomic::TempPath;
+use flexrom::io::output::{check_output, Origin};
+use flexrom::output::info;
+use flexrom::output::table::Table;
+use flexrom::pipeline::online::load_basis;
+use flexrom::pipeline::Pipeline;
+use std::path::PathBuf;
+
+/// The arguments of `flexrom train`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// pipeline file (TOML)
+    pipeline: PathBuf,
+    /// basis file to write (default: the pipeline's `basis`)
+    #[arg(long)]
+    basis: Option<PathBuf>,
+    /// only run the full model (at --load-scale X, or at the --shard K/N part of
+    /// train.load_scales) and write its snapshots to -o; no basis
+    #[arg(long, requires = "output", conflicts_with_all = ["from_snapshots", "basis"])]
+    snapshots_only: bool,
+    /// the load scale of a --snapshots-only run
+    #[arg(long, requires = "snapshots_only", conflicts_with = "shard")]
+    load_scale: Option<f64>,
+    /// `K/N`: the --snapshots-only runs of loads K, K+N, … of train.load_scales
+    #[arg(long, value_name = "K/N", requires = "snapshots_only")]
+    shard: Option<flexrom::pipeline::shard::Shard>,
+    /// snapshot file of --snapshots-only
+    #[arg(short, long, requires = "snapshots_only")]
+    output: Option<PathBuf>,
+    /// build the basis from these snapshot files instead of running the full model
+    #[arg(long, num_args = 1.., value_name = "SNAPS.h5")]
+    from_snapshots: Vec<PathBuf>,
+    #[command(flatten)]
+    format: FormatArgs,
+}
+
+impl Args {
+    pub fn run(self) -> flexrom::Result<()> {
+        let Args { pipeline, basis, snapshots_only, load_scale, shard, output, from_snapshots, format } = self;
+        let p = Pipeline::load(&pipeline)?;
+        if snapshots_only {
+            let out = output.expect("clap: --snapshots-only requires -o");
+            check_output(&out, Origin::Flag("-o"), &[(&p.path, "pipeline file"), (&p.model.path, "model file")])?;
+            let scales = flexrom::pipeline::snapshots::job_scales(&p, load_scale, shard)?;
+            let (n, secs) = flexrom::pipeline::snapshots::write_snapshots(&p, &scales, &out)?;
+            info(&format!("{}: {n} full run(s) at {scales:?} ({secs:.3} s) -> {}", p.path.display(), out.display()));
+            let mut t = Table::new(&["pipeline", "output", "n_runs", "load_scales", "seconds"]);
+            let list: Vec<String> = scales.iter().map(|x| x.to_string()).collect();
+            t.push(vec![
+                p.path.display().to_string().into(),
+                out.display().to_string().into(),
+                n.into(),
+                list.join(" ").into(),
+                secs.into(),
+            ]);
+            return print_table(&t, format.format(), true);
+        }
+        let origin =
+            if basis.is_some() { Origin::Flag("--basis") } else { Origin::Key { pipeline: &p.path, key: "basis" } };
+        let out = basis.clone().unwrap_or_else(|| p.basis_path.clone());
+        check_output(&out, origin, &[(&p.path, "pipeline file"), (&p.model.path, "model file")])?;
+        // trained into a temporary file, read back and checked, and only then renamed over
+        // the previous basis
+        let staged = TempPath::file_for(&out)?;
+        let s = if from_snapshots.is_empty() {
+            flexrom::pipeline::train::train_and_write(&p, staged.path())?
+        } else {
+            for f in &from_snapshots {
+                if flexrom::io::output::resolve(f) == flexrom::io::output::resolve(&out) {
+                    return Err(flexrom::Error::input(&out, "--basis", "is one of the --from-snapshots files"));
+                }
+            }
+            let (data, s) = flexrom::pipeline::snapshots::train_from_snapshots(&p, &from_snapshots)?;
+            flexrom::pipeline::train::write_trained(&p, staged.path(), &data, &s)?;
+            s
+        };
+        load_basis(&p, staged.path())?;
+        staged.commit()?;
+        let b = &s.trained.basis;
+        info(&format!(
+            "{}: {} snapshots from {} full run(s) ({:.3} s); {} basis, {} snapshots, {} POD modes{} (captured energy 1 − {:.2e}) -> {}",
+            p.path.display(),
+            s.n_snapshots,
+            s.n_runs,
+            s.full_seconds,
+            b.variant.name(),
+            b.snapshots.name(),
+            b.n_pod_modes,
+            if b.kept.is_empty() { String::new() } else { format!(" + {} joint coordinates", b.kept.len()) },
+            s.trained.uncaptured_energy(),
+            out.display()
+        ));
+        let mut t = Table::new(&[
+            "pipeline",
+            "basis",
+            "n_runs",
+            "n_snapshots",
+            "full_seconds",
+            "variant",
+            "snapshots",
+            "n_pod_modes",
+            "n_joint_coordinates",
+            "uncaptured_energy",
+        ]);
+        t.push(vec![
+            p.path.display().to_string().into(),
+            out.display().to_string().into(),
+            s.n_runs.into(),
+            s.n_snapshots.into(),
+            s.full_seconds.into(),
+            b.variant.name().into(),
+            b.snapshots.name().into(),
+            b.n_pod_modes.into(),
+            b.kept.len().into(),
+            s.trained.uncaptured_energy().into(),
+        ]);
+        print_table(&t, format.format(), true)
+    }
+}
