@@ -1,0 +1,362 @@
+//! The sweep file, written atomically at every checkpoint and read back by `--resume`
+//! (N load scales; rows of scales that failed or did not run yet hold NaN,
+//! and 0 in the counters):
+//!
+//! ```text
+//! /load_scales        (N)
+//! /status             (N)            0 = ok, 1 = failed, 2 = not run yet
+//! /message            (N)            why it failed ("" when ok)
+//! /t                  (n_t)
+//! /probes/<name>      (N, n_t, 2)    reduced-model probe positions, m
+//! /reduced_q          (N, n_t, r)    reduced coordinates (time first; layout 1: (N, r, n_t))
+//! /rom_seconds        (N)            reduced time loop of each run
+//! /newton_iterations  (N)
+//! /factorizations     (N)            iteration matrices factorized
+//! /error_estimate     (N)            the estimate of rel_error of each run (NaN: no estimator)
+//! /error_estimate_by_time (N, 5)     the estimate up to the end of each fifth of the run (the
+//!                                    last column is /error_estimate; NaN: no estimator)
+//! /extrapolated       (N)            1 where the load scale is outside the training range
+//! /estimate_seconds   (N)            the estimator's enriched run and norms, s
+//! with --validate:    /rel_error, /max_probe_error, /max_constraint_violation,
+//!                     /full_seconds, /speedup  (N each)
+//! every dataset: units, dims (src/io/attrs.rs)
+//! attributes on /: flexrom_layout, flexrom_file = "sweep", basis, basis_content_hash, model_fingerprint, variant, n_modes,
+//!   validated (0/1), wall_seconds (whole sweep), threads, continuation (1 when the runs
+//!   were continued from their neighbours), n_failed, n_pending, program_version
+//! ```
+
+use super::outcome::{ScaleResult, Sweep, SweepPoint, STATUS_OK, STATUS_PENDING};
+use crate::error::{Error, Result};
+use crate::io::attrs::{check_layout, write_atomically_as, Kind};
+use crate::io::basis_file::StoredBasis;
+use crate::io::h5::{attr_f64, attr_str, attr_u64, read_attr_str};
+use crate::model::Model;
+use crate::pipeline::estimate::Estimate;
+use crate::pipeline::online::ReducedRun;
+use crate::pipeline::validate::Validation;
+use crate::simulate::{Overrides, Settings, SimulationResult};
+use crate::solver::generalized_alpha::Stats;
+use hdf5::types::VarLenUnicode;
+use ndarray::{Array1, Array2, Array3};
+use std::path::Path;
+
+/// Extra content written into every version of a sweep file (a shard's `/shard` group).
+pub type Extra<'a> = &'a (dyn Fn(&hdf5::File) -> Result<()> + Sync);
+
+/// Writes the sweep file (atomically: a temporary file renamed over `path`).
+pub fn write_sweep(path: &Path, s: &Sweep, stored: &StoredBasis, basis_path: &Path) -> Result<()> {
+    write_sweep_with(path, s, stored, basis_path, &|_| Ok(()))
+}
+
+/// [`write_sweep`] with `extra` written into the file before it is renamed into place.
+pub fn write_sweep_with(path: &Path, s: &Sweep, stored: &StoredBasis, basis_path: &Path, extra: Extra) -> Result<()> {
+    let basis = &stored.basis;
+    let (n, nt, r) = (s.scales.len(), s.t.len(), s.n_reduced);
+    if n == 0 {
+        return Err(Error::Usage("the sweep has no load scales".into()));
+    }
+    write_atomically_as(path, Kind::Sweep, |f| {
+        let e = |err: hdf5::Error| Error::hdf5(path, err);
+        // one value per load scale: NaN where it did not run to the end
+        let col =
+            |g: &dyn Fn(&SweepPoint) -> f64| Array1::from_iter(s.scales.iter().map(|x| x.point().map_or(f64::NAN, g)));
+        let count = |g: &dyn Fn(&SweepPoint) -> usize| {
+            Array1::from_iter(s.scales.iter().map(|x| x.point().map_or(0, g) as u64))
+        };
+        f.new_dataset_builder()
+            .with_data(&Array1::from_iter(s.scales.iter().map(|x| x.load_scale)))
+            .create("load_scales")
+            .map_err(e)?;
+        f.new_dataset_builder()
+            .with_data(&Array1::from_iter(s.scales.iter().map(ScaleResult::status)))
+            .create("status")
+            .map_err(e)?;
+        let messages: Vec<VarLenUnicode> = s
+            .scales
+            .iter()
+            .map(|x| x.message().replace('\0', " ").parse::<VarLenUnicode>().unwrap_or_default())
+            .collect();
+        f.new_dataset_builder().with_data(&Array1::from(messages)).create("message").map_err(e)?;
+        f.new_dataset_builder().with_data(&s.t).create("t").map_err(e)?;
+        let g = f.create_group("probes").map_err(e)?;
+        for (i, name) in s.probe_names.iter().enumerate() {
+            let mut a = Array3::from_elem((n, nt, 2), f64::NAN);
+            for (k, x) in s.scales.iter().enumerate() {
+                if let Some(p) = x.point() {
+                    a.index_axis_mut(ndarray::Axis(0), k).assign(&p.rom.result.probes[i].1);
+                }
+            }
+            g.new_dataset_builder().with_data(&a).create(name.as_str()).map_err(e)?;
+        }
+        // time first: (load, time, mode); the runs keep r × n_t
+        let mut zq = Array3::from_elem((n, nt, r), f64::NAN);
+        for (k, x) in s.scales.iter().enumerate() {
+            if let Some(p) = x.point() {
+                zq.index_axis_mut(ndarray::Axis(0), k).assign(&p.rom.reduced_q.t());
+            }
+        }
+        // one chunk per run, not compressed: deflate took 15 % off the size of these
+        // trajectories for 0.15 s of a 1.5 s four-bar sweep
+        f.new_dataset_builder().chunk((1, nt.max(1), r.max(1))).with_data(&zq).create("reduced_q").map_err(e)?;
+        f.new_dataset_builder().with_data(&col(&|p| p.rom.result.wall_seconds)).create("rom_seconds").map_err(e)?;
+        f.new_dataset_builder()
+            .with_data(&count(&|p| p.rom.result.stats.newton_iterations))
+            .create("newton_iterations")
+            .map_err(e)?;
+        f.new_dataset_builder()
+            .with_data(&count(&|p| p.rom.result.stats.factorizations))
+            .create("factorizations")
+            .map_err(e)?;
+        f.new_dataset_builder()
+            .with_data(&col(&|p| p.estimate.map_or(f64::NAN, |e| e.error_estimate)))
+            .create("error_estimate")
+            .map_err(e)?;
+        let mut by_time = Array2::from_elem((n, 5), f64::NAN);
+        for (k, x) in s.scales.iter().enumerate() {
+            if let Some(est) = x.point().and_then(|p| p.estimate) {
+                by_time.row_mut(k).assign(&ndarray::ArrayView1::from(&est.by_time));
+            }
+        }
+        f.new_dataset_builder().with_data(&by_time).create("error_estimate_by_time").map_err(e)?;
+        f.new_dataset_builder()
+            .with_data(&col(&|p| p.estimate.map_or(f64::NAN, |e| e.seconds)))
+            .create("estimate_seconds")
+            .map_err(e)?;
+        f.new_dataset_builder()
+            .with_data(&Array1::from_iter(s.scales.iter().map(|x| x.point().is_some_and(|p| p.extrapolated) as u8)))
+            .create("extrapolated")
+            .map_err(e)?;
+        if s.validated {
+            let v = |g: &dyn Fn(&Validation) -> f64| col(&|p: &SweepPoint| p.validation.as_ref().map_or(f64::NAN, g));
+            f.new_dataset_builder().with_data(&v(&|x| x.rel_error)).create("rel_error").map_err(e)?;
+            f.new_dataset_builder().with_data(&v(&|x| x.max_probe_error)).create("max_probe_error").map_err(e)?;
+            f.new_dataset_builder()
+                .with_data(&v(&|x| x.max_constraint_violation))
+                .create("max_constraint_violation")
+                .map_err(e)?;
+            f.new_dataset_builder().with_data(&v(&|x| x.full_seconds)).create("full_seconds").map_err(e)?;
+            f.new_dataset_builder().with_data(&v(&|x| x.speedup)).create("speedup").map_err(e)?;
+        }
+        attr_str(f, "basis", &basis_path.display().to_string()).map_err(e)?;
+        attr_str(f, "basis_content_hash", &stored.content_hash).map_err(e)?;
+        attr_str(f, "model_fingerprint", &stored.model_fingerprint).map_err(e)?;
+        attr_str(f, "variant", basis.variant.name()).map_err(e)?;
+        attr_u64(f, "n_modes", basis.n_reduced() as u64).map_err(e)?;
+        attr_u64(f, "validated", s.validated as u64).map_err(e)?;
+        attr_f64(f, "wall_seconds", s.wall_seconds).map_err(e)?;
+        attr_u64(f, "threads", s.threads as u64).map_err(e)?;
+        attr_u64(f, "continuation", s.continuation as u64).map_err(e)?;
+        attr_u64(f, "n_failed", s.n_failed() as u64).map_err(e)?;
+        attr_u64(f, "n_pending", s.scales.iter().filter(|x| x.status() == STATUS_PENDING).count() as u64).map_err(e)?;
+        attr_str(f, "program_version", env!("CARGO_PKG_VERSION")).map_err(e)?;
+        extra(f)
+    })
+}
+
+/// Reads an earlier sweep file for `--resume`: (load scale, the finished run) for every
+/// scale it holds, `None` for those that failed or did not run. Refuses a file of another
+/// basis or model, and one without the validation a `--validate` sweep needs.
+pub fn read_sweep(
+    path: &Path,
+    model: &Model,
+    stored: &StoredBasis,
+    validate: bool,
+) -> Result<Vec<(f64, Option<SweepPoint>)>> {
+    let cannot = |field: &str, problem: String| {
+        Error::input(path, field, format!("{problem}; cannot resume from it (remove it, or run without --resume)"))
+    };
+    let f = hdf5::File::open(path).map_err(|e| cannot("(file)", format!("is not a readable HDF5 file: {e}")))?;
+    // layout 1 stored /reduced_q as (N, r, n_t): converted below; newer layouts are refused
+    let layout = check_layout(&f, path, "flexrom sweep")?;
+    let text = |name: &str| {
+        read_attr_str(&f, name).map_err(|e| cannot(name, format!("cannot be read ({e}): not a flexrom sweep file?")))
+    };
+    if text("basis_content_hash")? != stored.content_hash {
+        return Err(cannot("basis_content_hash", "comes from another basis than the one given".into()));
+    }
+    if text("model_fingerprint")? != model.fingerprint() {
+        return Err(cannot("model_fingerprint", "comes from another model than the pipeline's".into()));
+    }
+    let vec = |name: &str| {
+        f.dataset(name).and_then(|d| d.read_1d::<f64>()).map_err(|e| cannot(name, format!("cannot be read: {e}")))
+    };
+    let ints = |name: &str| {
+        f.dataset(name).and_then(|d| d.read_1d::<u64>()).map_err(|e| cannot(name, format!("cannot be read: {e}")))
+    };
+    let scales = vec("load_scales")?;
+    let status = f
+        .dataset("status")
+        .and_then(|d| d.read_1d::<u8>())
+        .map_err(|e| cannot("status", format!("cannot be read: {e}")))?;
+    let t = vec("t")?;
+    let s = Settings::resolve(model, &Overrides::default())?;
+    let (n, nt, r) = (scales.len(), s.n_steps + 1, stored.basis.n_reduced());
+    if status.len() != n || t.len() != nt {
+        return Err(cannot(
+            "status",
+            format!("has {} entries for {n} load scales, or /t {} for {nt} instants", status.len(), t.len()),
+        ));
+    }
+    let zq = f
+        .dataset("reduced_q")
+        .and_then(|d| d.read::<f64, ndarray::Ix3>())
+        .map_err(|e| cannot("reduced_q", format!("cannot be read: {e}")))?;
+    let zq = if layout == 1 {
+        if zq.dim() != (n, r, nt) {
+            return Err(cannot("reduced_q", format!("is {:?}, expected ({n}, {r}, {nt}) (layout 1)", zq.dim())));
+        }
+        zq
+    } else {
+        if zq.dim() != (n, nt, r) {
+            return Err(cannot("reduced_q", format!("is {:?}, expected ({n}, {nt}, {r})", zq.dim())));
+        }
+        // back to the runs' r × n_t
+        zq.permuted_axes([0, 2, 1]).as_standard_layout().to_owned()
+    };
+    let mut probes = Vec::new();
+    for name in model.probe_names() {
+        let a = f
+            .dataset(&format!("probes/{name}"))
+            .and_then(|d| d.read::<f64, ndarray::Ix3>())
+            .map_err(|e| cannot(&format!("probes/{name}"), format!("cannot be read: {e}")))?;
+        if a.dim() != (n, nt, 2) {
+            return Err(cannot(&format!("probes/{name}"), format!("is {:?}, expected ({n}, {nt}, 2)", a.dim())));
+        }
+        probes.push((name, a));
+    }
+    let rom_seconds = vec("rom_seconds")?;
+    // the estimate columns of the file (absent in files written before them: no estimate)
+    let optional = |name: &str| if f.link_exists(name) { vec(name).map(Some) } else { Ok(None) };
+    let (estimates, estimate_seconds, extrapolated) = (
+        optional("error_estimate")?,
+        optional("estimate_seconds")?,
+        if f.link_exists("extrapolated") {
+            Some(
+                f.dataset("extrapolated")
+                    .and_then(|d| d.read_1d::<u8>())
+                    .map_err(|e| cannot("extrapolated", format!("cannot be read: {e}")))?,
+            )
+        } else {
+            None
+        },
+    );
+    let by_time = if f.link_exists("error_estimate_by_time") {
+        let a = f
+            .dataset("error_estimate_by_time")
+            .and_then(|d| d.read::<f64, ndarray::Ix2>())
+            .map_err(|e| cannot("error_estimate_by_time", format!("cannot be read: {e}")))?;
+        if a.dim() != (n, 5) {
+            return Err(cannot("error_estimate_by_time", format!("is {:?}, expected ({n}, 5)", a.dim())));
+        }
+        Some(a)
+    } else {
+        None
+    };
+    let (newton, factorizations) = (ints("newton_iterations")?, ints("factorizations")?);
+    let validation = if validate && f.link_exists("rel_error") {
+        Some([
+            vec("rel_error")?,
+            vec("max_probe_error")?,
+            vec("max_constraint_violation")?,
+            vec("full_seconds")?,
+            vec("speedup")?,
+        ])
+    } else {
+        None
+    };
+    for a in [&rom_seconds]
+        .into_iter()
+        .chain(validation.iter().flatten())
+        .chain(estimates.iter())
+        .chain(estimate_seconds.iter())
+    {
+        if a.len() != n {
+            return Err(cannot(
+                "rom_seconds",
+                format!("a per-scale dataset has {} entries for {n} load scales", a.len()),
+            ));
+        }
+    }
+    let mut out = Vec::new();
+    for k in 0..n {
+        let x = scales[k];
+        // a finished run counts only when it has what this sweep writes
+        if status[k] != STATUS_OK || (validate && validation.is_none()) {
+            out.push((x, None));
+            continue;
+        }
+        let settings = Settings::resolve(model, &Overrides { load_scale: Some(x), ..Default::default() })?;
+        let stats = Stats {
+            steps: settings.n_steps,
+            newton_iterations: newton[k] as usize,
+            factorizations: factorizations[k] as usize,
+            ..Default::default()
+        };
+        let result = SimulationResult {
+            model_text: model.text.clone(),
+            model_path: model.path.display().to_string(),
+            settings,
+            t: t.clone(),
+            q: Array2::zeros((0, nt)),
+            multipliers: Array2::zeros((0, nt)),
+            probes: probes
+                .iter()
+                .map(|(name, a)| (name.clone(), a.index_axis(ndarray::Axis(0), k).to_owned()))
+                .collect(),
+            stats,
+            wall_seconds: rom_seconds[k],
+        };
+        let v = validation.as_ref().map(|c| Validation {
+            load_scale: x,
+            variant: stored.basis.variant.name().to_string(),
+            n_dof: stored.basis.n_dof(),
+            n_modes: r,
+            rel_error: c[0][k],
+            max_probe_error: c[1][k],
+            max_probe_error_probe: String::new(),
+            max_probe_error_t: f64::NAN,
+            max_constraint_violation: c[2][k],
+            full_seconds: c[3][k],
+            full_dense_seconds: None,
+            rom_seconds: rom_seconds[k],
+            speedup: c[4][k],
+            speedup_vs_dense: None,
+            full_newton_iterations: 0,
+            rom_newton_iterations: newton[k] as usize,
+            rom_step_cuts: 0,
+            // the estimate and the flags are set below from the file's columns
+            error_estimate: None,
+            effectivity: None,
+            estimate_calibrated: None,
+            estimate_seconds: None,
+            extrapolated: false,
+            training_range: None,
+            sensitivity: None,
+            rel_error_by_time: Vec::new(),
+            error_estimate_by_time: None,
+        });
+        // the stored estimate: its value and cost (the factor it was made with is the basis's)
+        let estimate = estimates.as_ref().map(|a| a[k]).filter(|e| !e.is_nan()).map(|error_estimate| Estimate {
+            error_estimate,
+            raw: f64::NAN,
+            factor: f64::NAN,
+            calibrated: false,
+            seconds: estimate_seconds.as_ref().map_or(f64::NAN, |a| a[k]),
+            by_time: by_time.as_ref().map_or([f64::NAN; 5], |a| std::array::from_fn(|i| a[[k, i]])),
+        });
+        let extrapolated = extrapolated.as_ref().is_some_and(|a| a.get(k).is_some_and(|&v| v != 0));
+        let v = v.map(|mut v| {
+            if let Some(e) = &estimate {
+                v.error_estimate = Some(e.error_estimate);
+                v.effectivity = Some(e.error_estimate / v.rel_error);
+                v.estimate_seconds = Some(e.seconds);
+                v.error_estimate_by_time = Some(e.by_time.to_vec());
+            }
+            v.extrapolated = extrapolated;
+            v
+        });
+        let rom = ReducedRun { result, reduced_q: zq.index_axis(ndarray::Axis(0), k).to_owned() };
+        out.push((x, Some(SweepPoint { rom, validation: v, estimate, extrapolated })));
+    }
+    Ok(out)
+}

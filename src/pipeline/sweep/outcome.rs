@@ -1,0 +1,112 @@
+//! What a sweep produced: the outcome of every load scale (done, failed, not run yet), the
+//! status codes of the sweep file's `/status`, and the one-line summary of the failures.
+
+use crate::pipeline::estimate::Estimate;
+use crate::pipeline::online::ReducedRun;
+use crate::pipeline::validate::Validation;
+use ndarray::Array1;
+
+/// Status codes of `/status`.
+pub const STATUS_OK: u8 = 0;
+pub const STATUS_FAILED: u8 = 1;
+pub const STATUS_PENDING: u8 = 2;
+
+pub struct SweepPoint {
+    pub rom: ReducedRun,
+    pub validation: Option<Validation>,
+    /// the run's error estimate (None: no estimator)
+    pub estimate: Option<Estimate>,
+    /// outside the training range
+    pub extrapolated: bool,
+}
+
+/// What became of one load scale.
+// one per load scale, built once and moved into place: the size difference costs nothing
+#[allow(clippy::large_enum_variant)]
+pub enum Outcome {
+    Done(SweepPoint),
+    /// the error message of its run
+    Failed(String),
+    /// not run (yet)
+    Pending,
+}
+
+pub struct ScaleResult {
+    pub load_scale: f64,
+    pub outcome: Outcome,
+}
+
+impl ScaleResult {
+    pub fn point(&self) -> Option<&SweepPoint> {
+        match &self.outcome {
+            Outcome::Done(p) => Some(p),
+            _ => None,
+        }
+    }
+
+    pub fn status(&self) -> u8 {
+        match self.outcome {
+            Outcome::Done(_) => STATUS_OK,
+            Outcome::Failed(_) => STATUS_FAILED,
+            Outcome::Pending => STATUS_PENDING,
+        }
+    }
+
+    pub fn message(&self) -> &str {
+        match &self.outcome {
+            Outcome::Done(_) => "",
+            Outcome::Failed(m) => m,
+            Outcome::Pending => "not run yet",
+        }
+    }
+}
+
+pub struct Sweep {
+    /// every requested load scale, in the order asked for
+    pub scales: Vec<ScaleResult>,
+    /// the time grid and probe names every run shares (from the model)
+    pub t: Array1<f64>,
+    pub probe_names: Vec<String>,
+    /// reduced coordinates r
+    pub n_reduced: usize,
+    pub validated: bool,
+    pub wall_seconds: f64,
+    pub threads: usize,
+    pub continuation: bool,
+    /// scales taken from an earlier sweep file (`--resume`)
+    pub resumed: usize,
+}
+
+impl Sweep {
+    /// The load scales that ran to the end, in order.
+    pub fn done(&self) -> impl Iterator<Item = &SweepPoint> {
+        self.scales.iter().filter_map(ScaleResult::point)
+    }
+
+    pub fn n_failed(&self) -> usize {
+        self.scales.iter().filter(|s| s.status() == STATUS_FAILED).count()
+    }
+
+    /// One line when some load scale failed, naming the first few and their errors:
+    /// "2 of 100 load scales failed: load scale 1e20: Newton failed at …; …".
+    pub fn failure_summary(&self) -> Option<String> {
+        let failed: Vec<&ScaleResult> = self.scales.iter().filter(|s| s.status() == STATUS_FAILED).collect();
+        if failed.is_empty() {
+            return None;
+        }
+        // each message names its stage and load scale already (`Error::at_stage`)
+        let shown: Vec<String> = failed.iter().take(3).map(|s| s.message().to_string()).collect();
+        let more = if failed.len() > 3 { format!("; and {} more", failed.len() - 3) } else { String::new() };
+        Some(format!("{} of {} load scales failed: {}{more}", failed.len(), self.scales.len(), shown.join("; ")))
+    }
+}
+
+/// A copy of a finished point (the resumed ones are taken from the file read back).
+pub(super) fn clone_point(p: &SweepPoint) -> SweepPoint {
+    SweepPoint {
+        rom: p.rom.clone(),
+        validation: p.validation.clone(),
+        estimate: p.estimate,
+        extrapolated: p.extrapolated,
+    }
+}

@@ -1,0 +1,58 @@
+//! The table `flexrom sweep` prints on stdout (text form; `--csv`/`--json` use
+//! `pipeline::tables::sweep_table`).
+
+use super::outcome::{Sweep, STATUS_FAILED};
+
+/// The table printed on stdout.
+pub fn table(s: &Sweep) -> String {
+    let mut out = String::new();
+    out.push_str("load_scale  rom_ms  newton  error_estimate  est_ms  extrap");
+    if s.validated {
+        out.push_str("   rel_error  probe_err_m  full_ms  speedup");
+    }
+    out.push('\n');
+    for x in &s.scales {
+        let Some(p) = x.point() else {
+            out.push_str(&format!(
+                "{}  {}: {}\n",
+                scale(x.load_scale),
+                if x.status() == STATUS_FAILED { "failed" } else { "not run" },
+                x.message()
+            ));
+            continue;
+        };
+        let r = &p.rom.result;
+        out.push_str(&format!(
+            "{}  {:>6.2}  {:>6}",
+            scale(r.settings.load_scale),
+            1e3 * r.wall_seconds,
+            r.stats.newton_iterations
+        ));
+        match &p.estimate {
+            Some(e) => out.push_str(&format!("  {:>14.3e}  {:>6.2}", e.error_estimate, 1e3 * e.seconds)),
+            None => out.push_str(&format!("  {:>14}  {:>6}", "-", "-")),
+        }
+        out.push_str(if p.extrapolated { "     yes" } else { "      no" });
+        if let Some(v) = &p.validation {
+            out.push_str(&format!(
+                "  {:>10.3e}  {:>11.3e}  {:>7.2}  {:>7.2}",
+                v.rel_error,
+                v.max_probe_error,
+                1e3 * v.full_seconds,
+                v.speedup
+            ));
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// A load scale in the table's first column: fixed point, or exponent form when that would
+/// not fit (|x| ≥ 1e6) or show nothing (|x| < 1e-3).
+fn scale(x: f64) -> String {
+    if x != 0.0 && !(1e-3..1e6).contains(&x.abs()) {
+        format!("{x:>10.3e}")
+    } else {
+        format!("{x:>10.4}")
+    }
+}
