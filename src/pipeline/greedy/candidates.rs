@@ -1,0 +1,109 @@
+//! What the greedy loop knows of every candidate load: the error estimate and the reduced
+//! model's sensitivity by fifth of the run (reduced runs in parallel), and the score of a
+//! candidate that the loop holds to the tolerance (the greedy module documentation).
+
+use crate::model::Model;
+use crate::pipeline::estimate::{raw_estimate_by_time, EstimatingRunner, Estimator};
+use crate::pipeline::online::Output;
+use crate::reduction::Basis;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rayon::prelude::*;
+
+/// δ of the sensitivity `s(λ) = ‖X_r(λ(1 + δ)) − X_r(λ)‖ / ‖X_r(λ)‖` (the issue's
+/// definition of `sensitivity`, 0.1 %).
+pub const SENSITIVITY_STEP: f64 = 1e-3;
+
+/// The score of one candidate (the greedy module documentation): `T · max_i η_i / max(T, s_i)`; NaN
+/// counts as ∞.
+pub fn score(tolerance: f64, estimate_by_time: &[f64; 5], sensitivity_by_time: &[f64; 5]) -> f64 {
+    let mut worst = 0.0_f64;
+    for (&e, &s) in estimate_by_time.iter().zip(sensitivity_by_time) {
+        let e = if e.is_nan() { f64::INFINITY } else { e };
+        let s = if s.is_finite() { s } else { 0.0 };
+        worst = worst.max(tolerance * e / tolerance.max(s));
+    }
+    worst
+}
+
+/// What the loop knows of one candidate.
+#[derive(Clone, Copy)]
+pub(super) struct CandidateRun {
+    /// the error estimate by fifth of the run (the last: the whole run's)
+    pub(super) by_time: [f64; 5],
+    /// the whole run's raw estimate
+    pub(super) raw: f64,
+    /// the reduced model's sensitivity by fifth of the run (the greedy module documentation)
+    pub(super) sensitivity: [f64; 5],
+}
+
+/// The seam to the error estimator: the estimate and the reduced model's sensitivity of
+/// `basis` at every load, reduced runs in parallel (one reduced model and its estimator's
+/// per worker, as `sweep` does); a run that fails gives ∞ estimates (and sensitivity 0,
+/// which holds its estimate to T).
+pub(super) fn estimate_candidates(
+    model: &Model,
+    basis: &Basis,
+    est: &Estimator,
+    loads: &[f64],
+    label: &str,
+) -> Vec<CandidateRun> {
+    let target =
+        if crate::output::show_progress() { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() };
+    let bar = ProgressBar::with_draw_target(Some(loads.len() as u64), target);
+    bar.set_style(
+        ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} candidates, {elapsed}")
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
+    bar.set_prefix(label.to_string());
+    let failed = CandidateRun { by_time: [f64::INFINITY; 5], raw: f64::INFINITY, sensitivity: [0.0; 5] };
+    let out: Vec<CandidateRun> = loads
+        .par_iter()
+        .map_init(
+            || EstimatingRunner::new(model, basis, Some(est)).ok(),
+            |runner, &x| {
+                let r = match runner {
+                    Some(r) => match r.run(x, Output::ReducedAndProbes) {
+                        Ok((run, Some(e))) => {
+                            // the same reduced model at λ(1 + δ): how much its answer moves
+                            let sensitivity =
+                                match r.reduced().run(x * (1.0 + SENSITIVITY_STEP), Output::ReducedAndProbes, &[]) {
+                                    Ok(moved) => raw_estimate_by_time(basis, basis, &moved.reduced_q, &run.reduced_q),
+                                    Err(_) => [0.0; 5],
+                                };
+                            CandidateRun { by_time: e.by_time, raw: e.raw, sensitivity }
+                        }
+                        _ => failed,
+                    },
+                    None => failed,
+                };
+                bar.inc(1);
+                r
+            },
+        )
+        .collect();
+    bar.finish_and_clear();
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::score;
+
+    /// Where the sensitivity stays below T the score is the largest estimate; a window
+    /// whose sensitivity exceeds T holds its estimate to that sensitivity instead; NaN
+    /// counts as ∞.
+    #[test]
+    fn score_holds_sensitive_windows_to_their_sensitivity() {
+        let t = 1e-2;
+        let calm = [1e-4; 5];
+        assert_eq!(score(t, &[1e-3, 2e-3, 3e-3, 4e-3, 5e-3], &calm), 5e-3);
+        // the last two fifths are sensitive (s = 0.2): an estimate of 0.1 there scores
+        // T·0.1/0.2 = 5e-3, below the early windows' 6e-3
+        let s = [1e-4, 1e-4, 1e-3, 0.2, 0.2];
+        assert!((score(t, &[1e-3, 2e-3, 6e-3, 0.1, 0.1], &s) - 6e-3).abs() < 1e-15);
+        // above the sensitivity it still counts, scaled: 0.4 against 0.2 scores 2 T
+        assert!((score(t, &[1e-3, 2e-3, 6e-3, 0.1, 0.4], &s) - 2e-2).abs() < 1e-15);
+        assert!(score(t, &[f64::NAN, 0.0, 0.0, 0.0, 0.0], &calm).is_infinite());
+    }
+}

@@ -1,0 +1,187 @@
+//! The mode and hyper-reduction search of one greedy iteration (the greedy module
+//! documentation): the energy ladder of POD tolerances ε, τ = √ε for ECSW, the half step back,
+//! then the loosest τ that still meets T / [`MARGIN`]; each rung a `Level`.
+
+use super::candidates::{estimate_candidates, score};
+use crate::error::{Error, Result};
+use crate::io::basis_file::TrainingData;
+use crate::pipeline::basis_build::build_basis;
+use crate::pipeline::config::{GreedySpec, Pipeline};
+use crate::pipeline::estimate::{calibrate, CalibrationPoint, Estimator, DEFAULT_EXTRA_MODES};
+use crate::pipeline::training_record::modes_text;
+use crate::reduction::{ModeRule, Trained};
+
+/// The loop accepts a level whose worst estimate is at most T / `MARGIN`.
+pub const MARGIN: f64 = 2.0;
+/// Energy tolerances ε tried, loose to tight: 10⁻², 10⁻³, …, 10⁻¹⁰.
+pub const ENERGY_LADDER: [f64; 9] = [1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10];
+/// ECSW tolerances τ tried with the chosen modes, loose to tight: 10^(−1 − i/2), down to 10⁻⁶
+/// (also the τ with given modes and no given τ).
+pub const TAU_LADDER: [f64; 11] =
+    [1e-1, 3.162e-2, 1e-2, 3.162e-3, 1e-3, 3.162e-4, 1e-4, 3.162e-5, 1e-5, 3.162e-6, 1e-6];
+
+/// A basis of one rung of the ladder with its estimator and its estimates at the candidates.
+pub(super) struct Level {
+    pub(super) energy: f64,
+    pub(super) hyper_tolerance: Option<f64>,
+    pub(super) trained: Trained,
+    pub(super) estimator: Estimator,
+    /// scores (the greedy module documentation)
+    pub(super) estimates: Vec<f64>,
+    pub(super) whole: Vec<f64>,
+    pub(super) raws: Vec<f64>,
+    pub(super) sensitivity: Vec<[f64; 5]>,
+    /// the estimator got its `k` extra modes in every block
+    fully_enriched: bool,
+}
+
+impl Level {
+    /// The candidate with the largest estimate and that estimate (NaN counts as ∞).
+    pub(super) fn worst(&self) -> (usize, f64) {
+        self.worst_where(|_| true).expect("at least two candidates")
+    }
+
+    /// [`Self::worst`] among the candidates `keep` accepts.
+    pub(super) fn worst_where(&self, keep: impl Fn(usize) -> bool) -> Option<(usize, f64)> {
+        let mut w: Option<(usize, f64)> = None;
+        for (i, &e) in self.estimates.iter().enumerate().filter(|(i, _)| keep(*i)) {
+            let e = if e.is_nan() { f64::INFINITY } else { e };
+            if w.is_none_or(|w| e > w.1) {
+                w = Some((i, e));
+            }
+        }
+        w
+    }
+}
+
+/// The mode and hyper-reduction search of one iteration (the greedy module documentation): the modes
+/// the pipeline gives, or the energy ladder loose → tight with τ = √ε (and a half step
+/// before the first accepted rung); then, unless the pipeline gives τ, the loosest τ that
+/// still meets T / 2 with those modes.
+pub(super) fn search(
+    p: &Pipeline,
+    g: &GreedySpec,
+    data: &TrainingData,
+    candidates: &[f64],
+    points: &[CalibrationPoint],
+    n: usize,
+    previous_energy: Option<f64>,
+) -> Result<Level> {
+    let given_hyper = p.file.reduction.hyper.as_ref().map(|h| h.tolerance);
+    let debug = std::env::var_os("FLEXROM_GREEDY_DEBUG").is_some();
+    let accepts = |l: &Level| l.worst().1 <= g.tolerance / MARGIN;
+    let mut last_error: Option<(&'static str, String)> = None;
+    let mut attempt = |modes: ModeRule, eps: f64, tau: f64| -> Option<Level> {
+        match level(p, data, candidates, points, modes, eps, Some(tau), n) {
+            Ok(l) => {
+                if debug {
+                    let (wi, w) = l.worst();
+                    let h = l.trained.basis.hyper.as_ref().map_or(0, |h| h.elements.len());
+                    crate::output::info(&format!("  rung ε = {eps:.1e}, τ = {tau:.1e}: {}, {h} elements, estimator {:?}, worst estimate {w:.3e} at λ = {}", modes_text(&l.trained.block_modes), l.estimator.block_modes, candidates[wi]));
+                }
+                Some(l)
+            }
+            Err(e) => {
+                last_error = Some(e);
+                None
+            }
+        }
+    };
+    let better = |best: &Option<Level>, l: &Level| best.as_ref().is_none_or(|b| l.worst().1 < b.worst().1);
+    let mut best: Option<Level> = None;
+    if let Some(m) = &p.file.reduction.modes {
+        best = attempt(m.clone(), f64::NAN, given_hyper.unwrap_or(TAU_LADDER[TAU_LADDER.len() - 1]));
+    } else {
+        let mut failed_eps: Option<f64> = None;
+        // after the first iteration the ladder starts two rungs looser than the rung chosen
+        // last time: more snapshots need as many modes or more for the same error, and the
+        // rungs far looser than that were already far off
+        let start = previous_energy
+            .and_then(|e| ENERGY_LADDER.iter().position(|&x| x <= e * (1.0 + 1e-9)))
+            .map_or(0, |i| i.saturating_sub(2));
+        for &eps in &ENERGY_LADDER[start..] {
+            let Some(l) = attempt(ModeRule::Energy(eps), eps, given_hyper.unwrap_or(eps.sqrt())) else { continue };
+            if !l.fully_enriched && best.is_some() {
+                // the snapshots span too little for a tighter basis with an honest estimate
+                break;
+            }
+            let (ok, enriched) = (accepts(&l), l.fully_enriched);
+            if ok {
+                // a half step back towards the last rung that failed: fewer modes may do
+                if let Some(f) = failed_eps {
+                    let half = (f * eps).sqrt();
+                    if let Some(h) = attempt(ModeRule::Energy(half), half, given_hyper.unwrap_or(half.sqrt())) {
+                        if accepts(&h) && h.fully_enriched && h.trained.basis.n_reduced() < l.trained.basis.n_reduced()
+                        {
+                            best = Some(h);
+                            break;
+                        }
+                    }
+                }
+                best = Some(l);
+                break;
+            }
+            failed_eps = Some(eps);
+            if better(&best, &l) {
+                best = Some(l);
+            }
+            if !enriched {
+                break;
+            }
+        }
+    }
+    // the cheapest hyper-reduction that keeps the accepted modes within T / 2
+    if let (Some(b), None) = (&best, given_hyper) {
+        if accepts(b) {
+            let modes = if p.blocks().is_some() {
+                ModeRule::Counts(b.trained.block_modes.clone())
+            } else {
+                ModeRule::Count(b.trained.block_modes[0])
+            };
+            let (eps, tau0) = (b.energy, b.hyper_tolerance.unwrap_or(0.0));
+            for &tau in TAU_LADDER.iter().filter(|&&t| t > tau0 * (1.0 + 1e-9)) {
+                if let Some(l) = attempt(modes.clone(), eps, tau) {
+                    if accepts(&l) {
+                        best = Some(l);
+                        break;
+                    }
+                }
+            }
+        }
+    }
+    best.ok_or_else(|| {
+        let (f, e) = last_error.unwrap_or(("reduction", "no basis could be built".into()));
+        Error::input(&p.path, f, format!("greedy training, iteration {n}: {e}"))
+    })
+}
+
+/// Builds the basis and estimator of one rung and estimates at every candidate.
+#[allow(clippy::too_many_arguments)]
+fn level(
+    p: &Pipeline,
+    data: &TrainingData,
+    candidates: &[f64],
+    points: &[CalibrationPoint],
+    modes: ModeRule,
+    energy: f64,
+    hyper_tolerance: Option<f64>,
+    n: usize,
+) -> std::result::Result<Level, (&'static str, String)> {
+    let (trained, mut estimator) = build_basis(p, data, modes, hyper_tolerance)?;
+    estimator.calibration = calibrate(points.to_vec());
+    let fully_enriched =
+        estimator.block_modes.iter().zip(&trained.block_modes).all(|(&e, &r)| e >= r + DEFAULT_EXTRA_MODES);
+    let label =
+        if energy.is_finite() { format!("iteration {n}, energy {energy:.0e}") } else { format!("iteration {n}") };
+    let runs = estimate_candidates(&p.model, &trained.basis, &estimator, candidates, &label);
+    let estimates = runs.iter().map(|r| score(p_tolerance(p), &r.by_time, &r.sensitivity)).collect();
+    let whole = runs.iter().map(|r| r.by_time[4]).collect();
+    let raws = runs.iter().map(|r| r.raw).collect();
+    let sensitivity = runs.iter().map(|r| r.sensitivity).collect();
+    Ok(Level { energy, hyper_tolerance, trained, estimator, estimates, whole, raws, sensitivity, fully_enriched })
+}
+
+/// The greedy tolerance of the pipeline (`[train] greedy`).
+fn p_tolerance(p: &Pipeline) -> f64 {
+    p.file.train.greedy.as_ref().map_or(f64::INFINITY, |g| g.tolerance)
+}
