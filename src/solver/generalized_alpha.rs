@@ -22,6 +22,7 @@
 //! nominal step is completed with the smaller steps.
 
 use super::model::{DynamicModel, IterationCoefficients};
+pub use super::predictor::Predictor;
 use crate::error::{Error, Result};
 
 /// Parameters of the integrator; `validate()` checks them.
@@ -41,6 +42,8 @@ pub struct IntegratorParams {
     pub max_cuts: u32,
     /// when the factorized iteration matrix may be kept instead of refreshed
     pub reuse: JacobianReuse,
+    /// where Newton starts a step that has no guess ([`Predictor`])
+    pub predictor: Predictor,
     /// blow-up check: the largest mean axial strain |ε̄| a run may reach (`[time]
     /// max_strain`, default 0.5 = 50 %; infinity disables it)
     pub max_strain: f64,
@@ -56,8 +59,8 @@ pub enum JacobianReuse {
     Never,
     /// within a step, once an iteration contracted fast (θ = ‖Δq_k‖/‖Δq_{k−1}‖ < 0.1), keep
     /// the matrix until the contraction slows (θ > 0.3); the first iteration of every step
-    /// refactors, and its matrix is kept at once when a guessed increment needed a
-    /// correction below 5 % of itself. The default: on every shipped model, full and
+    /// refactors, and its matrix is kept at once when a guessed increment (given, or the
+    /// constant-velocity [`Predictor`]'s) needed a correction below 5 % of itself. The default: on every shipped model, full and
     /// reduced, 15–25 % faster than full Newton for the same tolerance, and more so with
     /// good guesses (continuation sweeps).
     WithinStep,
@@ -81,6 +84,7 @@ impl Default for IntegratorParams {
             max_iterations: 25,
             max_cuts: 8,
             reuse: JacobianReuse::WithinStep,
+            predictor: Predictor::default(),
             max_strain: 0.5,
             max_total_cuts: 50,
         }
@@ -209,8 +213,8 @@ impl GeneralizedAlpha {
 
     /// [`Self::step`] with a guess of the step's increment `q_{n+1} − q_n` (e.g. the same
     /// step of a run at a nearby load scale) as Newton's starting point instead of the
-    /// zero-acceleration predictor. The guess only moves the start: the step still stops on
-    /// the same tolerance. Halved sub-steps, if any, use the default predictor.
+    /// predictor ([`IntegratorParams::predictor`]). The guess only moves the start: the step
+    /// still stops on the same tolerance. Halved sub-steps, if any, use the predictor.
     pub fn step_guided<M: DynamicModel>(
         &mut self,
         model: &mut M,
@@ -279,16 +283,24 @@ impl GeneralizedAlpha {
         let gamma_p = g / (b * h);
         let coef = IterationCoefficients { mass: 1.0, damping: gamma_p / beta_p, stiffness: 1.0 / beta_p };
         let t = st.t + h;
-        // predictor: q̈_{n+1} = 0 and a_{n+1} from the α relation; with a guessed increment,
-        // the q̈_{n+1} that puts q_{n+1} there (a_{n+1} = a₀ + c q̈_{n+1}, c = (1−α_f)/(1−α_m))
+        // predictor (super::predictor): with a guessed increment (given, or the predictor's),
+        // the q̈_{n+1} that puts q_{n+1} there (a_{n+1} = a₀ + c q̈_{n+1}, c = (1−α_f)/(1−α_m));
+        // else q̈_{n+1} = 0, and a_{n+1} from the α relation
         let c = (1.0 - af) / (1.0 - am);
         assert!(guess.is_none_or(|d| d.len() == n), "a guessed increment needs {n} entries");
+        let predictor = self.params.predictor;
+        // ‖guess‖∞, for keeping the first matrix of a good guess (below)
+        let guess_size = match guess {
+            Some(d) => Some(d.iter().fold(0.0_f64, |m, x| m.max(x.abs()))),
+            None => predictor.increment_size(h, &st.v),
+        };
         for i in 0..n {
             // a₀: the part of a_{n+1} that does not depend on q̈_{n+1}; st.a holds it while
             // Newton runs and gets c q̈_{n+1} added at convergence
             let a0 = (af * st.qdd[i] - am * st.a[i]) / (1.0 - am);
             let dq0 = h * st.v[i] + h * h * ((0.5 - b) * st.a[i] + b * a0);
-            let qdd = guess.map_or(0.0, |d| (d[i] - dq0) / (h * h * b * c));
+            let d = guess.map_or_else(|| predictor.increment(h, st.v[i]), |d| Some(d[i]));
+            let qdd = d.map_or(0.0, |d| (d - dq0) / (h * h * b * c));
             st.q[i] += dq0 + h * h * b * c * qdd;
             st.v[i] += h * ((1.0 - g) * st.a[i] + g * (a0 + c * qdd));
             st.a[i] = a0;
@@ -381,7 +393,7 @@ impl GeneralizedAlpha {
                     } else if it == 1 {
                         // keep the first matrix only when the guess was good: its
                         // correction small next to the step it guessed
-                        guess.is_none_or(|d| inc > 0.05 * d.iter().fold(0.0_f64, |m, x| m.max(x.abs())))
+                        guess_size.is_none_or(|g| inc > 0.05 * g)
                     } else {
                         theta >= 0.1
                     }

@@ -3,4 +3,5 @@
 pub mod generalized_alpha;
 pub mod model;
 pub mod parameters;
+pub mod predictor;
 pub mod statics;

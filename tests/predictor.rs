@@ -1,0 +1,121 @@
+//! The constant-velocity predictor (`Predictor::ConstantVelocity`, the default; see
+//! src/solver/predictor.rs) changes where Newton starts a step, not where it stops, and it
+//! starts closer: fewer factorizations than the zero-acceleration predictor.
+//!
+//! Checked step by step: from the very state the default run starts each step at, a
+//! zero-acceleration step is taken on a second copy of the model and a reference step on a
+//! third (full Newton to 1e-3 of the tolerance: the step's root to ~1e-13 L). Both
+//! predictors' step ends must lie within 30 · tol · L of the root (tol = 1e-10 the Newton
+//! tolerance, L the model's length scale). Each stops when its own remaining error, ‖Δq‖ or
+//! the contraction estimate θ/(1−θ)‖Δq‖, is below tol · L, which would put it within tol of
+//! the root if the estimate were exact; under the default modified Newton it is not (a kept
+//! matrix's θ predicts the next iteration only roughly; tests/jacobian_reuse.rs measured 3.7
+//! tol on the pendulum). Measured here: the zero-acceleration predictor (the old default) up
+//! to 21.5 tol (full) and 7.1 tol (reduced), the constant-velocity one 4.1 and 11.8 tol;
+//! hence 30 tol for both: the new start stops as close to the root as the old one did.
+//!
+//! Models: the full thesis four-bar (data/models/fourbar.toml, all 157 steps, λ = 0.85, a
+//! load no basis is trained at) and its hyper-reduced model with one POD per body
+//! (pipelines/thesis/fourbar_blocks.toml, trained here at λ = 0.935 in ~2 s, run at 0.85).
+//! The factorization counts must be strictly lower with the default predictor; measured on
+//! whole runs at λ = 0.74, 0.85, 1.0, 1.1 (docs/reduced-speed.md): full 537–565 against
+//! 569–656, greedy-trained shipped basis 516–543 against 565–720.
+
+use flexrom::physics::system::FlexibleSystem;
+use flexrom::pipeline::train::train;
+use flexrom::pipeline::Pipeline;
+use flexrom::reduction::HyperReducedModel;
+use flexrom::simulate::{prepare, Overrides, Settings};
+use flexrom::solver::generalized_alpha::{GeneralizedAlpha, IntegratorParams, JacobianReuse, Predictor, Stats};
+use flexrom::solver::model::{Bound, DynamicModel, Parameters, ParametricModel};
+use std::path::{Path, PathBuf};
+
+/// the bound on a step end's distance from the root, in tolerances (see the header)
+const BOUND: f64 = 30.0;
+
+fn repo(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
+}
+
+/// Runs `steps` steps of `dt` with the default predictor on `run` and, from each step's
+/// start, a zero-acceleration step on `check` and a full-Newton step to 1e-3 of the
+/// tolerance (the reference root) on `exact`; returns the largest distances of the two
+/// predictors' step ends from the reference, over the length scale, and their stats.
+fn compare<M: DynamicModel>(
+    run: &mut M,
+    check: &mut M,
+    exact: &mut M,
+    params: &IntegratorParams,
+    q0: Vec<f64>,
+    dt: f64,
+    steps: usize,
+) -> ((f64, f64), Stats, Stats) {
+    assert_eq!(params.predictor, Predictor::ConstantVelocity, "the default");
+    let v0 = vec![0.0; q0.len()];
+    let mut integ = GeneralizedAlpha::new(params.clone()).unwrap();
+    let za = IntegratorParams { predictor: Predictor::ZeroAcceleration, ..params.clone() };
+    let mut other = GeneralizedAlpha::new(za).unwrap();
+    let tight = IntegratorParams { tolerance: 1e-3 * params.tolerance, reuse: JacobianReuse::Never, ..params.clone() };
+    let mut reference = GeneralizedAlpha::new(tight).unwrap();
+    let mut st = integ.initialize(run, q0.clone(), v0.clone(), 0.0).unwrap();
+    other.initialize(check, q0.clone(), v0.clone(), 0.0).unwrap();
+    reference.initialize(exact, q0, v0, 0.0).unwrap();
+    let dist = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+    let (mut worst_cv, mut worst_za) = (0.0_f64, 0.0_f64);
+    for _ in 0..steps {
+        let (mut start, mut root) = (st.clone(), st.clone());
+        integ.step(run, &mut st, dt).unwrap();
+        other.step(check, &mut start, dt).unwrap();
+        reference.step(exact, &mut root, dt).unwrap();
+        worst_cv = worst_cv.max(dist(&st.q, &root.q) / run.length_scale());
+        worst_za = worst_za.max(dist(&start.q, &root.q) / run.length_scale());
+    }
+    ((worst_cv, worst_za), integ.stats, other.stats)
+}
+
+fn check<M: ParametricModel>(name: &str, make: impl Fn() -> M, s: &Settings, q0: Vec<f64>) {
+    let mu = Parameters::new(s.load_scale);
+    let (mut a, mut b, mut c) = (make(), make(), make());
+    let ((cv_err, za_err), cv, za) = compare(
+        &mut Bound::new(&mut a, &mu),
+        &mut Bound::new(&mut b, &mu),
+        &mut Bound::new(&mut c, &mu),
+        &s.params,
+        q0,
+        s.dt,
+        s.n_steps,
+    );
+    eprintln!(
+        "{name}: constant velocity {cv:?}\n  zero acceleration {za:?}\n  largest distance from the root: {cv_err:.3e} L vs {za_err:.3e} L"
+    );
+    let bound = BOUND * s.params.tolerance;
+    assert!(cv_err <= bound, "{name}: a step ends {cv_err:.3e} L from the root > {bound:.1e} L");
+    assert!(za_err <= bound, "{name}: the old predictor ends {za_err:.3e} L from the root > {bound:.1e} L");
+    assert_eq!((cv.step_cuts, za.step_cuts), (0, 0), "{name}");
+    assert!(cv.factorizations < za.factorizations, "{name}: factorizations {} vs {}", cv.factorizations, za.factorizations);
+}
+
+fn settings(p: &Pipeline, scale: f64) -> Settings {
+    Settings::resolve(&p.model, &Overrides { load_scale: Some(scale), ..Default::default() }).unwrap()
+}
+
+#[test]
+fn the_predictor_moves_no_full_order_step_end_and_saves_factorizations() {
+    let p = Pipeline::load(repo("pipelines/thesis/fourbar_blocks.toml")).unwrap();
+    let s = settings(&p, 0.85);
+    let q0 = prepare(&p.model, &s).unwrap().1;
+    check("full four-bar", || prepare(&p.model, &s).unwrap().0, &s, q0);
+}
+
+#[test]
+fn the_predictor_moves_no_reduced_step_end_and_saves_factorizations() {
+    let p = Pipeline::load(repo("pipelines/thesis/fourbar_blocks.toml")).unwrap();
+    let (_, summary) = train(&p).unwrap();
+    let basis = summary.trained.basis;
+    let hyper = basis.hyper.clone().expect("the pipeline asks for ECSW");
+    let s = settings(&p, 0.85);
+    let (sys, x0) = prepare(&p.model, &s).unwrap();
+    let q0 = basis.reduce(ndarray::ArrayView1::from(&x0)).to_vec();
+    let full = std::sync::Arc::new(sys);
+    check("reduced four-bar", || HyperReducedModel::<FlexibleSystem>::new(full.clone(), &basis, &hyper).unwrap(), &s, q0);
+}
