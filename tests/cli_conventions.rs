@@ -79,11 +79,7 @@ fn every_result_prints_as_csv_and_json() {
     let j = json(&o);
     assert_eq!(j.as_array().unwrap().len(), 5);
     assert_eq!(j[4]["t"].as_f64().unwrap(), rows[4][0].parse::<f64>().unwrap());
-    // the same digits in both (shortest round-trip form), but serde_json's default float
-    // parser is not correctly rounded: it may read a 17-digit number 1 ulp off (measured:
-    // "-0.0019620200056880074"), so the parsed values agree to 1 ulp, not bit for bit
-    let (a, b) = (j[4]["tip_y"].as_f64().unwrap(), rows[4][2].parse::<f64>().unwrap());
-    assert!((a - b).abs() <= f64::EPSILON * b.abs(), "JSON and CSV agree: {a} vs {b}");
+    assert_eq!(j[4]["tip_y"].as_f64().unwrap(), rows[4][2].parse::<f64>().unwrap(), "JSON and CSV agree");
     assert!(out.exists(), "simulate created sim/deep/");
 
     // train: one record; the basis's folder bases/deep/ does not exist yet
