@@ -95,6 +95,10 @@ fn bad_model_files_are_refused_with_file_field_and_problem() {
             &["time.jacobian_reuse", "within-step"],
         ),
         (
+            Box::new(|s: &str| s.replace("rho_inf = 1.0", "rho_inf = 1.0\npredictor = \"linear\"")),
+            &["time.predictor", "constant-velocity", "linear"],
+        ),
+        (
             Box::new(|s: &str| s.replace("body = \"beam\"\nnode = \"start\"", "body = \"bean\"\nnode = \"start\"")),
             &["joints[0].body", "bean"],
         ),

@@ -8,7 +8,7 @@ use super::Model;
 use crate::error::Result;
 use crate::physics::element::Section;
 use crate::physics::system::{BeamBody, Joint, Load, NodeId, Probe};
-use crate::solver::generalized_alpha::{IntegratorParams, JacobianReuse};
+use crate::solver::generalized_alpha::{IntegratorParams, JacobianReuse, Predictor};
 
 /// Relative tolerance for a joint to count as closed in the initial configuration.
 const CLOSURE_TOL: f64 = 1e-6;
@@ -335,6 +335,18 @@ impl Model {
                     return Err(self.err(
                         "time.jacobian_reuse",
                         format!("must be \"within-step\", \"across-steps\" or \"never\", got \"{r}\""),
+                    ))
+                }
+            };
+        }
+        if let Some(r) = &t.predictor {
+            p.predictor = match r.as_str() {
+                "zero-acceleration" => Predictor::ZeroAcceleration,
+                "constant-velocity" => Predictor::ConstantVelocity,
+                _ => {
+                    return Err(self.err(
+                        "time.predictor",
+                        format!("must be \"zero-acceleration\" or \"constant-velocity\", got \"{r}\""),
                     ))
                 }
             };

@@ -43,6 +43,10 @@ pub struct TimeSettings {
     /// fast) or "never" (a fresh matrix at every iteration: full Newton)
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub jacobian_reuse: Option<String>,
+    /// where Newton starts a step: "zero-acceleration" (the default) or
+    /// "constant-velocity" (q_n + h q̇_n; docs/reduced-speed.md)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub predictor: Option<String>,
     /// blow-up check: the largest mean axial strain |ε̄| a run may reach (default 0.5)
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_strain: Option<f64>,
