@@ -1,9 +1,10 @@
 //! Atomic, durable writes and the registry of live temporary paths.
 //!
 //! Every file flexrom writes is first written under a temporary name in the target's own
-//! folder (`.<name>.flexrom-tmp-<pid>-<n>`), flushed to disk (`fsync` of the file), renamed
-//! over the final name and the folder `fsync`ed, so the final path holds either the previous
-//! file or the complete new one, also after a power cut. Every temporary path is entered in a
+//! folder (`.<name>.flexrom-tmp-<pid>-<n>`), flushed to disk (`fdatasync` of the file: its
+//! bytes and size), renamed over the final name and the folder `fsync`ed, so the final path
+//! holds either the previous file or the complete new one, also after a power cut, and a
+//! reported success survives one ([`TempPath::commit`] gives the argument step by step). Every temporary path is entered in a
 //! process-wide registry while it lives; it leaves the registry when it is renamed into place
 //! or removed (on every error path, by `Drop`). On SIGINT or SIGTERM the handler installed by
 //! [`install_signal_handler`] removes every registered path, puts back a report folder that
@@ -15,14 +16,16 @@ mod swap;
 mod temp_path;
 
 use crate::error::{Error, Result};
-pub use fs::{check_replaceable, create_dirs, kind_of, names_an_entry, sync_path, sync_tree};
+pub use fs::{
+    check_replaceable, create_dirs, kind_of, names_an_entry, sync_file_data, sync_path, sync_tree,
+};
 pub use registry::{install_signal_handler, live_paths};
 use std::path::Path;
 pub use swap::swap_in_dir;
 pub use temp_path::TempPath;
 
 /// Writes `target` atomically: `fill` writes the temporary path it is given; on success
-/// the file is `fsync`ed and renamed into place, on any error it is removed and the
+/// the file is `fdatasync`ed and renamed into place, on any error it is removed and the
 /// previous file at `target` stays as it was.
 pub fn write_file_atomically(target: &Path, fill: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
     let tmp = TempPath::file_for(target)?;
@@ -36,7 +39,7 @@ pub fn write_bytes_atomically(target: &Path, bytes: &[u8]) -> Result<()> {
     write_file_atomically(target, |tmp| write_with(std::fs::OpenOptions::new().write(true).truncate(true), tmp, bytes))
 }
 
-/// Creates `path` (which must not exist) with `bytes` and `fsync`s it.
+/// Creates `path` (which must not exist) with `bytes` and `fdatasync`s it (its bytes and size).
 pub fn write_new(path: &Path, bytes: &[u8]) -> Result<()> {
     write_with(std::fs::OpenOptions::new().write(true).create_new(true), path, bytes)
 }
@@ -44,7 +47,7 @@ pub fn write_new(path: &Path, bytes: &[u8]) -> Result<()> {
 fn write_with(o: &std::fs::OpenOptions, path: &Path, bytes: &[u8]) -> Result<()> {
     use std::io::Write;
     let mut f = o.open(path).map_err(|e| Error::io(path, e))?;
-    f.write_all(bytes).and_then(|_| f.sync_all()).map_err(|e| Error::io(path, e))
+    f.write_all(bytes).and_then(|_| f.sync_data()).map_err(|e| Error::io(path, e))
 }
 
 #[cfg(test)]

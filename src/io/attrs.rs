@@ -199,12 +199,15 @@ pub fn annotate(f: &hdf5::File, kind: Kind) -> hdf5::Result<()> {
     fn walk(g: &hdf5::Group, prefix: &str, kind: Kind) -> hdf5::Result<()> {
         for name in g.member_names()? {
             let full = if prefix.is_empty() { name.clone() } else { format!("{prefix}/{name}") };
-            if let Ok(sub) = g.group(&name) {
-                walk(&sub, &full, kind)?;
-            } else if let Ok(d) = g.dataset(&name) {
-                if let Some((units, dims)) = units_of(kind, &full) {
-                    write_units(&d, units, dims)?;
+            // asked, not tried: a failed `group()` on a dataset builds a whole HDF5 error stack
+            match g.loc_type_by_name(&name) {
+                Ok(hdf5::LocationType::Group) => walk(&g.group(&name)?, &full, kind)?,
+                Ok(hdf5::LocationType::Dataset) => {
+                    if let Some((units, dims)) = units_of(kind, &full) {
+                        write_units(&g.dataset(&name)?, units, dims)?;
+                    }
                 }
+                _ => {}
             }
         }
         Ok(())

@@ -6,7 +6,7 @@ use std::path::Path;
 
 /// Creates `path` atomically and durably: `fill` writes into a temporary file beside it
 /// (unique name, created exclusively by flexrom, registered for removal on SIGINT/SIGTERM), which is
-/// closed, `fsync`ed and renamed over `path` only when `fill` succeeds, then the folder is
+/// closed, `fdatasync`ed and renamed over `path` only when `fill` succeeds, then the folder is
 /// `fsync`ed ([`super::atomic`]). A failed run never leaves a half-written file nor destroys a
 /// previous good one; a missing folder is created.
 pub fn write_atomically(path: &Path, fill: impl FnOnce(&hdf5::File) -> Result<()>) -> Result<()> {
@@ -15,7 +15,7 @@ pub fn write_atomically(path: &Path, fill: impl FnOnce(&hdf5::File) -> Result<()
         let file = hdf5::File::create(tmp).map_err(|e| Error::hdf5(path, format!("cannot create: {e}")))?;
         fill(&file)?;
         file.flush().map_err(|e| Error::hdf5(path, e))?;
-        // closed before the fsync and the rename (the last handle closes the file)
+        // closed before the fdatasync and the rename (the last handle closes the file)
         drop(file);
         Ok(())
     })

@@ -76,19 +76,20 @@ impl Labels {
     /// Writes `/labels` into `f`.
     pub fn write(&self, f: &hdf5::File) -> hdf5::Result<()> {
         let g = f.create_group("labels")?;
-        let text = |v: Vec<String>| -> hdf5::Result<Array1<VarLenUnicode>> {
+        let text = |v: Vec<String>| -> hdf5::Result<Vec<VarLenUnicode>> {
             v.iter()
                 .map(|s| s.parse::<VarLenUnicode>().map_err(|e| hdf5::Error::from(format!("label `{s}`: {e:?}"))))
                 .collect()
         };
         let idx = |v: Vec<usize>| Array1::from_iter(v.into_iter().map(|i| i as u64));
-        g.new_dataset_builder().with_data(&text(self.bodies.clone())?).create("body")?;
-        g.new_dataset_builder().with_data(&text(self.dof_names())?).create("dof")?;
+        // the string datasets through write_strings: a conversion buffer of their size, not 1 MiB
+        super::h5_text::write_strings(&g, "body", &text(self.bodies.clone())?)?;
+        super::h5_text::write_strings(&g, "dof", &text(self.dof_names())?)?;
         g.new_dataset_builder().with_data(&idx(self.dofs.iter().map(|d| d.0).collect())).create("dof_body")?;
         g.new_dataset_builder().with_data(&idx(self.dofs.iter().map(|d| d.1).collect())).create("dof_node")?;
         g.new_dataset_builder().with_data(&idx(self.dofs.iter().map(|d| d.2).collect())).create("dof_coordinate")?;
         let names = self.multipliers.iter().map(|m| m.1.clone()).collect();
-        g.new_dataset_builder().with_data(&text(names)?).create("multiplier")?;
+        super::h5_text::write_strings(&g, "multiplier", &text(names)?)?;
         g.new_dataset_builder()
             .with_data(&idx(self.multipliers.iter().map(|m| m.0).collect()))
             .create("multiplier_joint")?;

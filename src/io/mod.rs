@@ -8,6 +8,7 @@ pub mod basis_hash;
 pub mod basis_layout;
 pub mod estimator_file;
 pub mod h5;
+pub mod h5_text;
 pub mod labels;
 pub mod output;
 pub mod result_file;
