@@ -3,7 +3,7 @@
 mod cli;
 
 use clap::{Parser, Subcommand};
-use flexrom::output::{self, detail, note, Verbosity};
+use flexrom::output::{self, detail, note, verbosity, Verbosity};
 use std::process::ExitCode;
 
 /// The exit codes, as `flexrom --help` and every command's `--help` list them (a macro so
@@ -222,11 +222,15 @@ fn main() -> ExitCode {
         flexrom::limits::set(l);
         run(cli)
     });
-    detail(&format!(
-        "flexrom: {:.3} s wall time on {} thread(s)",
-        start.elapsed().as_secs_f64(),
-        rayon::current_num_threads()
-    ));
+    // built only when shown: asking rayon for its thread count starts its global pool
+    // (cgroup reads, two threads) at the end of every command otherwise
+    if verbosity() >= Verbosity::Verbose {
+        detail(&format!(
+            "flexrom: {:.3} s wall time on {} thread(s)",
+            start.elapsed().as_secs_f64(),
+            rayon::current_num_threads()
+        ));
+    }
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
         // the reader of stdout went away (`| head`): nothing to say, and no one to say it to

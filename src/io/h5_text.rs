@@ -36,9 +36,10 @@ pub fn write_strings(g: &hdf5::Group, name: &str, values: &[VarLenUnicode]) -> h
         // them) that outlive the call; HDF5 only reads them.
         unsafe {
             let xfer = hdf5::h5check(H5Pcreate(*hdf5::globals::H5P_DATASET_XFER))?;
-            let r = hdf5::h5check(H5Pset_buffer(xfer, bytes, std::ptr::null_mut(), std::ptr::null_mut())).and_then(
-                |_| hdf5::h5check(H5Dwrite(ds.id(), mem.id(), H5S_ALL, H5S_ALL, xfer, values.as_ptr().cast())),
-            );
+            let r =
+                hdf5::h5check(H5Pset_buffer(xfer, bytes, std::ptr::null_mut(), std::ptr::null_mut())).and_then(|_| {
+                    hdf5::h5check(H5Dwrite(ds.id(), mem.id(), H5S_ALL, H5S_ALL, xfer, values.as_ptr().cast()))
+                });
             H5Pclose(xfer);
             r.map(|_| ())
         }
