@@ -25,6 +25,7 @@
 //!     ‖x_ref + V⁺ q⁺‖² = ‖x_ref‖² + 2 (V⁺ᵀx_ref)·q⁺ + ‖q⁺‖².
 //! ```
 
+use super::estimate_coarse::CoarseRunner;
 use super::estimate_corrected::CorrectedRunner;
 use super::online::{Output, ReducedRun, ReducedRunner};
 use crate::error::Result;
@@ -200,6 +201,7 @@ pub struct EstimatingRunner<'a> {
 /// own (the `enriched` method, and the fallback where the corrected one is not available).
 enum EstimatorModel<'a> {
     Corrected(Box<CorrectedRunner<'a>>),
+    Coarse(Box<CoarseRunner<'a>>),
     Enriched(ReducedRunner<'a>),
 }
 
@@ -209,12 +211,17 @@ impl<'a> EstimatingRunner<'a> {
         let rom = ReducedRunner::new(model, basis)?;
         let est = match est {
             Some(e) => {
-                let corrected = match e.method {
-                    EstimateMethod::Corrected => CorrectedRunner::new(model, basis, &e.enriched)?,
+                let m = match e.method {
+                    EstimateMethod::Corrected => {
+                        CorrectedRunner::new(model, basis, &e.enriched)?.map(|c| EstimatorModel::Corrected(Box::new(c)))
+                    }
+                    EstimateMethod::Coarse => {
+                        CoarseRunner::new(model, basis, &e.enriched)?.map(|c| EstimatorModel::Coarse(Box::new(c)))
+                    }
                     EstimateMethod::Enriched => None,
                 };
-                let m = match corrected {
-                    Some(c) => EstimatorModel::Corrected(Box::new(c)),
+                let m = match m {
+                    Some(m) => m,
                     None => EstimatorModel::Enriched(ReducedRunner::new(model, &e.enriched)?),
                 };
                 Some((e, m))
@@ -222,6 +229,14 @@ impl<'a> EstimatingRunner<'a> {
             None => None,
         };
         Ok(EstimatingRunner { basis, rom, est })
+    }
+
+    /// Experiments with the `coarse` method (examples/estimate_table.rs): its step ratio
+    /// `m` and whether the reduced model's coarse run is subtracted; no effect otherwise.
+    pub fn configure_coarse(&mut self, stride: usize, cancel: bool) {
+        if let Some((_, EstimatorModel::Coarse(c))) = &mut self.est {
+            c.configure(stride, cancel);
+        }
     }
 
     /// The reduced model alone (no estimate), e.g. for the reduced model's own sensitivity.
@@ -248,12 +263,15 @@ impl<'a> EstimatingRunner<'a> {
         let Some((est, model)) = &mut self.est else { return Ok((run, None)) };
         let start = std::time::Instant::now();
         // the norms come from the reduced coordinates: nothing of full size is written
-        let qp = match model {
-            EstimatorModel::Corrected(c) => c.run(&run).ok(),
-            EstimatorModel::Enriched(r) => r.run(load_scale, Output::ReducedAndProbes, &[]).ok().map(|e| e.reduced_q),
+        let raw = match model {
+            EstimatorModel::Corrected(c) => c.run(&run).ok().map(|qp| (run.reduced_q.clone(), qp)),
+            EstimatorModel::Coarse(c) => c.run(&run).ok(),
+            EstimatorModel::Enriched(r) => {
+                r.run(load_scale, Output::ReducedAndProbes, &[]).ok().map(|e| (run.reduced_q.clone(), e.reduced_q))
+            }
         };
-        let raw = match &qp {
-            Some(qp) => raw_estimate_by_time(self.basis, &est.enriched, &run.reduced_q, qp),
+        let raw = match &raw {
+            Some((q, qp)) => raw_estimate_by_time(self.basis, &est.enriched, q, qp),
             None => [f64::INFINITY; 5],
         };
         let c = &est.calibration;

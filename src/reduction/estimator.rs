@@ -63,6 +63,9 @@ pub enum EstimateMethod {
     Corrected,
     /// the enriched model integrated on its own to convergence (about 2× the reduced run)
     Enriched,
+    /// the corrected step of both the enriched and the reduced model at a coarse step
+    /// `m·Δt`, their difference (`pipeline::estimate_coarse`)
+    Coarse,
 }
 
 impl EstimateMethod {
@@ -70,6 +73,7 @@ impl EstimateMethod {
         match self {
             EstimateMethod::Corrected => "corrected",
             EstimateMethod::Enriched => "enriched",
+            EstimateMethod::Coarse => "coarse",
         }
     }
 
@@ -77,7 +81,8 @@ impl EstimateMethod {
         match s {
             "corrected" => Ok(EstimateMethod::Corrected),
             "enriched" => Ok(EstimateMethod::Enriched),
-            _ => Err(format!("is \"{s}\"; expected \"corrected\" (default) or \"enriched\"")),
+            "coarse" => Ok(EstimateMethod::Coarse),
+            _ => Err(format!("is \"{s}\"; expected \"corrected\" (default), \"coarse\" or \"enriched\"")),
         }
     }
 }
