@@ -10,8 +10,8 @@
 //! cargo run --release --example estimate_table -- pipelines/thesis/pendulum_hyper.toml 0.5,1.0,1.5 0.4:1.6:15
 //! ```
 //!
-//! The estimator's method is the default; `ESTIMATE_METHOD=corrected|coarse|enriched` selects
-//! one (docs/error-estimate.md); `ESTIMATE_STRIDE=m` and `ESTIMATE_CANCEL=0` vary the coarse one.
+//! The estimator's method is the default; `ESTIMATE_METHOD=corrected|defects|enriched` selects
+//! one (docs/error-estimate.md); `ESTIMATE_SAMPLE=s` the defects method's sampling interval.
 
 use flexrom::pipeline::config::parse_range;
 use flexrom::pipeline::estimate::{is_extrapolated, EstimatingRunner};
@@ -86,12 +86,10 @@ fn main() -> flexrom::Result<()> {
     println!("| load scale | inside | rel_error | error_estimate | effectivity | reduced (s) | estimator (s) | cost | error to 0.4 T / estimate |");
     println!("|---|---|---|---|---|---|---|---|---|");
     let mut runner = EstimatingRunner::new(&p.model, basis, Some(est))?;
-    // experiments with the coarse method: ESTIMATE_STRIDE=m (default COARSE_STRIDE),
-    // ESTIMATE_CANCEL=0 compares the enriched coarse run with the reduced run itself
-    if let Ok(m) = std::env::var("ESTIMATE_STRIDE") {
-        let cancel = std::env::var("ESTIMATE_CANCEL").map_or(true, |c| c != "0");
-        runner.configure_coarse(m.parse().expect("ESTIMATE_STRIDE: a whole number"), cancel);
-        println!("experiment: ESTIMATE_STRIDE={m}, cancel {cancel}");
+    // experiments with the defects method: ESTIMATE_SAMPLE=s (default DEFECT_SAMPLE)
+    if let Ok(m) = std::env::var("ESTIMATE_SAMPLE") {
+        runner.set_defect_sample(m.parse().expect("ESTIMATE_SAMPLE: a whole number"));
+        println!("experiment: ESTIMATE_SAMPLE={m}");
     }
     let mut rows = Vec::new();
     for &x in &tests {

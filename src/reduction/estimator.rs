@@ -63,9 +63,9 @@ pub enum EstimateMethod {
     Corrected,
     /// the enriched model integrated on its own to convergence (about 2× the reduced run)
     Enriched,
-    /// the corrected step of both the enriched and the reduced model at a coarse step
-    /// `m·Δt`, their difference (`pipeline::estimate_coarse`)
-    Coarse,
+    /// the reduced run's local defects against the enriched model at every 10th step,
+    /// summed (`pipeline::estimate_defects`): a looser bound at a tenth of the cost
+    Defects,
 }
 
 impl EstimateMethod {
@@ -73,7 +73,7 @@ impl EstimateMethod {
         match self {
             EstimateMethod::Corrected => "corrected",
             EstimateMethod::Enriched => "enriched",
-            EstimateMethod::Coarse => "coarse",
+            EstimateMethod::Defects => "defects",
         }
     }
 
@@ -81,8 +81,8 @@ impl EstimateMethod {
         match s {
             "corrected" => Ok(EstimateMethod::Corrected),
             "enriched" => Ok(EstimateMethod::Enriched),
-            "coarse" => Ok(EstimateMethod::Coarse),
-            _ => Err(format!("is \"{s}\"; expected \"corrected\" (default), \"coarse\" or \"enriched\"")),
+            "defects" => Ok(EstimateMethod::Defects),
+            _ => Err(format!("is \"{s}\"; expected \"corrected\" (default), \"defects\" or \"enriched\"")),
         }
     }
 }
