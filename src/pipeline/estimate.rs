@@ -139,7 +139,9 @@ pub fn build_estimator(
         block_modes: richer.block_modes,
         extra_modes: extra,
         calibration: Calibration::default(),
-        method: EstimateMethod::default(),
+        // training steers greedy and calibrates `c` with the tight method; runs read from
+        // the basis file use the default (`defects`, whose factor follows `c`)
+        method: EstimateMethod::Corrected,
     })
 }
 

@@ -57,14 +57,16 @@ impl Default for Calibration {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum EstimateMethod {
-    /// the default: one modified-Newton iteration of the enriched model per step, from the
-    /// reduced run's increments (`pipeline::estimate_corrected`)
-    #[default]
+    /// the tight option: one modified-Newton iteration of the enriched model per step, from
+    /// the reduced run's increments (`pipeline::estimate_corrected`); 30–100 % of the
+    /// reduced run; what training (greedy steering, calibration) uses
     Corrected,
     /// the enriched model integrated on its own to convergence (about 2× the reduced run)
     Enriched,
-    /// the reduced run's local defects against the enriched model at every 10th step,
-    /// summed (`pipeline::estimate_defects`): a looser bound at a tenth of the cost
+    /// the default for reduced runs: the reduced run's local defects against the enriched
+    /// model at every 10th step, summed (`pipeline::estimate_defects`): a looser bound
+    /// (10–30× the error) at 3–10 % of the reduced run
+    #[default]
     Defects,
 }
 
@@ -82,7 +84,7 @@ impl EstimateMethod {
             "corrected" => Ok(EstimateMethod::Corrected),
             "enriched" => Ok(EstimateMethod::Enriched),
             "defects" => Ok(EstimateMethod::Defects),
-            _ => Err(format!("is \"{s}\"; expected \"corrected\" (default), \"defects\" or \"enriched\"")),
+            _ => Err(format!("is \"{s}\"; expected \"defects\" (default), \"corrected\" or \"enriched\"")),
         }
     }
 }
