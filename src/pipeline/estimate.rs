@@ -45,22 +45,6 @@ pub const ENRICHED_HYPER_FACTOR: f64 = 0.1;
 /// Safety margin over the largest ratio true/raw seen in calibration.
 pub const CALIBRATION_MARGIN: f64 = 1.25;
 
-/// One estimate.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
-pub struct Estimate {
-    /// `c · η_raw`; infinite when the enriched model failed to run
-    pub error_estimate: f64,
-    /// `η_raw`
-    pub raw: f64,
-    pub factor: f64,
-    pub calibrated: bool,
-    /// wall time of the enriched run's time loop and the norms, s
-    pub seconds: f64,
-    /// `c · η_raw` over the instants up to the end of each fifth of the run (as
-    /// [`rel_error_by_time`] for the true error); NaN where unknown
-    pub by_time: [f64; 5],
-}
-
 /// The constant `c` from held-out pairs `(η_i, e_i)`:
 ///
 /// ```text
@@ -312,7 +296,9 @@ pub fn rel_error_by_time(a: &Array2<f64>, b: &Array2<f64>) -> Vec<f64> {
         .collect()
 }
 
-pub use super::estimate_trust::{check_runs, describe, is_extrapolated, load_trust, write_run_attributes, TrustInfo};
+pub use super::estimate_trust::{
+    check_runs, describe, is_extrapolated, load_trust, write_run_attributes, Estimate, TrustInfo,
+};
 
 #[cfg(test)]
 mod tests {

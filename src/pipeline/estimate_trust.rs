@@ -1,11 +1,26 @@
 //! What the online tools tell a user about a reduced run besides the estimate itself
 //! (issue 15 item 3): the extrapolation flag, the tolerance check and `--strict`, the
 //! estimator read from a basis file, the result file's attributes. Moved from
-//! [`super::estimate`], which re-exports everything here.
+//! [`super::estimate`], which re-exports everything here (the struct [`Estimate`] too).
 
-use super::estimate::Estimate;
 use crate::error::Result;
 use crate::reduction::estimator::Estimator;
+
+/// One estimate.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Estimate {
+    /// `c · η_raw`; infinite when the enriched model failed to run
+    pub error_estimate: f64,
+    /// `η_raw`
+    pub raw: f64,
+    pub factor: f64,
+    pub calibrated: bool,
+    /// wall time of the enriched run's time loop and the norms, s
+    pub seconds: f64,
+    /// `c · η_raw` over the instants up to the end of each fifth of the run (as
+    /// `estimate::rel_error_by_time` for the true error); NaN where unknown
+    pub by_time: [f64; 5],
+}
 
 /// Whether `load_scale` lies outside `[lo, hi]` (with a relative slack of 1e-9 for the
 /// ends, which are training loads themselves).
