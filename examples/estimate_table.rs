@@ -10,8 +10,8 @@
 //! cargo run --release --example estimate_table -- pipelines/thesis/pendulum_hyper.toml 0.5,1.0,1.5 0.4:1.6:15
 //! ```
 //!
-//! The estimator's method is the default (`corrected`); `ESTIMATE_METHOD=enriched` selects
-//! the other (docs/error-estimate.md).
+//! The estimator's method is the default; `ESTIMATE_METHOD=corrected|defects|enriched` selects
+//! one (docs/error-estimate.md); `ESTIMATE_SAMPLE=s` the defects method's sampling interval.
 
 use flexrom::pipeline::config::parse_range;
 use flexrom::pipeline::estimate::{is_extrapolated, EstimatingRunner};
@@ -86,6 +86,11 @@ fn main() -> flexrom::Result<()> {
     println!("| load scale | inside | rel_error | error_estimate | effectivity | reduced (s) | estimator (s) | cost | error to 0.4 T / estimate |");
     println!("|---|---|---|---|---|---|---|---|---|");
     let mut runner = EstimatingRunner::new(&p.model, basis, Some(est))?;
+    // experiments with the defects method: ESTIMATE_SAMPLE=s (default DEFECT_SAMPLE)
+    if let Ok(m) = std::env::var("ESTIMATE_SAMPLE") {
+        runner.set_defect_sample(m.parse().expect("ESTIMATE_SAMPLE: a whole number"));
+        println!("experiment: ESTIMATE_SAMPLE={m}");
+    }
     let mut rows = Vec::new();
     for &x in &tests {
         let full = simulate(&p.model, &Overrides { load_scale: Some(x), ..Default::default() })?;

@@ -26,6 +26,7 @@
 //! ```
 
 use super::estimate_corrected::CorrectedRunner;
+use super::estimate_defects::DefectRunner;
 use super::online::{Output, ReducedRun, ReducedRunner};
 use crate::error::Result;
 use crate::model::Model;
@@ -43,22 +44,6 @@ pub const DEFAULT_EXTRA_MODES: usize = 10;
 pub const ENRICHED_HYPER_FACTOR: f64 = 0.1;
 /// Safety margin over the largest ratio true/raw seen in calibration.
 pub const CALIBRATION_MARGIN: f64 = 1.25;
-
-/// One estimate.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
-pub struct Estimate {
-    /// `c · η_raw`; infinite when the enriched model failed to run
-    pub error_estimate: f64,
-    /// `η_raw`
-    pub raw: f64,
-    pub factor: f64,
-    pub calibrated: bool,
-    /// wall time of the enriched run's time loop and the norms, s
-    pub seconds: f64,
-    /// `c · η_raw` over the instants up to the end of each fifth of the run (as
-    /// [`rel_error_by_time`] for the true error); NaN where unknown
-    pub by_time: [f64; 5],
-}
 
 /// The constant `c` from held-out pairs `(η_i, e_i)`:
 ///
@@ -138,7 +123,9 @@ pub fn build_estimator(
         block_modes: richer.block_modes,
         extra_modes: extra,
         calibration: Calibration::default(),
-        method: EstimateMethod::default(),
+        // training steers greedy and calibrates `c` with the tight method; runs read from
+        // the basis file use the default (`defects`, whose factor follows `c`)
+        method: EstimateMethod::Corrected,
     })
 }
 
@@ -200,6 +187,7 @@ pub struct EstimatingRunner<'a> {
 /// own (the `enriched` method, and the fallback where the corrected one is not available).
 enum EstimatorModel<'a> {
     Corrected(Box<CorrectedRunner<'a>>),
+    Defects(Box<DefectRunner<'a>>),
     Enriched(ReducedRunner<'a>),
 }
 
@@ -209,12 +197,17 @@ impl<'a> EstimatingRunner<'a> {
         let rom = ReducedRunner::new(model, basis)?;
         let est = match est {
             Some(e) => {
-                let corrected = match e.method {
-                    EstimateMethod::Corrected => CorrectedRunner::new(model, basis, &e.enriched)?,
+                let m = match e.method {
+                    EstimateMethod::Corrected => {
+                        CorrectedRunner::new(model, basis, &e.enriched)?.map(|c| EstimatorModel::Corrected(Box::new(c)))
+                    }
+                    EstimateMethod::Defects => {
+                        DefectRunner::new(model, basis, &e.enriched)?.map(|c| EstimatorModel::Defects(Box::new(c)))
+                    }
                     EstimateMethod::Enriched => None,
                 };
-                let m = match corrected {
-                    Some(c) => EstimatorModel::Corrected(Box::new(c)),
+                let m = match m {
+                    Some(m) => m,
                     None => EstimatorModel::Enriched(ReducedRunner::new(model, &e.enriched)?),
                 };
                 Some((e, m))
@@ -222,6 +215,14 @@ impl<'a> EstimatingRunner<'a> {
             None => None,
         };
         Ok(EstimatingRunner { basis, rom, est })
+    }
+
+    /// Experiments with the `defects` method (examples/estimate_table.rs): its sampling
+    /// interval; no effect with another method.
+    pub fn set_defect_sample(&mut self, sample: usize) {
+        if let Some((_, EstimatorModel::Defects(d))) = &mut self.est {
+            d.set_sample(sample);
+        }
     }
 
     /// The reduced model alone (no estimate), e.g. for the reduced model's own sensitivity.
@@ -248,22 +249,31 @@ impl<'a> EstimatingRunner<'a> {
         let Some((est, model)) = &mut self.est else { return Ok((run, None)) };
         let start = std::time::Instant::now();
         // the norms come from the reduced coordinates: nothing of full size is written
-        let qp = match model {
-            EstimatorModel::Corrected(c) => c.run(&run).ok(),
-            EstimatorModel::Enriched(r) => r.run(load_scale, Output::ReducedAndProbes, &[]).ok().map(|e| e.reduced_q),
+        let raw = match model {
+            EstimatorModel::Corrected(c) => {
+                c.run(&run).ok().map(|qp| raw_estimate_by_time(self.basis, &est.enriched, &run.reduced_q, &qp))
+            }
+            EstimatorModel::Defects(d) => d.raw_by_time(&run).ok(),
+            EstimatorModel::Enriched(r) => r
+                .run(load_scale, Output::ReducedAndProbes, &[])
+                .ok()
+                .map(|e| raw_estimate_by_time(self.basis, &est.enriched, &run.reduced_q, &e.reduced_q)),
         };
-        let raw = match &qp {
-            Some(qp) => raw_estimate_by_time(self.basis, &est.enriched, &run.reduced_q, qp),
-            None => [f64::INFINITY; 5],
-        };
+        let raw = raw.unwrap_or([f64::INFINITY; 5]);
         let c = &est.calibration;
+        // the defect sum is a bound by itself: factor 1, raised in the proportion that
+        // calibration raised the corrected method's c above its default
+        let factor = match model {
+            EstimatorModel::Defects(_) => c.factor / DEFAULT_FACTOR,
+            _ => c.factor,
+        };
         let e = Estimate {
-            error_estimate: c.factor * raw[4],
+            error_estimate: factor * raw[4],
             raw: raw[4],
-            factor: c.factor,
+            factor,
             calibrated: c.calibrated,
             seconds: start.elapsed().as_secs_f64(),
-            by_time: raw.map(|r| c.factor * r),
+            by_time: raw.map(|r| factor * r),
         };
         Ok((run, Some(e)))
     }
@@ -286,153 +296,9 @@ pub fn rel_error_by_time(a: &Array2<f64>, b: &Array2<f64>) -> Vec<f64> {
         .collect()
 }
 
-/// Whether `load_scale` lies outside `[lo, hi]` (with a relative slack of 1e-9 for the
-/// ends, which are training loads themselves).
-pub fn is_extrapolated(range: (f64, f64), load_scale: f64) -> bool {
-    let slack = 1e-9 * range.0.abs().max(range.1.abs()).max(1e-300);
-    load_scale < range.0 - slack || load_scale > range.1 + slack
-}
-
-/// What the online tools know about a basis beyond the basis itself: its estimator, the
-/// training range and the tolerance a run's estimate is held to.
-#[derive(Clone, Debug)]
-pub struct TrustInfo {
-    pub estimator: Option<Estimator>,
-    pub range: (f64, f64),
-    /// `[online] tolerance`, else greedy training's tolerance, else none
-    pub tolerance: Option<f64>,
-    /// the user asked for no estimate (`--no-estimate`): no warnings about its absence
-    pub skipped: bool,
-}
-
-/// Reads the estimator (checked against the model), the training range and tolerance of
-/// the basis file `path` already read as `stored`.
-pub fn load_trust(
-    p: &super::Pipeline,
-    path: &std::path::Path,
-    stored: &crate::io::basis_file::StoredBasis,
-) -> Result<TrustInfo> {
-    use crate::error::Error;
-    use crate::io::estimator_file::{read_estimator, read_training_range, read_training_tolerance};
-    use crate::solver::model::ParametricModel;
-    let mut estimator = read_estimator(path, &stored.basis)?;
-    if let (Some(e), Some(m)) = (&mut estimator, p.file.online.as_ref().and_then(|o| o.estimate)) {
-        e.method = m;
-    }
-    if let Some(e) = &estimator {
-        let sys = &*p.model.physics()?.sys;
-        let err = |(field, problem): (String, String)| Error::input(path, format!("estimator/{field}"), problem);
-        e.enriched.validate(sys.n_dof(), sys.n_constraints()).map_err(err)?;
-        if let Some(h) = &e.enriched.hyper {
-            h.validate(sys.n_elements()).map_err(err)?;
-        }
-    }
-    let tolerance = match p.online_tolerance() {
-        Some(t) => Some(t),
-        None => read_training_tolerance(path)?,
-    };
-    Ok(TrustInfo { estimator, range: read_training_range(path)?, tolerance, skipped: false })
-}
-
-/// One line for stderr: the estimate, whether calibrated, and its cost against the reduced run.
-pub fn describe(e: &Estimate, rom_seconds: f64) -> String {
-    format!(
-        "error_estimate {:.3e} ({}, c = {:.3}), estimator {:.4} s ({:.0} % of the reduced run)",
-        e.error_estimate,
-        if e.calibrated { "calibrated" } else { "uncalibrated" },
-        e.factor,
-        e.seconds,
-        100.0 * e.seconds / rom_seconds
-    )
-}
-
-/// Attributes of an `online` result file: `error_estimate` (NaN without an estimator),
-/// `error_estimate_by_time` (5 values: the estimate up to the end of each fifth of the run,
-/// the last = `error_estimate`; NaN without an estimator), `error_estimate_raw`, `error_estimate_factor`, `error_estimate_calibrated` (0/1),
-/// `extrapolated` (0/1), `training_range` ([min, max]), `tolerance` (when set).
-pub fn write_run_attributes(
-    f: &hdf5::File,
-    e: Option<&Estimate>,
-    trust: &TrustInfo,
-    extrapolated: bool,
-) -> hdf5::Result<()> {
-    use crate::io::h5::{attr_f64, attr_u64};
-    attr_f64(f, "error_estimate", e.map_or(f64::NAN, |e| e.error_estimate))?;
-    f.new_attr::<f64>().shape(5).create("error_estimate_by_time")?.write(&e.map_or([f64::NAN; 5], |e| e.by_time))?;
-    attr_f64(f, "error_estimate_raw", e.map_or(f64::NAN, |e| e.raw))?;
-    attr_f64(f, "error_estimate_factor", e.map_or(f64::NAN, |e| e.factor))?;
-    attr_u64(f, "error_estimate_calibrated", e.is_some_and(|e| e.calibrated) as u64)?;
-    attr_u64(f, "extrapolated", extrapolated as u64)?;
-    f.new_attr::<f64>().shape(2).create("training_range")?.write(&[trust.range.0, trust.range.1])?;
-    if let Some(t) = trust.tolerance {
-        attr_f64(f, "tolerance", t)?;
-    }
-    Ok(())
-}
-
-/// At most five entries of a list for a one-line message, then "…".
-fn few(v: &[String]) -> String {
-    if v.len() <= 5 {
-        v.join(", ")
-    } else {
-        format!("{}, …, {}", v[..4].join(", "), v[v.len() - 1])
-    }
-}
-
-/// Prints one warning line on stderr for extrapolated load scales and one for estimates
-/// above the tolerance (or for a basis without an estimator); `runs` are
-/// `(load scale, error_estimate)`. With `strict`, an estimate above the tolerance (or none
-/// at all when a tolerance is set) is an [`crate::Error::Strict`], for after the output is
-/// written.
-pub fn check_runs(trust: &TrustInfo, runs: &[(f64, Option<f64>)], strict: bool) -> Result<()> {
-    let (a, b) = trust.range;
-    let out: Vec<String> = runs
-        .iter()
-        .filter(|r| is_extrapolated(trust.range, r.0))
-        .map(|r| format!("{:.4}", r.0).trim_end_matches('0').trim_end_matches('.').to_string())
-        .collect();
-    if !out.is_empty() {
-        let what = if runs.len() == 1 {
-            format!("load scale {}", out[0])
-        } else {
-            format!("{} of {} load scales ({})", out.len(), runs.len(), few(&out))
-        };
-        eprintln!("warning: {what} outside the basis's training range [{a}, {b}]: extrapolated, the reduced model was never trained there");
-    }
-    if trust.estimator.is_none() && runs.iter().all(|r| r.1.is_none()) && !trust.skipped {
-        eprintln!("warning: the basis file has no error estimator (/estimator; written by `flexrom train` since this version): no error_estimate; train again");
-    }
-    let Some(tol) = trust.tolerance.filter(|_| !trust.skipped) else {
-        if strict {
-            eprintln!(
-                "warning: --strict: no tolerance to hold the estimates to (set [online] tolerance in the pipeline)"
-            );
-        }
-        return Ok(());
-    };
-    let over: Vec<String> = runs
-        .iter()
-        .filter(|r| r.1.is_none_or(|e| !(e <= tol)))
-        .map(|r| match r.1 {
-            Some(e) => format!("{:.4} ({e:.2e})", r.0),
-            None => format!("{:.4} (no estimate)", r.0),
-        })
-        .collect();
-    if over.is_empty() {
-        return Ok(());
-    }
-    let what = if runs.len() == 1 {
-        format!("load scale {}", over[0])
-    } else {
-        format!("{} of {} load scales: {}", over.len(), runs.len(), few(&over))
-    };
-    let msg = format!("error estimate above the tolerance {tol:e} at {what}");
-    if strict {
-        return Err(crate::Error::Strict(format!("--strict: {msg}")));
-    }
-    eprintln!("warning: {msg}");
-    Ok(())
-}
+pub use super::estimate_trust::{
+    check_runs, describe, is_extrapolated, load_trust, write_run_attributes, Estimate, TrustInfo,
+};
 
 #[cfg(test)]
 mod tests {

@@ -7,6 +7,8 @@ pub mod basis_build;
 pub mod config;
 pub mod dense;
 pub mod estimate;
+pub mod estimate_defects;
+pub mod estimate_trust;
 pub mod estimate_corrected;
 pub mod greedy;
 pub mod merge;
