@@ -50,7 +50,11 @@ impl<'a> DefectRunner<'a> {
     /// `None` where [`CorrectedRunner::new`] is not available (the caller then runs the
     /// enriched model on its own).
     pub fn new(model: &'a Model, basis: &'a Basis, enriched: &'a Basis) -> Result<Option<Self>> {
-        Ok(CorrectedRunner::new(model, basis, enriched)?.map(|plus| DefectRunner { plus, basis, sample: DEFECT_SAMPLE }))
+        Ok(CorrectedRunner::new(model, basis, enriched)?.map(|plus| DefectRunner {
+            plus,
+            basis,
+            sample: DEFECT_SAMPLE,
+        }))
     }
 
     /// Another sampling interval (experiments: examples/estimate_table.rs).
