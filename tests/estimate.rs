@@ -17,7 +17,7 @@
 //!   The prefix values are ratios of two growing sums and need not be monotone; the unit
 //!   test in src/pipeline/estimate.rs checks the case where they must be (a growing error).
 //! - `every_estimate_method_bounds_the_error_at_held_out_loads`: the same held-out loads with
-//!   `[online] estimate = "defects"` (the default) and `"corrected"` (the tight option):
+//!   `[online] estimate = "defects"` (the cheap option) and `"corrected"` (the default):
 //!   estimate ≥ rel_error and effectivity ≤ 30 for both (the targets), and the
 //!   corrected one below the defect sum at every load (a bound by the triangle inequality
 //!   against an estimate of the distance itself; docs/error-estimate.md, "Measurements").

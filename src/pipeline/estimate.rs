@@ -124,7 +124,7 @@ pub fn build_estimator(
         extra_modes: extra,
         calibration: Calibration::default(),
         // training steers greedy and calibrates `c` with the tight method; runs read from
-        // the basis file use the default (`defects`, whose factor follows `c`)
+        // the basis file use the pipeline's `[online] estimate` (default the same method)
         method: EstimateMethod::Corrected,
     })
 }

@@ -158,7 +158,7 @@ pub struct OnlineSpec {
     pub load_scales: Scales,
     #[serde(default)]
     pub tolerance: Option<f64>,
-    /// how every reduced run computes its error estimate: "defects" (default), "corrected" or
+    /// how every reduced run computes its error estimate: "corrected" (default), "defects" (cheap, looser) or
     /// "enriched" (docs/error-estimate.md)
     #[serde(default)]
     pub estimate: Option<EstimateMethod>,
