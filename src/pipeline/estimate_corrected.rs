@@ -171,15 +171,8 @@ impl<'a> CorrectedRunner<'a> {
                 // step the one-iteration correction from it is recorded, not applied
                 if k % self.sample == 0 {
                     lambda.iter_mut().for_each(|l| *l = 0.0);
-                    rom.mass_mul(&qdd, &mut work);
-                    rom.force(&q, &v, t, &mut rhs[..n]);
-                    rhs[..n].iter_mut().zip(&work).for_each(|(o, w)| *o += w);
-                    let sc = rom.factor(&q, &v, t, coef).map_err(|p| fail(t, p))?;
-                    let (rq, rc) = rhs.split_at_mut(n);
-                    rq.iter_mut().for_each(|x| *x *= -1.0 / beta_p);
-                    rom.constraint_residual(&q, rc);
-                    rc.iter_mut().for_each(|x| *x *= -sc);
-                    rom.solve(&mut rhs).map_err(|p| fail(t, p))?;
+                    newton_correction(rom, &q, &v, &qdd, &lambda, t, coef, beta_p, &mut rhs, &mut work)
+                        .map_err(|p| fail(t, p))?;
                     if !rhs[..n].iter().all(|x| x.is_finite()) {
                         return Err(fail(t, "the defect is not finite".into()));
                     }
@@ -190,17 +183,8 @@ impl<'a> CorrectedRunner<'a> {
                 }
                 continue;
             }
-            // one Newton iteration on r_q = M q̈ + g + Bᵀλ, r_c = B q − b, fresh matrix
-            rom.mass_mul(&qdd, &mut work);
-            rom.force(&q, &v, t, &mut rhs[..n]);
-            rhs[..n].iter_mut().zip(&work).for_each(|(o, w)| *o += w);
-            rom.add_constraint_force(&lambda, &mut rhs[..n]);
-            let sc = rom.factor(&q, &v, t, coef).map_err(|p| fail(t, p))?;
-            let (rq, rc) = rhs.split_at_mut(n);
-            rq.iter_mut().for_each(|x| *x *= -1.0 / beta_p);
-            rom.constraint_residual(&q, rc);
-            rc.iter_mut().for_each(|x| *x *= -sc);
-            rom.solve(&mut rhs).map_err(|p| fail(t, p))?;
+            let sc = newton_correction(rom, &q, &v, &qdd, &lambda, t, coef, beta_p, &mut rhs, &mut work)
+                .map_err(|p| fail(t, p))?;
             let mut inc = 0.0_f64;
             for i in 0..n {
                 let dq = rhs[i];
@@ -222,4 +206,40 @@ impl<'a> CorrectedRunner<'a> {
         }
         Ok(out)
     }
+}
+
+/// One Newton iteration's correction at the state `(q, q̇, q̈, λ)` with a fresh matrix: the
+/// residuals `r_q = M q̈ + g + Bᵀλ`, `r_c = B q − b`, scaled as the integrator scales them
+/// (momentum rows by `1/β'`, constraint rows by the matrix's scale `s`), solved in place:
+///
+/// ```text
+///     [S, Bᵀ; B, 0] [Δq; Δμ] = −[r_q / β'; s r_c]        (rhs ← [Δq; Δμ])
+/// ```
+///
+/// Returns `s` (the multipliers change by `β' s Δμ`). `work` holds `n` entries.
+#[allow(clippy::too_many_arguments)]
+fn newton_correction<M: DynamicModel>(
+    rom: &mut M,
+    q: &[f64],
+    v: &[f64],
+    qdd: &[f64],
+    lambda: &[f64],
+    t: f64,
+    coef: IterationCoefficients,
+    beta_p: f64,
+    rhs: &mut [f64],
+    work: &mut [f64],
+) -> std::result::Result<f64, String> {
+    let n = q.len();
+    rom.mass_mul(qdd, work);
+    rom.force(q, v, t, &mut rhs[..n]);
+    rhs[..n].iter_mut().zip(work.iter()).for_each(|(o, w)| *o += w);
+    rom.add_constraint_force(lambda, &mut rhs[..n]);
+    let sc = rom.factor(q, v, t, coef)?;
+    let (rq, rc) = rhs.split_at_mut(n);
+    rq.iter_mut().for_each(|x| *x *= -1.0 / beta_p);
+    rom.constraint_residual(q, rc);
+    rc.iter_mut().for_each(|x| *x *= -sc);
+    rom.solve(rhs)?;
+    Ok(sc)
 }
