@@ -11,6 +11,9 @@
 //!   skip (here forced by a memory bound, 800 KiB, between the banded run's ≈ 0.46 MiB and the
 //!   dense run's ≈ 1.1 MiB: `Model::check_full_run_memory`) prints exactly one line saying
 //!   so and how to force it; below both bounds the dense run is timed.
+//! * `validate` says whether the full and reduced runs took the same time steps:
+//!   `full_step_cuts`, `rom_step_cuts` and `steps_differ_from` (null, an empty CSV cell,
+//!   when neither run halved a step, as on this pendulum).
 //! * every command's `--help` has examples and the exit-code table.
 //! * every command creates the folders of its outputs.
 
@@ -112,6 +115,11 @@ fn every_result_prints_as_csv_and_json() {
     let rel: f64 = rows[0][col("rel_error")].parse().unwrap();
     assert!((rel - j["rel_error"].as_f64().unwrap()).abs() <= 1e-12, "the same deterministic run");
     let _ = col("rel_error_by_time_5");
+    // the pendulum's steps converge without halving in both runs (its Newton needs at most
+    // 3 iterations a step, docs/benchmarks.md): the same time grid, no differing step
+    assert_eq!((j["full_step_cuts"].as_u64(), j["rom_step_cuts"].as_u64()), (Some(0), Some(0)));
+    assert!(j["steps_differ_from"].is_null(), "{}", j["steps_differ_from"]);
+    assert_eq!(&rows[0][col("steps_differ_from")], "", "null: an empty cell");
 
     // sweep and merge: one row per load scale
     let sw = dir.join("sweep/deep/s.h5");

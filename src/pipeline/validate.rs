@@ -46,6 +46,18 @@ pub struct Validation {
     pub full_newton_iterations: usize,
     pub rom_newton_iterations: usize,
     pub rom_step_cuts: usize,
+    pub full_step_cuts: usize,
+    /// the earliest time from which the two runs took different steps (one halved a step
+    /// the other did not; null: the same steps): after it rel_error holds a difference of
+    /// time discretization as well as the reduction's
+    pub steps_differ_from: Option<f64>,
+    /// start times of the steps the full run halved (Newton failed at the full step); in
+    /// the text output only (a list of any length has no CSV columns)
+    #[serde(skip)]
+    pub full_step_cut_times: Vec<f64>,
+    /// start times of the steps the reduced run halved (text output only)
+    #[serde(skip)]
+    pub rom_step_cut_times: Vec<f64>,
     /// the estimate of `rel_error` without a full run (null: the basis has no estimator)
     pub error_estimate: Option<f64>,
     /// `error_estimate / rel_error`
@@ -120,6 +132,10 @@ pub fn compare(
         full_newton_iterations: full.stats.newton_iterations,
         rom_newton_iterations: r.stats.newton_iterations,
         rom_step_cuts: r.stats.step_cuts,
+        full_step_cuts: full.stats.step_cuts,
+        steps_differ_from: first_different_step(&full.stats.step_cut_times, &r.stats.step_cut_times),
+        full_step_cut_times: full.stats.step_cut_times.clone(),
+        rom_step_cut_times: r.stats.step_cut_times.clone(),
         error_estimate: None,
         effectivity: None,
         estimate_calibrated: None,
@@ -129,6 +145,17 @@ pub fn compare(
         sensitivity: None,
         rel_error_by_time: rel_error_by_time(&r.q, &full.q),
         error_estimate_by_time: None,
+    }
+}
+
+/// The earliest start of a step that one run halved and the other did not, from the two
+/// runs' lists of halved steps (`None`: both took the same steps).
+fn first_different_step(a: &[f64], b: &[f64]) -> Option<f64> {
+    // both lists hold starts of the same regular grid, computed alike: equal to round-off
+    let only = |x: &[f64], y: &[f64]| x.iter().copied().find(|t| !y.iter().any(|u| (u - t).abs() < 1e-9));
+    match (only(a, b), only(b, a)) {
+        (Some(x), Some(y)) => Some(x.min(y)),
+        (x, y) => x.or(y),
     }
 }
 
@@ -247,6 +274,23 @@ impl Validation {
         if let Some(x) = self.sensitivity {
             s.push_str(&format!("\n  sensitivity {x:.3e} (full runs at λ and 1.001 λ)"));
         }
+        if let Some(t) = self.steps_differ_from {
+            let list = |v: &[f64]| {
+                if v.is_empty() {
+                    "none".to_string()
+                } else {
+                    let at: Vec<String> = v.iter().map(|t| format!("{t:.4}")).collect();
+                    format!("t = {} s", at.join(", "))
+                }
+            };
+            s.push_str(&format!(
+                "\n  the runs halved different steps (full: {}; reduced: {}): from t = {t:.4} s they solve \
+                 different time discretizations, and rel_error after it holds their difference as well as \
+                 the reduction's (docs/benchmarks.md, \"Halved steps\")",
+                list(&self.full_step_cut_times),
+                list(&self.rom_step_cut_times),
+            ));
+        }
         let by: Vec<String> = self.rel_error_by_time.iter().map(|e| format!("{e:.2e}")).collect();
         s.push_str(&format!("\n  rel_error up to each fifth of the run: {}", by.join(", ")));
         if let Some(e) = &self.error_estimate_by_time {
@@ -254,5 +298,23 @@ impl Validation {
             s.push_str(&format!("\n  error_estimate up to each fifth of the run: {}", by.join(", ")));
         }
         s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::first_different_step;
+
+    /// Which step the runs first took differently: a cut only one of them made, the
+    /// earlier of two such, and none when both halved the same steps.
+    #[test]
+    fn the_first_step_taken_differently() {
+        assert_eq!(first_different_step(&[], &[]), None);
+        assert_eq!(first_different_step(&[0.875], &[]), Some(0.875));
+        assert_eq!(first_different_step(&[], &[0.931]), Some(0.931));
+        assert_eq!(first_different_step(&[0.1, 0.875], &[0.1]), Some(0.875));
+        assert_eq!(first_different_step(&[0.1, 0.875], &[0.1, 0.875]), None);
+        assert_eq!(first_different_step(&[0.931], &[0.5, 0.931]), Some(0.5));
+        assert_eq!(first_different_step(&[0.875], &[0.931]), Some(0.875));
     }
 }

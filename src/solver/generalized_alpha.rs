@@ -49,6 +49,11 @@ pub struct Stats {
     pub max_iterations_in_a_step: usize,
     /// steps accepted at the round-off floor ([`IntegratorParams::stagnation`])
     pub steps_at_round_off: usize,
+    /// the start time of every step that was halved, once per step however deep its cuts
+    /// went: where a run's time grid left the regular one (two runs compared step by step,
+    /// e.g. full and reduced, solve different discretizations after a cut one of them
+    /// alone took)
+    pub step_cut_times: Vec<f64>,
 }
 
 struct Failure {
@@ -177,6 +182,9 @@ impl GeneralizedAlpha {
                     });
                 }
                 self.stats.step_cuts += 1;
+                if depth == 0 {
+                    self.stats.step_cut_times.push(state.t);
+                }
                 self.advance(model, state, 0.5 * h, depth + 1, None)?;
                 self.advance(model, state, 0.5 * h, depth + 1, None)
             }
@@ -442,6 +450,13 @@ mod tests {
         assert_eq!((clean.step_cuts, clean.steps_at_round_off), (0, 0), "{clean:?}");
         let (cut, strict) = run(0.02, 0.0);
         assert!(strict.step_cuts > 0 && strict.steps_at_round_off == 0, "{strict:?}");
+        // each halved step is listed once, by its start: a point of the regular grid k h
+        // (k < 50 steps of h = 0.01), in increasing order, never more than the cuts
+        let times = &strict.step_cut_times;
+        assert!(!times.is_empty() && times.len() <= strict.step_cuts, "{strict:?}");
+        assert!(times.windows(2).all(|w| w[0] < w[1]), "{times:?}");
+        assert!(times.iter().all(|t| (t / 0.01 - (t / 0.01).round()).abs() < 1e-9 && *t < 0.5), "{times:?}");
+        assert!(clean.step_cut_times.is_empty(), "{clean:?}");
         let (floor, stats) = run(0.02, 1e-6);
         assert_eq!(stats.step_cuts, 0, "{stats:?}");
         assert!(stats.steps_at_round_off > 0, "{stats:?}");

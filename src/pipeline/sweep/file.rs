@@ -324,6 +324,10 @@ pub fn read_sweep(
             full_newton_iterations: 0,
             rom_newton_iterations: newton[k] as usize,
             rom_step_cuts: 0,
+            full_step_cuts: 0,
+            steps_differ_from: None,
+            full_step_cut_times: Vec::new(),
+            rom_step_cut_times: Vec::new(),
             // the estimate and the flags are set below from the file's columns
             error_estimate: None,
             effectivity: None,
