@@ -161,8 +161,18 @@ impl BandedLdlt {
 
 fn symmetric(blocks: &[Block]) -> bool {
     // blocks built as sums of symmetric matrices are symmetric to the bit; only others
-    // need the tolerance
-    let exact = |b: &Block| (0..8).all(|j| (j + 1..8).all(|i| b[(i, j)] == b[(j, i)]));
+    // need the tolerance. All 28 pairs compared, without a branch per pair (the early exit
+    // of `all` costs more than the comparisons it could skip).
+    let exact = |b: &Block| {
+        let s = b.as_slice();
+        let mut same = true;
+        for j in 0..8 {
+            for i in j + 1..8 {
+                same &= s[8 * j + i] == s[8 * i + j];
+            }
+        }
+        same
+    };
     blocks.iter().all(|b| {
         if exact(b) {
             return true;
@@ -248,16 +258,13 @@ fn band_ldlt_impl<const B: usize>(
             return false;
         }
         let inv = 1.0 / d;
-        let (w, l): (&mut [f64], &mut [f64]) =
-            if b > 64 { (&mut wv[..km], &mut lv[..km]) } else { (&mut w[..km], &mut l[..km]) };
-        for r in 0..km {
-            w[r] = col[1 + r];
-            l[r] = w[r] * inv;
-            col[1 + r] = l[r];
-        }
         if B != 0 && km == B {
-            let w: &[f64; B] = (&w[..B]).try_into().expect("length B");
-            let l: &[f64; B] = (&l[..B]).try_into().expect("length B");
+            // w (the column before scaling) and l as values, not through the scratch arrays:
+            // stored one by one and reloaded two at a time by the vectorized update, they
+            // stall on store-to-load forwarding (a fifth of this function's time)
+            let w: [f64; B] = std::array::from_fn(|r| col[1 + r]);
+            let l: [f64; B] = std::array::from_fn(|r| w[r] * inv);
+            col[1..=B].copy_from_slice(&l);
             // column j+1+k holds rows j+1+k..: entry (j+1+i, j+1+k) at k ld + i − k
             for k in 0..B {
                 let wk = w[k];
@@ -267,6 +274,13 @@ fn band_ldlt_impl<const B: usize>(
                 }
             }
         } else {
+            let (w, l): (&mut [f64], &mut [f64]) =
+                if b > 64 { (&mut wv[..km], &mut lv[..km]) } else { (&mut w[..km], &mut l[..km]) };
+            for r in 0..km {
+                w[r] = col[1 + r];
+                l[r] = w[r] * inv;
+                col[1 + r] = l[r];
+            }
             for k in 0..km {
                 let wk = w[k];
                 let tgt = &mut rest[k * ld..k * ld + km - k];
@@ -294,51 +308,63 @@ pub fn band_ldlt_solve(ab: &[f64], n: usize, b: usize, x: &mut [f64]) {
 }
 
 fn band_ldlt_solve_impl<const B: usize>(ab: &[f64], n: usize, b: usize, x: &mut [f64]) {
+    // Row-oriented substitutions that carry the last b solved values in a window of
+    // registers (`win`): the column-oriented form (`x[j+1..j+b] −= l x_j`) stores each
+    // entry and reloads it, two at a time, one row later, across two stores, and stalls on
+    // store-to-load forwarding at every row. The operations and their order are those of
+    // the column form, so the bits are the same: row i subtracts the terms of columns
+    // j = i−b, …, i−1 in that order, and only the last waits for the row just solved.
     let ld = b + 1;
-    for j in 0..n {
-        let km = b.min(n - 1 - j);
-        let xj = x[j];
-        let l = &ab[j * ld + 1..j * ld + 1 + km];
-        if B != 0 && km == B {
-            let t: &mut [f64; B] = (&mut x[j + 1..j + 1 + B]).try_into().expect("length B");
-            let l: &[f64; B] = l.try_into().expect("length B");
-            for r in 0..B {
-                t[r] -= l[r] * xj;
+    // L y = rhs: y_i = rhs_i − Σ_{j = i−b}^{i−1} L(i, j) y_j, L(i, j) at ab[j ld + i − j]
+    let full = if B != 0 { B.min(n) } else { n };
+    for i in 0..full {
+        let mut acc = x[i];
+        for j in i.saturating_sub(b)..i {
+            acc -= ab[j * ld + i - j] * x[j];
+        }
+        x[i] = acc;
+    }
+    if B != 0 && n > B {
+        // win[m] = y_{i−B+m}
+        let mut win: [f64; B] = std::array::from_fn(|m| x[m]);
+        for i in B..n {
+            let mut acc = x[i];
+            for m in 0..B {
+                acc -= ab[(i - B + m) * ld + B - m] * win[m];
             }
-        } else {
-            for (t, m) in x[j + 1..j + 1 + km].iter_mut().zip(l) {
-                *t -= m * xj;
-            }
+            x[i] = acc;
+            win = std::array::from_fn(|m| if m + 1 < B { win[m + 1] } else { acc });
         }
     }
-    for j in 0..n {
-        x[j] /= ab[j * ld];
-    }
-    for j in (0..n).rev() {
+    // D z = y and Lᵀ x = z: x_j = y_j / d_j − Σ_{r=1}^{b} L(j+r, j) x_{j+r}
+    let short = if B != 0 { n.min(B) } else { n };
+    for j in (n - short..n).rev() {
         let km = b.min(n - 1 - j);
         let l = &ab[j * ld + 1..j * ld + 1 + km];
-        let (head, tail) = x.split_at_mut(j + 1);
-        let s = if B != 0 && km == B {
-            let t: &[f64; B] = (&tail[..B]).try_into().expect("length B");
-            let l: &[f64; B] = l.try_into().expect("length B");
-            // x[j+1], just computed, enters last: the terms of the rows further down do not
-            // wait for it (the dependency chain from row to row is one multiply-add)
+        let s: f64 = x[j + 1..j + 1 + km].iter().zip(l).map(|(a, m)| a * m).sum();
+        x[j] = x[j] / ab[j * ld] - s;
+    }
+    if B != 0 && n > B {
+        // win[m] = x_{j+1+m}
+        let mut win: [f64; B] = std::array::from_fn(|m| x[n - B + m]);
+        for j in (0..n - B).rev() {
+            let l: &[f64; B] = (&ab[j * ld + 1..j * ld + 1 + B]).try_into().expect("length B");
+            // x_{j+1}, just solved, enters last: the terms of the rows further down do not
+            // wait for it (two partial sums, the chain from row to row one multiply-add)
             let (mut s0, mut s1) = (0.0, 0.0);
             let mut r = 1;
             while r + 1 < B {
-                s0 += t[r] * l[r];
-                s1 += t[r + 1] * l[r + 1];
+                s0 += win[r] * l[r];
+                s1 += win[r + 1] * l[r + 1];
                 r += 2;
             }
             if r < B {
-                s0 += t[r] * l[r];
+                s0 += win[r] * l[r];
             }
-            head[j] -= s0 + s1;
-            t[0] * l[0]
-        } else {
-            tail[..km].iter().zip(l).map(|(a, m)| a * m).sum()
-        };
-        head[j] -= s;
+            let xj = x[j] / ab[j * ld] - (s0 + s1) - win[0] * l[0];
+            x[j] = xj;
+            win = std::array::from_fn(|m| if m == 0 { xj } else { win[m - 1] });
+        }
     }
 }
 
