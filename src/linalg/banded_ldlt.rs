@@ -45,9 +45,11 @@ pub struct BandedLdlt {
     /// `A(i, j)`, `i ≥ j` (new numbering), at `ab[j (b+1) + i − j]`; after factoring, `D`
     /// on the diagonal and `L` below it
     ab: Vec<f64>,
-    /// per element: (entry k = 8 j + i of its block, slot in `ab`) for the entries on or
-    /// below the diagonal in the new numbering
-    elem: Vec<Vec<(u8, usize)>>,
+    /// per element e, `elem[elem_start[e]..elem_start[e + 1]]`: (entry k = 8 j + i of its
+    /// block, slot in `ab`) for the entries on or below the diagonal in the new numbering
+    /// (one flat list: 36 entries an element, no pointer to follow per element)
+    elem: Vec<(u32, usize)>,
+    elem_start: Vec<usize>,
     /// per constraint entry: (slot, coefficient)
     cons: Vec<(usize, f64)>,
     /// whether each new row is a coordinate (true) or a constraint row
@@ -96,21 +98,18 @@ impl BandedLdlt {
             debug_assert!(i >= j);
             j * ld + i - j
         };
-        let elem = pattern
-            .element_dofs
-            .iter()
-            .map(|dofs| {
-                let mut v = Vec::with_capacity(36);
-                for j in 0..8 {
-                    for i in 0..8 {
-                        if new_of[dofs[i]] >= new_of[dofs[j]] {
-                            v.push(((8 * j + i) as u8, slot(dofs[i], dofs[j])));
-                        }
+        let mut elem = Vec::with_capacity(36 * pattern.element_dofs.len());
+        let mut elem_start = vec![0];
+        for dofs in &pattern.element_dofs {
+            for j in 0..8 {
+                for i in 0..8 {
+                    if new_of[dofs[i]] >= new_of[dofs[j]] {
+                        elem.push(((8 * j + i) as u32, slot(dofs[i], dofs[j])));
                     }
                 }
-                v
-            })
-            .collect();
+            }
+            elem_start.push(elem.len());
+        }
         let mut cons = Vec::new();
         for (c, row) in pattern.constraint_rows.iter().enumerate() {
             for &(d, coef) in row {
@@ -125,6 +124,7 @@ impl BandedLdlt {
             new_of,
             ab: vec![0.0; ld * n],
             elem,
+            elem_start,
             cons,
             is_dof,
             work: vec![0.0; n],
@@ -145,36 +145,45 @@ impl BandedLdlt {
         self.state == Factored::Lu
     }
 
-    fn scatter(&mut self, blocks: &[Block], scale: f64) {
+    /// Assembles the lower band of `[Σ P_eᵀ blocks[e] P_e, s Bᵀ; s B, 0]` (new numbering)
+    /// into `ab`; returns whether every block is symmetric to the bit (checked in the same
+    /// pass, while each block is at hand).
+    fn scatter(&mut self, blocks: &[Block], scale: f64) -> bool {
         self.ab.iter_mut().for_each(|v| *v = 0.0);
-        for (block, slots) in blocks.iter().zip(&self.elem) {
+        let mut exact = true;
+        for (block, range) in blocks.iter().zip(self.elem_start.windows(2)) {
+            exact &= exactly_symmetric(block);
             let b = block.as_slice();
-            for &(k, s) in slots {
+            for &(k, s) in &self.elem[range[0]..range[1]] {
                 self.ab[s] += b[k as usize];
             }
         }
         for &(s, coef) in &self.cons {
             self.ab[s] += scale * coef;
         }
+        exact
     }
 }
 
-fn symmetric(blocks: &[Block]) -> bool {
-    // blocks built as sums of symmetric matrices are symmetric to the bit; only others
-    // need the tolerance. All 28 pairs compared, without a branch per pair (the early exit
-    // of `all` costs more than the comparisons it could skip).
-    let exact = |b: &Block| {
-        let s = b.as_slice();
-        let mut same = true;
-        for j in 0..8 {
-            for i in j + 1..8 {
-                same &= s[8 * j + i] == s[8 * i + j];
-            }
+/// Whether `b = bᵀ` to the bit: all 28 pairs compared, without a branch per pair (the
+/// early exit of `all` costs more than the comparisons it could skip).
+fn exactly_symmetric(b: &Block) -> bool {
+    let s = b.as_slice();
+    let mut same = true;
+    for j in 0..8 {
+        for i in j + 1..8 {
+            same &= s[8 * j + i] == s[8 * i + j];
         }
-        same
-    };
+    }
+    same
+}
+
+/// Whether every block is symmetric within [`SYMMETRY_TOL`]. Blocks built as sums of
+/// symmetric matrices are symmetric to the bit ([`BandedLdlt::scatter`] tells); only others
+/// need the tolerance.
+fn symmetric(blocks: &[Block]) -> bool {
     blocks.iter().all(|b| {
-        if exact(b) {
+        if exactly_symmetric(b) {
             return true;
         }
         let tol = SYMMETRY_TOL * b.amax();
@@ -185,8 +194,10 @@ fn symmetric(blocks: &[Block]) -> bool {
 impl KktSolver for BandedLdlt {
     fn factor(&mut self, blocks: &[Block], scale: f64) -> Result<(), String> {
         self.state = Factored::No;
-        if symmetric(blocks) {
-            self.scatter(blocks, scale);
+        // assembled first: the bit-exact symmetry check comes with it, the tolerant one only
+        // when some block fails that
+        let exact = self.scatter(blocks, scale);
+        if exact || symmetric(blocks) {
             let cons_min = PIVOT_RATIO * scale.abs();
             if band_ldlt(&mut self.ab, self.n, self.band, &self.is_dof, cons_min, &mut self.diag) {
                 self.state = Factored::Ldlt;
@@ -248,11 +259,15 @@ fn band_ldlt_impl<const B: usize>(
     let mut l = [0.0_f64; 64];
     let mut wv = vec![0.0; if b > 64 { b } else { 0 }];
     let mut lv = vec![0.0; if b > 64 { b } else { 0 }];
+    // the next pivot as computed by the last column's update, held in a register: the
+    // chain from pivot to pivot (divide, scale, update) is what bounds this loop, and
+    // reading the pivot back from memory would add a store-to-load round trip to it
+    let mut next_pivot = None;
     for j in 0..n {
         let km = b.min(n - 1 - j);
         let (head, rest) = ab.split_at_mut((j + 1) * ld);
         let col = &mut head[j * ld..(j + 1) * ld];
-        let d = col[0];
+        let d = next_pivot.take().unwrap_or(col[0]);
         let ok = if is_dof[j] { d.is_finite() && d > PIVOT_RATIO * diag[j] } else { d.is_finite() && d < -cons_min };
         if !ok {
             return false;
@@ -265,6 +280,8 @@ fn band_ldlt_impl<const B: usize>(
             let w: [f64; B] = std::array::from_fn(|r| col[1 + r]);
             let l: [f64; B] = std::array::from_fn(|r| w[r] * inv);
             col[1..=B].copy_from_slice(&l);
+            // the value the update below gives entry (j+1, j+1), the same operation
+            next_pivot = Some(rest[0] - l[0] * w[0]);
             // column j+1+k holds rows j+1+k..: entry (j+1+i, j+1+k) at k ld + i − k
             for k in 0..B {
                 let wk = w[k];
