@@ -51,11 +51,13 @@ fn short_write_error(problem: &str) -> String {
 /// file (docs/process-speed.md). The same bytes reach the file (a test reads both back).
 pub fn attr_str(loc: &hdf5::Location, name: &str, value: &str) -> hdf5::Result<()> {
     use hdf5_sys::h5::herr_t;
-    use hdf5_sys::h5i::hid_t;
     use hdf5_sys::h5a::{H5Aclose, H5Acreate2, H5Awrite};
+    use hdf5_sys::h5i::hid_t;
     use hdf5_sys::h5p::{H5Pclose, H5Pcreate, H5Pset_char_encoding, H5P_DEFAULT};
-    use hdf5_sys::h5s::{H5Sclose, H5Screate, H5S_class_t};
-    use hdf5_sys::h5t::{H5T_cset_t, H5T_str_t, H5Tclose, H5Tcopy, H5Tset_cset, H5Tset_size, H5Tset_strpad, H5T_VARIABLE};
+    use hdf5_sys::h5s::{H5S_class_t, H5Sclose, H5Screate};
+    use hdf5_sys::h5t::{
+        H5T_cset_t, H5T_str_t, H5Tclose, H5Tcopy, H5Tset_cset, H5Tset_size, H5Tset_strpad, H5T_VARIABLE,
+    };
     // the checks of `VarLenUnicode`'s parser: no NUL inside (HDF5 would cut the text there)
     let v: VarLenUnicode = value.parse().map_err(|e| hdf5::Error::from(format!("{e:?}")))?;
     let cname = std::ffi::CString::new(name).map_err(|e| hdf5::Error::from(format!("attribute name `{name}`: {e}")))?;
@@ -122,7 +124,11 @@ mod tests {
             let mine = format!("mine {i} é");
             super::attr_str(&f, &mine, text).unwrap();
             let theirs = format!("theirs {i} é");
-            f.new_attr::<VarLenUnicode>().create(theirs.as_str()).unwrap().write_scalar(&text.parse::<VarLenUnicode>().unwrap()).unwrap();
+            f.new_attr::<VarLenUnicode>()
+                .create(theirs.as_str())
+                .unwrap()
+                .write_scalar(&text.parse::<VarLenUnicode>().unwrap())
+                .unwrap();
             assert_eq!(super::read_attr_str(&f, &mine).unwrap(), *text);
             let (a, b) = (f.attr(&mine).unwrap(), f.attr(&theirs).unwrap());
             assert_eq!(a.dtype().unwrap(), b.dtype().unwrap());

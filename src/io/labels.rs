@@ -88,7 +88,8 @@ impl Labels {
             None => Ok(()),
         };
         let text = |v: &mut dyn Iterator<Item = &str>| -> hdf5::Result<Vec<VarLenUnicode>> {
-            v.map(|s| s.parse::<VarLenUnicode>().map_err(|e| hdf5::Error::from(format!("label `{s}`: {e:?}")))).collect()
+            v.map(|s| s.parse::<VarLenUnicode>().map_err(|e| hdf5::Error::from(format!("label `{s}`: {e:?}"))))
+                .collect()
         };
         let idx = |v: &mut dyn Iterator<Item = usize>| Array1::from_iter(v.map(|i| i as u64));
         let index = |g: &hdf5::Group, name: &str, v: &mut dyn Iterator<Item = usize>| {
