@@ -12,7 +12,8 @@
 //!
 //! The units of each dataset live in one table per file kind ([`units_of`]); the writers
 //! call [`annotate`] (through [`write_atomically_as`]) after filling a file, which labels
-//! every dataset it finds from the table. docs/file-formats.md shows the same tables
+//! every dataset it finds from the table (a writer may label some as it creates them,
+//! [`Labelled`]: the same attributes, without opening the datasets again). docs/file-formats.md shows the same tables
 //! (a test checks every row of them against this one).
 
 use super::h5::{attr_str, attr_u64, write_atomically};
@@ -192,18 +193,56 @@ pub fn write_units(d: &hdf5::Dataset, units: &str, dims: &str) -> hdf5::Result<(
     Ok(())
 }
 
+/// The datasets a writer labelled itself as it created them ([`Labelled::label`]), which
+/// [`annotate`] then passes by without opening them: opening every dataset of a result
+/// file again, to find the same attributes missing, was a fifth of the time of writing it
+/// (docs/process-speed.md).
+#[derive(Debug)]
+pub struct Labelled {
+    kind: Kind,
+    /// paths (no leading `/`) of the datasets labelled so far
+    done: Vec<String>,
+}
+
+impl Labelled {
+    pub fn new(kind: Kind) -> Labelled {
+        Labelled { kind, done: Vec::new() }
+    }
+
+    /// Writes `units` and `dims` from the table of the file's kind on the dataset `d` just
+    /// created at `path` (no leading `/`), as [`annotate`] would, and records it as done.
+    /// A path missing from the table gets nothing, and is not recorded (annotate passes it
+    /// by all the same).
+    pub fn label(&mut self, path: &str, d: &hdf5::Dataset) -> hdf5::Result<()> {
+        if let Some((units, dims)) = units_of(self.kind, path) {
+            attr_str(d, "units", units)?;
+            attr_str(d, "dims", dims)?;
+            self.done.push(path.to_string());
+        }
+        Ok(())
+    }
+}
+
 /// Labels a freshly written file: [`LAYOUT_ATTR`] and [`KIND_ATTR`] on `/`, `units` and
 /// `dims` on every dataset found in the table of `kind`. A dataset missing from the table
 /// keeps no `units` (tests/file_layout.rs fails on it: add it to the table and the docs).
 pub fn annotate(f: &hdf5::File, kind: Kind) -> hdf5::Result<()> {
-    fn walk(g: &hdf5::Group, prefix: &str, kind: Kind) -> hdf5::Result<()> {
+    annotate_rest(f, &Labelled::new(kind))
+}
+
+/// [`annotate`], passing by the datasets in `labelled` (their writer labelled them).
+pub fn annotate_rest(f: &hdf5::File, labelled: &Labelled) -> hdf5::Result<()> {
+    fn walk(g: &hdf5::Group, prefix: &str, labelled: &Labelled) -> hdf5::Result<()> {
         for name in g.member_names()? {
             let full = if prefix.is_empty() { name.clone() } else { format!("{prefix}/{name}") };
+            if labelled.done.contains(&full) {
+                continue;
+            }
             // asked, not tried: a failed `group()` on a dataset builds a whole HDF5 error stack
             match g.loc_type_by_name(&name) {
-                Ok(hdf5::LocationType::Group) => walk(&g.group(&name)?, &full, kind)?,
+                Ok(hdf5::LocationType::Group) => walk(&g.group(&name)?, &full, labelled)?,
                 Ok(hdf5::LocationType::Dataset) => {
-                    if let Some((units, dims)) = units_of(kind, &full) {
+                    if let Some((units, dims)) = units_of(labelled.kind, &full) {
                         write_units(&g.dataset(&name)?, units, dims)?;
                     }
                 }
@@ -212,19 +251,30 @@ pub fn annotate(f: &hdf5::File, kind: Kind) -> hdf5::Result<()> {
         }
         Ok(())
     }
-    walk(f, "", kind)?;
+    walk(f, "", labelled)?;
     if !f.attr_names()?.iter().any(|a| a == LAYOUT_ATTR) {
         attr_u64(f, LAYOUT_ATTR, LAYOUT_VERSION)?;
-        attr_str(f, KIND_ATTR, kind.name())?;
+        attr_str(f, KIND_ATTR, labelled.kind.name())?;
     }
     Ok(())
 }
 
 /// [`write_atomically`], then [`annotate`] as `kind`, in the same atomic write.
 pub fn write_atomically_as(path: &Path, kind: Kind, fill: impl FnOnce(&hdf5::File) -> Result<()>) -> Result<()> {
+    write_atomically_labelled(path, kind, |f, _| fill(f))
+}
+
+/// [`write_atomically_as`] for a writer that labels datasets as it creates them
+/// ([`Labelled::label`]); [`annotate_rest`] labels the others.
+pub fn write_atomically_labelled(
+    path: &Path,
+    kind: Kind,
+    fill: impl FnOnce(&hdf5::File, &mut Labelled) -> Result<()>,
+) -> Result<()> {
     write_atomically(path, |f| {
-        fill(f)?;
-        annotate(f, kind).map_err(|e| Error::hdf5(path, e))
+        let mut labelled = Labelled::new(kind);
+        fill(f, &mut labelled)?;
+        annotate_rest(f, &labelled).map_err(|e| Error::hdf5(path, e))
     })
 }
 

@@ -43,9 +43,54 @@ fn short_write_error(problem: &str) -> String {
     }
 }
 
+/// Writes the text attribute `name` = `value` on `loc`: a scalar, variable-length,
+/// NUL-terminated UTF-8 string with a UTF-8 name, as
+/// `loc.new_attr::<VarLenUnicode>().create(name)?.write_scalar(..)` writes it, in a dozen
+/// HDF5 calls instead of the crate's ~40 (type built, looked up and compared twice, shapes
+/// checked, handles validated on drop): the attributes were a sixth of writing a result
+/// file (docs/process-speed.md). The same bytes reach the file (a test reads both back).
 pub fn attr_str(loc: &hdf5::Location, name: &str, value: &str) -> hdf5::Result<()> {
+    use hdf5_sys::h5::herr_t;
+    use hdf5_sys::h5a::{H5Aclose, H5Acreate2, H5Awrite};
+    use hdf5_sys::h5i::hid_t;
+    use hdf5_sys::h5p::{H5Pclose, H5Pcreate, H5Pset_char_encoding, H5P_DEFAULT};
+    use hdf5_sys::h5s::{H5S_class_t, H5Sclose, H5Screate};
+    use hdf5_sys::h5t::{
+        H5T_cset_t, H5T_str_t, H5Tclose, H5Tcopy, H5Tset_cset, H5Tset_size, H5Tset_strpad, H5T_VARIABLE,
+    };
+    // the checks of `VarLenUnicode`'s parser: no NUL inside (HDF5 would cut the text there)
     let v: VarLenUnicode = value.parse().map_err(|e| hdf5::Error::from(format!("{e:?}")))?;
-    loc.new_attr::<VarLenUnicode>().create(name)?.write_scalar(&v)
+    let cname = std::ffi::CString::new(name).map_err(|e| hdf5::Error::from(format!("attribute name `{name}`: {e}")))?;
+    hdf5::sync::sync(|| {
+        // SAFETY: plain calls into HDF5 under hdf5-metno's library lock (`sync`). `loc` is a
+        // live object; every id created here is checked and closed here (`close` runs on
+        // every path). `H5Awrite` reads one `char*` from `ptr`, the pointer held by `v`, a
+        // NUL-terminated string that outlives the call, which HDF5 only reads and copies.
+        unsafe {
+            let mut ids: Vec<(hid_t, unsafe extern "C" fn(hid_t) -> herr_t)> = Vec::with_capacity(4);
+            let r = (|| -> hdf5::Result<()> {
+                let t = hdf5::h5check(H5Tcopy(*hdf5::globals::H5T_C_S1))?;
+                ids.push((t, H5Tclose));
+                hdf5::h5check(H5Tset_cset(t, H5T_cset_t::H5T_CSET_UTF8))?;
+                hdf5::h5check(H5Tset_strpad(t, H5T_str_t::H5T_STR_NULLTERM))?;
+                hdf5::h5check(H5Tset_size(t, H5T_VARIABLE))?;
+                let space = hdf5::h5check(H5Screate(H5S_class_t::H5S_SCALAR))?;
+                ids.push((space, H5Sclose));
+                let acpl = hdf5::h5check(H5Pcreate(*hdf5::globals::H5P_ATTRIBUTE_CREATE))?;
+                ids.push((acpl, H5Pclose));
+                hdf5::h5check(H5Pset_char_encoding(acpl, H5T_cset_t::H5T_CSET_UTF8))?;
+                let a = hdf5::h5check(H5Acreate2(loc.id(), cname.as_ptr(), t, space, acpl, H5P_DEFAULT))?;
+                ids.push((a, H5Aclose));
+                let ptr: *const VarLenUnicode = &v;
+                hdf5::h5check(H5Awrite(a, t, ptr.cast()))?;
+                Ok(())
+            })();
+            for (id, close) in ids.into_iter().rev() {
+                close(id);
+            }
+            r
+        }
+    })
 }
 
 pub fn attr_f64(loc: &hdf5::Location, name: &str, value: f64) -> hdf5::Result<()> {
@@ -66,6 +111,36 @@ pub fn read_attr_f64(loc: &hdf5::Location, name: &str) -> hdf5::Result<f64> {
 
 #[cfg(test)]
 mod tests {
+    /// `attr_str` writes what the crate's own attribute writer writes: read back equal
+    /// (empty, multi-byte and long texts), of the same datatype (variable-length UTF-8,
+    /// NUL-terminated) and with a UTF-8 name; a text with a NUL inside is refused.
+    #[test]
+    fn text_attributes_match_the_crate_writer() {
+        use hdf5::types::VarLenUnicode;
+        let d = tempfile::tempdir().unwrap();
+        let f = hdf5::File::create(d.path().join("a.h5")).unwrap();
+        let long = "ε".repeat(3000);
+        for (i, text) in ["", "N·m (slope rows)", long.as_str()].iter().enumerate() {
+            let mine = format!("mine {i} é");
+            super::attr_str(&f, &mine, text).unwrap();
+            let theirs = format!("theirs {i} é");
+            f.new_attr::<VarLenUnicode>()
+                .create(theirs.as_str())
+                .unwrap()
+                .write_scalar(&text.parse::<VarLenUnicode>().unwrap())
+                .unwrap();
+            assert_eq!(super::read_attr_str(&f, &mine).unwrap(), *text);
+            let (a, b) = (f.attr(&mine).unwrap(), f.attr(&theirs).unwrap());
+            assert_eq!(a.dtype().unwrap(), b.dtype().unwrap());
+            assert_eq!(a.dtype().unwrap().to_descriptor().unwrap(), b.dtype().unwrap().to_descriptor().unwrap());
+            assert_eq!(a.shape(), b.shape());
+            assert_eq!(a.acpl().unwrap().char_encoding(), b.acpl().unwrap().char_encoding());
+        }
+        assert!(super::attr_str(&f, "nul", "a\0b").is_err());
+        assert!(super::attr_str(&f, "nul\0name", "a").is_err());
+        assert!(f.attr_names().unwrap().iter().all(|n| !n.starts_with("nul")));
+    }
+
     #[test]
     fn hdf5_write_errors_are_one_line_with_the_system_message() {
         let p = "H5Dwrite(): can't write data: file write failed: time = Wed Nov 25 02:33:25 2026\n, filename = '/tmp/x/.out.h5.flexrom-tmp-1-0', file descriptor = 5, errno = 28, error message = 'No space left on device', buf = 0x55, total write size = 32424";

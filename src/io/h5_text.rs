@@ -20,11 +20,11 @@ use hdf5_sys::h5s::H5S_ALL;
 /// addresses, 24 with the largest, 16-byte ones).
 const ELEMENT_BYTES: usize = 32;
 
-/// Creates the dataset `name` (shape `n`) in `g` and writes `values` into it.
-pub fn write_strings(g: &hdf5::Group, name: &str, values: &[VarLenUnicode]) -> hdf5::Result<()> {
+/// Creates the dataset `name` (shape `n`) in `g`, writes `values` into it and returns it.
+pub fn write_strings(g: &hdf5::Group, name: &str, values: &[VarLenUnicode]) -> hdf5::Result<hdf5::Dataset> {
     let ds = g.new_dataset::<VarLenUnicode>().shape(values.len()).create(name)?;
     if values.is_empty() {
-        return Ok(());
+        return Ok(ds);
     }
     let mem = hdf5::Datatype::from_type::<VarLenUnicode>()?;
     let bytes = values.len() * ELEMENT_BYTES;
@@ -43,7 +43,8 @@ pub fn write_strings(g: &hdf5::Group, name: &str, values: &[VarLenUnicode]) -> h
             H5Pclose(xfer);
             r.map(|_| ())
         }
-    })
+    })?;
+    Ok(ds)
 }
 
 #[cfg(test)]

@@ -16,6 +16,7 @@
 //! pins (x, y) and clamps (x, y, x', y') in file order, then those of the pins (x, y) in file
 //! order (a unit test checks the labels against the assembled constraint rows).
 
+use super::attrs::Labelled;
 use crate::model::Model;
 use crate::physics::system::{Joint, NodeId};
 use hdf5::types::VarLenUnicode;
@@ -75,24 +76,35 @@ impl Labels {
 
     /// Writes `/labels` into `f`.
     pub fn write(&self, f: &hdf5::File) -> hdf5::Result<()> {
+        self.write_labelled(f, None)
+    }
+
+    /// Writes `/labels` into `f`, each dataset labelled as it is created when `labelled` is
+    /// given ([`Labelled`]).
+    pub fn write_labelled(&self, f: &hdf5::File, mut labelled: Option<&mut Labelled>) -> hdf5::Result<()> {
         let g = f.create_group("labels")?;
-        let text = |v: Vec<String>| -> hdf5::Result<Vec<VarLenUnicode>> {
-            v.iter()
-                .map(|s| s.parse::<VarLenUnicode>().map_err(|e| hdf5::Error::from(format!("label `{s}`: {e:?}"))))
+        let mut done = |name: &str, d: hdf5::Dataset| match labelled.as_deref_mut() {
+            Some(l) => l.label(&format!("labels/{name}"), &d),
+            None => Ok(()),
+        };
+        let text = |v: &mut dyn Iterator<Item = &str>| -> hdf5::Result<Vec<VarLenUnicode>> {
+            v.map(|s| s.parse::<VarLenUnicode>().map_err(|e| hdf5::Error::from(format!("label `{s}`: {e:?}"))))
                 .collect()
         };
-        let idx = |v: Vec<usize>| Array1::from_iter(v.into_iter().map(|i| i as u64));
+        let idx = |v: &mut dyn Iterator<Item = usize>| Array1::from_iter(v.map(|i| i as u64));
+        let index = |g: &hdf5::Group, name: &str, v: &mut dyn Iterator<Item = usize>| {
+            g.new_dataset_builder().with_data(&idx(v)).create(name)
+        };
         // the string datasets through write_strings: a conversion buffer of their size, not 1 MiB
-        super::h5_text::write_strings(&g, "body", &text(self.bodies.clone())?)?;
-        super::h5_text::write_strings(&g, "dof", &text(self.dof_names())?)?;
-        g.new_dataset_builder().with_data(&idx(self.dofs.iter().map(|d| d.0).collect())).create("dof_body")?;
-        g.new_dataset_builder().with_data(&idx(self.dofs.iter().map(|d| d.1).collect())).create("dof_node")?;
-        g.new_dataset_builder().with_data(&idx(self.dofs.iter().map(|d| d.2).collect())).create("dof_coordinate")?;
-        let names = self.multipliers.iter().map(|m| m.1.clone()).collect();
-        super::h5_text::write_strings(&g, "multiplier", &text(names)?)?;
-        g.new_dataset_builder()
-            .with_data(&idx(self.multipliers.iter().map(|m| m.0).collect()))
-            .create("multiplier_joint")?;
+        done("body", super::h5_text::write_strings(&g, "body", &text(&mut self.bodies.iter().map(|s| s.as_str()))?)?)?;
+        let dof_names = self.dof_names();
+        done("dof", super::h5_text::write_strings(&g, "dof", &text(&mut dof_names.iter().map(|s| s.as_str()))?)?)?;
+        done("dof_body", index(&g, "dof_body", &mut self.dofs.iter().map(|d| d.0))?)?;
+        done("dof_node", index(&g, "dof_node", &mut self.dofs.iter().map(|d| d.1))?)?;
+        done("dof_coordinate", index(&g, "dof_coordinate", &mut self.dofs.iter().map(|d| d.2))?)?;
+        let names = text(&mut self.multipliers.iter().map(|m| m.1.as_str()))?;
+        done("multiplier", super::h5_text::write_strings(&g, "multiplier", &names)?)?;
+        done("multiplier_joint", index(&g, "multiplier_joint", &mut self.multipliers.iter().map(|m| m.0))?)?;
         Ok(())
     }
 }
@@ -101,8 +113,18 @@ impl Labels {
 /// or basis): parsed again, which is cheap beside the run it labels. A text that does not
 /// parse (it did when the run started) writes no labels rather than failing the write.
 pub fn write_labels_of_text(f: &hdf5::File, model_text: &str, model_path: &str) -> hdf5::Result<()> {
+    write_labels_of_text_labelled(f, model_text, model_path, None)
+}
+
+/// [`write_labels_of_text`], each dataset labelled as it is created when `labelled` is given.
+pub fn write_labels_of_text_labelled(
+    f: &hdf5::File,
+    model_text: &str,
+    model_path: &str,
+    labelled: Option<&mut Labelled>,
+) -> hdf5::Result<()> {
     match Model::from_text(model_text, model_path) {
-        Ok(m) => Labels::of(&m).write(f),
+        Ok(m) => Labels::of(&m).write_labelled(f, labelled),
         Err(_) => Ok(()),
     }
 }

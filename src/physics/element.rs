@@ -157,26 +157,34 @@ impl BeamElement {
     /// one pass instead of the three 8×8 sums of [`Self::tangent`]).
     #[inline]
     pub fn iteration_block(&self, constant: &Mat8, k: f64, e: &Vec8) -> Mat8 {
+        let mut out = Mat8::zeros();
+        self.iteration_block_into(constant, k, e, &mut out);
+        out
+    }
+
+    /// [`Self::iteration_block`] written into `out` (the system's block of the element: no
+    /// 512-byte copy per element and factorization).
+    #[inline]
+    pub fn iteration_block_into(&self, constant: &Mat8, k: f64, e: &Vec8, out: &mut Mat8) {
         let sle = self.axial_product(e);
         let eps = e.dot(&sle) / (2.0 * self.length) - 0.5;
         let ea = self.section.ea();
         let (a, b) = (k * ea * eps, k * ea / self.length);
-        let mut out = *constant;
+        let (c, o) = (constant.as_slice(), out.as_mut_slice());
         // (sᵢ sⱼ) b: the same rounding for (i, j) and (j, i), so a symmetric `constant`
-        // gives a block symmetric to the bit (the band LDLᵀ checks it)
+        // gives a block symmetric to the bit (the band LDLᵀ checks it); column-major, k = 8 j + i
         for j in 0..8 {
             for i in 0..8 {
-                out[(i, j)] += sle[i] * sle[j] * b;
+                o[8 * j + i] = c[8 * j + i] + sle[i] * sle[j] * b;
             }
         }
         for j in 0..4 {
             for i in 0..4 {
                 let v = a * self.sl[i][j];
-                out[(2 * i, 2 * j)] += v;
-                out[(2 * i + 1, 2 * j + 1)] += v;
+                o[8 * (2 * j) + 2 * i] += v;
+                o[8 * (2 * j + 1) + 2 * i + 1] += v;
             }
         }
-        out
     }
 
     /// Mean Green strain `ε̄ = eᵀS_l e/(2l) − ½`; zero under rigid motion.

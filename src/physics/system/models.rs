@@ -160,12 +160,12 @@ impl ParametricModel for FlexibleSystem {
         let mut diag_max = 0.0_f64;
         for e in 0..self.elements.len() {
             let (b, _) = self.elements[e];
-            let blk =
-                self.prototypes[b].iteration_block(&self.iteration_constant[b], coef.stiffness, &self.gather(e, q));
+            let qe = self.gather(e, q);
+            let blk = &mut self.blocks[e];
+            self.prototypes[b].iteration_block_into(&self.iteration_constant[b], coef.stiffness, &qe, blk);
             for i in 0..8 {
                 diag_max = diag_max.max(blk[(i, i)].abs());
             }
-            self.blocks[e] = blk;
         }
         if coef.stiffness != 0.0 {
             for m in &self.moments {
