@@ -10,7 +10,8 @@
 //! - a small pendulum pipeline end to end: rel_error ≤ 1e-3 with 10 % of the coordinates
 //!   as modes (the target), the constraint-preserving four-bar keeps every joint to
 //!   round-off (its joint coordinates are unreduced) and its multipliers follow the full
-//!   ones (5e-2 relative, measured 2.4e-2);
+//!   ones (5e-2 relative, measured 2.4e-2); `sweep --validate` writes `/steps_differ_from`
+//!   (NaN where both runs took the same steps, as on the pendulum);
 //! - bad input: a basis of another model, a missing, truncated or foreign file, too many or
 //!   zero modes, per-block counts that do not fit the blocks, a non-finite load scale, an
 //!   empty training set — a clear message and a non-zero exit, and a failed train keeps
@@ -188,6 +189,10 @@ fn pendulum_pipeline_end_to_end_within_the_error_bound() {
     assert_eq!(f.dataset("probes/tip").unwrap().shape(), vec![3, 121, 2]);
     let err = f.dataset("rel_error").unwrap().read_1d::<f64>().unwrap();
     assert!(err.iter().all(|&e| e <= 1e-3), "{err}");
+    // neither run halves a step of this pendulum (Newton needs ≤ 3 iterations a step): the
+    // same time grid at every load, NaN in /steps_differ_from
+    let differ = f.dataset("steps_differ_from").unwrap().read_1d::<f64>().unwrap();
+    assert!(differ.len() == 3 && differ.iter().all(|t| t.is_nan()), "{differ}");
 
     // continuation in the load scale changes only where Newton starts: the same tips to the
     // level of the Newton tolerance (1e-10 · 1.2 m per step, bound 1e-7 m over 120 steps),

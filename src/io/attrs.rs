@@ -130,7 +130,7 @@ const BASIS: [Entry; 39] = [
     ("training/true_score", "1", "iteration"),
 ];
 
-const SWEEP: [Entry; 20] = [
+const SWEEP: [Entry; 21] = [
     ("load_scales", "1", "load"),
     ("status", "1", "load"),
     ("message", TEXT, "load"),
@@ -150,6 +150,7 @@ const SWEEP: [Entry; 20] = [
     ("max_constraint_violation", VIOLATION_UNITS, "load"),
     ("full_seconds", "s", "load"),
     ("speedup", "1", "load"),
+    ("steps_differ_from", "s", "load"),
     ("shard/all_load_scales", "1", "all loads"),
     ("shard/indices", "1", "load"),
 ];

@@ -23,7 +23,7 @@ pub fn sweep_table(s: &Sweep) -> Table {
         "extrapolated",
     ];
     if s.validated {
-        cols.extend(["rel_error", "max_probe_error", "full_seconds", "speedup"]);
+        cols.extend(["rel_error", "max_probe_error", "full_seconds", "speedup", "steps_differ_from"]);
     }
     let mut t = Table::new(&cols);
     for x in &s.scales {
@@ -46,6 +46,7 @@ pub fn sweep_table(s: &Sweep) -> Table {
                         v.map(|v| v.max_probe_error).into(),
                         v.map(|v| v.full_seconds).into(),
                         v.map(|v| v.speedup).into(),
+                        v.and_then(|v| v.steps_differ_from).into(),
                     ]);
                 }
             }

@@ -18,7 +18,7 @@
 //! /extrapolated       (N)            1 where the load scale is outside the training range
 //! /estimate_seconds   (N)            the estimator's enriched run and norms, s
 //! with --validate:    /rel_error, /max_probe_error, /max_constraint_violation,
-//!                     /full_seconds, /speedup  (N each)
+//!                     /full_seconds, /speedup, /steps_differ_from  (N each)
 //! every dataset: units, dims (src/io/attrs.rs)
 //! attributes on /: flexrom_layout, flexrom_file = "sweep", basis, basis_content_hash, model_fingerprint, variant, n_modes,
 //!   validated (0/1), wall_seconds (whole sweep), threads, continuation (1 when the runs
@@ -136,6 +136,10 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, stored: &StoredBasis, basis_path
                 .map_err(e)?;
             f.new_dataset_builder().with_data(&v(&|x| x.full_seconds)).create("full_seconds").map_err(e)?;
             f.new_dataset_builder().with_data(&v(&|x| x.speedup)).create("speedup").map_err(e)?;
+            f.new_dataset_builder()
+                .with_data(&v(&|x| x.steps_differ_from.unwrap_or(f64::NAN)))
+                .create("steps_differ_from")
+                .map_err(e)?;
         }
         attr_str(f, "basis", &basis_path.display().to_string()).map_err(e)?;
         attr_str(f, "basis_content_hash", &stored.content_hash).map_err(e)?;
@@ -253,6 +257,14 @@ pub fn read_sweep(
         None
     };
     let (newton, factorizations) = (ints("newton_iterations")?, ints("factorizations")?);
+    // files written before it have no /steps_differ_from: unknown, as no halved step
+    let differ = if validate && f.link_exists("steps_differ_from") { Some(vec("steps_differ_from")?) } else { None };
+    if differ.as_ref().is_some_and(|a| a.len() != n) {
+        return Err(cannot(
+            "steps_differ_from",
+            format!("has {} entries, expected {n}", differ.map_or(0, |a| a.len())),
+        ));
+    }
     let validation = if validate && f.link_exists("rel_error") {
         Some([
             vec("rel_error")?,
@@ -325,7 +337,7 @@ pub fn read_sweep(
             rom_newton_iterations: newton[k] as usize,
             rom_step_cuts: 0,
             full_step_cuts: 0,
-            steps_differ_from: None,
+            steps_differ_from: differ.as_ref().map(|a| a[k]).filter(|t| !t.is_nan()),
             full_step_cut_times: Vec::new(),
             rom_step_cut_times: Vec::new(),
             // the estimate and the flags are set below from the file's columns
