@@ -63,6 +63,31 @@ impl Kernel for SmallCholesky<'_> {
     }
 }
 
+/// `L Lᵀ x = b` in place with the factor of [`SmallCholesky`] (faer's triangular solves cost
+/// several times the 2n² flops at such sizes): forward by columns, `x_j /= l_jj`,
+/// `x_{j+1:n} −= x_j l_{j+1:n, j}`; backward by rows of `Lᵀ`, `x_j = (x_j − l_{j+1:n, j}·x_{j+1:n}) / l_jj`.
+struct SmallCholeskySolve<'a>(&'a [f64], &'a mut [f64]);
+
+impl Kernel for SmallCholeskySolve<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn run(self) {
+        let (l, x) = (self.0, self.1);
+        let n = x.len();
+        for j in 0..n {
+            let col = &l[j * n + j..(j + 1) * n];
+            let xj = x[j] / col[0];
+            x[j] = xj;
+            x[j + 1..].iter_mut().zip(&col[1..]).for_each(|(x, l)| *x -= xj * l);
+        }
+        for j in (0..n).rev() {
+            let col = &l[j * n + j..(j + 1) * n];
+            let dot = x[j + 1..].iter().zip(&col[1..]).fold(0.0, |s, (x, l)| s + x * l);
+            x[j] = (x[j] - dot) / col[0];
+        }
+    }
+}
+
 pub struct DenseLu {
     /// the matrix to factor (filled by the caller, column-major), then its factors
     a: Vec<f64>,
@@ -241,6 +266,10 @@ impl DenseLu {
         }
         if kind == Factors::Bordered {
             self.bordered_solve(rhs);
+            return Ok(());
+        }
+        if kind == Factors::Cholesky && n <= SMALL {
+            dispatch(SmallCholeskySolve(&self.a, rhs));
             return Ok(());
         }
         let b = MatMut::from_column_major_slice_mut(rhs, n, 1);

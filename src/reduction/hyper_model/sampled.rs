@@ -5,27 +5,25 @@
 //! body: one group per body, plus one per distinct set of joint columns). Per iteration:
 //!
 //! ```text
-//!   update (4 elements side by side, one per SIMD lane, no horizontal sums):
-//!       xₑ = x_ref,ₑ + Vₑ q,   yⱼ = Sⱼ xₑ,   sⱼ = xₑ·yⱼ,   uₑⱼ = Vₑᵀ yⱼ
-//!   force:    f_loc = Σₑⱼ 2wₑψₑⱼ uₑⱼ  (one pass over the group's uₑⱼ), scattered to the group's columns
+//!   update (per element):  xₑ = x_ref,ₑ + Vₑ q,   yⱼ = Sⱼ xₑ,   sⱼ = xₑ·yⱼ,   uₑⱼ = Vₑᵀ yⱼ
+//!   force:    Σₑⱼ 2wₑψₑⱼ uₑⱼ, element by element (the earlier sums, to the bit)
 //!   tangent:  T = Σₜ aₜ Gₜ + Σₜ wₜ uₜᵀ,   t = (e, j),  aₜ = 2wₑψₑⱼ,  wₜ = Σₖ 4wₑψₑⱼₖ uₑₖ
 //! ```
 //!
 //! The tangent is computed by 4 × 4 blocks of its upper block triangle, each summed over all
 //! terms of the group in registers (two accumulators per row: one for the `G` terms, one for
 //! the rank-one terms, so that the additions of consecutive terms do not wait on each other)
-//! and written once; `Gₜ` is stored by those blocks, contiguous per term, in single
+//! and written once; `Gₜ` is stored by those blocks, the terms of a block in turn, in single
 //! precision (it only enters the Newton matrix). The previous kernel added each element to
 //! the r × r accumulator row by row: rows of r/2 entries on average, read and written once
 //! per element (per pair of elements). Padding to a multiple of 4 adds zeros only.
 //!
-//! The update stores `Vₑ` of four elements interleaved, `[column][dof][lane]`: the sums run
-//! over columns and dofs with the four elements in the four lanes of one vector, in the
-//! same order as the per-element formulas (the same bits for `x`, `y`, `s` and `u`).
+//! The update and the force are the earlier per-element kernels (the same sums, to the bit);
+//! only where their results are stored changed.
 
 use super::columns::Cols;
 
-/// Block size of the tangent and number of lanes of the update.
+/// Block size of the tangent.
 pub(super) const L: usize = 4;
 
 /// Elements that see the same columns.
@@ -38,26 +36,23 @@ pub(super) struct Group {
     pub(super) members: Vec<usize>,
     /// global column of each local one
     glob: Vec<usize>,
-    /// per chunk of L members: `Vₑ` as `[a][i][lane]` (me · ne vectors of L)
-    v: Vec<[f64; L]>,
-    /// per chunk: `x_ref,ₑ` as `[i][lane]`
-    x_ref: Vec<[f64; L]>,
-    /// per chunk and invariant: `Sⱼ` (column-major ne × ne) as `[c][i][lane]`
-    s: Vec<[f64; L]>,
+    /// per member: `Vₑ` on the local columns by columns (me · ne, column a at `a ne`), so the
+    /// update runs over contiguous short vectors
+    vt: Vec<f64>,
+    /// per member: `x_ref,ₑ` (ne)
+    xr: Vec<f64>,
+    /// per member and invariant: `Sⱼ` (column-major ne × ne)
+    sm: Vec<f64>,
     /// `Gₜ` (t = member · nj + j) by the 4 × 4 blocks of the upper block triangle, block b
     /// of every term in turn (`[b][t][row]`, rows of L), so that a block's pass over the
     /// terms reads memory in order
     g: Vec<[f32; L]>,
     /// per term: uₜ (mp entries, zero past me) by L
     u: Vec<[f64; L]>,
-    /// uⱼ of one chunk, `[a][lane]` (me vectors)
-    ut: Vec<[f64; L]>,
     /// per term: the rank-one coefficient vectors wₜ by L
     w: Vec<[f64; L]>,
     /// per term: aₜ
     a: Vec<f64>,
-    /// the force on the local columns
-    f: Vec<f64>,
     /// the tangent on the local columns (mp × mp row-major, upper blocks)
     t: Vec<f64>,
 }
@@ -69,15 +64,6 @@ fn axpy4(acc: &mut [f64; L], a: f64, x: [f64; L]) {
     acc[1] += a * x[1];
     acc[2] += a * x[2];
     acc[3] += a * x[3];
-}
-
-/// `acc += x y`, lane by lane
-#[inline(always)]
-fn mul_add4(acc: &mut [f64; L], x: [f64; L], y: [f64; L]) {
-    acc[0] += x[0] * y[0];
-    acc[1] += x[1] * y[1];
-    acc[2] += x[2] * y[2];
-    acc[3] += x[3] * y[3];
 }
 
 #[inline(always)]
@@ -92,6 +78,8 @@ pub(super) struct Sampled {
     pub(super) nj: usize,
     r: usize,
     pub(super) groups: Vec<Group>,
+    /// (group, member) of each sample index k
+    order: Vec<(usize, usize)>,
     pub(super) weights: Vec<f64>,
     pub(super) s_val: Vec<f64>,
     pub(super) psi: Vec<f64>,
@@ -125,15 +113,13 @@ impl Sampled {
                         mp,
                         members: vec![k],
                         glob: c.iter().collect(),
-                        v: Vec::new(),
-                        x_ref: Vec::new(),
-                        s: Vec::new(),
+                        vt: Vec::new(),
+                        xr: Vec::new(),
+                        sm: Vec::new(),
                         g: Vec::new(),
                         u: Vec::new(),
-                        ut: vec![[0.0; L]; me],
                         w: Vec::new(),
                         a: Vec::new(),
-                        f: vec![0.0; mp],
                         t: vec![0.0; mp * mp],
                     })
                 }
@@ -141,10 +127,9 @@ impl Sampled {
         }
         for g in &mut groups {
             let (me, mp, nm) = (g.me, g.mp, g.members.len());
-            let nch = nm.div_ceil(L);
-            g.v = vec![[0.0; L]; nch * me * ne];
-            g.x_ref = vec![[0.0; L]; nch * ne];
-            g.s = vec![[0.0; L]; nch * nj * ne * ne];
+            g.vt = vec![0.0; nm * me * ne];
+            g.xr = vec![0.0; nm * ne];
+            g.sm = vec![0.0; nm * nj * ne * ne];
             let nb = mp / L;
             let nblk = nb * (nb + 1) / 2;
             g.g = vec![[0.0; L]; nm * nj * nblk * L];
@@ -152,34 +137,22 @@ impl Sampled {
             g.w = vec![[0.0; L]; nm * nj * nb];
             g.a = vec![0.0; nm * nj];
             for (mi, &k) in g.members.iter().enumerate() {
-                let (ch, l) = (mi / L, mi % L);
                 let ve = &v_el[k];
                 for (a, col) in g.glob.iter().enumerate() {
                     for i in 0..ne {
-                        g.v[(ch * me + a) * ne + i][l] = ve[[i, *col]];
+                        g.vt[(mi * me + a) * ne + i] = ve[[i, *col]];
                     }
                 }
-                for i in 0..ne {
-                    g.x_ref[ch * ne + i][l] = x_ref[k][i];
-                }
+                g.xr[mi * ne..(mi + 1) * ne].copy_from_slice(x_ref[k]);
                 for j in 0..nj {
                     let sm = &s_mat[k][j];
-                    for (ci, &x) in sm.iter().enumerate() {
-                        g.s[(ch * nj + j) * ne * ne + ci][l] = x;
-                    }
-                    // Gₑⱼ = Vₑᵀ Sⱼ Vₑ on the local columns
-                    let gm = |a: usize, b: usize| -> f64 {
-                        let (ca, cb) = (g.glob[a], g.glob[b]);
-                        let mut sum = 0.0;
-                        for c in 0..ne {
-                            let mut sv = 0.0;
-                            for i in 0..ne {
-                                sv += sm[c * ne + i] * ve[[i, ca]];
-                            }
-                            sum += sv * ve[[c, cb]];
-                        }
-                        sum
-                    };
+                    g.sm[(mi * nj + j) * ne * ne..(mi * nj + j + 1) * ne * ne].copy_from_slice(sm);
+                    // Gₑⱼ = Vₑᵀ Sⱼ Vₑ on the local columns (the products of the earlier kernel,
+                    // so that its single-precision copy is the same to the bit)
+                    let ves = ve.select(ndarray::Axis(1), &g.glob);
+                    let smat = ndarray::Array2::from_shape_fn((ne, ne), |(a, b)| sm[b * ne + a]);
+                    let gfull = ves.t().dot(&smat.dot(&ves));
+                    let gm = |a: usize, b: usize| gfull[[a, b]];
                     let (t, nt) = (mi * nj + j, nm * nj);
                     let mut b = 0;
                     for bi in 0..nb {
@@ -198,11 +171,18 @@ impl Sampled {
                 }
             }
         }
+        let mut order = vec![(0, 0); m];
+        for (gi, g) in groups.iter().enumerate() {
+            for (mi, &k) in g.members.iter().enumerate() {
+                order[k] = (gi, mi);
+            }
+        }
         Sampled {
             ne,
             nj,
             r,
             groups,
+            order,
             weights: weights.to_vec(),
             s_val: vec![0.0; m * nj],
             psi: vec![0.0; m * nj],
@@ -211,57 +191,47 @@ impl Sampled {
     }
 
     /// xₑ, sⱼ and uₑⱼ of every sampled element at `q` (elements of `N` dofs), then ψ and ψ'
-    /// from `derivatives(k, s, ψ, ψ')`.
+    /// from `derivatives(k, s, ψ, ψ')`: fixed-size kernels per element, unrolled and
+    /// vectorized over the dofs by the compiler (four elements side by side in the vector
+    /// lanes measured no faster on the pendulum and slower on the four-bar, whose groups of
+    /// one or two elements leave lanes empty).
     #[inline(always)]
     pub(super) fn update<const N: usize>(&mut self, q: &[f64], mut derivatives: impl FnMut(usize, &[f64], &mut [f64], &mut [f64])) {
         let nj = self.nj;
         debug_assert_eq!(N, self.ne);
         for g in &mut self.groups {
-            let (me, nb) = (g.me, g.mp / L);
-            let nm = g.members.len();
-            for ch in 0..nm.div_ceil(L) {
-                let v = &g.v[ch * me * N..(ch + 1) * me * N];
-                let mut x: [[f64; L]; N] = g.x_ref[ch * N..(ch + 1) * N].try_into().expect("N rows");
-                for (va, &col) in v.chunks_exact(N).zip(&g.glob) {
-                    let qa = q[col];
+            let (me, nb, n1) = (g.me, g.mp / L, g.cols.n1());
+            let (qa_run, qb_run) = (&q[g.cols.a.0..g.cols.a.1], &q[g.cols.b.0..g.cols.b.1]);
+            for (mi, &k) in g.members.iter().enumerate() {
+                let cols = &g.vt[mi * me * N..(mi + 1) * me * N];
+                let mut x: [f64; N] = g.xr[mi * N..(mi + 1) * N].try_into().expect("N entries");
+                let (c1, c2) = cols.split_at(n1 * N);
+                for (c, &qa) in c1.chunks_exact(N).zip(qa_run) {
                     for i in 0..N {
-                        axpy4(&mut x[i], qa, va[i]);
+                        x[i] += qa * c[i];
                     }
                 }
-                let lanes = (nm - ch * L).min(L);
+                // the second run, when there is one (a chained iterator would branch per column)
+                for (c, &qa) in c2.chunks_exact(N).zip(qb_run) {
+                    for i in 0..N {
+                        x[i] += qa * c[i];
+                    }
+                }
                 for j in 0..nj {
-                    let s = &g.s[(ch * nj + j) * N * N..(ch * nj + j + 1) * N * N];
-                    let mut y = [[0.0; L]; N];
-                    for (c, sc) in s.chunks_exact(N).enumerate() {
+                    let s = &g.sm[(mi * nj + j) * N * N..(mi * nj + j + 1) * N * N];
+                    let mut y = [0.0; N];
+                    for (sc, &xc) in s.chunks_exact(N).zip(&x) {
                         for i in 0..N {
-                            mul_add4(&mut y[i], sc[i], x[c]);
+                            y[i] += sc[i] * xc;
                         }
                     }
-                    let mut sv = [0.0; L];
-                    for i in 0..N {
-                        mul_add4(&mut sv, x[i], y[i]);
-                    }
-                    for (l, &s) in sv.iter().enumerate().take(lanes) {
-                        let k = g.members[ch * L + l];
-                        self.s_val[k * nj + j] = s;
-                    }
-                    // whole vectors first (stored lane by lane, the compiler would sum each lane
-                    // on its own), then to the terms' rows
-                    for (ua, va) in g.ut.iter_mut().zip(v.chunks_exact(N)) {
-                        *ua = [0.0; L];
-                        for i in 0..N {
-                            mul_add4(ua, va[i], y[i]);
-                        }
-                    }
-                    for l in 0..lanes {
-                        let row = &mut g.u[((ch * L + l) * nj + j) * nb..((ch * L + l) * nj + j + 1) * nb];
-                        for (o, ua) in row.as_flattened_mut().iter_mut().zip(&g.ut) {
-                            *o = ua[l];
-                        }
+                    self.s_val[k * nj + j] = (0..N).map(|i| x[i] * y[i]).sum();
+                    let t = mi * nj + j;
+                    let u = &mut g.u[t * nb..(t + 1) * nb].as_flattened_mut()[..me];
+                    for (ua, c) in u.iter_mut().zip(cols.chunks_exact(N)) {
+                        *ua = (0..N).map(|i| c[i] * y[i]).sum();
                     }
                 }
-            }
-            for &k in &g.members {
                 derivatives(
                     k,
                     &self.s_val[k * nj..(k + 1) * nj],
@@ -272,24 +242,21 @@ impl Sampled {
         }
     }
 
-    /// `out += Σₑ wₑ Σⱼ 2ψₑⱼ uₑⱼ` on the elements' columns.
+    /// `out += Σₑ wₑ Σⱼ 2ψₑⱼ uₑⱼ` on the elements' columns, element by element in sample
+    /// order (the sums of the earlier kernel, to the bit: the force decides where Newton
+    /// stops, and the four-bar's late trajectory amplifies any change of it).
     #[inline(always)]
     pub(super) fn add_force(&mut self, out: &mut [f64]) {
         let nj = self.nj;
-        for g in &mut self.groups {
-            g.f.fill(0.0);
-            for (mi, &k) in g.members.iter().enumerate() {
-                for j in 0..nj {
-                    let c = 2.0 * self.weights[k] * self.psi[k * nj + j];
-                    let t = mi * nj + j;
-                    let nb = g.mp / L;
-                    for (f, u) in g.f.iter_mut().zip(g.u[t * nb..(t + 1) * nb].as_flattened()) {
-                        *f += c * u;
-                    }
+        for &(gi, mi) in &self.order {
+            let g = &self.groups[gi];
+            let (k, nb) = (g.members[mi], g.mp / L);
+            for j in 0..nj {
+                let c = 2.0 * self.weights[k] * self.psi[k * nj + j];
+                let t = mi * nj + j;
+                for (&col, u) in g.glob.iter().zip(g.u[t * nb..(t + 1) * nb].as_flattened()) {
+                    out[col] += c * u;
                 }
-            }
-            for (&col, f) in g.glob.iter().zip(&g.f) {
-                out[col] += f;
             }
         }
     }
@@ -527,57 +494,3 @@ mod tests {
     }
 }
 
-#[cfg(test)]
-mod timing_tmp {
-    use super::*;
-    #[test]
-    #[ignore]
-    fn time_kernels() {
-        for &(r, m) in &[(18usize, 23usize), (50, 20)] {
-            let ne = 8;
-            let v: Vec<ndarray::Array2<f64>> =
-                (0..m).map(|k| ndarray::Array2::from_shape_fn((ne, r), |(i, j)| ((i * 7 + j * 3 + k) % 11) as f64 * 0.1 + 0.01)).collect();
-            let views: Vec<_> = v.iter().map(|a| a.view()).collect();
-            let x: Vec<Vec<f64>> = vec![vec![0.5; ne]; m];
-            let xr: Vec<&[f64]> = x.iter().map(|x| x.as_slice()).collect();
-            let s = vec![vec![(0..ne * ne).map(|i| (i % 5) as f64 * 0.1).collect::<Vec<_>>()]; m];
-            let mut sm = Sampled::new(r, &views, &xr, &s, &vec![1.0; m]);
-            let q: Vec<f64> = (0..r).map(|i| i as f64 * 0.01).collect();
-            let mut acc = vec![0.0; r * r];
-            let n = 200;
-            let (mut t1, mut t2) = (f64::MAX, f64::MAX);
-            for _ in 0..100 {
-                let t0 = std::time::Instant::now();
-                for _ in 0..n {
-                    crate::linalg::simd::dispatch(U(&mut sm, &q));
-                }
-                t1 = t1.min(t0.elapsed().as_secs_f64() / n as f64);
-                let t0 = std::time::Instant::now();
-                for _ in 0..n {
-                    crate::linalg::simd::dispatch(T(&mut sm, &mut acc));
-                }
-                t2 = t2.min(t0.elapsed().as_secs_f64() / n as f64);
-            }
-            eprintln!("r {r} m {m}: update {:.3} us, tangent {:.3} us", t1 * 1e6, t2 * 1e6);
-        }
-        struct U<'a>(&'a mut Sampled, &'a [f64]);
-        impl crate::linalg::simd::Kernel for U<'_> {
-            type Output = ();
-            #[inline(always)]
-            fn run(self) {
-                self.0.update::<8>(self.1, |_, s, d1, d2| {
-                    d1[0] = s[0];
-                    d2[0] = 1.0;
-                })
-            }
-        }
-        struct T<'a>(&'a mut Sampled, &'a mut [f64]);
-        impl crate::linalg::simd::Kernel for T<'_> {
-            type Output = ();
-            #[inline(always)]
-            fn run(self) {
-                self.0.add_tangent(self.1)
-            }
-        }
-    }
-}
