@@ -22,6 +22,7 @@
 //! only where their results are stored changed.
 
 use super::columns::Cols;
+use crate::linalg::vec_ops::axpy;
 
 /// Block size of the tangent.
 pub(super) const L: usize = 4;
@@ -254,9 +255,11 @@ impl Sampled {
             for j in 0..nj {
                 let c = 2.0 * self.weights[k] * self.psi[k * nj + j];
                 let t = mi * nj + j;
-                for (&col, u) in g.glob.iter().zip(g.u[t * nb..(t + 1) * nb].as_flattened()) {
-                    out[col] += c * u;
-                }
+                // on the (at most two) runs of columns: contiguous, vectorized
+                let u = &g.u[t * nb..(t + 1) * nb].as_flattened()[..g.me];
+                let ((a0, a1), (b0, b1)) = (g.cols.a, g.cols.b);
+                axpy(c, &u[..a1 - a0], &mut out[a0..a1]);
+                axpy(c, &u[a1 - a0..], &mut out[b0..b1]);
             }
         }
     }
