@@ -15,9 +15,11 @@
 //! takes the `Gₑⱼ` route (r² instead of the 16 r² of `Vₑᵀ Kₑ Vₑ`), as the issue's
 //! `G_e = Φ_eᵀ S_l Φ_e` suggests. Each element keeps only the columns of `V` it sees, as at
 //! most two runs (unreduced joint coordinates are unit columns that touch one or two
-//! elements; a block basis gives an element its own block's modes) and the upper triangle
-//! of `Gₑⱼ`, packed: on the thesis four-bar with a global basis that is 1275 instead of 3844
-//! numbers per element, with one block per body ~700 on the coupler, read once per tangent. `Gₑⱼ` is stored in single precision: it
+//! elements; a block basis gives an element its own block's modes) and the 4 × 4 blocks of
+//! the upper block triangle of `Gₑⱼ` on them; elements on the same columns are grouped, and
+//! the tangent is summed over a group block by block in registers (sampled.rs): on the
+//! thesis four-bar with a global basis that is ~1300 instead of 3844 numbers per element,
+//! with one block per body ~900 on the coupler, read once per tangent. `Gₑⱼ` is stored in single precision: it
 //! enters only the Newton matrix, where a relative error of 6e-8 changes how Newton gets
 //! to the solution, not where it stops (the force is summed in double precision); it halves
 //! the tangent's memory traffic (four-bar at 30 %: 7 → 3.5 MB per tangent). Work space is
