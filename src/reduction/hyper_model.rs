@@ -15,9 +15,11 @@
 //! takes the `Gₑⱼ` route (r² instead of the 16 r² of `Vₑᵀ Kₑ Vₑ`), as the issue's
 //! `G_e = Φ_eᵀ S_l Φ_e` suggests. Each element keeps only the columns of `V` it sees, as at
 //! most two runs (unreduced joint coordinates are unit columns that touch one or two
-//! elements; a block basis gives an element its own block's modes) and the upper triangle
-//! of `Gₑⱼ`, packed: on the thesis four-bar with a global basis that is 1275 instead of 3844
-//! numbers per element, with one block per body ~700 on the coupler, read once per tangent. `Gₑⱼ` is stored in single precision: it
+//! elements; a block basis gives an element its own block's modes) and the 4 × 4 blocks of
+//! the upper block triangle of `Gₑⱼ` on them; elements on the same columns are grouped, and
+//! the tangent is summed over a group block by block in registers (sampled.rs): on the
+//! thesis four-bar with a global basis that is ~1300 instead of 3844 numbers per element,
+//! with one block per body ~900 on the coupler, read once per tangent. `Gₑⱼ` is stored in single precision: it
 //! enters only the Newton matrix, where a relative error of 6e-8 changes how Newton gets
 //! to the solution, not where it stops (the force is summed in double precision); it halves
 //! the tangent's memory traffic (four-bar at 30 %: 7 → 3.5 MB per tangent). Work space is
@@ -26,13 +28,14 @@
 
 mod columns;
 mod kernels;
+mod sampled;
 
 use super::basis::Basis;
-use super::projection::{axpy, forward_to_projection, impl_reduced, Projection};
+use super::projection::{forward_to_projection, impl_reduced, Projection};
 use super::sample::Hyper;
 use crate::linalg::sparse_rows::SparseRows;
 use crate::solver::model::{InvariantElementModel, IterationCoefficients, Parameters, ParametricModel};
-use columns::Cols;
+use sampled::Sampled;
 use ndarray::{Array1, Array2, Axis};
 use std::sync::Arc;
 
@@ -41,39 +44,17 @@ pub struct HyperReducedModel<M: InvariantElementModel> {
     full: Arc<M>,
     p: Projection,
     ne: usize,
-    nj: usize,
     elements: Vec<usize>,
-    weights: Vec<f64>,
     /// `L_r` and `C_r` by runs of nonzeros (the projection keeps them dense for the matrix)
     l_rows: SparseRows,
     l0: Array1<f64>,
     c_rows: Option<SparseRows>,
-    /// the columns of `V` that are nonzero on each sampled element, as two runs (a basis
-    /// with a block of modes per body, its unreduced joint coordinates last, gives an
-    /// element its body's block and the few joint columns of its nodes)
-    cols: Vec<Cols>,
-    /// `Vₑ` of every sampled element by columns, its `mₑ` columns of `cols` only: local
-    /// column a of element k is the `ne` entries at `vt_off[k] + a ne`, so the per-element
-    /// kernels run over contiguous short vectors
-    vt_el: Vec<f64>,
-    vt_off: Vec<usize>,
-    x_ref_el: Array1<f64>,
-    /// `Sⱼ` per sampled element and invariant (ne × ne, column-major)
-    s_el: Vec<f64>,
-    /// `Gₑⱼ` per sampled element and invariant: upper triangle of its mₑ × mₑ block on the
-    /// element's columns packed by rows (the rest is zero), at `g_off[k nj + j]`; single
-    /// precision, as it only enters the Newton matrix
-    g_el: Vec<f32>,
-    g_off: Vec<usize>,
-    // cache at `at` (valid when `valid`): s_j, ψⱼ, ψⱼₖ, uⱼ
+    /// the sampled elements by groups that see the same columns of `V`, with `Sⱼ`, `Gₑⱼ`
+    /// and the invariants of the last update ([`Sampled`])
+    sampled: Sampled,
+    // cache at `at` (valid when `valid`)
     at: Vec<f64>,
     valid: bool,
-    s_val: Vec<f64>,
-    psi: Vec<f64>,
-    psi2: Vec<f64>,
-    /// uⱼ = Vₑᵀ yⱼ per sampled element and invariant, on the element's columns (the first
-    /// mₑ of r each)
-    u_el: Vec<f64>,
     /// tangent accumulator: upper triangle, row-major r × r
     acc: Vec<f64>,
     /// the runs `(row, first, end)` of `acc` that any sampled element reaches
@@ -130,38 +111,32 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
         // invariant-based element forces derive from an energy: symmetric tangents
         p.symmetric_newton_matrix();
 
-        // sampled elements: stacked rows, Sⱼ and Gₑⱼ = Vₑᵀ Sⱼ Vₑ
-        let rows: Vec<usize> = hyper.elements.iter().flat_map(|&e| full.element_dofs(e).to_vec()).collect();
-        let v_el = v.select(Axis(0), &rows);
-        let x_ref_el = basis.reference.select(Axis(0), &rows);
+        // sampled elements: their rows of V, references and Sⱼ, stored by groups (sampled.rs)
         let m = hyper.elements.len();
-        let mut s_el = vec![0.0; m * nj * ne * ne];
-        let (mut cols, mut vt_el, mut vt_off) = (Vec::with_capacity(m), Vec::new(), Vec::with_capacity(m));
-        let (mut g_el, mut g_off) = (Vec::new(), Vec::with_capacity(m * nj));
-        for (k, &e) in hyper.elements.iter().enumerate() {
-            let ve = v_el.slice(ndarray::s![k * ne..(k + 1) * ne, ..]);
-            let c = Cols::of(ve);
-            let me = c.len();
-            cols.push(c);
-            vt_off.push(vt_el.len());
-            for a in c.iter() {
-                vt_el.extend(ve.column(a).iter());
-            }
-            let ve = ve.select(Axis(1), &c.iter().collect::<Vec<_>>());
-            for j in 0..nj {
-                let s = &mut s_el[(k * nj + j) * ne * ne..(k * nj + j + 1) * ne * ne];
-                full.element_invariant_matrix(e, j, s);
-                let sm = Array2::from_shape_fn((ne, ne), |(a, b)| s[b * ne + a]);
-                let g = ve.t().dot(&sm.dot(&ve));
-                g_off.push(g_el.len());
-                for i in 0..me {
-                    g_el.extend(g.row(i).iter().skip(i).map(|&x| x as f32));
-                }
-            }
+        let mut v_el = Vec::with_capacity(m);
+        let mut x_el = Vec::with_capacity(m);
+        let mut s_mat = Vec::with_capacity(m);
+        for &e in &hyper.elements {
+            let dofs = full.element_dofs(e).to_vec();
+            v_el.push(v.select(Axis(0), &dofs));
+            x_el.push(basis.reference.select(Axis(0), &dofs).to_vec());
+            s_mat.push(
+                (0..nj)
+                    .map(|j| {
+                        let mut s = vec![0.0; ne * ne];
+                        full.element_invariant_matrix(e, j, &mut s);
+                        s
+                    })
+                    .collect::<Vec<_>>(),
+            );
         }
+        let views: Vec<_> = v_el.iter().map(|a| a.view()).collect();
+        let xr: Vec<&[f64]> = x_el.iter().map(|x| x.as_slice()).collect();
+        let sampled = Sampled::new(r, &views, &xr, &s_mat, &hyper.weights);
         // the parts of the accumulator any element reaches, row by row
         let mut reached = vec![false; r * r];
-        for c in &cols {
+        for g in &sampled.groups {
+            let c = g.cols;
             for l in 0..c.len() {
                 let (at, len, at2, len2) = c.row(l, r);
                 reached[at..at + len].iter_mut().for_each(|x| *x = true);
@@ -182,28 +157,16 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
             }
         }
         Ok(HyperReducedModel {
-            cols,
             runs,
-            vt_el,
-            vt_off,
-            g_off,
             ne,
-            nj,
             l_rows,
             l0,
             c_rows,
-            x_ref_el,
-            s_el,
-            g_el,
+            sampled,
             at: vec![0.0; r],
             valid: false,
-            s_val: vec![0.0; m * nj],
-            psi: vec![0.0; m * nj],
-            psi2: vec![0.0; m * nj * nj],
-            u_el: vec![0.0; m * nj * r],
             acc: vec![0.0; r * r],
             elements: hyper.elements.clone(),
-            weights: hyper.weights.clone(),
             full,
             p,
         })
@@ -221,19 +184,7 @@ impl<M: InvariantElementModel> ParametricModel for HyperReducedModel<M> {
             c.mul(v, out, true);
         }
         self.update(q);
-        let (nj, r) = (self.nj, self.p.r);
-        for (k, &w) in self.weights.iter().enumerate() {
-            let c = self.cols[k];
-            let (n1, me) = (c.n1(), c.len());
-            for j in 0..nj {
-                let f = 2.0 * w * self.psi[k * nj + j];
-                let u = &self.u_el[(k * nj + j) * r..(k * nj + j) * r + me];
-                axpy(f, &u[..n1], &mut out[c.a.0..c.a.1]);
-                if me > n1 {
-                    axpy(f, &u[n1..], &mut out[c.b.0..c.b.1]);
-                }
-            }
-        }
+        self.add_force(out);
     }
 
     fn factor(
@@ -260,10 +211,10 @@ impl<M: InvariantElementModel> ParametricModel for HyperReducedModel<M> {
         if !self.valid {
             return None;
         }
-        let nj = self.nj;
+        let nj = self.sampled.nj;
         let mut worst: Option<(f64, usize)> = None;
         for (k, &e) in self.elements.iter().enumerate() {
-            let eps = self.full.invariant_strain(e, &self.s_val[k * nj..(k + 1) * nj])?.abs();
+            let eps = self.full.invariant_strain(e, &self.sampled.s_val[k * nj..(k + 1) * nj])?.abs();
             if !worst.is_some_and(|w| eps <= w.0) {
                 worst = Some((eps, e));
             }

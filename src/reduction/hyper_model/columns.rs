@@ -1,5 +1,5 @@
-//! The columns of `V` a sampled element sees (at most two runs) and the packed-row kernels
-//! that add one element's `Gₑ` and rank-one terms to the hyper-reduced tangent on them.
+//! The columns of `V` a sampled element sees (at most two runs), and where its upper
+//! triangle lies in the row-major r × r tangent.
 
 /// The columns of `V` an element sees: the runs `a` and `b` (`b` empty when one will do).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -49,38 +49,5 @@ impl Cols {
             let i = self.b.0 + l - n1;
             (i * r + i, n1 + n2 - l, 0, 0)
         }
-    }
-}
-
-/// `o += a g + c u` (a row of the tangent: one element's `Gₑ` row and rank-one term).
-#[inline(always)]
-pub(super) fn add_row(o: &mut [f64], g: &[f32], u: &[f64], a: f64, c: f64) {
-    for ((o, &x), &v) in o.iter_mut().zip(g).zip(u) {
-        *o += a * f64::from(x) + c * v;
-    }
-}
-
-/// `acc += a Gₑ + b u uᵀ` on the element's columns `c`: one pass per row (the packed rows
-/// of `Gₑ`, upper triangle, follow each other).
-#[inline(always)]
-pub(super) fn add_element(acc: &mut [f64], c: &Cols, r: usize, g: &[f32], u: &[f64], a: f64, b: f64) {
-    let me = c.len();
-    let mut p = 0;
-    for l in 0..me {
-        let (at, len, at2, len2) = c.row(l, r);
-        add_row(&mut acc[at..at + len], &g[p..p + len], &u[l..l + len], a, b * u[l]);
-        if len2 > 0 {
-            add_row(&mut acc[at2..at2 + len2], &g[p + len..p + len + len2], &u[me - len2..me], a, b * u[l]);
-        }
-        p += len + len2;
-    }
-}
-
-/// [`add_row`] for two elements at once.
-#[inline(always)]
-pub(super) fn add_row_pair(o: &mut [f64], g: (&[f32], &[f32]), u: (&[f64], &[f64]), a: (f64, f64), c: (f64, f64)) {
-    let rows = g.0.iter().zip(g.1).zip(u.0.iter().zip(u.1));
-    for (o, ((&x1, &x2), (&v1, &v2))) in o.iter_mut().zip(rows) {
-        *o += (a.0 * f64::from(x1) + c.0 * v1) + (a.1 * f64::from(x2) + c.1 * v2);
     }
 }
