@@ -11,12 +11,12 @@
 //! Definite Systems*, §6.2, bordered block-diagonal form): the Cholesky factor has no fill
 //! outside the blocks and the border, so the blocks cost what they would on their own.
 
+use super::simd::{dispatch, Kernel};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt;
 use faer::linalg::lu::partial_pivoting::{factor, solve};
 use faer::perm::PermRef;
 use faer::{Conj, MatMut, MatRef, Par};
-use super::simd::{dispatch, Kernel};
 
 mod bordered;
 
@@ -357,7 +357,8 @@ mod tests {
             let mut a = vec![0.0; n * n];
             for i in 0..n {
                 for j in 0..n {
-                    a[i + n * j] = (0..n).map(|k| b[i + n * k] * b[j + n * k]).sum::<f64>() + if i == j { n as f64 } else { 0.0 };
+                    a[i + n * j] =
+                        (0..n).map(|k| b[i + n * k] * b[j + n * k]).sum::<f64>() + if i == j { n as f64 } else { 0.0 };
                 }
             }
             let mut lu = DenseLu::new(n);
@@ -365,10 +366,17 @@ mod tests {
             lu.factor_symmetric().unwrap();
             assert_eq!(lu.factored, Some(Factors::Cholesky), "n = {n}");
             let mut reference = a.clone();
-            let mut mem = MemBuffer::new(llt::factor::cholesky_in_place_scratch::<f64>(n, Par::Seq, Default::default()));
+            let mut mem =
+                MemBuffer::new(llt::factor::cholesky_in_place_scratch::<f64>(n, Par::Seq, Default::default()));
             let m = MatMut::from_column_major_slice_mut(&mut reference, n, n);
-            llt::factor::cholesky_in_place(m, Default::default(), Par::Seq, MemStack::new(&mut mem), Default::default())
-                .unwrap();
+            llt::factor::cholesky_in_place(
+                m,
+                Default::default(),
+                Par::Seq,
+                MemStack::new(&mut mem),
+                Default::default(),
+            )
+            .unwrap();
             let big = (0..n).map(|j| reference[j + n * j].abs()).fold(0.0, f64::max);
             for j in 0..n {
                 for i in j..n {

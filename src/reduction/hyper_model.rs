@@ -35,8 +35,8 @@ use super::projection::{forward_to_projection, impl_reduced, Projection};
 use super::sample::Hyper;
 use crate::linalg::sparse_rows::SparseRows;
 use crate::solver::model::{InvariantElementModel, IterationCoefficients, Parameters, ParametricModel};
-use sampled::Sampled;
 use ndarray::{Array1, Array2, Axis};
+use sampled::Sampled;
 use std::sync::Arc;
 
 pub struct HyperReducedModel<M: InvariantElementModel> {

@@ -197,7 +197,11 @@ impl Sampled {
     /// lanes measured no faster on the pendulum and slower on the four-bar, whose groups of
     /// one or two elements leave lanes empty).
     #[inline(always)]
-    pub(super) fn update<const N: usize>(&mut self, q: &[f64], mut derivatives: impl FnMut(usize, &[f64], &mut [f64], &mut [f64])) {
+    pub(super) fn update<const N: usize>(
+        &mut self,
+        q: &[f64],
+        mut derivatives: impl FnMut(usize, &[f64], &mut [f64], &mut [f64]),
+    ) {
         let nj = self.nj;
         debug_assert_eq!(N, self.ne);
         for g in &mut self.groups {
@@ -496,4 +500,3 @@ mod tests {
         assert_eq!(sm.groups.iter().map(|g| g.members.len()).sum::<usize>(), 10);
     }
 }
-
