@@ -368,8 +368,12 @@ fn a_killed_simulate_keeps_the_previous_result() {
     let d = tempfile::tempdir().unwrap();
     let root = d.path();
     let model = root.join("m.toml");
-    // 10 000 steps: seconds of work, stopped after 300 ms
-    std::fs::write(&model, model_text(50.0, "")).unwrap();
+    // 1200 steps of a 400-element pendulum: about a second of work (1.0 s measured), stopped
+    // after 300 ms (a long run of the 50-element one is no good: it stops itself by
+    // t ≈ 7 s, its step halvings over budget, in under 300 ms on a fast build)
+    let text = model_text(6.0, "");
+    assert!(text.contains("elements = 50\n"), "the shipped pendulum's mesh");
+    std::fs::write(&model, text.replace("elements = 50\n", "elements = 400\n")).unwrap();
     let out = root.join("out.h5");
     std::fs::write(&out, b"previous result").unwrap();
     let before = snapshot(root);

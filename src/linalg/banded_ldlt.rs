@@ -28,12 +28,8 @@ mod kernels;
 use super::banded::{solve_permuted, BandedKkt};
 pub use super::banded_order::quasi_definite_order;
 use super::kkt_pattern::{Block, KktPattern, KktSolver};
+use kernels::PIVOT_RATIO;
 pub use kernels::{band_ldlt, band_ldlt_solve};
-
-/// A coordinate pivot must keep at least this fraction of its diagonal entry (a smaller one
-/// means `S₁₁` is nearly singular or indefinite there), a constraint pivot this fraction of
-/// the constraint scale.
-const PIVOT_RATIO: f64 = 1e-8;
 
 /// Relative asymmetry `|a_ij − a_ji| / max|a|` of an element block above which the LU is
 /// used.

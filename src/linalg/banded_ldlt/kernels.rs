@@ -2,7 +2,10 @@
 //! and its substitutions, monomorphized for the common half-bandwidths (the pivot checks
 //! are the module doc's of [`super`]).
 
-use super::PIVOT_RATIO;
+/// A coordinate pivot must keep at least this fraction of its diagonal entry (a smaller one
+/// means `S₁₁` is nearly singular or indefinite there), a constraint pivot this fraction of
+/// the constraint scale.
+pub(super) const PIVOT_RATIO: f64 = 1e-8;
 
 /// `LDLᵀ` without pivoting of a symmetric band matrix in place: `A(i, j)`, `0 ≤ i − j ≤ b`,
 /// at `ab[j (b+1) + i − j]`; on return `D` on the diagonal and `L` (unit diagonal not
