@@ -19,6 +19,7 @@ use faer::perm::PermRef;
 use faer::{Conj, MatMut, MatRef, Par};
 
 mod bordered;
+mod triangular;
 
 /// Up to this order a symmetric matrix is factored by [`SmallCholesky`] instead of faer's
 /// blocked Cholesky, whose set-up dominates at such sizes (measured on the pendulum's 18 × 18
@@ -26,65 +27,37 @@ mod bordered;
 const SMALL: usize = 32;
 
 /// `A = L Lᵀ` in place on the lower triangle of the column-major n × n `A` (the layout of
-/// faer's Cholesky, whose triangular solves then use it), column by column:
-///
-/// ```text
-///     a_{j:n, j} −= Σ_{k<j} l_jk l_{j:n, k},     l_jj = √a_jj,     l_{j+1:n, j} = a_{j+1:n, j} / l_jj
-/// ```
-///
-/// (contiguous column updates, vectorized); false when a pivot is not positive (or NaN).
-struct SmallCholesky<'a>(&'a mut [f64], usize);
+/// faer's Cholesky) by [`triangular::cholesky_lower`], `1 / l_jj` kept aside and `Lᵀ`
+/// mirrored into the upper triangle (the input is kept in [`DenseLu`]'s copy) for the
+/// backward substitution. False when a pivot is not positive (or NaN).
+struct SmallCholesky<'a>(&'a mut [f64], &'a mut [f64], usize);
 
 impl Kernel for SmallCholesky<'_> {
     type Output = bool;
     #[inline(always)]
     fn run(self) -> bool {
-        let (a, n) = (self.0, self.1);
-        for j in 0..n {
-            let (done, rest) = a.split_at_mut(j * n);
-            let col = &mut rest[j..n];
-            for k in 0..j {
-                let lk = &done[k * n + j..k * n + n];
-                let f = lk[0];
-                for (c, l) in col.iter_mut().zip(lk) {
-                    *c -= f * l;
-                }
-            }
-            let d = col[0];
-            if d.is_nan() || d <= 0.0 {
-                return false;
-            }
-            let ljj = d.sqrt();
-            col[0] = ljj;
-            let inv = 1.0 / ljj;
-            col[1..].iter_mut().for_each(|c| *c *= inv);
+        let (a, inv_diag, n) = (self.0, self.1, self.2);
+        if !triangular::cholesky_lower(a, inv_diag, n, 0, n) {
+            return false;
         }
+        triangular::mirror_lower(a, n, 0, n);
         true
     }
 }
 
 /// `L Lᵀ x = b` in place with the factor of [`SmallCholesky`] (faer's triangular solves cost
-/// several times the 2n² flops at such sizes): forward by columns, `x_j /= l_jj`,
-/// `x_{j+1:n} −= x_j l_{j+1:n, j}`; backward by rows of `Lᵀ`, `x_j = (x_j − l_{j+1:n, j}·x_{j+1:n}) / l_jj`.
-struct SmallCholeskySolve<'a>(&'a [f64], &'a mut [f64]);
+/// several times the 2n² flops at such sizes): both substitutions down contiguous columns
+/// ([`triangular::forward_lower`], [`triangular::backward_upper`]).
+struct SmallCholeskySolve<'a>(&'a [f64], &'a [f64], &'a mut [f64]);
 
 impl Kernel for SmallCholeskySolve<'_> {
     type Output = ();
     #[inline(always)]
     fn run(self) {
-        let (l, x) = (self.0, self.1);
+        let (l, inv_diag, x) = (self.0, self.1, self.2);
         let n = x.len();
-        for j in 0..n {
-            let col = &l[j * n + j..(j + 1) * n];
-            let xj = x[j] / col[0];
-            x[j] = xj;
-            x[j + 1..].iter_mut().zip(&col[1..]).for_each(|(x, l)| *x -= xj * l);
-        }
-        for j in (0..n).rev() {
-            let col = &l[j * n + j..(j + 1) * n];
-            let dot = x[j + 1..].iter().zip(&col[1..]).fold(0.0, |s, (x, l)| s + x * l);
-            x[j] = (x[j] - dot) / col[0];
-        }
+        triangular::forward_lower(l, inv_diag, n, 0, x);
+        triangular::backward_upper(l, inv_diag, n, 0, x);
     }
 }
 
@@ -117,6 +90,8 @@ pub struct DenseLu {
 enum Factors {
     Lu,
     Cholesky,
+    /// `L Lᵀ` of a matrix of order ≤ [`SMALL`], `Lᵀ` also in the upper triangle
+    SmallCholesky,
     /// `L Lᵀ` of a bordered block-diagonal matrix (`blocks`, `border`)
     Bordered,
 }
@@ -186,8 +161,8 @@ impl DenseLu {
         }
         self.copy.copy_from_slice(&self.a);
         if n <= SMALL {
-            if dispatch(SmallCholesky(&mut self.a, n)) {
-                self.factored = Some(Factors::Cholesky);
+            if dispatch(SmallCholesky(&mut self.a, &mut self.inv_diag, n)) {
+                self.factored = Some(Factors::SmallCholesky);
                 return Ok(());
             }
             self.a.copy_from_slice(&self.copy);
@@ -268,8 +243,8 @@ impl DenseLu {
             self.bordered_solve(rhs);
             return Ok(());
         }
-        if kind == Factors::Cholesky && n <= SMALL {
-            dispatch(SmallCholeskySolve(&self.a, rhs));
+        if kind == Factors::SmallCholesky {
+            dispatch(SmallCholeskySolve(&self.a, &self.inv_diag, rhs));
             return Ok(());
         }
         let b = MatMut::from_column_major_slice_mut(rhs, n, 1);
@@ -282,7 +257,7 @@ impl DenseLu {
             Factors::Cholesky => {
                 llt::solve::solve_in_place_with_conj(a, Conj::No, b, Par::Seq, MemStack::new(&mut self.mem))
             }
-            Factors::Bordered => unreachable!("solved above"),
+            Factors::Bordered | Factors::SmallCholesky => unreachable!("solved above"),
         }
         Ok(())
     }
@@ -326,7 +301,7 @@ mod tests {
     fn symmetric_systems_by_cholesky_or_by_the_lu_fallback() {
         let x = [1.0, -2.0, 3.0];
         for (a, kind) in [
-            ([[4.0, 1.0, 0.5], [1.0, 3.0, -0.5], [0.5, -0.5, 2.0]], Factors::Cholesky),
+            ([[4.0, 1.0, 0.5], [1.0, 3.0, -0.5], [0.5, -0.5, 2.0]], Factors::SmallCholesky),
             ([[1.0, 2.0, 0.0], [2.0, 1.0, 1.0], [0.0, 1.0, 3.0]], Factors::Lu),
         ] {
             let (mut lu, mut b) = system(&a, &x);
@@ -364,7 +339,8 @@ mod tests {
             let mut lu = DenseLu::new(n);
             lu.matrix_mut().copy_from_slice(&a);
             lu.factor_symmetric().unwrap();
-            assert_eq!(lu.factored, Some(Factors::Cholesky), "n = {n}");
+            let small = n <= SMALL;
+            assert_eq!(lu.factored, Some(if small { Factors::SmallCholesky } else { Factors::Cholesky }), "n = {n}");
             let mut reference = a.clone();
             let mut mem =
                 MemBuffer::new(llt::factor::cholesky_in_place_scratch::<f64>(n, Par::Seq, Default::default()));

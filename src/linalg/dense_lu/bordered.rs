@@ -10,6 +10,7 @@
 //! with no fill outside the blocks and the border, so the blocks cost what they would on
 //! their own.
 
+use super::triangular::{backward_upper, cholesky_lower, forward_lower, mirror_lower};
 use super::DenseLu;
 use crate::linalg::simd::{dispatch, Kernel};
 use crate::linalg::vec_ops::{axpy, dot};
@@ -124,7 +125,16 @@ impl DenseLu {
                 self.a[t + i + n * (t + j)] -= dot(&self.w[i * t..(i + 1) * t], &self.w[j * t..(j + 1) * t]);
             }
         }
-        cholesky_lower(&mut self.a, &mut self.inv_diag, n, t, k)
+        if !cholesky_lower(&mut self.a, &mut self.inv_diag, n, t, k) {
+            return false;
+        }
+        // factored: the input's upper triangle is no longer needed (it restored the matrix
+        // after a failure); Lᵀ there lets the backward sweeps run down contiguous columns
+        for w in self.blocks.windows(2) {
+            mirror_lower(&mut self.a, n, w[0], w[1] - w[0]);
+        }
+        mirror_lower(&mut self.a, n, t, k);
+        true
     }
 
     /// The end of the diagonal block that column `c < border` belongs to.
@@ -144,75 +154,12 @@ impl DenseLu {
             *xi -= dot(&self.w[i * t..(i + 1) * t], xd);
         }
         forward_lower(&self.a, &inv[t..], n, t, xe);
-        backward_lower(&self.a, &inv[t..], n, t, xe);
+        backward_upper(&self.a, &inv[t..], n, t, xe);
         for (i, &xi) in xe.iter().enumerate() {
             axpy(-xi, &self.w[i * t..(i + 1) * t], xd);
         }
         for b in self.blocks.windows(2) {
-            backward_lower(&self.a, &inv[b[0]..b[1]], n, b[0], &mut xd[b[0]..b[1]]);
+            backward_upper(&self.a, &inv[b[0]..b[1]], n, b[0], &mut xd[b[0]..b[1]]);
         }
-    }
-}
-
-/// `A = L Lᵀ` of the block `A[s.., s..]` of size m of a column-major matrix with leading
-/// dimension `ld`, L written over its lower triangle (the upper one is left as it is).
-/// Left-looking, four earlier columns at a time: column j is updated by
-/// `A[j.., j] −= Σ_k L[j, k] L[j.., k]` reading each column piece once, then scaled by
-/// `1/√L_jj`. Small blocks (a per-body basis's 12–40 modes) are where faer's blocked
-/// kernel has its overheads: 35 × 35 took 4.7 µs there and about 1.3 µs here. False when
-/// a pivot is not positive.
-#[inline(always)]
-fn cholesky_lower(a: &mut [f64], inv_diag: &mut [f64], ld: usize, s: usize, m: usize) -> bool {
-    for j in 0..m {
-        let (left, right) = a.split_at_mut(ld * (s + j));
-        let colj = &mut right[s + j..s + m];
-        let col = |k: usize| &left[ld * (s + k) + s + j..ld * (s + k) + s + m];
-        let mut k = 0;
-        while k + 4 <= j {
-            let (c0, c1, c2, c3) = (col(k), col(k + 1), col(k + 2), col(k + 3));
-            let (f0, f1, f2, f3) = (c0[0], c1[0], c2[0], c3[0]);
-            for (o, ((x0, x1), (x2, x3))) in colj.iter_mut().zip(c0.iter().zip(c1).zip(c2.iter().zip(c3))) {
-                *o -= (f0 * x0 + f1 * x1) + (f2 * x2 + f3 * x3);
-            }
-            k += 4;
-        }
-        for kk in k..j {
-            let c = col(kk);
-            axpy(-c[0], c, colj);
-        }
-        let d = colj[0];
-        // written so that a NaN pivot fails too
-        #[allow(clippy::neg_cmp_op_on_partial_ord)]
-        if !(d > 0.0) {
-            return false;
-        }
-        let l = d.sqrt();
-        let inv = 1.0 / l;
-        colj[0] = l;
-        inv_diag[s + j] = inv;
-        colj[1..].iter_mut().for_each(|x| *x *= inv);
-    }
-    true
-}
-
-/// `x ← L⁻¹ x` with L the lower triangle of the block at `s` (size `x.len()`), by columns.
-#[inline(always)]
-fn forward_lower(a: &[f64], inv_diag: &[f64], ld: usize, s: usize, x: &mut [f64]) {
-    let m = x.len();
-    for j in 0..m {
-        let col = &a[ld * (s + j) + s + j..ld * (s + j) + s + m];
-        x[j] *= inv_diag[j];
-        let xj = x[j];
-        axpy(-xj, &col[1..], &mut x[j + 1..]);
-    }
-}
-
-/// `x ← L⁻ᵀ x` with L the lower triangle of the block at `s`, by dot products.
-#[inline(always)]
-fn backward_lower(a: &[f64], inv_diag: &[f64], ld: usize, s: usize, x: &mut [f64]) {
-    let m = x.len();
-    for j in (0..m).rev() {
-        let col = &a[ld * (s + j) + s + j..ld * (s + j) + s + m];
-        x[j] = (x[j] - dot(&col[1..], &x[j + 1..])) * inv_diag[j];
     }
 }
