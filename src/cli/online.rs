@@ -71,7 +71,8 @@ impl Args {
             output.display()
         ));
         if let Some(e) = &estimate {
-            info(&format!("  {}", flexrom::pipeline::estimate::describe(e, run.result.wall_seconds)));
+            let method = trust.estimator.as_ref().map_or("corrected", |m| m.method.name());
+            info(&format!("  {}", flexrom::pipeline::estimate::describe(e, method, run.result.wall_seconds)));
         }
         run_details(&run.result);
         let mut cols = vec!["load_scale", "n_modes"];

@@ -88,7 +88,7 @@ const RESULT: [Entry; 5] = [
     ("reduced/q", REDUCED_UNITS, "time, mode"),
 ];
 
-const BASIS: [Entry; 39] = [
+const BASIS: [Entry; 42] = [
     ("snapshots", COORDINATE_UNITS, "dof, snapshot"),
     ("snapshot_multipliers", MULTIPLIER_UNITS, "constraint, snapshot"),
     ("snapshot_load_scale", "1", "snapshot"),
@@ -112,6 +112,9 @@ const BASIS: [Entry; 39] = [
     ("estimator/calibration/load_scale", "1", "pair"),
     ("estimator/calibration/raw_estimate", "1", "pair"),
     ("estimator/calibration/rel_error", "1", "pair"),
+    ("estimator/defects/load_scale", "1", "load"),
+    ("estimator/defects/ratio", "1", "load, fifth"),
+    ("estimator/defects/factor", "1", "fifth"),
     ("training/range", "1", "bound"),
     ("training/tolerance", "1", ""),
     ("training/load_scales", "1", "run"),

@@ -9,6 +9,9 @@
 //! /estimator/hyper/elements, /estimator/hyper/weights   V⁺'s ECSW set (hyper-reduced bases)
 //!   attributes on /estimator/hyper: tolerance, training_residual, n_training
 //! /estimator/calibration/load_scale, raw_estimate, rel_error   (m) held-out calibration pairs
+//! /estimator/defects/load_scale (N), ratio (N, 5), factor (5)   the defects method's
+//!                                          calibration (greedy training only; `DefectsCalibration`);
+//!   attribute on /estimator/defects: reliable (1: its leave-one-out check passed)
 //!   attributes on /estimator: method ("enriched"), extra_modes (k), factor (c),
 //!   calibrated (1: c from calibration pairs, 0: the default), n_modes (r⁺)
 //! /training/range             (2)          [min, max] training load scale (greedy training;
@@ -18,7 +21,7 @@
 
 use super::h5::{attr_f64, attr_str, attr_u64, read_attr_f64, read_attr_str};
 use crate::error::{Error, Result};
-use crate::reduction::estimator::{Calibration, CalibrationPoint, Estimator};
+use crate::reduction::estimator::{Calibration, CalibrationPoint, DefectsCalibration, Estimator};
 use crate::reduction::{Basis, Hyper};
 use ndarray::Array1;
 use std::path::Path;
@@ -47,6 +50,14 @@ pub fn write_estimator(f: &hdf5::File, est: &Estimator) -> hdf5::Result<()> {
     cg.new_dataset_builder().with_data(&col(&|p| p.load_scale)).create("load_scale")?;
     cg.new_dataset_builder().with_data(&col(&|p| p.raw_estimate)).create("raw_estimate")?;
     cg.new_dataset_builder().with_data(&col(&|p| p.rel_error)).create("rel_error")?;
+    if let Some(d) = &est.defects {
+        let dg = g.create_group("defects")?;
+        dg.new_dataset_builder().with_data(&Array1::from(d.load_scales.clone())).create("load_scale")?;
+        let ratios = ndarray::Array2::from_shape_fn((d.ratios.len(), 5), |(j, i)| d.ratios[j][i]);
+        dg.new_dataset_builder().with_data(&ratios).create("ratio")?;
+        dg.new_dataset_builder().with_data(&Array1::from(d.factors.to_vec())).create("factor")?;
+        attr_u64(&dg, "reliable", d.reliable as u64)?;
+    }
     attr_str(&g, "method", "enriched")?;
     attr_u64(&g, "extra_modes", est.extra_modes as u64)?;
     attr_f64(&g, "factor", c.factor)?;
@@ -167,13 +178,56 @@ pub fn read_estimator(path: &Path, basis: &Basis) -> Result<Option<Estimator>> {
             ),
         ));
     }
+    let defects = match g.group("defects") {
+        Ok(dg) => Some(read_defects(&dg, &field)?),
+        Err(_) => None,
+    };
     Ok(Some(Estimator {
         enriched,
         block_modes,
         extra_modes: count("extra_modes")? as usize,
         calibration: Calibration { factor, calibrated: count("calibrated")? != 0, points },
+        defects,
         method: Default::default(),
     }))
+}
+
+/// `/estimator/defects`: the loads, their ratios (N × 5) and the five factors, which must
+/// be positive and finite.
+fn read_defects(dg: &hdf5::Group, field: &dyn Fn(&str, String) -> Error) -> Result<DefectsCalibration> {
+    let load_scales = dg
+        .dataset("load_scale")
+        .and_then(|d| d.read_1d::<f64>())
+        .map_err(|e| field("defects/load_scale", format!("cannot be read: {e}")))?
+        .to_vec();
+    let ratio = dg
+        .dataset("ratio")
+        .and_then(|d| d.read_2d::<f64>())
+        .map_err(|e| field("defects/ratio", format!("cannot be read: {e}")))?;
+    if ratio.dim() != (load_scales.len(), 5) {
+        return Err(field(
+            "defects/ratio",
+            format!("is {:?}; expected ({}, 5), a row per load of defects/load_scale", ratio.dim(), load_scales.len()),
+        ));
+    }
+    let f = dg
+        .dataset("factor")
+        .and_then(|d| d.read_1d::<f64>())
+        .map_err(|e| field("defects/factor", format!("cannot be read: {e}")))?;
+    let factors: [f64; 5] = f
+        .as_slice()
+        .and_then(|s| s.try_into().ok())
+        .ok_or_else(|| field("defects/factor", format!("has {} entries; expected 5", f.len())))?;
+    if let Some(bad) = factors.iter().find(|x| !(x.is_finite() && **x > 0.0)) {
+        return Err(field("defects/factor", format!("holds {bad}; every factor must be positive and finite")));
+    }
+    let ratios = ratio.rows().into_iter().map(|r| [r[0], r[1], r[2], r[3], r[4]]).collect();
+    let reliable = dg
+        .attr("reliable")
+        .and_then(|a| a.read_scalar::<u64>())
+        .map_err(|e| field("defects/reliable", format!("cannot be read: {e}")))?
+        != 0;
+    Ok(DefectsCalibration { load_scales, ratios, factors, reliable })
 }
 
 /// `[min, max]` of the training load scales: `/training/range` when present (greedy

@@ -123,8 +123,10 @@ pub fn build_estimator(
         block_modes: richer.block_modes,
         extra_modes: extra,
         calibration: Calibration::default(),
+        defects: None,
         // training steers greedy and calibrates `c` with the tight method; runs read from
-        // the basis file use the pipeline's `[online] estimate` (default the same method)
+        // the basis file use the pipeline's `[online] estimate` (default: the defects method
+        // where greedy training calibrated it, else this one: `estimate_trust::load_trust`)
         method: EstimateMethod::Corrected,
     })
 }
@@ -262,18 +264,22 @@ impl<'a> EstimatingRunner<'a> {
         let raw = raw.unwrap_or([f64::INFINITY; 5]);
         let c = &est.calibration;
         // the defect sum is a bound by itself: factor 1, raised in the proportion that
-        // calibration raised the corrected method's c above its default
-        let factor = match model {
-            EstimatorModel::Defects(_) => c.factor / DEFAULT_FACTOR,
-            _ => c.factor,
+        // calibration raised the corrected method's c above its default, or put on the
+        // corrected method's scale fifth by fifth where greedy training measured how
+        // (`DefectsCalibration`)
+        let factors = match (model, &est.defects) {
+            (EstimatorModel::Defects(_), Some(d)) => d.factors_at(load_scale),
+            (EstimatorModel::Defects(_), None) => [c.factor / DEFAULT_FACTOR; 5],
+            _ => [c.factor; 5],
         };
+        let by_time: [f64; 5] = std::array::from_fn(|i| factors[i] * raw[i]);
         let e = Estimate {
-            error_estimate: factor * raw[4],
+            error_estimate: by_time[4],
             raw: raw[4],
-            factor,
+            factor: factors[4],
             calibrated: c.calibrated,
             seconds: start.elapsed().as_secs_f64(),
-            by_time: raw.map(|r| factor * r),
+            by_time,
         };
         Ok((run, Some(e)))
     }
@@ -349,6 +355,7 @@ mod tests {
             block_modes: vec![5],
             extra_modes: 2,
             calibration: Calibration::default(),
+            defects: None,
             method: EstimateMethod::default(),
         };
         // nested (first 3 columns) and not nested (mixing columns 2..5)

@@ -52,8 +52,16 @@ pub fn load_trust(
     use crate::io::estimator_file::{read_estimator, read_training_range, read_training_tolerance};
     use crate::solver::model::ParametricModel;
     let mut estimator = read_estimator(path, &stored.basis)?;
-    if let (Some(e), Some(m)) = (&mut estimator, p.file.online.as_ref().and_then(|o| o.estimate)) {
-        e.method = m;
+    if let Some(e) = &mut estimator {
+        // the pipeline's choice, else the cheap method where training calibrated it and its
+        // calibration passed the leave-one-out check (`DefectsCalibration`)
+        e.method = p.file.online.as_ref().and_then(|o| o.estimate).unwrap_or(
+            if e.defects.as_ref().is_some_and(|d| d.reliable) {
+                crate::reduction::estimator::EstimateMethod::Defects
+            } else {
+                crate::reduction::estimator::EstimateMethod::Corrected
+            },
+        );
     }
     if let Some(e) = &estimator {
         let sys = &*p.model.physics()?.sys;
@@ -70,10 +78,11 @@ pub fn load_trust(
     Ok(TrustInfo { estimator, range: read_training_range(path)?, tolerance, skipped: false })
 }
 
-/// One line for stderr: the estimate, whether calibrated, and its cost against the reduced run.
-pub fn describe(e: &Estimate, rom_seconds: f64) -> String {
+/// One line for stderr: the estimate, its method, whether calibrated, and its cost against
+/// the reduced run.
+pub fn describe(e: &Estimate, method: &str, rom_seconds: f64) -> String {
     format!(
-        "error_estimate {:.3e} ({}, c = {:.3}), estimator {:.4} s ({:.0} % of the reduced run)",
+        "error_estimate {:.3e} ({method} method, {}, factor {:.3}), estimator {:.4} s ({:.0} % of the reduced run)",
         e.error_estimate,
         if e.calibrated { "calibrated" } else { "uncalibrated" },
         e.factor,
@@ -85,7 +94,8 @@ pub fn describe(e: &Estimate, rom_seconds: f64) -> String {
 /// Attributes of an `online` result file: `error_estimate` (NaN without an estimator),
 /// `error_estimate_by_time` (5 values: the estimate up to the end of each fifth of the run,
 /// the last = `error_estimate`; NaN without an estimator), `error_estimate_raw`, `error_estimate_factor`, `error_estimate_calibrated` (0/1),
-/// `extrapolated` (0/1), `training_range` ([min, max]), `tolerance` (when set).
+/// `extrapolated` (0/1), `training_range` ([min, max]), `tolerance` (when set),
+/// `error_estimate_method` (`corrected`, `defects` or `enriched`; when there is an estimator).
 pub fn write_run_attributes(
     f: &hdf5::File,
     e: Option<&Estimate>,
@@ -102,6 +112,9 @@ pub fn write_run_attributes(
     f.new_attr::<f64>().shape(2).create("training_range")?.write(&[trust.range.0, trust.range.1])?;
     if let Some(t) = trust.tolerance {
         attr_f64(f, "tolerance", t)?;
+    }
+    if let (Some(_), Some(est)) = (e, &trust.estimator) {
+        crate::io::h5::attr_str(f, "error_estimate_method", est.method.name())?;
     }
     Ok(())
 }

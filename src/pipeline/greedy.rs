@@ -216,6 +216,17 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
     }
     let Level { trained, mut estimator, .. } = chosen;
     estimator.calibration = calibrate(points);
+    // the cheap online estimate on the corrected one's scale (estimate_defects.rs)
+    estimator.defects = candidates::calibrate_defects(&p.model, &trained.basis, &estimator, &candidates);
+    crate::output::info(&match &estimator.defects {
+        Some(d) if d.reliable => format!(
+            "error estimate: the cheap `defects` method calibrated at the {} candidates (factors {}), the online default",
+            d.load_scales.len(),
+            d.factors.iter().map(|f| format!("{f:.3}")).collect::<Vec<_>>().join(", ")
+        ),
+        Some(_) => "error estimate: the `defects` method's ratio to the corrected estimate jumps between candidates (its leave-one-out check failed): the online default stays `corrected`".into(),
+        None => "error estimate: the `defects` method could not be calibrated: the online default stays `corrected`".into(),
+    });
     let data = training_data(&runs);
     let record = GreedyRecord {
         range,

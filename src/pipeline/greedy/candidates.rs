@@ -4,7 +4,9 @@
 
 use crate::model::Model;
 use crate::pipeline::estimate::{raw_estimate_by_time, EstimatingRunner, Estimator};
+use crate::pipeline::estimate_defects::DefectRunner;
 use crate::pipeline::online::Output;
+use crate::reduction::estimator::DefectsCalibration;
 use crate::reduction::Basis;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
@@ -84,6 +86,35 @@ pub(super) fn estimate_candidates(
         .collect();
     bar.finish_and_clear();
     out
+}
+
+/// The `defects` method's calibration (`DefectsCalibration`) of the final basis: at every
+/// candidate one reduced run, its corrected estimate (the estimator's calibration `c`
+/// included) and its raw defect sum, fifth by fifth, reduced runs in parallel. `None` when
+/// the estimator has no defects runner or some fifth has no usable ratio.
+pub(super) fn calibrate_defects(
+    model: &Model,
+    basis: &Basis,
+    est: &Estimator,
+    loads: &[f64],
+) -> Option<DefectsCalibration> {
+    let ratios: Vec<[f64; 5]> = loads
+        .par_iter()
+        .map_init(
+            || {
+                let corrected = EstimatingRunner::new(model, basis, Some(est)).ok();
+                let defects = DefectRunner::new(model, basis, &est.enriched).ok().flatten();
+                (corrected, defects)
+            },
+            |(corrected, defects), &x| {
+                let (Some(c), Some(d)) = (corrected, defects) else { return [f64::NAN; 5] };
+                let Ok((run, Some(e))) = c.run(x, Output::ReducedAndProbes) else { return [f64::NAN; 5] };
+                let Ok(raw) = d.raw_by_time(&run) else { return [f64::NAN; 5] };
+                std::array::from_fn(|i| e.by_time[i] / raw[i])
+            },
+        )
+        .collect();
+    DefectsCalibration::new(loads.to_vec(), ratios)
 }
 
 #[cfg(test)]

@@ -1,0 +1,119 @@
+//! The cheap estimate put on the corrected one's scale by greedy training (issue 15 item 2's
+//! cost target; `DefectsCalibration` in src/reduction/estimator.rs).
+//!
+//! On the thesis pendulum (data/models/pendulum.toml) coarsened to 20 elements and
+//! t_end = 0.4 s, trained greedily over [0.5, 1.5] to 1e-3 as in tests/greedy.rs:
+//! - `greedy_calibrates_the_defects_estimate`: the basis file holds `/estimator/defects`
+//!   (33 candidate loads, 33 × 5 ratios, 5 factors, `reliable` = 1: the pendulum's ratio
+//!   of the two estimates changes smoothly with the load, so its leave-one-out check
+//!   passes); the online default method is then `defects`, and an `online` result file
+//!   says so (`error_estimate_method`). At a candidate load the
+//!   calibrated defect estimate equals the corrected estimate fifth by fifth (to 1e-9
+//!   relative: the ratio was measured from the same reduced run there, so `ρ · defects_raw`
+//!   is the corrected estimate up to round-off). At loads that are neither training loads
+//!   nor candidates (0.57, 1.03, 1.41) and outside the range (0.4, 1.6: extrapolated) the
+//!   default estimate of `validate` bounds the true rel_error with effectivity ≤ 30 (the
+//!   issue's coverage and overestimate targets).
+//! - `pipelines_may_still_choose_the_corrected_estimate`: `[online] estimate = "corrected"`
+//!   overrides the default for the same basis file.
+
+use flexrom::pipeline::estimate::{EstimateMethod, EstimatingRunner};
+use flexrom::pipeline::estimate_trust::load_trust;
+use flexrom::pipeline::online::{load_basis, Output};
+use flexrom::pipeline::train::train_and_write;
+use flexrom::pipeline::validate::validate_with;
+use flexrom::pipeline::Pipeline;
+use std::path::{Path, PathBuf};
+
+fn repo(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
+}
+
+/// The coarse pendulum and a greedy pipeline in `dir`, `online` appended to `[online]`.
+fn setup(dir: &Path, online: &str) -> PathBuf {
+    let model = std::fs::read_to_string(repo("data/models/pendulum.toml"))
+        .unwrap()
+        .replace("elements = 50", "elements = 20")
+        .replace("t_end = 1.1", "t_end = 0.4");
+    assert!(model.contains("elements = 20") && model.contains("t_end = 0.4"));
+    std::fs::write(dir.join("model.toml"), model).unwrap();
+    let p = dir.join("pipe.toml");
+    std::fs::write(
+        &p,
+        format!(
+            "model = \"model.toml\"\nbasis = \"basis.h5\"\nreport = \"report\"\n[train]\ngreedy = {{ range = [0.5, 1.5], tolerance = 1e-3, max_runs = 8 }}\n[online]\nload_scales = \"0.5:1.5:3\"\n{online}"
+        ),
+    )
+    .unwrap();
+    p
+}
+
+#[test]
+fn greedy_calibrates_the_defects_estimate() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = Pipeline::load(setup(dir.path(), "")).unwrap();
+    let summary = train_and_write(&p, &p.basis_path).unwrap();
+    let candidates = summary.greedy.as_ref().expect("greedy record").candidates.clone();
+    assert_eq!(candidates.len(), 33);
+
+    // the file layout
+    let f = hdf5::File::open(&p.basis_path).unwrap();
+    let g = f.group("estimator/defects").expect("/estimator/defects");
+    assert_eq!(g.dataset("load_scale").unwrap().read_1d::<f64>().unwrap().to_vec(), candidates);
+    assert_eq!(g.dataset("ratio").unwrap().shape(), vec![33, 5]);
+    let factors = g.dataset("factor").unwrap().read_1d::<f64>().unwrap();
+    assert!(factors.len() == 5 && factors.iter().all(|x| x.is_finite() && *x > 0.0), "{factors:?}");
+    assert_eq!(g.attr("reliable").unwrap().read_scalar::<u64>().unwrap(), 1);
+    drop(f);
+
+    let stored = load_basis(&p, &p.basis_path).unwrap();
+    let trust = load_trust(&p, &p.basis_path, &stored).unwrap();
+    let est = trust.estimator.as_ref().expect("estimator");
+    assert_eq!(est.method, EstimateMethod::Defects, "the calibrated cheap method is the default");
+
+    // at a candidate: the corrected estimate, to round-off
+    let x = candidates[7];
+    let mut corrected = est.clone();
+    corrected.method = EstimateMethod::Corrected;
+    let (_, d) = EstimatingRunner::new(&p.model, &stored.basis, Some(est)).unwrap().run(x, Output::Full).unwrap();
+    let (_, c) =
+        EstimatingRunner::new(&p.model, &stored.basis, Some(&corrected)).unwrap().run(x, Output::Full).unwrap();
+    let (d, c) = (d.unwrap(), c.unwrap());
+    for i in 0..5 {
+        let rel = (d.by_time[i] - c.by_time[i]).abs() / c.by_time[i];
+        assert!(rel < 1e-9, "λ = {x}, fifth {i}: defects {:e}, corrected {:e}", d.by_time[i], c.by_time[i]);
+    }
+
+    // what a user's result file says of it
+    let out = dir.path().join("run.h5");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_flexrom"))
+        .args(["online", p.path.to_str().unwrap(), "--load-scale", "1.03", "-o", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "online: {}", String::from_utf8_lossy(&o.stderr));
+    let method: hdf5::types::VarLenUnicode =
+        hdf5::File::open(&out).unwrap().attr("error_estimate_method").unwrap().read_scalar().unwrap();
+    assert_eq!(method.as_str(), "defects");
+
+    // held out and outside the range: a bound, not a loose one
+    for x in [0.57, 1.03, 1.41, 0.4, 1.6] {
+        assert!(candidates.iter().all(|&l| (l - x).abs() > 1e-3));
+        let (v, _, _) = validate_with(&p.model, &stored.basis, Some(&trust), x, false).unwrap();
+        let e = v.error_estimate.expect("estimate");
+        assert!(e >= v.rel_error, "λ = {x}: estimate {e:e} below rel_error {:e}", v.rel_error);
+        assert!(e / v.rel_error <= 30.0, "λ = {x}: effectivity {}", e / v.rel_error);
+        assert_eq!(v.extrapolated, !(0.5..=1.5).contains(&x), "λ = {x}");
+    }
+}
+
+#[test]
+fn pipelines_may_still_choose_the_corrected_estimate() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = Pipeline::load(setup(dir.path(), "estimate = \"corrected\"\n")).unwrap();
+    train_and_write(&p, &p.basis_path).unwrap();
+    let stored = load_basis(&p, &p.basis_path).unwrap();
+    let trust = load_trust(&p, &p.basis_path, &stored).unwrap();
+    let est = trust.estimator.expect("estimator");
+    assert!(est.defects.is_some_and(|d| d.reliable));
+    assert_eq!(est.method, EstimateMethod::Corrected);
+}
