@@ -216,7 +216,7 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
     }
     let Level { trained, mut estimator, .. } = chosen;
     estimator.calibration = calibrate(points);
-    // the cheap online estimate on the corrected one's scale (estimate_defects.rs)
+    // the cheap online estimate on the corrected one's scale (`DefectsCalibration`)
     estimator.defects = candidates::calibrate_defects(&p.model, &trained.basis, &estimator, &candidates);
     crate::output::info(&match &estimator.defects {
         Some(d) if d.reliable => format!(

@@ -326,10 +326,11 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: boo
     let _ = writeln!(md, "\n## Error estimate, extrapolation, sensitivity\n");
     let _ = writeln!(
         md,
-        "Training range [{}, {}]; tolerance {}. The estimate predicts rel_error without a full run (docs/error-estimate.md); effectivity = estimate / rel_error (≥ 1: bounded). Sensitivity: the full model's own change for a 0.1 % change of the load.\n",
+        "Training range [{}, {}]; tolerance {}. The estimate predicts rel_error without a full run ({} method, docs/error-estimate.md); effectivity = estimate / rel_error (≥ 1: bounded). Sensitivity: the full model's own change for a 0.1 % change of the load.\n",
         trust.range.0,
         trust.range.1,
-        trust.tolerance.map_or("none".to_string(), |t| format!("{t:e}"))
+        trust.tolerance.map_or("none".to_string(), |t| format!("{t:e}")),
+        trust.estimator.as_ref().map_or("no", |e| e.method.name())
     );
     let _ = writeln!(md, "| load scale | rel_error | error_estimate | effectivity | calibrated | extrapolated | sensitivity | rel_error by fifth of the run | error_estimate by fifth of the run |");
     let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|");
