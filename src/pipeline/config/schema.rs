@@ -158,7 +158,8 @@ pub struct OnlineSpec {
     pub load_scales: Scales,
     #[serde(default)]
     pub tolerance: Option<f64>,
-    /// how every reduced run computes its error estimate: "corrected" (default), "defects" (cheap, looser) or
+    /// how every reduced run computes its error estimate: "defects" (cheap; the default where
+    /// greedy training calibrated it reliably), "corrected" (the default otherwise) or
     /// "enriched" (docs/error-estimate.md)
     #[serde(default)]
     pub estimate: Option<EstimateMethod>,
