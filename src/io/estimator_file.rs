@@ -200,6 +200,12 @@ fn read_defects(dg: &hdf5::Group, field: &dyn Fn(&str, String) -> Error) -> Resu
         .and_then(|d| d.read_1d::<f64>())
         .map_err(|e| field("defects/load_scale", format!("cannot be read: {e}")))?
         .to_vec();
+    if load_scales.iter().any(|x| !x.is_finite()) || load_scales.windows(2).any(|w| !(w[0] < w[1])) {
+        return Err(field(
+            "defects/load_scale",
+            "must hold finite load scales in increasing order (the candidate loads of greedy training)".into(),
+        ));
+    }
     let ratio = dg
         .dataset("ratio")
         .and_then(|d| d.read_2d::<f64>())
@@ -227,6 +233,12 @@ fn read_defects(dg: &hdf5::Group, field: &dyn Fn(&str, String) -> Error) -> Resu
         .and_then(|a| a.read_scalar::<u64>())
         .map_err(|e| field("defects/reliable", format!("cannot be read: {e}")))?
         != 0;
+    if reliable && load_scales.len() < 3 {
+        return Err(field(
+            "defects/reliable",
+            format!("is 1 with {} load(s); the check it records needs at least 3", load_scales.len()),
+        ));
+    }
     Ok(DefectsCalibration { load_scales, ratios, factors, reliable })
 }
 

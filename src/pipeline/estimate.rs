@@ -268,7 +268,10 @@ impl<'a> EstimatingRunner<'a> {
         // corrected method's scale fifth by fifth where greedy training measured how
         // (`DefectsCalibration`)
         let factors = match (model, &est.defects) {
-            (EstimatorModel::Defects(_), Some(d)) => d.factors_at(load_scale),
+            // interpolated in the load only where the calibration's check passed; else
+            // (a pipeline asking for `defects` on such a basis) the largest ratio measured
+            (EstimatorModel::Defects(_), Some(d)) if d.reliable => d.factors_at(load_scale),
+            (EstimatorModel::Defects(_), Some(d)) => d.factors,
             (EstimatorModel::Defects(_), None) => [c.factor / DEFAULT_FACTOR; 5],
             _ => [c.factor; 5],
         };

@@ -1,4 +1,5 @@
-//! The default error estimator (`estimate = "corrected"`, docs/error-estimate.md): the
+//! The tight error estimator (`estimate = "corrected"`, docs/error-estimate.md; the online
+//! default unless greedy training calibrated the cheap `defects` one reliably): the
 //! enriched model's trajectory, not integrated on its own but *corrected from the reduced
 //! run's*, one modified-Newton iteration per step.
 //!

@@ -17,7 +17,7 @@
 //! ```
 //!
 //! The triangle inequality ignores that defects of alternating sign cancel, so the bound
-//! is loose (measured: 10–30× the true error, docs/error-estimate.md), but it needs no
+//! is loose (measured: 1.2–46× the true error, docs/error-estimate.md), but it needs no
 //! constant fitted to a model; where the dynamics amplify differences (the four-bar after
 //! t ≈ 0.7 s) it is tighter than elsewhere and held there by its margin. `s` is
 //! [`DEFECT_SAMPLE`], lowered so that a run keeps at least [`MIN_SAMPLES`] samples: fixed

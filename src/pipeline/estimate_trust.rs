@@ -64,6 +64,14 @@ pub fn load_trust(
         );
     }
     if let Some(e) = &estimator {
+        if e.method == crate::reduction::estimator::EstimateMethod::Defects
+            && e.defects.as_ref().is_some_and(|d| !d.reliable)
+        {
+            eprintln!(
+                "warning: {}: [online] estimate = \"defects\" on a basis whose defects calibration failed its check between the candidate loads (docs/error-estimate.md): the estimate uses the largest ratio measured and may read far above the error; \"corrected\" is the tighter choice here",
+                p.path.display()
+            );
+        }
         let sys = &*p.model.physics()?.sys;
         let err = |(field, problem): (String, String)| Error::input(path, format!("estimator/{field}"), problem);
         e.enriched.validate(sys.n_dof(), sys.n_constraints()).map_err(err)?;

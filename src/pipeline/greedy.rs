@@ -166,11 +166,13 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
             } else {
                 "every candidate has a full run".into()
             };
+            // the same test as the stop below, without a held-out run to recalibrate with
+            let bound = level.between_candidates();
             crate::output::info(&format!(
-                "iteration {n}: {why}, worst estimate {worst:.2e} {cmp} {:e} at λ = {}, {shape}",
+                "iteration {n}: {why}, worst estimate {worst:.2e} {cmp} {:e} at λ = {} (bound between candidates {bound:.2e}), {shape}",
                 g.tolerance, it.worst_load
             ));
-            converged = worst <= g.tolerance;
+            converged = bound <= g.tolerance;
             iterations.push(it);
             break level;
         };

@@ -95,7 +95,12 @@ impl DefectsCalibration {
         }
         // the interval [λ_k, λ_(k+1)] holding λ (the last one for the last candidate)
         let k = (j - 1).min(l.len() - 2);
-        let w = (load_scale - l[k]) / (l[k + 1] - l[k]);
+        let width = l[k + 1] - l[k];
+        if !(width > 0.0) {
+            // not ascending (a basis file checks this when read): no interpolation
+            return self.factors;
+        }
+        let w = (load_scale - l[k]) / width;
         std::array::from_fn(|i| {
             let (a, b) = (self.ratios[k][i], self.ratios[k + 1][i]);
             if usable(a) && usable(b) {
@@ -156,7 +161,7 @@ impl Default for Calibration {
 #[serde(rename_all = "kebab-case")]
 pub enum EstimateMethod {
     /// one modified-Newton iteration of the enriched model per step, from the reduced
-    /// run's increments (`pipeline::estimate_corrected`); ≈ 1.5× the error at 30–130 % of
+    /// run's increments (`pipeline::estimate_corrected`); ≈ 1.5× the error at 45–130 % of
     /// the reduced run; what training (greedy steering, calibration) uses, so that an
     /// online estimate reads on the scale of the training tolerance. The default online
     /// estimate unless greedy training calibrated `Defects` reliably (`DefectsCalibration`)
@@ -166,7 +171,7 @@ pub enum EstimateMethod {
     Enriched,
     /// the cheap method: the reduced run's local defects against the enriched model at
     /// every 10th step, summed (`pipeline::estimate_defects`), 7–16 % of the reduced run.
-    /// Uncalibrated a loose bound (9–46× the error measured); calibrated by greedy training
+    /// Uncalibrated a loose bound (1.2–46× the error measured); calibrated by greedy training
     /// ([`DefectsCalibration`]) the corrected estimate's reading at its candidates, and
     /// then the online default where its leave-one-out check passed (docs/error-estimate.md)
     Defects,

@@ -173,9 +173,9 @@ pub(super) fn search(
 /// cent with the default 33 candidates), a jumpy one to much more. Nothing in it is fitted:
 /// a spike narrower than the spacing is what more candidates would find. A non-finite or
 /// non-positive estimate (a failed run, a basis with no extra modes to estimate from) gives
-/// ∞.
+/// ∞, as does an empty list.
 pub(crate) fn between_candidates(e: &[f64]) -> f64 {
-    if e.iter().any(|&x| !(x.is_finite() && x > 0.0)) {
+    if e.is_empty() || e.iter().any(|&x| !(x.is_finite() && x > 0.0)) {
         return f64::INFINITY;
     }
     if e.len() == 1 {
@@ -226,8 +226,8 @@ mod tests {
 
     /// A flat estimate is its value; a rising one is held to its largest value times the
     /// last step ratio (1.1 × 1.1 / 1.0 → 1.21 between the last two); a jump between two
-    /// neighbours counts in full (1e-3 next to 1e-4 bounds the gap by 1e-2); a failed or
-    /// empty estimate is ∞.
+    /// neighbours counts in full (1e-3 next to 1e-4 bounds the gap by 1e-2); a failed
+    /// estimate, a zero one and no estimates at all are ∞.
     #[test]
     fn the_bound_between_candidates_follows_the_neighbours() {
         assert_eq!(between_candidates(&[2e-4, 2e-4, 2e-4]), 2e-4);
@@ -236,5 +236,6 @@ mod tests {
         assert!(between_candidates(&[1e-4, f64::INFINITY]).is_infinite());
         assert!(between_candidates(&[1e-4, f64::NAN]).is_infinite());
         assert!(between_candidates(&[1e-4, 0.0]).is_infinite());
+        assert!(between_candidates(&[]).is_infinite());
     }
 }
