@@ -71,7 +71,7 @@ pub struct DenseLu {
     factored: Option<Factors>,
     /// the matrix as filled, kept while a dense Cholesky factorization is tried; the
     /// bordered one keeps only the diagonal here (its first n entries), as it leaves the
-    /// upper triangle as filled
+    /// upper triangle as filled until it has succeeded (then it holds `Lᵀ` there)
     copy: Vec<f64>,
     /// the first nonzero column of each row's lower triangle
     first: Vec<usize>,
@@ -80,7 +80,7 @@ pub struct DenseLu {
     border: usize,
     /// the border rows of `L`, `W = C L_D⁻ᵀ`, row-major (k × t)
     w: Vec<f64>,
-    /// `1 / L_jj` of the bordered factorization
+    /// `1 / L_jj` of the bordered and of the small Cholesky factorization
     inv_diag: Vec<f64>,
     /// whether `first` has a bordered block form (`blocks`), once it has been looked for
     blocks_known: Option<bool>,
@@ -373,9 +373,12 @@ mod tests {
     /// rows, like a block basis's Newton matrix with its joints, and without one (k = 0):
     /// the blocks and the border are found from the zero pattern and factored block by
     /// block; the matrix is diagonally dominant, hence positive definite. With one diagonal
-    /// entry made negative it is not: the LU fallback takes the matrix restored from its
-    /// upper triangle. All give the x that b was built from. Bound: round-off of a 34 × 34
-    /// solve, 1e-12.
+    /// entry made negative it is not: in a block (entry 7) or in the border (the last
+    /// entry: the blocks factor and the Schur complement fails) the LU fallback takes the
+    /// matrix restored from its upper triangle. One solver serves the cases in turn,
+    /// positive definite again at the end (the upper triangle a success leaves holds `Lᵀ`,
+    /// and the next matrix is written whole). All give the x that b was built from. Bound:
+    /// round-off of a 34 × 34 solve, 1e-12.
     #[test]
     fn bordered_block_systems_by_blocks_or_the_lu_fallback() {
         let blocks = [0usize, 9, 16, 24, 32];
@@ -391,9 +394,15 @@ mod tests {
                 }
             };
             let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.9).cos() + 0.1).collect();
-            for (flip, kind) in [(false, Factors::Bordered), (true, Factors::Lu)] {
-                let a = |i: usize, j: usize| if flip && i == 7 && j == 7 { -entry(i, j) } else { entry(i, j) };
-                let mut lu = DenseLu::new(n);
+            let mut lu = DenseLu::new(n);
+            let cases = [
+                (None, Factors::Bordered),
+                (Some(7), Factors::Lu),
+                (Some(n - 1), Factors::Lu),
+                (None, Factors::Bordered),
+            ];
+            for (flip, kind) in cases {
+                let a = |i: usize, j: usize| if flip == Some(i) && i == j { -entry(i, j) } else { entry(i, j) };
                 let m = lu.matrix_mut();
                 for j in 0..n {
                     for i in 0..n {
@@ -402,11 +411,11 @@ mod tests {
                 }
                 let mut b: Vec<f64> = (0..n).map(|i| (0..n).map(|j| a(i, j) * x[j]).sum()).collect();
                 lu.factor_symmetric().unwrap();
-                assert_eq!(lu.factored, Some(kind), "k = {k}");
+                assert_eq!(lu.factored, Some(kind), "k = {k}, flip {flip:?}");
                 assert_eq!((&lu.blocks[..], lu.border), (&blocks[..], 32), "k = {k}");
                 lu.solve(&mut b).unwrap();
                 for (bi, xi) in b.iter().zip(&x) {
-                    assert!((bi - xi).abs() < 1e-12, "k = {k}, {kind:?}: {b:?}");
+                    assert!((bi - xi).abs() < 1e-12, "k = {k}, flip {flip:?}, {kind:?}: {b:?}");
                 }
             }
         }

@@ -303,7 +303,7 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: boo
         sw.threads,
         sw.wall_seconds
     );
-    let _ = writeln!(md, "## Validation (time loops only; medians of up to 7 interleaved runs each)\n");
+    let _ = writeln!(md, "## Validation (time loops only; full and reduced: medians of up to 7 interleaved runs each; full dense: one run)\n");
     let _ = writeln!(md, "| load scale | rel_error | max probe error (m) | at | max constraint violation | full (s) | full dense (s) | reduced (s) | speedup | vs dense |");
     let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|");
     for v in &validations {
