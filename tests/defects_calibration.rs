@@ -16,10 +16,11 @@
 //!   nor candidates (0.57, 1.03, 1.41) and outside the range (0.4, 1.6: extrapolated) the
 //!   default estimate of `validate` bounds the true rel_error with effectivity ≤ 30 (the
 //!   issue's coverage and overestimate targets).
-//! - `an_unreliable_calibration_uses_its_largest_ratio_and_warns`: with the file's
-//!   `reliable` set to 0 and `[online] estimate = "defects"` asked for, `online` warns once
-//!   and its whole-run factor is the largest ratio of the last fifth (`defects/factor[4]`),
-//!   not an interpolation.
+//! - `an_unreliable_calibration_uses_its_largest_ratio_and_warns`: with every other
+//!   candidate's ratios made 10× larger (the leave-one-out check fails: a neighbours' mean
+//!   is then below own / 1.5) and `[online] estimate = "defects"` asked for, `online` warns
+//!   once and its whole-run factor is the largest ratio of the last fifth, not an
+//!   interpolation.
 //! - `pipelines_may_still_choose_the_corrected_estimate`: `[online] estimate = "corrected"`
 //!   overrides the default for the same basis file.
 
@@ -133,19 +134,26 @@ fn greedy_calibrates_the_defects_estimate() {
     }
 }
 
-/// A pipeline that asks for `defects` on a basis whose calibration failed its check gets
-/// the largest ratio measured (the whole run's factor is `/estimator/defects/factor[4]`)
-/// and one warning line saying so.
+/// A pipeline that asks for `defects` on a basis whose calibration fails its check gets
+/// the largest ratio measured and one warning line saying so.
 #[test]
 fn an_unreliable_calibration_uses_its_largest_ratio_and_warns() {
     let dir = tempfile::tempdir().unwrap();
     let p = Pipeline::load(setup(dir.path(), "estimate = \"defects\"\n")).unwrap();
     train_and_write(&p, &p.basis_path).unwrap();
+    // ratios that jump by 10× from one candidate to the next fail the leave-one-out check
     let largest = {
         let f = hdf5::File::open_rw(&p.basis_path).unwrap();
         let g = f.group("estimator/defects").unwrap();
-        g.attr("reliable").unwrap().write_scalar(&0u64).unwrap();
-        g.dataset("factor").unwrap().read_1d::<f64>().unwrap()[4]
+        let mut ratio = g.dataset("ratio").unwrap().read_2d::<f64>().unwrap();
+        for (j, mut row) in ratio.rows_mut().into_iter().enumerate() {
+            if j % 2 == 1 {
+                row.mapv_inplace(|x| 10.0 * x);
+            }
+        }
+        g.unlink("ratio").unwrap();
+        g.new_dataset_builder().with_data(&ratio).create("ratio").unwrap();
+        ratio.column(4).iter().copied().fold(f64::NAN, f64::max)
     };
     let out = dir.path().join("run.h5");
     let o = std::process::Command::new(env!("CARGO_BIN_EXE_flexrom"))

@@ -11,7 +11,8 @@
 //! /estimator/calibration/load_scale, raw_estimate, rel_error   (m) held-out calibration pairs
 //! /estimator/defects/load_scale (N), ratio (N, 5), factor (5)   the defects method's
 //!                                          calibration (greedy training only; `DefectsCalibration`);
-//!   attribute on /estimator/defects: reliable (1: its leave-one-out check passed)
+//!   attribute on /estimator/defects: reliable (1: its leave-one-out check passed); factor and
+//!   reliable follow from load_scale and ratio and are recomputed when read
 //!   attributes on /estimator: method ("enriched"), extra_modes (k), factor (c),
 //!   calibrated (1: c from calibration pairs, 0: the default), n_modes (r⁺)
 //! /training/range             (2)          [min, max] training load scale (greedy training;
@@ -192,8 +193,8 @@ pub fn read_estimator(path: &Path, basis: &Basis) -> Result<Option<Estimator>> {
     }))
 }
 
-/// `/estimator/defects`: the loads, their ratios (N × 5) and the five factors, which must
-/// be positive and finite.
+/// `/estimator/defects`: the loads (finite, increasing) and their ratios (N × 5); the
+/// factors and the check's outcome are derived from them, as training derived them.
 fn read_defects(dg: &hdf5::Group, field: &dyn Fn(&str, String) -> Error) -> Result<DefectsCalibration> {
     let load_scales = dg
         .dataset("load_scale")
@@ -216,30 +217,10 @@ fn read_defects(dg: &hdf5::Group, field: &dyn Fn(&str, String) -> Error) -> Resu
             format!("is {:?}; expected ({}, 5), a row per load of defects/load_scale", ratio.dim(), load_scales.len()),
         ));
     }
-    let f = dg
-        .dataset("factor")
-        .and_then(|d| d.read_1d::<f64>())
-        .map_err(|e| field("defects/factor", format!("cannot be read: {e}")))?;
-    let factors: [f64; 5] = f
-        .as_slice()
-        .and_then(|s| s.try_into().ok())
-        .ok_or_else(|| field("defects/factor", format!("has {} entries; expected 5", f.len())))?;
-    if let Some(bad) = factors.iter().find(|x| !(x.is_finite() && **x > 0.0)) {
-        return Err(field("defects/factor", format!("holds {bad}; every factor must be positive and finite")));
-    }
     let ratios = ratio.rows().into_iter().map(|r| [r[0], r[1], r[2], r[3], r[4]]).collect();
-    let reliable = dg
-        .attr("reliable")
-        .and_then(|a| a.read_scalar::<u64>())
-        .map_err(|e| field("defects/reliable", format!("cannot be read: {e}")))?
-        != 0;
-    if reliable && load_scales.len() < 3 {
-        return Err(field(
-            "defects/reliable",
-            format!("is 1 with {} load(s); the check it records needs at least 3", load_scales.len()),
-        ));
-    }
-    Ok(DefectsCalibration { load_scales, ratios, factors, reliable })
+    // `factor` and `reliable` follow from the ratios; the file carries them for its readers
+    DefectsCalibration::new(load_scales, ratios)
+        .ok_or_else(|| field("defects/ratio", "has a fifth of the run without one positive, finite ratio".into()))
 }
 
 /// `[min, max]` of the training load scales: `/training/range` when present (greedy

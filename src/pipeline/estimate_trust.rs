@@ -4,7 +4,7 @@
 //! [`super::estimate`], which re-exports everything here (the struct [`Estimate`] too).
 
 use crate::error::Result;
-use crate::reduction::estimator::Estimator;
+use crate::reduction::estimator::{EstimateMethod, Estimator};
 
 /// One estimate.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -53,20 +53,10 @@ pub fn load_trust(
     use crate::solver::model::ParametricModel;
     let mut estimator = read_estimator(path, &stored.basis)?;
     if let Some(e) = &mut estimator {
-        // the pipeline's choice, else the cheap method where training calibrated it and its
-        // calibration passed the leave-one-out check (`DefectsCalibration`)
-        e.method = p.file.online.as_ref().and_then(|o| o.estimate).unwrap_or(
-            if e.defects.as_ref().is_some_and(|d| d.reliable) {
-                crate::reduction::estimator::EstimateMethod::Defects
-            } else {
-                crate::reduction::estimator::EstimateMethod::Corrected
-            },
-        );
+        e.method = p.file.online.as_ref().and_then(|o| o.estimate).unwrap_or(e.default_method());
     }
     if let Some(e) = &estimator {
-        if e.method == crate::reduction::estimator::EstimateMethod::Defects
-            && e.defects.as_ref().is_some_and(|d| !d.reliable)
-        {
+        if e.method == EstimateMethod::Defects && e.defects.as_ref().is_some_and(|d| !d.reliable) {
             eprintln!(
                 "warning: {}: [online] estimate = \"defects\" on a basis whose defects calibration failed its check between the candidate loads (docs/error-estimate.md): the estimate uses the largest ratio measured and may read far above the error; \"corrected\" is the tighter choice here",
                 p.path.display()

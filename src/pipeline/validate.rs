@@ -125,11 +125,12 @@ pub fn compare(
         max_probe_error_probe: pe_name,
         max_probe_error_t: pe_t,
         max_constraint_violation: viol,
-        full_seconds: full.wall_seconds,
+        // set by with_timings below
+        full_seconds: f64::NAN,
         full_dense_seconds: dense_seconds,
-        rom_seconds: r.wall_seconds,
-        speedup: full.wall_seconds / r.wall_seconds,
-        speedup_vs_dense: dense_seconds.map(|d| d / r.wall_seconds),
+        rom_seconds: f64::NAN,
+        speedup: f64::NAN,
+        speedup_vs_dense: None,
         full_newton_iterations: full.stats.newton_iterations,
         rom_newton_iterations: r.stats.newton_iterations,
         rom_step_cuts: r.stats.step_cuts,
@@ -147,6 +148,7 @@ pub fn compare(
         rel_error_by_time: rel_error_by_time(&r.q, &full.q),
         error_estimate_by_time: None,
     }
+    .with_timings(full.wall_seconds, r.wall_seconds)
 }
 
 /// The earliest start of a step that one run halved and the other did not, from the two
@@ -187,6 +189,16 @@ fn median(x: &mut [f64]) -> f64 {
 }
 
 impl Validation {
+    /// The time loops' seconds and the speedups derived from them (against the dense run
+    /// too, when it was timed).
+    pub fn with_timings(mut self, full_seconds: f64, rom_seconds: f64) -> Self {
+        self.full_seconds = full_seconds;
+        self.rom_seconds = rom_seconds;
+        self.speedup = full_seconds / rom_seconds;
+        self.speedup_vs_dense = self.full_dense_seconds.map(|d| d / rom_seconds);
+        self
+    }
+
     /// Adds the estimate and the extrapolation flag of a run.
     pub fn with_trust(mut self, estimate: Option<&super::estimate::Estimate>, trust: Option<&TrustInfo>) -> Self {
         if let Some(e) = estimate {
@@ -250,11 +262,8 @@ pub fn validate_with(
         rom_times.push(again.result.wall_seconds);
     }
     let mut v = compare(model, &full, &rom, dense, basis.n_reduced(), basis.variant.name())
-        .with_trust(estimate.as_ref(), trust);
-    v.full_seconds = median(&mut full_times);
-    v.rom_seconds = median(&mut rom_times);
-    v.speedup = v.full_seconds / v.rom_seconds;
-    v.speedup_vs_dense = dense.map(|d| d / v.rom_seconds);
+        .with_trust(estimate.as_ref(), trust)
+        .with_timings(median(&mut full_times), median(&mut rom_times));
     let norm = full.q.mapv(|x| x * x).sum().sqrt();
     v.sensitivity = Some((&nearby.q - &full.q).mapv(|x| x * x).sum().sqrt() / norm);
     Ok((v, full, rom))

@@ -133,6 +133,18 @@ fn leave_one_out(ratios: &[[f64; 5]]) -> bool {
     })
 }
 
+impl Estimator {
+    /// The online method when the pipeline names none: `defects` where greedy training
+    /// calibrated it and the calibration passed its check, else `corrected`.
+    pub fn default_method(&self) -> EstimateMethod {
+        if self.defects.as_ref().is_some_and(|d| d.reliable) {
+            EstimateMethod::Defects
+        } else {
+            EstimateMethod::Corrected
+        }
+    }
+}
+
 /// One held-out load: the raw estimate of a basis there and its true `rel_error`.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct CalibrationPoint {
