@@ -142,6 +142,9 @@ fn a_failed_run_keeps_the_previous_good_result() {
         .unwrap();
     assert!(!o.status.success());
     assert_eq!(std::fs::read(&out).unwrap(), b"previous good data");
+    // the result file begun beside the run (src/io/result_file.rs) is gone with it
+    let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert_eq!(left, ["keep.h5"], "only the previous result is left");
 }
 
 #[test]

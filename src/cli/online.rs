@@ -2,7 +2,7 @@
 
 use super::{check_scale, print_table, run_details, FormatArgs};
 use flexrom::io::output::{check_output, Origin};
-use flexrom::io::result_file::write_result_with;
+use flexrom::io::result_file::begin_alongside;
 use flexrom::output::info;
 use flexrom::output::table::{Cell, Table};
 use flexrom::pipeline::online::load_basis;
@@ -46,12 +46,16 @@ impl Args {
         let trust = flexrom::pipeline::estimate::load_trust(&p, &path, &stored)?;
         let mut runner =
             flexrom::pipeline::estimate::EstimatingRunner::new(&p.model, &stored.basis, trust.estimator.as_ref())?;
-        let (run, estimate) = runner
-            .run(load_scale, flexrom::pipeline::online::Output::Full)
-            .map_err(|e| e.at_stage("online", load_scale))?;
+        // the result file's fixed part is written on a second thread while the run computes
+        let (file, (run, estimate)) =
+            begin_alongside(&output, &p.model.text, &p.model.path.display().to_string(), || {
+                runner
+                    .run(load_scale, flexrom::pipeline::online::Output::Full)
+                    .map_err(|e| e.at_stage("online", load_scale))
+            })?;
         let extrapolated = flexrom::pipeline::estimate::is_extrapolated(trust.range, load_scale);
         let basis_name = path.display().to_string();
-        write_result_with(&output, &run.result, |f| {
+        file.finish(&run.result, |f| {
             let e = |err: hdf5::Error| flexrom::Error::hdf5(&output, err);
             flexrom::io::result_file::write_reduced(f, &run.reduced_q).map_err(e)?;
             flexrom::io::h5::attr_str(f, "basis", &basis_name).map_err(e)?;

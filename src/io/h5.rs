@@ -10,19 +10,57 @@ use std::path::Path;
 /// `fsync`ed ([`super::atomic`]). A failed run never leaves a half-written file nor destroys a
 /// previous good one; a missing folder is created.
 pub fn write_atomically(path: &Path, fill: impl FnOnce(&hdf5::File) -> Result<()>) -> Result<()> {
-    super::atomic::write_file_atomically(path, |tmp| {
+    let staged = StagedFile::create(path)?;
+    fill(staged.file()).map_err(shorten)?;
+    staged.commit()
+}
+
+/// An HDF5 file written atomically in stages, [`write_atomically`] cut in two:
+/// [`StagedFile::create`] makes the temporary file beside `path`, [`StagedFile::commit`]
+/// closes it and moves it into place (`fdatasync`, rename, folder `fsync`). Dropped
+/// without a commit, the temporary file is closed and removed. Between the two the file
+/// may move to another thread (a result file's fixed part is written beside the run,
+/// [`super::result_file::begin_alongside`]).
+pub struct StagedFile {
+    // declared first, dropped first: the file is closed before its temporary is removed
+    file: hdf5::File,
+    tmp: super::atomic::TempPath,
+    path: std::path::PathBuf,
+}
+
+impl StagedFile {
+    pub fn create(path: &Path) -> Result<StagedFile> {
+        let tmp = super::atomic::TempPath::file_for(path)?;
         // the empty temporary file is flexrom's own (created exclusively): truncated here
-        let file = hdf5::File::create(tmp).map_err(|e| Error::hdf5(path, format!("cannot create: {e}")))?;
-        fill(&file)?;
-        file.flush().map_err(|e| Error::hdf5(path, e))?;
+        let file = hdf5::File::create(tmp.path()).map_err(|e| Error::hdf5(path, format!("cannot create: {e}")))?;
+        Ok(StagedFile { file, tmp, path: path.to_path_buf() })
+    }
+
+    pub fn file(&self) -> &hdf5::File {
+        &self.file
+    }
+
+    /// The final path (as given to [`Self::create`]).
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Flushes and closes the file, then `fdatasync`s it and renames it over the final path.
+    pub fn commit(self) -> Result<()> {
+        let StagedFile { file, tmp, path } = self;
+        file.flush().map_err(|e| shorten(Error::hdf5(&path, e)))?;
         // closed before the fdatasync and the rename (the last handle closes the file)
         drop(file);
-        Ok(())
-    })
-    .map_err(|e| match e {
+        tmp.commit()
+    }
+}
+
+/// [`short_write_error`] on an HDF5 error; other errors as they are.
+pub fn shorten(e: Error) -> Error {
+    match e {
         Error::Hdf5 { file, problem } => Error::Hdf5 { file, problem: short_write_error(&problem) },
         other => other,
-    })
+    }
 }
 
 /// HDF5's write errors span lines (time, temporary file name, buffer address, …); the

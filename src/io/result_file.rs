@@ -15,8 +15,8 @@
 //!   program_version
 //! ```
 
-use super::attrs::{write_atomically_labelled, Kind};
-use super::h5::{attr_f64, attr_str, attr_u64};
+use super::attrs::{annotate_rest, Kind, Labelled};
+use super::h5::{attr_f64, attr_str, attr_u64, shorten, StagedFile};
 use crate::error::{Error, Result};
 use crate::simulate::SimulationResult;
 use std::path::Path;
@@ -34,8 +34,47 @@ pub fn write_result_with(
     r: &SimulationResult,
     extra: impl FnOnce(&hdf5::File) -> Result<()>,
 ) -> Result<()> {
-    write_atomically_labelled(path, Kind::Result, |f, labelled| {
-        let e = |err: hdf5::Error| Error::hdf5(path, err);
+    ResultFile::begin(path, &r.model_text, &r.model_path)?.finish(r, extra)
+}
+
+/// A result file in the making: its fixed part, which depends on the model alone, is
+/// written by [`ResultFile::begin`] (HDF5's start-up, the temporary file, the model's text
+/// and the `/labels` of its coordinates); [`ResultFile::finish`] adds the run and moves
+/// the file into place. Dropped unfinished, the temporary file is removed.
+pub struct ResultFile {
+    staged: StagedFile,
+    labelled: Labelled,
+    model_text: String,
+    model_path: String,
+}
+
+impl ResultFile {
+    pub fn begin(path: &Path, model_text: &str, model_path: &str) -> Result<ResultFile> {
+        let staged = StagedFile::create(path)?;
+        let mut labelled = Labelled::new(Kind::Result);
+        let f = staged.file();
+        let e = |err: hdf5::Error| shorten(Error::hdf5(path, err));
+        attr_str(f, "model", model_text).map_err(e)?;
+        attr_str(f, "model_path", model_path).map_err(e)?;
+        attr_str(f, "program_version", env!("CARGO_PKG_VERSION")).map_err(e)?;
+        super::labels::write_labels_of_text_labelled(f, model_text, model_path, Some(&mut labelled)).map_err(e)?;
+        Ok(ResultFile { staged, labelled, model_text: model_text.to_string(), model_path: model_path.to_string() })
+    }
+
+    /// Writes the run `r` (of the model the file was begun with), then `extra`, labels the
+    /// datasets left, and commits the file (`fdatasync`, rename, folder `fsync`).
+    pub fn finish(self, r: &SimulationResult, extra: impl FnOnce(&hdf5::File) -> Result<()>) -> Result<()> {
+        let ResultFile { staged, mut labelled, model_text, model_path } = self;
+        let path = staged.path().to_path_buf();
+        if r.model_text != model_text || r.model_path != model_path {
+            return Err(Error::Usage(format!(
+                "internal: the result file {} was begun for the model {model_path}, not for the run's {}",
+                path.display(),
+                r.model_path
+            )));
+        }
+        let f = staged.file();
+        let e = |err: hdf5::Error| shorten(Error::hdf5(&path, err));
         // each dataset labelled (units, dims) as it is created
         let d = f.new_dataset_builder().with_data(&r.t).create("t").map_err(e)?;
         labelled.label("t", &d).map_err(e)?;
@@ -48,8 +87,6 @@ pub fn write_result_with(
             labelled.label(&format!("probes/{name}"), &d).map_err(e)?;
         }
         let s = &r.settings;
-        attr_str(f, "model", &r.model_text).map_err(e)?;
-        attr_str(f, "model_path", &r.model_path).map_err(e)?;
         attr_f64(f, "load_scale", s.load_scale).map_err(e)?;
         attr_f64(f, "dt", s.dt).map_err(e)?;
         attr_f64(f, "t_end", s.t_end).map_err(e)?;
@@ -62,9 +99,35 @@ pub fn write_result_with(
         attr_u64(f, "max_iterations_in_a_step", r.stats.max_iterations_in_a_step as u64).map_err(e)?;
         attr_u64(f, "steps_at_round_off", r.stats.steps_at_round_off as u64).map_err(e)?;
         attr_f64(f, "wall_seconds", r.wall_seconds).map_err(e)?;
-        attr_str(f, "program_version", env!("CARGO_PKG_VERSION")).map_err(e)?;
-        super::labels::write_labels_of_text_labelled(f, &r.model_text, &r.model_path, Some(labelled)).map_err(e)?;
-        extra(f)
+        extra(f).map_err(shorten)?;
+        annotate_rest(f, &labelled).map_err(e)?;
+        staged.commit()
+    }
+}
+
+/// Runs `run` on this thread while [`ResultFile::begin`] writes the result file's fixed
+/// part on a second one, so that the run's wall time hides it (HDF5's start-up and the
+/// labels are about 1.4 ms of a 12 ms pendulum `simulate`, docs/process-speed.md). Both
+/// are waited for; the run's error comes first, and the begun file is then removed. Where
+/// no thread can be started, the two run one after the other.
+pub fn begin_alongside<T>(
+    path: &Path,
+    model_text: &str,
+    model_path: &str,
+    run: impl FnOnce() -> Result<T>,
+) -> Result<(ResultFile, T)> {
+    std::thread::scope(|s| {
+        let begun = std::thread::Builder::new()
+            .name("flexrom-result-file".into())
+            .spawn_scoped(s, || ResultFile::begin(path, model_text, model_path));
+        let out = run();
+        let file = begun.ok().map(|h| h.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)));
+        let out = out?;
+        let file = match file {
+            Some(file) => file?,
+            None => ResultFile::begin(path, model_text, model_path)?,
+        };
+        Ok((file, out))
     })
 }
 
@@ -129,6 +192,66 @@ pub fn write_reduced(f: &hdf5::File, zq: &ndarray::Array2<f64>) -> hdf5::Result<
 
 #[cfg(test)]
 mod tests {
+    use crate::error::Error;
+
+    fn entries(d: &std::path::Path) -> Vec<String> {
+        let mut v: Vec<String> =
+            std::fs::read_dir(d).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        v.sort();
+        v
+    }
+
+    /// The file begun beside a run that fails is removed, and the previous file is kept;
+    /// beside a run that succeeds it holds the model's fixed part once finished; finished
+    /// with another model's run it is refused and removed.
+    #[test]
+    fn a_file_begun_beside_a_run_goes_with_a_failed_run() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("r.h5");
+        std::fs::write(&out, b"previous").unwrap();
+        let failed = super::begin_alongside(&out, "text = 1", "m.toml", || -> crate::Result<()> {
+            Err(Error::Usage("the run failed".into()))
+        });
+        assert!(matches!(failed, Err(Error::Usage(m)) if m == "the run failed"));
+        assert_eq!(entries(dir.path()), ["r.h5"]);
+        assert_eq!(std::fs::read(&out).unwrap(), b"previous");
+
+        let (file, v) = super::begin_alongside(&out, "text = 1", "m.toml", || Ok(7)).unwrap();
+        assert_eq!(v, 7);
+        // a temporary file beside the target until finished
+        assert_eq!(entries(dir.path()).len(), 2);
+        let r = crate::simulate::SimulationResult {
+            model_text: "other = 2".into(),
+            model_path: "m.toml".into(),
+            settings: crate::simulate::Settings::resolve(
+                &crate::model::Model::from_text(
+                    "[time]\nt_end = 0.1\ndt = 0.1\nrho_inf = 1.0\n[[bodies]]\nname = \"b\"\nstart = [0.0, 0.0]\nangle = 0.0\nlength = 1.0\nelements = 1\ndensity = 1.0\narea = 1.0\ninertia = 1.0\nyoungs_modulus = 1.0\n",
+                    "m.toml",
+                )
+                .unwrap(),
+                &Default::default(),
+            )
+            .unwrap(),
+            t: ndarray::Array1::zeros(1),
+            q: ndarray::Array2::zeros((8, 1)),
+            multipliers: ndarray::Array2::zeros((0, 1)),
+            probes: vec![],
+            stats: Default::default(),
+            wall_seconds: 0.0,
+        };
+        let refused = file.finish(&r, |_| Ok(()));
+        assert!(matches!(&refused, Err(Error::Usage(m)) if m.contains("internal")), "{refused:?}");
+        assert_eq!(entries(dir.path()), ["r.h5"]);
+        assert_eq!(std::fs::read(&out).unwrap(), b"previous");
+
+        let (file, ()) = super::begin_alongside(&out, "other = 2", "m.toml", || Ok(())).unwrap();
+        file.finish(&r, |_| Ok(())).unwrap();
+        assert_eq!(entries(dir.path()), ["r.h5"]);
+        let f = hdf5::File::open(&out).unwrap();
+        assert_eq!(crate::io::h5::read_attr_str(&f, "model").unwrap(), "other = 2");
+        assert_eq!(f.dataset("q").unwrap().shape(), [1, 8]);
+    }
+
     /// Blocks of 3 instants (the last one short) and one block give the transpose, from a
     /// row-major matrix and from a column-major one.
     #[test]
