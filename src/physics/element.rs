@@ -51,19 +51,24 @@ fn kron_i2(b: &[[f64; 4]; 4]) -> Mat8 {
     m
 }
 
-/// `(B ⊗ I₂) e` for a 4×4 scalar block `B`: x and y components separately, 32
-/// multiply-adds instead of 64.
-#[inline]
-fn kron_i2_mul(b: &[[f64; 4]; 4], e: &Vec8) -> Vec8 {
-    let mut out = Vec8::zeros();
-    for i in 0..4 {
-        let (mut sx, mut sy) = (0.0, 0.0);
-        for j in 0..4 {
-            sx += b[i][j] * e[2 * j];
-            sy += b[i][j] * e[2 * j + 1];
+/// A 4×4 scalar block `B` laid out for `(B ⊗ I₂) e` in 8-wide vector arithmetic: column
+/// `j` of `B`, each entry twice (`[B₀ⱼ, B₀ⱼ, B₁ⱼ, B₁ⱼ, B₂ⱼ, B₂ⱼ, B₃ⱼ, B₃ⱼ]`).
+type KronCols = [[f64; 8]; 4];
+
+fn kron_cols(b: &[[f64; 4]; 4]) -> KronCols {
+    std::array::from_fn(|j| std::array::from_fn(|k| b[k / 2][j]))
+}
+
+/// `(B ⊗ I₂) e`: x and y components separately, 32 multiply-adds instead of 64, as four
+/// 8-wide multiply-adds (column j of `B` times the pair `(e_{2j}, e_{2j+1})`). Entry `2i + c`
+/// sums `B_ij e_{2j+c}` over j = 0..3 from zero, in that order.
+#[inline(always)]
+fn kron_i2_mul(b: &KronCols, e: &[f64; 8]) -> [f64; 8] {
+    let mut out = [0.0; 8];
+    for (j, col) in b.iter().enumerate() {
+        for k in 0..8 {
+            out[k] += col[k] * e[2 * j + (k & 1)];
         }
-        out[2 * i] = sx;
-        out[2 * i + 1] = sy;
     }
     out
 }
@@ -79,10 +84,12 @@ pub fn shape_functions(xi: f64, l: f64) -> [f64; 4] {
 pub struct BeamElement {
     pub length: f64,
     pub section: Section,
-    /// scalar 4×4 blocks of `S_l`, `M` and `K_t` (kept for the fast products `B ⊗ I₂ e`)
+    /// scalar 4×4 block of `S_l`
     sl: [[f64; 4]; 4],
-    mass4: [[f64; 4]; 4],
-    bending4: [[f64; 4]; 4],
+    /// `S_l`, `M` and `K_t` laid out for the fast products `(B ⊗ I₂) e`
+    sl_cols: KronCols,
+    mass_cols: KronCols,
+    bending_cols: KronCols,
     mass: Mat8,
     bending: Mat8,
     axial: Mat8,
@@ -116,8 +123,9 @@ impl BeamElement {
             length,
             section,
             sl,
-            mass4: mass,
-            bending4: bending,
+            sl_cols: kron_cols(&sl),
+            mass_cols: kron_cols(&mass),
+            bending_cols: kron_cols(&bending),
             mass: kron_i2(&mass),
             bending: kron_i2(&bending),
             axial: kron_i2(&sl),
@@ -142,13 +150,13 @@ impl BeamElement {
     /// `S_l e`, using the ⊗ I₂ structure (32 multiply-adds instead of 64).
     #[inline]
     pub fn axial_product(&self, e: &Vec8) -> Vec8 {
-        kron_i2_mul(&self.sl, e)
+        Vec8::from(kron_i2_mul(&self.sl_cols, &(*e).into()))
     }
 
     /// `M a`, using the ⊗ I₂ structure.
     #[inline]
     pub fn mass_product(&self, a: &Vec8) -> Vec8 {
-        kron_i2_mul(&self.mass4, a)
+        Vec8::from(kron_i2_mul(&self.mass_cols, &(*a).into()))
     }
 
     /// The element block of the Newton iteration matrix `m M + c C + k K_T(e)` from its
@@ -200,9 +208,24 @@ impl BeamElement {
 
     /// Elastic force `Q_e = K_t e + EA ε̄ S_l e` (thesis eq. 7).
     pub fn elastic_force(&self, e: &Vec8) -> Vec8 {
-        let sle = self.axial_product(e);
-        let eps = e.dot(&sle) / (2.0 * self.length) - 0.5;
-        kron_i2_mul(&self.bending4, e) + sle * (self.section.ea() * eps)
+        Vec8::from(self.elastic(&(*e).into()))
+    }
+
+    #[inline(always)]
+    fn elastic(&self, e: &[f64; 8]) -> [f64; 8] {
+        let sle = kron_i2_mul(&self.sl_cols, e);
+        let eps = Vec8::from(*e).dot(&Vec8::from(sle)) / (2.0 * self.length) - 0.5;
+        let s = self.section.ea() * eps;
+        let kb = kron_i2_mul(&self.bending_cols, e);
+        std::array::from_fn(|k| kb[k] + sle[k] * s)
+    }
+
+    /// The elastic force `Q_e = K_t e + EA ε̄ S_l e` and the inertia `M a` of the element in
+    /// one pass, on plain arrays (the residual's loop over the elements,
+    /// `FlexibleSystem::force_and_inertia`).
+    #[inline(always)]
+    pub fn force_and_inertia(&self, e: &[f64; 8], a: &[f64; 8]) -> ([f64; 8], [f64; 8]) {
+        (self.elastic(e), kron_i2_mul(&self.mass_cols, a))
     }
 
     /// Exact tangent `K_T = K_t + EA ε̄ S_l + (EA/l)(S_l e)(S_l e)ᵀ` alone (the Newton matrix

@@ -75,6 +75,7 @@ impl FlexibleSystem {
             first_node.push(node);
             prototypes.push(BeamElement::new(body.length / body.n_elements as f64, body.section));
             for k in 0..body.n_elements {
+                // 8 consecutive dofs: the residual's loop reads an element's as one slice
                 let d0 = 4 * (node + k);
                 elements.push((b, std::array::from_fn(|i| d0 + i)));
             }

@@ -239,8 +239,7 @@ impl GeneralizedAlpha {
         for it in 1..=self.params.max_iterations {
             self.stats.newton_iterations += 1;
             // residual r_q = M q̈ + g + Bᵀλ, r_c = B q − b
-            model.mass_mul(&st.qdd, &mut self.work);
-            model.force(&st.q, &st.v, t, &mut self.rhs[..n]);
+            model.force_and_inertia(&st.q, &st.v, &st.qdd, t, &mut self.rhs[..n], &mut self.work);
             for i in 0..n {
                 self.rhs[i] += self.work[i];
             }
