@@ -2,11 +2,11 @@
 
 use super::{print_table, run_details, FormatArgs};
 use flexrom::io::output::{check_output, Origin};
-use flexrom::io::result_file::begin_alongside;
+use flexrom::io::result_file::{begin_alongside, RunShape};
 use flexrom::linalg::kkt::LinearSolverKind;
 use flexrom::model::Model;
 use flexrom::output::info;
-use flexrom::simulate::{simulate, Overrides};
+use flexrom::simulate::{simulate, Overrides, Settings};
 use std::path::PathBuf;
 
 /// The arguments of `flexrom simulate`.
@@ -28,9 +28,11 @@ impl Args {
         let Args { model, output, run, format } = self;
         check_output(&output, Origin::Flag("-o"), &[(&model, "model file")])?;
         let model = Model::load(&model)?;
+        let overrides = run.overrides();
+        let shape = RunShape::of(&model, Settings::resolve(&model, &overrides)?.n_steps);
         // the result file's fixed part is written on a second thread while the run computes
-        let (file, r) = begin_alongside(&output, &model.text, &model.path.display().to_string(), || {
-            simulate(&model, &run.overrides()).map_err(|e| e.at_stage("simulate", run.load_scale.unwrap_or(1.0)))
+        let (file, r) = begin_alongside(&output, &model.text, &model.path.display().to_string(), &shape, || {
+            simulate(&model, &overrides).map_err(|e| e.at_stage("simulate", run.load_scale.unwrap_or(1.0)))
         })?;
         file.finish(&r, |_| Ok(()))?;
         info(&format!(

@@ -34,22 +34,57 @@ pub fn write_result_with(
     r: &SimulationResult,
     extra: impl FnOnce(&hdf5::File) -> Result<()>,
 ) -> Result<()> {
-    ResultFile::begin(path, &r.model_text, &r.model_path)?.finish(r, extra)
+    ResultFile::begin(path, &r.model_text, &r.model_path, &RunShape::of_result(r))?.finish(r, extra)
 }
 
-/// A result file in the making: its fixed part, which depends on the model alone, is
-/// written by [`ResultFile::begin`] (HDF5's start-up, the temporary file, the model's text
-/// and the `/labels` of its coordinates); [`ResultFile::finish`] adds the run and moves
-/// the file into place. Dropped unfinished, the temporary file is removed.
+/// The sizes of a run's arrays, known before it runs: `n_t` instants, `n_dof`
+/// coordinates, `n_c` multipliers, and the probes by name.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunShape {
+    pub n_t: usize,
+    pub n_dof: usize,
+    pub n_c: usize,
+    pub probes: Vec<String>,
+}
+
+impl RunShape {
+    /// The shape of a run of `model` over `n_steps` steps (one instant recorded per step
+    /// and the start, whatever halving a step takes).
+    pub fn of(model: &crate::model::Model, n_steps: usize) -> RunShape {
+        let z = model.sizes();
+        RunShape {
+            n_t: n_steps + 1,
+            n_dof: z.n_dof as usize,
+            n_c: z.n_constraints as usize,
+            probes: model.probe_names(),
+        }
+    }
+
+    pub fn of_result(r: &SimulationResult) -> RunShape {
+        RunShape {
+            n_t: r.t.len(),
+            n_dof: r.q.nrows(),
+            n_c: r.multipliers.nrows(),
+            probes: r.probes.iter().map(|p| p.0.clone()).collect(),
+        }
+    }
+}
+
+/// A result file in the making: its fixed part, which depends on the model and the run's
+/// [`RunShape`] alone, is written by [`ResultFile::begin`] (HDF5's start-up, the temporary
+/// file, the model's text, the `/labels` of its coordinates and the empty, labelled
+/// datasets of the run); [`ResultFile::finish`] fills in the run and moves the file into
+/// place. Dropped unfinished, the temporary file is removed.
 pub struct ResultFile {
     staged: StagedFile,
     labelled: Labelled,
     model_text: String,
     model_path: String,
+    shape: RunShape,
 }
 
 impl ResultFile {
-    pub fn begin(path: &Path, model_text: &str, model_path: &str) -> Result<ResultFile> {
+    pub fn begin(path: &Path, model_text: &str, model_path: &str, shape: &RunShape) -> Result<ResultFile> {
         let staged = StagedFile::create(path)?;
         let mut labelled = Labelled::new(Kind::Result);
         let f = staged.file();
@@ -58,33 +93,48 @@ impl ResultFile {
         attr_str(f, "model_path", model_path).map_err(e)?;
         attr_str(f, "program_version", env!("CARGO_PKG_VERSION")).map_err(e)?;
         super::labels::write_labels_of_text_labelled(f, model_text, model_path, Some(&mut labelled)).map_err(e)?;
-        Ok(ResultFile { staged, labelled, model_text: model_text.to_string(), model_path: model_path.to_string() })
+        // the run's datasets, empty and labelled (units, dims), time first
+        let mut create = |g: &hdf5::Group, path: &str, name: &str, dims: &[usize]| {
+            let d = g.new_dataset::<f64>().shape(dims).create(name)?;
+            labelled.label(path, &d)
+        };
+        create(f, "t", "t", &[shape.n_t]).map_err(e)?;
+        create(f, "q", "q", &[shape.n_t, shape.n_dof]).map_err(e)?;
+        create(f, "multipliers", "multipliers", &[shape.n_t, shape.n_c]).map_err(e)?;
+        let g = f.create_group("probes").map_err(e)?;
+        for name in &shape.probes {
+            create(&g, &format!("probes/{name}"), name, &[shape.n_t, 2]).map_err(e)?;
+        }
+        Ok(ResultFile {
+            staged,
+            labelled,
+            model_text: model_text.to_string(),
+            model_path: model_path.to_string(),
+            shape: shape.clone(),
+        })
     }
 
-    /// Writes the run `r` (of the model the file was begun with), then `extra`, labels the
-    /// datasets left, and commits the file (`fdatasync`, rename, folder `fsync`).
+    /// Writes the run `r` (of the model and shape the file was begun with), then `extra`,
+    /// labels the datasets left, and commits the file (`fdatasync`, rename, folder `fsync`).
     pub fn finish(self, r: &SimulationResult, extra: impl FnOnce(&hdf5::File) -> Result<()>) -> Result<()> {
-        let ResultFile { staged, mut labelled, model_text, model_path } = self;
+        let ResultFile { staged, labelled, model_text, model_path, shape } = self;
         let path = staged.path().to_path_buf();
-        if r.model_text != model_text || r.model_path != model_path {
+        if r.model_text != model_text || r.model_path != model_path || RunShape::of_result(r) != shape {
             return Err(Error::Usage(format!(
-                "internal: the result file {} was begun for the model {model_path}, not for the run's {}",
+                "internal: the result file {} was begun for a run of {model_path} of shape {shape:?}, not for one of {} of shape {:?}",
                 path.display(),
-                r.model_path
+                r.model_path,
+                RunShape::of_result(r)
             )));
         }
         let f = staged.file();
         let e = |err: hdf5::Error| shorten(Error::hdf5(&path, err));
-        // each dataset labelled (units, dims) as it is created
-        let d = f.new_dataset_builder().with_data(&r.t).create("t").map_err(e)?;
-        labelled.label("t", &d).map_err(e)?;
+        f.dataset("t").and_then(|d| d.write(&r.t)).map_err(e)?;
         // time first: the solver's columns (one per instant) become rows
-        labelled.label("q", &write_time_first(f, "q", &r.q).map_err(e)?).map_err(e)?;
-        labelled.label("multipliers", &write_time_first(f, "multipliers", &r.multipliers).map_err(e)?).map_err(e)?;
-        let g = f.create_group("probes").map_err(e)?;
+        fill_time_first(&f.dataset("q").map_err(e)?, &r.q).map_err(e)?;
+        fill_time_first(&f.dataset("multipliers").map_err(e)?, &r.multipliers).map_err(e)?;
         for (name, xy) in &r.probes {
-            let d = g.new_dataset_builder().with_data(xy).create(name.as_str()).map_err(e)?;
-            labelled.label(&format!("probes/{name}"), &d).map_err(e)?;
+            f.dataset(&format!("probes/{name}")).and_then(|d| d.write(xy)).map_err(e)?;
         }
         let s = &r.settings;
         attr_f64(f, "load_scale", s.load_scale).map_err(e)?;
@@ -106,26 +156,27 @@ impl ResultFile {
 }
 
 /// Runs `run` on this thread while [`ResultFile::begin`] writes the result file's fixed
-/// part on a second one, so that the run's wall time hides it (HDF5's start-up and the
-/// labels are about 1.4 ms of a 12 ms pendulum `simulate`, docs/process-speed.md). Both
-/// are waited for; the run's error comes first, and the begun file is then removed. Where
-/// no thread can be started, the two run one after the other.
+/// part on a second one, so that the run's wall time hides it (HDF5's start-up, the
+/// labels and the datasets' creation are about 2 ms of a 12 ms pendulum `simulate`,
+/// docs/process-speed.md). Both are waited for; the run's error comes first, and the begun
+/// file is then removed. Where no thread can be started, the two run one after the other.
 pub fn begin_alongside<T>(
     path: &Path,
     model_text: &str,
     model_path: &str,
+    shape: &RunShape,
     run: impl FnOnce() -> Result<T>,
 ) -> Result<(ResultFile, T)> {
     std::thread::scope(|s| {
         let begun = std::thread::Builder::new()
             .name("flexrom-result-file".into())
-            .spawn_scoped(s, || ResultFile::begin(path, model_text, model_path));
+            .spawn_scoped(s, || ResultFile::begin(path, model_text, model_path, shape));
         let out = run();
         let file = begun.ok().map(|h| h.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)));
         let out = out?;
         let file = match file {
             Some(file) => file?,
-            None => ResultFile::begin(path, model_text, model_path)?,
+            None => ResultFile::begin(path, model_text, model_path, shape)?,
         };
         Ok((file, out))
     })
@@ -138,20 +189,28 @@ const BLOCK_BYTES: usize = 8 << 20;
 /// `name` of shape (n_t, n), time first, transposing a block of instants at a time so that
 /// a large run is not copied whole.
 pub fn write_time_first(g: &hdf5::Group, name: &str, a: &ndarray::Array2<f64>) -> hdf5::Result<hdf5::Dataset> {
-    write_in_blocks(g, name, a, (BLOCK_BYTES / (8 * a.nrows().max(1))).max(1))
+    let (n, nt) = a.dim();
+    let d = g.new_dataset::<f64>().shape((nt, n)).create(name)?;
+    fill_time_first(&d, a)?;
+    Ok(d)
 }
 
-fn write_in_blocks(g: &hdf5::Group, name: &str, a: &ndarray::Array2<f64>, rows: usize) -> hdf5::Result<hdf5::Dataset> {
+/// Fills the dataset `d` of shape (n_t, n) with `a` (n × n_t), time first, a block of
+/// instants at a time ([`BLOCK_BYTES`]).
+fn fill_time_first(d: &hdf5::Dataset, a: &ndarray::Array2<f64>) -> hdf5::Result<()> {
+    fill_in_blocks(d, a, (BLOCK_BYTES / (8 * a.nrows().max(1))).max(1))
+}
+
+fn fill_in_blocks(d: &hdf5::Dataset, a: &ndarray::Array2<f64>, rows: usize) -> hdf5::Result<()> {
     let (n, nt) = a.dim();
     if n == 0 || nt == 0 {
-        return g.new_dataset_builder().with_data(&a.t().as_standard_layout()).create(name);
+        return Ok(());
     }
-    let d = g.new_dataset::<f64>().shape((nt, n)).create(name)?;
     for start in (0..nt).step_by(rows) {
         let end = (start + rows).min(nt);
         d.write_slice(&transposed(a, start, end), ndarray::s![start..end, ..])?;
     }
-    Ok(d)
+    Ok(())
 }
 
 /// Columns `start..end` of `a` as rows: `out[(k − start, i)] = a[(i, k)]`. Eight rows of `a`
@@ -202,21 +261,22 @@ mod tests {
     }
 
     /// The file begun beside a run that fails is removed, and the previous file is kept;
-    /// beside a run that succeeds it holds the model's fixed part once finished; finished
-    /// with another model's run it is refused and removed.
+    /// beside a run that succeeds it holds the run once finished; finished with another
+    /// model's run, or a run of another shape, it is refused and removed.
     #[test]
     fn a_file_begun_beside_a_run_goes_with_a_failed_run() {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("r.h5");
         std::fs::write(&out, b"previous").unwrap();
-        let failed = super::begin_alongside(&out, "text = 1", "m.toml", || -> crate::Result<()> {
+        let shape = super::RunShape { n_t: 1, n_dof: 8, n_c: 0, probes: vec![] };
+        let failed = super::begin_alongside(&out, "text = 1", "m.toml", &shape, || -> crate::Result<()> {
             Err(Error::Usage("the run failed".into()))
         });
         assert!(matches!(failed, Err(Error::Usage(m)) if m == "the run failed"));
         assert_eq!(entries(dir.path()), ["r.h5"]);
         assert_eq!(std::fs::read(&out).unwrap(), b"previous");
 
-        let (file, v) = super::begin_alongside(&out, "text = 1", "m.toml", || Ok(7)).unwrap();
+        let (file, v) = super::begin_alongside(&out, "text = 1", "m.toml", &shape, || Ok(7)).unwrap();
         assert_eq!(v, 7);
         // a temporary file beside the target until finished
         assert_eq!(entries(dir.path()).len(), 2);
@@ -244,7 +304,12 @@ mod tests {
         assert_eq!(entries(dir.path()), ["r.h5"]);
         assert_eq!(std::fs::read(&out).unwrap(), b"previous");
 
-        let (file, ()) = super::begin_alongside(&out, "other = 2", "m.toml", || Ok(())).unwrap();
+        // the right model, the wrong shape
+        let wrong = super::RunShape { n_t: 2, ..shape.clone() };
+        let (file, ()) = super::begin_alongside(&out, "other = 2", "m.toml", &wrong, || Ok(())).unwrap();
+        assert!(matches!(file.finish(&r, |_| Ok(())), Err(Error::Usage(m)) if m.contains("internal")));
+        assert_eq!(entries(dir.path()), ["r.h5"]);
+        let (file, ()) = super::begin_alongside(&out, "other = 2", "m.toml", &shape, || Ok(())).unwrap();
         file.finish(&r, |_| Ok(())).unwrap();
         assert_eq!(entries(dir.path()), ["r.h5"]);
         let f = hdf5::File::open(&out).unwrap();
@@ -259,13 +324,17 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let f = hdf5::File::create(dir.path().join("t.h5")).unwrap();
         let a = ndarray::Array2::from_shape_fn((4, 10), |(i, k)| (10 * i + k) as f64);
-        super::write_in_blocks(&f, "blocks", &a, 3).unwrap();
+        let blocks = |name: &str, a: &ndarray::Array2<f64>| {
+            let d = f.new_dataset::<f64>().shape((a.ncols(), a.nrows())).create(name).unwrap();
+            super::fill_in_blocks(&d, a, 3).unwrap();
+        };
+        blocks("blocks", &a);
         super::write_time_first(&f, "whole", &a).unwrap();
         // a matrix in column-major order takes the other branch of the transposition
         let fortran = a.t().as_standard_layout().into_owned().reversed_axes();
         assert_eq!(fortran, a);
         assert!(fortran.as_slice().is_none());
-        super::write_in_blocks(&f, "fortran", &fortran, 3).unwrap();
+        blocks("fortran", &fortran);
         for name in ["blocks", "whole", "fortran"] {
             assert_eq!(f.dataset(name).unwrap().read_2d::<f64>().unwrap(), a.t(), "{name}");
         }
