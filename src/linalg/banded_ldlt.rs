@@ -144,14 +144,37 @@ impl BandedLdlt {
         self.state == Factored::Lu
     }
 
+    /// Assembles and factors; with `check`, blocks that are not symmetric (to the bit, or
+    /// else within [`SYMMETRY_TOL`]) go to the LU, without it they are taken as symmetric
+    /// ([`KktSolver::factor_symmetric`]).
+    fn factor_checked(&mut self, blocks: &[Block], scale: f64, check: bool) -> Result<(), String> {
+        self.state = Factored::No;
+        // assembled first: the bit-exact symmetry check comes with it, the tolerant one only
+        // when some block fails that
+        let exact = self.scatter(blocks, scale, check);
+        if exact || symmetric(blocks) {
+            let cons_min = PIVOT_RATIO * scale.abs();
+            if band_ldlt(&mut self.ab, self.n, self.band, &self.is_dof, cons_min, &mut self.diag) {
+                self.state = Factored::Ldlt;
+                return Ok(());
+            }
+        }
+        self.lu_fallbacks += 1;
+        self.fallback.factor(blocks, scale)?;
+        self.state = Factored::Lu;
+        Ok(())
+    }
+
     /// Assembles the lower band of `[Σ P_eᵀ blocks[e] P_e, s Bᵀ; s B, 0]` (new numbering)
     /// into `ab`; returns whether every block is symmetric to the bit (checked in the same
-    /// pass, while each block is at hand).
-    fn scatter(&mut self, blocks: &[Block], scale: f64) -> bool {
+    /// pass, while each block is at hand, when `check`; else taken to be).
+    fn scatter(&mut self, blocks: &[Block], scale: f64, check: bool) -> bool {
         self.ab.iter_mut().for_each(|v| *v = 0.0);
         let mut exact = true;
         for (block, range) in blocks.iter().zip(self.elem_start.windows(2)) {
-            exact &= exactly_symmetric(block);
+            if check {
+                exact &= exactly_symmetric(block);
+            }
             let b = block.as_slice();
             for &(k, s) in &self.elem[range[0]..range[1]] {
                 self.ab[s] += b[k as usize];
@@ -193,21 +216,12 @@ fn symmetric(blocks: &[Block]) -> bool {
 
 impl KktSolver for BandedLdlt {
     fn factor(&mut self, blocks: &[Block], scale: f64) -> Result<(), String> {
-        self.state = Factored::No;
-        // assembled first: the bit-exact symmetry check comes with it, the tolerant one only
-        // when some block fails that
-        let exact = self.scatter(blocks, scale);
-        if exact || symmetric(blocks) {
-            let cons_min = PIVOT_RATIO * scale.abs();
-            if band_ldlt(&mut self.ab, self.n, self.band, &self.is_dof, cons_min, &mut self.diag) {
-                self.state = Factored::Ldlt;
-                return Ok(());
-            }
-        }
-        self.lu_fallbacks += 1;
-        self.fallback.factor(blocks, scale)?;
-        self.state = Factored::Lu;
-        Ok(())
+        self.factor_checked(blocks, scale, true)
+    }
+
+    fn factor_symmetric(&mut self, blocks: &[Block], scale: f64) -> Result<(), String> {
+        debug_assert!(blocks.iter().all(exactly_symmetric), "blocks said symmetric are not");
+        self.factor_checked(blocks, scale, false)
     }
 
     fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {

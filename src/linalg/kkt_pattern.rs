@@ -86,6 +86,12 @@ impl SlotMap {
 pub trait KktSolver: Send + Sync {
     /// Assembles `[Σ P_eᵀ blocks[e] P_e, s Bᵀ; s B, 0]` and factors it.
     fn factor(&mut self, blocks: &[Block], scale: f64) -> Result<(), String>;
+    /// [`Self::factor`] of blocks their builder made symmetric to the bit (each entry and
+    /// its mirror computed by the same operations), so that a solver that would check the
+    /// symmetry need not; the default is [`Self::factor`].
+    fn factor_symmetric(&mut self, blocks: &[Block], scale: f64) -> Result<(), String> {
+        self.factor(blocks, scale)
+    }
     /// Solves in place with the last factorization; `rhs` has `n_dof + n_c` entries.
     fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String>;
 }

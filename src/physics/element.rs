@@ -172,12 +172,26 @@ impl BeamElement {
 
     /// [`Self::iteration_block`] written into `out` (the system's block of the element: no
     /// 512-byte copy per element and factorization).
-    #[inline]
+    #[inline(always)]
     pub fn iteration_block_into(&self, constant: &Mat8, k: f64, e: &Vec8, out: &mut Mat8) {
+        let (sle, a, b) = self.iteration_scalars(k, e);
+        self.iteration_block_from(constant, &sle, a, b, out);
+    }
+
+    /// The state-dependent part of [`Self::iteration_block`]: `S_l e`, `a = k EA ε̄` and
+    /// `b = k EA/l` (a dependency chain, dot product to division, which a loop over the
+    /// elements runs for several elements at once before it writes their blocks).
+    #[inline(always)]
+    pub fn iteration_scalars(&self, k: f64, e: &Vec8) -> (Vec8, f64, f64) {
         let sle = self.axial_product(e);
         let eps = e.dot(&sle) / (2.0 * self.length) - 0.5;
         let ea = self.section.ea();
-        let (a, b) = (k * ea * eps, k * ea / self.length);
+        (sle, k * ea * eps, k * ea / self.length)
+    }
+
+    /// The block `constant + a S_l + b (S_l e)(S_l e)ᵀ` from [`Self::iteration_scalars`].
+    #[inline(always)]
+    pub fn iteration_block_from(&self, constant: &Mat8, sle: &Vec8, a: f64, b: f64, out: &mut Mat8) {
         let (c, o) = (constant.as_slice(), out.as_mut_slice());
         // (sᵢ sⱼ) b: the same rounding for (i, j) and (j, i), so a symmetric `constant`
         // gives a block symmetric to the bit (the band LDLᵀ checks it); column-major, k = 8 j + i
