@@ -186,14 +186,14 @@ impl<'a> CorrectedRunner<'a> {
             }
             let sc = newton_correction(rom, &q, &v, &qdd, &lambda, t, coef, beta_p, &mut rhs, &mut work)
                 .map_err(|p| fail(t, p))?;
-            let mut inc = 0.0_f64;
             for i in 0..n {
                 let dq = rhs[i];
                 q[i] += dq;
                 v[i] += gamma_p * dq;
                 qdd[i] += beta_p * dq;
-                inc = inc.max(dq.abs());
             }
+            // NaN kept (f64::max would pass it by and call a NaN increment converged)
+            let inc = crate::linalg::vec_ops::max_abs(&rhs[..n]);
             for (l, m) in lambda.iter_mut().zip(&rhs[n..]) {
                 *l += beta_p * sc * m;
             }

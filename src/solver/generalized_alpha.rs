@@ -25,6 +25,7 @@ pub use super::integrator_params::{IntegratorParams, JacobianReuse};
 use super::model::{DynamicModel, IterationCoefficients};
 pub use super::predictor::Predictor;
 use crate::error::{Error, Result};
+use crate::linalg::vec_ops::max_abs;
 
 /// The integrator's state; `lambda` are the Lagrange multipliers (physical units).
 #[derive(Clone, Debug, PartialEq)]
@@ -213,7 +214,7 @@ impl GeneralizedAlpha {
         let predictor = self.params.predictor;
         // ‖guess‖∞, for keeping the first matrix of a good guess (below)
         let guess_size = match guess {
-            Some(d) => Some(d.iter().fold(0.0_f64, |m, x| m.max(x.abs()))),
+            Some(d) => Some(max_abs(d)),
             None => predictor.increment_size(h, &st.v),
         };
         for i in 0..n {
@@ -244,7 +245,7 @@ impl GeneralizedAlpha {
                 self.rhs[i] += self.work[i];
             }
             model.add_constraint_force(&st.lambda, &mut self.rhs[..n]);
-            residual = self.rhs[..n].iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+            residual = max_abs(&self.rhs[..n]);
             if !residual.is_finite() {
                 return Err(Failure { iterations: it, increment: last_increment, residual });
             }
@@ -267,13 +268,12 @@ impl GeneralizedAlpha {
             rc.iter_mut().for_each(|x| *x *= -s);
             model.solve(&mut self.rhs).map_err(|_| Failure { iterations: it, increment: last_increment, residual })?;
             let (dq, dmu) = self.rhs.split_at(n);
-            let mut inc = 0.0_f64;
-            for i in 0..n {
-                st.q[i] += dq[i];
-                st.v[i] += gamma_p * dq[i];
-                st.qdd[i] += beta_p * dq[i];
-                inc = inc.max(dq[i].abs());
+            for (((q, v), a), d) in st.q.iter_mut().zip(&mut st.v).zip(&mut st.qdd).zip(dq) {
+                *q += d;
+                *v += gamma_p * d;
+                *a += beta_p * d;
             }
+            let inc = max_abs(dq);
             for (l, m) in st.lambda.iter_mut().zip(dmu) {
                 *l += beta_p * s * m;
             }
@@ -416,6 +416,63 @@ mod tests {
             q.push(st.q[0]);
         }
         (q, integ.stats)
+    }
+
+    /// A residual that turns NaN (a force undefined past q = 0) fails the step instead of
+    /// being taken as converged: `f64::max` passes a NaN by, so a maximum of NaN entries
+    /// read 0 and the NaN state was accepted.
+    #[test]
+    fn a_nan_residual_fails_the_step() {
+        struct Undefined(Spring);
+        impl DynamicModel for Undefined {
+            fn n_dof(&self) -> usize {
+                1
+            }
+            fn n_constraints(&self) -> usize {
+                0
+            }
+            fn mass_mul(&self, a: &[f64], out: &mut [f64]) {
+                self.0.mass_mul(a, out)
+            }
+            fn force(&mut self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
+                self.0.force(q, v, t, out);
+                if q[0] < 0.0 {
+                    out[0] = f64::NAN;
+                }
+            }
+            fn constraint_residual(&self, _q: &[f64], _out: &mut [f64]) {}
+            fn add_constraint_force(&self, _lambda: &[f64], _out: &mut [f64]) {}
+            fn factor(
+                &mut self,
+                q: &[f64],
+                v: &[f64],
+                t: f64,
+                c: IterationCoefficients,
+            ) -> std::result::Result<f64, String> {
+                self.0.factor(q, v, t, c)
+            }
+            fn solve(&mut self, rhs: &mut [f64]) -> std::result::Result<(), String> {
+                self.0.solve(rhs)
+            }
+            fn length_scale(&self) -> f64 {
+                1.0
+            }
+        }
+        let mut m = Undefined(Spring { k: 100.0, c: 0.0, noise: 0.0, stale: 1.0, s: 1.0, fresh: false });
+        let mut integ = GeneralizedAlpha::new(IntegratorParams { max_cuts: 2, ..IntegratorParams::default() }).unwrap();
+        let mut st = integ.initialize(&mut m, vec![0.5], vec![0.0], 0.0).unwrap();
+        // q = 0.5 cos(10 t) reaches 0 at t ≈ 0.157: a step ends there or later
+        let mut failed = false;
+        for _ in 0..20 {
+            match integ.step(&mut m, &mut st, 0.02) {
+                Ok(()) => assert!(st.q[0].is_finite() && st.q[0] >= 0.0, "accepted q = {} at t = {}", st.q[0], st.t),
+                Err(_) => {
+                    failed = true;
+                    break;
+                }
+            }
+        }
+        assert!(failed, "the run went past q = 0");
     }
 
     /// A kept matrix that stops contracting (θ = 0.6 > ½) is stale, not at the round-off

@@ -54,7 +54,7 @@ impl Predictor {
     pub fn increment_size(self, h: f64, v: &[f64]) -> Option<f64> {
         match self {
             Predictor::ZeroAcceleration => None,
-            Predictor::ConstantVelocity => Some(h * v.iter().fold(0.0_f64, |m, x| m.max(x.abs()))),
+            Predictor::ConstantVelocity => Some(h * crate::linalg::vec_ops::max_abs(v)),
         }
     }
 }

@@ -24,14 +24,14 @@ pub fn solve_static<M: DynamicModel>(
     for it in 1..=max_iterations {
         model.force(q, &zero, t, &mut rhs[..n]);
         model.add_constraint_force(&lambda, &mut rhs[..n]);
-        residual = rhs[..n].iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        residual = crate::linalg::vec_ops::max_abs(&rhs[..n]);
         let s = model.factor(q, &zero, t, coef).map_err(|p| Error::LinearSolve { t, problem: p })?;
         let (rq, rc) = rhs.split_at_mut(n);
         rq.iter_mut().for_each(|x| *x = -*x);
         model.constraint_residual(q, rc);
         rc.iter_mut().for_each(|x| *x *= -s);
         model.solve(&mut rhs).map_err(|p| Error::LinearSolve { t, problem: p })?;
-        inc = rhs[..n].iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        inc = crate::linalg::vec_ops::max_abs(&rhs[..n]);
         for i in 0..n {
             q[i] += rhs[i];
         }
