@@ -260,8 +260,10 @@ pub fn simulate(model: &Model, overrides: &Overrides) -> Result<SimulationResult
 fn run_full(model: &Model, sys: &mut FlexibleSystem, q0: Vec<f64>, s: Settings) -> Result<SimulationResult> {
     model.check_full_run_memory(s.n_steps, s.solver == LinearSolverKind::Dense)?;
     let (n, nc, nt) = (ParametricModel::n_dof(sys), ParametricModel::n_constraints(sys), s.n_steps + 1);
-    let mut q = Array2::zeros((n, nt));
-    let mut mult = Array2::zeros((nc, nt));
+    // column-major: each instant's column is contiguous, so recording a step is one copy
+    // and the result file's time-first rows are the memory as it is (no transposition)
+    let mut q = Array2::zeros(ndarray::ShapeBuilder::f((n, nt)));
+    let mut mult = Array2::zeros(ndarray::ShapeBuilder::f((nc, nt)));
     let mut t = Array1::zeros(nt);
     let mut probes: Vec<(String, Array2<f64>)> =
         sys.probes.iter().map(|p| (p.name.clone(), Array2::zeros((nt, 2)))).collect();

@@ -2,7 +2,7 @@
 
 use super::{check_scale, print_table, run_details, FormatArgs};
 use flexrom::io::output::{check_output, Origin};
-use flexrom::io::result_file::{begin_alongside, RunShape};
+use flexrom::io::result_file::{begin_alongside, RunPlan};
 use flexrom::output::info;
 use flexrom::output::table::{Cell, Table};
 use flexrom::pipeline::online::load_basis;
@@ -48,9 +48,9 @@ impl Args {
             flexrom::pipeline::estimate::EstimatingRunner::new(&p.model, &stored.basis, trust.estimator.as_ref())?;
         // the result file's fixed part is written on a second thread while the run computes
         let overrides = flexrom::simulate::Overrides { load_scale: Some(load_scale), ..Default::default() };
-        let shape = RunShape::of(&p.model, flexrom::simulate::Settings::resolve(&p.model, &overrides)?.n_steps);
+        let plan = RunPlan::of(&p.model, &flexrom::simulate::Settings::resolve(&p.model, &overrides)?);
         let model_path = p.model.path.display().to_string();
-        let (file, (run, estimate)) = begin_alongside(&output, &p.model.text, &model_path, &shape, || {
+        let (file, (run, estimate)) = begin_alongside(&output, &p.model.text, &model_path, &plan, || {
             runner
                 .run(load_scale, flexrom::pipeline::online::Output::Full)
                 .map_err(|e| e.at_stage("online", load_scale))

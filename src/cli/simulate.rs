@@ -2,7 +2,7 @@
 
 use super::{print_table, run_details, FormatArgs};
 use flexrom::io::output::{check_output, Origin};
-use flexrom::io::result_file::{begin_alongside, RunShape};
+use flexrom::io::result_file::{begin_alongside, RunPlan};
 use flexrom::linalg::kkt::LinearSolverKind;
 use flexrom::model::Model;
 use flexrom::output::info;
@@ -29,9 +29,9 @@ impl Args {
         check_output(&output, Origin::Flag("-o"), &[(&model, "model file")])?;
         let model = Model::load(&model)?;
         let overrides = run.overrides();
-        let shape = RunShape::of(&model, Settings::resolve(&model, &overrides)?.n_steps);
+        let plan = RunPlan::of(&model, &Settings::resolve(&model, &overrides)?);
         // the result file's fixed part is written on a second thread while the run computes
-        let (file, r) = begin_alongside(&output, &model.text, &model.path.display().to_string(), &shape, || {
+        let (file, r) = begin_alongside(&output, &model.text, &model.path.display().to_string(), &plan, || {
             simulate(&model, &overrides).map_err(|e| e.at_stage("simulate", run.load_scale.unwrap_or(1.0)))
         })?;
         file.finish(&r, |_| Ok(()))?;

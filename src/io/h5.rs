@@ -88,55 +88,96 @@ fn short_write_error(problem: &str) -> String {
 /// checked, handles validated on drop): the attributes were a sixth of writing a result
 /// file (docs/process-speed.md). The same bytes reach the file (a test reads both back).
 pub fn attr_str(loc: &hdf5::Location, name: &str, value: &str) -> hdf5::Result<()> {
-    use hdf5_sys::h5::herr_t;
-    use hdf5_sys::h5a::{H5Aclose, H5Acreate2, H5Awrite};
-    use hdf5_sys::h5i::hid_t;
-    use hdf5_sys::h5p::{H5Pclose, H5Pcreate, H5Pset_char_encoding, H5P_DEFAULT};
-    use hdf5_sys::h5s::{H5S_class_t, H5Sclose, H5Screate};
     use hdf5_sys::h5t::{
         H5T_cset_t, H5T_str_t, H5Tclose, H5Tcopy, H5Tset_cset, H5Tset_size, H5Tset_strpad, H5T_VARIABLE,
     };
     // the checks of `VarLenUnicode`'s parser: no NUL inside (HDF5 would cut the text there)
     let v: VarLenUnicode = value.parse().map_err(|e| hdf5::Error::from(format!("{e:?}")))?;
-    let cname = std::ffi::CString::new(name).map_err(|e| hdf5::Error::from(format!("attribute name `{name}`: {e}")))?;
+    let cname = attr_name(name)?;
     hdf5::sync::sync(|| {
-        // SAFETY: plain calls into HDF5 under hdf5-metno's library lock (`sync`). `loc` is a
-        // live object; every id created here is checked and closed here (`close` runs on
-        // every path). `H5Awrite` reads one `char*` from `ptr`, the pointer held by `v`, a
-        // NUL-terminated string that outlives the call, which HDF5 only reads and copies.
+        // SAFETY: plain calls into HDF5 under hdf5-metno's library lock (`sync`); the type
+        // created here is checked and closed here. `H5Awrite` reads one `char*` from the
+        // pointer, the one held by `v`, a NUL-terminated string that outlives the call,
+        // which HDF5 only reads and copies.
         unsafe {
-            let mut ids: Vec<(hid_t, unsafe extern "C" fn(hid_t) -> herr_t)> = Vec::with_capacity(4);
+            let t = hdf5::h5check(H5Tcopy(*hdf5::globals::H5T_C_S1))?;
             let r = (|| -> hdf5::Result<()> {
-                let t = hdf5::h5check(H5Tcopy(*hdf5::globals::H5T_C_S1))?;
-                ids.push((t, H5Tclose));
                 hdf5::h5check(H5Tset_cset(t, H5T_cset_t::H5T_CSET_UTF8))?;
                 hdf5::h5check(H5Tset_strpad(t, H5T_str_t::H5T_STR_NULLTERM))?;
                 hdf5::h5check(H5Tset_size(t, H5T_VARIABLE))?;
-                let space = hdf5::h5check(H5Screate(H5S_class_t::H5S_SCALAR))?;
-                ids.push((space, H5Sclose));
-                let acpl = hdf5::h5check(H5Pcreate(*hdf5::globals::H5P_ATTRIBUTE_CREATE))?;
-                ids.push((acpl, H5Pclose));
-                hdf5::h5check(H5Pset_char_encoding(acpl, H5T_cset_t::H5T_CSET_UTF8))?;
-                let a = hdf5::h5check(H5Acreate2(loc.id(), cname.as_ptr(), t, space, acpl, H5P_DEFAULT))?;
-                ids.push((a, H5Aclose));
                 let ptr: *const VarLenUnicode = &v;
-                hdf5::h5check(H5Awrite(a, t, ptr.cast()))?;
-                Ok(())
+                scalar_attr(loc, &cname, t, ptr.cast())
             })();
-            for (id, close) in ids.into_iter().rev() {
-                close(id);
-            }
+            H5Tclose(t);
             r
         }
     })
 }
 
+/// Writes the scalar `f64` attribute `name` = `value` on `loc`, as the crate's
+/// `new_attr::<f64>().create(name)?.write_scalar(..)` does (the same type, a UTF-8 name; a
+/// test compares), in a few raw calls ([`attr_str`] says why).
 pub fn attr_f64(loc: &hdf5::Location, name: &str, value: f64) -> hdf5::Result<()> {
-    loc.new_attr::<f64>().create(name)?.write_scalar(&value)
+    let cname = attr_name(name)?;
+    // SAFETY: under the library lock; `value` outlives the call and is one native double,
+    // the type given
+    hdf5::sync::sync(|| unsafe {
+        scalar_attr(loc, &cname, *hdf5::globals::H5T_NATIVE_DOUBLE, (&value as *const f64).cast())
+    })
 }
 
+/// [`attr_f64`] for a `u64`.
 pub fn attr_u64(loc: &hdf5::Location, name: &str, value: u64) -> hdf5::Result<()> {
-    loc.new_attr::<u64>().create(name)?.write_scalar(&value)
+    let cname = attr_name(name)?;
+    // SAFETY: as in attr_f64, one native unsigned 64-bit integer
+    hdf5::sync::sync(|| unsafe {
+        scalar_attr(loc, &cname, *hdf5::globals::H5T_NATIVE_UINT64, (&value as *const u64).cast())
+    })
+}
+
+fn attr_name(name: &str) -> hdf5::Result<std::ffi::CString> {
+    std::ffi::CString::new(name).map_err(|e| hdf5::Error::from(format!("attribute name `{name}`: {e}")))
+}
+
+/// Creates the scalar attribute `name` of type `t` on `loc` (UTF-8 name) and writes the
+/// value at `value`.
+///
+/// # Safety
+/// Call under the library lock (`hdf5::sync::sync`); `t` must be a valid datatype id and
+/// `value` point at one value of that type (memory layout), alive for the call. Every id
+/// created here is checked and closed here, on every path.
+unsafe fn scalar_attr(
+    loc: &hdf5::Location,
+    name: &std::ffi::CStr,
+    t: hdf5_sys::h5i::hid_t,
+    value: *const std::ffi::c_void,
+) -> hdf5::Result<()> {
+    use hdf5_sys::h5::herr_t;
+    use hdf5_sys::h5a::{H5Aclose, H5Acreate2, H5Awrite};
+    use hdf5_sys::h5i::hid_t;
+    use hdf5_sys::h5p::{H5Pclose, H5Pcreate, H5Pset_char_encoding, H5P_DEFAULT};
+    use hdf5_sys::h5s::{H5S_class_t, H5Sclose, H5Screate};
+    use hdf5_sys::h5t::H5T_cset_t;
+    let mut ids: Vec<(hid_t, unsafe extern "C" fn(hid_t) -> herr_t)> = Vec::with_capacity(3);
+    // SAFETY: the caller's contract; each id is pushed as soon as it exists, closed below
+    let r = unsafe {
+        (|| -> hdf5::Result<()> {
+            let space = hdf5::h5check(H5Screate(H5S_class_t::H5S_SCALAR))?;
+            ids.push((space, H5Sclose));
+            let acpl = hdf5::h5check(H5Pcreate(*hdf5::globals::H5P_ATTRIBUTE_CREATE))?;
+            ids.push((acpl, H5Pclose));
+            hdf5::h5check(H5Pset_char_encoding(acpl, H5T_cset_t::H5T_CSET_UTF8))?;
+            let a = hdf5::h5check(H5Acreate2(loc.id(), name.as_ptr(), t, space, acpl, H5P_DEFAULT))?;
+            ids.push((a, H5Aclose));
+            hdf5::h5check(H5Awrite(a, t, value))?;
+            Ok(())
+        })()
+    };
+    for (id, close) in ids.into_iter().rev() {
+        // SAFETY: ids created above, closed once
+        unsafe { close(id) };
+    }
+    r
 }
 
 pub fn read_attr_str(loc: &hdf5::Location, name: &str) -> hdf5::Result<String> {
@@ -177,6 +218,28 @@ mod tests {
         assert!(super::attr_str(&f, "nul", "a\0b").is_err());
         assert!(super::attr_str(&f, "nul\0name", "a").is_err());
         assert!(f.attr_names().unwrap().iter().all(|n| !n.starts_with("nul")));
+    }
+
+    /// `attr_f64` and `attr_u64` write what the crate's own builder writes: the same value,
+    /// datatype, shape and name encoding.
+    #[test]
+    fn numeric_attributes_match_the_crate_writer() {
+        let d = tempfile::tempdir().unwrap();
+        let f = hdf5::File::create(d.path().join("a.h5")).unwrap();
+        super::attr_f64(&f, "mine f é", -1.25e-7).unwrap();
+        f.new_attr::<f64>().create("theirs f é").unwrap().write_scalar(&-1.25e-7).unwrap();
+        super::attr_u64(&f, "mine u é", u64::MAX - 3).unwrap();
+        f.new_attr::<u64>().create("theirs u é").unwrap().write_scalar(&(u64::MAX - 3)).unwrap();
+        assert_eq!(f.attr("mine f é").unwrap().read_scalar::<f64>().unwrap(), -1.25e-7);
+        assert_eq!(f.attr("mine u é").unwrap().read_scalar::<u64>().unwrap(), u64::MAX - 3);
+        for k in ["f", "u"] {
+            let (a, b) = (f.attr(&format!("mine {k} é")).unwrap(), f.attr(&format!("theirs {k} é")).unwrap());
+            assert_eq!(a.dtype().unwrap(), b.dtype().unwrap(), "{k}");
+            assert_eq!(a.dtype().unwrap().to_descriptor().unwrap(), b.dtype().unwrap().to_descriptor().unwrap());
+            assert_eq!(a.shape(), b.shape());
+            assert_eq!(a.acpl().unwrap().char_encoding(), b.acpl().unwrap().char_encoding());
+        }
+        assert!(super::attr_f64(&f, "nul\0name", 1.0).is_err());
     }
 
     #[test]

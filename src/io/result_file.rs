@@ -18,7 +18,8 @@
 use super::attrs::{annotate_rest, Kind, Labelled};
 use super::h5::{attr_f64, attr_str, attr_u64, shorten, StagedFile};
 use crate::error::{Error, Result};
-use crate::simulate::SimulationResult;
+use crate::linalg::kkt::LinearSolverKind;
+use crate::simulate::{Settings, SimulationResult};
 use std::path::Path;
 
 pub fn write_result(path: &Path, r: &SimulationResult) -> Result<()> {
@@ -34,57 +35,84 @@ pub fn write_result_with(
     r: &SimulationResult,
     extra: impl FnOnce(&hdf5::File) -> Result<()>,
 ) -> Result<()> {
-    ResultFile::begin(path, &r.model_text, &r.model_path, &RunShape::of_result(r))?.finish(r, extra)
+    ResultFile::begin(path, &r.model_text, &r.model_path, &RunPlan::of_result(r))?.finish(r, extra)
 }
 
-/// The sizes of a run's arrays, known before it runs: `n_t` instants, `n_dof`
-/// coordinates, `n_c` multipliers, and the probes by name.
+/// What is known of a run before it runs: the sizes of its arrays (`n_t` instants, `n_dof`
+/// coordinates, `n_c` multipliers, the probes by name) and the settings its file records.
 #[derive(Clone, Debug, PartialEq)]
-pub struct RunShape {
+pub struct RunPlan {
     pub n_t: usize,
     pub n_dof: usize,
     pub n_c: usize,
     pub probes: Vec<String>,
+    pub load_scale: f64,
+    pub dt: f64,
+    pub t_end: f64,
+    pub rho_inf: f64,
+    pub solver: LinearSolverKind,
 }
 
-impl RunShape {
-    /// The shape of a run of `model` over `n_steps` steps (one instant recorded per step
+impl RunPlan {
+    /// The plan of a run of `model` with the settings `s` (one instant recorded per step
     /// and the start, whatever halving a step takes).
-    pub fn of(model: &crate::model::Model, n_steps: usize) -> RunShape {
+    pub fn of(model: &crate::model::Model, s: &Settings) -> RunPlan {
         let z = model.sizes();
-        RunShape {
-            n_t: n_steps + 1,
+        RunPlan {
+            n_t: s.n_steps + 1,
             n_dof: z.n_dof as usize,
             n_c: z.n_constraints as usize,
             probes: model.probe_names(),
+            ..Self::settings(s)
         }
     }
 
-    pub fn of_result(r: &SimulationResult) -> RunShape {
-        RunShape {
+    /// The plan a finished run `r` followed.
+    pub fn of_result(r: &SimulationResult) -> RunPlan {
+        RunPlan {
             n_t: r.t.len(),
             n_dof: r.q.nrows(),
             n_c: r.multipliers.nrows(),
             probes: r.probes.iter().map(|p| p.0.clone()).collect(),
+            ..Self::settings(&r.settings)
+        }
+    }
+
+    fn settings(s: &Settings) -> RunPlan {
+        RunPlan {
+            n_t: 0,
+            n_dof: 0,
+            n_c: 0,
+            probes: Vec::new(),
+            load_scale: s.load_scale,
+            dt: s.dt,
+            t_end: s.t_end,
+            rho_inf: s.rho_inf,
+            solver: s.solver,
         }
     }
 }
 
-/// A result file in the making: its fixed part, which depends on the model and the run's
-/// [`RunShape`] alone, is written by [`ResultFile::begin`] (HDF5's start-up, the temporary
-/// file, the model's text, the `/labels` of its coordinates and the empty, labelled
-/// datasets of the run); [`ResultFile::finish`] fills in the run and moves the file into
-/// place. Dropped unfinished, the temporary file is removed.
+/// A result file in the making: its fixed part, which depends on the model and the
+/// [`RunPlan`] alone, is written by [`ResultFile::begin`] (HDF5's start-up, the temporary
+/// file, the model's text and the run's settings, the `/labels` of its coordinates and the
+/// empty, labelled datasets of the run); [`ResultFile::finish`] fills in the run and moves
+/// the file into place. Dropped unfinished, the temporary file is removed.
 pub struct ResultFile {
+    // the datasets before the file: closed first when dropped
+    t: hdf5::Dataset,
+    q: hdf5::Dataset,
+    multipliers: hdf5::Dataset,
+    probes: Vec<hdf5::Dataset>,
     staged: StagedFile,
     labelled: Labelled,
     model_text: String,
     model_path: String,
-    shape: RunShape,
+    plan: RunPlan,
 }
 
 impl ResultFile {
-    pub fn begin(path: &Path, model_text: &str, model_path: &str, shape: &RunShape) -> Result<ResultFile> {
+    pub fn begin(path: &Path, model_text: &str, model_path: &str, plan: &RunPlan) -> Result<ResultFile> {
         let staged = StagedFile::create(path)?;
         let mut labelled = Labelled::new(Kind::Result);
         let f = staged.file();
@@ -92,56 +120,63 @@ impl ResultFile {
         attr_str(f, "model", model_text).map_err(e)?;
         attr_str(f, "model_path", model_path).map_err(e)?;
         attr_str(f, "program_version", env!("CARGO_PKG_VERSION")).map_err(e)?;
+        attr_f64(f, "load_scale", plan.load_scale).map_err(e)?;
+        attr_f64(f, "dt", plan.dt).map_err(e)?;
+        attr_f64(f, "t_end", plan.t_end).map_err(e)?;
+        attr_f64(f, "rho_inf", plan.rho_inf).map_err(e)?;
+        attr_str(f, "linear_solver", &format!("{:?}", plan.solver).to_lowercase()).map_err(e)?;
         super::labels::write_labels_of_text_labelled(f, model_text, model_path, Some(&mut labelled)).map_err(e)?;
         // the run's datasets, empty and labelled (units, dims), time first
         let mut create = |g: &hdf5::Group, path: &str, name: &str, dims: &[usize]| {
             let d = g.new_dataset::<f64>().shape(dims).create(name)?;
-            labelled.label(path, &d)
+            labelled.label(path, &d)?;
+            Ok(d)
         };
-        create(f, "t", "t", &[shape.n_t]).map_err(e)?;
-        create(f, "q", "q", &[shape.n_t, shape.n_dof]).map_err(e)?;
-        create(f, "multipliers", "multipliers", &[shape.n_t, shape.n_c]).map_err(e)?;
+        let t = create(f, "t", "t", &[plan.n_t]).map_err(e)?;
+        let q = create(f, "q", "q", &[plan.n_t, plan.n_dof]).map_err(e)?;
+        let multipliers = create(f, "multipliers", "multipliers", &[plan.n_t, plan.n_c]).map_err(e)?;
         let g = f.create_group("probes").map_err(e)?;
-        for name in &shape.probes {
-            create(&g, &format!("probes/{name}"), name, &[shape.n_t, 2]).map_err(e)?;
-        }
+        let probes = plan
+            .probes
+            .iter()
+            .map(|name| create(&g, &format!("probes/{name}"), name, &[plan.n_t, 2]))
+            .collect::<hdf5::Result<Vec<_>>>()
+            .map_err(e)?;
         Ok(ResultFile {
+            t,
+            q,
+            multipliers,
+            probes,
             staged,
             labelled,
             model_text: model_text.to_string(),
             model_path: model_path.to_string(),
-            shape: shape.clone(),
+            plan: plan.clone(),
         })
     }
 
-    /// Writes the run `r` (of the model and shape the file was begun with), then `extra`,
+    /// Writes the run `r` (of the model and plan the file was begun with), then `extra`,
     /// labels the datasets left, and commits the file (`fdatasync`, rename, folder `fsync`).
     pub fn finish(self, r: &SimulationResult, extra: impl FnOnce(&hdf5::File) -> Result<()>) -> Result<()> {
-        let ResultFile { staged, labelled, model_text, model_path, shape } = self;
+        let ResultFile { t, q, multipliers, probes, staged, labelled, model_text, model_path, plan } = self;
         let path = staged.path().to_path_buf();
-        if r.model_text != model_text || r.model_path != model_path || RunShape::of_result(r) != shape {
+        if r.model_text != model_text || r.model_path != model_path || RunPlan::of_result(r) != plan {
             return Err(Error::Usage(format!(
-                "internal: the result file {} was begun for a run of {model_path} of shape {shape:?}, not for one of {} of shape {:?}",
+                "internal: the result file {} was begun for a run of {model_path} planned as {plan:?}, not for one of {} as {:?}",
                 path.display(),
                 r.model_path,
-                RunShape::of_result(r)
+                RunPlan::of_result(r)
             )));
         }
         let f = staged.file();
         let e = |err: hdf5::Error| shorten(Error::hdf5(&path, err));
-        f.dataset("t").and_then(|d| d.write(&r.t)).map_err(e)?;
+        t.write(&r.t).map_err(e)?;
         // time first: the solver's columns (one per instant) become rows
-        fill_time_first(&f.dataset("q").map_err(e)?, &r.q).map_err(e)?;
-        fill_time_first(&f.dataset("multipliers").map_err(e)?, &r.multipliers).map_err(e)?;
-        for (name, xy) in &r.probes {
-            f.dataset(&format!("probes/{name}")).and_then(|d| d.write(xy)).map_err(e)?;
+        fill_time_first(&q, &r.q).map_err(e)?;
+        fill_time_first(&multipliers, &r.multipliers).map_err(e)?;
+        for (d, (_, xy)) in probes.iter().zip(&r.probes) {
+            d.write(xy).map_err(e)?;
         }
-        let s = &r.settings;
-        attr_f64(f, "load_scale", s.load_scale).map_err(e)?;
-        attr_f64(f, "dt", s.dt).map_err(e)?;
-        attr_f64(f, "t_end", s.t_end).map_err(e)?;
-        attr_f64(f, "rho_inf", s.rho_inf).map_err(e)?;
-        attr_str(f, "linear_solver", &format!("{:?}", s.solver).to_lowercase()).map_err(e)?;
         attr_u64(f, "steps", r.stats.steps as u64).map_err(e)?;
         attr_u64(f, "newton_iterations", r.stats.newton_iterations as u64).map_err(e)?;
         attr_u64(f, "factorizations", r.stats.factorizations as u64).map_err(e)?;
@@ -151,6 +186,7 @@ impl ResultFile {
         attr_f64(f, "wall_seconds", r.wall_seconds).map_err(e)?;
         extra(f).map_err(shorten)?;
         annotate_rest(f, &labelled).map_err(e)?;
+        drop((t, q, multipliers, probes));
         staged.commit()
     }
 }
@@ -164,19 +200,19 @@ pub fn begin_alongside<T>(
     path: &Path,
     model_text: &str,
     model_path: &str,
-    shape: &RunShape,
+    plan: &RunPlan,
     run: impl FnOnce() -> Result<T>,
 ) -> Result<(ResultFile, T)> {
     std::thread::scope(|s| {
         let begun = std::thread::Builder::new()
             .name("flexrom-result-file".into())
-            .spawn_scoped(s, || ResultFile::begin(path, model_text, model_path, shape));
+            .spawn_scoped(s, || ResultFile::begin(path, model_text, model_path, plan));
         let out = run();
         let file = begun.ok().map(|h| h.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)));
         let out = out?;
         let file = match file {
             Some(file) => file?,
-            None => ResultFile::begin(path, model_text, model_path, shape)?,
+            None => ResultFile::begin(path, model_text, model_path, plan)?,
         };
         Ok((file, out))
     })
@@ -195,8 +231,8 @@ pub fn write_time_first(g: &hdf5::Group, name: &str, a: &ndarray::Array2<f64>) -
     Ok(d)
 }
 
-/// Fills the dataset `d` of shape (n_t, n) with `a` (n × n_t), time first, a block of
-/// instants at a time ([`BLOCK_BYTES`]).
+/// Fills the dataset `d` of shape (n_t, n) with `a` (n × n_t), time first: a column-major
+/// `a` as it is, a row-major one transposed a block of instants at a time ([`BLOCK_BYTES`]).
 fn fill_time_first(d: &hdf5::Dataset, a: &ndarray::Array2<f64>) -> hdf5::Result<()> {
     fill_in_blocks(d, a, (BLOCK_BYTES / (8 * a.nrows().max(1))).max(1))
 }
@@ -206,9 +242,14 @@ fn fill_in_blocks(d: &hdf5::Dataset, a: &ndarray::Array2<f64>, rows: usize) -> h
     if n == 0 || nt == 0 {
         return Ok(());
     }
+    if a.t().is_standard_layout() {
+        // column-major (as full runs keep it): the rows of the time-first dataset already
+        return d.write(&a.t());
+    }
     for start in (0..nt).step_by(rows) {
         let end = (start + rows).min(nt);
-        d.write_slice(&transposed(a, start, end), ndarray::s![start..end, ..])?;
+        let tr = transposed(a, start, end);
+        d.write_slice(&tr, ndarray::s![start..end, ..])?;
     }
     Ok(())
 }
@@ -262,24 +303,12 @@ mod tests {
 
     /// The file begun beside a run that fails is removed, and the previous file is kept;
     /// beside a run that succeeds it holds the run once finished; finished with another
-    /// model's run, or a run of another shape, it is refused and removed.
+    /// model's run, or a run of another plan (sizes, settings), it is refused and removed.
     #[test]
     fn a_file_begun_beside_a_run_goes_with_a_failed_run() {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("r.h5");
         std::fs::write(&out, b"previous").unwrap();
-        let shape = super::RunShape { n_t: 1, n_dof: 8, n_c: 0, probes: vec![] };
-        let failed = super::begin_alongside(&out, "text = 1", "m.toml", &shape, || -> crate::Result<()> {
-            Err(Error::Usage("the run failed".into()))
-        });
-        assert!(matches!(failed, Err(Error::Usage(m)) if m == "the run failed"));
-        assert_eq!(entries(dir.path()), ["r.h5"]);
-        assert_eq!(std::fs::read(&out).unwrap(), b"previous");
-
-        let (file, v) = super::begin_alongside(&out, "text = 1", "m.toml", &shape, || Ok(7)).unwrap();
-        assert_eq!(v, 7);
-        // a temporary file beside the target until finished
-        assert_eq!(entries(dir.path()).len(), 2);
         let r = crate::simulate::SimulationResult {
             model_text: "other = 2".into(),
             model_path: "m.toml".into(),
@@ -293,28 +322,43 @@ mod tests {
             )
             .unwrap(),
             t: ndarray::Array1::zeros(1),
-            q: ndarray::Array2::zeros((8, 1)),
+            q: ndarray::Array2::from_shape_fn((8, 1), |(i, _)| i as f64),
             multipliers: ndarray::Array2::zeros((0, 1)),
             probes: vec![],
             stats: Default::default(),
             wall_seconds: 0.0,
         };
+        let plan = super::RunPlan::of_result(&r);
+        assert_eq!((plan.n_t, plan.n_dof, plan.n_c, plan.dt), (1, 8, 0, 0.1));
+        let failed = super::begin_alongside(&out, "text = 1", "m.toml", &plan, || -> crate::Result<()> {
+            Err(Error::Usage("the run failed".into()))
+        });
+        assert!(matches!(failed, Err(Error::Usage(m)) if m == "the run failed"));
+        assert_eq!(entries(dir.path()), ["r.h5"]);
+        assert_eq!(std::fs::read(&out).unwrap(), b"previous");
+
+        let (file, v) = super::begin_alongside(&out, "text = 1", "m.toml", &plan, || Ok(7)).unwrap();
+        assert_eq!(v, 7);
+        // a temporary file beside the target until finished
+        assert_eq!(entries(dir.path()).len(), 2);
         let refused = file.finish(&r, |_| Ok(()));
         assert!(matches!(&refused, Err(Error::Usage(m)) if m.contains("internal")), "{refused:?}");
         assert_eq!(entries(dir.path()), ["r.h5"]);
         assert_eq!(std::fs::read(&out).unwrap(), b"previous");
 
-        // the right model, the wrong shape
-        let wrong = super::RunShape { n_t: 2, ..shape.clone() };
-        let (file, ()) = super::begin_alongside(&out, "other = 2", "m.toml", &wrong, || Ok(())).unwrap();
-        assert!(matches!(file.finish(&r, |_| Ok(())), Err(Error::Usage(m)) if m.contains("internal")));
-        assert_eq!(entries(dir.path()), ["r.h5"]);
-        let (file, ()) = super::begin_alongside(&out, "other = 2", "m.toml", &shape, || Ok(())).unwrap();
+        // the right model, the wrong sizes or settings
+        for wrong in [super::RunPlan { n_t: 2, ..plan.clone() }, super::RunPlan { dt: 0.2, ..plan.clone() }] {
+            let (file, ()) = super::begin_alongside(&out, "other = 2", "m.toml", &wrong, || Ok(())).unwrap();
+            assert!(matches!(file.finish(&r, |_| Ok(())), Err(Error::Usage(m)) if m.contains("internal")));
+            assert_eq!(entries(dir.path()), ["r.h5"]);
+        }
+        let (file, ()) = super::begin_alongside(&out, "other = 2", "m.toml", &plan, || Ok(())).unwrap();
         file.finish(&r, |_| Ok(())).unwrap();
         assert_eq!(entries(dir.path()), ["r.h5"]);
         let f = hdf5::File::open(&out).unwrap();
         assert_eq!(crate::io::h5::read_attr_str(&f, "model").unwrap(), "other = 2");
-        assert_eq!(f.dataset("q").unwrap().shape(), [1, 8]);
+        assert_eq!(crate::io::h5::read_attr_f64(&f, "dt").unwrap(), 0.1);
+        assert_eq!(f.dataset("q").unwrap().read_2d::<f64>().unwrap(), r.q.t());
     }
 
     /// Blocks of 3 instants (the last one short) and one block give the transpose, from a
