@@ -56,10 +56,29 @@ pub struct BandedLdlt {
     work: Vec<f64>,
     /// scratch: the diagonal before factoring
     diag: Vec<f64>,
-    fallback: BandedKkt,
+    /// the band LU, built at the first factorization that needs it (most runs never do)
+    fallback: Fallback,
     state: Factored,
     /// factorizations that went to the LU (reported by tests)
     pub lu_fallbacks: usize,
+}
+
+/// The LU fallback: its pattern until first needed, then the solver.
+enum Fallback {
+    Pattern(KktPattern),
+    Built(BandedKkt),
+}
+
+impl Fallback {
+    fn solver(&mut self) -> &mut BandedKkt {
+        if let Fallback::Pattern(p) = self {
+            *self = Fallback::Built(BandedKkt::new(std::mem::take(p)));
+        }
+        match self {
+            Fallback::Built(s) => s,
+            Fallback::Pattern(_) => unreachable!("built above"),
+        }
+    }
 }
 
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -128,7 +147,7 @@ impl BandedLdlt {
             is_dof,
             work: vec![0.0; n],
             diag: vec![0.0; n],
-            fallback: BandedKkt::new(pattern),
+            fallback: Fallback::Pattern(pattern),
             state: Factored::No,
             lu_fallbacks: 0,
         }
@@ -160,7 +179,7 @@ impl BandedLdlt {
             }
         }
         self.lu_fallbacks += 1;
-        self.fallback.factor(blocks, scale)?;
+        self.fallback.solver().factor(blocks, scale)?;
         self.state = Factored::Lu;
         Ok(())
     }
@@ -227,7 +246,7 @@ impl KktSolver for BandedLdlt {
     fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {
         match self.state {
             Factored::No => return Err("solve called without a valid factorization".into()),
-            Factored::Lu => return self.fallback.solve(rhs),
+            Factored::Lu => return self.fallback.solver().solve(rhs),
             Factored::Ldlt => {}
         }
         let (ab, n, band) = (&self.ab, self.n, self.band);
