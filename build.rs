@@ -57,9 +57,6 @@ fn main() {
         args.push("-l:libgfortran.so.5".into());
     }
     args.extend(["-lm", "-lpthread", "-ldl"].map(String::from));
-    // the PIE's ~21,500 relative relocations in RELR form (a few KB instead of 500 KB of
-    // RELA entries to read and apply at start-up; glibc ≥ 2.36, binutils ≥ 2.38): ASLR kept
-    args.push("-Wl,-z,pack-relative-relocs".into());
     for arg in args {
         println!("cargo::rustc-link-arg={arg}");
     }

@@ -96,7 +96,8 @@ fn main() -> flexrom::Result<()> {
         let full = simulate(&p.model, &Overrides { load_scale: Some(x), ..Default::default() })?;
         let (rom, e) = runner.run(x, Output::Full)?;
         let e = e.expect("estimator");
-        let err = (&rom.result.q - &full.q).mapv(|v| v * v).sum().sqrt() / full.q.mapv(|v| v * v).sum().sqrt();
+        let (distance, norm) = flexrom::pipeline::estimate::distance_and_norm(&rom.result.q, &full.q);
+        let err = distance / norm;
         let inside = !is_extrapolated((lo, hi), x);
         let cost = e.seconds / rom.result.wall_seconds;
         let by_time = flexrom::pipeline::estimate::rel_error_by_time(&rom.result.q, &full.q);

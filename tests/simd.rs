@@ -8,7 +8,9 @@
 //!   matrix of `dense_lu`'s unit test `bordered_block_systems_by_blocks_or_the_lu_fallback`,
 //!   which checks that it takes the bordered path), factored and solved;
 //! * a whole reduced run of `pipelines/thesis/fourbar_blocks.toml` (one POD per body, so its
-//!   Newton matrix is bordered block-diagonal, hyper-reduced by ECSW), trained in memory.
+//!   Newton matrix is bordered block-diagonal, hyper-reduced by ECSW), trained in memory;
+//! * full runs of the pendulum and the four-bar (the full system's iteration blocks,
+//!   `IterationBlocks` in src/physics/system/models.rs), 0.2 s of each.
 //!
 //! Expected: the same bits, a tolerance of 0 ulp. Why: the vector code performs the same
 //! IEEE-754 operations in the same order as the scalar code — Rust never contracts `a * b + c`
@@ -20,9 +22,11 @@
 
 use flexrom::linalg::dense_lu::DenseLu;
 use flexrom::linalg::simd::set_scalar_only;
+use flexrom::model::Model;
 use flexrom::pipeline::online::run_reduced;
 use flexrom::pipeline::train::train;
 use flexrom::pipeline::Pipeline;
+use flexrom::simulate::{simulate, Overrides};
 
 /// Factors and solves the bordered block system; returns the solution.
 fn bordered_solve() -> Vec<f64> {
@@ -68,15 +72,32 @@ fn scalar_and_simd_paths_give_the_same_bits() {
     let basis = summary.trained.basis;
     assert!(basis.hyper.is_some(), "the pipeline is hyper-reduced, so the hyper kernels run");
 
+    let full_models: Vec<Model> = ["pendulum", "fourbar"]
+        .iter()
+        .map(|m| Model::load(format!("{root}/data/models/{m}.toml")).expect("shipped model"))
+        .collect();
+    let short = Overrides { t_end: Some(0.2), ..Default::default() };
     let mut runs = Vec::new();
+    let mut full = Vec::new();
     for scalar in [false, true] {
         set_scalar_only(scalar);
         let x = bordered_solve();
         let rom = run_reduced(&p.model, &basis, 0.935).expect("reduced run");
         runs.push((x, rom));
+        full.push(full_models.iter().map(|m| simulate(m, &short).expect("full run")).collect::<Vec<_>>());
     }
     set_scalar_only(false);
     let ((x_simd, r_simd), (x_scalar, r_scalar)) = (&runs[0], &runs[1]);
+    for (s, c) in full[0].iter().zip(&full[1]) {
+        assert!(s.stats.factorizations > 0, "{}: the full run factored", s.model_path);
+        let (qs, qc) = (s.q.as_standard_layout(), c.q.as_standard_layout());
+        assert_eq!(
+            first_difference(qs.as_slice().unwrap(), qc.as_slice().unwrap()),
+            None,
+            "{}: full coordinates, (flat index, simd, scalar)",
+            s.model_path
+        );
+    }
 
     assert_eq!(first_difference(x_simd, x_scalar), None, "bordered Cholesky solve, (index, simd, scalar)");
     assert!(r_simd.result.stats.newton_iterations > 0, "the reduced run iterated");

@@ -47,15 +47,17 @@ impl StagedFile {
 
     /// Flushes and closes the file, then `fdatasync`s it and renames it over the final path.
     pub fn commit(self) -> Result<()> {
-        let StagedFile { file, tmp, path } = self;
-        file.flush().map_err(|e| shorten(Error::hdf5(&path, e)))?;
+        // on an error the whole struct is dropped: the file closed before its temporary goes
+        self.file.flush().map_err(|e| shorten(Error::hdf5(&self.path, e)))?;
+        let StagedFile { file, tmp, path: _ } = self;
         // closed before the fdatasync and the rename (the last handle closes the file)
         drop(file);
         tmp.commit()
     }
 }
 
-/// [`short_write_error`] on an HDF5 error; other errors as they are.
+/// An HDF5 error's message cut to the system's one line ("cannot write: No space left on
+/// device (errno 28)"); other errors as they are.
 pub fn shorten(e: Error) -> Error {
     match e {
         Error::Hdf5 { file, problem } => Error::Hdf5 { file, problem: short_write_error(&problem) },

@@ -155,26 +155,31 @@ impl ResultFile {
         })
     }
 
-    /// Writes the run `r` (of the model and plan the file was begun with), then `extra`,
-    /// labels the datasets left, and commits the file (`fdatasync`, rename, folder `fsync`).
+    /// Writes the run `r`, then `extra`, labels the datasets left, and commits the file
+    /// (`fdatasync`, rename, folder `fsync`). A run of another model or plan than the file
+    /// was begun with (a bug: the plan is made from the same model and settings) is not
+    /// lost: the begun file is removed and the file written again from the run.
     pub fn finish(self, r: &SimulationResult, extra: impl FnOnce(&hdf5::File) -> Result<()>) -> Result<()> {
-        let ResultFile { t, q, multipliers, probes, staged, labelled, model_text, model_path, plan } = self;
-        let path = staged.path().to_path_buf();
-        if r.model_text != model_text || r.model_path != model_path || RunPlan::of_result(r) != plan {
-            return Err(Error::Usage(format!(
-                "internal: the result file {} was begun for a run of {model_path} planned as {plan:?}, not for one of {} as {:?}",
-                path.display(),
-                r.model_path,
-                RunPlan::of_result(r)
-            )));
+        if r.model_text != self.model_text || r.model_path != self.model_path || RunPlan::of_result(r) != self.plan {
+            let path = self.staged.path().to_path_buf();
+            drop(self);
+            return ResultFile::begin(&path, &r.model_text, &r.model_path, &RunPlan::of_result(r))?.finish(r, extra);
         }
-        let f = staged.file();
-        let e = |err: hdf5::Error| shorten(Error::hdf5(&path, err));
-        t.write(&r.t).map_err(e)?;
+        // on an error `self` is dropped whole: datasets, then the file, then its temporary
+        self.write_run(r, extra)?;
+        let ResultFile { t, q, multipliers, probes, staged, .. } = self;
+        drop((t, q, multipliers, probes));
+        staged.commit()
+    }
+
+    fn write_run(&self, r: &SimulationResult, extra: impl FnOnce(&hdf5::File) -> Result<()>) -> Result<()> {
+        let f = self.staged.file();
+        let e = |err: hdf5::Error| shorten(Error::hdf5(self.staged.path(), err));
+        self.t.write(&r.t).map_err(e)?;
         // time first: the solver's columns (one per instant) become rows
-        fill_time_first(&q, &r.q).map_err(e)?;
-        fill_time_first(&multipliers, &r.multipliers).map_err(e)?;
-        for (d, (_, xy)) in probes.iter().zip(&r.probes) {
+        fill_time_first(&self.q, &r.q).map_err(e)?;
+        fill_time_first(&self.multipliers, &r.multipliers).map_err(e)?;
+        for (d, (_, xy)) in self.probes.iter().zip(&r.probes) {
             d.write(xy).map_err(e)?;
         }
         attr_u64(f, "steps", r.stats.steps as u64).map_err(e)?;
@@ -185,9 +190,7 @@ impl ResultFile {
         attr_u64(f, "steps_at_round_off", r.stats.steps_at_round_off as u64).map_err(e)?;
         attr_f64(f, "wall_seconds", r.wall_seconds).map_err(e)?;
         extra(f).map_err(shorten)?;
-        annotate_rest(f, &labelled).map_err(e)?;
-        drop((t, q, multipliers, probes));
-        staged.commit()
+        annotate_rest(f, &self.labelled).map_err(e)
     }
 }
 
@@ -303,7 +306,8 @@ mod tests {
 
     /// The file begun beside a run that fails is removed, and the previous file is kept;
     /// beside a run that succeeds it holds the run once finished; finished with another
-    /// model's run, or a run of another plan (sizes, settings), it is refused and removed.
+    /// model's run, or a run of another plan (sizes, settings), it is written again from
+    /// the run, with no temporary file left.
     #[test]
     fn a_file_begun_beside_a_run_goes_with_a_failed_run() {
         let dir = tempfile::tempdir().unwrap();
@@ -341,24 +345,92 @@ mod tests {
         assert_eq!(v, 7);
         // a temporary file beside the target until finished
         assert_eq!(entries(dir.path()).len(), 2);
-        let refused = file.finish(&r, |_| Ok(()));
-        assert!(matches!(&refused, Err(Error::Usage(m)) if m.contains("internal")), "{refused:?}");
-        assert_eq!(entries(dir.path()), ["r.h5"]);
-        assert_eq!(std::fs::read(&out).unwrap(), b"previous");
-
-        // the right model, the wrong sizes or settings
+        let written = |file: super::ResultFile| {
+            std::fs::write(&out, b"previous").unwrap();
+            file.finish(&r, |_| Ok(())).unwrap();
+            assert_eq!(entries(dir.path()), ["r.h5"]);
+            let f = hdf5::File::open(&out).unwrap();
+            assert_eq!(crate::io::h5::read_attr_str(&f, "model").unwrap(), "other = 2");
+            assert_eq!(crate::io::h5::read_attr_f64(&f, "dt").unwrap(), 0.1);
+            assert_eq!(f.dataset("q").unwrap().read_2d::<f64>().unwrap(), r.q.t());
+        };
+        // begun for another model: written again from the run
+        written(file);
+        // the right model, the wrong sizes or settings: the same
         for wrong in [super::RunPlan { n_t: 2, ..plan.clone() }, super::RunPlan { dt: 0.2, ..plan.clone() }] {
             let (file, ()) = super::begin_alongside(&out, "other = 2", "m.toml", &wrong, || Ok(())).unwrap();
-            assert!(matches!(file.finish(&r, |_| Ok(())), Err(Error::Usage(m)) if m.contains("internal")));
-            assert_eq!(entries(dir.path()), ["r.h5"]);
+            written(file);
         }
         let (file, ()) = super::begin_alongside(&out, "other = 2", "m.toml", &plan, || Ok(())).unwrap();
-        file.finish(&r, |_| Ok(())).unwrap();
-        assert_eq!(entries(dir.path()), ["r.h5"]);
-        let f = hdf5::File::open(&out).unwrap();
-        assert_eq!(crate::io::h5::read_attr_str(&f, "model").unwrap(), "other = 2");
-        assert_eq!(crate::io::h5::read_attr_f64(&f, "dt").unwrap(), 0.1);
-        assert_eq!(f.dataset("q").unwrap().read_2d::<f64>().unwrap(), r.q.t());
+        written(file);
+    }
+
+    /// The plan made before a run, from the model file and the settings alone, is the plan
+    /// of the run (else `finish` writes the file twice): every shipped model, and one with a
+    /// clamp (4 rows), a pin and a ground pin and a probe, over three steps.
+    #[test]
+    fn the_plan_of_a_model_is_that_of_its_run() {
+        const CLAMPED: &str = r#"
+            [time]
+            t_end = 0.1
+            dt = 0.01
+            rho_inf = 0.8
+            [[bodies]]
+            name = "beam"
+            start = [0.0, 0.0]
+            angle = 0.0
+            length = 1.0
+            elements = 2
+            density = 7800.0
+            area = 1e-4
+            inertia = 1e-9
+            youngs_modulus = 2e11
+            [[bodies]]
+            name = "link"
+            start = [1.0, 0.0]
+            angle = 0.0
+            length = 1.0
+            elements = 3
+            density = 7800.0
+            area = 1e-4
+            inertia = 1e-9
+            youngs_modulus = 2e11
+            [[joints]]
+            type = "clamp"
+            body = "beam"
+            node = "start"
+            [[joints]]
+            type = "pin"
+            a = { body = "beam", node = "end" }
+            b = { body = "link", node = 0 }
+            [[joints]]
+            type = "ground_pin"
+            body = "link"
+            node = "end"
+            [[probes]]
+            name = "mid"
+            body = "link"
+            node = 1
+        "#;
+        let mut models = vec![crate::model::Model::from_text(CLAMPED, "clamped.toml").unwrap()];
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/models");
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.extension().is_some_and(|x| x == "toml") && !path.to_string_lossy().contains("5000") {
+                models.push(crate::model::Model::load(&path).unwrap());
+            }
+        }
+        assert!(models.len() >= 5, "the shipped models were found");
+        for model in &models {
+            let overrides = crate::simulate::Overrides {
+                t_end: Some(3.0 * model.file.time.dt),
+                load_scale: Some(1.1),
+                ..Default::default()
+            };
+            let s = crate::simulate::Settings::resolve(model, &overrides).unwrap();
+            let r = crate::simulate::simulate(model, &overrides).unwrap();
+            assert_eq!(super::RunPlan::of(model, &s), super::RunPlan::of_result(&r), "{}", model.path.display());
+        }
     }
 
     /// Blocks of 3 instants (the last one short) and one block give the transpose, from a

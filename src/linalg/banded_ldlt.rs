@@ -19,7 +19,9 @@
 //! `n b(b+1)/2` multiply-adds against the LU's `n b²` plus its pivot searches. Every pivot
 //! is checked: a coordinate pivot below `PIVOT_RATIO` (1e-8) of its diagonal entry, a constraint
 //! pivot of the wrong sign or below `PIVOT_RATIO · s`, a non-finite one, or blocks that are
-//! not symmetric send that factorization to the band LU with threshold pivoting instead,
+//! not symmetric (checked by `factor`; `factor_symmetric` takes the word of a caller that
+//! builds them symmetric to the bit, as the full system does) send that factorization to
+//! the band LU with threshold pivoting instead,
 //! so nothing is assumed that a matrix does not satisfy (a stiff compressed configuration
 //! can make `S` indefinite).
 
@@ -239,7 +241,11 @@ impl KktSolver for BandedLdlt {
     }
 
     fn factor_symmetric(&mut self, blocks: &[Block], scale: f64) -> Result<(), String> {
-        debug_assert!(blocks.iter().all(exactly_symmetric), "blocks said symmetric are not");
+        // to the bit, NaN included (a diverging state gives NaN entries, built alike)
+        debug_assert!(
+            blocks.iter().all(|b| (0..8).all(|j| (j + 1..8).all(|i| b[(i, j)].to_bits() == b[(j, i)].to_bits()))),
+            "blocks said symmetric are not"
+        );
         self.factor_checked(blocks, scale, false)
     }
 

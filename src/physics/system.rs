@@ -334,12 +334,24 @@ impl FlexibleSystem {
 
     /// `fₑ = Cₑ q̇ₑ + Qₑ(qₑ)` with Rayleigh `Cₑ = a Mₑ + b K_bending,ₑ`.
     fn element_force_vec(&self, e: usize, qe: &Vec8, ve: &Vec8) -> Vec8 {
-        let el = self.element(e);
-        let mut f = el.elastic_force(qe);
+        let mut f = self.element(e).elastic_force(qe);
         if self.damping != Rayleigh::default() {
-            f += (el.mass() * self.damping.mass + el.bending_stiffness() * self.damping.stiffness) * ve;
+            f += self.damping_force(e, ve);
         }
         f
+    }
+
+    /// The Rayleigh damping force `Cₑ q̇ₑ = (a Mₑ + b K_bending,ₑ) q̇ₑ` of element `e`.
+    fn damping_force(&self, e: usize, ve: &Vec8) -> Vec8 {
+        let el = self.element(e);
+        (el.mass() * self.damping.mass + el.bending_stiffness() * self.damping.stiffness) * ve
+    }
+
+    /// `out = −g₀(μ)`: gravity, the fixed part and the scaled part times the load scale.
+    fn gravity_into(&self, mu: &Parameters, out: &mut [f64]) {
+        for (o, (gf, gs)) in out.iter_mut().zip(self.gravity_fixed.iter().zip(&self.gravity_scaled)) {
+            *o = -(gf + mu.load_scale * gs);
+        }
     }
 
     /// `c Cₑ + k Kₑ(qₑ)`.

@@ -290,6 +290,19 @@ impl<'a> EstimatingRunner<'a> {
 
 /// `rel_error` of `a` against `b` over the instants `..k`, for the end of each fifth of
 /// the run: `‖A[:, ..k] − B[:, ..k]‖_F / ‖B[:, ..k]‖_F`.
+/// `‖a − b‖_F` and `‖b‖_F`, summed in the arrays' logical order (rows, then columns)
+/// whatever their memory layout (a full run keeps its coordinates column-major, a reduced
+/// one row-major), so that the same two runs always give the same bits.
+pub fn distance_and_norm(a: &Array2<f64>, b: &Array2<f64>) -> (f64, f64) {
+    assert_eq!(a.dim(), b.dim(), "arrays of one shape");
+    let (mut d, mut n) = (0.0, 0.0);
+    for (x, y) in a.iter().zip(b.iter()) {
+        d += (x - y) * (x - y);
+        n += y * y;
+    }
+    (d.sqrt(), n.sqrt())
+}
+
 pub fn rel_error_by_time(a: &Array2<f64>, b: &Array2<f64>) -> Vec<f64> {
     let nt = b.ncols();
     let (mut diff, mut norm) = (Array1::<f64>::zeros(nt), Array1::<f64>::zeros(nt));
@@ -419,6 +432,27 @@ mod tests {
         let whole = (&q - &qp).mapv(|v| v * v).sum().sqrt() / qp.mapv(|v| v * v).sum().sqrt();
         assert!((by[4] - whole).abs() < 1e-14, "{} vs {whole}", by[4]);
         assert_eq!(by[4], raw_estimate_reduced(&b, &plus, &q, &qp));
+    }
+
+    /// The distance and the norm are the Frobenius ones (3-4-5 numbers), and the same bits
+    /// for row- and column-major copies of the same arrays (the full run keeps q
+    /// column-major, a file or a reduced run row-major).
+    #[test]
+    fn distance_and_norm_do_not_depend_on_the_layout() {
+        let b = ndarray::array![[3.0, 0.0], [0.0, 4.0]];
+        assert_eq!(distance_and_norm(&Array2::zeros((2, 2)), &b), (5.0, 5.0));
+        let b = Array2::from_shape_fn((7, 33), |(i, k)| (0.3 * i as f64 + 0.17 * k as f64).sin() * 1e3);
+        let a = Array2::from_shape_fn((7, 33), |(i, k)| b[[i, k]] + 1e-3 * ((i * k) as f64).cos());
+        let f = |x: &Array2<f64>| {
+            let mut y = Array2::zeros(ndarray::ShapeBuilder::f(x.dim()));
+            y.assign(x);
+            y
+        };
+        let (af, bf) = (f(&a), f(&b));
+        assert!(af.as_slice().is_none() && af.t().as_slice().is_some(), "column-major copy");
+        let bits = |(d, n): (f64, f64)| (d.to_bits(), n.to_bits());
+        assert_eq!(bits(distance_and_norm(&a, &b)), bits(distance_and_norm(&af, &bf)));
+        assert_eq!(bits(distance_and_norm(&a, &b)), bits(distance_and_norm(&af, &b)));
     }
 
     /// rel_error over growing prefixes; the last one is the whole run's.

@@ -90,8 +90,7 @@ pub fn compare(
     variant: &str,
 ) -> Validation {
     let r = &rom.result;
-    let diff = (&r.q - &full.q).mapv(|v| v * v).sum().sqrt();
-    let norm = full.q.mapv(|v| v * v).sum().sqrt();
+    let (diff, norm) = super::estimate::distance_and_norm(&r.q, &full.q);
     let (mut pe, mut pe_name, mut pe_t) = (0.0_f64, String::new(), 0.0);
     for ((name, a), (_, b)) in full.probes.iter().zip(&r.probes) {
         for k in 0..a.nrows() {
@@ -264,8 +263,8 @@ pub fn validate_with(
     let mut v = compare(model, &full, &rom, dense, basis.n_reduced(), basis.variant.name())
         .with_trust(estimate.as_ref(), trust)
         .with_timings(median(&mut full_times), median(&mut rom_times));
-    let norm = full.q.mapv(|x| x * x).sum().sqrt();
-    v.sensitivity = Some((&nearby.q - &full.q).mapv(|x| x * x).sum().sqrt() / norm);
+    let (distance, norm) = super::estimate::distance_and_norm(&nearby.q, &full.q);
+    v.sensitivity = Some(distance / norm);
     Ok((v, full, rom))
 }
 

@@ -25,6 +25,10 @@ pub fn solve_static<M: DynamicModel>(
         model.force(q, &zero, t, &mut rhs[..n]);
         model.add_constraint_force(&lambda, &mut rhs[..n]);
         residual = crate::linalg::vec_ops::max_abs(&rhs[..n]);
+        if !residual.is_finite() {
+            // diverged: no matrix to factor at a NaN or infinite state
+            break;
+        }
         let s = model.factor(q, &zero, t, coef).map_err(|p| Error::LinearSolve { t, problem: p })?;
         let (rq, rc) = rhs.split_at_mut(n);
         rq.iter_mut().for_each(|x| *x = -*x);
@@ -32,6 +36,9 @@ pub fn solve_static<M: DynamicModel>(
         rc.iter_mut().for_each(|x| *x *= -s);
         model.solve(&mut rhs).map_err(|p| Error::LinearSolve { t, problem: p })?;
         inc = crate::linalg::vec_ops::max_abs(&rhs[..n]);
+        if !inc.is_finite() {
+            break;
+        }
         for i in 0..n {
             q[i] += rhs[i];
         }

@@ -107,9 +107,7 @@ impl ParametricModel for FlexibleSystem {
     }
 
     fn force(&mut self, mu: &Parameters, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
-        for (o, (gf, gs)) in out.iter_mut().zip(self.gravity_fixed.iter().zip(&self.gravity_scaled)) {
-            *o = -(gf + mu.load_scale * gs);
-        }
+        self.gravity_into(mu, out);
         for e in 0..self.elements.len() {
             let f = self.element_force_vec(e, &self.gather(e, q), &self.gather(e, v));
             for (i, &d) in self.elements[e].1.iter().enumerate() {
@@ -132,9 +130,7 @@ impl ParametricModel for FlexibleSystem {
         force: &mut [f64],
         inertia: &mut [f64],
     ) {
-        for (o, (gf, gs)) in force.iter_mut().zip(self.gravity_fixed.iter().zip(&self.gravity_scaled)) {
-            *o = -(gf + mu.load_scale * gs);
-        }
+        self.gravity_into(mu, force);
         inertia.iter_mut().for_each(|x| *x = 0.0);
         let damped = self.damping != Rayleigh::default();
         for (e, (b, dofs)) in self.elements.iter().enumerate() {
@@ -144,7 +140,8 @@ impl ParametricModel for FlexibleSystem {
             let ae: &[f64; 8] = a[d0..d0 + 8].try_into().expect("8 consecutive dofs");
             let (mut f, m) = el.force_and_inertia(qe, ae);
             if damped {
-                f = self.element_force_vec(e, &Vec8::from(*qe), &self.gather(e, v)).into();
+                // as element_force_vec: the elastic force, then the damping force added
+                f = (Vec8::from(f) + self.damping_force(e, &self.gather(e, v))).into();
             }
             for (o, fi) in force[d0..d0 + 8].iter_mut().zip(f) {
                 *o += fi;
@@ -213,14 +210,11 @@ impl ParametricModel for FlexibleSystem {
             }
         }
         let scale = if diag_max > 0.0 { diag_max } else { 1.0 };
-        if self.moments.is_empty() {
-            // sums of symmetric element matrices, each entry and its mirror computed alike
-            // (BeamElement::iteration_block_from): symmetric to the bit (a test checks)
-            self.kkt.factor_symmetric(&self.blocks, scale)?;
-        } else {
-            // a moment's Jacobian need not be symmetric: the solver checks
-            self.kkt.factor(&self.blocks, scale)?;
-        }
+        // sums of symmetric element matrices, each entry and its mirror computed alike
+        // (BeamElement::iteration_block_from), plus the moments' Jacobians, whose two
+        // off-diagonal entries are one value (loads::moment_jacobian): symmetric to the bit
+        // (a test checks), so the solver need not check
+        self.kkt.factor_symmetric(&self.blocks, scale)?;
         Ok(scale)
     }
 
@@ -289,14 +283,19 @@ mod tests {
     use super::*;
     use crate::physics::element::Section;
 
-    /// The iteration blocks without moment loads are symmetric to the bit, as
-    /// `factor_symmetric` takes them to be (the band LDLᵀ then skips its check): with and
-    /// without Rayleigh damping, at a strained state, for mass-only and full coefficients.
+    /// The iteration blocks are symmetric to the bit, as `factor_symmetric` takes them to
+    /// be (the band LDLᵀ then skips its check): with and without Rayleigh damping, with a
+    /// moment load (its Jacobian enters two blocks' slope entries), at a strained state,
+    /// for mass-only and full coefficients.
     #[test]
     fn iteration_blocks_are_symmetric_to_the_bit() {
         let section = Section { density: 2700.0, area: 1e-3, inertia: 1e-7, youngs_modulus: 7e9 };
         let body = BeamBody { name: "b".into(), start: [0.0, 0.0], angle: 0.3, length: 1.0, n_elements: 5, section };
-        let gravity = [Load::Gravity { g: [0.0, -9.81], scaled: true }];
+        let gravity = [
+            Load::Gravity { g: [0.0, -9.81], scaled: true },
+            Load::Moment { node: (0, 2), function: TimeFunction::Constant { value: 3.0 }, scaled: true },
+            Load::Moment { node: (0, 5), function: TimeFunction::Constant { value: -1.5 }, scaled: false },
+        ];
         for damping in [Rayleigh::default(), Rayleigh { mass: 0.3, stiffness: 2e-3 }] {
             let mut sys =
                 FlexibleSystem::new(vec![body.clone()], &[], &gravity, vec![], damping, LinearSolverKind::Banded);
