@@ -47,8 +47,7 @@ impl Args {
         let mut runner =
             flexrom::pipeline::estimate::EstimatingRunner::new(&p.model, &stored.basis, trust.estimator.as_ref())?;
         // the result file's fixed part is written on a second thread while the run computes
-        let overrides = flexrom::simulate::Overrides { load_scale: Some(load_scale), ..Default::default() };
-        let plan = RunPlan::of(&p.model, &flexrom::simulate::Settings::resolve(&p.model, &overrides)?);
+        let plan = RunPlan::of(&p.model, &flexrom::pipeline::online::settings_at(&p.model, load_scale)?);
         let model_path = p.model.path.display().to_string();
         let (file, (run, estimate)) = begin_alongside(&output, &p.model.text, &model_path, &plan, || {
             runner

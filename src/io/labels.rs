@@ -130,14 +130,14 @@ pub fn write_labels_of_text_labelled(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::linalg::kkt::LinearSolverKind;
     use crate::solver::model::ParametricModel;
 
     /// A clamp, a pin listed before a ground pin (pins' rows come last): every joint kind
-    /// and the reordering.
-    const CLAMPED: &str = r#"
+    /// and the reordering; and a probe (for tests of result files, io::result_file).
+    pub(crate) const CLAMPED: &str = r#"
         [time]
         t_end = 0.1
         dt = 0.01
@@ -174,6 +174,10 @@ mod tests {
         type = "ground_pin"
         body = "link"
         node = "end"
+        [[probes]]
+        name = "mid"
+        body = "link"
+        node = 1
     "#;
 
     /// The labels name exactly the coordinates each assembled constraint row couples:

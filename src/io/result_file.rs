@@ -22,22 +22,6 @@ use crate::linalg::kkt::LinearSolverKind;
 use crate::simulate::{Settings, SimulationResult};
 use std::path::Path;
 
-pub fn write_result(path: &Path, r: &SimulationResult) -> Result<()> {
-    write_result_with(path, r, |_| Ok(()))
-}
-
-/// Writes the common layout, then lets `extra` add datasets and attributes (reduced runs
-/// add `/reduced/q` ([`write_reduced`]) and the basis they used), all in the same atomic
-/// write; every dataset gets its `units`: those of the common layout as they are created
-/// ([`super::attrs::Labelled`]), the others after `extra` ([`super::attrs::annotate_rest`]).
-pub fn write_result_with(
-    path: &Path,
-    r: &SimulationResult,
-    extra: impl FnOnce(&hdf5::File) -> Result<()>,
-) -> Result<()> {
-    ResultFile::begin(path, &r.model_text, &r.model_path, &RunPlan::of_result(r))?.finish(r, extra)
-}
-
 /// What is known of a run before it runs: the sizes of its arrays (`n_t` instants, `n_dof`
 /// coordinates, `n_c` multipliers, the probes by name) and the settings its file records.
 #[derive(Clone, Debug, PartialEq)]
@@ -58,32 +42,21 @@ impl RunPlan {
     /// and the start, whatever halving a step takes).
     pub fn of(model: &crate::model::Model, s: &Settings) -> RunPlan {
         let z = model.sizes();
-        RunPlan {
-            n_t: s.n_steps + 1,
-            n_dof: z.n_dof as usize,
-            n_c: z.n_constraints as usize,
-            probes: model.probe_names(),
-            ..Self::settings(s)
-        }
+        Self::new(s.n_steps + 1, z.n_dof as usize, z.n_constraints as usize, model.probe_names(), s)
     }
 
     /// The plan a finished run `r` followed.
     pub fn of_result(r: &SimulationResult) -> RunPlan {
-        RunPlan {
-            n_t: r.t.len(),
-            n_dof: r.q.nrows(),
-            n_c: r.multipliers.nrows(),
-            probes: r.probes.iter().map(|p| p.0.clone()).collect(),
-            ..Self::settings(&r.settings)
-        }
+        let probes = r.probes.iter().map(|p| p.0.clone()).collect();
+        Self::new(r.t.len(), r.q.nrows(), r.multipliers.nrows(), probes, &r.settings)
     }
 
-    fn settings(s: &Settings) -> RunPlan {
+    fn new(n_t: usize, n_dof: usize, n_c: usize, probes: Vec<String>, s: &Settings) -> RunPlan {
         RunPlan {
-            n_t: 0,
-            n_dof: 0,
-            n_c: 0,
-            probes: Vec::new(),
+            n_t,
+            n_dof,
+            n_c,
+            probes,
             load_scale: s.load_scale,
             dt: s.dt,
             t_end: s.t_end,
@@ -155,8 +128,10 @@ impl ResultFile {
         })
     }
 
-    /// Writes the run `r`, then `extra`, labels the datasets left, and commits the file
-    /// (`fdatasync`, rename, folder `fsync`). A run of another model or plan than the file
+    /// Writes the run `r`, then lets `extra` add datasets and attributes (reduced runs add
+    /// `/reduced/q` ([`write_reduced`]) and the basis they used), labels the datasets left
+    /// ([`super::attrs::annotate_rest`]), and commits the file (`fdatasync`, rename, folder
+    /// `fsync`). A run of another model or plan than the file
     /// was begun with (a bug: the plan is made from the same model and settings) is not
     /// lost: the begun file is removed and the file written again from the run.
     pub fn finish(self, r: &SimulationResult, extra: impl FnOnce(&hdf5::File) -> Result<()>) -> Result<()> {
@@ -370,49 +345,8 @@ mod tests {
     /// clamp (4 rows), a pin and a ground pin and a probe, over three steps.
     #[test]
     fn the_plan_of_a_model_is_that_of_its_run() {
-        const CLAMPED: &str = r#"
-            [time]
-            t_end = 0.1
-            dt = 0.01
-            rho_inf = 0.8
-            [[bodies]]
-            name = "beam"
-            start = [0.0, 0.0]
-            angle = 0.0
-            length = 1.0
-            elements = 2
-            density = 7800.0
-            area = 1e-4
-            inertia = 1e-9
-            youngs_modulus = 2e11
-            [[bodies]]
-            name = "link"
-            start = [1.0, 0.0]
-            angle = 0.0
-            length = 1.0
-            elements = 3
-            density = 7800.0
-            area = 1e-4
-            inertia = 1e-9
-            youngs_modulus = 2e11
-            [[joints]]
-            type = "clamp"
-            body = "beam"
-            node = "start"
-            [[joints]]
-            type = "pin"
-            a = { body = "beam", node = "end" }
-            b = { body = "link", node = 0 }
-            [[joints]]
-            type = "ground_pin"
-            body = "link"
-            node = "end"
-            [[probes]]
-            name = "mid"
-            body = "link"
-            node = 1
-        "#;
-        let mut models = vec![crate::model::Model::from_text(CLAMPED, "clamped.toml").unwrap()];
+        let clamped = crate::io::labels::tests::CLAMPED;
+        let mut models = vec![crate::model::Model::from_text(clamped, "clamped.toml").unwrap()];
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/models");
         for entry in std::fs::read_dir(&dir).unwrap() {
             let path = entry.unwrap().path();

@@ -58,29 +58,13 @@ pub struct BandedLdlt {
     work: Vec<f64>,
     /// scratch: the diagonal before factoring
     diag: Vec<f64>,
-    /// the band LU, built at the first factorization that needs it (most runs never do)
-    fallback: Fallback,
+    /// the band LU, built from `pattern` at the first factorization that needs it (most
+    /// runs never do)
+    fallback: Option<BandedKkt>,
+    pattern: KktPattern,
     state: Factored,
     /// factorizations that went to the LU (reported by tests)
     pub lu_fallbacks: usize,
-}
-
-/// The LU fallback: its pattern until first needed, then the solver.
-enum Fallback {
-    Pattern(KktPattern),
-    Built(BandedKkt),
-}
-
-impl Fallback {
-    fn solver(&mut self) -> &mut BandedKkt {
-        if let Fallback::Pattern(p) = self {
-            *self = Fallback::Built(BandedKkt::new(std::mem::take(p)));
-        }
-        match self {
-            Fallback::Built(s) => s,
-            Fallback::Pattern(_) => unreachable!("built above"),
-        }
-    }
 }
 
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -149,7 +133,8 @@ impl BandedLdlt {
             is_dof,
             work: vec![0.0; n],
             diag: vec![0.0; n],
-            fallback: Fallback::Pattern(pattern),
+            fallback: None,
+            pattern,
             state: Factored::No,
             lu_fallbacks: 0,
         }
@@ -181,7 +166,8 @@ impl BandedLdlt {
             }
         }
         self.lu_fallbacks += 1;
-        self.fallback.solver().factor(blocks, scale)?;
+        let pattern = &self.pattern;
+        self.fallback.get_or_insert_with(|| BandedKkt::new(pattern.clone())).factor(blocks, scale)?;
         self.state = Factored::Lu;
         Ok(())
     }
@@ -252,7 +238,9 @@ impl KktSolver for BandedLdlt {
     fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {
         match self.state {
             Factored::No => return Err("solve called without a valid factorization".into()),
-            Factored::Lu => return self.fallback.solver().solve(rhs),
+            Factored::Lu => {
+                return self.fallback.as_mut().map_or(Err("the LU fallback was never built".into()), |f| f.solve(rhs))
+            }
             Factored::Ldlt => {}
         }
         let (ab, n, band) = (&self.ab, self.n, self.band);

@@ -7,7 +7,7 @@ use nalgebra::SMatrix;
 pub type Block = SMatrix<f64, 8, 8>;
 
 /// Structure of a KKT system: element dof maps and constraint rows `Σ coef·q[dof]`.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct KktPattern {
     pub n_dof: usize,
     pub element_dofs: Vec<[usize; 8]>,

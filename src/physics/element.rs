@@ -166,16 +166,9 @@ impl BeamElement {
     #[inline]
     pub fn iteration_block(&self, constant: &Mat8, k: f64, e: &Vec8) -> Mat8 {
         let mut out = Mat8::zeros();
-        self.iteration_block_into(constant, k, e, &mut out);
-        out
-    }
-
-    /// [`Self::iteration_block`] written into `out` (the system's block of the element: no
-    /// 512-byte copy per element and factorization).
-    #[inline(always)]
-    pub fn iteration_block_into(&self, constant: &Mat8, k: f64, e: &Vec8, out: &mut Mat8) {
         let (sle, a, b) = self.iteration_scalars(k, e);
-        self.iteration_block_from(constant, &sle, a, b, out);
+        self.iteration_block_from(constant, &sle, a, b, &mut out);
+        out
     }
 
     /// The state-dependent part of [`Self::iteration_block`]: `S_l e`, `a = k EA ε̄` and

@@ -117,7 +117,7 @@ impl<'a> ReducedRunner<'a> {
     /// keeps its projected loads unscaled), so runs at any sequence of parameters give
     /// what fresh models give.
     pub fn solve(&mut self, mu: &Parameters, output: Output, previous: &[&ReducedRun]) -> Result<ReducedRun> {
-        let s = Settings::resolve(self.model, &Overrides { load_scale: Some(mu.load_scale), ..Default::default() })?;
+        let s = settings_at(self.model, mu.load_scale)?;
         let previous = &previous[previous.len().saturating_sub(2)..];
         let (model, basis, x0) = (self.model, self.basis, &self.x0[..]);
         let result = match &mut self.rom {
@@ -126,6 +126,12 @@ impl<'a> ReducedRunner<'a> {
         };
         result.map_err(|e| crate::reduction::whole_system::explain_failure(e, basis.variant, mu.load_scale))
     }
+}
+
+/// The settings of a reduced run of `model` at `load_scale`: the model file's time
+/// settings at that load scale (what `online` plans its result file from, before the run).
+pub fn settings_at(model: &Model, load_scale: f64) -> Result<Settings> {
+    Settings::resolve(model, &Overrides { load_scale: Some(load_scale), ..Default::default() })
 }
 
 /// Refuses `runs` reduced runs of `r` coordinates over `n_steps` whose kept arrays would

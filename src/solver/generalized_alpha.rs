@@ -361,7 +361,8 @@ mod tests {
     /// for the round-off of a residual summed from large terms that cancel (chaotic in q, of
     /// size A). With `stale` ≠ 1 the factorization goes stale when kept: the first solve
     /// after each `factor` uses the exact tangent, later ones a tangent `stale` times too
-    /// stiff (a kept matrix contracting at θ = 1 − 1/stale, like one from far back).
+    /// stiff (a kept matrix contracting at θ = 1 − 1/stale, like one from far back). With
+    /// `nan_below` the force is NaN for q below it (a force undefined there).
     struct Spring {
         k: f64,
         c: f64,
@@ -369,6 +370,7 @@ mod tests {
         stale: f64,
         s: f64,
         fresh: bool,
+        nan_below: f64,
     }
 
     impl DynamicModel for Spring {
@@ -383,6 +385,9 @@ mod tests {
         }
         fn force(&mut self, q: &[f64], _v: &[f64], _t: f64, out: &mut [f64]) {
             out[0] = self.k * q[0] + self.c * q[0].powi(3) + self.noise * (1e12 * q[0]).sin();
+            if q[0] < self.nan_below {
+                out[0] = f64::NAN;
+            }
         }
         fn constraint_residual(&self, _q: &[f64], _out: &mut [f64]) {}
         fn add_constraint_force(&self, _lambda: &[f64], _out: &mut [f64]) {}
@@ -423,42 +428,7 @@ mod tests {
     /// read 0 and the NaN state was accepted.
     #[test]
     fn a_nan_residual_fails_the_step() {
-        struct Undefined(Spring);
-        impl DynamicModel for Undefined {
-            fn n_dof(&self) -> usize {
-                1
-            }
-            fn n_constraints(&self) -> usize {
-                0
-            }
-            fn mass_mul(&self, a: &[f64], out: &mut [f64]) {
-                self.0.mass_mul(a, out)
-            }
-            fn force(&mut self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
-                self.0.force(q, v, t, out);
-                if q[0] < 0.0 {
-                    out[0] = f64::NAN;
-                }
-            }
-            fn constraint_residual(&self, _q: &[f64], _out: &mut [f64]) {}
-            fn add_constraint_force(&self, _lambda: &[f64], _out: &mut [f64]) {}
-            fn factor(
-                &mut self,
-                q: &[f64],
-                v: &[f64],
-                t: f64,
-                c: IterationCoefficients,
-            ) -> std::result::Result<f64, String> {
-                self.0.factor(q, v, t, c)
-            }
-            fn solve(&mut self, rhs: &mut [f64]) -> std::result::Result<(), String> {
-                self.0.solve(rhs)
-            }
-            fn length_scale(&self) -> f64 {
-                1.0
-            }
-        }
-        let mut m = Undefined(Spring { k: 100.0, c: 0.0, noise: 0.0, stale: 1.0, s: 1.0, fresh: false });
+        let mut m = Spring { k: 100.0, c: 0.0, noise: 0.0, stale: 1.0, s: 1.0, fresh: false, nan_below: 0.0 };
         let mut integ = GeneralizedAlpha::new(IntegratorParams { max_cuts: 2, ..IntegratorParams::default() }).unwrap();
         let mut st = integ.initialize(&mut m, vec![0.5], vec![0.0], 0.0).unwrap();
         // q = 0.5 cos(10 t) reaches 0 at t ≈ 0.157: a step ends there or later
@@ -482,7 +452,8 @@ mod tests {
     #[test]
     fn a_stale_kept_matrix_is_refreshed_not_taken_for_the_floor() {
         for reuse in [JacobianReuse::WithinStep, JacobianReuse::Never] {
-            let spring = Spring { k: 100.0, c: 1e4, noise: 0.0, stale: 2.5, s: 1.0, fresh: false };
+            let spring =
+                Spring { k: 100.0, c: 1e4, noise: 0.0, stale: 2.5, s: 1.0, fresh: false, nan_below: f64::NEG_INFINITY };
             let (_, stats) = run(spring, 0.5, 0.05, IntegratorParams { reuse, ..IntegratorParams::default() });
             assert_eq!((stats.steps_at_round_off, stats.step_cuts), (0, 0), "{reuse:?}: {stats:?}");
             if reuse == JacobianReuse::WithinStep {
@@ -499,7 +470,8 @@ mod tests {
     #[test]
     fn stagnation_at_the_round_off_floor_is_accepted() {
         let run = |noise: f64, stagnation: f64| {
-            let spring = Spring { k: 100.0, c: 0.0, noise, stale: 1.0, s: 1.0, fresh: false };
+            let spring =
+                Spring { k: 100.0, c: 0.0, noise, stale: 1.0, s: 1.0, fresh: false, nan_below: f64::NEG_INFINITY };
             run(spring, 1.0, 0.01, IntegratorParams { stagnation, ..IntegratorParams::default() })
         };
         let (exact, clean) = run(0.0, 1e-6);

@@ -239,7 +239,8 @@ impl ParametricModel for FlexibleSystem {
     }
 }
 
-/// The element blocks of the iteration matrix (`BeamElement::iteration_block_into`) at
+/// The element blocks of the iteration matrix (`BeamElement::iteration_block`, written
+/// into the system's blocks: no 512-byte copy per element and factorization) at
 /// `q`, and the largest diagonal entry, as a kernel for [`crate::linalg::simd::dispatch`]:
 /// the same operations in the same order on every instruction set.
 struct IterationBlocks<'a> {
