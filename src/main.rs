@@ -254,3 +254,27 @@ fn run(cli: Cli) -> flexrom::Result<()> {
         Command::Demo(a) => a.run(),
     }
 }
+
+/// Sets `OPENBLAS_NUM_THREADS=1` unless the user set it, before OpenBLAS's constructor runs.
+///
+/// OpenBLAS is linked statically (build.rs), so its constructor `gotoblas_init` runs before
+/// `main`, reads this variable, and without it starts one worker thread per extra core, which
+/// costs ~0.5 ms of a 2 ms start on a busy machine (thread start, and a join at exit).
+/// `gotoblas_init` sits in the plain `.init_array`; GNU ld places the prioritized
+/// `.init_array.NNNNN` sections before it (sorted by priority; 101 is the first one not
+/// reserved for the C runtime), and libc is initialized before any of them, so the variable
+/// set here stays set (in `.preinit_array` it would not: libc resets `environ` after it).
+/// It lives in the binary, not the library: a process that loads the library for other
+/// reasons (a Python interpreter with numpy's own OpenBLAS, say) has threads of its own,
+/// and setting the environment there is not sound; such a process calls
+/// [`flexrom::single_threaded_blas`] instead.
+#[used]
+#[link_section = ".init_array.00101"]
+static BLAS_ONE_THREAD_AT_START: extern "C" fn() = blas_one_thread_at_start;
+
+extern "C" fn blas_one_thread_at_start() {
+    if std::env::var_os("OPENBLAS_NUM_THREADS").is_none() {
+        // the process is still single-threaded here, which set_var requires
+        std::env::set_var("OPENBLAS_NUM_THREADS", "1");
+    }
+}

@@ -86,23 +86,20 @@ pub struct SimulationResult {
 
 /// The one solve of every run, full or reduced (`simulate`, `online`, `sweep`, `validate`,
 /// greedy training and the error estimate all come here): integrates `model` at the
-/// parameters `mu` over `n_steps` steps of `dt` from `q0` at rest, with the optional
-/// increment guess of [`integrate_guided`], calling `record` at t₀ and after every step.
-/// The model is not changed by the parameters: the same model runs at λ₁, λ₂, λ₁ and gives
-/// what three fresh models give (tests/parameters.rs).
-#[allow(clippy::too_many_arguments)]
+/// settings' parameters over its `n_steps` steps of `dt` from `q0` at rest, with the
+/// optional increment guess of [`integrate_guided`], calling `record` at t₀ and after every
+/// step. The model is not changed by the parameters: the same model runs at λ₁, λ₂, λ₁ and
+/// gives what three fresh models give (tests/parameters.rs).
 pub fn solve<M: ParametricModel + ?Sized>(
     model: &mut M,
-    mu: &Parameters,
-    params: &IntegratorParams,
+    s: &Settings,
     q0: Vec<f64>,
-    dt: f64,
-    n_steps: usize,
     guess: impl FnMut(usize, &mut [f64]) -> bool,
     record: impl FnMut(usize, &State),
 ) -> Result<Stats> {
+    let mu = s.parameters();
     mu.validate()?;
-    integrate_guided(&mut Bound::new(model, mu), params, q0, dt, n_steps, guess, record)
+    integrate_guided(&mut Bound::new(model, &mu), &s.params, q0, s.dt, s.n_steps, guess, record)
 }
 
 /// Integrates any [`DynamicModel`] (a model bound to its parameters) over `n_steps` steps
@@ -272,11 +269,8 @@ fn run_full(model: &Model, sys: &mut FlexibleSystem, q0: Vec<f64>, s: Settings) 
     // the probes are evaluated after the loop, from the stored coordinates
     let stats = solve(
         sys,
-        &s.parameters(),
-        &s.params,
+        &s,
         q0,
-        s.dt,
-        s.n_steps,
         |_, _| false,
         |k, st| {
             t[k] = st.t;

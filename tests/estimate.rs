@@ -15,7 +15,7 @@
 //!   instants), and bounds `rel_error_by_time` fifth by fifth at all three loads, as the
 //!   whole-run estimate bounds rel_error (the "good to 1e-3 up to 0.7 s" question).
 //!   The prefix values are ratios of two growing sums and need not be monotone; the unit
-//!   test in src/pipeline/estimate.rs checks the case where they must be (a growing error).
+//!   test in src/rom/estimator/norms.rs checks the case where they must be (a growing error).
 //! - `every_estimate_method_bounds_the_error_at_held_out_loads`: the same held-out loads with
 //!   `[online] estimate = "defects"` (the cheap option) and `"corrected"` (the default):
 //!   estimate ≥ rel_error and effectivity ≤ 30 for both (the targets), and the

@@ -1,11 +1,12 @@
 //! `flexrom sweep`: reduced runs at many load scales into one sweep file and a table
 //! (optionally one shard of the list, resumed, or validated).
 
-use super::{print_table, FormatArgs};
+use super::{print_table, warn, FormatArgs};
 use flexrom::io::output::{check_output, check_report_dir, claim_in_report, Origin};
 use flexrom::output::table::Format;
 use flexrom::output::{self, info};
-use flexrom::pipeline::online::load_basis;
+use flexrom::pipeline::online::load_rom;
+use flexrom::pipeline::sweep::SweepFile;
 use flexrom::pipeline::Pipeline;
 use std::path::PathBuf;
 
@@ -92,42 +93,20 @@ impl Args {
         } else {
             check_output(&out, Origin::Flag("-o"), &inputs)?;
         }
-        let stored = load_basis(&p, &path)?;
+        if no_estimate && strict {
+            return Err(flexrom::Error::Usage("--strict needs the error estimate; drop --no-estimate".into()));
+        }
+        let (stored, rom, warnings) = load_rom(&p, &path, None, no_estimate)?;
+        warn(&warnings);
         let options =
             flexrom::pipeline::sweep::SweepOptions { validate, continuation, progress: output::show_progress() };
-        let mut trust = flexrom::pipeline::estimate::load_trust(&p, &path, &stored)?;
-        if no_estimate {
-            if strict {
-                return Err(flexrom::Error::Usage("--strict needs the error estimate; drop --no-estimate".into()));
-            }
-            trust.estimator = None;
-            trust.skipped = true;
-        }
         if in_report {
             claim_in_report(&p.report_dir, &p.path, "sweep.h5")?;
         }
+        let file = SweepFile { stored: &stored, basis_path: &path, out: &out, resume, extra: &|_| Ok(()) };
         let sw = match shard {
-            Some(k) => flexrom::pipeline::shard::sweep_shard(
-                &p,
-                &stored,
-                Some(&trust),
-                &path,
-                &scales,
-                k,
-                options,
-                &out,
-                resume,
-            )?,
-            None => flexrom::pipeline::sweep::sweep_to_file(
-                &p.model,
-                &stored,
-                Some(&trust),
-                &path,
-                &scales,
-                options,
-                &out,
-                resume,
-            )?,
+            Some(k) => flexrom::pipeline::shard::sweep_shard(&p, &rom, &scales, k, options, file)?,
+            None => flexrom::pipeline::sweep::sweep_to_file(&rom, &scales, options, file)?,
         };
         match format.format() {
             Format::Text => output::print(&flexrom::pipeline::sweep::table(&sw))?,
@@ -155,6 +134,6 @@ impl Args {
             .filter_map(|x| x.point())
             .map(|q| (q.rom.result.settings.load_scale, q.estimate.map(|e| e.error_estimate)))
             .collect();
-        flexrom::pipeline::estimate::check_runs(&trust, &runs, strict)
+        super::check_runs(&rom, &runs, strict)
     }
 }

@@ -1,9 +1,9 @@
 //! `flexrom validate`: full and reduced runs at one load scale, compared.
 
-use super::{check_scale, DenseArgs, FormatArgs};
+use super::{check_scale, warn, DenseArgs, FormatArgs};
 use flexrom::output::table::{Format, Table};
 use flexrom::output::{self};
-use flexrom::pipeline::online::load_basis;
+use flexrom::pipeline::online::load_rom;
 use flexrom::pipeline::Pipeline;
 use std::path::PathBuf;
 
@@ -34,11 +34,10 @@ impl Args {
         let p = Pipeline::load(&pipeline)?;
         check_scale(load_scale)?;
         let path = basis.unwrap_or_else(|| p.basis_path.clone());
-        let stored = load_basis(&p, &path)?;
-        let trust = flexrom::pipeline::estimate::load_trust(&p, &path, &stored)?;
+        let (_, rom, warnings) = load_rom(&p, &path, None, false)?;
+        warn(&warnings);
         let with_dense = flexrom::pipeline::dense::decide(dense.choice(), &p.model)?;
-        let (v, _, _) =
-            flexrom::pipeline::validate::validate_with(&p.model, &stored.basis, Some(&trust), load_scale, with_dense)?;
+        let (v, _, _) = flexrom::pipeline::validate::validate(&rom, load_scale, with_dense)?;
         match format.format() {
             // the record as serde writes it (arrays stay arrays): the keys scripts read
             Format::Json => {
@@ -49,6 +48,6 @@ impl Args {
             Format::Csv => output::print(&Table::from_record(&v)?.to_csv()?)?,
             Format::Text => output::println(&v.describe())?,
         }
-        flexrom::pipeline::estimate::check_runs(&trust, &[(load_scale, v.error_estimate)], strict)
+        super::check_runs(&rom, &[(load_scale, v.error_estimate)], strict)
     }
 }

@@ -88,7 +88,7 @@ const RESULT: [Entry; 5] = [
     ("reduced/q", REDUCED_UNITS, "time, mode"),
 ];
 
-const BASIS: [Entry; 42] = [
+const BASIS: [Entry; 43] = [
     ("snapshots", COORDINATE_UNITS, "dof, snapshot"),
     ("snapshot_multipliers", MULTIPLIER_UNITS, "constraint, snapshot"),
     ("snapshot_load_scale", "1", "snapshot"),
@@ -131,6 +131,7 @@ const BASIS: [Entry; 42] = [
     ("training/whole_run_estimates", "1", "iteration, candidate"),
     ("training/sensitivity", "1", "iteration, candidate"),
     ("training/true_score", "1", "iteration"),
+    ("training/held_out_effectivity", "1", "iteration"),
 ];
 
 const SWEEP: [Entry; 21] = [
@@ -144,7 +145,7 @@ const SWEEP: [Entry; 21] = [
     ("newton_iterations", "1", "load"),
     ("factorizations", "1", "load"),
     ("error_estimate", "1", "load"),
-    // the estimate per fifth of the run (issue 15)
+    // the estimate per fifth of the run
     ("error_estimate_by_time", "1", "load, fifth"),
     ("estimate_seconds", "s", "load"),
     ("extrapolated", "1", "load"),

@@ -44,7 +44,7 @@ pub struct Pipeline {
     pub path: PathBuf,
     pub text: String,
     pub file: PipelineFile,
-    pub model: Model,
+    pub model: std::sync::Arc<Model>,
     pub basis_path: PathBuf,
     pub report_dir: PathBuf,
 }
@@ -63,7 +63,14 @@ impl Pipeline {
         let basis_path =
             dir.join(file.basis.clone().unwrap_or_else(|| PathBuf::from(format!("../data/bases/{stem}.h5"))));
         let report_dir = dir.join(file.report.clone().unwrap_or_else(|| PathBuf::from(format!("../reports/{stem}"))));
-        let p = Pipeline { path: path.to_path_buf(), text, file, model, basis_path, report_dir };
+        let p = Pipeline {
+            path: path.to_path_buf(),
+            text,
+            file,
+            model: std::sync::Arc::new(model),
+            basis_path,
+            report_dir,
+        };
         p.check()?;
         Ok(p)
     }

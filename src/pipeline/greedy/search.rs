@@ -8,9 +8,10 @@ use crate::error::{Error, Result};
 use crate::io::basis_file::TrainingData;
 use crate::pipeline::basis_build::build_basis;
 use crate::pipeline::config::{GreedySpec, Pipeline};
-use crate::pipeline::estimate::{calibrate, CalibrationPoint, Estimator, DEFAULT_EXTRA_MODES};
 use crate::pipeline::training_record::modes_text;
 use crate::reduction::{ModeRule, Trained};
+use crate::rom::estimator::training::{calibrate, CalibrationPoint, Estimator};
+use crate::rom::estimator::{ByFifth, EstimateMethod, FIFTHS};
 
 /// Energy tolerances ε tried, loose to tight: 10⁻², 10⁻³, …, 10⁻¹⁰.
 pub const ENERGY_LADDER: [f64; 9] = [1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10];
@@ -29,8 +30,8 @@ pub(super) struct Level {
     pub(super) estimates: Vec<f64>,
     pub(super) whole: Vec<f64>,
     pub(super) raws: Vec<f64>,
-    pub(super) sensitivity: Vec<[f64; 5]>,
-    /// the estimator got its `k` extra modes in every block
+    pub(super) sensitivity: Vec<ByFifth>,
+    /// the estimator's basis is richer than the basis in every block
     fully_enriched: bool,
 }
 
@@ -59,26 +60,31 @@ impl Level {
     }
 }
 
+/// What one iteration of the loop searches with: the pipeline, the snapshots so far, the
+/// candidate loads, the held-out calibration pairs so far, and the iteration's number.
+pub(super) struct Round<'a> {
+    pub(super) p: &'a Pipeline,
+    pub(super) data: &'a TrainingData,
+    pub(super) candidates: &'a [f64],
+    pub(super) points: &'a [CalibrationPoint],
+    pub(super) n: usize,
+    /// the estimate the candidates are read with
+    pub(super) method: EstimateMethod,
+}
+
 /// The mode and hyper-reduction search of one iteration (the greedy module documentation): the modes
 /// the pipeline gives, or the energy ladder loose → tight with τ = √ε (and a half step
 /// before the first accepted rung); then, unless the pipeline gives τ, the loosest τ that
 /// still meets T with those modes (the fewest sampled elements: the cheapest reduced run).
-pub(super) fn search(
-    p: &Pipeline,
-    g: &GreedySpec,
-    data: &TrainingData,
-    candidates: &[f64],
-    points: &[CalibrationPoint],
-    n: usize,
-    previous_energy: Option<f64>,
-) -> Result<Level> {
+pub(super) fn search(r: &Round, g: &GreedySpec, previous_energy: Option<f64>) -> Result<Level> {
+    let (p, candidates, n) = (r.p, r.candidates, r.n);
     let given_hyper = p.file.reduction.hyper.as_ref().map(|h| h.tolerance);
     let debug = std::env::var_os("FLEXROM_GREEDY_DEBUG").is_some();
     // what the tolerance promises is every load of the range, not the candidates alone
     let accepts = |l: &Level| l.between_candidates() <= g.tolerance;
     let mut last_error: Option<(&'static str, String)> = None;
     let mut attempt = |modes: ModeRule, eps: f64, tau: f64| -> Option<Level> {
-        match level(p, data, candidates, points, modes, eps, Some(tau), n) {
+        match level(r, modes, eps, Some(tau)) {
             Ok(l) => {
                 if debug {
                     let (wi, w) = l.worst();
@@ -190,29 +196,45 @@ pub(crate) fn between_candidates(e: &[f64]) -> f64 {
 }
 
 /// Builds the basis and estimator of one rung and estimates at every candidate.
-#[allow(clippy::too_many_arguments)]
 fn level(
-    p: &Pipeline,
-    data: &TrainingData,
-    candidates: &[f64],
-    points: &[CalibrationPoint],
+    r: &Round,
     modes: ModeRule,
     energy: f64,
     hyper_tolerance: Option<f64>,
-    n: usize,
 ) -> std::result::Result<Level, (&'static str, String)> {
+    let Round { p, data, candidates, points, n, method } = *r;
     let (trained, mut estimator) = build_basis(p, data, modes, hyper_tolerance)?;
     estimator.calibration = calibrate(points.to_vec());
-    let fully_enriched =
-        estimator.block_modes.iter().zip(&trained.block_modes).all(|(&e, &r)| e >= r + DEFAULT_EXTRA_MODES);
+    // a block whose snapshots span no more than the basis already holds leaves the estimator
+    // nothing richer to compare with there; a block with fewer than `k` more (a stiff body:
+    // its snapshots have low rank) is enriched by all it has
+    let fully_enriched = estimator.block_modes.iter().zip(&trained.block_modes).all(|(&e, &r)| e > r);
     let label =
         if energy.is_finite() { format!("iteration {n}, energy {energy:.0e}") } else { format!("iteration {n}") };
-    let runs = estimate_candidates(&p.model, &trained.basis, &estimator, candidates, &label);
-    let estimates = runs.iter().map(|r| score(p_tolerance(p), &r.by_time, &r.sensitivity)).collect();
-    let whole = runs.iter().map(|r| r.by_time[4]).collect();
-    let raws = runs.iter().map(|r| r.raw).collect();
-    let sensitivity = runs.iter().map(|r| r.sensitivity).collect();
-    Ok(Level { energy, hyper_tolerance, trained, estimator, estimates, whole, raws, sensitivity, fully_enriched })
+    let mut l = Level {
+        energy,
+        hyper_tolerance,
+        trained,
+        estimator,
+        estimates: Vec::new(),
+        whole: Vec::new(),
+        raws: Vec::new(),
+        sensitivity: Vec::new(),
+        fully_enriched,
+    };
+    l.estimate(p, candidates, &label, method);
+    Ok(l)
+}
+
+impl Level {
+    /// The estimates, scores and sensitivities at the candidates, with `method`.
+    pub(super) fn estimate(&mut self, p: &Pipeline, candidates: &[f64], label: &str, method: EstimateMethod) {
+        let runs = estimate_candidates(&p.model, &self.trained.basis, &self.estimator, candidates, label, method);
+        self.estimates = runs.iter().map(|r| score(p_tolerance(p), &r.by_time, &r.sensitivity)).collect();
+        self.whole = runs.iter().map(|r| r.by_time[FIFTHS - 1]).collect();
+        self.raws = runs.iter().map(|r| r.raw).collect();
+        self.sensitivity = runs.iter().map(|r| r.sensitivity).collect();
+    }
 }
 
 /// The greedy tolerance of the pipeline (`[train] greedy`).

@@ -1,9 +1,9 @@
 //! What a sweep produced: the outcome of every load scale (done, failed, not run yet), the
 //! status codes of the sweep file's `/status`, and the one-line summary of the failures.
 
-use crate::pipeline::estimate::Estimate;
-use crate::pipeline::online::ReducedRun;
 use crate::pipeline::validate::Validation;
+use crate::rom::estimator::Estimate;
+use crate::rom::ReducedRun;
 use ndarray::Array1;
 
 /// Status codes of `/status`.
