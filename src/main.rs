@@ -50,19 +50,19 @@ struct Cli {
     verbose: bool,
     /// memory bound for a stage's big arrays, e.g. 8G, 512M (default: env
     /// FLEXROM_MAX_MEMORY, else half of the machine's memory)
-    #[arg(long, global = true, value_name = "SIZE")]
+    #[arg(long, global = true, value_name = "SIZE", allow_negative_numbers = true)]
     max_memory: Option<String>,
     /// most time steps a run may take (default: env FLEXROM_MAX_STEPS, else 10000000)
-    #[arg(long, global = true, value_name = "N")]
+    #[arg(long, global = true, value_name = "N", allow_negative_numbers = true)]
     max_steps: Option<String>,
     /// most elements a model may have (default: env FLEXROM_MAX_ELEMENTS, else 200000)
-    #[arg(long, global = true, value_name = "N")]
+    #[arg(long, global = true, value_name = "N", allow_negative_numbers = true)]
     max_elements: Option<String>,
     /// a run whose strain or step cuts leave plausible bounds warns instead of failing
     #[arg(long, global = true)]
     allow_blowup: bool,
     /// worker threads (default: env RAYON_NUM_THREADS, else SLURM_CPUS_PER_TASK, else one per core)
-    #[arg(long, global = true, value_name = "N")]
+    #[arg(long, global = true, value_name = "N", allow_negative_numbers = true)]
     threads: Option<usize>,
 }
 
@@ -74,8 +74,10 @@ enum Command {
   flexrom simulate data/models/pendulum.toml -o out/pendulum.h5
   flexrom simulate data/models/fourbar.toml -o fourbar.h5 --t-end 0.5 --solver sparse
   flexrom simulate data/models/pendulum.toml -o p.h5 --load-scale 1.2 --csv > probes.csv
+  flexrom simulate data/models/pendulum.toml --load-scale -1 --csv > reversed.csv   no file
 
---csv/--json print every probe's position at every step: columns t (s), NAME_x, NAME_y (m).
+--csv/--json print every probe's position at every step: columns t (s), NAME_x, NAME_y (m);
+with either, -o may be left out (nothing is written then).
 
 ",
         exit_codes!()
@@ -188,11 +190,10 @@ fn main() -> ExitCode {
             let _ = e.print();
             return ExitCode::SUCCESS;
         }
-        // a usage error in two lines: clap's first (what is wrong), and where to look
+        // a usage error as clap words it: what is wrong (the argument named, a "did you
+        // mean" tip for a misspelt one), the usage line and where to read more; even under -q
         Err(e) => {
-            let text = e.render().to_string();
-            note(text.lines().find(|l| !l.trim().is_empty()).unwrap_or("error: bad arguments"));
-            note("run `flexrom --help` (or `flexrom <command> --help`) for usage");
+            let _ = e.print();
             return ExitCode::from(2);
         }
     };

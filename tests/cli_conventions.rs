@@ -155,6 +155,82 @@ fn every_result_prints_as_csv_and_json() {
 
     // --csv and --json together are a usage error (exit 2)
     assert_eq!(flexrom(&["demo", s(&model), "--csv", "--json"]).status.code(), Some(2));
+
+    // negative load scales are values, not flags: a sweep over reversed loads
+    let neg = dir.join("sweep/neg.h5");
+    let j = json(&ok(&["sweep", &p, "--load-scales", "-1.1:-0.9:3", "-o", s(&neg), "--json", "--no-estimate"]));
+    let scales: Vec<f64> = j.as_array().unwrap().iter().map(|r| r["load_scale"].as_f64().unwrap()).collect();
+    assert_eq!(scales, [-1.1, -1.0, -0.9]);
+}
+
+/// A command line clap cannot parse gets clap's whole message on stderr, exit 2: the
+/// missing arguments named, the usage line, a "did you mean" tip for a misspelt flag.
+#[test]
+fn parse_errors_show_the_whole_clap_message() {
+    let model = root().join("data/models/pendulum.toml");
+    let pipeline = root().join("pipelines/pendulum.toml");
+    let cases: [(&[&str], &[&str]); 4] = [
+        (
+            &["simulate", s(&model)],
+            &["required arguments were not provided", "--output <OUTPUT>", "Usage: flexrom simulate"],
+        ),
+        (&["online", s(&pipeline)], &["--load-scale <LOAD_SCALE>", "--output <OUTPUT>", "Usage: flexrom online"]),
+        (
+            &["sweep", s(&pipeline), "--loadscales", "1:2:3"],
+            &["'--loadscales'", "tip: a similar argument exists: '--load-scales'", "Usage: flexrom sweep"],
+        ),
+        (&["simulate", s(&model), "-o", "x.h5", "--threads", "-1"], &["invalid value '-1' for '--threads <N>'"]),
+    ];
+    for (args, needles) in cases {
+        let o = flexrom(args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.starts_with("error: ") && err.contains("For more information, try '--help'."), "{args:?}: {err}");
+        for n in needles {
+            assert!(err.contains(n), "{args:?}: `{n}` not in:\n{err}");
+        }
+    }
+}
+
+/// Negative numbers are values wherever a number is expected. The shipped pendulum starts on
+/// the x axis under gravity alone (its only scaled load), so λ = −1 (gravity up) is the
+/// mirror image of λ = 1 about that axis: the same tip x, the opposite tip y (to round-off;
+/// mirroring flips the sign of every y term). A negative time step reaches the model's own
+/// check (exit 1, naming the option), not the parser.
+#[test]
+fn negative_numbers_are_values() {
+    let model = root().join("data/models/pendulum.toml");
+    let run = |x: &str| {
+        let (_, rows) = csv_rows(&ok(&["simulate", s(&model), "--t-end", "0.05", "--load-scale", x, "--csv"]));
+        let last = rows.last().unwrap().iter().map(|c| c.parse::<f64>().unwrap()).collect::<Vec<_>>();
+        (last[1], last[2])
+    };
+    let ((x1, y1), (xm, ym)) = (run("1"), run("-1"));
+    assert!(y1 < -1e-3, "the tip falls at λ = 1: {y1}");
+    assert!((xm - x1).abs() <= 1e-12 && (ym + y1).abs() <= 1e-12, "({x1}, {y1}) against ({xm}, {ym})");
+    let o = flexrom(&["simulate", s(&model), "--dt", "-0.005", "--csv"]);
+    assert_eq!(o.status.code(), Some(1), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("dt"), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+/// `simulate --csv` (or `--json`) without `-o` prints the probes on stdout and writes no file;
+/// the CSV is the one a run with `-o` prints.
+#[test]
+fn simulate_prints_without_a_result_file() {
+    let d = tempfile::tempdir().unwrap();
+    let model = root().join("data/models/pendulum.toml");
+    let run = |extra: &[&str]| {
+        let mut args = vec!["simulate", s(&model), "--t-end", "0.02"];
+        args.extend(extra);
+        let o = Command::new(env!("CARGO_BIN_EXE_flexrom")).args(&args).current_dir(d.path()).output().unwrap();
+        assert!(o.status.success(), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
+        o.stdout
+    };
+    let csv = run(&["--csv"]);
+    let json = run(&["--json"]);
+    assert_eq!(std::fs::read_dir(d.path()).unwrap().count(), 0, "no file written");
+    assert_eq!(csv, run(&["--csv", "-o", "r.h5"]), "the same rows as with a result file");
+    assert_eq!(serde_json::from_slice::<serde_json::Value>(&json).unwrap().as_array().unwrap().len(), 5);
 }
 
 #[test]
