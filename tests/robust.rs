@@ -105,6 +105,41 @@ fn errors_inside_array_of_tables_entries_name_the_key_and_its_line() {
     assert!(err.contains(&format!("loads[0].type (line {line})")), "{err}");
 }
 
+/// An error inside a nested table of an entry (the four-bar's piecewise crank moment, a pin's
+/// `a`) names the whole path and the offending key's own line, not the line where the entry
+/// or its table opens.
+#[test]
+fn errors_in_nested_tables_point_at_the_key() {
+    let fourbar = std::fs::read_to_string(root().join("data/models/fourbar.toml")).unwrap();
+    let line_of = |text: &str, needle: &str| text.lines().position(|l| l.contains(needle)).unwrap() + 1;
+    let err = |text: &str| flexrom::model::Model::from_text(text, "m.toml").unwrap_err().to_string();
+    // the second piece's function as a table of its own, its amplitude a word
+    let text = fourbar.replace(
+        "[[loads.function.pieces]]\nfunction = { type = \"exponential\", amplitude = 465.9, rate = -16.32 }",
+        "[[loads.function.pieces]]\n[loads.function.pieces.function]\ntype = \"exponential\"\nrate = -16.32\namplitude = \"ten\"",
+    );
+    assert_ne!(text, fourbar);
+    let e = err(&text);
+    let want =
+        format!("loads[1].function.pieces[1].function.amplitude (line {})", line_of(&text, "amplitude = \"ten\""));
+    assert!(e.contains(&want) && e.contains("expected f64"), "want `{want}` in: {e}");
+    // the first piece's inline function
+    let text = fourbar.replace("amplitude = 10.0, frequency", "amplitude = \"ten\", frequency");
+    let e = err(&text);
+    let want = format!("loads[1].function.pieces[0].function.amplitude (line {})", line_of(&text, "\"ten\""));
+    assert!(e.contains(&want), "want `{want}` in: {e}");
+    // an unknown key in the table `[loads.function]` opens
+    let text = fourbar.replace("type = \"piecewise\"", "type = \"piecewise\"\nsteps = 3");
+    let e = err(&text);
+    let want = format!("loads[1].function.steps (line {})", line_of(&text, "steps = 3"));
+    assert!(e.contains(&want) && e.contains("unknown field"), "want `{want}` in: {e}");
+    // a pin's inline node reference
+    let text = fourbar.replace("a = { body = \"coupler\", node = \"end\" }", "a = { body = \"coupler\", node = 1.5 }");
+    let e = err(&text);
+    let want = format!("joints[2].a.node (line {})", line_of(&text, "node = 1.5"));
+    assert!(e.contains(&want), "want `{want}` in: {e}");
+}
+
 /// Three beams from one point, with a joint list to append.
 fn star(joints: &str) -> String {
     let mut t = String::from("[time]\nt_end = 0.1\ndt = 0.01\nrho_inf = 0.9\n");
