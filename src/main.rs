@@ -30,7 +30,7 @@ macro_rules! exit_codes {
   flexrom simulate data/models/pendulum.toml -o out/pendulum.h5
   flexrom run pipelines/pendulum.toml                     train, sweep, validate, report
   flexrom train pipelines/double_pendulum.toml
-  flexrom sweep pipelines/double_pendulum.toml --load-scales 0.5:1.5:21 --csv > sweep.csv
+  flexrom sweep pipelines/double_pendulum.toml --load-scales 0.5:1.5:21 -o out/dp.h5 --csv > sweep.csv
 
 Results go to stdout (--csv or --json where a command prints them), messages to stderr
 (-q: errors and warnings only; -v: timings and Newton statistics too).
@@ -128,10 +128,13 @@ stderr, when its matrix would exceed 256 MiB or the memory bound; --dense forces
     /// Reduced runs at many load scales, in parallel, into one HDF5 file and a table.
     #[command(after_help = concat!(
         "Examples:
-  flexrom sweep pipelines/double_pendulum.toml --load-scales 0.5:1.5:21
+  flexrom sweep pipelines/double_pendulum.toml --load-scales 0.5:1.5:21 -o out/dp_sweep.h5
   flexrom sweep pipelines/pendulum.toml -o out/sweep.h5 --validate --csv > sweep.csv
   flexrom sweep pipelines/fourbar.toml --load-scales 0.8:1.0:40 --shard 2/4 -o parts/part_2.h5
   flexrom sweep pipelines/fourbar.toml -o out/sweep.h5 --resume
+
+-o is required: the pipeline's report folder holds the sweep.h5 of `flexrom run`, which the
+report's summary.md describes, and a plain sweep does not replace it.
 
 --csv/--json print one row per load scale: load_scale, status (0 done, 1 failed, 2 not run),
 message, rom_seconds, newton_iterations, step_cuts, error_estimate, estimate_seconds,

@@ -2,7 +2,7 @@
 //! (optionally one shard of the list, resumed, or validated).
 
 use super::{print_table, FormatArgs};
-use flexrom::io::output::{check_output, check_report_dir, claim_in_report, Origin};
+use flexrom::io::output::{check_output, Origin};
 use flexrom::output::table::Format;
 use flexrom::output::{self, info};
 use flexrom::pipeline::online::load_basis;
@@ -32,9 +32,10 @@ pub struct Args {
     /// skip the error estimate (about 2× faster; `/error_estimate` is then NaN)
     #[arg(long)]
     no_estimate: bool,
-    /// sweep file (default: sweep.h5 in the pipeline's report folder)
+    /// sweep file to write (HDF5); no default: the pipeline's report folder holds the
+    /// sweep.h5 of `flexrom run`, which the report's summary.md describes
     #[arg(short, long)]
-    output: Option<PathBuf>,
+    output: PathBuf,
     /// basis file (default: the pipeline's `basis`)
     #[arg(long)]
     basis: Option<PathBuf>,
@@ -70,9 +71,6 @@ impl Args {
             format,
         } = self;
         let p = Pipeline::load(&pipeline)?;
-        if shard.is_some() && output.is_none() {
-            return Err(flexrom::Error::Usage("--shard needs -o PART.h5: every shard writes its own part file".into()));
-        }
         let scales = match load_scales {
             Some(s) => flexrom::pipeline::config::parse_range(&s)
                 .map_err(|e| flexrom::Error::Usage(format!("--load-scales: {e}")))?,
@@ -84,15 +82,8 @@ impl Args {
             (p.model.path.as_path(), "model file"),
             (path.as_path(), "basis file"),
         ];
-        // the default goes into the pipeline's report folder, which must then be flexrom's
-        let in_report = output.is_none();
-        let out = output.unwrap_or_else(|| p.report_dir.join("sweep.h5"));
-        if in_report {
-            check_report_dir(&p.report_dir, &p.path, &inputs)?;
-            check_output(&out, Origin::Key { pipeline: &p.path, key: "report" }, &inputs)?;
-        } else {
-            check_output(&out, Origin::Flag("-o"), &inputs)?;
-        }
+        let out = output;
+        check_output(&out, Origin::Flag("-o"), &inputs)?;
         let stored = load_basis(&p, &path)?;
         let options =
             flexrom::pipeline::sweep::SweepOptions { validate, continuation, progress: output::show_progress() };
@@ -103,9 +94,6 @@ impl Args {
             }
             trust.estimator = None;
             trust.skipped = true;
-        }
-        if in_report {
-            claim_in_report(&p.report_dir, &p.path, "sweep.h5")?;
         }
         let sw = match shard {
             Some(k) => flexrom::pipeline::shard::sweep_shard(
