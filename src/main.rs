@@ -109,17 +109,20 @@ with either, -o may be left out (nothing is written then).
         exit_codes!()
     ))]
     Online(cli::online::Args),
-    /// Run full and reduced models at one load scale and report errors and timings.
+    /// Run full and reduced models at a load scale (or the pipeline's [validate] loads) and report errors and timings.
     #[command(after_help = concat!(
         "Examples:
   flexrom validate pipelines/pendulum.toml --load-scale 1.0
   flexrom validate pipelines/fourbar.toml --load-scale 0.935 --json
+  flexrom validate pipelines/double_pendulum.toml --json      at every [validate] load
   flexrom validate pipelines/pendulum_5000.toml --load-scale 1.0 --no-dense
 
-The full run with a dense LU (the thesis's reference timing) is skipped, with one line on
-stderr, when its matrix would exceed 256 MiB or the memory bound; --dense forces it.
---json prints one object (null where not measured), --csv one header line and one row
-(arrays as NAME_1, NAME_2, ...).
+Without --load-scale every load of the pipeline's [validate] load_scales is validated in
+turn (default: the training loads). The full run with a dense LU (the thesis's reference
+timing) is skipped, with one line on stderr, when its matrix would exceed 256 MiB or the
+memory bound; --dense forces it. --json prints one object (null where not measured) for
+--load-scale, else an array of them, one per load, as the report's validation.json; --csv
+one header line and one row per load (arrays as NAME_1, NAME_2, ...).
 
 ",
         exit_codes!()

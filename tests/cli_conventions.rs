@@ -233,6 +233,38 @@ fn simulate_prints_without_a_result_file() {
     assert_eq!(serde_json::from_slice::<serde_json::Value>(&json).unwrap().as_array().unwrap().len(), 5);
 }
 
+/// `validate` without `--load-scale` validates at the pipeline's `[validate] load_scales`:
+/// one record per load, in the list's order, each the record `validate --load-scale X` gives
+/// (the runs are deterministic: the same rel_error and estimate to the bit); `--json` prints
+/// them as one array, as the report's validation.json, `--csv` one row each. The pipeline's
+/// `[online]` sets `estimate` alone, without `load_scales`.
+#[test]
+fn validate_defaults_to_the_pipelines_validate_loads() {
+    let d = tempfile::tempdir().unwrap();
+    let p = pipeline(d.path());
+    let text = std::fs::read_to_string(&p).unwrap()
+        + "\n[online]\nestimate = \"corrected\"\n\n[validate]\nload_scales = [1.1, 0.9]\n";
+    std::fs::write(&p, text).unwrap();
+    ok(&["-q", "train", &p]);
+    let all = json(&ok(&["validate", &p, "--json", "--no-dense"]));
+    let all = all.as_array().expect("an array, one object per load");
+    assert_eq!(all.iter().map(|v| v["load_scale"].as_f64().unwrap()).collect::<Vec<_>>(), [1.1, 0.9]);
+    for v in all {
+        let x = v["load_scale"].to_string();
+        let one = json(&ok(&["validate", &p, "--load-scale", &x, "--json", "--no-dense"]));
+        assert!(one.is_object(), "--load-scale: one object");
+        for key in ["rel_error", "error_estimate", "max_probe_error", "n_modes"] {
+            assert_eq!(v[key], one[key], "{key} at {x}");
+        }
+    }
+    let (head, rows) = csv_rows(&ok(&["validate", &p, "--csv", "--no-dense"]));
+    assert_eq!(head[0], "load_scale");
+    assert_eq!(rows.iter().map(|r| r[0].to_string()).collect::<Vec<_>>(), ["1.1", "0.9"]);
+    // the text form: one block per load
+    let text = String::from_utf8(ok(&["validate", &p, "--no-dense"]).stdout).unwrap();
+    assert!(text.contains("load scale 1.1:") && text.contains("load scale 0.9:"), "{text}");
+}
+
 #[test]
 fn train_snapshots_only_creates_its_folder() {
     let d = tempfile::tempdir().unwrap();
