@@ -8,8 +8,8 @@
 //!   asked for (0.9:1.1:3 → 0.9, 1.0, 1.1), and the JSON and CSV of one command agree.
 //! * `-q` leaves stderr empty on success, `-v` adds the Newton statistics line.
 //! * `validate --no-dense` leaves `full_dense_seconds` null without a word; the automatic
-//!   skip (here forced by a memory bound, 800 KiB, between the banded run's ≈ 0.46 MiB and the
-//!   dense run's ≈ 1.1 MiB: `Model::check_full_run_memory`) prints exactly one line saying
+//!   skip (here forced by a memory bound, 1 MiB, between the banded run's 813.1 KiB and the
+//!   dense run's 1.44 MiB: `Model::check_full_run_memory`, q and q̇ kept) prints exactly one line saying
 //!   so and how to force it; below both bounds the dense run is timed.
 //! * `validate` says whether the full and reduced runs took the same time steps:
 //!   `full_step_cuts`, `rom_step_cuts` and `steps_differ_from` (null, an empty CSV cell,
@@ -307,14 +307,14 @@ fn dense_comparison_flags_and_auto_skip() {
     assert!(json(&o)["full_dense_seconds"].is_null());
     assert_eq!(skip_lines(&o), 0, "--no-dense skips silently");
 
-    let o = ok(&["validate", &p, "--load-scale", "1.0", "--json", "--max-memory", "800K"]);
+    let o = ok(&["validate", &p, "--load-scale", "1.0", "--json", "--max-memory", "1M"]);
     assert!(json(&o)["full_dense_seconds"].is_null());
     assert!(json(&o)["speedup_vs_dense"].is_null());
     assert_eq!(skip_lines(&o), 1, "{}", String::from_utf8_lossy(&o.stderr));
     assert!(String::from_utf8_lossy(&o.stderr).contains("--dense forces it"));
 
     // forced over the memory bound: the bound's error, exit 1
-    let o = flexrom(&["validate", &p, "--load-scale", "1.0", "--dense", "--max-memory", "800K"]);
+    let o = flexrom(&["validate", &p, "--load-scale", "1.0", "--dense", "--max-memory", "1M"]);
     assert_eq!(o.status.code(), Some(1));
     assert!(
         String::from_utf8_lossy(&o.stderr).contains("dense 206 × 206 LU"),

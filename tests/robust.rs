@@ -4,9 +4,9 @@
 //!
 //! Where the expected figures come from:
 //! - memory of a full pendulum run (src/limits.rs): n_t = 221 instants (1.1 s / 0.005 s + 1)
-//!   × (204 coordinates + 2 multipliers + 2 probe columns + 1 time) × 8 B = 369 512 B, plus
-//!   50 elements × 2048 B = 102 400 B: 471 912 B = 460.9 KiB, so a 400 KiB bound refuses it
-//!   and a 500 KiB bound admits it;
+//!   × (2 × 204 coordinates and velocities + 2 multipliers + 2 probe columns + 1 time) × 8 B
+//!   = 730 184 B, plus 50 elements × 2048 B = 102 400 B: 832 584 B = 813.1 KiB, so an 800 KiB
+//!   bound refuses it and a 900 KiB bound admits it;
 //! - steps: 1.1 s / 1e-9 s = 1.1e9 steps > the default 10⁷; 1e12 s / 0.005 s = 2e14;
 //! - a 10⁶-element body is over the default 2·10⁵ elements; with the element bound raised
 //!   its run needs 221 × (4 000 004 + 2 + 2 + 1) × 8 B ≈ 6.6 GiB, over a 1 GiB bound;
@@ -59,15 +59,15 @@ fn runs_that_would_not_fit_are_refused_quickly_with_the_figure_and_the_option() 
         assert!(start.elapsed().as_secs_f64() < 5.0, "{flag} {value} took {:?}", start.elapsed());
         assert!(!out.exists());
     }
-    // the memory estimate: 460.9 KiB (header)
-    let (code, err) = run(&["simulate", m, "-o", o, "--max-memory", "400K"]);
+    // the memory estimate: 813.1 KiB (header)
+    let (code, err) = run(&["simulate", m, "-o", o, "--max-memory", "800K"]);
     assert_eq!(code, 1, "{err}");
-    assert!(err.contains("460.9 KiB") && err.contains("--max-memory") && err.contains("FLEXROM_MAX_MEMORY"), "{err}");
+    assert!(err.contains("813.1 KiB") && err.contains("--max-memory") && err.contains("FLEXROM_MAX_MEMORY"), "{err}");
     assert!(!out.exists());
-    let (code, err) = run(&["simulate", m, "-o", o, "--max-memory", "500K"]);
+    let (code, err) = run(&["simulate", m, "-o", o, "--max-memory", "900K"]);
     assert_eq!(code, 0, "{err}");
     // the same bound through the environment
-    let e = flexrom().args(["simulate", m, "-o", o]).env("FLEXROM_MAX_MEMORY", "400K").output().unwrap();
+    let e = flexrom().args(["simulate", m, "-o", o]).env("FLEXROM_MAX_MEMORY", "800K").output().unwrap();
     assert_eq!(e.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&e.stderr).contains("FLEXROM_MAX_MEMORY"));
 

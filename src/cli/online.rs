@@ -55,7 +55,8 @@ impl Args {
                 .map_err(|e| e.at_stage("online", load_scale))
         })?;
         let extrapolated = flexrom::pipeline::estimate::is_extrapolated(trust.range, load_scale);
-        let basis_name = path.display().to_string();
+        // absolute, so that the file names its basis wherever it is read from
+        let basis_name = flexrom::io::output::resolve(&path).display().to_string();
         file.finish(&run.result, |f| {
             let e = |err: hdf5::Error| flexrom::Error::hdf5(&output, err);
             flexrom::io::result_file::write_reduced(f, &run.reduced_q).map_err(e)?;

@@ -269,18 +269,17 @@ fn run_pending(
                             let (rom, estimate) = runner
                                 .run_with(x, output, &previous.iter().collect::<Vec<_>>())
                                 .map_err(|e| e.at_stage("sweep (reduced run)", x))?;
-                            let validation = if o.validate {
+                            let (validation, full_probes) = if o.validate {
                                 let full = simulate(model, &Overrides { load_scale: Some(x), ..Default::default() })
                                     .map_err(|e| e.at_stage("sweep (full run)", x))?;
-                                Some(
-                                    compare(model, &full, &rom, None, basis.n_reduced(), basis.variant.name())
-                                        .with_trust(estimate.as_ref(), trust),
-                                )
+                                let v = compare(model, &full, &rom, None, basis.n_reduced(), basis.variant.name())
+                                    .with_trust(estimate.as_ref(), trust);
+                                (Some(v), Some(full.probes))
                             } else {
-                                None
+                                (None, None)
                             };
                             let extrapolated = trust.is_some_and(|t| is_extrapolated(t.range, x));
-                            Ok(SweepPoint { rom, validation, estimate, extrapolated })
+                            Ok(SweepPoint { rom, validation, full_probes, estimate, extrapolated })
                         })();
                         bar.inc(1);
                         ticker.tick();
