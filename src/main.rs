@@ -76,8 +76,9 @@ enum Command {
   flexrom simulate data/models/pendulum.toml -o p.h5 --load-scale 1.2 --csv > probes.csv
   flexrom simulate data/models/pendulum.toml --load-scale -1 --csv > reversed.csv   no file
 
---csv/--json print every probe's position at every step: columns t (s), NAME_x, NAME_y (m);
-with either, -o may be left out (nothing is written then).
+--csv/--json print every probe's position at every step: columns t (s), NAME_x, NAME_y (m),
+then NAME_strain (1) and NAME_curvature (1/m) of the probes that record them; with either,
+-o may be left out (nothing is written then).
 
 ",
         exit_codes!()
