@@ -170,7 +170,7 @@ fn bad_model_files_are_refused_with_file_field_and_problem() {
     }
 }
 
-/// Every command creates a missing output folder (issue 16; tests/safety.rs checks the others).
+/// Every command creates a missing output folder (tests/safety.rs checks the others).
 #[test]
 fn output_into_a_missing_directory_creates_it() {
     let dir = tempfile::tempdir().unwrap();

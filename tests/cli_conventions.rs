@@ -1,4 +1,4 @@
-//! The command-line conventions of issue 18 item 5, as a user meets them:
+//! The command-line conventions of docs/cli.md, as a user meets them:
 //!
 //! * `--csv` and `--json` on every command that prints results (`simulate`, `train`,
 //!   `online`, `validate`, `sweep`, `merge`, `demo`) give stdout that the `csv` crate and

@@ -1,5 +1,4 @@
-//! The HDF5 files flexrom writes, as h5py and xarray users open them (issue 18 item 3;
-//! layout in docs/file-formats.md and src/io/attrs.rs), through the `flexrom` command.
+//! The HDF5 files flexrom writes, as h5py and xarray users open them (layout in docs/file-formats.md and src/io/attrs.rs), through the `flexrom` command.
 //!
 //! Checks, and where each expectation comes from:
 //! - every kind of file a short run writes — `simulate` and `online` results, fixed-load and

@@ -1,4 +1,4 @@
-//! The layering of the source tree (issue 19 item 2): reads every `src/**/*.rs`, collects each
+//! The layering of the source tree (docs/design.md): reads every `src/**/*.rs`, collects each
 //! file's references to other files of the crate (`use` trees and inline paths starting with
 //! `crate::`, `super::`, `self::`, a child module's name in a `use`, or `flexrom::` in the
 //! binary; imports and `pub use` re-exports are followed to the file that defines the item), and fails on

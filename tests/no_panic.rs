@@ -1,4 +1,4 @@
-//! No input makes flexrom panic (issue 16, item 3): tables of hostile command-line values
+//! No input makes flexrom panic: tables of hostile command-line values
 //! (71), model-file values (182) and pipeline-file values (19), each run through the
 //! release binary. Every case must end with an
 //! exit code (no signal), never 101 (Rust's panic exit), and a failing case must explain

@@ -8,7 +8,7 @@
 //!   tolerance 1e-10 · L and round-off);
 //! - the HDF5 basis file round trip is exact;
 //! - a small pendulum pipeline end to end: rel_error ≤ 1e-3 with 10 % of the coordinates
-//!   as modes (the issue's target), the constraint-preserving four-bar keeps every joint to
+//!   as modes (the thesis's reduction ratio, SPEC §3), the constraint-preserving four-bar keeps every joint to
 //!   round-off (its joint coordinates are unreduced) and its multipliers follow the full
 //!   ones (5e-2 relative, measured 2.4e-2); `sweep --validate` writes `/steps_differ_from`
 //!   (NaN where both runs took the same steps, as on the pendulum) and the full runs'
@@ -275,7 +275,7 @@ fn run_writes_a_report() {
     }
     let svg = std::fs::read_to_string(dir.path().join("report/singular_values.svg")).unwrap();
     assert!(svg.starts_with("<svg") && svg.contains("polyline"), "an SVG with a line in it");
-    // a PNG beside each figure (issue 18: SVG and PNG), starting with the PNG signature
+    // a PNG beside each figure (SVG for papers, PNG for slides), starting with the PNG signature
     let png = std::fs::read(dir.path().join("report/singular_values.png")).unwrap();
     assert!(png.starts_with(b"\x89PNG\r\n\x1a\n"), "singular_values.png is not a PNG");
 }
@@ -298,7 +298,7 @@ modes = { ratio = 0.1 }
     assert_eq!(b.kept.len(), 12, "x, y of the 6 joined nodes (2 ground pins, 2 pins of two nodes each; SPEC §4)");
     assert_eq!(b.n_pod_modes, 45, "10 % of 452, rounded");
     let (v, full, rom) = validate(&p.model, b, 0.935, false).unwrap();
-    // the issue's reference implementation: 10 % with reference snapshots ≈ 2.6e-4 to t = 0.9 s
+    // a reference implementation of the thesis gave 10 % with reference snapshots ≈ 2.6e-4 to t = 0.9 s
     assert!(v.rel_error < 1e-3, "rel_error {}", v.rel_error);
     assert!(v.max_constraint_violation < 1e-12, "joint coordinates are unreduced: {}", v.max_constraint_violation);
     // the multipliers are the reduced model's own (solved in the joints' null space), not a

@@ -1,4 +1,4 @@
-//! Issue 16, items 3, 4, 6, 7: resource bounds refused before allocating, errors that say
+//! Resource bounds refused before allocating, errors that say
 //! where (TOML entry lines, dependent joints, stage and load scale), blow-up detection, and
 //! a closed or full standard output.
 //!

@@ -1,4 +1,4 @@
-//! Issue 16, items 1 and 2: flexrom never deletes or overwrites what it did not create, and
+//! flexrom never deletes or overwrites what it did not create, and
 //! writes atomically (docs/guarantees.md). Each test runs the release binary as a user would,
 //! in a temporary folder, on a tiny copy of data/models/pendulum.toml (t_end shortened) and
 //! a pipeline written here; nothing is compared with stored numbers. The expected outcome of

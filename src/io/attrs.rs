@@ -150,7 +150,7 @@ const SWEEP: [Entry; 22] = [
     ("newton_iterations", "1", "load"),
     ("factorizations", "1", "load"),
     ("error_estimate", "1", "load"),
-    // the estimate per fifth of the run (issue 15)
+    // the estimate per fifth of the run
     ("error_estimate_by_time", "1", "load, fifth"),
     ("estimate_seconds", "s", "load"),
     ("extrapolated", "1", "load"),

@@ -1,5 +1,5 @@
 //! What the online tools tell a user about a reduced run besides the estimate itself
-//! (issue 15 item 3): the extrapolation flag, the tolerance check and `--strict`, the
+//! (docs/error-estimate.md): the extrapolation flag, the tolerance check and `--strict`, the
 //! estimator read from a basis file, the result file's attributes. Moved from
 //! [`super::estimate`], which re-exports everything here (the struct [`Estimate`] too).
 

@@ -1,5 +1,5 @@
 //! Greedy training over a load range (`[train] greedy = { range = [A, B], tolerance = T,
-//! max_runs = K, candidates = N }`, issue 15 item 1; docs/greedy-training.md).
+//! max_runs = K, candidates = N }`; docs/greedy-training.md).
 //!
 //! ```text
 //!     Λ = {λ₁ … λ_N}, N evenly spaced loads of [A, B]        (the candidates)
@@ -51,7 +51,7 @@
 //!
 //!   with `η_i` the estimate and `s_i` the reduced model's own *sensitivity* over the run
 //!   up to the end of fifth `i`: `s_i(λ) = ‖X_r(λ(1 + δ)) − X_r(λ)‖ / ‖X_r(λ)‖` over those
-//!   instants, δ = [`SENSITIVITY_STEP`] (the issue's 0.1 %). Where the model is not
+//!   instants, δ = [`SENSITIVITY_STEP`] (0.1 %). Where the model is not
 //!   sensitive (`s_i ≤ T`) the score is the estimate itself. Where its answer changes by
 //!   more than T when the load changes by 0.1 % (the four-bar after t ≈ 0.7 s), the
 //!   estimate there is held to `s_i` instead: any estimate compares two trajectories of

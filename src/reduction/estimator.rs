@@ -10,8 +10,8 @@
 
 use super::basis::Basis;
 
-/// `c` without calibration data (the probe: 1.5 covered every test load on both
-/// benchmark models with effectivity 1.1–1.5).
+/// `c` without calibration data (1.5 covered every test load on both benchmark models with
+/// effectivity 1.1–1.5 when the estimate was first probed, docs/error-estimate.md).
 pub const DEFAULT_FACTOR: f64 = 1.5;
 
 /// What the basis file stores under `/estimator`.
@@ -69,7 +69,7 @@ pub struct DefectsCalibration {
 }
 
 /// The share of interior candidates whose left-out ratio must be predicted well enough
-/// (the coverage target for the estimate, 90 %).
+/// (the coverage the estimate is held to, 90 %).
 pub const DEFECTS_RELIABLE_SHARE: f64 = 0.9;
 
 impl DefectsCalibration {

@@ -11,8 +11,8 @@ use crate::reduction::Basis;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
-/// δ of the sensitivity `s(λ) = ‖X_r(λ(1 + δ)) − X_r(λ)‖ / ‖X_r(λ)‖` (the issue's
-/// definition of `sensitivity`, 0.1 %).
+/// δ of the sensitivity `s(λ) = ‖X_r(λ(1 + δ)) − X_r(λ)‖ / ‖X_r(λ)‖`: how much the answer
+/// moves for a 0.1 % change of the load (the `sensitivity` `validate` reports).
 pub const SENSITIVITY_STEP: f64 = 1e-3;
 
 /// The score of one candidate (the greedy module documentation): `T · max_i η_i / max(T, s_i)`; NaN
