@@ -66,6 +66,9 @@ impl Settings {
     }
 }
 
+/// Named series of one value per instant (a probe's strain or curvature).
+pub type Series = Vec<(String, Array1<f64>)>;
+
 /// Everything `simulate` writes.
 #[derive(Clone, Debug)]
 pub struct SimulationResult {
@@ -82,9 +85,9 @@ pub struct SimulationResult {
     /// name → (n_t × 2)
     pub probes: Vec<(String, Array2<f64>)>,
     /// name → (n_t): the axial strain of each probe that records it
-    pub strains: Vec<(String, Array1<f64>)>,
+    pub strains: Series,
     /// name → (n_t): the curvature (1/m) of each probe that records it
-    pub curvatures: Vec<(String, Array1<f64>)>,
+    pub curvatures: Series,
     pub stats: Stats,
     /// wall time of the time loop alone
     pub wall_seconds: f64,
@@ -321,10 +324,7 @@ fn run_full(model: &Model, sys: &mut FlexibleSystem, q0: Vec<f64>, s: Settings) 
 /// The strain and the curvature series (each `(name, values at every instant)`) of the
 /// probes that record them, in probe order; `series(p)` is the probe's (strain, curvature)
 /// at every instant.
-pub fn probe_sections(
-    probes: &[Probe],
-    series: impl Fn(&Probe) -> Vec<(f64, f64)>,
-) -> (Vec<(String, Array1<f64>)>, Vec<(String, Array1<f64>)>) {
+pub fn probe_sections(probes: &[Probe], series: impl Fn(&Probe) -> Vec<(f64, f64)>) -> (Series, Series) {
     let (mut strains, mut curvatures) = (Vec::new(), Vec::new());
     for p in probes.iter().filter(|p| p.strain || p.curvature) {
         let values = series(p);

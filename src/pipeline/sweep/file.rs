@@ -80,7 +80,8 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, stored: &StoredBasis, basis_path
         f.new_dataset_builder().with_data(&Array1::from(messages)).create("message").map_err(e)?;
         f.new_dataset_builder().with_data(&s.t).create("t").map_err(e)?;
         // the reduced runs' probes, and beside them with --validate the full runs'
-        let groups: &[(&str, fn(&SweepPoint) -> Option<&[(String, Array2<f64>)]>)] =
+        type ProbesOf = fn(&SweepPoint) -> Option<&[(String, Array2<f64>)]>;
+        let groups: &[(&str, ProbesOf)] =
             &[("probes", |p| Some(&p.rom.result.probes)), ("full_probes", |p| p.full_probes.as_deref())];
         for (group, probes) in &groups[..if s.validated { 2 } else { 1 }] {
             let g = f.create_group(group).map_err(e)?;
