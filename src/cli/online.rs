@@ -46,8 +46,18 @@ impl Args {
         let trust = flexrom::pipeline::estimate::load_trust(&p, &path, &stored)?;
         let mut runner =
             flexrom::pipeline::estimate::EstimatingRunner::new(&p.model, &stored.basis, trust.estimator.as_ref())?;
-        // the result file's fixed part is written on a second thread while the run computes
-        let plan = RunPlan::of(&p.model, &flexrom::pipeline::online::settings_at(&p.model, load_scale)?);
+        // the result file's fixed part is written on a second thread while the run computes;
+        // a run too large for the memory bound is refused before the file is begun
+        let settings = flexrom::pipeline::online::settings_at(&p.model, load_scale)?;
+        let full = flexrom::pipeline::online::Output::Full;
+        flexrom::pipeline::online::check_reduced_memory(
+            &p.model,
+            stored.basis.n_reduced(),
+            settings.n_steps,
+            full,
+            1.0,
+        )?;
+        let plan = RunPlan::of(&p.model, &settings);
         let model_path = p.model.path.display().to_string();
         let (file, (run, estimate)) = begin_alongside(&output, &p.model.text, &model_path, &plan, || {
             runner

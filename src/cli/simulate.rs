@@ -37,7 +37,11 @@ impl Args {
         let r = match &output {
             // the result file's fixed part is written on a second thread while the run computes
             Some(output) => {
-                let plan = RunPlan::of(&model, &Settings::resolve(&model, &overrides)?);
+                let settings = Settings::resolve(&model, &overrides)?;
+                // a run too large for the memory bound is refused before the file is begun
+                // (its labels alone are a string per coordinate)
+                model.check_full_run_memory(settings.n_steps, settings.solver == LinearSolverKind::Dense)?;
+                let plan = RunPlan::of(&model, &settings);
                 let (file, r) =
                     begin_alongside(output, &model.text, &model.path.display().to_string(), &plan, compute)?;
                 file.finish(&r, |_| Ok(()))?;
