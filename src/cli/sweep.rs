@@ -14,8 +14,8 @@ use std::path::PathBuf;
 pub struct Args {
     /// pipeline file (TOML)
     pipeline: PathBuf,
-    /// `A:B:N`: N load scales from A to B (default: the pipeline's [online] list); A may be
-    /// negative (`-1:1:21`)
+    /// `A:B:N`: N load scales from A to B (default: the pipeline's [online] load_scales, else
+    /// its training loads); A may be negative (`-1:1:21`)
     #[arg(long, allow_hyphen_values = true, value_name = "A:B:N")]
     load_scales: Option<String>,
     /// also run the full model at each load scale and report errors
