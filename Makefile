@@ -29,6 +29,7 @@ run: deps
 	cargo build --release
 	./target/release/flexrom run pipelines/pendulum.toml
 	./target/release/flexrom run pipelines/fourbar.toml
+	@echo "flexrom is target/release/flexrom; 'cargo install --path .' puts it on PATH"
 
 test: deps
 	# the tests spawn flexrom while they hold HDF5 files open; HDF5's flock() locks travel into

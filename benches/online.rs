@@ -1,4 +1,4 @@
-//! Online benchmark (issue 4): full (banded, our default) against reduced runs of the
+//! Online benchmark: full (banded, our default) against reduced runs of the
 //! shipped pipelines, at the thesis meshes and refined, in one process: each pipeline is
 //! trained in memory, then full and reduced runs alternate, `runs` times each; the table
 //! gives medians of the time loops (release build, one core, BLAS single-threaded) and the

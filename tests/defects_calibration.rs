@@ -1,5 +1,5 @@
-//! The cheap estimate put on the corrected one's scale by greedy training
-//! (`DefectsCalibration` in src/reduction/estimator.rs).
+//! The cheap estimate put on the corrected one's scale by greedy training, so that it can be
+//! the default at a fraction of the cost (`DefectsCalibration` in src/reduction/estimator.rs).
 //!
 //! On the thesis pendulum (data/models/pendulum.toml) coarsened to 20 elements and
 //! t_end = 0.4 s, trained greedily over [0.5, 1.5] to 1e-3 as in tests/greedy.rs:
@@ -15,7 +15,8 @@
 //!   is the corrected estimate up to round-off). At loads that are neither training loads
 //!   nor candidates (0.57, 1.03, 1.41) and outside the range (0.4, 1.6: extrapolated) the
 //!   default estimate of `validate` bounds the true rel_error with effectivity ≤ 30 (the
-//!   coverage and overestimate targets of docs/error-estimate.md).
+//!   targets the estimate is held to: it covers the error, and overestimates it at most 30×;
+//!   docs/error-estimate.md).
 //! - `an_unreliable_calibration_uses_its_largest_ratio_and_warns`: with every other
 //!   candidate's ratios made 10× larger (the leave-one-out check fails: a neighbours' mean
 //!   is then below own / 1.5) and `[online] estimate = "defects"` asked for, `online` warns

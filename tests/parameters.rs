@@ -1,4 +1,4 @@
-//! The load scale is a parameter of a run, not state of a model (issue 19 item 1): one
+//! The load scale is a parameter of a run, not state of a model: one
 //! model run at λ₁, λ₂, λ₁ must give, bit for bit, what a freshly built model gives at each
 //! load, for the full model (`FullModel`) and for the reduced ones (`ReducedRunner`, which
 //! keeps the projected constant force unscaled and applies λ in each evaluation).

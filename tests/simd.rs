@@ -1,4 +1,4 @@
-//! The SIMD path against the scalar one (issue 19 item 3). The kernels that run through
+//! The SIMD path against the scalar one. The kernels that run through
 //! `flexrom::linalg::simd::dispatch` — the bordered block Cholesky of `DenseLu` and the
 //! hyper-reduced model's per-element update and tangent — are run once compiled for the CPU's
 //! best instruction set (pulp's dispatch: AVX2+FMA on x86-64) and once on the baseline one

@@ -1,19 +1,20 @@
-//! Whole-system reduction (issue 20): the plain variant (one POD of `[x; λ/w]`, thesis eqs.
+//! Whole-system reduction (docs/whole-system.md): the plain variant (one POD of `[x; λ/w]`, thesis eqs.
 //! 18–19) and the stabilized one (separate PODs, supremizers; src/reduction/whole_system.rs).
 //!
 //! Checks, with where each expected number comes from:
 //! - the plain four-bar basis (pipelines/thesis/fourbar_whole_system.toml) has inf-sup
 //!   constant σ_min(V_λᵀ B V) ≈ 0 (below 1e-6: every snapshot satisfies B x = b, so the
 //!   coordinate part of every POD mode has B V = 0 up to round-off over σ), and its reduced
-//!   run fails with a message naming the stabilized variant (issue 20 asks for that error);
+//!   run fails with a message naming the stabilized variant (what a user must switch to);
 //! - the stabilized basis of the thesis setting (pipelines/thesis/fourbar_whole_system_stabilized.toml,
 //!   30 % of the coordinates, λ = 0.935, 4 multiplier modes) has β ≥ INF_SUP_MIN (the basis
-//!   check's bound, 1e-6; trained ones are O(0.1–1)), and meets issue 20's targets:
+//!   check's bound, 1e-6; trained ones are O(0.1–1)), and meets the targets of
+//!   docs/whole-system.md:
 //!   rel_error ≤ 1e-3 and max_constraint_violation ≤ 1e-6 m, with fewer reduced unknowns
 //!   (POD modes + supremizers + reduced multipliers) than constraint-preserving (136 modes
 //!   + 12 joint coordinates + 8 multipliers = 156);
 //! - the pendulum with the pin reduced (pipelines/thesis/pendulum_whole_system_stabilized.toml,
-//!   10 %, ECSW τ = 1e-4): rel_error ≤ 1e-3 (issue 20), no kept coordinates.
+//!   10 %, ECSW τ = 1e-4): rel_error ≤ 1e-3, no kept coordinates.
 
 use flexrom::io::basis_check::INF_SUP_MIN;
 use flexrom::linalg::kkt::LinearSolverKind;

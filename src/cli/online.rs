@@ -14,8 +14,8 @@ use std::path::PathBuf;
 pub struct Args {
     /// pipeline file (TOML)
     pipeline: PathBuf,
-    /// multiplies every load marked `scaled` in the model file
-    #[arg(long)]
+    /// multiplies every load marked `scaled` in the model file (negative: the load reversed)
+    #[arg(long, allow_negative_numbers = true)]
     load_scale: f64,
     /// result file (HDF5)
     #[arg(short, long)]

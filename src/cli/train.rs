@@ -22,7 +22,7 @@ pub struct Args {
     #[arg(long, requires = "output", conflicts_with_all = ["from_snapshots", "basis"])]
     snapshots_only: bool,
     /// the load scale of a --snapshots-only run
-    #[arg(long, requires = "snapshots_only", conflicts_with = "shard")]
+    #[arg(long, requires = "snapshots_only", conflicts_with = "shard", allow_negative_numbers = true)]
     load_scale: Option<f64>,
     /// `K/N`: the --snapshots-only runs of loads K, K+N, … of train.load_scales
     #[arg(long, value_name = "K/N", requires = "snapshots_only")]

@@ -7,7 +7,7 @@ use crate::io::h5::{attr_str, attr_u64};
 use crate::io::result_file::{begin_alongside, RunPlan};
 use crate::rom::estimator::{Estimate, EstimateMethod};
 use crate::rom::trust::write_run_attributes;
-use crate::rom::{settings_at, LoadOptions, Output, ReducedRun, Rom, Trust};
+use crate::rom::{check_reduced_memory, settings_at, LoadOptions, Output, ReducedRun, Rom, Trust};
 use crate::solver::model::Parameters;
 use std::path::Path;
 
@@ -51,14 +51,18 @@ pub struct OnlineRun {
 /// when complete) with the reduced coordinates, the basis it came from (`basis_path`) and
 /// the estimate's attributes ([`crate::rom::trust::write_run_attributes`]).
 pub fn online_to_file(p: &Pipeline, rom: &Rom, basis_path: &Path, mu: &Parameters, out: &Path) -> Result<OnlineRun> {
-    let plan = RunPlan::of(&p.model, &settings_at(&p.model, mu.load_scale)?);
+    // a run too large for the memory bound is refused before the file is begun
+    let settings = settings_at(&p.model, mu.load_scale)?;
+    check_reduced_memory(&p.model, rom.basis().n_reduced(), settings.n_steps, Output::Full, 1.0)?;
+    let plan = RunPlan::of(&p.model, &settings);
     let model_path = p.model.path.display().to_string();
     let (file, (run, estimate)) = begin_alongside(out, &p.model.text, &model_path, &plan, || {
         rom.solve_and_estimate(mu, Output::Full, &[]).map_err(|e| e.at_stage("online", mu.load_scale))
     })?;
     let extrapolated = rom.is_extrapolated(mu);
     let basis = rom.basis();
-    let basis_name = basis_path.display().to_string();
+    // absolute, so that the file names its basis wherever it is read from
+    let basis_name = crate::io::output::resolve(basis_path).display().to_string();
     let trust = rom.trust().cloned().unwrap_or_else(|| Trust::range((f64::NAN, f64::NAN)));
     file.finish(&run.result, |f| {
         let e = |err: hdf5::Error| Error::hdf5(out, err);

@@ -1,4 +1,4 @@
-//! Sharded training: the full runs of `train` as separate jobs
+//! Sharded training (docs/scaling.md): the full runs of `train` as separate jobs
 //! (`train --snapshots-only --load-scale X | --shard K/N -o snaps.h5`), and the basis built
 //! from their snapshot files (`train --from-snapshots snaps*.h5`).
 //!

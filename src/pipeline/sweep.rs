@@ -227,18 +227,17 @@ fn run_pending(rom: &Rom, state: Sweep, o: SweepOptions, checkpoint: Option<Chec
                         let (run, estimate) = rom
                             .solve_and_estimate(&mu, output, &previous.iter().collect::<Vec<_>>())
                             .map_err(|e| e.at_stage("sweep (reduced run)", x))?;
-                        let validation = if o.validate {
+                        let (validation, full_probes) = if o.validate {
                             let full = simulate(model, &Overrides { load_scale: Some(x), ..Default::default() })
                                 .map_err(|e| e.at_stage("sweep (full run)", x))?;
-                            Some(
-                                compare(model, &full, &run, None, basis.n_reduced(), basis.variant.name())
-                                    .with_trust(estimate.as_ref(), Some(rom)),
-                            )
+                            let v = compare(model, &full, &run, None, basis.n_reduced(), basis.variant.name())
+                                .with_trust(estimate.as_ref(), Some(rom));
+                            (Some(v), Some(full.probes))
                         } else {
-                            None
+                            (None, None)
                         };
                         let extrapolated = rom.is_extrapolated(&mu);
-                        Ok(SweepPoint { rom: run, validation, estimate, extrapolated })
+                        Ok(SweepPoint { rom: run, validation, full_probes, estimate, extrapolated })
                     })();
                     bar.inc(1);
                     ticker.tick();

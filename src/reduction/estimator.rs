@@ -17,7 +17,7 @@ pub const FIFTHS: usize = 5;
 pub type ByFifth = [f64; FIFTHS];
 
 /// `c` without calibration data (1.5 covered every test load on both benchmark models with
-/// effectivity 1.1–1.5 when the estimator was introduced, docs/error-estimate.md).
+/// effectivity 1.1–1.5 when the estimate was first probed, docs/error-estimate.md).
 pub const DEFAULT_FACTOR: f64 = 1.5;
 
 /// What the basis file stores under `/estimator`.

@@ -107,13 +107,14 @@ pub fn settings_at(model: &Model, load_scale: f64) -> Result<Settings> {
 }
 
 /// Refuses `runs` reduced runs of `r` coordinates over `n_steps` whose kept arrays would
-/// not fit the memory bound: `8 n_t (r + n_c + 2 n_probes + 1)` each, plus the full
-/// coordinates `8 n_t (n_dof + n_c)` when they are reconstructed ([`crate::limits`]).
+/// not fit the memory bound: `8 n_t (2 r + n_c + n_pv + 1)` each (z and ż, the reduced
+/// multipliers, the probes' values, t), plus the full coordinates and velocities and the
+/// multipliers `8 n_t (2 n_dof + n_c)` when they are reconstructed ([`crate::limits`]).
 pub fn check_reduced_memory(model: &Model, r: usize, n_steps: usize, output: Output, runs: f64) -> Result<()> {
     let z = model.sizes();
     let nt = n_steps as f64 + 1.0;
-    let full = if output == Output::Full { z.n_dof + z.n_constraints } else { 0.0 };
-    let bytes = runs * 8.0 * nt * (r as f64 + z.n_constraints + 2.0 * z.n_probes + 1.0 + full);
+    let full = if output == Output::Full { 2.0 * z.n_dof + z.n_constraints } else { 0.0 };
+    let bytes = runs * 8.0 * nt * (2.0 * r as f64 + z.n_constraints + z.n_probe_values + 1.0 + full);
     let what = if runs > 1.0 {
         format!(
             "{runs} reduced runs of {n_steps} steps × {r} modes{}",
@@ -138,6 +139,7 @@ fn run<R: Reduced<FlexibleSystem>>(
     let (r, nt) = (rom.n_dof(), s.n_steps + 1);
     check_reduced_memory(model, r, s.n_steps, output, 1.0)?;
     let mut zq = Array2::zeros((r, nt));
+    let mut zv = Array2::zeros((r, nt));
     let mut lam = Array2::<f64>::zeros((rom.n_constraints(), nt));
     let mut t = Array1::zeros(nt);
     // (λᵢ, trajectory) of the earlier runs that fit this one, nearest last
@@ -168,34 +170,40 @@ fn run<R: Reduced<FlexibleSystem>>(
     let stats = crate::simulate::solve(rom, &s, q0, guess, |k, st| {
         t[k] = st.t;
         zq.column_mut(k).assign(&ArrayView1::from(&st.q));
+        zv.column_mut(k).assign(&ArrayView1::from(&st.v));
         lam.column_mut(k).assign(&ArrayView1::from(&st.lambda));
     })?;
     let wall_seconds = start.elapsed().as_secs_f64();
     // reconstruct only what is written out
     let full = rom.full();
     let n_c = full.n_constraints();
-    let (q, multipliers) = match output {
+    let (q, qd, multipliers) = match output {
         Output::Full => {
             let q = basis.reference.view().insert_axis(ndarray::Axis(1)).to_owned() + basis.modes.dot(&zq);
+            // q̇ = V ż: the reference is constant
+            let qd = basis.modes.dot(&zv);
             let mut multipliers = Array2::from_elem((n_c, nt), f64::NAN);
             for k in 0..nt {
                 if let Some(l) = rom.multipliers(&zq.column(k).to_vec(), &lam.column(k).to_vec()) {
                     multipliers.column_mut(k).assign(&l);
                 }
             }
-            (q, multipliers)
+            (q, qd, multipliers)
         }
-        Output::ReducedAndProbes => (Array2::zeros((0, nt)), Array2::zeros((0, nt))),
+        Output::ReducedAndProbes => (Array2::zeros((0, nt)), Array2::zeros((0, nt)), Array2::zeros((0, nt))),
     };
     // probes from the rows of V on their element: x_e = x_ref,e + V_e q
+    let element_coordinates = |p: &crate::physics::system::Probe| {
+        let dofs = full.element_dofs(p.element);
+        let ve = basis.modes.select(ndarray::Axis(0), dofs);
+        let xe_ref = basis.reference.select(ndarray::Axis(0), dofs);
+        ve.dot(&zq) + &xe_ref.insert_axis(ndarray::Axis(1))
+    };
     let probes = full
         .probes
         .iter()
         .map(|p| {
-            let dofs = full.element_dofs(p.element);
-            let ve = basis.modes.select(ndarray::Axis(0), dofs);
-            let xe_ref = basis.reference.select(ndarray::Axis(0), dofs);
-            let xe = ve.dot(&zq) + &xe_ref.insert_axis(ndarray::Axis(1));
+            let xe = element_coordinates(p);
             let el = full.element(p.element);
             let mut xy = Array2::zeros((nt, 2));
             for k in 0..nt {
@@ -206,6 +214,15 @@ fn run<R: Reduced<FlexibleSystem>>(
             (p.name.clone(), xy)
         })
         .collect();
+    let (strains, curvatures) = crate::simulate::probe_sections(&full.probes, |p| {
+        let (xe, el) = (element_coordinates(p), full.element(p.element));
+        (0..nt)
+            .map(|k| {
+                let e = Vec8::from_iterator(xe.column(k).iter().copied());
+                (el.axial_strain(&e, p.xi), el.curvature(&e, p.xi))
+            })
+            .collect()
+    });
     Ok(ReducedRun {
         result: SimulationResult {
             model_text: model.text.clone(),
@@ -213,8 +230,11 @@ fn run<R: Reduced<FlexibleSystem>>(
             settings: s,
             t,
             q,
+            qd,
             multipliers,
             probes,
+            strains,
+            curvatures,
             stats,
             wall_seconds,
         },

@@ -28,7 +28,7 @@ pub const CALIBRATION_MARGIN: f64 = 1.25;
 /// training: often one, made with an *earlier* iteration's basis), and an overestimate
 /// there says nothing about the final basis. With a floor of 1 the shipped four-bar (one
 /// pair, η = 5.5 e) stored c = 1 and its final basis's estimate then fell below the true
-/// error at 5 of 5 validation loads (effectivity 0.89–1.00; docs/benchmarks.md). Pairs with
+/// error at 5 of 5 validation loads (effectivity 0.89–1.00; measured before commit d42c82a). Pairs with
 /// a non-finite or non-positive value are ignored (an exact reduced run says nothing about
 /// `c`); with none left, `c` = [`DEFAULT_FACTOR`], uncalibrated. The points are kept either way.
 pub fn calibrate(points: Vec<CalibrationPoint>) -> Calibration {
