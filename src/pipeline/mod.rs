@@ -15,6 +15,7 @@ pub mod shard;
 pub mod snapshots;
 pub mod sweep;
 pub mod tables;
+pub mod timing;
 pub mod train;
 pub mod training_record;
 pub mod validate;
