@@ -6,7 +6,7 @@
 use super::config::Pipeline;
 use super::online::load_rom;
 use super::plot::{Figure, Panel, Series, Style};
-use super::sweep::{sweep, table, write_sweep, SweepOptions};
+use super::sweep::{sweep, table, write_sweep, SweepBasis, SweepOptions};
 use super::train::train_and_write;
 use super::validate::{validate, Validation};
 use crate::error::{Error, Result};
@@ -70,7 +70,7 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: boo
     let scales = p.online_scales();
     crate::output::info(&format!("[2/3] sweep: {} reduced and full runs", scales.len()));
     let sw = sweep(&rom, &scales, SweepOptions { validate: true, continuation: false, progress })?;
-    write_sweep(&out.join("sweep.h5"), &sw, &stored, &p.basis_path)?;
+    write_sweep(&out.join("sweep.h5"), &sw, Some(SweepBasis { stored: &stored, path: &p.basis_path }))?;
     // the plots and tables below need every load scale
     if let Some(s) = sw.failure_summary() {
         return Err(Error::PartlyFailed(format!("sweep: {s}; no report written (the basis is)")));
@@ -217,7 +217,7 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: boo
         .scales
         .iter()
         .filter_map(|x| x.point())
-        .filter_map(|q| q.estimate.map(|e| (q.rom.result.settings.load_scale, e.error_estimate)))
+        .filter_map(|q| q.estimate.map(|e| (q.run.result.settings.load_scale, e.error_estimate)))
         .collect();
     let mut errors = pts(&|v| v.rel_error);
     errors.extend(validations.iter().map(|v| (v.load_scale, v.rel_error)));
