@@ -98,6 +98,11 @@ impl Args {
         if let Some((_, _, warnings)) = &loaded {
             warn(warnings);
         }
+        // read before the runs (a damaged /timing fails now), said after them
+        let notice = match &loaded {
+            Some((_, rom, _)) => flexrom::pipeline::route::speed_notice_of(&path, rom)?,
+            None => None,
+        };
         let route = match &loaded {
             Some((stored, rom, _)) => Route::Reduced { rom, basis: SweepBasis { stored, path: &path } },
             None => Route::Full(&p.model),
@@ -131,6 +136,7 @@ impl Args {
             )));
         }
         let Some((_, rom, _)) = &loaded else { return Ok(()) };
+        warn(notice.as_slice());
         let runs: Vec<(f64, Option<f64>)> = sw
             .scales
             .iter()

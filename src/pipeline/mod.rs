@@ -11,6 +11,7 @@ pub mod merge;
 pub mod online;
 pub mod plot;
 pub mod report;
+pub mod route;
 pub mod shard;
 pub mod snapshots;
 pub mod sweep;
