@@ -98,7 +98,7 @@ impl Args {
         if let Some((_, _, warnings)) = &loaded {
             warn(warnings);
         }
-        // read before the runs (a damaged /timing fails now), said after them
+        // read before the runs (a damaged /timing fails now), said after them, failed runs or not
         let notice = match &loaded {
             Some((_, rom, _)) => flexrom::pipeline::route::speed_notice_of(&path, rom)?,
             None => None,
@@ -128,6 +128,7 @@ impl Args {
             sw.wall_seconds,
             out.display()
         ));
+        warn(notice.as_slice());
         // the good runs are written; the exit code (3) says that some failed
         if let Some(s) = sw.failure_summary() {
             return Err(flexrom::Error::PartlyFailed(format!(
@@ -136,7 +137,6 @@ impl Args {
             )));
         }
         let Some((_, rom, _)) = &loaded else { return Ok(()) };
-        warn(notice.as_slice());
         let runs: Vec<(f64, Option<f64>)> = sw
             .scales
             .iter()
