@@ -44,6 +44,8 @@ impl Args {
         )?;
         let (stored, rom, warnings) = load_rom(&p, &path, None, false)?;
         warn(&warnings);
+        // read before the run (a damaged /timing fails now), said after it
+        let notice = flexrom::pipeline::route::speed_notice_of(&path, &rom)?;
         let done = online_to_file(&p, &rom, &path, &Parameters::new(load_scale), &output)?;
         let (run, estimate) = (&done.run, &done.estimate);
         let st = &run.result.stats;
@@ -74,6 +76,7 @@ impl Args {
         ]);
         t.push(row);
         print_table(&t, format.format(), true)?;
+        warn(notice.as_slice());
         super::check_runs(&rom, &[(load_scale, estimate.map(|e| e.error_estimate))], strict)
     }
 }

@@ -93,7 +93,7 @@ const RESULT: [Entry; 8] = [
     ("reduced/q", REDUCED_UNITS, "time, mode"),
 ];
 
-const BASIS: [Entry; 43] = [
+const BASIS: [Entry; 46] = [
     ("snapshots", COORDINATE_UNITS, "dof, snapshot"),
     ("snapshot_multipliers", MULTIPLIER_UNITS, "constraint, snapshot"),
     ("snapshot_load_scale", "1", "snapshot"),
@@ -137,6 +137,9 @@ const BASIS: [Entry; 43] = [
     ("training/sensitivity", "1", "iteration, candidate"),
     ("training/true_score", "1", "iteration"),
     ("training/held_out_effectivity", "1", "iteration"),
+    ("timing/full_seconds", "s", ""),
+    ("timing/reduced_seconds", "s", ""),
+    ("timing/estimate_seconds", "s", ""),
 ];
 
 const SWEEP: [Entry; 22] = [

@@ -259,6 +259,24 @@ pub fn read_training_range(path: &Path) -> Result<(f64, f64)> {
     Ok((lo, hi))
 }
 
+/// The loads of the full runs whose snapshots the basis holds, sorted, each once:
+/// `/training/load_scales` (greedy training), else the values of `/snapshot_load_scale`.
+pub fn read_training_loads(path: &Path) -> Result<Vec<f64>> {
+    let f = hdf5::File::open(path)
+        .map_err(|e| Error::input(path, "(file)", format!("is not a readable HDF5 file: {e}")))?;
+    let mut l: Vec<f64> = match f.dataset("training/load_scales") {
+        Ok(d) => d.read_1d::<f64>().map_err(|e| Error::input(path, "training/load_scales", e.to_string()))?.to_vec(),
+        Err(_) => f
+            .dataset("snapshot_load_scale")
+            .and_then(|d| d.read_1d::<f64>())
+            .map_err(|e| Error::input(path, "snapshot_load_scale", e.to_string()))?
+            .to_vec(),
+    };
+    l.sort_by(f64::total_cmp);
+    l.dedup();
+    Ok(l)
+}
+
 /// Greedy training's tolerance: the dataset `/training/tolerance` or the attribute
 /// `tolerance` on `/training`; `None` without greedy training.
 pub fn read_training_tolerance(path: &Path) -> Result<Option<f64>> {

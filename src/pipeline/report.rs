@@ -6,7 +6,7 @@
 use super::config::Pipeline;
 use super::online::load_rom;
 use super::plot::{Figure, Panel, Series, Style};
-use super::sweep::{sweep, table, write_sweep, SweepOptions};
+use super::sweep::{sweep, table, write_sweep, SweepBasis, SweepOptions};
 use super::train::train_and_write;
 use super::validate::{validate, Validation};
 use crate::error::{Error, Result};
@@ -63,14 +63,15 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: boo
         Some(g) => crate::output::info(&format!("[1/3] train: greedy over [{}, {}]", g.range().0, g.range().1)),
         None => crate::output::info(&format!("[1/3] train: {} full run(s)", p.training_scales().len())),
     }
-    let trained = train_and_write(p, basis_path)?;
+    let mut trained = train_and_write(p, basis_path)?;
     // the warnings of loading it come with `check_report`'s, once
     let (stored, rom, _) = load_rom(p, basis_path, None, false)?;
+    trained.warnings.extend(super::route::time_and_store(&rom, basis_path)?);
 
     let scales = p.online_scales();
     crate::output::info(&format!("[2/3] sweep: {} reduced and full runs", scales.len()));
     let sw = sweep(&rom, &scales, SweepOptions { validate: true, continuation: false, progress })?;
-    write_sweep(&out.join("sweep.h5"), &sw, &stored, &p.basis_path)?;
+    write_sweep(&out.join("sweep.h5"), &sw, Some(SweepBasis { stored: &stored, path: &p.basis_path }))?;
     // the plots and tables below need every load scale
     if let Some(s) = sw.failure_summary() {
         return Err(Error::PartlyFailed(format!("sweep: {s}; no report written (the basis is)")));
@@ -170,23 +171,7 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: boo
         sw.done().filter_map(|q| q.validation.as_ref()).map(|v| (v.load_scale, f(v))).collect()
     };
     // the loads of the full runs the basis was trained on, marked on the plots against λ
-    let training: Vec<f64> = {
-        let f = hdf5::File::open(basis_path).map_err(|e| Error::hdf5(basis_path, e))?;
-        let mut l: Vec<f64> = match f.dataset("training/load_scales") {
-            Ok(d) => d
-                .read_1d::<f64>()
-                .map_err(|e| Error::input(basis_path, "training/load_scales", e.to_string()))?
-                .to_vec(),
-            Err(_) => f
-                .dataset("snapshot_load_scale")
-                .and_then(|d| d.read_1d::<f64>())
-                .map_err(|e| Error::input(basis_path, "snapshot_load_scale", e.to_string()))?
-                .to_vec(),
-        };
-        l.sort_by(f64::total_cmp);
-        l.dedup();
-        l
-    };
+    let training = crate::io::estimator_file::read_training_loads(basis_path)?;
     single(
         "Reduced vs full model",
         "load scale",
@@ -217,7 +202,7 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: boo
         .scales
         .iter()
         .filter_map(|x| x.point())
-        .filter_map(|q| q.estimate.map(|e| (q.rom.result.settings.load_scale, e.error_estimate)))
+        .filter_map(|q| q.estimate.map(|e| (q.run.result.settings.load_scale, e.error_estimate)))
         .collect();
     let mut errors = pts(&|v| v.rel_error);
     errors.extend(validations.iter().map(|v| (v.load_scale, v.rel_error)));
@@ -316,6 +301,18 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: boo
             v.speedup_vs_dense.unwrap_or(f64::NAN)
         );
     }
+    let mut warnings = trained.warnings;
+    if let Some(speed) = route_comparison(&validations) {
+        let _ = writeln!(md, "\n## Full or reduced\n");
+        let _ = writeln!(
+            md,
+            "{} Time loops on one thread: the median over the validated loads of the medians above{}.",
+            speed.verdict(),
+            if speed.estimate.is_some() { " (the estimate: one run at each load)" } else { "" }
+        );
+        let measured = format!("medians of `run`'s validation at {} load(s)", validations.len());
+        warnings.extend(speed.notice(&p.path, &measured));
+    }
     let _ = writeln!(md, "\n## Error estimate, extrapolation, sensitivity\n");
     let trust = rom.trust().expect("read from its basis file");
     let _ = writeln!(
@@ -363,7 +360,7 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: boo
     }
     let _ = writeln!(md, "![error by time](error_by_time.svg)");
     std::fs::write(out.join("summary.md"), md).map_err(|e| Error::io(out, e))?;
-    Ok(trained.warnings)
+    Ok(warnings)
 }
 
 /// After `run`: the warnings of the report's basis and sweep (read back from its
@@ -384,4 +381,19 @@ pub fn check_report(p: &Pipeline, dir: &Path, strict: bool) -> Result<Vec<String
     let trust = rom.trust().expect("read from its basis file");
     warnings.extend(crate::rom::trust::check_runs(trust, rom.estimator().is_some(), &runs, strict)?);
     Ok(warnings)
+}
+
+/// The two routes' times per run from the validation's medians (the median over the
+/// validated loads of each; the estimate counts when every validated run has one); `None`
+/// without validated loads.
+fn route_comparison(validations: &[Validation]) -> Option<super::route::Comparison> {
+    let mid = |f: &dyn Fn(&Validation) -> Option<f64>| -> Option<f64> {
+        let mut x: Vec<f64> = validations.iter().map(f).collect::<Option<_>>()?;
+        (!x.is_empty()).then(|| super::timing::median(&mut x))
+    };
+    Some(super::route::Comparison {
+        full: mid(&|v| Some(v.full_seconds))?,
+        reduced: mid(&|v| Some(v.rom_seconds))?,
+        estimate: mid(&|v| v.estimate_seconds),
+    })
 }

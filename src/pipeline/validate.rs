@@ -14,6 +14,7 @@
 //! `sensitivity` puts the error in context: how much the full model's own answer moves for
 //! a 0.1 % change of the load.
 
+use super::timing::{median, repeat_timing};
 use crate::error::Result;
 use crate::linalg::kkt::LinearSolverKind;
 use crate::model::Model;
@@ -37,7 +38,7 @@ pub struct Validation {
     pub max_probe_error_t: f64,
     pub max_constraint_violation: f64,
     /// full model, our default (banded) linear solver: time loop only, the median of up to
-    /// seven runs interleaved with the reduced ones (`TIMING_BUDGET`)
+    /// seven runs interleaved with the reduced ones ([`super::timing::TIMING_BUDGET`])
     pub full_seconds: f64,
     /// full model with dense LAPACK LU; `None` when not measured
     pub full_dense_seconds: Option<f64>,
@@ -162,32 +163,6 @@ fn first_different_step(a: &[f64], b: &[f64]) -> Option<f64> {
     }
 }
 
-/// Time loops of a few milliseconds move by ±30 % from one run to the next on a shared
-/// machine (other processes, page faults of a first run), so `validate` times the full and
-/// the reduced loop repeatedly, interleaved (a busy spell falls on both), and compares
-/// medians: while both kinds together have taken less than this, s…
-const TIMING_BUDGET: f64 = 0.25;
-/// …and each kind has fewer runs than this (odd: the median is a run). A full run that
-/// alone exceeds the budget is timed once, as before.
-const TIMING_RUNS: usize = 7;
-
-/// Whether to time one more pair of runs ([`TIMING_BUDGET`], [`TIMING_RUNS`]).
-fn repeat_timing(full: &[f64], rom: &[f64]) -> bool {
-    let spent: f64 = full.iter().chain(rom).sum();
-    full.len() < TIMING_RUNS && spent + full[full.len() - 1] + rom[rom.len() - 1] <= TIMING_BUDGET
-}
-
-/// The median (the middle of an odd count, the mean of the middle two of an even one).
-fn median(x: &mut [f64]) -> f64 {
-    x.sort_by(f64::total_cmp);
-    let n = x.len();
-    if n % 2 == 1 {
-        x[n / 2]
-    } else {
-        0.5 * (x[n / 2 - 1] + x[n / 2])
-    }
-}
-
 impl Validation {
     /// The time loops' seconds and the speedups derived from them (against the dense run
     /// too, when it was timed).
@@ -243,7 +218,7 @@ pub fn validate(rom: &Rom, load_scale: f64, with_dense: bool) -> Result<(Validat
     let (run, estimate) = rom.solve_and_estimate(&mu, Output::Full, &[]).map_err(stage("validate (reduced run)"))?;
     // the time loops again, interleaved, for the medians that `speedup` compares
     let (mut full_times, mut rom_times) = (vec![full.wall_seconds], vec![run.result.wall_seconds]);
-    while repeat_timing(&full_times, &rom_times) {
+    while repeat_timing(&[&full_times, &rom_times]) {
         full_times.push(full_model.simulate(&o).map_err(stage("validate (full run)"))?.wall_seconds);
         let again = rom.solve_with(&mu, Output::Full, &[]).map_err(stage("validate (reduced run)"))?;
         rom_times.push(again.result.wall_seconds);
@@ -337,21 +312,7 @@ impl Validation {
 
 #[cfg(test)]
 mod tests {
-    use super::{first_different_step, median, repeat_timing, TIMING_BUDGET, TIMING_RUNS};
-
-    /// Medians of odd and even counts, in any order; the timing repeats while another pair
-    /// fits the budget and stops at the run count, and a single run over the budget is
-    /// timed once.
-    #[test]
-    fn timing_medians_and_their_budget() {
-        assert_eq!(median(&mut [3.0, 1.0, 2.0]), 2.0);
-        assert_eq!(median(&mut [4.0, 1.0, 3.0, 2.0]), 2.5);
-        assert!(repeat_timing(&[5e-3], &[1e-3]));
-        assert!(!repeat_timing(&[5e-3; TIMING_RUNS], &[1e-3; TIMING_RUNS]));
-        assert!(!repeat_timing(&[TIMING_BUDGET], &[1e-3]));
-        // 0.1 + 0.05 spent, a next pair of 0.15 would exceed 0.25
-        assert!(!repeat_timing(&[0.1], &[0.05]));
-    }
+    use super::first_different_step;
 
     /// Which step the runs first took differently: a cut only one of them made, the
     /// earlier of two such, and none when both halved the same steps.

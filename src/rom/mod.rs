@@ -36,7 +36,7 @@ pub struct Rom {
     /// the training range and tolerance of a basis read from its file; `None` for one built
     /// in this process (training)
     trust: Option<Trust>,
-    runners: Pool<ReducedRunner>,
+    runners: Pool<'static, ReducedRunner>,
 }
 
 /// How [`Rom::load`] reads a basis file's estimator.

@@ -302,7 +302,7 @@ pub struct Corrected {
     model: Arc<Model>,
     basis: Arc<Basis>,
     data: Arc<Estimator>,
-    runners: Pool<CorrectedRunner>,
+    runners: Pool<'static, CorrectedRunner>,
     /// built at the first run that needs it
     fallback: std::sync::OnceLock<Option<super::enriched::Enriched>>,
 }

@@ -50,7 +50,7 @@ pub fn sample_for(steps: usize, sample: usize) -> usize {
 pub struct Defects {
     basis: Arc<Basis>,
     data: Arc<Estimator>,
-    runners: Pool<CorrectedRunner>,
+    runners: Pool<'static, CorrectedRunner>,
     sample: usize,
 }
 

@@ -18,7 +18,7 @@ use std::sync::Arc;
 pub struct Enriched {
     basis: Arc<Basis>,
     data: Arc<Estimator>,
-    runners: Pool<ReducedRunner>,
+    runners: Pool<'static, ReducedRunner>,
 }
 
 impl Enriched {
