@@ -63,7 +63,7 @@ impl Args {
         run_details(&run.result);
         let mut cols = vec!["load_scale", "n_modes"];
         cols.extend(flexrom::pipeline::tables::RUN_COLUMNS);
-        cols.extend(["error_estimate", "extrapolated", "output"]);
+        cols.extend(["error_estimate", "extrapolated", "output", "error_estimate_displacement"]);
         let mut t = Table::new(&cols);
         let mut row: Vec<Cell> = vec![load_scale.into(), stored.basis.n_reduced().into()];
         row.extend(flexrom::pipeline::tables::run_cells(&run.result));
@@ -71,9 +71,11 @@ impl Args {
             estimate.as_ref().map(|e| e.error_estimate).into(),
             done.extrapolated.into(),
             output.display().to_string().into(),
+            estimate.as_ref().map(|e| e.error_estimate_displacement).into(),
         ]);
         t.push(row);
         print_table(&t, format.format(), true)?;
-        super::check_runs(&rom, &[(load_scale, estimate.map(|e| e.error_estimate))], strict)
+        let measure = rom.tolerance_measure();
+        super::check_runs(&rom, &[(load_scale, estimate.map(|e| e.in_measure(measure)))], strict)
     }
 }

@@ -121,7 +121,7 @@ impl Args {
             .scales
             .iter()
             .filter_map(|x| x.point())
-            .map(|q| (q.rom.result.settings.load_scale, q.estimate.map(|e| e.error_estimate)))
+            .map(|q| (q.rom.result.settings.load_scale, q.estimate.map(|e| e.in_measure(rom.tolerance_measure()))))
             .collect();
         super::check_runs(&rom, &runs, strict)
     }

@@ -70,7 +70,8 @@ impl Args {
             }
             Format::Text => {}
         }
-        let runs: Vec<(f64, Option<f64>)> = vs.iter().map(|v| (v.load_scale, v.error_estimate)).collect();
+        let measure = rom.tolerance_measure();
+        let runs: Vec<(f64, Option<f64>)> = vs.iter().map(|v| (v.load_scale, v.estimate_in(measure))).collect();
         super::check_runs(&rom, &runs, strict)
     }
 }

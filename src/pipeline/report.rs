@@ -378,10 +378,14 @@ pub fn check_report(p: &Pipeline, dir: &Path, strict: bool) -> Result<Vec<String
             .and_then(|d| d.read_1d::<f64>())
             .map_err(|e| Error::input(&path, name, format!("cannot be read: {e}")))
     };
-    let (scales, est) = (read("load_scales")?, read("error_estimate")?);
+    let trust = rom.trust().expect("read from its basis file");
+    let estimates = match trust.measure {
+        crate::rom::estimator::ErrorMeasure::Relative => "error_estimate",
+        crate::rom::estimator::ErrorMeasure::Displacement => "error_estimate_displacement",
+    };
+    let (scales, est) = (read("load_scales")?, read(estimates)?);
     let runs: Vec<(f64, Option<f64>)> =
         scales.iter().zip(&est).map(|(&x, &e)| (x, if e.is_nan() { None } else { Some(e) })).collect();
-    let trust = rom.trust().expect("read from its basis file");
     warnings.extend(crate::rom::trust::check_runs(trust, rom.estimator().is_some(), &runs, strict)?);
     Ok(warnings)
 }

@@ -2,7 +2,7 @@
 //! (`GreedyRecord`, written under `/training` in the basis file).
 
 use crate::reduction::Trained;
-use crate::rom::estimator::{EstimateMethod, Estimator};
+use crate::rom::estimator::{ErrorMeasure, EstimateMethod, Estimator};
 
 pub struct TrainSummary {
     pub trained: Trained,
@@ -74,6 +74,8 @@ pub struct GreedyRecord {
     /// the estimate training ended with (`corrected`, or `enriched` when a held-out check
     /// found the correction off)
     pub method: EstimateMethod,
+    /// the error `tolerance`, the scores and the true errors are in
+    pub measure: ErrorMeasure,
 }
 
 impl GreedyRecord {
@@ -131,6 +133,7 @@ pub fn write_training(f: &hdf5::File, r: &GreedyRecord) -> hdf5::Result<()> {
     g.new_dataset_builder().with_data(&col(&|i| i.true_score)).create("true_score")?;
     g.new_dataset_builder().with_data(&col(&|i| i.held_out_effectivity)).create("held_out_effectivity")?;
     attr_str(&g, "estimate_method", r.method.name())?;
+    attr_str(&g, "measure", r.measure.name())?;
     attr_str(&g, "method", "greedy")?;
     attr_u64(&g, "iterations", ni as u64)?;
     attr_u64(&g, "max_runs", r.max_runs as u64)?;

@@ -9,15 +9,21 @@
 //!     sensitivity = ‖X_full(1.001 λ) − X_full(λ)‖_F / ‖X_full(λ)‖_F
 //!     rel_error_by_time[i] = rel_error over t ≤ the end of fifth i + 1 of the run
 //!     error_estimate_by_time[i] = error_estimate over the same instants (the last is error_estimate)
+//!     displacement_error = ‖X_rom − X_full‖_F / ‖X_full − X₀‖_F   (X₀ = X_full(t₀) at every instant)
+//!     error_estimate_displacement = c ‖X_r − X_{r+k}‖_F / ‖X_{r+k} − X₀‖_F
+//!     error_over_travel(probe) = max_k |r_rom(t_k) − r_full(t_k)| / max_k |r_full(t_k) − r_full(t₀)|
 //! ```
 //!
 //! `sensitivity` puts the error in context: how much the full model's own answer moves for
-//! a 0.1 % change of the load.
+//! a 0.1 % change of the load. `rel_error` divides by a norm that holds the undeformed
+//! geometry and the unit slopes; `displacement_error` and a probe's error over its travel
+//! measure the error against the motion itself (docs/error-estimate.md, "Two measures of
+//! the error").
 
 use crate::error::Result;
 use crate::linalg::kkt::LinearSolverKind;
 use crate::model::Model;
-use crate::rom::estimator::norms::{distance_and_norm, rel_error_by_time};
+use crate::rom::estimator::norms::{displacement_error_by_time, distance_and_norm, rel_error_by_time};
 use crate::rom::estimator::Estimate;
 use crate::rom::{Output, ReducedRun, Rom};
 use crate::simulate::{simulate, FullModel, Overrides, SimulationResult};
@@ -79,6 +85,50 @@ pub struct Validation {
     /// error_estimate up to the end of each fifth of the run, the estimate of
     /// `rel_error_by_time` (the last is error_estimate; null: no estimator)
     pub error_estimate_by_time: Option<Vec<f64>>,
+    /// `‖X_rom − X_full‖_F / ‖X_full − X₀‖_F`: the error against the motion from the
+    /// initial configuration X₀ (`ErrorMeasure::Displacement`)
+    pub displacement_error: f64,
+    /// displacement_error up to the end of each fifth of the run (the last is displacement_error)
+    pub displacement_error_by_time: Vec<f64>,
+    /// the estimate of `displacement_error` (null: the basis has no estimator)
+    pub error_estimate_displacement: Option<f64>,
+    /// `error_estimate_displacement / displacement_error`
+    pub effectivity_displacement: Option<f64>,
+    /// error_estimate_displacement up to the end of each fifth of the run
+    pub error_estimate_displacement_by_time: Option<Vec<f64>>,
+    /// the largest `error_over_travel` of the probes (null: no probe moved)
+    pub max_error_over_travel: Option<f64>,
+    pub max_error_over_travel_probe: String,
+    /// every probe's error over its travel
+    pub probe_errors_over_travel: Vec<ProbeTravel>,
+}
+
+/// One probe's error against its own motion.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct ProbeTravel {
+    pub probe: String,
+    /// `max_k |r_rom(t_k) − r_full(t_k)|`, m
+    pub max_error: f64,
+    /// `max_k |r_full(t_k) − r_full(t₀)|`, m: how far the probe moved from where it started
+    pub travel: f64,
+    /// `max_error / travel` (null for a probe that did not move)
+    pub error_over_travel: Option<f64>,
+}
+
+impl ProbeTravel {
+    /// The error of the probe positions `rom` against `full` (n_t × 2 each) over the
+    /// full run's travel.
+    pub fn of(name: &str, full: &ndarray::Array2<f64>, rom: &ndarray::Array2<f64>) -> ProbeTravel {
+        let dist = |a: [f64; 2], b: [f64; 2]| ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt();
+        let at = |x: &ndarray::Array2<f64>, k: usize| [x[[k, 0]], x[[k, 1]]];
+        let (mut max_error, mut travel) = (0.0_f64, 0.0_f64);
+        for k in 0..full.nrows() {
+            max_error = max_error.max(dist(at(rom, k), at(full, k)));
+            travel = travel.max(dist(at(full, k), at(full, 0)));
+        }
+        let error_over_travel = (travel > 0.0).then(|| max_error / travel);
+        ProbeTravel { probe: name.to_string(), max_error, travel, error_over_travel }
+    }
 }
 
 /// Compares a reduced run with a full run of the same model, load scale and Δt.
@@ -109,6 +159,14 @@ pub fn compare(
             &owned
         }
     };
+    let travels: Vec<ProbeTravel> =
+        full.probes.iter().zip(&r.probes).map(|((name, a), (_, b))| ProbeTravel::of(name, a, b)).collect();
+    let worst_travel = travels
+        .iter()
+        .filter_map(|p| p.error_over_travel.map(|e| (e, p.probe.clone())))
+        .fold(None::<(f64, String)>, |w, (e, n)| if w.as_ref().is_none_or(|w| e > w.0) { Some((e, n)) } else { w });
+    let x0 = full.q.column(0);
+    let displacement_error_by_time = displacement_error_by_time(&r.q, &full.q, x0).to_vec();
     let mut res = vec![0.0; sys.n_constraints()];
     let mut viol = 0.0_f64;
     for k in 0..r.q.ncols() {
@@ -147,6 +205,14 @@ pub fn compare(
         sensitivity: None,
         rel_error_by_time: rel_error_by_time(&r.q, &full.q).to_vec(),
         error_estimate_by_time: None,
+        displacement_error: displacement_error_by_time[displacement_error_by_time.len() - 1],
+        displacement_error_by_time,
+        error_estimate_displacement: None,
+        effectivity_displacement: None,
+        error_estimate_displacement_by_time: None,
+        max_error_over_travel: worst_travel.as_ref().map(|w| w.0),
+        max_error_over_travel_probe: worst_travel.map_or(String::new(), |w| w.1),
+        probe_errors_over_travel: travels,
     }
     .with_timings(full.wall_seconds, r.wall_seconds)
 }
@@ -189,6 +255,14 @@ fn median(x: &mut [f64]) -> f64 {
 }
 
 impl Validation {
+    /// The estimate of the error in `measure` (`None` without an estimator).
+    pub fn estimate_in(&self, measure: crate::rom::estimator::ErrorMeasure) -> Option<f64> {
+        match measure {
+            crate::rom::estimator::ErrorMeasure::Relative => self.error_estimate,
+            crate::rom::estimator::ErrorMeasure::Displacement => self.error_estimate_displacement,
+        }
+    }
+
     /// The time loops' seconds and the speedups derived from them (against the dense run
     /// too, when it was timed).
     pub fn with_timings(mut self, full_seconds: f64, rom_seconds: f64) -> Self {
@@ -208,6 +282,9 @@ impl Validation {
             self.estimate_calibrated = Some(e.calibrated);
             self.estimate_seconds = Some(e.seconds);
             self.error_estimate_by_time = Some(e.by_time.to_vec());
+            self.error_estimate_displacement = Some(e.error_estimate_displacement);
+            self.effectivity_displacement = Some(e.error_estimate_displacement / self.displacement_error);
+            self.error_estimate_displacement_by_time = Some(e.displacement_by_time.to_vec());
         }
         if let Some(t) = rom.and_then(|r| r.trust()) {
             self.extrapolated = crate::rom::trust::is_extrapolated(t.range, self.load_scale);
@@ -330,6 +407,29 @@ impl Validation {
         if let Some(e) = &self.error_estimate_by_time {
             let by: Vec<String> = e.iter().map(|e| format!("{e:.2e}")).collect();
             s.push_str(&format!("\n  error_estimate up to each fifth of the run: {}", by.join(", ")));
+        }
+        s.push_str(&self.motion_lines());
+        s
+    }
+
+    /// The lines of the errors against the motion: displacement_error (and its estimate),
+    /// each probe's error over its travel.
+    fn motion_lines(&self) -> String {
+        let mut s = format!(
+            "\n  displacement_error {:.3e} (against the motion from the initial configuration)",
+            self.displacement_error
+        );
+        if let (Some(e), Some(f)) = (self.error_estimate_displacement, self.effectivity_displacement) {
+            s.push_str(&format!(", error_estimate_displacement {e:.3e}, effectivity {f:.2}"));
+        }
+        for p in &self.probe_errors_over_travel {
+            s.push_str(&format!(
+                "\n  probe {}: max error {:.3e} m over a travel of {:.3e} m: {}",
+                p.probe,
+                p.max_error,
+                p.travel,
+                p.error_over_travel.map_or("the probe does not move".to_string(), |e| format!("{e:.3e} of its travel"))
+            ));
         }
         s
     }

@@ -218,6 +218,57 @@ impl EstimateMethod {
     }
 }
 
+/// Which error a tolerance is on (docs/error-estimate.md, "Two measures of the error"):
+///
+/// ```text
+///     relative:      ‖X_r − X_f‖_F / ‖X_f‖_F          (rel_error, the thesis's comparison)
+///     displacement:  ‖X_r − X_f‖_F / ‖X_f − X₀‖_F     (displacement_error; X₀ the initial
+///                                                      configuration at every instant)
+/// ```
+///
+/// `‖X_f‖` holds the undeformed geometry and the unit slopes, so the relative error of a
+/// run is smaller than its error against the motion itself, by as much as the motion is
+/// smaller than the configuration.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ErrorMeasure {
+    /// `rel_error`: against the whole configuration (the default)
+    #[default]
+    Relative,
+    /// `displacement_error`: against the displacement from the initial configuration
+    Displacement,
+}
+
+impl ErrorMeasure {
+    pub fn name(self) -> &'static str {
+        match self {
+            ErrorMeasure::Relative => "relative",
+            ErrorMeasure::Displacement => "displacement",
+        }
+    }
+
+    pub fn parse(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "relative" => Ok(ErrorMeasure::Relative),
+            "displacement" => Ok(ErrorMeasure::Displacement),
+            _ => Err(format!("is \"{s}\"; expected \"relative\" (default) or \"displacement\"")),
+        }
+    }
+
+    /// Whether this is the default (a pipeline that leaves the key out means it).
+    pub fn is_relative(&self) -> bool {
+        *self == ErrorMeasure::Relative
+    }
+
+    /// The name of the true error in this measure, as `validate` reports it.
+    pub fn error_name(self) -> &'static str {
+        match self {
+            ErrorMeasure::Relative => "rel_error",
+            ErrorMeasure::Displacement => "displacement_error",
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::DefectsCalibration;

@@ -7,8 +7,10 @@ use crate::model::Model;
 use crate::reduction::Basis;
 use crate::rom::estimator::corrected::CorrectedRunner;
 use crate::rom::estimator::defects::Defects;
-use crate::rom::estimator::norms::raw_estimate_by_time;
-use crate::rom::estimator::{self, ByFifth, DefectsCalibration, ErrorEstimator, EstimateMethod, Estimator, FIFTHS};
+use crate::rom::estimator::norms::raw_by_time;
+use crate::rom::estimator::{
+    self, ByFifth, DefectsCalibration, ErrorEstimator, ErrorMeasure, EstimateMethod, Estimator, FIFTHS,
+};
 use crate::rom::{Output, Rom};
 use crate::solver::model::Parameters;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -31,12 +33,12 @@ pub fn score(tolerance: f64, estimate_by_time: &ByFifth, sensitivity_by_time: &B
     worst
 }
 
-/// What the loop knows of one candidate.
+/// What the loop knows of one candidate, in the training's measure.
 #[derive(Clone, Copy)]
 pub(super) struct CandidateRun {
     /// the error estimate by fifth of the run (the last: the whole run's)
     pub(super) by_time: ByFifth,
-    /// the whole run's raw estimate
+    /// the whole run's raw estimate of rel_error (what `c` is calibrated with)
     pub(super) raw: f64,
     /// the reduced model's sensitivity by fifth of the run (the greedy module documentation)
     pub(super) sensitivity: ByFifth,
@@ -52,16 +54,17 @@ pub(super) fn training_rom(model: &Arc<Model>, basis: &Basis, est: &Estimator, m
 }
 
 /// The seam to the error estimator: the estimate and the reduced model's sensitivity of
-/// `basis` at every load, reduced runs in parallel (one reduced model and its estimator's
-/// per worker, as `sweep` does); a run that fails gives ∞ estimates (and sensitivity 0,
-/// which holds its estimate to T).
+/// `basis` at every load in `measure` (the sensitivity's displacement form divides by
+/// `‖X_r(λ) − X₀‖`), reduced runs in parallel (one reduced model and its estimator's per
+/// worker, as `sweep` does); a run that fails gives ∞ estimates (and sensitivity 0, which
+/// holds its estimate to T).
 pub(super) fn estimate_candidates(
     model: &Arc<Model>,
     basis: &Basis,
     est: &Estimator,
     loads: &[f64],
     label: &str,
-    method: EstimateMethod,
+    (method, measure): (EstimateMethod, ErrorMeasure),
 ) -> Vec<CandidateRun> {
     let target =
         if crate::output::show_progress() { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() };
@@ -74,6 +77,8 @@ pub(super) fn estimate_candidates(
     bar.set_prefix(label.to_string());
     let failed = CandidateRun { by_time: [f64::INFINITY; FIFTHS], raw: f64::INFINITY, sensitivity: [0.0; FIFTHS] };
     let Ok(rom) = training_rom(model, basis, est, method) else { return vec![failed; loads.len()] };
+    let Ok(physics) = model.physics() else { return vec![failed; loads.len()] };
+    let x0 = ndarray::ArrayView1::from(&physics.x0[..]);
     let out: Vec<CandidateRun> = loads
         .par_iter()
         .map(|&x| {
@@ -83,10 +88,10 @@ pub(super) fn estimate_candidates(
                     // the same reduced model at λ(1 + δ): how much its answer moves
                     let moved = Parameters::new(x * (1.0 + SENSITIVITY_STEP));
                     let sensitivity = match rom.solve_with(&moved, Output::ReducedAndProbes, &[]) {
-                        Ok(moved) => raw_estimate_by_time(basis, basis, &moved.reduced_q, &run.reduced_q),
+                        Ok(moved) => *raw_by_time(basis, basis, &moved.reduced_q, &run.reduced_q, x0).get(measure),
                         Err(_) => [0.0; FIFTHS],
                     };
-                    CandidateRun { by_time: e.by_time, raw: e.raw, sensitivity }
+                    CandidateRun { by_time: *e.by_time_in(measure), raw: e.raw, sensitivity }
                 }
                 _ => failed,
             };
@@ -123,7 +128,7 @@ pub(super) fn calibrate_defects(
                 return [f64::NAN; FIFTHS];
             };
             let Ok(raw) = d.raw(&run) else { return [f64::NAN; FIFTHS] };
-            std::array::from_fn(|i| e.by_time[i] / raw[i])
+            std::array::from_fn(|i| e.by_time[i] / raw.relative[i])
         })
         .collect();
     DefectsCalibration::new(loads.to_vec(), ratios)

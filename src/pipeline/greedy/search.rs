@@ -11,7 +11,7 @@ use crate::pipeline::config::{GreedySpec, Pipeline};
 use crate::pipeline::training_record::modes_text;
 use crate::reduction::{ModeRule, Trained};
 use crate::rom::estimator::training::{calibrate, CalibrationPoint, Estimator};
-use crate::rom::estimator::{ByFifth, EstimateMethod, FIFTHS};
+use crate::rom::estimator::{ByFifth, ErrorMeasure, EstimateMethod, FIFTHS};
 
 /// Energy tolerances ε tried, loose to tight: 10⁻², 10⁻³, …, 10⁻¹⁰.
 pub const ENERGY_LADDER: [f64; 9] = [1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10];
@@ -26,9 +26,10 @@ pub(super) struct Level {
     pub(super) hyper_tolerance: Option<f64>,
     pub(super) trained: Trained,
     pub(super) estimator: Estimator,
-    /// scores (the greedy module documentation)
+    /// scores (the greedy module documentation), in the training's measure as `whole`
     pub(super) estimates: Vec<f64>,
     pub(super) whole: Vec<f64>,
+    /// the raw estimates of rel_error (calibration)
     pub(super) raws: Vec<f64>,
     pub(super) sensitivity: Vec<ByFifth>,
     /// the estimator's basis is richer than the basis in every block
@@ -229,7 +230,9 @@ fn level(
 impl Level {
     /// The estimates, scores and sensitivities at the candidates, with `method`.
     pub(super) fn estimate(&mut self, p: &Pipeline, candidates: &[f64], label: &str, method: EstimateMethod) {
-        let runs = estimate_candidates(&p.model, &self.trained.basis, &self.estimator, candidates, label, method);
+        let measure = p.file.train.greedy.as_ref().map_or(ErrorMeasure::Relative, |g| g.measure);
+        let runs =
+            estimate_candidates(&p.model, &self.trained.basis, &self.estimator, candidates, label, (method, measure));
         self.estimates = runs.iter().map(|r| score(p_tolerance(p), &r.by_time, &r.sensitivity)).collect();
         self.whole = runs.iter().map(|r| r.by_time[FIFTHS - 1]).collect();
         self.raws = runs.iter().map(|r| r.raw).collect();
