@@ -163,7 +163,7 @@ fn pendulum_pipeline_end_to_end_within_the_error_bound() {
         .flat_map(|k| (0..84).map(move |i| (k, i)))
         .fold(0.0_f64, |m, (k, i)| m.max((q[[k + 1, i]] - q[[k, i]] - 0.0025 * (qd[[k, i]] + qd[[k + 1, i]])).abs()));
     assert!(gap < 1e-12, "{gap:e}");
-    let v = read_basis(&dir.path().join("basis.h5")).unwrap().basis.modes;
+    let v = read_basis(&dir.path().join("basis.h5")).unwrap().basis.modes.clone();
     let outside = &qd.t() - &v.dot(&v.t().dot(&qd.t()));
     assert!(outside.iter().all(|x| x.abs() < 1e-10 * qd.iter().fold(0.0_f64, |m, x| m.max(x.abs()))));
 

@@ -132,7 +132,9 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
     let chosen = loop {
         let data = training_data(&runs);
         let previous_energy = iterations.last().map(|i: &Iteration| i.energy);
-        let round = Round { p, data: &data, candidates: &candidates, points: &points, n: iterations.len() + 1, method };
+        let prior = iterations.last().map(|i: &Iteration| i.estimates.as_slice());
+        let n = iterations.len() + 1;
+        let round = Round { p, data: &data, candidates: &candidates, points: &points, n, method, prior };
         let mut level = search(&round, g, previous_energy)?;
         let (wi, worst) = level.worst();
         // where to run the full model: the worst candidate whose load has no full run yet

@@ -75,31 +75,76 @@ pub(super) fn estimate_candidates(
             .progress_chars("=> "),
     );
     bar.set_prefix(label.to_string());
-    let failed = CandidateRun { by_time: [f64::INFINITY; FIFTHS], raw: f64::INFINITY, sensitivity: [0.0; FIFTHS] };
-    let Ok(rom) = training_rom(model, basis, est, method) else { return vec![failed; loads.len()] };
-    let Ok(physics) = model.physics() else { return vec![failed; loads.len()] };
+    let Ok(rom) = training_rom(model, basis, est, method) else { return vec![FAILED; loads.len()] };
+    let Ok(physics) = model.physics() else { return vec![FAILED; loads.len()] };
     let x0 = ndarray::ArrayView1::from(&physics.x0[..]);
     let out: Vec<CandidateRun> = loads
         .par_iter()
         .map(|&x| {
-            let mu = Parameters::new(x);
-            let r = match rom.solve_and_estimate(&mu, Output::ReducedAndProbes, &[]) {
-                Ok((run, Some(e))) => {
-                    // the same reduced model at λ(1 + δ): how much its answer moves
-                    let moved = Parameters::new(x * (1.0 + SENSITIVITY_STEP));
-                    let sensitivity = match rom.solve_with(&moved, Output::ReducedAndProbes, &[]) {
-                        Ok(moved) => *raw_by_time(basis, basis, &moved.reduced_q, &run.reduced_q, x0).get(measure),
-                        Err(_) => [0.0; FIFTHS],
-                    };
-                    CandidateRun { by_time: *e.by_time_in(measure), raw: e.raw, sensitivity }
-                }
-                _ => failed,
-            };
+            let r = candidate_run(&rom, x, measure, x0);
             bar.inc(1);
             r
         })
         .collect();
     bar.finish_and_clear();
+    out
+}
+
+/// What a candidate whose reduced run fails counts as.
+const FAILED: CandidateRun =
+    CandidateRun { by_time: [f64::INFINITY; FIFTHS], raw: f64::INFINITY, sensitivity: [0.0; FIFTHS] };
+
+/// One candidate: the reduced run at `x` with its estimate, and the run at `x(1 + δ)`, in
+/// `measure` (`x0`: the initial configuration X₀ of the displacement measure).
+fn candidate_run(rom: &Rom, x: f64, measure: ErrorMeasure, x0: ndarray::ArrayView1<f64>) -> CandidateRun {
+    let mu = Parameters::new(x);
+    match rom.solve_and_estimate(&mu, Output::ReducedAndProbes, &[]) {
+        Ok((run, Some(e))) => {
+            // the same reduced model at λ(1 + δ): how much its answer moves
+            let moved = Parameters::new(x * (1.0 + SENSITIVITY_STEP));
+            let basis = rom.basis();
+            let sensitivity = match rom.solve_with(&moved, Output::ReducedAndProbes, &[]) {
+                Ok(moved) => *raw_by_time(basis, basis, &moved.reduced_q, &run.reduced_q, x0).get(measure),
+                Err(_) => [0.0; FIFTHS],
+            };
+            CandidateRun { by_time: *e.by_time_in(measure), raw: e.raw, sensitivity }
+        }
+        _ => FAILED,
+    }
+}
+
+/// [`estimate_candidates`] in the order `order`, a few at a time (as many as there are
+/// worker threads), stopping as soon as one candidate's score is above `tolerance`: such a
+/// rung cannot meet the tolerance, whatever the others read, so a rung that fails is
+/// rejected after a few reduced runs instead of all of them. The candidates not run are
+/// `None`.
+pub(super) fn screen_candidates(
+    model: &Arc<Model>,
+    basis: &Basis,
+    est: &Estimator,
+    loads: &[f64],
+    order: &[usize],
+    (method, measure): (EstimateMethod, ErrorMeasure),
+    tolerance: f64,
+) -> Vec<Option<CandidateRun>> {
+    let mut out = vec![None; loads.len()];
+    let (Ok(rom), Ok(physics)) = (training_rom(model, basis, est, method), model.physics()) else {
+        // like a failed run at every candidate: one is enough to reject
+        out[order[0]] = Some(FAILED);
+        return out;
+    };
+    let x0 = ndarray::ArrayView1::from(&physics.x0[..]);
+    let chunk = rayon::current_num_threads().max(1);
+    for part in order.chunks(chunk) {
+        let runs: Vec<CandidateRun> = part.par_iter().map(|&i| candidate_run(&rom, loads[i], measure, x0)).collect();
+        let over = runs.iter().any(|r| !(score(tolerance, &r.by_time, &r.sensitivity) <= tolerance));
+        for (&i, r) in part.iter().zip(runs) {
+            out[i] = Some(r);
+        }
+        if over {
+            break;
+        }
+    }
     out
 }
 
