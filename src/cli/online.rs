@@ -1,6 +1,6 @@
 //! `flexrom online`: one reduced run at one load scale, written to a result file.
 
-use super::{check_scale, print_table, run_details, warn, FormatArgs};
+use super::{check_scale, print_table, run_details, warn, EstimateArgs, FormatArgs};
 use flexrom::io::output::{check_output, Origin};
 use flexrom::output::info;
 use flexrom::output::table::{Cell, Table};
@@ -28,12 +28,14 @@ pub struct Args {
     #[arg(long)]
     strict: bool,
     #[command(flatten)]
+    estimate: EstimateArgs,
+    #[command(flatten)]
     format: FormatArgs,
 }
 
 impl Args {
     pub fn run(self) -> flexrom::Result<()> {
-        let Args { pipeline, load_scale, output, basis, strict, format } = self;
+        let Args { pipeline, load_scale, output, basis, strict, estimate, format } = self;
         let p = Pipeline::load(&pipeline)?;
         check_scale(load_scale)?;
         let path = basis.unwrap_or_else(|| p.basis_path.clone());
@@ -42,7 +44,7 @@ impl Args {
             Origin::Flag("-o"),
             &[(&p.path, "pipeline file"), (&p.model.path, "model file"), (&path, "basis file")],
         )?;
-        let (stored, rom, warnings) = load_rom(&p, &path, None, false)?;
+        let (stored, rom, warnings) = load_rom(&p, &path, estimate.method(), false)?;
         warn(&warnings);
         let done = online_to_file(&p, &rom, &path, &Parameters::new(load_scale), &output)?;
         let (run, estimate) = (&done.run, &done.estimate);

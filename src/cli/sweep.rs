@@ -1,7 +1,7 @@
 //! `flexrom sweep`: reduced runs at many load scales into one sweep file and a table
 //! (optionally one shard of the list, resumed, or validated).
 
-use super::{print_table, warn, FormatArgs};
+use super::{print_table, warn, EstimateArgs, FormatArgs};
 use flexrom::io::output::{check_output, Origin};
 use flexrom::output::table::Format;
 use flexrom::output::{self, info};
@@ -31,7 +31,7 @@ pub struct Args {
     #[arg(long)]
     continuation: bool,
     /// skip the error estimate (about 2× faster; `/error_estimate` is then NaN)
-    #[arg(long)]
+    #[arg(long, conflicts_with = "estimate")]
     no_estimate: bool,
     /// sweep file to write (HDF5); no default: the pipeline's report folder holds the
     /// sweep.h5 of `flexrom run`, which the report's summary.md describes
@@ -53,6 +53,8 @@ pub struct Args {
     #[arg(long, value_name = "K/N")]
     shard: Option<flexrom::pipeline::shard::Shard>,
     #[command(flatten)]
+    estimate: EstimateArgs,
+    #[command(flatten)]
     format: FormatArgs,
 }
 
@@ -69,6 +71,7 @@ impl Args {
             resume,
             strict,
             shard,
+            estimate,
             format,
         } = self;
         let p = Pipeline::load(&pipeline)?;
@@ -88,7 +91,7 @@ impl Args {
         if no_estimate && strict {
             return Err(flexrom::Error::Usage("--strict needs the error estimate; drop --no-estimate".into()));
         }
-        let (stored, rom, warnings) = load_rom(&p, &path, None, no_estimate)?;
+        let (stored, rom, warnings) = load_rom(&p, &path, estimate.method(), no_estimate)?;
         warn(&warnings);
         let options =
             flexrom::pipeline::sweep::SweepOptions { validate, continuation, progress: output::show_progress() };

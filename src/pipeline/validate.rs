@@ -101,6 +101,8 @@ pub struct Validation {
     pub max_error_over_travel_probe: String,
     /// every probe's error over its travel
     pub probe_errors_over_travel: Vec<ProbeTravel>,
+    /// how the estimate was computed (`corrected`, `defects`, `enriched`; null: no estimate)
+    pub error_estimate_method: Option<String>,
 }
 
 /// One probe's error against its own motion.
@@ -213,6 +215,7 @@ pub fn compare(
         max_error_over_travel: worst_travel.as_ref().map(|w| w.0),
         max_error_over_travel_probe: worst_travel.map_or(String::new(), |w| w.1),
         probe_errors_over_travel: travels,
+        error_estimate_method: None,
     }
     .with_timings(full.wall_seconds, r.wall_seconds)
 }
@@ -290,6 +293,9 @@ impl Validation {
             self.extrapolated = crate::rom::trust::is_extrapolated(t.range, self.load_scale);
             self.training_range = Some([t.range.0, t.range.1]);
         }
+        if estimate.is_some() {
+            self.error_estimate_method = rom.and_then(|r| r.method()).map(str::to_string);
+        }
         self
     }
 }
@@ -364,9 +370,10 @@ impl Validation {
         let mut s = String::new();
         match (self.error_estimate, self.effectivity) {
             (Some(e), Some(f)) => s.push_str(&format!(
-                "\n  error_estimate {:.3e} ({}), effectivity {:.2}{}",
+                "\n  error_estimate {:.3e} ({}{}), effectivity {:.2}{}",
                 e,
                 if self.estimate_calibrated == Some(true) { "calibrated" } else { "uncalibrated" },
+                self.error_estimate_method.as_ref().map_or(String::new(), |m| format!(", {m} method")),
                 f,
                 self.estimate_seconds.map_or(String::new(), |t| format!(
                     ", estimator {:.4} s ({:.0} % of the reduced run)",
@@ -437,7 +444,7 @@ impl Validation {
 
 #[cfg(test)]
 mod tests {
-    use super::{first_different_step, median, repeat_timing, TIMING_BUDGET, TIMING_RUNS};
+    use super::{first_different_step, median, repeat_timing, ProbeTravel, TIMING_BUDGET, TIMING_RUNS};
 
     /// Medians of odd and even counts, in any order; the timing repeats while another pair
     /// fits the budget and stops at the run count, and a single run over the budget is
@@ -464,5 +471,21 @@ mod tests {
         assert_eq!(first_different_step(&[0.1, 0.875], &[0.1, 0.875]), None);
         assert_eq!(first_different_step(&[0.931], &[0.5, 0.931]), Some(0.5));
         assert_eq!(first_different_step(&[0.875], &[0.931]), Some(0.875));
+    }
+
+    /// A probe moving on a 3-4-5 line, 0.5 m per instant over 4 instants (travel 1.5 m),
+    /// against a reduced one off by (0.006, 0.008) m (0.01 m) at one instant: error over
+    /// travel 0.01 / 1.5 in closed form; a probe that does not move has none.
+    #[test]
+    fn a_probe_error_over_its_travel() {
+        let full = ndarray::Array2::from_shape_fn((4, 2), |(k, i)| 1.0 + k as f64 * [0.3, 0.4][i]);
+        let mut rom = full.clone();
+        rom[[2, 0]] += 0.006;
+        rom[[2, 1]] += 0.008;
+        let p = ProbeTravel::of("tip", &full, &rom);
+        assert!((p.travel - 1.5).abs() < 1e-15 && (p.max_error - 0.01).abs() < 1e-15, "{p:?}");
+        assert!((p.error_over_travel.unwrap() - 0.01 / 1.5).abs() < 1e-15, "{p:?}");
+        let still = ndarray::Array2::from_elem((4, 2), 1.0);
+        assert_eq!(ProbeTravel::of("pin", &still, &(&still + 1e-3)).error_over_travel, None);
     }
 }

@@ -179,7 +179,7 @@ impl Default for Calibration {
 }
 
 /// How the enriched model's trajectory `X⁺` is obtained (docs/error-estimate.md).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize, clap::ValueEnum)]
 #[serde(rename_all = "kebab-case")]
 pub enum EstimateMethod {
     /// one Newton iteration of the enriched model per step, from the reduced run's

@@ -398,6 +398,7 @@ pub fn read_sweep(
             max_error_over_travel: None,
             max_error_over_travel_probe: String::new(),
             probe_errors_over_travel: Vec::new(),
+            error_estimate_method: None,
         });
         // the stored estimate: its value and cost (the factor it was made with is the basis's)
         let estimate = estimates.as_ref().map(|a| a[k]).filter(|e| !e.is_nan()).map(|error_estimate| Estimate {
