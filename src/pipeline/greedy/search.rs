@@ -235,7 +235,7 @@ fn rung_name(eps: f64, tau: f64) -> String {
 fn rung_text(r: &Round, l: &Level, eps: f64, tau: f64, tolerance: f64) -> String {
     let (wi, w) = l.worst();
     let elements = match &l.trained.basis.hyper {
-        Some(h) => format!("{} sampled elements", h.elements.len()),
+        Some(h) => format!("{} sampled element{}", h.elements.len(), if h.elements.len() == 1 { "" } else { "s" }),
         None => "every element".to_string(),
     };
     let run = l.evaluated.iter().filter(|&&e| e).count();
