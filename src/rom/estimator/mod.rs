@@ -47,7 +47,6 @@ pub use crate::reduction::estimator::{
 use crate::reduction::Basis;
 use crate::rom::run::ReducedRun;
 use crate::solver::model::Parameters;
-use norms::RawByFifth;
 use std::sync::Arc;
 
 /// Estimates and errors are reported over the instants up to the end of each fifth of the
@@ -55,6 +54,29 @@ use std::sync::Arc;
 pub const FIFTHS: usize = crate::reduction::estimator::FIFTHS;
 /// A value for each fifth of the run ([`FIFTHS`]), the last the whole run's.
 pub type ByFifth = crate::reduction::estimator::ByFifth;
+
+/// `η_raw` by fifth of the run in both measures (the last entry of each the whole run's).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RawByFifth {
+    /// `‖X_r − X⁺‖_F / ‖X⁺‖_F`
+    pub relative: ByFifth,
+    /// `‖X_r − X⁺‖_F / ‖X⁺ − X₀‖_F`
+    pub displacement: ByFifth,
+}
+
+impl RawByFifth {
+    /// Both ∞: an estimator whose model failed.
+    pub const INFINITE: RawByFifth =
+        RawByFifth { relative: [f64::INFINITY; FIFTHS], displacement: [f64::INFINITY; FIFTHS] };
+
+    /// The values in `measure`.
+    pub fn get(&self, measure: ErrorMeasure) -> &ByFifth {
+        match measure {
+            ErrorMeasure::Relative => &self.relative,
+            ErrorMeasure::Displacement => &self.displacement,
+        }
+    }
+}
 
 /// One estimate.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]

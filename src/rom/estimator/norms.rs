@@ -17,33 +17,10 @@
 //! the last two by expanding the square (`V⁺ᵀV⁺ = I`): the displacement norm is the
 //! configuration's with the reference shifted by the initial configuration.
 
+pub use super::RawByFifth;
 use super::{ByFifth, FIFTHS};
-use crate::reduction::estimator::ErrorMeasure;
 use crate::reduction::{Basis, Variant};
 use ndarray::{Array1, Array2, ArrayView1, Axis};
-
-/// `η_raw` by fifth of the run in both measures (the last entry of each the whole run's).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RawByFifth {
-    /// `‖X_r − X⁺‖_F / ‖X⁺‖_F`
-    pub relative: ByFifth,
-    /// `‖X_r − X⁺‖_F / ‖X⁺ − X₀‖_F`
-    pub displacement: ByFifth,
-}
-
-impl RawByFifth {
-    /// Both ∞: an estimator whose model failed.
-    pub const INFINITE: RawByFifth =
-        RawByFifth { relative: [f64::INFINITY; FIFTHS], displacement: [f64::INFINITY; FIFTHS] };
-
-    /// The values in `measure`.
-    pub fn get(&self, measure: ErrorMeasure) -> &ByFifth {
-        match measure {
-            ErrorMeasure::Relative => &self.relative,
-            ErrorMeasure::Displacement => &self.displacement,
-        }
-    }
-}
 
 /// The number of instants `..end` up to the end of fifth `i` (0-based) of a run of `nt`
 /// instants (at least one).
