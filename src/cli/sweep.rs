@@ -1,7 +1,7 @@
 //! `flexrom sweep`: reduced runs (or, with `--full`, full ones) at many load scales into one
 //! sweep file and a table (optionally one shard of the list, resumed, or validated).
 
-use super::{print_table, warn, FormatArgs};
+use super::{print_table, warn, EstimateArgs, FormatArgs};
 use flexrom::io::output::{check_output, Origin};
 use flexrom::output::table::Format;
 use flexrom::output::{self, info};
@@ -37,7 +37,7 @@ pub struct Args {
     #[arg(long)]
     continuation: bool,
     /// skip the error estimate (about 2× faster; `/error_estimate` is then NaN)
-    #[arg(long)]
+    #[arg(long, conflicts_with = "estimate")]
     no_estimate: bool,
     /// sweep file to write (HDF5); no default: the pipeline's report folder holds the
     /// sweep.h5 of `flexrom run`, which the report's summary.md describes
@@ -59,6 +59,8 @@ pub struct Args {
     #[arg(long, value_name = "K/N")]
     shard: Option<flexrom::pipeline::shard::Shard>,
     #[command(flatten)]
+    estimate: EstimateArgs,
+    #[command(flatten)]
     format: FormatArgs,
 }
 
@@ -76,6 +78,7 @@ impl Args {
             resume,
             strict,
             shard,
+            estimate,
             format,
         } = self;
         let p = Pipeline::load(&pipeline)?;
@@ -94,7 +97,7 @@ impl Args {
         if no_estimate && strict {
             return Err(flexrom::Error::Usage("--strict needs the error estimate; drop --no-estimate".into()));
         }
-        let loaded = if full { None } else { Some(load_rom(&p, &path, None, no_estimate)?) };
+        let loaded = if full { None } else { Some(load_rom(&p, &path, estimate.method(), no_estimate)?) };
         if let Some((_, _, warnings)) = &loaded {
             warn(warnings);
         }
@@ -141,7 +144,7 @@ impl Args {
             .scales
             .iter()
             .filter_map(|x| x.point())
-            .map(|q| (q.run.result.settings.load_scale, q.estimate.map(|e| e.error_estimate)))
+            .map(|q| (q.run.result.settings.load_scale, q.estimate.map(|e| e.in_measure(rom.tolerance_measure()))))
             .collect();
         super::check_runs(rom, &runs, strict)
     }

@@ -83,7 +83,7 @@ use crate::model::Model;
 use crate::reduction::Basis;
 use crate::rom::estimator::norms::rel_error_by_time;
 use crate::rom::estimator::training::{calibrate, CalibrationPoint};
-use crate::rom::estimator::{ByFifth, EstimateMethod, FIFTHS};
+use crate::rom::estimator::{ByFifth, ErrorMeasure, EstimateMethod, FIFTHS};
 use crate::rom::Rom;
 use crate::simulate::{simulate, Overrides, SimulationResult};
 use crate::solver::model::Parameters;
@@ -196,10 +196,12 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
             .map_err(|e| e.at_stage("train (greedy full run)", at))?;
         full_seconds += truth.wall_seconds;
         full_runs += 1;
-        let (e, e_by_time) = true_error(&p.model, &level.trained.basis, &truth, at);
-        let e_score = score(g.tolerance, &e_by_time, &level.sensitivity[ni]);
+        // rel_error `e` calibrates the estimator; the error in the training's measure is held to T
+        let truth_error = true_error(&p.model, &level.trained.basis, &truth, at);
+        let (e, e_measured) = (truth_error.rel_error, truth_error.in_measure(g.measure));
+        let e_score = score(g.tolerance, truth_error.by_time_in(g.measure), &level.sensitivity[ni]);
         let c = level.estimator.calibration.factor;
-        (it.run_load, it.true_error, it.true_score) = (at, e, e_score);
+        (it.run_load, it.true_error, it.true_score) = (at, e_measured, e_score);
         it.held_out_effectivity = c * level.raws[ni] / e;
         if level.raws[ni].is_finite() && e.is_finite() {
             points.push(CalibrationPoint { load_scale: at, raw_estimate: level.raws[ni], rel_error: e });
@@ -234,9 +236,10 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         let done = bound <= g.tolerance && e_score <= g.tolerance;
         let sens = level.sensitivity[ni][4];
         if done {
-            crate::output::info(&format!("iteration {n}: worst score {worst:.2e} ≤ {:e}; held-out check at λ = {at} (score {next_estimate:.2e}): rel_error {e:.2e} (score {e_score:.2e}, sensitivity {sens:.1e}); {shape}", g.tolerance));
+            let name = g.measure.error_name();
+            crate::output::info(&format!("iteration {n}: worst score {worst:.2e} ≤ {:e}; held-out check at λ = {at} (score {next_estimate:.2e}): {name} {e_measured:.2e} (score {e_score:.2e}, sensitivity {sens:.1e}); {shape}", g.tolerance));
         } else {
-            crate::output::info(&format!("iteration {n}: full run at λ = {at} (worst score {worst:.2e} {cmp} {:e}; {next_estimate:.2e} there, true error {e:.2e}, its score {e_score:.2e}, sensitivity {sens:.1e}), {shape}", g.tolerance));
+            crate::output::info(&format!("iteration {n}: full run at λ = {at} (worst score {worst:.2e} {cmp} {:e}; {next_estimate:.2e} there, true error {e_measured:.2e}, its score {e_score:.2e}, sensitivity {sens:.1e}), {shape}", g.tolerance));
         }
         iterations.push(it);
         if done {
@@ -282,6 +285,7 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         converged,
         full_runs,
         method,
+        measure: g.measure,
     };
     let n_snapshots = data.x.ncols();
     Ok((
@@ -415,15 +419,49 @@ fn why_not_converged(tolerance: f64, iterations: &[Iteration], candidates: &[f64
 }
 
 /// rel_error of `basis` at `load` against the full run `truth`, whole and by fifth of the
+/// The true errors of a basis at a held-out load: rel_error (what calibrates the estimator)
+/// and both measures by fifth of the run.
+struct TrueError {
+    rel_error: f64,
+    rel_error_by_time: ByFifth,
+    displacement_error_by_time: ByFifth,
+}
+
+impl TrueError {
+    /// The whole run's error in `measure` (rel_error as `validate` sums it).
+    fn in_measure(&self, measure: ErrorMeasure) -> f64 {
+        match measure {
+            ErrorMeasure::Relative => self.rel_error,
+            ErrorMeasure::Displacement => self.displacement_error_by_time[FIFTHS - 1],
+        }
+    }
+
+    fn by_time_in(&self, measure: ErrorMeasure) -> &ByFifth {
+        match measure {
+            ErrorMeasure::Relative => &self.rel_error_by_time,
+            ErrorMeasure::Displacement => &self.displacement_error_by_time,
+        }
+    }
+}
+
+/// The errors of `basis` at `load` against the full run `truth`, whole and by fifth of the
 /// run (∞ when the reduced run fails).
-fn true_error(model: &Arc<Model>, basis: &Basis, truth: &SimulationResult, load: f64) -> (f64, ByFifth) {
+fn true_error(model: &Arc<Model>, basis: &Basis, truth: &SimulationResult, load: f64) -> TrueError {
     let run = Rom::new(model, &Arc::new(basis.clone()), None, None).and_then(|r| r.solve(&Parameters::new(load)));
     match run {
         Ok(rom) => {
-            let by_time = rel_error_by_time(&rom.result.q, &truth.q);
-            (compare(model, truth, &rom, None, basis.n_reduced(), basis.variant.name()).rel_error, by_time)
+            let v = compare(model, truth, &rom, None, basis.n_reduced(), basis.variant.name());
+            TrueError {
+                rel_error: v.rel_error,
+                rel_error_by_time: rel_error_by_time(&rom.result.q, &truth.q),
+                displacement_error_by_time: std::array::from_fn(|i| v.displacement_error_by_time[i]),
+            }
         }
-        Err(_) => (f64::INFINITY, [f64::INFINITY; FIFTHS]),
+        Err(_) => TrueError {
+            rel_error: f64::INFINITY,
+            rel_error_by_time: [f64::INFINITY; FIFTHS],
+            displacement_error_by_time: [f64::INFINITY; FIFTHS],
+        },
     }
 }
 

@@ -3,7 +3,7 @@
 //! The folder is built beside the target and renamed into place at the end, the basis
 //! written under a temporary name and renamed into place only when every stage succeeded.
 
-use super::config::Pipeline;
+use super::config::{EstimateMethod, Pipeline};
 use super::online::load_rom;
 use super::plot::{Figure, Panel, Series, Style};
 use super::sweep::{sweep, table, write_sweep, SweepBasis, SweepOptions};
@@ -35,18 +35,24 @@ pub fn check_outputs(p: &Pipeline) -> Result<()> {
 /// were and the temporary ones removed. Returns the report folder and the training's
 /// warnings.
 pub fn run(p: &Pipeline, progress: bool) -> Result<(PathBuf, Vec<String>)> {
-    run_with(p, progress, super::dense::DenseChoice::Auto)
+    run_with(p, progress, super::dense::DenseChoice::Auto, None)
 }
 
 /// [`run`] with the choice of the dense-LU comparison ([`super::dense`]), decided before
-/// any work.
-pub fn run_with(p: &Pipeline, progress: bool, dense: super::dense::DenseChoice) -> Result<(PathBuf, Vec<String>)> {
+/// any work, and the error estimate's method (`--estimate`; `None`: the pipeline's
+/// `[online] estimate`, else the basis's default).
+pub fn run_with(
+    p: &Pipeline,
+    progress: bool,
+    dense: super::dense::DenseChoice,
+    method: Option<EstimateMethod>,
+) -> Result<(PathBuf, Vec<String>)> {
     check_outputs(p)?;
     let dense = super::dense::decide(dense, &p.model)?;
     let dir = p.report_dir.clone();
     let report = TempPath::dir_for(&dir)?;
     let basis = TempPath::file_for(&p.basis_path)?;
-    let warnings = build(p, report.path(), basis.path(), progress, dense)?;
+    let warnings = build(p, report.path(), basis.path(), progress, (dense, method))?;
     mark_new_report(report.path())?;
     // checked again: the folder or the basis path may have changed during a long run
     check_outputs(p)?;
@@ -57,7 +63,13 @@ pub fn run_with(p: &Pipeline, progress: bool, dense: super::dense::DenseChoice) 
 
 /// Every stage, writing the basis to `basis_path` (a temporary name) and the report files
 /// into `out` (a temporary folder); the files are `fsync`ed when the folder is swapped in.
-fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: bool) -> Result<Vec<String>> {
+fn build(
+    p: &Pipeline,
+    out: &Path,
+    basis_path: &Path,
+    progress: bool,
+    (dense, method): (bool, Option<EstimateMethod>),
+) -> Result<Vec<String>> {
     let plot_err = |e: String| Error::io(out, std::io::Error::other(e));
     match &p.file.train.greedy {
         Some(g) => crate::output::info(&format!("[1/3] train: greedy over [{}, {}]", g.range().0, g.range().1)),
@@ -65,7 +77,7 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: boo
     }
     let mut trained = train_and_write(p, basis_path)?;
     // the warnings of loading it come with `check_report`'s, once
-    let (stored, rom, _) = load_rom(p, basis_path, None, false)?;
+    let (stored, rom, _) = load_rom(p, basis_path, method, false)?;
     trained.warnings.extend(super::route::time_and_store(&rom, basis_path)?);
 
     let scales = p.online_scales();
@@ -262,9 +274,23 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: boo
         b.n_dof(),
         &p.model.fingerprint()[..12]
     );
+    // a held-out check run is named as such: its load is not among the basis's
+    let held_out = match trained.held_out_loads().as_slice() {
+        [] => String::new(),
+        loads => format!(
+            " ({}) + {} held-out check at λ = {} (not in the basis)",
+            if trained.n_training_runs() == 1 {
+                "1 training run".to_string()
+            } else {
+                format!("{} training runs", trained.n_training_runs())
+            },
+            loads.len(),
+            loads.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(", ")
+        ),
+    };
     let _ = writeln!(
         md,
-        "- basis: `{}`: {} reduction, {} snapshots, rule `{}` → {} POD modes{}, {} snapshots from load scales {:?}",
+        "- basis: `{}`: {} reduction, {} snapshots, rule `{}` → {} POD modes{}, {} snapshots from load scales {:?}{held_out}",
         p.basis_path.display(),
         b.variant.name(),
         b.snapshots.name(),
@@ -346,6 +372,7 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: boo
             est_by
         );
     }
+    motion_section(&mut md, &validations, trust);
     let _ = writeln!(md, "\n## Sweep\n\n```text\n{}```\n", table(&sw));
     let _ = writeln!(md, "## Plots\n");
     for (i, x) in vscales.iter().enumerate() {
@@ -363,11 +390,47 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: boo
     Ok(warnings)
 }
 
+/// The summary's section on the errors against the motion: displacement_error and its
+/// estimate, each probe's error over its travel.
+fn motion_section(md: &mut String, validations: &[Validation], trust: &crate::rom::Trust) {
+    let _ = writeln!(md, "\n## Errors against the motion\n");
+    let _ = writeln!(
+        md,
+        "rel_error divides by ‖X_full‖, which holds the undeformed geometry and the unit slopes; displacement_error = ‖X_rom − X_full‖ / ‖X_full − X₀‖ measures the error against the motion from the initial configuration X₀, and a probe's error over its travel is max_t |r_rom − r_full| / max_t |r_full(t) − r_full(0)| (docs/error-estimate.md). The tolerance is on {}.\n",
+        trust.measure.error_name()
+    );
+    let _ = writeln!(md, "| load scale | rel_error | displacement_error | error_estimate_displacement | effectivity | displacement_error by fifth of the run | probe error over its travel |");
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|");
+    for v in validations {
+        let by: Vec<String> = v.displacement_error_by_time.iter().map(|e| format!("{e:.2e}")).collect();
+        let probes: Vec<String> = v
+            .probe_errors_over_travel
+            .iter()
+            .map(|p| match p.error_over_travel {
+                Some(e) => format!("{} {e:.2e} ({:.2e} m of {:.3} m)", p.probe, p.max_error, p.travel),
+                None => format!("{} (does not move)", p.probe),
+            })
+            .collect();
+        let o = |x: Option<f64>, f: &dyn Fn(f64) -> String| x.map_or("–".to_string(), f);
+        let _ = writeln!(
+            md,
+            "| {} | {:.3e} | {:.3e} | {} | {} | {} | {} |",
+            v.load_scale,
+            v.rel_error,
+            v.displacement_error,
+            o(v.error_estimate_displacement, &|x| format!("{x:.3e}")),
+            o(v.effectivity_displacement, &|x| format!("{x:.2}")),
+            by.join(", "),
+            probes.join("; ")
+        );
+    }
+}
+
 /// After `run`: the warnings of the report's basis and sweep (read back from its
 /// `sweep.h5`: extrapolation, estimates above the tolerance), and `--strict`'s error when an
-/// estimate exceeds the tolerance.
-pub fn check_report(p: &Pipeline, dir: &Path, strict: bool) -> Result<Vec<String>> {
-    let (_, rom, mut warnings) = load_rom(p, &p.basis_path, None, false)?;
+/// estimate exceeds the tolerance (`method`: the estimate's, as `run_with` was given it).
+pub fn check_report(p: &Pipeline, dir: &Path, strict: bool, method: Option<EstimateMethod>) -> Result<Vec<String>> {
+    let (_, rom, mut warnings) = load_rom(p, &p.basis_path, method, false)?;
     let path = dir.join("sweep.h5");
     let f = hdf5::File::open(&path).map_err(|e| Error::hdf5(&path, e))?;
     let read = |name: &str| {
@@ -375,10 +438,14 @@ pub fn check_report(p: &Pipeline, dir: &Path, strict: bool) -> Result<Vec<String
             .and_then(|d| d.read_1d::<f64>())
             .map_err(|e| Error::input(&path, name, format!("cannot be read: {e}")))
     };
-    let (scales, est) = (read("load_scales")?, read("error_estimate")?);
+    let trust = rom.trust().expect("read from its basis file");
+    let estimates = match trust.measure {
+        crate::rom::estimator::ErrorMeasure::Relative => "error_estimate",
+        crate::rom::estimator::ErrorMeasure::Displacement => "error_estimate_displacement",
+    };
+    let (scales, est) = (read("load_scales")?, read(estimates)?);
     let runs: Vec<(f64, Option<f64>)> =
         scales.iter().zip(&est).map(|(&x, &e)| (x, if e.is_nan() { None } else { Some(e) })).collect();
-    let trust = rom.trust().expect("read from its basis file");
     warnings.extend(crate::rom::trust::check_runs(trust, rom.estimator().is_some(), &runs, strict)?);
     Ok(warnings)
 }

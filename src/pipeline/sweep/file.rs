@@ -17,10 +17,12 @@
 //! /error_estimate     (N)            the estimate of rel_error of each run (NaN: no estimator)
 //! /error_estimate_by_time (N, 5)     the estimate up to the end of each fifth of the run (the
 //!                                    last column is /error_estimate; NaN: no estimator)
+//! /error_estimate_displacement (N)   the estimate of displacement_error of each run
+//! /error_estimate_displacement_by_time (N, 5)   the same up to the end of each fifth
 //! /extrapolated       (N)            1 where the load scale is outside the training range
 //! /estimate_seconds   (N)            the estimator's enriched run and norms, s
 //! with --validate:    /rel_error, /max_probe_error, /max_constraint_violation,
-//!                     /full_seconds, /speedup, /steps_differ_from  (N each)
+//!                     /full_seconds, /speedup, /steps_differ_from, /displacement_error  (N each)
 //! with --full:        /full_seconds (N), the full time loop of each run; the estimate
 //!                     columns NaN (an exact run has none), /extrapolated 0
 //! every dataset: units, dims (src/io/attrs.rs)
@@ -155,6 +157,17 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, basis: Option<SweepBasis>, extra
         }
         f.new_dataset_builder().with_data(&by_time).create("error_estimate_by_time").map_err(e)?;
         f.new_dataset_builder()
+            .with_data(&col(&|p| p.estimate.map_or(f64::NAN, |e| e.error_estimate_displacement)))
+            .create("error_estimate_displacement")
+            .map_err(e)?;
+        let mut by_time = Array2::from_elem((n, 5), f64::NAN);
+        for (k, x) in s.scales.iter().enumerate() {
+            if let Some(est) = x.point().and_then(|p| p.estimate) {
+                by_time.row_mut(k).assign(&ndarray::ArrayView1::from(&est.displacement_by_time));
+            }
+        }
+        f.new_dataset_builder().with_data(&by_time).create("error_estimate_displacement_by_time").map_err(e)?;
+        f.new_dataset_builder()
             .with_data(&col(&|p| p.estimate.map_or(f64::NAN, |e| e.seconds)))
             .create("estimate_seconds")
             .map_err(e)?;
@@ -176,6 +189,7 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, basis: Option<SweepBasis>, extra
                 .with_data(&v(&|x| x.steps_differ_from.unwrap_or(f64::NAN)))
                 .create("steps_differ_from")
                 .map_err(e)?;
+            f.new_dataset_builder().with_data(&v(&|x| x.displacement_error)).create("displacement_error").map_err(e)?;
         }
         if s.full {
             // the full time loops, as a validated sweep's column of the same name
@@ -327,18 +341,24 @@ pub fn read_sweep(
             None
         },
     );
-    let by_time = if f.link_exists("error_estimate_by_time") {
-        let a = f
-            .dataset("error_estimate_by_time")
-            .and_then(|d| d.read::<f64, ndarray::Ix2>())
-            .map_err(|e| cannot("error_estimate_by_time", format!("cannot be read: {e}")))?;
-        if a.dim() != (n, 5) {
-            return Err(cannot("error_estimate_by_time", format!("is {:?}, expected ({n}, 5)", a.dim())));
+    let by_fifth = |name: &str| -> Result<Option<Array2<f64>>> {
+        if !f.link_exists(name) {
+            return Ok(None);
         }
-        Some(a)
-    } else {
-        None
+        let a = f
+            .dataset(name)
+            .and_then(|d| d.read::<f64, ndarray::Ix2>())
+            .map_err(|e| cannot(name, format!("cannot be read: {e}")))?;
+        if a.dim() != (n, 5) {
+            return Err(cannot(name, format!("is {:?}, expected ({n}, 5)", a.dim())));
+        }
+        Ok(Some(a))
     };
+    let by_time = by_fifth("error_estimate_by_time")?;
+    // files written before the displacement measure have neither: NaN
+    let (estimates_displacement, displacement_by_time) =
+        (optional("error_estimate_displacement")?, by_fifth("error_estimate_displacement_by_time")?);
+    let displacement = if validate { optional("displacement_error")? } else { None };
     let (newton, factorizations) = (ints("newton_iterations")?, ints("factorizations")?);
     // files written before it have no /steps_differ_from: unknown, as no halved step
     let differ = if validate && f.link_exists("steps_differ_from") { Some(vec("steps_differ_from")?) } else { None };
@@ -364,6 +384,8 @@ pub fn read_sweep(
         .chain(validation.iter().flatten())
         .chain(estimates.iter())
         .chain(estimate_seconds.iter())
+        .chain(estimates_displacement.iter())
+        .chain(displacement.iter())
     {
         if a.len() != n {
             return Err(cannot(
@@ -433,6 +455,15 @@ pub fn read_sweep(
             sensitivity: None,
             rel_error_by_time: Vec::new(),
             error_estimate_by_time: None,
+            displacement_error: displacement.as_ref().map_or(f64::NAN, |a| a[k]),
+            displacement_error_by_time: Vec::new(),
+            error_estimate_displacement: None,
+            effectivity_displacement: None,
+            error_estimate_displacement_by_time: None,
+            max_error_over_travel: None,
+            max_error_over_travel_probe: String::new(),
+            probe_errors_over_travel: Vec::new(),
+            error_estimate_method: None,
         });
         // the stored estimate: its value and cost (the factor it was made with is the basis's)
         let estimate = estimates.as_ref().map(|a| a[k]).filter(|e| !e.is_nan()).map(|error_estimate| Estimate {
@@ -442,6 +473,10 @@ pub fn read_sweep(
             calibrated: false,
             seconds: estimate_seconds.as_ref().map_or(f64::NAN, |a| a[k]),
             by_time: by_time.as_ref().map_or([f64::NAN; 5], |a| std::array::from_fn(|i| a[[k, i]])),
+            error_estimate_displacement: estimates_displacement.as_ref().map_or(f64::NAN, |a| a[k]),
+            displacement_by_time: displacement_by_time
+                .as_ref()
+                .map_or([f64::NAN; 5], |a| std::array::from_fn(|i| a[[k, i]])),
         });
         let extrapolated = extrapolated.as_ref().is_some_and(|a| a.get(k).is_some_and(|&v| v != 0));
         let v = v.map(|mut v| {
@@ -450,6 +485,9 @@ pub fn read_sweep(
                 v.effectivity = Some(e.error_estimate / v.rel_error);
                 v.estimate_seconds = Some(e.seconds);
                 v.error_estimate_by_time = Some(e.by_time.to_vec());
+                v.error_estimate_displacement = Some(e.error_estimate_displacement);
+                v.effectivity_displacement = Some(e.error_estimate_displacement / v.displacement_error);
+                v.error_estimate_displacement_by_time = Some(e.displacement_by_time.to_vec());
             }
             v.extrapolated = extrapolated;
             v
