@@ -250,10 +250,11 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
     };
     if !converged {
         warnings.push(format!(
-            "greedy training stopped after {full_runs} full runs (max_runs = {}) with worst estimate {:.2e} > tolerance {:e}: {}",
+            "greedy training stopped after {full_runs} full runs (max_runs = {}) above its tolerance {:e} (worst score {:.2e}, bound between candidates {:.2e}): {}",
             g.max_runs,
-            iterations.last().map_or(f64::NAN, |i| i.worst_estimate),
             g.tolerance,
+            iterations.last().map_or(f64::NAN, |i| i.worst_estimate),
+            iterations.last().map_or(f64::NAN, |i| search::between_candidates(&i.estimates)),
             why_not_converged(g.tolerance, &iterations, &candidates)
         ));
     }
@@ -388,19 +389,37 @@ fn why_not_converged(tolerance: f64, iterations: &[Iteration], candidates: &[f64
         );
     }
     // the largest sensitivity the loop met, over the candidates of every iteration
-    let (mut s_max, mut at) = (0.0_f64, f64::NAN);
+    let (mut s_max, mut at_max) = (0.0_f64, f64::NAN);
     for it in iterations {
         for (&s, &x) in it.sensitivity.iter().zip(candidates) {
             if s > s_max {
-                (s_max, at) = (s, x);
+                (s_max, at_max) = (s, x);
             }
         }
     }
     let sensitive_held_out =
         iterations.iter().filter(|it| it.true_error > tolerance && it.true_score <= tolerance).count();
+    // every score within T, but neighbours far apart: the loads between them are not certified
+    let bound = search::between_candidates(&last.estimates);
+    if last.worst_estimate <= tolerance && bound > tolerance {
+        let (ratio, at) = last
+            .estimates
+            .windows(2)
+            .zip(candidates)
+            .map(|(w, &x)| (w[0].max(w[1]) / w[0].min(w[1]), x))
+            .fold((0.0_f64, f64::NAN), |a, b| if b.0 > a.0 { b } else { a });
+        return format!(
+            "every candidate's score is within it, but neighbouring scores differ by up to {ratio:.0}× (from λ = {at}), which leaves the loads between them uncertified{}; more candidates (`[train] greedy candidates = N`) resolve an error that varies smoothly with the load, not one that jumps",
+            if s_max > tolerance {
+                format!(" (the full model is sensitive to the load: a 0.1 % change moves its answer by up to {s_max:.1e}, at λ = {at_s})", at_s = at_max)
+            } else {
+                String::new()
+            }
+        );
+    }
     if s_max > tolerance {
         return format!(
-            "the full model is sensitive to the load (a 0.1 % change moves its answer by up to {s_max:.1e} over the run, at λ = {at}{}): there the tolerance asks more than the load determines; a looser tolerance, a shorter run (`[time] t_end`) or a narrower range certifies, and `error_estimate_by_time` shows the early part of the run",
+            "the full model is sensitive to the load (a 0.1 % change moves its answer by up to {s_max:.1e} over the run, at λ = {at_max}{}): there the tolerance asks more than the load determines; a looser tolerance, a shorter run (`[time] t_end`) or a narrower range certifies, and `error_estimate_by_time` shows the early part of the run",
             if sensitive_held_out > 0 { format!("; {sensitive_held_out} held-out errors above T were within it") } else { String::new() }
         );
     }
@@ -505,6 +524,9 @@ mod tests {
         assert!(why.contains("sensitive to the load") && why.contains("1.6e-1") && why.contains("λ = 1"), "{why}");
         let off = iteration(vec![1e-3, 2e-2, 1e-3], vec![1e-3; 3], 250.0);
         assert!(why_not_converged(t, &[off], &loads).contains("at 1 of its held-out runs"));
+        let jumpy = iteration(vec![1e-3, 2e-5, 1e-3], vec![1e-3; 3], 1.5);
+        let why = why_not_converged(t, &[jumpy], &loads);
+        assert!(why.contains("differ by up to 50×") && why.contains("λ = 0.5"), "{why}");
         let slow = iteration(vec![1e-3, 2e-2, 1e-3], vec![1e-3; 3], 1.5);
         assert!(why_not_converged(t, &[slow], &loads).contains("raise max_runs"));
     }
