@@ -5,7 +5,7 @@
 //! ```text
 //! cargo build --release
 //! cargo run --release --example zoo -- [--seed S] [--models N] [--out DIR]
-//!     [--tolerances 5e-3,1e-2] [--subset] [--jobs 2] [--no-methods] [--draw-only] [--flexrom PATH]
+//!     [--tolerances 5e-3,1e-2] [--subset] [--jobs 2] [--no-methods] [--draw-only] [--resume] [--flexrom PATH]
 //! ```
 //!
 //! For every model and tolerance: `train` (greedy over [0.5, 1.5], `max_runs = 10`), then
@@ -16,7 +16,9 @@
 //! default estimate fails (reads under the error, or over it by more than 20×) it is
 //! validated again with each method (`[online] estimate`). Writes DIR/zoo.md (Markdown
 //! tables) and DIR/zoo.json (every number), DIR/models/NAME/ the model and pipelines.
-//! `--draw-only` writes the models and pipelines and stops. At most `--jobs` (≤ 2) flexrom processes at a time, each with `--threads 1`.
+//! `--draw-only` writes the models and pipelines and stops; `--resume` reads back what an
+//! interrupted run of the same binary kept (every process's output is kept beside its
+//! pipeline) instead of running it again. At most `--jobs` (≤ 2) flexrom processes at a time, each with `--threads 1`.
 
 #[path = "../tests/common/zoo/mod.rs"]
 mod zoo;
@@ -40,11 +42,12 @@ struct Args {
     jobs: usize,
     methods: bool,
     draw_only: bool,
+    resume: bool,
     flexrom: Option<PathBuf>,
 }
 
 fn usage(msg: &str) -> ! {
-    eprintln!("zoo: {msg}\nusage: zoo [--seed S] [--models N] [--out DIR] [--tolerances 5e-3,1e-2] [--subset] [--jobs 1|2] [--no-methods] [--draw-only] [--flexrom PATH]");
+    eprintln!("zoo: {msg}\nusage: zoo [--seed S] [--models N] [--out DIR] [--tolerances 5e-3,1e-2] [--subset] [--jobs 1|2] [--no-methods] [--draw-only] [--resume] [--flexrom PATH]");
     std::process::exit(2)
 }
 
@@ -58,6 +61,7 @@ fn args() -> Args {
         jobs: 2,
         methods: true,
         draw_only: false,
+        resume: false,
         flexrom: None,
     };
     let mut it = std::env::args().skip(1);
@@ -80,6 +84,7 @@ fn args() -> Args {
             "--subset" => a.subset = true,
             "--no-methods" => a.methods = false,
             "--draw-only" => a.draw_only = true,
+            "--resume" => a.resume = true,
             "--flexrom" => a.flexrom = Some(PathBuf::from(value())),
             _ => usage(&format!("unknown argument {k}")),
         }
@@ -111,6 +116,23 @@ fn write_atomic(path: &Path, text: &str) {
         .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
 }
 
+/// Writes a model file; where it replaces a different one, the outputs kept from runs of
+/// the old model (`*.done`, tests/common/zoo/drive.rs) no longer count.
+fn write_model(dir: &Path, text: &str) {
+    let path = dir.join("model.toml");
+    if std::fs::read_to_string(&path).is_ok_and(|old| old == text) {
+        return;
+    }
+    if let Ok(entries) = std::fs::read_dir(dir) {
+        for e in entries.flatten() {
+            if e.path().extension().is_some_and(|x| x == "done") {
+                let _ = std::fs::remove_file(e.path());
+            }
+        }
+    }
+    write_atomic(&path, text);
+}
+
 /// One model at one tolerance.
 #[derive(serde::Serialize)]
 struct Entry {
@@ -121,6 +143,8 @@ struct Entry {
     stats: ModelStats,
     /// the other estimate methods, where the default failed
     methods: Vec<MethodRun>,
+    /// wall time of the whole entry: training, validations, other methods
+    wall_seconds: f64,
 }
 
 #[derive(serde::Serialize)]
@@ -157,7 +181,7 @@ fn run_entry(fx: &Flexrom, dir: &Path, name: &str, tolerance: f64) -> Entry {
     let training = fx.train(dir, &pipeline);
     let validations = if training.is_ok() { validate_all(fx, dir, &pipeline) } else { Vec::new() };
     let stats = model_stats(&validations);
-    Entry { model: name.into(), tolerance, training, validations, stats, methods: Vec::new() }
+    Entry { model: name.into(), tolerance, training, validations, stats, methods: Vec::new(), wall_seconds: 0.0 }
 }
 
 fn run_methods(fx: &Flexrom, dir: &Path, e: &mut Entry) {
@@ -287,8 +311,44 @@ fn method_row(name: &str, tol: f64, m: &MethodRun) -> String {
     )
 }
 
+/// CPU seconds (user + system) of the finished child processes (Linux: /proc/self/stat's
+/// cutime and cstime, in clock ticks of `getconf CLK_TCK`); None elsewhere. On a shared
+/// machine this is the figure to compare: the wall time depends on the other users.
+fn children_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // the fields after the command name in parentheses; cutime and cstime are the 16th and 17th
+    let rest = &stat[stat.rfind(')')? + 2..];
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = f.get(13)?.parse::<f64>().ok()? + f.get(14)?.parse::<f64>().ok()?;
+    let o = std::process::Command::new("getconf").arg("CLK_TCK").output().ok()?;
+    let hz: f64 = String::from_utf8_lossy(&o.stdout).trim().parse().ok()?;
+    Some(ticks / hz)
+}
+
 fn replaced_json(r: &[Replacement]) -> serde_json::Value {
     r.iter().map(|r| serde_json::json!({"slot": r.slot, "attempt": r.attempt, "reason": r.reason})).collect()
+}
+
+const FAIL_HEAD: &str = "| model | tolerance | default | loads under (whole run) | triples under | worst under: true / estimate (whole, by fifth) | max effectivity | methods that hold |\n|---|---|---|---|---|---|---|---|";
+
+/// How a model's default estimate failed, and which methods hold there (every load and
+/// fifth covered, effectivity ≤ 20: `metrics::estimate_fails` false).
+fn failure_row(name: &str, e: &Entry) -> String {
+    let s = &e.stats;
+    let method = e.training.as_ref().map_or("–".to_string(), |t| t.method.clone());
+    let holds: Vec<&str> = e.methods.iter().filter(|m| !estimate_fails(&m.stats)).map(|m| m.method.as_str()).collect();
+    format!(
+        "| {name} | {} | {method} | {}/{} | {}/{} | {}, {} | {} | {} |",
+        tol_tag(e.tolerance),
+        s.under_pairs,
+        s.loads,
+        s.under_triples,
+        5 * s.loads,
+        g3(1.0 / s.effectivity_min),
+        g3(1.0 / s.fifth_effectivity_min),
+        g3(s.effectivity_max),
+        if holds.is_empty() { "none".to_string() } else { holds.join(", ") }
+    )
 }
 
 fn commit() -> String {
@@ -302,7 +362,7 @@ fn commit() -> String {
 
 fn main() {
     let a = args();
-    let fx = Flexrom { bin: find_flexrom(a.flexrom.clone()) };
+    let fx = Flexrom { bin: find_flexrom(a.flexrom.clone()), resume: a.resume };
     let start = Instant::now();
     // never write into a directory of something else
     if a.out.is_dir()
@@ -324,9 +384,8 @@ fn main() {
                 accepted(a.seed, slot, |m| {
                     let dir = models_dir.join(m.name());
                     std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-                    write_atomic(&dir.join("model.toml"), &m.mechanism.toml);
-                    fx.full_run(&dir, "model.toml", zoo::RANGE.0)?;
-                    fx.full_run(&dir, "model.toml", zoo::RANGE.1)
+                    write_model(&dir, &m.mechanism.toml);
+                    fx.full_runs_complete(&dir, "model.toml")
                 })
             })
             .collect()
@@ -402,6 +461,7 @@ fn main() {
                 if a.methods && e.training.is_ok() && estimate_fails(&e.stats) {
                     run_methods(&fx, &models_dir.join(&name), &mut e);
                 }
+                e.wall_seconds = t0.elapsed().as_secs_f64();
                 eprintln!(
                     "zoo: {name} at {}: {} ({:.0} s)",
                     tol_tag(t),
@@ -423,19 +483,21 @@ fn main() {
     });
     entries.sort_by(|x, y| x.0.cmp(&y.0).then(x.1.tolerance.total_cmp(&y.1.tolerance)));
     let wall = start.elapsed().as_secs_f64();
+    let cpu = children_cpu_seconds();
 
     // 3. the report
     let mut md = String::new();
     let _ = writeln!(
         md,
-        "Zoo seed {}, {} models ({} replaced), tolerances {}, commit {}; {:.0} s wall with {} jobs.\n",
+        "Zoo seed {}, {} models ({} replaced), tolerances {}, commit {}; {:.0} s wall with {} jobs, {} CPU seconds in flexrom.\n",
         a.seed,
         models.len(),
         replaced.len(),
         a.tolerances.iter().map(|t| tol_tag(*t)).collect::<Vec<_>>().join(", "),
         commit(),
         wall,
-        a.jobs
+        a.jobs,
+        cpu.map_or("?".into(), |c| format!("{c:.0}"))
     );
     let mut aggregates = Vec::new();
     for &t in &a.tolerances {
@@ -457,6 +519,16 @@ fn main() {
     }
     let failing: Vec<&(usize, Entry)> = entries.iter().filter(|(_, e)| !e.methods.is_empty()).collect();
     if !failing.is_empty() {
+        let _ = writeln!(
+            md,
+            "### Where the default estimate failed
+
+{FAIL_HEAD}"
+        );
+        for (i, e) in &failing {
+            let _ = writeln!(md, "{}", failure_row(&infos[*i].name, e));
+        }
+        let _ = writeln!(md);
         let _ = writeln!(
             md,
             "### Every estimate method where the default failed\n\n| model | tolerance | method | covered loads | coverage by fifth (%) | effectivity min | median | max | min by fifth | cost |\n|---|---|---|---|---|---|---|---|---|---|"
@@ -492,6 +564,7 @@ fn main() {
         "tolerances": a.tolerances,
         "validation_loads": validation_loads(),
         "wall_seconds": wall,
+        "flexrom_cpu_seconds": cpu,
         "jobs": a.jobs,
         "models": infos,
         "replaced": replaced_json(&replaced),
@@ -500,5 +573,11 @@ fn main() {
     });
     write_atomic(&a.out.join("zoo.json"), &serde_json::to_string_pretty(&json).expect("JSON"));
     print!("{md}");
-    eprintln!("zoo: {:.0} s wall; {} and {}", wall, a.out.join("zoo.md").display(), a.out.join("zoo.json").display());
+    eprintln!(
+        "zoo: {:.0} s wall, {} CPU seconds in flexrom; {} and {}",
+        wall,
+        cpu.map_or("?".into(), |c| format!("{c:.0}")),
+        a.out.join("zoo.md").display(),
+        a.out.join("zoo.json").display()
+    );
 }

@@ -2,6 +2,11 @@
 //! `simulate`), one worker thread per process, and reads what it prints: the JSON of
 //! `train --json` and `validate --json` (docs/cli.md) and greedy's lines on stderr
 //! (docs/greedy-training.md, "What `train` prints").
+//!
+//! Every call keeps what the process printed beside the pipeline (`KEY.out`, `KEY.err`,
+//! and `KEY.done` last, with the exit code, the wall time and the binary's size and
+//! modification time): the raw record of the run, and what `resume` reads back instead of
+//! running again when the same binary made it.
 
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -11,6 +16,16 @@ use std::time::Instant;
 /// The `flexrom` binary.
 pub struct Flexrom {
     pub bin: PathBuf,
+    /// read a call's kept output instead of running it again (same binary only)
+    pub resume: bool,
+}
+
+/// What one process printed.
+struct Printed {
+    success: bool,
+    stdout: Vec<u8>,
+    stderr: Vec<u8>,
+    wall_seconds: f64,
 }
 
 /// What `train` did.
@@ -70,39 +85,85 @@ fn elements_of(line: &str) -> Option<usize> {
 }
 
 impl Flexrom {
-    fn command(&self, dir: &Path) -> Command {
-        let mut c = Command::new(&self.bin);
-        c.current_dir(dir).env_remove("RAYON_NUM_THREADS");
-        c
+    /// The binary's size and modification time: which build made a kept output.
+    fn stamp(&self) -> String {
+        std::fs::metadata(&self.bin)
+            .map(|m| {
+                let t = m.modified().ok().and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok());
+                format!("{}:{}", m.len(), t.map_or(0, |d| d.as_nanos()))
+            })
+            .unwrap_or_default()
+    }
+
+    /// Runs `flexrom ARGS` in `dir` (or reads its kept output under `key`, see the module
+    /// documentation).
+    fn run(&self, dir: &Path, key: &str, args: &[&str]) -> Result<Printed, String> {
+        let (out, err, done) =
+            (dir.join(format!("{key}.out")), dir.join(format!("{key}.err")), dir.join(format!("{key}.done")));
+        let stamp = self.stamp();
+        if self.resume {
+            if let Ok(d) = std::fs::read_to_string(&done) {
+                let field = |k: &str| d.split_whitespace().find_map(|w| w.strip_prefix(k)).map(str::to_string);
+                if field("bin=").as_deref() == Some(stamp.as_str()) {
+                    if let (Ok(stdout), Ok(stderr), Some(exit), Some(wall)) =
+                        (std::fs::read(&out), std::fs::read(&err), field("exit="), field("wall="))
+                    {
+                        return Ok(Printed {
+                            success: exit == "0",
+                            stdout,
+                            stderr,
+                            wall_seconds: wall.parse().unwrap_or(f64::NAN),
+                        });
+                    }
+                }
+            }
+        }
+        let _ = std::fs::remove_file(&done);
+        let start = Instant::now();
+        let o = Command::new(&self.bin)
+            .current_dir(dir)
+            .env_remove("RAYON_NUM_THREADS")
+            .args(args)
+            .output()
+            .map_err(|e| format!("{}: {e}", self.bin.display()))?;
+        let wall_seconds = start.elapsed().as_secs_f64();
+        let exit = o.status.code().map_or("signal".to_string(), |c| c.to_string());
+        let kept = std::fs::write(&out, &o.stdout).and_then(|()| std::fs::write(&err, &o.stderr));
+        if kept.is_ok() {
+            let _ = std::fs::write(&done, format!("exit={exit} wall={wall_seconds} bin={stamp}\n"));
+        }
+        Ok(Printed { success: o.status.success(), stdout: o.stdout, stderr: o.stderr, wall_seconds })
     }
 
     /// The full model at `load`: Ok when the run completes (the binary's blow-up checks
     /// included), else its error line. The result file is removed.
     pub fn full_run(&self, dir: &Path, model: &str, load: f64) -> Result<(), String> {
         let out = format!("full_{load}.h5");
-        let o = self
-            .command(dir)
-            .args(["simulate", "-q", "--threads", "1", "--load-scale", &load.to_string(), "-o", &out, model])
-            .output()
-            .map_err(|e| format!("{}: {e}", self.bin.display()))?;
+        let key = format!("full_{load}");
+        let o = self.run(
+            dir,
+            &key,
+            &["simulate", "-q", "--threads", "1", "--load-scale", &load.to_string(), "-o", &out, model],
+        )?;
         let _ = std::fs::remove_file(dir.join(&out));
-        if o.status.success() {
+        if o.success {
             Ok(())
         } else {
             Err(format!("λ = {load}: {}", last_line(&o.stderr)))
         }
     }
 
+    /// The full model at every load of [`super::check_loads`], stopping at the first that fails.
+    pub fn full_runs_complete(&self, dir: &Path, model: &str) -> Result<(), String> {
+        super::check_loads().into_iter().try_for_each(|x| self.full_run(dir, model, x))
+    }
+
     /// `train --json` of `pipeline` (a file in `dir`).
     pub fn train(&self, dir: &Path, pipeline: &str) -> Result<Training, String> {
-        let start = Instant::now();
-        let o = self
-            .command(dir)
-            .args(["train", "--json", "--threads", "1", pipeline])
-            .output()
-            .map_err(|e| format!("{}: {e}", self.bin.display()))?;
-        let wall_seconds = start.elapsed().as_secs_f64();
-        if !o.status.success() {
+        let key = format!("{}.train", pipeline.trim_end_matches(".toml"));
+        let o = self.run(dir, &key, &["train", "--json", "--threads", "1", pipeline])?;
+        let wall_seconds = o.wall_seconds;
+        if !o.success {
             return Err(last_line(&o.stderr));
         }
         let v: Value = serde_json::from_slice(&o.stdout).map_err(|e| format!("train --json: {e}"))?;
@@ -132,22 +193,14 @@ impl Flexrom {
 
     /// `validate --json --no-dense` of `pipeline` at `load`.
     pub fn validate(&self, dir: &Path, pipeline: &str, load: f64) -> Result<Validation, String> {
-        let o = self
-            .command(dir)
-            .args([
-                "validate",
-                "--json",
-                "--no-dense",
-                "-q",
-                "--threads",
-                "1",
-                "--load-scale",
-                &load.to_string(),
-                pipeline,
-            ])
-            .output()
-            .map_err(|e| format!("{}: {e}", self.bin.display()))?;
-        if !o.status.success() {
+        let key = format!("{}.validate_{load}", pipeline.trim_end_matches(".toml"));
+        let x = load.to_string();
+        let o = self.run(
+            dir,
+            &key,
+            &["validate", "--json", "--no-dense", "-q", "--threads", "1", "--load-scale", &x, pipeline],
+        )?;
+        if !o.success {
             return Err(format!("λ = {load}: {}", last_line(&o.stderr)));
         }
         let v: Value = serde_json::from_slice(&o.stdout).map_err(|e| format!("validate --json: {e}"))?;

@@ -6,8 +6,10 @@
 //!
 //! Slot `i` of a zoo draws kind `KINDS[i mod 8]` from its own stream (seed, slot, attempt),
 //! so a slot's model does not depend on how many slots are drawn: the subset is the same
-//! models as in the whole zoo. A model whose full run fails at either end of the load range
-//! is replaced by the slot's next attempt (the report counts them).
+//! models as in the whole zoo. A model whose full run fails at either end of the load range,
+//! or at a load greedy training or the validation would run it at (`check_loads`), is
+//! replaced by the slot's next attempt (the report counts them): such a model says nothing
+//! about the reduction, and a full run that fails inside the range would end its training.
 #![allow(dead_code)]
 
 pub mod drive;
@@ -63,8 +65,8 @@ pub struct Replacement {
     pub reason: String,
 }
 
-/// The model of `slot`: the first attempt for which `runs` (the full model at both ends of
-/// [`RANGE`]) succeeds, and the attempts replaced before it. `Err` after [`MAX_ATTEMPTS`].
+/// The model of `slot`: the first attempt for which `runs` (the full model at every load of
+/// [`check_loads`]) succeeds, and the attempts replaced before it. `Err` after [`MAX_ATTEMPTS`].
 pub fn accepted(
     seed: u64,
     slot: usize,
@@ -94,6 +96,17 @@ pub fn validation_loads() -> Vec<f64> {
             a + (k as f64 + 0.5) * h
         })
         .collect()
+}
+
+/// Where a model's full run must complete: the range's ends first, then the validation loads,
+/// then the other candidate loads (greedy runs the full model at candidates only).
+pub fn check_loads() -> Vec<f64> {
+    let (a, b) = RANGE;
+    let n = GREEDY_CANDIDATES;
+    let mut loads = vec![a, b];
+    loads.extend(validation_loads());
+    loads.extend((1..n - 1).map(|i| a + (b - a) * i as f64 / (n - 1) as f64));
+    loads
 }
 
 /// The pipeline a user writes for a model: greedy over [`RANGE`] to `tolerance` with at
