@@ -29,11 +29,14 @@ run: deps
 	cargo build --release
 	./target/release/flexrom run pipelines/pendulum.toml
 	./target/release/flexrom run pipelines/fourbar.toml
+	@echo "flexrom is target/release/flexrom; 'cargo install --path .' puts it on PATH"
 
 test: deps
 	# the tests spawn flexrom while they hold HDF5 files open; HDF5's flock() locks travel into
 	# those children with the file descriptors, so a child could keep a test's file locked
-	HDF5_USE_FILE_LOCKING=FALSE cargo test --release
+	# one OpenBLAS thread in the test binaries too (the flexrom binary sets it itself): idle
+	# BLAS workers poll with sched_yield and would take CPU from the tests
+	HDF5_USE_FILE_LOCKING=FALSE OPENBLAS_NUM_THREADS=1 cargo test --release
 
 bench: deps
 	cargo build --release

@@ -1,4 +1,4 @@
-//! Full-order benchmark (issue 2): wall time of the time loop for the pendulum at growing
+//! Full-order benchmark: wall time of the time loop for the pendulum at growing
 //! meshes (dt = 0.005, 220 steps) and for the four-bar, median of several runs, release
 //! build, one core. Prints a Markdown table for the README.
 //!

@@ -1,4 +1,4 @@
-//! Online benchmark (issue 4): full (banded, our default) against reduced runs of the
+//! Online benchmark: full (banded, our default) against reduced runs of the
 //! shipped pipelines, at the thesis meshes and refined, in one process: each pipeline is
 //! trained in memory, then full and reduced runs alternate, `runs` times each; the table
 //! gives medians of the time loops (release build, one core, BLAS single-threaded) and the
@@ -8,12 +8,14 @@
 //!     cargo bench --bench online            # everything (about two minutes)
 //!     cargo bench --bench online -- quick   # the thesis meshes only
 
-use flexrom::pipeline::online::run_reduced;
 use flexrom::pipeline::train::{train, train_and_write};
 use flexrom::pipeline::validate::compare;
 use flexrom::pipeline::Pipeline;
+use flexrom::rom::Rom;
 use flexrom::simulate::{simulate, Overrides};
+use flexrom::solver::model::Parameters;
 use std::process::Command;
+use std::sync::Arc;
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(|a, b| a.total_cmp(b));
@@ -34,7 +36,8 @@ fn main() {
     for &(name, runs) in cases {
         let p = Pipeline::load(format!("{root}/pipelines/{name}.toml")).expect("shipped pipeline");
         let (_, summary) = train(&p).expect("training");
-        let basis = summary.trained.basis;
+        let basis = Arc::new(summary.trained.basis);
+        let reduced = Rom::new(&p.model, &basis, None, None).expect("reduced model");
         // the thesis load: the (first) training load scale of each shipped pipeline; for a
         // greedy pipeline the middle of its range
         let x = match &p.file.train.load_scales {
@@ -45,7 +48,7 @@ fn main() {
         let mut last = None;
         for _ in 0..runs {
             let full = simulate(&p.model, &Overrides { load_scale: Some(x), ..Default::default() }).expect("full run");
-            let rom = run_reduced(&p.model, &basis, x).expect("reduced run");
+            let rom = reduced.solve(&Parameters::new(x)).expect("reduced run");
             tf.push(full.wall_seconds);
             tr.push(rom.result.wall_seconds);
             last = Some((full, rom));

@@ -14,11 +14,15 @@
 //! one (docs/error-estimate.md); `ESTIMATE_SAMPLE=s` the defects method's sampling interval.
 
 use flexrom::pipeline::config::parse_range;
-use flexrom::pipeline::estimate::{is_extrapolated, EstimatingRunner};
-use flexrom::pipeline::online::Output;
 use flexrom::pipeline::train::train;
 use flexrom::pipeline::Pipeline;
+use flexrom::rom::estimator::norms::{distance_and_norm, rel_error_by_time};
+use flexrom::rom::estimator::{self, defects::Defects, ErrorEstimator, EstimateMethod};
+use flexrom::rom::trust::is_extrapolated;
+use flexrom::rom::{Output, Rom};
 use flexrom::simulate::{simulate, Overrides};
+use flexrom::solver::model::Parameters;
+use std::sync::Arc;
 
 fn list(s: &str) -> Vec<f64> {
     if s.contains(':') {
@@ -65,13 +69,23 @@ fn main() -> flexrom::Result<()> {
         }
         println!("experiment: ESTIMATE_HYPER={h}");
     }
-    if let Ok(m) = std::env::var("ESTIMATE_METHOD") {
-        summary.estimator.as_mut().expect("estimator").method =
-            flexrom::pipeline::estimate::EstimateMethod::parse(&m).expect("ESTIMATE_METHOD");
-    }
-    let basis = &summary.trained.basis;
-    let est = summary.estimator.as_ref().expect("train builds an estimator");
-    println!("estimate method: {}", est.method.name());
+    let method = match std::env::var("ESTIMATE_METHOD") {
+        Ok(m) => EstimateMethod::parse(&m).expect("ESTIMATE_METHOD"),
+        Err(_) => summary.estimator.as_ref().expect("estimator").default_method(),
+    };
+    let basis = Arc::new(summary.trained.basis.clone());
+    let est = Arc::new(summary.estimator.clone().expect("train builds an estimator"));
+    // experiments with the defects method: ESTIMATE_SAMPLE=s (default DEFECT_SAMPLE)
+    let estimator: Arc<dyn ErrorEstimator> = match std::env::var("ESTIMATE_SAMPLE") {
+        Ok(m) if method == EstimateMethod::Defects => {
+            println!("experiment: ESTIMATE_SAMPLE={m}");
+            Arc::new(
+                Defects::new(&p.model, &basis, &est)?.with_sample(m.parse().expect("ESTIMATE_SAMPLE: a whole number")),
+            )
+        }
+        _ => estimator::build(method, &p.model, &basis, &est)?,
+    };
+    println!("estimate method: {}", estimator.name());
     let lo = train_loads.iter().copied().fold(f64::INFINITY, f64::min);
     let hi = train_loads.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     println!(
@@ -85,28 +99,23 @@ fn main() -> flexrom::Result<()> {
     );
     println!("| load scale | inside | rel_error | error_estimate | effectivity | reduced (s) | estimator (s) | cost | error to 0.4 T / estimate |");
     println!("|---|---|---|---|---|---|---|---|---|");
-    let mut runner = EstimatingRunner::new(&p.model, basis, Some(est))?;
-    // experiments with the defects method: ESTIMATE_SAMPLE=s (default DEFECT_SAMPLE)
-    if let Ok(m) = std::env::var("ESTIMATE_SAMPLE") {
-        runner.set_defect_sample(m.parse().expect("ESTIMATE_SAMPLE: a whole number"));
-        println!("experiment: ESTIMATE_SAMPLE={m}");
-    }
+    let rom = Rom::new(&p.model, &basis, Some(estimator), None)?;
     let mut rows = Vec::new();
     for &x in &tests {
         let full = simulate(&p.model, &Overrides { load_scale: Some(x), ..Default::default() })?;
-        let (rom, e) = runner.run(x, Output::Full)?;
+        let (run, e) = rom.solve_and_estimate(&Parameters::new(x), Output::Full, &[])?;
         let e = e.expect("estimator");
-        let (distance, norm) = flexrom::pipeline::estimate::distance_and_norm(&rom.result.q, &full.q);
+        let (distance, norm) = distance_and_norm(&run.result.q, &full.q);
         let err = distance / norm;
         let inside = !is_extrapolated((lo, hi), x);
-        let cost = e.seconds / rom.result.wall_seconds;
-        let by_time = flexrom::pipeline::estimate::rel_error_by_time(&rom.result.q, &full.q);
+        let cost = e.seconds / run.result.wall_seconds;
+        let by_time = rel_error_by_time(&run.result.q, &full.q);
         println!(
             "| {x:.4} | {} | {err:.3e} | {:.3e} | {:.2} | {:.4} | {:.4} | {:.0} % | {:.2e} / {:.2e} |",
             if inside { "yes" } else { "no" },
             e.error_estimate,
             e.error_estimate / err,
-            rom.result.wall_seconds,
+            run.result.wall_seconds,
             e.seconds,
             100.0 * cost,
             by_time[1],

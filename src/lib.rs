@@ -19,6 +19,7 @@ pub mod output;
 pub mod physics;
 pub mod pipeline;
 pub mod reduction;
+pub mod rom;
 pub mod simulate;
 pub mod solver;
 
@@ -32,8 +33,10 @@ extern "C" {
 /// Keeps OpenBLAS on one thread: the dense reference solver then measures one core, like
 /// everything else, and parallel sweeps do not oversubscribe the machine.
 ///
-/// Usually OpenBLAS has started no worker at all (`BLAS_ONE_THREAD_AT_START`, below). When the
-/// user's `OPENBLAS_NUM_THREADS` asked for more, its constructor has started them before `main`;
+/// In the `flexrom` binary OpenBLAS has usually started no worker at all (its
+/// `BLAS_ONE_THREAD_AT_START` sets `OPENBLAS_NUM_THREADS=1` before OpenBLAS's constructor
+/// runs). When the user's `OPENBLAS_NUM_THREADS` asked for more, or in another program
+/// linking this library, the constructor has started them before `main`;
 /// setting the count to 1 only stops handing them work, and each keeps polling its queue with
 /// `sched_yield` (about a third of a pendulum run's CPU time). `blas_thread_shutdown_` joins
 /// them; with one thread no call starts them again (OpenBLAS's `exec_blas` is reached only
@@ -44,26 +47,5 @@ pub fn single_threaded_blas() {
     unsafe {
         openblas_set_num_threads(1);
         blas_thread_shutdown_();
-    }
-}
-
-/// Sets `OPENBLAS_NUM_THREADS=1` unless the user set it, before OpenBLAS's constructor runs.
-///
-/// OpenBLAS is linked statically (build.rs), so its constructor `gotoblas_init` runs before
-/// `main`, reads this variable, and without it starts one worker thread per extra core, which
-/// costs ~0.5 ms of a 2 ms start on a busy machine (thread start, and a join at exit).
-/// `gotoblas_init` sits in the plain `.init_array`; GNU ld places the prioritized
-/// `.init_array.NNNNN` sections before it (sorted by priority; 101 is the first one not
-/// reserved for the C runtime), and libc is initialized before any of them, so the variable
-/// set here stays set (in `.preinit_array` it would not: libc resets `environ` after it).
-/// Every binary linking flexrom (the CLI, tests, benches) gets it; they all want one BLAS thread.
-#[used]
-#[link_section = ".init_array.00101"]
-static BLAS_ONE_THREAD_AT_START: extern "C" fn() = blas_one_thread_at_start;
-
-extern "C" fn blas_one_thread_at_start() {
-    if std::env::var_os("OPENBLAS_NUM_THREADS").is_none() {
-        // the process is still single-threaded here, which set_var requires
-        std::env::set_var("OPENBLAS_NUM_THREADS", "1");
     }
 }

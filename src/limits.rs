@@ -7,10 +7,11 @@
 //! Estimates count only the big arrays a stage keeps (8 bytes per f64):
 //!
 //! ```text
-//!     full run      (n_t) (n_dof + n_c + 2 n_probes + 1) · 8  +  n_el · 2 KiB (system, banded KKT)
+//!     full run      (n_t) (2 n_dof + n_c + n_pv + 1) · 8  +  n_el · 2 KiB (system, banded KKT)
+//!                   (q and q̇; n_pv: the probes' values, 2 each plus 1 per strain or curvature)
 //!     dense LU      n_kkt² · 8 · 2                               (n_kkt = n_dof + n_c)
 //!     training      Σ runs + 3 · n_dof · n_snapshots · 8          (snapshot matrix, POD copies)
-//!     sweep         N · n_t · (r + 2 n_probes) · 8  (+ N · n_t · n_dof · 8 with --validate)
+//!     sweep         N · n_t · (r + n_pv) · 8  (+ N · n_t · n_dof · 8 with --validate)
 //! ```
 
 use crate::error::{show_number, Error, Result};

@@ -30,7 +30,7 @@ macro_rules! exit_codes {
   flexrom simulate data/models/pendulum.toml -o out/pendulum.h5
   flexrom run pipelines/pendulum.toml                     train, sweep, validate, report
   flexrom train pipelines/double_pendulum.toml
-  flexrom sweep pipelines/double_pendulum.toml --load-scales 0.5:1.5:21 --csv > sweep.csv
+  flexrom sweep pipelines/double_pendulum.toml --load-scales 0.5:1.5:21 -o out/dp.h5 --csv > sweep.csv
 
 Results go to stdout (--csv or --json where a command prints them), messages to stderr
 (-q: errors and warnings only; -v: timings and Newton statistics too).
@@ -50,19 +50,19 @@ struct Cli {
     verbose: bool,
     /// memory bound for a stage's big arrays, e.g. 8G, 512M (default: env
     /// FLEXROM_MAX_MEMORY, else half of the machine's memory)
-    #[arg(long, global = true, value_name = "SIZE")]
+    #[arg(long, global = true, value_name = "SIZE", allow_negative_numbers = true)]
     max_memory: Option<String>,
     /// most time steps a run may take (default: env FLEXROM_MAX_STEPS, else 10000000)
-    #[arg(long, global = true, value_name = "N")]
+    #[arg(long, global = true, value_name = "N", allow_negative_numbers = true)]
     max_steps: Option<String>,
     /// most elements a model may have (default: env FLEXROM_MAX_ELEMENTS, else 200000)
-    #[arg(long, global = true, value_name = "N")]
+    #[arg(long, global = true, value_name = "N", allow_negative_numbers = true)]
     max_elements: Option<String>,
     /// a run whose strain or step cuts leave plausible bounds warns instead of failing
     #[arg(long, global = true)]
     allow_blowup: bool,
     /// worker threads (default: env RAYON_NUM_THREADS, else SLURM_CPUS_PER_TASK, else one per core)
-    #[arg(long, global = true, value_name = "N")]
+    #[arg(long, global = true, value_name = "N", allow_negative_numbers = true)]
     threads: Option<usize>,
 }
 
@@ -74,8 +74,11 @@ enum Command {
   flexrom simulate data/models/pendulum.toml -o out/pendulum.h5
   flexrom simulate data/models/fourbar.toml -o fourbar.h5 --t-end 0.5 --solver sparse
   flexrom simulate data/models/pendulum.toml -o p.h5 --load-scale 1.2 --csv > probes.csv
+  flexrom simulate data/models/pendulum.toml --load-scale -1 --csv > reversed.csv   no file
 
---csv/--json print every probe's position at every step: columns t (s), NAME_x, NAME_y (m).
+--csv/--json print every probe's position at every step: columns t (s), NAME_x, NAME_y (m),
+then NAME_strain (1) and NAME_curvature (1/m) of the probes that record them; with either,
+-o may be left out (nothing is written then).
 
 ",
         exit_codes!()
@@ -107,17 +110,20 @@ enum Command {
         exit_codes!()
     ))]
     Online(cli::online::Args),
-    /// Run full and reduced models at one load scale and report errors and timings.
+    /// Run full and reduced models at a load scale (or the pipeline's [validate] loads) and report errors and timings.
     #[command(after_help = concat!(
         "Examples:
   flexrom validate pipelines/pendulum.toml --load-scale 1.0
   flexrom validate pipelines/fourbar.toml --load-scale 0.935 --json
+  flexrom validate pipelines/double_pendulum.toml --json      at every [validate] load
   flexrom validate pipelines/pendulum_5000.toml --load-scale 1.0 --no-dense
 
-The full run with a dense LU (the thesis's reference timing) is skipped, with one line on
-stderr, when its matrix would exceed 256 MiB or the memory bound; --dense forces it.
---json prints one object (null where not measured), --csv one header line and one row
-(arrays as NAME_1, NAME_2, ...).
+Without --load-scale every load of the pipeline's [validate] load_scales is validated in
+turn (default: the training loads). The full run with a dense LU (the thesis's reference
+timing) is skipped, with one line on stderr, when its matrix would exceed 256 MiB or the
+memory bound; --dense forces it. --json prints one object (null where not measured) for
+--load-scale, else an array of them, one per load, as the report's validation.json; --csv
+one header line and one row per load (arrays as NAME_1, NAME_2, ...).
 
 ",
         exit_codes!()
@@ -126,10 +132,13 @@ stderr, when its matrix would exceed 256 MiB or the memory bound; --dense forces
     /// Reduced runs at many load scales, in parallel, into one HDF5 file and a table.
     #[command(after_help = concat!(
         "Examples:
-  flexrom sweep pipelines/double_pendulum.toml --load-scales 0.5:1.5:21
+  flexrom sweep pipelines/double_pendulum.toml --load-scales 0.5:1.5:21 -o out/dp_sweep.h5
   flexrom sweep pipelines/pendulum.toml -o out/sweep.h5 --validate --csv > sweep.csv
   flexrom sweep pipelines/fourbar.toml --load-scales 0.8:1.0:40 --shard 2/4 -o parts/part_2.h5
   flexrom sweep pipelines/fourbar.toml -o out/sweep.h5 --resume
+
+-o is required: the pipeline's report folder holds the sweep.h5 of `flexrom run`, which the
+report's summary.md describes, and a plain sweep does not replace it.
 
 --csv/--json print one row per load scale: load_scale, status (0 done, 1 failed, 2 not run),
 message, rom_seconds, newton_iterations, step_cuts, error_estimate, estimate_seconds,
@@ -188,11 +197,10 @@ fn main() -> ExitCode {
             let _ = e.print();
             return ExitCode::SUCCESS;
         }
-        // a usage error in two lines: clap's first (what is wrong), and where to look
+        // a usage error as clap words it: what is wrong (the argument named, a "did you
+        // mean" tip for a misspelt one), the usage line and where to read more; even under -q
         Err(e) => {
-            let text = e.render().to_string();
-            note(text.lines().find(|l| !l.trim().is_empty()).unwrap_or("error: bad arguments"));
-            note("run `flexrom --help` (or `flexrom <command> --help`) for usage");
+            let _ = e.print();
             return ExitCode::from(2);
         }
     };
@@ -252,5 +260,29 @@ fn run(cli: Cli) -> flexrom::Result<()> {
         Command::Merge(a) => a.run(),
         Command::Run(a) => a.run(),
         Command::Demo(a) => a.run(),
+    }
+}
+
+/// Sets `OPENBLAS_NUM_THREADS=1` unless the user set it, before OpenBLAS's constructor runs.
+///
+/// OpenBLAS is linked statically (build.rs), so its constructor `gotoblas_init` runs before
+/// `main`, reads this variable, and without it starts one worker thread per extra core, which
+/// costs ~0.5 ms of a 2 ms start on a busy machine (thread start, and a join at exit).
+/// `gotoblas_init` sits in the plain `.init_array`; GNU ld places the prioritized
+/// `.init_array.NNNNN` sections before it (sorted by priority; 101 is the first one not
+/// reserved for the C runtime), and libc is initialized before any of them, so the variable
+/// set here stays set (in `.preinit_array` it would not: libc resets `environ` after it).
+/// It lives in the binary, not the library: a process that loads the library for other
+/// reasons (a Python interpreter with numpy's own OpenBLAS, say) has threads of its own,
+/// and setting the environment there is not sound; such a process calls
+/// [`flexrom::single_threaded_blas`] instead.
+#[used]
+#[link_section = ".init_array.00101"]
+static BLAS_ONE_THREAD_AT_START: extern "C" fn() = blas_one_thread_at_start;
+
+extern "C" fn blas_one_thread_at_start() {
+    if std::env::var_os("OPENBLAS_NUM_THREADS").is_none() {
+        // the process is still single-threaded here, which set_var requires
+        std::env::set_var("OPENBLAS_NUM_THREADS", "1");
     }
 }

@@ -4,7 +4,7 @@
 use crate::error::{Error, Result};
 use crate::linalg::kkt::LinearSolverKind;
 use crate::model::Model;
-use crate::physics::system::FlexibleSystem;
+use crate::physics::system::{FlexibleSystem, Probe};
 use crate::solver::generalized_alpha::{GeneralizedAlpha, IntegratorParams, State, Stats};
 use crate::solver::model::{Bound, DynamicModel, Parameters, ParametricModel};
 use ndarray::{Array1, Array2};
@@ -66,6 +66,9 @@ impl Settings {
     }
 }
 
+/// Named series of one value per instant (a probe's strain or curvature).
+pub type Series = Vec<(String, Array1<f64>)>;
+
 /// Everything `simulate` writes.
 #[derive(Clone, Debug)]
 pub struct SimulationResult {
@@ -75,10 +78,16 @@ pub struct SimulationResult {
     pub t: Array1<f64>,
     /// n_dof × n_t
     pub q: Array2<f64>,
+    /// n_dof × n_t: the velocities q̇ (a reduced run's V ż)
+    pub qd: Array2<f64>,
     /// n_c × n_t
     pub multipliers: Array2<f64>,
     /// name → (n_t × 2)
     pub probes: Vec<(String, Array2<f64>)>,
+    /// name → (n_t): the axial strain of each probe that records it
+    pub strains: Series,
+    /// name → (n_t): the curvature (1/m) of each probe that records it
+    pub curvatures: Series,
     pub stats: Stats,
     /// wall time of the time loop alone
     pub wall_seconds: f64,
@@ -86,23 +95,20 @@ pub struct SimulationResult {
 
 /// The one solve of every run, full or reduced (`simulate`, `online`, `sweep`, `validate`,
 /// greedy training and the error estimate all come here): integrates `model` at the
-/// parameters `mu` over `n_steps` steps of `dt` from `q0` at rest, with the optional
-/// increment guess of [`integrate_guided`], calling `record` at t₀ and after every step.
-/// The model is not changed by the parameters: the same model runs at λ₁, λ₂, λ₁ and gives
-/// what three fresh models give (tests/parameters.rs).
-#[allow(clippy::too_many_arguments)]
+/// settings' parameters over its `n_steps` steps of `dt` from `q0` at rest, with the
+/// optional increment guess of [`integrate_guided`], calling `record` at t₀ and after every
+/// step. The model is not changed by the parameters: the same model runs at λ₁, λ₂, λ₁ and
+/// gives what three fresh models give (tests/parameters.rs).
 pub fn solve<M: ParametricModel + ?Sized>(
     model: &mut M,
-    mu: &Parameters,
-    params: &IntegratorParams,
+    s: &Settings,
     q0: Vec<f64>,
-    dt: f64,
-    n_steps: usize,
     guess: impl FnMut(usize, &mut [f64]) -> bool,
     record: impl FnMut(usize, &State),
 ) -> Result<Stats> {
+    let mu = s.parameters();
     mu.validate()?;
-    integrate_guided(&mut Bound::new(model, mu), params, q0, dt, n_steps, guess, record)
+    integrate_guided(&mut Bound::new(model, &mu), &s.params, q0, s.dt, s.n_steps, guess, record)
 }
 
 /// Integrates any [`DynamicModel`] (a model bound to its parameters) over `n_steps` steps
@@ -263,6 +269,7 @@ fn run_full(model: &Model, sys: &mut FlexibleSystem, q0: Vec<f64>, s: Settings) 
     // column-major: each instant's column is contiguous, so recording a step is one copy
     // and the result file's time-first rows are the memory as it is (no transposition)
     let mut q = Array2::zeros(ndarray::ShapeBuilder::f((n, nt)));
+    let mut qd = Array2::zeros(ndarray::ShapeBuilder::f((n, nt)));
     let mut mult = Array2::zeros(ndarray::ShapeBuilder::f((nc, nt)));
     let mut t = Array1::zeros(nt);
     let mut probes: Vec<(String, Array2<f64>)> =
@@ -272,15 +279,13 @@ fn run_full(model: &Model, sys: &mut FlexibleSystem, q0: Vec<f64>, s: Settings) 
     // the probes are evaluated after the loop, from the stored coordinates
     let stats = solve(
         sys,
-        &s.parameters(),
-        &s.params,
+        &s,
         q0,
-        s.dt,
-        s.n_steps,
         |_, _| false,
         |k, st| {
             t[k] = st.t;
             q.column_mut(k).assign(&ndarray::ArrayView1::from(&st.q));
+            qd.column_mut(k).assign(&ndarray::ArrayView1::from(&st.v));
             mult.column_mut(k).assign(&ndarray::ArrayView1::from(&st.lambda));
         },
     )?;
@@ -292,15 +297,37 @@ fn run_full(model: &Model, sys: &mut FlexibleSystem, q0: Vec<f64>, s: Settings) 
             xy[[k, 1]] = r[1];
         }
     }
+    let (strains, curvatures) =
+        probe_sections(&probe_defs, |p| (0..nt).map(|k| sys.probe_section(p, &q.column(k).to_vec())).collect());
     Ok(SimulationResult {
         model_text: model.text.clone(),
         model_path: model.path.display().to_string(),
         settings: s,
         t,
         q,
+        qd,
         multipliers: mult,
         probes,
+        strains,
+        curvatures,
         stats,
         wall_seconds,
     })
+}
+
+/// The strain and the curvature series (each `(name, values at every instant)`) of the
+/// probes that record them, in probe order; `series(p)` is the probe's (strain, curvature)
+/// at every instant.
+pub fn probe_sections(probes: &[Probe], series: impl Fn(&Probe) -> Vec<(f64, f64)>) -> (Series, Series) {
+    let (mut strains, mut curvatures) = (Vec::new(), Vec::new());
+    for p in probes.iter().filter(|p| p.strain || p.curvature) {
+        let values = series(p);
+        if p.strain {
+            strains.push((p.name.clone(), values.iter().map(|v| v.0).collect()));
+        }
+        if p.curvature {
+            curvatures.push((p.name.clone(), values.iter().map(|v| v.1).collect()));
+        }
+    }
+    (strains, curvatures)
 }

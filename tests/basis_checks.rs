@@ -1,11 +1,11 @@
-//! Basis files checked against the model (issue 16, item 5): a tiny hyper-reduced pendulum
+//! Basis files checked against the model (docs/guarantees-robust.md): a tiny hyper-reduced pendulum
 //! basis is trained into a temporary folder, then bad copies are crafted with the hdf5 crate
 //! and each must be refused by `flexrom online` with a one-line error naming the file and the
 //! dataset, a non-zero exit that is not a panic (101), and no output file.
 //!
 //! Where the expectations come from:
 //! - the good basis is accepted (control: the checks do not refuse what `train` writes);
-//! - each crafted defect is one the issue lists: a shifted reference (x_ref must be the
+//! - each crafted defect is one a damaged or foreign file can have: a shifted reference (x_ref must be the
 //!   model's consistent initial state to 1e-9 relative, src/io/basis_check.rs), integer and
 //!   float32 modes, non-orthonormal modes (‖VᵀV − I‖ ≤ 1e-8), NaN, an ECSW weight of 1e-300
 //!   (below the 1e-8 floor; trained pendulum weights are 0.93–5.2), an element index out of

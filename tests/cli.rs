@@ -1,6 +1,7 @@
 //! The `flexrom simulate` command as a user meets it: the result-file layout that outside
-//! scripts read (issue 2, item 6), and bad input — a message naming the file, the field and
-//! the problem, a non-zero exit, and no output file.
+//! scripts read (velocities and the probes' strain and curvature included), and bad input —
+//! a message naming the file, the field and the problem, a non-zero exit, and no output
+//! file.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -46,11 +47,62 @@ fn simulate_writes_the_documented_layout() {
     let q = f.dataset("q").unwrap().read_2d::<f64>().unwrap();
     assert_eq!(tip[[10, 0]], q[[10, 200]]);
     assert_eq!(tip[[10, 1]], q[[10, 201]]);
+    // /qd: the velocities, laid out as /q; the pendulum's ρ∞ = 1 makes generalized-α the
+    // average-acceleration rule (β = ¼, γ = ½), whose two updates give
+    // q_{k+1} − q_k = h (q̇_k + q̇_{k+1}) / 2 at every step, to round-off; the run starts at rest
+    let qd = f.dataset("qd").unwrap();
+    assert_eq!(flexrom::io::h5::read_attr_str(&qd, "units").unwrap(), "m/s (positions x, y), 1/s (slopes x', y')");
+    assert_eq!(flexrom::io::h5::read_attr_str(&qd, "dims").unwrap(), "time, dof");
+    let qd = qd.read_2d::<f64>().unwrap();
+    assert_eq!(qd.shape(), q.shape());
+    assert!(qd.row(0).iter().all(|&v| v == 0.0) && qd.row(10).iter().any(|&v| v.abs() > 1e-3));
+    for k in 0..10 {
+        for i in 0..204 {
+            let gap = q[[k + 1, i]] - q[[k, i]] - 0.0025 * (qd[[k, i]] + qd[[k + 1, i]]);
+            assert!(gap.abs() < 1e-12, "step {k}, coordinate {i}: {gap:e}");
+        }
+    }
     assert!(flexrom::io::h5::read_attr_str(&f, "model").unwrap().contains("[[bodies]]"));
     assert_eq!(flexrom::io::h5::read_attr_f64(&f, "dt").unwrap(), 0.005);
     assert_eq!(flexrom::io::h5::read_attr_f64(&f, "load_scale").unwrap(), 1.0);
     assert!(f.attr("newton_iterations").unwrap().read_scalar::<u64>().unwrap() >= 10);
     assert!(flexrom::io::h5::read_attr_f64(&f, "wall_seconds").unwrap() > 0.0);
+}
+
+/// Probes that list `strain` and `curvature` in `quantities` write `/probe_strain/<name>`
+/// (1) and `/probe_curvature/<name>` (1/m), the values the element's formulas give from the
+/// file's own `/q` (src/physics/section.rs), and print them as CSV columns; a probe without
+/// the key records its position only.
+#[test]
+fn probes_record_strain_and_curvature_when_asked() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(data("pendulum.toml")).unwrap()
+        + "\n[[probes]]\nname = \"mid\"\nbody = \"beam\"\nat = 0.33\nquantities = [\"position\", \"strain\", \"curvature\"]\n";
+    let model = dir.path().join("m.toml");
+    std::fs::write(&model, &text).unwrap();
+    let out = dir.path().join("r.h5");
+    let args = ["simulate", model.to_str().unwrap(), "--t-end", "0.05"];
+    let o = flexrom().args(args).args(["-o", out.to_str().unwrap(), "--csv"]).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = String::from_utf8(o.stdout).unwrap();
+    assert_eq!(csv.lines().next(), Some("t,tip_x,tip_y,mid_x,mid_y,mid_strain,mid_curvature"));
+    let f = hdf5::File::open(&out).unwrap();
+    let m = flexrom::model::Model::from_text(&text, "m.toml").unwrap();
+    let sys = m.system(Default::default());
+    let q = f.dataset("q").unwrap().read_2d::<f64>().unwrap();
+    let strain = f.dataset("probe_strain/mid").unwrap();
+    let curvature = f.dataset("probe_curvature/mid").unwrap();
+    assert_eq!(flexrom::io::h5::read_attr_str(&strain, "units").unwrap(), "1");
+    assert_eq!(flexrom::io::h5::read_attr_str(&curvature, "units").unwrap(), "1/m");
+    let (strain, curvature) = (strain.read_1d::<f64>().unwrap(), curvature.read_1d::<f64>().unwrap());
+    let mid = &m.probes()[1];
+    for k in 0..q.nrows() {
+        let (e, c) = sys.probe_section(mid, q.row(k).as_slice().unwrap());
+        assert_eq!((strain[k], curvature[k]), (e, c), "instant {k}");
+    }
+    // straight at rest, bent as it falls
+    assert!(curvature[0] == 0.0 && curvature[10].abs() > 1e-6, "{curvature}");
+    assert!(f.link_exists("probe_strain") && !f.link_exists("probe_strain/tip"), "tip: position only");
 }
 
 /// Runs `simulate` on a broken copy of the pendulum file and returns stderr; asserts the
@@ -118,7 +170,7 @@ fn bad_model_files_are_refused_with_file_field_and_problem() {
     }
 }
 
-/// Every command creates a missing output folder (issue 16; tests/safety.rs checks the others).
+/// Every command creates a missing output folder (tests/safety.rs checks the others).
 #[test]
 fn output_into_a_missing_directory_creates_it() {
     let dir = tempfile::tempdir().unwrap();

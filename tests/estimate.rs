@@ -1,24 +1,24 @@
-//! The error estimate, the extrapolation flag and `--strict` (issue 15 items 2–4), through
+//! The error estimate, the extrapolation flag and `--strict` (docs/error-estimate.md), through
 //! the command line as a user meets them, on the pendulum of data/models/pendulum.toml
 //! shortened to t_end = 0.5 s for speed (100 steps), with the shipped pipeline's reduction
 //! (14 POD modes, ECSW at τ = 1e-2) trained at load scales 0.8 and 1.2.
 //!
 //! - `estimate_bounds_the_error_at_held_out_loads`: at loads the basis never saw (0.9, 1.1
 //!   inside the training range, 1.5 outside it) `validate --json` reports an
-//!   `error_estimate` ≥ the measured `rel_error` (the issue's coverage requirement), its
+//!   `error_estimate` ≥ the measured `rel_error` (the estimate must cover the error), its
 //!   `effectivity` = estimate / rel_error (recomputed here from the two numbers) at most 30
-//!   (the issue's overestimate bound), `extrapolated` false, false, true, a positive
+//!   (the overestimate it is held to), `extrapolated` false, false, true, a positive
 //!   `sensitivity`, and five `rel_error_by_time` values, non-decreasing in the sense of
 //!   prefixes being covered and the last one equal to `rel_error` (both are ‖·‖_F over the
 //!   whole run). Its `error_estimate_by_time` (the estimate over the same prefixes of the
 //!   run) has five values, the last one equal to `error_estimate` (same formula, same
 //!   instants), and bounds `rel_error_by_time` fifth by fifth at all three loads, as the
-//!   whole-run estimate bounds rel_error (the issue's "good to 1e-3 up to 0.7 s" question).
+//!   whole-run estimate bounds rel_error (so a user can read "good to 1e-3 up to 0.7 s").
 //!   The prefix values are ratios of two growing sums and need not be monotone; the unit
-//!   test in src/pipeline/estimate.rs checks the case where they must be (a growing error).
+//!   test in src/rom/estimator/norms.rs checks the case where they must be (a growing error).
 //! - `every_estimate_method_bounds_the_error_at_held_out_loads`: the same held-out loads with
 //!   `[online] estimate = "defects"` (the cheap option) and `"corrected"` (the default):
-//!   estimate ≥ rel_error and effectivity ≤ 30 for both (the issue's targets), and the
+//!   estimate ≥ rel_error and effectivity ≤ 30 for both (the targets above), and the
 //!   corrected one below the defect sum at every load (a bound by the triangle inequality
 //!   against an estimate of the distance itself; docs/error-estimate.md, "Measurements").
 //! - `extrapolation_warns_once_and_is_flagged`: `online` outside the range prints exactly

@@ -1,5 +1,4 @@
-//! The HDF5 files flexrom writes, as h5py and xarray users open them (issue 18 item 3;
-//! layout in docs/file-formats.md and src/io/attrs.rs), through the `flexrom` command.
+//! The HDF5 files flexrom writes, as h5py and xarray users open them (layout in docs/file-formats.md and src/io/attrs.rs), through the `flexrom` command.
 //!
 //! Checks, and where each expectation comes from:
 //! - every kind of file a short run writes — `simulate` and `online` results, fixed-load and
@@ -55,8 +54,9 @@ fn setup(dir: &Path) -> (PathBuf, PathBuf, PathBuf) {
     let model = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("data/models/pendulum.toml"))
         .unwrap()
         .replace("elements = 50", "elements = 8")
-        .replace("t_end = 1.1", "t_end = 0.1");
-    assert!(model.contains("elements = 8") && model.contains("t_end = 0.1"));
+        .replace("t_end = 1.1", "t_end = 0.1")
+        .replace("name = \"tip\"", "name = \"tip\"\nquantities = [\"strain\", \"curvature\"]");
+    assert!(model.contains("elements = 8") && model.contains("t_end = 0.1") && model.contains("quantities"));
     let m = dir.join("model.toml");
     std::fs::write(&m, model).unwrap();
     let p = dir.join("pipe.toml");
@@ -164,13 +164,18 @@ fn every_dataset_of_every_file_has_units_and_time_comes_first() {
 
     // units everywhere
     for f in ["sim.h5", "online.h5"] {
-        check_units(&out(f), "result");
+        let set = check_units(&out(f), "result");
+        for name in ["qd", "probe_strain/tip", "probe_curvature/tip"] {
+            assert!(set.iter().any(|n| n == name), "{f}: no /{name}");
+        }
         check_labels(&out(f));
     }
     let basis_sets: Vec<Vec<String>> =
         ["basis.h5", "greedy.h5", "from_snaps.h5"].iter().map(|f| check_units(&out(f), "basis")).collect();
     for f in ["sweep.h5", "part1.h5", "part2.h5", "merged.h5"] {
-        check_units(&out(f), "sweep");
+        let set = check_units(&out(f), "sweep");
+        // the validated sweep keeps the full runs' probes beside the reduced ones
+        assert_eq!(set.iter().any(|n| n == "full_probes/tip"), f == "sweep.h5", "{f}");
     }
     for f in ["snaps1.h5", "snaps2.h5"] {
         check_units(&out(f), "snapshots");
@@ -188,6 +193,11 @@ fn every_dataset_of_every_file_has_units_and_time_comes_first() {
     assert_eq!(shape(&sim, "t"), vec![N_T]);
     assert_eq!((shape(&sim, "q"), dims(&sim, "q")), (vec![N_T, N_DOF], "time, dof".to_string()));
     assert_eq!(shape(&sim, "multipliers"), vec![N_T, 2]);
+    assert_eq!((shape(&sim, "qd"), dims(&sim, "qd")), (vec![N_T, N_DOF], "time, dof".to_string()));
+    assert_eq!(
+        (shape(&sim, "probe_curvature/tip"), dims(&sim, "probe_curvature/tip")),
+        (vec![N_T], "time".to_string())
+    );
     assert_eq!(shape(&sim, "probes/tip"), vec![N_T, 2]);
     let on = out("online.h5");
     assert_eq!((shape(&on, "reduced/q"), dims(&on, "reduced/q")), (vec![N_T, 6], "time, mode".to_string()));

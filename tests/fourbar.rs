@@ -1,5 +1,5 @@
 //! The flexible four-bar of SPEC §4 (thesis Table 2) at the model file's settings: the run
-//! completes (issue 2: the soft coupler makes dt = 0.007 hard) and the loop closes to
+//! completes (the soft coupler makes dt = 0.007 hard) and the loop closes to
 //! 1e-10 m at every step (linear constraints hold to round-off after each Newton update).
 //! Closing a joint gap of the model file (P rounded to 9 digits, as in SPEC §4) leaves the
 //! bodies unstrained even on the 10× mesh: the initial forces equal those of the exact P to

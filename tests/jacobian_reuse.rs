@@ -10,7 +10,7 @@
 //! tol · L, which would put two answers within 2 tol of each other if the estimate were
 //! exact; it is not (θ of one iteration predicts the next only roughly): measured, the
 //! default within-step reuse ends steps up to 3.7 tol · L from full Newton's and across-steps
-//! reuse up to 6.4 tol · L, hence 10 tol (a finding for issue 19: the stopping test itself
+//! reuse up to 6.4 tol · L, hence 10 tol (so the stopping test itself
 //! is ~3–6× looser than its tolerance under modified Newton). And the
 //! kept matrix must really be kept: strictly fewer factorizations than full Newton and than
 //! within-step reuse (the default) over the same steps (measured 257 against 441 and 661).

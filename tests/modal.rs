@@ -1,7 +1,8 @@
 //! Bending frequencies of a clamped–free beam, 20 elements, linearized about the straight
 //! state, against Euler–Bernoulli theory: ω_i = (β_i L)² √(EI/(ρA L⁴)) with
 //! β_i L = 1.8751, 4.6941, 7.8548 (roots of cos βL cosh βL = −1; e.g. Rao, *Mechanical
-//! Vibrations*, Table 8.4). Bound: 0.5 % (issue 2).
+//! Vibrations*, Table 8.4). Bound: 0.5 % (20 cubic elements resolve the first three modes
+//! to well within it).
 
 mod common;
 

@@ -1,7 +1,7 @@
-//! The units and sign conventions of docs/model-format.md's key table hold in the program
-//! (issue 18 item 5). tests/docs.rs checks that every schema key has a row; this file checks
-//! that every row names a unit (or "–" for a pure number) and that the conventions users
-//! trip over are what the code does:
+//! The units and sign conventions of docs/model-format.md's key table hold in the program.
+//! tests/docs.rs checks that every schema key has a row; this file checks that every row
+//! names a unit (or "–" for a pure number) and that the conventions users trip over are what
+//! the code does:
 //!
 //! * `frequency` is in Hz and `phase` in rad: sin(2π f t + φ) with f = 1 Hz is 1 at
 //!   t = 0.25 s, and with φ = π/2 it is 1 at t = 0 (exact values of the sine);

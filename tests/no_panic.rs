@@ -1,8 +1,9 @@
-//! No input makes flexrom panic (issue 16, item 3): tables of hostile command-line values
+//! No input makes flexrom panic: tables of hostile command-line values
 //! (71), model-file values (182) and pipeline-file values (19), each run through the
 //! release binary. Every case must end with an
 //! exit code (no signal), never 101 (Rust's panic exit), and a failing case must explain
-//! itself in one or two lines of stderr. The expected outcome of each case is not
+//! itself in one or two lines of stderr, or, for a command line that does not parse (exit
+//! 2), in clap's own message (what is wrong, the usage line, "For more information"). The expected outcome of each case is not
 //! hard-coded beyond that: which of them are refused is the program's business, that none
 //! panics is the property. The values are the classic edges: 0, −1, 1e300, 1e-300, NaN,
 //! ±inf, the largest i64, wrong TOML types. Runs are kept short by `--t-end 0.02` (4 steps
@@ -28,6 +29,13 @@ fn violation(case: &str, o: &Output) -> Option<String> {
         Some(101) => Some(format!("{case}: panicked (exit 101)\n{stderr}")),
         _ if stderr.contains("panicked") => Some(format!("{case}: panic message on stderr\n{stderr}")),
         Some(0) => None,
+        Some(2)
+            if !(stderr.starts_with("error: ")
+                && stderr.trim_end().ends_with("For more information, try '--help'.")) =>
+        {
+            Some(format!("{case}: a parse error without clap's whole message\n{stderr}"))
+        }
+        Some(2) => None,
         Some(_) if lines == 0 || lines > 2 => {
             Some(format!("{case}: failed with {lines} lines of stderr (want 1 or 2)\n{stderr}"))
         }

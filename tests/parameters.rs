@@ -1,4 +1,4 @@
-//! The load scale is a parameter of a run, not state of a model (issue 19 item 1): one
+//! The load scale is a parameter of a run, not state of a model: one
 //! model run at λ₁, λ₂, λ₁ must give, bit for bit, what a freshly built model gives at each
 //! load, for the full model (`FullModel`) and for the reduced ones (`ReducedRunner`, which
 //! keeps the projected constant force unscaled and applies λ in each evaluation).
@@ -12,13 +12,14 @@
 
 use flexrom::linalg::kkt::LinearSolverKind;
 use flexrom::model::Model;
-use flexrom::pipeline::online::{Output, ReducedRunner};
 use flexrom::pipeline::train::train;
 use flexrom::pipeline::Pipeline;
+use flexrom::rom::{Output, ReducedRunner};
 use flexrom::simulate::{simulate, FullModel, Overrides};
 use flexrom::solver::model::Parameters;
 use ndarray::Array2;
 use std::path::Path;
+use std::sync::Arc;
 
 fn repo(rel: &str) -> String {
     std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap()
@@ -42,7 +43,7 @@ fn differ(a: &Array2<f64>, b: &Array2<f64>) -> f64 {
 
 fn check(p: &Pipeline, l1: f64, l2: f64) {
     let (_, summary) = train(p).unwrap();
-    let basis = summary.trained.basis;
+    let basis = Arc::new(summary.trained.basis);
     let model = &p.model;
 
     // reduced: one runner at λ₁, λ₂, λ₁ against a fresh model and runner at each
@@ -52,7 +53,7 @@ fn check(p: &Pipeline, l1: f64, l2: f64) {
         .map(|&x| one.solve(&Parameters::new(x), Output::ReducedAndProbes, &[]).unwrap().reduced_q)
         .collect();
     for (run, &x) in runs.iter().zip(&[l1, l2, l1]) {
-        let m = fresh(model);
+        let m = Arc::new(fresh(model));
         let mut new = ReducedRunner::new(&m, &basis).unwrap();
         let reference = new.solve(&Parameters::new(x), Output::ReducedAndProbes, &[]).unwrap().reduced_q;
         assert!(*run == reference, "reduced run at λ = {x} on a reused model differs from a fresh model's");

@@ -1,12 +1,12 @@
-//! Issue 16, items 3, 4, 6, 7: resource bounds refused before allocating, errors that say
+//! Resource bounds refused before allocating, errors that say
 //! where (TOML entry lines, dependent joints, stage and load scale), blow-up detection, and
 //! a closed or full standard output.
 //!
 //! Where the expected figures come from:
 //! - memory of a full pendulum run (src/limits.rs): n_t = 221 instants (1.1 s / 0.005 s + 1)
-//!   × (204 coordinates + 2 multipliers + 2 probe columns + 1 time) × 8 B = 369 512 B, plus
-//!   50 elements × 2048 B = 102 400 B: 471 912 B = 460.9 KiB, so a 400 KiB bound refuses it
-//!   and a 500 KiB bound admits it;
+//!   × (2 × 204 coordinates and velocities + 2 multipliers + 2 probe columns + 1 time) × 8 B
+//!   = 730 184 B, plus 50 elements × 2048 B = 102 400 B: 832 584 B = 813.1 KiB, so an 800 KiB
+//!   bound refuses it and a 900 KiB bound admits it;
 //! - steps: 1.1 s / 1e-9 s = 1.1e9 steps > the default 10⁷; 1e12 s / 0.005 s = 2e14;
 //! - a 10⁶-element body is over the default 2·10⁵ elements; with the element bound raised
 //!   its run needs 221 × (4 000 004 + 2 + 2 + 1) × 8 B ≈ 6.6 GiB, over a 1 GiB bound;
@@ -59,15 +59,15 @@ fn runs_that_would_not_fit_are_refused_quickly_with_the_figure_and_the_option() 
         assert!(start.elapsed().as_secs_f64() < 5.0, "{flag} {value} took {:?}", start.elapsed());
         assert!(!out.exists());
     }
-    // the memory estimate: 460.9 KiB (header)
-    let (code, err) = run(&["simulate", m, "-o", o, "--max-memory", "400K"]);
+    // the memory estimate: 813.1 KiB (header)
+    let (code, err) = run(&["simulate", m, "-o", o, "--max-memory", "800K"]);
     assert_eq!(code, 1, "{err}");
-    assert!(err.contains("460.9 KiB") && err.contains("--max-memory") && err.contains("FLEXROM_MAX_MEMORY"), "{err}");
+    assert!(err.contains("813.1 KiB") && err.contains("--max-memory") && err.contains("FLEXROM_MAX_MEMORY"), "{err}");
     assert!(!out.exists());
-    let (code, err) = run(&["simulate", m, "-o", o, "--max-memory", "500K"]);
+    let (code, err) = run(&["simulate", m, "-o", o, "--max-memory", "900K"]);
     assert_eq!(code, 0, "{err}");
     // the same bound through the environment
-    let e = flexrom().args(["simulate", m, "-o", o]).env("FLEXROM_MAX_MEMORY", "400K").output().unwrap();
+    let e = flexrom().args(["simulate", m, "-o", o]).env("FLEXROM_MAX_MEMORY", "800K").output().unwrap();
     assert_eq!(e.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&e.stderr).contains("FLEXROM_MAX_MEMORY"));
 
@@ -103,6 +103,41 @@ fn errors_inside_array_of_tables_entries_name_the_key_and_its_line() {
     let err = flexrom::model::Model::from_text(&text, "m.toml").unwrap_err().to_string();
     let line = text.lines().position(|l| l.contains("\"gravitation\"")).unwrap() + 1;
     assert!(err.contains(&format!("loads[0].type (line {line})")), "{err}");
+}
+
+/// An error inside a nested table of an entry (the four-bar's piecewise crank moment, a pin's
+/// `a`) names the whole path and the offending key's own line, not the line where the entry
+/// or its table opens.
+#[test]
+fn errors_in_nested_tables_point_at_the_key() {
+    let fourbar = std::fs::read_to_string(root().join("data/models/fourbar.toml")).unwrap();
+    let line_of = |text: &str, needle: &str| text.lines().position(|l| l.contains(needle)).unwrap() + 1;
+    let err = |text: &str| flexrom::model::Model::from_text(text, "m.toml").unwrap_err().to_string();
+    // the second piece's function as a table of its own, its amplitude a word
+    let text = fourbar.replace(
+        "[[loads.function.pieces]]\nfunction = { type = \"exponential\", amplitude = 465.9, rate = -16.32 }",
+        "[[loads.function.pieces]]\n[loads.function.pieces.function]\ntype = \"exponential\"\nrate = -16.32\namplitude = \"ten\"",
+    );
+    assert_ne!(text, fourbar);
+    let e = err(&text);
+    let want =
+        format!("loads[1].function.pieces[1].function.amplitude (line {})", line_of(&text, "amplitude = \"ten\""));
+    assert!(e.contains(&want) && e.contains("expected f64"), "want `{want}` in: {e}");
+    // the first piece's inline function
+    let text = fourbar.replace("amplitude = 10.0, frequency", "amplitude = \"ten\", frequency");
+    let e = err(&text);
+    let want = format!("loads[1].function.pieces[0].function.amplitude (line {})", line_of(&text, "\"ten\""));
+    assert!(e.contains(&want), "want `{want}` in: {e}");
+    // an unknown key in the table `[loads.function]` opens
+    let text = fourbar.replace("type = \"piecewise\"", "type = \"piecewise\"\nsteps = 3");
+    let e = err(&text);
+    let want = format!("loads[1].function.steps (line {})", line_of(&text, "steps = 3"));
+    assert!(e.contains(&want) && e.contains("unknown field"), "want `{want}` in: {e}");
+    // a pin's inline node reference
+    let text = fourbar.replace("a = { body = \"coupler\", node = \"end\" }", "a = { body = \"coupler\", node = 1.5 }");
+    let e = err(&text);
+    let want = format!("joints[2].a.node (line {})", line_of(&text, "node = 1.5"));
+    assert!(e.contains(&want), "want `{want}` in: {e}");
 }
 
 /// Three beams from one point, with a joint list to append.

@@ -1,4 +1,4 @@
-//! Issue 16, items 1 and 2: flexrom never deletes or overwrites what it did not create, and
+//! flexrom never deletes or overwrites what it did not create, and
 //! writes atomically (docs/guarantees.md). Each test runs the release binary as a user would,
 //! in a temporary folder, on a tiny copy of data/models/pendulum.toml (t_end shortened) and
 //! a pipeline written here; nothing is compared with stored numbers. The expected outcome of
@@ -148,10 +148,6 @@ fn report_folders_that_are_not_flexroms_own_are_refused_and_nothing_is_deleted()
         let err = fails_with(&o, &["pipe.toml", "report", why]);
         assert!(err.lines().count() <= 2, "{report}: {err}");
         assert_eq!(snapshot(root), before, "report = {report:?}: files changed");
-        // `sweep` writes into the report folder by default: the same refusal
-        let o = run(&[Path::new("sweep"), &p]);
-        fails_with(&o, &["report"]);
-        assert_eq!(snapshot(root), before, "sweep, report = {report:?}: files changed");
     }
 }
 
@@ -282,11 +278,15 @@ fn every_command_creates_missing_output_folders_and_follows_a_symlink_to_a_regul
     for k in ["basis", "sim", "online", "sweep"] {
         assert!(hdf5::File::open(new(k)).is_ok(), "{k}");
     }
-    // the default sweep output makes the report folder, marked, and `run` may replace it
-    assert!(run(&[Path::new("sweep"), &p, Path::new("--basis"), &b]).status.success());
-    assert!(root.join("reports/r/.flexrom-report").is_file() && root.join("reports/r/sweep.h5").is_file());
+    // `run` writes its report; a `sweep` without -o is refused (exit 2, naming -o) and leaves
+    // the report's sweep.h5, which its summary.md describes, as it was
     let o = run(&[Path::new("run"), &p]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let report_sweep = std::fs::read(root.join("reports/r/sweep.h5")).unwrap();
+    let o = run(&[Path::new("sweep"), &p, Path::new("--basis"), &b]);
+    assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--output <OUTPUT>"), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(std::fs::read(root.join("reports/r/sweep.h5")).unwrap(), report_sweep, "the report's sweep is kept");
     // a symlink to a regular file: the file it points to is replaced, the link stays
     let link = root.join("link.h5");
     std::os::unix::fs::symlink(new("sim"), &link).unwrap();

@@ -1,4 +1,4 @@
-//! Sharded sweeps and `merge` (issue 17, item 1), through the `flexrom` command.
+//! Sharded sweeps and `merge` (docs/scaling.md), through the `flexrom` command.
 //!
 //! Checks, and where each expectation comes from:
 //! - a 9-load sweep run as 4 shards (`sweep --shard K/4`) and merged (parts given out of
@@ -236,7 +236,7 @@ fn four_shards_merged_equal_one_sweep_and_bad_parts_are_refused() {
 
 /// A 64-load four-bar sweep as a 4-task Slurm job array plus a dependent merge job
 /// (scripts/slurm/sweep.sbatch), against the same sweep run locally: probes within 1e-12 m
-/// (issue 17's target) and, beyond it, every dataset as in [`assert_same_sweep`]. Needs a
+/// (a sharded sweep must be the local one) and, beyond it, every dataset as in [`assert_same_sweep`]. Needs a
 /// running Slurm (`SLURM_CONF` set, `sbatch` on PATH): scripts/slurm/ci-test.sh brings up a
 /// single-node one and runs this test; without one it prints "skipped: …" and passes.
 /// The four-bar is shortened to 0.3 s (about 43 steps) and trained at one load so that the whole
@@ -348,7 +348,7 @@ fn max_mode_difference(a: &Path, b: &Path) -> f64 {
     worst
 }
 
-/// Sharded training (issue 17, item 2): the pendulum trained at 8 fixed loads as 8
+/// Sharded training (docs/scaling.md): the pendulum trained at 8 fixed loads as 8
 /// `train --snapshots-only --shard K/8` jobs and `train --from-snapshots` (files given out
 /// of order) gives the basis of a single `train`: modes equal up to sign within 1e-10 (the
 /// target), the same singular values within 1e-10 relative, the same number of modes.

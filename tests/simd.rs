@@ -1,4 +1,4 @@
-//! The SIMD path against the scalar one (issue 19 item 3). The kernels that run through
+//! The SIMD path against the scalar one. The kernels that run through
 //! `flexrom::linalg::simd::dispatch` — the bordered block Cholesky of `DenseLu` and the
 //! hyper-reduced model's per-element update and tangent — are run once compiled for the CPU's
 //! best instruction set (pulp's dispatch: AVX2+FMA on x86-64) and once on the baseline one
@@ -23,10 +23,11 @@
 use flexrom::linalg::dense_lu::DenseLu;
 use flexrom::linalg::simd::set_scalar_only;
 use flexrom::model::Model;
-use flexrom::pipeline::online::run_reduced;
 use flexrom::pipeline::train::train;
 use flexrom::pipeline::Pipeline;
+use flexrom::rom::Rom;
 use flexrom::simulate::{simulate, Overrides};
+use flexrom::solver::model::Parameters;
 
 /// Factors and solves the bordered block system; returns the solution.
 fn bordered_solve() -> Vec<f64> {
@@ -82,7 +83,7 @@ fn scalar_and_simd_paths_give_the_same_bits() {
     for scalar in [false, true] {
         set_scalar_only(scalar);
         let x = bordered_solve();
-        let rom = run_reduced(&p.model, &basis, 0.935).expect("reduced run");
+        let rom = Rom::of(&p.model, &basis).and_then(|r| r.solve(&Parameters::new(0.935))).expect("reduced run");
         runs.push((x, rom));
         full.push(full_models.iter().map(|m| simulate(m, &short).expect("full run")).collect::<Vec<_>>());
     }

@@ -1,4 +1,4 @@
-//! The executable's start-up as issue 19 (item 5) wants it (docs/startup.md): HDF5 and
+//! The executable's start-up as docs/startup.md describes it: HDF5 and
 //! OpenBLAS linked statically, so the dynamic loader maps none of libhdf5, libopenblas or the
 //! network and security libraries the shared Debian libhdf5 drags in (libcurl, OpenSSL,
 //! GnuTLS, Kerberos, LDAP), and OpenBLAS starts no worker thread.

@@ -1,4 +1,4 @@
-//! Sweeps survive a bad load (issue 16, item 8), through the `flexrom sweep` command.
+//! Sweeps survive a bad load (docs/basis-and-sweep.md), through the `flexrom sweep` command.
 //!
 //! Checks, and where each expectation comes from:
 //! - a load scale that makes Newton fail (1e20 × gravity on a coarse pendulum: measured to

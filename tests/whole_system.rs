@@ -1,19 +1,20 @@
-//! Whole-system reduction (issue 20): the plain variant (one POD of `[x; λ/w]`, thesis eqs.
+//! Whole-system reduction (docs/whole-system.md): the plain variant (one POD of `[x; λ/w]`, thesis eqs.
 //! 18–19) and the stabilized one (separate PODs, supremizers; src/reduction/whole_system.rs).
 //!
 //! Checks, with where each expected number comes from:
 //! - the plain four-bar basis (pipelines/thesis/fourbar_whole_system.toml) has inf-sup
 //!   constant σ_min(V_λᵀ B V) ≈ 0 (below 1e-6: every snapshot satisfies B x = b, so the
 //!   coordinate part of every POD mode has B V = 0 up to round-off over σ), and its reduced
-//!   run fails with a message naming the stabilized variant (issue 20 asks for that error);
+//!   run fails with a message naming the stabilized variant (what a user must switch to);
 //! - the stabilized basis of the thesis setting (pipelines/thesis/fourbar_whole_system_stabilized.toml,
 //!   30 % of the coordinates, λ = 0.935, 4 multiplier modes) has β ≥ INF_SUP_MIN (the basis
-//!   check's bound, 1e-6; trained ones are O(0.1–1)), and meets issue 20's targets:
+//!   check's bound, 1e-6; trained ones are O(0.1–1)), and meets the targets of
+//!   docs/whole-system.md:
 //!   rel_error ≤ 1e-3 and max_constraint_violation ≤ 1e-6 m, with fewer reduced unknowns
 //!   (POD modes + supremizers + reduced multipliers) than constraint-preserving (136 modes
 //!   + 12 joint coordinates + 8 multipliers = 156);
 //! - the pendulum with the pin reduced (pipelines/thesis/pendulum_whole_system_stabilized.toml,
-//!   10 %, ECSW τ = 1e-4): rel_error ≤ 1e-3 (issue 20), no kept coordinates.
+//!   10 %, ECSW τ = 1e-4): rel_error ≤ 1e-3, no kept coordinates.
 
 use flexrom::io::basis_check::INF_SUP_MIN;
 use flexrom::linalg::kkt::LinearSolverKind;
@@ -21,6 +22,7 @@ use flexrom::pipeline::train::train;
 use flexrom::pipeline::validate::validate;
 use flexrom::pipeline::Pipeline;
 use flexrom::reduction::whole_system::{constraint_matrix, inf_sup};
+use flexrom::rom::Rom;
 use ndarray::Array2;
 use std::path::Path;
 
@@ -42,7 +44,9 @@ fn plain_whole_system_has_no_inf_sup_and_its_failure_points_to_the_stabilized_va
     let vl = basis.multiplier_modes.as_ref().unwrap();
     let beta = inf_sup(&b_of(&p), vl, &basis.modes);
     assert!(beta < 1e-6, "plain whole-system β = {beta:e}");
-    let Err(err) = validate(&p.model, basis, 0.935, false) else { panic!("the plain variant fails") };
+    let Err(err) = validate(&Rom::of(&p.model, basis).unwrap(), 0.935, false) else {
+        panic!("the plain variant fails")
+    };
     let err = err.to_string();
     assert!(err.contains("whole-system-stabilized"), "{err}");
 }
@@ -56,7 +60,7 @@ fn stabilized_four_bar_meets_the_targets_with_fewer_unknowns() {
     assert!(inf_sup(&b_of(&p), psi, &basis.modes) >= INF_SUP_MIN);
     let unknowns = basis.n_reduced() + psi.ncols();
     assert!(unknowns < 156, "{unknowns} reduced unknowns");
-    let (v, _, _) = validate(&p.model, basis, 0.935, false).unwrap();
+    let (v, _, _) = validate(&Rom::of(&p.model, basis).unwrap(), 0.935, false).unwrap();
     assert!(v.rel_error <= 1e-3, "rel_error {:e}", v.rel_error);
     assert!(v.max_constraint_violation <= 1e-6, "violation {:e}", v.max_constraint_violation);
 }
@@ -67,6 +71,6 @@ fn stabilized_pendulum_with_the_pin_reduced() {
     let (_, summary) = train(&p).unwrap();
     let basis = &summary.trained.basis;
     assert!(basis.kept.is_empty() && basis.hyper.is_some());
-    let (v, _, _) = validate(&p.model, basis, 1.0, false).unwrap();
+    let (v, _, _) = validate(&Rom::of(&p.model, basis).unwrap(), 1.0, false).unwrap();
     assert!(v.rel_error <= 1e-3, "rel_error {:e}", v.rel_error);
 }

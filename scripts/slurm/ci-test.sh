@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The Slurm test of CI (issue 17): brings up a throwaway single-node Slurm
+# The Slurm test of CI (docs/scaling.md): brings up a throwaway single-node Slurm
 # (scripts/slurm/single-node.sh: Debian, root, no systemd), runs the ignored test
 # `slurm_array_sweep_equals_local_sweep` of tests/shard.rs (a 64-load four-bar sweep as a
 # 4-task job array plus a dependent merge job, compared with a local sweep), and takes the

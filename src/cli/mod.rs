@@ -58,6 +58,21 @@ pub fn check_scale(x: f64) -> flexrom::Result<()> {
     }
 }
 
+/// Prints the library's warnings on stderr, one `warning: ` line each (every verbosity).
+pub fn warn(warnings: &[String]) {
+    for w in warnings {
+        flexrom::output::note(&format!("warning: {w}"));
+    }
+}
+
+/// The warnings about finished runs of `rom` (extrapolation, estimates above the
+/// tolerance), printed; with `strict`, an estimate above the tolerance is the error.
+pub fn check_runs(rom: &flexrom::rom::Rom, runs: &[(f64, Option<f64>)], strict: bool) -> flexrom::Result<()> {
+    let Some(trust) = rom.trust() else { return Ok(()) };
+    warn(&flexrom::rom::trust::check_runs(trust, rom.estimator().is_some(), runs, strict)?);
+    Ok(())
+}
+
 /// Prints `t` on stdout as CSV or JSON; nothing in text mode (the command's own lines, on
 /// stderr or stdout, are its text form). `single`: the command's result is one record,
 /// printed in JSON as one object rather than an array of one.

@@ -1,12 +1,12 @@
 //! `flexrom online`: one reduced run at one load scale, written to a result file.
 
-use super::{check_scale, print_table, run_details, FormatArgs};
+use super::{check_scale, print_table, run_details, warn, FormatArgs};
 use flexrom::io::output::{check_output, Origin};
-use flexrom::io::result_file::{begin_alongside, RunPlan};
 use flexrom::output::info;
 use flexrom::output::table::{Cell, Table};
-use flexrom::pipeline::online::load_basis;
+use flexrom::pipeline::online::{load_rom, online_to_file};
 use flexrom::pipeline::Pipeline;
+use flexrom::solver::model::Parameters;
 use std::path::PathBuf;
 
 /// The arguments of `flexrom online`.
@@ -14,8 +14,8 @@ use std::path::PathBuf;
 pub struct Args {
     /// pipeline file (TOML)
     pipeline: PathBuf,
-    /// multiplies every load marked `scaled` in the model file
-    #[arg(long)]
+    /// multiplies every load marked `scaled` in the model file (negative: the load reversed)
+    #[arg(long, allow_negative_numbers = true)]
     load_scale: f64,
     /// result file (HDF5)
     #[arg(short, long)]
@@ -42,28 +42,10 @@ impl Args {
             Origin::Flag("-o"),
             &[(&p.path, "pipeline file"), (&p.model.path, "model file"), (&path, "basis file")],
         )?;
-        let stored = load_basis(&p, &path)?;
-        let trust = flexrom::pipeline::estimate::load_trust(&p, &path, &stored)?;
-        let mut runner =
-            flexrom::pipeline::estimate::EstimatingRunner::new(&p.model, &stored.basis, trust.estimator.as_ref())?;
-        // the result file's fixed part is written on a second thread while the run computes
-        let plan = RunPlan::of(&p.model, &flexrom::pipeline::online::settings_at(&p.model, load_scale)?);
-        let model_path = p.model.path.display().to_string();
-        let (file, (run, estimate)) = begin_alongside(&output, &p.model.text, &model_path, &plan, || {
-            runner
-                .run(load_scale, flexrom::pipeline::online::Output::Full)
-                .map_err(|e| e.at_stage("online", load_scale))
-        })?;
-        let extrapolated = flexrom::pipeline::estimate::is_extrapolated(trust.range, load_scale);
-        let basis_name = path.display().to_string();
-        file.finish(&run.result, |f| {
-            let e = |err: hdf5::Error| flexrom::Error::hdf5(&output, err);
-            flexrom::io::result_file::write_reduced(f, &run.reduced_q).map_err(e)?;
-            flexrom::io::h5::attr_str(f, "basis", &basis_name).map_err(e)?;
-            flexrom::io::h5::attr_str(f, "variant", stored.basis.variant.name()).map_err(e)?;
-            flexrom::io::h5::attr_u64(f, "n_modes", stored.basis.n_reduced() as u64).map_err(e)?;
-            flexrom::pipeline::estimate::write_run_attributes(f, estimate.as_ref(), &trust, extrapolated).map_err(e)
-        })?;
+        let (stored, rom, warnings) = load_rom(&p, &path, None, false)?;
+        warn(&warnings);
+        let done = online_to_file(&p, &rom, &path, &Parameters::new(load_scale), &output)?;
+        let (run, estimate) = (&done.run, &done.estimate);
         let st = &run.result.stats;
         info(&format!(
             "{}: reduced run ({} modes) at load scale {load_scale}: {} steps in {:.4} s ({} Newton iterations, {} step cuts) -> {}",
@@ -75,9 +57,8 @@ impl Args {
             st.step_cuts,
             output.display()
         ));
-        if let Some(e) = &estimate {
-            let method = trust.estimator.as_ref().map_or("corrected", |m| m.method.name());
-            info(&format!("  {}", flexrom::pipeline::estimate::describe(e, method, run.result.wall_seconds)));
+        if let (Some(e), Some(method)) = (estimate, rom.method()) {
+            info(&format!("  {}", flexrom::rom::trust::describe(e, method, run.result.wall_seconds)));
         }
         run_details(&run.result);
         let mut cols = vec!["load_scale", "n_modes"];
@@ -88,11 +69,11 @@ impl Args {
         row.extend(flexrom::pipeline::tables::run_cells(&run.result));
         row.extend([
             estimate.as_ref().map(|e| e.error_estimate).into(),
-            extrapolated.into(),
+            done.extrapolated.into(),
             output.display().to_string().into(),
         ]);
         t.push(row);
         print_table(&t, format.format(), true)?;
-        flexrom::pipeline::estimate::check_runs(&trust, &[(load_scale, estimate.map(|e| e.error_estimate))], strict)
+        super::check_runs(&rom, &[(load_scale, estimate.map(|e| e.error_estimate))], strict)
     }
 }

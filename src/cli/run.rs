@@ -25,7 +25,8 @@ impl Args {
     pub fn run(self) -> flexrom::Result<()> {
         let Args { pipeline, strict, dense, format } = self;
         let p = Pipeline::load(&pipeline)?;
-        let dir = flexrom::pipeline::report::run_with(&p, output::show_progress(), dense.choice())?;
+        let (dir, warnings) = flexrom::pipeline::report::run_with(&p, output::show_progress(), dense.choice())?;
+        super::warn(&warnings);
         let read = |name: &str| {
             let f = dir.join(name);
             std::fs::read_to_string(&f).map_err(|e| flexrom::Error::io(&f, e))
@@ -35,6 +36,7 @@ impl Args {
             f => print_table(&Table::from_json_records(&read("validation.json")?)?, f, false)?,
         }
         info(&format!("report: {}", dir.display()));
-        flexrom::pipeline::report::check_report(&p, &dir, strict)
+        super::warn(&flexrom::pipeline::report::check_report(&p, &dir, strict)?);
+        Ok(())
     }
 }

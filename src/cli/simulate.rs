@@ -14,9 +14,10 @@ use std::path::PathBuf;
 pub struct Args {
     /// model file (TOML)
     model: PathBuf,
-    /// result file (HDF5)
-    #[arg(short, long)]
-    output: PathBuf,
+    /// result file (HDF5); may be left out with --csv or --json, which then print the
+    /// probes on stdout and write no file
+    #[arg(short, long, required_unless_present_any = ["csv", "json"])]
+    output: Option<PathBuf>,
     #[command(flatten)]
     run: RunArgs,
     #[command(flatten)]
@@ -26,15 +27,30 @@ pub struct Args {
 impl Args {
     pub fn run(self) -> flexrom::Result<()> {
         let Args { model, output, run, format } = self;
-        check_output(&output, Origin::Flag("-o"), &[(&model, "model file")])?;
+        if let Some(output) = &output {
+            check_output(output, Origin::Flag("-o"), &[(&model, "model file")])?;
+        }
         let model = Model::load(&model)?;
         let overrides = run.overrides();
-        let plan = RunPlan::of(&model, &Settings::resolve(&model, &overrides)?);
-        // the result file's fixed part is written on a second thread while the run computes
-        let (file, r) = begin_alongside(&output, &model.text, &model.path.display().to_string(), &plan, || {
-            simulate(&model, &overrides).map_err(|e| e.at_stage("simulate", run.load_scale.unwrap_or(1.0)))
-        })?;
-        file.finish(&r, |_| Ok(()))?;
+        let compute =
+            || simulate(&model, &overrides).map_err(|e| e.at_stage("simulate", run.load_scale.unwrap_or(1.0)));
+        let r = match &output {
+            // the result file's fixed part is written on a second thread while the run computes
+            Some(output) => {
+                let settings = Settings::resolve(&model, &overrides)?;
+                // a run too large for the memory bound is refused before the file is begun
+                // (its labels alone are a string per coordinate)
+                model.check_full_run_memory(settings.n_steps, settings.solver == LinearSolverKind::Dense)?;
+                let plan = RunPlan::of(&model, &settings);
+                let (file, r) =
+                    begin_alongside(output, &model.text, &model.path.display().to_string(), &plan, compute)?;
+                file.finish(&r, |_| Ok(()))?;
+                r
+            }
+            // --csv or --json alone: the probes on stdout, no file
+            None => compute()?,
+        };
+        let written = output.as_ref().map_or("no result file (-o not given)".to_string(), |o| o.display().to_string());
         info(&format!(
             "{}: {} steps in {:.3} s ({} Newton iterations, {} factorizations, {} step cuts) -> {}",
             model.path.display(),
@@ -43,7 +59,7 @@ impl Args {
             r.stats.newton_iterations,
             r.stats.factorizations,
             r.stats.step_cuts,
-            output.display()
+            written
         ));
         run_details(&r);
         print_table(&flexrom::pipeline::tables::probe_table(&r), format.format(), false)
@@ -53,16 +69,16 @@ impl Args {
 #[derive(clap::Args)]
 struct RunArgs {
     /// time step, s (default: the model file's)
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     dt: Option<f64>,
     /// end time, s (default: the model file's)
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     t_end: Option<f64>,
     /// generalized-α spectral radius ρ∞ in [0, 1] (default: the model file's)
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     rho_inf: Option<f64>,
-    /// multiplies every load marked `scaled` in the model file
-    #[arg(long)]
+    /// multiplies every load marked `scaled` in the model file (negative: the load reversed)
+    #[arg(long, allow_negative_numbers = true)]
     load_scale: Option<f64>,
     /// linear solver of the full model
     #[arg(long, value_enum, default_value_t = LinearSolverKind::Banded)]

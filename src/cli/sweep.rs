@@ -1,11 +1,12 @@
 //! `flexrom sweep`: reduced runs at many load scales into one sweep file and a table
 //! (optionally one shard of the list, resumed, or validated).
 
-use super::{print_table, FormatArgs};
-use flexrom::io::output::{check_output, check_report_dir, claim_in_report, Origin};
+use super::{print_table, warn, FormatArgs};
+use flexrom::io::output::{check_output, Origin};
 use flexrom::output::table::Format;
 use flexrom::output::{self, info};
-use flexrom::pipeline::online::load_basis;
+use flexrom::pipeline::online::load_rom;
+use flexrom::pipeline::sweep::SweepFile;
 use flexrom::pipeline::Pipeline;
 use std::path::PathBuf;
 
@@ -14,8 +15,9 @@ use std::path::PathBuf;
 pub struct Args {
     /// pipeline file (TOML)
     pipeline: PathBuf,
-    /// `A:B:N`: N load scales from A to B (default: the pipeline's [online] list)
-    #[arg(long)]
+    /// `A:B:N`: N load scales from A to B (default: the pipeline's [online] load_scales, else
+    /// its training loads); A may be negative (`-1:1:21`)
+    #[arg(long, allow_hyphen_values = true, value_name = "A:B:N")]
     load_scales: Option<String>,
     /// also run the full model at each load scale and report errors
     #[arg(long)]
@@ -31,9 +33,10 @@ pub struct Args {
     /// skip the error estimate (about 2× faster; `/error_estimate` is then NaN)
     #[arg(long)]
     no_estimate: bool,
-    /// sweep file (default: sweep.h5 in the pipeline's report folder)
+    /// sweep file to write (HDF5); no default: the pipeline's report folder holds the
+    /// sweep.h5 of `flexrom run`, which the report's summary.md describes
     #[arg(short, long)]
-    output: Option<PathBuf>,
+    output: PathBuf,
     /// basis file (default: the pipeline's `basis`)
     #[arg(long)]
     basis: Option<PathBuf>,
@@ -69,9 +72,6 @@ impl Args {
             format,
         } = self;
         let p = Pipeline::load(&pipeline)?;
-        if shard.is_some() && output.is_none() {
-            return Err(flexrom::Error::Usage("--shard needs -o PART.h5: every shard writes its own part file".into()));
-        }
         let scales = match load_scales {
             Some(s) => flexrom::pipeline::config::parse_range(&s)
                 .map_err(|e| flexrom::Error::Usage(format!("--load-scales: {e}")))?,
@@ -83,51 +83,19 @@ impl Args {
             (p.model.path.as_path(), "model file"),
             (path.as_path(), "basis file"),
         ];
-        // the default goes into the pipeline's report folder, which must then be flexrom's
-        let in_report = output.is_none();
-        let out = output.unwrap_or_else(|| p.report_dir.join("sweep.h5"));
-        if in_report {
-            check_report_dir(&p.report_dir, &p.path, &inputs)?;
-            check_output(&out, Origin::Key { pipeline: &p.path, key: "report" }, &inputs)?;
-        } else {
-            check_output(&out, Origin::Flag("-o"), &inputs)?;
+        let out = output;
+        check_output(&out, Origin::Flag("-o"), &inputs)?;
+        if no_estimate && strict {
+            return Err(flexrom::Error::Usage("--strict needs the error estimate; drop --no-estimate".into()));
         }
-        let stored = load_basis(&p, &path)?;
+        let (stored, rom, warnings) = load_rom(&p, &path, None, no_estimate)?;
+        warn(&warnings);
         let options =
             flexrom::pipeline::sweep::SweepOptions { validate, continuation, progress: output::show_progress() };
-        let mut trust = flexrom::pipeline::estimate::load_trust(&p, &path, &stored)?;
-        if no_estimate {
-            if strict {
-                return Err(flexrom::Error::Usage("--strict needs the error estimate; drop --no-estimate".into()));
-            }
-            trust.estimator = None;
-            trust.skipped = true;
-        }
-        if in_report {
-            claim_in_report(&p.report_dir, &p.path, "sweep.h5")?;
-        }
+        let file = SweepFile { stored: &stored, basis_path: &path, out: &out, resume, extra: &|_| Ok(()) };
         let sw = match shard {
-            Some(k) => flexrom::pipeline::shard::sweep_shard(
-                &p,
-                &stored,
-                Some(&trust),
-                &path,
-                &scales,
-                k,
-                options,
-                &out,
-                resume,
-            )?,
-            None => flexrom::pipeline::sweep::sweep_to_file(
-                &p.model,
-                &stored,
-                Some(&trust),
-                &path,
-                &scales,
-                options,
-                &out,
-                resume,
-            )?,
+            Some(k) => flexrom::pipeline::shard::sweep_shard(&p, &rom, &scales, k, options, file)?,
+            None => flexrom::pipeline::sweep::sweep_to_file(&rom, &scales, options, file)?,
         };
         match format.format() {
             Format::Text => output::print(&flexrom::pipeline::sweep::table(&sw))?,
@@ -155,6 +123,6 @@ impl Args {
             .filter_map(|x| x.point())
             .map(|q| (q.rom.result.settings.load_scale, q.estimate.map(|e| e.error_estimate)))
             .collect();
-        flexrom::pipeline::estimate::check_runs(&trust, &runs, strict)
+        super::check_runs(&rom, &runs, strict)
     }
 }

@@ -3,11 +3,9 @@
 //! that apart.
 
 use super::{print_table, FormatArgs};
-use flexrom::io::atomic::TempPath;
 use flexrom::io::output::{check_output, Origin};
 use flexrom::output::info;
 use flexrom::output::table::Table;
-use flexrom::pipeline::online::load_basis;
 use flexrom::pipeline::Pipeline;
 use std::path::PathBuf;
 
@@ -24,7 +22,7 @@ pub struct Args {
     #[arg(long, requires = "output", conflicts_with_all = ["from_snapshots", "basis"])]
     snapshots_only: bool,
     /// the load scale of a --snapshots-only run
-    #[arg(long, requires = "snapshots_only", conflicts_with = "shard")]
+    #[arg(long, requires = "snapshots_only", conflicts_with = "shard", allow_negative_numbers = true)]
     load_scale: Option<f64>,
     /// `K/N`: the --snapshots-only runs of loads K, K+N, … of train.load_scales
     #[arg(long, value_name = "K/N", requires = "snapshots_only")]
@@ -63,24 +61,8 @@ impl Args {
         let origin =
             if basis.is_some() { Origin::Flag("--basis") } else { Origin::Key { pipeline: &p.path, key: "basis" } };
         let out = basis.clone().unwrap_or_else(|| p.basis_path.clone());
-        check_output(&out, origin, &[(&p.path, "pipeline file"), (&p.model.path, "model file")])?;
-        // trained into a temporary file, read back and checked, and only then renamed over
-        // the previous basis
-        let staged = TempPath::file_for(&out)?;
-        let s = if from_snapshots.is_empty() {
-            flexrom::pipeline::train::train_and_write(&p, staged.path())?
-        } else {
-            for f in &from_snapshots {
-                if flexrom::io::output::resolve(f) == flexrom::io::output::resolve(&out) {
-                    return Err(flexrom::Error::input(&out, "--basis", "is one of the --from-snapshots files"));
-                }
-            }
-            let (data, s) = flexrom::pipeline::snapshots::train_from_snapshots(&p, &from_snapshots)?;
-            flexrom::pipeline::train::write_trained(&p, staged.path(), &data, &s)?;
-            s
-        };
-        load_basis(&p, staged.path())?;
-        staged.commit()?;
+        let s = flexrom::pipeline::train::train_to_file(&p, &out, origin, &from_snapshots)?;
+        super::warn(&s.warnings);
         let b = &s.trained.basis;
         info(&format!(
             "{}: {} snapshots from {} full run(s) ({:.3} s); {} basis, {} snapshots, {} POD modes{} (captured energy 1 − {:.2e}) -> {}",

@@ -1,9 +1,9 @@
 //! `flexrom validate`: full and reduced runs at one load scale, compared.
 
-use super::{check_scale, DenseArgs, FormatArgs};
+use super::{check_scale, warn, DenseArgs, FormatArgs};
 use flexrom::output::table::{Format, Table};
 use flexrom::output::{self};
-use flexrom::pipeline::online::load_basis;
+use flexrom::pipeline::online::load_rom;
 use flexrom::pipeline::Pipeline;
 use std::path::PathBuf;
 
@@ -12,9 +12,10 @@ use std::path::PathBuf;
 pub struct Args {
     /// pipeline file (TOML)
     pipeline: PathBuf,
-    /// multiplies every load marked `scaled` in the model file
-    #[arg(long)]
-    load_scale: f64,
+    /// multiplies every load marked `scaled` in the model file (negative: the load reversed);
+    /// default: every load of the pipeline's `[validate] load_scales`
+    #[arg(long, allow_negative_numbers = true)]
+    load_scale: Option<f64>,
     #[command(flatten)]
     format: FormatArgs,
     /// basis file (default: the pipeline's `basis`)
@@ -32,23 +33,44 @@ impl Args {
     pub fn run(self) -> flexrom::Result<()> {
         let Args { pipeline, load_scale, format, basis, dense, strict } = self;
         let p = Pipeline::load(&pipeline)?;
-        check_scale(load_scale)?;
-        let path = basis.unwrap_or_else(|| p.basis_path.clone());
-        let stored = load_basis(&p, &path)?;
-        let trust = flexrom::pipeline::estimate::load_trust(&p, &path, &stored)?;
-        let with_dense = flexrom::pipeline::dense::decide(dense.choice(), &p.model)?;
-        let (v, _, _) =
-            flexrom::pipeline::validate::validate_with(&p.model, &stored.basis, Some(&trust), load_scale, with_dense)?;
-        match format.format() {
-            // the record as serde writes it (arrays stay arrays): the keys scripts read
-            Format::Json => {
-                let text = serde_json::to_string(&v)
-                    .map_err(|e| flexrom::Error::Usage(format!("cannot write the JSON: {e}")))?;
-                output::println(&text)?;
+        let scales = match load_scale {
+            Some(x) => {
+                check_scale(x)?;
+                vec![x]
             }
-            Format::Csv => output::print(&Table::from_record(&v)?.to_csv()?)?,
-            Format::Text => output::println(&v.describe())?,
+            None => p.validate_scales(),
+        };
+        let path = basis.unwrap_or_else(|| p.basis_path.clone());
+        let (_, rom, warnings) = load_rom(&p, &path, None, false)?;
+        warn(&warnings);
+        let with_dense = flexrom::pipeline::dense::decide(dense.choice(), &p.model)?;
+        let mut vs = Vec::with_capacity(scales.len());
+        for &x in &scales {
+            let (v, _, _) = flexrom::pipeline::validate::validate(&rom, x, with_dense)?;
+            // text: each load's lines as soon as they are known
+            if format.format() == Format::Text {
+                output::println(&v.describe())?;
+            }
+            vs.push(v);
         }
-        flexrom::pipeline::estimate::check_runs(&trust, &[(load_scale, v.error_estimate)], strict)
+        let json_err = |e: serde_json::Error| flexrom::Error::Usage(format!("cannot write the JSON: {e}"));
+        match format.format() {
+            // the record as serde writes it (arrays stay arrays): the keys scripts read; one
+            // object for --load-scale, else an array as the report's validation.json
+            Format::Json => {
+                let text = match (load_scale, vs.as_slice()) {
+                    (Some(_), [v]) => serde_json::to_string(v),
+                    _ => serde_json::to_string(&vs),
+                };
+                output::println(&text.map_err(json_err)?)?;
+            }
+            Format::Csv => {
+                let text = serde_json::to_string(&vs).map_err(json_err)?;
+                output::print(&Table::from_json_records(&text)?.to_csv()?)?
+            }
+            Format::Text => {}
+        }
+        let runs: Vec<(f64, Option<f64>)> = vs.iter().map(|v| (v.load_scale, v.error_estimate)).collect();
+        super::check_runs(&rom, &runs, strict)
     }
 }

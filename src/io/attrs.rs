@@ -29,6 +29,8 @@ pub const KIND_ATTR: &str = "flexrom_file";
 
 /// Coordinates `q`: node `k` owns `(x, y, x', y')`, positions in m, slopes dimensionless.
 pub const COORDINATE_UNITS: &str = "m (positions x, y), 1 (slopes x', y')";
+/// Velocities `q̇`: of positions in m/s, of slopes in 1/s.
+pub const VELOCITY_UNITS: &str = "m/s (positions x, y), 1/s (slopes x', y')";
 /// Lagrange multipliers: forces on position rows, moments (N·m, conjugate to a
 /// dimensionless slope) on the slope rows of clamps.
 pub const MULTIPLIER_UNITS: &str = "N (position rows), N·m (slope rows of clamps)";
@@ -80,15 +82,18 @@ pub const LABELS: [Entry; 7] = [
     ("labels/multiplier_joint", "1", "constraint"),
 ];
 
-const RESULT: [Entry; 5] = [
+const RESULT: [Entry; 8] = [
     ("t", "s", "time"),
     ("q", COORDINATE_UNITS, "time, dof"),
+    ("qd", VELOCITY_UNITS, "time, dof"),
     ("multipliers", MULTIPLIER_UNITS, "time, constraint"),
     ("probes/*", "m", "time, xy"),
+    ("probe_strain/*", "1", "time"),
+    ("probe_curvature/*", "1/m", "time"),
     ("reduced/q", REDUCED_UNITS, "time, mode"),
 ];
 
-const BASIS: [Entry; 42] = [
+const BASIS: [Entry; 43] = [
     ("snapshots", COORDINATE_UNITS, "dof, snapshot"),
     ("snapshot_multipliers", MULTIPLIER_UNITS, "constraint, snapshot"),
     ("snapshot_load_scale", "1", "snapshot"),
@@ -131,20 +136,22 @@ const BASIS: [Entry; 42] = [
     ("training/whole_run_estimates", "1", "iteration, candidate"),
     ("training/sensitivity", "1", "iteration, candidate"),
     ("training/true_score", "1", "iteration"),
+    ("training/held_out_effectivity", "1", "iteration"),
 ];
 
-const SWEEP: [Entry; 21] = [
+const SWEEP: [Entry; 22] = [
     ("load_scales", "1", "load"),
     ("status", "1", "load"),
     ("message", TEXT, "load"),
     ("t", "s", "time"),
     ("probes/*", "m", "load, time, xy"),
+    ("full_probes/*", "m", "load, time, xy"),
     ("reduced_q", REDUCED_UNITS, "load, time, mode"),
     ("rom_seconds", "s", "load"),
     ("newton_iterations", "1", "load"),
     ("factorizations", "1", "load"),
     ("error_estimate", "1", "load"),
-    // the estimate per fifth of the run (issue 15)
+    // the estimate per fifth of the run
     ("error_estimate_by_time", "1", "load, fifth"),
     ("estimate_seconds", "s", "load"),
     ("extrapolated", "1", "load"),

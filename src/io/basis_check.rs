@@ -93,7 +93,7 @@ pub fn check(path: &Path, model: &Model, settings_hash: Option<&str>) -> Result<
             }
         }
     }
-    let stored = read_basis(path)?;
+    let mut stored = read_basis(path)?;
     // the model first: a basis of another model is the commonest mistake, and the shape
     // checks below would otherwise report its symptoms
     let mine = model.fingerprint();
@@ -124,12 +124,13 @@ pub fn check(path: &Path, model: &Model, settings_hash: Option<&str>) -> Result<
     }
     if let Some(h) = settings_hash {
         if stored.settings_hash != h {
-            eprintln!(
-                "warning: {}: trained with other [train]/[reduction] settings than the pipeline has now (settings_hash {} ≠ {}); run `flexrom train` to bring it up to date",
+            let w = format!(
+                "{}: trained with other [train]/[reduction] settings than the pipeline has now (settings_hash {} ≠ {}); run `flexrom train` to bring it up to date",
                 path.display(),
                 short(&stored.settings_hash),
                 short(h)
             );
+            stored.warnings.push(w);
         }
     }
     Ok(stored)

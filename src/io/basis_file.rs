@@ -78,7 +78,7 @@ pub struct BasisMeta {
 /// A basis as read back, with its provenance.
 #[derive(Clone, Debug)]
 pub struct StoredBasis {
-    pub basis: Basis,
+    pub basis: std::sync::Arc<Basis>,
     pub singular_values: Array1<f64>,
     pub energy: Array1<f64>,
     /// modes kept from each block's POD, and how many singular values each has
@@ -93,6 +93,9 @@ pub struct StoredBasis {
     pub content_hash: String,
     pub mode_rule: String,
     pub creation_time: String,
+    /// what reading and checking it found worth telling the user (not errors: a basis
+    /// trained with other settings than the pipeline has now), one line each
+    pub warnings: Vec<String>,
 }
 
 /// Chunked, shuffled and deflated (when the HDF5 library has zlib): snapshots compress well.
@@ -296,7 +299,7 @@ pub fn read_basis(path: &Path) -> Result<StoredBasis> {
         ));
     }
     Ok(StoredBasis {
-        basis,
+        basis: std::sync::Arc::new(basis),
         singular_values,
         energy,
         block_modes,
@@ -307,6 +310,7 @@ pub fn read_basis(path: &Path) -> Result<StoredBasis> {
         content_hash: text("content_hash")?,
         mode_rule: text("mode_rule")?,
         creation_time: text("creation_time")?,
+        warnings: Vec::new(),
     })
 }
 

@@ -1,4 +1,4 @@
-//! The error estimator's part of the basis file (see [`crate::pipeline::estimate`]), and
+//! The error estimator's part of the basis file (see [`crate::reduction::estimator`]), and
 //! the training range and tolerance the online tools compare against:
 //!
 //! ```text
@@ -13,7 +13,10 @@
 //!                                          calibration (greedy training only; `DefectsCalibration`);
 //!   attribute on /estimator/defects: reliable (1: its leave-one-out check passed); factor and
 //!   reliable follow from load_scale and ratio and are recomputed when read
-//!   attributes on /estimator: method ("enriched"), extra_modes (k), factor (c),
+//!   attributes on /estimator: method ("enriched": the estimators compare with an enriched
+//!   basis), default_method (the method online estimates use unless the pipeline names one:
+//!   "corrected", "defects" or "enriched"; files written before 2026-11-26 have none, and
+//!   the rule of `Estimator::default_method` decides), extra_modes (k), factor (c),
 //!   calibrated (1: c from calibration pairs, 0: the default), n_modes (r⁺)
 //! /training/range             (2)          [min, max] training load scale (greedy training;
 //!                                          otherwise min/max of /snapshot_load_scale)
@@ -22,7 +25,7 @@
 
 use super::h5::{attr_f64, attr_str, attr_u64, read_attr_f64, read_attr_str};
 use crate::error::{Error, Result};
-use crate::reduction::estimator::{Calibration, CalibrationPoint, DefectsCalibration, Estimator};
+use crate::reduction::estimator::{Calibration, CalibrationPoint, DefectsCalibration, EstimateMethod, Estimator};
 use crate::reduction::{Basis, Hyper};
 use ndarray::Array1;
 use std::path::Path;
@@ -60,6 +63,7 @@ pub fn write_estimator(f: &hdf5::File, est: &Estimator) -> hdf5::Result<()> {
         attr_u64(&dg, "reliable", d.reliable as u64)?;
     }
     attr_str(&g, "method", "enriched")?;
+    attr_str(&g, "default_method", est.default_method().name())?;
     attr_u64(&g, "extra_modes", est.extra_modes as u64)?;
     attr_f64(&g, "factor", c.factor)?;
     attr_u64(&g, "calibrated", c.calibrated as u64)?;
@@ -102,6 +106,14 @@ pub fn read_estimator(path: &Path, basis: &Basis) -> Result<Option<Estimator>> {
     if method != "enriched" {
         return Err(field("method", format!("is `{method}`; this program knows `enriched`")));
     }
+    let chosen = match g.attr("default_method") {
+        Ok(_) => {
+            let m = read_attr_str(&g, "default_method")
+                .map_err(|e| field("default_method", format!("cannot be read: {e}")))?;
+            Some(EstimateMethod::parse(&m).map_err(|p| field("default_method", p))?)
+        }
+        Err(_) => None,
+    };
     let multiplier_modes = match g.dataset("multiplier_modes") {
         Ok(d) => Some(d.read_2d::<f64>().map_err(|e| field("multiplier_modes", format!("cannot be read: {e}")))?),
         Err(_) => None,
@@ -189,7 +201,7 @@ pub fn read_estimator(path: &Path, basis: &Basis) -> Result<Option<Estimator>> {
         extra_modes: count("extra_modes")? as usize,
         calibration: Calibration { factor, calibrated: count("calibrated")? != 0, points },
         defects,
-        method: Default::default(),
+        method: chosen,
     }))
 }
 

@@ -1,4 +1,4 @@
-//! Small helpers over the `hdf5` crate: atomic file creation and typed attributes.
+//! Small wrappers over the `hdf5` crate: atomic file creation and typed attributes.
 
 use crate::error::{Error, Result};
 use hdf5::types::VarLenUnicode;

@@ -8,7 +8,7 @@
 //! its mark lists (and flexrom's own temporary files); anything else is the user's and is
 //! refused with an error naming the folder and the pipeline key `report`.
 
-use super::atomic::{kind_of, names_an_entry, swap_in_dir, write_bytes_atomically, write_new, TempPath};
+use super::atomic::{kind_of, names_an_entry, swap_in_dir, write_new, TempPath};
 use crate::error::{Error, Result};
 use std::os::unix::fs::MetadataExt;
 use std::path::{Component, Path, PathBuf};
@@ -270,24 +270,6 @@ pub fn swap_in_report(tmp: TempPath, pipeline: &Path) -> Result<()> {
     swap_in_dir(tmp, |d| check_marked(d, Origin::Key { pipeline, key: "report" }))
 }
 
-/// Makes sure the (checked) report folder exists and is marked, and that its mark lists
-/// `name`, before `name` is written into it (by `sweep`). A missing folder is created
-/// whole, marked, by rename.
-pub fn claim_in_report(report: &Path, pipeline: &Path, name: &str) -> Result<()> {
-    if std::fs::symlink_metadata(report).is_err() {
-        let tmp = TempPath::dir_for(report)?;
-        write_new(&tmp.path().join(MARKER), marker_text(&[name.to_string()]).as_bytes())?;
-        return swap_in_report(tmp, pipeline);
-    }
-    check_marked(report, Origin::Key { pipeline, key: "report" })?;
-    let mut names = marked_names(report).unwrap_or_default();
-    if !names.iter().any(|n| n == name) {
-        names.push(name.to_string());
-        write_bytes_atomically(&report.join(MARKER), marker_text(&names).as_bytes())?;
-    }
-    Ok(())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -311,8 +293,9 @@ mod tests {
         let rep = d.path().join("rep");
         let inputs = [(pipe.as_path(), "pipeline file")];
         check_report_dir(&rep, &pipe, &inputs).unwrap();
-        claim_in_report(&rep, &pipe, "sweep.h5").unwrap();
+        std::fs::create_dir(&rep).unwrap();
         std::fs::write(rep.join("sweep.h5"), "s").unwrap();
+        mark_new_report(&rep).unwrap();
         check_report_dir(&rep, &pipe, &inputs).unwrap();
         std::fs::write(rep.join("notes.txt"), "mine").unwrap();
         let e = check_report_dir(&rep, &pipe, &inputs).unwrap_err().to_string();

@@ -4,8 +4,11 @@
 //! ```text
 //! /t                      (n_t)          time, s
 //! /q                      (n_t, n_dof)   row k = all coordinates at t_k (m, slopes 1)
+//! /qd                     (n_t, n_dof)   their velocities q̇ (m/s, slopes 1/s; reduced: V ż)
 //! /multipliers            (n_t, n_c)     Lagrange multipliers (N; N·m on clamp slope rows)
 //! /probes/<name>          (n_t, 2)       x, y of each probe, m
+//! /probe_strain/<name>    (n_t)          axial strain at the probes that record it, 1
+//! /probe_curvature/<name> (n_t)          curvature at the probes that record it, 1/m
 //! /reduced/q              (n_t, r)       `online` only: the reduced coordinates
 //! /labels/...                            names of the coordinates and constraint rows
 //! every dataset: attributes units, dims (src/io/attrs.rs)
@@ -23,13 +26,16 @@ use crate::simulate::{Settings, SimulationResult};
 use std::path::Path;
 
 /// What is known of a run before it runs: the sizes of its arrays (`n_t` instants, `n_dof`
-/// coordinates, `n_c` multipliers, the probes by name) and the settings its file records.
+/// coordinates, `n_c` multipliers, the probes by name, those recording strain and those
+/// recording curvature) and the settings its file records.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RunPlan {
     pub n_t: usize,
     pub n_dof: usize,
     pub n_c: usize,
     pub probes: Vec<String>,
+    pub strains: Vec<String>,
+    pub curvatures: Vec<String>,
     pub load_scale: f64,
     pub dt: f64,
     pub t_end: f64,
@@ -42,21 +48,37 @@ impl RunPlan {
     /// and the start, whatever halving a step takes).
     pub fn of(model: &crate::model::Model, s: &Settings) -> RunPlan {
         let z = model.sizes();
-        Self::new(s.n_steps + 1, z.n_dof as usize, z.n_constraints as usize, model.probe_names(), s)
+        let names = |f: fn(&crate::physics::system::Probe) -> bool| {
+            model.probes().iter().filter(|p| f(p)).map(|p| p.name.clone()).collect()
+        };
+        let series = [names(|p| p.strain), names(|p| p.curvature)];
+        Self::new(s.n_steps + 1, z.n_dof as usize, z.n_constraints as usize, model.probe_names(), series, s)
     }
 
     /// The plan a finished run `r` followed.
     pub fn of_result(r: &SimulationResult) -> RunPlan {
+        let names = |v: &[(String, ndarray::Array1<f64>)]| v.iter().map(|p| p.0.clone()).collect();
+        let series = [names(&r.strains), names(&r.curvatures)];
         let probes = r.probes.iter().map(|p| p.0.clone()).collect();
-        Self::new(r.t.len(), r.q.nrows(), r.multipliers.nrows(), probes, &r.settings)
+        Self::new(r.t.len(), r.q.nrows(), r.multipliers.nrows(), probes, series, &r.settings)
     }
 
-    fn new(n_t: usize, n_dof: usize, n_c: usize, probes: Vec<String>, s: &Settings) -> RunPlan {
+    fn new(
+        n_t: usize,
+        n_dof: usize,
+        n_c: usize,
+        probes: Vec<String>,
+        series: [Vec<String>; 2],
+        s: &Settings,
+    ) -> RunPlan {
+        let [strains, curvatures] = series;
         RunPlan {
             n_t,
             n_dof,
             n_c,
             probes,
+            strains,
+            curvatures,
             load_scale: s.load_scale,
             dt: s.dt,
             t_end: s.t_end,
@@ -75,8 +97,11 @@ pub struct ResultFile {
     // the datasets before the file: closed first when dropped
     t: hdf5::Dataset,
     q: hdf5::Dataset,
+    qd: hdf5::Dataset,
     multipliers: hdf5::Dataset,
     probes: Vec<hdf5::Dataset>,
+    /// the strain series, then the curvature series
+    sections: Vec<hdf5::Dataset>,
     staged: StagedFile,
     labelled: Labelled,
     model_text: String,
@@ -107,6 +132,7 @@ impl ResultFile {
         };
         let t = create(f, "t", "t", &[plan.n_t]).map_err(e)?;
         let q = create(f, "q", "q", &[plan.n_t, plan.n_dof]).map_err(e)?;
+        let qd = create(f, "qd", "qd", &[plan.n_t, plan.n_dof]).map_err(e)?;
         let multipliers = create(f, "multipliers", "multipliers", &[plan.n_t, plan.n_c]).map_err(e)?;
         let g = f.create_group("probes").map_err(e)?;
         let probes = plan
@@ -115,11 +141,24 @@ impl ResultFile {
             .map(|name| create(&g, &format!("probes/{name}"), name, &[plan.n_t, 2]))
             .collect::<hdf5::Result<Vec<_>>>()
             .map_err(e)?;
+        // a group only where some probe records the quantity
+        let mut sections = Vec::new();
+        for (group, names) in [("probe_strain", &plan.strains), ("probe_curvature", &plan.curvatures)] {
+            if names.is_empty() {
+                continue;
+            }
+            let g = f.create_group(group).map_err(e)?;
+            for name in names {
+                sections.push(create(&g, &format!("{group}/{name}"), name, &[plan.n_t]).map_err(e)?);
+            }
+        }
         Ok(ResultFile {
             t,
             q,
+            qd,
             multipliers,
             probes,
+            sections,
             staged,
             labelled,
             model_text: model_text.to_string(),
@@ -142,8 +181,8 @@ impl ResultFile {
         }
         // on an error `self` is dropped whole: datasets, then the file, then its temporary
         self.write_run(r, extra)?;
-        let ResultFile { t, q, multipliers, probes, staged, .. } = self;
-        drop((t, q, multipliers, probes));
+        let ResultFile { t, q, qd, multipliers, probes, sections, staged, .. } = self;
+        drop((t, q, qd, multipliers, probes, sections));
         staged.commit()
     }
 
@@ -153,9 +192,13 @@ impl ResultFile {
         self.t.write(&r.t).map_err(e)?;
         // time first: the solver's columns (one per instant) become rows
         fill_time_first(&self.q, &r.q).map_err(e)?;
+        fill_time_first(&self.qd, &r.qd).map_err(e)?;
         fill_time_first(&self.multipliers, &r.multipliers).map_err(e)?;
         for (d, (_, xy)) in self.probes.iter().zip(&r.probes) {
             d.write(xy).map_err(e)?;
+        }
+        for (d, (_, v)) in self.sections.iter().zip(r.strains.iter().chain(&r.curvatures)) {
+            d.write(v).map_err(e)?;
         }
         attr_u64(f, "steps", r.stats.steps as u64).map_err(e)?;
         attr_u64(f, "newton_iterations", r.stats.newton_iterations as u64).map_err(e)?;
@@ -302,8 +345,11 @@ mod tests {
             .unwrap(),
             t: ndarray::Array1::zeros(1),
             q: ndarray::Array2::from_shape_fn((8, 1), |(i, _)| i as f64),
+            qd: ndarray::Array2::from_shape_fn((8, 1), |(i, _)| -(i as f64)),
             multipliers: ndarray::Array2::zeros((0, 1)),
             probes: vec![],
+            strains: vec![],
+            curvatures: vec![],
             stats: Default::default(),
             wall_seconds: 0.0,
         };
@@ -328,6 +374,7 @@ mod tests {
             assert_eq!(crate::io::h5::read_attr_str(&f, "model").unwrap(), "other = 2");
             assert_eq!(crate::io::h5::read_attr_f64(&f, "dt").unwrap(), 0.1);
             assert_eq!(f.dataset("q").unwrap().read_2d::<f64>().unwrap(), r.q.t());
+            assert_eq!(f.dataset("qd").unwrap().read_2d::<f64>().unwrap(), r.qd.t());
         };
         // begun for another model: written again from the run
         written(file);
@@ -342,11 +389,17 @@ mod tests {
 
     /// The plan made before a run, from the model file and the settings alone, is the plan
     /// of the run (else `finish` writes the file twice): every shipped model, and one with a
-    /// clamp (4 rows), a pin and a ground pin and a probe, over three steps.
+    /// clamp (4 rows), a pin and a ground pin and a probe, over three steps, also with its
+    /// probe recording strain and curvature.
     #[test]
     fn the_plan_of_a_model_is_that_of_its_run() {
         let clamped = crate::io::labels::tests::CLAMPED;
-        let mut models = vec![crate::model::Model::from_text(clamped, "clamped.toml").unwrap()];
+        let sectioned = clamped.replace("node = 1\n", "node = 1\nquantities = [\"strain\", \"curvature\"]\n");
+        assert_ne!(sectioned, clamped);
+        let mut models = vec![
+            crate::model::Model::from_text(clamped, "clamped.toml").unwrap(),
+            crate::model::Model::from_text(&sectioned, "sectioned.toml").unwrap(),
+        ];
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/models");
         for entry in std::fs::read_dir(&dir).unwrap() {
             let path = entry.unwrap().path();

@@ -13,7 +13,8 @@
 //! rows, a few hundred passive columns at most).
 
 use nalgebra::{DMatrix, DVector};
-use ndarray::{Array1, ArrayView1, ArrayView2};
+use ndarray::{Array1, Array2, ArrayView1, ArrayView2, ShapeBuilder};
+use rayon::prelude::*;
 
 /// Parameters of [`nnls`]; `validate()` checks them.
 #[derive(Clone, Debug, PartialEq)]
@@ -66,9 +67,17 @@ pub fn nnls(a: ArrayView2<f64>, b: ArrayView1<f64>, params: &NnlsParams) -> Resu
     if b_norm == 0.0 {
         return Ok(NnlsSolution { x, relative_residual: 0.0, iterations: 0 });
     }
-    // unit-norm columns (zero columns can never help and stay out)
+    // unit-norm columns (zero columns can never help and stay out), copied once into
+    // column-major storage: every iteration reads whole columns (the new column's products
+    // with the passive ones, the residual), which a row-major A would give strided
     let norms: Vec<f64> = (0..n).map(|j| a.column(j).dot(&a.column(j)).sqrt()).collect();
-    let col = |j: usize| a.column(j).mapv(|v| v / norms[j]);
+    let mut unit = Array2::<f64>::zeros((m, n).f());
+    for (j, mut c) in unit.columns_mut().into_iter().enumerate() {
+        if norms[j] > 0.0 {
+            c.zip_mut_with(&a.column(j), |u, &v| *u = v / norms[j]);
+        }
+    }
+    let col = |j: usize| unit.column(j);
     let mut passive: Vec<usize> = Vec::new();
     let mut excluded = vec![false; n];
     for (j, &nj) in norms.iter().enumerate() {
@@ -87,12 +96,15 @@ pub fn nnls(a: ArrayView2<f64>, b: ArrayView1<f64>, params: &NnlsParams) -> Resu
         if res_norm <= tol || iterations >= params.max_iterations {
             break;
         }
-        // the most promising column outside P
-        let w = a.t().dot(&residual);
-        let best = (0..n)
-            .filter(|&j| !in_p[j] && !excluded[j])
-            .map(|j| (j, w[j] / norms[j]))
-            .max_by(|p, q| p.1.total_cmp(&q.1));
+        // the most promising column outside P: the largest aⱼᵀr/‖aⱼ‖, one contiguous unit
+        // column at a time on every core (a row-major Aᵀr has no BLAS behind it here and
+        // was most of an ECSW training's time on 1100 elements)
+        let gain: Vec<f64> = (0..n)
+            .into_par_iter()
+            .map(|j| if in_p[j] || excluded[j] { f64::NEG_INFINITY } else { col(j).dot(&residual) })
+            .collect();
+        let best =
+            (0..n).filter(|&j| !in_p[j] && !excluded[j]).map(|j| (j, gain[j])).max_by(|p, q| p.1.total_cmp(&q.1));
         let Some((j, wj)) = best else { break };
         if wj <= 0.0 {
             break; // Kuhn–Tucker point: no column can lower the residual

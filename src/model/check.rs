@@ -199,7 +199,14 @@ impl Model {
                     (first_el + k, s - k as f64)
                 }
             };
-            self.probes.push(Probe { name: pr.name.clone(), element, xi });
+            let asks = |q: ProbeQuantity| pr.quantities.as_ref().is_some_and(|l| l.contains(&q));
+            self.probes.push(Probe {
+                name: pr.name.clone(),
+                element,
+                xi,
+                strain: asks(ProbeQuantity::Strain),
+                curvature: asks(ProbeQuantity::Curvature),
+            });
         }
         Ok(())
     }

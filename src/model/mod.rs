@@ -22,6 +22,9 @@ pub struct Sizes {
     pub n_constraints: f64,
     pub n_elements: f64,
     pub n_probes: f64,
+    /// the values all probes record at an instant: x and y of each, and one for each
+    /// strain and curvature series
+    pub n_probe_values: f64,
 }
 
 /// A validated model file.
@@ -99,7 +102,9 @@ impl Model {
         let n_elements: f64 = self.bodies.iter().map(|b| b.n_elements as f64).sum();
         let n_dof = 4.0 * self.bodies.iter().map(|b| b.n_elements as f64 + 1.0).sum::<f64>();
         let n_constraints = self.joints.iter().map(|j| if matches!(j, Joint::Clamp { .. }) { 4.0 } else { 2.0 }).sum();
-        Sizes { n_dof, n_constraints, n_elements, n_probes: self.probes.len() as f64 }
+        let sections: usize = self.probes.iter().map(|p| p.strain as usize + p.curvature as usize).sum();
+        let n_probes = self.probes.len() as f64;
+        Sizes { n_dof, n_constraints, n_elements, n_probes, n_probe_values: 2.0 * n_probes + sections as f64 }
     }
 
     /// Refuses a full run of `n_steps` whose arrays (plus, with `dense`, the dense LU of
@@ -107,7 +112,8 @@ impl Model {
     pub fn check_full_run_memory(&self, n_steps: usize, dense: bool) -> Result<()> {
         let z = self.sizes();
         let nt = n_steps as f64 + 1.0;
-        let arrays = 8.0 * nt * (z.n_dof + z.n_constraints + 2.0 * z.n_probes + 1.0);
+        // q and q̇, multipliers, probe values, t
+        let arrays = 8.0 * nt * (2.0 * z.n_dof + z.n_constraints + z.n_probe_values + 1.0);
         let system = z.n_elements * crate::limits::BYTES_PER_ELEMENT;
         let n_kkt = z.n_dof + z.n_constraints;
         let lu = if dense { 2.0 * 8.0 * n_kkt * n_kkt } else { 0.0 };
@@ -133,6 +139,11 @@ impl Model {
 
     pub fn probe_names(&self) -> Vec<String> {
         self.probes.iter().map(|p| p.name.clone()).collect()
+    }
+
+    /// The validated probes, in file order (element, ξ, what each records).
+    pub fn probes(&self) -> &[Probe] {
+        &self.probes
     }
 }
 

@@ -160,4 +160,21 @@ pub struct ProbeSpec {
     pub node: Option<NodeRef>,
     #[serde(default)]
     pub at: Option<f64>,
+    /// what the probe records: its position always, and the axial strain and curvature
+    /// there when listed (default `["position"]`); left out of the fingerprint when absent,
+    /// so that models without it keep theirs
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quantities: Option<Vec<ProbeQuantity>>,
+}
+
+/// A quantity a probe records ([`ProbeSpec::quantities`]).
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum ProbeQuantity {
+    /// x, y of the point, m (always recorded)
+    Position,
+    /// axial Green strain ½(r'·r' − 1) at the point, 1
+    Strain,
+    /// signed curvature (r' × r'')_z / |r'|³ of the centre line at the point, 1/m
+    Curvature,
 }

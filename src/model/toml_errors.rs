@@ -8,8 +8,8 @@ use std::path::Path;
 /// The entry of an array of tables (`[[bodies]]`, `[[joints]]`, `[[loads]]`, `[[probes]]`)
 /// that fails to parse, with the key at fault and its line: serde reports errors inside
 /// internally tagged or untagged entries against the whole entry, so each entry is parsed
-/// on its own, and the key at fault is the one whose removal changes the error (the
-/// `type` tag last: removing it always does). `None` when every entry parses by itself.
+/// on its own and the key at fault is searched for ([`fault_path`]), down through nested
+/// tables such as a piecewise function's pieces. `None` when every entry parses by itself.
 pub(super) fn entry_error(text: &str, path: &Path) -> Option<Error> {
     fn first_error<T: serde::de::DeserializeOwned>(v: &toml::Value) -> Option<String> {
         v.clone().try_into::<T>().err().map(|e| e.message().to_string())
@@ -26,30 +26,111 @@ pub(super) fn entry_error(text: &str, path: &Path) -> Option<Error> {
         let Some(toml::Value::Array(items)) = doc.get(name) else { continue };
         for (i, item) in items.iter().enumerate() {
             let Some(message) = parse(item) else { continue };
-            let key = item.as_table().and_then(|t| {
-                let changes = |k: &String| {
-                    let mut rest = t.clone();
-                    rest.remove(k);
-                    parse(&toml::Value::Table(rest)).as_deref() != Some(message.as_str())
-                };
-                t.keys()
-                    .filter(|k| k.as_str() != "type")
-                    .find(|k| changes(k))
-                    .or_else(|| t.keys().find(|k| changes(k)))
-                    .cloned()
-            });
-            let line =
-                entry_line(text, name, i).map(|l| key.as_deref().and_then(|k| key_line(text, l, k)).unwrap_or(l));
-            let field = match (&key, line) {
-                (Some(k), Some(l)) => format!("{name}[{i}].{k} (line {l})"),
-                (Some(k), None) => format!("{name}[{i}].{k}"),
-                (None, Some(l)) => format!("{name}[{i}] (line {l})"),
-                (None, None) => format!("{name}[{i}]"),
-            };
+            let fault = fault_path(item, |v| parse(v).as_deref() == Some(message.as_str()));
+            let mut full = vec![Step::Key(name.to_string()), Step::Index(i)];
+            full.extend(fault.iter().cloned());
+            let line = step_line(text, &full).or_else(|| entry_line(text, name, i));
+            let mut field = format!("{name}[{i}]");
+            for step in &fault {
+                match step {
+                    Step::Key(k) => field += &format!(".{k}"),
+                    Step::Index(j) => field += &format!("[{j}]"),
+                }
+            }
+            if let Some(l) = line {
+                field += &format!(" (line {l})");
+            }
             return Some(Error::input(path, field, message));
         }
     }
     None
+}
+
+/// One step of a path into a TOML value: a key of a table or an index into an array.
+#[derive(Clone, Debug, PartialEq)]
+enum Step {
+    Key(String),
+    Index(usize),
+}
+
+/// The path below `entry` to the value at fault: the first key (the `type` tag last, as
+/// removing it always changes the error) or array element whose removal makes the error
+/// differ (`fails_alike` false), then the same inside it, as long as it is a table or an
+/// array of tables. An error of a value's type or an unknown key is raised where serde
+/// meets the key, before any missing key is noticed, so removing another key leaves it
+/// alike; removing the key at fault changes it.
+fn fault_path(entry: &toml::Value, fails_alike: impl Fn(&toml::Value) -> bool) -> Vec<Step> {
+    let mut path = Vec::new();
+    loop {
+        let children: Vec<Step> = match value_at(entry, &path) {
+            Some(toml::Value::Table(t)) => {
+                let keys = t.keys().filter(|k| k.as_str() != "type").chain(t.keys().filter(|k| k.as_str() == "type"));
+                keys.map(|k| Step::Key(k.clone())).collect()
+            }
+            Some(toml::Value::Array(a)) if a.iter().all(|v| v.is_table()) => (0..a.len()).map(Step::Index).collect(),
+            _ => break,
+        };
+        let culprit = children.into_iter().find(|c| {
+            let mut at = path.clone();
+            at.push(c.clone());
+            !fails_alike(&without(entry, &at))
+        });
+        match culprit {
+            Some(c) => path.push(c),
+            None => break,
+        }
+    }
+    path
+}
+
+fn value_at<'a>(v: &'a toml::Value, path: &[Step]) -> Option<&'a toml::Value> {
+    path.iter().try_fold(v, |v, step| match (step, v) {
+        (Step::Key(k), toml::Value::Table(t)) => t.get(k),
+        (Step::Index(i), toml::Value::Array(a)) => a.get(*i),
+        _ => None,
+    })
+}
+
+/// A copy of `v` without the key or element at `path` (non-empty).
+fn without(v: &toml::Value, path: &[Step]) -> toml::Value {
+    let mut copy = v.clone();
+    let (last, parent) = path.split_last().expect("a path to remove");
+    let mut at = &mut copy;
+    for step in parent {
+        at = match (step, at) {
+            (Step::Key(k), toml::Value::Table(t)) => t.get_mut(k).expect("the path exists"),
+            (Step::Index(i), toml::Value::Array(a)) => &mut a[*i],
+            _ => unreachable!("the path exists"),
+        };
+    }
+    match (last, at) {
+        (Step::Key(k), toml::Value::Table(t)) => {
+            t.remove(k);
+        }
+        (Step::Index(i), toml::Value::Array(a)) => {
+            a.remove(*i);
+        }
+        _ => unreachable!("the path exists"),
+    }
+    copy
+}
+
+/// The line (1-based) where the last step of `path` (from the document's root) is written:
+/// the key's own line, or an array element's first line, from the parser's spans. The key's
+/// line holds for every way of writing it (`[a.b]` headers, inline tables, dotted keys).
+fn step_line(text: &str, path: &[Step]) -> Option<usize> {
+    use toml::de::DeValue;
+    let root = DeValue::Table(toml::de::DeTable::parse(text).ok()?.into_inner());
+    let (mut value, mut start) = (&root, None);
+    for step in path {
+        let (at, v) = match (step, value) {
+            (Step::Key(k), DeValue::Table(t)) => t.get_key_value(k.as_str()).map(|(key, v)| (key.span().start, v))?,
+            (Step::Index(i), DeValue::Array(a)) => a.get(*i).map(|v| (v.span().start, v))?,
+            _ => return None,
+        };
+        (value, start) = (v.get_ref(), Some(at));
+    }
+    Some(text.as_bytes()[..start?.min(text.len())].iter().filter(|&&b| b == b'\n').count() + 1)
 }
 
 /// The line (1-based) of the `[[name]]` header of entry `i`, if written that way.
@@ -57,21 +138,6 @@ pub(super) fn entry_line(text: &str, name: &str, i: usize) -> Option<usize> {
     let is_header =
         |l: &str| l.trim().strip_prefix("[[").and_then(|r| r.split("]]").next()).is_some_and(|n| n.trim() == name);
     text.lines().enumerate().filter(|(_, l)| is_header(l)).nth(i).map(|(k, _)| k + 1)
-}
-
-/// The line of `key = …` in the table whose header is on line `header`.
-fn key_line(text: &str, header: usize, key: &str) -> Option<usize> {
-    for (k, l) in text.lines().enumerate().skip(header) {
-        let l = l.trim();
-        if l.starts_with('[') {
-            return None;
-        }
-        let lhs = l.split('=').next().unwrap_or("").trim().trim_matches('"');
-        if l.contains('=') && (lhs == key || lhs.starts_with(&format!("{key}."))) {
-            return Some(k + 1);
-        }
-    }
-    None
 }
 
 /// The dotted key path (or line) at byte `pos` of a TOML text, for error messages.

@@ -3,5 +3,6 @@
 pub mod element;
 pub mod loads;
 pub mod parts;
+pub mod section;
 pub mod system;
 pub mod time_function;

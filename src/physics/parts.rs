@@ -48,12 +48,15 @@ pub enum Load {
     Force { node: NodeId, value: [f64; 2], function: Option<TimeFunction>, scaled: bool },
 }
 
-/// A material point whose position is recorded: element index and `ξ` in [0, 1].
+/// A material point whose position is recorded: element index and `ξ` in [0, 1]; with
+/// `strain` and `curvature` also those of the centre line there ([`super::section`]).
 #[derive(Clone, Debug)]
 pub struct Probe {
     pub name: String,
     pub element: usize,
     pub xi: f64,
+    pub strain: bool,
+    pub curvature: bool,
 }
 
 /// Rayleigh damping `C = a M + b K_t` on the constant parts of the element matrices.

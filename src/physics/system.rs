@@ -297,6 +297,12 @@ impl FlexibleSystem {
         self.element(probe.element).position(&self.gather(probe.element, q), probe.xi)
     }
 
+    /// Axial strain and curvature (1/m) at a probe ([`super::section`]).
+    pub fn probe_section(&self, probe: &Probe, q: &[f64]) -> (f64, f64) {
+        let (el, e) = (self.element(probe.element), self.gather(probe.element, q));
+        (el.axial_strain(&e, probe.xi), el.curvature(&e, probe.xi))
+    }
+
     /// Kinetic energy `½ q̇ᵀ M q̇`.
     pub fn kinetic_energy(&self, v: &[f64]) -> f64 {
         let mut mv = vec![0.0; self.n_dof];

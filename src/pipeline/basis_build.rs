@@ -2,10 +2,12 @@
 //! pipeline's variant and blocks, its hyper-reduction and its error estimator.
 
 use super::config::{Blocks, Pipeline};
-use super::estimate::{build_estimator, Estimator, DEFAULT_EXTRA_MODES};
+use super::training_record::TrainSummary;
+use crate::error::{Error, Result};
 use crate::io::basis_file::TrainingData;
 use crate::physics::system::FlexibleSystem;
 use crate::reduction::{ecsw, train_basis, BasisSpec, ModeRule, Trained};
+use crate::rom::estimator::training::{build_estimator, Estimator, Snapshots, DEFAULT_EXTRA_MODES};
 use crate::simulate::SimulationResult;
 use ndarray::{concatenate, Array1, Axis};
 
@@ -80,17 +82,34 @@ pub fn build_basis(
             .map_err(|e| ("reduction.hyper", format!("ECSW training failed: {e}")))?;
         trained.basis.hyper = Some(hyper);
     }
-    let estimator = build_estimator(
-        sys,
-        &trained,
-        &spec,
-        data.x.view(),
-        data.multipliers.view(),
-        &joints,
-        x_ref.view(),
-        hyper_tolerance,
-        DEFAULT_EXTRA_MODES,
-    )
-    .map_err(|e| ("reduction", format!("cannot build the error estimator: {e}")))?;
+    let snapshots =
+        Snapshots { x: data.x.view(), multipliers: data.multipliers.view(), joint_dofs: &joints, x_ref: x_ref.view() };
+    let estimator = build_estimator(sys, &trained, &spec, &snapshots, hyper_tolerance, DEFAULT_EXTRA_MODES)
+        .map_err(|e| ("reduction", format!("cannot build the error estimator: {e}")))?;
     Ok((trained, estimator))
+}
+
+/// The basis and estimator of fixed-load training (`train.load_scales`, the pipeline's
+/// `[reduction]` rule) from the snapshots of `n_runs` full runs, on one machine or gathered
+/// from sharded jobs ([`super::snapshots`]).
+pub(crate) fn basis_from_snapshots(
+    p: &Pipeline,
+    data: TrainingData,
+    full_seconds: f64,
+    n_runs: usize,
+) -> Result<(TrainingData, TrainSummary)> {
+    let modes = p.file.reduction.modes.clone().ok_or_else(|| Error::input(&p.path, "reduction.modes", "is missing"))?;
+    let tol = p.file.reduction.hyper.as_ref().map(|h| h.tolerance);
+    let (trained, estimator) = build_basis(p, &data, modes, tol).map_err(|(f, e)| Error::input(&p.path, f, e))?;
+    let n_snapshots = data.x.ncols();
+    let summary = TrainSummary {
+        trained,
+        n_snapshots,
+        full_seconds,
+        n_runs,
+        greedy: None,
+        estimator: Some(estimator),
+        warnings: Vec::new(),
+    };
+    Ok((data, summary))
 }

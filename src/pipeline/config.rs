@@ -44,7 +44,7 @@ pub struct Pipeline {
     pub path: PathBuf,
     pub text: String,
     pub file: PipelineFile,
-    pub model: Model,
+    pub model: std::sync::Arc<Model>,
     pub basis_path: PathBuf,
     pub report_dir: PathBuf,
 }
@@ -63,7 +63,14 @@ impl Pipeline {
         let basis_path =
             dir.join(file.basis.clone().unwrap_or_else(|| PathBuf::from(format!("../data/bases/{stem}.h5"))));
         let report_dir = dir.join(file.report.clone().unwrap_or_else(|| PathBuf::from(format!("../reports/{stem}"))));
-        let p = Pipeline { path: path.to_path_buf(), text, file, model, basis_path, report_dir };
+        let p = Pipeline {
+            path: path.to_path_buf(),
+            text,
+            file,
+            model: std::sync::Arc::new(model),
+            basis_path,
+            report_dir,
+        };
         p.check()?;
         Ok(p)
     }
@@ -141,7 +148,7 @@ impl Pipeline {
             }
         }
         for (name, scales) in [
-            ("online", self.file.online.as_ref().map(|o| &o.load_scales)),
+            ("online", self.file.online.as_ref().and_then(|o| o.load_scales.as_ref())),
             ("validate", self.file.validate.as_ref().map(|v| &v.load_scales)),
         ] {
             if let Some(s) = scales {
@@ -195,8 +202,10 @@ impl Pipeline {
         }
     }
 
+    /// `[online] load_scales`, or the training scales without them.
     pub fn online_scales(&self) -> Vec<f64> {
-        self.file.online.as_ref().map_or_else(|| self.training_scales(), |s| s.load_scales.values().expect("checked"))
+        let given = self.file.online.as_ref().and_then(|o| o.load_scales.as_ref());
+        given.map_or_else(|| self.training_scales(), |s| s.values().expect("checked"))
     }
 
     /// `[online] tolerance`, when given.
@@ -204,6 +213,8 @@ impl Pipeline {
         self.file.online.as_ref().and_then(|o| o.tolerance)
     }
 
+    /// `[validate] load_scales` (`run`'s validation, and `validate` without `--load-scale`),
+    /// or the training scales without them.
     pub fn validate_scales(&self) -> Vec<f64> {
         self.file.validate.as_ref().map_or_else(|| self.training_scales(), |s| s.load_scales.values().expect("checked"))
     }

@@ -6,10 +6,6 @@
 pub mod basis_build;
 pub mod config;
 pub mod dense;
-pub mod estimate;
-pub mod estimate_corrected;
-pub mod estimate_defects;
-pub mod estimate_trust;
 pub mod greedy;
 pub mod merge;
 pub mod online;

@@ -1,28 +1,15 @@
-//! `online`: load a basis, run the reduced model at a load scale, reconstruct.
+//! `online`: load a basis, check it against the pipeline, and build its reduced model.
 
 use super::config::Pipeline;
 use crate::error::{Error, Result};
 use crate::io::basis_file::StoredBasis;
-use crate::model::Model;
-use crate::physics::element::Vec8;
-use crate::physics::system::FlexibleSystem;
-use crate::reduction::{Basis, Hyper, HyperReducedModel, Reduced, ReducedModel};
-use crate::simulate::{Overrides, Settings, SimulationResult};
-use crate::solver::model::{Parameters, ParametricModel};
-use ndarray::{Array1, Array2, ArrayView1};
+use crate::io::h5::{attr_str, attr_u64};
+use crate::io::result_file::{begin_alongside, RunPlan};
+use crate::rom::estimator::{Estimate, EstimateMethod};
+use crate::rom::trust::write_run_attributes;
+use crate::rom::{check_reduced_memory, settings_at, LoadOptions, Output, ReducedRun, Rom, Trust};
+use crate::solver::model::Parameters;
 use std::path::Path;
-use std::sync::Arc;
-
-pub use crate::model::SharedPhysics;
-
-/// A reduced run: the full-coordinate result (same layout as `simulate`) and the reduced
-/// trajectory. `result.wall_seconds` is the reduced time loop alone.
-#[derive(Clone, Debug)]
-pub struct ReducedRun {
-    pub result: SimulationResult,
-    /// r × n_t
-    pub reduced_q: Array2<f64>,
-}
 
 /// Reads the pipeline's basis (or `path`) and checks it against the pipeline's model and
 /// settings ([`crate::io::basis_check::check`]).
@@ -30,222 +17,60 @@ pub fn load_basis(p: &Pipeline, path: &Path) -> Result<StoredBasis> {
     crate::io::basis_check::check(path, &p.model, Some(&p.settings_hash()))
 }
 
-/// What the run writes: the full coordinates (`online`, `validate`) or only the reduced
-/// ones and the probes (`sweep`: nothing of size n_dof, probes from their own rows of V).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Output {
-    Full,
-    ReducedAndProbes,
-}
-
-/// Runs the reduced model of `basis` at `load_scale` with the model's time settings; the
-/// hyper-reduced model when the basis carries a sampled element set, else the same model
-/// over every element at weight 1 (plain Galerkin).
-pub fn run_reduced(model: &Model, basis: &Basis, load_scale: f64) -> Result<ReducedRun> {
-    run_reduced_with(model, basis, load_scale, Output::Full, &[])
-}
-
-/// [`run_reduced`] with a choice of output and, in `previous`, up to two earlier runs of
-/// the same basis at nearby load scales (nearest last): see [`ReducedRunner::run`].
-pub fn run_reduced_with(
-    model: &Model,
-    basis: &Basis,
-    load_scale: f64,
-    output: Output,
-    previous: &[&ReducedRun],
-) -> Result<ReducedRun> {
-    ReducedRunner::new(model, basis)?.run(load_scale, output, previous)
-}
-
-/// The reduced model of a basis, built once and run at as many load scales as wanted (a
-/// sweep keeps one per thread: building it projects every element, ~1 ms on the four-bar).
-pub struct ReducedRunner<'a> {
-    model: &'a Model,
-    basis: &'a Basis,
-    rom: Rom,
-    x0: Arc<Vec<f64>>,
-}
-
-/// The hyper-reduced model when the basis carries a sampled set; without one, every element
-/// at weight 1, which is plain Galerkin (to round-off, tests/hyper.rs) through the cheaper
-/// per-element Gₑ route; the generic element-by-element projection only for elements that
-/// route does not support.
-enum Rom {
-    Invariant(Box<HyperReducedModel<FlexibleSystem>>),
-    Generic(Box<ReducedModel<FlexibleSystem>>),
-}
-
-impl<'a> ReducedRunner<'a> {
-    /// Projects the physics of `model` (assembled once per model: [`Model::physics`]) on
-    /// `basis`.
-    pub fn new(model: &'a Model, basis: &'a Basis) -> Result<Self> {
-        Self::with_physics(model, basis, model.physics()?)
-    }
-
-    /// Projects the already assembled physics of `model` on `basis`.
-    pub fn with_physics(model: &'a Model, basis: &'a Basis, physics: &SharedPhysics) -> Result<Self> {
-        let (sys, x0) = (Arc::clone(&physics.sys), Arc::clone(&physics.x0));
-        let cannot = |e: String| Error::Usage(format!("cannot build the reduced model: {e}"));
-        let rom = match &basis.hyper {
-            Some(h) => Rom::Invariant(Box::new(HyperReducedModel::new(sys, basis, h).map_err(cannot)?)),
-            None if HyperReducedModel::<FlexibleSystem>::supports(&sys) => {
-                let all = Hyper::all(sys.n_elements());
-                Rom::Invariant(Box::new(HyperReducedModel::new(sys, basis, &all).map_err(cannot)?))
-            }
-            None => Rom::Generic(Box::new(ReducedModel::new(sys, basis).map_err(cannot)?)),
-        };
-        Ok(ReducedRunner { model, basis, rom, x0 })
-    }
-
-    /// Runs at `load_scale` with the model's time settings. With `previous` runs (a
-    /// continuation in the load scale) each step's Newton solve starts from their
-    /// increment of that step, extrapolated linearly in the load scale,
-    ///
-    /// ```text
-    ///     Δq_k(λ) ≈ Δq_k(λ₁) + (λ − λ₁)/(λ₁ − λ₂) · (Δq_k(λ₁) − Δq_k(λ₂)),
-    /// ```
-    ///
-    /// and, with the default within-step reuse
-    /// ([`JacobianReuse`](crate::solver::generalized_alpha::JacobianReuse)), keeps the
-    /// factorized matrix of a good guess. Only the starting point changes: every step
-    /// stops on the same tolerance as a run on its own.
-    pub fn run(&mut self, load_scale: f64, output: Output, previous: &[&ReducedRun]) -> Result<ReducedRun> {
-        self.solve(&Parameters::new(load_scale), output, previous)
-    }
-
-    /// [`Self::run`] at the parameters `mu`: the reduced model is not changed by them (it
-    /// keeps its projected loads unscaled), so runs at any sequence of parameters give
-    /// what fresh models give.
-    pub fn solve(&mut self, mu: &Parameters, output: Output, previous: &[&ReducedRun]) -> Result<ReducedRun> {
-        let s = settings_at(self.model, mu.load_scale)?;
-        let previous = &previous[previous.len().saturating_sub(2)..];
-        let (model, basis, x0) = (self.model, self.basis, &self.x0[..]);
-        let result = match &mut self.rom {
-            Rom::Invariant(rom) => run(rom.as_mut(), model, basis, s, x0, output, previous),
-            Rom::Generic(rom) => run(rom.as_mut(), model, basis, s, x0, output, previous),
-        };
-        result.map_err(|e| crate::reduction::whole_system::explain_failure(e, basis.variant, mu.load_scale))
-    }
-}
-
-/// The settings of a reduced run of `model` at `load_scale`: the model file's time
-/// settings at that load scale (what `online` plans its result file from, before the run).
-pub fn settings_at(model: &Model, load_scale: f64) -> Result<Settings> {
-    Settings::resolve(model, &Overrides { load_scale: Some(load_scale), ..Default::default() })
-}
-
-/// Refuses `runs` reduced runs of `r` coordinates over `n_steps` whose kept arrays would
-/// not fit the memory bound: `8 n_t (r + n_c + 2 n_probes + 1)` each, plus the full
-/// coordinates `8 n_t (n_dof + n_c)` when they are reconstructed ([`crate::limits`]).
-pub fn check_reduced_memory(model: &Model, r: usize, n_steps: usize, output: Output, runs: f64) -> Result<()> {
-    let z = model.sizes();
-    let nt = n_steps as f64 + 1.0;
-    let full = if output == Output::Full { z.n_dof + z.n_constraints } else { 0.0 };
-    let bytes = runs * 8.0 * nt * (r as f64 + z.n_constraints + 2.0 * z.n_probes + 1.0 + full);
-    let what = if runs > 1.0 {
-        format!(
-            "{runs} reduced runs of {n_steps} steps × {r} modes{}",
-            if full > 0.0 { " with their full coordinates" } else { "" }
-        )
-    } else {
-        format!("a reduced run of {n_steps} steps × {r} modes")
+/// Reads and checks the basis file at `path` and builds its reduced model with the error
+/// estimator by `method` (else the pipeline's `[online] estimate`, else the one the basis
+/// file names; none with `no_estimate`), held to the pipeline's `[online] tolerance` (else
+/// the training tolerance). Returns the warnings a user should see.
+pub fn load_rom(
+    p: &Pipeline,
+    path: &Path,
+    method: Option<EstimateMethod>,
+    no_estimate: bool,
+) -> Result<(StoredBasis, Rom, Vec<String>)> {
+    let stored = load_basis(p, path)?;
+    let o = LoadOptions {
+        method: method.or_else(|| p.file.online.as_ref().and_then(|o| o.estimate)),
+        tolerance: p.online_tolerance(),
+        no_estimate,
     };
-    crate::limits::check_memory(&what, bytes)
+    let (rom, more) = Rom::load(&p.model, path, &stored, o)?;
+    let mut warnings = stored.warnings.clone();
+    warnings.extend(more);
+    Ok((stored, rom, warnings))
 }
 
-fn run<R: Reduced<FlexibleSystem>>(
-    rom: &mut R,
-    model: &Model,
-    basis: &Basis,
-    s: Settings,
-    x0: &[f64],
-    output: Output,
-    previous: &[&ReducedRun],
-) -> Result<ReducedRun> {
-    let q0 = basis.reduce(ArrayView1::from(x0)).to_vec();
-    let (r, nt) = (rom.n_dof(), s.n_steps + 1);
-    check_reduced_memory(model, r, s.n_steps, output, 1.0)?;
-    let mut zq = Array2::zeros((r, nt));
-    let mut lam = Array2::<f64>::zeros((rom.n_constraints(), nt));
-    let mut t = Array1::zeros(nt);
-    // (λᵢ, trajectory) of the earlier runs that fit this one, nearest last
-    let known: Vec<(f64, &Array2<f64>)> = previous
-        .iter()
-        .filter(|p| p.reduced_q.dim() == (r, nt))
-        .map(|p| (p.result.settings.load_scale, &p.reduced_q))
-        .collect();
-    let x = s.load_scale;
-    let guess = |k: usize, out: &mut [f64]| match known.as_slice() {
-        [] => false,
-        [.., (l2, z2), (l1, z1)] if l1 != l2 => {
-            let f = (x - l1) / (l1 - l2);
-            for (i, o) in out.iter_mut().enumerate() {
-                let (d1, d2) = (z1[[i, k]] - z1[[i, k - 1]], z2[[i, k]] - z2[[i, k - 1]]);
-                *o = d1 + f * (d1 - d2);
-            }
-            true
-        }
-        [.., (_, z1)] => {
-            for (i, o) in out.iter_mut().enumerate() {
-                *o = z1[[i, k]] - z1[[i, k - 1]];
-            }
-            true
-        }
-    };
-    let start = std::time::Instant::now();
-    let stats = crate::simulate::solve(rom, &s.parameters(), &s.params, q0, s.dt, s.n_steps, guess, |k, st| {
-        t[k] = st.t;
-        zq.column_mut(k).assign(&ArrayView1::from(&st.q));
-        lam.column_mut(k).assign(&ArrayView1::from(&st.lambda));
+/// What `online` produced: the run, its estimate and whether it left the training range.
+pub struct OnlineRun {
+    pub run: ReducedRun,
+    pub estimate: Option<Estimate>,
+    pub extrapolated: bool,
+}
+
+/// Runs `rom` at `mu` and writes the result file `out` ([`crate::io::result_file`]: its
+/// fixed part on a second thread while the run computes, the file renamed into place only
+/// when complete) with the reduced coordinates, the basis it came from (`basis_path`) and
+/// the estimate's attributes ([`crate::rom::trust::write_run_attributes`]).
+pub fn online_to_file(p: &Pipeline, rom: &Rom, basis_path: &Path, mu: &Parameters, out: &Path) -> Result<OnlineRun> {
+    // a run too large for the memory bound is refused before the file is begun
+    let settings = settings_at(&p.model, mu.load_scale)?;
+    check_reduced_memory(&p.model, rom.basis().n_reduced(), settings.n_steps, Output::Full, 1.0)?;
+    let plan = RunPlan::of(&p.model, &settings);
+    let model_path = p.model.path.display().to_string();
+    let (file, (run, estimate)) = begin_alongside(out, &p.model.text, &model_path, &plan, || {
+        rom.solve_and_estimate(mu, Output::Full, &[]).map_err(|e| e.at_stage("online", mu.load_scale))
     })?;
-    let wall_seconds = start.elapsed().as_secs_f64();
-    // reconstruct only what is written out
-    let full = rom.full();
-    let n_c = full.n_constraints();
-    let (q, multipliers) = match output {
-        Output::Full => {
-            let q = basis.reference.view().insert_axis(ndarray::Axis(1)).to_owned() + basis.modes.dot(&zq);
-            let mut multipliers = Array2::from_elem((n_c, nt), f64::NAN);
-            for k in 0..nt {
-                if let Some(l) = rom.multipliers(&zq.column(k).to_vec(), &lam.column(k).to_vec()) {
-                    multipliers.column_mut(k).assign(&l);
-                }
-            }
-            (q, multipliers)
-        }
-        Output::ReducedAndProbes => (Array2::zeros((0, nt)), Array2::zeros((0, nt))),
-    };
-    // probes from the rows of V on their element: x_e = x_ref,e + V_e q
-    let probes = full
-        .probes
-        .iter()
-        .map(|p| {
-            let dofs = full.element_dofs(p.element);
-            let ve = basis.modes.select(ndarray::Axis(0), dofs);
-            let xe_ref = basis.reference.select(ndarray::Axis(0), dofs);
-            let xe = ve.dot(&zq) + &xe_ref.insert_axis(ndarray::Axis(1));
-            let el = full.element(p.element);
-            let mut xy = Array2::zeros((nt, 2));
-            for k in 0..nt {
-                let r = el.position(&Vec8::from_iterator(xe.column(k).iter().copied()), p.xi);
-                xy[[k, 0]] = r[0];
-                xy[[k, 1]] = r[1];
-            }
-            (p.name.clone(), xy)
-        })
-        .collect();
-    Ok(ReducedRun {
-        result: SimulationResult {
-            model_text: model.text.clone(),
-            model_path: model.path.display().to_string(),
-            settings: s,
-            t,
-            q,
-            multipliers,
-            probes,
-            stats,
-            wall_seconds,
-        },
-        reduced_q: zq,
-    })
+    let extrapolated = rom.is_extrapolated(mu);
+    let basis = rom.basis();
+    // absolute, so that the file names its basis wherever it is read from
+    let basis_name = crate::io::output::resolve(basis_path).display().to_string();
+    let trust = rom.trust().cloned().unwrap_or_else(|| Trust::range((f64::NAN, f64::NAN)));
+    file.finish(&run.result, |f| {
+        let e = |err: hdf5::Error| Error::hdf5(out, err);
+        crate::io::result_file::write_reduced(f, &run.reduced_q).map_err(e)?;
+        attr_str(f, "basis", &basis_name).map_err(e)?;
+        attr_str(f, "variant", basis.variant.name()).map_err(e)?;
+        attr_u64(f, "n_modes", basis.n_reduced() as u64).map_err(e)?;
+        write_run_attributes(f, estimate.as_ref(), rom.method(), &trust, extrapolated).map_err(e)
+    })?;
+    Ok(OnlineRun { run, estimate, extrapolated })
 }

@@ -101,10 +101,13 @@ fn log_labels(lo: f64, hi: f64) -> impl Fn(&f64) -> String {
 }
 
 /// Linear labels with as many digits as the axis span `lo..hi` needs (scientific notation
-/// for spans below 1e-3, where fixed decimals would print every tick as 0).
+/// for spans below 1e-3, where fixed decimals would print every tick as 0). A tick within
+/// 1e-9 of the span of zero is 0: plotters computes ticks as lo + k·step, so the tick at
+/// zero carries the round-off of the span (it printed as -2.7e-20 on a probe-error axis).
 fn linear_labels(lo: f64, hi: f64) -> impl Fn(&f64) -> String {
     let span = (hi - lo).abs();
     move |v: &f64| {
+        let v = &if v.abs() <= 1e-9 * span { 0.0 } else { *v };
         if span > 0.0 && span < 1e-3 {
             return log_label_precise(*v);
         }
@@ -316,6 +319,11 @@ mod tests {
         // a span of 2e-4 m: the old fixed 4 decimals printed 0 for every tick
         let f = linear_labels(-1e-4, 1e-4);
         assert_eq!((f(&2e-5), f(&-1.5e-5), f(&0.0)), ("2e-5".into(), "-1.5e-5".into(), "0".into()));
+        // zero to round-off of the span is 0, on any span; a tick 1e-9 of the span off is not
+        assert_eq!((f(&-2.7e-20), f(&2.7e-20)), ("0".into(), "0".into()));
+        assert_eq!(linear_labels(-1e-12, 1e-12)(&3e-29), "0");
+        assert_eq!(linear_labels(-1.2, 1.2)(&-2.7e-17), "0");
+        assert_eq!(linear_labels(0.0, 1e-4)(&5e-12), "5e-12");
     }
 
     /// A figure writes a valid SVG and a PNG of the stated size (the PNG header's width and

@@ -4,12 +4,11 @@
 //! written under a temporary name and renamed into place only when every stage succeeded.
 
 use super::config::Pipeline;
-use super::estimate::{check_runs, load_trust};
-use super::online::load_basis;
+use super::online::load_rom;
 use super::plot::{Figure, Panel, Series, Style};
-use super::sweep::{sweep_with, table, write_sweep, SweepOptions};
+use super::sweep::{sweep, table, write_sweep, SweepOptions};
 use super::train::train_and_write;
-use super::validate::{validate_with, Validation};
+use super::validate::{validate, Validation};
 use crate::error::{Error, Result};
 use crate::io::atomic::TempPath;
 use crate::io::output::{check_output, check_report_dir, mark_new_report, swap_in_report, Origin};
@@ -33,50 +32,44 @@ pub fn check_outputs(p: &Pipeline) -> Result<()> {
 /// target and the basis under a temporary name beside the pipeline's `basis`. Only when
 /// every stage succeeded is the basis renamed into place and the report folder swapped in
 /// (the previous one, flexrom's own, removed after); on any failure both are left as they
-/// were and the temporary ones removed.
-pub fn run(p: &Pipeline, progress: bool) -> Result<PathBuf> {
+/// were and the temporary ones removed. Returns the report folder and the training's
+/// warnings.
+pub fn run(p: &Pipeline, progress: bool) -> Result<(PathBuf, Vec<String>)> {
     run_with(p, progress, super::dense::DenseChoice::Auto)
 }
 
 /// [`run`] with the choice of the dense-LU comparison ([`super::dense`]), decided before
 /// any work.
-pub fn run_with(p: &Pipeline, progress: bool, dense: super::dense::DenseChoice) -> Result<PathBuf> {
+pub fn run_with(p: &Pipeline, progress: bool, dense: super::dense::DenseChoice) -> Result<(PathBuf, Vec<String>)> {
     check_outputs(p)?;
     let dense = super::dense::decide(dense, &p.model)?;
     let dir = p.report_dir.clone();
     let report = TempPath::dir_for(&dir)?;
     let basis = TempPath::file_for(&p.basis_path)?;
-    build(p, report.path(), basis.path(), progress, dense)?;
+    let warnings = build(p, report.path(), basis.path(), progress, dense)?;
     mark_new_report(report.path())?;
     // checked again: the folder or the basis path may have changed during a long run
     check_outputs(p)?;
     basis.commit()?;
     swap_in_report(report, &p.path)?;
-    Ok(dir)
+    Ok((dir, warnings))
 }
 
 /// Every stage, writing the basis to `basis_path` (a temporary name) and the report files
 /// into `out` (a temporary folder); the files are `fsync`ed when the folder is swapped in.
-fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: bool) -> Result<()> {
+fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: bool) -> Result<Vec<String>> {
     let plot_err = |e: String| Error::io(out, std::io::Error::other(e));
     match &p.file.train.greedy {
         Some(g) => crate::output::info(&format!("[1/3] train: greedy over [{}, {}]", g.range().0, g.range().1)),
         None => crate::output::info(&format!("[1/3] train: {} full run(s)", p.training_scales().len())),
     }
     let trained = train_and_write(p, basis_path)?;
-    let stored = load_basis(p, basis_path)?;
-    let basis = &stored.basis;
-    let trust = load_trust(p, basis_path, &stored)?;
+    // the warnings of loading it come with `check_report`'s, once
+    let (stored, rom, _) = load_rom(p, basis_path, None, false)?;
 
     let scales = p.online_scales();
     crate::output::info(&format!("[2/3] sweep: {} reduced and full runs", scales.len()));
-    let sw = sweep_with(
-        &p.model,
-        basis,
-        Some(&trust),
-        &scales,
-        SweepOptions { validate: true, continuation: false, progress },
-    )?;
+    let sw = sweep(&rom, &scales, SweepOptions { validate: true, continuation: false, progress })?;
     write_sweep(&out.join("sweep.h5"), &sw, &stored, &p.basis_path)?;
     // the plots and tables below need every load scale
     if let Some(s) = sw.failure_summary() {
@@ -88,7 +81,7 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: boo
     crate::output::info(&format!("[3/3] validate at {} load scale(s){with}", vscales.len()));
     let mut validations: Vec<Validation> = Vec::new();
     for (i, &x) in vscales.iter().enumerate() {
-        let (v, full, rom) = validate_with(&p.model, basis, Some(&trust), x, dense)?;
+        let (v, full, reduced) = validate(&rom, x, dense)?;
         // x and y of every probe, full (line) and reduced (dashed), and their difference
         let t = &full.t;
         let mut panels: Vec<Panel> = ["x (m)", "y (m)"]
@@ -100,7 +93,7 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: boo
                 series: full
                     .probes
                     .iter()
-                    .zip(&rom.result.probes)
+                    .zip(&reduced.result.probes)
                     .flat_map(|((name, a), (_, b))| {
                         [
                             Series::new(
@@ -124,7 +117,7 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: boo
             series: full
                 .probes
                 .iter()
-                .zip(&rom.result.probes)
+                .zip(&reduced.result.probes)
                 .flat_map(|((name, a), (_, b))| {
                     (0..2).map(move |c| {
                         let d = t.iter().zip(a.column(c)).zip(b.column(c)).map(|((t, f), r)| (*t, r - f)).collect();
@@ -324,13 +317,14 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: boo
         );
     }
     let _ = writeln!(md, "\n## Error estimate, extrapolation, sensitivity\n");
+    let trust = rom.trust().expect("read from its basis file");
     let _ = writeln!(
         md,
         "Training range [{}, {}]; tolerance {}. The estimate predicts rel_error without a full run ({} method, docs/error-estimate.md); effectivity = estimate / rel_error (≥ 1: bounded). Sensitivity: the full model's own change for a 0.1 % change of the load.\n",
         trust.range.0,
         trust.range.1,
         trust.tolerance.map_or("none".to_string(), |t| format!("{t:e}")),
-        trust.estimator.as_ref().map_or("no", |e| e.method.name())
+        rom.method().unwrap_or("no")
     );
     let _ = writeln!(md, "| load scale | rel_error | error_estimate | effectivity | calibrated | extrapolated | sensitivity | rel_error by fifth of the run | error_estimate by fifth of the run |");
     let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|");
@@ -369,14 +363,14 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: boo
     }
     let _ = writeln!(md, "![error by time](error_by_time.svg)");
     std::fs::write(out.join("summary.md"), md).map_err(|e| Error::io(out, e))?;
-    Ok(())
+    Ok(trained.warnings)
 }
 
-/// After `run`: the extrapolation and tolerance warnings of the report's sweep (read back
-/// from its `sweep.h5`), and `--strict`'s error when an estimate exceeds the tolerance.
-pub fn check_report(p: &Pipeline, dir: &Path, strict: bool) -> Result<()> {
-    let stored = load_basis(p, &p.basis_path)?;
-    let trust = load_trust(p, &p.basis_path, &stored)?;
+/// After `run`: the warnings of the report's basis and sweep (read back from its
+/// `sweep.h5`: extrapolation, estimates above the tolerance), and `--strict`'s error when an
+/// estimate exceeds the tolerance.
+pub fn check_report(p: &Pipeline, dir: &Path, strict: bool) -> Result<Vec<String>> {
+    let (_, rom, mut warnings) = load_rom(p, &p.basis_path, None, false)?;
     let path = dir.join("sweep.h5");
     let f = hdf5::File::open(&path).map_err(|e| Error::hdf5(&path, e))?;
     let read = |name: &str| {
@@ -387,5 +381,7 @@ pub fn check_report(p: &Pipeline, dir: &Path, strict: bool) -> Result<()> {
     let (scales, est) = (read("load_scales")?, read("error_estimate")?);
     let runs: Vec<(f64, Option<f64>)> =
         scales.iter().zip(&est).map(|(&x, &e)| (x, if e.is_nan() { None } else { Some(e) })).collect();
-    check_runs(&trust, &runs, strict)
+    let trust = rom.trust().expect("read from its basis file");
+    warnings.extend(crate::rom::trust::check_runs(trust, rom.estimator().is_some(), &runs, strict)?);
+    Ok(warnings)
 }

@@ -19,14 +19,12 @@
 //! ```
 
 use super::config::Pipeline;
-use super::estimate::TrustInfo;
-use super::sweep::{sweep_to_file_with, Sweep, SweepOptions};
+use super::sweep::{sweep_to_file, Sweep, SweepFile, SweepOptions};
 use crate::error::{Error, Result};
-use crate::io::basis_file::StoredBasis;
 use crate::io::h5::{attr_str, attr_u64};
+use crate::rom::Rom;
 use ndarray::Array1;
 use sha2::{Digest, Sha256};
-use std::path::Path;
 
 /// One part of N (`index` 1-based).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -91,19 +89,9 @@ pub fn shard_scales(all: &[f64], shard: Shard) -> Result<(Vec<usize>, Vec<f64>)>
 
 /// Runs the loads of `shard` and writes the part file `out` (checkpointed like a sweep,
 /// every version with its `/shard` group, so a killed shard leaves a part that `--resume`
-/// finishes and `merge --partial` reads).
-#[allow(clippy::too_many_arguments)]
-pub fn sweep_shard(
-    p: &Pipeline,
-    stored: &StoredBasis,
-    trust: Option<&TrustInfo>,
-    basis_path: &Path,
-    all: &[f64],
-    shard: Shard,
-    o: SweepOptions,
-    out: &Path,
-    resume: bool,
-) -> Result<Sweep> {
+/// finishes and `merge --partial` reads). `f.extra` is replaced by the shard's group.
+pub fn sweep_shard(p: &Pipeline, rom: &Rom, all: &[f64], shard: Shard, o: SweepOptions, f: SweepFile) -> Result<Sweep> {
+    let (basis_path, out) = (f.basis_path, f.out);
     let (idx, scales) = shard_scales(all, shard)?;
     let hash = load_list_hash(all);
     let pipeline = crate::io::output::resolve(&p.path).display().to_string();
@@ -122,7 +110,7 @@ pub fn sweep_shard(
         attr_str(&g, "pipeline", &pipeline).map_err(e)?;
         attr_str(&g, "basis", &basis).map_err(e)
     };
-    sweep_to_file_with(&p.model, stored, trust, basis_path, &scales, o, out, resume, &extra)
+    sweep_to_file(rom, &scales, o, SweepFile { extra: &extra, ..f })
 }
 
 /// Sets the size of the worker pool: `--threads` when given, else `RAYON_NUM_THREADS` (read

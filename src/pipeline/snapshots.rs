@@ -1,4 +1,4 @@
-//! Sharded training (issue 17, item 2): the full runs of `train` as separate jobs
+//! Sharded training (docs/scaling.md): the full runs of `train` as separate jobs
 //! (`train --snapshots-only --load-scale X | --shard K/N -o snaps.h5`), and the basis built
 //! from their snapshot files (`train --from-snapshots snaps*.h5`).
 //!
@@ -27,9 +27,10 @@
 //!   pipeline: [train] and [reduction]), pipeline, full_seconds, program_version
 //! ```
 
+use super::basis_build::{basis_from_snapshots, training_data};
 use super::config::Pipeline;
 use super::shard::Shard;
-use super::train::{basis_from_snapshots, TrainSummary};
+use super::training_record::TrainSummary;
 use crate::error::{Error, Result};
 use crate::io::attrs::{check_layout, write_atomically_as, Kind};
 use crate::io::basis_file::TrainingData;
@@ -91,7 +92,7 @@ pub fn write_snapshots(p: &Pipeline, scales: &[f64], out: &Path) -> Result<(usiz
         seconds += r.wall_seconds;
         runs.push(r);
     }
-    let data = super::train::training_data(&runs);
+    let data = training_data(&runs);
     let settings_hash = p.settings_hash();
     let pipeline = crate::io::output::resolve(&p.path).display().to_string();
     write_atomically_as(out, Kind::Snapshots, |f| {

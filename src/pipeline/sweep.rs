@@ -20,14 +20,12 @@ pub use file::{read_sweep, write_sweep, write_sweep_with, Extra};
 pub use outcome::{Outcome, ScaleResult, Sweep, SweepPoint, STATUS_FAILED, STATUS_OK, STATUS_PENDING};
 pub use table::table;
 
-use super::estimate::{is_extrapolated, EstimatingRunner, TrustInfo};
-use super::online::{Output, ReducedRun};
 use super::validate::compare;
 use crate::error::Result;
 use crate::io::basis_file::StoredBasis;
-use crate::model::Model;
-use crate::reduction::Basis;
+use crate::rom::{Output, ReducedRun, Rom};
 use crate::simulate::{simulate, Overrides, Settings};
+use crate::solver::model::Parameters;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use ndarray::Array1;
 use outcome::clone_point;
@@ -49,7 +47,7 @@ pub struct SweepOptions {
     /// continuation in the load scale: each thread takes two contiguous parts of the list
     /// (one from each end) and starts every Newton solve from the previous points'
     /// increments
-    /// ([`super::online::ReducedRunner::run`]); off (the default): every load scale on its own, exactly as
+    /// ([`crate::rom::ReducedRunner::solve`]); off (the default): every load scale on its own, exactly as
     /// `online` runs it
     pub continuation: bool,
     /// a progress bar on stderr
@@ -78,56 +76,32 @@ fn continuation_lanes(n: usize, threads: usize) -> Vec<Vec<std::ops::Range<usize
 }
 
 /// Runs the reduced model at every scale, in parallel; with `validate`, also the full one.
-/// A scale whose run fails is recorded as failed and the others go on.
-pub fn sweep(model: &Model, basis: &Basis, scales: &[f64], o: SweepOptions) -> Result<Sweep> {
-    sweep_with(model, basis, None, scales, o)
+/// A scale whose run fails is recorded as failed and the others go on. Every point gets the
+/// reduced model's error estimate (when it has an estimator) and extrapolation flag.
+pub fn sweep(rom: &Rom, scales: &[f64], o: SweepOptions) -> Result<Sweep> {
+    let start = pending(rom, scales, o)?;
+    run_pending(rom, start, o, None)
 }
 
-/// [`sweep`] with the basis's estimator and training range: every point gets its error
-/// estimate and extrapolation flag.
-pub fn sweep_with(
-    model: &Model,
-    basis: &Basis,
-    trust: Option<&TrustInfo>,
-    scales: &[f64],
-    o: SweepOptions,
-) -> Result<Sweep> {
-    let start = pending(model, basis, scales, o)?;
-    run_pending(model, basis, trust, start, o, None)
+/// Where and how a sweep is written as it goes ([`sweep_to_file`]).
+pub struct SweepFile<'a> {
+    /// the basis file read as `stored`: the sweep file records which basis it is of
+    pub stored: &'a StoredBasis,
+    pub basis_path: &'a Path,
+    pub out: &'a Path,
+    /// take the scales `out` already holds as finished from it, run only the others
+    pub resume: bool,
+    /// written into the file at every checkpoint (a shard's own group)
+    pub extra: Extra<'a>,
 }
 
-/// [`sweep`] writing `out` as it goes (see the module documentation); with `resume`, the
-/// scales that `out` already holds as finished (same basis content and model) are taken
-/// from it, and only the others run. The returned sweep is written to `out`.
-#[allow(clippy::too_many_arguments)]
-pub fn sweep_to_file(
-    model: &Model,
-    stored: &StoredBasis,
-    trust: Option<&TrustInfo>,
-    basis_path: &Path,
-    scales: &[f64],
-    o: SweepOptions,
-    out: &Path,
-    resume: bool,
-) -> Result<Sweep> {
-    sweep_to_file_with(model, stored, trust, basis_path, scales, o, out, resume, &|_| Ok(()))
-}
-
-/// [`sweep_to_file`] with `extra` written into the file at every checkpoint.
-#[allow(clippy::too_many_arguments)]
-pub fn sweep_to_file_with(
-    model: &Model,
-    stored: &StoredBasis,
-    trust: Option<&TrustInfo>,
-    basis_path: &Path,
-    scales: &[f64],
-    o: SweepOptions,
-    out: &Path,
-    resume: bool,
-    extra: Extra,
-) -> Result<Sweep> {
-    let basis = &stored.basis;
-    let mut start = pending(model, basis, scales, o)?;
+/// [`sweep`] writing `f.out` as it goes (see the module documentation); with `f.resume`,
+/// the scales that `f.out` already holds as finished (same basis content and model) are
+/// taken from it, and only the others run. The returned sweep is written to `f.out`.
+pub fn sweep_to_file(rom: &Rom, scales: &[f64], o: SweepOptions, f: SweepFile) -> Result<Sweep> {
+    let SweepFile { stored, basis_path, out, resume, extra } = f;
+    let model = &**rom.model();
+    let mut start = pending(rom, scales, o)?;
     if resume {
         if out.exists() {
             let old = read_sweep(out, model, stored, o.validate)?;
@@ -162,13 +136,14 @@ pub fn sweep_to_file_with(
         }
     }
     let write = |s: &Sweep| write_sweep_with(out, s, stored, basis_path, extra);
-    let sw = run_pending(model, basis, trust, start, o, Some(&write))?;
+    let sw = run_pending(rom, start, o, Some(&write))?;
     write(&sw)?;
     Ok(sw)
 }
 
 /// Every scale pending, with the model's time grid and probe names.
-fn pending(model: &Model, basis: &Basis, scales: &[f64], o: SweepOptions) -> Result<Sweep> {
+fn pending(rom: &Rom, scales: &[f64], o: SweepOptions) -> Result<Sweep> {
+    let (model, basis) = (&**rom.model(), &**rom.basis());
     let s = Settings::resolve(model, &Overrides::default())?;
     let t = Array1::from_iter((0..=s.n_steps).map(|k| k as f64 * s.dt));
     Ok(Sweep {
@@ -188,15 +163,8 @@ type Checkpoint<'a> = &'a (dyn Fn(&Sweep) -> Result<()> + Sync);
 
 /// Runs the pending scales of `state`; after each one, `checkpoint` (when given, and at
 /// most every [`CHECKPOINT_SECONDS`]) writes what is done so far.
-fn run_pending(
-    model: &Model,
-    basis: &Basis,
-    trust: Option<&TrustInfo>,
-    state: Sweep,
-    o: SweepOptions,
-    checkpoint: Option<Checkpoint>,
-) -> Result<Sweep> {
-    let est = trust.and_then(|t| t.estimator.as_ref());
+fn run_pending(rom: &Rom, state: Sweep, o: SweepOptions, checkpoint: Option<Checkpoint>) -> Result<Sweep> {
+    let (model, basis) = (&**rom.model(), &**rom.basis());
     let todo: Vec<usize> = (0..state.scales.len()).filter(|&i| state.scales[i].status() != STATUS_OK).collect();
     let scales: Vec<f64> = todo.iter().map(|&i| state.scales[i].load_scale).collect();
     let bar = ProgressBar::with_draw_target(
@@ -217,7 +185,7 @@ fn run_pending(
     // every point's trajectories are kept until the file is written
     let n_steps = crate::simulate::Settings::resolve(model, &Overrides::default())?.n_steps;
     let output = if o.validate { Output::Full } else { Output::ReducedAndProbes };
-    super::online::check_reduced_memory(model, basis.n_reduced(), n_steps, output, scales.len() as f64)?;
+    crate::rom::check_reduced_memory(model, basis.n_reduced(), n_steps, output, scales.len() as f64)?;
     let start = std::time::Instant::now();
     let threads = state.threads;
     // continuation: a few chains of neighbouring scales per thread; otherwise one point per task
@@ -246,61 +214,49 @@ fn run_pending(
     };
     let results: Result<Vec<()>> = lanes
         .par_iter()
-        // one reduced model per worker, built at its first lane, its loads changed per scale
-        .map_init(
-            || None,
-            |slot: &mut Option<EstimatingRunner>, chains| {
-                let runner = match slot {
-                    Some(r) => r,
-                    // built at the model's own load scale, 1
-                    None => slot.insert(
-                        EstimatingRunner::new(model, basis, est)
-                            .map_err(|e| e.at_stage("sweep (building the reduced model)", 1.0))?,
-                    ),
-                };
-                for chain in chains {
-                    // the last two good runs of this chain (continuation only)
-                    let mut previous: Vec<ReducedRun> = Vec::new();
-                    for i in chain.clone() {
-                        let x = scales[i];
-                        // without validation nothing of full size is reconstructed
-                        let output = if o.validate { Output::Full } else { Output::ReducedAndProbes };
-                        let run = (|| -> Result<SweepPoint> {
-                            let (rom, estimate) = runner
-                                .run_with(x, output, &previous.iter().collect::<Vec<_>>())
-                                .map_err(|e| e.at_stage("sweep (reduced run)", x))?;
-                            let validation = if o.validate {
-                                let full = simulate(model, &Overrides { load_scale: Some(x), ..Default::default() })
-                                    .map_err(|e| e.at_stage("sweep (full run)", x))?;
-                                Some(
-                                    compare(model, &full, &rom, None, basis.n_reduced(), basis.variant.name())
-                                        .with_trust(estimate.as_ref(), trust),
-                                )
-                            } else {
-                                None
-                            };
-                            let extrapolated = trust.is_some_and(|t| is_extrapolated(t.range, x));
-                            Ok(SweepPoint { rom, validation, estimate, extrapolated })
-                        })();
-                        bar.inc(1);
-                        ticker.tick();
-                        match run {
-                            Ok(p) => {
-                                if o.continuation {
-                                    previous.push(p.rom.clone());
-                                    if previous.len() > 2 {
-                                        previous.remove(0);
-                                    }
+        .map(|chains| {
+            for chain in chains {
+                // the last two good runs of this chain (continuation only)
+                let mut previous: Vec<ReducedRun> = Vec::new();
+                for i in chain.clone() {
+                    let x = scales[i];
+                    let mu = Parameters::new(x);
+                    // without validation nothing of full size is reconstructed
+                    let output = if o.validate { Output::Full } else { Output::ReducedAndProbes };
+                    let run = (|| -> Result<SweepPoint> {
+                        let (run, estimate) = rom
+                            .solve_and_estimate(&mu, output, &previous.iter().collect::<Vec<_>>())
+                            .map_err(|e| e.at_stage("sweep (reduced run)", x))?;
+                        let (validation, full_probes) = if o.validate {
+                            let full = simulate(model, &Overrides { load_scale: Some(x), ..Default::default() })
+                                .map_err(|e| e.at_stage("sweep (full run)", x))?;
+                            let v = compare(model, &full, &run, None, basis.n_reduced(), basis.variant.name())
+                                .with_trust(estimate.as_ref(), Some(rom));
+                            (Some(v), Some(full.probes))
+                        } else {
+                            (None, None)
+                        };
+                        let extrapolated = rom.is_extrapolated(&mu);
+                        Ok(SweepPoint { rom: run, validation, full_probes, estimate, extrapolated })
+                    })();
+                    bar.inc(1);
+                    ticker.tick();
+                    match run {
+                        Ok(p) => {
+                            if o.continuation {
+                                previous.push(p.rom.clone());
+                                if previous.len() > 2 {
+                                    previous.remove(0);
                                 }
-                                record(i, Outcome::Done(p))?;
                             }
-                            Err(e) => record(i, Outcome::Failed(e.to_string()))?,
+                            record(i, Outcome::Done(p))?;
                         }
+                        Err(e) => record(i, Outcome::Failed(e.to_string()))?,
                     }
                 }
-                Ok(())
-            },
-        )
+            }
+            Ok(())
+        })
         .collect();
     bar.finish_and_clear();
     results?;

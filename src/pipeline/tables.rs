@@ -58,13 +58,16 @@ pub fn sweep_table(s: &Sweep) -> Table {
 }
 
 /// `simulate --csv/--json`: one row per instant, `t` (s) and every probe's `NAME_x`,
-/// `NAME_y` (m).
+/// `NAME_y` (m), then `NAME_strain` (1) and `NAME_curvature` (1/m) of the probes that
+/// record them.
 pub fn probe_table(r: &SimulationResult) -> Table {
     let mut cols = vec!["t".to_string()];
     for (n, _) in &r.probes {
         cols.push(format!("{n}_x"));
         cols.push(format!("{n}_y"));
     }
+    cols.extend(r.strains.iter().map(|(n, _)| format!("{n}_strain")));
+    cols.extend(r.curvatures.iter().map(|(n, _)| format!("{n}_curvature")));
     let mut t = Table { columns: cols, rows: Vec::new() };
     for k in 0..r.t.len() {
         let mut row = vec![Cell::from(r.t[k])];
@@ -72,6 +75,7 @@ pub fn probe_table(r: &SimulationResult) -> Table {
             row.push(xy[[k, 0]].into());
             row.push(xy[[k, 1]].into());
         }
+        row.extend(r.strains.iter().chain(&r.curvatures).map(|(_, v)| Cell::from(v[k])));
         t.push(row);
     }
     t

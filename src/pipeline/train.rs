@@ -5,10 +5,12 @@ pub use super::basis_build::{build_basis, training_data};
 use super::config::Pipeline;
 pub use super::training_record::TrainSummary;
 use crate::error::{Error, Result};
+use crate::io::atomic::TempPath;
 use crate::io::basis_file::{write_basis_with, BasisMeta, TrainingData};
+use crate::io::output::{check_output, Origin};
 use crate::linalg::kkt::LinearSolverKind;
 use crate::simulate::{FullModel, Overrides};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The coordinates that appear in any joint, sorted.
 pub fn joint_dofs(p: &Pipeline) -> Vec<usize> {
@@ -44,24 +46,7 @@ pub fn train(p: &Pipeline) -> Result<(TrainingData, TrainSummary)> {
         full_seconds += r.wall_seconds;
         runs.push(r);
     }
-    basis_from_snapshots(p, training_data(&runs), full_seconds, scales.len())
-}
-
-/// The basis and estimator of fixed-load training (`train.load_scales`, the pipeline's
-/// `[reduction]` rule) from the snapshots of `n_runs` full runs, on one machine or gathered
-/// from sharded jobs ([`super::snapshots`]).
-pub(crate) fn basis_from_snapshots(
-    p: &Pipeline,
-    data: TrainingData,
-    full_seconds: f64,
-    n_runs: usize,
-) -> Result<(TrainingData, TrainSummary)> {
-    let modes = p.file.reduction.modes.clone().ok_or_else(|| Error::input(&p.path, "reduction.modes", "is missing"))?;
-    let tol = p.file.reduction.hyper.as_ref().map(|h| h.tolerance);
-    let (trained, estimator) = build_basis(p, &data, modes, tol).map_err(|(f, e)| Error::input(&p.path, f, e))?;
-    let n_snapshots = data.x.ncols();
-    let summary = TrainSummary { trained, n_snapshots, full_seconds, n_runs, greedy: None, estimator: Some(estimator) };
-    Ok((data, summary))
+    super::basis_build::basis_from_snapshots(p, training_data(&runs), full_seconds, scales.len())
 }
 
 /// Trains and writes the basis file atomically (a failed run keeps the previous file).
@@ -93,4 +78,30 @@ pub fn write_trained(p: &Pipeline, out: &Path, data: &TrainingData, summary: &Tr
         }
         Ok(())
     })
+}
+
+/// `train` as a whole: checks that `out` may be written (not an input of the pipeline, not
+/// a file flexrom did not create: [`check_output`], `origin` names where the path came
+/// from), trains (from the full runs, or from the snapshot files `from_snapshots` when
+/// given) into a temporary file beside `out`, reads that back and checks it as every
+/// reader of a basis does, and only then renames it over `out`: a failure at any stage
+/// leaves the previous basis as it was.
+pub fn train_to_file(p: &Pipeline, out: &Path, origin: Origin, from_snapshots: &[PathBuf]) -> Result<TrainSummary> {
+    check_output(out, origin, &[(&p.path, "pipeline file"), (&p.model.path, "model file")])?;
+    let staged = TempPath::file_for(out)?;
+    let s = if from_snapshots.is_empty() {
+        train_and_write(p, staged.path())?
+    } else {
+        for f in from_snapshots {
+            if crate::io::output::resolve(f) == crate::io::output::resolve(out) {
+                return Err(Error::input(out, "--basis", "is one of the --from-snapshots files"));
+            }
+        }
+        let (data, s) = super::snapshots::train_from_snapshots(p, from_snapshots)?;
+        write_trained(p, staged.path(), &data, &s)?;
+        s
+    };
+    super::online::load_basis(p, staged.path())?;
+    staged.commit()?;
+    Ok(s)
 }

@@ -1,8 +1,8 @@
 //! The record of a training: what `train` returns (`TrainSummary`) and what the greedy loop did
 //! (`GreedyRecord`, written under `/training` in the basis file).
 
-use super::estimate::Estimator;
 use crate::reduction::Trained;
+use crate::rom::estimator::{EstimateMethod, Estimator};
 
 pub struct TrainSummary {
     pub trained: Trained,
@@ -15,6 +15,9 @@ pub struct TrainSummary {
     /// the error estimator (uncalibrated for `load_scales` training: no held-out runs;
     /// greedy training calibrates it on its held-out full runs)
     pub estimator: Option<Estimator>,
+    /// what the user should hear of the training beside its result (a greedy loop that ran
+    /// out of full runs), one line each; the caller shows them
+    pub warnings: Vec<String>,
 }
 
 /// One pass of the loop: the basis it chose and where its estimate was worst.
@@ -47,6 +50,11 @@ pub struct Iteration {
     /// the true error's score at `run_load` (as the estimates': held to the sensitivity where
     /// the model is sensitive; NaN when no run was made)
     pub true_score: f64,
+    /// the estimate at `run_load` over the true error there, the held-out check of the
+    /// estimate itself (NaN when no run was made)
+    pub held_out_effectivity: f64,
+    /// the method the candidates' estimates were made with
+    pub method: EstimateMethod,
 }
 
 /// What the greedy loop did: written under `/training` in the basis file.
@@ -63,6 +71,9 @@ pub struct GreedyRecord {
     pub converged: bool,
     /// full runs made, the held-out check included
     pub full_runs: usize,
+    /// the estimate training ended with (`corrected`, or `enriched` when a held-out check
+    /// found the correction off)
+    pub method: EstimateMethod,
 }
 
 impl GreedyRecord {
@@ -118,6 +129,8 @@ pub fn write_training(f: &hdf5::File, r: &GreedyRecord) -> hdf5::Result<()> {
     g.new_dataset_builder().with_data(&table(&|i| &i.whole_run_estimates)).create("whole_run_estimates")?;
     g.new_dataset_builder().with_data(&table(&|i| &i.sensitivity)).create("sensitivity")?;
     g.new_dataset_builder().with_data(&col(&|i| i.true_score)).create("true_score")?;
+    g.new_dataset_builder().with_data(&col(&|i| i.held_out_effectivity)).create("held_out_effectivity")?;
+    attr_str(&g, "estimate_method", r.method.name())?;
     attr_str(&g, "method", "greedy")?;
     attr_u64(&g, "iterations", ni as u64)?;
     attr_u64(&g, "max_runs", r.max_runs as u64)?;

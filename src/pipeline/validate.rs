@@ -4,7 +4,7 @@
 //!     rel_error = ‖X_rom − X_full‖_F / ‖X_full‖_F      (all coordinates, all instants)
 //!     max_probe_error = max_{probe, k} |r_rom(t_k) − r_full(t_k)|
 //!     max_constraint_violation = max_k ‖B x_rom(t_k) − b‖∞
-//!     error_estimate = c ‖X_r − X_{r+k}‖_F / ‖X_{r+k}‖_F   (no full run: super::estimate)
+//!     error_estimate = c ‖X_r − X_{r+k}‖_F / ‖X_{r+k}‖_F   (no full run: crate::rom::estimator)
 //!     effectivity = error_estimate / rel_error               (≥ 1: the estimate bounds the error)
 //!     sensitivity = ‖X_full(1.001 λ) − X_full(λ)‖_F / ‖X_full(λ)‖_F
 //!     rel_error_by_time[i] = rel_error over t ≤ the end of fifth i + 1 of the run
@@ -14,13 +14,14 @@
 //! `sensitivity` puts the error in context: how much the full model's own answer moves for
 //! a 0.1 % change of the load.
 
-use super::estimate::{is_extrapolated, rel_error_by_time, EstimatingRunner, TrustInfo};
-use super::online::{Output, ReducedRun};
 use crate::error::Result;
 use crate::linalg::kkt::LinearSolverKind;
 use crate::model::Model;
-use crate::reduction::Basis;
+use crate::rom::estimator::norms::{distance_and_norm, rel_error_by_time};
+use crate::rom::estimator::Estimate;
+use crate::rom::{Output, ReducedRun, Rom};
 use crate::simulate::{simulate, FullModel, Overrides, SimulationResult};
+use crate::solver::model::Parameters;
 use crate::solver::model::ParametricModel;
 
 /// The fixed keys of `validate --json`.
@@ -90,7 +91,7 @@ pub fn compare(
     variant: &str,
 ) -> Validation {
     let r = &rom.result;
-    let (diff, norm) = super::estimate::distance_and_norm(&r.q, &full.q);
+    let (diff, norm) = distance_and_norm(&r.q, &full.q);
     let (mut pe, mut pe_name, mut pe_t) = (0.0_f64, String::new(), 0.0);
     for ((name, a), (_, b)) in full.probes.iter().zip(&r.probes) {
         for k in 0..a.nrows() {
@@ -144,7 +145,7 @@ pub fn compare(
         extrapolated: false,
         training_range: None,
         sensitivity: None,
-        rel_error_by_time: rel_error_by_time(&r.q, &full.q),
+        rel_error_by_time: rel_error_by_time(&r.q, &full.q).to_vec(),
         error_estimate_by_time: None,
     }
     .with_timings(full.wall_seconds, r.wall_seconds)
@@ -198,8 +199,9 @@ impl Validation {
         self
     }
 
-    /// Adds the estimate and the extrapolation flag of a run.
-    pub fn with_trust(mut self, estimate: Option<&super::estimate::Estimate>, trust: Option<&TrustInfo>) -> Self {
+    /// Adds the estimate and, for a reduced model read from its basis file, the
+    /// extrapolation flag and training range of a run.
+    pub fn with_trust(mut self, estimate: Option<&Estimate>, rom: Option<&Rom>) -> Self {
         if let Some(e) = estimate {
             self.error_estimate = Some(e.error_estimate);
             self.effectivity = Some(e.error_estimate / self.rel_error);
@@ -207,33 +209,20 @@ impl Validation {
             self.estimate_seconds = Some(e.seconds);
             self.error_estimate_by_time = Some(e.by_time.to_vec());
         }
-        if let Some(t) = trust {
-            self.extrapolated = is_extrapolated(t.range, self.load_scale);
+        if let Some(t) = rom.and_then(|r| r.trust()) {
+            self.extrapolated = crate::rom::trust::is_extrapolated(t.range, self.load_scale);
             self.training_range = Some([t.range.0, t.range.1]);
         }
         self
     }
 }
 
-/// Runs full (banded, and dense LU when `with_dense`) and reduced at `load_scale`.
-pub fn validate(
-    model: &Model,
-    basis: &Basis,
-    load_scale: f64,
-    with_dense: bool,
-) -> Result<(Validation, SimulationResult, ReducedRun)> {
-    validate_with(model, basis, None, load_scale, with_dense)
-}
-
-/// [`validate`] with the basis's estimator, training range and tolerance (`trust`), and the
-/// full model's sensitivity (one more full run at 1.001 λ).
-pub fn validate_with(
-    model: &Model,
-    basis: &Basis,
-    trust: Option<&TrustInfo>,
-    load_scale: f64,
-    with_dense: bool,
-) -> Result<(Validation, SimulationResult, ReducedRun)> {
+/// Runs full (banded, and dense LU when `with_dense`) and reduced at `load_scale`, with the
+/// reduced model's estimate (when it has an estimator), its training range (when read from
+/// a basis file), and the full model's sensitivity (one more full run at 1.001 λ).
+pub fn validate(rom: &Rom, load_scale: f64, with_dense: bool) -> Result<(Validation, SimulationResult, ReducedRun)> {
+    let (model, basis) = (&**rom.model(), &**rom.basis());
+    let mu = Parameters::new(load_scale);
     let o = Overrides { load_scale: Some(load_scale), ..Default::default() };
     let stage = |what: &'static str| move |e: crate::Error| e.at_stage(what, load_scale);
     // the full model assembled once for the run at λ and the sensitivity run at 1.001 λ
@@ -251,21 +240,20 @@ pub fn validate_with(
     let nearby = full_model
         .simulate(&Overrides { load_scale: Some(1.001 * load_scale), ..o })
         .map_err(stage("validate (full run at 1.001 λ)"))?;
-    let mut runner = EstimatingRunner::new(model, basis, trust.and_then(|t| t.estimator.as_ref()))?;
-    let (rom, estimate) = runner.run(load_scale, Output::Full).map_err(stage("validate (reduced run)"))?;
+    let (run, estimate) = rom.solve_and_estimate(&mu, Output::Full, &[]).map_err(stage("validate (reduced run)"))?;
     // the time loops again, interleaved, for the medians that `speedup` compares
-    let (mut full_times, mut rom_times) = (vec![full.wall_seconds], vec![rom.result.wall_seconds]);
+    let (mut full_times, mut rom_times) = (vec![full.wall_seconds], vec![run.result.wall_seconds]);
     while repeat_timing(&full_times, &rom_times) {
         full_times.push(full_model.simulate(&o).map_err(stage("validate (full run)"))?.wall_seconds);
-        let again = runner.reduced().run(load_scale, Output::Full, &[]).map_err(stage("validate (reduced run)"))?;
+        let again = rom.solve_with(&mu, Output::Full, &[]).map_err(stage("validate (reduced run)"))?;
         rom_times.push(again.result.wall_seconds);
     }
-    let mut v = compare(model, &full, &rom, dense, basis.n_reduced(), basis.variant.name())
-        .with_trust(estimate.as_ref(), trust)
+    let mut v = compare(model, &full, &run, dense, basis.n_reduced(), basis.variant.name())
+        .with_trust(estimate.as_ref(), Some(rom))
         .with_timings(median(&mut full_times), median(&mut rom_times));
-    let (distance, norm) = super::estimate::distance_and_norm(&nearby.q, &full.q);
+    let (distance, norm) = distance_and_norm(&nearby.q, &full.q);
     v.sensitivity = Some(distance / norm);
-    Ok((v, full, rom))
+    Ok((v, full, run))
 }
 
 impl Validation {

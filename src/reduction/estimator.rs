@@ -6,12 +6,18 @@
 //!     error_estimate = c · ‖X_r − X_{r+k}‖_F / ‖X_{r+k}‖_F
 //! ```
 //!
-//! How it is built, calibrated and run is `crate::pipeline::estimate`'s.
+//! How it is built, calibrated and run is `crate::rom::estimator`'s.
 
 use super::basis::Basis;
 
-/// `c` without calibration data (the issue's probe: 1.5 covered every test load on both
-/// benchmark models with effectivity 1.1–1.5).
+/// Estimates and errors are reported over the instants up to the end of each fifth of the
+/// run (how the error grows in time; the last entry is the whole run's).
+pub const FIFTHS: usize = 5;
+/// One value per fifth of the run ([`FIFTHS`]).
+pub type ByFifth = [f64; FIFTHS];
+
+/// `c` without calibration data (1.5 covered every test load on both benchmark models with
+/// effectivity 1.1–1.5 when the estimate was first probed, docs/error-estimate.md).
 pub const DEFAULT_FACTOR: f64 = 1.5;
 
 /// What the basis file stores under `/estimator`.
@@ -29,9 +35,9 @@ pub struct Estimator {
     /// load (greedy training: [`DefectsCalibration`]); `None`: the defect sum is used as
     /// the bound it is where the dynamics do not amplify differences
     pub defects: Option<DefectsCalibration>,
-    /// how a run computes the estimate (not stored in the basis file: a run-time choice,
-    /// `[online] estimate` in the pipeline or `--estimate`)
-    pub method: EstimateMethod,
+    /// the method training chose for this basis's online estimates (the basis file's
+    /// `/estimator@default_method`); `None`: the rule of [`Estimator::default_method`]
+    pub method: Option<EstimateMethod>,
 }
 
 /// How the cheap `defects` estimate is put on the scale of the `corrected` one: at the
@@ -61,21 +67,21 @@ pub struct DefectsCalibration {
     /// the candidate loads, ascending
     pub load_scales: Vec<f64>,
     /// `ρ_ji` (loads × 5); NaN where either estimate was not finite and positive
-    pub ratios: Vec<[f64; 5]>,
+    pub ratios: Vec<ByFifth>,
     /// the largest ratio of each fifth
-    pub factors: [f64; 5],
+    pub factors: ByFifth,
     /// the leave-one-out check passed
     pub reliable: bool,
 }
 
 /// The share of interior candidates whose left-out ratio must be predicted well enough
-/// (the issue's coverage target for the estimate, 90 %).
+/// (the coverage the estimate is held to per fifth of the run, 90 %).
 pub const DEFECTS_RELIABLE_SHARE: f64 = 0.9;
 
 impl DefectsCalibration {
     /// From the ratios at the candidates; `None` when some fifth has no usable ratio.
-    pub fn new(load_scales: Vec<f64>, ratios: Vec<[f64; 5]>) -> Option<Self> {
-        let mut factors = [0.0_f64; 5];
+    pub fn new(load_scales: Vec<f64>, ratios: Vec<ByFifth>) -> Option<Self> {
+        let mut factors = [0.0_f64; FIFTHS];
         for (i, f) in factors.iter_mut().enumerate() {
             *f = ratios.iter().map(|r| r[i]).filter(|x| usable(*x)).fold(f64::NAN, f64::max);
             if !f.is_finite() {
@@ -87,7 +93,7 @@ impl DefectsCalibration {
     }
 
     /// `f_i(λ)` (the type's documentation).
-    pub fn factors_at(&self, load_scale: f64) -> [f64; 5] {
+    pub fn factors_at(&self, load_scale: f64) -> ByFifth {
         let l = &self.load_scales;
         let j = l.partition_point(|&x| x <= load_scale);
         if l.len() < 2 || j == 0 || (j == l.len() && l[j - 1] != load_scale) {
@@ -117,12 +123,12 @@ fn usable(x: f64) -> bool {
 }
 
 /// The leave-one-out check of [`DefectsCalibration`]: false with fewer than three loads.
-fn leave_one_out(ratios: &[[f64; 5]]) -> bool {
+fn leave_one_out(ratios: &[ByFifth]) -> bool {
     let n = ratios.len();
     if n < 3 {
         return false;
     }
-    (0..5).all(|i| {
+    (0..FIFTHS).all(|i| {
         let passed = (1..n - 1)
             .filter(|&j| {
                 let (a, b, own) = (ratios[j - 1][i], ratios[j + 1][i], ratios[j][i]);
@@ -134,9 +140,13 @@ fn leave_one_out(ratios: &[[f64; 5]]) -> bool {
 }
 
 impl Estimator {
-    /// The online method when the pipeline names none: `defects` where greedy training
-    /// calibrated it and the calibration passed its check, else `corrected`.
+    /// The online method when the pipeline names none: the one training chose, else
+    /// `defects` where greedy training calibrated it and the calibration passed its check,
+    /// else `corrected`.
     pub fn default_method(&self) -> EstimateMethod {
+        if let Some(m) = self.method {
+            return m;
+        }
         if self.defects.as_ref().is_some_and(|d| d.reliable) {
             EstimateMethod::Defects
         } else {
@@ -172,8 +182,8 @@ impl Default for Calibration {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum EstimateMethod {
-    /// one modified-Newton iteration of the enriched model per step, from the reduced
-    /// run's increments (`pipeline::estimate_corrected`); ≈ 1.5× the error at 45–130 % of
+    /// one Newton iteration of the enriched model per step, from the reduced run's
+    /// increments (`rom::estimator::corrected`); ≈ 1.5× the error at 45–130 % of
     /// the reduced run; what training (greedy steering, calibration) uses, so that an
     /// online estimate reads on the scale of the training tolerance. The default online
     /// estimate unless greedy training calibrated `Defects` reliably (`DefectsCalibration`)
@@ -182,7 +192,7 @@ pub enum EstimateMethod {
     /// the enriched model integrated on its own to convergence (about 2× the reduced run)
     Enriched,
     /// the cheap method: the reduced run's local defects against the enriched model at
-    /// every 10th step, summed (`pipeline::estimate_defects`), 7–16 % of the reduced run.
+    /// every 10th step, summed (`rom::estimator::defects`), 7–16 % of the reduced run.
     /// Uncalibrated a loose bound (1.2–46× the error measured); calibrated by greedy training
     /// ([`DefectsCalibration`]) the corrected estimate's reading at its candidates, and
     /// then the online default where its leave-one-out check passed (docs/error-estimate.md)

@@ -12,9 +12,9 @@
 //! ```
 //!
 //! The force takes the element route (4 ne r flops per element and invariant); the tangent
-//! takes the `Gₑⱼ` route (r² instead of the 16 r² of `Vₑᵀ Kₑ Vₑ`), as the issue's
-//! `G_e = Φ_eᵀ S_l Φ_e` suggests. Each element keeps only the columns of `V` it sees, as at
-//! most two runs (unreduced joint coordinates are unit columns that touch one or two
+//! takes the `Gₑⱼ` route (r² instead of the 16 r² of `Vₑᵀ Kₑ Vₑ`), `G_e = Φ_eᵀ S_l Φ_e`.
+//! Each element keeps only the columns of `V` it sees, as at most two runs (unreduced
+//! joint coordinates are unit columns that touch one or two
 //! elements; a block basis gives an element its own block's modes) and the 4 × 4 blocks of
 //! the upper block triangle of `Gₑⱼ` on them; elements on the same columns are grouped, and
 //! the tangent is summed over a group block by block in registers (sampled.rs): on the

@@ -63,6 +63,18 @@ struct Failure {
     residual: f64,
 }
 
+/// The constants of one step of size `h`: `β' = (1 − α_m)/(β h² (1 − α_f))`, `γ' = γ/(β h)`,
+/// the iteration matrix's coefficients `M + (γ'/β') C + K/β'` and `c = (1 − α_f)/(1 − α_m)`
+/// (`a_{n+1} = a₀ + c q̈_{n+1}`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepConstants {
+    pub h: f64,
+    pub beta_p: f64,
+    pub gamma_p: f64,
+    pub c: f64,
+    pub coef: IterationCoefficients,
+}
+
 pub struct GeneralizedAlpha {
     params: IntegratorParams,
     alpha_m: f64,
@@ -101,6 +113,107 @@ impl GeneralizedAlpha {
 
     pub fn params(&self) -> &IntegratorParams {
         &self.params
+    }
+
+    /// [`StepConstants`] of a step of `h`.
+    pub fn step_constants(&self, h: f64) -> StepConstants {
+        let (am, af, g, b) = (self.alpha_m, self.alpha_f, self.gamma, self.beta);
+        let beta_p = (1.0 - am) / (b * h * h * (1.0 - af));
+        let gamma_p = g / (b * h);
+        let coef = IterationCoefficients { mass: 1.0, damping: gamma_p / beta_p, stiffness: 1.0 / beta_p };
+        StepConstants { h, beta_p, gamma_p, c: (1.0 - af) / (1.0 - am), coef }
+    }
+
+    /// Starts the step of coordinate `i`: `a₀ = (α_f q̈_n − α_m a_n)/(1 − α_m)`, the part of
+    /// `a_{n+1}` that does not depend on `q̈_{n+1}` (kept in `a` while Newton runs; `c q̈_{n+1}` is
+    /// added at convergence, [`Self::finish_step`]), and the `q̈_{n+1}` that puts the increment
+    /// at `d` (`None`: `q̈_{n+1} = 0`), with `q̇_{n+1}` from it. Returns the increment the
+    /// scheme's update gives, `Δq₀ + h²βc q̈_{n+1}` (`d` to round-off); `q` is not moved.
+    #[inline]
+    fn start_coordinate(&self, st: &mut State, i: usize, k: &StepConstants, d: Option<f64>) -> f64 {
+        let (am, af, g, b, h, c) = (self.alpha_m, self.alpha_f, self.gamma, self.beta, k.h, k.c);
+        let a0 = (af * st.qdd[i] - am * st.a[i]) / (1.0 - am);
+        let dq0 = h * st.v[i] + h * h * ((0.5 - b) * st.a[i] + b * a0);
+        let qdd = d.map_or(0.0, |d| (d - dq0) / (h * h * b * c));
+        st.v[i] += h * ((1.0 - g) * st.a[i] + g * (a0 + c * qdd));
+        st.a[i] = a0;
+        st.qdd[i] = qdd;
+        dq0 + h * h * b * c * qdd
+    }
+
+    /// Starts the step to `t + h` at the increment `d` exactly (`q ← q + d`), with `q̇`, `q̈`
+    /// and `a` as the scheme has them for that increment: the state from which
+    /// [`Self::correction`] measures how far `d` is from the step's solution (the error
+    /// estimator lifts a reduced run's step into a richer model this way). `st.t` is not
+    /// moved.
+    pub fn start_step_at(&self, st: &mut State, k: &StepConstants, d: &[f64]) {
+        for (i, &di) in d.iter().enumerate() {
+            self.start_coordinate(st, i, k, Some(di));
+            st.q[i] += di;
+        }
+    }
+
+    /// Ends a step whose Newton iterations are done: `a_{n+1} = a₀ + c q̈_{n+1}`. `st.t` is
+    /// not moved.
+    pub fn finish_step(&self, st: &mut State, k: &StepConstants) {
+        for (a, qdd) in st.a.iter_mut().zip(&st.qdd) {
+            *a += k.c * qdd;
+        }
+    }
+
+    /// The residual of the equations of motion at `st` and time `t`, `r_q = M q̈ + g + Bᵀλ`,
+    /// into `rhs[..n]` (`work`: n entries).
+    pub fn residual<M: DynamicModel>(model: &mut M, st: &State, t: f64, rhs: &mut [f64], work: &mut [f64]) {
+        let n = st.q.len();
+        model.force_and_inertia(&st.q, &st.v, &st.qdd, t, &mut rhs[..n], work);
+        for i in 0..n {
+            rhs[i] += work[i];
+        }
+        model.add_constraint_force(&st.lambda, &mut rhs[..n]);
+    }
+
+    /// One Newton correction from the residual [`Self::residual`] left in `rhs[..n]`, with the
+    /// model's current factorization of scale `s`: the rows scaled as the iteration matrix
+    /// is (momentum by `1/β'`, constraints by `s`),
+    ///
+    /// ```text
+    ///     [S, Bᵀ; B, 0] [Δq; Δμ] = −[r_q / β'; s (B q − b)]        (rhs ← [Δq; Δμ])
+    /// ```
+    ///
+    /// and, with `apply`, the update of [`Self::apply_correction`]. Returns `‖Δq‖∞` (NaN
+    /// kept: `f64::max` would pass it by and call a NaN increment converged).
+    pub fn correction<M: DynamicModel>(
+        model: &mut M,
+        st: &mut State,
+        k: &StepConstants,
+        s: f64,
+        rhs: &mut [f64],
+        apply: bool,
+    ) -> std::result::Result<f64, String> {
+        let n = st.q.len();
+        let (rq, rc) = rhs.split_at_mut(n);
+        rq.iter_mut().for_each(|x| *x *= -1.0 / k.beta_p);
+        model.constraint_residual(&st.q, rc);
+        rc.iter_mut().for_each(|x| *x *= -s);
+        model.solve(rhs)?;
+        if apply {
+            Self::apply_correction(st, k, s, rhs);
+        }
+        Ok(max_abs(&rhs[..n]))
+    }
+
+    /// The Newton update from a solved correction `rhs = [Δq; Δμ]` ([`Self::correction`]):
+    /// `q += Δq`, `q̇ += γ'Δq`, `q̈ += β'Δq`, `λ += β' s Δμ`.
+    pub fn apply_correction(st: &mut State, k: &StepConstants, s: f64, rhs: &[f64]) {
+        let (dq, dmu) = rhs.split_at(st.q.len());
+        for (((q, v), a), d) in st.q.iter_mut().zip(&mut st.v).zip(&mut st.qdd).zip(dq) {
+            *q += d;
+            *v += k.gamma_p * d;
+            *a += k.beta_p * d;
+        }
+        for (l, m) in st.lambda.iter_mut().zip(dmu) {
+            *l += k.beta_p * s * m;
+        }
     }
 
     /// Consistent initial accelerations and multipliers from
@@ -200,16 +313,12 @@ impl GeneralizedAlpha {
         policy: JacobianReuse,
         guess: Option<&[f64]>,
     ) -> std::result::Result<(), Failure> {
-        let (am, af, g, b) = (self.alpha_m, self.alpha_f, self.gamma, self.beta);
         let n = model.n_dof();
-        let beta_p = (1.0 - am) / (b * h * h * (1.0 - af));
-        let gamma_p = g / (b * h);
-        let coef = IterationCoefficients { mass: 1.0, damping: gamma_p / beta_p, stiffness: 1.0 / beta_p };
+        let k = self.step_constants(h);
         let t = st.t + h;
         // predictor (super::predictor): with a guessed increment (given, or the predictor's),
-        // the q̈_{n+1} that puts q_{n+1} there (a_{n+1} = a₀ + c q̈_{n+1}, c = (1−α_f)/(1−α_m));
-        // else q̈_{n+1} = 0, and a_{n+1} from the α relation
-        let c = (1.0 - af) / (1.0 - am);
+        // the q̈_{n+1} that puts q_{n+1} there; else q̈_{n+1} = 0, and a_{n+1} from the α
+        // relation (Self::start_coordinate)
         assert!(guess.is_none_or(|d| d.len() == n), "a guessed increment needs {n} entries");
         let predictor = self.params.predictor;
         // ‖guess‖∞, for keeping the first matrix of a good guess (below)
@@ -218,16 +327,8 @@ impl GeneralizedAlpha {
             None => predictor.increment_size(h, &st.v),
         };
         for i in 0..n {
-            // a₀: the part of a_{n+1} that does not depend on q̈_{n+1}; st.a holds it while
-            // Newton runs and gets c q̈_{n+1} added at convergence
-            let a0 = (af * st.qdd[i] - am * st.a[i]) / (1.0 - am);
-            let dq0 = h * st.v[i] + h * h * ((0.5 - b) * st.a[i] + b * a0);
             let d = guess.map_or_else(|| predictor.increment(h, st.v[i]), |d| Some(d[i]));
-            let qdd = d.map_or(0.0, |d| (d - dq0) / (h * h * b * c));
-            st.q[i] += dq0 + h * h * b * c * qdd;
-            st.v[i] += h * ((1.0 - g) * st.a[i] + g * (a0 + c * qdd));
-            st.a[i] = a0;
-            st.qdd[i] = qdd;
+            st.q[i] += self.start_coordinate(st, i, &k, d);
         }
         if policy != JacobianReuse::AcrossSteps {
             self.factored = None;
@@ -239,12 +340,7 @@ impl GeneralizedAlpha {
         let mut residual = f64::NAN;
         for it in 1..=self.params.max_iterations {
             self.stats.newton_iterations += 1;
-            // residual r_q = M q̈ + g + Bᵀλ, r_c = B q − b
-            model.force_and_inertia(&st.q, &st.v, &st.qdd, t, &mut self.rhs[..n], &mut self.work);
-            for i in 0..n {
-                self.rhs[i] += self.work[i];
-            }
-            model.add_constraint_force(&st.lambda, &mut self.rhs[..n]);
+            Self::residual(model, st, t, &mut self.rhs, &mut self.work);
             residual = max_abs(&self.rhs[..n]);
             if !residual.is_finite() {
                 return Err(Failure { iterations: it, increment: last_increment, residual });
@@ -253,7 +349,7 @@ impl GeneralizedAlpha {
             let s = if reuse {
                 self.factored.expect("checked").1
             } else {
-                let s = model.factor(&st.q, &st.v, t, coef).map_err(|_| Failure {
+                let s = model.factor(&st.q, &st.v, t, k.coef).map_err(|_| Failure {
                     iterations: it,
                     increment: last_increment,
                     residual,
@@ -262,21 +358,11 @@ impl GeneralizedAlpha {
                 self.factored = Some((h, s));
                 s
             };
-            let (rq, rc) = self.rhs.split_at_mut(n);
-            rq.iter_mut().for_each(|x| *x *= -1.0 / beta_p);
-            model.constraint_residual(&st.q, rc);
-            rc.iter_mut().for_each(|x| *x *= -s);
-            model.solve(&mut self.rhs).map_err(|_| Failure { iterations: it, increment: last_increment, residual })?;
-            let (dq, dmu) = self.rhs.split_at(n);
-            for (((q, v), a), d) in st.q.iter_mut().zip(&mut st.v).zip(&mut st.qdd).zip(dq) {
-                *q += d;
-                *v += gamma_p * d;
-                *a += beta_p * d;
-            }
-            let inc = max_abs(dq);
-            for (l, m) in st.lambda.iter_mut().zip(dmu) {
-                *l += beta_p * s * m;
-            }
+            let inc = Self::correction(model, st, &k, s, &mut self.rhs, true).map_err(|_| Failure {
+                iterations: it,
+                increment: last_increment,
+                residual,
+            })?;
             if !inc.is_finite() {
                 return Err(Failure { iterations: it, increment: inc, residual });
             }
@@ -296,9 +382,7 @@ impl GeneralizedAlpha {
             let stagnated = !converged && judged_fresh && it > 3 && theta > 0.5 && inc <= floor;
             if converged || stagnated {
                 self.stats.steps_at_round_off += stagnated as usize;
-                for i in 0..n {
-                    st.a[i] += (1.0 - af) / (1.0 - am) * st.qdd[i];
-                }
+                self.finish_step(st, &k);
                 st.t = t;
                 self.stats.max_iterations_in_a_step = self.stats.max_iterations_in_a_step.max(it);
                 return Ok(());

@@ -1,4 +1,4 @@
-//! File-system helpers of the atomic writes: path checks (a final path must name an entry
+//! File-system functions of the atomic writes: path checks (a final path must name an entry
 //! and be replaceable), symlinks followed, and `fsync` of files, folders and trees.
 
 use crate::error::{Error, Result};

@@ -151,11 +151,14 @@ pub struct HyperSpec {
 }
 
 /// `[online]`: the load scales of `sweep` and `run`, and the tolerance every reduced run's
-/// error estimate is held to (a warning, or exit code 4 with `--strict`, above it).
+/// error estimate is held to (a warning, or exit code 4 with `--strict`, above it). Every
+/// key is optional: `estimate` or `tolerance` may be set without a load list.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OnlineSpec {
-    pub load_scales: Scales,
+    /// default: the training loads (greedy: the ends and the middle of its range)
+    #[serde(default)]
+    pub load_scales: Option<Scales>,
     #[serde(default)]
     pub tolerance: Option<f64>,
     /// how every reduced run computes its error estimate: "defects" (cheap; the default where

@@ -2,22 +2,26 @@
 //! model's sensitivity by fifth of the run (reduced runs in parallel), and the score of a
 //! candidate that the loop holds to the tolerance (the greedy module documentation).
 
+use crate::error::Result;
 use crate::model::Model;
-use crate::pipeline::estimate::{raw_estimate_by_time, EstimatingRunner, Estimator};
-use crate::pipeline::estimate_defects::DefectRunner;
-use crate::pipeline::online::Output;
-use crate::reduction::estimator::DefectsCalibration;
 use crate::reduction::Basis;
+use crate::rom::estimator::corrected::CorrectedRunner;
+use crate::rom::estimator::defects::Defects;
+use crate::rom::estimator::norms::raw_estimate_by_time;
+use crate::rom::estimator::{self, ByFifth, DefectsCalibration, ErrorEstimator, EstimateMethod, Estimator, FIFTHS};
+use crate::rom::{Output, Rom};
+use crate::solver::model::Parameters;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
+use std::sync::Arc;
 
-/// δ of the sensitivity `s(λ) = ‖X_r(λ(1 + δ)) − X_r(λ)‖ / ‖X_r(λ)‖` (the issue's
-/// definition of `sensitivity`, 0.1 %).
+/// δ of the sensitivity `s(λ) = ‖X_r(λ(1 + δ)) − X_r(λ)‖ / ‖X_r(λ)‖`: how much the answer
+/// moves for a 0.1 % change of the load (the `sensitivity` `validate` reports).
 pub const SENSITIVITY_STEP: f64 = 1e-3;
 
 /// The score of one candidate (the greedy module documentation): `T · max_i η_i / max(T, s_i)`; NaN
 /// counts as ∞.
-pub fn score(tolerance: f64, estimate_by_time: &[f64; 5], sensitivity_by_time: &[f64; 5]) -> f64 {
+pub fn score(tolerance: f64, estimate_by_time: &ByFifth, sensitivity_by_time: &ByFifth) -> f64 {
     let mut worst = 0.0_f64;
     for (&e, &s) in estimate_by_time.iter().zip(sensitivity_by_time) {
         let e = if e.is_nan() { f64::INFINITY } else { e };
@@ -31,11 +35,20 @@ pub fn score(tolerance: f64, estimate_by_time: &[f64; 5], sensitivity_by_time: &
 #[derive(Clone, Copy)]
 pub(super) struct CandidateRun {
     /// the error estimate by fifth of the run (the last: the whole run's)
-    pub(super) by_time: [f64; 5],
+    pub(super) by_time: ByFifth,
     /// the whole run's raw estimate
     pub(super) raw: f64,
     /// the reduced model's sensitivity by fifth of the run (the greedy module documentation)
-    pub(super) sensitivity: [f64; 5],
+    pub(super) sensitivity: ByFifth,
+}
+
+/// The reduced model training steers by: `basis` with the estimator of `est` by `method`
+/// (`corrected`, or `enriched` once a held-out check found the correction off; the enriched
+/// model also where the correction cannot run), the method `c` is calibrated for.
+pub(super) fn training_rom(model: &Arc<Model>, basis: &Basis, est: &Estimator, method: EstimateMethod) -> Result<Rom> {
+    let (basis, data) = (Arc::new(basis.clone()), Arc::new(est.clone()));
+    let e = estimator::build(method, model, &basis, &data)?;
+    Rom::new(model, &basis, Some(e), None)
 }
 
 /// The seam to the error estimator: the estimate and the reduced model's sensitivity of
@@ -43,11 +56,12 @@ pub(super) struct CandidateRun {
 /// per worker, as `sweep` does); a run that fails gives ∞ estimates (and sensitivity 0,
 /// which holds its estimate to T).
 pub(super) fn estimate_candidates(
-    model: &Model,
+    model: &Arc<Model>,
     basis: &Basis,
     est: &Estimator,
     loads: &[f64],
     label: &str,
+    method: EstimateMethod,
 ) -> Vec<CandidateRun> {
     let target =
         if crate::output::show_progress() { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() };
@@ -58,61 +72,102 @@ pub(super) fn estimate_candidates(
             .progress_chars("=> "),
     );
     bar.set_prefix(label.to_string());
-    let failed = CandidateRun { by_time: [f64::INFINITY; 5], raw: f64::INFINITY, sensitivity: [0.0; 5] };
+    let Ok(rom) = training_rom(model, basis, est, method) else { return vec![FAILED; loads.len()] };
     let out: Vec<CandidateRun> = loads
         .par_iter()
-        .map_init(
-            || EstimatingRunner::new(model, basis, Some(est)).ok(),
-            |runner, &x| {
-                let r = match runner {
-                    Some(r) => match r.run(x, Output::ReducedAndProbes) {
-                        Ok((run, Some(e))) => {
-                            // the same reduced model at λ(1 + δ): how much its answer moves
-                            let sensitivity =
-                                match r.reduced().run(x * (1.0 + SENSITIVITY_STEP), Output::ReducedAndProbes, &[]) {
-                                    Ok(moved) => raw_estimate_by_time(basis, basis, &moved.reduced_q, &run.reduced_q),
-                                    Err(_) => [0.0; 5],
-                                };
-                            CandidateRun { by_time: e.by_time, raw: e.raw, sensitivity }
-                        }
-                        _ => failed,
-                    },
-                    None => failed,
-                };
-                bar.inc(1);
-                r
-            },
-        )
+        .map(|&x| {
+            let r = candidate_run(&rom, x);
+            bar.inc(1);
+            r
+        })
         .collect();
     bar.finish_and_clear();
     out
 }
 
-/// The `defects` method's calibration (`DefectsCalibration`) of the final basis: at every
-/// candidate one reduced run, its corrected estimate (the estimator's calibration `c`
-/// included) and its raw defect sum, fifth by fifth, reduced runs in parallel. `None` when
-/// the estimator has no defects runner or some fifth has no usable ratio.
-pub(super) fn calibrate_defects(
-    model: &Model,
+/// What a candidate whose reduced run fails counts as.
+const FAILED: CandidateRun =
+    CandidateRun { by_time: [f64::INFINITY; FIFTHS], raw: f64::INFINITY, sensitivity: [0.0; FIFTHS] };
+
+/// One candidate: the reduced run at `x` with its estimate, and the run at `x(1 + δ)`.
+fn candidate_run(rom: &Rom, x: f64) -> CandidateRun {
+    let mu = Parameters::new(x);
+    match rom.solve_and_estimate(&mu, Output::ReducedAndProbes, &[]) {
+        Ok((run, Some(e))) => {
+            // the same reduced model at λ(1 + δ): how much its answer moves
+            let moved = Parameters::new(x * (1.0 + SENSITIVITY_STEP));
+            let basis = rom.basis();
+            let sensitivity = match rom.solve_with(&moved, Output::ReducedAndProbes, &[]) {
+                Ok(moved) => raw_estimate_by_time(basis, basis, &moved.reduced_q, &run.reduced_q),
+                Err(_) => [0.0; FIFTHS],
+            };
+            CandidateRun { by_time: e.by_time, raw: e.raw, sensitivity }
+        }
+        _ => FAILED,
+    }
+}
+
+/// [`estimate_candidates`] in the order `order`, a few at a time (as many as there are
+/// worker threads), stopping as soon as one candidate's score is above `tolerance`: such a
+/// rung cannot meet the tolerance, whatever the others read, so a rung that fails is
+/// rejected after a few reduced runs instead of all of them. The candidates not run are
+/// `None`.
+pub(super) fn screen_candidates(
+    model: &Arc<Model>,
     basis: &Basis,
     est: &Estimator,
     loads: &[f64],
+    order: &[usize],
+    method: EstimateMethod,
+    tolerance: f64,
+) -> Vec<Option<CandidateRun>> {
+    let mut out = vec![None; loads.len()];
+    let Ok(rom) = training_rom(model, basis, est, method) else {
+        // like a failed run at every candidate: one is enough to reject
+        out[order[0]] = Some(FAILED);
+        return out;
+    };
+    let chunk = rayon::current_num_threads().max(1);
+    for part in order.chunks(chunk) {
+        let runs: Vec<CandidateRun> = part.par_iter().map(|&i| candidate_run(&rom, loads[i])).collect();
+        let over = runs.iter().any(|r| !(score(tolerance, &r.by_time, &r.sensitivity) <= tolerance));
+        for (&i, r) in part.iter().zip(runs) {
+            out[i] = Some(r);
+        }
+        if over {
+            break;
+        }
+    }
+    out
+}
+
+/// The `defects` method's calibration (`DefectsCalibration`) of the final basis: at every
+/// candidate one reduced run, its estimate by the training's `method` (the estimator's
+/// calibration `c` included) and its raw defect sum, fifth by fifth, reduced runs in
+/// parallel. `None` when the estimator has no defects runner or some fifth has no usable
+/// ratio.
+pub(super) fn calibrate_defects(
+    model: &Arc<Model>,
+    basis: &Basis,
+    est: &Estimator,
+    loads: &[f64],
+    method: EstimateMethod,
 ) -> Option<DefectsCalibration> {
-    let ratios: Vec<[f64; 5]> = loads
+    let rom = training_rom(model, basis, est, method).ok()?;
+    let defects = match CorrectedRunner::supports(model, basis, &est.enriched) {
+        Ok(true) => Defects::new(model, rom.basis(), &Arc::new(est.clone())).ok(),
+        _ => None,
+    };
+    let ratios: Vec<ByFifth> = loads
         .par_iter()
-        .map_init(
-            || {
-                let corrected = EstimatingRunner::new(model, basis, Some(est)).ok();
-                let defects = DefectRunner::new(model, basis, &est.enriched).ok().flatten();
-                (corrected, defects)
-            },
-            |(corrected, defects), &x| {
-                let (Some(c), Some(d)) = (corrected, defects) else { return [f64::NAN; 5] };
-                let Ok((run, Some(e))) = c.run(x, Output::ReducedAndProbes) else { return [f64::NAN; 5] };
-                let Ok(raw) = d.raw_by_time(&run) else { return [f64::NAN; 5] };
-                std::array::from_fn(|i| e.by_time[i] / raw[i])
-            },
-        )
+        .map(|&x| {
+            let Some(d) = &defects else { return [f64::NAN; FIFTHS] };
+            let Ok((run, Some(e))) = rom.solve_and_estimate(&Parameters::new(x), Output::ReducedAndProbes, &[]) else {
+                return [f64::NAN; FIFTHS];
+            };
+            let Ok(raw) = d.raw(&run) else { return [f64::NAN; FIFTHS] };
+            std::array::from_fn(|i| e.by_time[i] / raw[i])
+        })
         .collect();
     DefectsCalibration::new(loads.to_vec(), ratios)
 }

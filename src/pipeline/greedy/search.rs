@@ -3,14 +3,15 @@
 //! then the loosest τ whose estimates still meet T between the candidates
 //! ([`Level::between_candidates`]); each rung a `Level`.
 
-use super::candidates::{estimate_candidates, score};
+use super::candidates::{estimate_candidates, score, screen_candidates, CandidateRun};
 use crate::error::{Error, Result};
 use crate::io::basis_file::TrainingData;
 use crate::pipeline::basis_build::build_basis;
 use crate::pipeline::config::{GreedySpec, Pipeline};
-use crate::pipeline::estimate::{calibrate, CalibrationPoint, Estimator, DEFAULT_EXTRA_MODES};
 use crate::pipeline::training_record::modes_text;
 use crate::reduction::{ModeRule, Trained};
+use crate::rom::estimator::training::{calibrate, CalibrationPoint, Estimator};
+use crate::rom::estimator::{ByFifth, EstimateMethod, FIFTHS};
 
 /// Energy tolerances ε tried, loose to tight: 10⁻², 10⁻³, …, 10⁻¹⁰.
 pub const ENERGY_LADDER: [f64; 9] = [1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10];
@@ -29,27 +30,40 @@ pub(super) struct Level {
     pub(super) estimates: Vec<f64>,
     pub(super) whole: Vec<f64>,
     pub(super) raws: Vec<f64>,
-    pub(super) sensitivity: Vec<[f64; 5]>,
-    /// the estimator got its `k` extra modes in every block
+    pub(super) sensitivity: Vec<ByFifth>,
+    /// the estimator's basis is richer than the basis in every block
     fully_enriched: bool,
+    /// which candidates have been run (a screened rung stops at its first score above T:
+    /// [`super::candidates::screen_candidates`])
+    evaluated: Vec<bool>,
 }
 
 impl Level {
-    /// The candidate with the largest estimate and that estimate (NaN counts as ∞).
+    /// The candidate with the largest estimate and that estimate (NaN counts as ∞), among
+    /// the candidates run.
     pub(super) fn worst(&self) -> (usize, f64) {
         self.worst_where(|_| true).expect("at least two candidates")
     }
 
+    /// Every candidate has been run.
+    pub(super) fn complete(&self) -> bool {
+        self.evaluated.iter().all(|&e| e)
+    }
+
     /// What the estimate may reach between the candidates, which are all the loop sees of
-    /// the range: [`between_candidates`] of the scores.
+    /// the range: [`between_candidates`] of the scores (∞ for a rung not run everywhere).
     pub(super) fn between_candidates(&self) -> f64 {
+        if !self.complete() {
+            return f64::INFINITY;
+        }
         between_candidates(&self.estimates)
     }
 
-    /// [`Self::worst`] among the candidates `keep` accepts.
+    /// [`Self::worst`] among the candidates `keep` accepts (and that were run).
     pub(super) fn worst_where(&self, keep: impl Fn(usize) -> bool) -> Option<(usize, f64)> {
         let mut w: Option<(usize, f64)> = None;
-        for (i, &e) in self.estimates.iter().enumerate().filter(|(i, _)| keep(*i)) {
+        let run = |i: usize| self.evaluated[i] && keep(i);
+        for (i, &e) in self.estimates.iter().enumerate().filter(|(i, _)| run(*i)) {
             let e = if e.is_nan() { f64::INFINITY } else { e };
             if w.is_none_or(|w| e > w.1) {
                 w = Some((i, e));
@@ -59,27 +73,58 @@ impl Level {
     }
 }
 
+/// What one iteration of the loop searches with: the pipeline, the snapshots so far, the
+/// candidate loads, the held-out calibration pairs so far, and the iteration's number.
+pub(super) struct Round<'a> {
+    pub(super) p: &'a Pipeline,
+    pub(super) data: &'a TrainingData,
+    pub(super) candidates: &'a [f64],
+    pub(super) points: &'a [CalibrationPoint],
+    pub(super) n: usize,
+    /// the estimate the candidates are read with
+    pub(super) method: EstimateMethod,
+    /// the scores the previous iteration's basis had at the candidates: where a rung is
+    /// screened first
+    pub(super) prior: Option<&'a [f64]>,
+}
+
+/// The order a rung's candidates are run in: the highest `scores` first (a failed run, NaN,
+/// before all), those without a score after them in their order. A rung that fails fails
+/// first where the rung before it was worst, so screening stops after a few runs.
+fn worst_first(scores: &[f64], evaluated: &[bool]) -> Vec<usize> {
+    let key = |i: usize| {
+        if !evaluated[i] {
+            f64::NEG_INFINITY
+        } else if scores[i].is_nan() {
+            f64::INFINITY
+        } else {
+            scores[i]
+        }
+    };
+    let mut order: Vec<usize> = (0..scores.len()).collect();
+    order.sort_by(|&a, &b| key(b).total_cmp(&key(a)));
+    order
+}
+
 /// The mode and hyper-reduction search of one iteration (the greedy module documentation): the modes
 /// the pipeline gives, or the energy ladder loose → tight with τ = √ε (and a half step
 /// before the first accepted rung); then, unless the pipeline gives τ, the loosest τ that
 /// still meets T with those modes (the fewest sampled elements: the cheapest reduced run).
-pub(super) fn search(
-    p: &Pipeline,
-    g: &GreedySpec,
-    data: &TrainingData,
-    candidates: &[f64],
-    points: &[CalibrationPoint],
-    n: usize,
-    previous_energy: Option<f64>,
-) -> Result<Level> {
+pub(super) fn search(r: &Round, g: &GreedySpec, previous_energy: Option<f64>) -> Result<Level> {
+    let (p, candidates, n) = (r.p, r.candidates, r.n);
     let given_hyper = p.file.reduction.hyper.as_ref().map(|h| h.tolerance);
     let debug = std::env::var_os("FLEXROM_GREEDY_DEBUG").is_some();
     // what the tolerance promises is every load of the range, not the candidates alone
     let accepts = |l: &Level| l.between_candidates() <= g.tolerance;
     let mut last_error: Option<(&'static str, String)> = None;
+    let mut order = match r.prior {
+        Some(s) if s.len() == candidates.len() => worst_first(s, &vec![true; s.len()]),
+        _ => (0..candidates.len()).collect(),
+    };
     let mut attempt = |modes: ModeRule, eps: f64, tau: f64| -> Option<Level> {
-        match level(p, data, candidates, points, modes, eps, Some(tau), n) {
+        match level(r, modes, eps, Some(tau), &order) {
             Ok(l) => {
+                order = worst_first(&l.estimates, &l.evaluated);
                 if debug {
                     let (wi, w) = l.worst();
                     let h = l.trained.basis.hyper.as_ref().map_or(0, |h| h.elements.len());
@@ -155,10 +200,15 @@ pub(super) fn search(
             }
         }
     }
-    best.ok_or_else(|| {
+    let mut best = best.ok_or_else(|| {
         let (f, e) = last_error.unwrap_or(("reduction", "no basis could be built".into()));
         Error::input(&p.path, f, format!("greedy training, iteration {n}: {e}"))
-    })
+    })?;
+    // no rung met T: the one kept was screened, and the loop needs it everywhere
+    if !best.complete() {
+        best.estimate(p, candidates, &format!("iteration {n}"), r.method);
+    }
+    Ok(best)
 }
 
 /// A bound of an estimate between evenly spaced candidate loads from its values `e` at
@@ -190,29 +240,62 @@ pub(crate) fn between_candidates(e: &[f64]) -> f64 {
 }
 
 /// Builds the basis and estimator of one rung and estimates at every candidate.
-#[allow(clippy::too_many_arguments)]
 fn level(
-    p: &Pipeline,
-    data: &TrainingData,
-    candidates: &[f64],
-    points: &[CalibrationPoint],
+    r: &Round,
     modes: ModeRule,
     energy: f64,
     hyper_tolerance: Option<f64>,
-    n: usize,
+    order: &[usize],
 ) -> std::result::Result<Level, (&'static str, String)> {
+    let Round { p, data, candidates, points, method, .. } = *r;
     let (trained, mut estimator) = build_basis(p, data, modes, hyper_tolerance)?;
     estimator.calibration = calibrate(points.to_vec());
-    let fully_enriched =
-        estimator.block_modes.iter().zip(&trained.block_modes).all(|(&e, &r)| e >= r + DEFAULT_EXTRA_MODES);
-    let label =
-        if energy.is_finite() { format!("iteration {n}, energy {energy:.0e}") } else { format!("iteration {n}") };
-    let runs = estimate_candidates(&p.model, &trained.basis, &estimator, candidates, &label);
-    let estimates = runs.iter().map(|r| score(p_tolerance(p), &r.by_time, &r.sensitivity)).collect();
-    let whole = runs.iter().map(|r| r.by_time[4]).collect();
-    let raws = runs.iter().map(|r| r.raw).collect();
-    let sensitivity = runs.iter().map(|r| r.sensitivity).collect();
-    Ok(Level { energy, hyper_tolerance, trained, estimator, estimates, whole, raws, sensitivity, fully_enriched })
+    // a block whose snapshots span no more than the basis already holds leaves the estimator
+    // nothing richer to compare with there; a block with fewer than `k` more (a stiff body:
+    // its snapshots have low rank) is enriched by all it has
+    let fully_enriched = estimator.block_modes.iter().zip(&trained.block_modes).all(|(&e, &r)| e > r);
+    let mut l = Level {
+        energy,
+        hyper_tolerance,
+        trained,
+        estimator,
+        estimates: Vec::new(),
+        whole: Vec::new(),
+        raws: Vec::new(),
+        sensitivity: Vec::new(),
+        fully_enriched,
+        evaluated: Vec::new(),
+    };
+    l.screen(p, candidates, order, method);
+    Ok(l)
+}
+
+impl Level {
+    /// The estimates, scores and sensitivities at every candidate, with `method`.
+    pub(super) fn estimate(&mut self, p: &Pipeline, candidates: &[f64], label: &str, method: EstimateMethod) {
+        let runs = estimate_candidates(&p.model, &self.trained.basis, &self.estimator, candidates, label, method);
+        self.record(p, runs.into_iter().map(Some).collect());
+    }
+
+    /// [`Self::estimate`] in `order` until a candidate scores above the tolerance
+    /// ([`super::candidates::screen_candidates`]); [`Self::complete`] says whether it got
+    /// through.
+    fn screen(&mut self, p: &Pipeline, candidates: &[f64], order: &[usize], method: EstimateMethod) {
+        let (basis, est) = (&self.trained.basis, &self.estimator);
+        let runs = screen_candidates(&p.model, basis, est, candidates, order, method, p_tolerance(p));
+        self.record(p, runs);
+    }
+
+    fn record(&mut self, p: &Pipeline, runs: Vec<Option<CandidateRun>>) {
+        let get = |f: &dyn Fn(&CandidateRun) -> f64| -> Vec<f64> {
+            runs.iter().map(|r| r.as_ref().map_or(f64::NAN, f)).collect()
+        };
+        self.estimates = get(&|r| score(p_tolerance(p), &r.by_time, &r.sensitivity));
+        self.whole = get(&|r| r.by_time[FIFTHS - 1]);
+        self.raws = get(&|r| r.raw);
+        self.sensitivity = runs.iter().map(|r| r.as_ref().map_or([f64::NAN; FIFTHS], |r| r.sensitivity)).collect();
+        self.evaluated = runs.iter().map(|r| r.is_some()).collect();
+    }
 }
 
 /// The greedy tolerance of the pipeline (`[train] greedy`).

@@ -8,6 +8,7 @@
 //! /message            (N)            why it failed ("" when ok)
 //! /t                  (n_t)
 //! /probes/<name>      (N, n_t, 2)    reduced-model probe positions, m
+//! /full_probes/<name> (N, n_t, 2)    with --validate: the full runs' probe positions, m
 //! /reduced_q          (N, n_t, r)    reduced coordinates (time first; layout 1: (N, r, n_t))
 //! /rom_seconds        (N)            reduced time loop of each run
 //! /newton_iterations  (N)
@@ -31,9 +32,9 @@ use crate::io::attrs::{check_layout, write_atomically_as, Kind};
 use crate::io::basis_file::StoredBasis;
 use crate::io::h5::{attr_f64, attr_str, attr_u64, read_attr_str};
 use crate::model::Model;
-use crate::pipeline::estimate::Estimate;
-use crate::pipeline::online::ReducedRun;
 use crate::pipeline::validate::Validation;
+use crate::rom::estimator::Estimate;
+use crate::rom::ReducedRun;
 use crate::simulate::{Overrides, Settings, SimulationResult};
 use crate::solver::generalized_alpha::Stats;
 use hdf5::types::VarLenUnicode;
@@ -78,15 +79,21 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, stored: &StoredBasis, basis_path
             .collect();
         f.new_dataset_builder().with_data(&Array1::from(messages)).create("message").map_err(e)?;
         f.new_dataset_builder().with_data(&s.t).create("t").map_err(e)?;
-        let g = f.create_group("probes").map_err(e)?;
-        for (i, name) in s.probe_names.iter().enumerate() {
-            let mut a = Array3::from_elem((n, nt, 2), f64::NAN);
-            for (k, x) in s.scales.iter().enumerate() {
-                if let Some(p) = x.point() {
-                    a.index_axis_mut(ndarray::Axis(0), k).assign(&p.rom.result.probes[i].1);
+        // the reduced runs' probes, and beside them with --validate the full runs'
+        type ProbesOf = fn(&SweepPoint) -> Option<&[(String, Array2<f64>)]>;
+        let groups: &[(&str, ProbesOf)] =
+            &[("probes", |p| Some(&p.rom.result.probes)), ("full_probes", |p| p.full_probes.as_deref())];
+        for (group, probes) in &groups[..if s.validated { 2 } else { 1 }] {
+            let g = f.create_group(group).map_err(e)?;
+            for (i, name) in s.probe_names.iter().enumerate() {
+                let mut a = Array3::from_elem((n, nt, 2), f64::NAN);
+                for (k, x) in s.scales.iter().enumerate() {
+                    if let Some(xy) = x.point().and_then(probes) {
+                        a.index_axis_mut(ndarray::Axis(0), k).assign(&xy[i].1);
+                    }
                 }
+                g.new_dataset_builder().with_data(&a).create(name.as_str()).map_err(e)?;
             }
-            g.new_dataset_builder().with_data(&a).create(name.as_str()).map_err(e)?;
         }
         // time first: (load, time, mode); the runs keep r × n_t
         let mut zq = Array3::from_elem((n, nt, r), f64::NAN);
@@ -141,7 +148,8 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, stored: &StoredBasis, basis_path
                 .create("steps_differ_from")
                 .map_err(e)?;
         }
-        attr_str(f, "basis", &basis_path.display().to_string()).map_err(e)?;
+        // absolute, so that the file names its basis wherever it is read from
+        attr_str(f, "basis", &crate::io::output::resolve(basis_path).display().to_string()).map_err(e)?;
         attr_str(f, "basis_content_hash", &stored.content_hash).map_err(e)?;
         attr_str(f, "model_fingerprint", &stored.model_fingerprint).map_err(e)?;
         attr_str(f, "variant", basis.variant.name()).map_err(e)?;
@@ -217,17 +225,27 @@ pub fn read_sweep(
         // back to the runs' r × n_t
         zq.permuted_axes([0, 2, 1]).as_standard_layout().to_owned()
     };
-    let mut probes = Vec::new();
-    for name in model.probe_names() {
-        let a = f
-            .dataset(&format!("probes/{name}"))
-            .and_then(|d| d.read::<f64, ndarray::Ix3>())
-            .map_err(|e| cannot(&format!("probes/{name}"), format!("cannot be read: {e}")))?;
-        if a.dim() != (n, nt, 2) {
-            return Err(cannot(&format!("probes/{name}"), format!("is {:?}, expected ({n}, {nt}, 2)", a.dim())));
+    let read_probes = |group: &str| -> Result<Vec<(String, Array3<f64>)>> {
+        let mut probes = Vec::new();
+        for name in model.probe_names() {
+            let path = format!("{group}/{name}");
+            let a = f
+                .dataset(&path)
+                .and_then(|d| d.read::<f64, ndarray::Ix3>())
+                .map_err(|e| cannot(&path, format!("cannot be read: {e}")))?;
+            if a.dim() != (n, nt, 2) {
+                return Err(cannot(&path, format!("is {:?}, expected ({n}, {nt}, 2)", a.dim())));
+            }
+            probes.push((name, a));
         }
-        probes.push((name, a));
-    }
+        Ok(probes)
+    };
+    let probes = read_probes("probes")?;
+    // files written before /full_probes hold validations without them: run again
+    let full_probes = if validate && f.link_exists("full_probes") { Some(read_probes("full_probes")?) } else { None };
+    let at = |probes: &[(String, Array3<f64>)], k: usize| -> Vec<(String, Array2<f64>)> {
+        probes.iter().map(|(name, a)| (name.clone(), a.index_axis(ndarray::Axis(0), k).to_owned())).collect()
+    };
     let rom_seconds = vec("rom_seconds")?;
     // the estimate columns of the file (absent in files written before them: no estimate)
     let optional = |name: &str| if f.link_exists(name) { vec(name).map(Some) } else { Ok(None) };
@@ -265,7 +283,7 @@ pub fn read_sweep(
             format!("has {} entries, expected {n}", differ.map_or(0, |a| a.len())),
         ));
     }
-    let validation = if validate && f.link_exists("rel_error") {
+    let validation = if validate && f.link_exists("rel_error") && full_probes.is_some() {
         Some([
             vec("rel_error")?,
             vec("max_probe_error")?,
@@ -310,11 +328,11 @@ pub fn read_sweep(
             settings,
             t: t.clone(),
             q: Array2::zeros((0, nt)),
+            qd: Array2::zeros((0, nt)),
             multipliers: Array2::zeros((0, nt)),
-            probes: probes
-                .iter()
-                .map(|(name, a)| (name.clone(), a.index_axis(ndarray::Axis(0), k).to_owned()))
-                .collect(),
+            probes: at(&probes, k),
+            strains: Vec::new(),
+            curvatures: Vec::new(),
             stats,
             wall_seconds: rom_seconds[k],
         };
@@ -372,7 +390,8 @@ pub fn read_sweep(
             v
         });
         let rom = ReducedRun { result, reduced_q: zq.index_axis(ndarray::Axis(0), k).to_owned() };
-        out.push((x, Some(SweepPoint { rom, validation: v, estimate, extrapolated })));
+        let full_probes = full_probes.as_deref().map(|p| at(p, k));
+        out.push((x, Some(SweepPoint { rom, validation: v, full_probes, estimate, extrapolated })));
     }
     Ok(out)
 }

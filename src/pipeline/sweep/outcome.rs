@@ -1,10 +1,10 @@
 //! What a sweep produced: the outcome of every load scale (done, failed, not run yet), the
 //! status codes of the sweep file's `/status`, and the one-line summary of the failures.
 
-use crate::pipeline::estimate::Estimate;
-use crate::pipeline::online::ReducedRun;
 use crate::pipeline::validate::Validation;
-use ndarray::Array1;
+use crate::rom::estimator::Estimate;
+use crate::rom::ReducedRun;
+use ndarray::{Array1, Array2};
 
 /// Status codes of `/status`.
 pub const STATUS_OK: u8 = 0;
@@ -14,6 +14,8 @@ pub const STATUS_PENDING: u8 = 2;
 pub struct SweepPoint {
     pub rom: ReducedRun,
     pub validation: Option<Validation>,
+    /// the full run's probe positions (name, n_t × 2), with the validation
+    pub full_probes: Option<Vec<(String, Array2<f64>)>>,
     /// the run's error estimate (None: no estimator)
     pub estimate: Option<Estimate>,
     /// outside the training range
@@ -106,6 +108,7 @@ pub(super) fn clone_point(p: &SweepPoint) -> SweepPoint {
     SweepPoint {
         rom: p.rom.clone(),
         validation: p.validation.clone(),
+        full_probes: p.full_probes.clone(),
         estimate: p.estimate,
         extrapolated: p.extrapolated,
     }

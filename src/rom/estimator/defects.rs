@@ -1,7 +1,7 @@
 //! The cheap error estimator (`estimate = "defects"`, docs/error-estimate.md): the reduced
 //! run's local defects against the enriched model at sampled steps, accumulated.
 //!
-//! The corrected estimator ([`super::estimate_corrected`]) assembles and factorizes one
+//! The corrected estimator ([`super::corrected`]) assembles and factorizes one
 //! enriched matrix per step (≈ 100 % of the reduced run on the pendulum, 30–45 % on the
 //! four-bar). Here the enriched model's one-iteration correction is taken only at every
 //! `s`-th step, from the reduced run's own lifted state ([`CorrectedRunner::defects`]):
@@ -23,11 +23,16 @@
 //! [`DEFECT_SAMPLE`], lowered so that a run keeps at least [`MIN_SAMPLES`] samples: fixed
 //! numbers, not fitted.
 
-use super::estimate_corrected::CorrectedRunner;
-use super::online::ReducedRun;
+use super::corrected::CorrectedRunner;
+use super::norms::fifth_end;
+use super::{ByFifth, ErrorEstimator, Estimator, FIFTHS};
 use crate::error::Result;
 use crate::model::Model;
 use crate::reduction::Basis;
+use crate::rom::pool::Pool;
+use crate::rom::run::ReducedRun;
+use crate::solver::model::Parameters;
+use std::sync::Arc;
 
 /// `s`: reduced-run steps per sampled defect.
 pub const DEFECT_SAMPLE: usize = 10;
@@ -39,38 +44,49 @@ pub fn sample_for(steps: usize, sample: usize) -> usize {
     sample.min(steps / MIN_SAMPLES).max(1)
 }
 
-/// The enriched model, evaluated at sampled steps of reduced runs.
-pub struct DefectRunner<'a> {
-    plus: CorrectedRunner<'a>,
-    basis: &'a Basis,
+/// The `defects` method: the defect sum of the module documentation, put on the corrected
+/// method's scale fifth by fifth where greedy training calibrated it
+/// ([`crate::reduction::estimator::DefectsCalibration`]).
+pub struct Defects {
+    basis: Arc<Basis>,
+    data: Arc<Estimator>,
+    runners: Pool<CorrectedRunner>,
     sample: usize,
 }
 
-impl<'a> DefectRunner<'a> {
-    /// `None` where [`CorrectedRunner::new`] is not available (the caller then runs the
-    /// enriched model on its own).
-    pub fn new(model: &'a Model, basis: &'a Basis, enriched: &'a Basis) -> Result<Option<Self>> {
-        Ok(CorrectedRunner::new(model, basis, enriched)?.map(|plus| DefectRunner {
-            plus,
-            basis,
-            sample: DEFECT_SAMPLE,
-        }))
+impl Defects {
+    /// With one runner built now (as [`super::corrected::Corrected::new`]).
+    pub fn new(model: &Arc<Model>, basis: &Arc<Basis>, data: &Arc<Estimator>) -> Result<Self> {
+        let (m, b, d) = (Arc::clone(model), Arc::clone(basis), Arc::clone(data));
+        let runners = Pool::new(move || CorrectedRunner::new(&m, &b, &d));
+        runners.put(CorrectedRunner::new(model, basis, data)?);
+        Ok(Defects { basis: Arc::clone(basis), data: Arc::clone(data), runners, sample: DEFECT_SAMPLE })
     }
 
     /// Another sampling interval (experiments: examples/estimate_table.rs).
-    pub fn set_sample(&mut self, sample: usize) {
+    pub fn with_sample(mut self, sample: usize) -> Self {
         self.sample = sample.max(1);
+        self
+    }
+}
+
+impl ErrorEstimator for Defects {
+    fn name(&self) -> &'static str {
+        "defects"
+    }
+    fn data(&self) -> &Estimator {
+        &self.data
     }
 
     /// `η_raw` over the instants up to the end of each fifth of `run` (module documentation).
-    pub fn raw_by_time(&mut self, run: &ReducedRun) -> Result<[f64; 5]> {
+    fn raw(&self, run: &ReducedRun) -> Result<ByFifth> {
         let z = &run.reduced_q;
         let nt = z.ncols();
         let s = sample_for(nt.saturating_sub(1), self.sample);
-        let defects = self.plus.defects(run, s)?;
+        let defects = self.runners.with(|r| r.defects(run, s))??;
         // ‖x_ref + V z_k‖² from the reduced coordinates (V orthonormal; the corrected runner
         // exists only for such bases)
-        let b = self.basis;
+        let b = &self.basis;
         let vtx = b.modes.t().dot(&b.reference);
         let xr2 = b.reference.dot(&b.reference);
         let (mut err2, mut norm2) = (vec![0.0; nt], vec![0.0; nt]);
@@ -83,12 +99,32 @@ impl<'a> DefectRunner<'a> {
             }
             err2[k] = acc * acc;
         }
-        let mut out = [0.0; 5];
+        let mut out = [0.0; FIFTHS];
         for (i, o) in out.iter_mut().enumerate() {
-            let end = ((nt as f64 * (i + 1) as f64 / 5.0).round() as usize).clamp(1, nt);
+            let end = fifth_end(nt, i);
             let (d, n): (f64, f64) = (err2[..end].iter().sum(), norm2[..end].iter().sum());
             *o = d.sqrt() / n.max(0.0).sqrt();
         }
         Ok(out)
+    }
+
+    /// The defect sum is a bound by itself: factor 1, raised in the proportion that
+    /// calibration raised the corrected method's `c` above its default; or put on the
+    /// corrected method's scale fifth by fifth where greedy training measured how
+    /// (`DefectsCalibration`): interpolated in the load where that calibration passed its
+    /// check, else the largest ratio measured.
+    fn factors(&self, mu: &Parameters) -> ByFifth {
+        let c = &self.data.calibration;
+        match &self.data.defects {
+            Some(d) if d.reliable => d.factors_at(mu.load_scale),
+            Some(d) => d.factors,
+            None => [c.factor / super::DEFAULT_FACTOR; FIFTHS],
+        }
+    }
+
+    fn self_check(&self) -> Option<String> {
+        self.data.defects.as_ref().filter(|d| !d.reliable).map(|_| {
+            "the defects calibration failed its check between the candidate loads (docs/error-estimate.md): the estimate uses the largest ratio measured and may read far above the error; \"corrected\" is the tighter choice here".to_string()
+        })
     }
 }

@@ -1,0 +1,348 @@
+//! The tight error estimator (`estimate = "corrected"`, docs/error-estimate.md; the online
+//! default unless greedy training calibrated the cheap `defects` one reliably): the
+//! enriched model's trajectory, not integrated on its own but *corrected from the reduced
+//! run's*, one Newton iteration per step.
+//!
+//! The enriched estimator (`estimate = "enriched"`, [`super::enriched`]) integrates the
+//! richer model `V⁺` (`r + k` modes, its own ECSW set) to convergence at every step, which
+//! costs about two reduced runs. Here the enriched model takes each step of generalized-α
+//! (the same scheme and step as the reduced run) from its own state `q⁺_n`, with the reduced
+//! run's increment as the predictor,
+//!
+//! ```text
+//!     q⁺_{n+1}⁽⁰⁾ = q⁺_n + M (q_{n+1} − q_n),          M = V⁺ᵀ V,
+//!     q⁺_{n+1}    = q⁺_{n+1}⁽⁰⁾ − S⁺⁻¹ R⁺(q⁺_{n+1}⁽⁰⁾)        (one iteration),
+//! ```
+//!
+//! `R⁺ = V⁺ᵀ R` the enriched model's step residual at its sampled elements and `S⁺` its
+//! iteration matrix at the predictor: the integrator's own step pieces
+//! ([`GeneralizedAlpha::start_step_at`], [`GeneralizedAlpha::residual`],
+//! [`GeneralizedAlpha::correction`]), so that the estimate follows the scheme the runs use. (A matrix kept over several steps is not enough:
+//! with one iteration per step the residual it leaves feeds the velocities and
+//! accelerations, and on the pendulum the corrected trajectory diverged within 60–100
+//! steps with the matrix refreshed every 2–8 steps.) The correction is the reduced run's *local defect* (how far
+//! its step lies from the richer model's step from the same state), and `q⁺_n − M q_n`
+//! carries the defects of earlier steps forward through the enriched model's dynamics, so
+//! growth of the error in time (and its decay) is the model's own, not a fixed rule. The
+//! estimate is then the enriched one's,
+//!
+//! ```text
+//!     η_raw = ‖X_r − X⁺‖_F / ‖X⁺‖_F,       error_estimate = c · η_raw,
+//! ```
+//!
+//! with the same calibration `c`. Cost per step: one residual, one matrix and one
+//! factorization of the enriched model, against the reduced run's two to three residuals
+//! and one to two factorizations of the smaller one, and no step halvings (measured:
+//! docs/error-estimate.md).
+//! Why one iteration usually suffices: the predictor is the reduced run's own converged
+//! step, so the correction is of the size of the reduced model's error, and a second
+//! iteration changes it by a fraction θ (the contraction of the matrix) of that. That
+//! argument needs θ small, and on some models it is not (a soft body whose enriched modes
+//! the reduced run does not excite: the correction is then large against the contraction,
+//! and one iteration per step leaves a residual that accumulates through the velocities
+//! into estimates hundreds of times the error, or several times below it). So every step
+//! checks it: the correction the same matrix gives from the corrected state, `δ₂`, is
+//! computed (one residual and one solve, no new matrix), and
+//!
+//! ```text
+//!     ‖δ₂‖ ≤ ACCEPT · ‖δ₁‖  or  ‖δ₂‖ ≤ tol · L     one iteration is kept (δ₂ not applied)
+//!     otherwise                                      Newton goes on until ‖δ_k‖ ≤ ACCEPT · ‖δ₁‖
+//!                                                    (or the integrator's tolerance)
+//! ```
+//!
+//! so that what a step leaves uncorrected is at most [`ACCEPT`] of its own correction: the
+//! estimate then follows the enriched model's converged trajectory to within that fraction,
+//! well inside the calibration factor's margin (≥ 1.5). The matrix is refreshed when it
+//! contracts slower than ½ (as the integrator's modified Newton does). A step that does not
+//! get there in the integrator's `max_iterations` makes the run's reading doubtful: the
+//! estimator then runs the enriched model on its own instead ([`Corrected`]).
+
+use super::{ByFifth, ErrorEstimator, Estimator};
+use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::physics::system::FlexibleSystem;
+use crate::reduction::{Basis, Hyper, HyperReducedModel, Variant};
+use crate::rom::pool::Pool;
+use crate::rom::run::ReducedRun;
+use crate::simulate::{Overrides, Settings};
+use crate::solver::generalized_alpha::{GeneralizedAlpha, State, StepConstants};
+use crate::solver::model::{Bound, DynamicModel};
+use ndarray::{Array2, ArrayView1};
+use std::sync::Arc;
+
+/// What a step's correction may leave uncorrected, relative to the correction itself
+/// (module documentation): a tenth, well inside the 1.5 margin of the calibration factor.
+pub const ACCEPT: f64 = 0.1;
+
+/// What following one reduced run found about its corrections.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FollowStats {
+    /// steps corrected
+    pub steps: usize,
+    /// steps where one iteration left more than [`ACCEPT`] of the correction, and Newton went on
+    pub iterated: usize,
+    /// steps that did not converge in the integrator's `max_iterations`
+    pub unconverged: usize,
+    /// iterations beyond the first, and the matrices refreshed for them
+    pub extra_iterations: usize,
+    pub refreshed: usize,
+    /// the largest `‖δ₂‖ / ‖δ₁‖` seen
+    pub worst_ratio: f64,
+}
+
+/// The enriched model, built once, corrected along reduced runs at many parameters.
+pub struct CorrectedRunner {
+    model: Arc<Model>,
+    data: Arc<Estimator>,
+    rom: Box<HyperReducedModel<FlexibleSystem>>,
+    /// `M = V⁺ᵀ V` (r⁺ × r)
+    lift: Array2<f64>,
+    x0: Vec<f64>,
+    /// [`ACCEPT`]; ∞ keeps one iteration per step whatever it leaves (experiments)
+    accept: f64,
+}
+
+impl CorrectedRunner {
+    /// Whether the correction can run for `basis`: it needs the invariant-based reduced
+    /// model of the enriched basis (sampled, or the physics supports it over every element)
+    /// and orthonormal bases (not whole-system); elsewhere the enriched model runs on its own.
+    pub fn supports(model: &Model, basis: &Basis, enriched: &Basis) -> Result<bool> {
+        if basis.variant == Variant::WholeSystem {
+            return Ok(false);
+        }
+        let sys = &model.physics()?.sys;
+        Ok(enriched.hyper.is_some() || HyperReducedModel::<FlexibleSystem>::supports(sys))
+    }
+
+    /// Projects the model on the enriched basis of `data` (see [`Self::supports`]).
+    pub fn new(model: &Arc<Model>, basis: &Basis, data: &Arc<Estimator>) -> Result<Self> {
+        let physics = model.physics()?;
+        let (sys, x0) = (physics.sys.clone(), physics.x0.to_vec());
+        let enriched = &data.enriched;
+        let all;
+        let h = match &enriched.hyper {
+            Some(h) => h,
+            None => {
+                all = Hyper::all(sys.n_elements());
+                &all
+            }
+        };
+        let rom = HyperReducedModel::new(sys, enriched, h)
+            .map_err(|e| Error::Usage(format!("cannot build the estimator's reduced model: {e}")))?;
+        let lift = enriched.modes.t().dot(&basis.modes);
+        Ok(CorrectedRunner {
+            model: Arc::clone(model),
+            data: Arc::clone(data),
+            rom: Box::new(rom),
+            lift,
+            x0,
+            accept: ACCEPT,
+        })
+    }
+
+    /// Another acceptance ratio ([`ACCEPT`]; ∞: one iteration per step, unchecked).
+    pub fn set_accept(&mut self, accept: f64) {
+        self.accept = accept;
+    }
+
+    /// The enriched trajectory `q⁺` (r⁺ × n_t) corrected along `run` (module documentation)
+    /// and what the corrections were like. `Err` when a solve fails or the trajectory stops
+    /// being finite.
+    pub fn trajectory(&mut self, run: &ReducedRun) -> Result<(Array2<f64>, FollowStats)> {
+        self.follow(run, 0)
+    }
+
+    /// The reduced run's local defects against the enriched model at every `sample`-th step
+    /// (r⁺ × n_t; columns `sample, 2·sample, …`, the others zero): the enriched model's
+    /// first Newton correction `δ_n = −S⁺⁻¹R⁺` of the step to `n` taken from the lifted
+    /// reduced state (`M q_{n−1}` and the generalized-α state of the lifted increments) with
+    /// the lifted reduced step `M q_n` as predictor. The state is not corrected: every
+    /// defect is measured from the reduced run itself. The multipliers start at zero: the
+    /// KKT solve's `Δq` does not depend on them (`Bᵀλ` lies in the range `Δq` is orthogonal
+    /// to in the solve's metric). Cost: one enriched residual, matrix and factorization per
+    /// sampled step, plus O(r⁺ r) per step.
+    pub fn defects(&mut self, run: &ReducedRun, sample: usize) -> Result<Array2<f64>> {
+        let (mut out, _) = self.follow(run, sample.max(1))?;
+        out.column_mut(0).fill(0.0);
+        Ok(out)
+    }
+
+    /// The loop of both: `sample` 0 corrects the trajectory, `s > 0` records the defects at
+    /// every s-th step from the lifted reduced state.
+    fn follow(&mut self, run: &ReducedRun, sample: usize) -> Result<(Array2<f64>, FollowStats)> {
+        let load_scale = run.result.settings.load_scale;
+        let s = Settings::resolve(&self.model, &Overrides { load_scale: Some(load_scale), ..Default::default() })?;
+        let mu = s.parameters();
+        let mut bound = Bound::new(self.rom.as_mut(), &mu);
+        let rom = &mut bound;
+        let z = &run.reduced_q;
+        let nt = z.ncols();
+        let (n, nc) = (rom.n_dof(), rom.n_constraints());
+        let fail = |t: f64, p: String| Error::LinearSolve { t, problem: format!("error estimator: {p}") };
+        let (tol, max_iterations) = (s.params.tolerance * rom.length_scale(), s.params.max_iterations);
+        let mut integ = GeneralizedAlpha::new(s.params).map_err(|p| fail(0.0, p))?;
+        let mut stats = FollowStats::default();
+        let h = s.dt;
+        let k = integ.step_constants(h);
+
+        // consistent start: [M, Bᵀ; B, 0][q̈; λ] = [−g; 0]
+        let q0 = self.data.enriched.reduce(ArrayView1::from(&self.x0)).to_vec();
+        let mut st: State = integ.initialize(rom, q0, vec![0.0; n], 0.0)?;
+        let mut rhs = vec![0.0; n + nc];
+        let mut work = vec![0.0; n];
+
+        let mut out = Array2::zeros((n, nt));
+        out.column_mut(0).assign(&ArrayView1::from(&st.q));
+        let mut dz = vec![0.0; z.nrows()];
+        let mut d = vec![0.0; n];
+        for step in 1..nt {
+            let t = step as f64 * h;
+            // the reduced run's increment, lifted: the predictor
+            for (i, o) in dz.iter_mut().enumerate() {
+                *o = z[[i, step]] - z[[i, step - 1]];
+            }
+            ndarray::linalg::general_mat_vec_mul(
+                1.0,
+                &self.lift,
+                &ArrayView1::from(&dz),
+                0.0,
+                &mut ndarray::ArrayViewMut1::from(&mut d[..]),
+            );
+            integ.start_step_at(&mut st, &k, &d);
+            // defect mode: the state follows the lifted reduced run; at every sample-th step
+            // the one-iteration correction from it is recorded, not applied
+            let record = sample > 0 && step % sample == 0;
+            if sample == 0 || record {
+                if record {
+                    st.lambda.iter_mut().for_each(|l| *l = 0.0);
+                }
+                GeneralizedAlpha::residual(rom, &st, t, &mut rhs, &mut work);
+                let sc = rom.factor(&st.q, &st.v, t, k.coef).map_err(|p| fail(t, p))?;
+                let inc = GeneralizedAlpha::correction(rom, &mut st, &k, sc, &mut rhs, sample == 0)
+                    .map_err(|p| fail(t, p))?;
+                if record {
+                    if !rhs[..n].iter().all(|x| x.is_finite()) {
+                        return Err(fail(t, "the defect is not finite".into()));
+                    }
+                    out.column_mut(step).assign(&ArrayView1::from(&rhs[..n]));
+                } else if !inc.is_finite() {
+                    return Err(fail(t, "the corrected trajectory is no longer finite".into()));
+                } else if self.accept.is_finite() {
+                    let c = Check { k, t, tol, max_iterations, accept: self.accept };
+                    check_step(rom, &mut st, &c, sc, inc, (&mut rhs, &mut work), &mut stats).map_err(|p| fail(t, p))?;
+                }
+            }
+            integ.finish_step(&mut st, &k);
+            if sample == 0 {
+                out.column_mut(step).assign(&ArrayView1::from(&st.q));
+            }
+        }
+        Ok((out, stats))
+    }
+}
+
+/// What [`check_step`] holds a step to.
+struct Check {
+    k: StepConstants,
+    t: f64,
+    /// the integrator's absolute Newton tolerance, `tolerance · L`
+    tol: f64,
+    max_iterations: usize,
+    accept: f64,
+}
+
+/// The self-check of a step whose first correction `first = ‖δ₁‖` has been applied with
+/// the matrix of scale `s` (module documentation): `δ₂` from the corrected state with the
+/// same matrix; kept unapplied when it is at most `accept · ‖δ₁‖` (or the tolerance), else
+/// Newton goes on, refreshing the matrix when it contracts slower than ½.
+fn check_step<M: DynamicModel>(
+    rom: &mut M,
+    st: &mut State,
+    c: &Check,
+    mut s: f64,
+    first: f64,
+    (rhs, work): (&mut [f64], &mut [f64]),
+    stats: &mut FollowStats,
+) -> std::result::Result<(), String> {
+    stats.steps += 1;
+    let limit = (c.accept * first).max(c.tol);
+    let mut last = first;
+    for it in 2..=c.max_iterations.max(2) {
+        GeneralizedAlpha::residual(rom, st, c.t, rhs, work);
+        let next = GeneralizedAlpha::correction(rom, st, &c.k, s, rhs, false)?;
+        if !next.is_finite() {
+            return Err("the corrected trajectory is no longer finite".into());
+        }
+        if it == 2 && first > 0.0 {
+            stats.worst_ratio = stats.worst_ratio.max(next / first);
+        }
+        if next <= limit {
+            return Ok(());
+        }
+        if it == 2 {
+            stats.iterated += 1;
+        }
+        GeneralizedAlpha::apply_correction(st, &c.k, s, rhs);
+        stats.extra_iterations += 1;
+        if next > 0.5 * last {
+            s = rom.factor(&st.q, &st.v, c.t, c.k.coef)?;
+            stats.refreshed += 1;
+        }
+        last = next;
+    }
+    stats.unconverged += 1;
+    Ok(())
+}
+
+/// The `corrected` method: η_raw from the corrected trajectory, times the calibrated `c`.
+/// A run whose corrections do not converge at some step is read by the enriched model on
+/// its own instead (the `enriched` method's reading, the reference the correction
+/// approximates).
+pub struct Corrected {
+    model: Arc<Model>,
+    basis: Arc<Basis>,
+    data: Arc<Estimator>,
+    runners: Pool<CorrectedRunner>,
+    /// built at the first run that needs it
+    fallback: std::sync::OnceLock<Option<super::enriched::Enriched>>,
+}
+
+impl Corrected {
+    /// With one runner built now, so that a model the estimator cannot be built for fails
+    /// here rather than at the first estimate.
+    pub fn new(model: &Arc<Model>, basis: &Arc<Basis>, data: &Arc<Estimator>) -> Result<Self> {
+        let (m, b, d) = (Arc::clone(model), Arc::clone(basis), Arc::clone(data));
+        let runners = Pool::new(move || CorrectedRunner::new(&m, &b, &d));
+        runners.put(CorrectedRunner::new(model, basis, data)?);
+        Ok(Corrected {
+            model: Arc::clone(model),
+            basis: Arc::clone(basis),
+            data: Arc::clone(data),
+            runners,
+            fallback: std::sync::OnceLock::new(),
+        })
+    }
+}
+
+impl ErrorEstimator for Corrected {
+    fn name(&self) -> &'static str {
+        "corrected"
+    }
+    fn data(&self) -> &Estimator {
+        &self.data
+    }
+    fn raw(&self, run: &ReducedRun) -> Result<ByFifth> {
+        let (qp, stats) = self.runners.with(|r| r.trajectory(run))??;
+        if stats.unconverged > 0 {
+            let fallback =
+                self.fallback.get_or_init(|| super::enriched::Enriched::new(&self.model, &self.basis, &self.data).ok());
+            return match fallback {
+                Some(e) => e.raw(run),
+                None => Err(crate::error::Error::Usage(
+                    "the corrected estimate did not converge and the enriched model cannot be built".into(),
+                )),
+            };
+        }
+        Ok(super::norms::raw_estimate_by_time(&self.basis, &self.data.enriched, &run.reduced_q, &qp))
+    }
+}

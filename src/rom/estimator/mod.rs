@@ -1,0 +1,128 @@
+//! An error estimate for every reduced run, without a full run (docs/error-estimate.md).
+//!
+//! Every method compares the reduced run with a second reduced model on the *enriched*
+//! basis `V⁺`: the same POD with `k` more modes (per block for a block basis), its own ECSW
+//! set when the basis is hyper-reduced. Both start from the same `x_ref` and solve the same
+//! equations; the richer one is closer to the full model, and their distance predicts the
+//! smaller one's error:
+//!
+//! ```text
+//!     η_raw = ‖X_r − X_{r+k}‖_F / ‖X_{r+k}‖_F            (all coordinates, all instants)
+//!     error_estimate = c · η_raw
+//! ```
+//!
+//! — the quantity `validate` measures, `rel_error = ‖X_r − X_full‖_F / ‖X_full‖_F`, with the
+//! full model replaced by the enriched one ([`norms`]). `c` is calibrated at training time
+//! on full runs at loads the basis did not see ([`training::calibrate`]); without such data
+//! it is [`DEFAULT_FACTOR`] and the estimator is marked uncalibrated. Both the estimate up
+//! to the end of each fifth of the run and the whole run's are reported ([`ByFifth`]).
+//!
+//! The methods differ in how they obtain `X_{r+k}`, each an [`ErrorEstimator`] in a file of
+//! its own: [`enriched`] integrates the richer model to convergence, [`corrected`] takes
+//! one Newton iteration of it per step along the reduced run, [`defects`] sums its local
+//! corrections at every 10th step. The basis file names the method its estimates default
+//! to; [`build`] picks the implementation by that name.
+
+pub mod corrected;
+pub mod defects;
+pub mod enriched;
+pub mod norms;
+pub mod training;
+
+use crate::error::Result;
+use crate::model::Model;
+pub use crate::reduction::estimator::{
+    Calibration, CalibrationPoint, DefectsCalibration, EstimateMethod, Estimator, DEFAULT_FACTOR,
+};
+use crate::reduction::Basis;
+use crate::rom::run::ReducedRun;
+use crate::solver::model::Parameters;
+use std::sync::Arc;
+
+/// Estimates and errors are reported over the instants up to the end of each fifth of the
+/// run: how the error grows in time, the last entry the whole run's.
+pub const FIFTHS: usize = crate::reduction::estimator::FIFTHS;
+/// A value for each fifth of the run ([`FIFTHS`]), the last the whole run's.
+pub type ByFifth = crate::reduction::estimator::ByFifth;
+
+/// One estimate.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Estimate {
+    /// `c · η_raw`; infinite when the enriched model failed to run
+    pub error_estimate: f64,
+    /// `η_raw`
+    pub raw: f64,
+    pub factor: f64,
+    pub calibrated: bool,
+    /// wall time of the estimator's run and the norms, s
+    pub seconds: f64,
+    /// `c · η_raw` over the instants up to the end of each fifth of the run (as
+    /// [`norms::rel_error_by_time`] for the true error); NaN where unknown
+    pub by_time: ByFifth,
+}
+
+/// An error estimator of one basis: how it reads a reduced run, and how far it can be trusted.
+/// Implementations keep their own work spaces, so one estimator serves runs on any number
+/// of threads.
+pub trait ErrorEstimator: Send + Sync {
+    /// The method's name, as the basis file, `[online] estimate` and `--estimate` spell it.
+    fn name(&self) -> &'static str;
+
+    /// The data training made (enriched basis, calibration).
+    fn data(&self) -> &Estimator;
+
+    /// `η_raw` of `run` by fifth of the run. `Err` when the estimator's model fails.
+    fn raw(&self, run: &ReducedRun) -> Result<ByFifth>;
+
+    /// The factor each fifth's `η_raw` is multiplied by at the parameters `mu`: the
+    /// calibrated `c` unless the method knows better.
+    fn factors(&self, _mu: &Parameters) -> ByFifth {
+        [self.data().calibration.factor; FIFTHS]
+    }
+
+    /// The estimate of `run` at its parameters `mu`. A failure of the estimator's model gives
+    /// an infinite estimate, not an error: the reduced answer itself exists.
+    fn estimate(&self, run: &ReducedRun, mu: &Parameters) -> Estimate {
+        let start = std::time::Instant::now();
+        let raw = self.raw(run).unwrap_or([f64::INFINITY; FIFTHS]);
+        let factors = self.factors(mu);
+        let by_time: ByFifth = std::array::from_fn(|i| factors[i] * raw[i]);
+        Estimate {
+            error_estimate: by_time[FIFTHS - 1],
+            raw: raw[FIFTHS - 1],
+            factor: factors[FIFTHS - 1],
+            calibrated: self.data().calibration.calibrated,
+            seconds: start.elapsed().as_secs_f64(),
+            by_time,
+        }
+    }
+
+    /// The calibration held-out full runs give this method: `(η_raw, rel_error)` pairs at
+    /// loads the basis never saw ([`training::calibrate`]).
+    fn calibrate(&self, held_out: Vec<CalibrationPoint>) -> Calibration {
+        training::calibrate(held_out)
+    }
+
+    /// `Some(why)` when this method's estimates should not be relied on for this basis
+    /// (a calibration that failed its own check); `None` otherwise.
+    fn self_check(&self) -> Option<String> {
+        None
+    }
+}
+
+/// The estimator of `basis` by `method`: `corrected` and `defects` where the correction can
+/// run ([`corrected::CorrectedRunner::supports`]), else the enriched model on its own, which
+/// then names itself `enriched`.
+pub fn build(
+    method: EstimateMethod,
+    model: &Arc<Model>,
+    basis: &Arc<Basis>,
+    data: &Arc<Estimator>,
+) -> Result<Arc<dyn ErrorEstimator>> {
+    let correctable = || corrected::CorrectedRunner::supports(model, basis, &data.enriched);
+    Ok(match method {
+        EstimateMethod::Corrected if correctable()? => Arc::new(corrected::Corrected::new(model, basis, data)?),
+        EstimateMethod::Defects if correctable()? => Arc::new(defects::Defects::new(model, basis, data)?),
+        _ => Arc::new(enriched::Enriched::new(model, basis, data)?),
+    })
+}

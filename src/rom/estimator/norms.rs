@@ -1,0 +1,210 @@
+//! The norms an estimate is made of, over the whole run and up to the end of each fifth of
+//! it: the estimator's `η_raw = ‖X_r − X⁺‖_F / ‖X⁺‖_F` from reduced coordinates, and the
+//! true `rel_error = ‖X_r − X_full‖_F / ‖X_full‖_F` that `validate` measures.
+//!
+//! With orthonormal `V` and `V⁺` (galerkin, constraint-preserving, block bases) the norms
+//! need no full-size reconstruction: with `M = V⁺ᵀV`,
+//!
+//! ```text
+//!     ‖V q − V⁺ q⁺‖² = ‖M q − q⁺‖² + qᵀ(I − MᵀM) q,
+//!     ‖x_ref + V⁺ q⁺‖² = ‖x_ref‖² + 2 (V⁺ᵀx_ref)·q⁺ + ‖q⁺‖².
+//! ```
+
+use super::{ByFifth, FIFTHS};
+use crate::reduction::{Basis, Variant};
+use ndarray::{Array1, Array2, Axis};
+
+/// The number of instants `..end` up to the end of fifth `i` (0-based) of a run of `nt`
+/// instants (at least one).
+pub fn fifth_end(nt: usize, i: usize) -> usize {
+    ((nt as f64 * (i + 1) as f64 / FIFTHS as f64).round() as usize).clamp(1, nt)
+}
+
+/// `η_raw` of the whole run from the reduced coordinates `q` (r × n_t) of `basis` and `qp`
+/// (r⁺ × n_t) of `enriched`, both with orthonormal columns and the same reference.
+pub fn raw_estimate_reduced(basis: &Basis, enriched: &Basis, q: &Array2<f64>, qp: &Array2<f64>) -> f64 {
+    raw_estimate_by_time(basis, enriched, q, qp)[FIFTHS - 1]
+}
+
+/// `η_raw` over the instants up to the end of each fifth of the run (the last entry is the
+/// whole run's), as [`rel_error_by_time`] splits the true error; ∞ when the shapes differ.
+pub fn raw_estimate_by_time(basis: &Basis, enriched: &Basis, q: &Array2<f64>, qp: &Array2<f64>) -> ByFifth {
+    let nt = qp.ncols();
+    if q.ncols() != nt || nt == 0 {
+        return [f64::INFINITY; FIFTHS];
+    }
+    let (diff2, norm2): (Array1<f64>, Array1<f64>) = if basis.variant == Variant::WholeSystem {
+        // V is not orthonormal: reconstruct x_ref + V q of both
+        let full = |b: &Basis, z: &Array2<f64>| b.modes.dot(z) + b.reference.view().insert_axis(Axis(1));
+        let (a, b) = (full(basis, q), full(enriched, qp));
+        ((&a - &b).mapv(|v| v * v).sum_axis(Axis(0)), b.mapv(|v| v * v).sum_axis(Axis(0)))
+    } else {
+        let vp = &enriched.modes;
+        let m = vp.t().dot(&basis.modes); // r⁺ × r
+        let mq = m.dot(q);
+        let q2 = q.mapv(|v| v * v).sum_axis(Axis(0));
+        let mq2 = mq.mapv(|v| v * v).sum_axis(Axis(0));
+        let d = (&mq - qp).mapv(|v| v * v).sum_axis(Axis(0)) + (&q2 - &mq2).mapv(|v| v.max(0.0));
+        let xr = &enriched.reference;
+        let vtx = vp.t().dot(xr);
+        let norm = xr.dot(xr) + 2.0 * vtx.dot(qp) + qp.mapv(|v| v * v).sum_axis(Axis(0));
+        (d, norm)
+    };
+    let mut out = [0.0; FIFTHS];
+    for (i, o) in out.iter_mut().enumerate() {
+        let end = fifth_end(nt, i);
+        let (d, n) = (diff2.slice(ndarray::s![..end]).sum(), norm2.slice(ndarray::s![..end]).sum());
+        *o = d.max(0.0).sqrt() / n.max(0.0).sqrt();
+    }
+    out
+}
+
+/// `‖a − b‖_F` and `‖b‖_F`, summed in the arrays' logical order (rows, then columns)
+/// whatever their memory layout (a full run keeps its coordinates column-major, a reduced
+/// one row-major), so that the same two runs always give the same bits.
+pub fn distance_and_norm(a: &Array2<f64>, b: &Array2<f64>) -> (f64, f64) {
+    assert_eq!(a.dim(), b.dim(), "arrays of one shape");
+    let (mut d, mut n) = (0.0, 0.0);
+    for (x, y) in a.iter().zip(b.iter()) {
+        d += (x - y) * (x - y);
+        n += y * y;
+    }
+    (d.sqrt(), n.sqrt())
+}
+
+/// `rel_error` of `a` against `b` over the instants `..k`, for the end of each fifth of
+/// the run: `‖A[:, ..k] − B[:, ..k]‖_F / ‖B[:, ..k]‖_F`.
+pub fn rel_error_by_time(a: &Array2<f64>, b: &Array2<f64>) -> ByFifth {
+    let nt = b.ncols();
+    let (mut diff, mut norm) = (Array1::<f64>::zeros(nt), Array1::<f64>::zeros(nt));
+    for k in 0..nt {
+        diff[k] = a.column(k).iter().zip(b.column(k)).map(|(x, y)| (x - y) * (x - y)).sum::<f64>();
+        norm[k] = b.column(k).iter().map(|y| y * y).sum::<f64>();
+    }
+    std::array::from_fn(|i| {
+        let end = fifth_end(nt, i);
+        (diff.slice(ndarray::s![..end]).sum() / norm.slice(ndarray::s![..end]).sum()).sqrt()
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The reduced-coordinate norms equal the full-coordinate ones for nested orthonormal
+    /// bases and for bases that are not nested (random rotations of a 3-column basis).
+    #[test]
+    fn reduced_norms_match_full_reconstruction() {
+        let n = 7;
+        let nt = 4;
+        let a =
+            Array2::from_shape_fn((n, 5), |(i, j)| ((i * 5 + j) as f64 * 0.37).sin() + if i == j { 2.0 } else { 0.0 });
+        let (qf, _) = ndarray_linalg::QR::qr(&a).unwrap();
+        let vp = qf.slice(ndarray::s![.., ..5]).to_owned();
+        let reference = Array1::from_shape_fn(n, |i| 0.1 * i as f64 + 1.0);
+        let mk = |modes: Array2<f64>| Basis {
+            variant: Variant::Galerkin,
+            snapshots: crate::reduction::SnapshotKind::Reference,
+            reference: reference.clone(),
+            n_pod_modes: modes.ncols(),
+            modes,
+            kept: vec![],
+            multiplier_modes: None,
+            multiplier_scale: 1.0,
+            hyper: None,
+        };
+        let plus = mk(vp.clone());
+
+        // nested (first 3 columns) and not nested (mixing columns 2..5)
+        let nested = vp.slice(ndarray::s![.., ..3]).to_owned();
+        let mixed = {
+            let (q, _) =
+                ndarray_linalg::QR::qr(&(&vp.slice(ndarray::s![.., 1..4]) + &(0.3 * &qf.slice(ndarray::s![.., 4..5]))))
+                    .unwrap();
+            q
+        };
+        for small in [nested, mixed] {
+            let b = mk(small);
+            let q = Array2::from_shape_fn((b.n_reduced(), nt), |(i, k)| (i as f64 + 1.0) * (k as f64 * 0.5).cos());
+            let qp = Array2::from_shape_fn((5, nt), |(i, k)| (i as f64 - 1.0) * (k as f64 * 0.3).sin());
+            let full =
+                |basis: &Basis, z: &Array2<f64>| basis.modes.dot(z) + basis.reference.view().insert_axis(Axis(1));
+            let (x1, x2) = (full(&b, &q), full(&plus, &qp));
+            let want = (&x1 - &x2).mapv(|v| v * v).sum().sqrt() / x2.mapv(|v| v * v).sum().sqrt();
+            let got = raw_estimate_reduced(&b, &plus, &q, &qp);
+            assert!((got - want).abs() < 1e-12 * want.max(1.0), "{got} vs {want}");
+        }
+    }
+
+    /// The estimate over prefixes of the run: zero while the two runs agree; non-decreasing
+    /// when the distance per instant grows and the norm per instant is constant (then each
+    /// prefix value is the RMS of a growing sequence); the last is the whole run's.
+    #[test]
+    fn estimate_by_time_follows_a_growing_error() {
+        let (n, nt) = (4, 20);
+        let eye = Array2::from_shape_fn((n, n), |(i, j)| if i == j { 1.0 } else { 0.0 });
+        let mk = |modes: Array2<f64>| Basis {
+            variant: Variant::Galerkin,
+            snapshots: crate::reduction::SnapshotKind::Reference,
+            reference: Array1::zeros(n),
+            n_pod_modes: modes.ncols(),
+            modes,
+            kept: vec![],
+            multiplier_modes: None,
+            multiplier_scale: 1.0,
+            hyper: None,
+        };
+        let (b, plus) = (mk(eye.clone()), mk(eye));
+        // X⁺ rotates at unit norm; X_r lags it by nothing for 8 instants, then by a growing angle
+        let lag = |k: usize| if k < 8 { 0.0 } else { 0.01 * (k - 7) as f64 };
+        let qp = Array2::from_shape_fn((n, nt), |(i, k)| match i {
+            0 => (0.1 * k as f64).cos(),
+            1 => (0.1 * k as f64).sin(),
+            _ => 0.0,
+        });
+        let q = Array2::from_shape_fn((n, nt), |(i, k)| match i {
+            0 => (0.1 * k as f64 - lag(k)).cos(),
+            1 => (0.1 * k as f64 - lag(k)).sin(),
+            _ => 0.0,
+        });
+        let by = raw_estimate_by_time(&b, &plus, &q, &qp);
+        assert_eq!(&by[..2], &[0.0, 0.0], "{by:?}");
+        assert!(by.windows(2).all(|w| w[1] >= w[0]) && by[4] > by[2], "{by:?}");
+        let whole = (&q - &qp).mapv(|v| v * v).sum().sqrt() / qp.mapv(|v| v * v).sum().sqrt();
+        assert!((by[4] - whole).abs() < 1e-14, "{} vs {whole}", by[4]);
+        assert_eq!(by[4], raw_estimate_reduced(&b, &plus, &q, &qp));
+    }
+
+    /// The distance and the norm are the Frobenius ones (3-4-5 numbers), and the same bits
+    /// for row- and column-major copies of the same arrays (the full run keeps q
+    /// column-major, a file or a reduced run row-major).
+    #[test]
+    fn distance_and_norm_do_not_depend_on_the_layout() {
+        let b = ndarray::array![[3.0, 0.0], [0.0, 4.0]];
+        assert_eq!(distance_and_norm(&Array2::zeros((2, 2)), &b), (5.0, 5.0));
+        let b = Array2::from_shape_fn((7, 33), |(i, k)| (0.3 * i as f64 + 0.17 * k as f64).sin() * 1e3);
+        let a = Array2::from_shape_fn((7, 33), |(i, k)| b[[i, k]] + 1e-3 * ((i * k) as f64).cos());
+        let f = |x: &Array2<f64>| {
+            let mut y = Array2::zeros(ndarray::ShapeBuilder::f(x.dim()));
+            y.assign(x);
+            y
+        };
+        let (af, bf) = (f(&a), f(&b));
+        assert!(af.as_slice().is_none() && af.t().as_slice().is_some(), "column-major copy");
+        let bits = |(d, n): (f64, f64)| (d.to_bits(), n.to_bits());
+        assert_eq!(bits(distance_and_norm(&a, &b)), bits(distance_and_norm(&af, &bf)));
+        assert_eq!(bits(distance_and_norm(&a, &b)), bits(distance_and_norm(&af, &b)));
+    }
+
+    /// rel_error over growing prefixes; the last one is the whole run's.
+    #[test]
+    fn rel_error_by_time_ends_with_the_whole_run() {
+        let b = Array2::from_shape_fn((3, 10), |(i, k)| 1.0 + i as f64 + k as f64);
+        let a = Array2::from_shape_fn((3, 10), |(i, k)| b[[i, k]] + if k >= 8 { 0.5 } else { 0.0 });
+        let r = rel_error_by_time(&a, &b);
+        assert_eq!(r.len(), 5);
+        assert!(r[..4].iter().all(|&v| v == 0.0), "{r:?}");
+        let whole = (&a - &b).mapv(|v| v * v).sum().sqrt() / b.mapv(|v| v * v).sum().sqrt();
+        assert!((r[4] - whole).abs() < 1e-15);
+    }
+}
