@@ -124,7 +124,6 @@ fn evaluate(fx: &Flexrom, root: &Path, slot: usize, tolerance: f64) -> Outcome {
 const TOLERANCE: f64 = 1e-2;
 
 #[test]
-#[ignore = "the default error estimate fails the issue's targets on zoo models (docs/zoo.md: under- and over-estimates by far more than 20x on driven and chaotic models); run with --ignored once the estimator checks itself"]
 fn the_estimate_holds_on_the_zoo_subset() {
     let fx = Flexrom { bin: PathBuf::from(env!("CARGO_BIN_EXE_flexrom")), resume: false };
     let root = tempfile::tempdir().expect("a temporary folder");
