@@ -11,7 +11,7 @@
 SYSTEM_PACKAGES := libhdf5-dev libopenblas-dev pkg-config gfortran
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: run test bench bench-exudyn deps thesis
+.PHONY: run test bench bench-routes bench-exudyn deps thesis
 
 deps:
 	@missing=""; \
@@ -42,6 +42,12 @@ bench: deps
 	cargo build --release
 	cargo bench --bench full_order
 	cargo bench --bench online
+
+# the four-bar's 100-load sweep by the full route and the reduced one (with and without its
+# estimate), whole processes in turn, medians (docs/benchmarks.md, "Full or reduced")
+bench-routes: deps
+	cargo build --release
+	python3 benches/sweep_routes.py
 
 # the pendulum in Exudyn (in-process) and flexrom (whole process), side by side
 bench-exudyn: deps

@@ -129,20 +129,29 @@ one header line and one row per load (arrays as NAME_1, NAME_2, ...).
         exit_codes!()
     ))]
     Validate(cli::validate::Args),
-    /// Reduced runs at many load scales, in parallel, into one HDF5 file and a table.
+    /// Reduced (or, with --full, full) runs at many load scales, in parallel, into one HDF5
+    /// file and a table.
     #[command(after_help = concat!(
         "Examples:
   flexrom sweep pipelines/double_pendulum.toml --load-scales 0.5:1.5:21 -o out/dp_sweep.h5
   flexrom sweep pipelines/pendulum.toml -o out/sweep.h5 --validate --csv > sweep.csv
   flexrom sweep pipelines/fourbar.toml --load-scales 0.8:1.0:40 --shard 2/4 -o parts/part_2.h5
   flexrom sweep pipelines/fourbar.toml -o out/sweep.h5 --resume
+  flexrom sweep pipelines/fourbar.toml --load-scales 0.8:1.2:100 --full -o out/full.h5
 
 -o is required: the pipeline's report folder holds the sweep.h5 of `flexrom run`, which the
 report's summary.md describes, and a plain sweep does not replace it.
 
+--full runs the full model instead (exact: no basis, no estimate, nothing to validate, so
+--validate, --continuation, --no-estimate, --strict and --basis are refused with it); on
+small meshes it is the faster route, and `online`/`sweep` say so when the basis's timing
+shows it. --resume, --shard and merge work alike (a full sweep does not resume from, or
+merge with, a reduced one).
+
 --csv/--json print one row per load scale: load_scale, status (0 done, 1 failed, 2 not run),
 message, rom_seconds, newton_iterations, step_cuts, error_estimate, estimate_seconds,
-extrapolated (and rel_error, max_probe_error (m), full_seconds, speedup with --validate).
+extrapolated (and rel_error, max_probe_error (m), full_seconds, speedup with --validate;
+--full: load_scale, status, message, full_seconds, newton_iterations, step_cuts).
 
 ",
         exit_codes!()

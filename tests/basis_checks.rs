@@ -125,6 +125,12 @@ fn refused(pipe: &Path, basis: &Path, needles: &[&str]) {
     }
 }
 
+/// The warning lines of `err`, but for the one saying which route is faster: that depends
+/// on the machine's timing, not on the basis checks (tests/full_route.rs checks it).
+fn warnings(err: &str) -> Vec<&str> {
+    err.lines().filter(|l| l.starts_with("warning:") && !l.contains("not faster than the full one")).collect()
+}
+
 #[test]
 fn crafted_basis_files_are_refused_naming_file_and_dataset() {
     let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
@@ -134,7 +140,7 @@ fn crafted_basis_files_are_refused_naming_file_and_dataset() {
     let good = d.join("a.h5");
     let (ok, err) = online(&pipe, &good);
     assert!(ok, "the trained basis is accepted: {err}");
-    assert!(!err.contains("warning"), "{err}");
+    assert!(warnings(&err).is_empty(), "{err}");
 
     let bad = craft(&good, "shifted.h5", |f| {
         let mut r = read1(f, "basis/reference");
@@ -267,9 +273,9 @@ fn crafted_basis_files_are_refused_naming_file_and_dataset() {
     std::fs::write(&pipe, text.replace("tolerance = 1e-2", "tolerance = 5e-3")).unwrap();
     let (ok, err) = online(&pipe, &good);
     assert!(ok, "{err}");
-    let warnings: Vec<&str> = err.lines().filter(|l| l.starts_with("warning:")).collect();
-    assert_eq!(warnings.len(), 1, "{err}");
-    assert!(warnings[0].contains("a.h5") && warnings[0].contains("settings"), "{err}");
+    let w = warnings(&err);
+    assert_eq!(w.len(), 1, "{err}");
+    assert!(w[0].contains("a.h5") && w[0].contains("settings"), "{err}");
     // comments and number spelling do not count as a change
     std::fs::write(
         &pipe,
@@ -277,7 +283,7 @@ fn crafted_basis_files_are_refused_naming_file_and_dataset() {
     )
     .unwrap();
     let (ok, err) = online(&pipe, &good);
-    assert!(ok && !err.contains("warning"), "{err}");
+    assert!(ok && warnings(&err).is_empty(), "{err}");
 }
 
 /// Whole-system (orthonormal as the stacked [V; V_λ]) and raw-snapshot (zero reference)

@@ -79,7 +79,14 @@ fn run(args: &[&str]) -> Output {
 }
 
 fn warnings(o: &Output) -> Vec<String> {
-    String::from_utf8_lossy(&o.stderr).lines().filter(|l| l.starts_with("warning:")).map(str::to_string).collect()
+    // the line saying which route is faster depends on the machine's timing, not on the
+    // estimate (tests/full_route.rs checks it)
+    let route = |l: &str| l.contains("not faster than the full one");
+    String::from_utf8_lossy(&o.stderr)
+        .lines()
+        .filter(|l| l.starts_with("warning:") && !route(l))
+        .map(str::to_string)
+        .collect()
 }
 
 #[test]

@@ -14,7 +14,11 @@
 //!   3 and 7, 0-based, i.e. 0.95 and 1.15 of 0.8:1.2:9); `-o` naming one of the parts;
 //! - `--partial` with shard 4 missing writes the merge with `/status` 2 in exactly those
 //!   rows, and `sweep --resume` over the whole list on that file runs exactly those 2 loads;
-//! - `--shard 10/10` of a 9-load list is a usage error (that shard would hold load 9, 0-based: none).
+//! - `--shard 10/10` of a 9-load list is a usage error (that shard would hold load 9, 0-based: none);
+//! - full sweeps (`sweep --full`) alike: two shards merged, and one shard merged `--partial`
+//!   then resumed, are the single full sweep (as above); `merge` refuses a full part beside a
+//!   reduced one, and `--resume` a file of the other route, each with one line naming
+//!   `route`.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -232,6 +236,59 @@ fn four_shards_merged_equal_one_sweep_and_bad_parts_are_refused() {
     let (o, err) =
         run(flexrom().args(["sweep", s(&p), "--load-scales", list, "--shard", "10/10", "-o", s(&d.join("y.h5"))]));
     one_line_error(&o, &err, "has no load for shard 10");
+}
+
+#[test]
+fn full_sweeps_shard_merge_and_resume_and_do_not_mix_with_reduced_ones() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let p = setup(d, 4, "basis.h5");
+    let list = "0.8:1.2:5";
+    let full = |extra: &[&str], out: &Path| {
+        let mut args = vec!["sweep", s(&p), "--full", "--load-scales", list, "-o", s(out)];
+        args.extend_from_slice(extra);
+        run(flexrom().args(&args))
+    };
+    let single = d.join("single.h5");
+    let (o, err) = full(&[], &single);
+    assert!(o.status.success(), "{err}");
+    let parts: Vec<PathBuf> = (1..=2).map(|k| d.join(format!("full{k}.h5"))).collect();
+    for (k, part) in parts.iter().enumerate() {
+        let (o, err) = full(&["--shard", &format!("{}/2", k + 1)], part);
+        assert!(o.status.success(), "{err}");
+    }
+    let merged = d.join("merged.h5");
+    let (o, err) = run(flexrom().args(["merge", s(&parts[1]), s(&parts[0]), "-o", s(&merged)]));
+    assert!(o.status.success(), "{err}");
+    assert_same_sweep(&single, &merged);
+
+    // the gaps of a partial merge run by --resume
+    let partial = d.join("partial.h5");
+    let (o, err) = run(flexrom().args(["merge", "--partial", s(&parts[0]), "-o", s(&partial)]));
+    assert!(o.status.success(), "{err}");
+    let status = hdf5::File::open(&partial).unwrap().dataset("status").unwrap().read_raw::<u8>().unwrap();
+    assert_eq!(status, vec![0, 2, 0, 2, 0]);
+    let (o, err) = full(&["--resume"], &partial);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("3 of 5 load scales already finished, running 2"), "{err}");
+    assert_same_sweep(&single, &partial);
+
+    // a reduced part beside a full one
+    let reduced_part = d.join("reduced2.h5");
+    shard(&p, list, 2, 2, &reduced_part);
+    let (o, err) = run(flexrom().args(["merge", s(&parts[0]), s(&reduced_part), "-o", s(&d.join("x.h5"))]));
+    one_line_error(&o, &err, "route");
+    assert!(err.contains("full model") && err.contains("reduced model") && err.contains(s(&reduced_part)), "{err}");
+    assert!(!d.join("x.h5").exists());
+    // resuming across routes, either way
+    let reduced = d.join("reduced.h5");
+    let (o, err) = run(flexrom().args(["sweep", s(&p), "--load-scales", list, "-o", s(&reduced)]));
+    assert!(o.status.success(), "{err}");
+    let (o, err) = full(&["--resume"], &reduced);
+    one_line_error(&o, &err, "route");
+    let (o, err) = run(flexrom().args(["sweep", s(&p), "--load-scales", list, "--resume", "-o", s(&single)]));
+    one_line_error(&o, &err, "route");
+    assert!(err.contains("`--full`"), "{err}");
 }
 
 /// A 64-load four-bar sweep as a 4-task Slurm job array plus a dependent merge job

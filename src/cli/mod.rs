@@ -50,6 +50,22 @@ impl DenseArgs {
     }
 }
 
+/// `--estimate METHOD` of `online`, `validate`, `sweep` and `run`: the error estimate's
+/// method, over the pipeline's `[online] estimate` (docs/error-estimate.md).
+#[derive(clap::Args, Clone, Copy)]
+pub struct EstimateArgs {
+    /// how the error estimate is computed, over the pipeline's [online] estimate (default:
+    /// that, else "defects" where greedy training calibrated it, else "corrected")
+    #[arg(long, value_enum, value_name = "METHOD")]
+    estimate: Option<flexrom::pipeline::config::EstimateMethod>,
+}
+
+impl EstimateArgs {
+    pub fn method(self) -> Option<flexrom::pipeline::config::EstimateMethod> {
+        self.estimate
+    }
+}
+
 pub fn check_scale(x: f64) -> flexrom::Result<()> {
     if x.is_finite() {
         Ok(())

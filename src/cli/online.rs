@@ -1,6 +1,6 @@
 //! `flexrom online`: one reduced run at one load scale, written to a result file.
 
-use super::{check_scale, print_table, run_details, warn, FormatArgs};
+use super::{check_scale, print_table, run_details, warn, EstimateArgs, FormatArgs};
 use flexrom::io::output::{check_output, Origin};
 use flexrom::output::info;
 use flexrom::output::table::{Cell, Table};
@@ -28,12 +28,14 @@ pub struct Args {
     #[arg(long)]
     strict: bool,
     #[command(flatten)]
+    estimate: EstimateArgs,
+    #[command(flatten)]
     format: FormatArgs,
 }
 
 impl Args {
     pub fn run(self) -> flexrom::Result<()> {
-        let Args { pipeline, load_scale, output, basis, strict, format } = self;
+        let Args { pipeline, load_scale, output, basis, strict, estimate, format } = self;
         let p = Pipeline::load(&pipeline)?;
         check_scale(load_scale)?;
         let path = basis.unwrap_or_else(|| p.basis_path.clone());
@@ -42,8 +44,10 @@ impl Args {
             Origin::Flag("-o"),
             &[(&p.path, "pipeline file"), (&p.model.path, "model file"), (&path, "basis file")],
         )?;
-        let (stored, rom, warnings) = load_rom(&p, &path, None, false)?;
+        let (stored, rom, warnings) = load_rom(&p, &path, estimate.method(), false)?;
         warn(&warnings);
+        // read before the run (a damaged /timing fails now), said after it
+        let notice = flexrom::pipeline::route::speed_notice_of(&path, &rom)?;
         let done = online_to_file(&p, &rom, &path, &Parameters::new(load_scale), &output)?;
         let (run, estimate) = (&done.run, &done.estimate);
         let st = &run.result.stats;
@@ -63,7 +67,7 @@ impl Args {
         run_details(&run.result);
         let mut cols = vec!["load_scale", "n_modes"];
         cols.extend(flexrom::pipeline::tables::RUN_COLUMNS);
-        cols.extend(["error_estimate", "extrapolated", "output"]);
+        cols.extend(["error_estimate", "extrapolated", "output", "error_estimate_displacement"]);
         let mut t = Table::new(&cols);
         let mut row: Vec<Cell> = vec![load_scale.into(), stored.basis.n_reduced().into()];
         row.extend(flexrom::pipeline::tables::run_cells(&run.result));
@@ -71,9 +75,12 @@ impl Args {
             estimate.as_ref().map(|e| e.error_estimate).into(),
             done.extrapolated.into(),
             output.display().to_string().into(),
+            estimate.as_ref().map(|e| e.error_estimate_displacement).into(),
         ]);
         t.push(row);
         print_table(&t, format.format(), true)?;
-        super::check_runs(&rom, &[(load_scale, estimate.map(|e| e.error_estimate))], strict)
+        warn(notice.as_slice());
+        let measure = rom.tolerance_measure();
+        super::check_runs(&rom, &[(load_scale, estimate.map(|e| e.in_measure(measure)))], strict)
     }
 }

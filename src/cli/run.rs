@@ -1,6 +1,6 @@
 //! `flexrom run`: the whole pipeline (train, sweep, validate) and its report folder.
 
-use super::{print_table, DenseArgs, FormatArgs};
+use super::{print_table, DenseArgs, EstimateArgs, FormatArgs};
 use flexrom::output::table::{Format, Table};
 use flexrom::output::{self, info};
 use flexrom::pipeline::Pipeline;
@@ -18,14 +18,17 @@ pub struct Args {
     #[command(flatten)]
     dense: DenseArgs,
     #[command(flatten)]
+    estimate: EstimateArgs,
+    #[command(flatten)]
     format: FormatArgs,
 }
 
 impl Args {
     pub fn run(self) -> flexrom::Result<()> {
-        let Args { pipeline, strict, dense, format } = self;
+        let Args { pipeline, strict, dense, estimate, format } = self;
         let p = Pipeline::load(&pipeline)?;
-        let (dir, warnings) = flexrom::pipeline::report::run_with(&p, output::show_progress(), dense.choice())?;
+        let (dir, warnings) =
+            flexrom::pipeline::report::run_with(&p, output::show_progress(), dense.choice(), estimate.method())?;
         super::warn(&warnings);
         let read = |name: &str| {
             let f = dir.join(name);
@@ -36,7 +39,7 @@ impl Args {
             f => print_table(&Table::from_json_records(&read("validation.json")?)?, f, false)?,
         }
         info(&format!("report: {}", dir.display()));
-        super::warn(&flexrom::pipeline::report::check_report(&p, &dir, strict)?);
+        super::warn(&flexrom::pipeline::report::check_report(&p, &dir, strict, estimate.method())?);
         Ok(())
     }
 }

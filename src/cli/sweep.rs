@@ -1,12 +1,12 @@
-//! `flexrom sweep`: reduced runs at many load scales into one sweep file and a table
-//! (optionally one shard of the list, resumed, or validated).
+//! `flexrom sweep`: reduced runs (or, with `--full`, full ones) at many load scales into one
+//! sweep file and a table (optionally one shard of the list, resumed, or validated).
 
-use super::{print_table, warn, FormatArgs};
+use super::{print_table, warn, EstimateArgs, FormatArgs};
 use flexrom::io::output::{check_output, Origin};
 use flexrom::output::table::Format;
 use flexrom::output::{self, info};
 use flexrom::pipeline::online::load_rom;
-use flexrom::pipeline::sweep::SweepFile;
+use flexrom::pipeline::sweep::{Route, SweepBasis, SweepFile};
 use flexrom::pipeline::Pipeline;
 use std::path::PathBuf;
 
@@ -22,6 +22,12 @@ pub struct Args {
     /// also run the full model at each load scale and report errors
     #[arg(long)]
     validate: bool,
+    /// run the full model at every load instead of the reduced one: exact (no estimate,
+    /// nothing to validate), no basis needed, into the same sweep file layout; faster than
+    /// the reduced model on small meshes (`train` measures both and `online`/`sweep` say
+    /// which is faster)
+    #[arg(long, conflicts_with_all = ["validate", "continuation", "no_estimate", "basis", "strict"])]
+    full: bool,
     /// continuation in the load scale: each thread takes two contiguous parts of the list
     /// (one from each end) and every run starts its Newton solves from its neighbours'
     /// steps (about 2× fewer iterations on the pendulum). Same step equations and tolerance, but where the
@@ -31,7 +37,7 @@ pub struct Args {
     #[arg(long)]
     continuation: bool,
     /// skip the error estimate (about 2× faster; `/error_estimate` is then NaN)
-    #[arg(long)]
+    #[arg(long, conflicts_with = "estimate")]
     no_estimate: bool,
     /// sweep file to write (HDF5); no default: the pipeline's report folder holds the
     /// sweep.h5 of `flexrom run`, which the report's summary.md describes
@@ -53,6 +59,8 @@ pub struct Args {
     #[arg(long, value_name = "K/N")]
     shard: Option<flexrom::pipeline::shard::Shard>,
     #[command(flatten)]
+    estimate: EstimateArgs,
+    #[command(flatten)]
     format: FormatArgs,
 }
 
@@ -62,6 +70,7 @@ impl Args {
             pipeline,
             load_scales,
             validate,
+            full,
             continuation,
             no_estimate,
             output,
@@ -69,6 +78,7 @@ impl Args {
             resume,
             strict,
             shard,
+            estimate,
             format,
         } = self;
         let p = Pipeline::load(&pipeline)?;
@@ -78,38 +88,50 @@ impl Args {
             None => p.online_scales(),
         };
         let path = basis.unwrap_or_else(|| p.basis_path.clone());
-        let inputs = [
-            (p.path.as_path(), "pipeline file"),
-            (p.model.path.as_path(), "model file"),
-            (path.as_path(), "basis file"),
-        ];
+        let mut inputs = vec![(p.path.as_path(), "pipeline file"), (p.model.path.as_path(), "model file")];
+        if !full {
+            inputs.push((path.as_path(), "basis file"));
+        }
         let out = output;
         check_output(&out, Origin::Flag("-o"), &inputs)?;
         if no_estimate && strict {
             return Err(flexrom::Error::Usage("--strict needs the error estimate; drop --no-estimate".into()));
         }
-        let (stored, rom, warnings) = load_rom(&p, &path, None, no_estimate)?;
-        warn(&warnings);
+        let loaded = if full { None } else { Some(load_rom(&p, &path, estimate.method(), no_estimate)?) };
+        if let Some((_, _, warnings)) = &loaded {
+            warn(warnings);
+        }
+        // read before the runs (a damaged /timing fails now), said after them, failed runs or not
+        let notice = match &loaded {
+            Some((_, rom, _)) => flexrom::pipeline::route::speed_notice_of(&path, rom)?,
+            None => None,
+        };
+        let route = match &loaded {
+            Some((stored, rom, _)) => Route::Reduced { rom, basis: SweepBasis { stored, path: &path } },
+            None => Route::Full(&p.model),
+        };
         let options =
             flexrom::pipeline::sweep::SweepOptions { validate, continuation, progress: output::show_progress() };
-        let file = SweepFile { stored: &stored, basis_path: &path, out: &out, resume, extra: &|_| Ok(()) };
+        let file = SweepFile { out: &out, resume, extra: &|_| Ok(()) };
         let sw = match shard {
-            Some(k) => flexrom::pipeline::shard::sweep_shard(&p, &rom, &scales, k, options, file)?,
-            None => flexrom::pipeline::sweep::sweep_to_file(&rom, &scales, options, file)?,
+            Some(k) => flexrom::pipeline::shard::sweep_shard(&p, route, &scales, k, options, file)?,
+            None => flexrom::pipeline::sweep::sweep_to_file(route, &scales, options, file)?,
         };
         match format.format() {
             Format::Text => output::print(&flexrom::pipeline::sweep::table(&sw))?,
             f => print_table(&flexrom::pipeline::tables::sweep_table(&sw), f, false)?,
         }
         info(&format!(
-            "{}{} load scales ({} resumed) on {} threads in {:.3} s -> {}",
+            "{}{}{} load scales ({} resumed) on {} threads in {:.3} s -> {}",
             shard.map(|k| format!("shard {k}: ")).unwrap_or_default(),
+            if full { "full model, " } else { "" },
             sw.scales.len(),
             sw.resumed,
             sw.threads,
             sw.wall_seconds,
             out.display()
         ));
+        warn(notice.as_slice());
         // the good runs are written; the exit code (3) says that some failed
         if let Some(s) = sw.failure_summary() {
             return Err(flexrom::Error::PartlyFailed(format!(
@@ -117,12 +139,13 @@ impl Args {
                 out.display()
             )));
         }
+        let Some((_, rom, _)) = &loaded else { return Ok(()) };
         let runs: Vec<(f64, Option<f64>)> = sw
             .scales
             .iter()
             .filter_map(|x| x.point())
-            .map(|q| (q.rom.result.settings.load_scale, q.estimate.map(|e| e.error_estimate)))
+            .map(|q| (q.run.result.settings.load_scale, q.estimate.map(|e| e.in_measure(rom.tolerance_measure()))))
             .collect();
-        super::check_runs(&rom, &runs, strict)
+        super::check_runs(rom, &runs, strict)
     }
 }

@@ -65,10 +65,10 @@ impl Args {
         super::warn(&s.warnings);
         let b = &s.trained.basis;
         info(&format!(
-            "{}: {} snapshots from {} full run(s) ({:.3} s); {} basis, {} snapshots, {} POD modes{} (captured energy 1 − {:.2e}) -> {}",
+            "{}: {} snapshots from {} ({:.3} s); {} basis, {} snapshots, {} POD modes{} (captured energy 1 − {:.2e}) -> {}",
             p.path.display(),
             s.n_snapshots,
-            s.n_runs,
+            s.runs_text(),
             s.full_seconds,
             b.variant.name(),
             b.snapshots.name(),
@@ -88,6 +88,8 @@ impl Args {
             "n_pod_modes",
             "n_joint_coordinates",
             "uncaptured_energy",
+            "n_training_runs",
+            "n_held_out",
         ]);
         t.push(vec![
             p.path.display().to_string().into(),
@@ -100,6 +102,8 @@ impl Args {
             b.n_pod_modes.into(),
             b.kept.len().into(),
             s.trained.uncaptured_energy().into(),
+            s.n_training_runs().into(),
+            s.n_held_out().into(),
         ]);
         print_table(&t, format.format(), true)
     }

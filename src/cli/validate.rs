@@ -1,6 +1,6 @@
 //! `flexrom validate`: full and reduced runs at one load scale, compared.
 
-use super::{check_scale, warn, DenseArgs, FormatArgs};
+use super::{check_scale, warn, DenseArgs, EstimateArgs, FormatArgs};
 use flexrom::output::table::{Format, Table};
 use flexrom::output::{self};
 use flexrom::pipeline::online::load_rom;
@@ -27,11 +27,13 @@ pub struct Args {
     /// tolerance ([online] tolerance, default the training tolerance)
     #[arg(long)]
     strict: bool,
+    #[command(flatten)]
+    estimate: EstimateArgs,
 }
 
 impl Args {
     pub fn run(self) -> flexrom::Result<()> {
-        let Args { pipeline, load_scale, format, basis, dense, strict } = self;
+        let Args { pipeline, load_scale, format, basis, dense, strict, estimate } = self;
         let p = Pipeline::load(&pipeline)?;
         let scales = match load_scale {
             Some(x) => {
@@ -41,7 +43,7 @@ impl Args {
             None => p.validate_scales(),
         };
         let path = basis.unwrap_or_else(|| p.basis_path.clone());
-        let (_, rom, warnings) = load_rom(&p, &path, None, false)?;
+        let (_, rom, warnings) = load_rom(&p, &path, estimate.method(), false)?;
         warn(&warnings);
         let with_dense = flexrom::pipeline::dense::decide(dense.choice(), &p.model)?;
         let mut vs = Vec::with_capacity(scales.len());
@@ -70,7 +72,8 @@ impl Args {
             }
             Format::Text => {}
         }
-        let runs: Vec<(f64, Option<f64>)> = vs.iter().map(|v| (v.load_scale, v.error_estimate)).collect();
+        let measure = rom.tolerance_measure();
+        let runs: Vec<(f64, Option<f64>)> = vs.iter().map(|v| (v.load_scale, v.estimate_in(measure))).collect();
         super::check_runs(&rom, &runs, strict)
     }
 }

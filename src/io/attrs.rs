@@ -93,7 +93,7 @@ const RESULT: [Entry; 8] = [
     ("reduced/q", REDUCED_UNITS, "time, mode"),
 ];
 
-const BASIS: [Entry; 43] = [
+const BASIS: [Entry; 46] = [
     ("snapshots", COORDINATE_UNITS, "dof, snapshot"),
     ("snapshot_multipliers", MULTIPLIER_UNITS, "constraint, snapshot"),
     ("snapshot_load_scale", "1", "snapshot"),
@@ -137,9 +137,12 @@ const BASIS: [Entry; 43] = [
     ("training/sensitivity", "1", "iteration, candidate"),
     ("training/true_score", "1", "iteration"),
     ("training/held_out_effectivity", "1", "iteration"),
+    ("timing/full_seconds", "s", ""),
+    ("timing/reduced_seconds", "s", ""),
+    ("timing/estimate_seconds", "s", ""),
 ];
 
-const SWEEP: [Entry; 22] = [
+const SWEEP: [Entry; 25] = [
     ("load_scales", "1", "load"),
     ("status", "1", "load"),
     ("message", TEXT, "load"),
@@ -153,6 +156,8 @@ const SWEEP: [Entry; 22] = [
     ("error_estimate", "1", "load"),
     // the estimate per fifth of the run
     ("error_estimate_by_time", "1", "load, fifth"),
+    ("error_estimate_displacement", "1", "load"),
+    ("error_estimate_displacement_by_time", "1", "load, fifth"),
     ("estimate_seconds", "s", "load"),
     ("extrapolated", "1", "load"),
     ("rel_error", "1", "load"),
@@ -161,6 +166,7 @@ const SWEEP: [Entry; 22] = [
     ("full_seconds", "s", "load"),
     ("speedup", "1", "load"),
     ("steps_differ_from", "s", "load"),
+    ("displacement_error", "1", "load"),
     ("shard/all_load_scales", "1", "all loads"),
     ("shard/indices", "1", "load"),
 ];

@@ -21,11 +21,15 @@
 //! /training/range             (2)          [min, max] training load scale (greedy training;
 //!                                          otherwise min/max of /snapshot_load_scale)
 //! /training/tolerance or attribute `tolerance` on /training: greedy's tolerance
+//!   attribute `measure` on /training: the error that tolerance is on ("relative" or
+//!   "displacement"; files written before 2026-11-26 have none: relative)
 //! ```
 
 use super::h5::{attr_f64, attr_str, attr_u64, read_attr_f64, read_attr_str};
 use crate::error::{Error, Result};
-use crate::reduction::estimator::{Calibration, CalibrationPoint, DefectsCalibration, EstimateMethod, Estimator};
+use crate::reduction::estimator::{
+    Calibration, CalibrationPoint, DefectsCalibration, ErrorMeasure, EstimateMethod, Estimator,
+};
 use crate::reduction::{Basis, Hyper};
 use ndarray::Array1;
 use std::path::Path;
@@ -259,6 +263,24 @@ pub fn read_training_range(path: &Path) -> Result<(f64, f64)> {
     Ok((lo, hi))
 }
 
+/// The loads of the full runs whose snapshots the basis holds, sorted, each once:
+/// `/training/load_scales` (greedy training), else the values of `/snapshot_load_scale`.
+pub fn read_training_loads(path: &Path) -> Result<Vec<f64>> {
+    let f = hdf5::File::open(path)
+        .map_err(|e| Error::input(path, "(file)", format!("is not a readable HDF5 file: {e}")))?;
+    let mut l: Vec<f64> = match f.dataset("training/load_scales") {
+        Ok(d) => d.read_1d::<f64>().map_err(|e| Error::input(path, "training/load_scales", e.to_string()))?.to_vec(),
+        Err(_) => f
+            .dataset("snapshot_load_scale")
+            .and_then(|d| d.read_1d::<f64>())
+            .map_err(|e| Error::input(path, "snapshot_load_scale", e.to_string()))?
+            .to_vec(),
+    };
+    l.sort_by(f64::total_cmp);
+    l.dedup();
+    Ok(l)
+}
+
 /// Greedy training's tolerance: the dataset `/training/tolerance` or the attribute
 /// `tolerance` on `/training`; `None` without greedy training.
 pub fn read_training_tolerance(path: &Path) -> Result<Option<f64>> {
@@ -277,4 +299,18 @@ pub fn read_training_tolerance(path: &Path) -> Result<Option<f64>> {
         return Err(Error::input(path, "training/tolerance", format!("is {t}; it must be positive and finite")));
     }
     Ok(Some(t))
+}
+
+/// The error greedy training's tolerance is on: the attribute `measure` on `/training`;
+/// relative without one (files written before the attribute, bases of fixed loads).
+pub fn read_training_measure(path: &Path) -> Result<ErrorMeasure> {
+    let f = hdf5::File::open(path)
+        .map_err(|e| Error::input(path, "(file)", format!("is not a readable HDF5 file: {e}")))?;
+    let Ok(g) = f.group("training") else { return Ok(ErrorMeasure::Relative) };
+    if g.attr("measure").is_err() {
+        return Ok(ErrorMeasure::Relative);
+    }
+    let m = read_attr_str(&g, "measure")
+        .map_err(|e| Error::input(path, "training/measure", format!("cannot be read: {e}")))?;
+    ErrorMeasure::parse(&m).map_err(|p| Error::input(path, "training/measure", p))
 }

@@ -12,3 +12,4 @@ pub mod h5_text;
 pub mod labels;
 pub mod output;
 pub mod result_file;
+pub mod timing_file;

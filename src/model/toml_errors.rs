@@ -166,12 +166,89 @@ fn locate(text: &str, pos: usize) -> String {
         }
     }
     let this = text.lines().nth(line - 1).unwrap_or("");
-    let key = this.split('=').next().unwrap_or("").trim();
-    let key = if this.contains('=') && !key.is_empty() { key } else { "" };
+    // the keys down to `pos` through the inline tables of the line (`greedy = { …, measure =
+    // "x" }`: greedy.measure), else the line's first key
+    let line_start = text.as_bytes()[..pos.min(text.len())].iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+    let inline = text.get(line_start..pos.min(text.len())).map(inline_key_path).unwrap_or_default();
+    let first = this.split('=').next().unwrap_or("").trim();
+    let key = if !inline.is_empty() {
+        inline.join(".")
+    } else if this.contains('=') && !first.is_empty() {
+        first.to_string()
+    } else {
+        String::new()
+    };
     match (table.is_empty(), key.is_empty()) {
         (true, true) => format!("line {line}"),
         (true, false) => format!("{key} (line {line})"),
         (false, true) => format!("{table} (line {line})"),
         (false, false) => format!("{table}.{key} (line {line})"),
+    }
+}
+
+/// The keys that lead to the end of `prefix` (the start of a line up to an error's
+/// position) through inline tables: `greedy = { range = [0.5, 1.5], measure = ` gives
+/// `["greedy", "measure"]`. Empty when the prefix ends on no `key =` (a header, a key
+/// already closed by a `,`). Strings are skipped, so a `=`, `{` or `,` inside one counts
+/// for nothing, and so is everything inside arrays but their nested inline tables.
+fn inline_key_path(prefix: &str) -> Vec<String> {
+    let (mut open, mut current, mut token) = (Vec::<String>::new(), None::<String>, String::new());
+    let mut arrays = 0_usize;
+    let mut chars = prefix.chars();
+    while let Some(c) = chars.next() {
+        match c {
+            '"' | '\'' => {
+                // to the closing quote (a basic string's \" does not close it)
+                let mut escaped = false;
+                for d in chars.by_ref() {
+                    if d == c && !(escaped && c == '"') {
+                        break;
+                    }
+                    escaped = d == '\\' && !escaped;
+                }
+            }
+            '=' => current = Some(token.trim().to_string()).filter(|k| !k.is_empty()),
+            '{' => open.extend(current.take()),
+            '}' => {
+                open.pop();
+                current = None;
+            }
+            '[' => arrays += 1,
+            ']' => arrays = arrays.saturating_sub(1),
+            ',' if arrays == 0 => current = None,
+            _ => {}
+        }
+        if matches!(c, '=' | '{' | '}' | ',' | '[' | ']' | '"' | '\'') {
+            token.clear();
+        } else {
+            token.push(c);
+        }
+    }
+    match current {
+        Some(k) => {
+            open.push(k);
+            open
+        }
+        None => Vec::new(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{inline_key_path, locate};
+
+    /// The key path through inline tables to an error's position: nested tables, arrays and
+    /// strings holding `=`, `,` or `{` passed over; none after a closed entry.
+    #[test]
+    fn inline_keys_lead_to_the_position() {
+        assert_eq!(inline_key_path("greedy = { range = [0.5, 1.5], measure = "), ["greedy", "measure"]);
+        assert_eq!(inline_key_path("a = { b = { c = "), ["a", "b", "c"]);
+        assert_eq!(inline_key_path("a = { s = \"x = {, y\", t = "), ["a", "t"]);
+        assert_eq!(inline_key_path("a = { b = 1, "), Vec::<String>::new());
+        assert_eq!(inline_key_path("range = [0.5, "), ["range"]);
+        assert_eq!(inline_key_path(""), Vec::<String>::new());
+        let text = "[train]\ngreedy = { range = [0.5, 1.5], measure = \"x\" }\n";
+        assert_eq!(locate(text, text.find("\"x\"").unwrap()), "train.greedy.measure (line 2)");
+        assert_eq!(locate(text, 0), "train (line 1)");
     }
 }

@@ -8,7 +8,8 @@
 //! [train]
 //! load_scales = [1.0]                       # or, over a load range (docs/greedy-training.md):
 //!                                           # greedy = { range = [0.5, 1.5], tolerance = 1e-3,
-//!                                           #            max_runs = 8, candidates = 33 }
+//!                                           #            max_runs = 8, candidates = 33,
+//!                                           #            measure = "relative" }
 //! snapshots = "reference"                   # or "raw" (the thesis)
 //! [reduction]                               # with greedy: optional, or partial
 //! variant = "galerkin"                      # or "constraint-preserving", "whole-system",
@@ -22,6 +23,7 @@
 //! load_scales = "0.5:1.5:21"                # or a list
 //! tolerance = 1e-3                          # error estimates above it warn (--strict: exit 4);
 //!                                           # default: greedy training's tolerance, if any
+//! tolerance_measure = "relative"            # or "displacement" (default: greedy's `measure`)
 //! [validate]
 //! load_scales = [0.8, 1.0, 1.2]
 //! ```
@@ -31,7 +33,7 @@ mod schema;
 
 use crate::error::{Error, Result};
 use crate::model::Model;
-pub use crate::reduction::estimator::EstimateMethod;
+pub use crate::reduction::estimator::{ErrorMeasure, EstimateMethod};
 use crate::reduction::{ModeRule, Variant};
 use scales::check_scales;
 pub use scales::{parse_range, Scales, MAX_LOAD_SCALES};
@@ -162,6 +164,15 @@ impl Pipeline {
                 return bad("online.tolerance", format!("is {t}; it must be positive and finite"));
             }
         }
+        if let Some(m) = self.file.online.as_ref().filter(|o| o.tolerance.is_none()).and_then(|o| o.tolerance_measure) {
+            return bad(
+                "online.tolerance_measure",
+                format!(
+                    "is \"{}\" but there is no online.tolerance for it to apply to (the training tolerance keeps the measure training used)",
+                    m.name()
+                ),
+            );
+        }
         Ok(())
     }
 
@@ -211,6 +222,11 @@ impl Pipeline {
     /// `[online] tolerance`, when given.
     pub fn online_tolerance(&self) -> Option<f64> {
         self.file.online.as_ref().and_then(|o| o.tolerance)
+    }
+
+    /// `[online] tolerance_measure`, when given (only with `[online] tolerance`).
+    pub fn online_tolerance_measure(&self) -> Option<ErrorMeasure> {
+        self.file.online.as_ref().and_then(|o| o.tolerance_measure)
     }
 
     /// `[validate] load_scales` (`run`'s validation, and `validate` without `--load-scale`),

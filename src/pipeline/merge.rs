@@ -5,8 +5,9 @@
 //! (the parts ran side by side) and `threads` the sum of the parts' threads.
 //!
 //! Checks, each failing with one line that names the file: every part is a part file (has
-//! `/shard`), all come from the same load list (hash), the same shard count, the same basis
-//! content and model, and the same options (`--validate`, `--continuation`). Two parts of
+//! `/shard`), all come from the same load list (hash), the same shard count, the same route
+//! (all reduced or all `--full`), the same basis content and model, and the same options
+//! (`--validate`, `--continuation`). Two parts of
 //! the same shard are refused (naming both files and the loads); a missing shard, or loads a
 //! part has not run yet (a killed shard), are refused naming the loads, unless `--partial`,
 //! which merges what is there and marks the gaps `status` 2 ("not run yet"), so that
@@ -15,7 +16,7 @@
 use super::config::Pipeline;
 use super::online::load_basis;
 use super::shard::load_list_hash;
-use super::sweep::{read_sweep, write_sweep, Outcome, ScaleResult, Sweep, STATUS_FAILED, STATUS_OK};
+use super::sweep::{read_sweep, write_sweep, Outcome, ScaleResult, Sweep, SweepBasis, STATUS_FAILED, STATUS_OK};
 use crate::error::{Error, Result};
 use crate::io::h5::{read_attr_f64, read_attr_str};
 use crate::simulate::{Overrides, Settings};
@@ -33,15 +34,22 @@ struct Part {
     indices: Vec<usize>,
     status: Vec<u8>,
     message: Vec<String>,
-    basis_hash: String,
+    /// a part of a full sweep (`--full`): no basis
+    full: bool,
+    /// the basis of a reduced sweep's part: its content hash, its path on `/shard` and on `/`
+    basis: Option<PartBasis>,
     model_fingerprint: String,
     validated: bool,
     continuation: bool,
     wall_seconds: f64,
     threads: u64,
     pipeline: PathBuf,
-    basis: PathBuf,
-    basis_attr: String,
+}
+
+struct PartBasis {
+    hash: String,
+    path: PathBuf,
+    attr: String,
 }
 
 fn read_part(path: &Path) -> Result<Part> {
@@ -123,6 +131,17 @@ fn read_part(path: &Path) -> Result<Part> {
             .map(|v| v != 0)
             .map_err(|e| bad(name, format!("cannot be read: {e}")))
     };
+    // parts written before the attribute are of reduced sweeps
+    let full = f.attr("route").is_ok() && s(&f, "route")? == "full";
+    let basis = if full {
+        None
+    } else {
+        Some(PartBasis {
+            hash: s(&f, "basis_content_hash")?,
+            path: PathBuf::from(s(&g, "basis")?),
+            attr: s(&f, "basis")?,
+        })
+    };
     Ok(Part {
         path: path.to_path_buf(),
         index,
@@ -132,15 +151,14 @@ fn read_part(path: &Path) -> Result<Part> {
         indices,
         status,
         message,
-        basis_hash: s(&f, "basis_content_hash")?,
+        full,
+        basis,
         model_fingerprint: s(&f, "model_fingerprint")?,
         validated: flag("validated")?,
         continuation: flag("continuation")?,
         wall_seconds: read_attr_f64(&f, "wall_seconds").unwrap_or(f64::NAN),
         threads: f.attr("threads").and_then(|a| a.read_scalar::<u64>()).unwrap_or(1),
         pipeline: PathBuf::from(s(&g, "pipeline")?),
-        basis: PathBuf::from(s(&g, "basis")?),
-        basis_attr: s(&f, "basis")?,
     })
 }
 
@@ -176,7 +194,20 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool) -> Result<Merged> {
                 format!("{what} than {}; parts of different sweeps cannot be merged", first.path.display()),
             )
         };
-        if p.basis_hash != first.basis_hash {
+        if p.full != first.full {
+            let kind = |full: bool| if full { "the full model (`sweep --full`)" } else { "a reduced model" };
+            return Err(Error::input(
+                &p.path,
+                "route",
+                format!(
+                    "is a sweep of {} and {} one of {}; parts of different sweeps cannot be merged",
+                    kind(p.full),
+                    first.path.display(),
+                    kind(first.full)
+                ),
+            ));
+        }
+        if p.basis.as_ref().map(|b| &b.hash) != first.basis.as_ref().map(|b| &b.hash) {
             return Err(differ("basis_content_hash", "comes from another basis"));
         }
         if p.model_fingerprint != first.model_fingerprint {
@@ -248,24 +279,32 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool) -> Result<Merged> {
     }
     // the model and basis the parts were run with, checked against the parts' basis hash
     let pipeline = Pipeline::load(&first.pipeline)?;
-    let stored = load_basis(&pipeline, &first.basis)?;
-    if stored.content_hash != first.basis_hash {
-        return Err(Error::input(
-            &first.basis,
-            "basis_content_hash",
-            format!(
-                "differs from the one the parts were swept with ({}): the basis changed since; rerun the sweep",
-                first.path.display()
-            ),
-        ));
-    }
+    let stored = match &first.basis {
+        None => None,
+        Some(b) => {
+            let stored = load_basis(&pipeline, &b.path)?;
+            if stored.content_hash != b.hash {
+                return Err(Error::input(
+                    &b.path,
+                    "basis_content_hash",
+                    format!(
+                        "differs from the one the parts were swept with ({}): the basis changed since; rerun the sweep",
+                        first.path.display()
+                    ),
+                ));
+            }
+            Some(stored)
+        }
+    };
     let model = &pipeline.model;
     let s = Settings::resolve(model, &Overrides::default())?;
     let mut sweep = Sweep {
         scales: all.iter().map(|&x| ScaleResult { load_scale: x, outcome: Outcome::Pending }).collect(),
         t: Array1::from_iter((0..=s.n_steps).map(|k| k as f64 * s.dt)),
         probe_names: model.probe_names(),
-        n_reduced: stored.basis.n_reduced(),
+        n_reduced: stored.as_ref().map_or(0, |b| b.basis.n_reduced()),
+        full: first.full,
+        model_fingerprint: model.fingerprint(),
         validated: first.validated,
         wall_seconds: parts.iter().map(|p| p.wall_seconds).fold(0.0, f64::max),
         threads: parts.iter().map(|p| p.threads as usize).sum(),
@@ -273,7 +312,7 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool) -> Result<Merged> {
         resumed: 0,
     };
     for p in &parts {
-        let rows = read_sweep(&p.path, model, &stored, p.validated)?;
+        let rows = read_sweep(&p.path, model, stored.as_ref(), p.validated)?;
         for (j, (_, point)) in rows.into_iter().enumerate() {
             let i = p.indices[j];
             sweep.scales[i].outcome = match (p.status[j], point) {
@@ -284,6 +323,8 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool) -> Result<Merged> {
         }
     }
     let gaps = sweep.scales.iter().filter(|x| matches!(x.outcome, Outcome::Pending)).count();
-    write_sweep(out, &sweep, &stored, Path::new(&first.basis_attr))?;
+    let basis =
+        stored.as_ref().zip(first.basis.as_ref()).map(|(stored, b)| SweepBasis { stored, path: Path::new(&b.attr) });
+    write_sweep(out, &sweep, basis)?;
     Ok(Merged { sweep, gaps, parts: parts.len() })
 }

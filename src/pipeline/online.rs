@@ -20,7 +20,7 @@ pub fn load_basis(p: &Pipeline, path: &Path) -> Result<StoredBasis> {
 /// Reads and checks the basis file at `path` and builds its reduced model with the error
 /// estimator by `method` (else the pipeline's `[online] estimate`, else the one the basis
 /// file names; none with `no_estimate`), held to the pipeline's `[online] tolerance` (else
-/// the training tolerance). Returns the warnings a user should see.
+/// the training tolerance) in its measure. Returns the warnings a user should see.
 pub fn load_rom(
     p: &Pipeline,
     path: &Path,
@@ -31,6 +31,7 @@ pub fn load_rom(
     let o = LoadOptions {
         method: method.or_else(|| p.file.online.as_ref().and_then(|o| o.estimate)),
         tolerance: p.online_tolerance(),
+        tolerance_measure: p.online_tolerance_measure(),
         no_estimate,
     };
     let (rom, more) = Rom::load(&p.model, path, &stored, o)?;

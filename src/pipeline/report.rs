@@ -3,10 +3,10 @@
 //! The folder is built beside the target and renamed into place at the end, the basis
 //! written under a temporary name and renamed into place only when every stage succeeded.
 
-use super::config::Pipeline;
+use super::config::{EstimateMethod, Pipeline};
 use super::online::load_rom;
 use super::plot::{Figure, Panel, Series, Style};
-use super::sweep::{sweep, table, write_sweep, SweepOptions};
+use super::sweep::{sweep, table, write_sweep, SweepBasis, SweepOptions};
 use super::train::train_and_write;
 use super::validate::{validate, Validation};
 use crate::error::{Error, Result};
@@ -35,18 +35,24 @@ pub fn check_outputs(p: &Pipeline) -> Result<()> {
 /// were and the temporary ones removed. Returns the report folder and the training's
 /// warnings.
 pub fn run(p: &Pipeline, progress: bool) -> Result<(PathBuf, Vec<String>)> {
-    run_with(p, progress, super::dense::DenseChoice::Auto)
+    run_with(p, progress, super::dense::DenseChoice::Auto, None)
 }
 
 /// [`run`] with the choice of the dense-LU comparison ([`super::dense`]), decided before
-/// any work.
-pub fn run_with(p: &Pipeline, progress: bool, dense: super::dense::DenseChoice) -> Result<(PathBuf, Vec<String>)> {
+/// any work, and the error estimate's method (`--estimate`; `None`: the pipeline's
+/// `[online] estimate`, else the basis's default).
+pub fn run_with(
+    p: &Pipeline,
+    progress: bool,
+    dense: super::dense::DenseChoice,
+    method: Option<EstimateMethod>,
+) -> Result<(PathBuf, Vec<String>)> {
     check_outputs(p)?;
     let dense = super::dense::decide(dense, &p.model)?;
     let dir = p.report_dir.clone();
     let report = TempPath::dir_for(&dir)?;
     let basis = TempPath::file_for(&p.basis_path)?;
-    let warnings = build(p, report.path(), basis.path(), progress, dense)?;
+    let warnings = build(p, report.path(), basis.path(), progress, (dense, method))?;
     mark_new_report(report.path())?;
     // checked again: the folder or the basis path may have changed during a long run
     check_outputs(p)?;
@@ -57,20 +63,27 @@ pub fn run_with(p: &Pipeline, progress: bool, dense: super::dense::DenseChoice) 
 
 /// Every stage, writing the basis to `basis_path` (a temporary name) and the report files
 /// into `out` (a temporary folder); the files are `fsync`ed when the folder is swapped in.
-fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: bool) -> Result<Vec<String>> {
+fn build(
+    p: &Pipeline,
+    out: &Path,
+    basis_path: &Path,
+    progress: bool,
+    (dense, method): (bool, Option<EstimateMethod>),
+) -> Result<Vec<String>> {
     let plot_err = |e: String| Error::io(out, std::io::Error::other(e));
     match &p.file.train.greedy {
         Some(g) => crate::output::info(&format!("[1/3] train: greedy over [{}, {}]", g.range().0, g.range().1)),
         None => crate::output::info(&format!("[1/3] train: {} full run(s)", p.training_scales().len())),
     }
-    let trained = train_and_write(p, basis_path)?;
+    let mut trained = train_and_write(p, basis_path)?;
     // the warnings of loading it come with `check_report`'s, once
-    let (stored, rom, _) = load_rom(p, basis_path, None, false)?;
+    let (stored, rom, _) = load_rom(p, basis_path, method, false)?;
+    trained.warnings.extend(super::route::time_and_store(&rom, basis_path)?);
 
     let scales = p.online_scales();
     crate::output::info(&format!("[2/3] sweep: {} reduced and full runs", scales.len()));
     let sw = sweep(&rom, &scales, SweepOptions { validate: true, continuation: false, progress })?;
-    write_sweep(&out.join("sweep.h5"), &sw, &stored, &p.basis_path)?;
+    write_sweep(&out.join("sweep.h5"), &sw, Some(SweepBasis { stored: &stored, path: &p.basis_path }))?;
     // the plots and tables below need every load scale
     if let Some(s) = sw.failure_summary() {
         return Err(Error::PartlyFailed(format!("sweep: {s}; no report written (the basis is)")));
@@ -170,23 +183,7 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: boo
         sw.done().filter_map(|q| q.validation.as_ref()).map(|v| (v.load_scale, f(v))).collect()
     };
     // the loads of the full runs the basis was trained on, marked on the plots against λ
-    let training: Vec<f64> = {
-        let f = hdf5::File::open(basis_path).map_err(|e| Error::hdf5(basis_path, e))?;
-        let mut l: Vec<f64> = match f.dataset("training/load_scales") {
-            Ok(d) => d
-                .read_1d::<f64>()
-                .map_err(|e| Error::input(basis_path, "training/load_scales", e.to_string()))?
-                .to_vec(),
-            Err(_) => f
-                .dataset("snapshot_load_scale")
-                .and_then(|d| d.read_1d::<f64>())
-                .map_err(|e| Error::input(basis_path, "snapshot_load_scale", e.to_string()))?
-                .to_vec(),
-        };
-        l.sort_by(f64::total_cmp);
-        l.dedup();
-        l
-    };
+    let training = crate::io::estimator_file::read_training_loads(basis_path)?;
     single(
         "Reduced vs full model",
         "load scale",
@@ -217,7 +214,7 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: boo
         .scales
         .iter()
         .filter_map(|x| x.point())
-        .filter_map(|q| q.estimate.map(|e| (q.rom.result.settings.load_scale, e.error_estimate)))
+        .filter_map(|q| q.estimate.map(|e| (q.run.result.settings.load_scale, e.error_estimate)))
         .collect();
     let mut errors = pts(&|v| v.rel_error);
     errors.extend(validations.iter().map(|v| (v.load_scale, v.rel_error)));
@@ -277,9 +274,23 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: boo
         b.n_dof(),
         &p.model.fingerprint()[..12]
     );
+    // a held-out check run is named as such: its load is not among the basis's
+    let held_out = match trained.held_out_loads().as_slice() {
+        [] => String::new(),
+        loads => format!(
+            " ({}) + {} held-out check at λ = {} (not in the basis)",
+            if trained.n_training_runs() == 1 {
+                "1 training run".to_string()
+            } else {
+                format!("{} training runs", trained.n_training_runs())
+            },
+            loads.len(),
+            loads.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(", ")
+        ),
+    };
     let _ = writeln!(
         md,
-        "- basis: `{}`: {} reduction, {} snapshots, rule `{}` → {} POD modes{}, {} snapshots from load scales {:?}",
+        "- basis: `{}`: {} reduction, {} snapshots, rule `{}` → {} POD modes{}, {} snapshots from load scales {:?}{held_out}",
         p.basis_path.display(),
         b.variant.name(),
         b.snapshots.name(),
@@ -316,6 +327,18 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: boo
             v.speedup_vs_dense.unwrap_or(f64::NAN)
         );
     }
+    let mut warnings = trained.warnings;
+    if let Some(speed) = route_comparison(&validations) {
+        let _ = writeln!(md, "\n## Full or reduced\n");
+        let _ = writeln!(
+            md,
+            "{} Time loops on one thread: the median over the validated loads of the medians above{}.",
+            speed.verdict(),
+            if speed.estimate.is_some() { " (the estimate: one run at each load)" } else { "" }
+        );
+        let measured = format!("medians of `run`'s validation at {} load(s)", validations.len());
+        warnings.extend(speed.notice(&p.path, &measured));
+    }
     let _ = writeln!(md, "\n## Error estimate, extrapolation, sensitivity\n");
     let trust = rom.trust().expect("read from its basis file");
     let _ = writeln!(
@@ -349,6 +372,7 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: boo
             est_by
         );
     }
+    motion_section(&mut md, &validations, trust);
     let _ = writeln!(md, "\n## Sweep\n\n```text\n{}```\n", table(&sw));
     let _ = writeln!(md, "## Plots\n");
     for (i, x) in vscales.iter().enumerate() {
@@ -363,14 +387,50 @@ fn build(p: &Pipeline, out: &Path, basis_path: &Path, progress: bool, dense: boo
     }
     let _ = writeln!(md, "![error by time](error_by_time.svg)");
     std::fs::write(out.join("summary.md"), md).map_err(|e| Error::io(out, e))?;
-    Ok(trained.warnings)
+    Ok(warnings)
+}
+
+/// The summary's section on the errors against the motion: displacement_error and its
+/// estimate, each probe's error over its travel.
+fn motion_section(md: &mut String, validations: &[Validation], trust: &crate::rom::Trust) {
+    let _ = writeln!(md, "\n## Errors against the motion\n");
+    let _ = writeln!(
+        md,
+        "rel_error divides by ‖X_full‖, which holds the undeformed geometry and the unit slopes; displacement_error = ‖X_rom − X_full‖ / ‖X_full − X₀‖ measures the error against the motion from the initial configuration X₀, and a probe's error over its travel is max_t |r_rom − r_full| / max_t |r_full(t) − r_full(0)| (docs/error-estimate.md). The tolerance is on {}.\n",
+        trust.measure.error_name()
+    );
+    let _ = writeln!(md, "| load scale | rel_error | displacement_error | error_estimate_displacement | effectivity | displacement_error by fifth of the run | probe error over its travel |");
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|");
+    for v in validations {
+        let by: Vec<String> = v.displacement_error_by_time.iter().map(|e| format!("{e:.2e}")).collect();
+        let probes: Vec<String> = v
+            .probe_errors_over_travel
+            .iter()
+            .map(|p| match p.error_over_travel {
+                Some(e) => format!("{} {e:.2e} ({:.2e} m of {:.3} m)", p.probe, p.max_error, p.travel),
+                None => format!("{} (does not move)", p.probe),
+            })
+            .collect();
+        let o = |x: Option<f64>, f: &dyn Fn(f64) -> String| x.map_or("–".to_string(), f);
+        let _ = writeln!(
+            md,
+            "| {} | {:.3e} | {:.3e} | {} | {} | {} | {} |",
+            v.load_scale,
+            v.rel_error,
+            v.displacement_error,
+            o(v.error_estimate_displacement, &|x| format!("{x:.3e}")),
+            o(v.effectivity_displacement, &|x| format!("{x:.2}")),
+            by.join(", "),
+            probes.join("; ")
+        );
+    }
 }
 
 /// After `run`: the warnings of the report's basis and sweep (read back from its
 /// `sweep.h5`: extrapolation, estimates above the tolerance), and `--strict`'s error when an
-/// estimate exceeds the tolerance.
-pub fn check_report(p: &Pipeline, dir: &Path, strict: bool) -> Result<Vec<String>> {
-    let (_, rom, mut warnings) = load_rom(p, &p.basis_path, None, false)?;
+/// estimate exceeds the tolerance (`method`: the estimate's, as `run_with` was given it).
+pub fn check_report(p: &Pipeline, dir: &Path, strict: bool, method: Option<EstimateMethod>) -> Result<Vec<String>> {
+    let (_, rom, mut warnings) = load_rom(p, &p.basis_path, method, false)?;
     let path = dir.join("sweep.h5");
     let f = hdf5::File::open(&path).map_err(|e| Error::hdf5(&path, e))?;
     let read = |name: &str| {
@@ -378,10 +438,29 @@ pub fn check_report(p: &Pipeline, dir: &Path, strict: bool) -> Result<Vec<String
             .and_then(|d| d.read_1d::<f64>())
             .map_err(|e| Error::input(&path, name, format!("cannot be read: {e}")))
     };
-    let (scales, est) = (read("load_scales")?, read("error_estimate")?);
+    let trust = rom.trust().expect("read from its basis file");
+    let estimates = match trust.measure {
+        crate::rom::estimator::ErrorMeasure::Relative => "error_estimate",
+        crate::rom::estimator::ErrorMeasure::Displacement => "error_estimate_displacement",
+    };
+    let (scales, est) = (read("load_scales")?, read(estimates)?);
     let runs: Vec<(f64, Option<f64>)> =
         scales.iter().zip(&est).map(|(&x, &e)| (x, if e.is_nan() { None } else { Some(e) })).collect();
-    let trust = rom.trust().expect("read from its basis file");
     warnings.extend(crate::rom::trust::check_runs(trust, rom.estimator().is_some(), &runs, strict)?);
     Ok(warnings)
+}
+
+/// The two routes' times per run from the validation's medians (the median over the
+/// validated loads of each; the estimate counts when every validated run has one); `None`
+/// without validated loads.
+fn route_comparison(validations: &[Validation]) -> Option<super::route::Comparison> {
+    let mid = |f: &dyn Fn(&Validation) -> Option<f64>| -> Option<f64> {
+        let mut x: Vec<f64> = validations.iter().map(f).collect::<Option<_>>()?;
+        (!x.is_empty()).then(|| super::timing::median(&mut x))
+    };
+    Some(super::route::Comparison {
+        full: mid(&|v| Some(v.full_seconds))?,
+        reduced: mid(&|v| Some(v.rom_seconds))?,
+        estimate: mid(&|v| v.estimate_seconds),
+    })
 }

@@ -14,15 +14,14 @@
 //! /shard/all_load_scales   (N_all)     the whole list, as the sweep was asked for
 //! /shard/indices           (n_part)    u64: row j of the part is load all_load_scales[indices[j]]
 //! attributes on /shard: index (K, 1-based), count (N), load_list_hash (SHA-256 hex of the
-//!   list: its length, then each value's IEEE-754 bits, little-endian), pipeline and basis
-//!   (absolute paths, for `merge`)
+//!   list: its length, then each value's IEEE-754 bits, little-endian), pipeline and, for a
+//!   reduced sweep, basis (absolute paths, for `merge`)
 //! ```
 
 use super::config::Pipeline;
-use super::sweep::{sweep_to_file, Sweep, SweepFile, SweepOptions};
+use super::sweep::{sweep_to_file, Route, Sweep, SweepFile, SweepOptions};
 use crate::error::{Error, Result};
 use crate::io::h5::{attr_str, attr_u64};
-use crate::rom::Rom;
 use ndarray::Array1;
 use sha2::{Digest, Sha256};
 
@@ -87,15 +86,23 @@ pub fn shard_scales(all: &[f64], shard: Shard) -> Result<(Vec<usize>, Vec<f64>)>
     Ok((idx, scales))
 }
 
-/// Runs the loads of `shard` and writes the part file `out` (checkpointed like a sweep,
-/// every version with its `/shard` group, so a killed shard leaves a part that `--resume`
-/// finishes and `merge --partial` reads). `f.extra` is replaced by the shard's group.
-pub fn sweep_shard(p: &Pipeline, rom: &Rom, all: &[f64], shard: Shard, o: SweepOptions, f: SweepFile) -> Result<Sweep> {
-    let (basis_path, out) = (f.basis_path, f.out);
+/// Runs the loads of `shard` by `route` and writes the part file `out` (checkpointed like
+/// a sweep, every version with its `/shard` group, so a killed shard leaves a part that
+/// `--resume` finishes and `merge --partial` reads). `f.extra` is replaced by the shard's
+/// group.
+pub fn sweep_shard(
+    p: &Pipeline,
+    route: Route,
+    all: &[f64],
+    shard: Shard,
+    o: SweepOptions,
+    f: SweepFile,
+) -> Result<Sweep> {
+    let out = f.out;
     let (idx, scales) = shard_scales(all, shard)?;
     let hash = load_list_hash(all);
     let pipeline = crate::io::output::resolve(&p.path).display().to_string();
-    let basis = crate::io::output::resolve(basis_path).display().to_string();
+    let basis = route.basis().map(|b| crate::io::output::resolve(b.path).display().to_string());
     let extra = |f: &hdf5::File| -> Result<()> {
         let e = |err: hdf5::Error| Error::hdf5(out, err);
         let g = f.create_group("shard").map_err(e)?;
@@ -108,9 +115,12 @@ pub fn sweep_shard(p: &Pipeline, rom: &Rom, all: &[f64], shard: Shard, o: SweepO
         attr_u64(&g, "count", shard.count as u64).map_err(e)?;
         attr_str(&g, "load_list_hash", &hash).map_err(e)?;
         attr_str(&g, "pipeline", &pipeline).map_err(e)?;
-        attr_str(&g, "basis", &basis).map_err(e)
+        match &basis {
+            Some(b) => attr_str(&g, "basis", b).map_err(e),
+            None => Ok(()),
+        }
     };
-    sweep_to_file(rom, &scales, o, SweepFile { extra: &extra, ..f })
+    sweep_to_file(route, &scales, o, SweepFile { extra: &extra, ..f })
 }
 
 /// Sets the size of the worker pool: `--threads` when given, else `RAYON_NUM_THREADS` (read

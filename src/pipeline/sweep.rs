@@ -1,5 +1,6 @@
-//! `sweep`: reduced runs at many load scales, in parallel across cores (rayon; BLAS stays
-//! on one thread inside each run), optionally validated against full runs.
+//! `sweep`: runs at many load scales, in parallel across cores (rayon; BLAS stays on one
+//! thread inside each run): the reduced model, optionally validated against full runs, or
+//! (`--full`, [`Route::Full`]) the full model itself, exact, one full model per worker.
 //!
 //! One load scale that fails (Newton, a singular matrix) does not stop the sweep: its status
 //! and message are stored and the others run on. The file is written as the sweep goes
@@ -16,18 +17,20 @@ mod file;
 mod outcome;
 mod table;
 
-pub use file::{read_sweep, write_sweep, write_sweep_with, Extra};
+pub use file::{read_sweep, write_sweep, write_sweep_with, Extra, SweepBasis};
 pub use outcome::{Outcome, ScaleResult, Sweep, SweepPoint, STATUS_FAILED, STATUS_OK, STATUS_PENDING};
 pub use table::table;
 
 use super::validate::compare;
 use crate::error::Result;
-use crate::io::basis_file::StoredBasis;
+use crate::linalg::kkt::LinearSolverKind;
+use crate::model::Model;
+use crate::rom::pool::Pool;
 use crate::rom::{Output, ReducedRun, Rom};
-use crate::simulate::{simulate, Overrides, Settings};
+use crate::simulate::{simulate, FullModel, Overrides, Settings};
 use crate::solver::model::Parameters;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use ndarray::Array1;
+use ndarray::{Array1, Array2};
 use outcome::clone_point;
 use rayon::prelude::*;
 use std::path::Path;
@@ -75,19 +78,43 @@ fn continuation_lanes(n: usize, threads: usize) -> Vec<Vec<std::ops::Range<usize
         .collect()
 }
 
+/// What a sweep runs at every load scale.
+#[derive(Clone, Copy)]
+pub enum Route<'a> {
+    /// the reduced model of a basis file (its estimate with every run, when it has an
+    /// estimator), and the file it was read from
+    Reduced { rom: &'a Rom, basis: SweepBasis<'a> },
+    /// the full model (`sweep --full`): exact, no basis, no estimate
+    Full(&'a Model),
+}
+
+impl<'a> Route<'a> {
+    pub fn model(&self) -> &'a Model {
+        match self {
+            Route::Reduced { rom, .. } => rom.model(),
+            Route::Full(model) => model,
+        }
+    }
+
+    /// The basis file of a reduced sweep.
+    pub fn basis(&self) -> Option<SweepBasis<'a>> {
+        match self {
+            Route::Reduced { basis, .. } => Some(*basis),
+            Route::Full(_) => None,
+        }
+    }
+}
+
 /// Runs the reduced model at every scale, in parallel; with `validate`, also the full one.
 /// A scale whose run fails is recorded as failed and the others go on. Every point gets the
 /// reduced model's error estimate (when it has an estimator) and extrapolation flag.
 pub fn sweep(rom: &Rom, scales: &[f64], o: SweepOptions) -> Result<Sweep> {
-    let start = pending(rom, scales, o)?;
-    run_pending(rom, start, o, None)
+    let start = pending(rom.model(), rom.basis().n_reduced(), false, scales, o)?;
+    run_reduced(rom, start, o, None)
 }
 
 /// Where and how a sweep is written as it goes ([`sweep_to_file`]).
 pub struct SweepFile<'a> {
-    /// the basis file read as `stored`: the sweep file records which basis it is of
-    pub stored: &'a StoredBasis,
-    pub basis_path: &'a Path,
     pub out: &'a Path,
     /// take the scales `out` already holds as finished from it, run only the others
     pub resume: bool,
@@ -95,16 +122,24 @@ pub struct SweepFile<'a> {
     pub extra: Extra<'a>,
 }
 
-/// [`sweep`] writing `f.out` as it goes (see the module documentation); with `f.resume`,
-/// the scales that `f.out` already holds as finished (same basis content and model) are
-/// taken from it, and only the others run. The returned sweep is written to `f.out`.
-pub fn sweep_to_file(rom: &Rom, scales: &[f64], o: SweepOptions, f: SweepFile) -> Result<Sweep> {
-    let SweepFile { stored, basis_path, out, resume, extra } = f;
-    let model = &**rom.model();
-    let mut start = pending(rom, scales, o)?;
+/// The runs of `route` at every scale, writing `f.out` as it goes (see the module
+/// documentation); with `f.resume`, the scales that `f.out` already holds as finished
+/// (same route, basis content and model) are taken from it, and only the others run. The
+/// returned sweep is written to `f.out`. A full sweep takes no options: it is neither
+/// validated (it is the reference itself) nor continued.
+pub fn sweep_to_file(route: Route, scales: &[f64], o: SweepOptions, f: SweepFile) -> Result<Sweep> {
+    let SweepFile { out, resume, extra } = f;
+    let model = route.model();
+    let full = matches!(route, Route::Full(_));
+    let o = if full { SweepOptions { validate: false, continuation: false, ..o } } else { o };
+    let n_reduced = match route {
+        Route::Reduced { rom, .. } => rom.basis().n_reduced(),
+        Route::Full(_) => 0,
+    };
+    let mut start = pending(model, n_reduced, full, scales, o)?;
     if resume {
         if out.exists() {
-            let old = read_sweep(out, model, stored, o.validate)?;
+            let old = read_sweep(out, model, route.basis().map(|b| b.stored), o.validate)?;
             let mut reused = 0;
             for s in start.scales.iter_mut() {
                 if let Some(i) = old.iter().position(|(x, _)| *x == s.load_scale) {
@@ -135,22 +170,27 @@ pub fn sweep_to_file(rom: &Rom, scales: &[f64], o: SweepOptions, f: SweepFile) -
             ));
         }
     }
-    let write = |s: &Sweep| write_sweep_with(out, s, stored, basis_path, extra);
-    let sw = run_pending(rom, start, o, Some(&write))?;
+    let basis = route.basis();
+    let write = |s: &Sweep| write_sweep_with(out, s, basis, extra);
+    let sw = match route {
+        Route::Reduced { rom, .. } => run_reduced(rom, start, o, Some(&write))?,
+        Route::Full(model) => run_full(model, start, o, Some(&write))?,
+    };
     write(&sw)?;
     Ok(sw)
 }
 
 /// Every scale pending, with the model's time grid and probe names.
-fn pending(rom: &Rom, scales: &[f64], o: SweepOptions) -> Result<Sweep> {
-    let (model, basis) = (&**rom.model(), &**rom.basis());
+fn pending(model: &Model, n_reduced: usize, full: bool, scales: &[f64], o: SweepOptions) -> Result<Sweep> {
     let s = Settings::resolve(model, &Overrides::default())?;
     let t = Array1::from_iter((0..=s.n_steps).map(|k| k as f64 * s.dt));
     Ok(Sweep {
         scales: scales.iter().map(|&x| ScaleResult { load_scale: x, outcome: Outcome::Pending }).collect(),
         t,
         probe_names: model.probe_names(),
-        n_reduced: basis.n_reduced(),
+        n_reduced,
+        full,
+        model_fingerprint: model.fingerprint(),
         validated: o.validate,
         wall_seconds: 0.0,
         threads: rayon::current_num_threads().max(1),
@@ -160,11 +200,73 @@ fn pending(rom: &Rom, scales: &[f64], o: SweepOptions) -> Result<Sweep> {
 }
 
 type Checkpoint<'a> = &'a (dyn Fn(&Sweep) -> Result<()> + Sync);
+/// One point of a sweep: the run at a load scale, given the last good runs of its chain
+/// (continuation only; empty otherwise).
+type RunPoint<'a> = &'a (dyn Fn(f64, &[&ReducedRun]) -> Result<SweepPoint> + Sync);
 
-/// Runs the pending scales of `state`; after each one, `checkpoint` (when given, and at
-/// most every [`CHECKPOINT_SECONDS`]) writes what is done so far.
-fn run_pending(rom: &Rom, state: Sweep, o: SweepOptions, checkpoint: Option<Checkpoint>) -> Result<Sweep> {
+/// The reduced runs of the pending scales of `state` (with `o.validate`, the full ones
+/// beside them), each with its estimate and extrapolation flag.
+fn run_reduced(rom: &Rom, state: Sweep, o: SweepOptions, checkpoint: Option<Checkpoint>) -> Result<Sweep> {
     let (model, basis) = (&**rom.model(), &**rom.basis());
+    // every point's trajectories are kept until the file is written; without validation
+    // nothing of full size is reconstructed
+    let n_steps = Settings::resolve(model, &Overrides::default())?.n_steps;
+    let output = if o.validate { Output::Full } else { Output::ReducedAndProbes };
+    crate::rom::check_reduced_memory(model, basis.n_reduced(), n_steps, output, state.n_todo() as f64)?;
+    let point = |x: f64, previous: &[&ReducedRun]| -> Result<SweepPoint> {
+        let mu = Parameters::new(x);
+        let (run, estimate) =
+            rom.solve_and_estimate(&mu, output, previous).map_err(|e| e.at_stage("sweep (reduced run)", x))?;
+        let (validation, full_probes) = if o.validate {
+            let full = simulate(model, &Overrides { load_scale: Some(x), ..Default::default() })
+                .map_err(|e| e.at_stage("sweep (full run)", x))?;
+            let v = compare(model, &full, &run, None, basis.n_reduced(), basis.variant.name())
+                .with_trust(estimate.as_ref(), Some(rom));
+            (Some(v), Some(full.probes))
+        } else {
+            (None, None)
+        };
+        let extrapolated = rom.is_extrapolated(&mu);
+        Ok(SweepPoint { run, validation, full_probes, estimate, extrapolated })
+    };
+    let label = if o.validate { "sweep + validate" } else { "sweep" };
+    run_pending(state, o, label, &point, checkpoint)
+}
+
+/// The full runs of the pending scales of `state`, one full model (system and work space)
+/// per worker ([`FullModel`]): each run is what `simulate` gives at its load, and only its
+/// probes and statistics are kept.
+fn run_full(model: &Model, state: Sweep, o: SweepOptions, checkpoint: Option<Checkpoint>) -> Result<Sweep> {
+    let n_steps = Settings::resolve(model, &Overrides::default())?.n_steps;
+    // a run too large is refused before any runs; the kept part of each is its probes and t
+    model.check_full_run_memory(n_steps, false)?;
+    let z = model.sizes();
+    let kept = state.n_todo() as f64 * 8.0 * (n_steps as f64 + 1.0) * (z.n_probe_values + 1.0);
+    crate::limits::check_memory(&format!("the probes of {} full runs of {n_steps} steps", state.n_todo()), kept)?;
+    let models = Pool::new(|| FullModel::new(model, LinearSolverKind::Banded));
+    let point = |x: f64, _: &[&ReducedRun]| -> Result<SweepPoint> {
+        let run = models.with(|full| full.simulate(&Overrides { load_scale: Some(x), ..Default::default() }));
+        let mut r = run.and_then(|r| r).map_err(|e| e.at_stage("sweep (full run)", x))?;
+        // the sweep file holds no coordinates: drop them now, not after the whole sweep
+        let nt = r.t.len();
+        (r.q, r.qd, r.multipliers) = (Array2::zeros((0, nt)), Array2::zeros((0, nt)), Array2::zeros((0, nt)));
+        (r.strains, r.curvatures) = (Vec::new(), Vec::new());
+        let run = ReducedRun { result: r, reduced_q: Array2::zeros((0, nt)) };
+        Ok(SweepPoint { run, validation: None, full_probes: None, estimate: None, extrapolated: false })
+    };
+    run_pending(state, o, "full sweep", &point, checkpoint)
+}
+
+/// Runs `point` at the pending scales of `state`, in parallel; after each one,
+/// `checkpoint` (when given, and at most every [`CHECKPOINT_SECONDS`]) writes what is done
+/// so far. `label` names the sweep on the progress bar.
+fn run_pending(
+    state: Sweep,
+    o: SweepOptions,
+    label: &str,
+    point: RunPoint,
+    checkpoint: Option<Checkpoint>,
+) -> Result<Sweep> {
     let todo: Vec<usize> = (0..state.scales.len()).filter(|&i| state.scales[i].status() != STATUS_OK).collect();
     let scales: Vec<f64> = todo.iter().map(|&i| state.scales[i].load_scale).collect();
     let bar = ProgressBar::with_draw_target(
@@ -176,16 +278,8 @@ fn run_pending(rom: &Rom, state: Sweep, o: SweepOptions, checkpoint: Option<Chec
             .expect("valid template")
             .progress_chars("=> "),
     );
-    bar.set_prefix(if o.validate { "sweep + validate" } else { "sweep" });
-    let ticker = crate::output::ticker::Ticker::new(
-        if o.validate { "sweep + validate" } else { "sweep" },
-        scales.len() as u64,
-        o.progress,
-    );
-    // every point's trajectories are kept until the file is written
-    let n_steps = crate::simulate::Settings::resolve(model, &Overrides::default())?.n_steps;
-    let output = if o.validate { Output::Full } else { Output::ReducedAndProbes };
-    crate::rom::check_reduced_memory(model, basis.n_reduced(), n_steps, output, scales.len() as f64)?;
+    bar.set_prefix(label.to_string());
+    let ticker = crate::output::ticker::Ticker::new(label, scales.len() as u64, o.progress);
     let start = std::time::Instant::now();
     let threads = state.threads;
     // continuation: a few chains of neighbouring scales per thread; otherwise one point per task
@@ -219,32 +313,13 @@ fn run_pending(rom: &Rom, state: Sweep, o: SweepOptions, checkpoint: Option<Chec
                 // the last two good runs of this chain (continuation only)
                 let mut previous: Vec<ReducedRun> = Vec::new();
                 for i in chain.clone() {
-                    let x = scales[i];
-                    let mu = Parameters::new(x);
-                    // without validation nothing of full size is reconstructed
-                    let output = if o.validate { Output::Full } else { Output::ReducedAndProbes };
-                    let run = (|| -> Result<SweepPoint> {
-                        let (run, estimate) = rom
-                            .solve_and_estimate(&mu, output, &previous.iter().collect::<Vec<_>>())
-                            .map_err(|e| e.at_stage("sweep (reduced run)", x))?;
-                        let (validation, full_probes) = if o.validate {
-                            let full = simulate(model, &Overrides { load_scale: Some(x), ..Default::default() })
-                                .map_err(|e| e.at_stage("sweep (full run)", x))?;
-                            let v = compare(model, &full, &run, None, basis.n_reduced(), basis.variant.name())
-                                .with_trust(estimate.as_ref(), Some(rom));
-                            (Some(v), Some(full.probes))
-                        } else {
-                            (None, None)
-                        };
-                        let extrapolated = rom.is_extrapolated(&mu);
-                        Ok(SweepPoint { rom: run, validation, full_probes, estimate, extrapolated })
-                    })();
+                    let run = point(scales[i], &previous.iter().collect::<Vec<_>>());
                     bar.inc(1);
                     ticker.tick();
                     match run {
                         Ok(p) => {
                             if o.continuation {
-                                previous.push(p.rom.clone());
+                                previous.push(p.run.clone());
                                 if previous.len() > 2 {
                                     previous.remove(0);
                                 }

@@ -8,9 +8,14 @@ use crate::simulate::SimulationResult;
 
 /// `sweep`, `merge`: one row per load scale, in the order asked for. `status` is 0 (done),
 /// 1 (failed, `message` says why) or 2 (not run yet), as `/status` of the sweep file;
-/// times in seconds, errors relative (`rel_error`, `error_estimate`) or in metres
-/// (`max_probe_error`). The validation columns are there only for `--validate` sweeps.
+/// times in seconds, errors relative (`rel_error`, `error_estimate`; `displacement_error`,
+/// `error_estimate_displacement` relative to the motion) or in metres (`max_probe_error`).
+/// The validation columns are there only for `--validate` sweeps; a full sweep (`--full`)
+/// has `full_seconds` (its time loops) and no estimate columns.
 pub fn sweep_table(s: &Sweep) -> Table {
+    if s.full {
+        return full_sweep_table(s);
+    }
     let mut cols = vec![
         "load_scale",
         "status",
@@ -25,12 +30,17 @@ pub fn sweep_table(s: &Sweep) -> Table {
     if s.validated {
         cols.extend(["rel_error", "max_probe_error", "full_seconds", "speedup", "steps_differ_from"]);
     }
+    // the columns added with the displacement measure go last: the others keep their places
+    cols.push("error_estimate_displacement");
+    if s.validated {
+        cols.push("displacement_error");
+    }
     let mut t = Table::new(&cols);
     for x in &s.scales {
         let mut row: Vec<Cell> = vec![x.load_scale.into(), (x.status() as u64).into(), x.message().into()];
         match x.point() {
             Some(p) => {
-                let r = &p.rom.result;
+                let r = &p.run.result;
                 row.extend([
                     r.wall_seconds.into(),
                     r.stats.newton_iterations.into(),
@@ -49,6 +59,29 @@ pub fn sweep_table(s: &Sweep) -> Table {
                         v.and_then(|v| v.steps_differ_from).into(),
                     ]);
                 }
+                row.push(p.estimate.as_ref().map(|e| e.error_estimate_displacement).into());
+                if s.validated {
+                    row.push(p.validation.as_ref().map(|v| v.displacement_error).into());
+                }
+            }
+            None => row.resize(cols.len(), Cell::Null),
+        }
+        t.push(row);
+    }
+    t
+}
+
+/// [`sweep_table`] of a full sweep: `load_scale`, `status`, `message`, `full_seconds`,
+/// `newton_iterations`, `step_cuts`.
+fn full_sweep_table(s: &Sweep) -> Table {
+    let cols = ["load_scale", "status", "message", "full_seconds", "newton_iterations", "step_cuts"];
+    let mut t = Table::new(&cols);
+    for x in &s.scales {
+        let mut row: Vec<Cell> = vec![x.load_scale.into(), (x.status() as u64).into(), x.message().into()];
+        match x.point() {
+            Some(p) => {
+                let r = &p.run.result;
+                row.extend([r.wall_seconds.into(), r.stats.newton_iterations.into(), r.stats.step_cuts.into()]);
             }
             None => row.resize(cols.len(), Cell::Null),
         }

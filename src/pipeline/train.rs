@@ -84,12 +84,13 @@ pub fn write_trained(p: &Pipeline, out: &Path, data: &TrainingData, summary: &Tr
 /// a file flexrom did not create: [`check_output`], `origin` names where the path came
 /// from), trains (from the full runs, or from the snapshot files `from_snapshots` when
 /// given) into a temporary file beside `out`, reads that back and checks it as every
-/// reader of a basis does, and only then renames it over `out`: a failure at any stage
-/// leaves the previous basis as it was.
+/// reader of a basis does, times the full and the reduced route at a training load into
+/// its `/timing` ([`super::route::time_and_store`]), and only then renames it over `out`:
+/// a failure at any stage leaves the previous basis as it was.
 pub fn train_to_file(p: &Pipeline, out: &Path, origin: Origin, from_snapshots: &[PathBuf]) -> Result<TrainSummary> {
     check_output(out, origin, &[(&p.path, "pipeline file"), (&p.model.path, "model file")])?;
     let staged = TempPath::file_for(out)?;
-    let s = if from_snapshots.is_empty() {
+    let mut s = if from_snapshots.is_empty() {
         train_and_write(p, staged.path())?
     } else {
         for f in from_snapshots {
@@ -101,7 +102,9 @@ pub fn train_to_file(p: &Pipeline, out: &Path, origin: Origin, from_snapshots: &
         write_trained(p, staged.path(), &data, &s)?;
         s
     };
-    super::online::load_basis(p, staged.path())?;
+    // read back and checked as every reader does, then both routes timed as users run them
+    let (_, rom, _) = super::online::load_rom(p, staged.path(), None, false)?;
+    s.warnings.extend(super::route::time_and_store(&rom, staged.path())?);
     staged.commit()?;
     Ok(s)
 }

@@ -2,13 +2,14 @@
 //! (`GreedyRecord`, written under `/training` in the basis file).
 
 use crate::reduction::Trained;
-use crate::rom::estimator::{EstimateMethod, Estimator};
+use crate::rom::estimator::{ErrorMeasure, EstimateMethod, Estimator};
 
 pub struct TrainSummary {
     pub trained: Trained,
     pub n_snapshots: usize,
     pub full_seconds: f64,
-    /// full runs made (greedy: with the last, held-out check run)
+    /// full runs made (greedy: with the last, held-out check run;
+    /// [`Self::n_training_runs`] + [`Self::n_held_out`])
     pub n_runs: usize,
     /// what the greedy loop did (`/training` in the basis file); `None` for `load_scales`
     pub greedy: Option<GreedyRecord>,
@@ -18,6 +19,40 @@ pub struct TrainSummary {
     /// what the user should hear of the training beside its result (a greedy loop that ran
     /// out of full runs), one line each; the caller shows them
     pub warnings: Vec<String>,
+}
+
+impl TrainSummary {
+    /// The full runs whose snapshots the basis holds.
+    pub fn n_training_runs(&self) -> usize {
+        self.greedy.as_ref().map_or(self.n_runs, |g| g.load_scales.len().min(self.n_runs))
+    }
+
+    /// The full runs made only to check the basis (greedy's last run when it converged): not
+    /// in the basis.
+    pub fn n_held_out(&self) -> usize {
+        self.n_runs - self.n_training_runs()
+    }
+
+    /// The loads of the held-out runs.
+    pub fn held_out_loads(&self) -> Vec<f64> {
+        let Some(g) = &self.greedy else { return Vec::new() };
+        let runs = g.iterations.iter().map(|i| i.run_load).filter(|x| !x.is_nan());
+        runs.filter(|x| !g.load_scales.contains(x)).collect()
+    }
+
+    /// "3 training runs + 1 held-out check" (a held-out run is not in the basis), or "3
+    /// full run(s)" without one.
+    pub fn runs_text(&self) -> String {
+        match self.n_held_out() {
+            0 => format!("{} full run(s)", self.n_runs),
+            h => format!(
+                "{} training run{} + {h} held-out check{}",
+                self.n_training_runs(),
+                if self.n_training_runs() == 1 { "" } else { "s" },
+                if h == 1 { "" } else { "s" }
+            ),
+        }
+    }
 }
 
 /// One pass of the loop: the basis it chose and where its estimate was worst.
@@ -74,6 +109,8 @@ pub struct GreedyRecord {
     /// the estimate training ended with (`corrected`, or `enriched` when a held-out check
     /// found the correction off)
     pub method: EstimateMethod,
+    /// the error `tolerance`, the scores and the true errors are in
+    pub measure: ErrorMeasure,
 }
 
 impl GreedyRecord {
@@ -131,6 +168,7 @@ pub fn write_training(f: &hdf5::File, r: &GreedyRecord) -> hdf5::Result<()> {
     g.new_dataset_builder().with_data(&col(&|i| i.true_score)).create("true_score")?;
     g.new_dataset_builder().with_data(&col(&|i| i.held_out_effectivity)).create("held_out_effectivity")?;
     attr_str(&g, "estimate_method", r.method.name())?;
+    attr_str(&g, "measure", r.measure.name())?;
     attr_str(&g, "method", "greedy")?;
     attr_u64(&g, "iterations", ni as u64)?;
     attr_u64(&g, "max_runs", r.max_runs as u64)?;

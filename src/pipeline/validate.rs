@@ -9,15 +9,22 @@
 //!     sensitivity = ‖X_full(1.001 λ) − X_full(λ)‖_F / ‖X_full(λ)‖_F
 //!     rel_error_by_time[i] = rel_error over t ≤ the end of fifth i + 1 of the run
 //!     error_estimate_by_time[i] = error_estimate over the same instants (the last is error_estimate)
+//!     displacement_error = ‖X_rom − X_full‖_F / ‖X_full − X₀‖_F   (X₀ = X_full(t₀) at every instant)
+//!     error_estimate_displacement = c ‖X_r − X_{r+k}‖_F / ‖X_{r+k} − X₀‖_F
+//!     error_over_travel(probe) = max_k |r_rom(t_k) − r_full(t_k)| / max_k |r_full(t_k) − r_full(t₀)|
 //! ```
 //!
 //! `sensitivity` puts the error in context: how much the full model's own answer moves for
-//! a 0.1 % change of the load.
+//! a 0.1 % change of the load. `rel_error` divides by a norm that holds the undeformed
+//! geometry and the unit slopes; `displacement_error` and a probe's error over its travel
+//! measure the error against the motion itself (docs/error-estimate.md, "Two measures of
+//! the error").
 
+use super::timing::{median, repeat_timing};
 use crate::error::Result;
 use crate::linalg::kkt::LinearSolverKind;
 use crate::model::Model;
-use crate::rom::estimator::norms::{distance_and_norm, rel_error_by_time};
+use crate::rom::estimator::norms::{displacement_error_by_time, distance_and_norm, rel_error_by_time};
 use crate::rom::estimator::Estimate;
 use crate::rom::{Output, ReducedRun, Rom};
 use crate::simulate::{simulate, FullModel, Overrides, SimulationResult};
@@ -37,7 +44,7 @@ pub struct Validation {
     pub max_probe_error_t: f64,
     pub max_constraint_violation: f64,
     /// full model, our default (banded) linear solver: time loop only, the median of up to
-    /// seven runs interleaved with the reduced ones (`TIMING_BUDGET`)
+    /// seven runs interleaved with the reduced ones ([`super::timing::TIMING_BUDGET`])
     pub full_seconds: f64,
     /// full model with dense LAPACK LU; `None` when not measured
     pub full_dense_seconds: Option<f64>,
@@ -79,6 +86,52 @@ pub struct Validation {
     /// error_estimate up to the end of each fifth of the run, the estimate of
     /// `rel_error_by_time` (the last is error_estimate; null: no estimator)
     pub error_estimate_by_time: Option<Vec<f64>>,
+    /// `‖X_rom − X_full‖_F / ‖X_full − X₀‖_F`: the error against the motion from the
+    /// initial configuration X₀ (`ErrorMeasure::Displacement`)
+    pub displacement_error: f64,
+    /// displacement_error up to the end of each fifth of the run (the last is displacement_error)
+    pub displacement_error_by_time: Vec<f64>,
+    /// the estimate of `displacement_error` (null: the basis has no estimator)
+    pub error_estimate_displacement: Option<f64>,
+    /// `error_estimate_displacement / displacement_error`
+    pub effectivity_displacement: Option<f64>,
+    /// error_estimate_displacement up to the end of each fifth of the run
+    pub error_estimate_displacement_by_time: Option<Vec<f64>>,
+    /// the largest `error_over_travel` of the probes (null: no probe moved)
+    pub max_error_over_travel: Option<f64>,
+    pub max_error_over_travel_probe: String,
+    /// every probe's error over its travel
+    pub probe_errors_over_travel: Vec<ProbeTravel>,
+    /// how the estimate was computed (`corrected`, `defects`, `enriched`; null: no estimate)
+    pub error_estimate_method: Option<String>,
+}
+
+/// One probe's error against its own motion.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct ProbeTravel {
+    pub probe: String,
+    /// `max_k |r_rom(t_k) − r_full(t_k)|`, m
+    pub max_error: f64,
+    /// `max_k |r_full(t_k) − r_full(t₀)|`, m: how far the probe moved from where it started
+    pub travel: f64,
+    /// `max_error / travel` (null for a probe that did not move)
+    pub error_over_travel: Option<f64>,
+}
+
+impl ProbeTravel {
+    /// The error of the probe positions `rom` against `full` (n_t × 2 each) over the
+    /// full run's travel.
+    pub fn of(name: &str, full: &ndarray::Array2<f64>, rom: &ndarray::Array2<f64>) -> ProbeTravel {
+        let dist = |a: [f64; 2], b: [f64; 2]| ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt();
+        let at = |x: &ndarray::Array2<f64>, k: usize| [x[[k, 0]], x[[k, 1]]];
+        let (mut max_error, mut travel) = (0.0_f64, 0.0_f64);
+        for k in 0..full.nrows() {
+            max_error = max_error.max(dist(at(rom, k), at(full, k)));
+            travel = travel.max(dist(at(full, k), at(full, 0)));
+        }
+        let error_over_travel = (travel > 0.0).then(|| max_error / travel);
+        ProbeTravel { probe: name.to_string(), max_error, travel, error_over_travel }
+    }
 }
 
 /// Compares a reduced run with a full run of the same model, load scale and Δt.
@@ -109,6 +162,14 @@ pub fn compare(
             &owned
         }
     };
+    let travels: Vec<ProbeTravel> =
+        full.probes.iter().zip(&r.probes).map(|((name, a), (_, b))| ProbeTravel::of(name, a, b)).collect();
+    let worst_travel = travels
+        .iter()
+        .filter_map(|p| p.error_over_travel.map(|e| (e, p.probe.clone())))
+        .fold(None::<(f64, String)>, |w, (e, n)| if w.as_ref().is_none_or(|w| e > w.0) { Some((e, n)) } else { w });
+    let x0 = full.q.column(0);
+    let displacement_error_by_time = displacement_error_by_time(&r.q, &full.q, x0).to_vec();
     let mut res = vec![0.0; sys.n_constraints()];
     let mut viol = 0.0_f64;
     for k in 0..r.q.ncols() {
@@ -147,6 +208,15 @@ pub fn compare(
         sensitivity: None,
         rel_error_by_time: rel_error_by_time(&r.q, &full.q).to_vec(),
         error_estimate_by_time: None,
+        displacement_error: displacement_error_by_time[displacement_error_by_time.len() - 1],
+        displacement_error_by_time,
+        error_estimate_displacement: None,
+        effectivity_displacement: None,
+        error_estimate_displacement_by_time: None,
+        max_error_over_travel: worst_travel.as_ref().map(|w| w.0),
+        max_error_over_travel_probe: worst_travel.map_or(String::new(), |w| w.1),
+        probe_errors_over_travel: travels,
+        error_estimate_method: None,
     }
     .with_timings(full.wall_seconds, r.wall_seconds)
 }
@@ -162,33 +232,15 @@ fn first_different_step(a: &[f64], b: &[f64]) -> Option<f64> {
     }
 }
 
-/// Time loops of a few milliseconds move by ±30 % from one run to the next on a shared
-/// machine (other processes, page faults of a first run), so `validate` times the full and
-/// the reduced loop repeatedly, interleaved (a busy spell falls on both), and compares
-/// medians: while both kinds together have taken less than this, s…
-const TIMING_BUDGET: f64 = 0.25;
-/// …and each kind has fewer runs than this (odd: the median is a run). A full run that
-/// alone exceeds the budget is timed once, as before.
-const TIMING_RUNS: usize = 7;
-
-/// Whether to time one more pair of runs ([`TIMING_BUDGET`], [`TIMING_RUNS`]).
-fn repeat_timing(full: &[f64], rom: &[f64]) -> bool {
-    let spent: f64 = full.iter().chain(rom).sum();
-    full.len() < TIMING_RUNS && spent + full[full.len() - 1] + rom[rom.len() - 1] <= TIMING_BUDGET
-}
-
-/// The median (the middle of an odd count, the mean of the middle two of an even one).
-fn median(x: &mut [f64]) -> f64 {
-    x.sort_by(f64::total_cmp);
-    let n = x.len();
-    if n % 2 == 1 {
-        x[n / 2]
-    } else {
-        0.5 * (x[n / 2 - 1] + x[n / 2])
-    }
-}
-
 impl Validation {
+    /// The estimate of the error in `measure` (`None` without an estimator).
+    pub fn estimate_in(&self, measure: crate::rom::estimator::ErrorMeasure) -> Option<f64> {
+        match measure {
+            crate::rom::estimator::ErrorMeasure::Relative => self.error_estimate,
+            crate::rom::estimator::ErrorMeasure::Displacement => self.error_estimate_displacement,
+        }
+    }
+
     /// The time loops' seconds and the speedups derived from them (against the dense run
     /// too, when it was timed).
     pub fn with_timings(mut self, full_seconds: f64, rom_seconds: f64) -> Self {
@@ -208,10 +260,16 @@ impl Validation {
             self.estimate_calibrated = Some(e.calibrated);
             self.estimate_seconds = Some(e.seconds);
             self.error_estimate_by_time = Some(e.by_time.to_vec());
+            self.error_estimate_displacement = Some(e.error_estimate_displacement);
+            self.effectivity_displacement = Some(e.error_estimate_displacement / self.displacement_error);
+            self.error_estimate_displacement_by_time = Some(e.displacement_by_time.to_vec());
         }
         if let Some(t) = rom.and_then(|r| r.trust()) {
             self.extrapolated = crate::rom::trust::is_extrapolated(t.range, self.load_scale);
             self.training_range = Some([t.range.0, t.range.1]);
+        }
+        if estimate.is_some() {
+            self.error_estimate_method = rom.and_then(|r| r.method()).map(str::to_string);
         }
         self
     }
@@ -243,7 +301,7 @@ pub fn validate(rom: &Rom, load_scale: f64, with_dense: bool) -> Result<(Validat
     let (run, estimate) = rom.solve_and_estimate(&mu, Output::Full, &[]).map_err(stage("validate (reduced run)"))?;
     // the time loops again, interleaved, for the medians that `speedup` compares
     let (mut full_times, mut rom_times) = (vec![full.wall_seconds], vec![run.result.wall_seconds]);
-    while repeat_timing(&full_times, &rom_times) {
+    while repeat_timing(&[&full_times, &rom_times]) {
         full_times.push(full_model.simulate(&o).map_err(stage("validate (full run)"))?.wall_seconds);
         let again = rom.solve_with(&mu, Output::Full, &[]).map_err(stage("validate (reduced run)"))?;
         rom_times.push(again.result.wall_seconds);
@@ -287,9 +345,10 @@ impl Validation {
         let mut s = String::new();
         match (self.error_estimate, self.effectivity) {
             (Some(e), Some(f)) => s.push_str(&format!(
-                "\n  error_estimate {:.3e} ({}), effectivity {:.2}{}",
+                "\n  error_estimate {:.3e} ({}{}), effectivity {:.2}{}",
                 e,
                 if self.estimate_calibrated == Some(true) { "calibrated" } else { "uncalibrated" },
+                self.error_estimate_method.as_ref().map_or(String::new(), |m| format!(", {m} method")),
                 f,
                 self.estimate_seconds.map_or(String::new(), |t| format!(
                     ", estimator {:.4} s ({:.0} % of the reduced run)",
@@ -331,27 +390,36 @@ impl Validation {
             let by: Vec<String> = e.iter().map(|e| format!("{e:.2e}")).collect();
             s.push_str(&format!("\n  error_estimate up to each fifth of the run: {}", by.join(", ")));
         }
+        s.push_str(&self.motion_lines());
+        s
+    }
+
+    /// The lines of the errors against the motion: displacement_error (and its estimate),
+    /// each probe's error over its travel.
+    fn motion_lines(&self) -> String {
+        let mut s = format!(
+            "\n  displacement_error {:.3e} (against the motion from the initial configuration)",
+            self.displacement_error
+        );
+        if let (Some(e), Some(f)) = (self.error_estimate_displacement, self.effectivity_displacement) {
+            s.push_str(&format!(", error_estimate_displacement {e:.3e}, effectivity {f:.2}"));
+        }
+        for p in &self.probe_errors_over_travel {
+            s.push_str(&format!(
+                "\n  probe {}: max error {:.3e} m over a travel of {:.3e} m: {}",
+                p.probe,
+                p.max_error,
+                p.travel,
+                p.error_over_travel.map_or("the probe does not move".to_string(), |e| format!("{e:.3e} of its travel"))
+            ));
+        }
         s
     }
 }
 
 #[cfg(test)]
 mod tests {
-    use super::{first_different_step, median, repeat_timing, TIMING_BUDGET, TIMING_RUNS};
-
-    /// Medians of odd and even counts, in any order; the timing repeats while another pair
-    /// fits the budget and stops at the run count, and a single run over the budget is
-    /// timed once.
-    #[test]
-    fn timing_medians_and_their_budget() {
-        assert_eq!(median(&mut [3.0, 1.0, 2.0]), 2.0);
-        assert_eq!(median(&mut [4.0, 1.0, 3.0, 2.0]), 2.5);
-        assert!(repeat_timing(&[5e-3], &[1e-3]));
-        assert!(!repeat_timing(&[5e-3; TIMING_RUNS], &[1e-3; TIMING_RUNS]));
-        assert!(!repeat_timing(&[TIMING_BUDGET], &[1e-3]));
-        // 0.1 + 0.05 spent, a next pair of 0.15 would exceed 0.25
-        assert!(!repeat_timing(&[0.1], &[0.05]));
-    }
+    use super::{first_different_step, ProbeTravel};
 
     /// Which step the runs first took differently: a cut only one of them made, the
     /// earlier of two such, and none when both halved the same steps.
@@ -364,5 +432,21 @@ mod tests {
         assert_eq!(first_different_step(&[0.1, 0.875], &[0.1, 0.875]), None);
         assert_eq!(first_different_step(&[0.931], &[0.5, 0.931]), Some(0.5));
         assert_eq!(first_different_step(&[0.875], &[0.931]), Some(0.875));
+    }
+
+    /// A probe moving on a 3-4-5 line, 0.5 m per instant over 4 instants (travel 1.5 m),
+    /// against a reduced one off by (0.006, 0.008) m (0.01 m) at one instant: error over
+    /// travel 0.01 / 1.5 in closed form; a probe that does not move has none.
+    #[test]
+    fn a_probe_error_over_its_travel() {
+        let full = ndarray::Array2::from_shape_fn((4, 2), |(k, i)| 1.0 + k as f64 * [0.3, 0.4][i]);
+        let mut rom = full.clone();
+        rom[[2, 0]] += 0.006;
+        rom[[2, 1]] += 0.008;
+        let p = ProbeTravel::of("tip", &full, &rom);
+        assert!((p.travel - 1.5).abs() < 1e-15 && (p.max_error - 0.01).abs() < 1e-15, "{p:?}");
+        assert!((p.error_over_travel.unwrap() - 0.01 / 1.5).abs() < 1e-15, "{p:?}");
+        let still = ndarray::Array2::from_elem((4, 2), 1.0);
+        assert_eq!(ProbeTravel::of("pin", &still, &(&still + 1e-3)).error_over_travel, None);
     }
 }

@@ -36,7 +36,7 @@ pub struct Rom {
     /// the training range and tolerance of a basis read from its file; `None` for one built
     /// in this process (training)
     trust: Option<Trust>,
-    runners: Pool<ReducedRunner>,
+    runners: Pool<'static, ReducedRunner>,
 }
 
 /// How [`Rom::load`] reads a basis file's estimator.
@@ -47,6 +47,9 @@ pub struct LoadOptions {
     pub method: Option<EstimateMethod>,
     /// the tolerance estimates are held to (`[online] tolerance`); `None`: greedy training's
     pub tolerance: Option<f64>,
+    /// the error `tolerance` is on (`[online] tolerance_measure`); `None`: the measure the
+    /// basis file records for its training tolerance
+    pub tolerance_measure: Option<estimator::ErrorMeasure>,
     /// no estimate at all (`--no-estimate`)
     pub no_estimate: bool,
 }
@@ -77,7 +80,9 @@ impl Rom {
     /// (else the one the file names), and its training range and tolerance. Returns the
     /// warnings a user should see (a method whose own check failed for this basis).
     pub fn load(model: &Arc<Model>, path: &Path, stored: &StoredBasis, o: LoadOptions) -> Result<(Self, Vec<String>)> {
-        use crate::io::estimator_file::{read_estimator, read_training_range, read_training_tolerance};
+        use crate::io::estimator_file::{
+            read_estimator, read_training_measure, read_training_range, read_training_tolerance,
+        };
         let mut warnings = Vec::new();
         let data = if o.no_estimate { None } else { read_estimator(path, &stored.basis)? };
         let estimator = match data {
@@ -98,11 +103,12 @@ impl Rom {
             }
             None => None,
         };
-        let tolerance = match o.tolerance {
-            Some(t) => Some(t),
-            None => read_training_tolerance(path)?,
+        let trained = read_training_measure(path)?;
+        let (tolerance, measure) = match o.tolerance {
+            Some(t) => (Some(t), o.tolerance_measure.unwrap_or(trained)),
+            None => (read_training_tolerance(path)?, trained),
         };
-        let trust = Trust { range: read_training_range(path)?, tolerance, skipped: o.no_estimate };
+        let trust = Trust { range: read_training_range(path)?, tolerance, measure, skipped: o.no_estimate };
         Ok((Rom::new(model, &stored.basis, estimator, Some(trust))?, warnings))
     }
 
@@ -127,6 +133,11 @@ impl Rom {
     /// The training range and tolerance, for a basis read from its file.
     pub fn trust(&self) -> Option<&Trust> {
         self.trust.as_ref()
+    }
+
+    /// The error the tolerance is on ([`Trust::measure`]; relative without a trust).
+    pub fn tolerance_measure(&self) -> estimator::ErrorMeasure {
+        self.trust.as_ref().map_or(estimator::ErrorMeasure::Relative, |t| t.measure)
     }
 
     /// Whether `mu` lies outside the parameters the basis was trained on (false when they

@@ -9,17 +9,18 @@
 use crate::error::Result;
 use std::sync::Mutex;
 
-type Make<T> = Box<dyn Fn() -> Result<T> + Send + Sync>;
+type Make<'a, T> = Box<dyn Fn() -> Result<T> + Send + Sync + 'a>;
 
 /// Work spaces built on demand by `make` and kept for reuse; at most as many exist as runs
-/// ever ran at once.
-pub struct Pool<T> {
+/// ever ran at once. `'a`: what `make` borrows (`'static` for an owning object such as
+/// [`super::Rom`]; a sweep's full models borrow the model for the sweep's length).
+pub struct Pool<'a, T> {
     free: Mutex<Vec<T>>,
-    make: Make<T>,
+    make: Make<'a, T>,
 }
 
-impl<T: Send> Pool<T> {
-    pub fn new(make: impl Fn() -> Result<T> + Send + Sync + 'static) -> Self {
+impl<'a, T: Send> Pool<'a, T> {
+    pub fn new(make: impl Fn() -> Result<T> + Send + Sync + 'a) -> Self {
         Pool { free: Mutex::new(Vec::new()), make: Box::new(make) }
     }
 
@@ -58,7 +59,7 @@ mod tests {
             assert_eq!(pool.with(|w| *w).unwrap(), 0);
         }
         assert_eq!(made.load(Ordering::SeqCst), 1);
-        let bad: Pool<u8> = Pool::new(|| Err(crate::Error::Usage("no".into())));
+        let bad: Pool<'_, u8> = Pool::new(|| Err(crate::Error::Usage("no".into())));
         assert!(bad.with(|_| ()).is_err());
     }
 

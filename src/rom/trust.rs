@@ -2,7 +2,7 @@
 //! cost, whether the parameters left the training range, and whether the estimate stays
 //! within the tolerance (`--strict`). Warnings are returned as lines for the caller to show.
 
-use super::estimator::Estimate;
+use super::estimator::{ErrorMeasure, Estimate};
 use crate::error::{Error, Result};
 
 /// What the online tools hold a basis's runs to.
@@ -12,6 +12,9 @@ pub struct Trust {
     pub range: (f64, f64),
     /// `[online] tolerance`, else greedy training's tolerance, else none
     pub tolerance: Option<f64>,
+    /// the error `tolerance` is on: `[online] tolerance_measure`, else greedy training's
+    /// `measure` (relative for other bases)
+    pub measure: ErrorMeasure,
     /// the user asked for no estimate (`--no-estimate`): no warnings about its absence
     pub skipped: bool,
 }
@@ -19,7 +22,7 @@ pub struct Trust {
 impl Trust {
     /// Trust in a basis trained over `range` with no tolerance to hold its estimates to.
     pub fn range(range: (f64, f64)) -> Self {
-        Trust { range, tolerance: None, skipped: false }
+        Trust { range, tolerance: None, measure: ErrorMeasure::Relative, skipped: false }
     }
 }
 
@@ -34,8 +37,9 @@ pub fn is_extrapolated(range: (f64, f64), load_scale: f64) -> bool {
 /// reduced run.
 pub fn describe(e: &Estimate, method: &str, rom_seconds: f64) -> String {
     format!(
-        "error_estimate {:.3e} ({method} method, {}, factor {:.3}), estimator {:.4} s ({:.0} % of the reduced run)",
+        "error_estimate {:.3e}, displacement {:.3e} ({method} method, {}, factor {:.3}), estimator {:.4} s ({:.0} % of the reduced run)",
         e.error_estimate,
+        e.error_estimate_displacement,
         if e.calibrated { "calibrated" } else { "uncalibrated" },
         e.factor,
         e.seconds,
@@ -47,8 +51,11 @@ pub fn describe(e: &Estimate, method: &str, rom_seconds: f64) -> String {
 /// `error_estimate_by_time` (5 values: the estimate up to the end of each fifth of the run,
 /// the last = `error_estimate`; NaN without an estimator), `error_estimate_raw`,
 /// `error_estimate_factor`, `error_estimate_calibrated` (0/1), `extrapolated` (0/1),
-/// `training_range` ([min, max]), `tolerance` (when set), `error_estimate_method`
-/// (`corrected`, `defects` or `enriched`; when there is an estimate).
+/// `training_range` ([min, max]), `tolerance` and `tolerance_measure` (`relative` or
+/// `displacement`: which estimate the tolerance holds; when set), `error_estimate_method`
+/// (`corrected`, `defects` or `enriched`; when there is an estimate),
+/// `error_estimate_displacement` and `error_estimate_displacement_by_time` (the estimate of
+/// the displacement-relative error, NaN without an estimator).
 pub fn write_run_attributes(
     f: &hdf5::File,
     e: Option<&Estimate>,
@@ -70,10 +77,16 @@ pub fn write_run_attributes(
     f.new_attr::<f64>().shape(2).create("training_range")?.write(&[trust.range.0, trust.range.1])?;
     if let Some(t) = trust.tolerance {
         attr_f64(f, "tolerance", t)?;
+        crate::io::h5::attr_str(f, "tolerance_measure", trust.measure.name())?;
     }
     if let (Some(_), Some(m)) = (e, method) {
         crate::io::h5::attr_str(f, "error_estimate_method", m)?;
     }
+    attr_f64(f, "error_estimate_displacement", e.map_or(f64::NAN, |e| e.error_estimate_displacement))?;
+    f.new_attr::<f64>()
+        .shape(FIFTHS)
+        .create("error_estimate_displacement_by_time")?
+        .write(&e.map_or([f64::NAN; FIFTHS], |e| e.displacement_by_time))?;
     Ok(())
 }
 
@@ -88,8 +101,8 @@ fn few(v: &[String]) -> String {
 
 /// The warnings about finished runs, one line each (without the `warning: ` prefix): the
 /// load scales outside the training range, a basis without an estimator, and estimates
-/// above the tolerance; `runs` are `(load scale, error_estimate)` and `has_estimator` says
-/// whether the basis has one. With `strict`, an estimate above the tolerance (or none at
+/// above the tolerance; `runs` are `(load scale, the estimate in the trust's measure)`
+/// ([`Estimate::in_measure`]) and `has_estimator` says whether the basis has one. With `strict`, an estimate above the tolerance (or none at
 /// all when a tolerance is set) is an [`Error::Strict`] instead, for after the output is
 /// written.
 pub fn check_runs(
@@ -142,7 +155,11 @@ pub fn check_runs(
     } else {
         format!("{} of {} load scales: {}", over.len(), runs.len(), few(&over))
     };
-    let msg = format!("error estimate above the tolerance {tol:e} at {what}");
+    let kind = match trust.measure {
+        ErrorMeasure::Relative => "error estimate",
+        ErrorMeasure::Displacement => "displacement error estimate",
+    };
+    let msg = format!("{kind} above the tolerance {tol:e} at {what}");
     if strict {
         return Err(Error::Strict(format!("--strict: {msg}")));
     }
@@ -166,10 +183,13 @@ mod tests {
     /// into an error.
     #[test]
     fn warnings_are_returned_and_strict_fails() {
-        let t = Trust { range: (0.5, 1.5), tolerance: Some(1e-3), skipped: false };
+        let t = Trust { range: (0.5, 1.5), tolerance: Some(1e-3), measure: ErrorMeasure::Relative, skipped: false };
         let w = check_runs(&t, true, &[(1.7, Some(1e-4)), (1.0, Some(2e-3))], false).unwrap();
         assert_eq!(w.len(), 2, "{w:?}");
         assert!(w[0].contains("1 of 2 load scales (1.7)") && w[1].contains("above the tolerance 1e-3"), "{w:?}");
+        let d = Trust { measure: ErrorMeasure::Displacement, ..t.clone() };
+        let w = check_runs(&d, true, &[(1.0, Some(2e-3))], false).unwrap();
+        assert!(w.len() == 1 && w[0].starts_with("displacement error estimate above the tolerance 1e-3"), "{w:?}");
         assert!(matches!(check_runs(&t, true, &[(1.0, Some(2e-3))], true), Err(Error::Strict(_))));
         assert!(check_runs(&t, true, &[(1.0, Some(1e-4))], true).unwrap().is_empty());
         let none = check_runs(&Trust::range((0.5, 1.5)), false, &[(1.0, None)], false).unwrap();

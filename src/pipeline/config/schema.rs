@@ -2,7 +2,7 @@
 //! [`super::Pipeline::load`] reads before it checks them against each other and the model.
 
 use super::scales::Scales;
-use crate::reduction::estimator::EstimateMethod;
+use crate::reduction::estimator::{ErrorMeasure, EstimateMethod};
 use crate::reduction::{ModeRule, SnapshotKind, Variant};
 use serde::Deserialize;
 use std::path::PathBuf;
@@ -44,9 +44,9 @@ fn default_snapshots() -> SnapshotKind {
     SnapshotKind::Reference
 }
 
-/// `[train] greedy = { range = [A, B], tolerance = T, max_runs = K, candidates = N }`:
-/// full runs where the error estimate over N evenly spaced loads of [A, B] is worst, until
-/// every estimate is ≤ T or K full runs were made.
+/// `[train] greedy = { range = [A, B], tolerance = T, max_runs = K, candidates = N,
+/// measure = "relative" }`: full runs where the error estimate over N evenly spaced loads
+/// of [A, B] is worst, until every estimate is ≤ T or K full runs were made.
 #[derive(Clone, Debug, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct GreedySpec {
@@ -55,6 +55,11 @@ pub struct GreedySpec {
     pub max_runs: usize,
     #[serde(default = "default_candidates")]
     pub candidates: usize,
+    /// the error `tolerance` is on: "relative" (rel_error, the default) or "displacement"
+    /// (displacement_error); left out of the settings hash when relative, so that a basis
+    /// trained before the key existed is not stale
+    #[serde(default, skip_serializing_if = "ErrorMeasure::is_relative")]
+    pub measure: ErrorMeasure,
 }
 
 fn default_candidates() -> usize {
@@ -161,6 +166,10 @@ pub struct OnlineSpec {
     pub load_scales: Option<Scales>,
     #[serde(default)]
     pub tolerance: Option<f64>,
+    /// the error `tolerance` is on: "relative" or "displacement"; default: the measure of
+    /// the basis's training tolerance (greedy's `measure`; "relative" for other bases)
+    #[serde(default)]
+    pub tolerance_measure: Option<ErrorMeasure>,
     /// how every reduced run computes its error estimate: "defects" (cheap; the default where
     /// greedy training calibrated it reliably), "corrected" (the default otherwise) or
     /// "enriched" (docs/error-estimate.md)

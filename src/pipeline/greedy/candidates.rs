@@ -7,8 +7,10 @@ use crate::model::Model;
 use crate::reduction::Basis;
 use crate::rom::estimator::corrected::CorrectedRunner;
 use crate::rom::estimator::defects::Defects;
-use crate::rom::estimator::norms::raw_estimate_by_time;
-use crate::rom::estimator::{self, ByFifth, DefectsCalibration, ErrorEstimator, EstimateMethod, Estimator, FIFTHS};
+use crate::rom::estimator::norms::raw_by_time;
+use crate::rom::estimator::{
+    self, ByFifth, DefectsCalibration, ErrorEstimator, ErrorMeasure, EstimateMethod, Estimator, FIFTHS,
+};
 use crate::rom::{Output, Rom};
 use crate::solver::model::Parameters;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -31,12 +33,12 @@ pub fn score(tolerance: f64, estimate_by_time: &ByFifth, sensitivity_by_time: &B
     worst
 }
 
-/// What the loop knows of one candidate.
+/// What the loop knows of one candidate, in the training's measure.
 #[derive(Clone, Copy)]
 pub(super) struct CandidateRun {
     /// the error estimate by fifth of the run (the last: the whole run's)
     pub(super) by_time: ByFifth,
-    /// the whole run's raw estimate
+    /// the whole run's raw estimate of rel_error (what `c` is calibrated with)
     pub(super) raw: f64,
     /// the reduced model's sensitivity by fifth of the run (the greedy module documentation)
     pub(super) sensitivity: ByFifth,
@@ -52,16 +54,17 @@ pub(super) fn training_rom(model: &Arc<Model>, basis: &Basis, est: &Estimator, m
 }
 
 /// The seam to the error estimator: the estimate and the reduced model's sensitivity of
-/// `basis` at every load, reduced runs in parallel (one reduced model and its estimator's
-/// per worker, as `sweep` does); a run that fails gives ∞ estimates (and sensitivity 0,
-/// which holds its estimate to T).
+/// `basis` at every load in `measure` (the sensitivity's displacement form divides by
+/// `‖X_r(λ) − X₀‖`), reduced runs in parallel (one reduced model and its estimator's per
+/// worker, as `sweep` does); a run that fails gives ∞ estimates (and sensitivity 0, which
+/// holds its estimate to T).
 pub(super) fn estimate_candidates(
     model: &Arc<Model>,
     basis: &Basis,
     est: &Estimator,
     loads: &[f64],
     label: &str,
-    method: EstimateMethod,
+    (method, measure): (EstimateMethod, ErrorMeasure),
 ) -> Vec<CandidateRun> {
     let target =
         if crate::output::show_progress() { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() };
@@ -73,10 +76,12 @@ pub(super) fn estimate_candidates(
     );
     bar.set_prefix(label.to_string());
     let Ok(rom) = training_rom(model, basis, est, method) else { return vec![FAILED; loads.len()] };
+    let Ok(physics) = model.physics() else { return vec![FAILED; loads.len()] };
+    let x0 = ndarray::ArrayView1::from(&physics.x0[..]);
     let out: Vec<CandidateRun> = loads
         .par_iter()
         .map(|&x| {
-            let r = candidate_run(&rom, x);
+            let r = candidate_run(&rom, x, measure, x0);
             bar.inc(1);
             r
         })
@@ -89,8 +94,9 @@ pub(super) fn estimate_candidates(
 const FAILED: CandidateRun =
     CandidateRun { by_time: [f64::INFINITY; FIFTHS], raw: f64::INFINITY, sensitivity: [0.0; FIFTHS] };
 
-/// One candidate: the reduced run at `x` with its estimate, and the run at `x(1 + δ)`.
-fn candidate_run(rom: &Rom, x: f64) -> CandidateRun {
+/// One candidate: the reduced run at `x` with its estimate, and the run at `x(1 + δ)`, in
+/// `measure` (`x0`: the initial configuration X₀ of the displacement measure).
+fn candidate_run(rom: &Rom, x: f64, measure: ErrorMeasure, x0: ndarray::ArrayView1<f64>) -> CandidateRun {
     let mu = Parameters::new(x);
     match rom.solve_and_estimate(&mu, Output::ReducedAndProbes, &[]) {
         Ok((run, Some(e))) => {
@@ -98,10 +104,10 @@ fn candidate_run(rom: &Rom, x: f64) -> CandidateRun {
             let moved = Parameters::new(x * (1.0 + SENSITIVITY_STEP));
             let basis = rom.basis();
             let sensitivity = match rom.solve_with(&moved, Output::ReducedAndProbes, &[]) {
-                Ok(moved) => raw_estimate_by_time(basis, basis, &moved.reduced_q, &run.reduced_q),
+                Ok(moved) => *raw_by_time(basis, basis, &moved.reduced_q, &run.reduced_q, x0).get(measure),
                 Err(_) => [0.0; FIFTHS],
             };
-            CandidateRun { by_time: e.by_time, raw: e.raw, sensitivity }
+            CandidateRun { by_time: *e.by_time_in(measure), raw: e.raw, sensitivity }
         }
         _ => FAILED,
     }
@@ -118,18 +124,19 @@ pub(super) fn screen_candidates(
     est: &Estimator,
     loads: &[f64],
     order: &[usize],
-    method: EstimateMethod,
+    (method, measure): (EstimateMethod, ErrorMeasure),
     tolerance: f64,
 ) -> Vec<Option<CandidateRun>> {
     let mut out = vec![None; loads.len()];
-    let Ok(rom) = training_rom(model, basis, est, method) else {
+    let (Ok(rom), Ok(physics)) = (training_rom(model, basis, est, method), model.physics()) else {
         // like a failed run at every candidate: one is enough to reject
         out[order[0]] = Some(FAILED);
         return out;
     };
+    let x0 = ndarray::ArrayView1::from(&physics.x0[..]);
     let chunk = rayon::current_num_threads().max(1);
     for part in order.chunks(chunk) {
-        let runs: Vec<CandidateRun> = part.par_iter().map(|&i| candidate_run(&rom, loads[i])).collect();
+        let runs: Vec<CandidateRun> = part.par_iter().map(|&i| candidate_run(&rom, loads[i], measure, x0)).collect();
         let over = runs.iter().any(|r| !(score(tolerance, &r.by_time, &r.sensitivity) <= tolerance));
         for (&i, r) in part.iter().zip(runs) {
             out[i] = Some(r);
@@ -166,7 +173,7 @@ pub(super) fn calibrate_defects(
                 return [f64::NAN; FIFTHS];
             };
             let Ok(raw) = d.raw(&run) else { return [f64::NAN; FIFTHS] };
-            std::array::from_fn(|i| e.by_time[i] / raw[i])
+            std::array::from_fn(|i| e.by_time[i] / raw.relative[i])
         })
         .collect();
     DefectsCalibration::new(loads.to_vec(), ratios)

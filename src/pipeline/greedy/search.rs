@@ -11,7 +11,7 @@ use crate::pipeline::config::{GreedySpec, Pipeline};
 use crate::pipeline::training_record::modes_text;
 use crate::reduction::{ModeRule, Trained};
 use crate::rom::estimator::training::{calibrate, CalibrationPoint, Estimator};
-use crate::rom::estimator::{ByFifth, EstimateMethod, FIFTHS};
+use crate::rom::estimator::{ByFifth, ErrorMeasure, EstimateMethod, FIFTHS};
 
 /// Energy tolerances ε tried, loose to tight: 10⁻², 10⁻³, …, 10⁻¹⁰.
 pub const ENERGY_LADDER: [f64; 9] = [1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10];
@@ -26,9 +26,10 @@ pub(super) struct Level {
     pub(super) hyper_tolerance: Option<f64>,
     pub(super) trained: Trained,
     pub(super) estimator: Estimator,
-    /// scores (the greedy module documentation)
+    /// scores (the greedy module documentation), in the training's measure as `whole`
     pub(super) estimates: Vec<f64>,
     pub(super) whole: Vec<f64>,
+    /// the raw estimates of rel_error (calibration)
     pub(super) raws: Vec<f64>,
     pub(super) sensitivity: Vec<ByFifth>,
     /// the estimator's basis is richer than the basis in every block
@@ -113,7 +114,6 @@ fn worst_first(scores: &[f64], evaluated: &[bool]) -> Vec<usize> {
 pub(super) fn search(r: &Round, g: &GreedySpec, previous_energy: Option<f64>) -> Result<Level> {
     let (p, candidates, n) = (r.p, r.candidates, r.n);
     let given_hyper = p.file.reduction.hyper.as_ref().map(|h| h.tolerance);
-    let debug = std::env::var_os("FLEXROM_GREEDY_DEBUG").is_some();
     // what the tolerance promises is every load of the range, not the candidates alone
     let accepts = |l: &Level| l.between_candidates() <= g.tolerance;
     let mut last_error: Option<(&'static str, String)> = None;
@@ -125,14 +125,16 @@ pub(super) fn search(r: &Round, g: &GreedySpec, previous_energy: Option<f64>) ->
         match level(r, modes, eps, Some(tau), &order) {
             Ok(l) => {
                 order = worst_first(&l.estimates, &l.evaluated);
-                if debug {
-                    let (wi, w) = l.worst();
-                    let h = l.trained.basis.hyper.as_ref().map_or(0, |h| h.elements.len());
-                    crate::output::info(&format!("  rung ε = {eps:.1e}, τ = {tau:.1e}: {}, {h} elements, estimator {:?}, worst estimate {w:.3e} at λ = {}", modes_text(&l.trained.block_modes), l.estimator.block_modes, candidates[wi]));
-                }
+                crate::output::detail(&rung_text(r, &l, eps, tau, g.tolerance));
                 Some(l)
             }
             Err(e) => {
+                crate::output::detail(&format!(
+                    "  iteration {n}, rung {}: rejected, the basis could not be built ({}: {})",
+                    rung_name(eps, tau),
+                    e.0,
+                    e.1
+                ));
                 last_error = Some(e);
                 None
             }
@@ -208,7 +210,68 @@ pub(super) fn search(r: &Round, g: &GreedySpec, previous_energy: Option<f64>) ->
     if !best.complete() {
         best.estimate(p, candidates, &format!("iteration {n}"), r.method);
     }
+    crate::output::detail(&format!(
+        "  iteration {n} keeps rung {}: {}{}",
+        rung_name(best.energy, best.hyper_tolerance.unwrap_or(f64::NAN)),
+        modes_text(&best.trained.block_modes),
+        if accepts(&best) { "" } else { " (the lowest worst estimate; no rung met the tolerance)" }
+    ));
     Ok(best)
+}
+
+/// "ε = 1.0e-4, τ = 1.0e-2" (ε is NaN where the pipeline gives the modes).
+fn rung_name(eps: f64, tau: f64) -> String {
+    if eps.is_nan() {
+        format!("of the given modes, τ = {tau:.1e}")
+    } else {
+        format!("ε = {eps:.1e}, τ = {tau:.1e}")
+    }
+}
+
+/// One rung of the search for `train -v`: its modes per block, sampled elements, the
+/// estimator's modes, the worst estimate and where, and whether it meets `tolerance` or
+/// why not (the order of the checks is the search's: a rung screened out at a candidate
+/// above T, the bound between the candidates, an estimator no richer than the basis).
+fn rung_text(r: &Round, l: &Level, eps: f64, tau: f64, tolerance: f64) -> String {
+    let (wi, w) = l.worst();
+    let elements = match &l.trained.basis.hyper {
+        Some(h) => format!("{} sampled element{}", h.elements.len(), if h.elements.len() == 1 { "" } else { "s" }),
+        None => "every element".to_string(),
+    };
+    let run = l.evaluated.iter().filter(|&&e| e).count();
+    let poor: Vec<String> = (l.estimator.block_modes.iter().zip(&l.trained.block_modes).enumerate())
+        .filter(|(_, (&e, &m))| e <= m)
+        .map(|(i, _)| match &r.p.model.file.bodies[..] {
+            bodies if l.trained.block_modes.len() > 1 => {
+                bodies.get(i).map_or_else(|| format!("block {i}"), |b| b.name.clone())
+            }
+            _ => "the basis".to_string(),
+        })
+        .collect();
+    let mut verdict = if !l.complete() {
+        format!(
+            "above the tolerance {tolerance:e} at λ = {} ({run} of {} candidates run)",
+            r.candidates[wi],
+            r.candidates.len()
+        )
+    } else if l.between_candidates() > tolerance {
+        format!("above the tolerance {tolerance:e} between the candidates (bound {:.2e})", l.between_candidates())
+    } else {
+        format!("within the tolerance {tolerance:e} (bound between the candidates {:.2e})", l.between_candidates())
+    };
+    if !poor.is_empty() {
+        // the search stops at such a rung: a tighter one would have nothing to be checked against
+        verdict +=
+            &format!("; the estimator is no richer than the basis in {}: no tighter rung is tried", poor.join(", "));
+    }
+    format!(
+        "  iteration {}, rung {}: {}, {elements}, estimator {}; worst score {w:.2e} at λ = {}: {verdict}",
+        r.n,
+        rung_name(eps, tau),
+        modes_text(&l.trained.block_modes),
+        modes_text(&l.estimator.block_modes),
+        r.candidates[wi]
+    )
 }
 
 /// A bound of an estimate between evenly spaced candidate loads from its values `e` at
@@ -273,7 +336,14 @@ fn level(
 impl Level {
     /// The estimates, scores and sensitivities at every candidate, with `method`.
     pub(super) fn estimate(&mut self, p: &Pipeline, candidates: &[f64], label: &str, method: EstimateMethod) {
-        let runs = estimate_candidates(&p.model, &self.trained.basis, &self.estimator, candidates, label, method);
+        let runs = estimate_candidates(
+            &p.model,
+            &self.trained.basis,
+            &self.estimator,
+            candidates,
+            label,
+            (method, measure_of(p)),
+        );
         self.record(p, runs.into_iter().map(Some).collect());
     }
 
@@ -282,7 +352,7 @@ impl Level {
     /// through.
     fn screen(&mut self, p: &Pipeline, candidates: &[f64], order: &[usize], method: EstimateMethod) {
         let (basis, est) = (&self.trained.basis, &self.estimator);
-        let runs = screen_candidates(&p.model, basis, est, candidates, order, method, p_tolerance(p));
+        let runs = screen_candidates(&p.model, basis, est, candidates, order, (method, measure_of(p)), p_tolerance(p));
         self.record(p, runs);
     }
 
@@ -301,6 +371,11 @@ impl Level {
 /// The greedy tolerance of the pipeline (`[train] greedy`).
 fn p_tolerance(p: &Pipeline) -> f64 {
     p.file.train.greedy.as_ref().map_or(f64::INFINITY, |g| g.tolerance)
+}
+
+/// The error measure greedy's tolerance is on (`[train] greedy.measure`).
+fn measure_of(p: &Pipeline) -> ErrorMeasure {
+    p.file.train.greedy.as_ref().map_or(ErrorMeasure::Relative, |g| g.measure)
 }
 
 #[cfg(test)]

@@ -7,21 +7,28 @@
 //! /status             (N)            0 = ok, 1 = failed, 2 = not run yet
 //! /message            (N)            why it failed ("" when ok)
 //! /t                  (n_t)
-//! /probes/<name>      (N, n_t, 2)    reduced-model probe positions, m
+//! /probes/<name>      (N, n_t, 2)    probe positions of each run (reduced; --full: full), m
 //! /full_probes/<name> (N, n_t, 2)    with --validate: the full runs' probe positions, m
-//! /reduced_q          (N, n_t, r)    reduced coordinates (time first; layout 1: (N, r, n_t))
-//! /rom_seconds        (N)            reduced time loop of each run
+//! /reduced_q          (N, n_t, r)    reduced coordinates (time first; layout 1: (N, r, n_t));
+//!                                    not in a full sweep
+//! /rom_seconds        (N)            reduced time loop of each run (not in a full sweep)
 //! /newton_iterations  (N)
 //! /factorizations     (N)            iteration matrices factorized
 //! /error_estimate     (N)            the estimate of rel_error of each run (NaN: no estimator)
 //! /error_estimate_by_time (N, 5)     the estimate up to the end of each fifth of the run (the
 //!                                    last column is /error_estimate; NaN: no estimator)
+//! /error_estimate_displacement (N)   the estimate of displacement_error of each run
+//! /error_estimate_displacement_by_time (N, 5)   the same up to the end of each fifth
 //! /extrapolated       (N)            1 where the load scale is outside the training range
 //! /estimate_seconds   (N)            the estimator's enriched run and norms, s
 //! with --validate:    /rel_error, /max_probe_error, /max_constraint_violation,
-//!                     /full_seconds, /speedup, /steps_differ_from  (N each)
+//!                     /full_seconds, /speedup, /steps_differ_from, /displacement_error  (N each)
+//! with --full:        /full_seconds (N), the full time loop of each run; the estimate
+//!                     columns NaN (an exact run has none), /extrapolated 0
 //! every dataset: units, dims (src/io/attrs.rs)
-//! attributes on /: flexrom_layout, flexrom_file = "sweep", basis, basis_content_hash, model_fingerprint, variant, n_modes,
+//! attributes on /: flexrom_layout, flexrom_file = "sweep", route ("reduced" or "full";
+//!   files written before 2026-11-26 have none and are reduced), basis,
+//!   basis_content_hash, variant, n_modes (reduced sweeps only), model_fingerprint,
 //!   validated (0/1), wall_seconds (whole sweep), threads, continuation (1 when the runs
 //!   were continued from their neighbours), n_failed, n_pending, program_version
 //! ```
@@ -44,17 +51,39 @@ use std::path::Path;
 /// Extra content written into every version of a sweep file (a shard's `/shard` group).
 pub type Extra<'a> = &'a (dyn Fn(&hdf5::File) -> Result<()> + Sync);
 
-/// Writes the sweep file (atomically: a temporary file renamed over `path`).
-pub fn write_sweep(path: &Path, s: &Sweep, stored: &StoredBasis, basis_path: &Path) -> Result<()> {
-    write_sweep_with(path, s, stored, basis_path, &|_| Ok(()))
+/// The basis file a reduced sweep ran: as read and checked (`stored`) and where (`path`).
+#[derive(Clone, Copy)]
+pub struct SweepBasis<'a> {
+    pub stored: &'a StoredBasis,
+    pub path: &'a Path,
+}
+
+/// The value of the `route` attribute: what the sweep ran.
+fn route_name(full: bool) -> &'static str {
+    if full {
+        "full"
+    } else {
+        "reduced"
+    }
+}
+
+/// Writes the sweep file (atomically: a temporary file renamed over `path`); `basis` is
+/// the basis of a reduced sweep, `None` for a full one.
+pub fn write_sweep(path: &Path, s: &Sweep, basis: Option<SweepBasis>) -> Result<()> {
+    write_sweep_with(path, s, basis, &|_| Ok(()))
 }
 
 /// [`write_sweep`] with `extra` written into the file before it is renamed into place.
-pub fn write_sweep_with(path: &Path, s: &Sweep, stored: &StoredBasis, basis_path: &Path, extra: Extra) -> Result<()> {
-    let basis = &stored.basis;
+pub fn write_sweep_with(path: &Path, s: &Sweep, basis: Option<SweepBasis>, extra: Extra) -> Result<()> {
     let (n, nt, r) = (s.scales.len(), s.t.len(), s.n_reduced);
     if n == 0 {
         return Err(Error::Usage("the sweep has no load scales".into()));
+    }
+    if s.full != basis.is_none() {
+        return Err(Error::Usage(format!(
+            "{}: a reduced sweep is written with its basis, a full one without",
+            path.display()
+        )));
     }
     write_atomically_as(path, Kind::Sweep, |f| {
         let e = |err: hdf5::Error| Error::hdf5(path, err);
@@ -82,7 +111,7 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, stored: &StoredBasis, basis_path
         // the reduced runs' probes, and beside them with --validate the full runs'
         type ProbesOf = fn(&SweepPoint) -> Option<&[(String, Array2<f64>)]>;
         let groups: &[(&str, ProbesOf)] =
-            &[("probes", |p| Some(&p.rom.result.probes)), ("full_probes", |p| p.full_probes.as_deref())];
+            &[("probes", |p| Some(&p.run.result.probes)), ("full_probes", |p| p.full_probes.as_deref())];
         for (group, probes) in &groups[..if s.validated { 2 } else { 1 }] {
             let g = f.create_group(group).map_err(e)?;
             for (i, name) in s.probe_names.iter().enumerate() {
@@ -95,23 +124,25 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, stored: &StoredBasis, basis_path
                 g.new_dataset_builder().with_data(&a).create(name.as_str()).map_err(e)?;
             }
         }
-        // time first: (load, time, mode); the runs keep r × n_t
-        let mut zq = Array3::from_elem((n, nt, r), f64::NAN);
-        for (k, x) in s.scales.iter().enumerate() {
-            if let Some(p) = x.point() {
-                zq.index_axis_mut(ndarray::Axis(0), k).assign(&p.rom.reduced_q.t());
+        if !s.full {
+            // time first: (load, time, mode); the runs keep r × n_t
+            let mut zq = Array3::from_elem((n, nt, r), f64::NAN);
+            for (k, x) in s.scales.iter().enumerate() {
+                if let Some(p) = x.point() {
+                    zq.index_axis_mut(ndarray::Axis(0), k).assign(&p.run.reduced_q.t());
+                }
             }
+            // one chunk per run, not compressed: deflate took 15 % off the size of these
+            // trajectories for 0.15 s of a 1.5 s four-bar sweep
+            f.new_dataset_builder().chunk((1, nt.max(1), r.max(1))).with_data(&zq).create("reduced_q").map_err(e)?;
+            f.new_dataset_builder().with_data(&col(&|p| p.run.result.wall_seconds)).create("rom_seconds").map_err(e)?;
         }
-        // one chunk per run, not compressed: deflate took 15 % off the size of these
-        // trajectories for 0.15 s of a 1.5 s four-bar sweep
-        f.new_dataset_builder().chunk((1, nt.max(1), r.max(1))).with_data(&zq).create("reduced_q").map_err(e)?;
-        f.new_dataset_builder().with_data(&col(&|p| p.rom.result.wall_seconds)).create("rom_seconds").map_err(e)?;
         f.new_dataset_builder()
-            .with_data(&count(&|p| p.rom.result.stats.newton_iterations))
+            .with_data(&count(&|p| p.run.result.stats.newton_iterations))
             .create("newton_iterations")
             .map_err(e)?;
         f.new_dataset_builder()
-            .with_data(&count(&|p| p.rom.result.stats.factorizations))
+            .with_data(&count(&|p| p.run.result.stats.factorizations))
             .create("factorizations")
             .map_err(e)?;
         f.new_dataset_builder()
@@ -125,6 +156,17 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, stored: &StoredBasis, basis_path
             }
         }
         f.new_dataset_builder().with_data(&by_time).create("error_estimate_by_time").map_err(e)?;
+        f.new_dataset_builder()
+            .with_data(&col(&|p| p.estimate.map_or(f64::NAN, |e| e.error_estimate_displacement)))
+            .create("error_estimate_displacement")
+            .map_err(e)?;
+        let mut by_time = Array2::from_elem((n, 5), f64::NAN);
+        for (k, x) in s.scales.iter().enumerate() {
+            if let Some(est) = x.point().and_then(|p| p.estimate) {
+                by_time.row_mut(k).assign(&ndarray::ArrayView1::from(&est.displacement_by_time));
+            }
+        }
+        f.new_dataset_builder().with_data(&by_time).create("error_estimate_displacement_by_time").map_err(e)?;
         f.new_dataset_builder()
             .with_data(&col(&|p| p.estimate.map_or(f64::NAN, |e| e.seconds)))
             .create("estimate_seconds")
@@ -147,13 +189,26 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, stored: &StoredBasis, basis_path
                 .with_data(&v(&|x| x.steps_differ_from.unwrap_or(f64::NAN)))
                 .create("steps_differ_from")
                 .map_err(e)?;
+            f.new_dataset_builder().with_data(&v(&|x| x.displacement_error)).create("displacement_error").map_err(e)?;
         }
-        // absolute, so that the file names its basis wherever it is read from
-        attr_str(f, "basis", &crate::io::output::resolve(basis_path).display().to_string()).map_err(e)?;
-        attr_str(f, "basis_content_hash", &stored.content_hash).map_err(e)?;
-        attr_str(f, "model_fingerprint", &stored.model_fingerprint).map_err(e)?;
-        attr_str(f, "variant", basis.variant.name()).map_err(e)?;
-        attr_u64(f, "n_modes", basis.n_reduced() as u64).map_err(e)?;
+        if s.full {
+            // the full time loops, as a validated sweep's column of the same name
+            f.new_dataset_builder()
+                .with_data(&col(&|p| p.run.result.wall_seconds))
+                .create("full_seconds")
+                .map_err(e)?;
+        }
+        attr_str(f, "route", route_name(s.full)).map_err(e)?;
+        if let Some(SweepBasis { stored, path: basis_path }) = basis {
+            // absolute, so that the file names its basis wherever it is read from
+            attr_str(f, "basis", &crate::io::output::resolve(basis_path).display().to_string()).map_err(e)?;
+            attr_str(f, "basis_content_hash", &stored.content_hash).map_err(e)?;
+            attr_str(f, "model_fingerprint", &stored.model_fingerprint).map_err(e)?;
+            attr_str(f, "variant", stored.basis.variant.name()).map_err(e)?;
+            attr_u64(f, "n_modes", stored.basis.n_reduced() as u64).map_err(e)?;
+        } else {
+            attr_str(f, "model_fingerprint", &s.model_fingerprint).map_err(e)?;
+        }
         attr_u64(f, "validated", s.validated as u64).map_err(e)?;
         attr_f64(f, "wall_seconds", s.wall_seconds).map_err(e)?;
         attr_u64(f, "threads", s.threads as u64).map_err(e)?;
@@ -166,12 +221,13 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, stored: &StoredBasis, basis_path
 }
 
 /// Reads an earlier sweep file for `--resume`: (load scale, the finished run) for every
-/// scale it holds, `None` for those that failed or did not run. Refuses a file of another
-/// basis or model, and one without the validation a `--validate` sweep needs.
+/// scale it holds, `None` for those that failed or did not run. `stored` is the basis of a
+/// reduced sweep, `None` for a full one. Refuses a file of another route, basis or model,
+/// and one without the validation a `--validate` sweep needs.
 pub fn read_sweep(
     path: &Path,
     model: &Model,
-    stored: &StoredBasis,
+    stored: Option<&StoredBasis>,
     validate: bool,
 ) -> Result<Vec<(f64, Option<SweepPoint>)>> {
     let cannot = |field: &str, problem: String| {
@@ -183,8 +239,23 @@ pub fn read_sweep(
     let text = |name: &str| {
         read_attr_str(&f, name).map_err(|e| cannot(name, format!("cannot be read ({e}): not a flexrom sweep file?")))
     };
-    if text("basis_content_hash")? != stored.content_hash {
-        return Err(cannot("basis_content_hash", "comes from another basis than the one given".into()));
+    // files written before the attribute are reduced sweeps
+    let file_full = f.attr("route").is_ok() && text("route")? == route_name(true);
+    match (stored, file_full) {
+        (Some(_), true) => {
+            return Err(cannot("route", "is \"full\": a sweep of the full model (`--full`), not of a basis".into()))
+        }
+        (None, false) => {
+            return Err(cannot(
+                "route",
+                "is not \"full\": a sweep of a reduced model, which a full sweep (`--full`) does not take runs from"
+                    .into(),
+            ))
+        }
+        (Some(stored), false) if text("basis_content_hash")? != stored.content_hash => {
+            return Err(cannot("basis_content_hash", "comes from another basis than the one given".into()));
+        }
+        _ => {}
     }
     if text("model_fingerprint")? != model.fingerprint() {
         return Err(cannot("model_fingerprint", "comes from another model than the pipeline's".into()));
@@ -202,18 +273,24 @@ pub fn read_sweep(
         .map_err(|e| cannot("status", format!("cannot be read: {e}")))?;
     let t = vec("t")?;
     let s = Settings::resolve(model, &Overrides::default())?;
-    let (n, nt, r) = (scales.len(), s.n_steps + 1, stored.basis.n_reduced());
+    let (n, nt, r) = (scales.len(), s.n_steps + 1, stored.map_or(0, |b| b.basis.n_reduced()));
     if status.len() != n || t.len() != nt {
         return Err(cannot(
             "status",
             format!("has {} entries for {n} load scales, or /t {} for {nt} instants", status.len(), t.len()),
         ));
     }
-    let zq = f
-        .dataset("reduced_q")
-        .and_then(|d| d.read::<f64, ndarray::Ix3>())
-        .map_err(|e| cannot("reduced_q", format!("cannot be read: {e}")))?;
-    let zq = if layout == 1 {
+    let zq = if file_full {
+        // a full sweep keeps no coordinates
+        Array3::zeros((n, 0, nt))
+    } else {
+        f.dataset("reduced_q")
+            .and_then(|d| d.read::<f64, ndarray::Ix3>())
+            .map_err(|e| cannot("reduced_q", format!("cannot be read: {e}")))?
+    };
+    let zq = if file_full {
+        zq
+    } else if layout == 1 {
         if zq.dim() != (n, r, nt) {
             return Err(cannot("reduced_q", format!("is {:?}, expected ({n}, {r}, {nt}) (layout 1)", zq.dim())));
         }
@@ -246,7 +323,9 @@ pub fn read_sweep(
     let at = |probes: &[(String, Array3<f64>)], k: usize| -> Vec<(String, Array2<f64>)> {
         probes.iter().map(|(name, a)| (name.clone(), a.index_axis(ndarray::Axis(0), k).to_owned())).collect()
     };
-    let rom_seconds = vec("rom_seconds")?;
+    // each run's time loop: the reduced one, or a full sweep's full one
+    let seconds_name = if file_full { "full_seconds" } else { "rom_seconds" };
+    let rom_seconds = vec(seconds_name)?;
     // the estimate columns of the file (absent in files written before them: no estimate)
     let optional = |name: &str| if f.link_exists(name) { vec(name).map(Some) } else { Ok(None) };
     let (estimates, estimate_seconds, extrapolated) = (
@@ -262,18 +341,24 @@ pub fn read_sweep(
             None
         },
     );
-    let by_time = if f.link_exists("error_estimate_by_time") {
-        let a = f
-            .dataset("error_estimate_by_time")
-            .and_then(|d| d.read::<f64, ndarray::Ix2>())
-            .map_err(|e| cannot("error_estimate_by_time", format!("cannot be read: {e}")))?;
-        if a.dim() != (n, 5) {
-            return Err(cannot("error_estimate_by_time", format!("is {:?}, expected ({n}, 5)", a.dim())));
+    let by_fifth = |name: &str| -> Result<Option<Array2<f64>>> {
+        if !f.link_exists(name) {
+            return Ok(None);
         }
-        Some(a)
-    } else {
-        None
+        let a = f
+            .dataset(name)
+            .and_then(|d| d.read::<f64, ndarray::Ix2>())
+            .map_err(|e| cannot(name, format!("cannot be read: {e}")))?;
+        if a.dim() != (n, 5) {
+            return Err(cannot(name, format!("is {:?}, expected ({n}, 5)", a.dim())));
+        }
+        Ok(Some(a))
     };
+    let by_time = by_fifth("error_estimate_by_time")?;
+    // files written before the displacement measure have neither: NaN
+    let (estimates_displacement, displacement_by_time) =
+        (optional("error_estimate_displacement")?, by_fifth("error_estimate_displacement_by_time")?);
+    let displacement = if validate { optional("displacement_error")? } else { None };
     let (newton, factorizations) = (ints("newton_iterations")?, ints("factorizations")?);
     // files written before it have no /steps_differ_from: unknown, as no halved step
     let differ = if validate && f.link_exists("steps_differ_from") { Some(vec("steps_differ_from")?) } else { None };
@@ -299,10 +384,12 @@ pub fn read_sweep(
         .chain(validation.iter().flatten())
         .chain(estimates.iter())
         .chain(estimate_seconds.iter())
+        .chain(estimates_displacement.iter())
+        .chain(displacement.iter())
     {
         if a.len() != n {
             return Err(cannot(
-                "rom_seconds",
+                seconds_name,
                 format!("a per-scale dataset has {} entries for {n} load scales", a.len()),
             ));
         }
@@ -336,7 +423,7 @@ pub fn read_sweep(
             stats,
             wall_seconds: rom_seconds[k],
         };
-        let v = validation.as_ref().map(|c| Validation {
+        let v = validation.as_ref().zip(stored).map(|(c, stored)| Validation {
             load_scale: x,
             variant: stored.basis.variant.name().to_string(),
             n_dof: stored.basis.n_dof(),
@@ -368,6 +455,15 @@ pub fn read_sweep(
             sensitivity: None,
             rel_error_by_time: Vec::new(),
             error_estimate_by_time: None,
+            displacement_error: displacement.as_ref().map_or(f64::NAN, |a| a[k]),
+            displacement_error_by_time: Vec::new(),
+            error_estimate_displacement: None,
+            effectivity_displacement: None,
+            error_estimate_displacement_by_time: None,
+            max_error_over_travel: None,
+            max_error_over_travel_probe: String::new(),
+            probe_errors_over_travel: Vec::new(),
+            error_estimate_method: None,
         });
         // the stored estimate: its value and cost (the factor it was made with is the basis's)
         let estimate = estimates.as_ref().map(|a| a[k]).filter(|e| !e.is_nan()).map(|error_estimate| Estimate {
@@ -377,6 +473,10 @@ pub fn read_sweep(
             calibrated: false,
             seconds: estimate_seconds.as_ref().map_or(f64::NAN, |a| a[k]),
             by_time: by_time.as_ref().map_or([f64::NAN; 5], |a| std::array::from_fn(|i| a[[k, i]])),
+            error_estimate_displacement: estimates_displacement.as_ref().map_or(f64::NAN, |a| a[k]),
+            displacement_by_time: displacement_by_time
+                .as_ref()
+                .map_or([f64::NAN; 5], |a| std::array::from_fn(|i| a[[k, i]])),
         });
         let extrapolated = extrapolated.as_ref().is_some_and(|a| a.get(k).is_some_and(|&v| v != 0));
         let v = v.map(|mut v| {
@@ -385,13 +485,16 @@ pub fn read_sweep(
                 v.effectivity = Some(e.error_estimate / v.rel_error);
                 v.estimate_seconds = Some(e.seconds);
                 v.error_estimate_by_time = Some(e.by_time.to_vec());
+                v.error_estimate_displacement = Some(e.error_estimate_displacement);
+                v.effectivity_displacement = Some(e.error_estimate_displacement / v.displacement_error);
+                v.error_estimate_displacement_by_time = Some(e.displacement_by_time.to_vec());
             }
             v.extrapolated = extrapolated;
             v
         });
-        let rom = ReducedRun { result, reduced_q: zq.index_axis(ndarray::Axis(0), k).to_owned() };
+        let run = ReducedRun { result, reduced_q: zq.index_axis(ndarray::Axis(0), k).to_owned() };
         let full_probes = full_probes.as_deref().map(|p| at(p, k));
-        out.push((x, Some(SweepPoint { rom, validation: v, full_probes, estimate, extrapolated })));
+        out.push((x, Some(SweepPoint { run, validation: v, full_probes, estimate, extrapolated })));
     }
     Ok(out)
 }

@@ -12,7 +12,9 @@ pub const STATUS_FAILED: u8 = 1;
 pub const STATUS_PENDING: u8 = 2;
 
 pub struct SweepPoint {
-    pub rom: ReducedRun,
+    /// the run: the reduced one with its reduced coordinates, or in a full sweep the full
+    /// one (its probes and statistics; no coordinates are kept, `reduced_q` has no rows)
+    pub run: ReducedRun,
     pub validation: Option<Validation>,
     /// the full run's probe positions (name, n_t × 2), with the validation
     pub full_probes: Option<Vec<(String, Array2<f64>)>>,
@@ -69,8 +71,12 @@ pub struct Sweep {
     /// the time grid and probe names every run shares (from the model)
     pub t: Array1<f64>,
     pub probe_names: Vec<String>,
-    /// reduced coordinates r
+    /// reduced coordinates r (0 in a full sweep)
     pub n_reduced: usize,
+    /// the full model at every load (`sweep --full`): exact, no estimate, no validation
+    pub full: bool,
+    /// the model's fingerprint ([`crate::model::Model::fingerprint`])
+    pub model_fingerprint: String,
     pub validated: bool,
     pub wall_seconds: f64,
     pub threads: usize,
@@ -83,6 +89,11 @@ impl Sweep {
     /// The load scales that ran to the end, in order.
     pub fn done(&self) -> impl Iterator<Item = &SweepPoint> {
         self.scales.iter().filter_map(ScaleResult::point)
+    }
+
+    /// The load scales not finished yet (failed or not run), which a sweep runs.
+    pub fn n_todo(&self) -> usize {
+        self.scales.iter().filter(|s| s.status() != STATUS_OK).count()
     }
 
     pub fn n_failed(&self) -> usize {
@@ -106,7 +117,7 @@ impl Sweep {
 /// A copy of a finished point (the resumed ones are taken from the file read back).
 pub(super) fn clone_point(p: &SweepPoint) -> SweepPoint {
     SweepPoint {
-        rom: p.rom.clone(),
+        run: p.run.clone(),
         validation: p.validation.clone(),
         full_probes: p.full_probes.clone(),
         estimate: p.estimate,

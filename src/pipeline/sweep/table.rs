@@ -5,8 +5,12 @@ use super::outcome::{Sweep, STATUS_FAILED};
 
 /// The table printed on stdout.
 pub fn table(s: &Sweep) -> String {
-    let mut out = String::new();
-    out.push_str("load_scale  rom_ms  newton  error_estimate  est_ms  extrap");
+    // a full sweep's runs are exact: no estimate, nothing extrapolated
+    let mut out = String::from(if s.full {
+        "load_scale  full_ms  newton"
+    } else {
+        "load_scale  rom_ms  newton  error_estimate  est_ms  extrap"
+    });
     if s.validated {
         out.push_str("   rel_error  probe_err_m  full_ms  speedup");
     }
@@ -21,7 +25,16 @@ pub fn table(s: &Sweep) -> String {
             ));
             continue;
         };
-        let r = &p.rom.result;
+        let r = &p.run.result;
+        if s.full {
+            out.push_str(&format!(
+                "{}  {:>7.2}  {:>6}\n",
+                scale(r.settings.load_scale),
+                1e3 * r.wall_seconds,
+                r.stats.newton_iterations
+            ));
+            continue;
+        }
         out.push_str(&format!(
             "{}  {:>6.2}  {:>6}",
             scale(r.settings.load_scale),

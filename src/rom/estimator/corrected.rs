@@ -57,7 +57,8 @@
 //! get there in the integrator's `max_iterations` makes the run's reading doubtful: the
 //! estimator then runs the enriched model on its own instead ([`Corrected`]).
 
-use super::{ByFifth, ErrorEstimator, Estimator};
+use super::norms::RawByFifth;
+use super::{ErrorEstimator, Estimator};
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::physics::system::FlexibleSystem;
@@ -302,9 +303,11 @@ pub struct Corrected {
     model: Arc<Model>,
     basis: Arc<Basis>,
     data: Arc<Estimator>,
-    runners: Pool<CorrectedRunner>,
+    runners: Pool<'static, CorrectedRunner>,
     /// built at the first run that needs it
     fallback: std::sync::OnceLock<Option<super::enriched::Enriched>>,
+    /// the initial configuration X₀ of the displacement measure
+    x0: Arc<Vec<f64>>,
 }
 
 impl Corrected {
@@ -320,6 +323,7 @@ impl Corrected {
             data: Arc::clone(data),
             runners,
             fallback: std::sync::OnceLock::new(),
+            x0: Arc::clone(&model.physics()?.x0),
         })
     }
 }
@@ -331,7 +335,7 @@ impl ErrorEstimator for Corrected {
     fn data(&self) -> &Estimator {
         &self.data
     }
-    fn raw(&self, run: &ReducedRun) -> Result<ByFifth> {
+    fn raw(&self, run: &ReducedRun) -> Result<RawByFifth> {
         let (qp, stats) = self.runners.with(|r| r.trajectory(run))??;
         if stats.unconverged > 0 {
             let fallback =
@@ -343,6 +347,7 @@ impl ErrorEstimator for Corrected {
                 )),
             };
         }
-        Ok(super::norms::raw_estimate_by_time(&self.basis, &self.data.enriched, &run.reduced_q, &qp))
+        let x0 = ndarray::ArrayView1::from(&self.x0[..]);
+        Ok(super::norms::raw_by_time(&self.basis, &self.data.enriched, &run.reduced_q, &qp, x0))
     }
 }

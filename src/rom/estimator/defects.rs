@@ -14,6 +14,7 @@
 //! ```text
 //!     e_k = s · Σ_{n ≤ k, n ∈ {s, 2s, …}} ‖δ_n‖,
 //!     η_raw = ( Σ_k e_k² )^½ / ‖X_r‖_F         (and the same up to each fifth of the run)
+//!     η_raw, displacement = ( Σ_k e_k² )^½ / ‖X_r − X₀‖_F
 //! ```
 //!
 //! The triangle inequality ignores that defects of alternating sign cancel, so the bound
@@ -24,7 +25,7 @@
 //! numbers, not fitted.
 
 use super::corrected::CorrectedRunner;
-use super::norms::fifth_end;
+use super::norms::{fifth_end, RawByFifth};
 use super::{ByFifth, ErrorEstimator, Estimator, FIFTHS};
 use crate::error::Result;
 use crate::model::Model;
@@ -50,8 +51,10 @@ pub fn sample_for(steps: usize, sample: usize) -> usize {
 pub struct Defects {
     basis: Arc<Basis>,
     data: Arc<Estimator>,
-    runners: Pool<CorrectedRunner>,
+    runners: Pool<'static, CorrectedRunner>,
     sample: usize,
+    /// the initial configuration X₀ of the displacement measure
+    x0: Arc<Vec<f64>>,
 }
 
 impl Defects {
@@ -60,7 +63,8 @@ impl Defects {
         let (m, b, d) = (Arc::clone(model), Arc::clone(basis), Arc::clone(data));
         let runners = Pool::new(move || CorrectedRunner::new(&m, &b, &d));
         runners.put(CorrectedRunner::new(model, basis, data)?);
-        Ok(Defects { basis: Arc::clone(basis), data: Arc::clone(data), runners, sample: DEFECT_SAMPLE })
+        let x0 = Arc::clone(&model.physics()?.x0);
+        Ok(Defects { basis: Arc::clone(basis), data: Arc::clone(data), runners, sample: DEFECT_SAMPLE, x0 })
     }
 
     /// Another sampling interval (experiments: examples/estimate_table.rs).
@@ -78,34 +82,40 @@ impl ErrorEstimator for Defects {
         &self.data
     }
 
-    /// `η_raw` over the instants up to the end of each fifth of `run` (module documentation).
-    fn raw(&self, run: &ReducedRun) -> Result<ByFifth> {
+    /// `η_raw` over the instants up to the end of each fifth of `run`, in both measures
+    /// (module documentation).
+    fn raw(&self, run: &ReducedRun) -> Result<RawByFifth> {
         let z = &run.reduced_q;
         let nt = z.ncols();
         let s = sample_for(nt.saturating_sub(1), self.sample);
         let defects = self.runners.with(|r| r.defects(run, s))??;
-        // ‖x_ref + V z_k‖² from the reduced coordinates (V orthonormal; the corrected runner
-        // exists only for such bases)
+        // ‖x_ref + V z_k‖² and ‖x_ref + V z_k − x₀‖² from the reduced coordinates (V
+        // orthonormal; the corrected runner exists only for such bases): norms.rs
         let b = &self.basis;
         let vtx = b.modes.t().dot(&b.reference);
         let xr2 = b.reference.dot(&b.reference);
-        let (mut err2, mut norm2) = (vec![0.0; nt], vec![0.0; nt]);
+        let shift = &b.reference - &ndarray::ArrayView1::from(&self.x0[..]);
+        let (vts, shift2) = (b.modes.t().dot(&shift), shift.dot(&shift));
+        let (mut err2, mut norm2, mut disp2) = (vec![0.0; nt], vec![0.0; nt], vec![0.0; nt]);
         let mut acc = 0.0;
         for k in 0..nt {
             let zk = z.column(k);
-            norm2[k] = xr2 + 2.0 * vtx.dot(&zk) + zk.dot(&zk);
+            let zk2 = zk.dot(&zk);
+            norm2[k] = xr2 + 2.0 * vtx.dot(&zk) + zk2;
+            disp2[k] = shift2 + 2.0 * vts.dot(&zk) + zk2;
             if k > 0 && k % s == 0 {
                 acc += s as f64 * defects.column(k).dot(&defects.column(k)).sqrt();
             }
             err2[k] = acc * acc;
         }
-        let mut out = [0.0; FIFTHS];
-        for (i, o) in out.iter_mut().enumerate() {
-            let end = fifth_end(nt, i);
-            let (d, n): (f64, f64) = (err2[..end].iter().sum(), norm2[..end].iter().sum());
-            *o = d.sqrt() / n.max(0.0).sqrt();
-        }
-        Ok(out)
+        let prefix = |per_instant: &[f64]| -> ByFifth {
+            std::array::from_fn(|i| {
+                let end = fifth_end(nt, i);
+                let (d, n): (f64, f64) = (err2[..end].iter().sum(), per_instant[..end].iter().sum());
+                d.sqrt() / n.max(0.0).sqrt()
+            })
+        };
+        Ok(RawByFifth { relative: prefix(&norm2), displacement: prefix(&disp2) })
     }
 
     /// The defect sum is a bound by itself: factor 1, raised in the proportion that

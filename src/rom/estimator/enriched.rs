@@ -4,8 +4,8 @@
 //! cheaply; it is also what runs where they are not available (whole-system bases, models
 //! without the invariant-based reduced model).
 
-use super::norms::raw_estimate_by_time;
-use super::{ByFifth, ErrorEstimator, Estimator};
+use super::norms::{raw_by_time, RawByFifth};
+use super::{ErrorEstimator, Estimator};
 use crate::error::Result;
 use crate::model::Model;
 use crate::reduction::Basis;
@@ -18,7 +18,9 @@ use std::sync::Arc;
 pub struct Enriched {
     basis: Arc<Basis>,
     data: Arc<Estimator>,
-    runners: Pool<ReducedRunner>,
+    runners: Pool<'static, ReducedRunner>,
+    /// the initial configuration X₀ of the displacement measure
+    x0: Arc<Vec<f64>>,
 }
 
 impl Enriched {
@@ -28,7 +30,8 @@ impl Enriched {
         let (m, e) = (Arc::clone(model), Arc::clone(&enriched));
         let runners = Pool::new(move || ReducedRunner::new(&m, &e));
         runners.put(ReducedRunner::new(model, &enriched)?);
-        Ok(Enriched { basis: Arc::clone(basis), data: Arc::clone(data), runners })
+        let x0 = Arc::clone(&model.physics()?.x0);
+        Ok(Enriched { basis: Arc::clone(basis), data: Arc::clone(data), runners, x0 })
     }
 }
 
@@ -39,9 +42,10 @@ impl ErrorEstimator for Enriched {
     fn data(&self) -> &Estimator {
         &self.data
     }
-    fn raw(&self, run: &ReducedRun) -> Result<ByFifth> {
+    fn raw(&self, run: &ReducedRun) -> Result<RawByFifth> {
         let mu = Parameters::new(run.result.settings.load_scale);
         let e = self.runners.with(|r| r.solve(&mu, Output::ReducedAndProbes, &[]))??;
-        Ok(raw_estimate_by_time(&self.basis, &self.data.enriched, &run.reduced_q, &e.reduced_q))
+        let x0 = ndarray::ArrayView1::from(&self.x0[..]);
+        Ok(raw_by_time(&self.basis, &self.data.enriched, &run.reduced_q, &e.reduced_q, x0))
     }
 }

@@ -12,7 +12,17 @@
 //! ```
 //!
 //! — the quantity `validate` measures, `rel_error = ‖X_r − X_full‖_F / ‖X_full‖_F`, with the
-//! full model replaced by the enriched one ([`norms`]). `c` is calibrated at training time
+//! full model replaced by the enriched one ([`norms`]). The same distance over the
+//! enriched model's displacement from the initial configuration X₀,
+//!
+//! ```text
+//!     error_estimate_displacement = c · ‖X_r − X_{r+k}‖_F / ‖X_{r+k} − X₀‖_F
+//! ```
+//!
+//! estimates `displacement_error` ([`ErrorMeasure`]) with the same `c`: calibrated on
+//! `rel_error`, it is the ratio of the true distance to the enriched one, and both measures
+//! divide that distance by norms of nearly the same trajectory (the enriched model's for the
+//! estimate, the full model's for the error). `c` is calibrated at training time
 //! on full runs at loads the basis did not see ([`training::calibrate`]); without such data
 //! it is [`DEFAULT_FACTOR`] and the estimator is marked uncalibrated. Both the estimate up
 //! to the end of each fifth of the run and the whole run's are reported ([`ByFifth`]).
@@ -32,7 +42,7 @@ pub mod training;
 use crate::error::Result;
 use crate::model::Model;
 pub use crate::reduction::estimator::{
-    Calibration, CalibrationPoint, DefectsCalibration, EstimateMethod, Estimator, DEFAULT_FACTOR,
+    Calibration, CalibrationPoint, DefectsCalibration, ErrorMeasure, EstimateMethod, Estimator, DEFAULT_FACTOR,
 };
 use crate::reduction::Basis;
 use crate::rom::run::ReducedRun;
@@ -44,6 +54,29 @@ use std::sync::Arc;
 pub const FIFTHS: usize = crate::reduction::estimator::FIFTHS;
 /// A value for each fifth of the run ([`FIFTHS`]), the last the whole run's.
 pub type ByFifth = crate::reduction::estimator::ByFifth;
+
+/// `η_raw` by fifth of the run in both measures (the last entry of each the whole run's).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RawByFifth {
+    /// `‖X_r − X⁺‖_F / ‖X⁺‖_F`
+    pub relative: ByFifth,
+    /// `‖X_r − X⁺‖_F / ‖X⁺ − X₀‖_F`
+    pub displacement: ByFifth,
+}
+
+impl RawByFifth {
+    /// Both ∞: an estimator whose model failed.
+    pub const INFINITE: RawByFifth =
+        RawByFifth { relative: [f64::INFINITY; FIFTHS], displacement: [f64::INFINITY; FIFTHS] };
+
+    /// The values in `measure`.
+    pub fn get(&self, measure: ErrorMeasure) -> &ByFifth {
+        match measure {
+            ErrorMeasure::Relative => &self.relative,
+            ErrorMeasure::Displacement => &self.displacement,
+        }
+    }
+}
 
 /// One estimate.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -59,6 +92,30 @@ pub struct Estimate {
     /// `c · η_raw` over the instants up to the end of each fifth of the run (as
     /// [`norms::rel_error_by_time`] for the true error); NaN where unknown
     pub by_time: ByFifth,
+    /// `c · ‖X_r − X⁺‖_F / ‖X⁺ − X₀‖_F`: the estimate of `displacement_error`; infinite
+    /// when the enriched model failed to run, NaN where unknown
+    pub error_estimate_displacement: f64,
+    /// the same up to the end of each fifth of the run (as
+    /// [`norms::displacement_error_by_time`] for the true error)
+    pub displacement_by_time: ByFifth,
+}
+
+impl Estimate {
+    /// The whole run's estimate in `measure`.
+    pub fn in_measure(&self, measure: ErrorMeasure) -> f64 {
+        match measure {
+            ErrorMeasure::Relative => self.error_estimate,
+            ErrorMeasure::Displacement => self.error_estimate_displacement,
+        }
+    }
+
+    /// The estimate up to the end of each fifth of the run in `measure`.
+    pub fn by_time_in(&self, measure: ErrorMeasure) -> &ByFifth {
+        match measure {
+            ErrorMeasure::Relative => &self.by_time,
+            ErrorMeasure::Displacement => &self.displacement_by_time,
+        }
+    }
 }
 
 /// An error estimator of one basis: how it reads a reduced run, and how far it can be trusted.
@@ -71,8 +128,9 @@ pub trait ErrorEstimator: Send + Sync {
     /// The data training made (enriched basis, calibration).
     fn data(&self) -> &Estimator;
 
-    /// `η_raw` of `run` by fifth of the run. `Err` when the estimator's model fails.
-    fn raw(&self, run: &ReducedRun) -> Result<ByFifth>;
+    /// `η_raw` of `run` by fifth of the run, in both measures. `Err` when the estimator's
+    /// model fails.
+    fn raw(&self, run: &ReducedRun) -> Result<RawByFifth>;
 
     /// The factor each fifth's `η_raw` is multiplied by at the parameters `mu`: the
     /// calibrated `c` unless the method knows better.
@@ -84,16 +142,19 @@ pub trait ErrorEstimator: Send + Sync {
     /// an infinite estimate, not an error: the reduced answer itself exists.
     fn estimate(&self, run: &ReducedRun, mu: &Parameters) -> Estimate {
         let start = std::time::Instant::now();
-        let raw = self.raw(run).unwrap_or([f64::INFINITY; FIFTHS]);
+        let raw = self.raw(run).unwrap_or(RawByFifth::INFINITE);
         let factors = self.factors(mu);
-        let by_time: ByFifth = std::array::from_fn(|i| factors[i] * raw[i]);
+        let by_time: ByFifth = std::array::from_fn(|i| factors[i] * raw.relative[i]);
+        let displacement_by_time: ByFifth = std::array::from_fn(|i| factors[i] * raw.displacement[i]);
         Estimate {
             error_estimate: by_time[FIFTHS - 1],
-            raw: raw[FIFTHS - 1],
+            raw: raw.relative[FIFTHS - 1],
             factor: factors[FIFTHS - 1],
             calibrated: self.data().calibration.calibrated,
             seconds: start.elapsed().as_secs_f64(),
             by_time,
+            error_estimate_displacement: displacement_by_time[FIFTHS - 1],
+            displacement_by_time,
         }
     }
 

@@ -1,18 +1,26 @@
 //! The norms an estimate is made of, over the whole run and up to the end of each fifth of
-//! it: the estimator's `η_raw = ‖X_r − X⁺‖_F / ‖X⁺‖_F` from reduced coordinates, and the
-//! true `rel_error = ‖X_r − X_full‖_F / ‖X_full‖_F` that `validate` measures.
+//! it: the estimator's `η_raw = ‖X_r − X⁺‖_F / ‖X⁺‖_F` and its displacement form
+//! `‖X_r − X⁺‖_F / ‖X⁺ − X₀‖_F` from reduced coordinates, and the true errors `validate`
+//! measures, `rel_error = ‖X_r − X_full‖_F / ‖X_full‖_F` and `displacement_error =
+//! ‖X_r − X_full‖_F / ‖X_full − X₀‖_F` (X₀ the initial configuration, the same at every
+//! instant).
 //!
 //! With orthonormal `V` and `V⁺` (galerkin, constraint-preserving, block bases) the norms
-//! need no full-size reconstruction: with `M = V⁺ᵀV`,
+//! need no full-size reconstruction: with `M = V⁺ᵀV` and `d = x_ref − x₀`,
 //!
 //! ```text
 //!     ‖V q − V⁺ q⁺‖² = ‖M q − q⁺‖² + qᵀ(I − MᵀM) q,
-//!     ‖x_ref + V⁺ q⁺‖² = ‖x_ref‖² + 2 (V⁺ᵀx_ref)·q⁺ + ‖q⁺‖².
+//!     ‖x_ref + V⁺ q⁺‖² = ‖x_ref‖² + 2 (V⁺ᵀx_ref)·q⁺ + ‖q⁺‖²,
+//!     ‖x_ref + V⁺ q⁺ − x₀‖² = ‖d‖² + 2 (V⁺ᵀd)·q⁺ + ‖q⁺‖²,
 //! ```
+//!
+//! the last two by expanding the square (`V⁺ᵀV⁺ = I`): the displacement norm is the
+//! configuration's with the reference shifted by the initial configuration.
 
+pub use super::RawByFifth;
 use super::{ByFifth, FIFTHS};
 use crate::reduction::{Basis, Variant};
-use ndarray::{Array1, Array2, Axis};
+use ndarray::{Array1, Array2, ArrayView1, Axis};
 
 /// The number of instants `..end` up to the end of fifth `i` (0-based) of a run of `nt`
 /// instants (at least one).
@@ -26,18 +34,38 @@ pub fn raw_estimate_reduced(basis: &Basis, enriched: &Basis, q: &Array2<f64>, qp
     raw_estimate_by_time(basis, enriched, q, qp)[FIFTHS - 1]
 }
 
-/// `η_raw` over the instants up to the end of each fifth of the run (the last entry is the
-/// whole run's), as [`rel_error_by_time`] splits the true error; ∞ when the shapes differ.
+/// `η_raw` (relative) over the instants up to the end of each fifth of the run: [`raw_by_time`]'s
+/// `relative`.
 pub fn raw_estimate_by_time(basis: &Basis, enriched: &Basis, q: &Array2<f64>, qp: &Array2<f64>) -> ByFifth {
+    raw_by_time(basis, enriched, q, qp, enriched.reference.view()).relative
+}
+
+/// `η_raw` in both measures over the instants up to the end of each fifth of the run (the
+/// last entry is the whole run's), as [`rel_error_by_time`] and
+/// [`displacement_error_by_time`] split the true errors; `x0` is the initial configuration
+/// X₀ (n_dof). ∞ when the shapes differ.
+pub fn raw_by_time(
+    basis: &Basis,
+    enriched: &Basis,
+    q: &Array2<f64>,
+    qp: &Array2<f64>,
+    x0: ArrayView1<f64>,
+) -> RawByFifth {
     let nt = qp.ncols();
     if q.ncols() != nt || nt == 0 {
-        return [f64::INFINITY; FIFTHS];
+        return RawByFifth::INFINITE;
     }
-    let (diff2, norm2): (Array1<f64>, Array1<f64>) = if basis.variant == Variant::WholeSystem {
+    // per instant: ‖x_r − x⁺‖², ‖x⁺‖², ‖x⁺ − x₀‖²
+    let (diff2, norm2, disp2): (Array1<f64>, Array1<f64>, Array1<f64>) = if basis.variant == Variant::WholeSystem {
         // V is not orthonormal: reconstruct x_ref + V q of both
         let full = |b: &Basis, z: &Array2<f64>| b.modes.dot(z) + b.reference.view().insert_axis(Axis(1));
         let (a, b) = (full(basis, q), full(enriched, qp));
-        ((&a - &b).mapv(|v| v * v).sum_axis(Axis(0)), b.mapv(|v| v * v).sum_axis(Axis(0)))
+        let moved = &b - &x0.insert_axis(Axis(1));
+        (
+            (&a - &b).mapv(|v| v * v).sum_axis(Axis(0)),
+            b.mapv(|v| v * v).sum_axis(Axis(0)),
+            moved.mapv(|v| v * v).sum_axis(Axis(0)),
+        )
     } else {
         let vp = &enriched.modes;
         let m = vp.t().dot(&basis.modes); // r⁺ × r
@@ -45,18 +73,23 @@ pub fn raw_estimate_by_time(basis: &Basis, enriched: &Basis, q: &Array2<f64>, qp
         let q2 = q.mapv(|v| v * v).sum_axis(Axis(0));
         let mq2 = mq.mapv(|v| v * v).sum_axis(Axis(0));
         let d = (&mq - qp).mapv(|v| v * v).sum_axis(Axis(0)) + (&q2 - &mq2).mapv(|v| v.max(0.0));
+        let qp2 = qp.mapv(|v| v * v).sum_axis(Axis(0));
         let xr = &enriched.reference;
         let vtx = vp.t().dot(xr);
-        let norm = xr.dot(xr) + 2.0 * vtx.dot(qp) + qp.mapv(|v| v * v).sum_axis(Axis(0));
-        (d, norm)
+        let norm = xr.dot(xr) + 2.0 * vtx.dot(qp) + &qp2;
+        let shift = xr - &x0;
+        let vts = vp.t().dot(&shift);
+        let disp = shift.dot(&shift) + 2.0 * vts.dot(qp) + &qp2;
+        (d, norm, disp)
     };
-    let mut out = [0.0; FIFTHS];
-    for (i, o) in out.iter_mut().enumerate() {
-        let end = fifth_end(nt, i);
-        let (d, n) = (diff2.slice(ndarray::s![..end]).sum(), norm2.slice(ndarray::s![..end]).sum());
-        *o = d.max(0.0).sqrt() / n.max(0.0).sqrt();
-    }
-    out
+    let prefix = |per_instant: &Array1<f64>| -> ByFifth {
+        std::array::from_fn(|i| {
+            let end = fifth_end(nt, i);
+            let (d, n) = (diff2.slice(ndarray::s![..end]).sum(), per_instant.slice(ndarray::s![..end]).sum());
+            d.max(0.0).sqrt() / n.max(0.0).sqrt()
+        })
+    };
+    RawByFifth { relative: prefix(&norm2), displacement: prefix(&disp2) }
 }
 
 /// `‖a − b‖_F` and `‖b‖_F`, summed in the arrays' logical order (rows, then columns)
@@ -80,6 +113,23 @@ pub fn rel_error_by_time(a: &Array2<f64>, b: &Array2<f64>) -> ByFifth {
     for k in 0..nt {
         diff[k] = a.column(k).iter().zip(b.column(k)).map(|(x, y)| (x - y) * (x - y)).sum::<f64>();
         norm[k] = b.column(k).iter().map(|y| y * y).sum::<f64>();
+    }
+    std::array::from_fn(|i| {
+        let end = fifth_end(nt, i);
+        (diff.slice(ndarray::s![..end]).sum() / norm.slice(ndarray::s![..end]).sum()).sqrt()
+    })
+}
+
+/// `displacement_error` of `a` against `b` over the instants `..k`, for the end of each
+/// fifth of the run: `‖A[:, ..k] − B[:, ..k]‖_F / ‖B[:, ..k] − X₀‖_F`, with the initial
+/// configuration `x0` subtracted from every column of `B` (a run that has not moved yet
+/// has no displacement to measure against: ∞, or NaN when it has no error either).
+pub fn displacement_error_by_time(a: &Array2<f64>, b: &Array2<f64>, x0: ArrayView1<f64>) -> ByFifth {
+    let nt = b.ncols();
+    let (mut diff, mut norm) = (Array1::<f64>::zeros(nt), Array1::<f64>::zeros(nt));
+    for k in 0..nt {
+        diff[k] = a.column(k).iter().zip(b.column(k)).map(|(x, y)| (x - y) * (x - y)).sum::<f64>();
+        norm[k] = b.column(k).iter().zip(x0.iter()).map(|(y, o)| (y - o) * (y - o)).sum::<f64>();
     }
     std::array::from_fn(|i| {
         let end = fifth_end(nt, i);
@@ -133,7 +183,64 @@ mod tests {
             let want = (&x1 - &x2).mapv(|v| v * v).sum().sqrt() / x2.mapv(|v| v * v).sum().sqrt();
             let got = raw_estimate_reduced(&b, &plus, &q, &qp);
             assert!((got - want).abs() < 1e-12 * want.max(1.0), "{got} vs {want}");
+            // the displacement form against X₀, an initial configuration off the reference
+            // (and outside the span of V⁺): ‖X_r − X⁺‖ / ‖X⁺ − X₀‖ reconstructed in full
+            let x0 = Array1::from_shape_fn(n, |i| 1.0 + 0.1 * i as f64 + 0.05 * (i as f64 * 1.3).sin());
+            let moved = &x2 - &x0.view().insert_axis(Axis(1));
+            let want_d = (&x1 - &x2).mapv(|v| v * v).sum().sqrt() / moved.mapv(|v| v * v).sum().sqrt();
+            let both = raw_by_time(&b, &plus, &q, &qp, x0.view());
+            assert!(
+                (both.displacement[4] - want_d).abs() < 1e-12 * want_d.max(1.0),
+                "{} vs {want_d}",
+                both.displacement[4]
+            );
+            assert_eq!(both.relative[4], got);
+            // and by fifth: the first two instants (the first fifth of four instants is one)
+            for (i, end) in [(0, 1), (2, 2), (4, 4)] {
+                assert_eq!(fifth_end(nt, i), end);
+                let s = ndarray::s![.., ..end];
+                let w = (&x1.slice(s) - &x2.slice(s)).mapv(|v| v * v).sum().sqrt()
+                    / moved.slice(s).mapv(|v| v * v).sum().sqrt();
+                assert!(
+                    (both.displacement[i] - w).abs() < 1e-12 * w.max(1.0),
+                    "fifth {i}: {} vs {w}",
+                    both.displacement[i]
+                );
+            }
         }
+    }
+
+    /// A run against the same run shifted by a known displacement field: X_f(t_k) = X₀ + k u
+    /// (‖u‖ = 0.5) and X_r = X_f + c w (‖w‖ = 1, the same at every instant). In closed form,
+    /// over the instants 0 … e − 1,
+    ///
+    /// ```text
+    ///     displacement_error = √e · c / (0.5 √(Σ_{k<e} k²)),    Σ_{k<e} k² = (e − 1) e (2e − 1) / 6,
+    /// ```
+    ///
+    /// while rel_error divides by ‖X_f‖, which holds X₀ (‖X₀‖ ≈ 12 against a travel of 4.5)
+    /// at every instant, and reads less.
+    #[test]
+    fn displacement_error_of_a_shifted_run_is_the_closed_form() {
+        let (n, nt, c) = (6, 10, 1e-3);
+        let x0 = Array1::from_shape_fn(n, |i| 2.0 + i as f64);
+        let u = Array1::from_shape_fn(n, |i| [0.3, 0.4, 0.0, 0.0, 0.0, 0.0][i]);
+        let w = Array1::from_shape_fn(n, |i| if i == 2 { 1.0 } else { 0.0 });
+        let full = Array2::from_shape_fn((n, nt), |(i, k)| x0[i] + k as f64 * u[i]);
+        let reduced = Array2::from_shape_fn((n, nt), |(i, k)| full[[i, k]] + c * w[i]);
+        let got = displacement_error_by_time(&reduced, &full, x0.view());
+        for (i, g) in got.iter().enumerate() {
+            let e = fifth_end(nt, i) as f64;
+            let want = e.sqrt() * c / (0.5 * ((e - 1.0) * e * (2.0 * e - 1.0) / 6.0).sqrt());
+            // X₀ + k u − X₀ and X_f + c w − X_f round at the last digits of X₀ and X_f (≈ 10)
+            assert!((g - want).abs() < 1e-11 * want, "fifth {i}: {g} vs {want}");
+        }
+        let rel = rel_error_by_time(&reduced, &full);
+        assert!(rel[4] < got[4] / 2.0, "rel_error {} against displacement_error {}", rel[4], got[4]);
+        // a run that has not moved has no displacement to measure against
+        let still = Array2::from_shape_fn((n, nt), |(i, _)| x0[i]);
+        assert!(displacement_error_by_time(&still, &still, x0.view())[4].is_nan());
+        assert!(displacement_error_by_time(&(&still + 1e-3), &still, x0.view())[4].is_infinite());
     }
 
     /// The estimate over prefixes of the run: zero while the two runs agree; non-decreasing
