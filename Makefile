@@ -11,7 +11,7 @@
 SYSTEM_PACKAGES := libhdf5-dev libopenblas-dev pkg-config gfortran
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: run test bench bench-routes bench-exudyn deps thesis
+.PHONY: run test bench bench-routes bench-exudyn deps thesis zoo
 
 deps:
 	@missing=""; \
@@ -48,6 +48,11 @@ bench: deps
 bench-routes: deps
 	cargo build --release
 	python3 benches/sweep_routes.py
+
+# greedy training and the error estimate on 24 generated mechanisms (docs/zoo.md; ~1 h on 2 cores)
+zoo: deps
+	cargo build --release
+	cargo run --release --example zoo -- --out target/zoo
 
 # the pendulum in Exudyn (in-process) and flexrom (whole process), side by side
 bench-exudyn: deps

@@ -1,0 +1,583 @@
+//! The zoo benchmark (docs/zoo.md): greedy training and held-out validation of the error
+//! estimate on mechanisms nobody tuned flexrom on, drawn from a seed
+//! (tests/common/zoo/). Drives the release binary as a subprocess, as a user would:
+//!
+//! ```text
+//! cargo build --release
+//! cargo run --release --example zoo -- [--seed S] [--models N] [--out DIR]
+//!     [--tolerances 5e-3,1e-2] [--subset] [--jobs 2] [--no-methods] [--draw-only] [--resume] [--flexrom PATH]
+//! ```
+//!
+//! For every model and tolerance: `train` (greedy over [0.5, 1.5], `max_runs = 10`), then
+//! `validate --json` at 8 loads that are neither training nor candidate loads; per model the
+//! convergence and its reason, full runs, modes, sampled elements, speedup, the estimate
+//! method, coverage over the whole run and per fifth, effectivity and estimator cost; over
+//! all models the issue's aggregate targets (tests/common/zoo/metrics.rs). Where a model's
+//! default estimate fails (reads under the error, or over it by more than 20×) it is
+//! validated again with each method (`[online] estimate`). Writes DIR/zoo.md (Markdown
+//! tables) and DIR/zoo.json (every number), DIR/models/NAME/ the model and pipelines.
+//! `--draw-only` writes the models and pipelines and stops; `--resume` reads back what an
+//! interrupted run of the same binary kept (every process's output is kept beside its
+//! pipeline) instead of running it again. At most `--jobs` (≤ 2) flexrom processes at a time, each with `--threads 1`.
+
+#[path = "../tests/common/zoo/mod.rs"]
+mod zoo;
+
+use rayon::prelude::*;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+use zoo::drive::{Flexrom, Training, Validation};
+use zoo::metrics::{aggregate, estimate_fails, model_stats, Aggregate, ModelStats};
+use zoo::{accepted, pipeline_toml, validation_loads, Replacement, ZooModel};
+
+const METHODS: [&str; 3] = ["corrected", "defects", "enriched"];
+
+struct Args {
+    seed: u64,
+    models: usize,
+    out: PathBuf,
+    tolerances: Vec<f64>,
+    subset: bool,
+    jobs: usize,
+    methods: bool,
+    draw_only: bool,
+    resume: bool,
+    flexrom: Option<PathBuf>,
+}
+
+fn usage(msg: &str) -> ! {
+    eprintln!("zoo: {msg}\nusage: zoo [--seed S] [--models N] [--out DIR] [--tolerances 5e-3,1e-2] [--subset] [--jobs 1|2] [--no-methods] [--draw-only] [--resume] [--flexrom PATH]");
+    std::process::exit(2)
+}
+
+fn args() -> Args {
+    let mut a = Args {
+        seed: zoo::DEFAULT_SEED,
+        models: 24,
+        out: PathBuf::from("target/zoo"),
+        tolerances: vec![5e-3, 1e-2],
+        subset: false,
+        jobs: 2,
+        methods: true,
+        draw_only: false,
+        resume: false,
+        flexrom: None,
+    };
+    let mut it = std::env::args().skip(1);
+    while let Some(k) = it.next() {
+        let mut value = || it.next().unwrap_or_else(|| usage(&format!("{k} needs a value")));
+        match k.as_str() {
+            "--seed" => a.seed = value().parse().unwrap_or_else(|_| usage("--seed: not an integer")),
+            "--models" => a.models = value().parse().unwrap_or_else(|_| usage("--models: not an integer")),
+            "--out" => a.out = PathBuf::from(value()),
+            "--tolerances" => {
+                a.tolerances = value()
+                    .split(',')
+                    .map(|t| t.trim().parse::<f64>().ok().filter(|t| *t > 0.0 && t.is_finite()))
+                    .collect::<Option<_>>()
+                    .unwrap_or_else(|| usage("--tolerances: positive numbers separated by commas"))
+            }
+            "--jobs" => {
+                a.jobs = value().parse().ok().filter(|j| (1..=2).contains(j)).unwrap_or_else(|| usage("--jobs: 1 or 2"))
+            }
+            "--subset" => a.subset = true,
+            "--no-methods" => a.methods = false,
+            "--draw-only" => a.draw_only = true,
+            "--resume" => a.resume = true,
+            "--flexrom" => a.flexrom = Some(PathBuf::from(value())),
+            _ => usage(&format!("unknown argument {k}")),
+        }
+    }
+    if a.models == 0 {
+        usage("--models: at least 1");
+    }
+    a
+}
+
+/// The release binary beside this example's directory (target/release/flexrom).
+fn find_flexrom(given: Option<PathBuf>) -> PathBuf {
+    let bin = given.unwrap_or_else(|| {
+        let exe = std::env::current_exe().expect("the example's path");
+        exe.parent().and_then(Path::parent).map_or_else(|| PathBuf::from("flexrom"), |d| d.join("flexrom"))
+    });
+    if !bin.is_file() {
+        eprintln!("zoo: {} not found; build it first: cargo build --release", bin.display());
+        std::process::exit(1);
+    }
+    bin
+}
+
+/// Writes `text` to `path` through a temporary file in the same directory.
+fn write_atomic(path: &Path, text: &str) {
+    let tmp = path.with_extension("tmp");
+    std::fs::write(&tmp, text)
+        .and_then(|()| std::fs::rename(&tmp, path))
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+}
+
+/// Writes a model file; where it replaces a different one, the outputs kept from runs of
+/// the old model (`*.done`, tests/common/zoo/drive.rs) no longer count.
+fn write_model(dir: &Path, text: &str) {
+    let path = dir.join("model.toml");
+    if std::fs::read_to_string(&path).is_ok_and(|old| old == text) {
+        return;
+    }
+    if let Ok(entries) = std::fs::read_dir(dir) {
+        for e in entries.flatten() {
+            if e.path().extension().is_some_and(|x| x == "done") {
+                let _ = std::fs::remove_file(e.path());
+            }
+        }
+    }
+    write_atomic(&path, text);
+}
+
+/// One model at one tolerance.
+#[derive(serde::Serialize)]
+struct Entry {
+    model: String,
+    tolerance: f64,
+    training: Result<Training, String>,
+    validations: Vec<Result<Validation, String>>,
+    stats: ModelStats,
+    /// the other estimate methods, where the default failed
+    methods: Vec<MethodRun>,
+    /// wall time of the whole entry: training, validations, other methods
+    wall_seconds: f64,
+}
+
+#[derive(serde::Serialize)]
+struct MethodRun {
+    method: String,
+    validations: Vec<Result<Validation, String>>,
+    stats: ModelStats,
+}
+
+#[derive(serde::Serialize)]
+struct ModelInfo {
+    name: String,
+    slot: usize,
+    attempt: usize,
+    kind: &'static str,
+    bodies: usize,
+    elements: usize,
+    coordinates: usize,
+    summary: String,
+}
+
+fn validate_all(fx: &Flexrom, dir: &Path, pipeline: &str) -> Vec<Result<Validation, String>> {
+    validation_loads().into_iter().map(|x| fx.validate(dir, pipeline, x)).collect()
+}
+
+fn tol_tag(t: f64) -> String {
+    format!("{t:e}")
+}
+
+fn run_entry(fx: &Flexrom, dir: &Path, name: &str, tolerance: f64) -> Entry {
+    let tag = tol_tag(tolerance);
+    let pipeline = format!("pipeline_{tag}.toml");
+    write_atomic(&dir.join(&pipeline), &pipeline_toml("model.toml", &format!("basis_{tag}.h5"), tolerance, None));
+    let training = fx.train(dir, &pipeline);
+    let validations = if training.is_ok() { validate_all(fx, dir, &pipeline) } else { Vec::new() };
+    let stats = model_stats(&validations);
+    Entry { model: name.into(), tolerance, training, validations, stats, methods: Vec::new(), wall_seconds: 0.0 }
+}
+
+fn run_methods(fx: &Flexrom, dir: &Path, e: &mut Entry) {
+    let tag = tol_tag(e.tolerance);
+    for m in METHODS {
+        let pipeline = format!("pipeline_{tag}_{m}.toml");
+        write_atomic(
+            &dir.join(&pipeline),
+            &pipeline_toml("model.toml", &format!("basis_{tag}.h5"), e.tolerance, Some(m)),
+        );
+        let validations = validate_all(fx, dir, &pipeline);
+        let stats = model_stats(&validations);
+        e.methods.push(MethodRun { method: m.into(), validations, stats });
+    }
+}
+
+fn pct(x: f64) -> String {
+    format!("{:.0} %", 100.0 * x)
+}
+
+fn g3(x: f64) -> String {
+    if x.is_nan() {
+        "–".into()
+    } else if x.is_infinite() {
+        "∞".into()
+    } else if (0.01..1000.0).contains(&x.abs()) {
+        format!("{x:.3}").trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        format!("{x:.2e}")
+    }
+}
+
+fn aggregate_row(a: &Aggregate) -> String {
+    format!(
+        "| {}/{} ({}) | {}/{} ({:.1} %) | {}/{} ({:.1} %) | {} | {} | {} | {} |",
+        a.converged,
+        a.models,
+        pct(a.share_converged()),
+        a.covered_pairs,
+        a.pairs,
+        100.0 * a.pair_coverage(),
+        a.covered_triples,
+        a.triples,
+        100.0 * a.triple_coverage(),
+        g3(a.effectivity_median),
+        g3(a.effectivity_p95),
+        g3(a.effectivity_max),
+        pct(a.cost_median)
+    )
+}
+
+const AGG_HEAD: &str = "| converged | coverage (model, load) | coverage (model, load, fifth) | effectivity median | 95th pct | max | estimator cost median |\n|---|---|---|---|---|---|---|";
+
+fn short_reason(t: &Training) -> String {
+    if t.converged {
+        return "yes".into();
+    }
+    // "iteration n: no full run left (max_runs = 10), worst estimate X > T at λ = …"
+    let r = &t.reason;
+    let worst = r.split("worst estimate ").nth(1).and_then(|s| s.split_whitespace().next()).unwrap_or("?");
+    if r.contains("no full run left") {
+        format!("no: max_runs spent, worst score {worst}")
+    } else if r.contains("every candidate has a full run") {
+        format!("no: every candidate run, worst score {worst}")
+    } else {
+        "no".into()
+    }
+}
+
+fn fifths(c: &[f64; 5]) -> String {
+    c.iter().map(|x| format!("{:.0}", 100.0 * x)).collect::<Vec<_>>().join("/")
+}
+
+fn model_row(info: &ModelInfo, e: &Entry) -> String {
+    let s = &e.stats;
+    match &e.training {
+        Err(msg) => format!(
+            "| {} | {}/{}/{} | training failed: {} | | | | | | | | | | |",
+            info.name,
+            info.bodies,
+            info.elements,
+            info.coordinates,
+            msg.replace('|', "/")
+        ),
+        Ok(t) => format!(
+            "| {} | {}/{}/{} | {} | {} | {} | {} | {} | {} | {}/{} | {} | {} | {} | {} |",
+            info.name,
+            info.bodies,
+            info.elements,
+            info.coordinates,
+            short_reason(t),
+            t.full_runs,
+            if t.joint_coordinates > 0 {
+                format!("{}+{}", t.pod_modes, t.joint_coordinates)
+            } else {
+                t.pod_modes.to_string()
+            },
+            t.elements.map_or("–".into(), |n| n.to_string()),
+            g3(s.speedup_median),
+            t.method,
+            s.covered_pairs,
+            s.loads,
+            fifths(&s.coverage_by_fifth),
+            g3(s.effectivity_median),
+            g3(s.effectivity_max),
+            pct(s.cost_median)
+        ),
+    }
+}
+
+const MODEL_HEAD: &str = "| model | bodies/elements/coordinates | converged | full runs | modes | sampled elements | speedup | method | covered loads | coverage by fifth (%) | effectivity median | max | estimator cost |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|";
+
+fn method_row(name: &str, tol: f64, m: &MethodRun) -> String {
+    let s = &m.stats;
+    format!(
+        "| {name} | {} | {} | {}/{} | {} | {} | {} | {} | {} | {} |",
+        tol_tag(tol),
+        m.method,
+        s.covered_pairs,
+        s.loads,
+        fifths(&s.coverage_by_fifth),
+        g3(s.effectivity_min),
+        g3(s.effectivity_median),
+        g3(s.effectivity_max),
+        g3(s.fifth_effectivity_min),
+        pct(s.cost_median)
+    )
+}
+
+/// CPU seconds (user + system) of the finished child processes (Linux: /proc/self/stat's
+/// cutime and cstime, in clock ticks of `getconf CLK_TCK`); None elsewhere. On a shared
+/// machine this is the figure to compare: the wall time depends on the other users.
+fn children_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // the fields after the command name in parentheses; cutime and cstime are the 16th and 17th
+    let rest = &stat[stat.rfind(')')? + 2..];
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = f.get(13)?.parse::<f64>().ok()? + f.get(14)?.parse::<f64>().ok()?;
+    let o = std::process::Command::new("getconf").arg("CLK_TCK").output().ok()?;
+    let hz: f64 = String::from_utf8_lossy(&o.stdout).trim().parse().ok()?;
+    Some(ticks / hz)
+}
+
+fn replaced_json(r: &[Replacement]) -> serde_json::Value {
+    r.iter().map(|r| serde_json::json!({"slot": r.slot, "attempt": r.attempt, "reason": r.reason})).collect()
+}
+
+const FAIL_HEAD: &str = "| model | tolerance | default | loads under (whole run) | triples under | worst under: true / estimate (whole, by fifth) | max effectivity | methods that hold |\n|---|---|---|---|---|---|---|---|";
+
+/// How a model's default estimate failed, and which methods hold there (every load and
+/// fifth covered, effectivity ≤ 20: `metrics::estimate_fails` false).
+fn failure_row(name: &str, e: &Entry) -> String {
+    let s = &e.stats;
+    let method = e.training.as_ref().map_or("–".to_string(), |t| t.method.clone());
+    let holds: Vec<&str> = e.methods.iter().filter(|m| !estimate_fails(&m.stats)).map(|m| m.method.as_str()).collect();
+    format!(
+        "| {name} | {} | {method} | {}/{} | {}/{} | {}, {} | {} | {} |",
+        tol_tag(e.tolerance),
+        s.under_pairs,
+        s.loads,
+        s.under_triples,
+        5 * s.loads,
+        g3(1.0 / s.effectivity_min),
+        g3(1.0 / s.fifth_effectivity_min),
+        g3(s.effectivity_max),
+        if holds.is_empty() { "none".to_string() } else { holds.join(", ") }
+    )
+}
+
+fn commit() -> String {
+    std::process::Command::new("git")
+        .args(["rev-parse", "--short", "HEAD"])
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .map_or("unknown".into(), |o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+}
+
+fn main() {
+    let a = args();
+    let fx = Flexrom { bin: find_flexrom(a.flexrom.clone()), resume: a.resume };
+    let start = Instant::now();
+    // never write into a directory of something else
+    if a.out.is_dir()
+        && std::fs::read_dir(&a.out).is_ok_and(|mut d| d.next().is_some())
+        && !a.out.join("zoo.json").is_file()
+    {
+        eprintln!("zoo: {} exists and holds no earlier zoo run (zoo.json); choose another --out", a.out.display());
+        std::process::exit(1);
+    }
+    let slots: Vec<usize> = if a.subset { zoo::SUBSET.to_vec() } else { (0..a.models).collect() };
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(a.jobs).build().expect("a thread pool");
+    let models_dir = a.out.join("models");
+
+    // 1. the models: each slot's first draw whose full runs at both ends of the range complete
+    let drawn: Vec<Result<(ZooModel, Vec<Replacement>), String>> = pool.install(|| {
+        slots
+            .par_iter()
+            .map(|&slot| {
+                accepted(a.seed, slot, |m| {
+                    let dir = models_dir.join(m.name());
+                    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+                    write_model(&dir, &m.mechanism.toml);
+                    fx.full_runs_complete(&dir, "model.toml")
+                })
+            })
+            .collect()
+    });
+    let mut models = Vec::new();
+    let mut replaced = Vec::new();
+    for d in drawn {
+        match d {
+            Ok((m, r)) => {
+                models.push(m);
+                replaced.extend(r);
+            }
+            Err(e) => {
+                eprintln!("zoo: {e}");
+                std::process::exit(1);
+            }
+        }
+    }
+    let infos: Vec<ModelInfo> = models
+        .iter()
+        .map(|m| ModelInfo {
+            name: m.name(),
+            slot: m.slot,
+            attempt: m.attempt,
+            kind: m.kind.name(),
+            bodies: m.mechanism.n_bodies,
+            elements: m.mechanism.n_elements,
+            coordinates: m.mechanism.n_coordinates,
+            summary: m.mechanism.summary.clone(),
+        })
+        .collect();
+    eprintln!(
+        "zoo: {} models (seed {}), {} replaced, drawn in {:.0} s",
+        models.len(),
+        a.seed,
+        replaced.len(),
+        start.elapsed().as_secs_f64()
+    );
+
+    if a.draw_only {
+        for (m, i) in models.iter().zip(&infos) {
+            let dir = models_dir.join(&i.name);
+            for &t in &a.tolerances {
+                let tag = tol_tag(t);
+                let text = pipeline_toml("model.toml", &format!("basis_{tag}.h5"), t, None);
+                write_atomic(&dir.join(format!("pipeline_{tag}.toml")), &text);
+            }
+            println!(
+                "{}{}: {}",
+                i.name,
+                if m.attempt > 0 { format!(" (attempt {})", m.attempt) } else { String::new() },
+                i.summary
+            );
+        }
+        for r in &replaced {
+            println!("replaced: slot {} attempt {}: {}", r.slot, r.attempt, r.reason);
+        }
+        let json = serde_json::json!({ "seed": a.seed, "models": infos, "replaced": replaced_json(&replaced) });
+        write_atomic(&a.out.join("zoo.json"), &serde_json::to_string_pretty(&json).expect("JSON"));
+        return;
+    }
+
+    // 2. train and validate every model at every tolerance, the largest first
+    let mut jobs: Vec<(usize, f64)> =
+        (0..models.len()).flat_map(|i| a.tolerances.iter().map(move |&t| (i, t))).collect();
+    jobs.sort_by_key(|&(i, _)| std::cmp::Reverse(models[i].mechanism.n_coordinates));
+    let mut entries: Vec<(usize, Entry)> = pool.install(|| {
+        jobs.par_iter()
+            .map(|&(i, t)| {
+                let name = infos[i].name.clone();
+                let t0 = Instant::now();
+                let mut e = run_entry(&fx, &models_dir.join(&name), &name, t);
+                if a.methods && e.training.is_ok() && estimate_fails(&e.stats) {
+                    run_methods(&fx, &models_dir.join(&name), &mut e);
+                }
+                e.wall_seconds = t0.elapsed().as_secs_f64();
+                eprintln!(
+                    "zoo: {name} at {}: {} ({:.0} s)",
+                    tol_tag(t),
+                    match &e.training {
+                        Ok(tr) => format!(
+                            "{}, covered {}/{}, effectivity ≤ {}",
+                            short_reason(tr),
+                            e.stats.covered_pairs,
+                            e.stats.loads,
+                            g3(e.stats.effectivity_max)
+                        ),
+                        Err(m) => format!("training failed: {m}"),
+                    },
+                    t0.elapsed().as_secs_f64()
+                );
+                (i, e)
+            })
+            .collect()
+    });
+    entries.sort_by(|x, y| x.0.cmp(&y.0).then(x.1.tolerance.total_cmp(&y.1.tolerance)));
+    let wall = start.elapsed().as_secs_f64();
+    let cpu = children_cpu_seconds();
+
+    // 3. the report
+    let mut md = String::new();
+    let _ = writeln!(
+        md,
+        "Zoo seed {}, {} models ({} replaced), tolerances {}, commit {}; {:.0} s wall with {} jobs, {} CPU seconds in flexrom.\n",
+        a.seed,
+        models.len(),
+        replaced.len(),
+        a.tolerances.iter().map(|t| tol_tag(*t)).collect::<Vec<_>>().join(", "),
+        commit(),
+        wall,
+        a.jobs,
+        cpu.map_or("?".into(), |c| format!("{c:.0}"))
+    );
+    let mut aggregates = Vec::new();
+    for &t in &a.tolerances {
+        let at: Vec<&(usize, Entry)> = entries.iter().filter(|(_, e)| e.tolerance == t).collect();
+        let agg = aggregate(&at.iter().map(|(_, e)| (e.training.as_ref().ok(), &e.stats)).collect::<Vec<_>>());
+        let _ = writeln!(md, "### Tolerance {}\n\n{AGG_HEAD}\n{}\n", tol_tag(t), aggregate_row(&agg));
+        let missed = agg.missed();
+        if missed.is_empty() {
+            let _ = writeln!(md, "Every target met.\n");
+        } else {
+            let _ = writeln!(md, "Targets missed: {}.\n", missed.join("; "));
+        }
+        let _ = writeln!(md, "{MODEL_HEAD}");
+        for (i, e) in &at {
+            let _ = writeln!(md, "{}", model_row(&infos[*i], e));
+        }
+        let _ = writeln!(md);
+        aggregates.push((t, agg));
+    }
+    let failing: Vec<&(usize, Entry)> = entries.iter().filter(|(_, e)| !e.methods.is_empty()).collect();
+    if !failing.is_empty() {
+        let _ = writeln!(
+            md,
+            "### Where the default estimate failed
+
+{FAIL_HEAD}"
+        );
+        for (i, e) in &failing {
+            let _ = writeln!(md, "{}", failure_row(&infos[*i].name, e));
+        }
+        let _ = writeln!(md);
+        let _ = writeln!(
+            md,
+            "### Every estimate method where the default failed\n\n| model | tolerance | method | covered loads | coverage by fifth (%) | effectivity min | median | max | min by fifth | cost |\n|---|---|---|---|---|---|---|---|---|---|"
+        );
+        for (i, e) in failing {
+            for m in &e.methods {
+                let _ = writeln!(md, "{}", method_row(&infos[*i].name, e.tolerance, m));
+            }
+        }
+        let _ = writeln!(md);
+    }
+    let _ = writeln!(md, "### The models\n");
+    for i in &infos {
+        let _ = writeln!(
+            md,
+            "- `{}`{}: {}",
+            i.name,
+            if i.attempt > 0 { format!(" (attempt {})", i.attempt) } else { String::new() },
+            i.summary
+        );
+    }
+    if !replaced.is_empty() {
+        let _ = writeln!(md, "\nReplaced (the full run failed at an end of the range):\n");
+        for r in &replaced {
+            let _ = writeln!(md, "- slot {} attempt {}: {}", r.slot, r.attempt, r.reason);
+        }
+    }
+    std::fs::create_dir_all(&a.out).expect("the output folder");
+    write_atomic(&a.out.join("zoo.md"), &md);
+    let json = serde_json::json!({
+        "seed": a.seed,
+        "commit": commit(),
+        "tolerances": a.tolerances,
+        "validation_loads": validation_loads(),
+        "wall_seconds": wall,
+        "flexrom_cpu_seconds": cpu,
+        "jobs": a.jobs,
+        "models": infos,
+        "replaced": replaced_json(&replaced),
+        "aggregates": aggregates.iter().map(|(t, g)| serde_json::json!({"tolerance": t, "aggregate": g, "missed": g.missed()})).collect::<Vec<_>>(),
+        "entries": entries.iter().map(|(_, e)| e).collect::<Vec<_>>(),
+    });
+    write_atomic(&a.out.join("zoo.json"), &serde_json::to_string_pretty(&json).expect("JSON"));
+    print!("{md}");
+    eprintln!(
+        "zoo: {:.0} s wall, {} CPU seconds in flexrom; {} and {}",
+        wall,
+        cpu.map_or("?".into(), |c| format!("{c:.0}")),
+        a.out.join("zoo.md").display(),
+        a.out.join("zoo.json").display()
+    );
+}

@@ -1,0 +1,611 @@
+//! The kinds of mechanism in the zoo and how each is drawn from a random stream: what a user
+//! would build first (a pendulum, a cantilever, a chain, a driven arm, a clamped boom with
+//! links, a four-bar, a frame, a five-bar), with materials, sections, loads and time settings
+//! drawn over the ranges of the zoo's brief (tests/common/zoo/mod.rs).
+
+use super::parts::{
+    ahead, beam, material, model_toml, sig, time, unit_function, Beam, Func, Joint, Load, Material, Rng, Time, G,
+};
+use std::f64::consts::PI;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// one beam on a ground pin (at its end or inside), swinging or driven round
+    Pendulum,
+    /// one clamped beam (sometimes propped by a ground pin at its far end) under a point load
+    Cantilever,
+    /// 2–4 beams pinned in a chain from a ground pin, falling under gravity
+    NPendulum,
+    /// 2–3 beams pinned in a chain, driven by a moment at the ground pin (the shoulder)
+    DrivenArm,
+    /// a clamped beam carrying 1–3 pinned links
+    ClampedChain,
+    /// crank, coupler, follower: a closed loop of three beams, the crank driven
+    FourBar,
+    /// a V of two beams pinned at the apex, or a portal of two clamped columns and a pinned beam
+    Frame,
+    /// a closed loop of four beams between two ground pins (two degrees of freedom)
+    FiveBar,
+}
+
+pub const KINDS: [Kind; 8] = [
+    Kind::Pendulum,
+    Kind::Cantilever,
+    Kind::NPendulum,
+    Kind::DrivenArm,
+    Kind::ClampedChain,
+    Kind::FourBar,
+    Kind::Frame,
+    Kind::FiveBar,
+];
+
+impl Kind {
+    pub fn name(self) -> &'static str {
+        match self {
+            Kind::Pendulum => "pendulum",
+            Kind::Cantilever => "cantilever",
+            Kind::NPendulum => "n-pendulum",
+            Kind::DrivenArm => "driven-arm",
+            Kind::ClampedChain => "clamped-chain",
+            Kind::FourBar => "four-bar",
+            Kind::Frame => "frame",
+            Kind::FiveBar => "five-bar",
+        }
+    }
+}
+
+/// E over the whole range of the zoo: 1e6 (soft elastomer) to 1e11 Pa (steel-like).
+const E_ALL: (f64, f64) = (1e6, 1e11);
+/// Flexibility caps (`Beam::flexibility`): a body hanging or driven from one end, a
+/// cantilever, a body held at both ends.
+const FLEX_FREE: f64 = 1.0;
+const FLEX_CLAMPED: f64 = 0.5;
+const FLEX_HELD: f64 = 3.0;
+/// How far a drive's peak moment may bend the link it acts on (M L / EI, rad).
+const DRIVE_BEND: f64 = 0.3;
+
+/// A drawn mechanism: the model file and a one-line account of it.
+pub struct Mechanism {
+    pub toml: String,
+    pub summary: String,
+    pub n_bodies: usize,
+    pub n_elements: usize,
+    /// 4 per node (x, y and the slope's two components)
+    pub n_coordinates: usize,
+}
+
+pub fn build(kind: Kind, rng: &mut Rng) -> Mechanism {
+    let t = time(rng);
+    let mut m = match kind {
+        Kind::Pendulum => pendulum(rng, t),
+        Kind::Cantilever => cantilever(rng, t),
+        Kind::NPendulum => n_pendulum(rng, t),
+        Kind::DrivenArm => driven_arm(rng, t),
+        Kind::ClampedChain => clamped_chain(rng, t),
+        Kind::FourBar => four_bar(rng, t),
+        Kind::Frame => frame(rng, t),
+        Kind::FiveBar => five_bar(rng, t),
+    };
+    // a light Rayleigh damping in one model of five, as some users add
+    if rng.chance(0.2) {
+        m.damping = Some(if rng.chance(0.5) {
+            (sig(rng.log_uniform(0.1, 2.0), 2), 0.0)
+        } else {
+            (0.0, sig(rng.log_uniform(1e-5, 1e-3), 2))
+        });
+    }
+    // at least one load follows the load scale, or λ would change nothing
+    if !m.loads.iter().any(Load::is_scaled) {
+        match &mut m.loads[0] {
+            Load::Gravity { scaled, .. } | Load::Moment { scaled, .. } | Load::Force { scaled, .. } => {
+                *scaled = Some(true)
+            }
+        }
+    }
+    m.finish(kind, t)
+}
+
+/// A mechanism being drawn.
+struct Draft {
+    bodies: Vec<Beam>,
+    joints: Vec<Joint>,
+    loads: Vec<Load>,
+    damping: Option<(f64, f64)>,
+    /// what the drive aims at, for the summary
+    motion: String,
+}
+
+impl Draft {
+    fn new(bodies: Vec<Beam>, joints: Vec<Joint>, loads: Vec<Load>, motion: String) -> Self {
+        Draft { bodies, joints, loads, damping: None, motion }
+    }
+
+    fn finish(self, kind: Kind, t: Time) -> Mechanism {
+        let last = self.bodies.last().expect("a body");
+        let probes = vec![("tip".to_string(), last.name.clone(), 1.0)];
+        let bodies: Vec<String> = self
+            .bodies
+            .iter()
+            .map(|b| {
+                format!(
+                    "{} {} el. E {:.0e} L/r {:.0} flex {:.1e}",
+                    b.name,
+                    b.elements,
+                    b.youngs_modulus,
+                    b.slenderness(),
+                    b.flexibility()
+                )
+            })
+            .collect();
+        let loads: Vec<String> = self.loads.iter().map(Load::describe).collect();
+        let damping = match self.damping {
+            Some((a, 0.0)) => format!("; damping {a} M"),
+            Some((_, b)) => format!("; damping {b:e} K"),
+            None => String::new(),
+        };
+        let summary = format!(
+            "{}: {}; {}; {}; t_end {} s, dt {} s, rho_inf {}{}",
+            kind.name(),
+            bodies.join(", "),
+            loads.join(", "),
+            self.motion,
+            t.t_end,
+            t.dt,
+            t.rho_inf,
+            damping
+        );
+        let toml = model_toml(&summary, t, self.damping, &self.bodies, &self.joints, &self.loads, &probes);
+        let n_elements: usize = self.bodies.iter().map(|b| b.elements).sum();
+        Mechanism {
+            toml,
+            summary,
+            n_bodies: self.bodies.len(),
+            n_elements,
+            n_coordinates: self.bodies.iter().map(|b| 4 * (b.elements + 1)).sum(),
+        }
+    }
+}
+
+fn gravity(rng: &mut Rng, p_scaled: f64) -> Load {
+    let scaled = if rng.chance(p_scaled) {
+        Some(true)
+    } else if rng.chance(0.5) {
+        Some(false)
+    } else {
+        None // the default: unscaled
+    };
+    Load::Gravity { g: [0.0, -G], scaled }
+}
+
+/// A moment history of a drawn shape whose size turns a body of rotational inertia `j`
+/// by about `theta` over the run (rigid estimate; gravity and elasticity ignored), at
+/// least `hold` at its peak (a moment that can lift the mechanism against its weight).
+fn drive(rng: &mut Rng, t: Time, j: f64, theta: f64, hold: f64) -> Func {
+    let f = unit_function(rng, t.t_end, t.dt);
+    let per_unit = f.max_double_integral(t.t_end) / j;
+    let amplitude = (theta / per_unit).max(hold / f.peak(t.t_end).max(1e-12));
+    f.scaled(amplitude)
+}
+
+/// A moment load on `body` at `node` that turns by about `theta` (`drive`), its link
+/// thickened to carry it (`DRIVE_BEND`).
+fn driving_moment(rng: &mut Rng, t: Time, body: &mut Beam, node: &str, j: f64, theta: f64, hold: f64) -> Load {
+    let f = drive(rng, t, j, theta, hold);
+    body.carry_moment(f.peak(t.t_end), DRIVE_BEND);
+    Load::Moment { body: body.name.clone(), node: node.into(), function: f, scaled: None }
+}
+
+/// A gravity hold for a drive that aims at more than a swing: 1.5× the weight's moment
+/// (`weight`), so the drive can lift the mechanism over the top; none for smaller aims.
+fn hold_for(theta: f64, weight: f64) -> f64 {
+    if theta > 1.0 {
+        1.5 * weight
+    } else {
+        0.0
+    }
+}
+
+/// A rotation target from small swings (0.05 rad) to several full turns (4π).
+fn rotation(rng: &mut Rng) -> f64 {
+    rng.log_uniform(0.05, 4.0 * PI)
+}
+
+fn describe_rotation(theta: f64) -> String {
+    if theta >= 2.0 * PI {
+        format!("drive aims at {:.1} turns", theta / (2.0 * PI))
+    } else {
+        format!("drive aims at {theta:.2} rad")
+    }
+}
+
+fn pendulum(rng: &mut Rng, t: Time) -> Draft {
+    let m = material(rng, E_ALL);
+    let length = sig(rng.uniform(0.3, 1.5), 2);
+    // released at `swing` from hanging straight down (small swings to horizontal and beyond)
+    let swing = rng.log_uniform(0.05, 0.6 * PI) * if rng.chance(0.5) { 1.0 } else { -1.0 };
+    let angle = -0.5 * PI + swing;
+    // pinned at its end, or at a node a quarter along (a swinging bar pivoted inside)
+    let inside = rng.chance(0.25);
+    let mut b = beam(rng, "beam", [0.0, 0.0], ahead([0.0, 0.0], length, angle), m, FLEX_FREE);
+    let pivot_node = if inside { b.elements / 4 } else { 0 };
+    let offset = length * pivot_node as f64 / b.elements as f64;
+    b.start = ahead([0.0, 0.0], -offset, angle);
+    b.end = ahead(b.start, length, angle);
+    let pivot = b.start;
+    let node = if inside { pivot_node.to_string() } else { "start".into() };
+    let mut loads = vec![gravity(rng, 0.6)];
+    let mut motion = format!("released {swing:.2} rad from hanging");
+    match rng.int(0, 2) {
+        0 => {}
+        1 => {
+            // driven round at the pivot
+            let theta = rotation(rng);
+            let (j, w) = (b.inertia_about(pivot), b.weight_moment_about(pivot));
+            loads.push(driving_moment(rng, t, &mut b, &node, j, theta, hold_for(theta, w)));
+            motion = format!("{motion}, {}", describe_rotation(theta));
+        }
+        _ => {
+            let p = rng.log_uniform(0.1, 2.0) * b.mass() * G;
+            let dir = rng.uniform(0.0, 2.0 * PI);
+            let f = unit_function(rng, t.t_end, t.dt);
+            loads.push(Load::Force {
+                body: "beam".into(),
+                node: "end".into(),
+                value: [sig(p * dir.cos(), 3), sig(p * dir.sin(), 3)],
+                function: Some(f),
+                scaled: if rng.chance(0.5) { None } else { Some(rng.chance(0.7)) },
+            });
+        }
+    }
+    Draft::new(vec![b], vec![Joint::GroundPin { body: "beam".into(), node }], loads, motion)
+}
+
+fn cantilever(rng: &mut Rng, t: Time) -> Draft {
+    let m = material(rng, E_ALL);
+    let length = sig(rng.uniform(0.3, 1.5), 2);
+    let angle = match rng.int(0, 4) {
+        0..=2 => 0.0,
+        3 => 0.5 * PI,
+        _ => sig(rng.uniform(-0.5 * PI, 0.5 * PI), 2),
+    };
+    let b = beam(rng, "beam", [0.0, 0.0], ahead([0.0, 0.0], length, angle), m, FLEX_CLAMPED);
+    let propped = rng.chance(0.25);
+    let mut joints = vec![Joint::Clamp { body: "beam".into(), node: "start".into() }];
+    if propped {
+        joints.push(Joint::GroundPin { body: "beam".into(), node: "end".into() });
+    }
+    let ei = b.bending_stiffness();
+    let f = unit_function(rng, t.t_end, t.dt);
+    // loads of the elastica's range: P L²/EI (or M L/EI) from 0.02 to 2
+    let kappa = rng.log_uniform(0.02, 2.0);
+    let load_node = if propped { (b.elements / 2).to_string() } else { "end".into() };
+    let mut loads = Vec::new();
+    let motion;
+    if rng.chance(0.7) || propped {
+        let p = kappa * ei / (length * length) * if propped { 8.0 } else { 1.0 };
+        let dir = angle + if rng.chance(0.7) { -0.5 * PI } else { rng.uniform(0.0, 2.0 * PI) };
+        loads.push(Load::Force {
+            body: "beam".into(),
+            node: load_node,
+            value: [sig(p * dir.cos(), 3), sig(p * dir.sin(), 3)],
+            function: Some(f),
+            scaled: if rng.chance(0.5) { None } else { Some(true) },
+        });
+        motion = format!("point force P L²/EI up to {kappa:.2}{}", if propped { ", propped end" } else { "" });
+    } else {
+        let mo = kappa.min(1.0) * ei / length;
+        loads.push(Load::Moment { body: "beam".into(), node: "end".into(), function: f.scaled(mo), scaled: None });
+        motion = format!("tip moment M L/EI up to {:.2}", kappa.min(1.0));
+    }
+    if rng.chance(0.5) {
+        loads.push(gravity(rng, 0.3));
+    }
+    Draft::new(vec![b], joints, loads, motion)
+}
+
+/// Beams end to end from `origin`, each at its own angle; pins between neighbours.
+fn chain(rng: &mut Rng, origin: [f64; 2], specs: &[(f64, f64, Material, f64)]) -> (Vec<Beam>, Vec<Joint>) {
+    let mut bodies: Vec<Beam> = Vec::new();
+    let mut joints = Vec::new();
+    let mut p = origin;
+    for (i, &(length, angle, m, cap)) in specs.iter().enumerate() {
+        let name = format!("link{}", i + 1);
+        let b = beam(rng, &name, p, ahead(p, length, angle), m, cap);
+        p = b.end;
+        if let Some(prev) = bodies.last() {
+            joints.push(Joint::Pin { a: (prev.name.clone(), "end".into()), b: (name.clone(), "start".into()) });
+        }
+        bodies.push(b);
+    }
+    (bodies, joints)
+}
+
+fn n_pendulum(rng: &mut Rng, t: Time) -> Draft {
+    let n = rng.int(2, 4);
+    let straight = rng.chance(0.5);
+    let first = if straight { sig(rng.uniform(-0.5 * PI, 0.0), 2) } else { 0.0 };
+    let specs: Vec<_> = (0..n)
+        .map(|_| {
+            let angle = if straight { first } else { sig(rng.uniform(-PI, 0.0), 2) };
+            (sig(rng.uniform(0.2, 0.8), 2), angle, material(rng, E_ALL), FLEX_FREE)
+        })
+        .collect();
+    let (bodies, mut joints) = chain(rng, [0.0, 0.0], &specs);
+    joints.insert(0, Joint::GroundPin { body: "link1".into(), node: "start".into() });
+    let mut loads = vec![gravity(rng, 0.7)];
+    if rng.chance(0.4) {
+        let last = bodies.last().expect("a link");
+        let total: f64 = bodies.iter().map(Beam::mass).sum();
+        let p = rng.log_uniform(0.05, 1.0) * total * G;
+        let dir = rng.uniform(0.0, 2.0 * PI);
+        loads.push(Load::Force {
+            body: last.name.clone(),
+            node: "end".into(),
+            value: [sig(p * dir.cos(), 3), sig(p * dir.sin(), 3)],
+            function: Some(unit_function(rng, t.t_end, t.dt)),
+            scaled: None,
+        });
+    }
+    let motion = if straight { "released straight".to_string() } else { "released bent".to_string() };
+    Draft::new(bodies, joints, loads, motion)
+}
+
+fn driven_arm(rng: &mut Rng, t: Time) -> Draft {
+    let n = rng.int(2, 3);
+    // half of them: a stiff crank carrying soft links
+    let stiff_crank = rng.chance(0.5);
+    let specs: Vec<_> = (0..n)
+        .map(|i| {
+            let e = if !stiff_crank {
+                E_ALL
+            } else if i == 0 {
+                (1e10, 1e11)
+            } else {
+                (1e6, 1e8)
+            };
+            (sig(rng.uniform(0.2, 0.8), 2), sig(rng.uniform(-PI, PI), 2), material(rng, e), FLEX_FREE)
+        })
+        .collect();
+    let (mut bodies, mut joints) = chain(rng, [0.0, 0.0], &specs);
+    joints.insert(0, Joint::GroundPin { body: "link1".into(), node: "start".into() });
+    let with_gravity = rng.chance(0.5);
+    let j: f64 = bodies.iter().map(|b| b.inertia_about([0.0, 0.0])).sum();
+    let weight: f64 =
+        if with_gravity { bodies.iter().map(|b| b.weight_moment_about([0.0, 0.0])).sum::<f64>() } else { 0.0 };
+    let theta = rotation(rng);
+    let mut loads = vec![driving_moment(rng, t, &mut bodies[0], "start", j, theta, hold_for(theta, weight))];
+    if with_gravity {
+        loads.push(gravity(rng, 0.3));
+    }
+    // an elbow moment on the second link, in one arm of three
+    if rng.chance(0.33) {
+        let j2: f64 = bodies[1..].iter().map(|b| b.inertia_about(bodies[1].start)).sum();
+        let theta2 = rotation(rng);
+        let mut elbow = driving_moment(rng, t, &mut bodies[1], "start", j2, theta2, 0.0);
+        if let Load::Moment { scaled, .. } = &mut elbow {
+            *scaled = if rng.chance(0.5) { None } else { Some(false) };
+        }
+        loads.push(elbow);
+    }
+    let motion = format!("{}{}", if stiff_crank { "stiff crank, soft links; " } else { "" }, describe_rotation(theta));
+    Draft::new(bodies, joints, loads, motion)
+}
+
+fn clamped_chain(rng: &mut Rng, t: Time) -> Draft {
+    let n = rng.int(2, 4);
+    let base_angle = if rng.chance(0.5) { 0.5 * PI } else { 0.0 };
+    let specs: Vec<_> = (0..n)
+        .map(|i| {
+            let angle = if i == 0 { base_angle } else { sig(rng.uniform(-PI, PI), 2) };
+            let cap = if i == 0 { FLEX_CLAMPED } else { FLEX_FREE };
+            (sig(rng.uniform(0.2, 0.9), 2), angle, material(rng, E_ALL), cap)
+        })
+        .collect();
+    let (mut bodies, mut joints) = chain(rng, [0.0, 0.0], &specs);
+    joints.insert(0, Joint::Clamp { body: "link1".into(), node: "start".into() });
+    let mut loads = vec![gravity(rng, 0.5)];
+    let motion;
+    if rng.chance(0.5) {
+        // a moment on the first pinned link, at its pin
+        let j: f64 = bodies[1..].iter().map(|b| b.inertia_about(bodies[1].start)).sum();
+        let theta = rotation(rng);
+        loads.push(driving_moment(rng, t, &mut bodies[1], "start", j, theta, 0.0));
+        motion = describe_rotation(theta);
+    } else {
+        let last = bodies.last().expect("a link");
+        let total: f64 = bodies.iter().map(Beam::mass).sum();
+        let p = rng.log_uniform(0.1, 2.0) * total * G;
+        let dir = rng.uniform(0.0, 2.0 * PI);
+        loads.push(Load::Force {
+            body: last.name.clone(),
+            node: "end".into(),
+            value: [sig(p * dir.cos(), 3), sig(p * dir.sin(), 3)],
+            function: Some(unit_function(rng, t.t_end, t.dt)),
+            scaled: None,
+        });
+        motion = "tip force".into();
+    }
+    Draft::new(bodies, joints, loads, motion)
+}
+
+/// Where the circles |P − a| = ra and |P − b| = rb meet, on the left of a → b.
+fn circles(a: [f64; 2], ra: f64, b: [f64; 2], rb: f64) -> Option<[f64; 2]> {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let d = dx.hypot(dy);
+    if d >= ra + rb || d <= (ra - rb).abs() {
+        return None;
+    }
+    let x = (d * d + ra * ra - rb * rb) / (2.0 * d);
+    let h = (ra * ra - x * x).sqrt();
+    Some([a[0] + (x * dx - h * dy) / d, a[1] + (x * dy + h * dx) / d])
+}
+
+fn four_bar(rng: &mut Rng, t: Time) -> Draft {
+    // a Grashof crank-rocker (crank the shortest link, s + l ≤ p + q with 10 % to spare) so
+    // that the crank may turn fully without the loop locking
+    let (o, gp, a, p) = loop {
+        let g = sig(rng.uniform(0.4, 0.9), 2);
+        let a = sig(rng.uniform(0.1, 0.25), 2);
+        let b = sig(rng.uniform(0.4, 1.0), 2);
+        let c = sig(rng.uniform(0.3, 0.9), 2);
+        let l = g.max(b).max(c);
+        if !(a < g.min(b).min(c) && 1.1 * (a + l) <= g + b + c - l) {
+            continue;
+        }
+        let (ground, crank, coupler, follower) = (g, a, b, c);
+        let theta0 = sig(rng.uniform(0.3 * PI, 0.7 * PI), 2);
+        let o = [0.0, 0.0];
+        let gp = [ground, 0.0];
+        let a = ahead(o, crank, theta0);
+        // the coupler's far end, above the line from the crank pin to the follower's ground pin
+        // (a Grashof crank-rocker closes at every crank angle, so the draw is not repeated)
+        let Some(p) = circles(a, coupler, gp, follower) else { continue };
+        break (o, gp, a, p);
+    };
+    let mats: Vec<Material> = (0..3).map(|_| material(rng, E_ALL)).collect();
+    let mut bodies = vec![
+        beam(rng, "crank", o, a, mats[0], FLEX_HELD),
+        beam(rng, "coupler", a, p, mats[1], FLEX_HELD),
+        beam(rng, "follower", gp, p, mats[2], FLEX_HELD),
+    ];
+    let joints = vec![
+        Joint::GroundPin { body: "crank".into(), node: "start".into() },
+        Joint::Pin { a: ("crank".into(), "end".into()), b: ("coupler".into(), "start".into()) },
+        Joint::Pin { a: ("coupler".into(), "end".into()), b: ("follower".into(), "end".into()) },
+        Joint::GroundPin { body: "follower".into(), node: "start".into() },
+    ];
+    let with_gravity = rng.chance(0.7);
+    // the loop's inertia and weight seen from the crank, roughly (virtual work with the
+    // crank pin moving at speed a·ω): the coupler moves with the crank pin, the follower
+    // turns at about a/c of the crank's rate
+    let r = bodies[0].length();
+    let (mc, mf) = (bodies[1].mass(), bodies[2].mass());
+    let j = bodies[0].inertia_about(o) + (mc + mf / 3.0) * r * r;
+    let weight = if with_gravity { bodies[0].weight_moment_about(o) + (mc + 0.5 * mf) * G * r } else { 0.0 };
+    let theta = rotation(rng);
+    let mut loads = vec![driving_moment(rng, t, &mut bodies[0], "start", j, theta, hold_for(theta, weight))];
+    if with_gravity {
+        loads.push(gravity(rng, 0.2));
+    }
+    Draft::new(bodies, joints, loads, describe_rotation(theta))
+}
+
+fn frame(rng: &mut Rng, t: Time) -> Draft {
+    let f = unit_function(rng, t.t_end, t.dt);
+    let mut loads = Vec::new();
+    let (bodies, joints, motion);
+    if rng.chance(0.5) {
+        // a V: two struts from the ground to a pinned apex, a point load at the apex
+        let w = sig(rng.uniform(0.4, 1.2), 2);
+        let h = sig(rng.uniform(0.3, 1.0), 2);
+        let apex = [sig(w * rng.uniform(0.2, 0.8), 3), h];
+        let ma = material(rng, E_ALL);
+        let mb = if rng.chance(0.5) { ma } else { material(rng, E_ALL) };
+        bodies =
+            vec![beam(rng, "left", [0.0, 0.0], apex, ma, FLEX_HELD), beam(rng, "right", [w, 0.0], apex, mb, FLEX_HELD)];
+        joints = vec![
+            Joint::GroundPin { body: "left".into(), node: "start".into() },
+            Joint::GroundPin { body: "right".into(), node: "start".into() },
+            Joint::Pin { a: ("left".into(), "end".into()), b: ("right".into(), "end".into()) },
+        ];
+        // up to 60 % of the weaker strut's Euler load
+        let euler =
+            bodies.iter().map(|b| PI * PI * b.bending_stiffness() / b.length().powi(2)).fold(f64::INFINITY, f64::min);
+        let kappa = rng.log_uniform(0.05, 0.6);
+        let dir = rng.uniform(-PI, 0.0);
+        loads.push(Load::Force {
+            body: "left".into(),
+            node: "end".into(),
+            value: [sig(kappa * euler * dir.cos(), 3), sig(kappa * euler * dir.sin(), 3)],
+            function: Some(f),
+            scaled: None,
+        });
+        motion = format!("V, apex load up to {kappa:.2} of the Euler load");
+    } else {
+        // a portal: two clamped columns, a beam pinned across their tops, a side load
+        let w = sig(rng.uniform(0.4, 1.2), 2);
+        let h = sig(rng.uniform(0.3, 1.0), 2);
+        let mc = material(rng, E_ALL);
+        let mbeam = material(rng, E_ALL);
+        let left = beam(rng, "left", [0.0, 0.0], [0.0, h], mc, FLEX_CLAMPED);
+        let mut right = left.clone();
+        right.name = "right".into();
+        right.start = [w, 0.0];
+        right.end = [w, h];
+        right.elements = rng.int(10, 60);
+        let top = beam(rng, "top", [0.0, h], [w, h], mbeam, FLEX_HELD);
+        // side sway δ/h from 0.5 % to 20 % (two columns of stiffness 3EI/h³ each)
+        let sway = rng.log_uniform(0.005, 0.2);
+        let p = sway * h * 6.0 * left.bending_stiffness() / h.powi(3);
+        loads.push(Load::Force {
+            body: "top".into(),
+            node: "start".into(),
+            value: [sig(p, 3), 0.0],
+            function: Some(f),
+            scaled: None,
+        });
+        bodies = vec![left, right, top];
+        joints = vec![
+            Joint::Clamp { body: "left".into(), node: "start".into() },
+            Joint::Clamp { body: "right".into(), node: "start".into() },
+            Joint::Pin { a: ("left".into(), "end".into()), b: ("top".into(), "start".into()) },
+            Joint::Pin { a: ("right".into(), "end".into()), b: ("top".into(), "end".into()) },
+        ];
+        motion = format!("portal, side sway up to {:.1} % of the height", 100.0 * sway);
+    }
+    if rng.chance(0.5) {
+        loads.push(gravity(rng, 0.3));
+    }
+    Draft::new(bodies, joints, loads, motion)
+}
+
+fn five_bar(rng: &mut Rng, t: Time) -> Draft {
+    let (o, a, p, b, gp) = loop {
+        let d = sig(rng.uniform(0.3, 0.6), 2);
+        let (a1, a2) = (sig(rng.uniform(0.1, 0.25), 2), sig(rng.uniform(0.1, 0.25), 2));
+        let (b1, b2) = (sig(rng.uniform(0.4, 0.8), 2), sig(rng.uniform(0.4, 0.8), 2));
+        let o = [0.0, 0.0];
+        let gp = [d, 0.0];
+        let a = ahead(o, a1, sig(rng.uniform(0.4 * PI, 0.8 * PI), 2));
+        let b = ahead(gp, a2, sig(rng.uniform(0.2 * PI, 0.6 * PI), 2));
+        // the two links meet above, not near a straight (locking) angle
+        if let Some(p) = circles(a, b1, b, b2) {
+            let ang = |u: [f64; 2], v: [f64; 2]| (v[1] - u[1]).atan2(v[0] - u[0]);
+            let bend = (ang(a, p) - ang(b, p)).rem_euclid(2.0 * PI);
+            if p[1] > a[1].max(b[1]) && (0.3 * PI..1.7 * PI).contains(&bend) {
+                break (o, a, p, b, gp);
+            }
+        }
+    };
+    let mats: Vec<Material> = (0..4).map(|_| material(rng, E_ALL)).collect();
+    let mut bodies = vec![
+        beam(rng, "crank1", o, a, mats[0], FLEX_HELD),
+        beam(rng, "link1", a, p, mats[1], FLEX_HELD),
+        beam(rng, "link2", b, p, mats[2], FLEX_HELD),
+        beam(rng, "crank2", gp, b, mats[3], FLEX_HELD),
+    ];
+    let joints = vec![
+        Joint::GroundPin { body: "crank1".into(), node: "start".into() },
+        Joint::Pin { a: ("crank1".into(), "end".into()), b: ("link1".into(), "start".into()) },
+        Joint::Pin { a: ("link1".into(), "end".into()), b: ("link2".into(), "end".into()) },
+        Joint::Pin { a: ("link2".into(), "start".into()), b: ("crank2".into(), "end".into()) },
+        Joint::GroundPin { body: "crank2".into(), node: "start".into() },
+    ];
+    // each crank with the link it carries, the link moving with the crank pin
+    let j1 = bodies[0].inertia_about(o) + bodies[1].mass() * bodies[0].length().powi(2);
+    let j2 = bodies[3].inertia_about(gp) + bodies[2].mass() * bodies[3].length().powi(2);
+    let theta = rng.log_uniform(0.05, 1.0);
+    let mut loads = vec![driving_moment(rng, t, &mut bodies[0], "start", j1, theta, 0.0)];
+    if rng.chance(0.5) {
+        let theta2 = rng.log_uniform(0.05, 1.0);
+        let mut second = driving_moment(rng, t, &mut bodies[3], "start", j2, theta2, 0.0);
+        if let Load::Moment { scaled, .. } = &mut second {
+            *scaled = if rng.chance(0.5) { None } else { Some(false) };
+        }
+        loads.push(second);
+    }
+    if rng.chance(0.6) {
+        loads.push(gravity(rng, 0.3));
+    }
+    Draft::new(bodies, joints, loads, describe_rotation(theta))
+}

@@ -1,0 +1,277 @@
+//! How the zoo judges a basis and its error estimate (docs/zoo.md), and the targets it is
+//! held to (the issue's "Trust on any model", item 3):
+//!
+//! ```text
+//! coverage      estimate ≥ true rel_error, over the whole run (pairs: model, load) and up
+//!               to the end of each fifth (triples: model, load, fifth)
+//! effectivity   estimate / true rel_error over the whole run (median, 95th percentile, max)
+//! cost          estimate seconds / reduced-run seconds (median over a model's loads)
+//! ```
+//!
+//! A validation that failed (no reduced answer) counts as uncovered; its effectivity as ∞.
+
+use super::drive::{Training, Validation};
+
+/// The issue's targets over all models together.
+pub const MIN_CONVERGED: f64 = 0.90;
+pub const MIN_PAIR_COVERAGE: f64 = 0.95;
+pub const MIN_TRIPLE_COVERAGE: f64 = 0.90;
+pub const MAX_MEDIAN_EFFECTIVITY: f64 = 3.0;
+pub const MAX_P95_EFFECTIVITY: f64 = 20.0;
+pub const MAX_EFFECTIVITY: f64 = 100.0;
+pub const MAX_MEDIAN_COST: f64 = 1.0;
+
+/// A model's estimate fails where it reads under the error or over it by more than the
+/// 95th-percentile target.
+pub fn estimate_fails(s: &ModelStats) -> bool {
+    s.under_pairs > 0 || s.under_triples > 0 || !(s.effectivity_max <= MAX_P95_EFFECTIVITY)
+}
+
+/// The median (mean of the middle two); NaN for none.
+pub fn median(v: &[f64]) -> f64 {
+    let mut v: Vec<f64> = v.to_vec();
+    v.sort_by(f64::total_cmp);
+    match v.len() {
+        0 => f64::NAN,
+        n if n % 2 == 1 => v[n / 2],
+        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
+    }
+}
+
+/// The `p`-th percentile by nearest rank (the smallest value with ≥ p % of them at or below).
+pub fn percentile(v: &[f64], p: f64) -> f64 {
+    let mut v: Vec<f64> = v.to_vec();
+    v.sort_by(f64::total_cmp);
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    let rank = ((p / 100.0) * v.len() as f64).ceil().max(1.0) as usize;
+    v[rank.min(v.len()) - 1]
+}
+
+/// One model's numbers at one tolerance.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct ModelStats {
+    pub loads: usize,
+    pub failed_loads: usize,
+    pub covered_pairs: usize,
+    pub covered_triples: usize,
+    pub under_pairs: usize,
+    pub under_triples: usize,
+    /// coverage per fifth (0..1)
+    pub coverage_by_fifth: [f64; 5],
+    pub effectivities: Vec<f64>,
+    pub effectivity_median: f64,
+    pub effectivity_max: f64,
+    pub effectivity_min: f64,
+    /// the smallest estimate / true ratio over every fifth (below 1: an underestimate)
+    pub fifth_effectivity_min: f64,
+    pub cost_median: f64,
+    pub speedup_median: f64,
+    pub rel_error_max: f64,
+    pub error_estimate_max: f64,
+    pub modes: usize,
+}
+
+fn ratio(e: f64, t: f64) -> f64 {
+    if e.is_nan() || t.is_nan() {
+        f64::INFINITY
+    } else {
+        e / t
+    }
+}
+
+pub fn model_stats(runs: &[Result<Validation, String>]) -> ModelStats {
+    let mut s = ModelStats { loads: runs.len(), ..Default::default() };
+    let mut fifth_cover = [0usize; 5];
+    let (mut costs, mut speedups) = (Vec::new(), Vec::new());
+    s.fifth_effectivity_min = f64::INFINITY;
+    s.rel_error_max = 0.0;
+    s.error_estimate_max = 0.0;
+    for r in runs {
+        let Ok(v) = r else {
+            s.failed_loads += 1;
+            s.under_pairs += 1;
+            s.under_triples += 5;
+            s.effectivities.push(f64::INFINITY);
+            continue;
+        };
+        s.modes = v.n_modes;
+        if v.error_estimate >= v.rel_error {
+            s.covered_pairs += 1;
+        } else {
+            s.under_pairs += 1;
+        }
+        for (i, (e, t)) in v.error_estimate_by_time.iter().zip(&v.rel_error_by_time).enumerate() {
+            if e >= t {
+                s.covered_triples += 1;
+                fifth_cover[i] += 1;
+            } else {
+                s.under_triples += 1;
+            }
+            s.fifth_effectivity_min = s.fifth_effectivity_min.min(ratio(*e, *t));
+        }
+        s.effectivities.push(ratio(v.error_estimate, v.rel_error));
+        costs.push(v.estimate_seconds / v.rom_seconds);
+        speedups.push(v.speedup);
+        s.rel_error_max = s.rel_error_max.max(v.rel_error);
+        s.error_estimate_max = s.error_estimate_max.max(v.error_estimate);
+    }
+    let n = runs.len().max(1) as f64;
+    s.coverage_by_fifth = fifth_cover.map(|c| c as f64 / n);
+    s.effectivity_median = median(&s.effectivities);
+    s.effectivity_max = s.effectivities.iter().copied().fold(f64::NAN, f64::max);
+    s.effectivity_min = s.effectivities.iter().copied().fold(f64::NAN, f64::min);
+    s.cost_median = median(&costs);
+    s.speedup_median = median(&speedups);
+    s
+}
+
+/// The numbers over all models together.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Aggregate {
+    pub models: usize,
+    pub converged: usize,
+    pub pairs: usize,
+    pub covered_pairs: usize,
+    pub triples: usize,
+    pub covered_triples: usize,
+    pub effectivity_median: f64,
+    pub effectivity_p95: f64,
+    pub effectivity_max: f64,
+    pub cost_median: f64,
+}
+
+impl Aggregate {
+    pub fn share_converged(&self) -> f64 {
+        self.converged as f64 / self.models.max(1) as f64
+    }
+    pub fn pair_coverage(&self) -> f64 {
+        self.covered_pairs as f64 / self.pairs.max(1) as f64
+    }
+    pub fn triple_coverage(&self) -> f64 {
+        self.covered_triples as f64 / self.triples.max(1) as f64
+    }
+
+    /// The targets missed, one line each (empty: all met).
+    pub fn missed(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        let mut need = |ok: bool, what: String| {
+            if !ok {
+                out.push(what)
+            }
+        };
+        need(
+            self.share_converged() >= MIN_CONVERGED,
+            format!("converged {}/{} < {:.0} %", self.converged, self.models, 100.0 * MIN_CONVERGED),
+        );
+        need(
+            self.pair_coverage() >= MIN_PAIR_COVERAGE,
+            format!(
+                "coverage (model, load) {:.1} % < {:.0} %",
+                100.0 * self.pair_coverage(),
+                100.0 * MIN_PAIR_COVERAGE
+            ),
+        );
+        need(
+            self.triple_coverage() >= MIN_TRIPLE_COVERAGE,
+            format!(
+                "coverage (model, load, fifth) {:.1} % < {:.0} %",
+                100.0 * self.triple_coverage(),
+                100.0 * MIN_TRIPLE_COVERAGE
+            ),
+        );
+        need(
+            self.effectivity_median <= MAX_MEDIAN_EFFECTIVITY,
+            format!("median effectivity {:.3} > {MAX_MEDIAN_EFFECTIVITY}", self.effectivity_median),
+        );
+        need(
+            self.effectivity_p95 <= MAX_P95_EFFECTIVITY,
+            format!("95th percentile effectivity {:.3} > {MAX_P95_EFFECTIVITY}", self.effectivity_p95),
+        );
+        need(
+            self.effectivity_max <= MAX_EFFECTIVITY,
+            format!("max effectivity {:.3} > {MAX_EFFECTIVITY}", self.effectivity_max),
+        );
+        need(
+            self.cost_median <= MAX_MEDIAN_COST,
+            format!("median estimator cost {:.0} % > {:.0} %", 100.0 * self.cost_median, 100.0 * MAX_MEDIAN_COST),
+        );
+        out
+    }
+}
+
+/// Over models: each a training (None: it failed) and the statistics of its validations.
+pub fn aggregate(models: &[(Option<&Training>, &ModelStats)]) -> Aggregate {
+    let mut eff = Vec::new();
+    let mut costs = Vec::new();
+    let mut a = Aggregate {
+        models: models.len(),
+        converged: 0,
+        pairs: 0,
+        covered_pairs: 0,
+        triples: 0,
+        covered_triples: 0,
+        effectivity_median: f64::NAN,
+        effectivity_p95: f64::NAN,
+        effectivity_max: f64::NAN,
+        cost_median: f64::NAN,
+    };
+    for (t, s) in models {
+        a.converged += usize::from(t.is_some_and(|t| t.converged));
+        // a model whose training failed has no validation: all its pairs uncovered
+        let loads = if t.is_some() { s.loads } else { super::validation_loads().len() };
+        a.pairs += loads;
+        a.triples += 5 * loads;
+        a.covered_pairs += s.covered_pairs;
+        a.covered_triples += s.covered_triples;
+        eff.extend(&s.effectivities);
+        if t.is_none() {
+            eff.extend(std::iter::repeat_n(f64::INFINITY, loads));
+        }
+        if s.cost_median.is_finite() {
+            costs.push(s.cost_median);
+        }
+    }
+    a.effectivity_median = median(&eff);
+    a.effectivity_p95 = percentile(&eff, 95.0);
+    a.effectivity_max = eff.iter().copied().fold(f64::NAN, f64::max);
+    a.cost_median = median(&costs);
+    a
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn v(e: f64, t: f64) -> Validation {
+        Validation {
+            load_scale: 1.0,
+            n_modes: 3,
+            rel_error: t,
+            error_estimate: e,
+            rel_error_by_time: [t; 5],
+            error_estimate_by_time: [e, e, e, e, 0.5 * t],
+            full_seconds: 1.0,
+            rom_seconds: 0.5,
+            estimate_seconds: 0.25,
+            speedup: 2.0,
+        }
+    }
+
+    /// Hand-counted: two loads, one covered with effectivity 2, one under (0.5); the last
+    /// fifth of both is under by construction.
+    #[test]
+    fn coverage_and_effectivity_are_counted() {
+        let s = model_stats(&[Ok(v(2e-3, 1e-3)), Ok(v(1e-3, 2e-3)), Err("failed".into())]);
+        assert_eq!((s.covered_pairs, s.under_pairs, s.failed_loads), (1, 2, 1));
+        assert_eq!((s.covered_triples, s.under_triples), (4, 11));
+        assert_eq!(s.effectivity_median, 2.0);
+        assert_eq!(s.effectivity_max, f64::INFINITY);
+        assert_eq!(s.cost_median, 0.5);
+        assert!(estimate_fails(&s));
+        assert_eq!(percentile(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0, 10.0], 95.0), 10.0);
+        assert_eq!(percentile(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0, 10.0], 50.0), 5.0);
+        assert_eq!(median(&[4.0, 1.0, 3.0, 2.0]), 2.5);
+    }
+}

@@ -1,0 +1,164 @@
+//! The zoo (tests/common/zoo, docs/zoo.md): mechanisms nobody tuned flexrom on.
+//!
+//! * The generator: a seed names the same models every time (two draws of every slot are
+//!   equal to the byte, another seed draws others); the first eight slots hold every kind;
+//!   every model parses and stays within the zoo's ranges (1–4 bodies, 10–60 elements per
+//!   body, E in [1e6, 1e11] Pa, some load follows the load scale, the kinds' joints); the
+//!   validation loads are neither greedy candidates nor the range's ends.
+//! * The subset (`zoo::SUBSET`, six models): greedy training at tolerance 1e-2 and
+//!   validation at the 8 held-out loads through the release binary, held to the issue's
+//!   targets over the subset (`metrics::Aggregate::missed`: converged ≥ 90 %, coverage
+//!   ≥ 95 % of (model, load) pairs and ≥ 90 % of (model, load, fifth) triples, effectivity
+//!   median ≤ 3, 95th percentile ≤ 20, max ≤ 100, estimator cost median ≤ 100 %). The
+//!   numbers are measured, not chosen: they are the targets.
+
+#[path = "common/zoo/mod.rs"]
+mod zoo;
+
+use flexrom::model::schema::{JointSpec, LoadSpec};
+use flexrom::model::Model;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+use zoo::drive::Flexrom;
+use zoo::mechanisms::{Kind, KINDS};
+use zoo::metrics::{aggregate, model_stats, ModelStats};
+
+#[test]
+fn a_seed_names_the_same_models() {
+    for slot in 0..16 {
+        let a = zoo::draw(zoo::DEFAULT_SEED, slot, 0);
+        let b = zoo::draw(zoo::DEFAULT_SEED, slot, 0);
+        assert_eq!(a.mechanism.toml, b.mechanism.toml, "slot {slot}");
+        assert_ne!(a.mechanism.toml, zoo::draw(zoo::DEFAULT_SEED + 1, slot, 0).mechanism.toml, "slot {slot}");
+        assert_ne!(a.mechanism.toml, zoo::draw(zoo::DEFAULT_SEED, slot, 1).mechanism.toml, "slot {slot}");
+    }
+    let kinds: Vec<Kind> = (0..KINDS.len()).map(|s| zoo::draw(zoo::DEFAULT_SEED, s, 0).kind).collect();
+    assert_eq!(kinds, KINDS.to_vec());
+}
+
+#[test]
+fn every_drawn_model_is_within_the_zoo_ranges() {
+    for seed in [zoo::DEFAULT_SEED, 7, 12345] {
+        for slot in 0..24 {
+            for attempt in 0..3 {
+                let m = zoo::draw(seed, slot, attempt);
+                let what = format!("seed {seed} slot {slot} attempt {attempt}");
+                let model = Model::from_text(&m.mechanism.toml, format!("{}.toml", m.name()))
+                    .unwrap_or_else(|e| panic!("{what}: {e}\n{}", m.mechanism.toml));
+                let f = &model.file;
+                assert!((1..=4).contains(&f.bodies.len()), "{what}");
+                for b in &f.bodies {
+                    assert!((10..=60).contains(&b.elements), "{what}: {} elements", b.elements);
+                    assert!((1e6..=1e11).contains(&b.youngs_modulus), "{what}: E = {}", b.youngs_modulus);
+                }
+                let scaled = f.loads.iter().any(|l| match l {
+                    LoadSpec::Gravity { scaled, .. }
+                    | LoadSpec::Moment { scaled, .. }
+                    | LoadSpec::Force { scaled, .. } => *scaled,
+                });
+                assert!(scaled, "{what}: no load follows the load scale");
+                let count = |p: fn(&JointSpec) -> bool| f.joints.iter().filter(|j| p(j)).count();
+                let ground = count(|j| matches!(j, JointSpec::GroundPin { .. }));
+                let clamps = count(|j| matches!(j, JointSpec::Clamp { .. }));
+                let pins = count(|j| matches!(j, JointSpec::Pin { .. }));
+                let n = f.bodies.len();
+                match m.kind {
+                    Kind::Pendulum => assert_eq!((ground, clamps, pins), (1, 0, 0), "{what}"),
+                    Kind::Cantilever => assert!(clamps == 1 && ground <= 1 && pins == 0, "{what}"),
+                    Kind::NPendulum | Kind::DrivenArm => assert_eq!((ground, clamps, pins), (1, 0, n - 1), "{what}"),
+                    Kind::ClampedChain => assert_eq!((ground, clamps, pins), (0, 1, n - 1), "{what}"),
+                    // closed loops: as many pins between bodies as bodies, less one, plus one
+                    Kind::FourBar | Kind::FiveBar => assert_eq!((ground, clamps, pins), (2, 0, n - 1), "{what}"),
+                    Kind::Frame => assert!(ground + clamps == 2 && pins == n - 1, "{what}"),
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn validation_loads_are_neither_candidates_nor_training_loads() {
+    let (a, b) = zoo::RANGE;
+    let n = zoo::GREEDY_CANDIDATES;
+    let candidates: Vec<f64> = (0..n).map(|i| a + (b - a) * i as f64 / (n - 1) as f64).collect();
+    let loads = zoo::validation_loads();
+    assert_eq!(loads.len(), 8);
+    for x in &loads {
+        assert!(*x > a && *x < b, "{x}");
+        // half a candidate spacing from the nearest candidate (they are midpoints)
+        let nearest = candidates.iter().map(|c| (c - x).abs()).fold(f64::INFINITY, f64::min);
+        assert!((nearest - 0.5 * (b - a) / (n - 1) as f64).abs() < 1e-12, "{x}: {nearest}");
+    }
+    assert!(loads.windows(2).all(|w| w[1] > w[0]));
+}
+
+/// One subset model at the test's tolerance: its training and validation statistics.
+struct Outcome {
+    name: String,
+    training: Result<zoo::drive::Training, String>,
+    stats: ModelStats,
+}
+
+fn evaluate(fx: &Flexrom, root: &Path, slot: usize, tolerance: f64) -> Outcome {
+    let (m, _) = zoo::accepted(zoo::DEFAULT_SEED, slot, |m| {
+        let dir = root.join(m.name());
+        std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+        std::fs::write(dir.join("model.toml"), &m.mechanism.toml).map_err(|e| e.to_string())?;
+        fx.full_runs_complete(&dir, "model.toml")
+    })
+    .expect("a model whose full runs complete");
+    let dir = root.join(m.name());
+    std::fs::write(dir.join("pipeline.toml"), zoo::pipeline_toml("model.toml", "basis.h5", tolerance, None))
+        .expect("pipeline file");
+    let training = fx.train(&dir, "pipeline.toml");
+    let validations: Vec<_> = if training.is_ok() {
+        zoo::validation_loads().into_iter().map(|x| fx.validate(&dir, "pipeline.toml", x)).collect()
+    } else {
+        Vec::new()
+    };
+    Outcome { name: m.name(), training, stats: model_stats(&validations) }
+}
+
+/// Tolerance of the subset test: the looser of the two (the cheaper training).
+const TOLERANCE: f64 = 1e-2;
+
+#[test]
+fn the_estimate_holds_on_the_zoo_subset() {
+    let fx = Flexrom { bin: PathBuf::from(env!("CARGO_BIN_EXE_flexrom")), resume: false };
+    let root = tempfile::tempdir().expect("a temporary folder");
+    // two flexrom processes at a time, one thread each
+    let next = AtomicUsize::new(0);
+    let out = Mutex::new(Vec::new());
+    std::thread::scope(|s| {
+        for _ in 0..2 {
+            s.spawn(|| loop {
+                let i = next.fetch_add(1, Ordering::SeqCst);
+                let Some(&slot) = zoo::SUBSET.get(i) else { break };
+                let o = evaluate(&fx, root.path(), slot, TOLERANCE);
+                out.lock().expect("results").push(o);
+            });
+        }
+    });
+    let outcomes = out.into_inner().expect("results");
+    let report: Vec<String> = outcomes
+        .iter()
+        .map(|o| match &o.training {
+            Ok(t) => format!(
+                "{}: converged {} ({}), covered {}/{}, effectivity median {:.3} max {:.3}, cost {:.2}",
+                o.name,
+                t.converged,
+                t.reason,
+                o.stats.covered_pairs,
+                o.stats.loads,
+                o.stats.effectivity_median,
+                o.stats.effectivity_max,
+                o.stats.cost_median
+            ),
+            Err(e) => format!("{}: training failed: {e}", o.name),
+        })
+        .collect();
+    let agg = aggregate(&outcomes.iter().map(|o| (o.training.as_ref().ok(), &o.stats)).collect::<Vec<_>>());
+    let missed = agg.missed();
+    assert!(missed.is_empty(), "targets missed on the zoo subset: {}\n{}", missed.join("; "), report.join("\n"));
+}
