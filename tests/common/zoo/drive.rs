@@ -168,7 +168,7 @@ impl Flexrom {
         }
         let v: Value = serde_json::from_slice(&o.stdout).map_err(|e| format!("train --json: {e}"))?;
         let err = String::from_utf8_lossy(&o.stderr);
-        let last = err.lines().filter(|l| l.starts_with("iteration ")).next_back().unwrap_or("").to_string();
+        let last = err.lines().rfind(|l| l.starts_with("iteration ")).unwrap_or("").to_string();
         let warning = err.lines().find(|l| l.starts_with("warning: greedy training stopped"));
         let method = if err.lines().any(|l| l.starts_with("error estimate:") && l.ends_with("the online default")) {
             "defects"

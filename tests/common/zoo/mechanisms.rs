@@ -280,8 +280,7 @@ fn cantilever(rng: &mut Rng, t: Time) -> Draft {
     let kappa = rng.log_uniform(0.02, 2.0);
     let load_node = if propped { (b.elements / 2).to_string() } else { "end".into() };
     let mut loads = Vec::new();
-    let motion;
-    if rng.chance(0.7) || propped {
+    let motion = if rng.chance(0.7) || propped {
         let p = kappa * ei / (length * length) * if propped { 8.0 } else { 1.0 };
         let dir = angle + if rng.chance(0.7) { -0.5 * PI } else { rng.uniform(0.0, 2.0 * PI) };
         loads.push(Load::Force {
@@ -291,12 +290,12 @@ fn cantilever(rng: &mut Rng, t: Time) -> Draft {
             function: Some(f),
             scaled: if rng.chance(0.5) { None } else { Some(true) },
         });
-        motion = format!("point force P L²/EI up to {kappa:.2}{}", if propped { ", propped end" } else { "" });
+        format!("point force P L²/EI up to {kappa:.2}{}", if propped { ", propped end" } else { "" })
     } else {
         let mo = kappa.min(1.0) * ei / length;
         loads.push(Load::Moment { body: "beam".into(), node: "end".into(), function: f.scaled(mo), scaled: None });
-        motion = format!("tip moment M L/EI up to {:.2}", kappa.min(1.0));
-    }
+        format!("tip moment M L/EI up to {:.2}", kappa.min(1.0))
+    };
     if rng.chance(0.5) {
         loads.push(gravity(rng, 0.3));
     }
@@ -404,13 +403,12 @@ fn clamped_chain(rng: &mut Rng, t: Time) -> Draft {
     let (mut bodies, mut joints) = chain(rng, [0.0, 0.0], &specs);
     joints.insert(0, Joint::Clamp { body: "link1".into(), node: "start".into() });
     let mut loads = vec![gravity(rng, 0.5)];
-    let motion;
-    if rng.chance(0.5) {
+    let motion = if rng.chance(0.5) {
         // a moment on the first pinned link, at its pin
         let j: f64 = bodies[1..].iter().map(|b| b.inertia_about(bodies[1].start)).sum();
         let theta = rotation(rng);
         loads.push(driving_moment(rng, t, &mut bodies[1], "start", j, theta, 0.0));
-        motion = describe_rotation(theta);
+        describe_rotation(theta)
     } else {
         let last = bodies.last().expect("a link");
         let total: f64 = bodies.iter().map(Beam::mass).sum();
@@ -423,8 +421,8 @@ fn clamped_chain(rng: &mut Rng, t: Time) -> Draft {
             function: Some(unit_function(rng, t.t_end, t.dt)),
             scaled: None,
         });
-        motion = "tip force".into();
-    }
+        "tip force".into()
+    };
     Draft::new(bodies, joints, loads, motion)
 }
 

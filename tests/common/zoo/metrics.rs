@@ -24,7 +24,12 @@ pub const MAX_MEDIAN_COST: f64 = 1.0;
 /// A model's estimate fails where it reads under the error or over it by more than the
 /// 95th-percentile target.
 pub fn estimate_fails(s: &ModelStats) -> bool {
-    s.under_pairs > 0 || s.under_triples > 0 || !(s.effectivity_max <= MAX_P95_EFFECTIVITY)
+    s.under_pairs > 0 || s.under_triples > 0 || !within(s.effectivity_max, MAX_P95_EFFECTIVITY)
+}
+
+/// `x ≤ bound`, with NaN outside every bound.
+fn within(x: f64, bound: f64) -> bool {
+    matches!(x.partial_cmp(&bound), Some(std::cmp::Ordering::Less | std::cmp::Ordering::Equal))
 }
 
 /// The median (mean of the middle two); NaN for none.
