@@ -12,7 +12,7 @@
 //! `validate --json` at 8 loads that are neither training nor candidate loads; per model the
 //! convergence and its reason, full runs, modes, sampled elements, speedup, the estimate
 //! method, coverage over the whole run and per fifth, effectivity and estimator cost; over
-//! all models the aggregate targets (tests/common/zoo/metrics.rs). Where a model's
+//! all models the aggregate targets of docs/zoo.md (tests/common/zoo/metrics.rs). Where a model's
 //! default estimate fails (reads under the error, or over it by more than 20×) it is
 //! validated again with each method (`[online] estimate`). Writes DIR/zoo.md (Markdown
 //! tables) and DIR/zoo.json (every number), DIR/models/NAME/ the model and pipelines.

@@ -6,11 +6,11 @@
 //!   body, E in [1e6, 1e11] Pa, some load follows the load scale, the kinds' joints); the
 //!   validation loads are neither greedy candidates nor the range's ends.
 //! * The subset (`zoo::SUBSET`, six models): greedy training at tolerance 1e-2 and
-//!   validation at the 8 held-out loads through the release binary, held to the issue's
+//!   validation at the 8 held-out loads through the release binary, held to the
 //!   targets over the subset (`metrics::Aggregate::missed`: converged ≥ 90 %, coverage
 //!   ≥ 95 % of (model, load) pairs and ≥ 90 % of (model, load, fifth) triples, effectivity
 //!   median ≤ 3, 95th percentile ≤ 20, max ≤ 100, estimator cost median ≤ 100 %). The
-//!   numbers are measured, not chosen: they are the targets.
+//!   bounds are the targets of docs/zoo.md, not fitted to these models.
 
 #[path = "common/zoo/mod.rs"]
 mod zoo;
@@ -120,7 +120,7 @@ fn evaluate(fx: &Flexrom, root: &Path, slot: usize, tolerance: f64) -> Outcome {
     Outcome { name: m.name(), training, stats: model_stats(&validations) }
 }
 
-/// Tolerance of the subset test: the looser of the two (the cheaper training).
+/// Tolerance of the subset test: the looser of the zoo's two (the cheaper training).
 const TOLERANCE: f64 = 1e-2;
 
 #[test]

@@ -1,5 +1,5 @@
 //! How the zoo judges a basis and its error estimate (docs/zoo.md), and the targets it is
-//! held to (the issue's "Trust on any model", item 3):
+//! held to (docs/zoo.md, "Targets"):
 //!
 //! ```text
 //! coverage      estimate ≥ true rel_error, over the whole run (pairs: model, load) and up
@@ -12,7 +12,7 @@
 
 use super::drive::{Training, Validation};
 
-/// The issue's targets over all models together.
+/// The zoo's targets over all models together.
 pub const MIN_CONVERGED: f64 = 0.90;
 pub const MIN_PAIR_COVERAGE: f64 = 0.95;
 pub const MIN_TRIPLE_COVERAGE: f64 = 0.90;
