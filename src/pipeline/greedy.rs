@@ -26,7 +26,8 @@
 //!   (`search::between_candidates`): the tolerance is a promise for every load of the
 //!   range, and between two candidates the estimate is taken to rise above the larger by
 //!   as much as it changes between them (a few per cent for a smooth estimate, 33
-//!   candidates). The search and the stopping test hold the same bound to T: an earlier
+//!   candidates); between two *sensitive* candidates (sensitivity above T, below) the
+//!   larger of the two alone, as their scores jump with the dynamics. The search and the stopping test hold the same bound to T: an earlier
 //!   fixed T / 2 in the search chose bases twice as costly as needed (the pendulum: 23
 //!   sampled elements where 10 keep every estimate within T).
 //! - the stopping test rescales the estimates by the calibration the held-out run just
@@ -179,7 +180,7 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
                 "every candidate has a full run".into()
             };
             // the same test as the stop below, without a held-out run to recalibrate with
-            let bound = level.between_candidates();
+            let bound = level.between_candidates(g.tolerance);
             crate::output::info(&format!(
                 "iteration {n}: {why}, worst estimate {worst:.2e} {cmp} {:e} at λ = {} (bound between candidates {bound:.2e}), {shape}",
                 g.tolerance, it.worst_load
@@ -232,7 +233,7 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         // the held-out pair may have raised the calibration factor: the estimates this
         // basis will report are the candidates' scaled by it (the estimate is linear in c)
         let rescale = calibrate(points.clone()).factor / level.estimator.calibration.factor;
-        let bound = level.between_candidates() * rescale.max(1.0);
+        let bound = level.between_candidates(g.tolerance) * rescale.max(1.0);
         let done = bound <= g.tolerance && e_score <= g.tolerance;
         let sens = level.sensitivity[ni][4];
         if done {
@@ -254,7 +255,7 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
             g.max_runs,
             g.tolerance,
             iterations.last().map_or(f64::NAN, |i| i.worst_estimate),
-            iterations.last().map_or(f64::NAN, |i| search::between_candidates(&i.estimates)),
+            iterations.last().map_or(f64::NAN, |i| search::between_candidates(&i.estimates, &sensitive(&i.sensitivity, g.tolerance))),
             why_not_converged(g.tolerance, &iterations, &candidates)
         ));
     }
@@ -374,6 +375,11 @@ fn check_method(
     Some(MethodCheck { switch, raw: reading.raw, message })
 }
 
+/// Which candidates are sensitive: a whole-run sensitivity above the tolerance.
+fn sensitive(sensitivity: &[f64], tolerance: f64) -> Vec<bool> {
+    sensitivity.iter().map(|&s| s > tolerance).collect()
+}
+
 /// Why the loop ended above its tolerance, from what it saw, in the order a user can act on:
 /// candidates where no estimate could be computed; the full model's own sensitivity to the
 /// load (where a 0.1 % change of the load moves the answer by more than T, the held-out
@@ -400,7 +406,7 @@ fn why_not_converged(tolerance: f64, iterations: &[Iteration], candidates: &[f64
     let sensitive_held_out =
         iterations.iter().filter(|it| it.true_error > tolerance && it.true_score <= tolerance).count();
     // every score within T, but neighbours far apart: the loads between them are not certified
-    let bound = search::between_candidates(&last.estimates);
+    let bound = search::between_candidates(&last.estimates, &sensitive(&last.sensitivity, tolerance));
     if last.worst_estimate <= tolerance && bound > tolerance {
         let (ratio, at) = last
             .estimates

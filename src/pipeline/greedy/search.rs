@@ -52,12 +52,14 @@ impl Level {
     }
 
     /// What the estimate may reach between the candidates, which are all the loop sees of
-    /// the range: [`between_candidates`] of the scores (∞ for a rung not run everywhere).
-    pub(super) fn between_candidates(&self) -> f64 {
+    /// the range: [`between_candidates`] of the scores (∞ for a rung not run everywhere),
+    /// with the candidates where the model's whole-run sensitivity exceeds `tolerance`.
+    pub(super) fn between_candidates(&self, tolerance: f64) -> f64 {
         if !self.complete() {
             return f64::INFINITY;
         }
-        between_candidates(&self.estimates)
+        let sensitive: Vec<bool> = self.sensitivity.iter().map(|s| s[FIFTHS - 1] > tolerance).collect();
+        between_candidates(&self.estimates, &sensitive)
     }
 
     /// [`Self::worst`] among the candidates `keep` accepts (and that were run).
@@ -115,7 +117,7 @@ pub(super) fn search(r: &Round, g: &GreedySpec, previous_energy: Option<f64>) ->
     let (p, candidates, n) = (r.p, r.candidates, r.n);
     let given_hyper = p.file.reduction.hyper.as_ref().map(|h| h.tolerance);
     // what the tolerance promises is every load of the range, not the candidates alone
-    let accepts = |l: &Level| l.between_candidates() <= g.tolerance;
+    let accepts = |l: &Level| l.between_candidates(g.tolerance) <= g.tolerance;
     let mut last_error: Option<(&'static str, String)> = None;
     let mut order = match r.prior {
         Some(s) if s.len() == candidates.len() => worst_first(s, &vec![true; s.len()]),
@@ -254,10 +256,16 @@ fn rung_text(r: &Round, l: &Level, eps: f64, tau: f64, tolerance: f64) -> String
             r.candidates[wi],
             r.candidates.len()
         )
-    } else if l.between_candidates() > tolerance {
-        format!("above the tolerance {tolerance:e} between the candidates (bound {:.2e})", l.between_candidates())
+    } else if l.between_candidates(tolerance) > tolerance {
+        format!(
+            "above the tolerance {tolerance:e} between the candidates (bound {:.2e})",
+            l.between_candidates(tolerance)
+        )
     } else {
-        format!("within the tolerance {tolerance:e} (bound between the candidates {:.2e})", l.between_candidates())
+        format!(
+            "within the tolerance {tolerance:e} (bound between the candidates {:.2e})",
+            l.between_candidates(tolerance)
+        )
     };
     if !poor.is_empty() {
         // the search stops at such a rung: a tighter one would have nothing to be checked against
@@ -284,20 +292,32 @@ fn rung_text(r: &Round, l: &Level, eps: f64, tau: f64, tolerance: f64) -> String
 ///
 /// so a smooth estimate is held to its largest value times the local step ratio (a few per
 /// cent with the default 33 candidates), a jumpy one to much more. Nothing in it is fitted:
-/// a spike narrower than the spacing is what more candidates would find. A non-finite or
+/// a spike narrower than the spacing is what more candidates would find. Between two
+/// candidates that are both `sensitive` (the model's answer moves by more than the
+/// tolerance for a 0.1 % change of the load, so their scores are already held to that
+/// sensitivity, the greedy module documentation) the pair counts with its larger value
+/// only: there the scores jump because the dynamics do, not along a trend a ratio could
+/// extrapolate, and no number of candidates would resolve them. A non-finite or
 /// non-positive estimate (a failed run, a basis with no extra modes to estimate from) gives
 /// ∞, as does an empty list.
-pub(crate) fn between_candidates(e: &[f64]) -> f64 {
+pub(crate) fn between_candidates(e: &[f64], sensitive: &[bool]) -> f64 {
     if e.is_empty() || e.iter().any(|&x| !(x.is_finite() && x > 0.0)) {
         return f64::INFINITY;
     }
     if e.len() == 1 {
         return e[0];
     }
+    let both_sensitive =
+        |i: usize| sensitive.get(i).copied().unwrap_or(false) && sensitive.get(i + 1).copied().unwrap_or(false);
     e.windows(2)
-        .map(|w| {
+        .enumerate()
+        .map(|(i, w)| {
             let (hi, lo) = (w[0].max(w[1]), w[0].min(w[1]));
-            hi * (hi / lo)
+            if both_sensitive(i) {
+                hi
+            } else {
+                hi * (hi / lo)
+            }
         })
         .fold(0.0, f64::max)
 }
@@ -388,12 +408,23 @@ mod tests {
     /// estimate, a zero one and no estimates at all are ∞.
     #[test]
     fn the_bound_between_candidates_follows_the_neighbours() {
-        assert_eq!(between_candidates(&[2e-4, 2e-4, 2e-4]), 2e-4);
-        assert!((between_candidates(&[1.0, 1.0, 1.1]) - 1.21).abs() < 1e-12);
-        assert!((between_candidates(&[1e-4, 1e-3, 1e-4]) - 1e-2).abs() < 1e-15);
-        assert!(between_candidates(&[1e-4, f64::INFINITY]).is_infinite());
-        assert!(between_candidates(&[1e-4, f64::NAN]).is_infinite());
-        assert!(between_candidates(&[1e-4, 0.0]).is_infinite());
-        assert!(between_candidates(&[]).is_infinite());
+        let calm = [false; 3];
+        assert_eq!(between_candidates(&[2e-4, 2e-4, 2e-4], &calm), 2e-4);
+        assert!((between_candidates(&[1.0, 1.0, 1.1], &calm) - 1.21).abs() < 1e-12);
+        assert!((between_candidates(&[1e-4, 1e-3, 1e-4], &calm) - 1e-2).abs() < 1e-15);
+        assert!(between_candidates(&[1e-4, f64::INFINITY], &calm).is_infinite());
+        assert!(between_candidates(&[1e-4, f64::NAN], &calm).is_infinite());
+        assert!(between_candidates(&[1e-4, 0.0], &calm).is_infinite());
+        assert!(between_candidates(&[], &calm).is_infinite());
+    }
+
+    /// Between two sensitive candidates a jump counts with its larger value (1e-3, not
+    /// 1e-2); a pair with one calm candidate keeps the ratio (1e-4 next to 1e-3: 1e-2);
+    /// a failed estimate is ∞ whatever the sensitivity.
+    #[test]
+    fn sensitive_neighbours_are_not_extrapolated() {
+        assert_eq!(between_candidates(&[1e-4, 1e-3, 1e-4], &[true; 3]), 1e-3);
+        assert!((between_candidates(&[1e-4, 1e-3, 1e-4], &[false, true, true]) - 1e-2).abs() < 1e-15);
+        assert!(between_candidates(&[1e-4, f64::INFINITY], &[true; 2]).is_infinite());
     }
 }
