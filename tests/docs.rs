@@ -265,6 +265,7 @@ fn the_files_speak_of_the_project_not_of_its_making() {
     for (dir, exts) in [
         ("docs", &["md"][..]),
         ("pipelines", &["md", "toml", "sh"][..]),
+        ("data", &["toml", "md"][..]),
         ("src", &["rs"][..]),
         ("scripts", &["py", "sh", "sbatch"][..]),
         ("benches", &["rs", "py"][..]),
