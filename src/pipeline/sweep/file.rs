@@ -149,24 +149,25 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, basis: Option<SweepBasis>, extra
             .with_data(&col(&|p| p.estimate.map_or(f64::NAN, |e| e.error_estimate)))
             .create("error_estimate")
             .map_err(e)?;
-        let mut by_time = Array2::from_elem((n, 5), f64::NAN);
-        for (k, x) in s.scales.iter().enumerate() {
-            if let Some(est) = x.point().and_then(|p| p.estimate) {
-                by_time.row_mut(k).assign(&ndarray::ArrayView1::from(&est.by_time));
+        // (load, fifth) of an estimate's by-fifth figures; NaN where a load has none
+        let by_fifth = |get: &dyn Fn(&crate::rom::estimator::Estimate) -> crate::rom::estimator::ByFifth| {
+            let mut a = Array2::from_elem((n, 5), f64::NAN);
+            for (k, x) in s.scales.iter().enumerate() {
+                if let Some(est) = x.point().and_then(|p| p.estimate) {
+                    a.row_mut(k).assign(&ndarray::ArrayView1::from(&get(&est)));
+                }
             }
-        }
-        f.new_dataset_builder().with_data(&by_time).create("error_estimate_by_time").map_err(e)?;
+            a
+        };
+        f.new_dataset_builder().with_data(&by_fifth(&|e| e.by_time)).create("error_estimate_by_time").map_err(e)?;
         f.new_dataset_builder()
             .with_data(&col(&|p| p.estimate.map_or(f64::NAN, |e| e.error_estimate_displacement)))
             .create("error_estimate_displacement")
             .map_err(e)?;
-        let mut by_time = Array2::from_elem((n, 5), f64::NAN);
-        for (k, x) in s.scales.iter().enumerate() {
-            if let Some(est) = x.point().and_then(|p| p.estimate) {
-                by_time.row_mut(k).assign(&ndarray::ArrayView1::from(&est.displacement_by_time));
-            }
-        }
-        f.new_dataset_builder().with_data(&by_time).create("error_estimate_displacement_by_time").map_err(e)?;
+        f.new_dataset_builder()
+            .with_data(&by_fifth(&|e| e.displacement_by_time))
+            .create("error_estimate_displacement_by_time")
+            .map_err(e)?;
         f.new_dataset_builder()
             .with_data(&col(&|p| p.estimate.map_or(f64::NAN, |e| e.seconds)))
             .create("estimate_seconds")

@@ -141,6 +141,21 @@ pub fn displacement_error_by_time(a: &Array2<f64>, b: &Array2<f64>, x0: ArrayVie
 mod tests {
     use super::*;
 
+    /// A Galerkin basis of `modes` about `reference`, without hyper-reduction.
+    fn galerkin(modes: Array2<f64>, reference: Array1<f64>) -> Basis {
+        Basis {
+            variant: Variant::Galerkin,
+            snapshots: crate::reduction::SnapshotKind::Reference,
+            reference,
+            n_pod_modes: modes.ncols(),
+            modes,
+            kept: vec![],
+            multiplier_modes: None,
+            multiplier_scale: 1.0,
+            hyper: None,
+        }
+    }
+
     /// The reduced-coordinate norms equal the full-coordinate ones for nested orthonormal
     /// bases and for bases that are not nested (random rotations of a 3-column basis).
     #[test]
@@ -152,17 +167,7 @@ mod tests {
         let (qf, _) = ndarray_linalg::QR::qr(&a).unwrap();
         let vp = qf.slice(ndarray::s![.., ..5]).to_owned();
         let reference = Array1::from_shape_fn(n, |i| 0.1 * i as f64 + 1.0);
-        let mk = |modes: Array2<f64>| Basis {
-            variant: Variant::Galerkin,
-            snapshots: crate::reduction::SnapshotKind::Reference,
-            reference: reference.clone(),
-            n_pod_modes: modes.ncols(),
-            modes,
-            kept: vec![],
-            multiplier_modes: None,
-            multiplier_scale: 1.0,
-            hyper: None,
-        };
+        let mk = |modes: Array2<f64>| galerkin(modes, reference.clone());
         let plus = mk(vp.clone());
 
         // nested (first 3 columns) and not nested (mixing columns 2..5)
@@ -250,17 +255,7 @@ mod tests {
     fn estimate_by_time_follows_a_growing_error() {
         let (n, nt) = (4, 20);
         let eye = Array2::from_shape_fn((n, n), |(i, j)| if i == j { 1.0 } else { 0.0 });
-        let mk = |modes: Array2<f64>| Basis {
-            variant: Variant::Galerkin,
-            snapshots: crate::reduction::SnapshotKind::Reference,
-            reference: Array1::zeros(n),
-            n_pod_modes: modes.ncols(),
-            modes,
-            kept: vec![],
-            multiplier_modes: None,
-            multiplier_scale: 1.0,
-            hyper: None,
-        };
+        let mk = |modes: Array2<f64>| galerkin(modes, Array1::zeros(n));
         let (b, plus) = (mk(eye.clone()), mk(eye));
         // X⁺ rotates at unit norm; X_r lags it by nothing for 8 instants, then by a growing angle
         let lag = |k: usize| if k < 8 { 0.0 } else { 0.01 * (k - 7) as f64 };
