@@ -47,8 +47,8 @@ fn main() {
         let (mut tf, mut tr) = (Vec::new(), Vec::new());
         let mut last = None;
         for _ in 0..runs {
-            let full = simulate(&p.model, &Overrides { load_scale: Some(x), ..Default::default() }).expect("full run");
-            let rom = reduced.solve(&Parameters::new(x)).expect("reduced run");
+            let full = simulate(&p.model, &Overrides::at(&Parameters::load_scale(x))).expect("full run");
+            let rom = reduced.solve(&Parameters::load_scale(x)).expect("reduced run");
             tf.push(full.wall_seconds);
             tr.push(rom.result.wall_seconds);
             last = Some((full, rom));

@@ -102,8 +102,8 @@ fn main() -> flexrom::Result<()> {
     let rom = Rom::new(&p.model, &basis, Some(estimator), None)?;
     let mut rows = Vec::new();
     for &x in &tests {
-        let full = simulate(&p.model, &Overrides { load_scale: Some(x), ..Default::default() })?;
-        let (run, e) = rom.solve_and_estimate(&Parameters::new(x), Output::Full, &[])?;
+        let full = simulate(&p.model, &Overrides::at(&Parameters::load_scale(x)))?;
+        let (run, e) = rom.solve_and_estimate(&Parameters::load_scale(x), Output::Full, &[])?;
         let e = e.expect("estimator");
         let (distance, norm) = distance_and_norm(&run.result.q, &full.q);
         let err = distance / norm;

@@ -54,11 +54,12 @@ pub enum Error {
     BlowUp { t: f64, problem: String },
 
     /// A numerical failure with the stage (simulate, train, online, validate, sweep) and
-    /// the load scale it happened at; the time is in `source`.
-    #[error("{stage} at load scale {}: {source}", show_number(*.load_scale))]
+    /// the parameters it happened at (as `Parameters` print them: `load scale 1.1`); the
+    /// time is in `source`.
+    #[error("{stage} at {parameters}: {source}")]
     Stage {
         stage: String,
-        load_scale: f64,
+        parameters: String,
         #[source]
         source: Box<Error>,
     },
@@ -110,12 +111,12 @@ impl Error {
         Error::Io { file: file.as_ref().display().to_string(), source }
     }
 
-    /// Adds the stage and the load scale to a numerical failure (Newton, linear solve,
+    /// Adds the stage and the parameters to a numerical failure (Newton, linear solve,
     /// blow-up); other errors already name their file or option and pass unchanged.
-    pub fn at_stage(self, stage: &str, load_scale: f64) -> Self {
+    pub fn at_stage(self, stage: &str, mu: &impl std::fmt::Display) -> Self {
         match self {
             Error::NewtonFailed { .. } | Error::LinearSolve { .. } | Error::BlowUp { .. } => {
-                Error::Stage { stage: stage.to_string(), load_scale, source: Box::new(self) }
+                Error::Stage { stage: stage.to_string(), parameters: mu.to_string(), source: Box::new(self) }
             }
             other => other,
         }

@@ -15,8 +15,16 @@ pub struct Overrides {
     pub dt: Option<f64>,
     pub t_end: Option<f64>,
     pub rho_inf: Option<f64>,
-    pub load_scale: Option<f64>,
+    /// the run's parameters; `None`: the model file's own loads ([`Parameters::default`])
+    pub mu: Option<Parameters>,
     pub solver: LinearSolverKind,
+}
+
+impl Overrides {
+    /// The model file's settings at the parameters `mu`.
+    pub fn at(mu: &Parameters) -> Self {
+        Overrides { mu: Some(mu.clone()), ..Default::default() }
+    }
 }
 
 /// The settings a run actually used.
@@ -25,7 +33,8 @@ pub struct Settings {
     pub dt: f64,
     pub t_end: f64,
     pub rho_inf: f64,
-    pub load_scale: f64,
+    /// the run's parameters `μ`
+    pub mu: Parameters,
     pub n_steps: usize,
     pub solver: LinearSolverKind,
     pub params: IntegratorParams,
@@ -37,7 +46,7 @@ impl Settings {
         let dt = o.dt.unwrap_or(t.dt);
         let t_end = o.t_end.unwrap_or(t.t_end);
         let rho_inf = o.rho_inf.unwrap_or(t.rho_inf);
-        let load_scale = o.load_scale.unwrap_or(1.0);
+        let mu = o.mu.clone().unwrap_or_default();
         let bad = |name: &str, v: f64| Error::Usage(format!("--{name} must be positive and finite, got {v}"));
         if !(dt.is_finite() && dt > 0.0) {
             return Err(bad("dt", dt));
@@ -45,7 +54,7 @@ impl Settings {
         if !(t_end.is_finite() && t_end > 0.0) {
             return Err(bad("t-end", t_end));
         }
-        Parameters::new(load_scale).validate()?;
+        mu.validate()?;
         let params = IntegratorParams { rho_inf, ..model.integrator_params() };
         params.validate().map_err(|e| Error::Usage(format!("--rho-inf: {e}")))?;
         // the number of whole steps that fit (SPEC §4: 1.1 s at 0.007 s is 157 steps),
@@ -57,12 +66,12 @@ impl Settings {
         if n_steps == 0 {
             return Err(Error::Usage(format!("dt = {dt} is longer than t_end = {t_end}")));
         }
-        Ok(Settings { dt, t_end, rho_inf, load_scale, n_steps, solver: o.solver, params })
+        Ok(Settings { dt, t_end, rho_inf, mu, n_steps, solver: o.solver, params })
     }
 
     /// The parameters μ of the run.
-    pub fn parameters(&self) -> Parameters {
-        Parameters::new(self.load_scale)
+    pub fn parameters(&self) -> &Parameters {
+        &self.mu
     }
 }
 

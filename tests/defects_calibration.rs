@@ -92,7 +92,7 @@ fn greedy_calibrates_the_defects_estimate() {
     let x = candidates[7];
     let (_, corrected, _) = load_rom(&p, &p.basis_path, Some(EstimateMethod::Corrected), false).unwrap();
     assert_eq!(corrected.method(), Some("corrected"));
-    let mu = Parameters::new(x);
+    let mu = Parameters::load_scale(x);
     let (_, d) = rom.solve_and_estimate(&mu, Output::Full, &[]).unwrap();
     let (_, c) = corrected.solve_and_estimate(&mu, Output::Full, &[]).unwrap();
     let (d, c) = (d.unwrap(), c.unwrap());
@@ -136,7 +136,7 @@ fn greedy_calibrates_the_defects_estimate() {
     // held out and outside the range: a bound, not a loose one
     for x in [0.57, 1.03, 1.41, 0.4, 1.6] {
         assert!(candidates.iter().all(|&l| (l - x).abs() > 1e-3));
-        let (v, _, _) = validate(&rom, x, false).unwrap();
+        let (v, _, _) = validate(&rom, &Parameters::load_scale(x), false).unwrap();
         let e = v.error_estimate.expect("estimate");
         assert!(e >= v.rel_error, "λ = {x}: estimate {e:e} below rel_error {:e}", v.rel_error);
         assert!(e / v.rel_error <= 30.0, "λ = {x}: effectivity {}", e / v.rel_error);

@@ -26,6 +26,7 @@ use flexrom::pipeline::validate::validate;
 use flexrom::pipeline::Pipeline;
 use flexrom::reduction::Variant;
 use flexrom::rom::Rom;
+use flexrom::solver::parameters::Parameters;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -73,7 +74,8 @@ fn greedy_pendulum_meets_its_tolerance() {
     let stored = flexrom::pipeline::online::load_basis(&p, &p.basis_path).unwrap();
     for x in [0.57, 1.03, 1.41] {
         assert!(g.load_scales.iter().chain(&g.candidates).all(|&l| (l - x).abs() > 1e-3));
-        let (v, _, _) = validate(&Rom::of(&p.model, &stored.basis).unwrap(), x, false).unwrap();
+        let (v, _, _) =
+            validate(&Rom::of(&p.model, &stored.basis).unwrap(), &Parameters::load_scale(x), false).unwrap();
         assert!(v.rel_error <= t, "λ = {x}: rel_error {:.3e} > {t}", v.rel_error);
     }
 

@@ -24,6 +24,7 @@ use flexrom::reduction::{ecsw, Hyper, HyperReducedModel, Reduced, ReducedModel};
 use flexrom::rom::Rom;
 use flexrom::simulate::{prepare, solve, Overrides, Settings};
 use flexrom::solver::model::{InvariantElementModel, IterationCoefficients, ParametricModel};
+use flexrom::solver::parameters::Parameters;
 use ndarray::{Array1, Array2, ArrayView1};
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -69,7 +70,7 @@ fn every_element_at_weight_one_equals_plain_galerkin_with(modes: &str) {
     let (data, summary) = train(&p).unwrap();
     let basis = summary.trained.basis;
     let model: &Model = &p.model;
-    let s = Settings::resolve(model, &Overrides { load_scale: Some(0.935), ..Default::default() }).unwrap();
+    let s = Settings::resolve(model, &Overrides::at(&Parameters::load_scale(0.935))).unwrap();
     let (sys, _) = prepare(model, &s).unwrap();
     let all = Hyper::all(sys.n_elements());
     let mut hyper = HyperReducedModel::new(sys, &basis, &all).unwrap();
@@ -168,7 +169,7 @@ fn hyper_reduced_pendulum_stays_within_the_error_bound() {
     let basis = summary.trained.basis;
     let h = basis.hyper.as_ref().expect("trained with hyper-reduction");
     assert!(h.elements.len() < 50, "{} of 50 elements sampled", h.elements.len());
-    let (v, _, _) = validate(&Rom::of(&p.model, &basis).unwrap(), 1.0, false).unwrap();
+    let (v, _, _) = validate(&Rom::of(&p.model, &basis).unwrap(), &Parameters::default(), false).unwrap();
     // the accuracy target, at the thesis mesh and load (SPEC §4)
     assert!(v.rel_error <= 1e-3, "rel_error {}", v.rel_error);
     assert!(v.max_constraint_violation < 1e-10, "{}", v.max_constraint_violation);
@@ -185,7 +186,7 @@ fn shipped_block_basis_fourbar_stays_within_the_error_bound() {
     let (_, summary) = train(&p).unwrap();
     assert_eq!(summary.trained.block_modes, vec![7, 35, 14], "one block per body, as the pipeline asks");
     let basis = summary.trained.basis;
-    let (v, _, _) = validate(&Rom::of(&p.model, &basis).unwrap(), 0.935, false).unwrap();
+    let (v, _, _) = validate(&Rom::of(&p.model, &basis).unwrap(), &Parameters::load_scale(0.935), false).unwrap();
     // the accuracy target, at the thesis mesh and load λ = 0.935 (SPEC §4); measured 5.5e-4
     assert!(v.rel_error <= 1e-3, "rel_error {}", v.rel_error);
     assert!(v.max_constraint_violation < 1e-10, "{}", v.max_constraint_violation);

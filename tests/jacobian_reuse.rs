@@ -89,7 +89,7 @@ fn check_model<M: ParametricModel>(
 }
 
 fn settings(m: &Model, scale: f64) -> Settings {
-    Settings::resolve(m, &Overrides { load_scale: Some(scale), ..Default::default() }).unwrap()
+    Settings::resolve(m, &Overrides::at(&Parameters::load_scale(scale))).unwrap()
 }
 
 #[test]
@@ -98,6 +98,6 @@ fn kept_matrices_end_every_full_order_step_where_full_newton_does() {
     let m = Model::load(repo(model)).unwrap();
     let s = settings(&m, scale);
     let q0 = prepare(&m, &s).unwrap().1;
-    let mu = Parameters::new(s.load_scale);
+    let mu = s.mu.clone();
     check_model(model, || prepare(&m, &s).unwrap().0, &mu, &s.params, q0, s.dt, steps.min(s.n_steps));
 }

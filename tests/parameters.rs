@@ -50,12 +50,12 @@ fn check(p: &Pipeline, l1: f64, l2: f64) {
     let mut one = ReducedRunner::new(model, &basis).unwrap();
     let runs: Vec<Array2<f64>> = [l1, l2, l1]
         .iter()
-        .map(|&x| one.solve(&Parameters::new(x), Output::ReducedAndProbes, &[]).unwrap().reduced_q)
+        .map(|&x| one.solve(&Parameters::load_scale(x), Output::ReducedAndProbes, &[]).unwrap().reduced_q)
         .collect();
     for (run, &x) in runs.iter().zip(&[l1, l2, l1]) {
         let m = Arc::new(fresh(model));
         let mut new = ReducedRunner::new(&m, &basis).unwrap();
-        let reference = new.solve(&Parameters::new(x), Output::ReducedAndProbes, &[]).unwrap().reduced_q;
+        let reference = new.solve(&Parameters::load_scale(x), Output::ReducedAndProbes, &[]).unwrap().reduced_q;
         assert!(*run == reference, "reduced run at λ = {x} on a reused model differs from a fresh model's");
     }
     assert!(differ(&runs[0], &runs[1]) > 1e-6, "λ = {l1} and {l2} gave the same reduced trajectory");
@@ -64,7 +64,7 @@ fn check(p: &Pipeline, l1: f64, l2: f64) {
     let mut full = FullModel::new(model, LinearSolverKind::Banded).unwrap();
     let mut qs = Vec::new();
     for x in [l1, l2, l1] {
-        let o = Overrides { load_scale: Some(x), ..Default::default() };
+        let o = Overrides::at(&Parameters::load_scale(x));
         let q = full.simulate(&o).unwrap().q;
         let reference = simulate(&fresh(model), &o).unwrap().q;
         assert!(q == reference, "full run at λ = {x} on a reused model differs from a fresh model's");

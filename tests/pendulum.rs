@@ -139,7 +139,7 @@ fn a_guessed_increment_moves_only_the_start_of_newton() {
     let s = Settings::resolve(&m, &Overrides::default()).unwrap();
     let run = |params: &IntegratorParams, scale: f64, guide: Option<&Vec<Vec<f64>>>| {
         let (mut sys, q0) = prepare(&m, &s).unwrap();
-        let mu = flexrom::solver::model::Parameters::new(scale);
+        let mu = flexrom::solver::model::Parameters::load_scale(scale);
         let mut sys = flexrom::solver::model::Bound::new(&mut sys, &mu);
         let mut integ = GeneralizedAlpha::new(params.clone()).unwrap();
         let mut st = integ.initialize(&mut sys, q0.clone(), vec![0.0; q0.len()], 0.0).unwrap();

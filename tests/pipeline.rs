@@ -20,6 +20,7 @@
 //!   the previous good basis.
 
 use flexrom::io::basis_file::read_basis;
+use flexrom::solver::parameters::Parameters;
 
 use flexrom::pipeline::train::train_and_write;
 use flexrom::pipeline::validate::validate;
@@ -106,7 +107,7 @@ fn full_rank_basis_reproduces_the_full_model() {
     let p = Pipeline::load(setup(dir.path(), &pendulum_text(10, 0.3), &body)).unwrap();
     let s = train_and_write(&p, &p.basis_path).unwrap();
     assert_eq!(s.trained.basis.n_reduced(), 44, "r = n_dof");
-    let (v, _, _) = validate(&Rom::of(&p.model, &s.trained.basis).unwrap(), 1.0, false).unwrap();
+    let (v, _, _) = validate(&Rom::of(&p.model, &s.trained.basis).unwrap(), &Parameters::default(), false).unwrap();
     assert!(v.rel_error < 1e-8, "rel_error {}", v.rel_error);
 }
 
@@ -117,7 +118,6 @@ fn full_rank_basis_reproduces_the_full_model() {
 #[test]
 fn a_reused_reduced_model_follows_the_load_scale_exactly() {
     use flexrom::rom::{Output, ReducedRunner};
-    use flexrom::solver::model::Parameters;
     for hyper in ["", "hyper = { tolerance = 1e-2 }\n"] {
         let dir = tempfile::tempdir().unwrap();
         let body = PENDULUM_PIPE.replace("modes = { ratio = 0.1 }", &format!("modes = {{ ratio = 0.2 }}\n{hyper}"));
@@ -125,9 +125,9 @@ fn a_reused_reduced_model_follows_the_load_scale_exactly() {
         let basis = std::sync::Arc::new(train_and_write(&p, &p.basis_path).unwrap().trained.basis);
         assert_eq!(basis.hyper.is_some(), !hyper.is_empty());
         let mut runner = ReducedRunner::new(&p.model, &basis).unwrap();
-        let first = runner.solve(&Parameters::new(0.5), Output::Full, &[]).unwrap();
-        let again = runner.solve(&Parameters::new(1.3), Output::Full, &[]).unwrap();
-        let fresh = Rom::of(&p.model, &basis).unwrap().solve(&Parameters::new(1.3)).unwrap();
+        let first = runner.solve(&Parameters::load_scale(0.5), Output::Full, &[]).unwrap();
+        let again = runner.solve(&Parameters::load_scale(1.3), Output::Full, &[]).unwrap();
+        let fresh = Rom::of(&p.model, &basis).unwrap().solve(&Parameters::load_scale(1.3)).unwrap();
         assert_eq!(again.reduced_q, fresh.reduced_q, "hyper: {}", !hyper.is_empty());
         assert_ne!(first.reduced_q, fresh.reduced_q, "the load scale changes the motion");
     }
@@ -299,7 +299,7 @@ modes = { ratio = 0.1 }
     let b = &s.trained.basis;
     assert_eq!(b.kept.len(), 12, "x, y of the 6 joined nodes (2 ground pins, 2 pins of two nodes each; SPEC §4)");
     assert_eq!(b.n_pod_modes, 45, "10 % of 452, rounded");
-    let (v, full, rom) = validate(&Rom::of(&p.model, b).unwrap(), 0.935, false).unwrap();
+    let (v, full, rom) = validate(&Rom::of(&p.model, b).unwrap(), &Parameters::load_scale(0.935), false).unwrap();
     // a reference implementation of the thesis gave 10 % with reference snapshots ≈ 2.6e-4 to t = 0.9 s
     assert!(v.rel_error < 1e-3, "rel_error {}", v.rel_error);
     assert!(v.max_constraint_violation < 1e-12, "joint coordinates are unreduced: {}", v.max_constraint_violation);

@@ -74,7 +74,7 @@ fn compare<M: DynamicModel>(
 }
 
 fn check<M: ParametricModel>(name: &str, make: impl Fn() -> M, s: &Settings, q0: Vec<f64>) {
-    let mu = Parameters::new(s.load_scale);
+    let mu = s.mu.clone();
     let (mut a, mut b, mut c) = (make(), make(), make());
     let ((cv_err, za_err), cv, za) = compare(
         &mut Bound::new(&mut a, &mu),
@@ -101,7 +101,7 @@ fn check<M: ParametricModel>(name: &str, make: impl Fn() -> M, s: &Settings, q0:
 }
 
 fn settings(p: &Pipeline, scale: f64) -> Settings {
-    Settings::resolve(&p.model, &Overrides { load_scale: Some(scale), ..Default::default() }).unwrap()
+    Settings::resolve(&p.model, &Overrides::at(&Parameters::load_scale(scale))).unwrap()
 }
 
 #[test]

@@ -83,7 +83,7 @@ fn scalar_and_simd_paths_give_the_same_bits() {
     for scalar in [false, true] {
         set_scalar_only(scalar);
         let x = bordered_solve();
-        let rom = Rom::of(&p.model, &basis).and_then(|r| r.solve(&Parameters::new(0.935))).expect("reduced run");
+        let rom = Rom::of(&p.model, &basis).and_then(|r| r.solve(&Parameters::load_scale(0.935))).expect("reduced run");
         runs.push((x, rom));
         full.push(full_models.iter().map(|m| simulate(m, &short).expect("full run")).collect::<Vec<_>>());
     }

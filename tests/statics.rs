@@ -26,7 +26,7 @@ fn solve(elements: usize, p: f64, steps: usize) -> ([f64; 2], [f64; 2]) {
     let mut sys = m.system(Default::default());
     let mut q = sys.initial_state();
     for k in 1..=steps {
-        let mu = Parameters::new(k as f64 / steps as f64);
+        let mu = Parameters::load_scale(k as f64 / steps as f64);
         solve_static(&mut Bound::new(&mut sys, &mu), &mut q, 0.0, 1e-12, 30).expect("static Newton converges");
     }
     let n = sys.n_dof();
@@ -122,7 +122,7 @@ fn tip_moment_bends_a_cantilever_to_constant_curvature() {
     let mut q = sys.initial_state();
     let steps = 10;
     for k in 1..=steps {
-        let mu = Parameters::new(k as f64 / steps as f64);
+        let mu = Parameters::load_scale(k as f64 / steps as f64);
         solve_static(&mut Bound::new(&mut sys, &mu), &mut q, 0.0, 1e-12, 30).expect("static Newton converges");
     }
     let kappa = m / ei;

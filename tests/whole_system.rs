@@ -23,6 +23,7 @@ use flexrom::pipeline::validate::validate;
 use flexrom::pipeline::Pipeline;
 use flexrom::reduction::whole_system::{constraint_matrix, inf_sup};
 use flexrom::rom::Rom;
+use flexrom::solver::parameters::Parameters;
 use ndarray::Array2;
 use std::path::Path;
 
@@ -44,7 +45,7 @@ fn plain_whole_system_has_no_inf_sup_and_its_failure_points_to_the_stabilized_va
     let vl = basis.multiplier_modes.as_ref().unwrap();
     let beta = inf_sup(&b_of(&p), vl, &basis.modes);
     assert!(beta < 1e-6, "plain whole-system β = {beta:e}");
-    let Err(err) = validate(&Rom::of(&p.model, basis).unwrap(), 0.935, false) else {
+    let Err(err) = validate(&Rom::of(&p.model, basis).unwrap(), &Parameters::load_scale(0.935), false) else {
         panic!("the plain variant fails")
     };
     let err = err.to_string();
@@ -60,7 +61,7 @@ fn stabilized_four_bar_meets_the_targets_with_fewer_unknowns() {
     assert!(inf_sup(&b_of(&p), psi, &basis.modes) >= INF_SUP_MIN);
     let unknowns = basis.n_reduced() + psi.ncols();
     assert!(unknowns < 156, "{unknowns} reduced unknowns");
-    let (v, _, _) = validate(&Rom::of(&p.model, basis).unwrap(), 0.935, false).unwrap();
+    let (v, _, _) = validate(&Rom::of(&p.model, basis).unwrap(), &Parameters::load_scale(0.935), false).unwrap();
     assert!(v.rel_error <= 1e-3, "rel_error {:e}", v.rel_error);
     assert!(v.max_constraint_violation <= 1e-6, "violation {:e}", v.max_constraint_violation);
 }
@@ -71,6 +72,6 @@ fn stabilized_pendulum_with_the_pin_reduced() {
     let (_, summary) = train(&p).unwrap();
     let basis = &summary.trained.basis;
     assert!(basis.kept.is_empty() && basis.hyper.is_some());
-    let (v, _, _) = validate(&Rom::of(&p.model, basis).unwrap(), 1.0, false).unwrap();
+    let (v, _, _) = validate(&Rom::of(&p.model, basis).unwrap(), &Parameters::default(), false).unwrap();
     assert!(v.rel_error <= 1e-3, "rel_error {:e}", v.rel_error);
 }

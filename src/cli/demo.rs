@@ -5,6 +5,7 @@ use flexrom::model::Model;
 use flexrom::output::table::{Format, Table};
 use flexrom::output::{self};
 use flexrom::simulate::{simulate, Overrides};
+use flexrom::solver::parameters::Parameters;
 use std::path::PathBuf;
 
 /// The arguments of `flexrom demo`.
@@ -22,7 +23,7 @@ impl Args {
         let mut table = Table::new(&["model", "t", "probe", "x", "y"]);
         for path in models {
             let model = Model::load(&path)?;
-            let r = simulate(&model, &Overrides::default()).map_err(|e| e.at_stage("demo", 1.0))?;
+            let r = simulate(&model, &Overrides::default()).map_err(|e| e.at_stage("demo", &Parameters::default()))?;
             run_details(&r);
             let nt = r.t.len();
             if format.format() != Format::Text {

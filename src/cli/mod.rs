@@ -109,7 +109,7 @@ pub fn run_details(r: &flexrom::simulate::SimulationResult) {
         s.dt,
         s.t_end,
         s.rho_inf,
-        s.load_scale,
+        s.mu.scale(),
         s.solver,
         r.q.nrows()
     ));

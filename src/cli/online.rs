@@ -48,7 +48,7 @@ impl Args {
         warn(&warnings);
         // read before the run (a damaged /timing fails now), said after it
         let notice = flexrom::pipeline::route::speed_notice_of(&path, &rom)?;
-        let done = online_to_file(&p, &rom, &path, &Parameters::new(load_scale), &output)?;
+        let done = online_to_file(&p, &rom, &path, &Parameters::load_scale(load_scale), &output)?;
         let (run, estimate) = (&done.run, &done.estimate);
         let st = &run.result.stats;
         info(&format!(

@@ -7,6 +7,7 @@ use flexrom::linalg::kkt::LinearSolverKind;
 use flexrom::model::Model;
 use flexrom::output::info;
 use flexrom::simulate::{simulate, Overrides, Settings};
+use flexrom::solver::parameters::Parameters;
 use std::path::PathBuf;
 
 /// The arguments of `flexrom simulate`.
@@ -32,8 +33,8 @@ impl Args {
         }
         let model = Model::load(&model)?;
         let overrides = run.overrides();
-        let compute =
-            || simulate(&model, &overrides).map_err(|e| e.at_stage("simulate", run.load_scale.unwrap_or(1.0)));
+        let mu = overrides.mu.clone().unwrap_or_default();
+        let compute = || simulate(&model, &overrides).map_err(|e| e.at_stage("simulate", &mu));
         let r = match &output {
             // the result file's fixed part is written on a second thread while the run computes
             Some(output) => {
@@ -91,7 +92,7 @@ impl RunArgs {
             dt: self.dt,
             t_end: self.t_end,
             rho_inf: self.rho_inf,
-            load_scale: self.load_scale,
+            mu: self.load_scale.map(Parameters::load_scale),
             solver: self.solver,
         }
     }

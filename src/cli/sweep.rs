@@ -144,7 +144,7 @@ impl Args {
             .scales
             .iter()
             .filter_map(|x| x.point())
-            .map(|q| (q.run.result.settings.load_scale, q.estimate.map(|e| e.in_measure(rom.tolerance_measure()))))
+            .map(|q| (q.run.result.settings.mu.scale(), q.estimate.map(|e| e.in_measure(rom.tolerance_measure()))))
             .collect();
         super::check_runs(rom, &runs, strict)
     }

@@ -5,6 +5,7 @@ use flexrom::output::table::{Format, Table};
 use flexrom::output::{self};
 use flexrom::pipeline::online::load_rom;
 use flexrom::pipeline::Pipeline;
+use flexrom::solver::parameters::Parameters;
 use std::path::PathBuf;
 
 /// The arguments of `flexrom validate`.
@@ -48,7 +49,7 @@ impl Args {
         let with_dense = flexrom::pipeline::dense::decide(dense.choice(), &p.model)?;
         let mut vs = Vec::with_capacity(scales.len());
         for &x in &scales {
-            let (v, _, _) = flexrom::pipeline::validate::validate(&rom, x, with_dense)?;
+            let (v, _, _) = flexrom::pipeline::validate::validate(&rom, &Parameters::load_scale(x), with_dense)?;
             // text: each load's lines as soon as they are known
             if format.format() == Format::Text {
                 output::println(&v.describe())?;

@@ -36,7 +36,8 @@ pub struct RunPlan {
     pub probes: Vec<String>,
     pub strains: Vec<String>,
     pub curvatures: Vec<String>,
-    pub load_scale: f64,
+    /// the run's parameters (the file records `λ` as its `load_scale` attribute)
+    pub mu: crate::solver::parameters::Parameters,
     pub dt: f64,
     pub t_end: f64,
     pub rho_inf: f64,
@@ -79,7 +80,7 @@ impl RunPlan {
             probes,
             strains,
             curvatures,
-            load_scale: s.load_scale,
+            mu: s.mu.clone(),
             dt: s.dt,
             t_end: s.t_end,
             rho_inf: s.rho_inf,
@@ -118,7 +119,7 @@ impl ResultFile {
         attr_str(f, "model", model_text).map_err(e)?;
         attr_str(f, "model_path", model_path).map_err(e)?;
         attr_str(f, "program_version", env!("CARGO_PKG_VERSION")).map_err(e)?;
-        attr_f64(f, "load_scale", plan.load_scale).map_err(e)?;
+        attr_f64(f, "load_scale", plan.mu.scale()).map_err(e)?;
         attr_f64(f, "dt", plan.dt).map_err(e)?;
         attr_f64(f, "t_end", plan.t_end).map_err(e)?;
         attr_f64(f, "rho_inf", plan.rho_inf).map_err(e)?;
@@ -411,7 +412,7 @@ mod tests {
         for model in &models {
             let overrides = crate::simulate::Overrides {
                 t_end: Some(3.0 * model.file.time.dt),
-                load_scale: Some(1.1),
+                mu: Some(crate::solver::parameters::Parameters::load_scale(1.1)),
                 ..Default::default()
             };
             let s = crate::simulate::Settings::resolve(model, &overrides).unwrap();

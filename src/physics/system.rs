@@ -315,7 +315,7 @@ impl FlexibleSystem {
     pub fn potential_energy(&self, mu: &Parameters, q: &[f64]) -> f64 {
         let strain: f64 = (0..self.elements.len()).map(|e| self.element(e).strain_energy(&self.gather(e, q))).sum();
         let grav: f64 =
-            (0..self.n_dof).map(|i| (self.gravity_fixed[i] + mu.load_scale * self.gravity_scaled[i]) * q[i]).sum();
+            (0..self.n_dof).map(|i| (self.gravity_fixed[i] + mu.scale() * self.gravity_scaled[i]) * q[i]).sum();
         strain - grav
     }
 
@@ -356,7 +356,7 @@ impl FlexibleSystem {
     /// `out = −g₀(μ)`: gravity, the fixed part and the scaled part times the load scale.
     fn gravity_into(&self, mu: &Parameters, out: &mut [f64]) {
         for (o, (gf, gs)) in out.iter_mut().zip(self.gravity_fixed.iter().zip(&self.gravity_scaled)) {
-            *o = -(gf + mu.load_scale * gs);
+            *o = -(gf + mu.scale() * gs);
         }
     }
 

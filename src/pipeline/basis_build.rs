@@ -39,7 +39,7 @@ pub fn training_data(runs: &[SimulationResult]) -> TrainingData {
     TrainingData {
         x: cat(&|r| r.q.view()),
         multipliers: cat(&|r| r.multipliers.view()),
-        load_scale: Array1::from_iter(runs.iter().flat_map(|r| std::iter::repeat_n(r.settings.load_scale, r.t.len()))),
+        load_scale: Array1::from_iter(runs.iter().flat_map(|r| std::iter::repeat_n(r.settings.mu.scale(), r.t.len()))),
         t: Array1::from_iter(runs.iter().flat_map(|r| r.t.iter().copied())),
     }
 }

@@ -107,8 +107,8 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
     let range = g.range();
     let candidates = g.candidate_loads();
     let full = |x: f64| {
-        simulate(&p.model, &Overrides { load_scale: Some(x), ..Default::default() })
-            .map_err(|e| e.at_stage("train (greedy full run)", x))
+        let mu = Parameters::load_scale(x);
+        simulate(&p.model, &Overrides::at(&mu)).map_err(|e| e.at_stage("train (greedy full run)", &mu))
     };
     let first = initial_loads(range, g.max_runs);
     crate::output::info(&format!(
@@ -141,7 +141,7 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         // where to run the full model: the worst candidate whose load has no full run yet
         // (a training load's own run is already in the snapshots)
         let fresh = |i: usize| {
-            runs.iter().all(|r| (r.settings.load_scale - candidates[i]).abs() > 1e-12 * candidates[i].abs().max(1.0))
+            runs.iter().all(|r| (r.settings.mu.scale() - candidates[i]).abs() > 1e-12 * candidates[i].abs().max(1.0))
         };
         let next = level.worst_where(fresh);
         let b = &level.trained.basis;
@@ -192,9 +192,8 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         // the full run at the worst candidate: snapshots for the next basis, and the true
         // error of this one there (it never saw that load)
         let at = candidates[ni];
-        let truth = full_model
-            .simulate(&Overrides { load_scale: Some(at), ..Default::default() })
-            .map_err(|e| e.at_stage("train (greedy full run)", at))?;
+        let mu = Parameters::load_scale(at);
+        let truth = full_model.simulate(&Overrides::at(&mu)).map_err(|e| e.at_stage("train (greedy full run)", &mu))?;
         full_seconds += truth.wall_seconds;
         full_runs += 1;
         // rel_error `e` calibrates the estimator; the error in the training's measure is held to T
@@ -282,7 +281,7 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         tolerance: g.tolerance,
         max_runs: g.max_runs,
         candidates,
-        load_scales: runs.iter().map(|r| r.settings.load_scale).collect(),
+        load_scales: runs.iter().map(|r| r.settings.mu.scale()).collect(),
         iterations,
         converged,
         full_runs,
@@ -341,7 +340,7 @@ fn check_method(
 
     let rom =
         candidates::training_rom(&p.model, &level.trained.basis, &level.estimator, EstimateMethod::Enriched).ok()?;
-    let mu = Parameters::new(at);
+    let mu = Parameters::load_scale(at);
     let run = rom.solve_with(&mu, crate::rom::Output::ReducedAndProbes, &[]).ok()?;
     let reading = rom.estimate_error(&run, &mu)?;
     let eff_ref = reading.error_estimate / e;
@@ -472,7 +471,8 @@ impl TrueError {
 /// The errors of `basis` at `load` against the full run `truth`, whole and by fifth of the
 /// run (∞ when the reduced run fails).
 fn true_error(model: &Arc<Model>, basis: &Basis, truth: &SimulationResult, load: f64) -> TrueError {
-    let run = Rom::new(model, &Arc::new(basis.clone()), None, None).and_then(|r| r.solve(&Parameters::new(load)));
+    let run =
+        Rom::new(model, &Arc::new(basis.clone()), None, None).and_then(|r| r.solve(&Parameters::load_scale(load)));
     match run {
         Ok(rom) => {
             let v = compare(model, truth, &rom, None, basis.n_reduced(), basis.variant.name());

@@ -20,6 +20,7 @@ use super::sweep::{read_sweep, write_sweep, Outcome, ScaleResult, Sweep, SweepBa
 use crate::error::{Error, Result};
 use crate::io::h5::{read_attr_f64, read_attr_str};
 use crate::simulate::{Overrides, Settings};
+use crate::solver::parameters::Parameters;
 use hdf5::types::VarLenUnicode;
 use ndarray::Array1;
 use std::path::{Path, PathBuf};
@@ -299,7 +300,7 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool) -> Result<Merged> {
     let model = &pipeline.model;
     let s = Settings::resolve(model, &Overrides::default())?;
     let mut sweep = Sweep {
-        scales: all.iter().map(|&x| ScaleResult { load_scale: x, outcome: Outcome::Pending }).collect(),
+        scales: all.iter().map(|&x| ScaleResult { mu: Parameters::load_scale(x), outcome: Outcome::Pending }).collect(),
         t: Array1::from_iter((0..=s.n_steps).map(|k| k as f64 * s.dt)),
         probe_names: model.probe_names(),
         n_reduced: stored.as_ref().map_or(0, |b| b.basis.n_reduced()),

@@ -53,12 +53,12 @@ pub struct OnlineRun {
 /// the estimate's attributes ([`crate::rom::trust::write_run_attributes`]).
 pub fn online_to_file(p: &Pipeline, rom: &Rom, basis_path: &Path, mu: &Parameters, out: &Path) -> Result<OnlineRun> {
     // a run too large for the memory bound is refused before the file is begun
-    let settings = settings_at(&p.model, mu.load_scale)?;
+    let settings = settings_at(&p.model, mu)?;
     check_reduced_memory(&p.model, rom.basis().n_reduced(), settings.n_steps, Output::Full, 1.0)?;
     let plan = RunPlan::of(&p.model, &settings);
     let model_path = p.model.path.display().to_string();
     let (file, (run, estimate)) = begin_alongside(out, &p.model.text, &model_path, &plan, || {
-        rom.solve_and_estimate(mu, Output::Full, &[]).map_err(|e| e.at_stage("online", mu.load_scale))
+        rom.solve_and_estimate(mu, Output::Full, &[]).map_err(|e| e.at_stage("online", mu))
     })?;
     let extrapolated = rom.is_extrapolated(mu);
     let basis = rom.basis();

@@ -12,6 +12,7 @@ use super::validate::{validate, Validation};
 use crate::error::{Error, Result};
 use crate::io::atomic::TempPath;
 use crate::io::output::{check_output, check_report_dir, mark_new_report, swap_in_report, Origin};
+use crate::solver::parameters::Parameters;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -94,7 +95,7 @@ fn build(
     crate::output::info(&format!("[3/3] validate at {} load scale(s){with}", vscales.len()));
     let mut validations: Vec<Validation> = Vec::new();
     for (i, &x) in vscales.iter().enumerate() {
-        let (v, full, reduced) = validate(&rom, x, dense)?;
+        let (v, full, reduced) = validate(&rom, &Parameters::load_scale(x), dense)?;
         // x and y of every probe, full (line) and reduced (dashed), and their difference
         let t = &full.t;
         let mut panels: Vec<Panel> = ["x (m)", "y (m)"]
@@ -214,7 +215,7 @@ fn build(
         .scales
         .iter()
         .filter_map(|x| x.point())
-        .filter_map(|q| q.estimate.map(|e| (q.run.result.settings.load_scale, e.error_estimate)))
+        .filter_map(|q| q.estimate.map(|e| (q.run.result.settings.mu.scale(), e.error_estimate)))
         .collect();
     let mut errors = pts(&|v| v.rel_error);
     errors.extend(validations.iter().map(|v| (v.load_scale, v.rel_error)));

@@ -20,19 +20,18 @@ use crate::solver::model::Parameters;
 use std::path::Path;
 
 /// Times the full time loop (banded solver) and the reduced one with its estimate at
-/// `load_scale`, interleaved, one run at a time, within the budget of `validate`'s timing
-/// ([`super::timing`]), and returns their medians.
-pub fn time_routes(rom: &Rom, load_scale: f64) -> Result<RouteTiming> {
+/// the parameters `mu`, interleaved, one run at a time, within the budget of `validate`'s
+/// timing ([`super::timing`]), and returns their medians.
+pub fn time_routes(rom: &Rom, mu: &Parameters) -> Result<RouteTiming> {
     let model = &**rom.model();
-    let mu = Parameters::new(load_scale);
-    let o = Overrides { load_scale: Some(load_scale), ..Default::default() };
-    let stage = |what: &'static str| move |e: crate::Error| e.at_stage(what, load_scale);
+    let o = Overrides::at(mu);
+    let stage = |what: &'static str| move |e: crate::Error| e.at_stage(what, mu);
     let mut full = FullModel::new(model, LinearSolverKind::Banded).map_err(stage("train (timing the full run)"))?;
     let (mut full_times, mut rom_times, mut estimate_times) = (Vec::new(), Vec::new(), Vec::new());
     loop {
         full_times.push(full.simulate(&o).map_err(stage("train (timing the full run)"))?.wall_seconds);
         let (run, estimate) = rom
-            .solve_and_estimate(&mu, Output::ReducedAndProbes, &[])
+            .solve_and_estimate(mu, Output::ReducedAndProbes, &[])
             .map_err(stage("train (timing the reduced run)"))?;
         rom_times.push(run.result.wall_seconds);
         if let Some(e) = estimate {
@@ -44,7 +43,7 @@ pub fn time_routes(rom: &Rom, load_scale: f64) -> Result<RouteTiming> {
         }
     }
     Ok(RouteTiming {
-        load_scale,
+        load_scale: mu.scale(),
         full_seconds: median(&mut full_times),
         reduced_seconds: median(&mut rom_times),
         estimate_seconds: if estimate_times.is_empty() { f64::NAN } else { median(&mut estimate_times) },
@@ -66,7 +65,7 @@ pub fn timing_load(training_loads: &[f64]) -> Option<f64> {
 pub fn time_and_store(rom: &Rom, path: &Path) -> Result<Option<String>> {
     let loads = crate::io::estimator_file::read_training_loads(path)?;
     let Some(x) = timing_load(&loads) else { return Ok(None) };
-    match time_routes(rom, x) {
+    match time_routes(rom, &Parameters::load_scale(x)) {
         Ok(t) => {
             crate::io::timing_file::append_timing(path, &t)?;
             Ok(None)

@@ -36,6 +36,7 @@ use crate::io::attrs::{check_layout, write_atomically_as, Kind};
 use crate::io::basis_file::TrainingData;
 use crate::io::h5::{attr_f64, attr_str, read_attr_f64, read_attr_str};
 use crate::simulate::{simulate, Overrides, Settings};
+use crate::solver::parameters::Parameters;
 use ndarray::{concatenate, s, Array1, Array2, Axis};
 use std::path::{Path, PathBuf};
 
@@ -87,8 +88,9 @@ pub fn write_snapshots(p: &Pipeline, scales: &[f64], out: &Path) -> Result<(usiz
     let mut runs = Vec::new();
     let mut seconds = 0.0;
     for &x in scales {
-        let r = simulate(&p.model, &Overrides { load_scale: Some(x), ..Default::default() })
-            .map_err(|e| e.at_stage("train --snapshots-only (full run)", x))?;
+        let mu = Parameters::load_scale(x);
+        let r = simulate(&p.model, &Overrides::at(&mu))
+            .map_err(|e| e.at_stage("train --snapshots-only (full run)", &mu))?;
         seconds += r.wall_seconds;
         runs.push(r);
     }

@@ -142,7 +142,7 @@ pub fn sweep_to_file(route: Route, scales: &[f64], o: SweepOptions, f: SweepFile
             let old = read_sweep(out, model, route.basis().map(|b| b.stored), o.validate)?;
             let mut reused = 0;
             for s in start.scales.iter_mut() {
-                if let Some(i) = old.iter().position(|(x, _)| *x == s.load_scale) {
+                if let Some(i) = old.iter().position(|(x, _)| *x == s.mu.scale()) {
                     if let Some(p) = old[i].1.as_ref() {
                         s.outcome = Outcome::Done(clone_point(p));
                         reused += 1;
@@ -185,7 +185,10 @@ fn pending(model: &Model, n_reduced: usize, full: bool, scales: &[f64], o: Sweep
     let s = Settings::resolve(model, &Overrides::default())?;
     let t = Array1::from_iter((0..=s.n_steps).map(|k| k as f64 * s.dt));
     Ok(Sweep {
-        scales: scales.iter().map(|&x| ScaleResult { load_scale: x, outcome: Outcome::Pending }).collect(),
+        scales: scales
+            .iter()
+            .map(|&x| ScaleResult { mu: Parameters::load_scale(x), outcome: Outcome::Pending })
+            .collect(),
         t,
         probe_names: model.probe_names(),
         n_reduced,
@@ -202,7 +205,7 @@ fn pending(model: &Model, n_reduced: usize, full: bool, scales: &[f64], o: Sweep
 type Checkpoint<'a> = &'a (dyn Fn(&Sweep) -> Result<()> + Sync);
 /// One point of a sweep: the run at a load scale, given the last good runs of its chain
 /// (continuation only; empty otherwise).
-type RunPoint<'a> = &'a (dyn Fn(f64, &[&ReducedRun]) -> Result<SweepPoint> + Sync);
+type RunPoint<'a> = &'a (dyn Fn(&Parameters, &[&ReducedRun]) -> Result<SweepPoint> + Sync);
 
 /// The reduced runs of the pending scales of `state` (with `o.validate`, the full ones
 /// beside them), each with its estimate and extrapolation flag.
@@ -213,20 +216,18 @@ fn run_reduced(rom: &Rom, state: Sweep, o: SweepOptions, checkpoint: Option<Chec
     let n_steps = Settings::resolve(model, &Overrides::default())?.n_steps;
     let output = if o.validate { Output::Full } else { Output::ReducedAndProbes };
     crate::rom::check_reduced_memory(model, basis.n_reduced(), n_steps, output, state.n_todo() as f64)?;
-    let point = |x: f64, previous: &[&ReducedRun]| -> Result<SweepPoint> {
-        let mu = Parameters::new(x);
+    let point = |mu: &Parameters, previous: &[&ReducedRun]| -> Result<SweepPoint> {
         let (run, estimate) =
-            rom.solve_and_estimate(&mu, output, previous).map_err(|e| e.at_stage("sweep (reduced run)", x))?;
+            rom.solve_and_estimate(mu, output, previous).map_err(|e| e.at_stage("sweep (reduced run)", mu))?;
         let (validation, full_probes) = if o.validate {
-            let full = simulate(model, &Overrides { load_scale: Some(x), ..Default::default() })
-                .map_err(|e| e.at_stage("sweep (full run)", x))?;
+            let full = simulate(model, &Overrides::at(mu)).map_err(|e| e.at_stage("sweep (full run)", mu))?;
             let v = compare(model, &full, &run, None, basis.n_reduced(), basis.variant.name())
                 .with_trust(estimate.as_ref(), Some(rom));
             (Some(v), Some(full.probes))
         } else {
             (None, None)
         };
-        let extrapolated = rom.is_extrapolated(&mu);
+        let extrapolated = rom.is_extrapolated(mu);
         Ok(SweepPoint { run, validation, full_probes, estimate, extrapolated })
     };
     let label = if o.validate { "sweep + validate" } else { "sweep" };
@@ -244,9 +245,9 @@ fn run_full(model: &Model, state: Sweep, o: SweepOptions, checkpoint: Option<Che
     let kept = state.n_todo() as f64 * 8.0 * (n_steps as f64 + 1.0) * (z.n_probe_values + 1.0);
     crate::limits::check_memory(&format!("the probes of {} full runs of {n_steps} steps", state.n_todo()), kept)?;
     let models = Pool::new(|| FullModel::new(model, LinearSolverKind::Banded));
-    let point = |x: f64, _: &[&ReducedRun]| -> Result<SweepPoint> {
-        let run = models.with(|full| full.simulate(&Overrides { load_scale: Some(x), ..Default::default() }));
-        let mut r = run.and_then(|r| r).map_err(|e| e.at_stage("sweep (full run)", x))?;
+    let point = |mu: &Parameters, _: &[&ReducedRun]| -> Result<SweepPoint> {
+        let run = models.with(|full| full.simulate(&Overrides::at(mu)));
+        let mut r = run.and_then(|r| r).map_err(|e| e.at_stage("sweep (full run)", mu))?;
         // the sweep file holds no coordinates: drop them now, not after the whole sweep
         let nt = r.t.len();
         (r.q, r.qd, r.multipliers) = (Array2::zeros((0, nt)), Array2::zeros((0, nt)), Array2::zeros((0, nt)));
@@ -268,9 +269,9 @@ fn run_pending(
     checkpoint: Option<Checkpoint>,
 ) -> Result<Sweep> {
     let todo: Vec<usize> = (0..state.scales.len()).filter(|&i| state.scales[i].status() != STATUS_OK).collect();
-    let scales: Vec<f64> = todo.iter().map(|&i| state.scales[i].load_scale).collect();
+    let points: Vec<Parameters> = todo.iter().map(|&i| state.scales[i].mu.clone()).collect();
     let bar = ProgressBar::with_draw_target(
-        Some(scales.len() as u64),
+        Some(points.len() as u64),
         if o.progress { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() },
     );
     bar.set_style(
@@ -279,14 +280,14 @@ fn run_pending(
             .progress_chars("=> "),
     );
     bar.set_prefix(label.to_string());
-    let ticker = crate::output::ticker::Ticker::new(label, scales.len() as u64, o.progress);
+    let ticker = crate::output::ticker::Ticker::new(label, points.len() as u64, o.progress);
     let start = std::time::Instant::now();
     let threads = state.threads;
     // continuation: a few chains of neighbouring scales per thread; otherwise one point per task
     let lanes = if o.continuation {
-        continuation_lanes(scales.len(), threads)
+        continuation_lanes(points.len(), threads)
     } else {
-        (0..scales.len()).map(|i| std::iter::once(i..i + 1).collect()).collect()
+        (0..points.len()).map(|i| std::iter::once(i..i + 1).collect()).collect()
     };
     // the sweep so far, and when the next write is due (None: now, so the first finished
     // scale is written at once)
@@ -313,7 +314,7 @@ fn run_pending(
                 // the last two good runs of this chain (continuation only)
                 let mut previous: Vec<ReducedRun> = Vec::new();
                 for i in chain.clone() {
-                    let run = point(scales[i], &previous.iter().collect::<Vec<_>>());
+                    let run = point(&points[i], &previous.iter().collect::<Vec<_>>());
                     bar.inc(1);
                     ticker.tick();
                     match run {

@@ -37,7 +37,7 @@ pub fn sweep_table(s: &Sweep) -> Table {
     }
     let mut t = Table::new(&cols);
     for x in &s.scales {
-        let mut row: Vec<Cell> = vec![x.load_scale.into(), (x.status() as u64).into(), x.message().into()];
+        let mut row: Vec<Cell> = vec![x.mu.scale().into(), (x.status() as u64).into(), x.message().into()];
         match x.point() {
             Some(p) => {
                 let r = &p.run.result;
@@ -77,7 +77,7 @@ fn full_sweep_table(s: &Sweep) -> Table {
     let cols = ["load_scale", "status", "message", "full_seconds", "newton_iterations", "step_cuts"];
     let mut t = Table::new(&cols);
     for x in &s.scales {
-        let mut row: Vec<Cell> = vec![x.load_scale.into(), (x.status() as u64).into(), x.message().into()];
+        let mut row: Vec<Cell> = vec![x.mu.scale().into(), (x.status() as u64).into(), x.message().into()];
         match x.point() {
             Some(p) => {
                 let r = &p.run.result;

@@ -10,6 +10,7 @@ use crate::io::basis_file::{write_basis_with, BasisMeta, TrainingData};
 use crate::io::output::{check_output, Origin};
 use crate::linalg::kkt::LinearSolverKind;
 use crate::simulate::{FullModel, Overrides};
+use crate::solver::parameters::Parameters;
 use std::path::{Path, PathBuf};
 
 /// The coordinates that appear in any joint, sorted.
@@ -40,9 +41,8 @@ pub fn train(p: &Pipeline) -> Result<(TrainingData, TrainSummary)> {
     // the full model assembled once for every training load
     let mut full = FullModel::new(&p.model, LinearSolverKind::Banded)?;
     for &s in &scales {
-        let r = full
-            .simulate(&Overrides { load_scale: Some(s), ..Default::default() })
-            .map_err(|e| e.at_stage("train (full run)", s))?;
+        let mu = Parameters::load_scale(s);
+        let r = full.simulate(&Overrides::at(&mu)).map_err(|e| e.at_stage("train (full run)", &mu))?;
         full_seconds += r.wall_seconds;
         runs.push(r);
     }

@@ -177,7 +177,7 @@ pub fn compare(
         viol = res.iter().fold(viol, |m, v| m.max(v.abs()));
     }
     Validation {
-        load_scale: r.settings.load_scale,
+        load_scale: r.settings.mu.scale(),
         variant: variant.to_string(),
         n_dof: full.q.nrows(),
         n_modes,
@@ -275,14 +275,13 @@ impl Validation {
     }
 }
 
-/// Runs full (banded, and dense LU when `with_dense`) and reduced at `load_scale`, with the
-/// reduced model's estimate (when it has an estimator), its training range (when read from
-/// a basis file), and the full model's sensitivity (one more full run at 1.001 λ).
-pub fn validate(rom: &Rom, load_scale: f64, with_dense: bool) -> Result<(Validation, SimulationResult, ReducedRun)> {
+/// Runs full (banded, and dense LU when `with_dense`) and reduced at the parameters `mu`,
+/// with the reduced model's estimate (when it has an estimator), its training range (when
+/// read from a basis file), and the full model's sensitivity (one more full run at 1.001 λ).
+pub fn validate(rom: &Rom, mu: &Parameters, with_dense: bool) -> Result<(Validation, SimulationResult, ReducedRun)> {
     let (model, basis) = (&**rom.model(), &**rom.basis());
-    let mu = Parameters::new(load_scale);
-    let o = Overrides { load_scale: Some(load_scale), ..Default::default() };
-    let stage = |what: &'static str| move |e: crate::Error| e.at_stage(what, load_scale);
+    let o = Overrides::at(mu);
+    let stage = |what: &'static str| move |e: crate::Error| e.at_stage(what, mu);
     // the full model assembled once for the run at λ and the sensitivity run at 1.001 λ
     let mut full_model = FullModel::new(model, LinearSolverKind::Banded).map_err(stage("validate (full run)"))?;
     let full = full_model.simulate(&o).map_err(stage("validate (full run)"))?;
@@ -296,9 +295,9 @@ pub fn validate(rom: &Rom, load_scale: f64, with_dense: bool) -> Result<(Validat
         None
     };
     let nearby = full_model
-        .simulate(&Overrides { load_scale: Some(1.001 * load_scale), ..o })
+        .simulate(&Overrides { mu: Some(mu.scaled_by(1.001)), ..o })
         .map_err(stage("validate (full run at 1.001 λ)"))?;
-    let (run, estimate) = rom.solve_and_estimate(&mu, Output::Full, &[]).map_err(stage("validate (reduced run)"))?;
+    let (run, estimate) = rom.solve_and_estimate(mu, Output::Full, &[]).map_err(stage("validate (reduced run)"))?;
     // the time loops again, interleaved, for the medians that `speedup` compares
     let (mut full_times, mut rom_times) = (vec![full.wall_seconds], vec![run.result.wall_seconds]);
     while repeat_timing(&[&full_times, &rom_times]) {

@@ -9,6 +9,7 @@
 //! How it is built, calibrated and run is `crate::rom::estimator`'s.
 
 use super::basis::Basis;
+use crate::solver::parameters::Parameters;
 
 /// Estimates and errors are reported over the instants up to the end of each fifth of the
 /// run (how the error grows in time; the last entry is the whole run's).
@@ -92,8 +93,9 @@ impl DefectsCalibration {
         Some(DefectsCalibration { load_scales, ratios, factors, reliable })
     }
 
-    /// `f_i(λ)` (the type's documentation).
-    pub fn factors_at(&self, load_scale: f64) -> ByFifth {
+    /// `f_i(λ)` at the parameters `mu` (the type's documentation).
+    pub fn factors_at(&self, mu: &Parameters) -> ByFifth {
+        let load_scale = mu.scale();
         let l = &self.load_scales;
         let j = l.partition_point(|&x| x <= load_scale);
         if l.len() < 2 || j == 0 || (j == l.len() && l[j - 1] != load_scale) {
@@ -279,6 +281,7 @@ impl ErrorMeasure {
 #[cfg(test)]
 mod tests {
     use super::DefectsCalibration;
+    use crate::solver::parameters::Parameters;
 
     /// At a candidate its own ratio, between two the linear interpolation, outside the
     /// candidates the largest of all; a fifth without a usable ratio anywhere gives no
@@ -288,19 +291,19 @@ mod tests {
         let r = |a: f64| [a, 2.0 * a, 3.0 * a, 4.0 * a, 5.0 * a];
         let c = DefectsCalibration::new(vec![1.0, 2.0, 3.0], vec![r(0.1), r(0.3), r(0.2)]).unwrap();
         assert_eq!(c.factors, r(0.3));
-        assert_eq!(c.factors_at(1.0), r(0.1));
-        assert_eq!(c.factors_at(2.0), r(0.3));
-        assert_eq!(c.factors_at(3.0), r(0.2));
-        let mid = c.factors_at(1.5);
+        assert_eq!(c.factors_at(&Parameters::load_scale(1.0)), r(0.1));
+        assert_eq!(c.factors_at(&Parameters::load_scale(2.0)), r(0.3));
+        assert_eq!(c.factors_at(&Parameters::load_scale(3.0)), r(0.2));
+        let mid = c.factors_at(&Parameters::load_scale(1.5));
         assert!(mid.iter().zip(r(0.2)).all(|(a, b)| (a - b).abs() < 1e-15), "{mid:?}");
-        let late = c.factors_at(2.75);
+        let late = c.factors_at(&Parameters::load_scale(2.75));
         assert!(late.iter().zip(r(0.225)).all(|(a, b)| (a - b).abs() < 1e-15), "{late:?}");
-        assert_eq!(c.factors_at(0.5), r(0.3));
-        assert_eq!(c.factors_at(3.5), r(0.3));
+        assert_eq!(c.factors_at(&Parameters::load_scale(0.5)), r(0.3));
+        assert_eq!(c.factors_at(&Parameters::load_scale(3.5)), r(0.3));
         let mut gap = r(0.1);
         gap[2] = f64::NAN;
         let g = DefectsCalibration::new(vec![1.0, 2.0], vec![gap, r(0.05)]).unwrap();
-        assert_eq!(g.factors_at(1.5)[2], r(0.05)[2]);
+        assert_eq!(g.factors_at(&Parameters::load_scale(1.5))[2], r(0.05)[2]);
         assert!(DefectsCalibration::new(vec![1.0], vec![[f64::NAN; 5]]).is_none());
     }
 

@@ -252,7 +252,7 @@ impl Projection {
         t: f64,
         out: &mut [f64],
     ) {
-        let x = mu.load_scale;
+        let x = mu.scale();
         for (o, (f, s)) in out.iter_mut().zip(self.g0_fixed.iter().zip(&self.g0_scaled)) {
             *o = f + x * s;
         }

@@ -136,7 +136,11 @@ pub(crate) fn train_stabilized(
 
 /// A failed Newton solve (or singular matrix) of the plain whole-system variant, with the
 /// reason and the way out in the message; other errors and variants pass unchanged.
-pub fn explain_failure(e: crate::error::Error, variant: super::Variant, load_scale: f64) -> crate::error::Error {
+pub fn explain_failure(
+    e: crate::error::Error,
+    variant: super::Variant,
+    mu: &crate::solver::parameters::Parameters,
+) -> crate::error::Error {
     use crate::error::Error;
     match e {
         Error::NewtonFailed { .. } | Error::LinearSolve { .. } if variant == super::Variant::WholeSystem => {
@@ -146,7 +150,7 @@ pub fn explain_failure(e: crate::error::Error, variant: super::Variant, load_sca
                     B V = 0 for POD modes of constraint-satisfying snapshots, docs/whole-system.md; \
                     use variant = \"whole-system-stabilized\")"
                         .into(),
-                load_scale,
+                parameters: mu.to_string(),
                 source: Box::new(e),
             }
         }

@@ -143,7 +143,7 @@ impl Rom {
     /// Whether `mu` lies outside the parameters the basis was trained on (false when they
     /// are not known).
     pub fn is_extrapolated(&self, mu: &Parameters) -> bool {
-        self.trust.as_ref().is_some_and(|t| trust::is_extrapolated(t.range, mu.load_scale))
+        self.trust.as_ref().is_some_and(|t| trust::is_extrapolated(t.range, mu.scale()))
     }
 
     /// The reduced run at `mu`, reconstructed in full coordinates.

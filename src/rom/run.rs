@@ -81,29 +81,25 @@ impl ReducedRunner {
     /// ([`JacobianReuse`](crate::solver::generalized_alpha::JacobianReuse)), keeps the
     /// factorized matrix of a good guess. Only the starting point changes: every step
     /// stops on the same tolerance as a run on its own.
-    pub fn run(&mut self, load_scale: f64, output: Output, previous: &[&ReducedRun]) -> Result<ReducedRun> {
-        self.solve(&Parameters::new(load_scale), output, previous)
-    }
-
-    /// [`Self::run`] at the parameters `mu`: the reduced model is not changed by them (it
-    /// keeps its projected loads unscaled), so runs at any sequence of parameters give
-    /// what fresh models give.
+    ///
+    /// The reduced model is not changed by the parameters (it keeps its projected loads
+    /// unscaled), so runs at any sequence of parameters give what fresh models give.
     pub fn solve(&mut self, mu: &Parameters, output: Output, previous: &[&ReducedRun]) -> Result<ReducedRun> {
-        let s = settings_at(&self.model, mu.load_scale)?;
+        let s = settings_at(&self.model, mu)?;
         let previous = &previous[previous.len().saturating_sub(2)..];
         let (model, basis, x0) = (&*self.model, &*self.basis, &self.x0[..]);
         let result = match &mut self.rom {
             Kind::Invariant(rom) => run(rom.as_mut(), model, basis, s, x0, output, previous),
             Kind::Generic(rom) => run(rom.as_mut(), model, basis, s, x0, output, previous),
         };
-        result.map_err(|e| crate::reduction::whole_system::explain_failure(e, basis.variant, mu.load_scale))
+        result.map_err(|e| crate::reduction::whole_system::explain_failure(e, basis.variant, mu))
     }
 }
 
-/// The settings of a reduced run of `model` at `load_scale`: the model file's time
-/// settings at that load scale (what `online` plans its result file from, before the run).
-pub fn settings_at(model: &Model, load_scale: f64) -> Result<Settings> {
-    Settings::resolve(model, &Overrides { load_scale: Some(load_scale), ..Default::default() })
+/// The settings of a reduced run of `model` at the parameters `mu`: the model file's time
+/// settings (what `online` plans its result file from, before the run).
+pub fn settings_at(model: &Model, mu: &Parameters) -> Result<Settings> {
+    Settings::resolve(model, &Overrides::at(mu))
 }
 
 /// Refuses `runs` reduced runs of `r` coordinates over `n_steps` whose kept arrays would
@@ -146,9 +142,9 @@ fn run<R: Reduced<FlexibleSystem>>(
     let known: Vec<(f64, &Array2<f64>)> = previous
         .iter()
         .filter(|p| p.reduced_q.dim() == (r, nt))
-        .map(|p| (p.result.settings.load_scale, &p.reduced_q))
+        .map(|p| (p.result.settings.mu.scale(), &p.reduced_q))
         .collect();
-    let x = s.load_scale;
+    let x = s.mu.scale();
     let guess = |k: usize, out: &mut [f64]| match known.as_slice() {
         [] => false,
         [.., (l2, z2), (l1, z1)] if l1 != l2 => {

@@ -117,7 +117,7 @@ pub struct Bound<'a, M: ?Sized> {
 
 impl<'a, M: ParametricModel + ?Sized> Bound<'a, M> {
     pub fn new(model: &'a mut M, mu: &Parameters) -> Self {
-        Bound { model, mu: *mu }
+        Bound { model, mu: mu.clone() }
     }
 }
 

@@ -3,7 +3,9 @@
 //! ([`super::model::ParametricModel`]), and the integrator sees a model bound to one run's
 //! ([`super::model::Bound`]).
 //!
-//! A model's loads are affine in the load scale `λ` (SPEC §4):
+//! `μ` is a set of named values. The default parameter, [`LOAD_SCALE`] (`λ`), multiplies
+//! every load marked `scaled` in the model file; it is `1` (the model file's own loads) when
+//! not given. A model's loads are affine in it (SPEC §4):
 //!
 //! ```text
 //!     g(q, q̇, t; μ) = C q̇ + Q_e(q) − Q_fixed(q, t) − λ Q_scaled(q, t)
@@ -13,30 +15,75 @@
 //! combines them at `λ` when it evaluates, `g₀,r(μ) = Vᵀg₀,fixed + λ Vᵀg₀,scaled`: one
 //! reduced model serves every load without projecting anything again.
 
-use crate::error::{Error, Result};
+use crate::error::{show_number, Error, Result};
+use std::collections::BTreeMap;
+use std::fmt;
 
-/// The parameters of one run. `Default` is the model file's own loads (`λ = 1`).
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// The name of the default parameter: the load scale `λ` of every load marked
+/// `scaled = true` (`--load-scale X` on the command line).
+pub const LOAD_SCALE: &str = "load_scale";
+
+/// The parameters of one run: named values. `Default` is the model file's own loads
+/// (`λ = 1`, no other parameter set).
+///
+/// The default parameter is kept in a field of its own, so the force evaluations that read
+/// it on every Newton iteration do not look a name up.
+#[derive(Clone, Debug, PartialEq)]
 pub struct Parameters {
-    /// `λ`: multiplies every load marked `scaled` in the model file
-    pub load_scale: f64,
+    load_scale: f64,
+    /// every other parameter, by name (empty for a model with the load scale alone)
+    named: BTreeMap<String, f64>,
 }
 
 impl Default for Parameters {
     fn default() -> Self {
-        Parameters { load_scale: 1.0 }
+        Parameters::load_scale(1.0)
     }
 }
 
 impl Parameters {
-    pub fn new(load_scale: f64) -> Self {
-        Parameters { load_scale }
+    /// The parameters of a run at load scale `λ` (the short form of `--load-scale`).
+    pub fn load_scale(load_scale: f64) -> Self {
+        Parameters { load_scale, named: BTreeMap::new() }
     }
 
-    /// Refuses parameters no run can use: a non-finite load scale (NaN or ±∞).
+    /// Sets the value of the parameter `name` ([`LOAD_SCALE`] sets `λ`).
+    pub fn with(mut self, name: &str, value: f64) -> Self {
+        if name == LOAD_SCALE {
+            self.load_scale = value;
+        } else {
+            self.named.insert(name.to_string(), value);
+        }
+        self
+    }
+
+    /// `λ`, the default parameter.
+    #[inline]
+    pub fn scale(&self) -> f64 {
+        self.load_scale
+    }
+
+    /// The value of the parameter `name`, if set (`λ` is always set).
+    pub fn get(&self, name: &str) -> Option<f64> {
+        if name == LOAD_SCALE {
+            Some(self.load_scale)
+        } else {
+            self.named.get(name).copied()
+        }
+    }
+
+    /// Every parameter, by name: the default one first, then the others in name order.
+    pub fn iter(&self) -> impl Iterator<Item = (&str, f64)> {
+        std::iter::once((LOAD_SCALE, self.load_scale)).chain(self.named.iter().map(|(k, &v)| (k.as_str(), v)))
+    }
+
+    /// Refuses parameters no run can use: a non-finite value (NaN or ±∞).
     pub fn validate(&self) -> Result<()> {
-        if !self.load_scale.is_finite() {
-            return Err(Error::Usage(format!("--load-scale must be finite, got {}", self.load_scale)));
+        for (name, value) in self.iter() {
+            if !value.is_finite() {
+                let option = if name == LOAD_SCALE { "--load-scale".to_string() } else { format!("parameter {name}") };
+                return Err(Error::Usage(format!("{option} must be finite, got {value}")));
+            }
         }
         Ok(())
     }
@@ -50,6 +97,24 @@ impl Parameters {
             1.0
         }
     }
+
+    /// The same parameters with `λ` multiplied by `factor` (the neighbouring run of a
+    /// sensitivity check).
+    pub fn scaled_by(&self, factor: f64) -> Self {
+        Parameters { load_scale: factor * self.load_scale, named: self.named.clone() }
+    }
+}
+
+/// `load scale 1.1` (as messages have always named a run), then `, name = value` for every
+/// other parameter.
+impl fmt::Display for Parameters {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "load scale {}", show_number(self.load_scale))?;
+        for (name, value) in &self.named {
+            write!(f, ", {name} = {}", show_number(*value))?;
+        }
+        Ok(())
+    }
 }
 
 #[cfg(test)]
@@ -57,12 +122,31 @@ mod tests {
     use super::*;
 
     #[test]
-    fn default_is_the_model_files_loads_and_non_finite_scales_are_refused() {
-        assert_eq!(Parameters::default().load_scale, 1.0);
-        assert!(Parameters::new(-2.5).validate().is_ok());
+    fn default_is_the_model_files_loads_and_non_finite_values_are_refused() {
+        // the default parameter is λ = 1: the loads as the model file writes them (SPEC §4)
+        assert_eq!(Parameters::default().scale(), 1.0);
+        assert_eq!(Parameters::default(), Parameters::load_scale(1.0));
+        assert!(Parameters::load_scale(-2.5).validate().is_ok());
         for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
-            let e = Parameters::new(bad).validate().expect_err("non-finite load scale accepted").to_string();
+            let e = Parameters::load_scale(bad).validate().expect_err("non-finite load scale accepted").to_string();
             assert!(e.contains("--load-scale must be finite"), "{e}");
+            let e = Parameters::default().with("E_lower", bad).validate().expect_err("non-finite value accepted");
+            assert!(e.to_string().contains("parameter E_lower must be finite"), "{e}");
         }
+    }
+
+    #[test]
+    fn named_values_are_kept_apart_from_the_load_scale() {
+        let mu = Parameters::load_scale(1.1).with("E_lower", 2.5e8).with(LOAD_SCALE, 0.9);
+        assert_eq!(mu.scale(), 0.9, "naming the default parameter sets λ");
+        assert_eq!(mu.get("E_lower"), Some(2.5e8));
+        assert_eq!(mu.get("drive"), None);
+        assert_eq!(mu.iter().collect::<Vec<_>>(), [(LOAD_SCALE, 0.9), ("E_lower", 2.5e8)]);
+        assert_eq!(mu.load_factor(true), 0.9);
+        assert_eq!(mu.load_factor(false), 1.0);
+        assert_eq!(mu.scaled_by(2.0).get("E_lower"), Some(2.5e8));
+        // messages name a run as they always did; other parameters follow
+        assert_eq!(Parameters::load_scale(1.1).to_string(), "load scale 1.1");
+        assert_eq!(mu.to_string(), "load scale 0.9, E_lower = 2.5e8");
     }
 }

@@ -307,7 +307,7 @@ mod tests {
                 IterationCoefficients { mass: 1.0, damping: 0.0, stiffness: 0.0 },
                 IterationCoefficients { mass: 1.0, damping: 37.0, stiffness: 1.3e-5 },
             ] {
-                ParametricModel::factor(&mut sys, &Parameters::new(1.0), &q, &vec![0.1; n], 0.0, coef).unwrap();
+                ParametricModel::factor(&mut sys, &Parameters::load_scale(1.0), &q, &vec![0.1; n], 0.0, coef).unwrap();
                 for (e, b) in sys.blocks.iter().enumerate() {
                     assert!(b.iter().any(|x| *x != 0.0));
                     for i in 0..8 {
@@ -358,7 +358,7 @@ mod tests {
                 sys.initial_state().iter().enumerate().map(|(i, x)| x + 0.01 * (i as f64 * 0.7).sin()).collect();
             let v: Vec<f64> = (0..n).map(|i| (i as f64 * 0.3).cos()).collect();
             let a: Vec<f64> = (0..n).map(|i| (i as f64 * 1.1).sin() * 5.0).collect();
-            let mu = Parameters::new(1.3);
+            let mu = Parameters::load_scale(1.3);
             let (mut f_ref, mut m_ref, mut f, mut m) = (vec![0.0; n], vec![0.0; n], vec![1.0; n], vec![1.0; n]);
             ParametricModel::force(&mut sys, &mu, &q, &v, 0.2, &mut f_ref);
             ParametricModel::mass_mul(&sys, &a, &mut m_ref);

@@ -97,11 +97,11 @@ const FAILED: CandidateRun =
 /// One candidate: the reduced run at `x` with its estimate, and the run at `x(1 + δ)`, in
 /// `measure` (`x0`: the initial configuration X₀ of the displacement measure).
 fn candidate_run(rom: &Rom, x: f64, measure: ErrorMeasure, x0: ndarray::ArrayView1<f64>) -> CandidateRun {
-    let mu = Parameters::new(x);
+    let mu = Parameters::load_scale(x);
     match rom.solve_and_estimate(&mu, Output::ReducedAndProbes, &[]) {
         Ok((run, Some(e))) => {
             // the same reduced model at λ(1 + δ): how much its answer moves
-            let moved = Parameters::new(x * (1.0 + SENSITIVITY_STEP));
+            let moved = Parameters::load_scale(x * (1.0 + SENSITIVITY_STEP));
             let basis = rom.basis();
             let sensitivity = match rom.solve_with(&moved, Output::ReducedAndProbes, &[]) {
                 Ok(moved) => *raw_by_time(basis, basis, &moved.reduced_q, &run.reduced_q, x0).get(measure),
@@ -169,7 +169,8 @@ pub(super) fn calibrate_defects(
         .par_iter()
         .map(|&x| {
             let Some(d) = &defects else { return [f64::NAN; FIFTHS] };
-            let Ok((run, Some(e))) = rom.solve_and_estimate(&Parameters::new(x), Output::ReducedAndProbes, &[]) else {
+            let Ok((run, Some(e))) = rom.solve_and_estimate(&Parameters::load_scale(x), Output::ReducedAndProbes, &[])
+            else {
                 return [f64::NAN; FIFTHS];
             };
             let Ok(raw) = d.raw(&run) else { return [f64::NAN; FIFTHS] };

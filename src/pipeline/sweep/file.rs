@@ -44,6 +44,7 @@ use crate::rom::estimator::Estimate;
 use crate::rom::ReducedRun;
 use crate::simulate::{Overrides, Settings, SimulationResult};
 use crate::solver::generalized_alpha::Stats;
+use crate::solver::parameters::Parameters;
 use hdf5::types::VarLenUnicode;
 use ndarray::{Array1, Array2, Array3};
 use std::path::Path;
@@ -94,7 +95,7 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, basis: Option<SweepBasis>, extra
             Array1::from_iter(s.scales.iter().map(|x| x.point().map_or(0, g) as u64))
         };
         f.new_dataset_builder()
-            .with_data(&Array1::from_iter(s.scales.iter().map(|x| x.load_scale)))
+            .with_data(&Array1::from_iter(s.scales.iter().map(|x| x.mu.scale())))
             .create("load_scales")
             .map_err(e)?;
         f.new_dataset_builder()
@@ -403,7 +404,7 @@ pub fn read_sweep(
             out.push((x, None));
             continue;
         }
-        let settings = Settings::resolve(model, &Overrides { load_scale: Some(x), ..Default::default() })?;
+        let settings = Settings::resolve(model, &Overrides::at(&Parameters::load_scale(x)))?;
         let stats = Stats {
             steps: settings.n_steps,
             newton_iterations: newton[k] as usize,

@@ -4,6 +4,7 @@
 use crate::pipeline::validate::Validation;
 use crate::rom::estimator::Estimate;
 use crate::rom::ReducedRun;
+use crate::solver::parameters::Parameters;
 use ndarray::{Array1, Array2};
 
 /// Status codes of `/status`.
@@ -36,7 +37,8 @@ pub enum Outcome {
 }
 
 pub struct ScaleResult {
-    pub load_scale: f64,
+    /// the point's parameters
+    pub mu: Parameters,
     pub outcome: Outcome,
 }
 

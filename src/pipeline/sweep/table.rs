@@ -19,7 +19,7 @@ pub fn table(s: &Sweep) -> String {
         let Some(p) = x.point() else {
             out.push_str(&format!(
                 "{}  {}: {}\n",
-                scale(x.load_scale),
+                scale(x.mu.scale()),
                 if x.status() == STATUS_FAILED { "failed" } else { "not run" },
                 x.message()
             ));
@@ -29,7 +29,7 @@ pub fn table(s: &Sweep) -> String {
         if s.full {
             out.push_str(&format!(
                 "{}  {:>7.2}  {:>6}\n",
-                scale(r.settings.load_scale),
+                scale(r.settings.mu.scale()),
                 1e3 * r.wall_seconds,
                 r.stats.newton_iterations
             ));
@@ -37,7 +37,7 @@ pub fn table(s: &Sweep) -> String {
         }
         out.push_str(&format!(
             "{}  {:>6.2}  {:>6}",
-            scale(r.settings.load_scale),
+            scale(r.settings.mu.scale()),
             1e3 * r.wall_seconds,
             r.stats.newton_iterations
         ));

@@ -171,10 +171,8 @@ impl CorrectedRunner {
     /// The loop of both: `sample` 0 corrects the trajectory, `s > 0` records the defects at
     /// every s-th step from the lifted reduced state.
     fn follow(&mut self, run: &ReducedRun, sample: usize) -> Result<(Array2<f64>, FollowStats)> {
-        let load_scale = run.result.settings.load_scale;
-        let s = Settings::resolve(&self.model, &Overrides { load_scale: Some(load_scale), ..Default::default() })?;
-        let mu = s.parameters();
-        let mut bound = Bound::new(self.rom.as_mut(), &mu);
+        let s = Settings::resolve(&self.model, &Overrides::at(run.result.settings.parameters()))?;
+        let mut bound = Bound::new(self.rom.as_mut(), s.parameters());
         let rom = &mut bound;
         let z = &run.reduced_q;
         let nt = z.ncols();

@@ -126,7 +126,7 @@ impl ErrorEstimator for Defects {
     fn factors(&self, mu: &Parameters) -> ByFifth {
         let c = &self.data.calibration;
         match &self.data.defects {
-            Some(d) if d.reliable => d.factors_at(mu.load_scale),
+            Some(d) if d.reliable => d.factors_at(mu),
             Some(d) => d.factors,
             None => [c.factor / super::DEFAULT_FACTOR; FIFTHS],
         }

@@ -11,7 +11,6 @@ use crate::model::Model;
 use crate::reduction::Basis;
 use crate::rom::pool::Pool;
 use crate::rom::run::{Output, ReducedRun, ReducedRunner};
-use crate::solver::model::Parameters;
 use std::sync::Arc;
 
 /// The `enriched` method: η_raw against the enriched model's own run, times the calibrated `c`.
@@ -43,8 +42,8 @@ impl ErrorEstimator for Enriched {
         &self.data
     }
     fn raw(&self, run: &ReducedRun) -> Result<RawByFifth> {
-        let mu = Parameters::new(run.result.settings.load_scale);
-        let e = self.runners.with(|r| r.solve(&mu, Output::ReducedAndProbes, &[]))??;
+        let mu = run.result.settings.parameters();
+        let e = self.runners.with(|r| r.solve(mu, Output::ReducedAndProbes, &[]))??;
         let x0 = ndarray::ArrayView1::from(&self.x0[..]);
         Ok(raw_by_time(&self.basis, &self.data.enriched, &run.reduced_q, &e.reduced_q, x0))
     }
