@@ -117,7 +117,7 @@ pub fn solve<M: ParametricModel + ?Sized>(
 ) -> Result<Stats> {
     let mu = s.parameters();
     mu.validate()?;
-    integrate_guided(&mut Bound::new(model, &mu), &s.params, q0, s.dt, s.n_steps, guess, record)
+    integrate_guided(&mut Bound::new(model, mu), &s.params, q0, s.dt, s.n_steps, guess, record)
 }
 
 /// Integrates any [`DynamicModel`] (a model bound to its parameters) over `n_steps` steps

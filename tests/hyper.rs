@@ -83,8 +83,8 @@ fn every_element_at_weight_one_equals_plain_galerkin_with(modes: &str) {
     let r = q.len();
     let (mut f1, mut f2) = (vec![0.0; r], vec![0.0; r]);
     let mu = s.parameters();
-    galerkin.force(&mu, &q, &v, 0.2, &mut f1);
-    hyper.force(&mu, &q, &v, 0.2, &mut f2);
+    galerkin.force(mu, &q, &v, 0.2, &mut f1);
+    hyper.force(mu, &q, &v, 0.2, &mut f2);
     // round-off is relative to the terms summed, not to their (much smaller) sum: the
     // bending forces K_t xₑ of a straight element cancel entry by entry (EI/l³ ≈ 1e8 on the
     // crank), so the scale is Σₑ ‖Lₑ‖_F ‖xₑ‖ + ‖Vₑᵀ f̂ₑ‖, and 64 ε of it is round-off of 8×8
@@ -103,8 +103,8 @@ fn every_element_at_weight_one_equals_plain_galerkin_with(modes: &str) {
     let diff = rel(&f2, &f1) * f1.iter().map(|x| x * x).sum::<f64>().sqrt();
     assert!(diff < 64.0 * f64::EPSILON * terms, "forces differ by {diff:e}, terms sum to {terms:e}");
     let coef = IterationCoefficients { mass: 1.0, damping: 30.0, stiffness: 1e-4 };
-    let s1 = galerkin.factor(&mu, &q, &v, 0.2, coef).unwrap();
-    let s2 = hyper.factor(&mu, &q, &v, 0.2, coef).unwrap();
+    let s1 = galerkin.factor(mu, &q, &v, 0.2, coef).unwrap();
+    let s2 = hyper.factor(mu, &q, &v, 0.2, coef).unwrap();
     assert!((s1 - s2).abs() <= 1e-12 * s1, "constraint scales {s1} vs {s2}");
     let nc = galerkin.n_constraints();
     let rhs: Vec<f64> = (0..r + nc).map(|i| 1.0 + (i as f64).cos()).collect();

@@ -33,10 +33,10 @@ fn energy_is_conserved_and_the_pin_holds() {
     let mut energies = Vec::new();
     let mut kinetic_peak = 0.0_f64;
     let mut pin_error = 0.0_f64;
-    integrate(&mut Bound::new(&mut sys, &s.parameters()), &s.params, q0, s.dt, s.n_steps, |_, st| {
+    integrate(&mut Bound::new(&mut sys, s.parameters()), &s.params, q0, s.dt, s.n_steps, |_, st| {
         let t = probe_sys.kinetic_energy(&st.v);
         kinetic_peak = kinetic_peak.max(t);
-        energies.push(t + probe_sys.potential_energy(&s.parameters(), &st.q));
+        energies.push(t + probe_sys.potential_energy(s.parameters(), &st.q));
         pin_error = pin_error.max(st.q[0].abs()).max(st.q[1].abs());
     })
     .unwrap();
@@ -83,13 +83,13 @@ fn every_step_satisfies_the_equations_of_motion() {
     let g_node = 5540.0 * 1.8e-3 * (1.2 / 50.0) * 9.81;
     let mut worst = 0.0_f64;
     let mu = s.parameters();
-    integrate(&mut Bound::new(&mut sys, &mu), &s.params, q0, s.dt, s.n_steps, |k, st| {
+    integrate(&mut Bound::new(&mut sys, mu), &s.params, q0, s.dt, s.n_steps, |k, st| {
         if k == 0 {
             return;
         }
         let mut r = vec![0.0; n];
         let mut mq = vec![0.0; n];
-        check.force(&mu, &st.q, &st.v, st.t, &mut r);
+        check.force(mu, &st.q, &st.v, st.t, &mut r);
         check.mass_mul(&st.qdd, &mut mq);
         check.add_constraint_force(&st.lambda, &mut r);
         for i in 0..n {
@@ -112,7 +112,7 @@ fn factorization_reuse_reaches_the_same_solution() {
     let run = |params: &IntegratorParams| {
         let (mut sys, q0) = prepare(&m, &s).unwrap();
         let mut last = Vec::new();
-        let mut sys = Bound::new(&mut sys, &s.parameters());
+        let mut sys = Bound::new(&mut sys, s.parameters());
         let stats = integrate(&mut sys, params, q0, s.dt, s.n_steps, |_, st| last = st.q.clone()).unwrap();
         (last, stats)
     };

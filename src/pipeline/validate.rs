@@ -302,7 +302,7 @@ pub fn validate(rom: &Rom, mu: &Parameters, with_dense: bool) -> Result<(Validat
     let (mut full_times, mut rom_times) = (vec![full.wall_seconds], vec![run.result.wall_seconds]);
     while repeat_timing(&[&full_times, &rom_times]) {
         full_times.push(full_model.simulate(&o).map_err(stage("validate (full run)"))?.wall_seconds);
-        let again = rom.solve_with(&mu, Output::Full, &[]).map_err(stage("validate (reduced run)"))?;
+        let again = rom.solve_with(mu, Output::Full, &[]).map_err(stage("validate (reduced run)"))?;
         rom_times.push(again.result.wall_seconds);
     }
     let mut v = compare(model, &full, &run, dense, basis.n_reduced(), basis.variant.name())
