@@ -1,8 +1,10 @@
 //! Resource bounds checked before anything large is allocated, and the switch that turns
-//! blow-up errors into warnings. The command line sets them once (`--max-memory`,
-//! `--max-steps`, `--allow-blowup`); without it they come from the environment
-//! (`FLEXROM_MAX_MEMORY`, `FLEXROM_MAX_STEPS`) or the defaults: half of the machine's
-//! memory (`MemTotal` in /proc/meminfo, 4 GiB when unreadable) and 10⁷ time steps.
+//! blow-up errors into warnings. They belong to a loaded model (`Model::load_with`), not
+//! to the process: the command line gives them (`--max-memory`, `--max-steps`,
+//! `--max-elements`, `--allow-blowup`); a library caller passes its own, or takes the
+//! environment's (`FLEXROM_MAX_MEMORY`, `FLEXROM_MAX_STEPS`, `FLEXROM_MAX_ELEMENTS`) and
+//! the defaults with [`Limits::from_env_or_defaults`]: half of the machine's memory
+//! (`MemTotal` in /proc/meminfo, 4 GiB when unreadable), 10⁷ time steps and 2·10⁵ elements.
 //!
 //! Estimates count only the big arrays a stage keeps (8 bytes per f64):
 //!
@@ -15,7 +17,6 @@
 //! ```
 
 use crate::error::{show_number, Error, Result};
-use std::sync::OnceLock;
 
 /// The bounds in force.
 #[derive(Clone, Debug, PartialEq)]
@@ -39,16 +40,12 @@ pub const BYTES_PER_ELEMENT: f64 = 2048.0;
 pub const DEFAULT_MAX_STEPS: u64 = 10_000_000;
 pub const DEFAULT_MAX_ELEMENTS: u64 = 200_000;
 
-static LIMITS: OnceLock<Limits> = OnceLock::new();
-
-/// Sets the bounds for the rest of the process (the first call wins).
-pub fn set(l: Limits) {
-    let _ = LIMITS.set(l);
-}
-
-/// The bounds in force: those given to [`set`], else the environment's, else the defaults.
-pub fn get() -> &'static Limits {
-    LIMITS.get_or_init(|| from_env(None, None, None, false).unwrap_or_else(|_| defaults()))
+impl Limits {
+    /// The environment's bounds, else the defaults (a malformed variable counts as unset:
+    /// only the command line reports it, through [`from_env`]).
+    pub fn from_env_or_defaults() -> Limits {
+        from_env(None, None, None, false).unwrap_or_else(|_| defaults())
+    }
 }
 
 fn defaults() -> Limits {
@@ -149,45 +146,47 @@ pub fn show_bytes(b: f64) -> String {
     }
 }
 
-/// Refuses an allocation estimated at `bytes` (computed in f64, so it cannot overflow)
-/// above the memory bound; `what` says what it is for.
-pub fn check_memory(what: &str, bytes: f64) -> Result<()> {
-    let l = get();
-    if bytes.is_finite() && bytes <= l.max_memory as f64 {
-        return Ok(());
-    }
-    Err(Error::Resource(format!(
+impl Limits {
+    /// Refuses an allocation estimated at `bytes` (computed in f64, so it cannot overflow)
+    /// above the memory bound; `what` says what it is for.
+    pub fn check_memory(&self, what: &str, bytes: f64) -> Result<()> {
+        let l = self;
+        if bytes.is_finite() && bytes <= l.max_memory as f64 {
+            return Ok(());
+        }
+        Err(Error::Resource(format!(
         "{what} would need about {} of memory, over the limit of {} ({}); raise it with --max-memory or FLEXROM_MAX_MEMORY, or use fewer steps, elements or load scales",
         show_bytes(bytes),
         show_bytes(l.max_memory as f64),
         l.memory_source
     )))
-}
-
-/// Refuses a model of `n` elements above the element bound.
-pub fn check_elements(n: f64) -> std::result::Result<(), String> {
-    let l = get();
-    if n <= l.max_elements as f64 {
-        return Ok(());
     }
-    Err(format!(
-        "{n:.0} elements in all, over the limit of {} (raise it with --max-elements or FLEXROM_MAX_ELEMENTS)",
-        l.max_elements
-    ))
-}
 
-/// Refuses a run of `steps` (a float, so 1e300 / 1e-300 cannot overflow) above the step bound.
-pub fn check_steps(steps: f64, dt: f64, t_end: f64) -> Result<()> {
-    let l = get();
-    if steps.is_finite() && steps <= l.max_steps as f64 {
-        return Ok(());
+    /// Refuses a model of `n` elements above the element bound.
+    pub fn check_elements(&self, n: f64) -> std::result::Result<(), String> {
+        let l = self;
+        if n <= l.max_elements as f64 {
+            return Ok(());
+        }
+        Err(format!(
+            "{n:.0} elements in all, over the limit of {} (raise it with --max-elements or FLEXROM_MAX_ELEMENTS)",
+            l.max_elements
+        ))
     }
-    Err(Error::Resource(format!(
+
+    /// Refuses a run of `steps` (a float, so 1e300 / 1e-300 cannot overflow) above the step bound.
+    pub fn check_steps(&self, steps: f64, dt: f64, t_end: f64) -> Result<()> {
+        let l = self;
+        if steps.is_finite() && steps <= l.max_steps as f64 {
+            return Ok(());
+        }
+        Err(Error::Resource(format!(
         "t_end = {} s at dt = {} s is {steps:.3e} steps, over the limit of {} steps; raise it with --max-steps or FLEXROM_MAX_STEPS, or use a larger dt",
         show_number(t_end),
         show_number(dt),
         l.max_steps
     )))
+    }
 }
 
 #[cfg(test)]

@@ -235,10 +235,7 @@ fn main() -> ExitCode {
         cli.allow_blowup,
     );
     let start = std::time::Instant::now();
-    let outcome = limits.and_then(|l| {
-        flexrom::limits::set(l);
-        run(cli)
-    });
+    let outcome = limits.and_then(|l| run(cli, &l));
     // built only when shown: asking rayon for its thread count starts its global pool
     // (cgroup reads, two threads) at the end of every command otherwise
     if verbosity() >= Verbosity::Verbose {
@@ -259,16 +256,16 @@ fn main() -> ExitCode {
     }
 }
 
-fn run(cli: Cli) -> flexrom::Result<()> {
+fn run(cli: Cli, limits: &flexrom::limits::Limits) -> flexrom::Result<()> {
     match cli.command {
-        Command::Simulate(a) => a.run(),
-        Command::Train(a) => a.run(),
-        Command::Online(a) => a.run(),
-        Command::Validate(a) => a.run(),
-        Command::Sweep(a) => a.run(),
-        Command::Merge(a) => a.run(),
-        Command::Run(a) => a.run(),
-        Command::Demo(a) => a.run(),
+        Command::Simulate(a) => a.run(limits),
+        Command::Train(a) => a.run(limits),
+        Command::Online(a) => a.run(limits),
+        Command::Validate(a) => a.run(limits),
+        Command::Sweep(a) => a.run(limits),
+        Command::Merge(a) => a.run(limits),
+        Command::Run(a) => a.run(limits),
+        Command::Demo(a) => a.run(limits),
     }
 }
 

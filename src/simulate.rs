@@ -38,6 +38,8 @@ pub struct Settings {
     pub n_steps: usize,
     pub solver: LinearSolverKind,
     pub params: IntegratorParams,
+    /// blow-up checks warn instead of failing (the model's [`crate::limits::Limits`])
+    pub allow_blowup: bool,
 }
 
 impl Settings {
@@ -61,12 +63,21 @@ impl Settings {
         // bounded in floating point before the cast (t_end = 1e300 or dt = 1e-300 would
         // saturate it and overflow n_t = n_steps + 1)
         let steps = (t_end / dt + 1e-9).floor();
-        crate::limits::check_steps(steps, dt, t_end)?;
+        model.limits.check_steps(steps, dt, t_end)?;
         let n_steps = steps as usize;
         if n_steps == 0 {
             return Err(Error::Usage(format!("dt = {dt} is longer than t_end = {t_end}")));
         }
-        Ok(Settings { dt, t_end, rho_inf, mu, n_steps, solver: o.solver, params })
+        Ok(Settings {
+            dt,
+            t_end,
+            rho_inf,
+            mu,
+            n_steps,
+            solver: o.solver,
+            params,
+            allow_blowup: model.limits.allow_blowup,
+        })
     }
 
     /// The parameters μ of the run.
@@ -117,38 +128,36 @@ pub fn solve<M: ParametricModel + ?Sized>(
 ) -> Result<Stats> {
     let mu = s.parameters();
     mu.validate()?;
-    integrate_guided(&mut Bound::new(model, mu), &s.params, q0, s.dt, s.n_steps, guess, record)
+    integrate_guided(&mut Bound::new(model, mu), s, q0, guess, record)
 }
 
-/// Integrates any [`DynamicModel`] (a model bound to its parameters) over `n_steps` steps
-/// of `dt`, calling `record` at t₀ and after every step. Returns the integrator statistics.
+/// Integrates any [`DynamicModel`] (a model bound to its parameters) with the settings'
+/// integrator over their `n_steps` steps of `dt`, calling `record` at t₀ and after every
+/// step. Returns the integrator statistics.
 pub fn integrate<M: DynamicModel>(
     model: &mut M,
-    params: &IntegratorParams,
+    s: &Settings,
     q0: Vec<f64>,
-    dt: f64,
-    n_steps: usize,
     record: impl FnMut(usize, &State),
 ) -> Result<Stats> {
-    integrate_guided(model, params, q0, dt, n_steps, |_, _| false, record)
+    integrate_guided(model, s, q0, |_, _| false, record)
 }
 
 /// [`integrate`] with a guess of each step's increment: `guess(k, out)` fills `out` with
 /// `q_k − q_{k−1}` and returns true, or returns false for the default predictor.
 pub fn integrate_guided<M: DynamicModel>(
     model: &mut M,
-    params: &IntegratorParams,
+    s: &Settings,
     q0: Vec<f64>,
-    dt: f64,
-    n_steps: usize,
     mut guess: impl FnMut(usize, &mut [f64]) -> bool,
     mut record: impl FnMut(usize, &State),
 ) -> Result<Stats> {
+    let (params, dt, n_steps) = (&s.params, s.dt, s.n_steps);
     let mut integ = GeneralizedAlpha::new(params.clone()).map_err(Error::Usage)?;
     let v0 = vec![0.0; q0.len()];
     let mut state = integ.initialize(model, q0, v0, 0.0)?;
     let mut increment = vec![0.0; state.q.len()];
-    let mut watch = BlowUpWatch::new(params, crate::limits::get().allow_blowup);
+    let mut watch = BlowUpWatch::new(params, s.allow_blowup);
     record(0, &state);
     for k in 1..=n_steps {
         let guessed = guess(k, &mut increment);
@@ -339,4 +348,32 @@ pub fn probe_sections(probes: &[Probe], series: impl Fn(&Probe) -> Vec<(f64, f64
         }
     }
     (strains, curvatures)
+}
+
+#[cfg(test)]
+mod limits_tests {
+    use super::*;
+    use crate::limits::Limits;
+
+    /// Two models with different bounds in one process: each stage keeps to its own
+    /// model's (no process-wide setting, so a library caller's choice cannot leak into
+    /// another's). The pendulum (data/models/pendulum.toml: 1.1 s at dt 0.005 s) is 220
+    /// steps and 50 elements.
+    #[test]
+    fn each_model_keeps_to_its_own_limits() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/data/models/pendulum.toml");
+        let tight = Limits { max_steps: 100, ..Limits::from_env_or_defaults() };
+        let few = Limits { max_elements: 10, ..Limits::from_env_or_defaults() };
+        let e = Model::load_with(path, few).expect_err("50 elements over a bound of 10").to_string();
+        assert!(e.contains("over the limit of 10"), "{e}");
+        let bounded = Model::load_with(path, tight).unwrap();
+        let free = Model::load(path).unwrap();
+        let e = Settings::resolve(&bounded, &Overrides::default()).expect_err("220 steps over 100").to_string();
+        assert!(e.contains("over the limit of 100 steps"), "{e}");
+        assert_eq!(Settings::resolve(&free, &Overrides::default()).unwrap().n_steps, 220);
+        // the blow-up switch travels with the model into its runs' settings
+        let lenient = Model::load_with(path, Limits { allow_blowup: true, ..Limits::from_env_or_defaults() }).unwrap();
+        assert!(Settings::resolve(&lenient, &Overrides::default()).unwrap().allow_blowup);
+        assert!(!Settings::resolve(&free, &Overrides::default()).unwrap().allow_blowup);
+    }
 }

@@ -33,7 +33,7 @@ fn energy_is_conserved_and_the_pin_holds() {
     let mut energies = Vec::new();
     let mut kinetic_peak = 0.0_f64;
     let mut pin_error = 0.0_f64;
-    integrate(&mut Bound::new(&mut sys, s.parameters()), &s.params, q0, s.dt, s.n_steps, |_, st| {
+    integrate(&mut Bound::new(&mut sys, s.parameters()), &s, q0, |_, st| {
         let t = probe_sys.kinetic_energy(&st.v);
         kinetic_peak = kinetic_peak.max(t);
         energies.push(t + probe_sys.potential_energy(s.parameters(), &st.q));
@@ -83,7 +83,7 @@ fn every_step_satisfies_the_equations_of_motion() {
     let g_node = 5540.0 * 1.8e-3 * (1.2 / 50.0) * 9.81;
     let mut worst = 0.0_f64;
     let mu = s.parameters();
-    integrate(&mut Bound::new(&mut sys, mu), &s.params, q0, s.dt, s.n_steps, |k, st| {
+    integrate(&mut Bound::new(&mut sys, mu), &s, q0, |k, st| {
         if k == 0 {
             return;
         }
@@ -113,7 +113,9 @@ fn factorization_reuse_reaches_the_same_solution() {
         let (mut sys, q0) = prepare(&m, &s).unwrap();
         let mut last = Vec::new();
         let mut sys = Bound::new(&mut sys, s.parameters());
-        let stats = integrate(&mut sys, params, q0, s.dt, s.n_steps, |_, st| last = st.q.clone()).unwrap();
+        let stats =
+            integrate(&mut sys, &Settings { params: params.clone(), ..s.clone() }, q0, |_, st| last = st.q.clone())
+                .unwrap();
         (last, stats)
     };
     assert_eq!(s.params.reuse, JacobianReuse::WithinStep, "the documented default");

@@ -1,6 +1,7 @@
 //! `flexrom demo`: each model run once and its probe positions printed at a few times.
 
 use super::{print_table, run_details, FormatArgs};
+use flexrom::limits::Limits;
 use flexrom::model::Model;
 use flexrom::output::table::{Format, Table};
 use flexrom::output::{self};
@@ -18,11 +19,11 @@ pub struct Args {
 }
 
 impl Args {
-    pub fn run(self) -> flexrom::Result<()> {
+    pub fn run(self, limits: &Limits) -> flexrom::Result<()> {
         let Args { models, format } = self;
         let mut table = Table::new(&["model", "t", "probe", "x", "y"]);
         for path in models {
-            let model = Model::load(&path)?;
+            let model = Model::load_with(&path, limits.clone())?;
             let r = simulate(&model, &Overrides::default()).map_err(|e| e.at_stage("demo", &Parameters::default()))?;
             run_details(&r);
             let nt = r.t.len();

@@ -2,6 +2,7 @@
 
 use super::{print_table, FormatArgs};
 use flexrom::io::output::{check_output, Origin};
+use flexrom::limits::Limits;
 use flexrom::output::info;
 use std::path::PathBuf;
 
@@ -23,11 +24,11 @@ pub struct Args {
 }
 
 impl Args {
-    pub fn run(self) -> flexrom::Result<()> {
+    pub fn run(self, limits: &Limits) -> flexrom::Result<()> {
         let Args { parts, output, partial, format } = self;
         let inputs: Vec<(&std::path::Path, &str)> = parts.iter().map(|p| (p.as_path(), "part file")).collect();
         check_output(&output, Origin::Flag("-o"), &inputs)?;
-        let m = flexrom::pipeline::merge::merge(&parts, &output, partial)?;
+        let m = flexrom::pipeline::merge::merge(&parts, &output, partial, limits)?;
         print_table(&flexrom::pipeline::tables::sweep_table(&m.sweep), format.format(), false)?;
         info(&format!(
             "{} parts, {} load scales ({} not run) -> {}",

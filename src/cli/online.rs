@@ -2,6 +2,7 @@
 
 use super::{check_scale, print_table, run_details, warn, EstimateArgs, FormatArgs};
 use flexrom::io::output::{check_output, Origin};
+use flexrom::limits::Limits;
 use flexrom::output::info;
 use flexrom::output::table::{Cell, Table};
 use flexrom::pipeline::online::{load_rom, online_to_file};
@@ -34,9 +35,9 @@ pub struct Args {
 }
 
 impl Args {
-    pub fn run(self) -> flexrom::Result<()> {
+    pub fn run(self, limits: &Limits) -> flexrom::Result<()> {
         let Args { pipeline, load_scale, output, basis, strict, estimate, format } = self;
-        let p = Pipeline::load(&pipeline)?;
+        let p = Pipeline::load_with(&pipeline, limits.clone())?;
         check_scale(load_scale)?;
         let path = basis.unwrap_or_else(|| p.basis_path.clone());
         check_output(

@@ -1,6 +1,7 @@
 //! `flexrom run`: the whole pipeline (train, sweep, validate) and its report folder.
 
 use super::{print_table, DenseArgs, EstimateArgs, FormatArgs};
+use flexrom::limits::Limits;
 use flexrom::output::table::{Format, Table};
 use flexrom::output::{self, info};
 use flexrom::pipeline::Pipeline;
@@ -24,9 +25,9 @@ pub struct Args {
 }
 
 impl Args {
-    pub fn run(self) -> flexrom::Result<()> {
+    pub fn run(self, limits: &Limits) -> flexrom::Result<()> {
         let Args { pipeline, strict, dense, estimate, format } = self;
-        let p = Pipeline::load(&pipeline)?;
+        let p = Pipeline::load_with(&pipeline, limits.clone())?;
         let (dir, warnings) =
             flexrom::pipeline::report::run_with(&p, output::show_progress(), dense.choice(), estimate.method())?;
         super::warn(&warnings);

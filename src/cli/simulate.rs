@@ -3,6 +3,7 @@
 use super::{print_table, run_details, FormatArgs};
 use flexrom::io::output::{check_output, Origin};
 use flexrom::io::result_file::{begin_alongside, RunPlan};
+use flexrom::limits::Limits;
 use flexrom::linalg::kkt::LinearSolverKind;
 use flexrom::model::Model;
 use flexrom::output::info;
@@ -26,12 +27,12 @@ pub struct Args {
 }
 
 impl Args {
-    pub fn run(self) -> flexrom::Result<()> {
+    pub fn run(self, limits: &Limits) -> flexrom::Result<()> {
         let Args { model, output, run, format } = self;
         if let Some(output) = &output {
             check_output(output, Origin::Flag("-o"), &[(&model, "model file")])?;
         }
-        let model = Model::load(&model)?;
+        let model = Model::load_with(&model, limits.clone())?;
         let overrides = run.overrides();
         let mu = overrides.mu.clone().unwrap_or_default();
         let compute = || simulate(&model, &overrides).map_err(|e| e.at_stage("simulate", &mu));

@@ -3,6 +3,7 @@
 
 use super::{print_table, warn, EstimateArgs, FormatArgs};
 use flexrom::io::output::{check_output, Origin};
+use flexrom::limits::Limits;
 use flexrom::output::table::Format;
 use flexrom::output::{self, info};
 use flexrom::pipeline::online::load_rom;
@@ -65,7 +66,7 @@ pub struct Args {
 }
 
 impl Args {
-    pub fn run(self) -> flexrom::Result<()> {
+    pub fn run(self, limits: &Limits) -> flexrom::Result<()> {
         let Args {
             pipeline,
             load_scales,
@@ -81,7 +82,7 @@ impl Args {
             estimate,
             format,
         } = self;
-        let p = Pipeline::load(&pipeline)?;
+        let p = Pipeline::load_with(&pipeline, limits.clone())?;
         let scales = match load_scales {
             Some(s) => flexrom::pipeline::config::parse_range(&s)
                 .map_err(|e| flexrom::Error::Usage(format!("--load-scales: {e}")))?,

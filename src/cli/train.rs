@@ -4,6 +4,7 @@
 
 use super::{print_table, FormatArgs};
 use flexrom::io::output::{check_output, Origin};
+use flexrom::limits::Limits;
 use flexrom::output::info;
 use flexrom::output::table::Table;
 use flexrom::pipeline::Pipeline;
@@ -38,9 +39,9 @@ pub struct Args {
 }
 
 impl Args {
-    pub fn run(self) -> flexrom::Result<()> {
+    pub fn run(self, limits: &Limits) -> flexrom::Result<()> {
         let Args { pipeline, basis, snapshots_only, load_scale, shard, output, from_snapshots, format } = self;
-        let p = Pipeline::load(&pipeline)?;
+        let p = Pipeline::load_with(&pipeline, limits.clone())?;
         if snapshots_only {
             let out = output.expect("clap: --snapshots-only requires -o");
             check_output(&out, Origin::Flag("-o"), &[(&p.path, "pipeline file"), (&p.model.path, "model file")])?;

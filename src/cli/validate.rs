@@ -1,6 +1,7 @@
 //! `flexrom validate`: full and reduced runs at one load scale, compared.
 
 use super::{check_scale, warn, DenseArgs, EstimateArgs, FormatArgs};
+use flexrom::limits::Limits;
 use flexrom::output::table::{Format, Table};
 use flexrom::output::{self};
 use flexrom::pipeline::online::load_rom;
@@ -33,9 +34,9 @@ pub struct Args {
 }
 
 impl Args {
-    pub fn run(self) -> flexrom::Result<()> {
+    pub fn run(self, limits: &Limits) -> flexrom::Result<()> {
         let Args { pipeline, load_scale, format, basis, dense, strict, estimate } = self;
-        let p = Pipeline::load(&pipeline)?;
+        let p = Pipeline::load_with(&pipeline, limits.clone())?;
         let scales = match load_scale {
             Some(x) => {
                 check_scale(x)?;

@@ -46,7 +46,7 @@ impl Model {
                 return Err(self.err(p("elements"), format!("must be a positive integer, got {}", b.elements)));
             }
             let total: f64 = f.bodies[..=i].iter().map(|b| b.elements.max(0) as f64).sum();
-            crate::limits::check_elements(total).map_err(|e| self.err(p("elements"), e))?;
+            self.limits.check_elements(total).map_err(|e| self.err(p("elements"), e))?;
             for (k, v) in
                 [("density", b.density), ("area", b.area), ("inertia", b.inertia), ("youngs_modulus", b.youngs_modulus)]
             {

@@ -7,6 +7,7 @@ pub mod shared;
 mod toml_errors;
 
 use crate::error::{Error, Result};
+use crate::limits::Limits;
 use crate::linalg::kkt::LinearSolverKind;
 use crate::physics::system::{BeamBody, FlexibleSystem, Joint, Load, Probe, Rayleigh};
 use crate::solver::generalized_alpha::IntegratorParams;
@@ -40,16 +41,30 @@ pub struct Model {
     probes: Vec<Probe>,
     /// the physics, assembled at the first [`Model::physics`] call ([`shared`])
     physics: std::sync::OnceLock<SharedPhysics>,
+    /// the resource bounds of every stage that runs this model ([`crate::limits`])
+    pub limits: Limits,
 }
 
 impl Model {
+    /// [`Model::load_with`] the environment's bounds or the defaults.
     pub fn load(path: impl AsRef<Path>) -> Result<Model> {
-        let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-        Model::from_text(&text, path)
+        Model::load_with(path, Limits::from_env_or_defaults())
     }
 
+    /// Reads and checks the model file at `path`; every run of it keeps to `limits`.
+    pub fn load_with(path: impl AsRef<Path>, limits: Limits) -> Result<Model> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        Model::from_text_with(&text, path, limits)
+    }
+
+    /// [`Model::from_text_with`] the environment's bounds or the defaults.
     pub fn from_text(text: &str, path: impl AsRef<Path>) -> Result<Model> {
+        Model::from_text_with(text, path, Limits::from_env_or_defaults())
+    }
+
+    /// Checks a model file's `text` (`path` names it in messages).
+    pub fn from_text_with(text: &str, path: impl AsRef<Path>, limits: Limits) -> Result<Model> {
         let path = path.as_ref();
         let file: ModelFile = parse_toml(text, path).map_err(|e| entry_error(text, path).unwrap_or(e))?;
         let mut model = Model {
@@ -61,6 +76,7 @@ impl Model {
             loads: vec![],
             probes: vec![],
             physics: std::sync::OnceLock::new(),
+            limits,
         };
         model.check()?;
         Ok(model)
@@ -123,7 +139,7 @@ impl Model {
             z.n_dof,
             if dense { format!(" with a dense {n_kkt} × {n_kkt} LU") } else { String::new() }
         );
-        crate::limits::check_memory(&what, arrays + system + lu)
+        self.limits.check_memory(&what, arrays + system + lu)
     }
 
     /// The validated bodies, in file order (node `k` of body `b` is global node

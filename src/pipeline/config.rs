@@ -32,6 +32,7 @@ mod scales;
 mod schema;
 
 use crate::error::{Error, Result};
+use crate::limits::Limits;
 use crate::model::Model;
 pub use crate::reduction::estimator::{ErrorMeasure, EstimateMethod};
 use crate::reduction::{ModeRule, Variant};
@@ -52,13 +53,20 @@ pub struct Pipeline {
 }
 
 impl Pipeline {
+    /// [`Pipeline::load_with`] the environment's bounds or the defaults.
     pub fn load(path: impl AsRef<Path>) -> Result<Pipeline> {
+        Pipeline::load_with(path, Limits::from_env_or_defaults())
+    }
+
+    /// Reads and checks the pipeline file at `path` and its model, which every stage runs
+    /// within `limits`.
+    pub fn load_with(path: impl AsRef<Path>, limits: Limits) -> Result<Pipeline> {
         let path = path.as_ref();
         let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
         let file: PipelineFile = crate::model::parse_toml(&text, path)?;
         let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
         let stem = path.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_else(|| "pipeline".into());
-        let model = Model::load(dir.join(&file.model)).map_err(|e| match e {
+        let model = Model::load_with(dir.join(&file.model), limits).map_err(|e| match e {
             Error::Io { .. } => Error::input(path, "model", format!("cannot read `{}`: {e}", file.model.display())),
             other => other,
         })?;

@@ -19,6 +19,7 @@ use super::shard::load_list_hash;
 use super::sweep::{read_sweep, write_sweep, Outcome, ScaleResult, Sweep, SweepBasis, STATUS_FAILED, STATUS_OK};
 use crate::error::{Error, Result};
 use crate::io::h5::{read_attr_f64, read_attr_str};
+use crate::limits::Limits;
 use crate::simulate::{Overrides, Settings};
 use crate::solver::parameters::Parameters;
 use hdf5::types::VarLenUnicode;
@@ -181,7 +182,7 @@ pub struct Merged {
 }
 
 /// Joins `parts` into `out` (atomically; the caller has checked that `out` may be written).
-pub fn merge(parts: &[PathBuf], out: &Path, partial: bool) -> Result<Merged> {
+pub fn merge(parts: &[PathBuf], out: &Path, partial: bool, limits: &Limits) -> Result<Merged> {
     if parts.is_empty() {
         return Err(Error::Usage("merge: no part files given".into()));
     }
@@ -279,7 +280,7 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool) -> Result<Merged> {
         }
     }
     // the model and basis the parts were run with, checked against the parts' basis hash
-    let pipeline = Pipeline::load(&first.pipeline)?;
+    let pipeline = Pipeline::load_with(&first.pipeline, limits.clone())?;
     let stored = match &first.basis {
         None => None,
         Some(b) => {

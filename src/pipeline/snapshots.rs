@@ -189,7 +189,7 @@ pub fn train_from_snapshots(p: &Pipeline, files: &[PathBuf]) -> Result<(Training
     let n_t = Settings::resolve(&p.model, &Overrides::default())?.n_steps + 1;
     let z = p.model.sizes();
     let snapshots = scales.len() as f64 * n_t as f64;
-    crate::limits::check_memory(
+    p.model.limits.check_memory(
         &format!("training on {} snapshots × {} coordinates", snapshots, z.n_dof),
         3.0 * 8.0 * snapshots * (z.n_dof + z.n_constraints) + z.n_elements * crate::limits::BYTES_PER_ELEMENT,
     )?;

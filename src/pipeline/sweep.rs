@@ -243,7 +243,7 @@ fn run_full(model: &Model, state: Sweep, o: SweepOptions, checkpoint: Option<Che
     model.check_full_run_memory(n_steps, false)?;
     let z = model.sizes();
     let kept = state.n_todo() as f64 * 8.0 * (n_steps as f64 + 1.0) * (z.n_probe_values + 1.0);
-    crate::limits::check_memory(&format!("the probes of {} full runs of {n_steps} steps", state.n_todo()), kept)?;
+    model.limits.check_memory(&format!("the probes of {} full runs of {n_steps} steps", state.n_todo()), kept)?;
     let models = Pool::new(|| FullModel::new(model, LinearSolverKind::Banded));
     let point = |mu: &Parameters, _: &[&ReducedRun]| -> Result<SweepPoint> {
         let run = models.with(|full| full.simulate(&Overrides::at(mu)));

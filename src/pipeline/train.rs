@@ -32,7 +32,7 @@ pub fn train(p: &Pipeline) -> Result<(TrainingData, TrainSummary)> {
     let n_steps = crate::simulate::Settings::resolve(&p.model, &Overrides::default())?.n_steps;
     let z = p.model.sizes();
     let snapshots = scales.len() as f64 * (n_steps as f64 + 1.0);
-    crate::limits::check_memory(
+    p.model.limits.check_memory(
         &format!("training on {} snapshots × {} coordinates", snapshots, z.n_dof),
         3.0 * 8.0 * snapshots * (z.n_dof + z.n_constraints) + z.n_elements * crate::limits::BYTES_PER_ELEMENT,
     )?;

@@ -119,7 +119,7 @@ pub fn check_reduced_memory(model: &Model, r: usize, n_steps: usize, output: Out
     } else {
         format!("a reduced run of {n_steps} steps × {r} modes")
     };
-    crate::limits::check_memory(&what, bytes)
+    model.limits.check_memory(&what, bytes)
 }
 
 fn run<R: Reduced<FlexibleSystem>>(
