@@ -165,7 +165,7 @@ impl GeneralizedAlpha {
     /// into `rhs[..n]` (`work`: n entries).
     pub fn residual<M: DynamicModel>(model: &mut M, st: &State, t: f64, rhs: &mut [f64], work: &mut [f64]) {
         let n = st.q.len();
-        model.force_and_inertia(&st.q, &st.v, &st.qdd, t, &mut rhs[..n], work);
+        model.force_and_inertia(&st.q, &st.v, &st.qdd, t, (&mut rhs[..n], work));
         for i in 0..n {
             rhs[i] += work[i];
         }

@@ -29,10 +29,11 @@ pub trait DynamicModel {
     fn mass_mul(&self, a: &[f64], out: &mut [f64]);
     /// `out = g(q, q̇, t) = C q̇ + Q_e(q) − Q_ext(q, t)`
     fn force(&mut self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]);
-    /// `force = g(q, q̇, t)` and `inertia = M a` together, the two parts of every Newton
+    /// `(force, inertia) = (g(q, q̇, t), M a)` together, the two parts of every Newton
     /// residual: a model may evaluate both in one pass over its elements (the full system
     /// does). The same values as [`Self::force`] and [`Self::mass_mul`].
-    fn force_and_inertia(&mut self, q: &[f64], v: &[f64], a: &[f64], t: f64, force: &mut [f64], inertia: &mut [f64]) {
+    fn force_and_inertia(&mut self, q: &[f64], v: &[f64], a: &[f64], t: f64, out: (&mut [f64], &mut [f64])) {
+        let (force, inertia) = out;
         self.mass_mul(a, inertia);
         self.force(q, v, t, force);
     }
@@ -73,7 +74,6 @@ pub trait ParametricModel {
     /// `out = g(q, q̇, t; μ)`
     fn force(&mut self, mu: &Parameters, q: &[f64], v: &[f64], t: f64, out: &mut [f64]);
     /// [`DynamicModel::force_and_inertia`] at the parameters `mu`.
-    #[allow(clippy::too_many_arguments)]
     fn force_and_inertia(
         &mut self,
         mu: &Parameters,
@@ -81,9 +81,9 @@ pub trait ParametricModel {
         v: &[f64],
         a: &[f64],
         t: f64,
-        force: &mut [f64],
-        inertia: &mut [f64],
+        out: (&mut [f64], &mut [f64]),
     ) {
+        let (force, inertia) = out;
         self.mass_mul(a, inertia);
         self.force(mu, q, v, t, force);
     }
@@ -134,8 +134,8 @@ impl<M: ParametricModel + ?Sized> DynamicModel for Bound<'_, M> {
     fn force(&mut self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
         self.model.force(&self.mu, q, v, t, out)
     }
-    fn force_and_inertia(&mut self, q: &[f64], v: &[f64], a: &[f64], t: f64, force: &mut [f64], inertia: &mut [f64]) {
-        self.model.force_and_inertia(&self.mu, q, v, a, t, force, inertia)
+    fn force_and_inertia(&mut self, q: &[f64], v: &[f64], a: &[f64], t: f64, out: (&mut [f64], &mut [f64])) {
+        self.model.force_and_inertia(&self.mu, q, v, a, t, out)
     }
     fn constraint_residual(&self, q: &[f64], out: &mut [f64]) {
         self.model.constraint_residual(q, out)

@@ -127,9 +127,9 @@ impl ParametricModel for FlexibleSystem {
         v: &[f64],
         a: &[f64],
         t: f64,
-        force: &mut [f64],
-        inertia: &mut [f64],
+        out: (&mut [f64], &mut [f64]),
     ) {
+        let (force, inertia) = out;
         self.gravity_into(mu, force);
         inertia.iter_mut().for_each(|x| *x = 0.0);
         let damped = self.damping != Rayleigh::default();
@@ -362,7 +362,7 @@ mod tests {
             let (mut f_ref, mut m_ref, mut f, mut m) = (vec![0.0; n], vec![0.0; n], vec![1.0; n], vec![1.0; n]);
             ParametricModel::force(&mut sys, &mu, &q, &v, 0.2, &mut f_ref);
             ParametricModel::mass_mul(&sys, &a, &mut m_ref);
-            sys.force_and_inertia(&mu, &q, &v, &a, 0.2, &mut f, &mut m);
+            sys.force_and_inertia(&mu, &q, &v, &a, 0.2, (&mut f, &mut m));
             let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(&f), bits(&f_ref), "force, {damping:?}");
             assert_eq!(bits(&m), bits(&m_ref), "inertia, {damping:?}");
