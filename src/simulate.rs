@@ -223,7 +223,7 @@ impl BlowUpWatch {
         if !self.warn_only {
             return Err(Error::BlowUp { t, problem });
         }
-        crate::output::note(&format!("warning: blow-up at t = {t:.6} s: {problem}"));
+        log::warn!("warning: blow-up at t = {t:.6} s: {problem}");
         if cuts {
             self.warned_cuts = true
         } else {

@@ -25,7 +25,7 @@ impl Ticker {
         Ticker {
             label: label.to_string(),
             total,
-            active: progress && super::verbosity::show_progress() && !std::io::stderr().is_terminal(),
+            active: progress && super::verbosity::progress_wanted() && !std::io::stderr().is_terminal(),
             start: Instant::now(),
             state: Mutex::new((0, 0.0)),
         }
@@ -38,7 +38,7 @@ impl Ticker {
         let t = self.start.elapsed().as_secs_f64();
         if self.active && t - s.1 >= TICK_SECONDS && s.0 < self.total {
             s.1 = t;
-            super::verbosity::info(&format!("{}: {}/{} done ({t:.0} s)", self.label, s.0, self.total));
+            log::info!("{}: {}/{} done ({t:.0} s)", self.label, s.0, self.total);
         }
     }
 }

@@ -1,6 +1,12 @@
-//! The verbosity chosen on the command line, one process-wide setting read by every
-//! printing site: `-q` keeps errors and warnings only, `-v` adds timings and solver
-//! statistics.
+//! The verbosity chosen on the command line: `-q` keeps errors and warnings only, `-v` adds
+//! timings and solver statistics.
+//!
+//! The library itself never reads it: its info, detail and warning lines go through the
+//! `log` facade (`log::info!`, `log::debug!`, `log::warn!`) and its progress bars show only
+//! when the caller's logger takes info lines, so whoever calls the library owns what is
+//! said. [`set_verbosity`] is the command line's choice: it installs [`StderrLog`], which
+//! writes each line as it is, at the matching level. A caller that installs no logger
+//! hears nothing.
 
 use std::io::Write;
 use std::sync::atomic::{AtomicU8, Ordering};
@@ -18,9 +24,38 @@ pub enum Verbosity {
 
 static LEVEL: AtomicU8 = AtomicU8::new(Verbosity::Normal as u8);
 
-/// Sets the process-wide verbosity (once, from the command line).
+/// Sets the command line's verbosity and routes the library's `log` lines to standard
+/// error at that level ([`StderrLog`]; the first logger installed in a process stays).
 pub fn set_verbosity(v: Verbosity) {
     LEVEL.store(v as u8, Ordering::Relaxed);
+    let _ = log::set_logger(&StderrLog);
+    log::set_max_level(match v {
+        Verbosity::Quiet => log::LevelFilter::Warn,
+        Verbosity::Normal => log::LevelFilter::Info,
+        Verbosity::Verbose => log::LevelFilter::Debug,
+    });
+}
+
+/// The command line's logger: each line of the library, as written, on standard error
+/// ([`note`]); the level filter is `log`'s maximum level, which [`set_verbosity`] sets.
+pub struct StderrLog;
+
+impl log::Log for StderrLog {
+    fn enabled(&self, metadata: &log::Metadata) -> bool {
+        metadata.level() <= log::max_level()
+    }
+    fn log(&self, record: &log::Record) {
+        if self.enabled(record.metadata()) {
+            note(&record.args().to_string());
+        }
+    }
+    fn flush(&self) {}
+}
+
+/// Whether a library run draws progress (bars and lines): when the caller's logger takes
+/// info lines.
+pub fn progress_wanted() -> bool {
+    log::log_enabled!(log::Level::Info)
 }
 
 pub fn verbosity() -> Verbosity {

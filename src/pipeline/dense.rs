@@ -76,9 +76,9 @@ pub fn decide(choice: DenseChoice, model: &Model) -> Result<bool> {
             match auto_skip_reason(z.n_dof + z.n_constraints, model.check_full_run_memory(n_steps, true)) {
                 None => Ok(true),
                 Some(why) => {
-                    crate::output::info(&format!(
+                    log::info!(
                         "skipping the dense-LU comparison (full_dense_seconds and speedup_vs_dense will be empty): {why}; --dense forces it, --no-dense skips it silently"
-                    ));
+                    );
                     Ok(false)
                 }
             }

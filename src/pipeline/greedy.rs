@@ -111,14 +111,14 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         simulate(&p.model, &Overrides::at(&mu)).map_err(|e| e.at_stage("train (greedy full run)", &mu))
     };
     let first = initial_loads(range, g.max_runs);
-    crate::output::info(&format!(
+    log::info!(
         "greedy training over [{}, {}], tolerance {:e}, {} candidates: full runs at {:?}",
         range.0,
         range.1,
         g.tolerance,
         candidates.len(),
         first
-    ));
+    );
     let mut runs: Vec<SimulationResult> = first.par_iter().map(|&x| full(x)).collect::<Result<_>>()?;
     // the later full runs, one at a time, on one full model
     let mut full_model = crate::simulate::FullModel::new(&p.model, crate::linalg::kkt::LinearSolverKind::Banded)?;
@@ -181,10 +181,10 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
             };
             // the same test as the stop below, without a held-out run to recalibrate with
             let bound = level.between_candidates(g.tolerance);
-            crate::output::info(&format!(
+            log::info!(
                 "iteration {n}: {why}, worst estimate {worst:.2e} {cmp} {:e} at λ = {} (bound between candidates {bound:.2e}), {shape}",
                 g.tolerance, it.worst_load
-            ));
+            );
             converged = bound <= g.tolerance;
             iterations.push(it);
             break level;
@@ -210,7 +210,7 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         // loop reads the candidates with the enriched model (the reference the correction
         // approximates) from here on, when that reads closer at this load
         if let Some(checked) = check_method(p, &level, method, at, e, it.held_out_effectivity) {
-            crate::output::info(&checked.message);
+            log::info!("{}", checked.message);
             if !checked.switch && it.held_out_effectivity > MAX_HELD_OUT_OVERESTIMATE {
                 warnings.push(checked.message);
             } else if checked.switch {
@@ -237,9 +237,9 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         let sens = level.sensitivity[ni][4];
         if done {
             let name = g.measure.error_name();
-            crate::output::info(&format!("iteration {n}: worst score {worst:.2e} ≤ {:e}; held-out check at λ = {at} (score {next_estimate:.2e}): {name} {e_measured:.2e} (score {e_score:.2e}, sensitivity {sens:.1e}); {shape}", g.tolerance));
+            log::info!("iteration {n}: worst score {worst:.2e} ≤ {:e}; held-out check at λ = {at} (score {next_estimate:.2e}): {name} {e_measured:.2e} (score {e_score:.2e}, sensitivity {sens:.1e}); {shape}", g.tolerance);
         } else {
-            crate::output::info(&format!("iteration {n}: full run at λ = {at} (worst score {worst:.2e} {cmp} {:e}; {next_estimate:.2e} there, true error {e_measured:.2e}, its score {e_score:.2e}, sensitivity {sens:.1e}), {shape}", g.tolerance));
+            log::info!("iteration {n}: full run at λ = {at} (worst score {worst:.2e} {cmp} {:e}; {next_estimate:.2e} there, true error {e_measured:.2e}, its score {e_score:.2e}, sensitivity {sens:.1e}), {shape}", g.tolerance);
         }
         iterations.push(it);
         if done {
@@ -266,7 +266,7 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         // the correction was found off for this basis: its online estimates read the reference
         estimator.method = Some(EstimateMethod::Enriched);
     }
-    crate::output::info(&match &estimator.defects {
+    log::info!("{}", match &estimator.defects {
         Some(d) if d.reliable => format!(
             "error estimate: the cheap `defects` method calibrated at the {} candidates (factors {}), the online default",
             d.load_scales.len(),

@@ -73,8 +73,8 @@ fn build(
 ) -> Result<Vec<String>> {
     let plot_err = |e: String| Error::io(out, std::io::Error::other(e));
     match &p.file.train.greedy {
-        Some(g) => crate::output::info(&format!("[1/3] train: greedy over [{}, {}]", g.range().0, g.range().1)),
-        None => crate::output::info(&format!("[1/3] train: {} full run(s)", p.training_scales().len())),
+        Some(g) => log::info!("[1/3] train: greedy over [{}, {}]", g.range().0, g.range().1),
+        None => log::info!("[1/3] train: {} full run(s)", p.training_scales().len()),
     }
     let mut trained = train_and_write(p, basis_path)?;
     // the warnings of loading it come with `check_report`'s, once
@@ -82,7 +82,7 @@ fn build(
     trained.warnings.extend(super::route::time_and_store(&rom, basis_path)?);
 
     let scales = p.online_scales();
-    crate::output::info(&format!("[2/3] sweep: {} reduced and full runs", scales.len()));
+    log::info!("[2/3] sweep: {} reduced and full runs", scales.len());
     let sw = sweep(&rom, &scales, SweepOptions { validate: true, continuation: false, progress })?;
     write_sweep(&out.join("sweep.h5"), &sw, Some(SweepBasis { stored: &stored, path: &p.basis_path }))?;
     // the plots and tables below need every load scale
@@ -92,7 +92,7 @@ fn build(
 
     let vscales = p.validate_scales();
     let with = if dense { ", with the dense full solve" } else { "" };
-    crate::output::info(&format!("[3/3] validate at {} load scale(s){with}", vscales.len()));
+    log::info!("[3/3] validate at {} load scale(s){with}", vscales.len());
     let mut validations: Vec<Validation> = Vec::new();
     for (i, &x) in vscales.iter().enumerate() {
         let (v, full, reduced) = validate(&rom, &Parameters::load_scale(x), dense)?;

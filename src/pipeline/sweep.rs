@@ -151,7 +151,7 @@ pub fn sweep_to_file(route: Route, scales: &[f64], o: SweepOptions, f: SweepFile
             }
             start.resumed = reused;
             let dropped = old.iter().filter(|(x, p)| p.is_some() && !scales.contains(x)).count();
-            crate::output::info(&format!(
+            log::info!(
                 "resuming {}: {reused} of {} load scales already finished, running {}{}",
                 out.display(),
                 scales.len(),
@@ -161,13 +161,9 @@ pub fn sweep_to_file(route: Route, scales: &[f64], o: SweepOptions, f: SweepFile
                 } else {
                     String::new()
                 }
-            ));
+            );
         } else {
-            crate::output::info(&format!(
-                "resuming {}: no such file yet, running all {} load scales",
-                out.display(),
-                scales.len()
-            ));
+            log::info!("resuming {}: no such file yet, running all {} load scales", out.display(), scales.len());
         }
     }
     let basis = route.basis();

@@ -67,7 +67,7 @@ pub(super) fn estimate_candidates(
     (method, measure): (EstimateMethod, ErrorMeasure),
 ) -> Vec<CandidateRun> {
     let target =
-        if crate::output::show_progress() { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() };
+        if crate::output::progress_wanted() { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() };
     let bar = ProgressBar::with_draw_target(Some(loads.len() as u64), target);
     bar.set_style(
         ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} candidates, {elapsed}")

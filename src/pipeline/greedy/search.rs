@@ -127,16 +127,16 @@ pub(super) fn search(r: &Round, g: &GreedySpec, previous_energy: Option<f64>) ->
         match level(r, modes, eps, Some(tau), &order) {
             Ok(l) => {
                 order = worst_first(&l.estimates, &l.evaluated);
-                crate::output::detail(&rung_text(r, &l, eps, tau, g.tolerance));
+                log::debug!("{}", rung_text(r, &l, eps, tau, g.tolerance));
                 Some(l)
             }
             Err(e) => {
-                crate::output::detail(&format!(
+                log::debug!(
                     "  iteration {n}, rung {}: rejected, the basis could not be built ({}: {})",
                     rung_name(eps, tau),
                     e.0,
                     e.1
-                ));
+                );
                 last_error = Some(e);
                 None
             }
@@ -212,12 +212,12 @@ pub(super) fn search(r: &Round, g: &GreedySpec, previous_energy: Option<f64>) ->
     if !best.complete() {
         best.estimate(p, candidates, &format!("iteration {n}"), r.method);
     }
-    crate::output::detail(&format!(
+    log::debug!(
         "  iteration {n} keeps rung {}: {}{}",
         rung_name(best.energy, best.hyper_tolerance.unwrap_or(f64::NAN)),
         modes_text(&best.trained.block_modes),
         if accepts(&best) { "" } else { " (the lowest worst estimate; no rung met the tolerance)" }
-    ));
+    );
     Ok(best)
 }
 
