@@ -281,6 +281,39 @@ pub fn read_training_loads(path: &Path) -> Result<Vec<f64>> {
     Ok(l)
 }
 
+/// Greedy training's candidates and the reduced model's whole-run sensitivity at each, as
+/// its last iteration measured them (`/training/candidates`, the last row of
+/// `/training/sensitivity`); `None` without greedy training or in files written before the
+/// sensitivity was recorded.
+pub fn read_training_sensitivity(path: &Path) -> Result<Option<(Vec<f64>, Vec<f64>)>> {
+    let f = hdf5::File::open(path)
+        .map_err(|e| Error::input(path, "(file)", format!("is not a readable HDF5 file: {e}")))?;
+    let Ok(g) = f.group("training") else { return Ok(None) };
+    let (Ok(c), Ok(s)) = (g.dataset("candidates"), g.dataset("sensitivity")) else { return Ok(None) };
+    let c =
+        c.read_1d::<f64>().map_err(|e| Error::input(path, "training/candidates", format!("cannot be read: {e}")))?;
+    let s =
+        s.read_2d::<f64>().map_err(|e| Error::input(path, "training/sensitivity", format!("cannot be read: {e}")))?;
+    if !c.iter().all(|x| x.is_finite()) || c.windows(2).into_iter().any(|w| !(w[0] < w[1])) {
+        return Err(Error::input(path, "training/candidates", "must be finite and increasing"));
+    }
+    if s.nrows() == 0 {
+        return Ok(None);
+    }
+    if s.ncols() != c.len() {
+        return Err(Error::input(
+            path,
+            "training/sensitivity",
+            format!("has {} columns for {} candidates (training/candidates)", s.ncols(), c.len()),
+        ));
+    }
+    let last = s.row(s.nrows() - 1).to_vec();
+    if last.iter().any(|x| *x < 0.0) {
+        return Err(Error::input(path, "training/sensitivity", "has a negative entry: a sensitivity is a norm ratio"));
+    }
+    Ok(Some((c.to_vec(), last)))
+}
+
 /// Greedy training's tolerance: the dataset `/training/tolerance` or the attribute
 /// `tolerance` on `/training`; `None` without greedy training.
 pub fn read_training_tolerance(path: &Path) -> Result<Option<f64>> {

@@ -81,6 +81,9 @@ pub struct Validation {
     pub training_range: Option<[f64; 2]>,
     /// relative difference of full runs at λ and 1.001 λ (null when not measured)
     pub sensitivity: Option<f64>,
+    /// the reduced model's sensitivity at greedy training's candidates beside the load
+    /// ([`crate::rom::trust::LoadSensitivity`]; null for other bases)
+    pub sensitivity_near: Option<f64>,
     /// rel_error up to the end of each fifth of the run (the last is rel_error)
     pub rel_error_by_time: Vec<f64>,
     /// error_estimate up to the end of each fifth of the run, the estimate of
@@ -206,6 +209,7 @@ pub fn compare(
         extrapolated: false,
         training_range: None,
         sensitivity: None,
+        sensitivity_near: None,
         rel_error_by_time: rel_error_by_time(&r.q, &full.q).to_vec(),
         error_estimate_by_time: None,
         displacement_error: displacement_error_by_time[displacement_error_by_time.len() - 1],
@@ -267,6 +271,7 @@ impl Validation {
         if let Some(t) = rom.and_then(|r| r.trust()) {
             self.extrapolated = crate::rom::trust::is_extrapolated(t.range, self.load_scale);
             self.training_range = Some([t.range.0, t.range.1]);
+            self.sensitivity_near = t.sensitivity.as_ref().and_then(|s| s.near(self.load_scale));
         }
         if estimate.is_some() {
             self.error_estimate_method = rom.and_then(|r| r.method()).map(str::to_string);

@@ -81,7 +81,8 @@ impl Rom {
     /// warnings a user should see (a method whose own check failed for this basis).
     pub fn load(model: &Arc<Model>, path: &Path, stored: &StoredBasis, o: LoadOptions) -> Result<(Self, Vec<String>)> {
         use crate::io::estimator_file::{
-            read_estimator, read_training_measure, read_training_range, read_training_tolerance,
+            read_estimator, read_training_measure, read_training_range, read_training_sensitivity,
+            read_training_tolerance,
         };
         let mut warnings = Vec::new();
         let data = if o.no_estimate { None } else { read_estimator(path, &stored.basis)? };
@@ -108,7 +109,9 @@ impl Rom {
             Some(t) => (Some(t), o.tolerance_measure.unwrap_or(trained)),
             None => (read_training_tolerance(path)?, trained),
         };
-        let trust = Trust { range: read_training_range(path)?, tolerance, measure, skipped: o.no_estimate };
+        let sensitivity = read_training_sensitivity(path)?.map(|(c, s)| trust::LoadSensitivity::new(c, s));
+        let range = read_training_range(path)?;
+        let trust = Trust { range, tolerance, measure, skipped: o.no_estimate, sensitivity };
         Ok((Rom::new(model, &stored.basis, estimator, Some(trust))?, warnings))
     }
 
@@ -144,6 +147,13 @@ impl Rom {
     /// are not known).
     pub fn is_extrapolated(&self, mu: &Parameters) -> bool {
         self.trust.as_ref().is_some_and(|t| trust::is_extrapolated(t.range, mu.scale()))
+    }
+
+    /// How far the reduced answer moves for a 0.1 % change of the load near `mu`, as
+    /// greedy training measured it at the candidates beside it ([`trust::LoadSensitivity`]);
+    /// `None` for bases without that record.
+    pub fn sensitivity_near(&self, mu: &Parameters) -> Option<f64> {
+        self.trust.as_ref()?.sensitivity.as_ref()?.near(mu.scale())
     }
 
     /// The reduced run at `mu`, reconstructed in full coordinates.

@@ -17,12 +17,73 @@ pub struct Trust {
     pub measure: ErrorMeasure,
     /// the user asked for no estimate (`--no-estimate`): no warnings about its absence
     pub skipped: bool,
+    /// the reduced model's sensitivity to the load along the training range (greedy bases)
+    pub sensitivity: Option<LoadSensitivity>,
 }
 
 impl Trust {
     /// Trust in a basis trained over `range` with no tolerance to hold its estimates to.
     pub fn range(range: (f64, f64)) -> Self {
-        Trust { range, tolerance: None, measure: ErrorMeasure::Relative, skipped: false }
+        Trust { range, tolerance: None, measure: ErrorMeasure::Relative, skipped: false, sensitivity: None }
+    }
+}
+
+/// δ of the sensitivity `s(λ) = ‖X_r(λ(1 + δ)) − X_r(λ)‖ / ‖X_r(λ)‖`: how much the answer
+/// moves for a 0.1 % change of the load (the `sensitivity` `validate` reports).
+pub const SENSITIVITY_STEP: f64 = 1e-3;
+
+/// How much more than the load's own relative change `δ` the answer must move before the
+/// model counts as amplifying it: an order of magnitude. A response that follows the load
+/// moves the answer by `δ ‖λ ∂X/∂λ‖ / ‖X‖`, about `δ` or less (the load-driven part of the
+/// answer is no larger than the answer; the period of a swinging pendulum shifting with
+/// its amplitude adds a few times that: `s/δ` ≤ 2.7 over the zoo's calm models and the
+/// shipped pendulums, docs/zoo.md); chaotic dynamics amplify it tens to hundreds of times
+/// (the four-bar after t ≈ 0.7 s: `s/δ` 9–160).
+pub const AMPLIFYING: f64 = 10.0;
+
+/// The reduced model's whole-run sensitivity at greedy training's candidates (its last
+/// iteration; docs/greedy-training.md):
+///
+/// ```text
+///     s(λ_c) = ‖X_r(λ_c (1 + δ)) − X_r(λ_c)‖ / ‖X_r(λ_c)‖,   δ = 0.1 %
+/// ```
+///
+/// Where `s` exceeds the tolerance and [`AMPLIFYING`]` · δ`, the dynamics amplify a small
+/// difference of the load — or of the model, the reduction's among them — to an error
+/// above the tolerance, which no estimate that follows the reduced trajectory sees (it
+/// compares two trajectories of the same amplifying dynamics). Between candidates the
+/// larger neighbour counts: the sensitivity jumps with the dynamics, it does not
+/// interpolate.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoadSensitivity {
+    candidates: Vec<f64>,
+    whole_run: Vec<f64>,
+}
+
+impl LoadSensitivity {
+    /// `candidates` increasing, one sensitivity each (NaN where it was not measured).
+    pub fn new(candidates: Vec<f64>, whole_run: Vec<f64>) -> Self {
+        LoadSensitivity { candidates, whole_run }
+    }
+
+    /// The larger sensitivity of the candidates beside `x` (the candidate itself when `x` is
+    /// one, the end candidate outside their range); `None` when neither was measured.
+    pub fn near(&self, x: f64) -> Option<f64> {
+        let c = &self.candidates;
+        if c.is_empty() || !x.is_finite() {
+            return None;
+        }
+        let k = c.partition_point(|&y| y < x);
+        let beside: &[usize] = if k < c.len() && c[k] == x {
+            &[k]
+        } else if k == 0 {
+            &[0]
+        } else if k == c.len() {
+            &[c.len() - 1]
+        } else {
+            &[k - 1, k]
+        };
+        beside.iter().map(|&i| self.whole_run[i]).filter(|s| s.is_finite()).reduce(f64::max)
     }
 }
 
@@ -55,14 +116,18 @@ pub fn describe(e: &Estimate, method: &str, rom_seconds: f64) -> String {
 /// `displacement`: which estimate the tolerance holds; when set), `error_estimate_method`
 /// (`corrected`, `defects` or `enriched`; when there is an estimate),
 /// `error_estimate_displacement` and `error_estimate_displacement_by_time` (the estimate of
-/// the displacement-relative error, NaN without an estimator).
+/// the displacement-relative error, NaN without an estimator), `sensitivity_near` (the
+/// reduced model's sensitivity at greedy training's candidates beside the load, NaN for
+/// other bases: [`LoadSensitivity`]).
 pub fn write_run_attributes(
     f: &hdf5::File,
     e: Option<&Estimate>,
     method: Option<&str>,
     trust: &Trust,
-    extrapolated: bool,
+    load_scale: f64,
 ) -> hdf5::Result<()> {
+    let extrapolated = is_extrapolated(trust.range, load_scale);
+    let sensitivity_near = trust.sensitivity.as_ref().and_then(|s| s.near(load_scale));
     use crate::io::h5::{attr_f64, attr_u64};
     use crate::reduction::estimator::FIFTHS;
     attr_f64(f, "error_estimate", e.map_or(f64::NAN, |e| e.error_estimate))?;
@@ -87,7 +152,13 @@ pub fn write_run_attributes(
         .shape(FIFTHS)
         .create("error_estimate_displacement_by_time")?
         .write(&e.map_or([f64::NAN; FIFTHS], |e| e.displacement_by_time))?;
+    attr_f64(f, "sensitivity_near", sensitivity_near.unwrap_or(f64::NAN))?;
     Ok(())
+}
+
+/// A load scale in a list of a message: four decimals at most, no trailing zeros.
+fn short(x: f64) -> String {
+    format!("{x:.4}").trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
 /// At most five entries of a list for a one-line message, then "…".
@@ -100,8 +171,9 @@ fn few(v: &[String]) -> String {
 }
 
 /// The warnings about finished runs, one line each (without the `warning: ` prefix): the
-/// load scales outside the training range, a basis without an estimator, and estimates
-/// above the tolerance; `runs` are `(load scale, the estimate in the trust's measure)`
+/// load scales outside the training range, a basis without an estimator, load scales where
+/// the model is sensitive beyond the tolerance and the estimate below that sensitivity
+/// ([`LoadSensitivity`]), and estimates above the tolerance; `runs` are `(load scale, the estimate in the trust's measure)`
 /// ([`Estimate::in_measure`]) and `has_estimator` says whether the basis has one. With `strict`, an estimate above the tolerance (or none at
 /// all when a tolerance is set) is an [`Error::Strict`] instead, for after the output is
 /// written.
@@ -113,11 +185,7 @@ pub fn check_runs(
 ) -> Result<Vec<String>> {
     let mut warnings = Vec::new();
     let (a, b) = trust.range;
-    let out: Vec<String> = runs
-        .iter()
-        .filter(|r| is_extrapolated(trust.range, r.0))
-        .map(|r| format!("{:.4}", r.0).trim_end_matches('0').trim_end_matches('.').to_string())
-        .collect();
+    let out: Vec<String> = runs.iter().filter(|r| is_extrapolated(trust.range, r.0)).map(|r| short(r.0)).collect();
     if !out.is_empty() {
         let what = if runs.len() == 1 {
             format!("load scale {}", out[0])
@@ -127,6 +195,29 @@ pub fn check_runs(
         warnings.push(format!(
             "{what} outside the basis's training range [{a}, {b}]: extrapolated, the reduced model was never trained there"
         ));
+    }
+    if let (Some(sens), Some(tol)) = (&trust.sensitivity, trust.tolerance) {
+        let sensitive: Vec<String> = runs
+            .iter()
+            .filter_map(|r| {
+                let s = sens.near(r.0)?;
+                let amplifying = s > tol.max(AMPLIFYING * SENSITIVITY_STEP);
+                (amplifying && r.1.is_none_or(|e| !(e >= s))).then(|| format!("{} ({s:.1e})", short(r.0)))
+            })
+            .collect();
+        if !sensitive.is_empty() {
+            let what = if runs.len() == 1 {
+                format!("load scale {}", sensitive[0])
+            } else {
+                format!("{} of {} load scales: {}", sensitive.len(), runs.len(), few(&sensitive))
+            };
+            warnings.push(format!(
+                "the model amplifies changes of the load at {what}: near there a 0.1 % change of the load moved \
+                 the reduced answer by more than the tolerance {tol:e} and more than 1 % over the run (training's \
+                 sensitivity, in brackets); errors up to that size come from the dynamics, and the error estimate \
+                 does not see them. Where it matters, run the full model there (`validate`, `sweep --full`)"
+            ));
+        }
     }
     if !has_estimator && runs.iter().all(|r| r.1.is_none()) && !trust.skipped {
         warnings.push("the basis file has no error estimator (/estimator; written by `flexrom train` since this version): no error_estimate; train again".into());
@@ -183,7 +274,13 @@ mod tests {
     /// into an error.
     #[test]
     fn warnings_are_returned_and_strict_fails() {
-        let t = Trust { range: (0.5, 1.5), tolerance: Some(1e-3), measure: ErrorMeasure::Relative, skipped: false };
+        let t = Trust {
+            range: (0.5, 1.5),
+            tolerance: Some(1e-3),
+            measure: ErrorMeasure::Relative,
+            skipped: false,
+            sensitivity: None,
+        };
         let w = check_runs(&t, true, &[(1.7, Some(1e-4)), (1.0, Some(2e-3))], false).unwrap();
         assert_eq!(w.len(), 2, "{w:?}");
         assert!(w[0].contains("1 of 2 load scales (1.7)") && w[1].contains("above the tolerance 1e-3"), "{w:?}");
@@ -194,5 +291,61 @@ mod tests {
         assert!(check_runs(&t, true, &[(1.0, Some(1e-4))], true).unwrap().is_empty());
         let none = check_runs(&Trust::range((0.5, 1.5)), false, &[(1.0, None)], false).unwrap();
         assert!(none.len() == 1 && none[0].contains("no error estimator"), "{none:?}");
+    }
+}
+
+#[cfg(test)]
+mod sensitivity_tests {
+    use super::*;
+
+    /// Between two candidates the larger neighbour counts; at a candidate, its own value;
+    /// outside, the end one; unmeasured (NaN) neighbours are left out.
+    #[test]
+    fn the_sensitivity_near_a_load_is_its_larger_neighbour() {
+        let s = LoadSensitivity::new(vec![0.5, 1.0, 1.5], vec![1e-3, 3e-2, f64::NAN]);
+        assert_eq!(s.near(0.75), Some(3e-2));
+        assert_eq!(s.near(0.5), Some(1e-3));
+        assert_eq!(s.near(1.0), Some(3e-2));
+        assert_eq!(s.near(0.1), Some(1e-3));
+        assert_eq!(s.near(1.25), Some(3e-2));
+        assert_eq!(s.near(1.5), None);
+        assert_eq!(s.near(9.0), None);
+        assert_eq!(LoadSensitivity::new(vec![], vec![]).near(1.0), None);
+    }
+
+    /// A load whose neighbouring sensitivity is above the tolerance, ten times δ and the estimate
+    /// is named (the estimate cannot see the errors the dynamics amplify there); an estimate
+    /// at or above that sensitivity, or a calm neighbourhood, says nothing.
+    #[test]
+    fn loads_where_the_model_is_sensitive_beyond_the_estimate_are_named() {
+        let t = Trust {
+            range: (0.5, 1.5),
+            tolerance: Some(1e-2),
+            measure: ErrorMeasure::Relative,
+            skipped: false,
+            sensitivity: Some(LoadSensitivity::new(vec![0.5, 1.0, 1.5], vec![1e-3, 3e-2, 1e-3])),
+        };
+        let w = check_runs(&t, true, &[(1.2, Some(1e-4))], false).unwrap();
+        assert_eq!(w.len(), 1, "{w:?}");
+        assert!(w[0].contains("amplifies changes of the load at load scale 1.2 (3.0e-2)"), "{}", w[0]);
+        // below the first candidate only its own, calm value counts
+        assert!(check_runs(&t, true, &[(0.4, Some(1e-4))], false).unwrap().iter().all(|w| !w.contains("amplifies")));
+        // an estimate already as large as the sensitivity (but within T) covers it
+        let t2 = Trust { tolerance: Some(5e-2), ..t.clone() };
+        assert!(check_runs(&t2, true, &[(1.2, Some(1e-4))], false).unwrap().is_empty(), "s below T: calm enough");
+        let w = check_runs(&t, true, &[(1.2, Some(4e-2)), (0.7, None), (0.3, Some(1e-4))], false).unwrap();
+        let sens: Vec<_> = w.iter().filter(|w| w.contains("amplifies")).collect();
+        assert_eq!(sens.len(), 1);
+        assert!(sens[0].contains("1 of 3 load scales: 0.7 (3.0e-2)"), "{}", sens[0]);
+        // above a tight tolerance but a response that follows the load (s = 5 δ, as a
+        // swinging pendulum's): not amplifying, nothing said
+        let calm = Trust {
+            tolerance: Some(1e-3),
+            sensitivity: Some(LoadSensitivity::new(vec![0.5, 1.5], vec![5e-3, 5e-3])),
+            ..t.clone()
+        };
+        assert!(check_runs(&calm, true, &[(1.2, Some(1e-4))], false).unwrap().is_empty());
+        // not an error under --strict: the estimates themselves are within the tolerance
+        assert!(check_runs(&t, true, &[(1.2, Some(1e-4))], true).is_ok());
     }
 }

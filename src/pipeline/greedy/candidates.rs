@@ -17,9 +17,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use std::sync::Arc;
 
-/// δ of the sensitivity `s(λ) = ‖X_r(λ(1 + δ)) − X_r(λ)‖ / ‖X_r(λ)‖`: how much the answer
-/// moves for a 0.1 % change of the load (the `sensitivity` `validate` reports).
-pub const SENSITIVITY_STEP: f64 = 1e-3;
+pub use crate::rom::trust::SENSITIVITY_STEP;
 
 /// The score of one candidate (the greedy module documentation): `T · max_i η_i / max(T, s_i)`; NaN
 /// counts as ∞.
