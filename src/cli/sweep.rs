@@ -108,7 +108,14 @@ impl Args {
             None => None,
         };
         let route = match &loaded {
-            Some((stored, rom, _)) => Route::Reduced { rom, basis: SweepBasis { stored, path: &path } },
+            Some((stored, rom, _)) => Route::Reduced {
+                rom,
+                basis: SweepBasis {
+                    stored,
+                    path: &path,
+                    sensitivity: rom.trust().and_then(|t| t.sensitivity.as_ref()),
+                },
+            },
             None => Route::Full(&p.model),
         };
         let options =

@@ -142,7 +142,7 @@ const BASIS: [Entry; 46] = [
     ("timing/estimate_seconds", "s", ""),
 ];
 
-const SWEEP: [Entry; 25] = [
+const SWEEP: [Entry; 26] = [
     ("load_scales", "1", "load"),
     ("status", "1", "load"),
     ("message", TEXT, "load"),
@@ -160,6 +160,7 @@ const SWEEP: [Entry; 25] = [
     ("error_estimate_displacement_by_time", "1", "load, fifth"),
     ("estimate_seconds", "s", "load"),
     ("extrapolated", "1", "load"),
+    ("sensitivity_near", "1", "load"),
     ("rel_error", "1", "load"),
     ("max_probe_error", "m", "load"),
     ("max_constraint_violation", VIOLATION_UNITS, "load"),

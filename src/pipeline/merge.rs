@@ -325,8 +325,17 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool, limits: &Limits) -> R
         }
     }
     let gaps = sweep.scales.iter().filter(|x| matches!(x.outcome, Outcome::Pending)).count();
-    let basis =
-        stored.as_ref().zip(first.basis.as_ref()).map(|(stored, b)| SweepBasis { stored, path: Path::new(&b.attr) });
+    // the basis file is where the parts say (checked against their hash above)
+    let sensitivity = match &first.basis {
+        Some(b) if stored.is_some() => crate::io::estimator_file::read_training_sensitivity(&b.path)?
+            .map(|(c, v)| crate::rom::trust::LoadSensitivity::new(c, v)),
+        _ => None,
+    };
+    let basis = stored.as_ref().zip(first.basis.as_ref()).map(|(stored, b)| SweepBasis {
+        stored,
+        path: Path::new(&b.attr),
+        sensitivity: sensitivity.as_ref(),
+    });
     write_sweep(out, &sweep, basis)?;
     Ok(Merged { sweep, gaps, parts: parts.len() })
 }

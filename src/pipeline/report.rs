@@ -84,7 +84,15 @@ fn build(
     let scales = p.online_scales();
     log::info!("[2/3] sweep: {} reduced and full runs", scales.len());
     let sw = sweep(&rom, &scales, SweepOptions { validate: true, continuation: false, progress })?;
-    write_sweep(&out.join("sweep.h5"), &sw, Some(SweepBasis { stored: &stored, path: &p.basis_path }))?;
+    write_sweep(
+        &out.join("sweep.h5"),
+        &sw,
+        Some(SweepBasis {
+            stored: &stored,
+            path: &p.basis_path,
+            sensitivity: rom.trust().and_then(|t| t.sensitivity.as_ref()),
+        }),
+    )?;
     // the plots and tables below need every load scale
     if let Some(s) = sw.failure_summary() {
         return Err(Error::PartlyFailed(format!("sweep: {s}; no report written (the basis is)")));

@@ -20,6 +20,8 @@
 //! /error_estimate_displacement (N)   the estimate of displacement_error of each run
 //! /error_estimate_displacement_by_time (N, 5)   the same up to the end of each fifth
 //! /extrapolated       (N)            1 where the load scale is outside the training range
+//! /sensitivity_near   (N)            the reduced model's sensitivity at greedy training's
+//!                                    candidates beside the load (NaN for other bases)
 //! /estimate_seconds   (N)            the estimator's enriched run and norms, s
 //! with --validate:    /rel_error, /max_probe_error, /max_constraint_violation,
 //!                     /full_seconds, /speedup, /steps_differ_from, /displacement_error  (N each)
@@ -41,6 +43,7 @@ use crate::io::h5::{attr_f64, attr_str, attr_u64, read_attr_str};
 use crate::model::Model;
 use crate::pipeline::validate::Validation;
 use crate::rom::estimator::Estimate;
+use crate::rom::trust::LoadSensitivity;
 use crate::rom::ReducedRun;
 use crate::simulate::{Overrides, Settings, SimulationResult};
 use crate::solver::generalized_alpha::Stats;
@@ -57,6 +60,8 @@ pub type Extra<'a> = &'a (dyn Fn(&hdf5::File) -> Result<()> + Sync);
 pub struct SweepBasis<'a> {
     pub stored: &'a StoredBasis,
     pub path: &'a Path,
+    /// greedy training's sensitivity along the range (`/sensitivity_near`), when it has one
+    pub sensitivity: Option<&'a LoadSensitivity>,
 }
 
 /// The value of the `route` attribute: what the sweep ran.
@@ -177,6 +182,14 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, basis: Option<SweepBasis>, extra
             .with_data(&Array1::from_iter(s.scales.iter().map(|x| x.point().is_some_and(|p| p.extrapolated) as u8)))
             .create("extrapolated")
             .map_err(e)?;
+        // training's sensitivity beside each load (NaN: a full sweep, or a basis without it)
+        let sensitivity = basis.as_ref().and_then(|b| b.sensitivity);
+        f.new_dataset_builder()
+            .with_data(&Array1::from_iter(
+                s.scales.iter().map(|x| sensitivity.as_ref().and_then(|t| t.near(x.mu.scale())).unwrap_or(f64::NAN)),
+            ))
+            .create("sensitivity_near")
+            .map_err(e)?;
         if s.validated {
             let v = |g: &dyn Fn(&Validation) -> f64| col(&|p: &SweepPoint| p.validation.as_ref().map_or(f64::NAN, g));
             f.new_dataset_builder().with_data(&v(&|x| x.rel_error)).create("rel_error").map_err(e)?;
@@ -201,7 +214,7 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, basis: Option<SweepBasis>, extra
                 .map_err(e)?;
         }
         attr_str(f, "route", route_name(s.full)).map_err(e)?;
-        if let Some(SweepBasis { stored, path: basis_path }) = basis {
+        if let Some(SweepBasis { stored, path: basis_path, .. }) = basis {
             // absolute, so that the file names its basis wherever it is read from
             attr_str(f, "basis", &crate::io::output::resolve(basis_path).display().to_string()).map_err(e)?;
             attr_str(f, "basis_content_hash", &stored.content_hash).map_err(e)?;
