@@ -216,13 +216,14 @@ fn g3(x: f64) -> String {
 
 fn aggregate_row(a: &Aggregate) -> String {
     format!(
-        "| {}/{} ({}) | {}/{} ({:.1} %) | {}/{} ({:.1} %) | {} | {} | {} | {} |",
+        "| {}/{} ({}) | {}/{} ({:.1} %) | {} | {}/{} ({:.1} %) | {} | {} | {} | {} |",
         a.converged,
         a.models,
         pct(a.share_converged()),
         a.covered_pairs,
         a.pairs,
         100.0 * a.pair_coverage(),
+        a.silent_under_pairs,
         a.covered_triples,
         a.triples,
         100.0 * a.triple_coverage(),
@@ -233,7 +234,7 @@ fn aggregate_row(a: &Aggregate) -> String {
     )
 }
 
-const AGG_HEAD: &str = "| converged | coverage (model, load) | coverage (model, load, fifth) | effectivity median | 95th pct | max | estimator cost median |\n|---|---|---|---|---|---|---|";
+const AGG_HEAD: &str = "| converged | coverage (model, load) | under without a warning | coverage (model, load, fifth) | effectivity median | 95th pct | max | estimator cost median |\n|---|---|---|---|---|---|---|---|";
 
 fn short_reason(t: &Training) -> String {
     if t.converged {

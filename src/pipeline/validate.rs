@@ -84,6 +84,9 @@ pub struct Validation {
     /// the reduced model's sensitivity at greedy training's candidates beside the load
     /// ([`crate::rom::trust::LoadSensitivity`]; null for other bases)
     pub sensitivity_near: Option<f64>,
+    /// `online`, `validate` and `sweep` warn that the model amplifies changes of the load
+    /// here beyond what the estimate sees ([`crate::rom::Trust::amplifying_near`])
+    pub amplifying: bool,
     /// rel_error up to the end of each fifth of the run (the last is rel_error)
     pub rel_error_by_time: Vec<f64>,
     /// error_estimate up to the end of each fifth of the run, the estimate of
@@ -210,6 +213,7 @@ pub fn compare(
         training_range: None,
         sensitivity: None,
         sensitivity_near: None,
+        amplifying: false,
         rel_error_by_time: rel_error_by_time(&r.q, &full.q).to_vec(),
         error_estimate_by_time: None,
         displacement_error: displacement_error_by_time[displacement_error_by_time.len() - 1],
@@ -272,6 +276,8 @@ impl Validation {
             self.extrapolated = crate::rom::trust::is_extrapolated(t.range, self.load_scale);
             self.training_range = Some([t.range.0, t.range.1]);
             self.sensitivity_near = t.sensitivity.as_ref().and_then(|s| s.near(self.load_scale));
+            let in_measure = estimate.map(|e| e.in_measure(t.measure));
+            self.amplifying = t.amplifying_near(self.load_scale, in_measure).is_some();
         }
         if estimate.is_some() {
             self.error_estimate_method = rom.and_then(|r| r.method()).map(str::to_string);
@@ -370,6 +376,12 @@ impl Validation {
         }
         if let Some(x) = self.sensitivity {
             s.push_str(&format!("\n  sensitivity {x:.3e} (full runs at λ and 1.001 λ)"));
+        }
+        if let (true, Some(x)) = (self.amplifying, self.sensitivity_near) {
+            s.push_str(&format!(
+                "\n  the model amplifies changes of the load here (training's sensitivity {x:.1e} beside it): \
+                 the estimate does not see errors up to that size"
+            ));
         }
         if let Some(t) = self.steps_differ_from {
             let list = |v: &[f64]| {

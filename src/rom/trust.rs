@@ -26,6 +26,16 @@ impl Trust {
     pub fn range(range: (f64, f64)) -> Self {
         Trust { range, tolerance: None, measure: ErrorMeasure::Relative, skipped: false, sensitivity: None }
     }
+
+    /// The sensitivity near load scale `x` when the model amplifies changes of the load
+    /// there beyond what `estimate` (in the trust's measure; `None`: no estimate) can see:
+    /// above the tolerance, above [`AMPLIFYING`]` · δ` and above the estimate
+    /// ([`LoadSensitivity`]). `None` otherwise, or without a tolerance or the training record.
+    pub fn amplifying_near(&self, x: f64, estimate: Option<f64>) -> Option<f64> {
+        let (tol, s) = (self.tolerance?, self.sensitivity.as_ref()?.near(x)?);
+        let amplifying = s > tol.max(AMPLIFYING * SENSITIVITY_STEP);
+        (amplifying && estimate.is_none_or(|e| !(e >= s))).then_some(s)
+    }
 }
 
 /// δ of the sensitivity `s(λ) = ‖X_r(λ(1 + δ)) − X_r(λ)‖ / ‖X_r(λ)‖`: how much the answer
@@ -196,14 +206,10 @@ pub fn check_runs(
             "{what} outside the basis's training range [{a}, {b}]: extrapolated, the reduced model was never trained there"
         ));
     }
-    if let (Some(sens), Some(tol)) = (&trust.sensitivity, trust.tolerance) {
+    if let Some(tol) = trust.tolerance {
         let sensitive: Vec<String> = runs
             .iter()
-            .filter_map(|r| {
-                let s = sens.near(r.0)?;
-                let amplifying = s > tol.max(AMPLIFYING * SENSITIVITY_STEP);
-                (amplifying && r.1.is_none_or(|e| !(e >= s))).then(|| format!("{} ({s:.1e})", short(r.0)))
-            })
+            .filter_map(|r| trust.amplifying_near(r.0, r.1).map(|s| format!("{} ({s:.1e})", short(r.0))))
             .collect();
         if !sensitive.is_empty() {
             let what = if runs.len() == 1 {

@@ -469,6 +469,7 @@ pub fn read_sweep(
             training_range: None,
             sensitivity: None,
             sensitivity_near: None,
+            amplifying: false,
             rel_error_by_time: Vec::new(),
             error_estimate_by_time: None,
             displacement_error: displacement.as_ref().map_or(f64::NAN, |a| a[k]),

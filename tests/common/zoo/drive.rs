@@ -57,6 +57,9 @@ pub struct Validation {
     pub rom_seconds: f64,
     pub estimate_seconds: f64,
     pub speedup: f64,
+    /// the run warned that the model amplifies changes of the load beyond what the estimate
+    /// sees (`amplifying` of `validate --json`; false when absent)
+    pub amplifying: bool,
 }
 
 /// The last line of a process's stderr that says something (its error).
@@ -215,6 +218,7 @@ impl Flexrom {
             rom_seconds: number(&v, "rom_seconds"),
             estimate_seconds: number(&v, "estimate_seconds"),
             speedup: number(&v, "speedup"),
+            amplifying: v.get("amplifying").and_then(Value::as_bool).unwrap_or(false),
         })
     }
 }

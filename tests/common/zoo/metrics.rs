@@ -62,6 +62,9 @@ pub struct ModelStats {
     pub covered_pairs: usize,
     pub covered_triples: usize,
     pub under_pairs: usize,
+    /// under pairs of runs that gave an answer without warning that the model amplifies
+    /// changes of the load there: the estimate read low silently
+    pub silent_under_pairs: usize,
     pub under_triples: usize,
     /// coverage per fifth (0..1)
     pub coverage_by_fifth: [f64; 5],
@@ -106,6 +109,7 @@ pub fn model_stats(runs: &[Result<Validation, String>]) -> ModelStats {
             s.covered_pairs += 1;
         } else {
             s.under_pairs += 1;
+            s.silent_under_pairs += usize::from(!v.amplifying);
         }
         for (i, (e, t)) in v.error_estimate_by_time.iter().zip(&v.rel_error_by_time).enumerate() {
             if e >= t {
@@ -139,6 +143,8 @@ pub struct Aggregate {
     pub converged: usize,
     pub pairs: usize,
     pub covered_pairs: usize,
+    /// validations whose estimate read below the error without the amplification warning
+    pub silent_under_pairs: usize,
     pub triples: usize,
     pub covered_triples: usize,
     pub effectivity_median: f64,
@@ -215,6 +221,7 @@ pub fn aggregate(models: &[(Option<&Training>, &ModelStats)]) -> Aggregate {
         converged: 0,
         pairs: 0,
         covered_pairs: 0,
+        silent_under_pairs: 0,
         triples: 0,
         covered_triples: 0,
         effectivity_median: f64::NAN,
@@ -229,6 +236,7 @@ pub fn aggregate(models: &[(Option<&Training>, &ModelStats)]) -> Aggregate {
         a.pairs += loads;
         a.triples += 5 * loads;
         a.covered_pairs += s.covered_pairs;
+        a.silent_under_pairs += s.silent_under_pairs;
         a.covered_triples += s.covered_triples;
         eff.extend(&s.effectivities);
         if t.is_none() {
@@ -261,6 +269,7 @@ mod tests {
             rom_seconds: 0.5,
             estimate_seconds: 0.25,
             speedup: 2.0,
+            amplifying: false,
         }
     }
 
@@ -270,6 +279,9 @@ mod tests {
     fn coverage_and_effectivity_are_counted() {
         let s = model_stats(&[Ok(v(2e-3, 1e-3)), Ok(v(1e-3, 2e-3)), Err("failed".into())]);
         assert_eq!((s.covered_pairs, s.under_pairs, s.failed_loads), (1, 2, 1));
+        assert_eq!(s.silent_under_pairs, 1, "the under one gave no warning; a failed run is no silent answer");
+        let warned = Validation { amplifying: true, ..v(1e-3, 2e-3) };
+        assert_eq!(model_stats(&[Ok(warned)]).silent_under_pairs, 0);
         assert_eq!((s.covered_triples, s.under_triples), (4, 11));
         assert_eq!(s.effectivity_median, 2.0);
         assert_eq!(s.effectivity_max, f64::INFINITY);
