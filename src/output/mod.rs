@@ -13,7 +13,9 @@ pub mod table;
 pub mod ticker;
 mod verbosity;
 
-pub use verbosity::{detail, info, note, progress_wanted, set_verbosity, show_progress, verbosity, Verbosity};
+pub use verbosity::{
+    detail, info, note, progress_wanted, set_verbosity, show_progress, verbosity, StderrLog, Verbosity,
+};
 
 use crate::error::{Error, Result};
 use std::io::Write;
