@@ -171,6 +171,16 @@ fn short(x: f64) -> String {
     format!("{x:.4}").trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
+/// The loads a warning is about, of `of` runs: "load scale X" for a single run, else
+/// "K of N load scales" and the list, after `sep`.
+fn which(named: &[String], of: usize, sep: (&str, &str)) -> String {
+    if of == 1 {
+        format!("load scale {}", named[0])
+    } else {
+        format!("{} of {of} load scales{}{}{}", named.len(), sep.0, few(named), sep.1)
+    }
+}
+
 /// At most five entries of a list for a one-line message, then "…".
 fn few(v: &[String]) -> String {
     if v.len() <= 5 {
@@ -197,11 +207,7 @@ pub fn check_runs(
     let (a, b) = trust.range;
     let out: Vec<String> = runs.iter().filter(|r| is_extrapolated(trust.range, r.0)).map(|r| short(r.0)).collect();
     if !out.is_empty() {
-        let what = if runs.len() == 1 {
-            format!("load scale {}", out[0])
-        } else {
-            format!("{} of {} load scales ({})", out.len(), runs.len(), few(&out))
-        };
+        let what = which(&out, runs.len(), (" (", ")"));
         warnings.push(format!(
             "{what} outside the basis's training range [{a}, {b}]: extrapolated, the reduced model was never trained there"
         ));
@@ -212,11 +218,7 @@ pub fn check_runs(
             .filter_map(|r| trust.amplifying_near(r.0, r.1).map(|s| format!("{} ({s:.1e})", short(r.0))))
             .collect();
         if !sensitive.is_empty() {
-            let what = if runs.len() == 1 {
-                format!("load scale {}", sensitive[0])
-            } else {
-                format!("{} of {} load scales: {}", sensitive.len(), runs.len(), few(&sensitive))
-            };
+            let what = which(&sensitive, runs.len(), (": ", ""));
             warnings.push(format!(
                 "the model amplifies changes of the load at {what}: near there a 0.1 % change of the load moved \
                  the reduced answer by more than the tolerance {tol:e} and more than 1 % over the run (training's \
@@ -247,11 +249,7 @@ pub fn check_runs(
     if over.is_empty() {
         return Ok(warnings);
     }
-    let what = if runs.len() == 1 {
-        format!("load scale {}", over[0])
-    } else {
-        format!("{} of {} load scales: {}", over.len(), runs.len(), few(&over))
-    };
+    let what = which(&over, runs.len(), (": ", ""));
     let kind = match trust.measure {
         ErrorMeasure::Relative => "error estimate",
         ErrorMeasure::Displacement => "displacement error estimate",

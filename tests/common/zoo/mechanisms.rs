@@ -177,6 +177,22 @@ fn gravity(rng: &mut Rng, p_scaled: f64) -> Load {
     Load::Gravity { g: [0.0, -G], scaled }
 }
 
+/// A force at the end of the last link, `ratio` (log-uniform in the given range) times the
+/// mechanism's weight, in a drawn direction, with a drawn time function.
+fn tip_force(rng: &mut Rng, bodies: &[Beam], ratio: (f64, f64), t: Time) -> Load {
+    let last = bodies.last().expect("a link");
+    let total: f64 = bodies.iter().map(Beam::mass).sum();
+    let p = rng.log_uniform(ratio.0, ratio.1) * total * G;
+    let dir = rng.uniform(0.0, 2.0 * PI);
+    Load::Force {
+        body: last.name.clone(),
+        node: "end".into(),
+        value: [sig(p * dir.cos(), 3), sig(p * dir.sin(), 3)],
+        function: Some(unit_function(rng, t.t_end, t.dt)),
+        scaled: None,
+    }
+}
+
 /// A moment history of a drawn shape whose size turns a body of rotational inertia `j`
 /// by about `theta` over the run (rigid estimate; gravity and elasticity ignored), at
 /// least `hold` at its peak (a moment that can lift the mechanism against its weight).
@@ -333,17 +349,7 @@ fn n_pendulum(rng: &mut Rng, t: Time) -> Draft {
     joints.insert(0, Joint::GroundPin { body: "link1".into(), node: "start".into() });
     let mut loads = vec![gravity(rng, 0.7)];
     if rng.chance(0.4) {
-        let last = bodies.last().expect("a link");
-        let total: f64 = bodies.iter().map(Beam::mass).sum();
-        let p = rng.log_uniform(0.05, 1.0) * total * G;
-        let dir = rng.uniform(0.0, 2.0 * PI);
-        loads.push(Load::Force {
-            body: last.name.clone(),
-            node: "end".into(),
-            value: [sig(p * dir.cos(), 3), sig(p * dir.sin(), 3)],
-            function: Some(unit_function(rng, t.t_end, t.dt)),
-            scaled: None,
-        });
+        loads.push(tip_force(rng, &bodies, (0.05, 1.0), t));
     }
     let motion = if straight { "released straight".to_string() } else { "released bent".to_string() };
     Draft::new(bodies, joints, loads, motion)
@@ -410,17 +416,7 @@ fn clamped_chain(rng: &mut Rng, t: Time) -> Draft {
         loads.push(driving_moment(rng, t, &mut bodies[1], "start", j, theta, 0.0));
         describe_rotation(theta)
     } else {
-        let last = bodies.last().expect("a link");
-        let total: f64 = bodies.iter().map(Beam::mass).sum();
-        let p = rng.log_uniform(0.1, 2.0) * total * G;
-        let dir = rng.uniform(0.0, 2.0 * PI);
-        loads.push(Load::Force {
-            body: last.name.clone(),
-            node: "end".into(),
-            value: [sig(p * dir.cos(), 3), sig(p * dir.sin(), 3)],
-            function: Some(unit_function(rng, t.t_end, t.dt)),
-            scaled: None,
-        });
+        loads.push(tip_force(rng, &bodies, (0.1, 2.0), t));
         "tip force".into()
     };
     Draft::new(bodies, joints, loads, motion)
