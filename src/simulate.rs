@@ -57,6 +57,7 @@ impl Settings {
             return Err(bad("t-end", t_end));
         }
         mu.validate()?;
+        model.check_parameters(&mu)?;
         let params = IntegratorParams { rho_inf, ..model.integrator_params() };
         params.validate().map_err(|e| Error::Usage(format!("--rho-inf: {e}")))?;
         // the number of whole steps that fit (SPEC §4: 1.1 s at 0.007 s is 157 steps),

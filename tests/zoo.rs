@@ -15,7 +15,7 @@
 #[path = "common/zoo/mod.rs"]
 mod zoo;
 
-use flexrom::model::schema::{JointSpec, LoadSpec};
+use flexrom::model::schema::{JointSpec, LoadSpec, ScaledSpec};
 use flexrom::model::Model;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -55,7 +55,7 @@ fn every_drawn_model_is_within_the_zoo_ranges() {
                 let scaled = f.loads.iter().any(|l| match l {
                     LoadSpec::Gravity { scaled, .. }
                     | LoadSpec::Moment { scaled, .. }
-                    | LoadSpec::Force { scaled, .. } => *scaled,
+                    | LoadSpec::Force { scaled, .. } => *scaled == ScaledSpec::Flag(true),
                 });
                 assert!(scaled, "{what}: no load follows the load scale");
                 let count = |p: fn(&JointSpec) -> bool| f.joints.iter().filter(|j| p(j)).count();

@@ -14,6 +14,7 @@ pub mod validate;
 use flexrom::output::table::{Format, Table};
 use flexrom::output::{self, detail};
 use flexrom::pipeline::dense::DenseChoice;
+use flexrom::solver::parameters::Parameters;
 
 /// `--csv` / `--json`: how a command prints its results on stdout.
 #[derive(clap::Args, Clone, Copy)]
@@ -66,6 +67,53 @@ impl EstimateArgs {
     }
 }
 
+/// `--param NAME=VALUE` (repeatable): the model's named parameters (`scaled = "drive"` on a
+/// load), beside `--load-scale`.
+#[derive(clap::Args, Clone, Default)]
+pub struct ParamArgs {
+    /// a named parameter of the model (a load with `scaled = "NAME"`), e.g. `--param
+    /// drive=1.1`; repeat it for several; `--param load_scale=X` is `--load-scale X`;
+    /// parameters not given keep the model file's loads
+    #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_param, allow_negative_numbers = true)]
+    params: Vec<(String, f64)>,
+}
+
+fn parse_param(s: &str) -> Result<(String, f64), String> {
+    let (name, value) = s.split_once('=').ok_or_else(|| format!("`{s}` is not NAME=VALUE"))?;
+    let v: f64 = value.trim().parse().map_err(|_| format!("`{value}` (parameter {name}) is not a number"))?;
+    Ok((name.trim().to_string(), v))
+}
+
+impl ParamArgs {
+    /// Whether any `--param` was given.
+    pub fn any(&self) -> bool {
+        !self.params.is_empty()
+    }
+
+    /// The parameters of `--load-scale` (if given, else `default_scale`) and every
+    /// `--param`; a parameter given twice, or `--param load_scale` beside `--load-scale`,
+    /// is refused.
+    pub fn parameters(&self, load_scale: Option<f64>, default_scale: f64) -> flexrom::Result<Parameters> {
+        use flexrom::solver::parameters::LOAD_SCALE;
+        let mut mu = Parameters::load_scale(load_scale.unwrap_or(default_scale));
+        let mut seen: Vec<&str> = load_scale.map(|_| LOAD_SCALE).into_iter().collect();
+        for (name, value) in &self.params {
+            if seen.contains(&name.as_str()) {
+                let twice = if name == LOAD_SCALE {
+                    "--load-scale and --param load_scale".to_string()
+                } else {
+                    format!("--param {name}")
+                };
+                return Err(flexrom::Error::Usage(format!("{twice} given twice")));
+            }
+            seen.push(name);
+            mu = mu.with(name, *value);
+        }
+        mu.validate()?;
+        Ok(mu)
+    }
+}
+
 pub fn check_scale(x: f64) -> flexrom::Result<()> {
     if x.is_finite() {
         Ok(())
@@ -105,11 +153,11 @@ pub fn print_table(t: &Table, format: Format, single: bool) -> flexrom::Result<(
 pub fn run_details(r: &flexrom::simulate::SimulationResult) {
     let (s, st) = (&r.settings, &r.stats);
     detail(&format!(
-        "  settings: dt {} s, t_end {} s, rho_inf {}, load scale {}, solver {:?}, {} coordinates",
+        "  settings: dt {} s, t_end {} s, rho_inf {}, {}, solver {:?}, {} coordinates",
         s.dt,
         s.t_end,
         s.rho_inf,
-        s.mu.scale(),
+        s.mu,
         s.solver,
         r.q.nrows()
     ));

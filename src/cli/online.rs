@@ -7,7 +7,6 @@ use flexrom::output::info;
 use flexrom::output::table::{Cell, Table};
 use flexrom::pipeline::online::{load_rom, online_to_file};
 use flexrom::pipeline::Pipeline;
-use flexrom::solver::model::Parameters;
 use std::path::PathBuf;
 
 /// The arguments of `flexrom online`.
@@ -16,8 +15,10 @@ pub struct Args {
     /// pipeline file (TOML)
     pipeline: PathBuf,
     /// multiplies every load marked `scaled` in the model file (negative: the load reversed)
-    #[arg(long, allow_negative_numbers = true)]
-    load_scale: f64,
+    #[arg(long, allow_negative_numbers = true, required_unless_present = "params")]
+    load_scale: Option<f64>,
+    #[command(flatten)]
+    params: super::ParamArgs,
     /// result file (HDF5)
     #[arg(short, long)]
     output: PathBuf,
@@ -36,9 +37,14 @@ pub struct Args {
 
 impl Args {
     pub fn run(self, limits: &Limits) -> flexrom::Result<()> {
-        let Args { pipeline, load_scale, output, basis, strict, estimate, format } = self;
+        let Args { pipeline, load_scale, params, output, basis, strict, estimate, format } = self;
         let p = Pipeline::load_with(&pipeline, limits.clone())?;
-        check_scale(load_scale)?;
+        if let Some(x) = load_scale {
+            check_scale(x)?;
+        }
+        let mu = params.parameters(load_scale, 1.0)?;
+        p.model.check_parameters(&mu)?;
+        let load_scale = mu.scale();
         let path = basis.unwrap_or_else(|| p.basis_path.clone());
         check_output(
             &output,
@@ -49,11 +55,11 @@ impl Args {
         warn(&warnings);
         // read before the run (a damaged /timing fails now), said after it
         let notice = flexrom::pipeline::route::speed_notice_of(&path, &rom)?;
-        let done = online_to_file(&p, &rom, &path, &Parameters::load_scale(load_scale), &output)?;
+        let done = online_to_file(&p, &rom, &path, &mu, &output)?;
         let (run, estimate) = (&done.run, &done.estimate);
         let st = &run.result.stats;
         info(&format!(
-            "{}: reduced run ({} modes) at load scale {load_scale}: {} steps in {:.4} s ({} Newton iterations, {} step cuts) -> {}",
+            "{}: reduced run ({} modes) at {mu}: {} steps in {:.4} s ({} Newton iterations, {} step cuts) -> {}",
             p.path.display(),
             stored.basis.n_reduced(),
             st.steps,
@@ -82,6 +88,7 @@ impl Args {
         print_table(&t, format.format(), true)?;
         warn(notice.as_slice());
         let measure = rom.tolerance_measure();
+        warn(&rom.untrained_parameters(&mu));
         super::check_runs(&rom, &[(load_scale, estimate.map(|e| e.in_measure(measure)))], strict)
     }
 }

@@ -33,7 +33,7 @@ impl Args {
             check_output(output, Origin::Flag("-o"), &[(&model, "model file")])?;
         }
         let model = Model::load_with(&model, limits.clone())?;
-        let overrides = run.overrides();
+        let overrides = run.overrides()?;
         let mu = overrides.mu.clone().unwrap_or_default();
         let compute = || simulate(&model, &overrides).map_err(|e| e.at_stage("simulate", &mu));
         let r = match &output {
@@ -82,19 +82,20 @@ struct RunArgs {
     /// multiplies every load marked `scaled` in the model file (negative: the load reversed)
     #[arg(long, allow_negative_numbers = true)]
     load_scale: Option<f64>,
+    #[command(flatten)]
+    params: super::ParamArgs,
     /// linear solver of the full model
     #[arg(long, value_enum, default_value_t = LinearSolverKind::Banded)]
     solver: LinearSolverKind,
 }
 
 impl RunArgs {
-    fn overrides(&self) -> Overrides {
-        Overrides {
-            dt: self.dt,
-            t_end: self.t_end,
-            rho_inf: self.rho_inf,
-            mu: self.load_scale.map(Parameters::load_scale),
-            solver: self.solver,
-        }
+    fn overrides(&self) -> flexrom::Result<Overrides> {
+        let mu = if self.params.any() {
+            Some(self.params.parameters(self.load_scale, 1.0)?)
+        } else {
+            self.load_scale.map(Parameters::load_scale)
+        };
+        Ok(Overrides { dt: self.dt, t_end: self.t_end, rho_inf: self.rho_inf, mu, solver: self.solver })
     }
 }

@@ -83,6 +83,7 @@ impl Args {
             format,
         } = self;
         let p = Pipeline::load_with(&pipeline, limits.clone())?;
+        p.refuse_box("a sweep")?;
         let scales = match load_scales {
             Some(s) => flexrom::pipeline::config::parse_range(&s)
                 .map_err(|e| flexrom::Error::Usage(format!("--load-scales: {e}")))?,

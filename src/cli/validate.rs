@@ -19,6 +19,8 @@ pub struct Args {
     #[arg(long, allow_negative_numbers = true)]
     load_scale: Option<f64>,
     #[command(flatten)]
+    params: super::ParamArgs,
+    #[command(flatten)]
     format: FormatArgs,
     /// basis file (default: the pipeline's `basis`)
     #[arg(long)]
@@ -35,22 +37,32 @@ pub struct Args {
 
 impl Args {
     pub fn run(self, limits: &Limits) -> flexrom::Result<()> {
-        let Args { pipeline, load_scale, format, basis, dense, strict, estimate } = self;
+        let Args { pipeline, load_scale, params, format, basis, dense, strict, estimate } = self;
         let p = Pipeline::load_with(&pipeline, limits.clone())?;
-        let scales = match load_scale {
-            Some(x) => {
-                check_scale(x)?;
-                vec![x]
+        if let Some(x) = load_scale {
+            check_scale(x)?;
+        }
+        // --param with the pipeline's loads: the named values at each of them
+        let points: Vec<Parameters> = match (load_scale, params.any()) {
+            (Some(_), _) => vec![params.parameters(load_scale, 1.0)?],
+            // the pipeline's validation points: [validate] load_scales, or points of the box
+            (None, false) => p.validation_points(),
+            // named values at each of the [validate] loads (a box: at the point given)
+            (None, true) if !p.space().is_empty() => vec![params.parameters(None, 1.0)?],
+            (None, true) => {
+                p.validate_scales().into_iter().map(|x| params.parameters(Some(x), x)).collect::<Result<_, _>>()?
             }
-            None => p.validate_scales(),
         };
+        if let Some(mu) = points.first() {
+            p.model.check_parameters(mu)?;
+        }
         let path = basis.unwrap_or_else(|| p.basis_path.clone());
         let (_, rom, warnings) = load_rom(&p, &path, estimate.method(), false)?;
         warn(&warnings);
         let with_dense = flexrom::pipeline::dense::decide(dense.choice(), &p.model)?;
-        let mut vs = Vec::with_capacity(scales.len());
-        for &x in &scales {
-            let (v, _, _) = flexrom::pipeline::validate::validate(&rom, &Parameters::load_scale(x), with_dense)?;
+        let mut vs = Vec::with_capacity(points.len());
+        for mu in &points {
+            let (v, _, _) = flexrom::pipeline::validate::validate(&rom, mu, with_dense)?;
             // text: each load's lines as soon as they are known
             if format.format() == Format::Text {
                 output::println(&v.describe())?;
@@ -62,8 +74,8 @@ impl Args {
             // the record as serde writes it (arrays stay arrays): the keys scripts read; one
             // object for --load-scale, else an array as the report's validation.json
             Format::Json => {
-                let text = match (load_scale, vs.as_slice()) {
-                    (Some(_), [v]) => serde_json::to_string(v),
+                let text = match (load_scale.is_some() || params.any(), vs.as_slice()) {
+                    (true, [v]) => serde_json::to_string(v),
                     _ => serde_json::to_string(&vs),
                 };
                 output::println(&text.map_err(json_err)?)?;
@@ -76,6 +88,9 @@ impl Args {
         }
         let measure = rom.tolerance_measure();
         let runs: Vec<(f64, Option<f64>)> = vs.iter().map(|v| (v.load_scale, v.estimate_in(measure))).collect();
+        let mut outside: Vec<String> = points.iter().flat_map(|mu| rom.untrained_parameters(mu)).collect();
+        outside.dedup();
+        warn(&outside);
         super::check_runs(&rom, &runs, strict)
     }
 }

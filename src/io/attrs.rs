@@ -93,7 +93,7 @@ const RESULT: [Entry; 8] = [
     ("reduced/q", REDUCED_UNITS, "time, mode"),
 ];
 
-const BASIS: [Entry; 46] = [
+const BASIS: [Entry; 47] = [
     ("snapshots", COORDINATE_UNITS, "dof, snapshot"),
     ("snapshot_multipliers", MULTIPLIER_UNITS, "constraint, snapshot"),
     ("snapshot_load_scale", "1", "snapshot"),
@@ -120,6 +120,7 @@ const BASIS: [Entry; 46] = [
     ("estimator/defects/load_scale", "1", "load"),
     ("estimator/defects/ratio", "1", "load, fifth"),
     ("estimator/defects/factor", "1", "fifth"),
+    ("parameters/*", "1", "run"),
     ("training/range", "1", "bound"),
     ("training/tolerance", "1", ""),
     ("training/load_scales", "1", "run"),

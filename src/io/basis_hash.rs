@@ -75,7 +75,16 @@ pub fn content_hash(c: &HashInput) -> String {
 /// parsed values as JSON): comments, layout and number spelling do not change it, any
 /// setting that changes the basis does. A pipeline's own is
 /// `crate::pipeline::Pipeline::settings_hash`.
-pub fn settings_hash(train: &impl serde::Serialize, reduction: &impl serde::Serialize) -> String {
-    let json = serde_json::json!({ "train": train, "reduction": reduction });
+pub fn settings_hash<P: serde::Serialize>(
+    train: &impl serde::Serialize,
+    reduction: &impl serde::Serialize,
+    parameters: &std::collections::BTreeMap<String, P>,
+) -> String {
+    // without a [parameters] box the hash is the one of files written before it existed
+    let json = if parameters.is_empty() {
+        serde_json::json!({ "train": train, "reduction": reduction })
+    } else {
+        serde_json::json!({ "train": train, "reduction": reduction, "parameters": parameters })
+    };
     Sha256::digest(json.to_string().as_bytes()).iter().map(|b| format!("{b:02x}")).collect()
 }

@@ -11,5 +11,6 @@ pub mod h5;
 pub mod h5_text;
 pub mod labels;
 pub mod output;
+pub mod parameter_space_file;
 pub mod result_file;
 pub mod timing_file;

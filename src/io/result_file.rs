@@ -120,6 +120,10 @@ impl ResultFile {
         attr_str(f, "model_path", model_path).map_err(e)?;
         attr_str(f, "program_version", env!("CARGO_PKG_VERSION")).map_err(e)?;
         attr_f64(f, "load_scale", plan.mu.scale()).map_err(e)?;
+        // the model's named parameters, where the run sets any: `parameter:NAME`
+        for (name, value) in plan.mu.named() {
+            attr_f64(f, &format!("parameter:{name}"), value).map_err(e)?;
+        }
         attr_f64(f, "dt", plan.dt).map_err(e)?;
         attr_f64(f, "t_end", plan.t_end).map_err(e)?;
         attr_f64(f, "rho_inf", plan.rho_inf).map_err(e)?;

@@ -9,6 +9,7 @@ use crate::error::Result;
 use crate::physics::element::Section;
 use crate::physics::system::{BeamBody, Joint, Load, NodeId, Probe};
 use crate::solver::generalized_alpha::{IntegratorParams, JacobianReuse, Predictor};
+use crate::solver::parameters::{Scaling, LOAD_SCALE};
 
 /// Relative tolerance for a joint to count as closed in the initial configuration.
 const CLOSURE_TOL: f64 = 1e-6;
@@ -150,12 +151,12 @@ impl Model {
             let load = match l {
                 LoadSpec::Gravity { g, scaled } => {
                     self.finite2(&p("g"), *g)?;
-                    Load::Gravity { g: *g, scaled: *scaled }
+                    Load::Gravity { g: *g, scaled: self.scaling(&p("scaled"), scaled)? }
                 }
                 LoadSpec::Moment { body, node, function, scaled } => {
                     let id = self.node_id(&p("body"), &p("node"), body, node)?;
                     function.check().map_err(|e| self.err(p("function"), e))?;
-                    Load::Moment { node: id, function: function.clone(), scaled: *scaled }
+                    Load::Moment { node: id, function: function.clone(), scaled: self.scaling(&p("scaled"), scaled)? }
                 }
                 LoadSpec::Force { body, node, value, function, scaled } => {
                     let id = self.node_id(&p("body"), &p("node"), body, node)?;
@@ -163,7 +164,8 @@ impl Model {
                     if let Some(func) = function {
                         func.check().map_err(|e| self.err(p("function"), e))?;
                     }
-                    Load::Force { node: id, value: *value, function: function.clone(), scaled: *scaled }
+                    let scaled = self.scaling(&p("scaled"), scaled)?;
+                    Load::Force { node: id, value: *value, function: function.clone(), scaled }
                 }
             };
             self.loads.push(load);
@@ -374,6 +376,28 @@ impl Model {
             Ok(())
         } else {
             Err(self.err(field, format!("must be finite, got {v}")))
+        }
+    }
+
+    /// `scaled = true | false | "name"`; a name is a parameter's: letters, digits and `_`,
+    /// not starting with a digit (it becomes `--param name=…` and an HDF5 attribute).
+    fn scaling(&self, field: &str, spec: &ScaledSpec) -> Result<Scaling> {
+        match spec {
+            ScaledSpec::Flag(false) => Ok(Scaling::Fixed),
+            ScaledSpec::Flag(true) => Ok(Scaling::LoadScale),
+            ScaledSpec::Parameter(name) if name == LOAD_SCALE => Ok(Scaling::LoadScale),
+            ScaledSpec::Parameter(name) => {
+                let ok = name.chars().next().is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+                    && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+                if ok {
+                    Ok(Scaling::Named(name.clone()))
+                } else {
+                    Err(self.err(
+                        field,
+                        format!("`{name}` is not a parameter name: use letters, digits and `_`, starting with a letter (or true / false)"),
+                    ))
+                }
+            }
         }
     }
 

@@ -11,6 +11,7 @@ use crate::limits::Limits;
 use crate::linalg::kkt::LinearSolverKind;
 use crate::physics::system::{BeamBody, FlexibleSystem, Joint, Load, Probe, Rayleigh};
 use crate::solver::generalized_alpha::IntegratorParams;
+use crate::solver::parameters::Parameters;
 use schema::*;
 use std::path::{Path, PathBuf};
 use toml_errors::entry_error;
@@ -95,6 +96,39 @@ impl Model {
         canonical.description.clear();
         let json = serde_json::to_string(&canonical).expect("the schema serializes");
         Sha256::digest(json.as_bytes()).iter().map(|b| format!("{b:02x}")).collect()
+    }
+
+    /// The parameters the model's loads are scaled by (`scaled = true` is
+    /// [`crate::solver::parameters::LOAD_SCALE`]), each once, in the order of the loads.
+    pub fn parameter_names(&self) -> Vec<&str> {
+        let mut names: Vec<&str> = Vec::new();
+        for l in &self.loads {
+            let scaling = match l {
+                Load::Gravity { scaled, .. } | Load::Moment { scaled, .. } | Load::Force { scaled, .. } => scaled,
+            };
+            if let Some(name) = scaling.parameter() {
+                if !names.contains(&name) {
+                    names.push(name);
+                }
+            }
+        }
+        names
+    }
+
+    /// Refuses parameters the model does not have (a `--param` misspelt, or one of another
+    /// model): the error names the model file and the parameters it has.
+    pub fn check_parameters(&self, mu: &Parameters) -> Result<()> {
+        let names = self.parameter_names();
+        for (name, _) in mu.named() {
+            if !names.contains(&name) {
+                let have = if names.is_empty() { "none: no load is scaled".to_string() } else { names.join(", ") };
+                return Err(Error::Usage(format!(
+                    "{}: the model has no parameter `{name}` (its parameters: {have})",
+                    self.path.display()
+                )));
+            }
+        }
+        Ok(())
     }
 
     /// Integrator parameters from the `[time]` table.

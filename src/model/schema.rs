@@ -117,18 +117,32 @@ pub enum JointSpec {
     Clamp { body: String, node: NodeRef },
 }
 
-fn yes() -> bool {
-    true
+/// `scaled` of a load: `true` (times the load scale), `false` (fixed), or the name of the
+/// parameter that multiplies it (`scaled = "drive"`).
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(untagged)]
+pub enum ScaledSpec {
+    Flag(bool),
+    Parameter(String),
+}
+
+fn yes() -> ScaledSpec {
+    ScaledSpec::Flag(true)
+}
+
+fn no() -> ScaledSpec {
+    ScaledSpec::Flag(false)
 }
 
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum LoadSpec {
-    /// gravity acceleration vector, m/s²; `scaled` = multiplied by the load scale
+    /// gravity acceleration vector, m/s²; `scaled` = multiplied by the load scale (or by
+    /// the parameter it names)
     Gravity {
         g: [f64; 2],
-        #[serde(default)]
-        scaled: bool,
+        #[serde(default = "no")]
+        scaled: ScaledSpec,
     },
     /// moment (N·m) at a node, `function` of time
     Moment {
@@ -136,7 +150,7 @@ pub enum LoadSpec {
         node: NodeRef,
         function: TimeFunction,
         #[serde(default = "yes")]
-        scaled: bool,
+        scaled: ScaledSpec,
     },
     /// force (N) at a node, times `function` of time if given
     Force {
@@ -146,7 +160,7 @@ pub enum LoadSpec {
         #[serde(default)]
         function: Option<TimeFunction>,
         #[serde(default = "yes")]
-        scaled: bool,
+        scaled: ScaledSpec,
     },
 }
 

@@ -3,6 +3,7 @@
 
 use super::element::Section;
 use super::time_function::TimeFunction;
+use crate::solver::parameters::Scaling;
 
 /// A straight beam in its undeformed configuration.
 #[derive(Clone, Debug)]
@@ -41,11 +42,11 @@ pub enum Joint {
 #[derive(Clone, Debug)]
 pub enum Load {
     /// body force `ρA g` on every element
-    Gravity { g: [f64; 2], scaled: bool },
+    Gravity { g: [f64; 2], scaled: Scaling },
     /// moment `M(t)` at a node, acting on its slope
-    Moment { node: NodeId, function: TimeFunction, scaled: bool },
+    Moment { node: NodeId, function: TimeFunction, scaled: Scaling },
     /// force `F f(t)` at a node (f = 1 without a function)
-    Force { node: NodeId, value: [f64; 2], function: Option<TimeFunction>, scaled: bool },
+    Force { node: NodeId, value: [f64; 2], function: Option<TimeFunction>, scaled: Scaling },
 }
 
 /// A material point whose position is recorded: element index and `ξ` in [0, 1]; with

@@ -9,6 +9,7 @@ use super::loads::{moment_force, moment_jacobian};
 use super::time_function::TimeFunction;
 use crate::linalg::kkt::{make_solver, KktPattern, KktSolver, LinearSolverKind};
 use crate::solver::model::{IterationCoefficients, Parameters, ParametricModel};
+use crate::solver::parameters::Scaling;
 
 pub use super::parts::{BeamBody, Constraint, Joint, Load, NodeId, Probe, Rayleigh};
 
@@ -19,14 +20,14 @@ struct MomentLoad {
     element: usize,
     local: usize,
     function: TimeFunction,
-    scaled: bool,
+    scaled: Scaling,
 }
 
 struct ForceLoad {
     dofs: [usize; 2],
     value: [f64; 2],
     function: Option<TimeFunction>,
-    scaled: bool,
+    scaled: Scaling,
 }
 
 pub struct FlexibleSystem {
@@ -42,6 +43,8 @@ pub struct FlexibleSystem {
     damping: Rayleigh,
     gravity_fixed: Vec<f64>,
     gravity_scaled: Vec<f64>,
+    /// gravity multiplied by a named parameter (`scaled = "name"`), one vector per name
+    gravity_named: Vec<(String, Vec<f64>)>,
     moments: Vec<MomentLoad>,
     forces: Vec<ForceLoad>,
     /// the dofs that moments and nodal forces act on, sorted
@@ -112,6 +115,7 @@ impl FlexibleSystem {
 
         let mut gravity_fixed = vec![0.0; n_dof];
         let mut gravity_scaled = vec![0.0; n_dof];
+        let mut gravity_named: Vec<(String, Vec<f64>)> = Vec::new();
         let mut moments = Vec::new();
         let mut forces = Vec::new();
         // the element that holds a node: the one it starts, or the last of its body
@@ -126,7 +130,20 @@ impl FlexibleSystem {
         for load in loads {
             match load {
                 Load::Gravity { g, scaled } => {
-                    let target = if *scaled { &mut gravity_scaled } else { &mut gravity_fixed };
+                    let target = match scaled {
+                        Scaling::Fixed => &mut gravity_fixed,
+                        Scaling::LoadScale => &mut gravity_scaled,
+                        Scaling::Named(name) => {
+                            let i = match gravity_named.iter().position(|(n, _)| n == name) {
+                                Some(i) => i,
+                                None => {
+                                    gravity_named.push((name.clone(), vec![0.0; n_dof]));
+                                    gravity_named.len() - 1
+                                }
+                            };
+                            &mut gravity_named[i].1
+                        }
+                    };
                     for (b, dofs) in &elements {
                         let qg = prototypes[*b].gravity_force(*g);
                         for i in 0..8 {
@@ -142,7 +159,7 @@ impl FlexibleSystem {
                         element,
                         local: local + 2,
                         function: function.clone(),
-                        scaled: *scaled,
+                        scaled: scaled.clone(),
                     });
                 }
                 Load::Force { node, value, function, scaled } => {
@@ -151,7 +168,7 @@ impl FlexibleSystem {
                         dofs: [4 * n, 4 * n + 1],
                         value: *value,
                         function: function.clone(),
-                        scaled: *scaled,
+                        scaled: scaled.clone(),
                     });
                 }
             }
@@ -177,6 +194,7 @@ impl FlexibleSystem {
             damping,
             gravity_fixed,
             gravity_scaled,
+            gravity_named,
             moments,
             forces,
             load_dofs,
@@ -314,8 +332,9 @@ impl FlexibleSystem {
     /// gravity loads.
     pub fn potential_energy(&self, mu: &Parameters, q: &[f64]) -> f64 {
         let strain: f64 = (0..self.elements.len()).map(|e| self.element(e).strain_energy(&self.gather(e, q))).sum();
-        let grav: f64 =
-            (0..self.n_dof).map(|i| (self.gravity_fixed[i] + mu.scale() * self.gravity_scaled[i]) * q[i]).sum();
+        let mut g = vec![0.0; self.n_dof];
+        self.gravity_into(mu, &mut g);
+        let grav: f64 = g.iter().zip(q).map(|(g, q)| -g * q).sum();
         strain - grav
     }
 
@@ -353,10 +372,16 @@ impl FlexibleSystem {
         (el.mass() * self.damping.mass + el.bending_stiffness() * self.damping.stiffness) * ve
     }
 
-    /// `out = −g₀(μ)`: gravity, the fixed part and the scaled part times the load scale.
+    /// `out = −g₀(μ)`: gravity, the fixed part, the scaled part times the load scale, and
+    /// each named part times its parameter.
     fn gravity_into(&self, mu: &Parameters, out: &mut [f64]) {
         for (o, (gf, gs)) in out.iter_mut().zip(self.gravity_fixed.iter().zip(&self.gravity_scaled)) {
             *o = -(gf + mu.scale() * gs);
+        }
+        for (name, g) in &self.gravity_named {
+            // a parameter the run does not set keeps the file's load
+            let x = mu.get(name).unwrap_or(1.0);
+            out.iter_mut().zip(g).for_each(|(o, g)| *o -= x * g);
         }
     }
 
@@ -375,7 +400,7 @@ impl FlexibleSystem {
 
     /// Jacobian of the moment's contribution `−Q_M` to `g`.
     fn moment_load_jacobian(mu: &Parameters, m: &MomentLoad, t: f64, slope: [f64; 2]) -> [[f64; 2]; 2] {
-        let j = moment_jacobian(mu.load_factor(m.scaled) * m.function.eval(t), slope);
+        let j = moment_jacobian(mu.factor(&m.scaled) * m.function.eval(t), slope);
         // g carries −Q_ext, so its Jacobian enters with a minus sign
         [[-j[0][0], -j[0][1]], [-j[1][0], -j[1][1]]]
     }
@@ -384,13 +409,12 @@ impl FlexibleSystem {
     /// `q(dof)` reads the coordinates they depend on.
     fn add_nodal_loads(&self, mu: &Parameters, t: f64, q: impl Fn(usize) -> f64, mut add: impl FnMut(usize, f64)) {
         for m in &self.moments {
-            let qm =
-                moment_force(mu.load_factor(m.scaled) * m.function.eval(t), [q(m.slope_dofs[0]), q(m.slope_dofs[1])]);
+            let qm = moment_force(mu.factor(&m.scaled) * m.function.eval(t), [q(m.slope_dofs[0]), q(m.slope_dofs[1])]);
             add(m.slope_dofs[0], -qm[0]);
             add(m.slope_dofs[1], -qm[1]);
         }
         for f in &self.forces {
-            let ft = mu.load_factor(f.scaled) * f.function.as_ref().map_or(1.0, |func| func.eval(t));
+            let ft = mu.factor(&f.scaled) * f.function.as_ref().map_or(1.0, |func| func.eval(t));
             add(f.dofs[0], -ft * f.value[0]);
             add(f.dofs[1], -ft * f.value[1]);
         }

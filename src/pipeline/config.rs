@@ -36,9 +36,14 @@ use crate::limits::Limits;
 use crate::model::Model;
 pub use crate::reduction::estimator::{ErrorMeasure, EstimateMethod};
 use crate::reduction::{ModeRule, Variant};
+use crate::solver::parameter_space::ParameterSpace;
+use crate::solver::parameters::Parameters;
 use scales::check_scales;
 pub use scales::{parse_range, Scales, MAX_LOAD_SCALES};
-pub use schema::{Blocks, GreedySpec, HyperSpec, OnlineSpec, PipelineFile, ReductionSpec, ScalesSpec, TrainSpec};
+pub use schema::{
+    Blocks, GreedySpec, HyperSpec, OnlineSpec, ParameterSpec, PipelineFile, PointsSpec, ReductionSpec, ScalesSpec,
+    TrainSpec,
+};
 use std::path::{Path, PathBuf};
 
 /// A loaded, checked pipeline with its model.
@@ -88,12 +93,15 @@ impl Pipeline {
     fn check(&self) -> Result<()> {
         let bad = |field: &str, problem: String| Err(Error::input(&self.path, field, problem));
         let red = &self.file.reduction;
+        self.check_parameters()?;
         match (&self.file.train.load_scales, &self.file.train.greedy) {
+            // checked with [parameters]
+            _ if self.file.train.points.is_some() => {}
             (Some(_), Some(_)) => return bad("train", "has both load_scales and greedy; give exactly one".into()),
             (None, None) => {
                 return bad(
                     "train",
-                    "needs load_scales = [..] or greedy = { range = [A, B], tolerance = T, max_runs = K }".into(),
+                    "needs load_scales = [..], greedy = { range = [A, B], tolerance = T, max_runs = K }, or points = { count = N } with [parameters]".into(),
                 )
             }
             (Some(s), None) => {
@@ -184,6 +192,80 @@ impl Pipeline {
         Ok(())
     }
 
+    /// `[parameters]` against the model and `[train]`: every name one of the model's
+    /// parameters, every range one a sample can be drawn from, and training that samples the
+    /// box (`points`) exactly when there is one.
+    fn check_parameters(&self) -> Result<()> {
+        let bad = |field: &str, problem: String| Err(Error::input(&self.path, field, problem));
+        let names = self.model.parameter_names();
+        for (name, spec) in &self.file.parameters {
+            let field = format!("parameters.{name}");
+            if !names.contains(&name.as_str()) {
+                let have = if names.is_empty() { "none: no load is scaled".to_string() } else { names.join(", ") };
+                return bad(&field, format!("the model has no parameter `{name}` (its parameters: {have})"));
+            }
+            if let Err(e) = spec.range(name).validate() {
+                return bad(&field, e);
+            }
+        }
+        let t = &self.file.train;
+        match (&t.points, self.file.parameters.is_empty()) {
+            (Some(_), true) => bad("train.points", "samples the [parameters] box, but the pipeline has no [parameters] table (add e.g. `[parameters]` with `drive = [0.5, 1.5]`)".into()),
+            (Some(pts), false) => {
+                if t.load_scales.is_some() || t.greedy.is_some() {
+                    return bad("train", "has points and load_scales or greedy; give exactly one".into());
+                }
+                if pts.count == 0 || pts.count > MAX_LOAD_SCALES {
+                    return bad("train.points.count", format!("is {}; it must lie in 1..={MAX_LOAD_SCALES}", pts.count));
+                }
+                if self.file.reduction.modes.is_none() {
+                    return bad("reduction.modes", "is missing: with train.points the mode count must be given".into());
+                }
+                Ok(())
+            }
+            (None, false) => bad(
+                "train",
+                "trains over the load scale alone, but the pipeline has a [parameters] box: sample it with `points = { count = N }` (greedy training over a box of several parameters is not there yet)".into(),
+            ),
+            (None, true) => Ok(()),
+        }
+    }
+
+    /// Refuses `what` (a sweep, a report, sharded training) on a pipeline with a
+    /// `[parameters]` box: those work on a line of load scales so far.
+    pub fn refuse_box(&self, what: &str) -> Result<()> {
+        if self.file.parameters.is_empty() {
+            return Ok(());
+        }
+        Err(Error::input(
+            &self.path,
+            "parameters",
+            format!("{what} over a box of several parameters is not there yet: run `flexrom online` or `flexrom validate` with `--param NAME=X` at each point"),
+        ))
+    }
+
+    /// Where `validate` and a report check a basis when no load is given: `[validate]
+    /// load_scales`, or for a `[parameters]` box four points drawn at random from it (seed:
+    /// the training points' plus one), which are not training points.
+    pub fn validation_points(&self) -> Vec<Parameters> {
+        match &self.file.train.points {
+            Some(pts) => {
+                self.space().sample(4, crate::solver::parameter_space::Sampling::Random, pts.seed.wrapping_add(1))
+            }
+            None => self.validate_scales().into_iter().map(Parameters::load_scale).collect(),
+        }
+    }
+
+    /// The box of `[parameters]`, in name order (empty without the table).
+    pub fn space(&self) -> ParameterSpace {
+        ParameterSpace { ranges: self.file.parameters.iter().map(|(n, s)| s.range(n)).collect() }
+    }
+
+    /// The training points of `train.points`, drawn from the box (empty without them).
+    pub fn training_points(&self) -> Vec<Parameters> {
+        self.file.train.points.as_ref().map_or_else(Vec::new, |p| self.space().sample(p.count, p.sampling, p.seed))
+    }
+
     /// The reduction variant: the file's, or constraint-preserving when the model has
     /// joints between bodies, galerkin when it has none or only ground joints.
     pub fn variant(&self) -> Variant {
@@ -247,6 +329,6 @@ impl Pipeline {
     /// ([`crate::io::basis_hash::settings_hash`]): a basis trained with other settings is
     /// flagged as stale.
     pub fn settings_hash(&self) -> String {
-        crate::io::basis_hash::settings_hash(&self.file.train, &self.file.reduction)
+        crate::io::basis_hash::settings_hash(&self.file.train, &self.file.reduction, &self.file.parameters)
     }
 }

@@ -35,6 +35,30 @@ pub fn load_rom(
         no_estimate,
     };
     let (rom, more) = Rom::load(&p.model, path, &stored, o)?;
+    let trained = rom.trust().map(|t| t.space.clone()).unwrap_or_default();
+    if trained != p.space() {
+        let show = |s: &crate::solver::parameter_space::ParameterSpace| {
+            if s.is_empty() {
+                "the load scale alone".to_string()
+            } else {
+                s.ranges
+                    .iter()
+                    .map(|r| format!("{} [{}, {}] {}", r.name, r.lower, r.upper, r.spacing.name()))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            }
+        };
+        return Err(Error::input(
+            path,
+            "parameters",
+            format!(
+                "the basis was trained over {}, the pipeline {} names {}; run `flexrom train` for this pipeline",
+                show(&trained),
+                p.path.display(),
+                show(&p.space())
+            ),
+        ));
+    }
     let mut warnings = stored.warnings.clone();
     warnings.extend(more);
     Ok((stored, rom, warnings))

@@ -48,6 +48,7 @@ pub fn run_with(
     dense: super::dense::DenseChoice,
     method: Option<EstimateMethod>,
 ) -> Result<(PathBuf, Vec<String>)> {
+    p.refuse_box("`flexrom run` (its sweep and report)")?;
     check_outputs(p)?;
     let dense = super::dense::decide(dense, &p.model)?;
     let dir = p.report_dir.clone();

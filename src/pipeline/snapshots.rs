@@ -67,6 +67,7 @@ pub fn job_scales(p: &Pipeline, x: Option<f64>, shard: Option<Shard>) -> Result<
 
 /// The pipeline's fixed training loads (greedy training has none to split).
 fn fixed_scales(p: &Pipeline) -> Result<Vec<f64>> {
+    p.refuse_box("training in separate jobs (--snapshots-only, --from-snapshots)")?;
     if p.file.train.greedy.is_some() {
         return Err(Error::input(
             &p.path,

@@ -24,14 +24,18 @@ pub fn train(p: &Pipeline) -> Result<(TrainingData, TrainSummary)> {
     if let Some(g) = &p.file.train.greedy {
         return super::greedy::train(p, g);
     }
-    let scales = p.file.train.load_scales.clone().unwrap_or_default();
-    if scales.is_empty() {
+    // the training runs' parameters: the load scales, or the points of the box
+    let points: Vec<Parameters> = match &p.file.train.load_scales {
+        Some(scales) => scales.iter().map(|&s| Parameters::load_scale(s)).collect(),
+        None => p.training_points(),
+    };
+    if points.is_empty() {
         return Err(Error::input(&p.path, "train.load_scales", "is empty: no training run, no snapshots"));
     }
     // the runs, their concatenated snapshots and the POD's working copy
     let n_steps = crate::simulate::Settings::resolve(&p.model, &Overrides::default())?.n_steps;
     let z = p.model.sizes();
-    let snapshots = scales.len() as f64 * (n_steps as f64 + 1.0);
+    let snapshots = points.len() as f64 * (n_steps as f64 + 1.0);
     p.model.limits.check_memory(
         &format!("training on {} snapshots × {} coordinates", snapshots, z.n_dof),
         3.0 * 8.0 * snapshots * (z.n_dof + z.n_constraints) + z.n_elements * crate::limits::BYTES_PER_ELEMENT,
@@ -40,13 +44,12 @@ pub fn train(p: &Pipeline) -> Result<(TrainingData, TrainSummary)> {
     let mut full_seconds = 0.0;
     // the full model assembled once for every training load
     let mut full = FullModel::new(&p.model, LinearSolverKind::Banded)?;
-    for &s in &scales {
-        let mu = Parameters::load_scale(s);
-        let r = full.simulate(&Overrides::at(&mu)).map_err(|e| e.at_stage("train (full run)", &mu))?;
+    for mu in &points {
+        let r = full.simulate(&Overrides::at(mu)).map_err(|e| e.at_stage("train (full run)", mu))?;
         full_seconds += r.wall_seconds;
         runs.push(r);
     }
-    super::basis_build::basis_from_snapshots(p, training_data(&runs), full_seconds, scales.len())
+    super::basis_build::basis_from_snapshots(p, training_data(&runs), full_seconds, points.len())
 }
 
 /// Trains and writes the basis file atomically (a failed run keeps the previous file).
@@ -75,6 +78,11 @@ pub fn write_trained(p: &Pipeline, out: &Path, data: &TrainingData, summary: &Tr
         }
         if let Some(g) = &summary.greedy {
             super::training_record::write_training(f, g).map_err(|e| Error::hdf5(out, e))?;
+        }
+        let space = p.space();
+        if !space.is_empty() {
+            crate::io::parameter_space_file::write_parameter_space(f, &space, &p.training_points())
+                .map_err(|e| Error::hdf5(out, e))?;
         }
         Ok(())
     })

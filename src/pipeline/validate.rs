@@ -35,6 +35,8 @@ use crate::solver::model::ParametricModel;
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Validation {
     pub load_scale: f64,
+    /// every parameter of the run by name: `load_scale` and the model's named ones
+    pub parameters: std::collections::BTreeMap<String, f64>,
     pub variant: String,
     pub n_dof: usize,
     pub n_modes: usize,
@@ -184,6 +186,7 @@ pub fn compare(
     }
     Validation {
         load_scale: r.settings.mu.scale(),
+        parameters: r.settings.mu.iter().map(|(n, v)| (n.to_string(), v)).collect(),
         variant: variant.to_string(),
         n_dof: full.q.nrows(),
         n_modes,
@@ -332,8 +335,13 @@ impl Validation {
             _ => String::new(),
         };
         format!(
-            "load scale {}: {} reduction, {} of {} coordinates\n  rel_error {:.3e}, max probe error {:.3e} m ({} at t = {:.4} s), max constraint violation {:.3e}\n  full {:.4} s, reduced {:.4} s, speedup {:.2}×{}{}",
+            "load scale {}{}: {} reduction, {} of {} coordinates\n  rel_error {:.3e}, max probe error {:.3e} m ({} at t = {:.4} s), max constraint violation {:.3e}\n  full {:.4} s, reduced {:.4} s, speedup {:.2}×{}{}",
             self.load_scale,
+            self.parameters
+                .iter()
+                .filter(|(n, _)| n.as_str() != crate::solver::parameters::LOAD_SCALE)
+                .map(|(n, v)| format!(", {n} = {}", crate::error::show_number(*v)))
+                .collect::<String>(),
             self.variant,
             self.n_modes,
             self.n_dof,

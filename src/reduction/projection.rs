@@ -89,6 +89,8 @@ pub(crate) struct Projection {
     /// `Vᵀg₀,fixed` and `Vᵀg₀,scaled`: `g₀,r(μ) = g0_fixed + λ g0_scaled`
     g0_fixed: Array1<f64>,
     g0_scaled: Array1<f64>,
+    /// `Vᵀg₀,name` of each named parameter's constant force ([`ElementModel::named_constant_forces`])
+    g0_named: Vec<(String, Array1<f64>)>,
     /// B V and B x_ref − b (reduced rows)
     b_r: Array2<f64>,
     c_r: Array1<f64>,
@@ -140,6 +142,11 @@ impl Projection {
         full.constant_force_parts(&mut col, &mut col_scaled);
         let g0_fixed = v.t().dot(&ArrayView1::from(&col));
         let g0_scaled = v.t().dot(&ArrayView1::from(&col_scaled));
+        let g0_named = full
+            .named_constant_forces()
+            .into_iter()
+            .map(|(name, g)| (name, v.t().dot(&ArrayView1::from(&g))))
+            .collect();
 
         // constraints are linear: B y − b, so B V_j = res(V_j) − res(0)
         let mut res0 = vec![0.0; nc_full];
@@ -206,6 +213,7 @@ impl Projection {
             mass,
             g0_fixed,
             g0_scaled,
+            g0_named,
             b_r,
             c_r,
             coupling,
@@ -255,6 +263,10 @@ impl Projection {
         let x = mu.scale();
         for (o, (f, s)) in out.iter_mut().zip(self.g0_fixed.iter().zip(&self.g0_scaled)) {
             *o = f + x * s;
+        }
+        for (name, g) in &self.g0_named {
+            let x = mu.get(name).unwrap_or(1.0);
+            out.iter_mut().zip(g).for_each(|(o, g)| *o += x * g);
         }
         if !self.load_dofs.is_empty() {
             expand(&self.v_load, Some(&self.x_ref_load), 0, q, &mut self.xl);

@@ -21,6 +21,7 @@ use crate::io::basis_file::StoredBasis;
 use crate::model::Model;
 use crate::reduction::Basis;
 use crate::solver::model::{Parameters, ParametricModel};
+use crate::solver::parameter_space::ParameterSpace;
 use estimator::{ErrorEstimator, Estimate, EstimateMethod};
 use pool::Pool;
 use std::path::Path;
@@ -110,8 +111,13 @@ impl Rom {
             None => (read_training_tolerance(path)?, trained),
         };
         let sensitivity = read_training_sensitivity(path)?.map(|(c, s)| trust::LoadSensitivity::new(c, s));
-        let range = read_training_range(path)?;
-        let trust = Trust { range, tolerance, measure, skipped: o.no_estimate, sensitivity };
+        let space = crate::io::parameter_space_file::read_parameter_space(path)?.unwrap_or_default();
+        // a box that holds λ gives its range; else the training loads' [min, max]
+        let range = match space.ranges.iter().find(|r| r.name == crate::solver::parameters::LOAD_SCALE) {
+            Some(r) => (r.lower, r.upper),
+            None => read_training_range(path)?,
+        };
+        let trust = Trust { range, tolerance, measure, skipped: o.no_estimate, sensitivity, space };
         Ok((Rom::new(model, &stored.basis, estimator, Some(trust))?, warnings))
     }
 
@@ -146,7 +152,28 @@ impl Rom {
     /// Whether `mu` lies outside the parameters the basis was trained on (false when they
     /// are not known).
     pub fn is_extrapolated(&self, mu: &Parameters) -> bool {
-        self.trust.as_ref().is_some_and(|t| trust::is_extrapolated(t.range, mu.scale()))
+        match &self.trust {
+            Some(t) => trust::is_extrapolated(t.range, mu.scale()) || !t.named_outside(mu).is_empty(),
+            None => !ParameterSpace::default().outside(mu).is_empty(),
+        }
+    }
+
+    /// One warning naming the parameters of `mu` other than the load scale that lie
+    /// outside what the basis was trained on: outside the `[parameters]` box it was trained
+    /// over, or, for a parameter training did not vary, anywhere but 1 (the model file's
+    /// load). Empty when there are none (the load scale's range is [`trust::check_runs`]'s).
+    pub fn untrained_parameters(&self, mu: &Parameters) -> Vec<String> {
+        let away = match &self.trust {
+            Some(t) => t.named_outside(mu),
+            None => ParameterSpace::default().outside(mu),
+        };
+        if away.is_empty() {
+            return Vec::new();
+        }
+        vec![format!(
+            "outside what the basis was trained on: {}; the reduced model extrapolates there (check it with `flexrom validate`)",
+            away.join(", ")
+        )]
     }
 
     /// How far the reduced answer moves for a 0.1 % change of the load near `mu`, as

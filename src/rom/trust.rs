@@ -4,6 +4,8 @@
 
 use super::estimator::{ErrorMeasure, Estimate};
 use crate::error::{Error, Result};
+use crate::solver::parameter_space::ParameterSpace;
+use crate::solver::parameters::{Parameters, LOAD_SCALE};
 
 /// What the online tools hold a basis's runs to.
 #[derive(Clone, Debug, PartialEq)]
@@ -19,12 +21,29 @@ pub struct Trust {
     pub skipped: bool,
     /// the reduced model's sensitivity to the load along the training range (greedy bases)
     pub sensitivity: Option<LoadSensitivity>,
+    /// the box of parameters the basis was trained over (`/parameters`); empty: the load
+    /// scale alone, every named parameter at 1
+    pub space: ParameterSpace,
 }
 
 impl Trust {
     /// Trust in a basis trained over `range` with no tolerance to hold its estimates to.
     pub fn range(range: (f64, f64)) -> Self {
-        Trust { range, tolerance: None, measure: ErrorMeasure::Relative, skipped: false, sensitivity: None }
+        Trust {
+            range,
+            tolerance: None,
+            measure: ErrorMeasure::Relative,
+            skipped: false,
+            sensitivity: None,
+            space: ParameterSpace::default(),
+        }
+    }
+
+    /// The named parameters of `mu` outside what the basis was trained on, one line each
+    /// ([`ParameterSpace::outside`]; the load scale is the range checks' to say).
+    pub fn named_outside(&self, mu: &Parameters) -> Vec<String> {
+        let lambda = format!("{LOAD_SCALE} = ");
+        self.space.outside(mu).into_iter().filter(|l| !l.starts_with(&lambda)).collect()
     }
 
     /// The sensitivity near load scale `x` when the model amplifies changes of the load
@@ -284,6 +303,7 @@ mod tests {
             measure: ErrorMeasure::Relative,
             skipped: false,
             sensitivity: None,
+            space: ParameterSpace::default(),
         };
         let w = check_runs(&t, true, &[(1.7, Some(1e-4)), (1.0, Some(2e-3))], false).unwrap();
         assert_eq!(w.len(), 2, "{w:?}");
@@ -328,6 +348,7 @@ mod sensitivity_tests {
             measure: ErrorMeasure::Relative,
             skipped: false,
             sensitivity: Some(LoadSensitivity::new(vec![0.5, 1.0, 1.5], vec![1e-3, 3e-2, 1e-3])),
+            space: ParameterSpace::default(),
         };
         let w = check_runs(&t, true, &[(1.2, Some(1e-4))], false).unwrap();
         assert_eq!(w.len(), 1, "{w:?}");

@@ -3,6 +3,7 @@
 pub mod generalized_alpha;
 pub mod integrator_params;
 pub mod model;
+pub mod parameter_space;
 pub mod parameters;
 pub mod predictor;
 pub mod statics;

@@ -186,6 +186,11 @@ pub trait ElementModel: ParametricModel {
     /// `g₀,fixed` and `g₀,scaled` of `g₀(μ) = g₀,fixed + λ g₀,scaled`, the part of `g`
     /// that depends on neither `q`, `q̇` nor `t`: a reduction projects each once.
     fn constant_force_parts(&self, fixed: &mut [f64], scaled: &mut [f64]);
+    /// The parts of `g₀` multiplied by named parameters (`scaled = "name"`), one per name:
+    /// `g₀(μ)` adds `μ_name g₀,name` for each (`μ_name = 1` where μ does not set it).
+    fn named_constant_forces(&self) -> Vec<(String, Vec<f64>)> {
+        Vec::new()
+    }
     /// The dofs the state- or time-dependent loads act on (and depend on).
     fn load_dofs(&self) -> Vec<usize>;
     /// `g_l(q_l, t; μ)` on `load_dofs()`, given `q` on the same dofs.

@@ -88,20 +88,51 @@ impl Parameters {
         Ok(())
     }
 
-    /// The factor of a load: `λ` when it is marked `scaled`, else 1.
+    /// The factor of a load ([`Scaling`]): 1 for a fixed load, `λ` for one marked
+    /// `scaled = true`, the value of the parameter it names otherwise (1, the model file's own
+    /// load, where `μ` does not set it).
     #[inline]
-    pub fn load_factor(&self, scaled: bool) -> f64 {
-        if scaled {
-            self.load_scale
-        } else {
-            1.0
+    pub fn factor(&self, scaling: &Scaling) -> f64 {
+        match scaling {
+            Scaling::Fixed => 1.0,
+            Scaling::LoadScale => self.load_scale,
+            Scaling::Named(name) => self.named.get(name).copied().unwrap_or(1.0),
         }
+    }
+
+    /// The parameters other than `λ`, by name.
+    pub fn named(&self) -> impl Iterator<Item = (&str, f64)> {
+        self.named.iter().map(|(k, &v)| (k.as_str(), v))
     }
 
     /// The same parameters with `λ` multiplied by `factor` (the neighbouring run of a
     /// sensitivity check).
     pub fn scaled_by(&self, factor: f64) -> Self {
         Parameters { load_scale: factor * self.load_scale, named: self.named.clone() }
+    }
+}
+
+/// Which parameter multiplies a load: `scaled` in the model file (`false`, `true`, or the
+/// name of a parameter). A load is linear in its factor, so a model stays affine in every
+/// parameter that scales loads.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Scaling {
+    /// `scaled = false`: the file's load at every `μ`
+    Fixed,
+    /// `scaled = true` (or `"load_scale"`): times `λ`
+    LoadScale,
+    /// `scaled = "drive"`: times the parameter `drive`
+    Named(String),
+}
+
+impl Scaling {
+    /// The parameter's name, if the load has one.
+    pub fn parameter(&self) -> Option<&str> {
+        match self {
+            Scaling::Fixed => None,
+            Scaling::LoadScale => Some(LOAD_SCALE),
+            Scaling::Named(n) => Some(n),
+        }
     }
 }
 
@@ -142,8 +173,11 @@ mod tests {
         assert_eq!(mu.get("E_lower"), Some(2.5e8));
         assert_eq!(mu.get("drive"), None);
         assert_eq!(mu.iter().collect::<Vec<_>>(), [(LOAD_SCALE, 0.9), ("E_lower", 2.5e8)]);
-        assert_eq!(mu.load_factor(true), 0.9);
-        assert_eq!(mu.load_factor(false), 1.0);
+        assert_eq!(mu.factor(&Scaling::LoadScale), 0.9);
+        assert_eq!(mu.factor(&Scaling::Fixed), 1.0);
+        assert_eq!(mu.factor(&Scaling::Named("E_lower".into())), 2.5e8);
+        // a load named after a parameter the run does not set keeps the file's value
+        assert_eq!(mu.factor(&Scaling::Named("drive".into())), 1.0);
         assert_eq!(mu.scaled_by(2.0).get("E_lower"), Some(2.5e8));
         // messages name a run as they always did; other parameters follow
         assert_eq!(Parameters::load_scale(1.1).to_string(), "load scale 1.1");

@@ -32,6 +32,10 @@ impl ElementModel for FlexibleSystem {
         }
     }
 
+    fn named_constant_forces(&self) -> Vec<(String, Vec<f64>)> {
+        self.gravity_named.iter().map(|(name, g)| (name.clone(), g.iter().map(|x| -x).collect())).collect()
+    }
+
     fn load_dofs(&self) -> Vec<usize> {
         self.load_dofs.clone()
     }
@@ -293,9 +297,9 @@ mod tests {
         let section = Section { density: 2700.0, area: 1e-3, inertia: 1e-7, youngs_modulus: 7e9 };
         let body = BeamBody { name: "b".into(), start: [0.0, 0.0], angle: 0.3, length: 1.0, n_elements: 5, section };
         let gravity = [
-            Load::Gravity { g: [0.0, -9.81], scaled: true },
-            Load::Moment { node: (0, 2), function: TimeFunction::Constant { value: 3.0 }, scaled: true },
-            Load::Moment { node: (0, 5), function: TimeFunction::Constant { value: -1.5 }, scaled: false },
+            Load::Gravity { g: [0.0, -9.81], scaled: Scaling::LoadScale },
+            Load::Moment { node: (0, 2), function: TimeFunction::Constant { value: 3.0 }, scaled: Scaling::LoadScale },
+            Load::Moment { node: (0, 5), function: TimeFunction::Constant { value: -1.5 }, scaled: Scaling::Fixed },
         ];
         for damping in [Rayleigh::default(), Rayleigh { mass: 0.3, stiffness: 2e-3 }] {
             let mut sys =
@@ -339,10 +343,12 @@ mod tests {
             section,
         };
         let loads = [
-            Load::Gravity { g: [0.5, -9.81], scaled: true },
-            Load::Gravity { g: [0.0, -1.0], scaled: false },
-            Load::Moment { node: (1, 2), function: TimeFunction::Constant { value: 3.0 }, scaled: true },
-            Load::Force { node: (0, 1), value: [1.0, 2.0], function: None, scaled: false },
+            Load::Gravity { g: [0.5, -9.81], scaled: Scaling::LoadScale },
+            Load::Gravity { g: [0.0, -1.0], scaled: Scaling::Fixed },
+            Load::Moment { node: (1, 2), function: TimeFunction::Constant { value: 3.0 }, scaled: Scaling::LoadScale },
+            Load::Force { node: (0, 1), value: [1.0, 2.0], function: None, scaled: Scaling::Fixed },
+            Load::Gravity { g: [0.2, 0.0], scaled: Scaling::Named("wind".into()) },
+            Load::Force { node: (1, 1), value: [0.5, -1.0], function: None, scaled: Scaling::Named("push".into()) },
         ];
         for damping in [Rayleigh::default(), Rayleigh { mass: 0.3, stiffness: 2e-3 }] {
             let mut sys = FlexibleSystem::new(
@@ -358,7 +364,7 @@ mod tests {
                 sys.initial_state().iter().enumerate().map(|(i, x)| x + 0.01 * (i as f64 * 0.7).sin()).collect();
             let v: Vec<f64> = (0..n).map(|i| (i as f64 * 0.3).cos()).collect();
             let a: Vec<f64> = (0..n).map(|i| (i as f64 * 1.1).sin() * 5.0).collect();
-            let mu = Parameters::load_scale(1.3);
+            let mu = Parameters::load_scale(1.3).with("wind", 0.7).with("push", -2.0);
             let (mut f_ref, mut m_ref, mut f, mut m) = (vec![0.0; n], vec![0.0; n], vec![1.0; n], vec![1.0; n]);
             ParametricModel::force(&mut sys, &mu, &q, &v, 0.2, &mut f_ref);
             ParametricModel::mass_mul(&sys, &a, &mut m_ref);

@@ -4,6 +4,7 @@
 use super::scales::Scales;
 use crate::reduction::estimator::{ErrorMeasure, EstimateMethod};
 use crate::reduction::{ModeRule, SnapshotKind, Variant};
+use crate::solver::parameter_space::{ParameterRange, Sampling, Spacing};
 use serde::Deserialize;
 use std::path::PathBuf;
 
@@ -25,6 +26,53 @@ pub struct PipelineFile {
     pub online: Option<OnlineSpec>,
     #[serde(default)]
     pub validate: Option<ScalesSpec>,
+    /// the box of parameters training samples (`[parameters]`, by name); empty: the load
+    /// scale alone, as `[train]` gives it
+    #[serde(default)]
+    pub parameters: std::collections::BTreeMap<String, ParameterSpec>,
+}
+
+/// A parameter's range in `[parameters]`: `drive = [0.5, 1.5]`, or `E = { range = [1e8,
+/// 4e8], scale = "log" }`.
+#[derive(Clone, Debug, Deserialize, serde::Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum ParameterSpec {
+    Range([f64; 2]),
+    Table(ParameterTable),
+}
+
+#[derive(Clone, Debug, Deserialize, serde::Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ParameterTable {
+    pub range: [f64; 2],
+    #[serde(default)]
+    pub scale: Spacing,
+}
+
+impl ParameterSpec {
+    pub fn range(&self, name: &str) -> ParameterRange {
+        let (r, spacing) = match self {
+            ParameterSpec::Range(r) => (r, Spacing::Linear),
+            ParameterSpec::Table(t) => (&t.range, t.scale),
+        };
+        ParameterRange { name: name.to_string(), lower: r[0], upper: r[1], spacing }
+    }
+}
+
+/// `[train] points = { count = N, sampling = "sobol", seed = 1 }`: full runs at N points of
+/// the `[parameters]` box (sobol, lhs or random; the same points for the same seed).
+#[derive(Clone, Debug, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointsSpec {
+    pub count: usize,
+    #[serde(default)]
+    pub sampling: Sampling,
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+}
+
+fn default_seed() -> u64 {
+    1
 }
 
 #[derive(Clone, Debug, Deserialize, serde::Serialize)]
@@ -36,6 +84,9 @@ pub struct TrainSpec {
     /// greedy training over a load range (src/pipeline/greedy.rs)
     #[serde(default)]
     pub greedy: Option<GreedySpec>,
+    /// training points sampled from the `[parameters]` box
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub points: Option<PointsSpec>,
     #[serde(default = "default_snapshots")]
     pub snapshots: SnapshotKind,
 }

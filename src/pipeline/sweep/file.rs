@@ -440,6 +440,7 @@ pub fn read_sweep(
         };
         let v = validation.as_ref().zip(stored).map(|(c, stored)| Validation {
             load_scale: x,
+            parameters: std::iter::once((crate::solver::parameters::LOAD_SCALE.to_string(), x)).collect(),
             variant: stored.basis.variant.name().to_string(),
             n_dof: stored.basis.n_dof(),
             n_modes: r,

@@ -1,0 +1,59 @@
+//! The box of parameters a basis was trained over, in its file:
+//!
+//! ```text
+//! /parameters/<name>   (n_runs)   the parameter's value at each training run, in run order
+//!   attributes: range ([lower, upper]), scale ("linear" or "log")
+//! ```
+//!
+//! Written by `train` for a pipeline with a `[parameters]` table; a basis without the group
+//! was trained over the load scale alone (every named parameter at 1).
+
+use super::h5::{attr_str, read_attr_str};
+use crate::error::{Error, Result};
+use crate::solver::parameter_space::{ParameterRange, ParameterSpace, Spacing};
+use crate::solver::parameters::Parameters;
+use std::path::Path;
+
+/// Writes `/parameters` into an open basis file: the box and the training `points`.
+pub fn write_parameter_space(f: &hdf5::File, space: &ParameterSpace, points: &[Parameters]) -> hdf5::Result<()> {
+    let g = f.create_group("parameters")?;
+    for r in &space.ranges {
+        let values: Vec<f64> = points.iter().map(|mu| mu.get(&r.name).unwrap_or(1.0)).collect();
+        let d = g.new_dataset_builder().with_data(&values).create(r.name.as_str())?;
+        d.new_attr::<f64>().shape(2).create("range")?.write(&[r.lower, r.upper])?;
+        attr_str(&d, "scale", r.spacing.name())?;
+    }
+    Ok(())
+}
+
+/// The box of `/parameters` (`None`: the basis was trained over the load scale alone).
+/// A range that is not `[lower, upper]` with lower < upper, or an unknown scale, is an
+/// error naming the dataset.
+pub fn read_parameter_space(path: &Path) -> Result<Option<ParameterSpace>> {
+    let f = hdf5::File::open(path)
+        .map_err(|e| Error::input(path, "(file)", format!("is not a readable HDF5 file: {e}")))?;
+    let Ok(g) = f.group("parameters") else { return Ok(None) };
+    let mut names = g.member_names().map_err(|e| Error::hdf5(path, e))?;
+    names.sort();
+    let mut ranges = Vec::with_capacity(names.len());
+    for name in names {
+        let field = format!("parameters/{name}");
+        let bad = |problem: String| Error::input(path, &field, problem);
+        let d = g.dataset(&name).map_err(|e| bad(format!("cannot be read: {e}")))?;
+        let r = d
+            .attr("range")
+            .and_then(|a| a.read_raw::<f64>())
+            .map_err(|e| bad(format!("has no readable attribute `range`: {e}")))?;
+        let scale = read_attr_str(&d, "scale").map_err(|e| bad(format!("has no readable attribute `scale`: {e}")))?;
+        let spacing = match scale.as_str() {
+            "linear" => Spacing::Linear,
+            "log" => Spacing::Log,
+            other => return Err(bad(format!("has scale \"{other}\"; expected \"linear\" or \"log\""))),
+        };
+        let [lower, upper] = r[..] else { return Err(bad(format!("has a range of {} values; expected 2", r.len()))) };
+        let range = ParameterRange { name, lower, upper, spacing };
+        range.validate().map_err(&bad)?;
+        ranges.push(range);
+    }
+    Ok(Some(ParameterSpace { ranges }))
+}

@@ -1,0 +1,254 @@
+//! A box of parameters ([`ParameterSpace`]): for each parameter a range and a scale
+//! (linear or logarithmic), as the pipeline's `[parameters]` table gives them; the training
+//! points drawn from it, and which parameters a run's `μ` takes outside it.
+//!
+//! Points are drawn in the unit cube `[0, 1)^d` and mapped to the box per parameter,
+//!
+//! ```text
+//!     linear:  μ_i = a_i + u_i (b_i − a_i)
+//!     log:     μ_i = a_i (b_i / a_i)^u_i
+//! ```
+//!
+//! so that parameters of different units weigh alike. Sobol points are the Owen-scrambled
+//! sequence of Burley (2020) (`sobol_burley`, seeded); Latin hypercube points put one point
+//! in each of `n` equal slices of every axis, slices paired at random; random points are
+//! uniform. The random streams are ChaCha8 from the seed, the same on every platform.
+
+use super::parameters::{Parameters, LOAD_SCALE};
+use crate::error::show_number;
+use rand_chacha::rand_core::{RngCore, SeedableRng};
+
+/// How a parameter's range is spanned.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Spacing {
+    /// evenly in the value
+    #[default]
+    Linear,
+    /// evenly in the logarithm of the value (a range of positive values)
+    Log,
+}
+
+impl Spacing {
+    pub fn name(self) -> &'static str {
+        match self {
+            Spacing::Linear => "linear",
+            Spacing::Log => "log",
+        }
+    }
+}
+
+/// One parameter's range.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParameterRange {
+    pub name: String,
+    pub lower: f64,
+    pub upper: f64,
+    pub spacing: Spacing,
+}
+
+impl ParameterRange {
+    /// Refuses a range no sample can be drawn from: non-finite ends, `lower ≥ upper`, or a
+    /// logarithmic range that does not lie above zero.
+    pub fn validate(&self) -> Result<(), String> {
+        let (a, b) = (self.lower, self.upper);
+        if !(a.is_finite() && b.is_finite() && a < b) {
+            return Err(format!("range [{a}, {b}] must be finite with lower < upper"));
+        }
+        if self.spacing == Spacing::Log && a <= 0.0 {
+            return Err(format!("range [{a}, {b}] with scale = \"log\" must lie above zero"));
+        }
+        Ok(())
+    }
+
+    /// The value at `u ∈ [0, 1]` of the range (the module's mapping).
+    pub fn at(&self, u: f64) -> f64 {
+        match self.spacing {
+            Spacing::Linear => self.lower + u * (self.upper - self.lower),
+            Spacing::Log => self.lower * (self.upper / self.lower).powf(u),
+        }
+    }
+
+    /// Whether `x` lies outside the range by more than round-off (1e-9 of the larger end).
+    pub fn excludes(&self, x: f64) -> bool {
+        let slack = 1e-9 * self.lower.abs().max(self.upper.abs()).max(1e-300);
+        !(x >= self.lower - slack && x <= self.upper + slack)
+    }
+}
+
+/// How training points are drawn from the box.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Sampling {
+    /// Owen-scrambled Sobol points (low discrepancy: the box is covered evenly at any count)
+    #[default]
+    Sobol,
+    /// Latin hypercube: every axis cut into `n` slices, one point in each
+    Lhs,
+    /// independent uniform points
+    Random,
+}
+
+/// The box of a pipeline's `[parameters]`, parameters in name order.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct ParameterSpace {
+    pub ranges: Vec<ParameterRange>,
+}
+
+impl ParameterSpace {
+    pub fn is_empty(&self) -> bool {
+        self.ranges.is_empty()
+    }
+
+    pub fn names(&self) -> impl Iterator<Item = &str> {
+        self.ranges.iter().map(|r| r.name.as_str())
+    }
+
+    /// The parameters at the unit-cube point `u` (one coordinate per range); `λ` is 1
+    /// unless the box holds it.
+    pub fn at(&self, u: &[f64]) -> Parameters {
+        self.ranges.iter().zip(u).fold(Parameters::default(), |mu, (r, &x)| mu.with(&r.name, r.at(x)))
+    }
+
+    /// `n` points of the box drawn by `sampling` from `seed`.
+    pub fn sample(&self, n: usize, sampling: Sampling, seed: u64) -> Vec<Parameters> {
+        let d = self.ranges.len();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        // uniform in [0, 1) from 53 random bits
+        let mut uniform = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+        let cube: Vec<Vec<f64>> = match sampling {
+            Sampling::Sobol => (0..n)
+                .map(|i| (0..d).map(|j| sobol_burley::sample(i as u32, j as u32, seed as u32) as f64).collect())
+                .collect(),
+            Sampling::Random => (0..n).map(|_| (0..d).map(|_| uniform()).collect()).collect(),
+            Sampling::Lhs => {
+                let mut cube = vec![vec![0.0; d]; n];
+                for j in 0..d {
+                    // a random permutation of the slices (Fisher–Yates), a random point in each
+                    let mut slices: Vec<usize> = (0..n).collect();
+                    for i in (1..n).rev() {
+                        let k = (uniform() * (i + 1) as f64) as usize;
+                        slices.swap(i, k.min(i));
+                    }
+                    for (i, s) in slices.into_iter().enumerate() {
+                        cube[i][j] = (s as f64 + uniform()) / n as f64;
+                    }
+                }
+                cube
+            }
+        };
+        cube.iter().map(|u| self.at(u)).collect()
+    }
+
+    /// The parameters of `mu` outside what a basis trained on this box covers, one line
+    /// each (`drive = 1.7 (trained over [0.5, 1.5])`): a parameter of the box outside its
+    /// range, and a named parameter the box does not hold set to anything but 1 (training
+    /// kept it at the model file's load). `λ` outside the box is said by the load-scale
+    /// checks when the box does not hold it.
+    pub fn outside(&self, mu: &Parameters) -> Vec<String> {
+        let mut out = Vec::new();
+        for r in &self.ranges {
+            let x = mu.get(&r.name).unwrap_or(1.0);
+            if r.excludes(x) {
+                out.push(format!(
+                    "{} = {} (trained over [{}, {}])",
+                    r.name,
+                    show_number(x),
+                    show_number(r.lower),
+                    show_number(r.upper)
+                ));
+            }
+        }
+        for (name, x) in mu.named() {
+            if x != 1.0 && !self.names().any(|n| n == name) {
+                out.push(format!("{name} = {} (trained at 1, the model file's load)", show_number(x)));
+            }
+        }
+        out
+    }
+
+    /// Whether the box holds the load scale `λ`.
+    pub fn holds_load_scale(&self) -> bool {
+        self.names().any(|n| n == LOAD_SCALE)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn space() -> ParameterSpace {
+        ParameterSpace {
+            ranges: vec![
+                ParameterRange { name: "drive".into(), lower: 0.5, upper: 1.5, spacing: Spacing::Linear },
+                ParameterRange { name: "stiff".into(), lower: 1e8, upper: 4e8, spacing: Spacing::Log },
+            ],
+        }
+    }
+
+    #[test]
+    fn the_unit_cube_maps_onto_each_range_by_its_scale() {
+        // the ends and the middle: linear midpoint 1.0; log midpoint the geometric mean
+        // √(1e8 · 4e8) = 2e8
+        let s = space();
+        let mid = s.at(&[0.5, 0.5]);
+        assert_eq!(mid.get("drive"), Some(1.0));
+        assert!((mid.get("stiff").unwrap() - 2e8).abs() < 1e-6 * 2e8);
+        assert_eq!(s.at(&[0.0, 0.0]).get("stiff"), Some(1e8));
+        assert_eq!(s.at(&[1.0, 0.0]).get("drive"), Some(1.5));
+        assert_eq!(mid.scale(), 1.0, "λ stays 1 when the box does not hold it");
+    }
+
+    #[test]
+    fn every_sampling_stays_in_the_box_and_is_reproducible_from_its_seed() {
+        let s = space();
+        for sampling in [Sampling::Sobol, Sampling::Lhs, Sampling::Random] {
+            let a = s.sample(16, sampling, 7);
+            assert_eq!(a, s.sample(16, sampling, 7), "{sampling:?}: not reproducible");
+            assert_ne!(a, s.sample(16, sampling, 8), "{sampling:?}: the seed is not used");
+            for mu in &a {
+                assert!(s.outside(mu).is_empty(), "{sampling:?}: {mu} left the box");
+            }
+        }
+        // Latin hypercube: exactly one point in each of the 16 slices of every axis
+        let lhs = s.sample(16, Sampling::Lhs, 3);
+        for r in &s.ranges {
+            let mut slices: Vec<usize> = lhs
+                .iter()
+                .map(|mu| {
+                    let x = mu.get(&r.name).unwrap();
+                    let u = match r.spacing {
+                        Spacing::Linear => (x - r.lower) / (r.upper - r.lower),
+                        Spacing::Log => (x / r.lower).ln() / (r.upper / r.lower).ln(),
+                    };
+                    (u * 16.0).floor() as usize
+                })
+                .collect();
+            slices.sort_unstable();
+            assert_eq!(slices, (0..16).collect::<Vec<_>>(), "{}", r.name);
+        }
+        // Sobol: the first 4 points of a scrambled 2-D Sobol sequence fall one in each
+        // quadrant of the unit square (its (0, 2)-net property, Owen scrambling keeps it)
+        let sobol = s.sample(4, Sampling::Sobol, 11);
+        let mut quadrants: Vec<(bool, bool)> = sobol
+            .iter()
+            .map(|mu| (mu.get("drive").unwrap() >= 1.0, mu.get("stiff").unwrap() >= 2e8 * (1.0 - 1e-12)))
+            .collect();
+        quadrants.sort_unstable();
+        assert_eq!(quadrants, [(false, false), (false, true), (true, false), (true, true)]);
+    }
+
+    #[test]
+    fn outside_names_each_parameter_that_left_the_box() {
+        let s = space();
+        let mu = Parameters::default().with("drive", 1.7).with("stiff", 2e8).with("other", 0.5);
+        let out = s.outside(&mu);
+        assert_eq!(out, ["drive = 1.7 (trained over [0.5, 1.5])", "other = 0.5 (trained at 1, the model file's load)"]);
+        // round-off at an end is inside
+        assert!(s.outside(&Parameters::default().with("drive", 1.5 * (1.0 + 1e-12)).with("stiff", 4e8)).is_empty());
+        assert!(ParameterRange { name: "x".into(), lower: 0.0, upper: 1.0, spacing: Spacing::Log }.validate().is_err());
+        assert!(ParameterRange { name: "x".into(), lower: 1.0, upper: 1.0, spacing: Spacing::Linear }
+            .validate()
+            .is_err());
+    }
+}

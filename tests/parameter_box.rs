@@ -1,0 +1,142 @@
+//! Training over a box of parameters (`[parameters]` and `[train] points` in the pipeline):
+//! the points are drawn from the box and stored in the basis with it, a reduced run inside
+//! the box is not extrapolated and one outside names the parameter that left it, a pipeline
+//! whose box differs from the basis's is refused, and what works on a line only (sweeps,
+//! reports, sharded training) says so instead of running at the wrong parameters.
+//!
+//! Model: the tutorial's double pendulum (`data/models/double_pendulum.toml`) with gravity
+//! scaled by `g` and a horizontal tip force scaled by `push`. The accuracy bound at held-out
+//! points (rel_error ≤ 1e-3) is the tutorial's own tolerance (pipelines/double_pendulum.toml,
+//! greedy tolerance 1e-3), which 12 modes meet on the line with room to spare (5.6e-5 at
+//! λ = 1.1, `flexrom validate` at commit a455e23).
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+const TIP_FORCE: &str =
+    "\n[[loads]]\ntype = \"force\"\nbody = \"lower\"\nnode = \"end\"\nvalue = [0.5, 0.0]\nscaled = \"push\"\n";
+
+const BOX: &str = "[parameters]\ng = [0.8, 1.2]\npush = { range = [0.2, 2.0], scale = \"log\" }\n";
+
+const TRAIN: &str =
+    "[train]\npoints = { count = 6 }\n[reduction]\nvariant = \"constraint-preserving\"\nmodes = { count = 12 }\n";
+
+fn setup(dir: &Path, pipeline_body: &str) {
+    let base = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("data/models/double_pendulum.toml"))
+        .unwrap();
+    std::fs::write(dir.join("m.toml"), format!("{}{TIP_FORCE}", base.replace("scaled = true", "scaled = \"g\"")))
+        .unwrap();
+    std::fs::write(
+        dir.join("p.toml"),
+        format!("model = \"m.toml\"\nbasis = \"b.h5\"\nreport = \"r\"\n{pipeline_body}"),
+    )
+    .unwrap();
+}
+
+fn flexrom(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_flexrom"))
+        .args(args)
+        .current_dir(dir)
+        .env("HDF5_USE_FILE_LOCKING", "FALSE")
+        .output()
+        .unwrap()
+}
+
+fn text(o: &Output) -> (String, String) {
+    (String::from_utf8_lossy(&o.stdout).into_owned(), String::from_utf8_lossy(&o.stderr).into_owned())
+}
+
+#[test]
+fn a_basis_trained_over_a_box_holds_it_and_checks_runs_against_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    setup(d, &format!("{BOX}{TRAIN}"));
+    let out = flexrom(d, &["train", "p.toml", "-q"]);
+    assert!(out.status.success(), "{}", text(&out).1);
+
+    // the basis holds the box and the training points, as the pipeline draws them
+    let p = flexrom::pipeline::Pipeline::load(d.join("p.toml")).unwrap();
+    let space = flexrom::io::parameter_space_file::read_parameter_space(&d.join("b.h5")).unwrap().unwrap();
+    assert_eq!(space, p.space());
+    let points = p.training_points();
+    assert_eq!(points.len(), 6);
+    let f = hdf5::File::open(d.join("b.h5")).unwrap();
+    for r in &space.ranges {
+        let stored = f.dataset(&format!("parameters/{}", r.name)).unwrap().read_raw::<f64>().unwrap();
+        let drawn: Vec<f64> = points.iter().map(|mu| mu.get(&r.name).unwrap()).collect();
+        assert_eq!(stored, drawn, "{}", r.name);
+        assert!(stored.iter().all(|x| !r.excludes(*x)), "{}: a training point left the box", r.name);
+    }
+    drop(f);
+
+    // validate without a point: held-out points of the box, accurate and not extrapolated
+    let out = flexrom(d, &["validate", "p.toml", "--json", "--no-dense"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    let vs: Vec<serde_json::Value> = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(vs.len(), 4);
+    for v in &vs {
+        let params = v["parameters"].as_object().unwrap();
+        assert!(params.contains_key("g") && params.contains_key("push"), "{v}");
+        assert!(!points.iter().any(|mu| mu.get("g") == params["g"].as_f64()), "a validation point is a training point");
+        assert_eq!(v["extrapolated"], false, "{v}");
+        assert!(v["rel_error"].as_f64().unwrap() <= 1e-3, "{v}");
+    }
+    assert!(!stderr.contains("outside what the basis was trained on"), "{stderr}");
+
+    // a point outside the box names the parameter and the range it left
+    let out = flexrom(d, &["online", "p.toml", "--param", "push=3", "--param", "g=1.0", "-o", "o.h5", "--json"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("outside what the basis was trained on: push = 3 (trained over [0.2, 2])"), "{stderr}");
+    assert!(stdout.contains("\"extrapolated\":true"), "{stdout}");
+
+    // what works on a line only refuses a box, naming the pipeline's table; nothing written
+    let out = flexrom(d, &["sweep", "p.toml", "-o", "s.h5"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out).1.contains("p.toml: parameters: a sweep over a box of several parameters is not there yet"));
+    assert!(!d.join("s.h5").exists());
+
+    // a pipeline whose box differs from the basis's is refused before anything runs
+    std::fs::write(
+        d.join("p2.toml"),
+        format!("model = \"m.toml\"\nbasis = \"b.h5\"\nreport = \"r\"\n{}{TRAIN}", BOX.replace("0.8, 1.2", "0.7, 1.2")),
+    )
+    .unwrap();
+    let out = flexrom(d, &["online", "p2.toml", "--param", "g=1.0", "-o", "o2.h5"]);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = text(&out).1;
+    assert!(stderr.contains("b.h5: parameters: the basis was trained over g [0.8, 1.2] linear"), "{stderr}");
+    assert!(stderr.contains("names g [0.7, 1.2] linear"), "{stderr}");
+    assert!(!d.join("o2.h5").exists());
+}
+
+#[test]
+fn a_box_that_does_not_fit_the_model_or_the_training_is_refused_naming_the_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for (body, field, problem) in [
+        (
+            format!("{}{TRAIN}", BOX.replace("push =", "pushh =")),
+            "parameters.pushh",
+            "the model has no parameter `pushh` (its parameters: g, push)",
+        ),
+        (
+            format!("{}{TRAIN}", BOX.replace("0.2, 2.0", "0.0, 2.0")),
+            "parameters.push",
+            "with scale = \"log\" must lie above zero",
+        ),
+        (format!("{}{TRAIN}", BOX.replace("0.8, 1.2", "1.2, 0.8")), "parameters.g", "lower < upper"),
+        (
+            format!("{BOX}[train]\nload_scales = [1.0]\n[reduction]\nmodes = {{ count = 4 }}\n"),
+            "train",
+            "sample it with `points = { count = N }`",
+        ),
+        (TRAIN.to_string(), "train.points", "the pipeline has no [parameters] table"),
+        (format!("{}{}", BOX, TRAIN.replace("count = 6", "count = 0")), "train.points.count", "is 0"),
+    ] {
+        setup(d, &body);
+        let e = flexrom::pipeline::Pipeline::load(d.join("p.toml")).expect_err(&body).to_string();
+        assert!(e.contains(&format!("p.toml: {field}: ")) && e.contains(problem), "{body}\n{e}");
+    }
+}
