@@ -1,8 +1,9 @@
 //! Training over a box of parameters (`[parameters]` and `[train] points` in the pipeline):
 //! the points are drawn from the box and stored in the basis with it, a reduced run inside
 //! the box is not extrapolated and one outside names the parameter that left it, a pipeline
-//! whose box differs from the basis's is refused, and what works on a line only (sweeps,
-//! reports, sharded training) says so instead of running at the wrong parameters.
+//! whose box differs from the basis's is refused, sweeps run grids and lists of points, and
+//! what works on a line only (the report, sharded training) says so instead of running at
+//! the wrong parameters.
 //!
 //! Model: the tutorial's double pendulum (`data/models/double_pendulum.toml`) with gravity
 //! scaled by `g` and a horizontal tip force scaled by `push`. The accuracy bound at held-out
@@ -92,10 +93,10 @@ fn a_basis_trained_over_a_box_holds_it_and_checks_runs_against_it() {
     assert!(stdout.contains("\"extrapolated\":true"), "{stdout}");
 
     // what works on a line only refuses a box, naming the pipeline's table; nothing written
-    let out = flexrom(d, &["sweep", "p.toml", "-o", "s.h5"]);
+    let out = flexrom(d, &["run", "p.toml"]);
     assert_eq!(out.status.code(), Some(1));
-    assert!(text(&out).1.contains("p.toml: parameters: a sweep over a box of several parameters is not there yet"));
-    assert!(!d.join("s.h5").exists());
+    assert!(text(&out).1.contains("p.toml: parameters: `flexrom run` (its sweep and report) over a box"));
+    assert!(!d.join("r").exists());
 
     // a pipeline whose box differs from the basis's is refused before anything runs
     std::fs::write(
@@ -139,4 +140,72 @@ fn a_box_that_does_not_fit_the_model_or_the_training_is_refused_naming_the_field
         let e = flexrom::pipeline::Pipeline::load(d.join("p.toml")).expect_err(&body).to_string();
         assert!(e.contains(&format!("p.toml: {field}: ")) && e.contains(problem), "{body}\n{e}");
     }
+}
+
+#[test]
+fn a_sweep_over_a_grid_of_points_runs_each_point_as_online_does_and_resumes_by_point() {
+    // the grid's point (g = 1.2, push = 2) swept and run alone by `online` give the same
+    // probe trajectory to the bit (a sweep without --continuation runs each point exactly as
+    // `online`); the file's /points hold the grid, first axis slowest
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    setup(d, &format!("{BOX}{TRAIN}"));
+    assert!(flexrom(d, &["train", "p.toml", "-q"]).status.success());
+    let grid = ["--param", "g=0.8:1.2:3", "--param", "push=0.2:2:2:log"];
+    let out = flexrom(d, &[&["sweep", "p.toml", "-o", "s.h5", "--csv"][..], &grid].concat());
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stdout.lines().next().unwrap().ends_with(",parameter:g,parameter:push"), "{stdout}");
+    let f = hdf5::File::open(d.join("s.h5")).unwrap();
+    let points = f.dataset("points").unwrap();
+    assert_eq!(flexrom::io::h5::read_attr_str(&points, "parameters").unwrap(), "load_scale,g,push");
+    let p = points.read_2d::<f64>().unwrap();
+    let expected =
+        [[1.0, 0.8, 0.2], [1.0, 0.8, 2.0], [1.0, 1.0, 0.2], [1.0, 1.0, 2.0], [1.0, 1.2, 0.2], [1.0, 1.2, 2.0]];
+    assert_eq!(p.shape(), [6, 3]);
+    for (row, e) in p.rows().into_iter().zip(expected) {
+        for (a, b) in row.iter().zip(e) {
+            assert!((a - b).abs() <= 1e-12 * b, "{p}");
+        }
+    }
+    let swept = f.dataset("probes/tip").unwrap().read::<f64, ndarray::Ix3>().unwrap();
+    drop(f);
+    let (g, push) = (p[[5, 1]].to_string(), p[[5, 2]].to_string());
+    let out = flexrom(
+        d,
+        &["online", "p.toml", "--param", &format!("g={g}"), "--param", &format!("push={push}"), "-o", "o.h5"],
+    );
+    assert!(out.status.success(), "{}", text(&out).1);
+    let alone = hdf5::File::open(d.join("o.h5")).unwrap().dataset("probes/tip").unwrap().read_2d::<f64>().unwrap();
+    assert!(swept.index_axis(ndarray::Axis(0), 5) == alone, "the swept point differs from `online` at it");
+
+    // --resume over the same grid takes every point from the file; a grid with a new axis
+    // value runs only the new points
+    let out = flexrom(d, &[&["sweep", "p.toml", "-o", "s.h5", "--resume", "-v"][..], &grid].concat());
+    assert!(text(&out).1.contains("6 of 6 load scales already finished"), "{}", text(&out).1);
+    let more = ["--param", "g=0.8:1.2:3", "--param", "push=0.2:2:3:log"];
+    let out = flexrom(d, &[&["sweep", "p.toml", "-o", "s.h5", "--resume", "-v"][..], &more].concat());
+    assert!(text(&out).1.contains("6 of 9 load scales already finished"), "{}", text(&out).1);
+
+    // a point outside the box is flagged, and the warning counts such points
+    let out = flexrom(d, &["sweep", "p.toml", "-o", "s2.h5", "--param", "g=1.0", "--param", "push=1:3:3", "--json"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    let rows: Vec<serde_json::Value> = serde_json::from_str(&stdout).unwrap();
+    let flags: Vec<bool> = rows.iter().map(|r| r["extrapolated"].as_bool().unwrap()).collect();
+    assert_eq!(flags, [false, false, true], "push = 1, 2 inside [0.2, 2], 3 outside");
+    assert!(
+        stderr.contains("1 of 3 points lie outside what the basis was trained on (the first: push = 3"),
+        "{stderr}"
+    );
+
+    // a points file, and a box pipeline without points to sweep
+    std::fs::write(d.join("pts.csv"), "g,push\n0.9,0.5\n1.1,1.5\n").unwrap();
+    let out = flexrom(d, &["sweep", "p.toml", "-o", "s3.h5", "--points", "pts.csv", "--json"]);
+    let rows: Vec<serde_json::Value> = serde_json::from_str(&text(&out).0).unwrap();
+    assert_eq!(rows.iter().map(|r| r["parameter:push"].as_f64().unwrap()).collect::<Vec<_>>(), [0.5, 1.5]);
+    let out = flexrom(d, &["sweep", "p.toml", "-o", "s4.h5"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out).1.contains("sweeps the points of `--param NAME=A:B:N`"));
+    assert!(!d.join("s4.h5").exists());
 }

@@ -9,6 +9,7 @@ use flexrom::output::{self, info};
 use flexrom::pipeline::online::load_rom;
 use flexrom::pipeline::sweep::{Route, SweepBasis, SweepFile};
 use flexrom::pipeline::Pipeline;
+use flexrom::solver::parameters::{Parameters, LOAD_SCALE};
 use std::path::PathBuf;
 
 /// The arguments of `flexrom sweep`.
@@ -20,6 +21,15 @@ pub struct Args {
     /// its training loads); A may be negative (`-1:1:21`)
     #[arg(long, allow_hyphen_values = true, value_name = "A:B:N")]
     load_scales: Option<String>,
+    /// an axis of a grid of named parameters: `NAME=A:B:N`, `NAME=A:B:N:log` or `NAME=X`;
+    /// repeat it for several (with --load-scales, or the pipeline's loads, as the first
+    /// axis); the grid runs every combination, the first axis slowest
+    #[arg(long = "param", value_name = "NAME=A:B:N", allow_hyphen_values = true)]
+    params: Vec<String>,
+    /// a CSV file of points: a header of parameter names (`load_scale` for the load
+    /// scale), one point per row
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["load_scales", "params"])]
+    points: Option<PathBuf>,
     /// also run the full model at each load scale and report errors
     #[arg(long)]
     validate: bool,
@@ -70,6 +80,8 @@ impl Args {
         let Args {
             pipeline,
             load_scales,
+            params,
+            points,
             validate,
             full,
             continuation,
@@ -83,12 +95,14 @@ impl Args {
             format,
         } = self;
         let p = Pipeline::load_with(&pipeline, limits.clone())?;
-        p.refuse_box("a sweep")?;
-        let scales = match load_scales {
-            Some(s) => flexrom::pipeline::config::parse_range(&s)
-                .map_err(|e| flexrom::Error::Usage(format!("--load-scales: {e}")))?,
-            None => p.online_scales(),
-        };
+        let points = sweep_points(&p, load_scales.as_deref(), &params, points.as_deref())?;
+        let named = points.iter().any(|mu| mu.named().next().is_some());
+        if named && shard.is_some() {
+            return Err(flexrom::Error::Usage(
+                "--shard splits a list of load scales; a sweep over named parameters runs in one process so far".into(),
+            ));
+        }
+        let scales: Vec<f64> = points.iter().map(|mu| mu.scale()).collect();
         let path = basis.unwrap_or_else(|| p.basis_path.clone());
         let mut inputs = vec![(p.path.as_path(), "pipeline file"), (p.model.path.as_path(), "model file")];
         if !full {
@@ -124,17 +138,18 @@ impl Args {
         let file = SweepFile { out: &out, resume, extra: &|_| Ok(()) };
         let sw = match shard {
             Some(k) => flexrom::pipeline::shard::sweep_shard(&p, route, &scales, k, options, file)?,
-            None => flexrom::pipeline::sweep::sweep_to_file(route, &scales, options, file)?,
+            None => flexrom::pipeline::sweep::sweep_to_file(route, &points, options, file)?,
         };
         match format.format() {
             Format::Text => output::print(&flexrom::pipeline::sweep::table(&sw))?,
             f => print_table(&flexrom::pipeline::tables::sweep_table(&sw), f, false)?,
         }
         info(&format!(
-            "{}{}{} load scales ({} resumed) on {} threads in {:.3} s -> {}",
+            "{}{}{} {} ({} resumed) on {} threads in {:.3} s -> {}",
             shard.map(|k| format!("shard {k}: ")).unwrap_or_default(),
             if full { "full model, " } else { "" },
             sw.scales.len(),
+            if named { "points" } else { "load scales" },
             sw.resumed,
             sw.threads,
             sw.wall_seconds,
@@ -149,6 +164,16 @@ impl Args {
             )));
         }
         let Some((_, rom, _)) = &loaded else { return Ok(()) };
+        let outside: Vec<Vec<String>> =
+            points.iter().map(|mu| rom.named_outside(mu)).filter(|w| !w.is_empty()).collect();
+        if let Some(first) = outside.first() {
+            warn(&[format!(
+                "{} of {} points lie outside what the basis was trained on (the first: {}); the reduced model extrapolates there",
+                outside.len(),
+                points.len(),
+                first.join(", ")
+            )]);
+        }
         let runs: Vec<(f64, Option<f64>)> = sw
             .scales
             .iter()
@@ -157,4 +182,50 @@ impl Args {
             .collect();
         super::check_runs(rom, &runs, strict)
     }
+}
+
+/// The points of the sweep: `--points FILE`; or the grid of `--param` axes after the load
+/// scales (`--load-scales`, else the pipeline's, which a `[parameters]` box pipeline does
+/// not have: it needs `--param` or `--points`); or the line of load scales alone.
+fn sweep_points(
+    p: &Pipeline,
+    load_scales: Option<&str>,
+    params: &[String],
+    file: Option<&std::path::Path>,
+) -> flexrom::Result<Vec<Parameters>> {
+    use flexrom::pipeline::points::{grid, parse_axis, read_points_csv};
+    let range = |s: &str| {
+        flexrom::pipeline::config::parse_range(s).map_err(|e| flexrom::Error::Usage(format!("--load-scales: {e}")))
+    };
+    let points = if let Some(f) = file {
+        read_points_csv(f)?
+    } else if params.is_empty() && p.space().is_empty() {
+        let scales = match load_scales {
+            Some(s) => range(s)?,
+            None => p.online_scales(),
+        };
+        scales.into_iter().map(Parameters::load_scale).collect()
+    } else {
+        let mut axes = Vec::new();
+        match load_scales {
+            Some(s) => axes.push((LOAD_SCALE.to_string(), range(s)?)),
+            None if p.space().is_empty() => axes.push((LOAD_SCALE.to_string(), p.online_scales())),
+            None => {}
+        }
+        for spec in params {
+            axes.push(parse_axis(spec).map_err(|e| flexrom::Error::Usage(format!("--param: {e}")))?);
+        }
+        if axes.is_empty() {
+            return Err(flexrom::Error::Usage(format!(
+                "{}: a pipeline with a [parameters] box sweeps the points of `--param NAME=A:B:N` (one per parameter) or `--points FILE`",
+                p.path.display()
+            )));
+        }
+        grid(&axes)?
+    };
+    for mu in &points {
+        mu.validate()?;
+        p.model.check_parameters(mu)?;
+    }
+    Ok(points)
 }

@@ -143,8 +143,9 @@ const BASIS: [Entry; 47] = [
     ("timing/estimate_seconds", "s", ""),
 ];
 
-const SWEEP: [Entry; 26] = [
+const SWEEP: [Entry; 27] = [
     ("load_scales", "1", "load"),
+    ("points", "1", "load, parameter"),
     ("status", "1", "load"),
     ("message", TEXT, "load"),
     ("t", "s", "time"),

@@ -10,6 +10,7 @@ pub mod greedy;
 pub mod merge;
 pub mod online;
 pub mod plot;
+pub mod points;
 pub mod report;
 pub mod route;
 pub mod shard;

@@ -22,6 +22,7 @@ use super::config::Pipeline;
 use super::sweep::{sweep_to_file, Route, Sweep, SweepFile, SweepOptions};
 use crate::error::{Error, Result};
 use crate::io::h5::{attr_str, attr_u64};
+use crate::solver::parameters::Parameters;
 use ndarray::Array1;
 use sha2::{Digest, Sha256};
 
@@ -120,7 +121,8 @@ pub fn sweep_shard(
             None => Ok(()),
         }
     };
-    sweep_to_file(route, &scales, o, SweepFile { extra: &extra, ..f })
+    let points: Vec<Parameters> = scales.iter().map(|&x| Parameters::load_scale(x)).collect();
+    sweep_to_file(route, &points, o, SweepFile { extra: &extra, ..f })
 }
 
 /// Sets the size of the worker pool: `--threads` when given, else `RAYON_NUM_THREADS` (read

@@ -17,7 +17,7 @@ mod file;
 mod outcome;
 mod table;
 
-pub use file::{read_sweep, write_sweep, write_sweep_with, Extra, SweepBasis};
+pub use file::{point_names, read_sweep, write_sweep, write_sweep_with, Extra, SweepBasis};
 pub use outcome::{Outcome, ScaleResult, Sweep, SweepPoint, STATUS_FAILED, STATUS_OK, STATUS_PENDING};
 pub use table::table;
 
@@ -109,7 +109,8 @@ impl<'a> Route<'a> {
 /// A scale whose run fails is recorded as failed and the others go on. Every point gets the
 /// reduced model's error estimate (when it has an estimator) and extrapolation flag.
 pub fn sweep(rom: &Rom, scales: &[f64], o: SweepOptions) -> Result<Sweep> {
-    let start = pending(rom.model(), rom.basis().n_reduced(), false, scales, o)?;
+    let points: Vec<Parameters> = scales.iter().map(|&x| Parameters::load_scale(x)).collect();
+    let start = pending(rom.model(), rom.basis().n_reduced(), false, &points, o)?;
     run_reduced(rom, start, o, None)
 }
 
@@ -127,7 +128,7 @@ pub struct SweepFile<'a> {
 /// (same route, basis content and model) are taken from it, and only the others run. The
 /// returned sweep is written to `f.out`. A full sweep takes no options: it is neither
 /// validated (it is the reference itself) nor continued.
-pub fn sweep_to_file(route: Route, scales: &[f64], o: SweepOptions, f: SweepFile) -> Result<Sweep> {
+pub fn sweep_to_file(route: Route, points: &[Parameters], o: SweepOptions, f: SweepFile) -> Result<Sweep> {
     let SweepFile { out, resume, extra } = f;
     let model = route.model();
     let full = matches!(route, Route::Full(_));
@@ -136,13 +137,13 @@ pub fn sweep_to_file(route: Route, scales: &[f64], o: SweepOptions, f: SweepFile
         Route::Reduced { rom, .. } => rom.basis().n_reduced(),
         Route::Full(_) => 0,
     };
-    let mut start = pending(model, n_reduced, full, scales, o)?;
+    let mut start = pending(model, n_reduced, full, points, o)?;
     if resume {
         if out.exists() {
             let old = read_sweep(out, model, route.basis().map(|b| b.stored), o.validate)?;
             let mut reused = 0;
             for s in start.scales.iter_mut() {
-                if let Some(i) = old.iter().position(|(x, _)| *x == s.mu.scale()) {
+                if let Some(i) = old.iter().position(|(x, _)| *x == s.mu) {
                     if let Some(p) = old[i].1.as_ref() {
                         s.outcome = Outcome::Done(clone_point(p));
                         reused += 1;
@@ -150,12 +151,12 @@ pub fn sweep_to_file(route: Route, scales: &[f64], o: SweepOptions, f: SweepFile
                 }
             }
             start.resumed = reused;
-            let dropped = old.iter().filter(|(x, p)| p.is_some() && !scales.contains(x)).count();
+            let dropped = old.iter().filter(|(x, p)| p.is_some() && !points.contains(x)).count();
             log::info!(
                 "resuming {}: {reused} of {} load scales already finished, running {}{}",
                 out.display(),
-                scales.len(),
-                scales.len() - reused,
+                points.len(),
+                points.len() - reused,
                 if dropped > 0 {
                     format!(" ({dropped} finished load scales of the file are not in the list and are left out)")
                 } else {
@@ -163,7 +164,7 @@ pub fn sweep_to_file(route: Route, scales: &[f64], o: SweepOptions, f: SweepFile
                 }
             );
         } else {
-            log::info!("resuming {}: no such file yet, running all {} load scales", out.display(), scales.len());
+            log::info!("resuming {}: no such file yet, running all {} load scales", out.display(), points.len());
         }
     }
     let basis = route.basis();
@@ -177,14 +178,11 @@ pub fn sweep_to_file(route: Route, scales: &[f64], o: SweepOptions, f: SweepFile
 }
 
 /// Every scale pending, with the model's time grid and probe names.
-fn pending(model: &Model, n_reduced: usize, full: bool, scales: &[f64], o: SweepOptions) -> Result<Sweep> {
+fn pending(model: &Model, n_reduced: usize, full: bool, points: &[Parameters], o: SweepOptions) -> Result<Sweep> {
     let s = Settings::resolve(model, &Overrides::default())?;
     let t = Array1::from_iter((0..=s.n_steps).map(|k| k as f64 * s.dt));
     Ok(Sweep {
-        scales: scales
-            .iter()
-            .map(|&x| ScaleResult { mu: Parameters::load_scale(x), outcome: Outcome::Pending })
-            .collect(),
+        scales: points.iter().map(|mu| ScaleResult { mu: mu.clone(), outcome: Outcome::Pending }).collect(),
         t,
         probe_names: model.probe_names(),
         n_reduced,

@@ -35,6 +35,9 @@ pub fn sweep_table(s: &Sweep) -> Table {
     if s.validated {
         cols.push("displacement_error");
     }
+    let base = cols.len();
+    let named = named_columns(s);
+    cols.extend(named.iter().map(|(c, _)| c.as_str()));
     let mut t = Table::new(&cols);
     for x in &s.scales {
         let mut row: Vec<Cell> = vec![x.mu.scale().into(), (x.status() as u64).into(), x.message().into()];
@@ -64,17 +67,28 @@ pub fn sweep_table(s: &Sweep) -> Table {
                     row.push(p.validation.as_ref().map(|v| v.displacement_error).into());
                 }
             }
-            None => row.resize(cols.len(), Cell::Null),
+            None => row.resize(base, Cell::Null),
         }
+        row.extend(named.iter().map(|(_, n)| x.mu.get(n).unwrap_or(1.0).into()));
         t.push(row);
     }
     t
 }
 
+/// The columns `parameter:NAME` of the named parameters the sweep's points set (none for a
+/// line of load scales), appended after the others so that those keep their places.
+fn named_columns(s: &Sweep) -> Vec<(String, String)> {
+    let names = super::sweep::point_names(s.scales.iter().map(|x| &x.mu));
+    names.into_iter().skip(1).map(|n| (format!("parameter:{n}"), n)).collect()
+}
+
 /// [`sweep_table`] of a full sweep: `load_scale`, `status`, `message`, `full_seconds`,
 /// `newton_iterations`, `step_cuts`.
 fn full_sweep_table(s: &Sweep) -> Table {
-    let cols = ["load_scale", "status", "message", "full_seconds", "newton_iterations", "step_cuts"];
+    let mut cols = vec!["load_scale", "status", "message", "full_seconds", "newton_iterations", "step_cuts"];
+    let base = cols.len();
+    let named = named_columns(s);
+    cols.extend(named.iter().map(|(c, _)| c.as_str()));
     let mut t = Table::new(&cols);
     for x in &s.scales {
         let mut row: Vec<Cell> = vec![x.mu.scale().into(), (x.status() as u64).into(), x.message().into()];
@@ -83,8 +97,9 @@ fn full_sweep_table(s: &Sweep) -> Table {
                 let r = &p.run.result;
                 row.extend([r.wall_seconds.into(), r.stats.newton_iterations.into(), r.stats.step_cuts.into()]);
             }
-            None => row.resize(cols.len(), Cell::Null),
+            None => row.resize(base, Cell::Null),
         }
+        row.extend(named.iter().map(|(_, n)| x.mu.get(n).unwrap_or(1.0).into()));
         t.push(row);
     }
     t

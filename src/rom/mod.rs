@@ -158,15 +158,21 @@ impl Rom {
         }
     }
 
+    /// The parameters of `mu` other than the load scale outside what the basis was trained
+    /// on, one line each ([`Trust::named_outside`]).
+    pub fn named_outside(&self, mu: &Parameters) -> Vec<String> {
+        match &self.trust {
+            Some(t) => t.named_outside(mu),
+            None => ParameterSpace::default().outside(mu),
+        }
+    }
+
     /// One warning naming the parameters of `mu` other than the load scale that lie
     /// outside what the basis was trained on: outside the `[parameters]` box it was trained
     /// over, or, for a parameter training did not vary, anywhere but 1 (the model file's
     /// load). Empty when there are none (the load scale's range is [`trust::check_runs`]'s).
     pub fn untrained_parameters(&self, mu: &Parameters) -> Vec<String> {
-        let away = match &self.trust {
-            Some(t) => t.named_outside(mu),
-            None => ParameterSpace::default().outside(mu),
-        };
+        let away = self.named_outside(mu);
         if away.is_empty() {
             return Vec::new();
         }

@@ -4,6 +4,9 @@
 //!
 //! ```text
 //! /load_scales        (N)
+//! /points             (N, d)         a sweep over named parameters only: every parameter's
+//!                                    value at each point (attribute `parameters`: the d names,
+//!                                    comma-separated, load_scale first)
 //! /status             (N)            0 = ok, 1 = failed, 2 = not run yet
 //! /message            (N)            why it failed ("" when ok)
 //! /t                  (n_t)
@@ -103,6 +106,13 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, basis: Option<SweepBasis>, extra
             .with_data(&Array1::from_iter(s.scales.iter().map(|x| x.mu.scale())))
             .create("load_scales")
             .map_err(e)?;
+        // the points, where the sweep sets a named parameter (a line of load scales has none)
+        let names = point_names(s.scales.iter().map(|x| &x.mu));
+        if names.len() > 1 {
+            let points = Array2::from_shape_fn((n, names.len()), |(k, j)| s.scales[k].mu.get(&names[j]).unwrap_or(1.0));
+            let d = f.new_dataset_builder().with_data(&points).create("points").map_err(e)?;
+            attr_str(&d, "parameters", &names.join(",")).map_err(e)?;
+        }
         f.new_dataset_builder()
             .with_data(&Array1::from_iter(s.scales.iter().map(ScaleResult::status)))
             .create("status")
@@ -235,8 +245,18 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, basis: Option<SweepBasis>, extra
     })
 }
 
-/// Reads an earlier sweep file for `--resume`: (load scale, the finished run) for every
-/// scale it holds, `None` for those that failed or did not run. `stored` is the basis of a
+/// The parameters of `points`: `load_scale` first, then every named one any point sets, in
+/// name order (the columns of `/points`).
+pub fn point_names<'a>(points: impl Iterator<Item = &'a Parameters>) -> Vec<String> {
+    let mut named = std::collections::BTreeSet::new();
+    for mu in points {
+        named.extend(mu.named().map(|(n, _)| n.to_string()));
+    }
+    std::iter::once(crate::solver::parameters::LOAD_SCALE.to_string()).chain(named).collect()
+}
+
+/// Reads an earlier sweep file for `--resume`: (parameters, the finished run) for every
+/// point it holds, `None` for those that failed or did not run. `stored` is the basis of a
 /// reduced sweep, `None` for a full one. Refuses a file of another route, basis or model,
 /// and one without the validation a `--validate` sweep needs.
 pub fn read_sweep(
@@ -244,7 +264,7 @@ pub fn read_sweep(
     model: &Model,
     stored: Option<&StoredBasis>,
     validate: bool,
-) -> Result<Vec<(f64, Option<SweepPoint>)>> {
+) -> Result<Vec<(Parameters, Option<SweepPoint>)>> {
     let cannot = |field: &str, problem: String| {
         Error::input(path, field, format!("{problem}; cannot resume from it (remove it, or run without --resume)"))
     };
@@ -282,6 +302,25 @@ pub fn read_sweep(
         f.dataset(name).and_then(|d| d.read_1d::<u64>()).map_err(|e| cannot(name, format!("cannot be read: {e}")))
     };
     let scales = vec("load_scales")?;
+    let points: Vec<Parameters> = if f.link_exists("points") {
+        let d = f.dataset("points").map_err(|e| cannot("points", format!("cannot be read: {e}")))?;
+        let a = d.read::<f64, ndarray::Ix2>().map_err(|e| cannot("points", format!("cannot be read: {e}")))?;
+        let names = read_attr_str(&d, "parameters")
+            .map_err(|e| cannot("points", format!("has no readable attribute `parameters`: {e}")))?;
+        let names: Vec<&str> = names.split(',').collect();
+        if a.dim() != (scales.len(), names.len()) {
+            return Err(cannot(
+                "points",
+                format!("is {:?}, expected ({}, {}) for its parameters {names:?}", a.dim(), scales.len(), names.len()),
+            ));
+        }
+        a.rows()
+            .into_iter()
+            .map(|row| names.iter().zip(row).fold(Parameters::default(), |mu, (n, &v)| mu.with(n, v)))
+            .collect()
+    } else {
+        scales.iter().map(|&x| Parameters::load_scale(x)).collect()
+    };
     let status = f
         .dataset("status")
         .and_then(|d| d.read_1d::<u8>())
@@ -411,13 +450,13 @@ pub fn read_sweep(
     }
     let mut out = Vec::new();
     for k in 0..n {
-        let x = scales[k];
+        let mu = points[k].clone();
         // a finished run counts only when it has what this sweep writes
         if status[k] != STATUS_OK || (validate && validation.is_none()) {
-            out.push((x, None));
+            out.push((mu, None));
             continue;
         }
-        let settings = Settings::resolve(model, &Overrides::at(&Parameters::load_scale(x)))?;
+        let settings = Settings::resolve(model, &Overrides::at(&mu))?;
         let stats = Stats {
             steps: settings.n_steps,
             newton_iterations: newton[k] as usize,
@@ -439,8 +478,8 @@ pub fn read_sweep(
             wall_seconds: rom_seconds[k],
         };
         let v = validation.as_ref().zip(stored).map(|(c, stored)| Validation {
-            load_scale: x,
-            parameters: std::iter::once((crate::solver::parameters::LOAD_SCALE.to_string(), x)).collect(),
+            load_scale: mu.scale(),
+            parameters: mu.iter().map(|(n, v)| (n.to_string(), v)).collect(),
             variant: stored.basis.variant.name().to_string(),
             n_dof: stored.basis.n_dof(),
             n_modes: r,
@@ -512,7 +551,7 @@ pub fn read_sweep(
         });
         let run = ReducedRun { result, reduced_q: zq.index_axis(ndarray::Axis(0), k).to_owned() };
         let full_probes = full_probes.as_deref().map(|p| at(p, k));
-        out.push((x, Some(SweepPoint { run, validation: v, full_probes, estimate, extrapolated })));
+        out.push((mu, Some(SweepPoint { run, validation: v, full_probes, estimate, extrapolated })));
     }
     Ok(out)
 }

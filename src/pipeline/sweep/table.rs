@@ -14,8 +14,13 @@ pub fn table(s: &Sweep) -> String {
     if s.validated {
         out.push_str("   rel_error  probe_err_m  full_ms  speedup");
     }
+    // the named parameters of the points, where there are any, lead each line
+    let named: Vec<String> = super::file::point_names(s.scales.iter().map(|x| &x.mu)).into_iter().skip(1).collect();
+    let lead = |values: Vec<String>| values.into_iter().map(|v| format!("{v}  ")).collect::<String>();
+    out.insert_str(0, &lead(named.iter().map(|n| format!("{n:>10}")).collect()));
     out.push('\n');
     for x in &s.scales {
+        out.push_str(&lead(named.iter().map(|n| scale(x.mu.get(n).unwrap_or(1.0))).collect()));
         let Some(p) = x.point() else {
             out.push_str(&format!(
                 "{}  {}: {}\n",
