@@ -94,11 +94,12 @@ pub struct FollowStats {
 /// The enriched model, built once, corrected along reduced runs at many parameters.
 pub struct CorrectedRunner {
     model: Arc<Model>,
-    data: Arc<Estimator>,
     rom: Box<HyperReducedModel<FlexibleSystem>>,
     /// `M = V⁺ᵀ V` (r⁺ × r)
     lift: Array2<f64>,
-    x0: Vec<f64>,
+    /// the initial configuration in the enriched coordinates, `V⁺ᵀ(x₀ − x_ref)`, projected
+    /// once (O(n_dof r⁺): on a refined mesh, most of a run's estimate otherwise)
+    q0: Vec<f64>,
     /// [`ACCEPT`]; ∞ keeps one iteration per step whatever it leaves (experiments)
     accept: f64,
 }
@@ -118,7 +119,7 @@ impl CorrectedRunner {
     /// Projects the model on the enriched basis of `data` (see [`Self::supports`]).
     pub fn new(model: &Arc<Model>, basis: &Basis, data: &Arc<Estimator>) -> Result<Self> {
         let physics = model.physics()?;
-        let (sys, x0) = (physics.sys.clone(), physics.x0.to_vec());
+        let sys = physics.sys.clone();
         let enriched = &data.enriched;
         let all;
         let h = match &enriched.hyper {
@@ -131,14 +132,8 @@ impl CorrectedRunner {
         let rom = HyperReducedModel::new(sys, enriched, h)
             .map_err(|e| Error::Usage(format!("cannot build the estimator's reduced model: {e}")))?;
         let lift = enriched.modes.t().dot(&basis.modes);
-        Ok(CorrectedRunner {
-            model: Arc::clone(model),
-            data: Arc::clone(data),
-            rom: Box::new(rom),
-            lift,
-            x0,
-            accept: ACCEPT,
-        })
+        let q0 = enriched.reduce(ArrayView1::from(&physics.x0[..])).to_vec();
+        Ok(CorrectedRunner { model: Arc::clone(model), rom: Box::new(rom), lift, q0, accept: ACCEPT })
     }
 
     /// Another acceptance ratio ([`ACCEPT`]; ∞: one iteration per step, unchecked).
@@ -185,7 +180,7 @@ impl CorrectedRunner {
         let k = integ.step_constants(h);
 
         // consistent start: [M, Bᵀ; B, 0][q̈; λ] = [−g; 0]
-        let q0 = self.data.enriched.reduce(ArrayView1::from(&self.x0)).to_vec();
+        let q0 = self.q0.clone();
         let mut st: State = integ.initialize(rom, q0, vec![0.0; n], 0.0)?;
         let mut rhs = vec![0.0; n + nc];
         let mut work = vec![0.0; n];
@@ -306,6 +301,8 @@ pub struct Corrected {
     fallback: std::sync::OnceLock<Option<super::enriched::Enriched>>,
     /// the initial configuration X₀ of the displacement measure
     x0: Arc<Vec<f64>>,
+    /// the norms' projections of the basis pair, made once
+    norms: super::norms::NormProjection,
 }
 
 impl Corrected {
@@ -315,13 +312,16 @@ impl Corrected {
         let (m, b, d) = (Arc::clone(model), Arc::clone(basis), Arc::clone(data));
         let runners = Pool::new(move || CorrectedRunner::new(&m, &b, &d));
         runners.put(CorrectedRunner::new(model, basis, data)?);
+        let x0 = Arc::clone(&model.physics()?.x0);
+        let norms = super::norms::NormProjection::new(basis, &data.enriched, ndarray::ArrayView1::from(&x0[..]));
         Ok(Corrected {
             model: Arc::clone(model),
             basis: Arc::clone(basis),
             data: Arc::clone(data),
             runners,
             fallback: std::sync::OnceLock::new(),
-            x0: Arc::clone(&model.physics()?.x0),
+            x0,
+            norms,
         })
     }
 }
@@ -346,6 +346,6 @@ impl ErrorEstimator for Corrected {
             };
         }
         let x0 = ndarray::ArrayView1::from(&self.x0[..]);
-        Ok(super::norms::raw_by_time(&self.basis, &self.data.enriched, &run.reduced_q, &qp, x0))
+        Ok(self.norms.raw_by_time(&self.basis, &self.data.enriched, &run.reduced_q, &qp, x0))
     }
 }

@@ -49,12 +49,22 @@ pub fn sample_for(steps: usize, sample: usize) -> usize {
 /// method's scale fifth by fifth where greedy training calibrated it
 /// ([`crate::reduction::estimator::DefectsCalibration`]).
 pub struct Defects {
-    basis: Arc<Basis>,
     data: Arc<Estimator>,
     runners: Pool<'static, CorrectedRunner>,
     sample: usize,
-    /// the initial configuration X₀ of the displacement measure
-    x0: Arc<Vec<f64>>,
+    /// the norms' constants, `Vᵀx_ref`, `‖x_ref‖²`, `Vᵀ(x_ref − x₀)`, `‖x_ref − x₀‖²`:
+    /// projected once, so that an estimate costs O(r n_t), not O(n_dof r)
+    norms: NormConstants,
+}
+
+/// The constants of the configuration and displacement norms from reduced coordinates
+/// (`norms.rs`): `‖x_ref + V z‖² = ‖x_ref‖² + 2 (Vᵀx_ref)·z + ‖z‖²` and the same with the
+/// reference shifted by the initial configuration X₀ (orthonormal `V`).
+struct NormConstants {
+    vtx: ndarray::Array1<f64>,
+    xr2: f64,
+    vts: ndarray::Array1<f64>,
+    shift2: f64,
 }
 
 impl Defects {
@@ -63,8 +73,16 @@ impl Defects {
         let (m, b, d) = (Arc::clone(model), Arc::clone(basis), Arc::clone(data));
         let runners = Pool::new(move || CorrectedRunner::new(&m, &b, &d));
         runners.put(CorrectedRunner::new(model, basis, data)?);
-        let x0 = Arc::clone(&model.physics()?.x0);
-        Ok(Defects { basis: Arc::clone(basis), data: Arc::clone(data), runners, sample: DEFECT_SAMPLE, x0 })
+        let x0 = &model.physics()?.x0;
+        let b = &**basis;
+        let shift = &b.reference - &ndarray::ArrayView1::from(&x0[..]);
+        let norms = NormConstants {
+            vtx: b.modes.t().dot(&b.reference),
+            xr2: b.reference.dot(&b.reference),
+            vts: b.modes.t().dot(&shift),
+            shift2: shift.dot(&shift),
+        };
+        Ok(Defects { data: Arc::clone(data), runners, sample: DEFECT_SAMPLE, norms })
     }
 
     /// Another sampling interval (experiments: examples/estimate_table.rs).
@@ -91,11 +109,8 @@ impl ErrorEstimator for Defects {
         let defects = self.runners.with(|r| r.defects(run, s))??;
         // ‖x_ref + V z_k‖² and ‖x_ref + V z_k − x₀‖² from the reduced coordinates (V
         // orthonormal; the corrected runner exists only for such bases): norms.rs
-        let b = &self.basis;
-        let vtx = b.modes.t().dot(&b.reference);
-        let xr2 = b.reference.dot(&b.reference);
-        let shift = &b.reference - &ndarray::ArrayView1::from(&self.x0[..]);
-        let (vts, shift2) = (b.modes.t().dot(&shift), shift.dot(&shift));
+        let NormConstants { vtx, xr2, vts, shift2 } = &self.norms;
+        let (xr2, shift2) = (*xr2, *shift2);
         let (mut err2, mut norm2, mut disp2) = (vec![0.0; nt], vec![0.0; nt], vec![0.0; nt]);
         let mut acc = 0.0;
         for k in 0..nt {

@@ -4,7 +4,7 @@
 //! cheaply; it is also what runs where they are not available (whole-system bases, models
 //! without the invariant-based reduced model).
 
-use super::norms::{raw_by_time, RawByFifth};
+use super::norms::{NormProjection, RawByFifth};
 use super::{ErrorEstimator, Estimator};
 use crate::error::Result;
 use crate::model::Model;
@@ -20,6 +20,8 @@ pub struct Enriched {
     runners: Pool<'static, ReducedRunner>,
     /// the initial configuration X₀ of the displacement measure
     x0: Arc<Vec<f64>>,
+    /// the norms' projections of the basis pair, made once
+    norms: NormProjection,
 }
 
 impl Enriched {
@@ -30,7 +32,8 @@ impl Enriched {
         let runners = Pool::new(move || ReducedRunner::new(&m, &e));
         runners.put(ReducedRunner::new(model, &enriched)?);
         let x0 = Arc::clone(&model.physics()?.x0);
-        Ok(Enriched { basis: Arc::clone(basis), data: Arc::clone(data), runners, x0 })
+        let norms = NormProjection::new(basis, &data.enriched, ndarray::ArrayView1::from(&x0[..]));
+        Ok(Enriched { basis: Arc::clone(basis), data: Arc::clone(data), runners, x0, norms })
     }
 }
 
@@ -45,6 +48,6 @@ impl ErrorEstimator for Enriched {
         let mu = run.result.settings.parameters();
         let e = self.runners.with(|r| r.solve(mu, Output::ReducedAndProbes, &[]))??;
         let x0 = ndarray::ArrayView1::from(&self.x0[..]);
-        Ok(raw_by_time(&self.basis, &self.data.enriched, &run.reduced_q, &e.reduced_q, x0))
+        Ok(self.norms.raw_by_time(&self.basis, &self.data.enriched, &run.reduced_q, &e.reduced_q, x0))
     }
 }
