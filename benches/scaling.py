@@ -11,18 +11,22 @@ work folder, then
 * times `flexrom train P.toml` (wall and CPU of the whole process),
 * reads from the basis: full runs, converged or not, POD modes + joint coordinates, sampled
   elements,
-* runs `flexrom validate P.toml --load-scale X --json --no-dense` at each of the pipeline's
-  [validate] loads (neither training loads nor greedy candidates), `--rounds` times, the
-  loads in turn, round after round. Each `validate` times the full and the reduced time loop
-  interleaved (up to 7 pairs within 0.25 s, one pair where a full run alone takes longer)
-  and the estimate once; the table gives medians over all rounds and loads: reduced without
-  the estimate = `rom_seconds`, with it = `rom_seconds + estimate_seconds`.
 
-It writes one JSON file per size into the work folder (a later run skips sizes already
-there unless --force), prints the markdown table, the break-even size, log-log slopes and
-draws the figure (matplotlib, if installed).
+then, once every size is trained, runs `flexrom validate P.toml --load-scale X --json
+--no-dense` at each pipeline's [validate] loads (neither training loads nor greedy
+candidates), `--rounds` times, every size and load in turn, round after round, so a busy
+spell of the host falls on all sizes. Each `validate` times the full and the reduced time
+loop interleaved in one process (up to 7 pairs within 0.25 s, one pair where a full run
+alone takes longer) and the estimate once; the table gives medians over all rounds and
+loads: reduced without the estimate = `rom_seconds`, with it = `rom_seconds +
+estimate_seconds`; rel_error and the estimate (the same in every round) at their largest
+over the loads.
 
-    python3 benches/scaling.py [--work DIR] [--fourbar 1,2,5,10,20] [--pendulum 50,200,500,1000,5000]
+It writes one JSON file per size into the work folder (a later run trains only sizes that
+have none, unless --force, and times them all again), prints the markdown table, the
+break-even sizes and log-log slopes and draws the figure (matplotlib, if installed).
+
+    python3 benches/scaling.py [--work DIR] [--fourbar 1,2,5,10,20] [--pendulum 50,200,500,1000,2000,5000]
                                [--rounds 3] [--flexrom EXE] [--figure docs/img/scaling.png]
 
 Run it on one core of a quiet machine, e.g. `taskset -c 1 python3 benches/scaling.py`: every
@@ -157,8 +161,8 @@ def read_basis(path):
     return out
 
 
-def measure(family, size, args, env):
-    work = args.work
+def case(family, size, work):
+    """Writes the model and pipeline of one size; returns (name, pipeline path, result stub)."""
     if family == "fourbar":
         text, elements = fourbar_model(size)
         name = f"fourbar_{size}x"
@@ -167,67 +171,86 @@ def measure(family, size, args, env):
         name = f"pendulum_{size}"
     for sub in ("models", "pipelines", "bases", "logs"):
         os.makedirs(os.path.join(work, sub), exist_ok=True)
-    model = os.path.join(work, "models", f"{name}.toml")
-    with open(model, "w") as f:
+    with open(os.path.join(work, "models", f"{name}.toml"), "w") as f:
         f.write(text)
-    ptext = pipeline(family, name)
     pfile = os.path.join(work, "pipelines", f"{name}.toml")
     with open(pfile, "w") as f:
-        f.write(ptext)
-    basis = os.path.join(work, "bases", f"{name}.h5")
-    exe = [args.flexrom]
-    r = {"family": family, "name": name, "elements": elements,
-         "coordinates": coordinates(elements, FAMILIES[family]["bodies"])}
+        f.write(pipeline(family, name))
+    stub = {"family": family, "name": name, "elements": elements,
+            "coordinates": coordinates(elements, FAMILIES[family]["bodies"]), "pipeline": pfile,
+            "basis": os.path.join(work, "bases", f"{name}.h5")}
+    return name, pfile, stub
 
+
+def train(r, args, env):
+    """`flexrom train` of one size, timed; what the basis holds."""
+    name, work = r["name"], args.work
     print(f"{name}: train ...", file=sys.stderr, flush=True)
-    wall, cpu, code, out, err = run(exe + ["train", pfile, "--threads", "1"], env)
+    wall, cpu, code, out, err = run([args.flexrom, "train", r["pipeline"], "--threads", "1"], env)
     with open(os.path.join(work, "logs", f"{name}.train.log"), "w") as f:
         f.write(out + err)
+    r["train_date"] = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
     if code != 0:
         print(f"{name}: train exit {code}\n{err}", file=sys.stderr)
         r["train_exit"] = code
-        if not os.path.exists(basis):
+        if not os.path.exists(r["basis"]):
             return r
     r["train_wall"], r["train_cpu"] = wall, cpu
-    r["train_warnings"] = [l for l in err.splitlines() if "greedy training stopped" in l]
-    r.update(read_basis(basis))
+    r["train_warnings"] = [l for l in err.splitlines() if l.startswith("warning: greedy training") and "above its tolerance" in l]
+    r.update(read_basis(r["basis"]))
     print(f"{name}: trained in {wall:.1f} s, {r.get('full_runs')} full runs, converged {r.get('converged')}",
           file=sys.stderr, flush=True)
+    return r
 
-    loads = validate_loads(ptext)
-    per_load = {x: [] for x in loads}
+
+def time_all(results, args, env):
+    """`flexrom validate` at every held-out load of every size, round after round (sizes and
+    loads in turn, so a busy spell of the host falls on all of them); medians per size."""
+    todo = [r for r in results if "train_wall" in r]
+    per = {r["name"]: {x: [] for x in validate_loads(open(r["pipeline"]).read())} for r in todo}
     for k in range(args.rounds):
-        for x in loads:
-            w, _, code, out, err = run(exe + ["validate", pfile, "--load-scale", str(x), "--json", "--no-dense",
-                                              "--threads", "1"], env)
-            if code != 0:
-                print(f"{name}: validate {x} exit {code}: {err}", file=sys.stderr)
-                per_load[x].append({"exit": code, "stderr": err[-2000:]})
-                continue
-            per_load[x].append(json.loads(out))
-    r["validate"] = {str(x): v for x, v in per_load.items()}
-    ok = [v for vs in per_load.values() for v in vs if "exit" not in v]
-    if ok:
-        full = [v["full_seconds"] for v in ok]
-        rom = [v["rom_seconds"] for v in ok]
-        est = [v["rom_seconds"] + (v["estimate_seconds"] or 0.0) for v in ok]
-        r["full_ms"] = 1e3 * statistics.median(full)
-        r["rom_ms"] = 1e3 * statistics.median(rom)
-        r["rom_est_ms"] = 1e3 * statistics.median(est)
+        print(f"timing round {k + 1} of {args.rounds} ...", file=sys.stderr, flush=True)
+        for r in todo:
+            for x in per[r["name"]]:
+                cmd = [args.flexrom, "validate", r["pipeline"], "--load-scale", str(x), "--json", "--no-dense",
+                       "--threads", "1"]
+                _, _, code, out, err = run(cmd, env)
+                if code != 0:
+                    print(f"{r['name']}: validate {x} exit {code}: {err}", file=sys.stderr)
+                    per[r["name"]][x].append({"exit": code, "stderr": err[-2000:]})
+                else:
+                    per[r["name"]][x].append(json.loads(out))
+    for r in todo:
+        per_load = per[r["name"]]
+        for key in ("full_ms", "rom_ms", "rom_est_ms", "speedup", "speedup_est", "rel_error_max", "estimate_max",
+                    "covered", "held_out", "timings"):
+            r.pop(key, None)
+        r["validate"] = {str(x): v for x, v in per_load.items()}
+        r["timed_date"] = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
+        r["loadavg"] = os.getloadavg()
+        ok = [v for vs in per_load.values() for v in vs if "exit" not in v]
+        r["failed_validations"] = sum(1 for vs in per_load.values() for v in vs if "exit" in v)
+        if not ok:
+            continue
+        est = lambda v: v["rom_seconds"] + (v["estimate_seconds"] or 0.0)
+        r["full_ms"] = 1e3 * statistics.median([v["full_seconds"] for v in ok])
+        r["rom_ms"] = 1e3 * statistics.median([v["rom_seconds"] for v in ok])
+        r["rom_est_ms"] = 1e3 * statistics.median([est(v) for v in ok])
         r["speedup"] = statistics.median([v["full_seconds"] / v["rom_seconds"] for v in ok])
-        r["speedup_est"] = statistics.median(
-            [v["full_seconds"] / (v["rom_seconds"] + (v["estimate_seconds"] or 0.0)) for v in ok])
+        r["speedup_est"] = statistics.median([v["full_seconds"] / est(v) for v in ok])
         firsts = [vs[0] for vs in per_load.values() if vs and "exit" not in vs[0]]
         r["rel_error_max"] = max(v["rel_error"] for v in firsts)
         r["estimate_max"] = max((v["error_estimate"] or float("nan")) for v in firsts)
         r["covered"] = sum(1 for v in firsts if (v["error_estimate"] or 0.0) >= v["rel_error"])
         r["held_out"] = len(firsts)
         r["timings"] = len(ok)
-    r["failed_validations"] = sum(1 for vs in per_load.values() for v in vs if "exit" in v)
-    print(f"{name}: full {r.get('full_ms', float('nan')):.2f} ms, reduced {r.get('rom_ms', float('nan')):.2f} ms "
-          f"(+ estimate {r.get('rom_est_ms', float('nan')):.2f} ms), rel_error ≤ {r.get('rel_error_max', float('nan')):.2e}",
-          file=sys.stderr, flush=True)
-    return r
+        print(f"{r['name']}: full {r['full_ms']:.2f} ms, reduced {r['rom_ms']:.2f} ms (+ estimate "
+              f"{r['rom_est_ms']:.2f} ms), rel_error ≤ {r['rel_error_max']:.2e}", file=sys.stderr, flush=True)
+
+
+def num(x):
+    """3 significant digits, without an exponent up to 99 999."""
+    return f"{x:.0f}" if x >= 100 else f"{x:.3g}"
 
 
 def fmt_time(s):
@@ -253,8 +276,8 @@ def table(results):
         lines.append(
             f"| {r['family']} | {r['elements']} | {r['coordinates']} | {fmt_time(r['train_wall'])}{conv} "
             f"| {r.get('full_runs', '')} | {red} | {r.get('sampled_elements', '')} "
-            f"| {r['full_ms']:.3g} | {r['rom_est_ms']:.3g} | {r['rom_ms']:.3g} "
-            f"| {r['speedup_est']:.3g} / {r['speedup']:.3g} | {r['rel_error_max']:.2e} | {r['estimate_max']:.2e} |"
+            f"| {num(r['full_ms'])} | {num(r['rom_est_ms'])} | {num(r['rom_ms'])} "
+            f"| {num(r['speedup_est'])} / {num(r['speedup'])} | {r['rel_error_max']:.2e} | {r['estimate_max']:.2e} |"
         )
     return "\n".join(lines)
 
@@ -276,6 +299,15 @@ def break_even(rs, key):
     return None
 
 
+def newton(r):
+    """Median over the held-out loads of the full and the reduced run's Newton iterations."""
+    firsts = [vs[0] for vs in r.get("validate", {}).values() if vs and "exit" not in vs[0]]
+    if not firsts:
+        return None
+    return (int(statistics.median(v["full_newton_iterations"] for v in firsts)),
+            int(statistics.median(v["rom_newton_iterations"] for v in firsts)))
+
+
 def summary(results):
     out = []
     for fam in FAMILIES:
@@ -287,6 +319,10 @@ def summary(results):
                  f"reduced ∝ elements^{loglog_slope(e, [r['rom_ms'] for r in rs]):.2f}",
                  f"reduced + estimate ∝ elements^{loglog_slope(e, [r['rom_est_ms'] for r in rs]):.2f}",
                  f"training ∝ elements^{loglog_slope(e, [r['train_wall'] for r in rs]):.2f}"]
+        its = [newton(r) for r in rs]
+        if all(its):
+            parts.append("Newton iterations full / reduced (median over the loads): " +
+                         ", ".join(f"{r['elements']}: {f} / {m}" for r, (f, m) in zip(rs, its)))
         for key, what in (("speedup", "without estimate"), ("speedup_est", "with estimate")):
             b = break_even(rs, key)
             if b is not None:
@@ -320,6 +356,10 @@ def figure(results, path):
         ax.loglog(e, [r["rom_ms"] for r in rs], "^:", color=c, label=f"{fam}: reduced, no estimate")
         bx.loglog(e, [r["speedup_est"] for r in rs], "s--", color=c, label=f"{fam}: with estimate")
         bx.loglog(e, [r["speedup"] for r in rs], "^:", color=c, label=f"{fam}: without estimate")
+        for r in rs:
+            if r.get("converged") is False:
+                bx.annotate("greedy not converged", (r["elements"], r["speedup_est"]), textcoords="offset points",
+                            xytext=(6, -16), ha="right", fontsize=8, color=c)
     ax.set(xlabel="elements", ylabel="time loop [ms] (median, one core)", title="Full and reduced time loop")
     bx.axhline(1.0, color="k", lw=0.8)
     bx.set(xlabel="elements", ylabel="full / reduced (median)", title="Speedup (below 1: the full model is faster)")
@@ -341,12 +381,12 @@ def main():
     a = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     a.add_argument("--work", default=os.path.join(ROOT, "out", "scaling"), help="work folder (models, bases, results)")
     a.add_argument("--fourbar", default="1,2,5,10,20", help="refinement factors of the four-bar ('' for none)")
-    a.add_argument("--pendulum", default="50,200,500,1000,5000", help="pendulum element counts ('' for none)")
+    a.add_argument("--pendulum", default="50,200,500,1000,2000,5000", help="pendulum element counts ('' for none)")
     a.add_argument("--rounds", type=int, default=3, help="validate rounds over the held-out loads")
     a.add_argument("--flexrom", default=os.path.join(ROOT, "target", "release", "flexrom"))
     a.add_argument("--figure", default=os.path.join(ROOT, "docs", "img", "scaling.png"))
-    a.add_argument("--force", action="store_true", help="measure sizes again that have a result file")
-    a.add_argument("--report-only", action="store_true", help="only print the table and draw the figure")
+    a.add_argument("--force", action="store_true", help="train sizes again that have a result file")
+    a.add_argument("--report-only", action="store_true", help="no runs: the table and figure of the result files")
     args = a.parse_args()
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1", HDF5_USE_FILE_LOCKING="FALSE", RAYON_NUM_THREADS="1")
     cases = [("fourbar", int(x)) for x in args.fourbar.split(",") if x] + \
@@ -354,19 +394,23 @@ def main():
     os.makedirs(args.work, exist_ok=True)
     results = []
     for fam, size in cases:
-        name = f"fourbar_{size}x" if fam == "fourbar" else f"pendulum_{size}"
+        name, pfile, stub = case(fam, size, args.work)
         rfile = os.path.join(args.work, f"{name}.json")
-        if os.path.exists(rfile) and (args.report_only or not args.force):
-            results.append(json.load(open(rfile)))
+        if os.path.exists(rfile) and not args.force:
+            r = json.load(open(rfile))
+            r.update({k: stub[k] for k in ("pipeline", "basis")})
+        elif args.report_only:
             continue
-        if args.report_only:
-            continue
-        r = measure(fam, size, args, env)
-        r["date"] = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
-        r["loadavg"] = os.getloadavg()
-        with open(rfile, "w") as f:
-            json.dump(r, f, indent=1)
+        else:
+            r = train(stub, args, env)
+            with open(rfile, "w") as f:
+                json.dump(r, f, indent=1)
         results.append(r)
+    if not args.report_only:
+        time_all(results, args, env)
+        for r in results:
+            with open(os.path.join(args.work, f"{r['name']}.json"), "w") as f:
+                json.dump(r, f, indent=1)
     results.sort(key=lambda r: (r["family"] != "fourbar", r["elements"]))
     print(table(results))
     print()
