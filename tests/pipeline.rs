@@ -434,7 +434,7 @@ print("ok")
 
 #[test]
 fn shipped_pipelines_load() {
-    for name in ["pipelines/pendulum.toml", "pipelines/fourbar.toml"] {
+    for name in ["pipelines/pendulum.toml", "pipelines/fourbar.toml", "pipelines/double_pendulum_box.toml"] {
         let p = Pipeline::load(repo(name)).unwrap();
         assert!(p
             .basis_path

@@ -233,14 +233,14 @@ impl Pipeline {
 
     /// Refuses `what` (a sweep, a report, sharded training) on a pipeline with a
     /// `[parameters]` box: those work on a line of load scales so far.
-    pub fn refuse_box(&self, what: &str) -> Result<()> {
+    pub fn refuse_box(&self, what: &str, instead: &str) -> Result<()> {
         if self.file.parameters.is_empty() {
             return Ok(());
         }
         Err(Error::input(
             &self.path,
             "parameters",
-            format!("{what} over a box of several parameters is not there yet: run `flexrom online` or `flexrom validate` with `--param NAME=X` at each point"),
+            format!("{what} over a box of several parameters is not there yet: {instead}"),
         ))
     }
 

@@ -48,7 +48,10 @@ pub fn run_with(
     dense: super::dense::DenseChoice,
     method: Option<EstimateMethod>,
 ) -> Result<(PathBuf, Vec<String>)> {
-    p.refuse_box("`flexrom run` (its sweep and report)")?;
+    p.refuse_box(
+        "`flexrom run` (its sweep and report)",
+        "run `flexrom train`, then `flexrom sweep --param NAME=A:B:N` and `flexrom validate`",
+    )?;
     check_outputs(p)?;
     let dense = super::dense::decide(dense, &p.model)?;
     let dir = p.report_dir.clone();

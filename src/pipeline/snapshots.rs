@@ -45,6 +45,10 @@ const KIND: &str = "flexrom snapshots";
 /// The training loads a `--snapshots-only` job runs: `x` alone, or the `shard` of the
 /// pipeline's `train.load_scales` ([`Shard::indices`]).
 pub fn job_scales(p: &Pipeline, x: Option<f64>, shard: Option<Shard>) -> Result<Vec<f64>> {
+    p.refuse_box(
+        "training in separate jobs (--snapshots-only, --from-snapshots)",
+        "run `flexrom train` in one process",
+    )?;
     match (x, shard) {
         (Some(x), None) if x.is_finite() => Ok(vec![x]),
         (Some(x), None) => Err(Error::Usage(format!("--load-scale must be finite, got {x}"))),
@@ -67,7 +71,10 @@ pub fn job_scales(p: &Pipeline, x: Option<f64>, shard: Option<Shard>) -> Result<
 
 /// The pipeline's fixed training loads (greedy training has none to split).
 fn fixed_scales(p: &Pipeline) -> Result<Vec<f64>> {
-    p.refuse_box("training in separate jobs (--snapshots-only, --from-snapshots)")?;
+    p.refuse_box(
+        "training in separate jobs (--snapshots-only, --from-snapshots)",
+        "run `flexrom train` in one process",
+    )?;
     if p.file.train.greedy.is_some() {
         return Err(Error::input(
             &p.path,
