@@ -137,6 +137,10 @@ fn online_at_a_named_parameter_says_the_basis_was_not_trained_over_it() {
     let out = flexrom(&["validate", "p.toml", "--param", "push=0.5", "--load-scale", "1.1", "--json", "--no-dense"]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("\"parameters\":{\"load_scale\":1.1,\"push\":0.5}"), "{stdout}");
+    // `--param load_scale=X` is `--load-scale X`: one point, not the [validate] loads
+    let out = flexrom(&["validate", "p.toml", "--param", "load_scale=1.1", "--json", "--no-dense"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.starts_with('{') && stdout.contains("\"parameters\":{\"load_scale\":1.1}"), "{stdout}");
     // a misspelt name is refused before anything runs
     let out = flexrom(&["online", "p.toml", "--param", "pus=1.5", "-o", "c.h5"]);
     assert_eq!(out.status.code(), Some(1));

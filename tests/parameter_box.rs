@@ -91,6 +91,14 @@ fn a_basis_trained_over_a_box_holds_it_and_checks_runs_against_it() {
     assert!(out.status.success(), "{stderr}");
     assert!(stderr.contains("outside what the basis was trained on: push = 3 (trained over [0.2, 2])"), "{stderr}");
     assert!(stdout.contains("\"extrapolated\":true"), "{stdout}");
+    // and the result file says so too, as `validate` does
+    let f = hdf5::File::open(d.join("o.h5")).unwrap();
+    assert_eq!(f.attr("extrapolated").unwrap().read_scalar::<u64>().unwrap(), 1);
+    assert_eq!(f.attr("parameter:push").unwrap().read_scalar::<f64>().unwrap(), 3.0);
+    drop(f);
+    let out = flexrom(d, &["validate", "p.toml", "--param", "push=3", "--param", "g=1.0", "--json", "--no-dense"]);
+    let v: serde_json::Value = serde_json::from_str(&text(&out).0).unwrap();
+    assert_eq!(v["extrapolated"], true, "{v}");
 
     // what works on a line only refuses a box, naming the pipeline's table; nothing written
     let out = flexrom(d, &["run", "p.toml"]);

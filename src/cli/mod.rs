@@ -85,6 +85,11 @@ fn parse_param(s: &str) -> Result<(String, f64), String> {
 }
 
 impl ParamArgs {
+    /// Whether `--param load_scale=X` was given.
+    pub fn sets_load_scale(&self) -> bool {
+        self.params.iter().any(|(n, _)| n == flexrom::solver::parameters::LOAD_SCALE)
+    }
+
     /// Whether any `--param` was given.
     pub fn any(&self) -> bool {
         !self.params.is_empty()

@@ -209,7 +209,10 @@ fn sweep_points(
         let mut axes = Vec::new();
         match load_scales {
             Some(s) => axes.push((LOAD_SCALE.to_string(), range(s)?)),
-            None if p.space().is_empty() => axes.push((LOAD_SCALE.to_string(), p.online_scales())),
+            // the pipeline's loads as the first axis, unless --param gives the load scale
+            None if p.space().is_empty() && !params.iter().any(|s| s.trim_start().starts_with("load_scale=")) => {
+                axes.push((LOAD_SCALE.to_string(), p.online_scales()))
+            }
             None => {}
         }
         for spec in params {

@@ -48,7 +48,7 @@ impl Args {
             // the pipeline's validation points: [validate] load_scales, or points of the box
             (None, false) => p.validation_points(),
             // named values at each of the [validate] loads (a box: at the point given)
-            (None, true) if !p.space().is_empty() => vec![params.parameters(None, 1.0)?],
+            (None, true) if !p.space().is_empty() || params.sets_load_scale() => vec![params.parameters(None, 1.0)?],
             (None, true) => {
                 p.validate_scales().into_iter().map(|x| params.parameters(Some(x), x)).collect::<Result<_, _>>()?
             }

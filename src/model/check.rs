@@ -387,7 +387,7 @@ impl Model {
             ScaledSpec::Flag(true) => Ok(Scaling::LoadScale),
             ScaledSpec::Parameter(name) if name == LOAD_SCALE => Ok(Scaling::LoadScale),
             ScaledSpec::Parameter(name) => {
-                let ok = name.chars().next().is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+                let ok = name.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
                     && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
                 if ok {
                     Ok(Scaling::Named(name.clone()))

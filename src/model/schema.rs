@@ -120,7 +120,7 @@ pub enum JointSpec {
 /// `scaled` of a load: `true` (times the load scale), `false` (fixed), or the name of the
 /// parameter that multiplies it (`scaled = "drive"`).
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq, Eq)]
-#[serde(untagged)]
+#[serde(untagged, expecting = "true, false or the name of a parameter (\"drive\")")]
 pub enum ScaledSpec {
     Flag(bool),
     Parameter(String),

@@ -218,6 +218,16 @@ impl Pipeline {
                 if pts.count == 0 || pts.count > MAX_LOAD_SCALES {
                     return bad("train.points.count", format!("is {}; it must lie in 1..={MAX_LOAD_SCALES}", pts.count));
                 }
+                let sobol = pts.sampling == crate::solver::parameter_space::Sampling::Sobol;
+                if sobol && pts.count > crate::solver::parameter_space::MAX_SOBOL_POINTS {
+                    return bad(
+                        "train.points.count",
+                        format!("is {}; Sobol points go up to {} (use sampling = \"lhs\" for more)", pts.count, crate::solver::parameter_space::MAX_SOBOL_POINTS),
+                    );
+                }
+                if sobol && pts.seed > u64::from(u32::MAX) {
+                    return bad("train.points.seed", format!("is {}; a Sobol seed lies in 0..={}", pts.seed, u32::MAX));
+                }
                 if self.file.reduction.modes.is_none() {
                     return bad("reduction.modes", "is missing: with train.points the mode count must be given".into());
                 }

@@ -15,7 +15,9 @@ pub fn parse_axis(spec: &str) -> std::result::Result<(String, Vec<f64>), String>
     let (name, values) = (name.trim().to_string(), values.trim());
     let axis = if let Some(linear) = values.strip_suffix(":log") {
         let v = parse_range(linear)?;
-        let (a, b) = (v[0], *v.last().expect("N ≥ 1"));
+        // the ends as written (the linear range's last value may differ from B in the last bit)
+        let b: f64 = linear.split(':').nth(1).and_then(|x| x.trim().parse().ok()).unwrap_or(v[v.len() - 1]);
+        let a = v[0];
         if !(a > 0.0 && b > 0.0) {
             return Err(format!("`{values}`: a logarithmic axis needs A and B above zero"));
         }
@@ -23,7 +25,8 @@ pub fn parse_axis(spec: &str) -> std::result::Result<(String, Vec<f64>), String>
         if n == 1 {
             vec![a]
         } else {
-            (0..n).map(|i| a * (b / a).powf(i as f64 / (n - 1) as f64)).collect()
+            // the ends exactly as given (a point of a file or a later grid then matches them)
+            (0..n).map(|i| if i + 1 == n { b } else { a * (b / a).powf(i as f64 / (n - 1) as f64) }).collect()
         }
     } else if values.contains(':') {
         parse_range(values)?
@@ -124,6 +127,7 @@ mod tests {
         // log: 1e8 … 4e8 in 3 points has the geometric mean 2e8 in the middle
         let (_, log) = parse_axis("E=1e8:4e8:3:log").unwrap();
         assert_eq!((log[0], log[2]), (1e8, 4e8));
+        assert_eq!(*parse_axis("p=0.2:3:4:log").unwrap().1.last().unwrap(), 3.0, "the end exactly");
         assert!((log[1] - 2e8).abs() < 1e-6 * 2e8, "{log:?}");
         assert_eq!(parse_axis("g=1.2").unwrap().1, [1.2]);
         for bad in ["g", "g=abc", "E=0:4e8:3:log", "g=1:2:0", "g=inf"] {

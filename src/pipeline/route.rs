@@ -65,7 +65,12 @@ pub fn timing_load(training_loads: &[f64]) -> Option<f64> {
 pub fn time_and_store(rom: &Rom, path: &Path) -> Result<Option<String>> {
     let loads = crate::io::estimator_file::read_training_loads(path)?;
     let Some(x) = timing_load(&loads) else { return Ok(None) };
-    match time_routes(rom, &Parameters::load_scale(x)) {
+    // a basis of a [parameters] box: its centre (in the unit cube), inside the box
+    let mu = match rom.trust().map(|t| &t.space).filter(|s| !s.is_empty()) {
+        Some(space) => space.at(&vec![0.5; space.ranges.len()]),
+        None => Parameters::load_scale(x),
+    };
+    match time_routes(rom, &mu) {
         Ok(t) => {
             crate::io::timing_file::append_timing(path, &t)?;
             Ok(None)

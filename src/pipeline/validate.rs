@@ -276,7 +276,8 @@ impl Validation {
             self.error_estimate_displacement_by_time = Some(e.displacement_by_time.to_vec());
         }
         if let Some(t) = rom.and_then(|r| r.trust()) {
-            self.extrapolated = crate::rom::trust::is_extrapolated(t.range, self.load_scale);
+            let mu = self.parameters.iter().fold(Parameters::default(), |mu, (n, &v)| mu.with(n, v));
+            self.extrapolated = t.extrapolated(&mu);
             self.training_range = Some([t.range.0, t.range.1]);
             self.sensitivity_near = t.sensitivity.as_ref().and_then(|s| s.near(self.load_scale));
             let in_measure = estimate.map(|e| e.in_measure(t.measure));

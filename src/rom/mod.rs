@@ -153,7 +153,7 @@ impl Rom {
     /// are not known).
     pub fn is_extrapolated(&self, mu: &Parameters) -> bool {
         match &self.trust {
-            Some(t) => trust::is_extrapolated(t.range, mu.scale()) || !t.named_outside(mu).is_empty(),
+            Some(t) => t.extrapolated(mu),
             None => !ParameterSpace::default().outside(mu).is_empty(),
         }
     }

@@ -39,6 +39,12 @@ impl Trust {
         }
     }
 
+    /// Whether `mu` lies outside what the basis was trained on: the load scale outside the
+    /// training range, or a named parameter outside the box ([`Self::named_outside`]).
+    pub fn extrapolated(&self, mu: &Parameters) -> bool {
+        is_extrapolated(self.range, mu.scale()) || !self.named_outside(mu).is_empty()
+    }
+
     /// The named parameters of `mu` outside what the basis was trained on, one line each
     /// ([`ParameterSpace::outside`]; the load scale is the range checks' to say).
     pub fn named_outside(&self, mu: &Parameters) -> Vec<String> {
@@ -153,10 +159,10 @@ pub fn write_run_attributes(
     e: Option<&Estimate>,
     method: Option<&str>,
     trust: &Trust,
-    load_scale: f64,
+    mu: &Parameters,
 ) -> hdf5::Result<()> {
-    let extrapolated = is_extrapolated(trust.range, load_scale);
-    let sensitivity_near = trust.sensitivity.as_ref().and_then(|s| s.near(load_scale));
+    let extrapolated = trust.extrapolated(mu);
+    let sensitivity_near = trust.sensitivity.as_ref().and_then(|s| s.near(mu.scale()));
     use crate::io::h5::{attr_f64, attr_u64};
     use crate::reduction::estimator::FIFTHS;
     attr_f64(f, "error_estimate", e.map_or(f64::NAN, |e| e.error_estimate))?;

@@ -89,6 +89,9 @@ pub enum Sampling {
     Random,
 }
 
+/// The most Sobol points one sample holds (`sobol_burley`'s sequence length, 2¹⁶).
+pub const MAX_SOBOL_POINTS: usize = 1 << 16;
+
 /// The box of a pipeline's `[parameters]`, parameters in name order.
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct ParameterSpace {
