@@ -119,14 +119,6 @@ impl ParamArgs {
     }
 }
 
-pub fn check_scale(x: f64) -> flexrom::Result<()> {
-    if x.is_finite() {
-        Ok(())
-    } else {
-        Err(flexrom::Error::Usage(format!("--load-scale must be finite, got {x}")))
-    }
-}
-
 /// Prints the library's warnings on stderr, one `warning: ` line each (every verbosity).
 pub fn warn(warnings: &[String]) {
     for w in warnings {

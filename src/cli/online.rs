@@ -1,6 +1,6 @@
 //! `flexrom online`: one reduced run at one load scale, written to a result file.
 
-use super::{check_scale, print_table, run_details, warn, EstimateArgs, FormatArgs};
+use super::{print_table, run_details, warn, EstimateArgs, FormatArgs};
 use flexrom::io::output::{check_output, Origin};
 use flexrom::limits::Limits;
 use flexrom::output::info;
@@ -39,9 +39,7 @@ impl Args {
     pub fn run(self, limits: &Limits) -> flexrom::Result<()> {
         let Args { pipeline, load_scale, params, output, basis, strict, estimate, format } = self;
         let p = Pipeline::load_with(&pipeline, limits.clone())?;
-        if let Some(x) = load_scale {
-            check_scale(x)?;
-        }
+        // λ checked finite with the named values
         let mu = params.parameters(load_scale, 1.0)?;
         p.model.check_parameters(&mu)?;
         let load_scale = mu.scale();

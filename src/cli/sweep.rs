@@ -206,18 +206,18 @@ fn sweep_points(
         };
         scales.into_iter().map(Parameters::load_scale).collect()
     } else {
-        let mut axes = Vec::new();
-        match load_scales {
-            Some(s) => axes.push((LOAD_SCALE.to_string(), range(s)?)),
-            // the pipeline's loads as the first axis, unless --param gives the load scale
-            None if p.space().is_empty() && !params.iter().any(|s| s.trim_start().starts_with("load_scale=")) => {
-                axes.push((LOAD_SCALE.to_string(), p.online_scales()))
-            }
-            None => {}
-        }
-        for spec in params {
-            axes.push(parse_axis(spec).map_err(|e| flexrom::Error::Usage(format!("--param: {e}")))?);
-        }
+        let named = params
+            .iter()
+            .map(|spec| parse_axis(spec).map_err(|e| flexrom::Error::Usage(format!("--param: {e}"))))
+            .collect::<flexrom::Result<Vec<_>>>()?;
+        let first = match load_scales {
+            Some(s) => Some(range(s)?),
+            // the pipeline's loads, unless --param gives the load scale
+            None if p.space().is_empty() && !named.iter().any(|(n, _)| n == LOAD_SCALE) => Some(p.online_scales()),
+            None => None,
+        };
+        let axes: Vec<(String, Vec<f64>)> =
+            first.map(|v| (LOAD_SCALE.to_string(), v)).into_iter().chain(named).collect();
         if axes.is_empty() {
             return Err(flexrom::Error::Usage(format!(
                 "{}: a pipeline with a [parameters] box sweeps the points of `--param NAME=A:B:N` (one per parameter) or `--points FILE`",

@@ -1,6 +1,6 @@
 //! `flexrom validate`: full and reduced runs at one load scale, compared.
 
-use super::{check_scale, warn, DenseArgs, EstimateArgs, FormatArgs};
+use super::{warn, DenseArgs, EstimateArgs, FormatArgs};
 use flexrom::limits::Limits;
 use flexrom::output::table::{Format, Table};
 use flexrom::output::{self};
@@ -39,9 +39,6 @@ impl Args {
     pub fn run(self, limits: &Limits) -> flexrom::Result<()> {
         let Args { pipeline, load_scale, params, format, basis, dense, strict, estimate } = self;
         let p = Pipeline::load_with(&pipeline, limits.clone())?;
-        if let Some(x) = load_scale {
-            check_scale(x)?;
-        }
         // --param with the pipeline's loads: the named values at each of them
         let points: Vec<Parameters> = match (load_scale, params.any()) {
             (Some(_), _) => vec![params.parameters(load_scale, 1.0)?],

@@ -118,17 +118,21 @@ impl Model {
     /// Refuses parameters the model does not have (a `--param` misspelt, or one of another
     /// model): the error names the model file and the parameters it has.
     pub fn check_parameters(&self, mu: &Parameters) -> Result<()> {
-        let names = self.parameter_names();
-        for (name, _) in mu.named() {
-            if !names.contains(&name) {
-                let have = if names.is_empty() { "none: no load is scaled".to_string() } else { names.join(", ") };
-                return Err(Error::Usage(format!(
-                    "{}: the model has no parameter `{name}` (its parameters: {have})",
-                    self.path.display()
-                )));
-            }
+        match mu.named().find_map(|(name, _)| self.unknown_parameter(name)) {
+            Some(problem) => Err(Error::Usage(format!("{}: {problem}", self.path.display()))),
+            None => Ok(()),
         }
-        Ok(())
+    }
+
+    /// Why `name` is not a parameter of this model (the parameters it has), or `None` when
+    /// it is one.
+    pub fn unknown_parameter(&self, name: &str) -> Option<String> {
+        let names = self.parameter_names();
+        if names.contains(&name) {
+            return None;
+        }
+        let have = if names.is_empty() { "none: no load is scaled".to_string() } else { names.join(", ") };
+        Some(format!("the model has no parameter `{name}` (its parameters: {have})"))
     }
 
     /// Integrator parameters from the `[time]` table.

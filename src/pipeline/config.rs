@@ -197,12 +197,10 @@ impl Pipeline {
     /// box (`points`) exactly when there is one.
     fn check_parameters(&self) -> Result<()> {
         let bad = |field: &str, problem: String| Err(Error::input(&self.path, field, problem));
-        let names = self.model.parameter_names();
         for (name, spec) in &self.file.parameters {
             let field = format!("parameters.{name}");
-            if !names.contains(&name.as_str()) {
-                let have = if names.is_empty() { "none: no load is scaled".to_string() } else { names.join(", ") };
-                return bad(&field, format!("the model has no parameter `{name}` (its parameters: {have})"));
+            if let Some(problem) = self.model.unknown_parameter(name) {
+                return bad(&field, problem);
             }
             if let Err(e) = spec.range(name).validate() {
                 return bad(&field, e);

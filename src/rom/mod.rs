@@ -113,7 +113,7 @@ impl Rom {
         let sensitivity = read_training_sensitivity(path)?.map(|(c, s)| trust::LoadSensitivity::new(c, s));
         let space = crate::io::parameter_space_file::read_parameter_space(path)?.unwrap_or_default();
         // a box that holds λ gives its range; else the training loads' [min, max]
-        let range = match space.ranges.iter().find(|r| r.name == crate::solver::parameters::LOAD_SCALE) {
+        let range = match space.range(crate::solver::parameters::LOAD_SCALE) {
             Some(r) => (r.lower, r.upper),
             None => read_training_range(path)?,
         };
@@ -154,7 +154,7 @@ impl Rom {
     pub fn is_extrapolated(&self, mu: &Parameters) -> bool {
         match &self.trust {
             Some(t) => t.extrapolated(mu),
-            None => !ParameterSpace::default().outside(mu).is_empty(),
+            None => !self.named_outside(mu).is_empty(),
         }
     }
 
@@ -163,7 +163,7 @@ impl Rom {
     pub fn named_outside(&self, mu: &Parameters) -> Vec<String> {
         match &self.trust {
             Some(t) => t.named_outside(mu),
-            None => ParameterSpace::default().outside(mu),
+            None => ParameterSpace::default().outside_named(mu),
         }
     }
 

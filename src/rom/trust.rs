@@ -5,7 +5,7 @@
 use super::estimator::{ErrorMeasure, Estimate};
 use crate::error::{Error, Result};
 use crate::solver::parameter_space::ParameterSpace;
-use crate::solver::parameters::{Parameters, LOAD_SCALE};
+use crate::solver::parameters::Parameters;
 
 /// What the online tools hold a basis's runs to.
 #[derive(Clone, Debug, PartialEq)]
@@ -46,10 +46,9 @@ impl Trust {
     }
 
     /// The named parameters of `mu` outside what the basis was trained on, one line each
-    /// ([`ParameterSpace::outside`]; the load scale is the range checks' to say).
+    /// ([`ParameterSpace::outside_named`]; the load scale is the range checks' to say).
     pub fn named_outside(&self, mu: &Parameters) -> Vec<String> {
-        let lambda = format!("{LOAD_SCALE} = ");
-        self.space.outside(mu).into_iter().filter(|l| !l.starts_with(&lambda)).collect()
+        self.space.outside_named(mu)
     }
 
     /// The sensitivity near load scale `x` when the model amplifies changes of the load

@@ -149,8 +149,17 @@ impl ParameterSpace {
     /// kept it at the model file's load). `λ` outside the box is said by the load-scale
     /// checks when the box does not hold it.
     pub fn outside(&self, mu: &Parameters) -> Vec<String> {
+        self.outside_of(mu, true)
+    }
+
+    /// [`Self::outside`] without the load scale (the range checks of λ say that one).
+    pub fn outside_named(&self, mu: &Parameters) -> Vec<String> {
+        self.outside_of(mu, false)
+    }
+
+    fn outside_of(&self, mu: &Parameters, with_load_scale: bool) -> Vec<String> {
         let mut out = Vec::new();
-        for r in &self.ranges {
+        for r in self.ranges.iter().filter(|r| with_load_scale || r.name != LOAD_SCALE) {
             let x = mu.get(&r.name).unwrap_or(1.0);
             if r.excludes(x) {
                 out.push(format!(
@@ -170,9 +179,9 @@ impl ParameterSpace {
         out
     }
 
-    /// Whether the box holds the load scale `λ`.
-    pub fn holds_load_scale(&self) -> bool {
-        self.names().any(|n| n == LOAD_SCALE)
+    /// The range of the parameter `name`, if the box holds it.
+    pub fn range(&self, name: &str) -> Option<&ParameterRange> {
+        self.ranges.iter().find(|r| r.name == name)
     }
 }
 
@@ -247,6 +256,12 @@ mod tests {
         let mu = Parameters::default().with("drive", 1.7).with("stiff", 2e8).with("other", 0.5);
         let out = s.outside(&mu);
         assert_eq!(out, ["drive = 1.7 (trained over [0.5, 1.5])", "other = 0.5 (trained at 1, the model file's load)"]);
+        // the load scale is left to its own range check where asked
+        let with_lambda = ParameterSpace {
+            ranges: vec![ParameterRange { name: LOAD_SCALE.into(), lower: 0.5, upper: 1.5, spacing: Spacing::Linear }],
+        };
+        assert_eq!(with_lambda.outside(&Parameters::load_scale(2.0)), ["load_scale = 2 (trained over [0.5, 1.5])"]);
+        assert!(with_lambda.outside_named(&Parameters::load_scale(2.0)).is_empty());
         // round-off at an end is inside
         assert!(s.outside(&Parameters::default().with("drive", 1.5 * (1.0 + 1e-12)).with("stiff", 4e8)).is_empty());
         assert!(ParameterRange { name: "x".into(), lower: 0.0, upper: 1.0, spacing: Spacing::Log }.validate().is_err());

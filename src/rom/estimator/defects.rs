@@ -25,7 +25,7 @@
 //! numbers, not fitted.
 
 use super::corrected::CorrectedRunner;
-use super::norms::{fifth_end, RawByFifth};
+use super::norms::{fifth_end, ConfigurationNorms, RawByFifth};
 use super::{ByFifth, ErrorEstimator, Estimator, FIFTHS};
 use crate::error::Result;
 use crate::model::Model;
@@ -52,19 +52,9 @@ pub struct Defects {
     data: Arc<Estimator>,
     runners: Pool<'static, CorrectedRunner>,
     sample: usize,
-    /// the norms' constants, `Vᵀx_ref`, `‖x_ref‖²`, `Vᵀ(x_ref − x₀)`, `‖x_ref − x₀‖²`:
-    /// projected once, so that an estimate costs O(r n_t), not O(n_dof r)
-    norms: NormConstants,
-}
-
-/// The constants of the configuration and displacement norms from reduced coordinates
-/// (`norms.rs`): `‖x_ref + V z‖² = ‖x_ref‖² + 2 (Vᵀx_ref)·z + ‖z‖²` and the same with the
-/// reference shifted by the initial configuration X₀ (orthonormal `V`).
-struct NormConstants {
-    vtx: ndarray::Array1<f64>,
-    xr2: f64,
-    vts: ndarray::Array1<f64>,
-    shift2: f64,
+    /// the configuration norms' constants, projected once: an estimate costs O(r n_t),
+    /// not O(n_dof r)
+    norms: ConfigurationNorms,
 }
 
 impl Defects {
@@ -73,15 +63,7 @@ impl Defects {
         let (m, b, d) = (Arc::clone(model), Arc::clone(basis), Arc::clone(data));
         let runners = Pool::new(move || CorrectedRunner::new(&m, &b, &d));
         runners.put(CorrectedRunner::new(model, basis, data)?);
-        let x0 = &model.physics()?.x0;
-        let b = &**basis;
-        let shift = &b.reference - &ndarray::ArrayView1::from(&x0[..]);
-        let norms = NormConstants {
-            vtx: b.modes.t().dot(&b.reference),
-            xr2: b.reference.dot(&b.reference),
-            vts: b.modes.t().dot(&shift),
-            shift2: shift.dot(&shift),
-        };
+        let norms = ConfigurationNorms::new(basis, ndarray::ArrayView1::from(&model.physics()?.x0[..]));
         Ok(Defects { data: Arc::clone(data), runners, sample: DEFECT_SAMPLE, norms })
     }
 
@@ -109,15 +91,12 @@ impl ErrorEstimator for Defects {
         let defects = self.runners.with(|r| r.defects(run, s))??;
         // ‖x_ref + V z_k‖² and ‖x_ref + V z_k − x₀‖² from the reduced coordinates (V
         // orthonormal; the corrected runner exists only for such bases): norms.rs
-        let NormConstants { vtx, xr2, vts, shift2 } = &self.norms;
-        let (xr2, shift2) = (*xr2, *shift2);
         let (mut err2, mut norm2, mut disp2) = (vec![0.0; nt], vec![0.0; nt], vec![0.0; nt]);
         let mut acc = 0.0;
         for k in 0..nt {
             let zk = z.column(k);
             let zk2 = zk.dot(&zk);
-            norm2[k] = xr2 + 2.0 * vtx.dot(&zk) + zk2;
-            disp2[k] = shift2 + 2.0 * vts.dot(&zk) + zk2;
+            (norm2[k], disp2[k]) = self.norms.at(zk, zk2);
             if k > 0 && k % s == 0 {
                 acc += s as f64 * defects.column(k).dot(&defects.column(k)).sqrt();
             }

@@ -66,10 +66,36 @@ pub struct NormProjection {
 
 struct Projected {
     m: Array2<f64>,
+    /// the enriched basis's configuration norms
+    config: ConfigurationNorms,
+}
+
+/// The constants of the configuration and displacement norms of `x = x_ref + V z` from the
+/// reduced coordinates of an orthonormal `V`: `‖x‖² = ‖x_ref‖² + 2 (Vᵀx_ref)·z + ‖z‖²` and
+/// `‖x − x₀‖²`, the same with the reference shifted by the initial configuration X₀.
+pub struct ConfigurationNorms {
     vtx: Array1<f64>,
     xr2: f64,
     vts: Array1<f64>,
     shift2: f64,
+}
+
+impl ConfigurationNorms {
+    pub fn new(basis: &Basis, x0: ArrayView1<f64>) -> Self {
+        let (v, xr) = (&basis.modes, &basis.reference);
+        let shift = xr - &x0;
+        ConfigurationNorms { vtx: v.t().dot(xr), xr2: xr.dot(xr), vts: v.t().dot(&shift), shift2: shift.dot(&shift) }
+    }
+
+    /// `‖x‖²` and `‖x − x₀‖²` at one instant `z` whose `‖z‖²` is `z2`.
+    pub fn at(&self, z: ArrayView1<f64>, z2: f64) -> (f64, f64) {
+        (self.xr2 + 2.0 * self.vtx.dot(&z) + z2, self.shift2 + 2.0 * self.vts.dot(&z) + z2)
+    }
+
+    /// [`Self::at`] at every instant (column) of `z`, whose squared norms are `z2`.
+    fn per_instant(&self, z: &Array2<f64>, z2: &Array1<f64>) -> (Array1<f64>, Array1<f64>) {
+        (self.xr2 + 2.0 * self.vtx.dot(z) + z2, self.shift2 + 2.0 * self.vts.dot(z) + z2)
+    }
 }
 
 impl NormProjection {
@@ -77,16 +103,10 @@ impl NormProjection {
         if basis.variant == Variant::WholeSystem {
             return NormProjection { orthonormal: None };
         }
-        let vp = &enriched.modes;
-        let xr = &enriched.reference;
-        let shift = xr - &x0;
         NormProjection {
             orthonormal: Some(Projected {
-                m: vp.t().dot(&basis.modes), // r⁺ × r
-                vtx: vp.t().dot(xr),
-                xr2: xr.dot(xr),
-                vts: vp.t().dot(&shift),
-                shift2: shift.dot(&shift),
+                m: enriched.modes.t().dot(&basis.modes), // r⁺ × r
+                config: ConfigurationNorms::new(enriched, x0),
             }),
         }
     }
@@ -124,8 +144,7 @@ impl NormProjection {
                 let mq2 = mq.mapv(|v| v * v).sum_axis(Axis(0));
                 let d = (&mq - qp).mapv(|v| v * v).sum_axis(Axis(0)) + (&q2 - &mq2).mapv(|v| v.max(0.0));
                 let qp2 = qp.mapv(|v| v * v).sum_axis(Axis(0));
-                let norm = p.xr2 + 2.0 * p.vtx.dot(qp) + &qp2;
-                let disp = p.shift2 + 2.0 * p.vts.dot(qp) + &qp2;
+                let (norm, disp) = p.config.per_instant(qp, &qp2);
                 (d, norm, disp)
             }
         };
