@@ -62,7 +62,7 @@ fn greedy_calibrates_the_defects_estimate() {
     let dir = tempfile::tempdir().unwrap();
     let p = Pipeline::load(setup(dir.path(), "")).unwrap();
     let summary = train_and_write(&p, &p.basis_path).unwrap();
-    let candidates = summary.greedy.as_ref().expect("greedy record").candidates.clone();
+    let candidates = summary.greedy.as_ref().expect("greedy record").candidate_loads();
     assert_eq!(candidates.len(), 33);
 
     // the file layout

@@ -1,5 +1,6 @@
-//! Training over a box of parameters (`[parameters]` and `[train] points` in the pipeline):
-//! the points are drawn from the box and stored in the basis with it, a reduced run inside
+//! Training over a box of parameters (`[parameters]` and `[train] points` or `greedy` in the
+//! pipeline): the points are drawn from the box and stored in the basis with it, greedy
+//! training converges over it, sharded sweeps over points merge into the single sweep, a reduced run inside
 //! the box is not extrapolated and one outside names the parameter that left it, a pipeline
 //! whose box differs from the basis's is refused, sweeps run grids and lists of points, and
 //! what works on a line only (the report, sharded training) says so instead of running at
@@ -120,6 +121,56 @@ fn a_basis_trained_over_a_box_holds_it_and_checks_runs_against_it() {
     assert!(!d.join("o2.h5").exists());
 }
 
+/// Greedy training over the box (no range: `[parameters]` is the range): it converges at
+/// the tutorial's tolerance 1e-3 (the double pendulum over g × push: 5 full runs at commit
+/// of 2026-11-26, benches/greedy_box.py), its first runs are the box's lower and upper
+/// corners and its centre, the basis records the candidates and the runs as points of the
+/// box, and at the four held-out random points `validate` checks the error is within the
+/// tolerance and the estimate covers it (the coverage the estimate promises on a line).
+#[test]
+fn greedy_training_over_a_box_converges_and_its_estimate_covers_held_out_points() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    setup(d, &format!("{BOX}[train]\ngreedy = {{ tolerance = 1e-3, max_runs = 8 }}\n[reduction]\nvariant = \"constraint-preserving\"\n"));
+    let out = flexrom(d, &["train", "p.toml"]);
+    let stderr = text(&out).1;
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("greedy training over the box g ∈ [0.8, 1.2], push ∈ [0.2, 2] (log)"), "{stderr}");
+    assert!(!stderr.contains("warning"), "{stderr}");
+
+    let f = hdf5::File::open(d.join("b.h5")).unwrap();
+    let t = f.group("training").unwrap();
+    assert_eq!(t.attr("converged").unwrap().read_scalar::<u64>().unwrap(), 1);
+    assert!(t.dataset("range").is_err() && t.dataset("candidates").is_err(), "a box has no load range");
+    let cands = t.dataset("candidate_points").unwrap();
+    assert_eq!(flexrom::io::h5::read_attr_str(&cands, "parameters").unwrap(), "g,push");
+    let cands = cands.read_2d::<f64>().unwrap();
+    // 32 candidates per parameter, inside the box
+    assert_eq!(cands.dim(), (64, 2));
+    assert!(cands.rows().into_iter().all(|r| (0.8..=1.2).contains(&r[0]) && (0.2..=2.0).contains(&r[1])));
+    let runs = t.dataset("points").unwrap().read_2d::<f64>().unwrap();
+    // the first runs: lower corner, centre (a log axis's centre: √(0.2 · 2)), upper corner
+    let first = [[0.8, 0.2], [1.0, (0.2f64 * 2.0).sqrt()], [1.2, 2.0]];
+    for (row, want) in runs.rows().into_iter().zip(first) {
+        assert!((row[0] - want[0]).abs() < 1e-12 && (row[1] - want[1]).abs() < 1e-12, "{row} vs {want:?}");
+    }
+    // `/parameters` holds the same runs
+    let g = f.dataset("parameters/g").unwrap().read_raw::<f64>().unwrap();
+    assert_eq!(g, runs.column(0).to_vec());
+    drop(f);
+
+    let out = flexrom(d, &["validate", "p.toml", "--json", "--no-dense"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    let vs: Vec<serde_json::Value> = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(vs.len(), 4);
+    for v in &vs {
+        let (e, est) = (v["rel_error"].as_f64().unwrap(), v["error_estimate"].as_f64().unwrap());
+        assert!(e <= 1e-3 && est >= e, "{v}");
+        assert_eq!(v["extrapolated"], false, "{v}");
+    }
+}
+
 #[test]
 fn a_box_that_does_not_fit_the_model_or_the_training_is_refused_naming_the_field() {
     let dir = tempfile::tempdir().unwrap();
@@ -143,6 +194,17 @@ fn a_box_that_does_not_fit_the_model_or_the_training_is_refused_naming_the_field
         ),
         (TRAIN.to_string(), "train.points", "the pipeline has no [parameters] table"),
         (format!("{}{}", BOX, TRAIN.replace("count = 6", "count = 0")), "train.points.count", "is 0"),
+        (
+            format!("{BOX}[train]\ngreedy = {{ range = [0.5, 1.5], tolerance = 1e-3, max_runs = 4 }}\n"),
+            "train.greedy.range",
+            "leave `range` out",
+        ),
+        (
+            "[train]\ngreedy = { range = [0.5, 1.5], tolerance = 1e-3, max_runs = 4, seed = 3 }\n".to_string(),
+            "train.greedy.seed",
+            "the pipeline has no [parameters] box",
+        ),
+        ("[train]\ngreedy = { tolerance = 1e-3, max_runs = 4 }\n".to_string(), "train.greedy.range", "is missing"),
     ] {
         setup(d, &body);
         let e = flexrom::pipeline::Pipeline::load(d.join("p.toml")).expect_err(&body).to_string();
@@ -186,6 +248,26 @@ fn a_sweep_over_a_grid_of_points_runs_each_point_as_online_does_and_resumes_by_p
     assert!(out.status.success(), "{}", text(&out).1);
     let alone = hdf5::File::open(d.join("o.h5")).unwrap().dataset("probes/tip").unwrap().read_2d::<f64>().unwrap();
     assert!(swept.index_axis(ndarray::Axis(0), 5) == alone, "the swept point differs from `online` at it");
+
+    // the same grid in two shards, merged: the single sweep's points and probes, to the bit
+    for k in ["1/2", "2/2"] {
+        let part = format!("part_{}.h5", &k[..1]);
+        let out = flexrom(d, &[&["sweep", "p.toml", "-o", &part, "--shard", k, "-q"][..], &grid].concat());
+        assert!(out.status.success(), "{}", text(&out).1);
+    }
+    let out = flexrom(d, &["merge", "part_2.h5", "part_1.h5", "-o", "m.h5"]);
+    assert!(out.status.success(), "{}", text(&out).1);
+    let m = hdf5::File::open(d.join("m.h5")).unwrap();
+    assert_eq!(m.dataset("points").unwrap().read_2d::<f64>().unwrap(), p);
+    assert!(m.dataset("probes/tip").unwrap().read::<f64, ndarray::Ix3>().unwrap() == swept, "merged ≠ single sweep");
+    drop(m);
+    // a part of another list of points is refused, naming the hash
+    let other = ["--param", "g=0.8:1.2:3", "--param", "push=0.2:2:3:log"];
+    let out = flexrom(d, &[&["sweep", "p.toml", "-o", "other_1.h5", "--shard", "1/2", "-q"][..], &other].concat());
+    assert!(out.status.success(), "{}", text(&out).1);
+    let out = flexrom(d, &["merge", "part_2.h5", "other_1.h5", "-o", "m2.h5"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out).1.contains("shard/load_list_hash"), "{}", text(&out).1);
 
     // --resume over the same grid takes every point from the file; a grid with a new axis
     // value runs only the new points

@@ -434,7 +434,12 @@ print("ok")
 
 #[test]
 fn shipped_pipelines_load() {
-    for name in ["pipelines/pendulum.toml", "pipelines/fourbar.toml", "pipelines/double_pendulum_box.toml"] {
+    for name in [
+        "pipelines/pendulum.toml",
+        "pipelines/fourbar.toml",
+        "pipelines/double_pendulum_box.toml",
+        "pipelines/fourbar_box.toml",
+    ] {
         let p = Pipeline::load(repo(name)).unwrap();
         assert!(p
             .basis_path

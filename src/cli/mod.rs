@@ -128,7 +128,11 @@ pub fn warn(warnings: &[String]) {
 
 /// The warnings about finished runs of `rom` (extrapolation, estimates above the
 /// tolerance), printed; with `strict`, an estimate above the tolerance is the error.
-pub fn check_runs(rom: &flexrom::rom::Rom, runs: &[(f64, Option<f64>)], strict: bool) -> flexrom::Result<()> {
+pub fn check_runs(
+    rom: &flexrom::rom::Rom,
+    runs: &[(flexrom::solver::parameters::Parameters, Option<f64>)],
+    strict: bool,
+) -> flexrom::Result<()> {
     let Some(trust) = rom.trust() else { return Ok(()) };
     warn(&flexrom::rom::trust::check_runs(trust, rom.estimator().is_some(), runs, strict)?);
     Ok(())

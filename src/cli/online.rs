@@ -87,6 +87,6 @@ impl Args {
         warn(notice.as_slice());
         let measure = rom.tolerance_measure();
         warn(&rom.untrained_parameters(&mu));
-        super::check_runs(&rom, &[(load_scale, estimate.map(|e| e.in_measure(measure)))], strict)
+        super::check_runs(&rom, &[(mu.clone(), estimate.map(|e| e.in_measure(measure)))], strict)
     }
 }

@@ -97,12 +97,6 @@ impl Args {
         let p = Pipeline::load_with(&pipeline, limits.clone())?;
         let points = sweep_points(&p, load_scales.as_deref(), &params, points.as_deref())?;
         let named = points.iter().any(|mu| mu.named().next().is_some());
-        if named && shard.is_some() {
-            return Err(flexrom::Error::Usage(
-                "--shard splits a list of load scales; a sweep over named parameters runs in one process so far".into(),
-            ));
-        }
-        let scales: Vec<f64> = points.iter().map(|mu| mu.scale()).collect();
         let path = basis.unwrap_or_else(|| p.basis_path.clone());
         let mut inputs = vec![(p.path.as_path(), "pipeline file"), (p.model.path.as_path(), "model file")];
         if !full {
@@ -137,7 +131,7 @@ impl Args {
             flexrom::pipeline::sweep::SweepOptions { validate, continuation, progress: output::show_progress() };
         let file = SweepFile { out: &out, resume, extra: &|_| Ok(()) };
         let sw = match shard {
-            Some(k) => flexrom::pipeline::shard::sweep_shard(&p, route, &scales, k, options, file)?,
+            Some(k) => flexrom::pipeline::shard::sweep_shard(&p, route, &points, k, options, file)?,
             None => flexrom::pipeline::sweep::sweep_to_file(route, &points, options, file)?,
         };
         match format.format() {
@@ -174,11 +168,11 @@ impl Args {
                 first.join(", ")
             )]);
         }
-        let runs: Vec<(f64, Option<f64>)> = sw
+        let runs: Vec<_> = sw
             .scales
             .iter()
             .filter_map(|x| x.point())
-            .map(|q| (q.run.result.settings.mu.scale(), q.estimate.map(|e| e.in_measure(rom.tolerance_measure()))))
+            .map(|q| (q.run.result.settings.mu.clone(), q.estimate.map(|e| e.in_measure(rom.tolerance_measure()))))
             .collect();
         super::check_runs(rom, &runs, strict)
     }

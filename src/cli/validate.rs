@@ -84,7 +84,7 @@ impl Args {
             Format::Text => {}
         }
         let measure = rom.tolerance_measure();
-        let runs: Vec<(f64, Option<f64>)> = vs.iter().map(|v| (v.load_scale, v.estimate_in(measure))).collect();
+        let runs: Vec<_> = points.iter().cloned().zip(vs.iter().map(|v| v.estimate_in(measure))).collect();
         let mut outside: Vec<String> = points.iter().flat_map(|mu| rom.untrained_parameters(mu)).collect();
         outside.dedup();
         warn(&outside);

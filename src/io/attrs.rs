@@ -93,7 +93,7 @@ const RESULT: [Entry; 8] = [
     ("reduced/q", REDUCED_UNITS, "time, mode"),
 ];
 
-const BASIS: [Entry; 47] = [
+const BASIS: [Entry; 52] = [
     ("snapshots", COORDINATE_UNITS, "dof, snapshot"),
     ("snapshot_multipliers", MULTIPLIER_UNITS, "constraint, snapshot"),
     ("snapshot_load_scale", "1", "snapshot"),
@@ -120,11 +120,16 @@ const BASIS: [Entry; 47] = [
     ("estimator/defects/load_scale", "1", "load"),
     ("estimator/defects/ratio", "1", "load, fifth"),
     ("estimator/defects/factor", "1", "fifth"),
+    ("estimator/defects/unit_point", "1", "candidate, parameter"),
     ("parameters/*", "1", "run"),
     ("training/range", "1", "bound"),
     ("training/tolerance", "1", ""),
     ("training/load_scales", "1", "run"),
     ("training/candidates", "1", "candidate"),
+    ("training/candidate_points", "1", "candidate, parameter"),
+    ("training/points", "1", "run, parameter"),
+    ("training/worst_point", "1", "iteration, parameter"),
+    ("training/run_point", "1", "iteration, parameter"),
     ("training/worst_estimate", "1", "iteration"),
     ("training/worst_load", "1", "iteration"),
     ("training/run_load", "1", "iteration"),
@@ -143,7 +148,7 @@ const BASIS: [Entry; 47] = [
     ("timing/estimate_seconds", "s", ""),
 ];
 
-const SWEEP: [Entry; 27] = [
+const SWEEP: [Entry; 28] = [
     ("load_scales", "1", "load"),
     ("points", "1", "load, parameter"),
     ("status", "1", "load"),
@@ -171,6 +176,7 @@ const SWEEP: [Entry; 27] = [
     ("steps_differ_from", "s", "load"),
     ("displacement_error", "1", "load"),
     ("shard/all_load_scales", "1", "all loads"),
+    ("shard/all_points", "1", "all loads, parameter"),
     ("shard/indices", "1", "load"),
 ];
 

@@ -10,7 +10,10 @@
 //!   attributes on /estimator/hyper: tolerance, training_residual, n_training
 //! /estimator/calibration/load_scale, raw_estimate, rel_error   (m) held-out calibration pairs
 //! /estimator/defects/load_scale (N), ratio (N, 5), factor (5)   the defects method's
-//!                                          calibration (greedy training only; `DefectsCalibration`);
+//!                                          calibration (greedy training only; `DefectsCalibration`;
+//!                                          load_scale empty: the N candidates were points of a
+//!                                          parameter box, `unit_point` (N, d) where they lie in
+//!                                          its unit cube, attribute `parameters`);
 //!   attribute on /estimator/defects: reliable (1: its leave-one-out check passed); factor and
 //!   reliable follow from load_scale and ratio and are recomputed when read
 //!   attributes on /estimator: method ("enriched": the estimators compare with an enriched
@@ -64,6 +67,12 @@ pub fn write_estimator(f: &hdf5::File, est: &Estimator) -> hdf5::Result<()> {
         let ratios = ndarray::Array2::from_shape_fn((d.ratios.len(), 5), |(j, i)| d.ratios[j][i]);
         dg.new_dataset_builder().with_data(&ratios).create("ratio")?;
         dg.new_dataset_builder().with_data(&Array1::from(d.factors.to_vec())).create("factor")?;
+        if let Some(sc) = &d.scattered {
+            let dims = sc.space.ranges.len();
+            let unit = ndarray::Array2::from_shape_fn((sc.unit.len(), dims), |(j, i)| sc.unit[j][i]);
+            let ds = dg.new_dataset_builder().with_data(&unit).create("unit_point")?;
+            attr_str(&ds, "parameters", &sc.space.names().collect::<Vec<_>>().join(","))?;
+        }
         attr_u64(&dg, "reliable", d.reliable as u64)?;
     }
     attr_str(&g, "method", "enriched")?;
@@ -196,7 +205,7 @@ pub fn read_estimator(path: &Path, basis: &Basis) -> Result<Option<Estimator>> {
         ));
     }
     let defects = match g.group("defects") {
-        Ok(dg) => Some(read_defects(&dg, &field)?),
+        Ok(dg) => Some(read_defects(path, &dg, &field)?),
         Err(_) => None,
     };
     Ok(Some(Estimator {
@@ -211,7 +220,7 @@ pub fn read_estimator(path: &Path, basis: &Basis) -> Result<Option<Estimator>> {
 
 /// `/estimator/defects`: the loads (finite, increasing) and their ratios (N × 5); the
 /// factors and the check's outcome are derived from them, as training derived them.
-fn read_defects(dg: &hdf5::Group, field: &dyn Fn(&str, String) -> Error) -> Result<DefectsCalibration> {
+fn read_defects(path: &Path, dg: &hdf5::Group, field: &dyn Fn(&str, String) -> Error) -> Result<DefectsCalibration> {
     let load_scales = dg
         .dataset("load_scale")
         .and_then(|d| d.read_1d::<f64>())
@@ -227,7 +236,9 @@ fn read_defects(dg: &hdf5::Group, field: &dyn Fn(&str, String) -> Error) -> Resu
         .dataset("ratio")
         .and_then(|d| d.read_2d::<f64>())
         .map_err(|e| field("defects/ratio", format!("cannot be read: {e}")))?;
-    if ratio.dim() != (load_scales.len(), 5) {
+    // no loads: the candidates were points of a parameter box (one row each)
+    let scattered = load_scales.is_empty();
+    if ratio.ncols() != 5 || !(scattered || ratio.nrows() == load_scales.len()) {
         return Err(field(
             "defects/ratio",
             format!("is {:?}; expected ({}, 5), a row per load of defects/load_scale", ratio.dim(), load_scales.len()),
@@ -235,8 +246,30 @@ fn read_defects(dg: &hdf5::Group, field: &dyn Fn(&str, String) -> Error) -> Resu
     }
     let ratios = ratio.rows().into_iter().map(|r| [r[0], r[1], r[2], r[3], r[4]]).collect();
     // `factor` and `reliable` follow from the ratios; the file carries them for its readers
-    DefectsCalibration::new(load_scales, ratios)
-        .ok_or_else(|| field("defects/ratio", "has a fifth of the run without one positive, finite ratio".into()))
+    let c = if scattered {
+        // where the candidates lie: their unit-cube coordinates in the basis's box
+        let space = crate::io::parameter_space_file::read_parameter_space(path)?.unwrap_or_default();
+        let unit = dg
+            .dataset("unit_point")
+            .and_then(|d| d.read_2d::<f64>())
+            .map_err(|e| field("defects/unit_point", format!("cannot be read (the candidates of a box): {e}")))?;
+        if unit.dim() != (ratio.nrows(), space.ranges.len()) || unit.iter().any(|x| !x.is_finite()) {
+            return Err(field(
+                "defects/unit_point",
+                format!(
+                    "is {:?}; expected ({}, {}) finite values, a row per row of defects/ratio and a column per parameter of /parameters",
+                    unit.dim(),
+                    ratio.nrows(),
+                    space.ranges.len()
+                ),
+            ));
+        }
+        let unit = unit.rows().into_iter().map(|r| r.to_vec()).collect();
+        DefectsCalibration::scattered(space, unit, ratios)
+    } else {
+        DefectsCalibration::new(load_scales, ratios)
+    };
+    c.ok_or_else(|| field("defects/ratio", "has a fifth of the run without one positive, finite ratio".into()))
 }
 
 /// `[min, max]` of the training load scales: `/training/range` when present (greedy
@@ -312,6 +345,54 @@ pub fn read_training_sensitivity(path: &Path) -> Result<Option<(Vec<f64>, Vec<f6
         return Err(Error::input(path, "training/sensitivity", "has a negative entry: a sensitivity is a norm ratio"));
     }
     Ok(Some((c.to_vec(), last)))
+}
+
+/// A box's candidates in its unit cube, and the sensitivity at each.
+pub type BoxSensitivity = (Vec<Vec<f64>>, Vec<f64>);
+
+/// Greedy training's candidates over a box (`/training/candidate_points`, the columns named
+/// by its attribute `parameters`) in the unit cube of `space`, and the reduced model's
+/// whole-run sensitivity at each (the last row of `/training/sensitivity`); `None` without
+/// them.
+pub fn read_training_box_sensitivity(
+    path: &Path,
+    space: &crate::solver::parameter_space::ParameterSpace,
+) -> Result<Option<BoxSensitivity>> {
+    let f = hdf5::File::open(path)
+        .map_err(|e| Error::input(path, "(file)", format!("is not a readable HDF5 file: {e}")))?;
+    let Ok(g) = f.group("training") else { return Ok(None) };
+    let (Ok(c), Ok(s)) = (g.dataset("candidate_points"), g.dataset("sensitivity")) else { return Ok(None) };
+    let bad = |field: &str, problem: String| Error::input(path, field, problem);
+    let names = read_attr_str(&c, "parameters")
+        .map_err(|e| bad("training/candidate_points", format!("has no readable attribute `parameters`: {e}")))?;
+    let names: Vec<&str> = names.split(',').collect();
+    let c = c.read_2d::<f64>().map_err(|e| bad("training/candidate_points", format!("cannot be read: {e}")))?;
+    let s = s.read_2d::<f64>().map_err(|e| bad("training/sensitivity", format!("cannot be read: {e}")))?;
+    if c.ncols() != names.len() || names.iter().any(|n| space.range(n).is_none()) {
+        return Err(bad(
+            "training/candidate_points",
+            format!("has columns {names:?}; expected the parameters of /parameters, one column each"),
+        ));
+    }
+    if s.nrows() == 0 {
+        return Ok(None);
+    }
+    if s.ncols() != c.nrows() {
+        return Err(bad(
+            "training/sensitivity",
+            format!("has {} columns for {} candidates (training/candidate_points)", s.ncols(), c.nrows()),
+        ));
+    }
+    let unit = c
+        .rows()
+        .into_iter()
+        .map(|row| {
+            let mu =
+                names.iter().zip(row).fold(crate::solver::parameters::Parameters::default(), |m, (n, &x)| m.with(n, x));
+            space.unit_of(&mu)
+        })
+        .collect();
+    Ok(Some((unit, s.row(s.nrows() - 1).to_vec())))
 }
 
 /// Greedy training's tolerance: the dataset `/training/tolerance` or the attribute

@@ -42,7 +42,7 @@ use scales::check_scales;
 pub use scales::{parse_range, Scales, MAX_LOAD_SCALES};
 pub use schema::{
     Blocks, GreedySpec, HyperSpec, OnlineSpec, ParameterSpec, PipelineFile, PointsSpec, ReductionSpec, ScalesSpec,
-    TrainSpec,
+    TrainSpec, DEFAULT_BOX_CANDIDATES_PER_PARAMETER, DEFAULT_LINE_CANDIDATES,
 };
 use std::path::{Path, PathBuf};
 
@@ -113,7 +113,7 @@ impl Pipeline {
                 }
             }
             (None, Some(g)) => {
-                if let Err((f, p)) = g.validate() {
+                if let Err((f, p)) = g.validate(!self.file.parameters.is_empty()) {
                     return bad(&f, p);
                 }
             }
@@ -231,9 +231,10 @@ impl Pipeline {
                 }
                 Ok(())
             }
+            (None, false) if t.greedy.is_some() => Ok(()),
             (None, false) => bad(
                 "train",
-                "trains over the load scale alone, but the pipeline has a [parameters] box: sample it with `points = { count = N }` (greedy training over a box of several parameters is not there yet)".into(),
+                "trains over the load scale alone, but the pipeline has a [parameters] box: train greedily over it with `greedy = { tolerance = T, max_runs = K }`, or sample it with `points = { count = N }`".into(),
             ),
             (None, true) => Ok(()),
         }
@@ -256,12 +257,16 @@ impl Pipeline {
     /// load_scales`, or for a `[parameters]` box four points drawn at random from it (seed:
     /// the training points' plus one), which are not training points.
     pub fn validation_points(&self) -> Vec<Parameters> {
-        match &self.file.train.points {
-            Some(pts) => {
-                self.space().sample(4, crate::solver::parameter_space::Sampling::Random, pts.seed.wrapping_add(1))
-            }
-            None => self.validate_scales().into_iter().map(Parameters::load_scale).collect(),
+        if self.file.parameters.is_empty() {
+            return self.validate_scales().into_iter().map(Parameters::load_scale).collect();
         }
+        self.space().sample(4, crate::solver::parameter_space::Sampling::Random, self.box_seed().wrapping_add(1))
+    }
+
+    /// The seed a box's points are drawn with: `train.points`' or greedy's (default 1).
+    fn box_seed(&self) -> u64 {
+        let t = &self.file.train;
+        t.points.as_ref().map(|p| p.seed).or(t.greedy.as_ref().and_then(|g| g.seed)).unwrap_or(1)
     }
 
     /// The box of `[parameters]`, in name order (empty without the table).
@@ -303,10 +308,12 @@ impl Pipeline {
     pub fn training_scales(&self) -> Vec<f64> {
         match (&self.file.train.load_scales, &self.file.train.greedy) {
             (Some(s), _) => s.clone(),
-            (None, Some(g)) => {
+            (None, Some(g)) if g.range.len() == 2 => {
                 let (a, b) = g.range();
                 vec![a, 0.5 * (a + b), b]
             }
+            // a box: λ is what the model file gives unless the box holds it
+            (None, Some(_)) => vec![1.0],
             (None, None) => Vec::new(),
         }
     }

@@ -1,9 +1,12 @@
 //! Greedy training over a load range (`[train] greedy = { range = [A, B], tolerance = T,
-//! max_runs = K, candidates = N }`; docs/greedy-training.md).
+//! max_runs = K, candidates = N }`) or over a `[parameters]` box (`greedy = { tolerance = T,
+//! max_runs = K }`); docs/greedy-training.md.
 //!
 //! ```text
-//!     Λ = {λ₁ … λ_N}, N evenly spaced loads of [A, B]        (the candidates)
-//!     S = full runs at A, (A + B)/2, B                        (at most K of them)
+//!     Λ = {λ₁ … λ_N}, N evenly spaced loads of [A, B]        (the candidates;
+//!         in a box N points drawn in the unit cube: `candidate_set.rs`)
+//!     S = full runs at A, (A + B)/2, B                        (at most K of them;
+//!         in a box the lower and upper corners and the centre)
 //!     repeat:
 //!         for ε = 10⁻², 10⁻³, … (loose → tight):              (the mode search)
 //!             V_ε = POD of S per block, the fewest modes with energy ≥ 1 − ε,
@@ -23,7 +26,8 @@
 //!   snapshots by ε, ECSW's τ bounds a relative force error in norm; √ε puts both at the
 //!   same relative size, so neither dominates the other as the search tightens.
 //! - B(η) = max over neighbouring candidates of max(ηᵢ, ηᵢ₊₁)² / min(ηᵢ, ηᵢ₊₁)
-//!   (`search::between_candidates`): the tolerance is a promise for every load of the
+//!   (`search::between_candidates`; in a box over each candidate and its nearest
+//!   neighbour in the unit cube): the tolerance is a promise for every load of the
 //!   range, and between two candidates the estimate is taken to rise above the larger by
 //!   as much as it changes between them (a few per cent for a smooth estimate, 33
 //!   candidates); between two *sensitive* candidates (sensitivity above T, below) the
@@ -52,7 +56,8 @@
 //!
 //!   with `η_i` the estimate and `s_i` the reduced model's own *sensitivity* over the run
 //!   up to the end of fifth `i`: `s_i(λ) = ‖X_r(λ(1 + δ)) − X_r(λ)‖ / ‖X_r(λ)‖` over those
-//!   instants, δ = [`SENSITIVITY_STEP`] (0.1 %). Where the model is not
+//!   instants, δ = [`SENSITIVITY_STEP`] (0.1 %; in a box every parameter of the box
+//!   times 1 + δ). Where the model is not
 //!   sensitive (`s_i ≤ T`) the score is the estimate itself. Where its answer changes by
 //!   more than T when the load changes by 0.1 % (the four-bar after t ≈ 0.7 s), the
 //!   estimate there is held to `s_i` instead: any estimate compares two trajectories of
@@ -67,9 +72,11 @@
 //! The loop is here; the mode and hyper-reduction search of one iteration is in `search.rs`,
 //! the estimates, sensitivities and scores at the candidates in `candidates.rs`.
 
+mod candidate_set;
 mod candidates;
 mod search;
 
+pub use candidate_set::CandidateSet;
 pub use candidates::{score, SENSITIVITY_STEP};
 pub use search::{ENERGY_LADDER, TAU_LADDER};
 
@@ -92,34 +99,32 @@ use rayon::prelude::*;
 use search::{search, Level, Round};
 use std::sync::Arc;
 
-/// The first loads: the range's ends and middle (middle only for K = 1, the ends for K = 2).
-pub fn initial_loads(range: (f64, f64), max_runs: usize) -> Vec<f64> {
-    let (a, b) = range;
-    match max_runs {
-        1 => vec![0.5 * (a + b)],
-        2 => vec![a, b],
-        _ => vec![a, 0.5 * (a + b), b],
-    }
-}
-
 /// Greedy training (module documentation); nothing is written.
 pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary)> {
-    let range = g.range();
-    let candidates = g.candidate_loads();
-    let full = |x: f64| {
-        let mu = Parameters::load_scale(x);
-        simulate(&p.model, &Overrides::at(&mu)).map_err(|e| e.at_stage("train (greedy full run)", &mu))
-    };
-    let first = initial_loads(range, g.max_runs);
-    log::info!(
-        "greedy training over [{}, {}], tolerance {:e}, {} candidates: full runs at {:?}",
-        range.0,
-        range.1,
-        g.tolerance,
-        candidates.len(),
-        first
-    );
-    let mut runs: Vec<SimulationResult> = first.par_iter().map(|&x| full(x)).collect::<Result<_>>()?;
+    let candidates = CandidateSet::new(g, &p.space());
+    let full =
+        |mu: &Parameters| simulate(&p.model, &Overrides::at(mu)).map_err(|e| e.at_stage("train (greedy full run)", mu));
+    let first = candidates.first(g, g.max_runs);
+    if candidates.is_box() {
+        log::info!(
+            "greedy training over the box {}, tolerance {:e}, {} candidates: full runs at {}",
+            candidates.space.describe(),
+            g.tolerance,
+            candidates.len(),
+            first.iter().map(|mu| format!("({})", candidates.label(mu))).collect::<Vec<_>>().join(", ")
+        );
+    } else {
+        let range = g.range();
+        log::info!(
+            "greedy training over [{}, {}], tolerance {:e}, {} candidates: full runs at {:?}",
+            range.0,
+            range.1,
+            g.tolerance,
+            candidates.len(),
+            first.iter().map(Parameters::scale).collect::<Vec<_>>()
+        );
+    }
+    let mut runs: Vec<SimulationResult> = first.par_iter().map(full).collect::<Result<_>>()?;
     // the later full runs, one at a time, on one full model
     let mut full_model = crate::simulate::FullModel::new(&p.model, crate::linalg::kkt::LinearSolverKind::Banded)?;
     let mut full_seconds: f64 = runs.iter().map(|r| r.wall_seconds).sum();
@@ -138,11 +143,9 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         let round = Round { p, data: &data, candidates: &candidates, points: &points, n, method, prior };
         let mut level = search(&round, g, previous_energy)?;
         let (wi, worst) = level.worst();
-        // where to run the full model: the worst candidate whose load has no full run yet
-        // (a training load's own run is already in the snapshots)
-        let fresh = |i: usize| {
-            runs.iter().all(|r| (r.settings.mu.scale() - candidates[i]).abs() > 1e-12 * candidates[i].abs().max(1.0))
-        };
+        // where to run the full model: the worst candidate without a full run yet (a
+        // training point's own run is already in the snapshots)
+        let fresh = |i: usize| runs.iter().all(|r| !candidates.is_at(i, &r.settings.mu));
         let next = level.worst_where(fresh);
         let b = &level.trained.basis;
         let mut it = Iteration {
@@ -157,9 +160,9 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
             estimates: level.estimates.clone(),
             whole_run_estimates: level.whole.clone(),
             sensitivity: level.sensitivity.iter().map(|s| s[4]).collect(),
-            worst_load: candidates[wi],
+            worst_candidate: wi,
             worst_estimate: worst,
-            run_load: f64::NAN,
+            run_candidate: None,
             true_error: f64::NAN,
             true_score: f64::NAN,
             held_out_effectivity: f64::NAN,
@@ -182,41 +185,42 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
             // the same test as the stop below, without a held-out run to recalibrate with
             let bound = level.between_candidates(g.tolerance);
             log::info!(
-                "iteration {n}: {why}, worst estimate {worst:.2e} {cmp} {:e} at λ = {} (bound between candidates {bound:.2e}), {shape}",
-                g.tolerance, it.worst_load
+                "iteration {n}: {why}, worst estimate {worst:.2e} {cmp} {:e} at {} (bound between candidates {bound:.2e}), {shape}",
+                g.tolerance,
+                candidates.label_of(wi)
             );
             converged = bound <= g.tolerance;
             iterations.push(it);
             break level;
         };
         // the full run at the worst candidate: snapshots for the next basis, and the true
-        // error of this one there (it never saw that load)
-        let at = candidates[ni];
-        let mu = Parameters::load_scale(at);
+        // error of this one there (it never saw that point)
+        let mu = candidates.points[ni].clone();
+        let at = candidates.label(&mu);
         let truth = full_model.simulate(&Overrides::at(&mu)).map_err(|e| e.at_stage("train (greedy full run)", &mu))?;
         full_seconds += truth.wall_seconds;
         full_runs += 1;
         // rel_error `e` calibrates the estimator; the error in the training's measure is held to T
-        let truth_error = true_error(&p.model, &level.trained.basis, &truth, at);
+        let truth_error = true_error(&p.model, &level.trained.basis, &truth, &mu);
         let (e, e_measured) = (truth_error.rel_error, truth_error.in_measure(g.measure));
         let e_score = score(g.tolerance, truth_error.by_time_in(g.measure), &level.sensitivity[ni]);
         let c = level.estimator.calibration.factor;
-        (it.run_load, it.true_error, it.true_score) = (at, e_measured, e_score);
+        (it.run_candidate, it.true_error, it.true_score) = (Some(ni), e_measured, e_score);
         it.held_out_effectivity = c * level.raws[ni] / e;
         if level.raws[ni].is_finite() && e.is_finite() {
-            points.push(CalibrationPoint { load_scale: at, raw_estimate: level.raws[ni], rel_error: e });
+            points.push(CalibrationPoint { load_scale: mu.scale(), raw_estimate: level.raws[ni], rel_error: e });
         }
         // the held-out check of the estimate itself: off by more than the method assumes, the
         // loop reads the candidates with the enriched model (the reference the correction
-        // approximates) from here on, when that reads closer at this load
-        if let Some(checked) = check_method(p, &level, method, at, e, it.held_out_effectivity) {
+        // approximates) from here on, when that reads closer at this point
+        if let Some(checked) = check_method(p, &level, method, (&mu, &at), e, it.held_out_effectivity) {
             log::info!("{}", checked.message);
             if !checked.switch && it.held_out_effectivity > MAX_HELD_OUT_OVERESTIMATE {
                 warnings.push(checked.message);
             } else if checked.switch {
                 method = EstimateMethod::Enriched;
                 // the earlier pairs were the other method's readings
-                points = vec![CalibrationPoint { load_scale: at, raw_estimate: checked.raw, rel_error: e }];
+                points = vec![CalibrationPoint { load_scale: mu.scale(), raw_estimate: checked.raw, rel_error: e }];
                 level.estimator.calibration = calibrate(points.clone());
                 level.estimate(
                     p,
@@ -237,9 +241,9 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         let sens = level.sensitivity[ni][4];
         if done {
             let name = g.measure.error_name();
-            log::info!("iteration {n}: worst score {worst:.2e} ≤ {:e}; held-out check at λ = {at} (score {next_estimate:.2e}): {name} {e_measured:.2e} (score {e_score:.2e}, sensitivity {sens:.1e}); {shape}", g.tolerance);
+            log::info!("iteration {n}: worst score {worst:.2e} ≤ {:e}; held-out check at {at} (score {next_estimate:.2e}): {name} {e_measured:.2e} (score {e_score:.2e}, sensitivity {sens:.1e}); {shape}", g.tolerance);
         } else {
-            log::info!("iteration {n}: full run at λ = {at} (worst score {worst:.2e} {cmp} {:e}; {next_estimate:.2e} there, true error {e_measured:.2e}, its score {e_score:.2e}, sensitivity {sens:.1e}), {shape}", g.tolerance);
+            log::info!("iteration {n}: full run at {at} (worst score {worst:.2e} {cmp} {:e}; {next_estimate:.2e} there, true error {e_measured:.2e}, its score {e_score:.2e}, sensitivity {sens:.1e}), {shape}", g.tolerance);
         }
         iterations.push(it);
         if done {
@@ -254,7 +258,11 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
             g.max_runs,
             g.tolerance,
             iterations.last().map_or(f64::NAN, |i| i.worst_estimate),
-            iterations.last().map_or(f64::NAN, |i| search::between_candidates(&i.estimates, &sensitive(&i.sensitivity, g.tolerance))),
+            iterations.last().map_or(f64::NAN, |i| search::between_candidates(
+                &i.estimates,
+                &sensitive(&i.sensitivity, g.tolerance),
+                &candidates.pairs
+            )),
             why_not_converged(g.tolerance, &iterations, &candidates)
         ));
     }
@@ -269,19 +277,19 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
     log::info!("{}", match &estimator.defects {
         Some(d) if d.reliable => format!(
             "error estimate: the cheap `defects` method calibrated at the {} candidates (factors {}), the online default",
-            d.load_scales.len(),
+            d.ratios.len(),
             d.factors.iter().map(|f| format!("{f:.3}")).collect::<Vec<_>>().join(", ")
         ),
-        Some(_) => "error estimate: the `defects` method's ratio to the corrected estimate jumps between candidates (its leave-one-out check failed): the online default stays `corrected`".into(),
-        None => "error estimate: the `defects` method could not be calibrated: the online default stays `corrected`".into(),
+        Some(_) => format!("error estimate: the `defects` method's ratio to the {} estimate jumps between candidates (its leave-one-out check failed): the online default stays `{}`", method.name(), estimator.default_method().name()),
+        None => format!("error estimate: the `defects` method could not be calibrated: the online default stays `{}`", estimator.default_method().name()),
     });
     let data = training_data(&runs);
     let record = GreedyRecord {
-        range,
+        range: if candidates.is_box() { None } else { Some(g.range()) },
         tolerance: g.tolerance,
         max_runs: g.max_runs,
         candidates,
-        load_scales: runs.iter().map(|r| r.settings.mu.scale()).collect(),
+        runs: runs.iter().map(|r| r.settings.mu.clone()).collect(),
         iterations,
         converged,
         full_runs,
@@ -318,8 +326,8 @@ struct MethodCheck {
     message: String,
 }
 
-/// The held-out check of the estimate itself: at the load `at`, where the full run gave the
-/// true error `e`, the estimate by `method` read `eff` times it. Outside
+/// The held-out check of the estimate itself: at the point `mu` (named `at` in messages),
+/// where the full run gave the true error `e`, the estimate by `method` read `eff` times it. Outside
 /// `[1, MAX_HELD_OUT_OVERESTIMATE]` the enriched model (integrated to convergence, the
 /// reference the `corrected` method approximates) reads the same load; when it is closer
 /// to that range, the loop switches to it. `None`: nothing to check or nothing found.
@@ -327,7 +335,7 @@ fn check_method(
     p: &Pipeline,
     level: &search::Level,
     method: EstimateMethod,
-    at: f64,
+    (mu, at): (&Parameters, &str),
     e: f64,
     eff: f64,
 ) -> Option<MethodCheck> {
@@ -340,9 +348,8 @@ fn check_method(
 
     let rom =
         candidates::training_rom(&p.model, &level.trained.basis, &level.estimator, EstimateMethod::Enriched).ok()?;
-    let mu = Parameters::load_scale(at);
-    let run = rom.solve_with(&mu, crate::rom::Output::ReducedAndProbes, &[]).ok()?;
-    let reading = rom.estimate_error(&run, &mu)?;
+    let run = rom.solve_with(mu, crate::rom::Output::ReducedAndProbes, &[]).ok()?;
+    let reading = rom.estimate_error(&run, mu)?;
     let eff_ref = reading.error_estimate / e;
     // how far outside [1, MAX] (in orders of magnitude); NaN counts as infinitely far
     let off = |x: f64| {
@@ -356,12 +363,12 @@ fn check_method(
     };
     let switch = off(eff_ref) < off(eff);
     let head = format!(
-        "held-out check at λ = {at}: the {} estimate read {eff:.3}× the true error {e:.2e} (1–{MAX_HELD_OUT_OVERESTIMATE}× expected)",
+        "held-out check at {at}: the {} estimate read {eff:.3}× the true error {e:.2e} (1–{MAX_HELD_OUT_OVERESTIMATE}× expected)",
         method.name()
     );
     let message = if !eff.is_finite() && !eff_ref.is_finite() {
         format!(
-            "held-out check at λ = {at}: neither the {} estimate nor the enriched model's could be computed there (their richer model's run failed; true error {e:.2e})",
+            "held-out check at {at}: neither the {} estimate nor the enriched model's could be computed there (their richer model's run failed; true error {e:.2e})",
             method.name()
         )
     } else if switch {
@@ -384,7 +391,7 @@ fn sensitive(sensitivity: &[f64], tolerance: f64) -> Vec<bool> {
 /// load (where a 0.1 % change of the load moves the answer by more than T, the held-out
 /// errors and the estimates there measure the dynamics as much as the basis); held-out
 /// checks that found the estimate off by more than its method allows; else too few runs.
-fn why_not_converged(tolerance: f64, iterations: &[Iteration], candidates: &[f64]) -> String {
+fn why_not_converged(tolerance: f64, iterations: &[Iteration], candidates: &CandidateSet) -> String {
     let Some(last) = iterations.last() else { return "no iteration ran".into() };
     let n = candidates.len();
     let failed = last.estimates.iter().filter(|e| e.is_infinite() || e.is_nan()).count();
@@ -394,29 +401,31 @@ fn why_not_converged(tolerance: f64, iterations: &[Iteration], candidates: &[f64
         );
     }
     // the largest sensitivity the loop met, over the candidates of every iteration
-    let (mut s_max, mut at_max) = (0.0_f64, f64::NAN);
+    let (mut s_max, mut at_max) = (0.0_f64, String::new());
     for it in iterations {
-        for (&s, &x) in it.sensitivity.iter().zip(candidates) {
+        for (i, &s) in it.sensitivity.iter().enumerate() {
             if s > s_max {
-                (s_max, at_max) = (s, x);
+                (s_max, at_max) = (s, candidates.label_of(i));
             }
         }
     }
     let sensitive_held_out =
         iterations.iter().filter(|it| it.true_error > tolerance && it.true_score <= tolerance).count();
     // every score within T, but neighbours far apart: the loads between them are not certified
-    let bound = search::between_candidates(&last.estimates, &sensitive(&last.sensitivity, tolerance));
+    let bound =
+        search::between_candidates(&last.estimates, &sensitive(&last.sensitivity, tolerance), &candidates.pairs);
     if last.worst_estimate <= tolerance && bound > tolerance {
-        let (ratio, at) = last
-            .estimates
-            .windows(2)
-            .zip(candidates)
-            .map(|(w, &x)| (w[0].max(w[1]) / w[0].min(w[1]), x))
-            .fold((0.0_f64, f64::NAN), |a, b| if b.0 > a.0 { b } else { a });
+        let e = &last.estimates;
+        let (ratio, at) = candidates
+            .pairs
+            .iter()
+            .map(|&(i, j)| (e[i].max(e[j]) / e[i].min(e[j]), i))
+            .fold((0.0_f64, 0), |a, b| if b.0 > a.0 { b } else { a });
         return format!(
-            "every candidate's score is within it, but neighbouring scores differ by up to {ratio:.0}× (from λ = {at}), which leaves the loads between them uncertified{}; more candidates (`[train] greedy candidates = N`) resolve an error that varies smoothly with the load, not one that jumps",
+            "every candidate's score is within it, but neighbouring scores differ by up to {ratio:.0}× (from {}), which leaves the loads between them uncertified{}; more candidates (`[train] greedy candidates = N`) resolve an error that varies smoothly with the load, not one that jumps",
+            candidates.label_of(at),
             if s_max > tolerance {
-                format!(" (the full model is sensitive to the load: a 0.1 % change moves its answer by up to {s_max:.1e}, at λ = {at_s})", at_s = at_max)
+                format!(" (the full model is sensitive to the load: a 0.1 % change moves its answer by up to {s_max:.1e}, at {at_max})")
             } else {
                 String::new()
             }
@@ -424,7 +433,7 @@ fn why_not_converged(tolerance: f64, iterations: &[Iteration], candidates: &[f64
     }
     if s_max > tolerance {
         return format!(
-            "the full model is sensitive to the load (a 0.1 % change moves its answer by up to {s_max:.1e} over the run, at λ = {at_max}{}): there the tolerance asks more than the load determines; a looser tolerance, a shorter run (`[time] t_end`) or a narrower range certifies, and `error_estimate_by_time` shows the early part of the run",
+            "the full model is sensitive to the load (a 0.1 % change moves its answer by up to {s_max:.1e} over the run, at {at_max}{}): there the tolerance asks more than the load determines; a looser tolerance, a shorter run (`[time] t_end`) or a narrower range certifies, and `error_estimate_by_time` shows the early part of the run",
             if sensitive_held_out > 0 { format!("; {sensitive_held_out} held-out errors above T were within it") } else { String::new() }
         );
     }
@@ -442,8 +451,7 @@ fn why_not_converged(tolerance: f64, iterations: &[Iteration], candidates: &[f64
     "each full run lowered the worst estimate less than the tolerance needs; raise max_runs (or the tolerance)".into()
 }
 
-/// rel_error of `basis` at `load` against the full run `truth`, whole and by fifth of the
-/// The true errors of a basis at a held-out load: rel_error (what calibrates the estimator)
+/// The true errors of a basis at a held-out point: rel_error (what calibrates the estimator)
 /// and both measures by fifth of the run.
 struct TrueError {
     rel_error: f64,
@@ -468,11 +476,10 @@ impl TrueError {
     }
 }
 
-/// The errors of `basis` at `load` against the full run `truth`, whole and by fifth of the
+/// The errors of `basis` at `mu` against the full run `truth`, whole and by fifth of the
 /// run (∞ when the reduced run fails).
-fn true_error(model: &Arc<Model>, basis: &Basis, truth: &SimulationResult, load: f64) -> TrueError {
-    let run =
-        Rom::new(model, &Arc::new(basis.clone()), None, None).and_then(|r| r.solve(&Parameters::load_scale(load)));
+fn true_error(model: &Arc<Model>, basis: &Basis, truth: &SimulationResult, mu: &Parameters) -> TrueError {
+    let run = Rom::new(model, &Arc::new(basis.clone()), None, None).and_then(|r| r.solve(mu));
     match run {
         Ok(rom) => {
             let v = compare(model, truth, &rom, None, basis.n_reduced(), basis.variant.name());
@@ -502,11 +509,11 @@ mod tests {
             n_modes: 4,
             n_elements: 3,
             whole_run_estimates: estimates.clone(),
-            worst_load: 1.0,
+            worst_candidate: 1,
             worst_estimate: estimates.iter().cloned().fold(0.0, f64::max),
             estimates,
             sensitivity,
-            run_load: 1.0,
+            run_candidate: Some(1),
             true_error: 2e-3,
             true_score: 2e-3,
             held_out_effectivity,
@@ -521,7 +528,7 @@ mod tests {
     /// answer moved by 1.6e-1 for a 0.1 % change of the load).
     #[test]
     fn the_stop_line_names_the_cause() {
-        let loads = [0.5, 1.0, 1.5];
+        let loads = CandidateSet::line(&[0.5, 1.0, 1.5]);
         let t = 1e-2;
         let failed = iteration(vec![1e-3, f64::INFINITY, 2e-2], vec![1e-3; 3], 1.5);
         assert!(why_not_converged(t, &[failed], &loads).contains("no estimate could be computed at 1 of 3"));

@@ -15,13 +15,13 @@
 
 use super::config::Pipeline;
 use super::online::load_basis;
-use super::shard::load_list_hash;
+use super::shard::point_list_hash;
 use super::sweep::{read_sweep, write_sweep, Outcome, ScaleResult, Sweep, SweepBasis, STATUS_FAILED, STATUS_OK};
 use crate::error::{Error, Result};
 use crate::io::h5::{read_attr_f64, read_attr_str};
 use crate::limits::Limits;
 use crate::simulate::{Overrides, Settings};
-use crate::solver::parameters::Parameters;
+use crate::solver::parameters::{Parameters, LOAD_SCALE};
 use hdf5::types::VarLenUnicode;
 use ndarray::Array1;
 use std::path::{Path, PathBuf};
@@ -32,7 +32,8 @@ struct Part {
     index: usize,
     count: usize,
     list_hash: String,
-    all: Vec<f64>,
+    /// the whole list of points (of load scales alone, or `/shard/all_points`)
+    all: Vec<Parameters>,
     indices: Vec<usize>,
     status: Vec<u8>,
     message: Vec<String>,
@@ -75,14 +76,45 @@ fn read_part(path: &Path) -> Result<Part> {
     if index == 0 || index > count {
         return Err(bad("shard/index", format!("is {index} of {count}: need 1 ≤ index ≤ count")));
     }
-    let all = g
+    let scales_all = g
         .dataset("all_load_scales")
         .and_then(|d| d.read_1d::<f64>())
         .map_err(|e| bad("shard/all_load_scales", format!("cannot be read: {e}")))?
         .to_vec();
+    // a sweep over named parameters: the points, as /points holds them
+    let (all, names): (Vec<Parameters>, Vec<String>) = match g.dataset("all_points") {
+        Ok(d) => {
+            let a = d.read_2d::<f64>().map_err(|e| bad("shard/all_points", format!("cannot be read: {e}")))?;
+            let names = read_attr_str(&d, "parameters")
+                .map_err(|e| bad("shard/all_points", format!("has no readable attribute `parameters`: {e}")))?;
+            let names: Vec<String> = names.split(',').map(str::to_string).collect();
+            if a.dim() != (scales_all.len(), names.len()) || names.first().map(String::as_str) != Some(LOAD_SCALE) {
+                return Err(bad(
+                    "shard/all_points",
+                    format!(
+                        "is {:?} with parameters {names:?}; expected ({}, d), load_scale first (a damaged file)",
+                        a.dim(),
+                        scales_all.len()
+                    ),
+                ));
+            }
+            let all = a
+                .rows()
+                .into_iter()
+                .map(|row| names.iter().zip(row).fold(Parameters::default(), |mu, (n, &v)| mu.with(n, v)))
+                .collect();
+            (all, names)
+        }
+        Err(_) => (scales_all.iter().map(|&x| Parameters::load_scale(x)).collect(), vec![LOAD_SCALE.to_string()]),
+    };
     let list_hash = s(&g, "load_list_hash")?;
-    if load_list_hash(&all) != list_hash {
-        return Err(bad("shard/load_list_hash", "does not match shard/all_load_scales (a damaged file)".into()));
+    if point_list_hash(&all, &names) != list_hash
+        || all.iter().zip(&scales_all).any(|(mu, x)| mu.scale().to_bits() != x.to_bits())
+    {
+        return Err(bad(
+            "shard/load_list_hash",
+            "does not match shard/all_load_scales and shard/all_points (a damaged file)".into(),
+        ));
     }
     let indices: Vec<usize> = g
         .dataset("indices")
@@ -120,7 +152,7 @@ fn read_part(path: &Path) -> Result<Part> {
         ));
     }
     if indices != (index - 1..all.len()).step_by(count).collect::<Vec<_>>()
-        || indices.iter().zip(scales.iter()).any(|(&i, &x)| all[i].to_bits() != x.to_bits())
+        || indices.iter().zip(scales.iter()).any(|(&i, &x)| all[i].scale().to_bits() != x.to_bits())
     {
         return Err(bad(
             "shard/indices",
@@ -164,13 +196,22 @@ fn read_part(path: &Path) -> Result<Part> {
     })
 }
 
-/// A few load scales for a message: "0.5, 0.53, 0.56 and 13 more".
-fn some(xs: &[f64]) -> String {
-    let shown: Vec<String> = xs.iter().take(4).map(|x| x.to_string()).collect();
-    if xs.len() > 4 {
-        format!("{} and {} more", shown.join(", "), xs.len() - 4)
+/// A few runs for a message: "load scales 0.5, 0.53, 0.56 and 13 more", or for named
+/// parameters "points (load scale 1, push = 0.5); … and 13 more".
+fn some(xs: &[Parameters]) -> String {
+    let named = xs.iter().any(|mu| mu.named().next().is_some());
+    let shown: Vec<String> =
+        xs.iter().take(4).map(|mu| if named { format!("({mu})") } else { mu.scale().to_string() }).collect();
+    let head = if named { "points" } else { "load scales" };
+    let sep = if named { "; " } else { ", " };
+    format!("{head} {}", some_of(&shown, xs.len(), sep))
+}
+
+fn some_of(shown: &[String], n: usize, sep: &str) -> String {
+    if n > 4 {
+        format!("{} and {} more", shown.join(sep), n - 4)
     } else {
-        shown.join(", ")
+        shown.join(sep)
     }
 }
 
@@ -235,12 +276,12 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool, limits: &Limits) -> R
     let mut holder: Vec<Option<usize>> = vec![None; first.count];
     for (j, p) in parts.iter().enumerate() {
         if let Some(other) = holder[p.index - 1] {
-            let loads: Vec<f64> = p.indices.iter().map(|&i| p.all[i]).collect();
+            let loads: Vec<Parameters> = p.indices.iter().map(|&i| p.all[i].clone()).collect();
             return Err(Error::input(
                 &p.path,
                 "shard/index",
                 format!(
-                    "is shard {}/{} again, as is {} (duplicate load scales {}); give each shard once",
+                    "is shard {}/{} again, as is {} (duplicate {}); give each shard once",
                     p.index,
                     p.count,
                     parts[other].path.display(),
@@ -253,26 +294,27 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool, limits: &Limits) -> R
     let all = &first.all;
     let missing: Vec<usize> = (0..first.count).filter(|&k| holder[k].is_none()).collect();
     if !missing.is_empty() && !partial {
-        let loads: Vec<f64> = (0..all.len()).filter(|i| missing.contains(&(i % first.count))).map(|i| all[i]).collect();
+        let loads: Vec<Parameters> =
+            (0..all.len()).filter(|i| missing.contains(&(i % first.count))).map(|i| all[i].clone()).collect();
         let names: Vec<String> = missing.iter().map(|k| format!("{}/{}", k + 1, first.count)).collect();
         return Err(Error::Usage(format!(
-            "merge: shard(s) {} missing: load scales {} not in any part; give their parts, or --partial to merge the rest with these marked not run",
+            "merge: shard(s) {} missing: {} not in any part; give their parts, or --partial to merge the rest with these marked not run",
             names.join(", "),
             some(&loads)
         )));
     }
     if !partial {
         for p in &parts {
-            let not_run: Vec<f64> = (0..p.status.len())
+            let not_run: Vec<Parameters> = (0..p.status.len())
                 .filter(|&j| p.status[j] != STATUS_OK && p.status[j] != STATUS_FAILED)
-                .map(|j| p.all[p.indices[j]])
+                .map(|j| p.all[p.indices[j]].clone())
                 .collect();
             if !not_run.is_empty() {
                 return Err(Error::input(
                     &p.path,
                     "status",
                     format!(
-                        "load scales {} were not run (the shard did not finish); rerun it with --resume, or merge --partial",
+                        "{} were not run (the shard did not finish); rerun it with --resume, or merge --partial",
                         some(&not_run)
                     ),
                 ));
@@ -301,7 +343,7 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool, limits: &Limits) -> R
     let model = &pipeline.model;
     let s = Settings::resolve(model, &Overrides::default())?;
     let mut sweep = Sweep {
-        scales: all.iter().map(|&x| ScaleResult { mu: Parameters::load_scale(x), outcome: Outcome::Pending }).collect(),
+        scales: all.iter().map(|mu| ScaleResult { mu: mu.clone(), outcome: Outcome::Pending }).collect(),
         t: Array1::from_iter((0..=s.n_steps).map(|k| k as f64 * s.dt)),
         probe_names: model.probe_names(),
         n_reduced: stored.as_ref().map_or(0, |b| b.basis.n_reduced()),

@@ -288,7 +288,8 @@ fn build(
         &p.model.fingerprint()[..12]
     );
     // a held-out check run is named as such: its load is not among the basis's
-    let held_out = match trained.held_out_loads().as_slice() {
+    let held_out_loads: Vec<f64> = trained.held_out_points().iter().map(|mu| mu.scale()).collect();
+    let held_out = match held_out_loads.as_slice() {
         [] => String::new(),
         loads => format!(
             " ({}) + {} held-out check at λ = {} (not in the basis)",
@@ -311,7 +312,7 @@ fn build(
         b.n_pod_modes,
         if b.kept.is_empty() { String::new() } else { format!(" + {} joint coordinates", b.kept.len()) },
         trained.n_snapshots,
-        trained.greedy.as_ref().map_or_else(|| p.training_scales(), |g| g.load_scales.clone())
+        trained.greedy.as_ref().map_or_else(|| p.training_scales(), |g| g.runs.iter().map(|mu| mu.scale()).collect())
     );
     let _ = writeln!(
         md,
@@ -457,8 +458,11 @@ pub fn check_report(p: &Pipeline, dir: &Path, strict: bool, method: Option<Estim
         crate::rom::estimator::ErrorMeasure::Displacement => "error_estimate_displacement",
     };
     let (scales, est) = (read("load_scales")?, read(estimates)?);
-    let runs: Vec<(f64, Option<f64>)> =
-        scales.iter().zip(&est).map(|(&x, &e)| (x, if e.is_nan() { None } else { Some(e) })).collect();
+    let runs: Vec<_> = scales
+        .iter()
+        .zip(&est)
+        .map(|(&x, &e)| (crate::solver::parameters::Parameters::load_scale(x), if e.is_nan() { None } else { Some(e) }))
+        .collect();
     warnings.extend(crate::rom::trust::check_runs(trust, rom.estimator().is_some(), &runs, strict)?);
     Ok(warnings)
 }

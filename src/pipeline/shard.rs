@@ -12,10 +12,13 @@
 //!
 //! ```text
 //! /shard/all_load_scales   (N_all)     the whole list, as the sweep was asked for
+//! /shard/all_points        (N_all, d)  a sweep over named parameters: the whole list of
+//!                                      points (attribute `parameters`, as `/points`)
 //! /shard/indices           (n_part)    u64: row j of the part is load all_load_scales[indices[j]]
 //! attributes on /shard: index (K, 1-based), count (N), load_list_hash (SHA-256 hex of the
-//!   list: its length, then each value's IEEE-754 bits, little-endian), pipeline and, for a
-//!   reduced sweep, basis (absolute paths, for `merge`)
+//!   list: its length, then each value's IEEE-754 bits, little-endian; for points the names
+//!   and every point's values too: [`point_list_hash`]), pipeline and, for a reduced sweep,
+//!   basis (absolute paths, for `merge`)
 //! ```
 
 use super::config::Pipeline;
@@ -72,19 +75,41 @@ pub fn load_list_hash(scales: &[f64]) -> String {
     h.finalize().iter().map(|b| format!("{b:02x}")).collect()
 }
 
-/// The loads of `shard` in `all`, or a usage error when it holds none.
-pub fn shard_scales(all: &[f64], shard: Shard) -> Result<(Vec<usize>, Vec<f64>)> {
-    let idx = shard.indices(all.len());
+/// SHA-256 (hex) of a list of points with the parameters `names` (`load_scale` first, as
+/// [`super::sweep::point_names`] gives them): [`load_list_hash`] of their load scales when
+/// they set nothing else (so a part file of a line of loads keeps its hash), else the
+/// count, each name (length, bytes) and each point's values in `names` order (bits,
+/// little-endian).
+pub fn point_list_hash(all: &[Parameters], names: &[String]) -> String {
+    if names.len() <= 1 {
+        return load_list_hash(&all.iter().map(Parameters::scale).collect::<Vec<_>>());
+    }
+    let mut h = Sha256::new();
+    h.update((all.len() as u64).to_le_bytes());
+    for n in names {
+        h.update((n.len() as u64).to_le_bytes());
+        h.update(n.as_bytes());
+    }
+    for mu in all {
+        for n in names {
+            h.update(mu.get(n).unwrap_or(1.0).to_bits().to_le_bytes());
+        }
+    }
+    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// The indices of `shard` in a list of `n` runs (`points`: of named parameters, else of
+/// load scales), or a usage error when it holds none.
+pub fn shard_indices(n: usize, shard: Shard, points: bool) -> Result<Vec<usize>> {
+    let idx = shard.indices(n);
     if idx.is_empty() {
+        let (many, one) = if points { ("points", "point") } else { ("load scales", "load") };
         return Err(Error::Usage(format!(
-            "--shard {shard}: a list of {} load scales has no load for shard {}; use at most {} shards",
-            all.len(),
-            shard.index,
-            all.len()
+            "--shard {shard}: a list of {n} {many} has no {one} for shard {}; use at most {n} shards",
+            shard.index
         )));
     }
-    let scales = idx.iter().map(|&i| all[i]).collect();
-    Ok((idx, scales))
+    Ok(idx)
 }
 
 /// Runs the loads of `shard` by `route` and writes the part file `out` (checkpointed like
@@ -94,20 +119,28 @@ pub fn shard_scales(all: &[f64], shard: Shard) -> Result<(Vec<usize>, Vec<f64>)>
 pub fn sweep_shard(
     p: &Pipeline,
     route: Route,
-    all: &[f64],
+    all: &[Parameters],
     shard: Shard,
     o: SweepOptions,
     f: SweepFile,
 ) -> Result<Sweep> {
     let out = f.out;
-    let (idx, scales) = shard_scales(all, shard)?;
-    let hash = load_list_hash(all);
+    let names = super::sweep::point_names(all.iter());
+    let idx = shard_indices(all.len(), shard, names.len() > 1)?;
+    let hash = point_list_hash(all, &names);
+    let scales: Vec<f64> = all.iter().map(Parameters::scale).collect();
     let pipeline = crate::io::output::resolve(&p.path).display().to_string();
     let basis = route.basis().map(|b| crate::io::output::resolve(b.path).display().to_string());
     let extra = |f: &hdf5::File| -> Result<()> {
         let e = |err: hdf5::Error| Error::hdf5(out, err);
         let g = f.create_group("shard").map_err(e)?;
-        g.new_dataset_builder().with_data(&Array1::from(all.to_vec())).create("all_load_scales").map_err(e)?;
+        g.new_dataset_builder().with_data(&Array1::from(scales.clone())).create("all_load_scales").map_err(e)?;
+        if names.len() > 1 {
+            let table =
+                ndarray::Array2::from_shape_fn((all.len(), names.len()), |(k, j)| all[k].get(&names[j]).unwrap_or(1.0));
+            let d = g.new_dataset_builder().with_data(&table).create("all_points").map_err(e)?;
+            attr_str(&d, "parameters", &names.join(",")).map_err(e)?;
+        }
         g.new_dataset_builder()
             .with_data(&Array1::from_iter(idx.iter().map(|&i| i as u64)))
             .create("indices")
@@ -121,7 +154,7 @@ pub fn sweep_shard(
             None => Ok(()),
         }
     };
-    let points: Vec<Parameters> = scales.iter().map(|&x| Parameters::load_scale(x)).collect();
+    let points: Vec<Parameters> = idx.iter().map(|&i| all[i].clone()).collect();
     sweep_to_file(route, &points, o, SweepFile { extra: &extra, ..f })
 }
 
@@ -168,8 +201,23 @@ mod tests {
         for bad in ["0/4", "5/4", "1/0", "2", "a/4", "1/b"] {
             assert!(bad.parse::<Shard>().is_err(), "{bad}");
         }
-        assert!(shard_scales(&[1.0, 2.0], Shard { index: 3, count: 3 }).is_err());
+        assert!(shard_indices(2, Shard { index: 3, count: 3 }, false).is_err());
         assert_ne!(load_list_hash(&[1.0, 2.0]), load_list_hash(&[2.0, 1.0]));
         assert_ne!(load_list_hash(&[1.0]), load_list_hash(&[1.0, 1.0]));
+    }
+
+    /// A list of load scales alone hashes as it always has (part files written before
+    /// points existed keep merging); points hash their names and values, so a changed
+    /// value or name gives another hash.
+    #[test]
+    fn point_lists_hash_their_names_and_values() {
+        let line = [Parameters::load_scale(0.8), Parameters::load_scale(1.2)];
+        assert_eq!(point_list_hash(&line, &["load_scale".into()]), load_list_hash(&[0.8, 1.2]));
+        let names: Vec<String> = vec!["load_scale".into(), "push".into()];
+        let pts = |x: f64| [Parameters::default().with("push", 0.5), Parameters::default().with("push", x)];
+        let h = point_list_hash(&pts(2.0), &names);
+        assert_eq!(h, point_list_hash(&pts(2.0), &names));
+        assert_ne!(h, point_list_hash(&pts(2.5), &names));
+        assert_ne!(h, point_list_hash(&pts(2.0), &["load_scale".into(), "pull".into()]));
     }
 }

@@ -81,7 +81,9 @@ pub fn write_trained(p: &Pipeline, out: &Path, data: &TrainingData, summary: &Tr
         }
         let space = p.space();
         if !space.is_empty() {
-            crate::io::parameter_space_file::write_parameter_space(f, &space, &p.training_points())
+            // the runs whose snapshots the basis holds: greedy's, or the sampled points
+            let runs = summary.greedy.as_ref().map_or_else(|| p.training_points(), |g| g.runs.clone());
+            crate::io::parameter_space_file::write_parameter_space(f, &space, &runs)
                 .map_err(|e| Error::hdf5(out, e))?;
         }
         Ok(())

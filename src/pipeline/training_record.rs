@@ -1,8 +1,10 @@
 //! The record of a training: what `train` returns (`TrainSummary`) and what the greedy loop did
 //! (`GreedyRecord`, written under `/training` in the basis file).
 
+use super::greedy::CandidateSet;
 use crate::reduction::Trained;
 use crate::rom::estimator::{ErrorMeasure, EstimateMethod, Estimator};
+use crate::solver::parameters::Parameters;
 
 pub struct TrainSummary {
     pub trained: Trained,
@@ -24,7 +26,7 @@ pub struct TrainSummary {
 impl TrainSummary {
     /// The full runs whose snapshots the basis holds.
     pub fn n_training_runs(&self) -> usize {
-        self.greedy.as_ref().map_or(self.n_runs, |g| g.load_scales.len().min(self.n_runs))
+        self.greedy.as_ref().map_or(self.n_runs, |g| g.runs.len().min(self.n_runs))
     }
 
     /// The full runs made only to check the basis (greedy's last run when it converged): not
@@ -33,11 +35,11 @@ impl TrainSummary {
         self.n_runs - self.n_training_runs()
     }
 
-    /// The loads of the held-out runs.
-    pub fn held_out_loads(&self) -> Vec<f64> {
+    /// The points of the held-out runs.
+    pub fn held_out_points(&self) -> Vec<Parameters> {
         let Some(g) = &self.greedy else { return Vec::new() };
-        let runs = g.iterations.iter().map(|i| i.run_load).filter(|x| !x.is_nan());
-        runs.filter(|x| !g.load_scales.contains(x)).collect()
+        let runs = g.iterations.iter().filter_map(|i| i.run_candidate).map(|c| &g.candidates.points[c]);
+        runs.filter(|mu| !g.runs.contains(mu)).cloned().collect()
     }
 
     /// "3 training runs + 1 held-out check" (a held-out run is not in the basis), or "3
@@ -74,11 +76,12 @@ pub struct Iteration {
     pub whole_run_estimates: Vec<f64>,
     /// the reduced model's whole-run sensitivity at every candidate
     pub sensitivity: Vec<f64>,
-    pub worst_load: f64,
+    /// the candidate with the largest score
+    pub worst_candidate: usize,
     pub worst_estimate: f64,
     /// where this iteration ran the full model: the worst candidate without a full run yet
-    /// (NaN when no run was made)
-    pub run_load: f64,
+    /// (`None` when no run was made)
+    pub run_candidate: Option<usize>,
     /// the true rel_error of this iteration's basis at `run_load`, from the full run there
     /// (NaN when no run was made)
     pub true_error: f64,
@@ -95,12 +98,13 @@ pub struct Iteration {
 /// What the greedy loop did: written under `/training` in the basis file.
 #[derive(Clone, Debug)]
 pub struct GreedyRecord {
-    pub range: (f64, f64),
+    /// the load range; `None` for a box (the candidates' space)
+    pub range: Option<(f64, f64)>,
     pub tolerance: f64,
     pub max_runs: usize,
-    pub candidates: Vec<f64>,
-    /// the loads whose snapshots the basis holds, in run order
-    pub load_scales: Vec<f64>,
+    pub candidates: CandidateSet,
+    /// the points whose snapshots the basis holds, in run order
+    pub runs: Vec<Parameters>,
     pub iterations: Vec<Iteration>,
     /// every candidate's estimate ≤ T and the held-out check run within T
     pub converged: bool,
@@ -114,6 +118,16 @@ pub struct GreedyRecord {
 }
 
 impl GreedyRecord {
+    /// The load scales of the runs whose snapshots the basis holds (`/training/load_scales`).
+    pub fn load_scales(&self) -> Vec<f64> {
+        self.runs.iter().map(Parameters::scale).collect()
+    }
+
+    /// The candidates' load scales (`/training/candidates` on a line).
+    pub fn candidate_loads(&self) -> Vec<f64> {
+        self.candidates.loads()
+    }
+
     /// The `mode_rule` attribute of the basis file.
     pub fn mode_rule(&self) -> String {
         match self.iterations.last() {
@@ -136,19 +150,46 @@ pub(super) fn modes_text(block_modes: &[usize]) -> String {
     format!("{} modes", v.join(" + "))
 }
 
-/// Writes `/training` (the basis file's layout: src/io/basis_file.rs).
+/// Writes `/training` (the basis file's layout: src/io/basis_file.rs): on a line the load
+/// range, candidates and runs as load scales; in a box as points (`candidate_points`,
+/// `points`, `worst_point`, `run_point`: one column per parameter, named by the attribute
+/// `parameters`).
 pub fn write_training(f: &hdf5::File, r: &GreedyRecord) -> hdf5::Result<()> {
     use crate::io::h5::{attr_str, attr_u64};
     use ndarray::{arr0, Array1, Array2};
     let g = f.create_group("training")?;
     let col = |get: &dyn Fn(&Iteration) -> f64| Array1::from_iter(r.iterations.iter().map(get));
-    g.new_dataset_builder().with_data(&Array1::from(vec![r.range.0, r.range.1])).create("range")?;
+    let c = &r.candidates;
+    let candidate = |i: Option<usize>| i.map(|i| &c.points[i]);
+    if let Some(range) = r.range {
+        let load = |mu: Option<&Parameters>| mu.map_or(f64::NAN, Parameters::scale);
+        g.new_dataset_builder().with_data(&Array1::from(vec![range.0, range.1])).create("range")?;
+        g.new_dataset_builder()
+            .with_data(&Array1::from_iter(r.runs.iter().map(Parameters::scale)))
+            .create("load_scales")?;
+        g.new_dataset_builder().with_data(&Array1::from(c.loads())).create("candidates")?;
+        g.new_dataset_builder().with_data(&col(&|i| load(candidate(Some(i.worst_candidate))))).create("worst_load")?;
+        g.new_dataset_builder().with_data(&col(&|i| load(candidate(i.run_candidate)))).create("run_load")?;
+    } else {
+        let names: Vec<&str> = c.space.names().collect();
+        let table = |rows: Vec<Option<&Parameters>>| {
+            Array2::from_shape_fn((rows.len(), names.len()), |(i, j)| {
+                rows[i].map_or(f64::NAN, |mu| mu.get(names[j]).unwrap_or(1.0))
+            })
+        };
+        let its = &r.iterations;
+        for (name, rows) in [
+            ("candidate_points", c.points.iter().map(Some).collect::<Vec<_>>()),
+            ("points", r.runs.iter().map(Some).collect()),
+            ("worst_point", its.iter().map(|i| candidate(Some(i.worst_candidate))).collect()),
+            ("run_point", its.iter().map(|i| candidate(i.run_candidate)).collect()),
+        ] {
+            let d = g.new_dataset_builder().with_data(&table(rows)).create(name)?;
+            attr_str(&d, "parameters", &names.join(","))?;
+        }
+    }
     g.new_dataset_builder().with_data(&arr0(r.tolerance)).create("tolerance")?;
-    g.new_dataset_builder().with_data(&Array1::from(r.load_scales.clone())).create("load_scales")?;
-    g.new_dataset_builder().with_data(&Array1::from(r.candidates.clone())).create("candidates")?;
     g.new_dataset_builder().with_data(&col(&|i| i.worst_estimate)).create("worst_estimate")?;
-    g.new_dataset_builder().with_data(&col(&|i| i.worst_load)).create("worst_load")?;
-    g.new_dataset_builder().with_data(&col(&|i| i.run_load)).create("run_load")?;
     g.new_dataset_builder().with_data(&col(&|i| i.true_error)).create("true_error")?;
     g.new_dataset_builder().with_data(&col(&|i| i.energy)).create("energy_tolerance")?;
     g.new_dataset_builder().with_data(&col(&|i| i.hyper_tolerance)).create("hyper_tolerance")?;
@@ -158,7 +199,7 @@ pub fn write_training(f: &hdf5::File, r: &GreedyRecord) -> hdf5::Result<()> {
     g.new_dataset_builder()
         .with_data(&Array1::from_iter(r.iterations.iter().map(|i| i.n_elements as u64)))
         .create("n_elements")?;
-    let (ni, nc) = (r.iterations.len(), r.candidates.len());
+    let (ni, nc) = (r.iterations.len(), c.len());
     let table = |get: &dyn Fn(&Iteration) -> &Vec<f64>| {
         Array2::from_shape_fn((ni, nc), |(i, j)| get(&r.iterations[i]).get(j).copied().unwrap_or(f64::NAN))
     };

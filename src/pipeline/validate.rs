@@ -81,8 +81,12 @@ pub struct Validation {
     pub extrapolated: bool,
     /// `[min, max]` training load scale (null when unknown)
     pub training_range: Option<[f64; 2]>,
-    /// relative difference of full runs at λ and 1.001 λ (null when not measured)
+    /// relative difference of full runs at λ and 1.001 λ (null when not measured); for a
+    /// basis trained over a box, at μ and every parameter of the box times 1.001
     pub sensitivity: Option<f64>,
+    /// the box the basis was trained over (`describe`d; none for a line of load scales)
+    #[serde(skip)]
+    pub training_box: Option<String>,
     /// the reduced model's sensitivity at greedy training's candidates beside the load
     /// ([`crate::rom::trust::LoadSensitivity`]; null for other bases)
     pub sensitivity_near: Option<f64>,
@@ -215,6 +219,7 @@ pub fn compare(
         extrapolated: false,
         training_range: None,
         sensitivity: None,
+        training_box: None,
         sensitivity_near: None,
         amplifying: false,
         rel_error_by_time: rel_error_by_time(&r.q, &full.q).to_vec(),
@@ -279,9 +284,10 @@ impl Validation {
             let mu = self.parameters.iter().fold(Parameters::default(), |mu, (n, &v)| mu.with(n, v));
             self.extrapolated = t.extrapolated(&mu);
             self.training_range = Some([t.range.0, t.range.1]);
-            self.sensitivity_near = t.sensitivity.as_ref().and_then(|s| s.near(self.load_scale));
+            self.training_box = Some(t.space.describe()).filter(|_| !t.space.is_empty());
+            self.sensitivity_near = t.sensitivity.as_ref().and_then(|s| s.near(&mu));
             let in_measure = estimate.map(|e| e.in_measure(t.measure));
-            self.amplifying = t.amplifying_near(self.load_scale, in_measure).is_some();
+            self.amplifying = t.amplifying_near(&mu, in_measure).is_some();
         }
         if estimate.is_some() {
             self.error_estimate_method = rom.and_then(|r| r.method()).map(str::to_string);
@@ -309,9 +315,10 @@ pub fn validate(rom: &Rom, mu: &Parameters, with_dense: bool) -> Result<(Validat
     } else {
         None
     };
-    let nearby = full_model
-        .simulate(&Overrides { mu: Some(mu.scaled_by(1.001)), ..o })
-        .map_err(stage("validate (full run at 1.001 λ)"))?;
+    // a box's basis: every parameter of the box moves (λ alone on a line)
+    let moved = rom.trust().map_or_else(|| mu.scaled_by(1.001), |t| t.space.moved(mu, 1.001));
+    let nearby =
+        full_model.simulate(&Overrides { mu: Some(moved), ..o }).map_err(stage("validate (full run at 1.001 μ)"))?;
     let (run, estimate) = rom.solve_and_estimate(mu, Output::Full, &[]).map_err(stage("validate (reduced run)"))?;
     // the time loops again, interleaved, for the medians that `speedup` compares
     let (mut full_times, mut rom_times) = (vec![full.wall_seconds], vec![run.result.wall_seconds]);
@@ -377,14 +384,19 @@ impl Validation {
             )),
             _ => s.push_str("\n  error_estimate: none (the basis file has no /estimator; train again)"),
         }
-        if let Some([a, b]) = self.training_range {
-            s.push_str(&format!(
-                "\n  training range [{a}, {b}]{}",
-                if self.extrapolated { ": EXTRAPOLATED" } else { "" }
-            ));
+        let out = if self.extrapolated { ": EXTRAPOLATED" } else { "" };
+        match (&self.training_box, self.training_range) {
+            (Some(b), _) => s.push_str(&format!("\n  training box {b}{out}")),
+            (None, Some([a, b])) => s.push_str(&format!("\n  training range [{a}, {b}]{out}")),
+            (None, None) => {}
         }
         if let Some(x) = self.sensitivity {
-            s.push_str(&format!("\n  sensitivity {x:.3e} (full runs at λ and 1.001 λ)"));
+            let runs = if self.training_box.is_some() {
+                "full runs here and with every parameter of the box times 1.001"
+            } else {
+                "full runs at λ and 1.001 λ"
+            };
+            s.push_str(&format!("\n  sensitivity {x:.3e} ({runs})"));
         }
         if let (true, Some(x)) = (self.amplifying, self.sensitivity_near) {
             s.push_str(&format!(

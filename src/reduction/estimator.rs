@@ -9,6 +9,7 @@
 //! How it is built, calibrated and run is `crate::rom::estimator`'s.
 
 use super::basis::Basis;
+use crate::solver::parameter_space::ParameterSpace;
 use crate::solver::parameters::Parameters;
 
 /// Estimates and errors are reported over the instants up to the end of each fifth of the
@@ -65,7 +66,8 @@ pub struct Estimator {
 /// default stays `corrected`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DefectsCalibration {
-    /// the candidate loads, ascending
+    /// the candidate loads, ascending; empty for scattered candidates (a parameter box:
+    /// [`Self::scattered`])
     pub load_scales: Vec<f64>,
     /// `ρ_ji` (loads × 5); NaN where either estimate was not finite and positive
     pub ratios: Vec<ByFifth>,
@@ -73,6 +75,24 @@ pub struct DefectsCalibration {
     pub factors: ByFifth,
     /// the leave-one-out check passed
     pub reliable: bool,
+    /// scattered candidates (a parameter box): where they lie ([`Self::scattered`])
+    pub scattered: Option<Scattered>,
+}
+
+/// Where scattered candidates lie: the box and each candidate in its unit cube, in the
+/// order of [`DefectsCalibration::ratios`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scattered {
+    pub space: ParameterSpace,
+    pub unit: Vec<Vec<f64>>,
+}
+
+impl Scattered {
+    /// The `d + 1` candidates nearest to the unit-cube point `u` (a simplex's worth: on a
+    /// line the two that bracket it), `skip` left out.
+    fn nearest(&self, u: &[f64], skip: Option<usize>) -> Vec<usize> {
+        crate::solver::parameter_space::nearest(&self.unit, u, self.space.ranges.len() + 1, skip)
+    }
 }
 
 /// The share of interior candidates whose left-out ratio must be predicted well enough
@@ -90,11 +110,51 @@ impl DefectsCalibration {
             }
         }
         let reliable = leave_one_out(&ratios);
-        Some(DefectsCalibration { load_scales, ratios, factors, reliable })
+        Some(DefectsCalibration { load_scales, ratios, factors, reliable, scattered: None })
+    }
+
+    /// From the ratios at scattered candidates (points `unit` of the box `space`'s unit
+    /// cube, no order to interpolate along): a point reads, fifth by fifth, the largest
+    /// ratio of its `d + 1` nearest candidates (on a line: the two that bracket it, the
+    /// larger of the two where [`Self::new`] interpolates), and the leave-one-out check asks
+    /// that this reading from the *other* candidates reach `ρ_ji / DEFAULT_FACTOR` at ≥
+    /// [`DEFECTS_RELIABLE_SHARE`] of the candidates, in every fifth. `load_scales` is
+    /// empty. `None` as [`Self::new`].
+    pub fn scattered(space: ParameterSpace, unit: Vec<Vec<f64>>, ratios: Vec<ByFifth>) -> Option<Self> {
+        let mut c = Self::new(Vec::new(), ratios)?;
+        let s = Scattered { space, unit };
+        c.reliable = c.ratios.len() >= 3
+            && (0..FIFTHS).all(|i| {
+                let n = c.ratios.len();
+                let passed = (0..n)
+                    .filter(|&j| {
+                        let own = c.ratios[j][i];
+                        usable(own) && c.largest(&s.nearest(&s.unit[j], Some(j)), i) >= own / DEFAULT_FACTOR
+                    })
+                    .count();
+                passed as f64 >= DEFECTS_RELIABLE_SHARE * n as f64
+            });
+        c.scattered = Some(s);
+        Some(c)
+    }
+
+    /// The largest usable ratio of fifth `i` among the candidates `js` (the largest of all
+    /// when none is usable).
+    fn largest(&self, js: &[usize], i: usize) -> f64 {
+        let r = js.iter().map(|&j| self.ratios[j][i]).filter(|x| usable(*x)).fold(f64::NAN, f64::max);
+        if r.is_nan() {
+            self.factors[i]
+        } else {
+            r
+        }
     }
 
     /// `f_i(λ)` at the parameters `mu` (the type's documentation).
     pub fn factors_at(&self, mu: &Parameters) -> ByFifth {
+        if let Some(s) = &self.scattered {
+            let near = s.nearest(&s.space.unit_of(mu), None);
+            return std::array::from_fn(|i| self.largest(&near, i));
+        }
         let load_scale = mu.scale();
         let l = &self.load_scales;
         let j = l.partition_point(|&x| x <= load_scale);
@@ -323,5 +383,31 @@ mod tests {
         spike[5] = r(2.0 * 0.15);
         assert!(!DefectsCalibration::new(loads(11), spike).unwrap().reliable);
         assert!(!DefectsCalibration::new(loads(2), smooth[..2].to_vec()).unwrap().reliable);
+    }
+
+    /// Scattered candidates (a box, here a line of the unit cube to keep the numbers
+    /// plain): a point reads the largest ratio of its d + 1 = 2 nearest candidates; the
+    /// check passes while that reading from the others reaches own / DEFAULT_FACTOR (1.5)
+    /// at 90 % of the candidates: smooth ratios 0.10 … 0.19 pass; spikes of 0.5 at 2 and 6
+    /// fail (each is read from neighbours of 0.11–0.17, far below 0.5/1.5: 8 of 10 pass).
+    #[test]
+    fn scattered_ratios_read_their_nearest() {
+        use crate::solver::parameter_space::{ParameterRange, ParameterSpace, Spacing};
+        let r = |a: f64| [a; 5];
+        let space = ParameterSpace {
+            ranges: vec![ParameterRange { name: "p".into(), lower: 0.0, upper: 9.0, spacing: Spacing::Linear }],
+        };
+        let unit: Vec<Vec<f64>> = (0..10).map(|j| vec![j as f64 / 9.0]).collect();
+        let calm: Vec<_> = (0..10).map(|j| r(0.1 + 0.01 * j as f64)).collect();
+        let c = DefectsCalibration::scattered(space.clone(), unit.clone(), calm.clone()).unwrap();
+        assert!(c.reliable && c.load_scales.is_empty());
+        // p = 3.4 lies between the candidates 3 and 4: the larger of their ratios, 0.14
+        assert_eq!(c.factors_at(&Parameters::default().with("p", 3.4)), r(0.14));
+        // beyond the box: its nearest two, 8 and 9
+        assert_eq!(c.factors_at(&Parameters::default().with("p", 12.0)), r(0.19));
+        let mut spike = calm;
+        spike[2] = r(0.5);
+        spike[6] = r(0.5);
+        assert!(!DefectsCalibration::scattered(space, unit, spike).unwrap().reliable);
     }
 }

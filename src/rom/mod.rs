@@ -110,8 +110,12 @@ impl Rom {
             Some(t) => (Some(t), o.tolerance_measure.unwrap_or(trained)),
             None => (read_training_tolerance(path)?, trained),
         };
-        let sensitivity = read_training_sensitivity(path)?.map(|(c, s)| trust::LoadSensitivity::new(c, s));
         let space = crate::io::parameter_space_file::read_parameter_space(path)?.unwrap_or_default();
+        let sensitivity = match read_training_sensitivity(path)? {
+            Some((c, s)) => Some(trust::LoadSensitivity::new(c, s)),
+            None => crate::io::estimator_file::read_training_box_sensitivity(path, &space)?
+                .map(|(unit, s)| trust::LoadSensitivity::in_box(space.clone(), unit, s)),
+        };
         // a box that holds λ gives its range; else the training loads' [min, max]
         let range = match space.range(crate::solver::parameters::LOAD_SCALE) {
             Some(r) => (r.lower, r.upper),
@@ -186,7 +190,7 @@ impl Rom {
     /// greedy training measured it at the candidates beside it ([`trust::LoadSensitivity`]);
     /// `None` for bases without that record.
     pub fn sensitivity_near(&self, mu: &Parameters) -> Option<f64> {
-        self.trust.as_ref()?.sensitivity.as_ref()?.near(mu.scale())
+        self.trust.as_ref()?.sensitivity.as_ref()?.near(mu)
     }
 
     /// The reduced run at `mu`, reconstructed in full coordinates.

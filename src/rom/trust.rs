@@ -51,12 +51,12 @@ impl Trust {
         self.space.outside_named(mu)
     }
 
-    /// The sensitivity near load scale `x` when the model amplifies changes of the load
+    /// The sensitivity near `mu` when the model amplifies changes of the load
     /// there beyond what `estimate` (in the trust's measure; `None`: no estimate) can see:
     /// above the tolerance, above [`AMPLIFYING`]` · δ` and above the estimate
     /// ([`LoadSensitivity`]). `None` otherwise, or without a tolerance or the training record.
-    pub fn amplifying_near(&self, x: f64, estimate: Option<f64>) -> Option<f64> {
-        let (tol, s) = (self.tolerance?, self.sensitivity.as_ref()?.near(x)?);
+    pub fn amplifying_near(&self, mu: &Parameters, estimate: Option<f64>) -> Option<f64> {
+        let (tol, s) = (self.tolerance?, self.sensitivity.as_ref()?.near(mu)?);
         let amplifying = s > tol.max(AMPLIFYING * SENSITIVITY_STEP);
         (amplifying && estimate.is_none_or(|e| !(e >= s))).then_some(s)
     }
@@ -87,22 +87,36 @@ pub const AMPLIFYING: f64 = 10.0;
 /// above the tolerance, which no estimate that follows the reduced trajectory sees (it
 /// compares two trajectories of the same amplifying dynamics). Between candidates the
 /// larger neighbour counts: the sensitivity jumps with the dynamics, it does not
-/// interpolate.
+/// interpolate. In a box of parameters (every parameter of the box moved by δ) the
+/// candidates are points, and the largest of the d + 1 nearest counts.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LoadSensitivity {
     candidates: Vec<f64>,
     whole_run: Vec<f64>,
+    /// a box's candidates: the box and each candidate in its unit cube
+    points: Option<(ParameterSpace, Vec<Vec<f64>>)>,
 }
 
 impl LoadSensitivity {
     /// `candidates` increasing, one sensitivity each (NaN where it was not measured).
     pub fn new(candidates: Vec<f64>, whole_run: Vec<f64>) -> Self {
-        LoadSensitivity { candidates, whole_run }
+        LoadSensitivity { candidates, whole_run, points: None }
     }
 
-    /// The larger sensitivity of the candidates beside `x` (the candidate itself when `x` is
-    /// one, the end candidate outside their range); `None` when neither was measured.
-    pub fn near(&self, x: f64) -> Option<f64> {
+    /// Candidates at the points `unit` of the box `space`'s unit cube, one sensitivity each.
+    pub fn in_box(space: ParameterSpace, unit: Vec<Vec<f64>>, whole_run: Vec<f64>) -> Self {
+        LoadSensitivity { candidates: Vec::new(), whole_run, points: Some((space, unit)) }
+    }
+
+    /// The larger sensitivity of the candidates beside `mu` (the candidate itself when `mu` is
+    /// one, the end candidate outside their range; in a box the largest of the d + 1
+    /// nearest); `None` when none was measured.
+    pub fn near(&self, mu: &Parameters) -> Option<f64> {
+        if let Some((space, unit)) = &self.points {
+            let near = crate::solver::parameter_space::nearest(unit, &space.unit_of(mu), space.ranges.len() + 1, None);
+            return near.iter().map(|&i| self.whole_run[i]).filter(|s| s.is_finite()).reduce(f64::max);
+        }
+        let x = mu.scale();
         let c = &self.candidates;
         if c.is_empty() || !x.is_finite() {
             return None;
@@ -161,7 +175,7 @@ pub fn write_run_attributes(
     mu: &Parameters,
 ) -> hdf5::Result<()> {
     let extrapolated = trust.extrapolated(mu);
-    let sensitivity_near = trust.sensitivity.as_ref().and_then(|s| s.near(mu.scale()));
+    let sensitivity_near = trust.sensitivity.as_ref().and_then(|s| s.near(mu));
     use crate::io::h5::{attr_f64, attr_u64};
     use crate::reduction::estimator::FIFTHS;
     attr_f64(f, "error_estimate", e.map_or(f64::NAN, |e| e.error_estimate))?;
@@ -196,13 +210,24 @@ fn short(x: f64) -> String {
 }
 
 /// The loads a warning is about, of `of` runs: "load scale X" for a single run, else
-/// "K of N load scales" and the list, after `sep`.
-fn which(named: &[String], of: usize, sep: (&str, &str)) -> String {
+/// "K of N load scales" and the list, after `sep` ("point", "points" in a box).
+fn which(named: &[String], of: usize, sep: (&str, &str), in_box: bool) -> String {
+    let (one, many) = if in_box { ("point", "points") } else { ("load scale", "load scales") };
     if of == 1 {
-        format!("load scale {}", named[0])
+        format!("{one} {}", named[0])
     } else {
-        format!("{} of {of} load scales{}{}{}", named.len(), sep.0, few(named), sep.1)
+        format!("{} of {of} {many}{}{}{}", named.len(), sep.0, few(named), sep.1)
     }
+}
+
+/// A run's parameters in a list of a message: its load scale ([`short`]), or in a box the
+/// box's parameters, `(g = 1.1, push = 0.3)`.
+fn label(trust: &Trust, mu: &Parameters) -> String {
+    if trust.space.is_empty() {
+        return short(mu.scale());
+    }
+    let one = |n: &str| format!("{n} = {}", short(mu.get(n).unwrap_or(1.0)));
+    format!("({})", trust.space.names().map(one).collect::<Vec<_>>().join(", "))
 }
 
 /// At most five entries of a list for a one-line message, then "…".
@@ -217,21 +242,23 @@ fn few(v: &[String]) -> String {
 /// The warnings about finished runs, one line each (without the `warning: ` prefix): the
 /// load scales outside the training range, a basis without an estimator, load scales where
 /// the model is sensitive beyond the tolerance and the estimate below that sensitivity
-/// ([`LoadSensitivity`]), and estimates above the tolerance; `runs` are `(load scale, the estimate in the trust's measure)`
+/// ([`LoadSensitivity`]), and estimates above the tolerance; `runs` are `(parameters, the estimate in the trust's measure)`
 /// ([`Estimate::in_measure`]) and `has_estimator` says whether the basis has one. With `strict`, an estimate above the tolerance (or none at
 /// all when a tolerance is set) is an [`Error::Strict`] instead, for after the output is
 /// written.
 pub fn check_runs(
     trust: &Trust,
     has_estimator: bool,
-    runs: &[(f64, Option<f64>)],
+    runs: &[(Parameters, Option<f64>)],
     strict: bool,
 ) -> Result<Vec<String>> {
     let mut warnings = Vec::new();
     let (a, b) = trust.range;
-    let out: Vec<String> = runs.iter().filter(|r| is_extrapolated(trust.range, r.0)).map(|r| short(r.0)).collect();
+    // λ outside its range (a box's other parameters are the caller's to name)
+    let out: Vec<String> =
+        runs.iter().filter(|r| is_extrapolated(trust.range, r.0.scale())).map(|r| short(r.0.scale())).collect();
     if !out.is_empty() {
-        let what = which(&out, runs.len(), (" (", ")"));
+        let what = which(&out, runs.len(), (" (", ")"), false);
         warnings.push(format!(
             "{what} outside the basis's training range [{a}, {b}]: extrapolated, the reduced model was never trained there"
         ));
@@ -239,10 +266,10 @@ pub fn check_runs(
     if let Some(tol) = trust.tolerance {
         let sensitive: Vec<String> = runs
             .iter()
-            .filter_map(|r| trust.amplifying_near(r.0, r.1).map(|s| format!("{} ({s:.1e})", short(r.0))))
+            .filter_map(|r| trust.amplifying_near(&r.0, r.1).map(|s| format!("{} ({s:.1e})", label(trust, &r.0))))
             .collect();
         if !sensitive.is_empty() {
-            let what = which(&sensitive, runs.len(), (": ", ""));
+            let what = which(&sensitive, runs.len(), (": ", ""), !trust.space.is_empty());
             warnings.push(format!(
                 "the model amplifies changes of the load at {what}: near there a 0.1 % change of the load moved \
                  the reduced answer by more than the tolerance {tol:e} and more than 1 % over the run (training's \
@@ -265,15 +292,18 @@ pub fn check_runs(
     let over: Vec<String> = runs
         .iter()
         .filter(|r| r.1.is_none_or(|e| !(e <= tol)))
-        .map(|r| match r.1 {
-            Some(e) => format!("{:.4} ({e:.2e})", r.0),
-            None => format!("{:.4} (no estimate)", r.0),
+        .map(|r| {
+            let at = if trust.space.is_empty() { format!("{:.4}", r.0.scale()) } else { label(trust, &r.0) };
+            match r.1 {
+                Some(e) => format!("{at} ({e:.2e})"),
+                None => format!("{at} (no estimate)"),
+            }
         })
         .collect();
     if over.is_empty() {
         return Ok(warnings);
     }
-    let what = which(&over, runs.len(), (": ", ""));
+    let what = which(&over, runs.len(), (": ", ""), !trust.space.is_empty());
     let kind = match trust.measure {
         ErrorMeasure::Relative => "error estimate",
         ErrorMeasure::Displacement => "displacement error estimate",
@@ -289,6 +319,10 @@ pub fn check_runs(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn l(x: f64) -> Parameters {
+        Parameters::load_scale(x)
+    }
 
     /// The training range's ends are inside (they are training loads), anything beyond by
     /// more than round-off is outside.
@@ -310,15 +344,15 @@ mod tests {
             sensitivity: None,
             space: ParameterSpace::default(),
         };
-        let w = check_runs(&t, true, &[(1.7, Some(1e-4)), (1.0, Some(2e-3))], false).unwrap();
+        let w = check_runs(&t, true, &[(l(1.7), Some(1e-4)), (l(1.0), Some(2e-3))], false).unwrap();
         assert_eq!(w.len(), 2, "{w:?}");
         assert!(w[0].contains("1 of 2 load scales (1.7)") && w[1].contains("above the tolerance 1e-3"), "{w:?}");
         let d = Trust { measure: ErrorMeasure::Displacement, ..t.clone() };
-        let w = check_runs(&d, true, &[(1.0, Some(2e-3))], false).unwrap();
+        let w = check_runs(&d, true, &[(l(1.0), Some(2e-3))], false).unwrap();
         assert!(w.len() == 1 && w[0].starts_with("displacement error estimate above the tolerance 1e-3"), "{w:?}");
-        assert!(matches!(check_runs(&t, true, &[(1.0, Some(2e-3))], true), Err(Error::Strict(_))));
-        assert!(check_runs(&t, true, &[(1.0, Some(1e-4))], true).unwrap().is_empty());
-        let none = check_runs(&Trust::range((0.5, 1.5)), false, &[(1.0, None)], false).unwrap();
+        assert!(matches!(check_runs(&t, true, &[(l(1.0), Some(2e-3))], true), Err(Error::Strict(_))));
+        assert!(check_runs(&t, true, &[(l(1.0), Some(1e-4))], true).unwrap().is_empty());
+        let none = check_runs(&Trust::range((0.5, 1.5)), false, &[(l(1.0), None)], false).unwrap();
         assert!(none.len() == 1 && none[0].contains("no error estimator"), "{none:?}");
     }
 }
@@ -327,19 +361,34 @@ mod tests {
 mod sensitivity_tests {
     use super::*;
 
+    fn l(x: f64) -> Parameters {
+        Parameters::load_scale(x)
+    }
+
     /// Between two candidates the larger neighbour counts; at a candidate, its own value;
     /// outside, the end one; unmeasured (NaN) neighbours are left out.
     #[test]
     fn the_sensitivity_near_a_load_is_its_larger_neighbour() {
         let s = LoadSensitivity::new(vec![0.5, 1.0, 1.5], vec![1e-3, 3e-2, f64::NAN]);
-        assert_eq!(s.near(0.75), Some(3e-2));
-        assert_eq!(s.near(0.5), Some(1e-3));
-        assert_eq!(s.near(1.0), Some(3e-2));
-        assert_eq!(s.near(0.1), Some(1e-3));
-        assert_eq!(s.near(1.25), Some(3e-2));
-        assert_eq!(s.near(1.5), None);
-        assert_eq!(s.near(9.0), None);
-        assert_eq!(LoadSensitivity::new(vec![], vec![]).near(1.0), None);
+        assert_eq!(s.near(&l(0.75)), Some(3e-2));
+        assert_eq!(s.near(&l(0.5)), Some(1e-3));
+        assert_eq!(s.near(&l(1.0)), Some(3e-2));
+        assert_eq!(s.near(&l(0.1)), Some(1e-3));
+        assert_eq!(s.near(&l(1.25)), Some(3e-2));
+        assert_eq!(s.near(&l(1.5)), None);
+        assert_eq!(s.near(&l(9.0)), None);
+        assert_eq!(LoadSensitivity::new(vec![], vec![]).near(&l(1.0)), None);
+        // in a box (here one parameter, p over [0, 2]) the largest of the d + 1 = 2 nearest
+        // candidates: p = 0.5 lies between 0 and 1; p = 1.8 beside 2 (unmeasured) and 1
+        use crate::solver::parameter_space::{ParameterRange, ParameterSpace, Spacing};
+        let space = ParameterSpace {
+            ranges: vec![ParameterRange { name: "p".into(), lower: 0.0, upper: 2.0, spacing: Spacing::Linear }],
+        };
+        let b = LoadSensitivity::in_box(space, vec![vec![0.0], vec![0.5], vec![1.0]], vec![1e-3, 3e-2, f64::NAN]);
+        let p = |x: f64| Parameters::default().with("p", x);
+        assert_eq!(b.near(&p(0.5)), Some(3e-2));
+        assert_eq!(b.near(&p(0.1)), Some(3e-2));
+        assert_eq!(b.near(&p(1.8)), Some(3e-2));
     }
 
     /// A load whose neighbouring sensitivity is above the tolerance, ten times δ and the estimate
@@ -355,15 +404,15 @@ mod sensitivity_tests {
             sensitivity: Some(LoadSensitivity::new(vec![0.5, 1.0, 1.5], vec![1e-3, 3e-2, 1e-3])),
             space: ParameterSpace::default(),
         };
-        let w = check_runs(&t, true, &[(1.2, Some(1e-4))], false).unwrap();
+        let w = check_runs(&t, true, &[(l(1.2), Some(1e-4))], false).unwrap();
         assert_eq!(w.len(), 1, "{w:?}");
         assert!(w[0].contains("amplifies changes of the load at load scale 1.2 (3.0e-2)"), "{}", w[0]);
         // below the first candidate only its own, calm value counts
-        assert!(check_runs(&t, true, &[(0.4, Some(1e-4))], false).unwrap().iter().all(|w| !w.contains("amplifies")));
+        assert!(check_runs(&t, true, &[(l(0.4), Some(1e-4))], false).unwrap().iter().all(|w| !w.contains("amplifies")));
         // an estimate already as large as the sensitivity (but within T) covers it
         let t2 = Trust { tolerance: Some(5e-2), ..t.clone() };
-        assert!(check_runs(&t2, true, &[(1.2, Some(1e-4))], false).unwrap().is_empty(), "s below T: calm enough");
-        let w = check_runs(&t, true, &[(1.2, Some(4e-2)), (0.7, None), (0.3, Some(1e-4))], false).unwrap();
+        assert!(check_runs(&t2, true, &[(l(1.2), Some(1e-4))], false).unwrap().is_empty(), "s below T: calm enough");
+        let w = check_runs(&t, true, &[(l(1.2), Some(4e-2)), (l(0.7), None), (l(0.3), Some(1e-4))], false).unwrap();
         let sens: Vec<_> = w.iter().filter(|w| w.contains("amplifies")).collect();
         assert_eq!(sens.len(), 1);
         assert!(sens[0].contains("1 of 3 load scales: 0.7 (3.0e-2)"), "{}", sens[0]);
@@ -374,8 +423,8 @@ mod sensitivity_tests {
             sensitivity: Some(LoadSensitivity::new(vec![0.5, 1.5], vec![5e-3, 5e-3])),
             ..t.clone()
         };
-        assert!(check_runs(&calm, true, &[(1.2, Some(1e-4))], false).unwrap().is_empty());
+        assert!(check_runs(&calm, true, &[(l(1.2), Some(1e-4))], false).unwrap().is_empty());
         // not an error under --strict: the estimates themselves are within the tolerance
-        assert!(check_runs(&t, true, &[(1.2, Some(1e-4))], true).is_ok());
+        assert!(check_runs(&t, true, &[(l(1.2), Some(1e-4))], true).is_ok());
     }
 }

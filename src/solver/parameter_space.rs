@@ -69,6 +69,15 @@ impl ParameterRange {
         }
     }
 
+    /// The inverse of [`Self::at`]: where `x` lies in the range's unit interval (outside
+    /// [0, 1] for a value outside the range).
+    pub fn unit(&self, x: f64) -> f64 {
+        match self.spacing {
+            Spacing::Linear => (x - self.lower) / (self.upper - self.lower),
+            Spacing::Log => (x / self.lower).ln() / (self.upper / self.lower).ln(),
+        }
+    }
+
     /// Whether `x` lies outside the range by more than round-off (1e-9 of the larger end).
     pub fn excludes(&self, x: f64) -> bool {
         let slack = 1e-9 * self.lower.abs().max(self.upper.abs()).max(1e-300);
@@ -92,6 +101,16 @@ pub enum Sampling {
 /// The most Sobol points one sample holds (`sobol_burley`'s sequence length, 2¹⁶).
 pub const MAX_SOBOL_POINTS: usize = 1 << 16;
 
+/// The `k` points of `points` (unit-cube coordinates) nearest to `u` (Euclidean distance),
+/// nearest first, `skip` left out: what a point of a box reads from the candidates around it.
+pub fn nearest(points: &[Vec<f64>], u: &[f64], k: usize, skip: Option<usize>) -> Vec<usize> {
+    let d2 = |v: &[f64]| u.iter().zip(v).map(|(a, b)| (a - b) * (a - b)).sum::<f64>();
+    let mut order: Vec<usize> = (0..points.len()).filter(|&j| Some(j) != skip).collect();
+    order.sort_by(|&a, &b| d2(&points[a]).total_cmp(&d2(&points[b])));
+    order.truncate(k);
+    order
+}
+
 /// The box of a pipeline's `[parameters]`, parameters in name order.
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct ParameterSpace {
@@ -113,8 +132,20 @@ impl ParameterSpace {
         self.ranges.iter().zip(u).fold(Parameters::default(), |mu, (r, &x)| mu.with(&r.name, r.at(x)))
     }
 
+    /// Where `mu` lies in the unit cube ([`ParameterRange::unit`]; a parameter `mu` does not
+    /// set counts as 1).
+    pub fn unit_of(&self, mu: &Parameters) -> Vec<f64> {
+        self.ranges.iter().map(|r| r.unit(mu.get(&r.name).unwrap_or(1.0))).collect()
+    }
+
     /// `n` points of the box drawn by `sampling` from `seed`.
     pub fn sample(&self, n: usize, sampling: Sampling, seed: u64) -> Vec<Parameters> {
+        self.sample_unit(n, sampling, seed).iter().map(|u| self.at(u)).collect()
+    }
+
+    /// [`Self::sample`]'s points in the unit cube (one coordinate per range, in `[0, 1)`),
+    /// where parameters of different units weigh alike.
+    pub fn sample_unit(&self, n: usize, sampling: Sampling, seed: u64) -> Vec<Vec<f64>> {
         let d = self.ranges.len();
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
         // uniform in [0, 1) from 53 random bits
@@ -140,7 +171,7 @@ impl ParameterSpace {
                 cube
             }
         };
-        cube.iter().map(|u| self.at(u)).collect()
+        cube
     }
 
     /// The parameters of `mu` outside what a basis trained on this box covers, one line
@@ -179,6 +210,32 @@ impl ParameterSpace {
         out
     }
 
+    /// The neighbouring point of a sensitivity check: every parameter of the box times
+    /// `factor` (λ alone for an empty box, as a line of load scales moves it).
+    pub fn moved(&self, mu: &Parameters, factor: f64) -> Parameters {
+        if self.is_empty() {
+            return mu.scaled_by(factor);
+        }
+        self.names().fold(mu.clone(), |m, n| {
+            let x = mu.get(n).unwrap_or(1.0);
+            m.with(n, x * factor)
+        })
+    }
+
+    /// `drive ∈ [0.5, 1.5], E ∈ [1e8, 4e8] (log)`: the box as messages name it.
+    pub fn describe(&self) -> String {
+        let one = |r: &ParameterRange| {
+            format!(
+                "{} ∈ [{}, {}]{}",
+                r.name,
+                show_number(r.lower),
+                show_number(r.upper),
+                if r.spacing == Spacing::Log { " (log)" } else { "" }
+            )
+        };
+        self.ranges.iter().map(one).collect::<Vec<_>>().join(", ")
+    }
+
     /// The range of the parameter `name`, if the box holds it.
     pub fn range(&self, name: &str) -> Option<&ParameterRange> {
         self.ranges.iter().find(|r| r.name == name)
@@ -209,6 +266,11 @@ mod tests {
         assert_eq!(s.at(&[0.0, 0.0]).get("stiff"), Some(1e8));
         assert_eq!(s.at(&[1.0, 0.0]).get("drive"), Some(1.5));
         assert_eq!(mid.scale(), 1.0, "λ stays 1 when the box does not hold it");
+        // and back: unit_of inverts at (to round-off), also beyond the box
+        for u in [[0.0, 0.0], [0.25, 0.75], [1.0, 1.0], [1.5, -0.5]] {
+            let back = s.unit_of(&s.at(&u));
+            assert!(back.iter().zip(u).all(|(a, b)| (a - b).abs() < 1e-12), "{u:?} → {back:?}");
+        }
     }
 
     #[test]

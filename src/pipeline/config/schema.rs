@@ -97,37 +97,64 @@ fn default_snapshots() -> SnapshotKind {
 
 /// `[train] greedy = { range = [A, B], tolerance = T, max_runs = K, candidates = N,
 /// measure = "relative" }`: full runs where the error estimate over N evenly spaced loads
-/// of [A, B] is worst, until every estimate is ≤ T or K full runs were made.
+/// of [A, B] is worst, until every estimate is ≤ T or K full runs were made. With a
+/// `[parameters]` box the range is the box's (no `range`), and the candidates are N points
+/// drawn from the box by `sampling` from `seed` (default N: 32 per parameter).
 #[derive(Clone, Debug, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct GreedySpec {
+    /// `[A, B]` of the load scale; empty with a `[parameters]` box
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub range: Vec<f64>,
     pub tolerance: f64,
     pub max_runs: usize,
-    #[serde(default = "default_candidates")]
-    pub candidates: usize,
+    /// the candidates' count; `None`: 33 on a line (hashed as 33, as before the key was
+    /// optional), 32 per parameter in a box
+    #[serde(default, serialize_with = "candidates_as_hashed")]
+    pub candidates: Option<usize>,
     /// the error `tolerance` is on: "relative" (rel_error, the default) or "displacement"
     /// (displacement_error); left out of the settings hash when relative, so that a basis
     /// trained before the key existed is not stale
     #[serde(default, skip_serializing_if = "ErrorMeasure::is_relative")]
     pub measure: ErrorMeasure,
+    /// how a box's candidates are drawn (a box only)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sampling: Option<Sampling>,
+    /// the seed of a box's candidates (a box only; default 1)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
 }
 
-fn default_candidates() -> usize {
-    33
+/// The candidates on a line of loads when `candidates` is not given.
+pub const DEFAULT_LINE_CANDIDATES: usize = 33;
+/// A box's candidates per parameter when `candidates` is not given.
+pub const DEFAULT_BOX_CANDIDATES_PER_PARAMETER: usize = 32;
+
+fn candidates_as_hashed<S: serde::Serializer>(c: &Option<usize>, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_u64(c.unwrap_or(DEFAULT_LINE_CANDIDATES) as u64)
 }
 
 impl GreedySpec {
-    /// `Err((field, problem))` with the field under `train.greedy`.
-    pub fn validate(&self) -> std::result::Result<(), (String, String)> {
+    /// `Err((field, problem))` with the field under `train.greedy`; `in_box`: the pipeline
+    /// has a `[parameters]` box (which gives the range).
+    pub fn validate(&self, in_box: bool) -> std::result::Result<(), (String, String)> {
         let bad = |f: &str, p: String| Err((format!("train.greedy.{f}"), p));
-        match self.range[..] {
-            [a, b] if !(a.is_finite() && b.is_finite()) => {
+        match (in_box, &self.range[..]) {
+            (true, []) => {}
+            (true, _) => return bad("range", "is given, but the pipeline has a [parameters] box, which is the range of greedy training: leave `range` out (a box holding the load scale says so with `load_scale = [A, B]`)".into()),
+            (false, [a, b]) if !(a.is_finite() && b.is_finite()) => {
                 return bad("range", format!("[{a}, {b}] must be two finite numbers"))
             }
-            [a, b] if a >= b => return bad("range", format!("[{a}, {b}]: the first end must be less than the second")),
-            [_, _] => {}
-            _ => return bad("range", format!("has {} entries; it must be [A, B] with A < B", self.range.len())),
+            (false, [a, b]) if a >= b => return bad("range", format!("[{a}, {b}]: the first end must be less than the second")),
+            (false, [_, _]) => {}
+            (false, []) => return bad("range", "is missing: give `range = [A, B]` (the load scales to train over), or a [parameters] box".into()),
+            (false, _) => return bad("range", format!("has {} entries; it must be [A, B] with A < B", self.range.len())),
+        }
+        if !in_box && (self.sampling.is_some() || self.seed.is_some()) {
+            return bad(
+                if self.sampling.is_some() { "sampling" } else { "seed" },
+                "draws a box's candidates, but the pipeline has no [parameters] box (on a line the candidates are evenly spaced)".into(),
+            );
         }
         if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
             return bad(
@@ -138,8 +165,18 @@ impl GreedySpec {
         if self.max_runs == 0 {
             return bad("max_runs", "is 0; at least one full run is needed".into());
         }
-        if self.candidates < 2 {
-            return bad("candidates", format!("is {}; at least 2 (the range ends) are needed", self.candidates));
+        match self.candidates {
+            Some(n) if n < 2 => return bad("candidates", format!("is {n}; at least 2 (the range ends) are needed")),
+            Some(n) if n > crate::solver::parameter_space::MAX_SOBOL_POINTS => {
+                return bad(
+                    "candidates",
+                    format!("is {n}; at most {}", crate::solver::parameter_space::MAX_SOBOL_POINTS),
+                )
+            }
+            _ => {}
+        }
+        if self.sampling.unwrap_or_default() == Sampling::Sobol && self.seed.is_some_and(|s| s > u64::from(u32::MAX)) {
+            return bad("seed", format!("is {}; a Sobol seed lies in 0..={}", self.seed.unwrap_or(0), u32::MAX));
         }
         Ok(())
     }
@@ -152,7 +189,7 @@ impl GreedySpec {
     /// The N evenly spaced candidate loads `A + (B − A) i/(N − 1)`.
     pub fn candidate_loads(&self) -> Vec<f64> {
         let (a, b) = self.range();
-        let n = self.candidates;
+        let n = self.candidates.unwrap_or(DEFAULT_LINE_CANDIDATES);
         // rounded to 12 significant digits: 0.7 + 0.5 · 19/20 prints as 1.175, not 1.1749999999999998
         let round = |x: f64| {
             if x == 0.0 {

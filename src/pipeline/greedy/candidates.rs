@@ -2,6 +2,7 @@
 //! model's sensitivity by fifth of the run (reduced runs in parallel), and the score of a
 //! candidate that the loop holds to the tolerance (the greedy module documentation).
 
+use super::candidate_set::CandidateSet;
 use crate::error::Result;
 use crate::model::Model;
 use crate::reduction::Basis;
@@ -12,7 +13,6 @@ use crate::rom::estimator::{
     self, ByFifth, DefectsCalibration, ErrorEstimator, ErrorMeasure, EstimateMethod, Estimator, FIFTHS,
 };
 use crate::rom::{Output, Rom};
-use crate::solver::model::Parameters;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -52,7 +52,7 @@ pub(super) fn training_rom(model: &Arc<Model>, basis: &Basis, est: &Estimator, m
 }
 
 /// The seam to the error estimator: the estimate and the reduced model's sensitivity of
-/// `basis` at every load in `measure` (the sensitivity's displacement form divides by
+/// `basis` at every candidate in `measure` (the sensitivity's displacement form divides by
 /// `‖X_r(λ) − X₀‖`), reduced runs in parallel (one reduced model and its estimator's per
 /// worker, as `sweep` does); a run that fails gives ∞ estimates (and sensitivity 0, which
 /// holds its estimate to T).
@@ -60,26 +60,26 @@ pub(super) fn estimate_candidates(
     model: &Arc<Model>,
     basis: &Basis,
     est: &Estimator,
-    loads: &[f64],
+    cands: &CandidateSet,
     label: &str,
     (method, measure): (EstimateMethod, ErrorMeasure),
 ) -> Vec<CandidateRun> {
     let target =
         if crate::output::progress_wanted() { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() };
-    let bar = ProgressBar::with_draw_target(Some(loads.len() as u64), target);
+    let bar = ProgressBar::with_draw_target(Some(cands.len() as u64), target);
     bar.set_style(
         ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} candidates, {elapsed}")
             .expect("valid template")
             .progress_chars("=> "),
     );
     bar.set_prefix(label.to_string());
-    let Ok(rom) = training_rom(model, basis, est, method) else { return vec![FAILED; loads.len()] };
-    let Ok(physics) = model.physics() else { return vec![FAILED; loads.len()] };
+    let Ok(rom) = training_rom(model, basis, est, method) else { return vec![FAILED; cands.len()] };
+    let Ok(physics) = model.physics() else { return vec![FAILED; cands.len()] };
     let x0 = ndarray::ArrayView1::from(&physics.x0[..]);
-    let out: Vec<CandidateRun> = loads
-        .par_iter()
-        .map(|&x| {
-            let r = candidate_run(&rom, x, measure, x0);
+    let out: Vec<CandidateRun> = (0..cands.len())
+        .into_par_iter()
+        .map(|i| {
+            let r = candidate_run(&rom, cands, i, measure, x0);
             bar.inc(1);
             r
         })
@@ -92,14 +92,20 @@ pub(super) fn estimate_candidates(
 const FAILED: CandidateRun =
     CandidateRun { by_time: [f64::INFINITY; FIFTHS], raw: f64::INFINITY, sensitivity: [0.0; FIFTHS] };
 
-/// One candidate: the reduced run at `x` with its estimate, and the run at `x(1 + δ)`, in
-/// `measure` (`x0`: the initial configuration X₀ of the displacement measure).
-fn candidate_run(rom: &Rom, x: f64, measure: ErrorMeasure, x0: ndarray::ArrayView1<f64>) -> CandidateRun {
-    let mu = Parameters::load_scale(x);
-    match rom.solve_and_estimate(&mu, Output::ReducedAndProbes, &[]) {
+/// One candidate, `i`: the reduced run there with its estimate, and the run at its
+/// parameters times `1 + δ` ([`CandidateSet::moved`]), in `measure` (`x0`: the initial
+/// configuration X₀ of the displacement measure).
+fn candidate_run(
+    rom: &Rom,
+    cands: &CandidateSet,
+    i: usize,
+    measure: ErrorMeasure,
+    x0: ndarray::ArrayView1<f64>,
+) -> CandidateRun {
+    match rom.solve_and_estimate(&cands.points[i], Output::ReducedAndProbes, &[]) {
         Ok((run, Some(e))) => {
-            // the same reduced model at λ(1 + δ): how much its answer moves
-            let moved = Parameters::load_scale(x * (1.0 + SENSITIVITY_STEP));
+            // the same reduced model at μ(1 + δ): how much its answer moves
+            let moved = cands.moved(i, SENSITIVITY_STEP);
             let basis = rom.basis();
             let sensitivity = match rom.solve_with(&moved, Output::ReducedAndProbes, &[]) {
                 Ok(moved) => *raw_by_time(basis, basis, &moved.reduced_q, &run.reduced_q, x0).get(measure),
@@ -120,12 +126,12 @@ pub(super) fn screen_candidates(
     model: &Arc<Model>,
     basis: &Basis,
     est: &Estimator,
-    loads: &[f64],
+    cands: &CandidateSet,
     order: &[usize],
     (method, measure): (EstimateMethod, ErrorMeasure),
     tolerance: f64,
 ) -> Vec<Option<CandidateRun>> {
-    let mut out = vec![None; loads.len()];
+    let mut out = vec![None; cands.len()];
     let (Ok(rom), Ok(physics)) = (training_rom(model, basis, est, method), model.physics()) else {
         // like a failed run at every candidate: one is enough to reject
         out[order[0]] = Some(FAILED);
@@ -134,7 +140,7 @@ pub(super) fn screen_candidates(
     let x0 = ndarray::ArrayView1::from(&physics.x0[..]);
     let chunk = rayon::current_num_threads().max(1);
     for part in order.chunks(chunk) {
-        let runs: Vec<CandidateRun> = part.par_iter().map(|&i| candidate_run(&rom, loads[i], measure, x0)).collect();
+        let runs: Vec<CandidateRun> = part.par_iter().map(|&i| candidate_run(&rom, cands, i, measure, x0)).collect();
         let over = runs.iter().any(|r| !(score(tolerance, &r.by_time, &r.sensitivity) <= tolerance));
         for (&i, r) in part.iter().zip(runs) {
             out[i] = Some(r);
@@ -150,12 +156,13 @@ pub(super) fn screen_candidates(
 /// candidate one reduced run, its estimate by the training's `method` (the estimator's
 /// calibration `c` included) and its raw defect sum, fifth by fifth, reduced runs in
 /// parallel. `None` when the estimator has no defects runner or some fifth has no usable
-/// ratio.
+/// ratio. On a line the ratios are interpolated between neighbouring loads online; in a
+/// box a point reads the largest of its nearest candidates' ([`DefectsCalibration::scattered`]).
 pub(super) fn calibrate_defects(
     model: &Arc<Model>,
     basis: &Basis,
     est: &Estimator,
-    loads: &[f64],
+    cands: &CandidateSet,
     method: EstimateMethod,
 ) -> Option<DefectsCalibration> {
     let rom = training_rom(model, basis, est, method).ok()?;
@@ -163,19 +170,23 @@ pub(super) fn calibrate_defects(
         Ok(true) => Defects::new(model, rom.basis(), &Arc::new(est.clone())).ok(),
         _ => None,
     };
-    let ratios: Vec<ByFifth> = loads
+    let ratios: Vec<ByFifth> = cands
+        .points
         .par_iter()
-        .map(|&x| {
+        .map(|mu| {
             let Some(d) = &defects else { return [f64::NAN; FIFTHS] };
-            let Ok((run, Some(e))) = rom.solve_and_estimate(&Parameters::load_scale(x), Output::ReducedAndProbes, &[])
-            else {
+            let Ok((run, Some(e))) = rom.solve_and_estimate(mu, Output::ReducedAndProbes, &[]) else {
                 return [f64::NAN; FIFTHS];
             };
             let Ok(raw) = d.raw(&run) else { return [f64::NAN; FIFTHS] };
             std::array::from_fn(|i| e.by_time[i] / raw.relative[i])
         })
         .collect();
-    DefectsCalibration::new(loads.to_vec(), ratios)
+    if cands.is_box() {
+        DefectsCalibration::scattered(cands.space.clone(), cands.unit.clone(), ratios)
+    } else {
+        DefectsCalibration::new(cands.loads(), ratios)
+    }
 }
 
 #[cfg(test)]

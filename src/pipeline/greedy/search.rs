@@ -3,6 +3,7 @@
 //! then the loosest τ whose estimates still meet T between the candidates
 //! ([`Level::between_candidates`]); each rung a `Level`.
 
+use super::candidate_set::CandidateSet;
 use super::candidates::{estimate_candidates, score, screen_candidates, CandidateRun};
 use crate::error::{Error, Result};
 use crate::io::basis_file::TrainingData;
@@ -37,6 +38,8 @@ pub(super) struct Level {
     /// which candidates have been run (a screened rung stops at its first score above T:
     /// [`super::candidates::screen_candidates`])
     evaluated: Vec<bool>,
+    /// the neighbouring candidates ([`CandidateSet::pairs`])
+    pairs: Vec<(usize, usize)>,
 }
 
 impl Level {
@@ -59,7 +62,7 @@ impl Level {
             return f64::INFINITY;
         }
         let sensitive: Vec<bool> = self.sensitivity.iter().map(|s| s[FIFTHS - 1] > tolerance).collect();
-        between_candidates(&self.estimates, &sensitive)
+        between_candidates(&self.estimates, &sensitive, &self.pairs)
     }
 
     /// [`Self::worst`] among the candidates `keep` accepts (and that were run).
@@ -81,7 +84,7 @@ impl Level {
 pub(super) struct Round<'a> {
     pub(super) p: &'a Pipeline,
     pub(super) data: &'a TrainingData,
-    pub(super) candidates: &'a [f64],
+    pub(super) candidates: &'a CandidateSet,
     pub(super) points: &'a [CalibrationPoint],
     pub(super) n: usize,
     /// the estimate the candidates are read with
@@ -252,8 +255,8 @@ fn rung_text(r: &Round, l: &Level, eps: f64, tau: f64, tolerance: f64) -> String
         .collect();
     let mut verdict = if !l.complete() {
         format!(
-            "above the tolerance {tolerance:e} at λ = {} ({run} of {} candidates run)",
-            r.candidates[wi],
+            "above the tolerance {tolerance:e} at {} ({run} of {} candidates run)",
+            r.candidates.label_of(wi),
             r.candidates.len()
         )
     } else if l.between_candidates(tolerance) > tolerance {
@@ -273,21 +276,22 @@ fn rung_text(r: &Round, l: &Level, eps: f64, tau: f64, tolerance: f64) -> String
             &format!("; the estimator is no richer than the basis in {}: no tighter rung is tried", poor.join(", "));
     }
     format!(
-        "  iteration {}, rung {}: {}, {elements}, estimator {}; worst score {w:.2e} at λ = {}: {verdict}",
+        "  iteration {}, rung {}: {}, {elements}, estimator {}; worst score {w:.2e} at {}: {verdict}",
         r.n,
         rung_name(eps, tau),
         modes_text(&l.trained.block_modes),
         modes_text(&l.estimator.block_modes),
-        r.candidates[wi]
+        r.candidates.label_of(wi)
     )
 }
 
-/// A bound of an estimate between evenly spaced candidate loads from its values `e` at
-/// them: between neighbours `i`, `i + 1` the estimate is taken to rise above the larger of
-/// the two by as much as it changes from one to the other,
+/// A bound of an estimate between the candidates from its values `e` at them: between
+/// neighbours `i`, `j` (the `pairs`: `i`, `i + 1` on a line of evenly spaced loads, each
+/// point and its nearest in a box, [`CandidateSet`]) the estimate is taken to rise above the
+/// larger of the two by as much as it changes from one to the other,
 ///
 /// ```text
-///     max_i  max(eᵢ, eᵢ₊₁)² / min(eᵢ, eᵢ₊₁)
+///     max_(i,j)  max(eᵢ, eⱼ)² / min(eᵢ, eⱼ)
 /// ```
 ///
 /// so a smooth estimate is held to its largest value times the local step ratio (a few per
@@ -300,26 +304,31 @@ fn rung_text(r: &Round, l: &Level, eps: f64, tau: f64, tolerance: f64) -> String
 /// extrapolate, and no number of candidates would resolve them. A non-finite or
 /// non-positive estimate (a failed run, a basis with no extra modes to estimate from) gives
 /// ∞, as does an empty list.
-pub(crate) fn between_candidates(e: &[f64], sensitive: &[bool]) -> f64 {
+pub(crate) fn between_candidates(e: &[f64], sensitive: &[bool], pairs: &[(usize, usize)]) -> f64 {
     if e.is_empty() || e.iter().any(|&x| !(x.is_finite() && x > 0.0)) {
         return f64::INFINITY;
     }
     if e.len() == 1 {
         return e[0];
     }
-    let both_sensitive =
-        |i: usize| sensitive.get(i).copied().unwrap_or(false) && sensitive.get(i + 1).copied().unwrap_or(false);
-    e.windows(2)
-        .enumerate()
-        .map(|(i, w)| {
-            let (hi, lo) = (w[0].max(w[1]), w[0].min(w[1]));
-            if both_sensitive(i) {
+    let is_sensitive = |i: usize| sensitive.get(i).copied().unwrap_or(false);
+    pairs
+        .iter()
+        .map(|&(i, j)| {
+            let (hi, lo) = (e[i].max(e[j]), e[i].min(e[j]));
+            if is_sensitive(i) && is_sensitive(j) {
                 hi
             } else {
                 hi * (hi / lo)
             }
         })
         .fold(0.0, f64::max)
+}
+
+/// The neighbours of a line of `n` candidates: `(i, i + 1)`.
+#[cfg(test)]
+pub(crate) fn line_pairs(n: usize) -> Vec<(usize, usize)> {
+    (1..n).map(|i| (i - 1, i)).collect()
 }
 
 /// Builds the basis and estimator of one rung and estimates at every candidate.
@@ -348,6 +357,7 @@ fn level(
         sensitivity: Vec::new(),
         fully_enriched,
         evaluated: Vec::new(),
+        pairs: candidates.pairs.clone(),
     };
     l.screen(p, candidates, order, method);
     Ok(l)
@@ -355,7 +365,7 @@ fn level(
 
 impl Level {
     /// The estimates, scores and sensitivities at every candidate, with `method`.
-    pub(super) fn estimate(&mut self, p: &Pipeline, candidates: &[f64], label: &str, method: EstimateMethod) {
+    pub(super) fn estimate(&mut self, p: &Pipeline, candidates: &CandidateSet, label: &str, method: EstimateMethod) {
         let runs = estimate_candidates(
             &p.model,
             &self.trained.basis,
@@ -370,7 +380,7 @@ impl Level {
     /// [`Self::estimate`] in `order` until a candidate scores above the tolerance
     /// ([`super::candidates::screen_candidates`]); [`Self::complete`] says whether it got
     /// through.
-    fn screen(&mut self, p: &Pipeline, candidates: &[f64], order: &[usize], method: EstimateMethod) {
+    fn screen(&mut self, p: &Pipeline, candidates: &CandidateSet, order: &[usize], method: EstimateMethod) {
         let (basis, est) = (&self.trained.basis, &self.estimator);
         let runs = screen_candidates(&p.model, basis, est, candidates, order, (method, measure_of(p)), p_tolerance(p));
         self.record(p, runs);
@@ -400,7 +410,11 @@ fn measure_of(p: &Pipeline) -> ErrorMeasure {
 
 #[cfg(test)]
 mod tests {
-    use super::between_candidates;
+    use super::{between_candidates, line_pairs};
+
+    fn between(e: &[f64], sensitive: &[bool]) -> f64 {
+        between_candidates(e, sensitive, &line_pairs(e.len()))
+    }
 
     /// A flat estimate is its value; a rising one is held to its largest value times the
     /// last step ratio (1.1 × 1.1 / 1.0 → 1.21 between the last two); a jump between two
@@ -409,13 +423,13 @@ mod tests {
     #[test]
     fn the_bound_between_candidates_follows_the_neighbours() {
         let calm = [false; 3];
-        assert_eq!(between_candidates(&[2e-4, 2e-4, 2e-4], &calm), 2e-4);
-        assert!((between_candidates(&[1.0, 1.0, 1.1], &calm) - 1.21).abs() < 1e-12);
-        assert!((between_candidates(&[1e-4, 1e-3, 1e-4], &calm) - 1e-2).abs() < 1e-15);
-        assert!(between_candidates(&[1e-4, f64::INFINITY], &calm).is_infinite());
-        assert!(between_candidates(&[1e-4, f64::NAN], &calm).is_infinite());
-        assert!(between_candidates(&[1e-4, 0.0], &calm).is_infinite());
-        assert!(between_candidates(&[], &calm).is_infinite());
+        assert_eq!(between(&[2e-4, 2e-4, 2e-4], &calm), 2e-4);
+        assert!((between(&[1.0, 1.0, 1.1], &calm) - 1.21).abs() < 1e-12);
+        assert!((between(&[1e-4, 1e-3, 1e-4], &calm) - 1e-2).abs() < 1e-15);
+        assert!(between(&[1e-4, f64::INFINITY], &calm).is_infinite());
+        assert!(between(&[1e-4, f64::NAN], &calm).is_infinite());
+        assert!(between(&[1e-4, 0.0], &calm).is_infinite());
+        assert!(between(&[], &calm).is_infinite());
     }
 
     /// Between two sensitive candidates a jump counts with its larger value (1e-3, not
@@ -423,8 +437,18 @@ mod tests {
     /// a failed estimate is ∞ whatever the sensitivity.
     #[test]
     fn sensitive_neighbours_are_not_extrapolated() {
-        assert_eq!(between_candidates(&[1e-4, 1e-3, 1e-4], &[true; 3]), 1e-3);
-        assert!((between_candidates(&[1e-4, 1e-3, 1e-4], &[false, true, true]) - 1e-2).abs() < 1e-15);
-        assert!(between_candidates(&[1e-4, f64::INFINITY], &[true; 2]).is_infinite());
+        assert_eq!(between(&[1e-4, 1e-3, 1e-4], &[true; 3]), 1e-3);
+        assert!((between(&[1e-4, 1e-3, 1e-4], &[false, true, true]) - 1e-2).abs() < 1e-15);
+        assert!(between(&[1e-4, f64::INFINITY], &[true; 2]).is_infinite());
+    }
+
+    /// In a box the bound runs over the given pairs only: 1e-4 and 1e-3 that are not
+    /// neighbours do not bound each other (1.1e-4 · 1.1 between 0 and 2, 1.1e-3 · 1.1
+    /// between 1 and 3).
+    #[test]
+    fn the_bound_runs_over_the_pairs() {
+        let e = [1e-4, 1e-3, 1.1e-4, 1.1e-3];
+        let b = between_candidates(&e, &[false; 4], &[(0, 2), (1, 3)]);
+        assert!((b - 1.1e-3 * 1.1).abs() < 1e-15, "{b}");
     }
 }

@@ -196,7 +196,7 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, basis: Option<SweepBasis>, extra
         let sensitivity = basis.as_ref().and_then(|b| b.sensitivity);
         f.new_dataset_builder()
             .with_data(&Array1::from_iter(
-                s.scales.iter().map(|x| sensitivity.as_ref().and_then(|t| t.near(x.mu.scale())).unwrap_or(f64::NAN)),
+                s.scales.iter().map(|x| sensitivity.as_ref().and_then(|t| t.near(&x.mu)).unwrap_or(f64::NAN)),
             ))
             .create("sensitivity_near")
             .map_err(e)?;
@@ -508,6 +508,7 @@ pub fn read_sweep(
             extrapolated: false,
             training_range: None,
             sensitivity: None,
+            training_box: None,
             sensitivity_near: None,
             amplifying: false,
             rel_error_by_time: Vec::new(),
