@@ -1,9 +1,10 @@
 //! Training over a box of parameters (`[parameters]` and `[train] points` or `greedy` in the
 //! pipeline): the points are drawn from the box and stored in the basis with it, greedy
-//! training converges over it, sharded sweeps over points merge into the single sweep, a reduced run inside
+//! training converges over it, sharded sweeps over points merge into the single sweep,
+//! `run` sweeps and reports over the box, a reduced run inside
 //! the box is not extrapolated and one outside names the parameter that left it, a pipeline
 //! whose box differs from the basis's is refused, sweeps run grids and lists of points, and
-//! what works on a line only (the report, sharded training) says so instead of running at
+//! what works on a line only (sharded training) says so instead of running at
 //! the wrong parameters.
 //!
 //! Model: the tutorial's double pendulum (`data/models/double_pendulum.toml`) with gravity
@@ -101,11 +102,20 @@ fn a_basis_trained_over_a_box_holds_it_and_checks_runs_against_it() {
     let v: serde_json::Value = serde_json::from_str(&text(&out).0).unwrap();
     assert_eq!(v["extrapolated"], true, "{v}");
 
-    // what works on a line only refuses a box, naming the pipeline's table; nothing written
-    let out = flexrom(d, &["run", "p.toml"]);
-    assert_eq!(out.status.code(), Some(1));
-    assert!(text(&out).1.contains("p.toml: parameters: `flexrom run` (its sweep and report) over a box"));
-    assert!(!d.join("r").exists());
+    // `run` over the box: its sweep at 16 random points of the box, validated, and a report
+    // that names points, not load scales
+    let out = flexrom(d, &["run", "p.toml", "-q"]);
+    assert!(out.status.success(), "{}", text(&out).1);
+    let summary = std::fs::read_to_string(d.join("r/summary.md")).unwrap();
+    assert!(summary.contains("Training box g ∈ [0.8, 1.2], push ∈ [0.2, 2] (log)"), "{summary}");
+    assert!(summary.contains("16 random points of the box") && summary.contains("| point | rel_error"), "{summary}");
+    let f = hdf5::File::open(d.join("r/sweep.h5")).unwrap();
+    let swept = f.dataset("points").unwrap().read_2d::<f64>().unwrap();
+    assert_eq!(swept.nrows(), 16);
+    assert!(swept.rows().into_iter().all(|r| (0.8..=1.2).contains(&r[1]) && (0.2..=2.0).contains(&r[2])), "{swept}");
+    let errors = f.dataset("rel_error").unwrap().read_raw::<f64>().unwrap();
+    assert!(errors.iter().all(|&e| e <= 1e-3), "{errors:?}");
+    drop(f);
 
     // a pipeline whose box differs from the basis's is refused before anything runs
     std::fs::write(
@@ -193,6 +203,11 @@ fn a_box_that_does_not_fit_the_model_or_the_training_is_refused_naming_the_field
             "sample it with `points = { count = N }`",
         ),
         (TRAIN.to_string(), "train.points", "the pipeline has no [parameters] table"),
+        (
+            format!("{BOX}{TRAIN}[validate]\nload_scales = [1.0]\n"),
+            "validate.load_scales",
+            "use random points of the box",
+        ),
         (format!("{}{}", BOX, TRAIN.replace("count = 6", "count = 0")), "train.points.count", "is 0"),
         (
             format!("{BOX}[train]\ngreedy = {{ range = [0.5, 1.5], tolerance = 1e-3, max_runs = 4 }}\n"),
@@ -272,10 +287,10 @@ fn a_sweep_over_a_grid_of_points_runs_each_point_as_online_does_and_resumes_by_p
     // --resume over the same grid takes every point from the file; a grid with a new axis
     // value runs only the new points
     let out = flexrom(d, &[&["sweep", "p.toml", "-o", "s.h5", "--resume", "-v"][..], &grid].concat());
-    assert!(text(&out).1.contains("6 of 6 load scales already finished"), "{}", text(&out).1);
+    assert!(text(&out).1.contains("6 of 6 points already finished"), "{}", text(&out).1);
     let more = ["--param", "g=0.8:1.2:3", "--param", "push=0.2:2:3:log"];
     let out = flexrom(d, &[&["sweep", "p.toml", "-o", "s.h5", "--resume", "-v"][..], &more].concat());
-    assert!(text(&out).1.contains("6 of 9 load scales already finished"), "{}", text(&out).1);
+    assert!(text(&out).1.contains("6 of 9 points already finished"), "{}", text(&out).1);
 
     // a point outside the box is flagged, and the warning counts such points
     let out = flexrom(d, &["sweep", "p.toml", "-o", "s2.h5", "--param", "g=1.0", "--param", "push=1:3:3", "--json"]);

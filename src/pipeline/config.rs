@@ -173,6 +173,13 @@ impl Pipeline {
                 if let Err(e) = s.values() {
                     return bad(&format!("{name}.load_scales"), e);
                 }
+                if !self.file.parameters.is_empty() {
+                    // a box's runs are points of it: a list of λ would be silently left out
+                    return bad(
+                        &format!("{name}.load_scales"),
+                        "lists load scales, but the pipeline has a [parameters] box: `run` and `validate` use random points of the box; sweep chosen points with `flexrom sweep --param NAME=A:B:N` or `--points FILE.csv`, validate one with `flexrom validate --param NAME=X`".into(),
+                    );
+                }
             }
         }
         if let Some(t) = self.online_tolerance() {
@@ -261,6 +268,16 @@ impl Pipeline {
             return self.validate_scales().into_iter().map(Parameters::load_scale).collect();
         }
         self.space().sample(4, crate::solver::parameter_space::Sampling::Random, self.box_seed().wrapping_add(1))
+    }
+
+    /// Where `run` sweeps: `[online] load_scales` (or the training scales), or for a
+    /// `[parameters]` box sixteen points drawn at random from it (seed: the training
+    /// points' plus two), neither training nor `validate`'s points.
+    pub fn online_points(&self) -> Vec<Parameters> {
+        if self.file.parameters.is_empty() {
+            return self.online_scales().into_iter().map(Parameters::load_scale).collect();
+        }
+        self.space().sample(16, crate::solver::parameter_space::Sampling::Random, self.box_seed().wrapping_add(2))
     }
 
     /// The seed a box's points are drawn with: `train.points`' or greedy's (default 1).

@@ -1,5 +1,7 @@
 //! `run`: train → online sweep (validated) → validation with timings at chosen points →
-//! a report folder: `summary.md`, `validation.json`, `sweep.h5` and SVG plots.
+//! a report folder: `summary.md`, `validation.json`, `sweep.h5` and SVG plots. Over a line
+//! of load scales the plots run along λ; over a `[parameters]` box the sweep's points are
+//! numbered in the order of the summary's sweep table and the plots run along that number.
 //! The folder is built beside the target and renamed into place at the end, the basis
 //! written under a temporary name and renamed into place only when every stage succeeded.
 
@@ -48,10 +50,6 @@ pub fn run_with(
     dense: super::dense::DenseChoice,
     method: Option<EstimateMethod>,
 ) -> Result<(PathBuf, Vec<String>)> {
-    p.refuse_box(
-        "`flexrom run` (its sweep and report)",
-        "run `flexrom train`, then `flexrom sweep --param NAME=A:B:N` and `flexrom validate`",
-    )?;
     check_outputs(p)?;
     let dense = super::dense::decide(dense, &p.model)?;
     let dir = p.report_dir.clone();
@@ -76,8 +74,14 @@ fn build(
     (dense, method): (bool, Option<EstimateMethod>),
 ) -> Result<Vec<String>> {
     let plot_err = |e: String| Error::io(out, std::io::Error::other(e));
+    let space = p.space();
+    let in_box = !space.is_empty();
+    // how the report names a run: its load scale, or its point of the box
+    let name = |mu: &Parameters| if in_box { space.label(mu) } else { mu.scale().to_string() };
     match &p.file.train.greedy {
+        Some(_) if in_box => log::info!("[1/3] train: greedy over the box {}", space.describe()),
         Some(g) => log::info!("[1/3] train: greedy over [{}, {}]", g.range().0, g.range().1),
+        None if in_box => log::info!("[1/3] train: {} full run(s)", p.training_points().len()),
         None => log::info!("[1/3] train: {} full run(s)", p.training_scales().len()),
     }
     let mut trained = train_and_write(p, basis_path)?;
@@ -85,9 +89,9 @@ fn build(
     let (stored, rom, _) = load_rom(p, basis_path, method, false)?;
     trained.warnings.extend(super::route::time_and_store(&rom, basis_path)?);
 
-    let scales = p.online_scales();
-    log::info!("[2/3] sweep: {} reduced and full runs", scales.len());
-    let sw = sweep(&rom, &scales, SweepOptions { validate: true, continuation: false, progress })?;
+    let points = p.online_points();
+    log::info!("[2/3] sweep: {} reduced and full runs", points.len());
+    let sw = sweep(&rom, &points, SweepOptions { validate: true, continuation: false, progress })?;
     write_sweep(
         &out.join("sweep.h5"),
         &sw,
@@ -102,12 +106,12 @@ fn build(
         return Err(Error::PartlyFailed(format!("sweep: {s}; no report written (the basis is)")));
     }
 
-    let vscales = p.validate_scales();
+    let vpoints = p.validation_points();
     let with = if dense { ", with the dense full solve" } else { "" };
-    log::info!("[3/3] validate at {} load scale(s){with}", vscales.len());
+    log::info!("[3/3] validate at {} {}{with}", vpoints.len(), if in_box { "point(s)" } else { "load scale(s)" });
     let mut validations: Vec<Validation> = Vec::new();
-    for (i, &x) in vscales.iter().enumerate() {
-        let (v, full, reduced) = validate(&rom, &Parameters::load_scale(x), dense)?;
+    for (i, mu) in vpoints.iter().enumerate() {
+        let (v, full, reduced) = validate(&rom, mu, dense)?;
         // x and y of every probe, full (line) and reduced (dashed), and their difference
         let t = &full.t;
         let mut panels: Vec<Panel> = ["x (m)", "y (m)"]
@@ -153,7 +157,7 @@ fn build(
                 .collect(),
         });
         Figure {
-            title: format!("Probes, full and reduced, load scale {x}"),
+            title: format!("Probes, full and reduced, {}{}", if in_box { "" } else { "load scale " }, name(mu)),
             x_label: "t (s)".into(),
             panels,
             markers: vec![],
@@ -192,14 +196,20 @@ fn build(
         vec![],
         "singular_values",
     )?;
+    // along λ, or along the sweep's points numbered 1, 2, … in a box
+    let along = |i: usize, mu: &Parameters| if in_box { (i + 1) as f64 } else { mu.scale() };
+    let x_label = if in_box { "sweep point (summary.md, Sweep)" } else { "load scale" };
     let pts = |f: &dyn Fn(&Validation) -> f64| -> Vec<(f64, f64)> {
-        sw.done().filter_map(|q| q.validation.as_ref()).map(|v| (v.load_scale, f(v))).collect()
+        (sw.scales.iter().enumerate())
+            .filter_map(|(i, x)| Some((i, x.point()?.validation.as_ref()?)))
+            .map(|(i, v)| (along(i, &v.mu()), f(v)))
+            .collect()
     };
     // the loads of the full runs the basis was trained on, marked on the plots against λ
-    let training = crate::io::estimator_file::read_training_loads(basis_path)?;
+    let training = if in_box { Vec::new() } else { crate::io::estimator_file::read_training_loads(basis_path)? };
     single(
         "Reduced vs full model",
-        "load scale",
+        x_label,
         Panel {
             y_label: "error".into(),
             log_y: true,
@@ -213,7 +223,7 @@ fn build(
     )?;
     single(
         "Speedup of the reduced time loop over the full one",
-        "load scale",
+        x_label,
         Panel {
             y_label: "speedup".into(),
             log_y: false,
@@ -223,18 +233,19 @@ fn build(
         "speedup_vs_load",
     )?;
     // the estimate over the sweep, the true errors of the sweep and of the validation runs
-    let estimates: Vec<(f64, f64)> = sw
-        .scales
-        .iter()
-        .filter_map(|x| x.point())
-        .filter_map(|q| q.estimate.map(|e| (q.run.result.settings.mu.scale(), e.error_estimate)))
+    let estimates: Vec<(f64, f64)> = (sw.scales.iter().enumerate())
+        .filter_map(|(i, x)| Some((i, x.point()?)))
+        .filter_map(|(i, q)| q.estimate.map(|e| (along(i, &q.run.result.settings.mu), e.error_estimate)))
         .collect();
     let mut errors = pts(&|v| v.rel_error);
-    errors.extend(validations.iter().map(|v| (v.load_scale, v.rel_error)));
+    if !in_box {
+        // the validation's own loads lie on the same axis (in a box they are other points)
+        errors.extend(validations.iter().map(|v| (v.load_scale, v.rel_error)));
+    }
     if !estimates.is_empty() {
         single(
             "Error estimate (no full run) and true error (full runs)",
-            "load scale",
+            x_label,
             Panel {
                 y_label: "relative error".into(),
                 log_y: true,
@@ -252,15 +263,12 @@ fn build(
     let by_time: Vec<Series> = validations
         .iter()
         .flat_map(|v| {
-            let truth = Series::new(
-                format!("rel_error, load scale {}", v.load_scale),
-                fifths(&v.rel_error_by_time),
-                Style::Line,
-            );
+            let at = if in_box { name(&v.mu()) } else { format!("load scale {}", v.load_scale) };
+            let truth = Series::new(format!("rel_error, {at}"), fifths(&v.rel_error_by_time), Style::Line);
             let est = v
                 .error_estimate_by_time
                 .as_ref()
-                .map(|e| Series::new(format!("error_estimate, load scale {}", v.load_scale), fifths(e), Style::Dashed));
+                .map(|e| Series::new(format!("error_estimate, {at}"), fifths(e), Style::Dashed));
             std::iter::once(truth).chain(est)
         })
         .collect();
@@ -288,23 +296,29 @@ fn build(
         &p.model.fingerprint()[..12]
     );
     // a held-out check run is named as such: its load is not among the basis's
-    let held_out_loads: Vec<f64> = trained.held_out_points().iter().map(|mu| mu.scale()).collect();
+    let held_out_loads: Vec<String> = trained.held_out_points().iter().map(&name).collect();
     let held_out = match held_out_loads.as_slice() {
         [] => String::new(),
         loads => format!(
-            " ({}) + {} held-out check at λ = {} (not in the basis)",
+            " ({}) + {} held-out check at {}{} (not in the basis)",
             if trained.n_training_runs() == 1 {
                 "1 training run".to_string()
             } else {
                 format!("{} training runs", trained.n_training_runs())
             },
             loads.len(),
-            loads.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(", ")
+            if in_box { "" } else { "λ = " },
+            loads.join("; ")
         ),
+    };
+    let runs: Vec<String> = match &trained.greedy {
+        Some(g) => g.runs.iter().map(&name).collect(),
+        None if in_box => p.training_points().iter().map(&name).collect(),
+        None => p.training_scales().iter().map(|x| x.to_string()).collect(),
     };
     let _ = writeln!(
         md,
-        "- basis: `{}`: {} reduction, {} snapshots, rule `{}` → {} POD modes{}, {} snapshots from load scales {:?}{held_out}",
+        "- basis: `{}`: {} reduction, {} snapshots, rule `{}` → {} POD modes{}, {} snapshots from {} [{}]{held_out}",
         p.basis_path.display(),
         b.variant.name(),
         b.snapshots.name(),
@@ -312,23 +326,27 @@ fn build(
         b.n_pod_modes,
         if b.kept.is_empty() { String::new() } else { format!(" + {} joint coordinates", b.kept.len()) },
         trained.n_snapshots,
-        trained.greedy.as_ref().map_or_else(|| p.training_scales(), |g| g.runs.iter().map(|mu| mu.scale()).collect())
+        if in_box { "points" } else { "load scales" },
+        runs.join(if in_box { "; " } else { ", " })
     );
     let _ = writeln!(
         md,
-        "- sweep: {} load scales on {} threads in {:.3} s (whole sweep, reduced and full runs)\n",
+        "- sweep: {} {} on {} threads in {:.3} s (whole sweep, reduced and full runs)\n",
         sw.scales.len(),
+        if in_box { "random points of the box" } else { "load scales" },
         sw.threads,
         sw.wall_seconds
     );
     let _ = writeln!(md, "## Validation (time loops only; full and reduced: medians of up to 7 interleaved runs each; full dense: one run)\n");
-    let _ = writeln!(md, "| load scale | rel_error | max probe error (m) | at | max constraint violation | full (s) | full dense (s) | reduced (s) | speedup | vs dense |");
+    let head = if in_box { "point" } else { "load scale" };
+    let at = |v: &Validation| if in_box { name(&v.mu()) } else { v.load_scale.to_string() };
+    let _ = writeln!(md, "| {head} | rel_error | max probe error (m) | at | max constraint violation | full (s) | full dense (s) | reduced (s) | speedup | vs dense |");
     let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|");
     for v in &validations {
         let _ = writeln!(
             md,
             "| {} | {:.3e} | {:.3e} | {} t = {:.3} s | {:.2e} | {:.4} | {:.4} | {:.4} | {:.2} | {:.2} |",
-            v.load_scale,
+            at(v),
             v.rel_error,
             v.max_probe_error,
             v.max_probe_error_probe,
@@ -355,15 +373,19 @@ fn build(
     }
     let _ = writeln!(md, "\n## Error estimate, extrapolation, sensitivity\n");
     let trust = rom.trust().expect("read from its basis file");
+    let trained_over = if in_box {
+        format!("Training box {}", space.describe())
+    } else {
+        format!("Training range [{}, {}]", trust.range.0, trust.range.1)
+    };
     let _ = writeln!(
         md,
-        "Training range [{}, {}]; tolerance {}. The estimate predicts rel_error without a full run ({} method, docs/error-estimate.md); effectivity = estimate / rel_error (≥ 1: bounded). Sensitivity: the full model's own change for a 0.1 % change of the load.\n",
-        trust.range.0,
-        trust.range.1,
+        "{trained_over}; tolerance {}. The estimate predicts rel_error without a full run ({} method, docs/error-estimate.md); effectivity = estimate / rel_error (≥ 1: bounded). Sensitivity: the full model's own change for a 0.1 % change of the load{}.\n",
         trust.tolerance.map_or("none".to_string(), |t| format!("{t:e}")),
-        rom.method().unwrap_or("no")
+        rom.method().unwrap_or("no"),
+        if in_box { " (every parameter of the box)" } else { "" }
     );
-    let _ = writeln!(md, "| load scale | rel_error | error_estimate | effectivity | calibrated | extrapolated | sensitivity | rel_error by fifth of the run | error_estimate by fifth of the run |");
+    let _ = writeln!(md, "| {head} | rel_error | error_estimate | effectivity | calibrated | extrapolated | sensitivity | rel_error by fifth of the run | error_estimate by fifth of the run |");
     let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|");
     for v in &validations {
         let by: Vec<String> = v.rel_error_by_time.iter().map(|e| format!("{e:.2e}")).collect();
@@ -375,7 +397,7 @@ fn build(
         let _ = writeln!(
             md,
             "| {} | {:.3e} | {} | {} | {} | {} | {} | {} | {} |",
-            v.load_scale,
+            at(v),
             v.rel_error,
             o(v.error_estimate, &|x| format!("{x:.3e}")),
             o(v.effectivity, &|x| format!("{x:.2}")),
@@ -386,10 +408,11 @@ fn build(
             est_by
         );
     }
-    motion_section(&mut md, &validations, trust);
+    let labels: Vec<String> = validations.iter().map(at).collect();
+    motion_section(&mut md, &validations, &labels, head, trust);
     let _ = writeln!(md, "\n## Sweep\n\n```text\n{}```\n", table(&sw));
     let _ = writeln!(md, "## Plots\n");
-    for (i, x) in vscales.iter().enumerate() {
+    for (i, x) in labels.iter().enumerate() {
         let _ = writeln!(md, "![probes at {x}](probes_{i}.svg)");
     }
     let _ = writeln!(
@@ -405,17 +428,24 @@ fn build(
 }
 
 /// The summary's section on the errors against the motion: displacement_error and its
-/// estimate, each probe's error over its travel.
-fn motion_section(md: &mut String, validations: &[Validation], trust: &crate::rom::Trust) {
+/// estimate, each probe's error over its travel (a row per validation, named by `labels`
+/// under the column `head`).
+fn motion_section(
+    md: &mut String,
+    validations: &[Validation],
+    labels: &[String],
+    head: &str,
+    trust: &crate::rom::Trust,
+) {
     let _ = writeln!(md, "\n## Errors against the motion\n");
     let _ = writeln!(
         md,
         "rel_error divides by ‖X_full‖, which holds the undeformed geometry and the unit slopes; displacement_error = ‖X_rom − X_full‖ / ‖X_full − X₀‖ measures the error against the motion from the initial configuration X₀, and a probe's error over its travel is max_t |r_rom − r_full| / max_t |r_full(t) − r_full(0)| (docs/error-estimate.md). The tolerance is on {}.\n",
         trust.measure.error_name()
     );
-    let _ = writeln!(md, "| load scale | rel_error | displacement_error | error_estimate_displacement | effectivity | displacement_error by fifth of the run | probe error over its travel |");
+    let _ = writeln!(md, "| {head} | rel_error | displacement_error | error_estimate_displacement | effectivity | displacement_error by fifth of the run | probe error over its travel |");
     let _ = writeln!(md, "|---|---|---|---|---|---|---|");
-    for v in validations {
+    for (v, label) in validations.iter().zip(labels) {
         let by: Vec<String> = v.displacement_error_by_time.iter().map(|e| format!("{e:.2e}")).collect();
         let probes: Vec<String> = v
             .probe_errors_over_travel
@@ -429,7 +459,7 @@ fn motion_section(md: &mut String, validations: &[Validation], trust: &crate::ro
         let _ = writeln!(
             md,
             "| {} | {:.3e} | {:.3e} | {} | {} | {} | {} |",
-            v.load_scale,
+            label,
             v.rel_error,
             v.displacement_error,
             o(v.error_estimate_displacement, &|x| format!("{x:.3e}")),
@@ -458,11 +488,10 @@ pub fn check_report(p: &Pipeline, dir: &Path, strict: bool, method: Option<Estim
         crate::rom::estimator::ErrorMeasure::Displacement => "error_estimate_displacement",
     };
     let (scales, est) = (read("load_scales")?, read(estimates)?);
-    let runs: Vec<_> = scales
-        .iter()
-        .zip(&est)
-        .map(|(&x, &e)| (crate::solver::parameters::Parameters::load_scale(x), if e.is_nan() { None } else { Some(e) }))
-        .collect();
+    let points = super::sweep::file::points_of(&f, &scales.to_vec())
+        .map_err(|(field, problem)| Error::input(&path, field, problem))?;
+    let runs: Vec<_> =
+        points.into_iter().zip(&est).map(|(mu, &e)| (mu, if e.is_nan() { None } else { Some(e) })).collect();
     warnings.extend(crate::rom::trust::check_runs(trust, rom.estimator().is_some(), &runs, strict)?);
     Ok(warnings)
 }

@@ -13,7 +13,7 @@
 //! file's layout and its writing and reading (`--resume`) in `file.rs`, the table printed
 //! on stdout in `table.rs`.
 
-mod file;
+pub mod file;
 mod outcome;
 mod table;
 
@@ -105,12 +105,21 @@ impl<'a> Route<'a> {
     }
 }
 
-/// Runs the reduced model at every scale, in parallel; with `validate`, also the full one.
-/// A scale whose run fails is recorded as failed and the others go on. Every point gets the
+/// What a sweep's runs are called in messages: "points" when some set a named parameter,
+/// else "load scales".
+fn runs_noun(points: &[Parameters]) -> &'static str {
+    if points.iter().any(|mu| mu.named().next().is_some()) {
+        "points"
+    } else {
+        "load scales"
+    }
+}
+
+/// Runs the reduced model at every point, in parallel; with `validate`, also the full one.
+/// A point whose run fails is recorded as failed and the others go on. Every point gets the
 /// reduced model's error estimate (when it has an estimator) and extrapolation flag.
-pub fn sweep(rom: &Rom, scales: &[f64], o: SweepOptions) -> Result<Sweep> {
-    let points: Vec<Parameters> = scales.iter().map(|&x| Parameters::load_scale(x)).collect();
-    let start = pending(rom.model(), rom.basis().n_reduced(), false, &points, o)?;
+pub fn sweep(rom: &Rom, points: &[Parameters], o: SweepOptions) -> Result<Sweep> {
+    let start = pending(rom.model(), rom.basis().n_reduced(), false, points, o)?;
     run_reduced(rom, start, o, None)
 }
 
@@ -152,13 +161,14 @@ pub fn sweep_to_file(route: Route, points: &[Parameters], o: SweepOptions, f: Sw
             }
             start.resumed = reused;
             let dropped = old.iter().filter(|(x, p)| p.is_some() && !points.contains(x)).count();
+            let runs = runs_noun(points);
             log::info!(
-                "resuming {}: {reused} of {} load scales already finished, running {}{}",
+                "resuming {}: {reused} of {} {runs} already finished, running {}{}",
                 out.display(),
                 points.len(),
                 points.len() - reused,
                 if dropped > 0 {
-                    format!(" ({dropped} finished load scales of the file are not in the list and are left out)")
+                    format!(" ({dropped} finished {runs} of the file are not in the list and are left out)")
                 } else {
                     String::new()
                 }
@@ -269,9 +279,12 @@ fn run_pending(
         if o.progress { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() },
     );
     bar.set_style(
-        ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} load scales, {elapsed} elapsed, ETA {eta}")
-            .expect("valid template")
-            .progress_chars("=> "),
+        ProgressStyle::with_template(&format!(
+            "{{prefix}} [{{bar:30}}] {{pos}}/{{len}} {}, {{elapsed}} elapsed, ETA {{eta}}",
+            runs_noun(&points)
+        ))
+        .expect("valid template")
+        .progress_chars("=> "),
     );
     bar.set_prefix(label.to_string());
     let ticker = crate::output::ticker::Ticker::new(label, points.len() as u64, o.progress);

@@ -281,7 +281,7 @@ impl Validation {
             self.error_estimate_displacement_by_time = Some(e.displacement_by_time.to_vec());
         }
         if let Some(t) = rom.and_then(|r| r.trust()) {
-            let mu = self.parameters.iter().fold(Parameters::default(), |mu, (n, &v)| mu.with(n, v));
+            let mu = self.mu();
             self.extrapolated = t.extrapolated(&mu);
             self.training_range = Some([t.range.0, t.range.1]);
             self.training_box = Some(t.space.describe()).filter(|_| !t.space.is_empty());
@@ -293,6 +293,13 @@ impl Validation {
             self.error_estimate_method = rom.and_then(|r| r.method()).map(str::to_string);
         }
         self
+    }
+}
+
+impl Validation {
+    /// The parameters of the run (from `parameters`).
+    pub fn mu(&self) -> Parameters {
+        self.parameters.iter().fold(Parameters::default(), |mu, (n, &v)| mu.with(n, v))
     }
 }
 

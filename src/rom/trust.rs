@@ -226,8 +226,7 @@ fn label(trust: &Trust, mu: &Parameters) -> String {
     if trust.space.is_empty() {
         return short(mu.scale());
     }
-    let one = |n: &str| format!("{n} = {}", short(mu.get(n).unwrap_or(1.0)));
-    format!("({})", trust.space.names().map(one).collect::<Vec<_>>().join(", "))
+    format!("({})", trust.space.label(mu))
 }
 
 /// At most five entries of a list for a one-line message, then "…".

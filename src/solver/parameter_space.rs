@@ -101,6 +101,17 @@ pub enum Sampling {
 /// The most Sobol points one sample holds (`sobol_burley`'s sequence length, 2¹⁶).
 pub const MAX_SOBOL_POINTS: usize = 1 << 16;
 
+/// `x` to four significant digits ([`show_number`] of the rounded value): 1.315, 0.2086, 2e8.
+pub fn short_number(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return show_number(x);
+    }
+    // scaled by an exact power of ten either way, so 2e8 stays 2e8
+    let e = 3 - x.abs().log10().floor() as i32;
+    let k = 10f64.powi(e.abs());
+    show_number(if e >= 0 { (x * k).round() / k } else { (x / k).round() * k })
+}
+
 /// The `k` points of `points` (unit-cube coordinates) nearest to `u` (Euclidean distance),
 /// nearest first, `skip` left out: what a point of a box reads from the candidates around it.
 pub fn nearest(points: &[Vec<f64>], u: &[f64], k: usize, skip: Option<usize>) -> Vec<usize> {
@@ -220,6 +231,13 @@ impl ParameterSpace {
             let x = mu.get(n).unwrap_or(1.0);
             m.with(n, x * factor)
         })
+    }
+
+    /// `drive = 1.1, E = 2.5e8`: the point `mu` as messages name it, the box's parameters
+    /// to four significant digits (drawn points have sixteen; files keep them).
+    pub fn label(&self, mu: &Parameters) -> String {
+        let one = |n: &str| format!("{n} = {}", short_number(mu.get(n).unwrap_or(1.0)));
+        self.names().map(one).collect::<Vec<_>>().join(", ")
     }
 
     /// `drive ∈ [0.5, 1.5], E ∈ [1e8, 4e8] (log)`: the box as messages name it.

@@ -14,7 +14,6 @@
 //! are the line's ends and middle, in a box the lower and upper corners and the centre
 //! (the same three points on a line).
 
-use crate::error::show_number;
 use crate::pipeline::config::{GreedySpec, DEFAULT_BOX_CANDIDATES_PER_PARAMETER};
 use crate::solver::parameter_space::ParameterSpace;
 use crate::solver::parameters::Parameters;
@@ -107,8 +106,7 @@ impl CandidateSet {
         if !self.is_box() {
             return format!("λ = {}", mu.scale());
         }
-        let names = self.space.names();
-        names.map(|n| format!("{n} = {}", short(mu.get(n).unwrap_or(1.0)))).collect::<Vec<_>>().join(", ")
+        self.space.label(mu)
     }
 
     /// [`Self::label`] of candidate `i`.
@@ -135,18 +133,6 @@ impl CandidateSet {
         }
         self.space.moved(mu, 1.0 + step)
     }
-}
-
-/// `x` to four significant digits, as messages show a box's points (drawn points have
-/// all sixteen; the files keep them).
-fn short(x: f64) -> String {
-    if x == 0.0 || !x.is_finite() {
-        return show_number(x);
-    }
-    // scaled by an exact power of ten either way, so 2e8 stays 2e8
-    let e = 3 - x.abs().log10().floor() as i32;
-    let k = 10f64.powi(e.abs());
-    show_number(if e >= 0 { (x * k).round() / k } else { (x / k).round() * k })
 }
 
 /// Each point paired with its nearest other point (Euclidean distance in the unit cube),
@@ -223,8 +209,8 @@ mod tests {
         assert_eq!(first[2].get("stiff"), Some(4e8));
         assert!((first[1].get("stiff").unwrap() - 2e8).abs() < 1e-6 * 2e8);
         assert_eq!(c.label(&first[1]), "drive = 1, stiff = 2e8");
-        assert_eq!(short(1.3148486614227295), "1.315");
-        assert_eq!(short(0.20863951807746545), "0.2086");
+        assert_eq!(crate::solver::parameter_space::short_number(1.3148486614227295), "1.315");
+        assert_eq!(crate::solver::parameter_space::short_number(0.20863951807746545), "0.2086");
         // the sensitivity's neighbour moves every parameter by the step
         let m = c.moved(3, 1e-3);
         assert_eq!(m.get("drive"), Some(c.points[3].get("drive").unwrap() * 1.001));

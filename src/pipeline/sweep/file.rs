@@ -255,6 +255,29 @@ pub fn point_names<'a>(points: impl Iterator<Item = &'a Parameters>) -> Vec<Stri
     std::iter::once(crate::solver::parameters::LOAD_SCALE.to_string()).chain(named).collect()
 }
 
+/// The parameters of every run of an open sweep file: `/points` when it has them, else the
+/// load scales `scales` (`/load_scales`). `Err((field, problem))`.
+pub fn points_of(f: &hdf5::File, scales: &[f64]) -> std::result::Result<Vec<Parameters>, (&'static str, String)> {
+    if !f.link_exists("points") {
+        return Ok(scales.iter().map(|&x| Parameters::load_scale(x)).collect());
+    }
+    let d = f.dataset("points").map_err(|e| ("points", format!("cannot be read: {e}")))?;
+    let a = d.read::<f64, ndarray::Ix2>().map_err(|e| ("points", format!("cannot be read: {e}")))?;
+    let names = read_attr_str(&d, "parameters")
+        .map_err(|e| ("points", format!("has no readable attribute `parameters`: {e}")))?;
+    let names: Vec<&str> = names.split(',').collect();
+    if a.dim() != (scales.len(), names.len()) {
+        return Err((
+            "points",
+            format!("is {:?}, expected ({}, {}) for its parameters {names:?}", a.dim(), scales.len(), names.len()),
+        ));
+    }
+    Ok(a.rows()
+        .into_iter()
+        .map(|row| names.iter().zip(row).fold(Parameters::default(), |mu, (n, &v)| mu.with(n, v)))
+        .collect())
+}
+
 /// Reads an earlier sweep file for `--resume`: (parameters, the finished run) for every
 /// point it holds, `None` for those that failed or did not run. `stored` is the basis of a
 /// reduced sweep, `None` for a full one. Refuses a file of another route, basis or model,
@@ -302,25 +325,7 @@ pub fn read_sweep(
         f.dataset(name).and_then(|d| d.read_1d::<u64>()).map_err(|e| cannot(name, format!("cannot be read: {e}")))
     };
     let scales = vec("load_scales")?;
-    let points: Vec<Parameters> = if f.link_exists("points") {
-        let d = f.dataset("points").map_err(|e| cannot("points", format!("cannot be read: {e}")))?;
-        let a = d.read::<f64, ndarray::Ix2>().map_err(|e| cannot("points", format!("cannot be read: {e}")))?;
-        let names = read_attr_str(&d, "parameters")
-            .map_err(|e| cannot("points", format!("has no readable attribute `parameters`: {e}")))?;
-        let names: Vec<&str> = names.split(',').collect();
-        if a.dim() != (scales.len(), names.len()) {
-            return Err(cannot(
-                "points",
-                format!("is {:?}, expected ({}, {}) for its parameters {names:?}", a.dim(), scales.len(), names.len()),
-            ));
-        }
-        a.rows()
-            .into_iter()
-            .map(|row| names.iter().zip(row).fold(Parameters::default(), |mu, (n, &v)| mu.with(n, v)))
-            .collect()
-    } else {
-        scales.iter().map(|&x| Parameters::load_scale(x)).collect()
-    };
+    let points = points_of(&f, &scales.to_vec()).map_err(|(field, problem)| cannot(field, problem))?;
     let status = f
         .dataset("status")
         .and_then(|d| d.read_1d::<u8>())
