@@ -73,6 +73,23 @@ def two_parameters(text):
     return "[[loads]]".join(blocks)
 
 
+def train(out, name, pipeline_text):
+    """Writes the pipeline `name`.toml in `out`, trains it, and returns its path, the
+    training's wall time and what /training says: converged, full runs, candidates, modes,
+    sampled elements."""
+    p = os.path.join(out, name + ".toml")
+    with open(p, "w") as f:
+        f.write(pipeline_text)
+    t0 = time.perf_counter()
+    subprocess.run([FLEXROM, "train", p, "-q"], check=True)
+    wall = time.perf_counter() - t0
+    with h5py.File(os.path.join(out, name + ".h5"), "r") as h:
+        t = h["training"]
+        record = ("yes" if t.attrs["converged"] else "no", int(t.attrs["full_runs"]), t["estimates"].shape[1],
+                  int(t["n_modes"][-1]), int(t["n_elements"][-1]))
+    return p, wall, record
+
+
 def validate_points(flexrom_args, points, out):
     rows = json.loads(subprocess.run(flexrom_args + ["--points", points, "--validate", "-o", out, "-q", "--json"],
                                      check=True, capture_output=True, text=True).stdout)
@@ -108,20 +125,13 @@ def zoo(a):
             f.write(text)
         for tol in a.tolerances.split(","):
             name = f"{m}_t{tol}"
-            p = os.path.join(a.out, name + ".toml")
-            with open(p, "w") as f:
-                f.write(
-                    f'model = "{model}"\nbasis = "{name}.h5"\nreport = "report_{name}"\n'
-                    f"[parameters]\nload_scale = [0.5, 1.5]\np2 = [0.5, 1.5]\n"
-                    f"[train]\ngreedy = {{ tolerance = {tol}, max_runs = 10 }}\n"
-                )
-            t0 = time.perf_counter()
-            subprocess.run([FLEXROM, "train", p, "-q"], check=True)
-            wall = time.perf_counter() - t0
-            with h5py.File(os.path.join(a.out, name + ".h5"), "r") as h:
-                t = h["training"]
-                converged = "yes" if t.attrs["converged"] else "no"
-                runs, modes, elements = int(t.attrs["full_runs"]), int(t["n_modes"][-1]), int(t["n_elements"][-1])
+            p, wall, (converged, runs, _, modes, elements) = train(
+                a.out,
+                name,
+                f'model = "{model}"\nbasis = "{name}.h5"\nreport = "report_{name}"\n'
+                f"[parameters]\nload_scale = [0.5, 1.5]\np2 = [0.5, 1.5]\n"
+                f"[train]\ngreedy = {{ tolerance = {tol}, max_runs = 10 }}\n",
+            )
             err, est, eff = validate_points([FLEXROM, "sweep", p], points, os.path.join(a.out, name + "_sweep.h5"))
             covered = sum(e >= x for e, x in zip(est, err))
             print(
@@ -153,32 +163,15 @@ def main():
         box = "".join(f"{n} = {r}\n" for n, r, _ in AXES[:dim])
         for tol in a.tolerances.split(","):
             name = f"d{dim}_t{tol}"
-            p = os.path.join(a.out, name + ".toml")
-            with open(p, "w") as f:
-                f.write(
-                    f'model = "{model}"\nbasis = "{name}.h5"\nreport = "report_{name}"\n[parameters]\n{box}'
-                    f"[train]\ngreedy = {{ tolerance = {tol}, max_runs = 16 }}\n"
-                    f'[reduction]\nvariant = "constraint-preserving"\n'
-                )
-            t0 = time.perf_counter()
-            subprocess.run([FLEXROM, "train", p, "-q"], check=True)
-            wall = time.perf_counter() - t0
-            with h5py.File(os.path.join(a.out, name + ".h5"), "r") as h:
-                t = h["training"]
-                converged = "yes" if t.attrs["converged"] else "no"
-                runs = int(t.attrs["full_runs"])
-                cands = t["estimates"].shape[1]
-                modes = int(t["n_modes"][-1])
-                elements = int(t["n_elements"][-1])
-            out = subprocess.run(
-                [FLEXROM, "sweep", p, "--points", points, "--validate", "-o", os.path.join(a.out, name + "_sweep.h5"), "-q", "--json"],
-                check=True, capture_output=True, text=True,
+            p, wall, (converged, runs, cands, modes, elements) = train(
+                a.out,
+                name,
+                f'model = "{model}"\nbasis = "{name}.h5"\nreport = "report_{name}"\n[parameters]\n{box}'
+                f"[train]\ngreedy = {{ tolerance = {tol}, max_runs = 16 }}\n"
+                f'[reduction]\nvariant = "constraint-preserving"\n',
             )
-            rows = json.loads(out.stdout)
-            err = [r["rel_error"] for r in rows]
-            est = [r["error_estimate"] for r in rows]
+            err, est, eff = validate_points([FLEXROM, "sweep", p], points, os.path.join(a.out, name + "_sweep.h5"))
             covered = sum(e >= x for e, x in zip(est, err))
-            eff = [e / x for e, x in zip(est, err)]
             print(
                 f"| {dim} | {tol} | {converged} | {runs} | {cands} | {modes} | {elements} | {wall:.1f} s | {max(err):.2e} | "
                 f"{statistics.median(err):.2e} | {covered}/16 | {statistics.median(eff):.2f} | {max(eff):.2f} |",
