@@ -4,8 +4,8 @@
 //! `run` sweeps and reports over the box, a reduced run inside
 //! the box is not extrapolated and one outside names the parameter that left it, a pipeline
 //! whose box differs from the basis's is refused, sweeps run grids and lists of points, and
-//! what works on a line only (sharded training) says so instead of running at
-//! the wrong parameters.
+//! training in separate jobs (`--snapshots-only --shard`, `--from-snapshots`) gives the
+//! single training's basis.
 //!
 //! Model: the tutorial's double pendulum (`data/models/double_pendulum.toml`) with gravity
 //! scaled by `g` and a horizontal tip force scaled by `push`. The accuracy bound at held-out
@@ -116,6 +116,27 @@ fn a_basis_trained_over_a_box_holds_it_and_checks_runs_against_it() {
     let errors = f.dataset("rel_error").unwrap().read_raw::<f64>().unwrap();
     assert!(errors.iter().all(|&e| e <= 1e-3), "{errors:?}");
     drop(f);
+
+    // training in separate jobs: two shards of the six points, joined in the pipeline's
+    // order, give the single `train`'s basis (the same snapshot matrix: same POD)
+    for k in ["1/2", "2/2"] {
+        let out = flexrom(d, &["train", "p.toml", "--snapshots-only", "--shard", k, "-o", &format!("s{}.h5", &k[..1])]);
+        assert!(out.status.success(), "{}", text(&out).1);
+    }
+    let out = flexrom(d, &["train", "p.toml", "--basis", "b2.h5", "--from-snapshots", "s2.h5", "s1.h5", "-q"]);
+    assert!(out.status.success(), "{}", text(&out).1);
+    let read = |file: &str, name: &str| {
+        hdf5::File::open(d.join(file)).unwrap().dataset(name).unwrap().read_raw::<f64>().unwrap()
+    };
+    assert_eq!(read("b2.h5", "parameters/push"), read("b.h5", "parameters/push"));
+    let (sv, sv2) = (read("b.h5", "basis/singular_values"), read("b2.h5", "basis/singular_values"));
+    assert!(sv.iter().zip(&sv2).all(|(a, b)| (a - b).abs() <= 1e-10 * sv[0]), "{sv:?} vs {sv2:?}");
+    // one of the two files is not enough, and a box's jobs are shards, not load scales
+    let out = flexrom(d, &["train", "p.toml", "--basis", "b3.h5", "--from-snapshots", "s1.h5"]);
+    assert!(text(&out).1.contains("no file holds the training point(s) 1 (g = "), "{}", text(&out).1);
+    let out = flexrom(d, &["train", "p.toml", "--snapshots-only", "--load-scale", "1.0", "-o", "s3.h5"]);
+    assert!(text(&out).1.contains("split them with --shard K/N"), "{}", text(&out).1);
+    assert!(!d.join("b3.h5").exists() && !d.join("s3.h5").exists());
 
     // a pipeline whose box differs from the basis's is refused before anything runs
     std::fs::write(

@@ -45,9 +45,15 @@ impl Args {
         if snapshots_only {
             let out = output.expect("clap: --snapshots-only requires -o");
             check_output(&out, Origin::Flag("-o"), &[(&p.path, "pipeline file"), (&p.model.path, "model file")])?;
-            let scales = flexrom::pipeline::snapshots::job_scales(&p, load_scale, shard)?;
-            let (n, secs) = flexrom::pipeline::snapshots::write_snapshots(&p, &scales, &out)?;
-            info(&format!("{}: {n} full run(s) at {scales:?} ({secs:.3} s) -> {}", p.path.display(), out.display()));
+            let points = flexrom::pipeline::snapshots::job_points(&p, load_scale, shard)?;
+            let (n, secs) = flexrom::pipeline::snapshots::write_snapshots(&p, &points, &out)?;
+            let scales: Vec<f64> = points.iter().map(|mu| mu.scale()).collect();
+            let at = if p.space().is_empty() {
+                format!("{scales:?}")
+            } else {
+                points.iter().map(|mu| format!("({})", p.space().label(mu))).collect::<Vec<_>>().join(", ")
+            };
+            info(&format!("{}: {n} full run(s) at {at} ({secs:.3} s) -> {}", p.path.display(), out.display()));
             let mut t = Table::new(&["pipeline", "output", "n_runs", "load_scales", "seconds"]);
             let list: Vec<String> = scales.iter().map(|x| x.to_string()).collect();
             t.push(vec![

@@ -180,11 +180,13 @@ const SWEEP: [Entry; 28] = [
     ("shard/indices", "1", "load"),
 ];
 
-const SNAPSHOTS: [Entry; 4] = [
+const SNAPSHOTS: [Entry; 6] = [
     ("x", COORDINATE_UNITS, "dof, snapshot"),
     ("multipliers", MULTIPLIER_UNITS, "constraint, snapshot"),
     ("load_scale", "1", "snapshot"),
     ("t", "s", "snapshot"),
+    ("point_index", "1", "run"),
+    ("points", "1", "run, parameter"),
 ];
 
 /// The table of a file kind (without `/labels`).

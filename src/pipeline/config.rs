@@ -247,19 +247,6 @@ impl Pipeline {
         }
     }
 
-    /// Refuses `what` (a sweep, a report, sharded training) on a pipeline with a
-    /// `[parameters]` box: those work on a line of load scales so far.
-    pub fn refuse_box(&self, what: &str, instead: &str) -> Result<()> {
-        if self.file.parameters.is_empty() {
-            return Ok(());
-        }
-        Err(Error::input(
-            &self.path,
-            "parameters",
-            format!("{what} over a box of several parameters is not there yet: {instead}"),
-        ))
-    }
-
     /// Where `validate` and a report check a basis when no load is given: `[validate]
     /// load_scales`, or for a `[parameters]` box four points drawn at random from it (seed:
     /// the training points' plus one), which are not training points.

@@ -21,6 +21,9 @@
 //! /multipliers  (n_c, m n_t)       Lagrange multipliers
 //! /load_scale   (m n_t)            each column's load scale
 //! /t            (m n_t)            each column's time, s
+//! /point_index  (m)                a pipeline with a [parameters] box only: each run's index
+//!                                  in the pipeline's training points (`train.points`)
+//! /points       (m, d)             and its parameters (attribute `parameters`, the names)
 //! /labels/...                      names of the coordinates and constraint rows
 //! every dataset: units, dims ("dof, snapshot": src/io/attrs.rs)
 //! attributes on /: flexrom_layout, flexrom_file = "snapshots", kind = "flexrom snapshots", model_fingerprint, settings_hash (of the
@@ -42,39 +45,39 @@ use std::path::{Path, PathBuf};
 
 const KIND: &str = "flexrom snapshots";
 
-/// The training loads a `--snapshots-only` job runs: `x` alone, or the `shard` of the
-/// pipeline's `train.load_scales` ([`Shard::indices`]).
-pub fn job_scales(p: &Pipeline, x: Option<f64>, shard: Option<Shard>) -> Result<Vec<f64>> {
-    p.refuse_box(
-        "training in separate jobs (--snapshots-only, --from-snapshots)",
-        "run `flexrom train` in one process",
-    )?;
+/// The training runs a `--snapshots-only` job makes: the load scale `x` alone, or the
+/// `shard` of the pipeline's `train.load_scales` ([`Shard::indices`]), or of its
+/// `train.points` for a pipeline with a `[parameters]` box.
+pub fn job_points(p: &Pipeline, x: Option<f64>, shard: Option<Shard>) -> Result<Vec<Parameters>> {
     match (x, shard) {
-        (Some(x), None) if x.is_finite() => Ok(vec![x]),
+        (Some(_), None) if !p.file.parameters.is_empty() => Err(Error::input(
+            &p.path,
+            "parameters",
+            "trains at the points of its box: split them with --shard K/N, not --load-scale",
+        )),
+        (Some(x), None) if x.is_finite() => Ok(vec![Parameters::load_scale(x)]),
         (Some(x), None) => Err(Error::Usage(format!("--load-scale must be finite, got {x}"))),
         (None, Some(k)) => {
-            let all = fixed_scales(p)?;
+            let all = fixed_points(p)?;
             let idx = k.indices(all.len());
             if idx.is_empty() {
+                let what = if p.file.parameters.is_empty() { "train.load_scales has" } else { "train.points has" };
                 return Err(Error::Usage(format!(
-                    "--shard {k}: train.load_scales has {} loads, none for shard {}; use at most {} shards",
+                    "--shard {k}: {what} {} runs, none for shard {}; use at most {} shards",
                     all.len(),
                     k.index,
                     all.len()
                 )));
             }
-            Ok(idx.iter().map(|&i| all[i]).collect())
+            Ok(idx.iter().map(|&i| all[i].clone()).collect())
         }
         _ => Err(Error::Usage("--snapshots-only needs either --load-scale X or --shard K/N".into())),
     }
 }
 
-/// The pipeline's fixed training loads (greedy training has none to split).
-fn fixed_scales(p: &Pipeline) -> Result<Vec<f64>> {
-    p.refuse_box(
-        "training in separate jobs (--snapshots-only, --from-snapshots)",
-        "run `flexrom train` in one process",
-    )?;
+/// The pipeline's fixed training runs: its load scales, or the points of its box (greedy
+/// training has none to split).
+fn fixed_points(p: &Pipeline) -> Result<Vec<Parameters>> {
     if p.file.train.greedy.is_some() {
         return Err(Error::input(
             &p.path,
@@ -83,22 +86,35 @@ fn fixed_scales(p: &Pipeline) -> Result<Vec<f64>> {
              shard it by --load-scale runs only with train.load_scales",
         ));
     }
+    if !p.file.parameters.is_empty() {
+        return Ok(p.training_points());
+    }
     let scales = p.file.train.load_scales.clone().unwrap_or_default();
     if scales.is_empty() {
         return Err(Error::input(&p.path, "train.load_scales", "is empty: no training run, no snapshots"));
     }
-    Ok(scales)
+    Ok(scales.into_iter().map(Parameters::load_scale).collect())
 }
 
-/// Runs the full model at `scales` and writes their snapshots to `out` (atomically).
-/// Returns (runs, seconds of the time loops).
-pub fn write_snapshots(p: &Pipeline, scales: &[f64], out: &Path) -> Result<(usize, f64)> {
+/// Runs the full model at `points` and writes their snapshots to `out` (atomically); for a
+/// pipeline with a box, each run's index among its training points too. Returns (runs,
+/// seconds of the time loops).
+pub fn write_snapshots(p: &Pipeline, points: &[Parameters], out: &Path) -> Result<(usize, f64)> {
+    let space = p.space();
+    // where each run lies in the box's training points (they come from that list)
+    let index: Vec<u64> = if space.is_empty() {
+        Vec::new()
+    } else {
+        let all = p.training_points();
+        points.iter().map(|mu| all.iter().position(|a| a == mu).map(|i| i as u64)).collect::<Option<_>>().ok_or_else(
+            || Error::Usage("--snapshots-only: a point is not among the pipeline's training points".into()),
+        )?
+    };
     let mut runs = Vec::new();
     let mut seconds = 0.0;
-    for &x in scales {
-        let mu = Parameters::load_scale(x);
-        let r = simulate(&p.model, &Overrides::at(&mu))
-            .map_err(|e| e.at_stage("train --snapshots-only (full run)", &mu))?;
+    for mu in points {
+        let r =
+            simulate(&p.model, &Overrides::at(mu)).map_err(|e| e.at_stage("train --snapshots-only (full run)", mu))?;
         seconds += r.wall_seconds;
         runs.push(r);
     }
@@ -112,6 +128,14 @@ pub fn write_snapshots(p: &Pipeline, scales: &[f64], out: &Path) -> Result<(usiz
         f.new_dataset_builder().with_data(&data.multipliers.as_standard_layout()).create("multipliers").map_err(e)?;
         f.new_dataset_builder().with_data(&data.load_scale).create("load_scale").map_err(e)?;
         f.new_dataset_builder().with_data(&data.t).create("t").map_err(e)?;
+        if !index.is_empty() {
+            f.new_dataset_builder().with_data(&Array1::from(index.clone())).create("point_index").map_err(e)?;
+            let names: Vec<&str> = space.names().collect();
+            let table =
+                Array2::from_shape_fn((points.len(), names.len()), |(k, j)| points[k].get(names[j]).unwrap_or(1.0));
+            let d = f.new_dataset_builder().with_data(&table).create("points").map_err(e)?;
+            attr_str(&d, "parameters", &names.join(",")).map_err(e)?;
+        }
         attr_str(f, "kind", KIND).map_err(e)?;
         attr_str(f, "model_fingerprint", &p.model.fingerprint()).map_err(e)?;
         attr_str(f, "settings_hash", &settings_hash).map_err(e)?;
@@ -126,6 +150,8 @@ pub fn write_snapshots(p: &Pipeline, scales: &[f64], out: &Path) -> Result<(usiz
 struct Run {
     file: PathBuf,
     load_scale: f64,
+    /// the run's index among a box pipeline's training points (`/point_index`)
+    point: Option<usize>,
     x: Array2<f64>,
     multipliers: Array2<f64>,
     t: Array1<f64>,
@@ -171,6 +197,16 @@ fn read_runs(p: &Pipeline, path: &Path, n_t: usize) -> Result<(Vec<Run>, f64)> {
     if ls.len() != cols || t.len() != cols {
         return Err(bad("load_scale", format!("has {} entries and /t {}, for {cols} columns", ls.len(), t.len())));
     }
+    let index: Option<Vec<usize>> = match f.dataset("point_index") {
+        Ok(d) => {
+            let i = d.read_1d::<u64>().map_err(|e| bad("point_index", format!("cannot be read: {e}")))?;
+            if i.len() != cols / n_t {
+                return Err(bad("point_index", format!("has {} entries for {} runs", i.len(), cols / n_t)));
+            }
+            Some(i.iter().map(|&k| k as usize).collect())
+        }
+        Err(_) => None,
+    };
     let mut runs = Vec::new();
     for k in 0..cols / n_t {
         let c = s![.., k * n_t..(k + 1) * n_t];
@@ -181,6 +217,7 @@ fn read_runs(p: &Pipeline, path: &Path, n_t: usize) -> Result<(Vec<Run>, f64)> {
         runs.push(Run {
             file: path.to_path_buf(),
             load_scale: col[0],
+            point: index.as_ref().map(|i| i[k]),
             x: x.slice(c).to_owned(),
             multipliers: mult.slice(c).to_owned(),
             t: t.slice(s![k * n_t..(k + 1) * n_t]).to_owned(),
@@ -189,52 +226,79 @@ fn read_runs(p: &Pipeline, path: &Path, n_t: usize) -> Result<(Vec<Run>, f64)> {
     Ok((runs, read_attr_f64(&f, "full_seconds").unwrap_or(f64::NAN)))
 }
 
-/// Builds the basis from snapshot files: every load of `train.load_scales` exactly once
-/// among the files (a missing, doubled or foreign load is an error naming it), runs in the
-/// pipeline's order.
+/// Builds the basis from snapshot files: every run of `train.load_scales` (or of a box's
+/// `train.points`) exactly once among the files (a missing, doubled or foreign run is an
+/// error naming it), runs in the pipeline's order.
 pub fn train_from_snapshots(p: &Pipeline, files: &[PathBuf]) -> Result<(TrainingData, TrainSummary)> {
-    let scales = fixed_scales(p)?;
+    let points = fixed_points(p)?;
+    let in_box = !p.file.parameters.is_empty();
     let n_t = Settings::resolve(&p.model, &Overrides::default())?.n_steps + 1;
     let z = p.model.sizes();
-    let snapshots = scales.len() as f64 * n_t as f64;
+    let snapshots = points.len() as f64 * n_t as f64;
     p.model.limits.check_memory(
         &format!("training on {} snapshots × {} coordinates", snapshots, z.n_dof),
         3.0 * 8.0 * snapshots * (z.n_dof + z.n_constraints) + z.n_elements * crate::limits::BYTES_PER_ELEMENT,
     )?;
-    let mut runs: Vec<Run> = Vec::new();
+    // which training run a file's run is: its load scale on a line, its point index in a box
+    let slot = |run: &Run| -> Result<usize> {
+        let found = if in_box {
+            run.point.filter(|&i| i < points.len())
+        } else {
+            points.iter().position(|mu| mu.scale().to_bits() == run.load_scale.to_bits())
+        };
+        found.ok_or_else(|| match (in_box, run.point) {
+            (true, None) => Error::input(
+                &run.file,
+                "point_index",
+                format!("is missing: not a snapshot file of {}'s box (written for a line of loads?)", p.path.display()),
+            ),
+            (true, Some(i)) => Error::input(
+                &run.file,
+                "point_index",
+                format!("{i} is not one of the {} training points of {}", points.len(), p.path.display()),
+            ),
+            (false, _) => Error::input(
+                &run.file,
+                "load_scale",
+                format!(
+                    "{} is not in {}'s train.load_scales {:?}",
+                    run.load_scale,
+                    p.path.display(),
+                    points.iter().map(Parameters::scale).collect::<Vec<_>>()
+                ),
+            ),
+        })
+    };
+    let mut held: Vec<Option<Run>> = (0..points.len()).map(|_| None).collect();
     let mut full_seconds = 0.0;
     for f in files {
         let (r, s) = read_runs(p, f, n_t)?;
         full_seconds += s;
         for run in r {
-            if !scales.iter().any(|x| x.to_bits() == run.load_scale.to_bits()) {
+            let k = slot(&run)?;
+            if let Some(other) = &held[k] {
+                let what = if in_box { format!("training point {k}") } else { format!("{}", run.load_scale) };
                 return Err(Error::input(
                     &run.file,
-                    "load_scale",
-                    format!("{} is not in {}'s train.load_scales {scales:?}", run.load_scale, p.path.display()),
+                    if in_box { "point_index" } else { "load_scale" },
+                    format!("{what} is also in {}: give each training run once", other.file.display()),
                 ));
             }
-            if let Some(other) = runs.iter().find(|o| o.load_scale.to_bits() == run.load_scale.to_bits()) {
-                return Err(Error::input(
-                    &run.file,
-                    "load_scale",
-                    format!("{} is also in {}: give each training load once", run.load_scale, other.file.display()),
-                ));
-            }
-            runs.push(run);
+            held[k] = Some(run);
         }
     }
-    let missing: Vec<f64> =
-        scales.iter().copied().filter(|x| !runs.iter().any(|r| r.load_scale.to_bits() == x.to_bits())).collect();
+    let missing: Vec<usize> = (0..points.len()).filter(|&k| held[k].is_none()).collect();
     if !missing.is_empty() {
-        return Err(Error::Usage(format!(
-            "--from-snapshots: no file holds the training load(s) {missing:?} of {}",
-            p.path.display()
-        )));
+        let what = if in_box {
+            let named = missing.iter().map(|&k| format!("{k} ({})", p.space().label(&points[k])));
+            format!("training point(s) {}", named.collect::<Vec<_>>().join(", "))
+        } else {
+            format!("training load(s) {:?}", missing.iter().map(|&k| points[k].scale()).collect::<Vec<_>>())
+        };
+        return Err(Error::Usage(format!("--from-snapshots: no file holds the {what} of {}", p.path.display())));
     }
     // the pipeline's order, as a single `train` concatenates its runs
-    let ordered: Vec<&Run> =
-        scales.iter().map(|x| runs.iter().find(|r| r.load_scale.to_bits() == x.to_bits()).expect("checked")).collect();
+    let ordered: Vec<&Run> = held.iter().map(|r| r.as_ref().expect("checked above")).collect();
     let cat = |g: &dyn Fn(&Run) -> ndarray::ArrayView2<f64>| {
         concatenate(Axis(1), &ordered.iter().map(|r| g(r)).collect::<Vec<_>>()).expect("same row counts")
     };
@@ -244,5 +308,5 @@ pub fn train_from_snapshots(p: &Pipeline, files: &[PathBuf]) -> Result<(Training
         load_scale: Array1::from_iter(ordered.iter().flat_map(|r| std::iter::repeat_n(r.load_scale, n_t))),
         t: Array1::from_iter(ordered.iter().flat_map(|r| r.t.iter().copied())),
     };
-    basis_from_snapshots(p, data, full_seconds, scales.len())
+    basis_from_snapshots(p, data, full_seconds, points.len())
 }
