@@ -190,6 +190,21 @@ fn greedy_training_over_a_box_converges_and_its_estimate_covers_held_out_points(
     assert_eq!(g, runs.column(0).to_vec());
     drop(f);
 
+    // a sharded sweep merged keeps training's sensitivity at the nearest candidates, as
+    // the single sweep does
+    let grid = ["--param", "g=0.8:1.2:2", "--param", "push=0.2:2:2:log", "-q"];
+    for (k, o) in [("1/2", "q1.h5"), ("2/2", "q2.h5")] {
+        let out = flexrom(d, &[&["sweep", "p.toml", "-o", o, "--shard", k][..], &grid].concat());
+        assert!(out.status.success(), "{}", text(&out).1);
+    }
+    assert!(flexrom(d, &[&["sweep", "p.toml", "-o", "q.h5"][..], &grid].concat()).status.success());
+    assert!(flexrom(d, &["merge", "q1.h5", "q2.h5", "-o", "qm.h5"]).status.success());
+    let near =
+        |f: &str| hdf5::File::open(d.join(f)).unwrap().dataset("sensitivity_near").unwrap().read_raw::<f64>().unwrap();
+    let single = near("q.h5");
+    assert!(single.iter().all(|s| s.is_finite()), "{single:?}");
+    assert_eq!(near("qm.h5"), single);
+
     let out = flexrom(d, &["validate", "p.toml", "--json", "--no-dense"]);
     let (stdout, stderr) = text(&out);
     assert!(out.status.success(), "{stderr}");

@@ -369,8 +369,10 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool, limits: &Limits) -> R
     let gaps = sweep.scales.iter().filter(|x| matches!(x.outcome, Outcome::Pending)).count();
     // the basis file is where the parts say (checked against their hash above)
     let sensitivity = match &first.basis {
-        Some(b) if stored.is_some() => crate::io::estimator_file::read_training_sensitivity(&b.path)?
-            .map(|(c, v)| crate::rom::trust::LoadSensitivity::new(c, v)),
+        Some(b) if stored.is_some() => {
+            let space = crate::io::parameter_space_file::read_parameter_space(&b.path)?.unwrap_or_default();
+            crate::rom::trust::LoadSensitivity::read(&b.path, &space)?
+        }
         _ => None,
     };
     let basis = stored.as_ref().zip(first.basis.as_ref()).map(|(stored, b)| SweepBasis {

@@ -82,8 +82,7 @@ impl Rom {
     /// warnings a user should see (a method whose own check failed for this basis).
     pub fn load(model: &Arc<Model>, path: &Path, stored: &StoredBasis, o: LoadOptions) -> Result<(Self, Vec<String>)> {
         use crate::io::estimator_file::{
-            read_estimator, read_training_measure, read_training_range, read_training_sensitivity,
-            read_training_tolerance,
+            read_estimator, read_training_measure, read_training_range, read_training_tolerance,
         };
         let mut warnings = Vec::new();
         let data = if o.no_estimate { None } else { read_estimator(path, &stored.basis)? };
@@ -111,11 +110,7 @@ impl Rom {
             None => (read_training_tolerance(path)?, trained),
         };
         let space = crate::io::parameter_space_file::read_parameter_space(path)?.unwrap_or_default();
-        let sensitivity = match read_training_sensitivity(path)? {
-            Some((c, s)) => Some(trust::LoadSensitivity::new(c, s)),
-            None => crate::io::estimator_file::read_training_box_sensitivity(path, &space)?
-                .map(|(unit, s)| trust::LoadSensitivity::in_box(space.clone(), unit, s)),
-        };
+        let sensitivity = trust::LoadSensitivity::read(path, &space)?;
         // a box that holds λ gives its range; else the training loads' [min, max]
         let range = match space.range(crate::solver::parameters::LOAD_SCALE) {
             Some(r) => (r.lower, r.upper),

@@ -103,6 +103,17 @@ impl LoadSensitivity {
         LoadSensitivity { candidates, whole_run, points: None }
     }
 
+    /// Greedy training's record in the basis file `path` (trained over the box `space`,
+    /// empty for a line): on a line `/training/candidates`, in a box
+    /// `/training/candidate_points`; `None` for other bases.
+    pub fn read(path: &std::path::Path, space: &ParameterSpace) -> Result<Option<Self>> {
+        use crate::io::estimator_file::{read_training_box_sensitivity, read_training_sensitivity};
+        Ok(match read_training_sensitivity(path)? {
+            Some((c, s)) => Some(Self::new(c, s)),
+            None => read_training_box_sensitivity(path, space)?.map(|(unit, s)| Self::in_box(space.clone(), unit, s)),
+        })
+    }
+
     /// Candidates at the points `unit` of the box `space`'s unit cube, one sensitivity each.
     pub fn in_box(space: ParameterSpace, unit: Vec<Vec<f64>>, whole_run: Vec<f64>) -> Self {
         LoadSensitivity { candidates: Vec::new(), whole_run, points: Some((space, unit)) }
