@@ -84,25 +84,11 @@ fn read_part(path: &Path) -> Result<Part> {
     // a sweep over named parameters: the points, as /points holds them
     let (all, names): (Vec<Parameters>, Vec<String>) = match g.dataset("all_points") {
         Ok(d) => {
-            let a = d.read_2d::<f64>().map_err(|e| bad("shard/all_points", format!("cannot be read: {e}")))?;
-            let names = read_attr_str(&d, "parameters")
-                .map_err(|e| bad("shard/all_points", format!("has no readable attribute `parameters`: {e}")))?;
-            let names: Vec<String> = names.split(',').map(str::to_string).collect();
-            if a.dim() != (scales_all.len(), names.len()) || names.first().map(String::as_str) != Some(LOAD_SCALE) {
-                return Err(bad(
-                    "shard/all_points",
-                    format!(
-                        "is {:?} with parameters {names:?}; expected ({}, d), load_scale first (a damaged file)",
-                        a.dim(),
-                        scales_all.len()
-                    ),
-                ));
+            let (names, all) = super::sweep::file::read_point_table(&d, scales_all.len())
+                .map_err(|problem| bad("shard/all_points", problem))?;
+            if names.first().map(String::as_str) != Some(LOAD_SCALE) {
+                return Err(bad("shard/all_points", format!("has parameters {names:?}; load_scale comes first")));
             }
-            let all = a
-                .rows()
-                .into_iter()
-                .map(|row| names.iter().zip(row).fold(Parameters::default(), |mu, (n, &v)| mu.with(n, v)))
-                .collect();
             (all, names)
         }
         Err(_) => (scales_all.iter().map(|&x| Parameters::load_scale(x)).collect(), vec![LOAD_SCALE.to_string()]),

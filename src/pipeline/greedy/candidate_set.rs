@@ -127,11 +127,7 @@ impl CandidateSet {
     /// The neighbouring run of a sensitivity check at candidate `i`: every parameter of the
     /// box (λ on a line) times `1 + step`.
     pub fn moved(&self, i: usize, step: f64) -> Parameters {
-        let mu = &self.points[i];
-        if !self.is_box() {
-            return Parameters::load_scale(mu.scale() * (1.0 + step));
-        }
-        self.space.moved(mu, 1.0 + step)
+        self.space.moved(&self.points[i], 1.0 + step)
     }
 }
 

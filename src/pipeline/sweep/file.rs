@@ -262,20 +262,22 @@ pub fn points_of(f: &hdf5::File, scales: &[f64]) -> std::result::Result<Vec<Para
         return Ok(scales.iter().map(|&x| Parameters::load_scale(x)).collect());
     }
     let d = f.dataset("points").map_err(|e| ("points", format!("cannot be read: {e}")))?;
-    let a = d.read::<f64, ndarray::Ix2>().map_err(|e| ("points", format!("cannot be read: {e}")))?;
-    let names = read_attr_str(&d, "parameters")
-        .map_err(|e| ("points", format!("has no readable attribute `parameters`: {e}")))?;
-    let names: Vec<&str> = names.split(',').collect();
-    if a.dim() != (scales.len(), names.len()) {
-        return Err((
-            "points",
-            format!("is {:?}, expected ({}, {}) for its parameters {names:?}", a.dim(), scales.len(), names.len()),
-        ));
+    read_point_table(&d, scales.len()).map(|(_, points)| points).map_err(|e| ("points", e))
+}
+
+/// A (point, parameter) table as `/points` stores it (the names in its attribute
+/// `parameters`): the names and one `Parameters` per row; `Err(problem)` when it cannot be
+/// read or has not `rows` rows and a column per name.
+pub fn read_point_table(d: &hdf5::Dataset, rows: usize) -> std::result::Result<(Vec<String>, Vec<Parameters>), String> {
+    let a = d.read::<f64, ndarray::Ix2>().map_err(|e| format!("cannot be read: {e}"))?;
+    let names = read_attr_str(d, "parameters").map_err(|e| format!("has no readable attribute `parameters`: {e}"))?;
+    let names: Vec<String> = names.split(',').map(str::to_string).collect();
+    if a.dim() != (rows, names.len()) {
+        return Err(format!("is {:?}, expected ({rows}, {}) for its parameters {names:?}", a.dim(), names.len()));
     }
-    Ok(a.rows()
-        .into_iter()
-        .map(|row| names.iter().zip(row).fold(Parameters::default(), |mu, (n, &v)| mu.with(n, v)))
-        .collect())
+    let points =
+        a.rows().into_iter().map(|row| names.iter().zip(row).fold(Parameters::default(), |mu, (n, &v)| mu.with(n, v)));
+    Ok((names.clone(), points.collect()))
 }
 
 /// Reads an earlier sweep file for `--resume`: (parameters, the finished run) for every
