@@ -176,8 +176,9 @@ fn greedy_training_over_a_box_converges_and_its_estimate_covers_held_out_points(
     let cands = t.dataset("candidate_points").unwrap();
     assert_eq!(flexrom::io::h5::read_attr_str(&cands, "parameters").unwrap(), "g,push");
     let cands = cands.read_2d::<f64>().unwrap();
-    // 32 candidates per parameter, inside the box
-    assert_eq!(cands.dim(), (64, 2));
+    // the box's 4 corners and 4 face centres, and 32 drawn candidates per parameter, inside the box
+    assert_eq!(cands.dim(), (4 + 4 + 64, 2));
+    assert_eq!(cands.row(3).to_vec(), vec![1.2, 2.0]);
     assert!(cands.rows().into_iter().all(|r| (0.8..=1.2).contains(&r[0]) && (0.2..=2.0).contains(&r[1])));
     let runs = t.dataset("points").unwrap().read_2d::<f64>().unwrap();
     // the first runs: lower corner, centre (a log axis's centre: √(0.2 · 2)), upper corner
@@ -256,11 +257,32 @@ fn a_box_that_does_not_fit_the_model_or_the_training_is_refused_naming_the_field
             "the pipeline has no [parameters] box",
         ),
         ("[train]\ngreedy = { tolerance = 1e-3, max_runs = 4 }\n".to_string(), "train.greedy.range", "is missing"),
+        // the model's loads are scaled by g and push, none by λ
+        (
+            "[train]\ngreedy = { range = [0.5, 1.5], tolerance = 1e-3, max_runs = 4 }\n".to_string(),
+            "train.greedy.range",
+            "no load of the model is `scaled = true`, so it would change nothing; its parameters are g, push",
+        ),
+        (
+            format!("{}{TRAIN}", BOX.replace("\"log\"", "\"logarithmic\"")),
+            "parameters.push",
+            "unknown variant `logarithmic`, expected `linear` or `log`",
+        ),
     ] {
         setup(d, &body);
         let e = flexrom::pipeline::Pipeline::load(d.join("p.toml")).expect_err(&body).to_string();
-        assert!(e.contains(&format!("p.toml: {field}: ")) && e.contains(problem), "{body}\n{e}");
+        // a problem serde finds while reading also names the line
+        let named = e.contains(&format!("p.toml: {field}: ")) || e.contains(&format!("p.toml: {field} (line "));
+        assert!(named && e.contains(problem), "{body}\n{e}");
     }
+    // a box's settings hash counts the candidates it draws (32 per parameter when not
+    // given), so that a basis trained with another count is flagged as stale
+    let hash = |candidates: &str| {
+        setup(d, &format!("{BOX}[train]\ngreedy = {{ tolerance = 1e-3, max_runs = 4{candidates} }}\n"));
+        flexrom::pipeline::Pipeline::load(d.join("p.toml")).unwrap().settings_hash()
+    };
+    assert_eq!(hash(""), hash(", candidates = 64"));
+    assert_ne!(hash(""), hash(", candidates = 33"));
 }
 
 #[test]
@@ -349,4 +371,36 @@ fn a_sweep_over_a_grid_of_points_runs_each_point_as_online_does_and_resumes_by_p
     assert_eq!(out.status.code(), Some(1));
     assert!(text(&out).1.contains("sweeps the points of `--param NAME=A:B:N`"));
     assert!(!d.join("s4.h5").exists());
+}
+
+/// A parameter the model does not have, or one that means nothing to it: a misspelt CSV
+/// column is refused naming the CSV's header; a load scale on a model none of whose loads
+/// is `scaled = true` (here: gravity by `g`, the push by `push`) runs, but warns that it
+/// changes nothing and names the parameters the model has.
+#[test]
+fn parameters_the_model_does_not_have_are_refused_or_warned_about() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    setup(d, &format!("{BOX}{TRAIN}"));
+    std::fs::write(d.join("pts.csv"), "g,puhs\n1.0,0.5\n").unwrap();
+    let out = flexrom(d, &["sweep", "p.toml", "--points", "pts.csv", "-o", "s.h5"]);
+    let err = text(&out).1;
+    assert!(!out.status.success() && !d.join("s.h5").exists(), "{err}");
+    assert!(
+        err.contains("pts.csv: header: column `puhs`: the model has no parameter `puhs` (its parameters: g, push)"),
+        "{err}"
+    );
+    for args in [
+        &["simulate", "m.toml", "--load-scale", "1.2", "--t-end", "0.01", "-o", "x.h5"][..],
+        &["simulate", "m.toml", "--param", "load_scale=0.8", "--t-end", "0.01", "-o", "y.h5"],
+    ] {
+        let out = flexrom(d, args);
+        let err = text(&out).1;
+        assert!(out.status.success(), "{err}");
+        assert!(
+            err.contains("warning: m.toml: the load scale")
+                && err.contains("so it would change nothing; its parameters are g, push"),
+            "{err}"
+        );
+    }
 }

@@ -192,7 +192,14 @@ fn sweep_points(
         flexrom::pipeline::config::parse_range(s).map_err(|e| flexrom::Error::Usage(format!("--load-scales: {e}")))
     };
     let points = if let Some(f) = file {
-        read_points_csv(f)?
+        let points = read_points_csv(f)?;
+        // a misspelt column is the CSV's problem: name its header
+        let unknown =
+            points[0].named().find_map(|(n, _)| p.model.unknown_parameter(n).map(|why| format!("column `{n}`: {why}")));
+        if let Some(problem) = unknown {
+            return Err(flexrom::Error::input(f, "header", problem));
+        }
+        points
     } else if params.is_empty() && p.space().is_empty() {
         let scales = match load_scales {
             Some(s) => range(s)?,
@@ -224,5 +231,6 @@ fn sweep_points(
         mu.validate()?;
         p.model.check_parameters(mu)?;
     }
+    super::warn(p.model.load_scale_warning(points.iter().map(Parameters::scale)).as_slice());
     Ok(points)
 }

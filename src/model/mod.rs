@@ -124,6 +124,31 @@ impl Model {
         }
     }
 
+    /// The warning for load scales other than 1 on a model none of whose loads is `scaled =
+    /// true`: they change nothing, and a run would read as at another load.
+    pub fn load_scale_warning(&self, mut scales: impl Iterator<Item = f64>) -> Option<String> {
+        let why = self.unscaled_load_scale()?;
+        let x = scales.find(|&x| x != 1.0)?;
+        Some(format!("{}: the load scale {x} is given, but {why}", self.path.display()))
+    }
+
+    /// Why a load scale λ means nothing to this model (no load is `scaled = true`), or
+    /// `None` when some load is.
+    pub fn unscaled_load_scale(&self) -> Option<String> {
+        let names = self.parameter_names();
+        if names.contains(&crate::solver::parameters::LOAD_SCALE) {
+            return None;
+        }
+        Some(if names.is_empty() {
+            "no load of the model is scaled (`scaled = true`), so it would change nothing".to_string()
+        } else {
+            format!(
+                "no load of the model is `scaled = true`, so it would change nothing; its parameters are {} (set them with --param NAME=VALUE)",
+                names.join(", ")
+            )
+        })
+    }
+
     /// Why `name` is not a parameter of this model (the parameters it has), or `None` when
     /// it is one.
     pub fn unknown_parameter(&self, name: &str) -> Option<String> {

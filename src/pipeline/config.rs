@@ -118,6 +118,18 @@ impl Pipeline {
                 }
             }
         }
+        let t = &self.file.train;
+        if self.file.parameters.is_empty() {
+            // a line of load scales trains over λ, which must move some load
+            let varies = t.greedy.is_some() || t.load_scales.as_ref().is_some_and(|s| s.iter().any(|&x| x != 1.0));
+            if let Some(why) = self.model.unscaled_load_scale().filter(|_| varies) {
+                let field = if t.greedy.is_some() { "train.greedy.range" } else { "train.load_scales" };
+                return bad(
+                    field,
+                    format!("trains over load scales, but {why}; a [parameters] box trains over named parameters"),
+                );
+            }
+        }
         if let Err(e) = red.modes.as_ref().map_or(Ok(()), |m| m.validate()) {
             return bad("reduction.modes", e);
         }
@@ -348,6 +360,12 @@ impl Pipeline {
     /// ([`crate::io::basis_hash::settings_hash`]): a basis trained with other settings is
     /// flagged as stale.
     pub fn settings_hash(&self) -> String {
-        crate::io::basis_hash::settings_hash(&self.file.train, &self.file.reduction, &self.file.parameters)
+        let mut train = self.file.train.clone();
+        // a box's default candidate count is its own (32 per parameter), not the line's 33
+        // that an absent `candidates` hashes as
+        if let Some(g) = train.greedy.as_mut().filter(|_| !self.file.parameters.is_empty()) {
+            g.candidates.get_or_insert(DEFAULT_BOX_CANDIDATES_PER_PARAMETER * self.file.parameters.len());
+        }
+        crate::io::basis_hash::settings_hash(&train, &self.file.reduction, &self.file.parameters)
     }
 }

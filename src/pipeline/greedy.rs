@@ -26,8 +26,8 @@
 //!   snapshots by ε, ECSW's τ bounds a relative force error in norm; √ε puts both at the
 //!   same relative size, so neither dominates the other as the search tightens.
 //! - B(η) = max over neighbouring candidates of max(ηᵢ, ηᵢ₊₁)² / min(ηᵢ, ηᵢ₊₁)
-//!   (`search::between_candidates`; in a box over each candidate and its nearest
-//!   neighbour in the unit cube): the tolerance is a promise for every load of the
+//!   (`search::between_candidates`; in a box over each candidate and its d + 1 nearest
+//!   neighbours in the unit cube): the tolerance is a promise for every load of the
 //!   range, and between two candidates the estimate is taken to rise above the larger by
 //!   as much as it changes between them (a few per cent for a smooth estimate, 33
 //!   candidates); between two *sensitive* candidates (sensitivity above T, below) the
@@ -243,7 +243,15 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
             let name = g.measure.error_name();
             log::info!("iteration {n}: worst score {worst:.2e} ≤ {:e}; held-out check at {at} (score {next_estimate:.2e}): {name} {e_measured:.2e} (score {e_score:.2e}, sensitivity {sens:.1e}); {shape}", g.tolerance);
         } else {
-            log::info!("iteration {n}: full run at {at} (worst score {worst:.2e} {cmp} {:e}; {next_estimate:.2e} there, true error {e_measured:.2e}, its score {e_score:.2e}, sensitivity {sens:.1e}), {shape}", g.tolerance);
+            // with every score within T, say what keeps the loop going
+            let why = if worst > g.tolerance {
+                String::new()
+            } else if bound > g.tolerance {
+                format!("; the bound between candidates is {bound:.2e} > {:e}", g.tolerance)
+            } else {
+                format!("; the held-out run's own score is above {:e}", g.tolerance)
+            };
+            log::info!("iteration {n}: full run at {at} (worst score {worst:.2e} {cmp} {:e}; {next_estimate:.2e} there, true error {e_measured:.2e}, its score {e_score:.2e}, sensitivity {sens:.1e}){why}, {shape}", g.tolerance);
         }
         iterations.push(it);
         if done {

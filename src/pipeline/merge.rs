@@ -126,11 +126,12 @@ fn read_part(path: &Path) -> Result<Part> {
         .map(|m| m.as_str().to_string())
         .collect();
     let n = scales.len();
+    let noun = if names.len() > 1 { "points" } else { "load scales" };
     if indices.len() != n || status.len() != n || message.len() != n {
         return Err(bad(
             "shard/indices",
             format!(
-                "has {} entries, /status {}, /message {}, for {n} load scales",
+                "has {} entries, /status {}, /message {}, for {n} {noun}",
                 indices.len(),
                 status.len(),
                 message.len()
@@ -142,8 +143,22 @@ fn read_part(path: &Path) -> Result<Part> {
     {
         return Err(bad(
             "shard/indices",
-            format!("are not the loads of shard {index}/{count} of shard/all_load_scales (a damaged file)"),
+            format!("are not the {noun} of shard {index}/{count} of shard/all_load_scales (a damaged file)"),
         ));
+    }
+    // over named parameters every parameter of each row, not λ alone
+    if names.len() > 1 {
+        let d = f.dataset("points").map_err(|e| bad("points", format!("cannot be read: {e}")))?;
+        let (_, rows) = super::sweep::file::read_point_table(&d, n).map_err(|problem| bad("points", problem))?;
+        let same = |a: &Parameters, b: &Parameters| {
+            names.iter().all(|k| a.get(k).map(f64::to_bits) == b.get(k).map(f64::to_bits))
+        };
+        if indices.iter().zip(&rows).any(|(&i, mu)| !same(&all[i], mu)) {
+            return Err(bad(
+                "points",
+                format!("are not the points of shard {index}/{count} of shard/all_points (a damaged file)"),
+            ));
+        }
     }
     let flag = |name: &str| -> Result<bool> {
         f.attr(name)
@@ -243,7 +258,8 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool, limits: &Limits) -> R
             return Err(differ("model_fingerprint", "comes from another model"));
         }
         if p.list_hash != first.list_hash {
-            return Err(differ("shard/load_list_hash", "comes from another load list"));
+            let list = if first.all.iter().any(|mu| mu.named().next().is_some()) { "point list" } else { "load list" };
+            return Err(differ("shard/load_list_hash", &format!("comes from another {list}")));
         }
         if p.count != first.count {
             return Err(differ(

@@ -410,7 +410,16 @@ fn build(
     }
     let labels: Vec<String> = validations.iter().map(at).collect();
     motion_section(&mut md, &validations, &labels, head, trust);
-    let _ = writeln!(md, "\n## Sweep\n\n```text\n{}```\n", table(&sw));
+    let mut swept = table(&sw);
+    if in_box {
+        // the plots run along the sweep's points: number the rows as they do
+        swept = swept
+            .lines()
+            .enumerate()
+            .map(|(i, l)| format!("{:>5}{l}\n", if i == 0 { "#".to_string() } else { i.to_string() }))
+            .collect();
+    }
+    let _ = writeln!(md, "\n## Sweep\n\n```text\n{swept}```\n");
     let _ = writeln!(md, "## Plots\n");
     for (i, x) in labels.iter().enumerate() {
         let _ = writeln!(md, "![probes at {x}](probes_{i}.svg)");

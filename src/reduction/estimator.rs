@@ -128,8 +128,12 @@ impl DefectsCalibration {
                 let n = c.ratios.len();
                 let passed = (0..n)
                     .filter(|&j| {
+                        // no usable neighbour is a failed prediction: the global factor
+                        // would include the left-out ratio itself
                         let own = c.ratios[j][i];
-                        usable(own) && c.largest(&s.nearest(&s.unit[j], Some(j)), i) >= own / DEFAULT_FACTOR
+                        usable(own)
+                            && c.largest_usable(&s.nearest(&s.unit[j], Some(j)), i)
+                                .is_some_and(|r| r >= own / DEFAULT_FACTOR)
                     })
                     .count();
                 passed as f64 >= DEFECTS_RELIABLE_SHARE * n as f64
@@ -141,12 +145,12 @@ impl DefectsCalibration {
     /// The largest usable ratio of fifth `i` among the candidates `js` (the largest of all
     /// when none is usable).
     fn largest(&self, js: &[usize], i: usize) -> f64 {
-        let r = js.iter().map(|&j| self.ratios[j][i]).filter(|x| usable(*x)).fold(f64::NAN, f64::max);
-        if r.is_nan() {
-            self.factors[i]
-        } else {
-            r
-        }
+        self.largest_usable(js, i).unwrap_or(self.factors[i])
+    }
+
+    /// The largest usable ratio of fifth `i` among the candidates `js`, if any is usable.
+    fn largest_usable(&self, js: &[usize], i: usize) -> Option<f64> {
+        js.iter().map(|&j| self.ratios[j][i]).filter(|x| usable(*x)).reduce(f64::max)
     }
 
     /// `f_i(λ)` at the parameters `mu` (the type's documentation).
@@ -409,5 +413,22 @@ mod tests {
         spike[2] = r(0.5);
         spike[6] = r(0.5);
         assert!(!DefectsCalibration::scattered(space, unit, spike).unwrap().reliable);
+    }
+
+    /// A candidate whose nearest candidates have no usable ratio is not predicted, so it
+    /// fails the check: of 20 calm candidates with no ratio at 9 and 11, those two and 10
+    /// (whose two nearest they are) fail — 17 of 20 pass, below 90 %. Reading 10 from the
+    /// largest ratio of all, its own among them, would have passed it (18 of 20).
+    #[test]
+    fn a_candidate_without_usable_neighbours_fails_the_scattered_check() {
+        use crate::solver::parameter_space::{ParameterRange, ParameterSpace, Spacing};
+        let space = ParameterSpace {
+            ranges: vec![ParameterRange { name: "p".into(), lower: 0.0, upper: 19.0, spacing: Spacing::Linear }],
+        };
+        let unit: Vec<Vec<f64>> = (0..20).map(|j| vec![j as f64 / 19.0]).collect();
+        let mut ratios: Vec<[f64; 5]> = (0..20).map(|j| [0.1 + 0.001 * j as f64; 5]).collect();
+        ratios[9] = [f64::NAN; 5];
+        ratios[11] = [f64::NAN; 5];
+        assert!(!DefectsCalibration::scattered(space, unit, ratios).unwrap().reliable);
     }
 }

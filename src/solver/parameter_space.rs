@@ -222,14 +222,17 @@ impl ParameterSpace {
     }
 
     /// The neighbouring point of a sensitivity check: every parameter of the box times
-    /// `factor` (λ alone for an empty box, as a line of load scales moves it).
+    /// `factor` (λ alone for an empty box, as a line of load scales moves it). A parameter
+    /// at 0 (a moment's range [−1, 1] at its centre) moves by `factor − 1` of its range's
+    /// larger end instead, so that the check sees it too.
     pub fn moved(&self, mu: &Parameters, factor: f64) -> Parameters {
         if self.is_empty() {
             return mu.scaled_by(factor);
         }
-        self.names().fold(mu.clone(), |m, n| {
-            let x = mu.get(n).unwrap_or(1.0);
-            m.with(n, x * factor)
+        self.ranges.iter().fold(mu.clone(), |m, r| {
+            let x = mu.get(&r.name).unwrap_or(1.0);
+            let to = if x == 0.0 { (factor - 1.0) * r.lower.abs().max(r.upper.abs()) } else { x * factor };
+            m.with(&r.name, to)
         })
     }
 
@@ -348,5 +351,23 @@ mod tests {
         assert!(ParameterRange { name: "x".into(), lower: 1.0, upper: 1.0, spacing: Spacing::Linear }
             .validate()
             .is_err());
+    }
+
+    /// The sensitivity's neighbour moves every box parameter by the step, relatively — and a
+    /// parameter at 0 by the step times its range's larger end (|−2| here), which a
+    /// relative step would leave where it was.
+    #[test]
+    fn moved_moves_every_parameter_even_at_zero() {
+        let s = ParameterSpace {
+            ranges: vec![
+                ParameterRange { name: "drive".into(), lower: 0.5, upper: 1.5, spacing: Spacing::Linear },
+                ParameterRange { name: "pin".into(), lower: -2.0, upper: 1.0, spacing: Spacing::Linear },
+            ],
+        };
+        let m = s.moved(&Parameters::default().with("drive", 1.2).with("pin", 0.0), 1.001);
+        assert_eq!(m.get("drive"), Some(1.2 * 1.001));
+        assert_eq!(m.get("pin"), Some((1.001 - 1.0) * 2.0));
+        let m = s.moved(&Parameters::default().with("drive", 1.2).with("pin", -0.5), 1.001);
+        assert_eq!(m.get("pin"), Some(-0.5 * 1.001));
     }
 }

@@ -34,11 +34,30 @@ pub struct PipelineFile {
 
 /// A parameter's range in `[parameters]`: `drive = [0.5, 1.5]`, or `E = { range = [1e8,
 /// 4e8], scale = "log" }`.
-#[derive(Clone, Debug, Deserialize, serde::Serialize, PartialEq)]
+#[derive(Clone, Debug, serde::Serialize, PartialEq)]
 #[serde(untagged)]
 pub enum ParameterSpec {
     Range([f64; 2]),
     Table(ParameterTable),
+}
+
+// by hand rather than `untagged`, whose only message is "data did not match any variant":
+// a table's own problem (`scale = "logarithmic"`) is worth naming
+impl<'de> Deserialize<'de> for ParameterSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        use serde::de::Error as _;
+        let v = toml::Value::deserialize(d)?;
+        match v {
+            toml::Value::Array(_) => v.try_into().map(ParameterSpec::Range).map_err(|_| {
+                D::Error::custom("a range is two numbers [A, B] (or { range = [A, B], scale = \"log\" })")
+            }),
+            toml::Value::Table(_) => v.try_into().map(ParameterSpec::Table).map_err(|e| D::Error::custom(e.message())),
+            _ => Err(D::Error::custom(format!(
+                "is a {}; expected [A, B] or {{ range = [A, B], scale = \"linear\" | \"log\" }}",
+                v.type_str()
+            ))),
+        }
+    }
 }
 
 #[derive(Clone, Debug, Deserialize, serde::Serialize, PartialEq)]
@@ -166,11 +185,14 @@ impl GreedySpec {
             return bad("max_runs", "is 0; at least one full run is needed".into());
         }
         match self.candidates {
-            Some(n) if n < 2 => return bad("candidates", format!("is {n}; at least 2 (the range ends) are needed")),
-            Some(n) if n > crate::solver::parameter_space::MAX_SOBOL_POINTS => {
+            Some(n) if n < 2 => {
+                let why = if in_box { "at least 2 points of the box" } else { "at least 2 (the range ends)" };
+                return bad("candidates", format!("is {n}; {why} are needed"));
+            }
+            Some(n) if in_box && n > crate::solver::parameter_space::MAX_SOBOL_POINTS => {
                 return bad(
                     "candidates",
-                    format!("is {n}; at most {}", crate::solver::parameter_space::MAX_SOBOL_POINTS),
+                    format!("is {n}; a box draws at most {}", crate::solver::parameter_space::MAX_SOBOL_POINTS),
                 )
             }
             _ => {}
@@ -269,4 +291,28 @@ pub struct OnlineSpec {
 #[serde(deny_unknown_fields)]
 pub struct ScalesSpec {
     pub load_scales: Scales,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The Sobol sampler's limit (2¹⁶ points, `MAX_SOBOL_POINTS`) bounds a box's candidates;
+    /// a line's evenly spaced loads have no such limit.
+    #[test]
+    fn only_a_box_caps_the_candidates() {
+        let g = |range: Vec<f64>| GreedySpec {
+            range,
+            tolerance: 1e-3,
+            max_runs: 4,
+            candidates: Some(70_000),
+            measure: Default::default(),
+            sampling: None,
+            seed: None,
+        };
+        assert!(g(vec![0.5, 1.5]).validate(false).is_ok());
+        let (field, problem) = g(vec![]).validate(true).unwrap_err();
+        assert_eq!(field, "train.greedy.candidates");
+        assert!(problem.contains("a box draws at most 65536"), "{problem}");
+    }
 }

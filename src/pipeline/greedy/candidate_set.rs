@@ -3,16 +3,22 @@
 //!
 //! ```text
 //!     line:  λᵢ = A + (B − A) i/(N − 1)                 neighbours: (i, i + 1)
-//!     box:   uᵢ ∈ [0, 1)ᵈ drawn by Sobol (or LHS, random) from a fixed seed,
-//!            μᵢ = the box's point at uᵢ                  neighbours: each point and its nearest
+//!     box:   the 2ᵈ corners and 2d face centres of [0, 1]ᵈ (when they are no more than N),
+//!            then N points uᵢ ∈ [0, 1)ᵈ drawn by Sobol (or LHS, random) from a fixed seed,
+//!            μᵢ = the box's point at uᵢ                  neighbours: each point and its d + 1 nearest
 //! ```
 //!
 //! In a box the candidates live in the unit cube, so parameters of different units (a
 //! load factor, a Young's modulus on a log scale) weigh alike in the distances, and their
 //! count grows with the dimension (32 per parameter by default), not as countᵈ: a grid of
-//! 33 per axis would be 1089 reduced runs per rung in two dimensions. The first full runs
-//! are the line's ends and middle, in a box the lower and upper corners and the centre
-//! (the same three points on a line).
+//! 33 per axis would be 1089 reduced runs per rung in two dimensions. Drawn points stay
+//! about 1/N^(1/d) inside the faces, where a response is often at its largest (the largest
+//! loads), so the corners and the faces' centres are candidates too — as long as they do not
+//! outnumber the drawn points. Pairing each point with its d + 1 nearest (a simplex's worth, as the `defects`
+//! calibration reads) keeps the pairs one connected graph in practice; pairing each with
+//! its single nearest split a 64-point plane into about 19 islands with no bound between
+//! them. The first full runs are the line's ends and middle, in a box the lower and upper
+//! corners and the centre (the same three points on a line).
 
 use crate::pipeline::config::{GreedySpec, DEFAULT_BOX_CANDIDATES_PER_PARAMETER};
 use crate::solver::parameter_space::ParameterSpace;
@@ -38,10 +44,12 @@ impl CandidateSet {
         if space.is_empty() {
             return Self::line(&g.candidate_loads());
         }
-        let n = g.candidates.unwrap_or(DEFAULT_BOX_CANDIDATES_PER_PARAMETER * space.ranges.len());
-        let unit = space.sample_unit(n, g.sampling.unwrap_or_default(), g.seed.unwrap_or(1));
+        let d = space.ranges.len();
+        let n = g.candidates.unwrap_or(DEFAULT_BOX_CANDIDATES_PER_PARAMETER * d);
+        let mut unit = boundary_points(d, n);
+        unit.extend(space.sample_unit(n, g.sampling.unwrap_or_default(), g.seed.unwrap_or(1)));
         let points = unit.iter().map(|u| space.at(u)).collect();
-        let pairs = nearest_pairs(&unit);
+        let pairs = nearest_pairs(&unit, d + 1);
         CandidateSet { points, unit, pairs, space: space.clone() }
     }
 
@@ -131,21 +139,61 @@ impl CandidateSet {
     }
 }
 
-/// Each point paired with its nearest other point (Euclidean distance in the unit cube),
-/// each pair once, `i < j`, sorted.
-fn nearest_pairs(unit: &[Vec<f64>]) -> Vec<(usize, usize)> {
-    let d2 = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>();
+/// The 2ᵈ corners of the unit cube (the lower corner first, the upper one last), then the
+/// centres of its 2d faces; none when they would outnumber the `n` drawn points.
+fn boundary_points(d: usize, n: usize) -> Vec<Vec<f64>> {
+    if d >= usize::BITS as usize || (1usize << d) + 2 * d > n {
+        return Vec::new();
+    }
+    let mut out: Vec<Vec<f64>> = (0..1usize << d).map(|c| (0..d).map(|j| ((c >> j) & 1) as f64).collect()).collect();
+    // the faces' centres (on a line they are the corners)
+    for j in (0..d).filter(|_| d > 1) {
+        for side in [0.0, 1.0] {
+            let mut u = vec![0.5; d];
+            u[j] = side;
+            out.push(u);
+        }
+    }
+    out
+}
+
+/// Each point paired with its `k` nearest other points (Euclidean distance in the unit
+/// cube), and, where that leaves islands, each island joined to the rest by its shortest
+/// pair; each pair once, `i < j`, sorted.
+fn nearest_pairs(unit: &[Vec<f64>], k: usize) -> Vec<(usize, usize)> {
     let mut pairs: Vec<(usize, usize)> = (0..unit.len())
-        .filter_map(|i| {
-            (0..unit.len())
-                .filter(|&j| j != i)
-                .min_by(|&a, &b| d2(&unit[i], &unit[a]).total_cmp(&d2(&unit[i], &unit[b])))
-                .map(|j| (i.min(j), i.max(j)))
+        .flat_map(|i| {
+            crate::solver::parameter_space::nearest(unit, &unit[i], k, Some(i))
+                .into_iter()
+                .map(move |j| (i.min(j), i.max(j)))
         })
         .collect();
+    // the island holding point 0 grows by the shortest pair out of it until it holds all
+    let d2 = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>();
+    let mut island = reached(unit.len(), &pairs);
+    while let Some(bridge) = (0..unit.len())
+        .filter(|&i| island[i])
+        .flat_map(|i| (0..unit.len()).filter(|&j| !island[j]).map(move |j| (i, j)))
+        .min_by(|&(a, b), &(c, e)| d2(&unit[a], &unit[b]).total_cmp(&d2(&unit[c], &unit[e])))
+    {
+        pairs.push((bridge.0.min(bridge.1), bridge.0.max(bridge.1)));
+        island = reached(unit.len(), &pairs);
+    }
     pairs.sort_unstable();
     pairs.dedup();
     pairs
+}
+
+/// Which of `n` points a walk along `pairs` from point 0 reaches.
+fn reached(n: usize, pairs: &[(usize, usize)]) -> Vec<bool> {
+    let mut seen = vec![false; n];
+    let mut stack = if n > 0 { vec![0] } else { vec![] };
+    while let Some(i) = stack.pop() {
+        if !std::mem::replace(&mut seen[i], true) {
+            stack.extend(pairs.iter().filter_map(|&(a, b)| (a == i).then_some(b).or((b == i).then_some(a))));
+        }
+    }
+    seen
 }
 
 #[cfg(test)]
@@ -188,18 +236,19 @@ mod tests {
         assert_eq!(c.moved(2, 1e-3).scale(), 1.0 * (1.0 + 1e-3));
     }
 
-    /// In a box: 32 candidates per parameter by default, inside the box, each with a
-    /// nearest neighbour among the pairs; the first runs are the corners and the centre
-    /// (a log axis's centre is the geometric mean: √(1e8 · 4e8) = 2e8).
+    /// In a box: the 4 corners, 4 face centres and 32 drawn candidates per parameter by
+    /// default, inside
+    /// the box, the pairs one connected graph; the first runs are the corners and the
+    /// centre (a log axis's centre is the geometric mean: √(1e8 · 4e8) = 2e8).
     #[test]
     fn a_box_is_sampled_in_the_unit_cube() {
         let g = spec(None, vec![]);
         let c = CandidateSet::new(&g, &plane());
-        assert_eq!(c.len(), 64);
+        assert_eq!(c.len(), 4 + 4 + 64);
         assert!(c.points.iter().all(|mu| plane().outside(mu).is_empty()));
-        for i in 0..c.len() {
-            assert!(c.pairs.iter().any(|&(a, b)| a == i || b == i), "candidate {i} has no neighbour");
-        }
+        assert_eq!((c.points[0].get("drive"), c.points[0].get("stiff")), (Some(0.5), Some(1e8)));
+        assert_eq!((c.points[3].get("drive"), c.points[3].get("stiff")), (Some(1.5), Some(4e8)));
+        assert!(connected(c.len(), &c.pairs), "the pairs split the candidates");
         let first = c.first(&g, 8);
         assert_eq!(first[0].get("drive"), Some(0.5));
         assert_eq!(first[2].get("stiff"), Some(4e8));
@@ -213,11 +262,43 @@ mod tests {
         assert!(c.is_at(3, &c.points[3]) && !c.is_at(3, &m));
     }
 
+    fn connected(n: usize, pairs: &[(usize, usize)]) -> bool {
+        reached(n, pairs).iter().all(|&s| s)
+    }
+
     /// The nearest-neighbour pairs of four points on a line of the cube, 0, 0.1, 0.5, 1:
-    /// (0, 1) twice, (1, 2) from 0.5, (2, 3) from 1 — each once.
+    /// with one neighbour each (0, 1) twice, (1, 2) from 0.5, (2, 3) from 1 — each once;
+    /// with two, 0 also reaches 0.5 and 1 reaches 0.1.
     #[test]
     fn nearest_pairs_are_each_points_nearest() {
         let unit = vec![vec![0.0, 0.0], vec![0.1, 0.0], vec![0.5, 0.0], vec![1.0, 0.0]];
-        assert_eq!(nearest_pairs(&unit), vec![(0, 1), (1, 2), (2, 3)]);
+        assert_eq!(nearest_pairs(&unit, 1), vec![(0, 1), (1, 2), (2, 3)]);
+        assert_eq!(nearest_pairs(&unit, 2), vec![(0, 1), (0, 2), (1, 2), (1, 3), (2, 3)]);
+        // two far clusters: each point's nearest is in its own, and the shortest pair
+        // between them, (1, 2), joins them
+        let unit = vec![vec![0.0, 0.0], vec![0.1, 0.0], vec![0.9, 0.0], vec![1.0, 0.0]];
+        assert_eq!(nearest_pairs(&unit, 1), vec![(0, 1), (1, 2), (2, 3)]);
+    }
+
+    /// The corners, 2ᵈ of them, lower first and upper last, then the 2d face centres; none
+    /// when they would outnumber the drawn points (2⁶ + 12 = 76 > 40).
+    #[test]
+    fn the_boundary_comes_first_unless_it_outnumbers_the_draws() {
+        let square = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0], [0.0, 0.5], [1.0, 0.5], [0.5, 0.0], [0.5, 1.0]];
+        assert_eq!(boundary_points(2, 8), square.map(|u| u.to_vec()).to_vec());
+        assert_eq!(boundary_points(3, 96).len(), 8 + 6);
+        assert!(boundary_points(6, 40).is_empty());
+        // in every dimension the default set's pairs stay connected (1 to 4 parameters)
+        for d in 1..=4 {
+            let space = ParameterSpace {
+                ranges: (0..d)
+                    .map(|j| ParameterRange { name: format!("p{j}"), lower: 0.0, upper: 1.0, spacing: Spacing::Linear })
+                    .collect(),
+            };
+            let c = CandidateSet::new(&spec(None, vec![]), &space);
+            let faces = if d > 1 { 2 * d } else { 0 };
+            assert_eq!(c.len(), (1 << d) + faces + 32 * d);
+            assert!(connected(c.len(), &c.pairs), "{d} parameters: the pairs split the candidates");
+        }
     }
 }

@@ -287,7 +287,7 @@ fn rung_text(r: &Round, l: &Level, eps: f64, tau: f64, tolerance: f64) -> String
 
 /// A bound of an estimate between the candidates from its values `e` at them: between
 /// neighbours `i`, `j` (the `pairs`: `i`, `i + 1` on a line of evenly spaced loads, each
-/// point and its nearest in a box, [`CandidateSet`]) the estimate is taken to rise above the
+/// point and its d + 1 nearest in a box, [`CandidateSet`]) the estimate is taken to rise above the
 /// larger of the two by as much as it changes from one to the other,
 ///
 /// ```text
