@@ -189,6 +189,10 @@ fn greedy_training_over_a_box_converges_and_its_estimate_covers_held_out_points(
     // `/parameters` holds the same runs
     let g = f.dataset("parameters/g").unwrap().read_raw::<f64>().unwrap();
     assert_eq!(g, runs.column(0).to_vec());
+    // the routes were timed at the box's centre, which `/timing` names
+    let t = flexrom::io::timing_file::read_timing(&d.join("b.h5")).unwrap().unwrap();
+    assert_eq!(t.named.iter().map(|(n, _)| n.as_str()).collect::<Vec<_>>(), ["g", "push"]);
+    assert!((t.named[0].1 - 1.0).abs() < 1e-12 && (t.named[1].1 - (0.2f64 * 2.0).sqrt()).abs() < 1e-12, "{t:?}");
     drop(f);
 
     // a sharded sweep merged keeps training's sensitivity at the nearest candidates, as

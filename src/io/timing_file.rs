@@ -7,7 +7,8 @@
 //! /timing/reduced_seconds   ()   the reduced time loop, median, s
 //! /timing/estimate_seconds  ()   the error estimate of the reduced run, median, s (NaN:
 //!                                the basis has no estimator)
-//! attributes on /timing: load_scale (the training load timed), threads (1: one run at a
+//! attributes on /timing: load_scale (the training load timed), parameter:NAME (the other
+//!   parameters of the point timed, over a box: its centre), threads (1: one run at a
 //!   time on the calling thread), runs (timed rounds, each a full run, a reduced run and
 //!   its estimate, interleaved), estimate_method ("none" without an estimator)
 //! ```
@@ -24,6 +25,8 @@ use std::path::Path;
 #[derive(Clone, Debug, PartialEq)]
 pub struct RouteTiming {
     pub load_scale: f64,
+    /// the named parameters of the point timed (a box's centre), in name order
+    pub named: Vec<(String, f64)>,
     pub full_seconds: f64,
     pub reduced_seconds: f64,
     /// NaN without an estimator
@@ -49,6 +52,9 @@ pub fn append_timing(path: &Path, t: &RouteTiming) -> Result<()> {
         write_units(&d, units, dims).map_err(e)?;
     }
     attr_f64(&g, "load_scale", t.load_scale).map_err(e)?;
+    for (name, value) in &t.named {
+        attr_f64(&g, &format!("parameter:{name}"), *value).map_err(e)?;
+    }
     attr_u64(&g, "threads", t.threads as u64).map_err(e)?;
     attr_u64(&g, "runs", t.runs as u64).map_err(e)?;
     attr_str(&g, "estimate_method", t.estimate_method.as_deref().unwrap_or("none")).map_err(e)?;
@@ -79,8 +85,16 @@ pub fn read_timing(path: &Path) -> Result<Option<RouteTiming>> {
     };
     let method =
         read_attr_str(&g, "estimate_method").map_err(|e| bad("estimate_method", format!("cannot be read: {e}")))?;
+    let mut named = Vec::new();
+    for a in g.attr_names().map_err(|e| bad("(attributes)", format!("cannot be listed: {e}")))? {
+        if let Some(name) = a.strip_prefix("parameter:") {
+            named.push((name.to_string(), read_attr_f64(&g, &a).map_err(|e| bad(&a, format!("cannot be read: {e}")))?));
+        }
+    }
+    named.sort_by(|a, b| a.0.cmp(&b.0));
     Ok(Some(RouteTiming {
         load_scale: read_attr_f64(&g, "load_scale").map_err(|e| bad("load_scale", format!("cannot be read: {e}")))?,
+        named,
         full_seconds: seconds[0],
         reduced_seconds: seconds[1],
         estimate_seconds: seconds[2],

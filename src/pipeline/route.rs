@@ -44,6 +44,7 @@ pub fn time_routes(rom: &Rom, mu: &Parameters) -> Result<RouteTiming> {
     }
     Ok(RouteTiming {
         load_scale: mu.scale(),
+        named: mu.named().map(|(n, x)| (n.to_string(), x)).collect(),
         full_seconds: median(&mut full_times),
         reduced_seconds: median(&mut rom_times),
         estimate_seconds: if estimate_times.is_empty() { f64::NAN } else { median(&mut estimate_times) },
@@ -152,7 +153,11 @@ impl Comparison {
 /// `train`) says that the reduced model, with its estimate when runs make one
 /// (`with_estimate`), is not faster than the full one; `None` when it is faster.
 pub fn speed_notice(basis: &Path, timing: &RouteTiming, with_estimate: bool) -> Option<String> {
-    let measured = format!("timed by `train` at load scale {}, one run at a time", timing.load_scale);
+    let at = std::iter::once(format!("load scale {}", timing.load_scale))
+        .chain(timing.named.iter().map(|(n, x)| format!("{n} = {}", crate::solver::parameter_space::short_number(*x))))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let measured = format!("timed by `train` at {at}, one run at a time");
     Comparison::stored(timing, with_estimate).notice(basis, &measured)
 }
 
@@ -170,6 +175,7 @@ mod tests {
     fn timing(full: f64, reduced: f64, estimate: f64) -> RouteTiming {
         RouteTiming {
             load_scale: 0.935,
+            named: Vec::new(),
             full_seconds: full,
             reduced_seconds: reduced,
             estimate_seconds: estimate,
