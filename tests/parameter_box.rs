@@ -209,6 +209,19 @@ fn greedy_training_over_a_box_converges_and_its_estimate_covers_held_out_points(
     let single = near("q.h5");
     assert!(single.iter().all(|s| s.is_finite()), "{single:?}");
     assert_eq!(near("qm.h5"), single);
+    // a part whose own rows are not its points (a named value changed, λ kept) is refused
+    std::fs::copy(d.join("q1.h5"), d.join("q1bad.h5")).unwrap();
+    {
+        let f = hdf5::File::open_rw(d.join("q1bad.h5")).unwrap();
+        let pts = f.dataset("points").unwrap();
+        let mut a = pts.read_2d::<f64>().unwrap();
+        a[[0, 2]] *= 1.5;
+        pts.write(&a).unwrap();
+    }
+    let out = flexrom(d, &["merge", "q1bad.h5", "q2.h5", "-o", "qbad.h5"]);
+    let err = text(&out).1;
+    assert!(!out.status.success() && !d.join("qbad.h5").exists(), "{err}");
+    assert!(err.contains("q1bad.h5: points: are not the points of shard 1/2"), "{err}");
 
     let out = flexrom(d, &["validate", "p.toml", "--json", "--no-dense"]);
     let (stdout, stderr) = text(&out);
