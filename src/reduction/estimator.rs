@@ -88,10 +88,10 @@ pub struct Scattered {
 }
 
 impl Scattered {
-    /// The `d + 1` candidates nearest to the unit-cube point `u` (a simplex's worth: on a
-    /// line the two that bracket it), `skip` left out.
-    fn nearest(&self, u: &[f64], skip: Option<usize>) -> Vec<usize> {
-        crate::solver::parameter_space::nearest(&self.unit, u, self.space.ranges.len() + 1, skip)
+    /// The candidates around the unit-cube point `u`, the nearest in each orthant (on a line
+    /// the two that bracket it: [`crate::solver::parameter_space::around`]), `skip` left out.
+    fn around(&self, u: &[f64], skip: Option<usize>) -> Vec<usize> {
+        crate::solver::parameter_space::around(&self.unit, u, skip)
     }
 }
 
@@ -115,8 +115,8 @@ impl DefectsCalibration {
 
     /// From the ratios at scattered candidates (points `unit` of the box `space`'s unit
     /// cube, no order to interpolate along): a point reads, fifth by fifth, the largest
-    /// ratio of its `d + 1` nearest candidates (on a line: the two that bracket it, the
-    /// larger of the two where [`Self::new`] interpolates), and the leave-one-out check asks
+    /// ratio of the candidates around it, the nearest in each orthant (on a line: the two
+    /// that bracket it, the larger of the two where [`Self::new`] interpolates), and the leave-one-out check asks
     /// that this reading from the *other* candidates reach `ρ_ji / DEFAULT_FACTOR` at ≥
     /// [`DEFECTS_RELIABLE_SHARE`] of the candidates, in every fifth. `load_scales` is
     /// empty. `None` as [`Self::new`].
@@ -132,7 +132,7 @@ impl DefectsCalibration {
                         // would include the left-out ratio itself
                         let own = c.ratios[j][i];
                         usable(own)
-                            && c.largest_usable(&s.nearest(&s.unit[j], Some(j)), i)
+                            && c.largest_usable(&s.around(&s.unit[j], Some(j)), i)
                                 .is_some_and(|r| r >= own / DEFAULT_FACTOR)
                     })
                     .count();
@@ -156,7 +156,7 @@ impl DefectsCalibration {
     /// `f_i(λ)` at the parameters `mu` (the type's documentation).
     pub fn factors_at(&self, mu: &Parameters) -> ByFifth {
         if let Some(s) = &self.scattered {
-            let near = s.nearest(&s.space.unit_of(mu), None);
+            let near = s.around(&s.space.unit_of(mu), None);
             return std::array::from_fn(|i| self.largest(&near, i));
         }
         let load_scale = mu.scale();
@@ -390,7 +390,7 @@ mod tests {
     }
 
     /// Scattered candidates (a box, here a line of the unit cube to keep the numbers
-    /// plain): a point reads the largest ratio of its d + 1 = 2 nearest candidates; the
+    /// plain): a point reads the largest ratio of the two candidates that bracket it; the
     /// check passes while that reading from the others reaches own / DEFAULT_FACTOR (1.5)
     /// at 90 % of the candidates: smooth ratios 0.10 … 0.19 pass; spikes of 0.5 at 2 and 6
     /// fail (each is read from neighbours of 0.11–0.17, far below 0.5/1.5: 8 of 10 pass).
@@ -407,7 +407,7 @@ mod tests {
         assert!(c.reliable && c.load_scales.is_empty());
         // p = 3.4 lies between the candidates 3 and 4: the larger of their ratios, 0.14
         assert_eq!(c.factors_at(&Parameters::default().with("p", 3.4)), r(0.14));
-        // beyond the box: its nearest two, 8 and 9
+        // beyond the box: the last candidate, 9
         assert_eq!(c.factors_at(&Parameters::default().with("p", 12.0)), r(0.19));
         let mut spike = calm;
         spike[2] = r(0.5);
@@ -417,7 +417,7 @@ mod tests {
 
     /// A candidate whose nearest candidates have no usable ratio is not predicted, so it
     /// fails the check: of 20 calm candidates with no ratio at 9 and 11, those two and 10
-    /// (whose two nearest they are) fail — 17 of 20 pass, below 90 %. Reading 10 from the
+    /// (which they bracket) fail — 17 of 20 pass, below 90 %. Reading 10 from the
     /// largest ratio of all, its own among them, would have passed it (18 of 20).
     #[test]
     fn a_candidate_without_usable_neighbours_fails_the_scattered_check() {

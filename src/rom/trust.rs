@@ -88,7 +88,8 @@ pub const AMPLIFYING: f64 = 10.0;
 /// compares two trajectories of the same amplifying dynamics). Between candidates the
 /// larger neighbour counts: the sensitivity jumps with the dynamics, it does not
 /// interpolate. In a box of parameters (every parameter of the box moved by δ) the
-/// candidates are points, and the largest of the d + 1 nearest counts.
+/// candidates are points, and the largest of those around the point counts (the nearest
+/// in each orthant about it).
 #[derive(Clone, Debug, PartialEq)]
 pub struct LoadSensitivity {
     candidates: Vec<f64>,
@@ -120,11 +121,11 @@ impl LoadSensitivity {
     }
 
     /// The larger sensitivity of the candidates beside `mu` (the candidate itself when `mu` is
-    /// one, the end candidate outside their range; in a box the largest of the d + 1
-    /// nearest); `None` when none was measured.
+    /// one, the end candidate outside their range; in a box the largest of those around it,
+    /// the nearest in each orthant: [`crate::solver::parameter_space::around`]); `None` when none was measured.
     pub fn near(&self, mu: &Parameters) -> Option<f64> {
         if let Some((space, unit)) = &self.points {
-            let near = crate::solver::parameter_space::nearest(unit, &space.unit_of(mu), space.ranges.len() + 1, None);
+            let near = crate::solver::parameter_space::around(unit, &space.unit_of(mu), None);
             return near.iter().map(|&i| self.whole_run[i]).filter(|s| s.is_finite()).reduce(f64::max);
         }
         let x = mu.scale();
@@ -388,8 +389,8 @@ mod sensitivity_tests {
         assert_eq!(s.near(&l(1.5)), None);
         assert_eq!(s.near(&l(9.0)), None);
         assert_eq!(LoadSensitivity::new(vec![], vec![]).near(&l(1.0)), None);
-        // in a box (here one parameter, p over [0, 2]) the largest of the d + 1 = 2 nearest
-        // candidates: p = 0.5 lies between 0 and 1; p = 1.8 beside 2 (unmeasured) and 1
+        // in a box (here one parameter, p over [0, 2]) the largest of the candidates around
+        // the point: p = 0.5 lies between 0 and 1, p = 0.1 between 0 and 1 too
         use crate::solver::parameter_space::{ParameterRange, ParameterSpace, Spacing};
         let space = ParameterSpace {
             ranges: vec![ParameterRange { name: "p".into(), lower: 0.0, upper: 2.0, spacing: Spacing::Linear }],

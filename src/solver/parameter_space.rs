@@ -112,8 +112,30 @@ pub fn short_number(x: f64) -> String {
     show_number(if e >= 0 { (x * k).round() / k } else { (x / k).round() * k })
 }
 
+/// The points around `u` (unit-cube coordinates): in each of the 2ᵈ orthants about `u`
+/// (a point counts on the upper side of an axis where its coordinate is ≥ `u`'s), the
+/// nearest point there (Euclidean distance), `skip` left out; in index order. What a point of
+/// a box reads from the candidates about it: on a line the two that bracket it, on a face of
+/// the box the candidates on that face as well as those inside — where the `d + 1` nearest
+/// can all lie on one side of it.
+pub fn around(points: &[Vec<f64>], u: &[f64], skip: Option<usize>) -> Vec<usize> {
+    let d2 = |v: &[f64]| u.iter().zip(v).map(|(a, b)| (a - b) * (a - b)).sum::<f64>();
+    let mut best: std::collections::BTreeMap<Vec<bool>, (f64, usize)> = std::collections::BTreeMap::new();
+    for (j, p) in points.iter().enumerate().filter(|&(j, _)| Some(j) != skip) {
+        let side: Vec<bool> = p.iter().zip(u).map(|(c, x)| c >= x).collect();
+        let dist = d2(p);
+        let e = best.entry(side).or_insert((dist, j));
+        if dist < e.0 {
+            *e = (dist, j);
+        }
+    }
+    let mut out: Vec<usize> = best.into_values().map(|(_, j)| j).collect();
+    out.sort_unstable();
+    out
+}
+
 /// The `k` points of `points` (unit-cube coordinates) nearest to `u` (Euclidean distance),
-/// nearest first, `skip` left out: what a point of a box reads from the candidates around it.
+/// nearest first, `skip` left out.
 pub fn nearest(points: &[Vec<f64>], u: &[f64], k: usize, skip: Option<usize>) -> Vec<usize> {
     let d2 = |v: &[f64]| u.iter().zip(v).map(|(a, b)| (a - b) * (a - b)).sum::<f64>();
     let mut order: Vec<usize> = (0..points.len()).filter(|&j| Some(j) != skip).collect();
@@ -369,5 +391,22 @@ mod tests {
         assert_eq!(m.get("pin"), Some((1.001 - 1.0) * 2.0));
         let m = s.moved(&Parameters::default().with("drive", 1.2).with("pin", -0.5), 1.001);
         assert_eq!(m.get("pin"), Some(-0.5 * 1.001));
+    }
+
+    /// The points around a point: the nearest in each orthant. On a line, 0.35 among 0, 0.2,
+    /// 0.4, 0.9 reads 0.2 and 0.4 (the two that bracket it); on the square's upper face at
+    /// (0.8, 1), with the corner (1, 1), the face's centre (0.5, 1) and three points inside
+    /// just below it, it reads both face points and the nearest inside on each side, where
+    /// its three nearest, (0.84, 0.97), (0.72, 0.88), (0.8, 0.85), all lie below it.
+    #[test]
+    fn around_reads_the_nearest_on_every_side() {
+        let line: Vec<Vec<f64>> = [0.0, 0.2, 0.4, 0.9].iter().map(|&x| vec![x]).collect();
+        assert_eq!(around(&line, &[0.35], None), vec![1, 2]);
+        assert_eq!(around(&line, &[0.35], Some(2)), vec![1, 3]);
+        assert_eq!(around(&line, &[1.2], None), vec![3], "beyond the end: the end");
+        let square = vec![vec![1.0, 1.0], vec![0.5, 1.0], vec![0.84, 0.97], vec![0.72, 0.88], vec![0.8, 0.85]];
+        let u = [0.8, 1.0];
+        assert_eq!(nearest(&square, &u, 3, None), vec![2, 3, 4]);
+        assert_eq!(around(&square, &u, None), vec![0, 1, 2, 3]);
     }
 }

@@ -14,8 +14,8 @@
 //! 33 per axis would be 1089 reduced runs per rung in two dimensions. Drawn points stay
 //! about 1/N^(1/d) inside the faces, where a response is often at its largest (the largest
 //! loads), so the corners and the faces' centres are candidates too — as long as they do not
-//! outnumber the drawn points. Pairing each point with its d + 1 nearest (a simplex's worth, as the `defects`
-//! calibration reads) keeps the pairs one connected graph in practice; pairing each with
+//! outnumber the drawn points. Pairing each point with its d + 1 nearest (a simplex's worth)
+//! and joining any islands left keeps the pairs one connected graph; pairing each with
 //! its single nearest split a 64-point plane into about 19 islands with no bound between
 //! them. The first full runs are the line's ends and middle, in a box the lower and upper
 //! corners and the centre (the same three points on a line).
