@@ -78,6 +78,9 @@ fn a_parameter_the_model_does_not_have_is_refused_naming_the_file_and_its_parame
         e.contains("bad.toml") && e.contains("loads[0].scaled") && e.contains("`2g` is not a parameter name"),
         "{e}"
     );
+    // a quoted flag is not taken for a parameter named "true"
+    let e = Model::from_text(&model_text("\"true\"", "false"), "bad.toml").expect_err("\"true\" accepted").to_string();
+    assert!(e.contains("loads[0].scaled") && e.contains("write true without quotes"), "{e}");
 }
 
 #[test]

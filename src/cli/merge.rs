@@ -31,9 +31,10 @@ impl Args {
         let m = flexrom::pipeline::merge::merge(&parts, &output, partial, limits)?;
         print_table(&flexrom::pipeline::tables::sweep_table(&m.sweep), format.format(), false)?;
         info(&format!(
-            "{} parts, {} load scales ({} not run) -> {}",
+            "{} parts, {} {} ({} not run) -> {}",
             m.parts,
             m.sweep.scales.len(),
+            if m.sweep.scales.iter().any(|x| x.mu.named().next().is_some()) { "points" } else { "load scales" },
             m.gaps,
             output.display()
         ));

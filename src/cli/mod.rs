@@ -80,6 +80,9 @@ pub struct ParamArgs {
 
 fn parse_param(s: &str) -> Result<(String, f64), String> {
     let (name, value) = s.split_once('=').ok_or_else(|| format!("`{s}` is not NAME=VALUE"))?;
+    if !flexrom::solver::parameters::is_parameter_name(name.trim()) {
+        return Err(format!("`{s}` is not NAME=VALUE (a name is letters, digits and `_`, starting with a letter)"));
+    }
     let v: f64 = value.trim().parse().map_err(|_| format!("`{value}` (parameter {name}) is not a number"))?;
     Ok((name.trim().to_string(), v))
 }

@@ -42,7 +42,7 @@ impl Args {
         // λ checked finite with the named values
         let mu = params.parameters(load_scale, 1.0)?;
         p.model.check_parameters(&mu)?;
-        super::warn(p.model.load_scale_warning(std::iter::once(mu.scale())).as_slice());
+        p.model.refuse_load_scale(std::iter::once(mu.scale()))?;
         let load_scale = mu.scale();
         let path = basis.unwrap_or_else(|| p.basis_path.clone());
         check_output(

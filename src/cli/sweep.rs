@@ -231,6 +231,6 @@ fn sweep_points(
         mu.validate()?;
         p.model.check_parameters(mu)?;
     }
-    super::warn(p.model.load_scale_warning(points.iter().map(Parameters::scale)).as_slice());
+    p.model.refuse_load_scale(points.iter().map(Parameters::scale))?;
     Ok(points)
 }

@@ -53,7 +53,7 @@ impl Args {
         if let Some(mu) = points.first() {
             p.model.check_parameters(mu)?;
         }
-        super::warn(p.model.load_scale_warning(points.iter().map(|mu| mu.scale())).as_slice());
+        p.model.refuse_load_scale(points.iter().map(|mu| mu.scale()))?;
         let path = basis.unwrap_or_else(|| p.basis_path.clone());
         let (_, rom, warnings) = load_rom(&p, &path, estimate.method(), false)?;
         warn(&warnings);

@@ -386,10 +386,17 @@ impl Model {
             ScaledSpec::Flag(false) => Ok(Scaling::Fixed),
             ScaledSpec::Flag(true) => Ok(Scaling::LoadScale),
             ScaledSpec::Parameter(name) if name == LOAD_SCALE => Ok(Scaling::LoadScale),
+            // a quoted flag would silently become a parameter named "true"
+            ScaledSpec::Parameter(name) if matches!(name.to_ascii_lowercase().as_str(), "true" | "false") => Err(self
+                .err(
+                    field,
+                    format!(
+                        "is the string \"{name}\"; write {} without quotes (or a parameter's name)",
+                        name.to_ascii_lowercase()
+                    ),
+                )),
             ScaledSpec::Parameter(name) => {
-                let ok = name.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
-                    && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
-                if ok {
+                if crate::solver::parameters::is_parameter_name(name) {
                     Ok(Scaling::Named(name.clone()))
                 } else {
                     Err(self.err(

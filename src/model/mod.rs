@@ -132,6 +132,15 @@ impl Model {
         Some(format!("{}: the load scale {x} is given, but {why}", self.path.display()))
     }
 
+    /// [`Self::load_scale_warning`] as an error: a reduced run at a load scale that changes
+    /// nothing would read as outside its basis's training (λ = 1) though it is not.
+    pub fn refuse_load_scale(&self, scales: impl Iterator<Item = f64>) -> Result<()> {
+        match self.load_scale_warning(scales) {
+            Some(w) => Err(Error::Usage(w)),
+            None => Ok(()),
+        }
+    }
+
     /// Why a load scale λ means nothing to this model (no load is `scaled = true`), or
     /// `None` when some load is.
     pub fn unscaled_load_scale(&self) -> Option<String> {

@@ -140,7 +140,9 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         let previous_energy = iterations.last().map(|i: &Iteration| i.energy);
         let prior = iterations.last().map(|i: &Iteration| i.estimates.as_slice());
         let n = iterations.len() + 1;
-        let round = Round { p, data: &data, candidates: &candidates, points: &points, n, method, prior };
+        let settled = settled(&candidates, &runs);
+        let round =
+            Round { p, data: &data, candidates: &candidates, points: &points, n, method, prior, settled: &settled };
         let mut level = search(&round, g, previous_energy)?;
         let (wi, worst) = level.worst();
         // where to run the full model: the worst candidate without a full run yet (a
@@ -269,9 +271,10 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
             iterations.last().map_or(f64::NAN, |i| search::between_candidates(
                 &i.estimates,
                 &sensitive(&i.sensitivity, g.tolerance),
+                &settled(&candidates, &runs),
                 &candidates.pairs
             )),
-            why_not_converged(g.tolerance, &iterations, &candidates)
+            why_not_converged(g.tolerance, &iterations, &candidates, &settled(&candidates, &runs))
         ));
     }
     let Level { trained, mut estimator, .. } = chosen;
@@ -394,12 +397,21 @@ fn sensitive(sensitivity: &[f64], tolerance: f64) -> Vec<bool> {
     sensitivity.iter().map(|&s| s > tolerance).collect()
 }
 
+/// In a box, which candidates have a full run among `runs` ([`search::between_candidates`]);
+/// none on a line.
+fn settled(candidates: &CandidateSet, runs: &[SimulationResult]) -> Vec<bool> {
+    if !candidates.is_box() {
+        return Vec::new();
+    }
+    (0..candidates.len()).map(|i| runs.iter().any(|r| candidates.is_at(i, &r.settings.mu))).collect()
+}
+
 /// Why the loop ended above its tolerance, from what it saw, in the order a user can act on:
 /// candidates where no estimate could be computed; the full model's own sensitivity to the
 /// load (where a 0.1 % change of the load moves the answer by more than T, the held-out
 /// errors and the estimates there measure the dynamics as much as the basis); held-out
 /// checks that found the estimate off by more than its method allows; else too few runs.
-fn why_not_converged(tolerance: f64, iterations: &[Iteration], candidates: &CandidateSet) -> String {
+fn why_not_converged(tolerance: f64, iterations: &[Iteration], candidates: &CandidateSet, settled: &[bool]) -> String {
     let Some(last) = iterations.last() else { return "no iteration ran".into() };
     let n = candidates.len();
     let failed = last.estimates.iter().filter(|e| e.is_infinite() || e.is_nan()).count();
@@ -420,8 +432,12 @@ fn why_not_converged(tolerance: f64, iterations: &[Iteration], candidates: &Cand
     let sensitive_held_out =
         iterations.iter().filter(|it| it.true_error > tolerance && it.true_score <= tolerance).count();
     // every score within T, but neighbours far apart: the loads between them are not certified
-    let bound =
-        search::between_candidates(&last.estimates, &sensitive(&last.sensitivity, tolerance), &candidates.pairs);
+    let bound = search::between_candidates(
+        &last.estimates,
+        &sensitive(&last.sensitivity, tolerance),
+        settled,
+        &candidates.pairs,
+    );
     if last.worst_estimate <= tolerance && bound > tolerance {
         let e = &last.estimates;
         let (ratio, at) = candidates
@@ -539,16 +555,16 @@ mod tests {
         let loads = CandidateSet::line(&[0.5, 1.0, 1.5]);
         let t = 1e-2;
         let failed = iteration(vec![1e-3, f64::INFINITY, 2e-2], vec![1e-3; 3], 1.5);
-        assert!(why_not_converged(t, &[failed], &loads).contains("no estimate could be computed at 1 of 3"));
+        assert!(why_not_converged(t, &[failed], &loads, &[]).contains("no estimate could be computed at 1 of 3"));
         let sensitive = iteration(vec![1e-3, 2e-2, 1e-3], vec![1e-3, 1.6e-1, 1e-3], 1.5);
-        let why = why_not_converged(t, &[sensitive], &loads);
+        let why = why_not_converged(t, &[sensitive], &loads, &[]);
         assert!(why.contains("sensitive to the load") && why.contains("1.6e-1") && why.contains("λ = 1"), "{why}");
         let off = iteration(vec![1e-3, 2e-2, 1e-3], vec![1e-3; 3], 250.0);
-        assert!(why_not_converged(t, &[off], &loads).contains("at 1 of its held-out runs"));
+        assert!(why_not_converged(t, &[off], &loads, &[]).contains("at 1 of its held-out runs"));
         let jumpy = iteration(vec![1e-3, 2e-5, 1e-3], vec![1e-3; 3], 1.5);
-        let why = why_not_converged(t, &[jumpy], &loads);
+        let why = why_not_converged(t, &[jumpy], &loads, &[]);
         assert!(why.contains("differ by up to 50×") && why.contains("λ = 0.5"), "{why}");
         let slow = iteration(vec![1e-3, 2e-2, 1e-3], vec![1e-3; 3], 1.5);
-        assert!(why_not_converged(t, &[slow], &loads).contains("raise max_runs"));
+        assert!(why_not_converged(t, &[slow], &loads, &[]).contains("raise max_runs"));
     }
 }

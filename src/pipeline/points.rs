@@ -13,6 +13,9 @@ use std::path::Path;
 pub fn parse_axis(spec: &str) -> std::result::Result<(String, Vec<f64>), String> {
     let (name, values) = spec.split_once('=').ok_or_else(|| format!("`{spec}` is not NAME=A:B:N (or NAME=X)"))?;
     let (name, values) = (name.trim().to_string(), values.trim());
+    if !crate::solver::parameters::is_parameter_name(&name) {
+        return Err(format!("`{spec}` is not NAME=A:B:N (a name is letters, digits and `_`, starting with a letter)"));
+    }
     let axis = if let Some(linear) = values.strip_suffix(":log") {
         let v = parse_range(linear)?;
         // the ends as written (the linear range's last value may differ from B in the last bit)
@@ -81,6 +84,12 @@ pub fn read_points_csv(path: &Path) -> Result<Vec<Parameters>> {
         .collect();
     if names.is_empty() || names.iter().any(String::is_empty) {
         return Err(bad("header".into(), "must name every column's parameter (e.g. `drive,E_lower`)".into()));
+    }
+    if let Some(n) = names.iter().find(|n| !crate::solver::parameters::is_parameter_name(n)) {
+        return Err(bad(
+            "header".into(),
+            format!("`{n}` is not a parameter name (letters, digits and `_`, starting with a letter); columns are separated by commas"),
+        ));
     }
     for (i, n) in names.iter().enumerate() {
         if names[..i].contains(n) {
@@ -156,5 +165,10 @@ mod tests {
         assert!(read_points_csv(&p).unwrap_err().to_string().contains("names `drive` twice"));
         std::fs::write(&p, "drive\n").unwrap();
         assert!(read_points_csv(&p).unwrap_err().to_string().contains("holds no point"));
+        // another separator makes one column of a name no parameter can have
+        std::fs::write(&p, "drive;E\n0.5;1\n").unwrap();
+        let e = read_points_csv(&p).unwrap_err().to_string();
+        assert!(e.contains("points.csv: header: `drive;E` is not a parameter name"), "{e}");
+        assert!(parse_axis("=1:2:3").unwrap_err().contains("is not NAME=A:B:N"));
     }
 }

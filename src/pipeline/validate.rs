@@ -79,19 +79,22 @@ pub struct Validation {
     pub estimate_seconds: Option<f64>,
     /// the load scale lies outside the basis's training range
     pub extrapolated: bool,
-    /// `[min, max]` training load scale (null when unknown)
+    /// `[min, max]` training load scale (null when unknown; over a box λ's range, `[1, 1]`
+    /// unless the box holds λ: `training_box` names the box)
     pub training_range: Option<[f64; 2]>,
     /// relative difference of full runs at λ and 1.001 λ (null when not measured); for a
     /// basis trained over a box, at μ and every parameter of the box times 1.001
     pub sensitivity: Option<f64>,
-    /// the box the basis was trained over (`describe`d; none for a line of load scales)
-    #[serde(skip)]
+    /// the box the basis was trained over, `drive ∈ [0.5, 1.5], E ∈ [1e8, 4e8] (log)`
+    /// (left out for a line of load scales)
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub training_box: Option<String>,
     /// the reduced model's sensitivity at greedy training's candidates beside the load
     /// ([`crate::rom::trust::LoadSensitivity`]; null for other bases)
     pub sensitivity_near: Option<f64>,
     /// `online`, `validate` and `sweep` warn that the model amplifies changes of the load
-    /// here beyond what the estimate sees ([`crate::rom::Trust::amplifying_near`])
+    /// here beyond what the estimate sees ([`crate::rom::Trust::amplifying_near`]; in
+    /// `validate` also from the sensitivity its full runs measured here)
     pub amplifying: bool,
     /// rel_error up to the end of each fifth of the run (the last is rel_error)
     pub rel_error_by_time: Vec<f64>,
@@ -338,7 +341,12 @@ pub fn validate(rom: &Rom, mu: &Parameters, with_dense: bool) -> Result<(Validat
         .with_trust(estimate.as_ref(), Some(rom))
         .with_timings(median(&mut full_times), median(&mut rom_times));
     let (distance, norm) = distance_and_norm(&nearby.q, &full.q);
-    v.sensitivity = Some(distance / norm);
+    let measured = distance / norm;
+    v.sensitivity = Some(measured);
+    // the full runs here measured the sensitivity itself: it counts as training's beside it does
+    if let Some(t) = rom.trust() {
+        v.amplifying |= t.amplifies(measured, estimate.as_ref().map(|e| e.in_measure(t.measure)));
+    }
     Ok((v, full, run))
 }
 
@@ -405,10 +413,12 @@ impl Validation {
             };
             s.push_str(&format!("\n  sensitivity {x:.3e} ({runs})"));
         }
-        if let (true, Some(x)) = (self.amplifying, self.sensitivity_near) {
+        if self.amplifying {
+            let x = self.sensitivity_near.into_iter().chain(self.sensitivity).fold(f64::NAN, f64::max);
+            let load = if self.training_box.is_some() { "the parameters" } else { "the load" };
             s.push_str(&format!(
-                "\n  the model amplifies changes of the load here (training's sensitivity {x:.1e} beside it): \
-                 the estimate does not see errors up to that size"
+                "\n  the model amplifies changes of {load} here (sensitivity up to {x:.1e}, training's beside it \
+                 and the full runs here): the estimate does not see errors up to that size"
             ));
         }
         if let Some(t) = self.steps_differ_from {

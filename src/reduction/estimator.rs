@@ -156,6 +156,10 @@ impl DefectsCalibration {
     /// `f_i(λ)` at the parameters `mu` (the type's documentation).
     pub fn factors_at(&self, mu: &Parameters) -> ByFifth {
         if let Some(s) = &self.scattered {
+            // outside the box, as beyond a line's ends, no candidate brackets the point
+            if !s.space.outside(mu).is_empty() {
+                return self.factors;
+            }
             let near = s.around(&s.space.unit_of(mu), None);
             return std::array::from_fn(|i| self.largest(&near, i));
         }
@@ -407,8 +411,10 @@ mod tests {
         assert!(c.reliable && c.load_scales.is_empty());
         // p = 3.4 lies between the candidates 3 and 4: the larger of their ratios, 0.14
         assert_eq!(c.factors_at(&Parameters::default().with("p", 3.4)), r(0.14));
-        // beyond the box: the last candidate, 9
+        // beyond the box: the largest ratio of all (here the last candidate's, 0.19), as
+        // beyond a line's ends
         assert_eq!(c.factors_at(&Parameters::default().with("p", 12.0)), r(0.19));
+        assert_eq!(c.factors_at(&Parameters::default().with("p", -3.0)), r(0.19));
         let mut spike = calm;
         spike[2] = r(0.5);
         spike[6] = r(0.5);

@@ -56,9 +56,16 @@ impl Trust {
     /// above the tolerance, above [`AMPLIFYING`]` · δ` and above the estimate
     /// ([`LoadSensitivity`]). `None` otherwise, or without a tolerance or the training record.
     pub fn amplifying_near(&self, mu: &Parameters, estimate: Option<f64>) -> Option<f64> {
-        let (tol, s) = (self.tolerance?, self.sensitivity.as_ref()?.near(mu)?);
-        let amplifying = s > tol.max(AMPLIFYING * SENSITIVITY_STEP);
-        (amplifying && estimate.is_none_or(|e| !(e >= s))).then_some(s)
+        let s = self.sensitivity.as_ref()?.near(mu)?;
+        self.amplifies(s, estimate).then_some(s)
+    }
+
+    /// Whether a sensitivity `s` (training's beside a point, or one measured there by full
+    /// runs) counts as amplifying beyond `estimate`: above the tolerance, above
+    /// [`AMPLIFYING`]` · δ` and above the estimate. False without a tolerance.
+    pub fn amplifies(&self, s: f64, estimate: Option<f64>) -> bool {
+        let Some(tol) = self.tolerance else { return false };
+        s > tol.max(AMPLIFYING * SENSITIVITY_STEP) && estimate.is_none_or(|e| !(e >= s))
     }
 }
 
@@ -281,8 +288,9 @@ pub fn check_runs(
             .collect();
         if !sensitive.is_empty() {
             let what = which(&sensitive, runs.len(), (": ", ""), !trust.space.is_empty());
+            let load = if trust.space.is_empty() { "the load" } else { "the parameters" };
             warnings.push(format!(
-                "the model amplifies changes of the load at {what}: near there a 0.1 % change of the load moved \
+                "the model amplifies changes of {load} at {what}: near there a 0.1 % change of {load} moved \
                  the reduced answer by more than the tolerance {tol:e} and more than 1 % over the run (training's \
                  sensitivity, in brackets); errors up to that size come from the dynamics, and the error estimate \
                  does not see them. Where it matters, run the full model there (`validate`, `sweep --full`)"

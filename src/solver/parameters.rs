@@ -28,6 +28,13 @@ pub const LOAD_SCALE: &str = "load_scale";
 ///
 /// The default parameter is kept in a field of its own, so the force evaluations that read
 /// it on every Newton iteration do not look a name up.
+/// Whether `name` can name a parameter: letters, digits and `_`, starting with a letter
+/// (it becomes `--param name=…`, a CSV column and an HDF5 attribute).
+pub fn is_parameter_name(name: &str) -> bool {
+    name.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
+        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Parameters {
     load_scale: f64,

@@ -40,6 +40,8 @@ pub(super) struct Level {
     evaluated: Vec<bool>,
     /// the neighbouring candidates ([`CandidateSet::pairs`])
     pairs: Vec<(usize, usize)>,
+    /// the candidates whose error is settled by a full run in the snapshots ([`Round::settled`])
+    settled: Vec<bool>,
 }
 
 impl Level {
@@ -62,7 +64,7 @@ impl Level {
             return f64::INFINITY;
         }
         let sensitive: Vec<bool> = self.sensitivity.iter().map(|s| s[FIFTHS - 1] > tolerance).collect();
-        between_candidates(&self.estimates, &sensitive, &self.pairs)
+        between_candidates(&self.estimates, &sensitive, &self.settled, &self.pairs)
     }
 
     /// [`Self::worst`] among the candidates `keep` accepts (and that were run).
@@ -92,6 +94,9 @@ pub(super) struct Round<'a> {
     /// the scores the previous iteration's basis had at the candidates: where a rung is
     /// screened first
     pub(super) prior: Option<&'a [f64]>,
+    /// in a box, the candidates at which a full run is in the snapshots (all false on a
+    /// line): [`between_candidates`]
+    pub(super) settled: &'a [bool],
 }
 
 /// The order a rung's candidates are run in: the highest `scores` first (a failed run, NaN,
@@ -303,8 +308,13 @@ fn rung_text(r: &Round, l: &Level, eps: f64, tau: f64, tolerance: f64) -> String
 /// only: there the scores jump because the dynamics do, not along a trend a ratio could
 /// extrapolate, and no number of candidates would resolve them. A non-finite or
 /// non-positive estimate (a failed run, a basis with no extra modes to estimate from) gives
-/// ∞, as does an empty list.
-pub(crate) fn between_candidates(e: &[f64], sensitive: &[bool], pairs: &[(usize, usize)]) -> f64 {
+/// ∞, as does an empty list. In a box a pair with a `settled` candidate — one whose full
+/// run is in the snapshots, so that its estimate measures only what the basis truncates
+/// there, not a trend — counts with its larger value too: between a point the basis holds
+/// and its neighbour the error rises from about nothing towards the neighbour's, and a
+/// ratio against that nothing says nothing. (On a line no candidate is marked: its rule is
+/// kept as measured.)
+pub(crate) fn between_candidates(e: &[f64], sensitive: &[bool], settled: &[bool], pairs: &[(usize, usize)]) -> f64 {
     if e.is_empty() || e.iter().any(|&x| !(x.is_finite() && x > 0.0)) {
         return f64::INFINITY;
     }
@@ -312,11 +322,12 @@ pub(crate) fn between_candidates(e: &[f64], sensitive: &[bool], pairs: &[(usize,
         return e[0];
     }
     let is_sensitive = |i: usize| sensitive.get(i).copied().unwrap_or(false);
+    let is_settled = |i: usize| settled.get(i).copied().unwrap_or(false);
     pairs
         .iter()
         .map(|&(i, j)| {
             let (hi, lo) = (e[i].max(e[j]), e[i].min(e[j]));
-            if is_sensitive(i) && is_sensitive(j) {
+            if is_sensitive(i) && is_sensitive(j) || is_settled(i) || is_settled(j) {
                 hi
             } else {
                 hi * (hi / lo)
@@ -358,6 +369,7 @@ fn level(
         fully_enriched,
         evaluated: Vec::new(),
         pairs: candidates.pairs.clone(),
+        settled: r.settled.to_vec(),
     };
     l.screen(p, candidates, order, method);
     Ok(l)
@@ -413,7 +425,7 @@ mod tests {
     use super::{between_candidates, line_pairs};
 
     fn between(e: &[f64], sensitive: &[bool]) -> f64 {
-        between_candidates(e, sensitive, &line_pairs(e.len()))
+        between_candidates(e, sensitive, &[], &line_pairs(e.len()))
     }
 
     /// A flat estimate is its value; a rising one is held to its largest value times the
@@ -448,7 +460,20 @@ mod tests {
     #[test]
     fn the_bound_runs_over_the_pairs() {
         let e = [1e-4, 1e-3, 1.1e-4, 1.1e-3];
-        let b = between_candidates(&e, &[false; 4], &[(0, 2), (1, 3)]);
+        let b = between_candidates(&e, &[false; 4], &[], &[(0, 2), (1, 3)]);
         assert!((b - 1.1e-3 * 1.1).abs() < 1e-15, "{b}");
+    }
+
+    /// A pair with a settled candidate (its full run in the snapshots, its estimate the
+    /// basis's truncation there, 1e-7) counts with its larger value, 1e-3, not 1e-3 · 1e4;
+    /// the other pairs keep the ratio (1e-3 next to 2e-3: 4e-3).
+    #[test]
+    fn a_settled_candidate_bounds_its_pairs_by_the_larger_value() {
+        let e = [1e-7, 1e-3, 2e-3];
+        let pairs = [(0, 1), (1, 2)];
+        assert!((between_candidates(&e, &[false; 3], &[], &pairs[..1]) - 10.0).abs() < 1e-9);
+        assert_eq!(between_candidates(&e, &[false; 3], &[true, false, false], &pairs[..1]), 1e-3);
+        let b = between_candidates(&e, &[false; 3], &[true, false, false], &pairs);
+        assert!((b - 4e-3).abs() < 1e-15, "{b}");
     }
 }
