@@ -156,6 +156,13 @@ fn greedy_on_the_displacement_measure() {
     let rel = s.dataset("rel_error").unwrap().read_1d::<f64>().unwrap();
     let disp = s.dataset("displacement_error").unwrap().read_1d::<f64>().unwrap();
     assert!(disp.iter().zip(&rel).all(|(d, r)| d > r), "{disp:?} vs {rel:?}");
+    // rel_error by fifth beside the estimate's (each over the run up to the fifth's end):
+    // measured everywhere, the last column rel_error itself (to round-off: summed apart)
+    let by = s.dataset("rel_error_by_time").unwrap().read_2d::<f64>().unwrap();
+    assert_eq!(by.dim(), (2, 5));
+    for (row, r) in by.rows().into_iter().zip(&rel) {
+        assert!(row.iter().all(|x| x.is_finite() && *x > 0.0) && (row[4] - r).abs() <= 1e-12 * r, "{row} vs {r}");
+    }
 
     // run: the method, the motion section, the held-out run named
     let o = flexrom(&["run", p, "--no-dense", "--estimate", "enriched"]);

@@ -148,7 +148,7 @@ const BASIS: [Entry; 52] = [
     ("timing/estimate_seconds", "s", ""),
 ];
 
-const SWEEP: [Entry; 28] = [
+const SWEEP: [Entry; 29] = [
     ("load_scales", "1", "load"),
     ("points", "1", "load, parameter"),
     ("status", "1", "load"),
@@ -175,6 +175,7 @@ const SWEEP: [Entry; 28] = [
     ("speedup", "1", "load"),
     ("steps_differ_from", "s", "load"),
     ("displacement_error", "1", "load"),
+    ("rel_error_by_time", "1", "load, fifth"),
     ("shard/all_load_scales", "1", "all loads"),
     ("shard/all_points", "1", "all loads, parameter"),
     ("shard/indices", "1", "load"),

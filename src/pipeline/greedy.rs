@@ -132,6 +132,8 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
     let mut points: Vec<CalibrationPoint> = Vec::new();
     let mut iterations: Vec<Iteration> = Vec::new();
     let mut warnings = Vec::new();
+    // warnings that the training's method over-reads: moot once the loop switches method
+    let mut over_reading: Vec<String> = Vec::new();
     // the estimate the loop steers by, until a held-out check finds it off (below)
     let mut method = EstimateMethod::Corrected;
     let converged;
@@ -218,8 +220,9 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         if let Some(checked) = check_method(p, &level, method, (&mu, &at), e, it.held_out_effectivity) {
             log::info!("{}", checked.message);
             if !checked.switch && it.held_out_effectivity > MAX_HELD_OUT_OVERESTIMATE {
-                warnings.push(checked.message);
+                over_reading.push(checked.message);
             } else if checked.switch {
+                over_reading.clear();
                 method = EstimateMethod::Enriched;
                 // the earlier pairs were the other method's readings
                 points = vec![CalibrationPoint { load_scale: mu.scale(), raw_estimate: checked.raw, rel_error: e }];
@@ -287,8 +290,9 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
     }
     log::info!("{}", match &estimator.defects {
         Some(d) if d.reliable => format!(
-            "error estimate: the cheap `defects` method calibrated at the {} candidates (factors {}), the online default",
+            "error estimate: the cheap `defects` method calibrated at the {} candidates against the `{}` estimate (factors {}), the online default",
             d.ratios.len(),
+            method.name(),
             d.factors.iter().map(|f| format!("{f:.3}")).collect::<Vec<_>>().join(", ")
         ),
         Some(_) => format!("error estimate: the `defects` method's ratio to the {} estimate jumps between candidates (its leave-one-out check failed): the online default stays `{}`", method.name(), estimator.default_method().name()),
@@ -307,6 +311,7 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         method,
         measure: g.measure,
     };
+    warnings.splice(0..0, over_reading);
     let n_snapshots = data.x.ncols();
     Ok((
         data,

@@ -27,7 +27,9 @@
 //!                                    candidates beside the load (NaN for other bases)
 //! /estimate_seconds   (N)            the estimator's enriched run and norms, s
 //! with --validate:    /rel_error, /max_probe_error, /max_constraint_violation,
-//!                     /full_seconds, /speedup, /steps_differ_from, /displacement_error  (N each)
+//!                     /full_seconds, /speedup, /steps_differ_from, /displacement_error  (N each),
+//!                     /rel_error_by_time (N, 5): rel_error up to the end of each fifth, beside
+//!                     /error_estimate_by_time (files before 2026-11-26 lack it)
 //! with --full:        /full_seconds (N), the full time loop of each run; the estimate
 //!                     columns NaN (an exact run has none), /extrapolated 0
 //! every dataset: units, dims (src/io/attrs.rs)
@@ -215,6 +217,14 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, basis: Option<SweepBasis>, extra
                 .create("steps_differ_from")
                 .map_err(e)?;
             f.new_dataset_builder().with_data(&v(&|x| x.displacement_error)).create("displacement_error").map_err(e)?;
+            let mut by_time = Array2::from_elem((n, 5), f64::NAN);
+            for (k, x) in s.scales.iter().enumerate() {
+                let r = x.point().and_then(|p| p.validation.as_ref()).map(|v| &v.rel_error_by_time);
+                if let Some(r) = r.filter(|r| r.len() == 5) {
+                    by_time.row_mut(k).assign(&ndarray::ArrayView1::from(&r[..]));
+                }
+            }
+            f.new_dataset_builder().with_data(&by_time).create("rel_error_by_time").map_err(e)?;
         }
         if s.full {
             // the full time loops, as a validated sweep's column of the same name
@@ -420,6 +430,7 @@ pub fn read_sweep(
     let (estimates_displacement, displacement_by_time) =
         (optional("error_estimate_displacement")?, by_fifth("error_estimate_displacement_by_time")?);
     let displacement = if validate { optional("displacement_error")? } else { None };
+    let rel_by_time = if validate { by_fifth("rel_error_by_time")? } else { None };
     let (newton, factorizations) = (ints("newton_iterations")?, ints("factorizations")?);
     // files written before it have no /steps_differ_from: unknown, as no halved step
     let differ = if validate && f.link_exists("steps_differ_from") { Some(vec("steps_differ_from")?) } else { None };
@@ -518,7 +529,7 @@ pub fn read_sweep(
             training_box: None,
             sensitivity_near: None,
             amplifying: false,
-            rel_error_by_time: Vec::new(),
+            rel_error_by_time: rel_by_time.as_ref().map_or_else(Vec::new, |a| a.row(k).to_vec()),
             error_estimate_by_time: None,
             displacement_error: displacement.as_ref().map_or(f64::NAN, |a| a[k]),
             displacement_error_by_time: Vec::new(),
