@@ -71,7 +71,7 @@ fn a_parameter_the_model_does_not_have_is_refused_naming_the_file_and_its_parame
     let e = simulate(&named, &Overrides::at(&Parameters::default().with("gg", 1.1))).expect_err("`gg` accepted");
     let text = e.to_string();
     assert!(text.contains("double_pendulum_named.toml") && text.contains("no parameter `gg`"), "{text}");
-    assert!(text.contains("its parameters: g"), "{text}");
+    assert!(text.contains("its parameters: g") && text.contains("did you mean `g`?"), "{text}");
     let bad = model_text("\"2g\"", "false");
     let e = Model::from_text(&bad, "bad.toml").expect_err("`2g` accepted as a name").to_string();
     assert!(

@@ -404,7 +404,7 @@ fn parameters_the_model_does_not_have_are_refused_or_warned_about() {
     let err = text(&out).1;
     assert!(!out.status.success() && !d.join("s.h5").exists(), "{err}");
     assert!(
-        err.contains("pts.csv: header: column `puhs`: the model has no parameter `puhs` (its parameters: g, push)"),
+        err.contains("pts.csv: header: column `puhs`: the model has no parameter `puhs` (its parameters: g, push); did you mean `push`?"),
         "{err}"
     );
     for args in [

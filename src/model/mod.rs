@@ -166,7 +166,14 @@ impl Model {
             return None;
         }
         let have = if names.is_empty() { "none: no load is scaled".to_string() } else { names.join(", ") };
-        Some(format!("the model has no parameter `{name}` (its parameters: {have})"))
+        // the closest name, as clap suggests a flag (Jaro similarity above 0.7)
+        let close = names
+            .iter()
+            .map(|n| (strsim::jaro(name, n), n))
+            .filter(|(s, _)| *s > 0.7)
+            .max_by(|a, b| a.0.total_cmp(&b.0))
+            .map_or(String::new(), |(_, n)| format!("; did you mean `{n}`?"));
+        Some(format!("the model has no parameter `{name}` (its parameters: {have}){close}"))
     }
 
     /// Integrator parameters from the `[time]` table.

@@ -331,10 +331,11 @@ fn build(
     );
     let _ = writeln!(
         md,
-        "- sweep: {} {} on {} threads in {:.3} s (whole sweep, reduced and full runs)\n",
+        "- sweep: {} {} on {} thread{} in {:.3} s (whole sweep, reduced and full runs)\n",
         sw.scales.len(),
         if in_box { "random points of the box" } else { "load scales" },
         sw.threads,
+        if sw.threads == 1 { "" } else { "s" },
         sw.wall_seconds
     );
     let _ = writeln!(md, "## Validation (time loops only; full and reduced: medians of up to 7 interleaved runs each; full dense: one run)\n");
