@@ -34,7 +34,7 @@ impl Args {
             "{} parts, {} {} ({} not run) -> {}",
             m.parts,
             m.sweep.scales.len(),
-            if m.sweep.scales.iter().any(|x| x.mu.named().next().is_some()) { "points" } else { "load scales" },
+            flexrom::pipeline::sweep::runs_noun(m.sweep.scales.iter().map(|x| &x.mu)),
             m.gaps,
             output.display()
         ));

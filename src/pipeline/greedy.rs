@@ -266,6 +266,7 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         runs.push(truth);
     };
     if !converged {
+        let settled = settled(&candidates, &runs);
         warnings.push(format!(
             "greedy training stopped after {full_runs} full runs (max_runs = {}) above its tolerance {:e} (worst score {:.2e}, bound between candidates {:.2e}): {}",
             g.max_runs,
@@ -274,10 +275,10 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
             iterations.last().map_or(f64::NAN, |i| search::between_candidates(
                 &i.estimates,
                 &sensitive(&i.sensitivity, g.tolerance),
-                &settled(&candidates, &runs),
+                &settled,
                 &candidates.pairs
             )),
-            why_not_converged(g.tolerance, &iterations, &candidates, &settled(&candidates, &runs))
+            why_not_converged(g.tolerance, &iterations, &candidates, &settled)
         ));
     }
     let Level { trained, mut estimator, .. } = chosen;

@@ -200,10 +200,10 @@ fn read_part(path: &Path) -> Result<Part> {
 /// A few runs for a message: "load scales 0.5, 0.53, 0.56 and 13 more", or for named
 /// parameters "points (load scale 1, push = 0.5); … and 13 more".
 fn some(xs: &[Parameters]) -> String {
-    let named = xs.iter().any(|mu| mu.named().next().is_some());
+    let head = super::sweep::runs_noun(xs);
+    let named = head == "points";
     let shown: Vec<String> =
         xs.iter().take(4).map(|mu| if named { format!("({mu})") } else { mu.scale().to_string() }).collect();
-    let head = if named { "points" } else { "load scales" };
     let sep = if named { "; " } else { ", " };
     format!("{head} {}", some_of(&shown, xs.len(), sep))
 }
@@ -258,7 +258,7 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool, limits: &Limits) -> R
             return Err(differ("model_fingerprint", "comes from another model"));
         }
         if p.list_hash != first.list_hash {
-            let list = if first.all.iter().any(|mu| mu.named().next().is_some()) { "point list" } else { "load list" };
+            let list = if super::sweep::runs_noun(&first.all) == "points" { "point list" } else { "load list" };
             return Err(differ("shard/load_list_hash", &format!("comes from another {list}")));
         }
         if p.count != first.count {

@@ -107,8 +107,8 @@ impl<'a> Route<'a> {
 
 /// What a sweep's runs are called in messages: "points" when some set a named parameter,
 /// else "load scales".
-fn runs_noun(points: &[Parameters]) -> &'static str {
-    if points.iter().any(|mu| mu.named().next().is_some()) {
+pub fn runs_noun<'a>(points: impl IntoIterator<Item = &'a Parameters>) -> &'static str {
+    if points.into_iter().any(|mu| mu.named().next().is_some()) {
         "points"
     } else {
         "load scales"
