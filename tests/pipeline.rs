@@ -439,6 +439,7 @@ fn shipped_pipelines_load() {
         "pipelines/fourbar.toml",
         "pipelines/double_pendulum_box.toml",
         "pipelines/fourbar_box.toml",
+        "pipelines/fourbar_stiffness.toml",
     ] {
         let p = Pipeline::load(repo(name)).unwrap();
         assert!(p

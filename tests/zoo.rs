@@ -50,7 +50,11 @@ fn every_drawn_model_is_within_the_zoo_ranges() {
                 assert!((1..=4).contains(&f.bodies.len()), "{what}");
                 for b in &f.bodies {
                     assert!((10..=60).contains(&b.elements), "{what}: {} elements", b.elements);
-                    assert!((1e6..=1e11).contains(&b.youngs_modulus), "{what}: E = {}", b.youngs_modulus);
+                    assert!(
+                        (1e6..=1e11).contains(&b.youngs_modulus.value()),
+                        "{what}: E = {}",
+                        b.youngs_modulus.value()
+                    );
                 }
                 let scaled = f.loads.iter().any(|l| match l {
                     LoadSpec::Gravity { scaled, .. }

@@ -48,11 +48,26 @@ impl Model {
             }
             let total: f64 = f.bodies[..=i].iter().map(|b| b.elements.max(0) as f64).sum();
             self.limits.check_elements(total).map_err(|e| self.err(p("elements"), e))?;
-            for (k, v) in
-                [("density", b.density), ("area", b.area), ("inertia", b.inertia), ("youngs_modulus", b.youngs_modulus)]
-            {
-                self.positive(&p(k), v)?;
+            // a property given as `{ value, parameter }` names its `value`
+            let property = |k: &str, spec: &PropertySpec| match spec {
+                PropertySpec::Value(v) => (k.to_string(), *v),
+                PropertySpec::Parameter(x) => (format!("{k}.value"), x.value),
+            };
+            for (k, v) in [
+                property("density", &b.density),
+                ("area".into(), b.area),
+                ("inertia".into(), b.inertia),
+                property("youngs_modulus", &b.youngs_modulus),
+            ] {
+                self.positive(&p(&k), v)?;
             }
+            if b.density.parameter().is_some() {
+                return Err(self.err(
+                    p("density"),
+                    "cannot be a parameter yet (Young's modulus can): give a number, density = VALUE",
+                ));
+            }
+            let youngs_modulus_parameter = self.youngs_modulus_parameter(&f, i)?;
             let (angle, length) = match (b.angle, b.end) {
                 (Some(_), Some(_)) => return Err(self.err(p("end"), "give either `angle` or `end`, not both")),
                 (None, None) => return Err(self.err(p("angle"), "missing: give `angle` (rad) with `length`, or `end`")),
@@ -89,11 +104,12 @@ impl Model {
                 length,
                 n_elements: b.elements as usize,
                 section: Section {
-                    density: b.density,
+                    density: b.density.value(),
                     area: b.area,
                     inertia: b.inertia,
-                    youngs_modulus: b.youngs_modulus,
+                    youngs_modulus: b.youngs_modulus.value(),
                 },
+                youngs_modulus_parameter,
             });
         }
         let lmax = self.bodies.iter().map(|b| b.length).fold(0.0, f64::max);
@@ -377,6 +393,48 @@ impl Model {
         } else {
             Err(self.err(field, format!("must be finite, got {v}")))
         }
+    }
+
+    /// The parameter that body `i`'s `youngs_modulus = { value, parameter }` names, if any:
+    /// a parameter name that no load scales (a load's parameter is a factor, a modulus's
+    /// its value), the same value wherever bodies share it, and an undamped model (Rayleigh
+    /// damping's stiffness part would change with the modulus, its mass part would not: the
+    /// affine split a reduced model relies on holds without it).
+    fn youngs_modulus_parameter(&self, f: &ModelFile, i: usize) -> Result<Option<String>> {
+        let field = format!("bodies[{i}].youngs_modulus.parameter");
+        let Some(name) = f.bodies[i].youngs_modulus.parameter() else { return Ok(None) };
+        if !crate::solver::parameters::is_parameter_name(name) || name == LOAD_SCALE {
+            return Err(self.err(
+                field,
+                format!("`{name}` is not a parameter name: use letters, digits and `_`, starting with a letter (and not `{LOAD_SCALE}`, the load scale)"),
+            ));
+        }
+        let value = f.bodies[i].youngs_modulus.value();
+        if let Some(other) = f.bodies[..i].iter().find(|o| o.youngs_modulus.parameter() == Some(name)) {
+            if other.youngs_modulus.value() != value {
+                return Err(self.err(
+                    format!("bodies[{i}].youngs_modulus.value"),
+                    format!(
+                        "is {value}, but body `{}` gives the parameter `{name}` the value {}: a parameter has one value",
+                        other.name,
+                        other.youngs_modulus.value()
+                    ),
+                ));
+            }
+        }
+        if let Some((k, _)) = f.loads.iter().enumerate().find(|(_, l)| l.scaled_parameter() == Some(name)) {
+            return Err(self.err(
+                field,
+                format!("`{name}` also scales loads[{k}]: a load's parameter multiplies it, a modulus's is its value; give them different names"),
+            ));
+        }
+        if f.damping.as_ref().is_some_and(|d| d.mass != 0.0 || d.stiffness != 0.0) {
+            return Err(self.err(
+                field,
+                "a Young's modulus parameter needs a model without [damping] (Rayleigh damping with a parameter modulus is not supported)",
+            ));
+        }
+        Ok(Some(name.to_string()))
     }
 
     /// `scaled = true | false | "name"`; a name is a parameter's: letters, digits and `_`,

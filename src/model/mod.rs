@@ -98,8 +98,9 @@ impl Model {
         Sha256::digest(json.as_bytes()).iter().map(|b| format!("{b:02x}")).collect()
     }
 
-    /// The parameters the model's loads are scaled by (`scaled = true` is
-    /// [`crate::solver::parameters::LOAD_SCALE`]), each once, in the order of the loads.
+    /// The model's parameters, each once: those its loads are scaled by (`scaled = true` is
+    /// [`crate::solver::parameters::LOAD_SCALE`]) in the order of the loads, then the
+    /// bodies' Young's moduli that are parameters, in the order of the bodies.
     pub fn parameter_names(&self) -> Vec<&str> {
         let mut names: Vec<&str> = Vec::new();
         for l in &self.loads {
@@ -112,14 +113,31 @@ impl Model {
                 }
             }
         }
+        for name in self.bodies.iter().filter_map(|b| b.youngs_modulus_parameter.as_deref()) {
+            if !names.contains(&name) {
+                names.push(name);
+            }
+        }
         names
     }
 
+    /// Whether `name` is a body's Young's modulus (a value in Pa, not a factor).
+    pub fn is_modulus_parameter(&self, name: &str) -> bool {
+        self.bodies.iter().any(|b| b.youngs_modulus_parameter.as_deref() == Some(name))
+    }
+
     /// Refuses parameters the model does not have (a `--param` misspelt, or one of another
-    /// model): the error names the model file and the parameters it has.
+    /// model), and a Young's modulus that is not positive: the error names the model file
+    /// and the parameters it has.
     pub fn check_parameters(&self, mu: &Parameters) -> Result<()> {
-        match mu.named().find_map(|(name, _)| self.unknown_parameter(name)) {
-            Some(problem) => Err(Error::Usage(format!("{}: {problem}", self.path.display()))),
+        if let Some(problem) = mu.named().find_map(|(name, _)| self.unknown_parameter(name)) {
+            return Err(Error::Usage(format!("{}: {problem}", self.path.display())));
+        }
+        match mu.named().find(|&(name, value)| self.is_modulus_parameter(name) && !(value > 0.0)) {
+            Some((name, value)) => Err(Error::Usage(format!(
+                "{}: parameter {name} is a Young's modulus and must be positive, got {value}",
+                self.path.display()
+            ))),
             None => Ok(()),
         }
     }
@@ -165,7 +183,11 @@ impl Model {
         if names.contains(&name) {
             return None;
         }
-        let have = if names.is_empty() { "none: no load is scaled".to_string() } else { names.join(", ") };
+        let have = if names.is_empty() {
+            "none: no load is scaled, no Young's modulus is a parameter".to_string()
+        } else {
+            names.join(", ")
+        };
         // the closest name, as clap suggests a flag (Jaro similarity above 0.7)
         let close = names
             .iter()

@@ -80,10 +80,45 @@ pub struct BodySpec {
     #[serde(default)]
     pub length: Option<f64>,
     pub elements: i64,
-    pub density: f64,
+    pub density: PropertySpec,
     pub area: f64,
     pub inertia: f64,
-    pub youngs_modulus: f64,
+    pub youngs_modulus: PropertySpec,
+}
+
+/// A material property: a number, or `{ value = …, parameter = "name" }`, which makes the
+/// property the parameter `name` (`value` where a run does not set it).
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(untagged, expecting = "a number, or { value = NUMBER, parameter = \"NAME\" }")]
+pub enum PropertySpec {
+    Value(f64),
+    Parameter(ParameterProperty),
+}
+
+/// `{ value = …, parameter = "name" }` of a [`PropertySpec`].
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ParameterProperty {
+    pub value: f64,
+    pub parameter: String,
+}
+
+impl PropertySpec {
+    /// The value the model file gives (used where the parameter is not set).
+    pub fn value(&self) -> f64 {
+        match self {
+            PropertySpec::Value(v) => *v,
+            PropertySpec::Parameter(p) => p.value,
+        }
+    }
+
+    /// The parameter's name, when the property is one.
+    pub fn parameter(&self) -> Option<&str> {
+        match self {
+            PropertySpec::Value(_) => None,
+            PropertySpec::Parameter(p) => Some(&p.parameter),
+        }
+    }
 }
 
 /// A node of a body: its index (0 = start) or `"start"` / `"end"`.
@@ -162,6 +197,20 @@ pub enum LoadSpec {
         #[serde(default = "yes")]
         scaled: ScaledSpec,
     },
+}
+
+impl LoadSpec {
+    /// The name `scaled = "name"` gives, if any.
+    pub fn scaled_parameter(&self) -> Option<&str> {
+        match self {
+            LoadSpec::Gravity { scaled, .. } | LoadSpec::Moment { scaled, .. } | LoadSpec::Force { scaled, .. } => {
+                match scaled {
+                    ScaledSpec::Parameter(name) => Some(name),
+                    ScaledSpec::Flag(_) => None,
+                }
+            }
+        }
+    }
 }
 
 /// A recorded point: a `node` of a body, or the point at fraction `at` ∈ [0, 1] of its length.

@@ -14,7 +14,11 @@ pub struct BeamBody {
     pub angle: f64,
     pub length: f64,
     pub n_elements: usize,
+    /// the section at the model file's values
     pub section: Section,
+    /// the parameter that sets the body's Young's modulus, if any: at μ the modulus is
+    /// `μ[name]` (the file's `section.youngs_modulus` where μ does not set it)
+    pub youngs_modulus_parameter: Option<String>,
 }
 
 impl BeamBody {

@@ -36,8 +36,12 @@ pub struct FlexibleSystem {
     first_node: Vec<usize>,
     /// element → (body, dofs)
     elements: Vec<(usize, [usize; 8])>,
-    /// one element prototype per body
+    /// one element prototype per body, at the model file's values
     prototypes: Vec<BeamElement>,
+    /// one element prototype per body at the parameters of the last evaluation (the
+    /// bodies' Young's moduli), and each body's factor `E(μ)/E_file` in it
+    bound: Vec<BeamElement>,
+    bound_factors: Vec<f64>,
     pub constraints: Vec<Constraint>,
     pub probes: Vec<Probe>,
     damping: Rayleigh,
@@ -184,11 +188,12 @@ impl FlexibleSystem {
             moments.iter().flat_map(|m| m.slope_dofs).chain(forces.iter().flat_map(|f| f.dofs)).collect();
         load_dofs.sort_unstable();
         load_dofs.dedup();
+        let n_bodies = bodies.len();
         FlexibleSystem {
             bodies,
             first_node,
             elements,
-            prototypes,
+            prototypes: prototypes.clone(),
             constraints,
             probes,
             damping,
@@ -199,6 +204,8 @@ impl FlexibleSystem {
             forces,
             load_dofs,
             n_dof,
+            bound: prototypes.clone(),
+            bound_factors: vec![1.0; n_bodies],
             kkt: make_solver(solver, pattern),
             blocks: vec![Mat8::zeros(); n_el],
             iteration_constant: Vec::new(),
@@ -216,9 +223,40 @@ impl FlexibleSystem {
         &self.elements[e].1
     }
 
-    /// The element object (constant matrices, force, tangent) of element `e`.
+    /// The element object (constant matrices, force, tangent) of element `e`, at the
+    /// model file's values.
     pub fn element(&self, e: usize) -> &BeamElement {
         &self.prototypes[self.elements[e].0]
+    }
+
+    /// Body `b`'s stiffness factor `E(μ)/E_file` at `mu` (1 where no parameter sets its
+    /// Young's modulus, or μ does not set the parameter).
+    fn body_stiffness_factor(&self, b: usize, mu: &Parameters) -> f64 {
+        let body = &self.bodies[b];
+        match body.youngs_modulus_parameter.as_deref().and_then(|name| mu.get(name)) {
+            Some(e) => e / body.section.youngs_modulus,
+            None => 1.0,
+        }
+    }
+
+    /// Makes the element prototypes the evaluations use those at `mu`: a body whose Young's
+    /// modulus is a parameter gets a prototype at `E = μ[name]` (its elastic force and
+    /// stiffness scale by `E(μ)/E_file`; its mass does not change) whenever that changes.
+    fn bind(&mut self, mu: &Parameters) {
+        for b in 0..self.bodies.len() {
+            let factor = self.body_stiffness_factor(b, mu);
+            if factor != self.bound_factors[b] {
+                let body = &self.bodies[b];
+                let mut section = body.section;
+                if let Some(e) = body.youngs_modulus_parameter.as_deref().and_then(|name| mu.get(name)) {
+                    section.youngs_modulus = e;
+                }
+                self.bound[b] = BeamElement::new(body.length / body.n_elements as f64, section);
+                self.bound_factors[b] = factor;
+                // the iteration matrix's constant part holds the bending stiffness
+                self.iteration_coef = None;
+            }
+        }
     }
 
     /// Global node index of node `k` of body `b`.
@@ -331,15 +369,21 @@ impl FlexibleSystem {
     /// Potential energy at the parameters `mu`: strain energy plus that of the (constant)
     /// gravity loads.
     pub fn potential_energy(&self, mu: &Parameters, q: &[f64]) -> f64 {
-        let strain: f64 = (0..self.elements.len()).map(|e| self.element(e).strain_energy(&self.gather(e, q))).sum();
+        // the strain energy is linear in Young's modulus
+        let strain: f64 = (0..self.elements.len())
+            .map(|e| {
+                let b = self.elements[e].0;
+                self.body_stiffness_factor(b, mu) * self.element(e).strain_energy(&self.gather(e, q))
+            })
+            .sum();
         let mut g = vec![0.0; self.n_dof];
         self.gravity_into(mu, &mut g);
         let grav: f64 = g.iter().zip(q).map(|(g, q)| -g * q).sum();
         strain - grav
     }
 
-    /// Dense global mass matrix and tangent stiffness at `q` (row-major n×n), for modal
-    /// analysis and tests.
+    /// Dense global mass matrix and tangent stiffness at `q` (row-major n×n) at the model
+    /// file's values, for modal analysis and tests.
     pub fn dense_mass_and_stiffness(&self, q: &[f64]) -> (Vec<f64>, Vec<f64>) {
         let n = self.n_dof;
         let (mut m, mut k) = (vec![0.0; n * n], vec![0.0; n * n]);
@@ -357,9 +401,10 @@ impl FlexibleSystem {
         (m, k)
     }
 
-    /// `fₑ = Cₑ q̇ₑ + Qₑ(qₑ)` with Rayleigh `Cₑ = a Mₑ + b K_bending,ₑ`.
-    fn element_force_vec(&self, e: usize, qe: &Vec8, ve: &Vec8) -> Vec8 {
-        let mut f = self.element(e).elastic_force(qe);
+    /// `fₑ = Cₑ q̇ₑ + Qₑ(qₑ)` with Rayleigh `Cₑ = a Mₑ + b K_bending,ₑ`, `Qₑ` from the
+    /// element prototype `el` (the file's or the bound one).
+    fn element_force_vec(&self, el: &BeamElement, e: usize, qe: &Vec8, ve: &Vec8) -> Vec8 {
+        let mut f = el.elastic_force(qe);
         if self.damping != Rayleigh::default() {
             f += self.damping_force(e, ve);
         }

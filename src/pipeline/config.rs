@@ -221,8 +221,18 @@ impl Pipeline {
             if let Some(problem) = self.model.unknown_parameter(name) {
                 return bad(&field, problem);
             }
-            if let Err(e) = spec.range(name).validate() {
+            let range = spec.range(name);
+            if let Err(e) = range.validate() {
                 return bad(&field, e);
+            }
+            if self.model.is_modulus_parameter(name) && !(range.lower > 0.0) {
+                return bad(
+                    &field,
+                    format!(
+                        "is a Young's modulus (Pa); its range must be positive, got {} … {}",
+                        range.lower, range.upper
+                    ),
+                );
             }
         }
         let t = &self.file.train;

@@ -14,16 +14,28 @@
 //! exactly over every element and need no sampling. Positive weights keep each sampled
 //! term a true element force, so the hyper-reduced model keeps the energy structure
 //! (symmetric tangent, conservative internal forces).
+//!
+//! Where elements' stiffness is a parameter ([`stiffness_groups`]), each group `g` of
+//! elements that share one gets rows of its own, `b_g = Σ_{e∈g} c_{·,e}`: the weighted sum
+//! then reproduces each group's force apart, so that it stays right when the groups scale
+//! differently at another μ (the model is affine in each group's factor).
 
 use super::basis::Basis;
 use super::sample::Hyper;
 use crate::linalg::nnls::{nnls, NnlsParams};
-use crate::solver::model::InvariantElementModel;
+use crate::solver::model::{stiffness_groups, InvariantElementModel};
 use ndarray::{Array1, Array2, ArrayView2};
 
-/// The ECSW training matrix `C` (n_snapshots·r × n_elements) of the module documentation.
+/// The ECSW training matrix `C` (n_groups·n_snapshots·r × n_elements) of the module
+/// documentation: element `e`'s column holds its terms in the rows of its stiffness group
+/// (one group, all rows, for a model without stiffness parameters).
 pub fn training_matrix<M: InvariantElementModel>(full: &M, basis: &Basis, snapshots: ArrayView2<f64>) -> Array2<f64> {
     let (r, ns, n_el) = (basis.n_reduced(), snapshots.ncols(), full.n_elements());
+    let groups = stiffness_groups(full);
+    let mut group_of = vec![0; n_el];
+    for (g, (_, members)) in groups.iter().enumerate() {
+        members.iter().for_each(|&e| group_of[e] = g);
+    }
     let ne = if n_el > 0 { full.element_dofs(0).len() } else { 0 };
     let v = basis.modes.as_standard_layout();
     // the snapshots as the basis represents them: x_ref + V q_k, all at once
@@ -32,12 +44,13 @@ pub fn training_matrix<M: InvariantElementModel>(full: &M, basis: &Basis, snapsh
         q.column_mut(k).assign(&basis.reduce(snapshots.column(k)));
     }
     let x = v.dot(&q) + basis.reference.view().insert_axis(ndarray::Axis(1));
-    let mut c = Array2::zeros((ns * r, n_el));
+    let mut c = Array2::zeros((groups.len().max(1) * ns * r, n_el));
     let (mut xe, ve, mut fe, mut l, mut d) =
         (vec![0.0; ne], vec![0.0; ne], vec![0.0; ne], vec![0.0; ne * ne], vec![0.0; ne * ne]);
     for e in 0..n_el {
         let dofs = full.element_dofs(e);
         full.element_linear(e, &mut l, &mut d);
+        let rows = group_of[e] * ns * r;
         for k in 0..ns {
             for (i, &dof) in dofs.iter().enumerate() {
                 xe[i] = x[[dof, k]];
@@ -50,7 +63,7 @@ pub fn training_matrix<M: InvariantElementModel>(full: &M, basis: &Basis, snapsh
             }
             for (i, &dof) in dofs.iter().enumerate() {
                 for a in 0..r {
-                    c[[k * r + a, e]] += v[[dof, a]] * fe[i];
+                    c[[rows + k * r + a, e]] += v[[dof, a]] * fe[i];
                 }
             }
         }

@@ -25,6 +25,12 @@
 //! the tangent's memory traffic (four-bar at 30 %: 7 → 3.5 MB per tangent). Work space is
 //! allocated once: the time loop does not touch the heap, and nothing of size n_dof is
 //! visited.
+//!
+//! A model whose elements' stiffness is a parameter
+//! ([`crate::solver::model::ElementModel::stiffness_factor`],
+//! Young's modulus) is affine in it: `L_r(μ) = Σ_g s_g(μ) L_r,g`, `l_r(μ)` alike, over the
+//! groups `g` of elements that share a parameter, and each sampled weight becomes
+//! `s_g(μ) wₑ`; both are set again when μ changes (once per run).
 
 mod columns;
 mod kernels;
@@ -34,7 +40,9 @@ use super::basis::Basis;
 use super::projection::{forward_to_projection, impl_reduced, Projection};
 use super::sample::Hyper;
 use crate::linalg::sparse_rows::SparseRows;
-use crate::solver::model::{InvariantElementModel, IterationCoefficients, Parameters, ParametricModel};
+use crate::solver::model::{
+    stiffness_groups, InvariantElementModel, IterationCoefficients, Parameters, ParametricModel,
+};
 use ndarray::{Array1, Array2, Axis};
 use sampled::Sampled;
 use std::sync::Arc;
@@ -59,6 +67,20 @@ pub struct HyperReducedModel<M: InvariantElementModel> {
     acc: Vec<f64>,
     /// the runs `(row, first, end)` of `acc` that any sampled element reaches
     runs: Vec<(usize, usize, usize)>,
+    /// the affine split in the elements' stiffness parameters; `None` without any
+    stiffness: Option<StiffnessSplit>,
+}
+
+/// `L_r,g`, `l_r,g` and `C_r` of the module documentation, with the sampled weights at
+/// `s = 1` and the factors the model is set to.
+struct StiffnessSplit {
+    /// per group: an element of it (to ask its factor), `L_r,g`, `l_r,g`
+    groups: Vec<(usize, Array2<f64>, Array1<f64>)>,
+    c_r: Option<Array2<f64>>,
+    /// per sampled element: its group and its weight at `s = 1`
+    sample_group: Vec<usize>,
+    weights: Vec<f64>,
+    factors: Vec<f64>,
 }
 
 impl<M: InvariantElementModel> HyperReducedModel<M> {
@@ -82,6 +104,14 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
             return Err(format!("hyper-reduction supports elements of 4, 6, 8 or 12 dofs, not {ne}"));
         }
 
+        // the elements by stiffness parameter, each group's linear part summed apart
+        let split = stiffness_groups(&*full);
+        let mut group_of = vec![0; n_el];
+        for (g, (_, members)) in split.iter().enumerate() {
+            members.iter().for_each(|&e| group_of[e] = g);
+        }
+        let mut group_l: Vec<(Array2<f64>, Array1<f64>)> =
+            split.iter().map(|_| (Array2::zeros((r, r)), Array1::zeros(r))).collect();
         // linear element parts, exact over all elements
         let mut l_r = Array2::zeros((r, r));
         let mut c_r = Array2::zeros((r, r));
@@ -97,15 +127,30 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
             let lm = Array2::from_shape_fn((ne, ne), |(i, j)| le[j * ne + i]);
             let cm = Array2::from_shape_fn((ne, ne), |(i, j)| ce[j * ne + i]);
             ndarray::linalg::general_mat_mul(1.0, &lm, &ve, 0.0, &mut lv);
-            ndarray::linalg::general_mat_mul(1.0, &ve.t(), &lv, 1.0, &mut l_r);
+            let (l_sum, l0_sum) = match group_l.get_mut(group_of[e]) {
+                Some((lg, l0g)) => (lg, l0g),
+                None => (&mut l_r, &mut l0),
+            };
+            ndarray::linalg::general_mat_mul(1.0, &ve.t(), &lv, 1.0, l_sum);
             // undamped models (both benchmarks) skip half the work of every run's set-up
             if ce.iter().any(|&x| x != 0.0) {
                 ndarray::linalg::general_mat_mul(1.0, &cm, &ve, 0.0, &mut cv);
                 ndarray::linalg::general_mat_mul(1.0, &ve.t(), &cv, 1.0, &mut c_r);
             }
-            l0 += &ve.t().dot(&lm.dot(&xe));
+            *l0_sum += &ve.t().dot(&lm.dot(&xe));
+        }
+        for (lg, l0g) in &group_l {
+            l_r += lg;
+            l0 += l0g;
         }
         let c_r = if c_r.iter().any(|&x| x != 0.0) { Some(c_r) } else { None };
+        let stiffness = (!split.is_empty()).then(|| StiffnessSplit {
+            groups: split.iter().zip(group_l).map(|((_, members), (lg, l0g))| (members[0], lg, l0g)).collect(),
+            c_r: c_r.clone(),
+            sample_group: hyper.elements.iter().map(|&e| group_of[e]).collect(),
+            weights: hyper.weights.clone(),
+            factors: vec![1.0; split.len()],
+        });
         let (l_rows, c_rows) = (SparseRows::new(&l_r), c_r.as_ref().map(SparseRows::new));
         p.set_linear_terms(Some(l_r), c_r);
         // invariant-based element forces derive from an energy: symmetric tangents
@@ -169,7 +214,31 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
             elements: hyper.elements.clone(),
             full,
             p,
+            stiffness,
         })
+    }
+
+    /// Sets the linear parts and the sampled weights to the elements' stiffness at `mu`
+    /// (nothing to do for a model without stiffness parameters, or at the same factors).
+    fn bind(&mut self, mu: &Parameters) {
+        let Some(split) = &mut self.stiffness else { return };
+        let factors: Vec<f64> = split.groups.iter().map(|(e, ..)| self.full.stiffness_factor(*e, mu)).collect();
+        if factors == split.factors {
+            return;
+        }
+        let r = self.p.r;
+        let (mut l_r, mut l0) = (Array2::zeros((r, r)), Array1::zeros(r));
+        for ((_, lg, l0g), &f) in split.groups.iter().zip(&factors) {
+            l_r.scaled_add(f, lg);
+            l0.scaled_add(f, l0g);
+        }
+        self.l_rows = SparseRows::new(&l_r);
+        self.l0 = l0;
+        self.p.set_linear_terms(Some(l_r), split.c_r.clone());
+        for (k, (w, &g)) in split.weights.iter().zip(&split.sample_group).enumerate() {
+            self.sampled.weights[k] = factors[g] * w;
+        }
+        split.factors = factors;
     }
 }
 
@@ -177,6 +246,7 @@ impl<M: InvariantElementModel> ParametricModel for HyperReducedModel<M> {
     forward_to_projection!();
 
     fn force(&mut self, mu: &Parameters, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
+        self.bind(mu);
         self.p.constant_and_load_force(&*self.full, mu, q, t, out);
         self.l_rows.mul(q, out, true);
         out.iter_mut().zip(&self.l0).for_each(|(o, l)| *o += l);
@@ -196,6 +266,7 @@ impl<M: InvariantElementModel> ParametricModel for HyperReducedModel<M> {
         coef: IterationCoefficients,
     ) -> Result<f64, String> {
         // m M_r + k (L_r + J_l,r) + c C_r
+        self.bind(mu);
         self.p.start_matrix(&*self.full, mu, q, t, coef);
         if coef.stiffness != 0.0 {
             self.update(q);

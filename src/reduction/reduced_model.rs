@@ -10,7 +10,9 @@
 //!
 //! where `Vₑ` are the rows of `V` on element `e`'s dofs: nothing of the full size is
 //! touched per iteration except the tangent's `Vᵀ Y` (Y = Σ Aₑᵀ Sₑ Vₑ, n × r): plain Galerkin
-//! costs as much as the mesh. The element weights `wₑ` are 1 for plain Galerkin.
+//! costs as much as the mesh. The element weights `wₑ` are 1 for plain Galerkin; an
+//! element whose stiffness is a parameter weighs `sₑ(μ) wₑ`
+//! ([`ElementModel::stiffness_factor`]: such a model is undamped, `fₑ` is elastic alone).
 //!
 //! Joints, mass and nodal loads: see `reduction::projection` (private).
 
@@ -27,7 +29,11 @@ pub struct ReducedModel<M: ElementModel> {
     /// dofs per element
     ne: usize,
     elements: Vec<usize>,
+    /// the weights at μ: `sₑ(μ) wₑ`, with `wₑ` in `base_weights` and μ in `bound` (`None`
+    /// for a model without stiffness parameters: the weights are `wₑ`)
     weights: Vec<f64>,
+    base_weights: Vec<f64>,
+    bound: Option<Parameters>,
     /// rows of V on each element's dofs, stacked: (elements.len()·ne) × r
     v_el: Array2<f64>,
     x_ref_el: Array1<f64>,
@@ -72,6 +78,9 @@ impl<M: ElementModel> ReducedModel<M> {
         let ne = if full.n_elements() > 0 { full.element_dofs(0).len() } else { 0 };
         let rows: Vec<usize> = elements.iter().flat_map(|&e| full.element_dofs(e).to_vec()).collect();
         let n_rows = rows.len();
+        let full_elements = full.n_elements();
+        let stiffness_parameter: Vec<bool> =
+            (0..full_elements).map(|e| full.stiffness_parameter(e).is_some()).collect();
         Ok(ReducedModel {
             v_el: v.select(Axis(0), &rows),
             x_ref_el: basis.reference.select(Axis(0), &rows),
@@ -88,9 +97,23 @@ impl<M: ElementModel> ReducedModel<M> {
             full,
             p,
             ne,
+            bound: (0..full_elements).any(|e| stiffness_parameter[e]).then(Parameters::default),
             elements,
+            base_weights: weights.clone(),
             weights,
         })
+    }
+
+    /// Sets the weights to the elements' stiffness at `mu` (see the module documentation).
+    fn bind(&mut self, mu: &Parameters) {
+        match &self.bound {
+            Some(at) if at != mu => {}
+            _ => return,
+        }
+        for ((w, &e), &base) in self.weights.iter_mut().zip(&self.elements).zip(&self.base_weights) {
+            *w = self.full.stiffness_factor(e, mu) * base;
+        }
+        self.bound = Some(mu.clone());
     }
 
     /// Element coordinates `x_ref,ₑ + Vₑ q` of every visited element, computed once per `q`.
@@ -109,6 +132,7 @@ impl<M: ElementModel> ParametricModel for ReducedModel<M> {
     forward_to_projection!();
 
     fn force(&mut self, mu: &Parameters, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
+        self.bind(mu);
         self.p.constant_and_load_force(&*self.full, mu, q, t, out);
         let ne = self.ne;
         self.update_element_coordinates(q);
@@ -129,6 +153,7 @@ impl<M: ElementModel> ParametricModel for ReducedModel<M> {
         coef: IterationCoefficients,
     ) -> Result<f64, String> {
         let (r, ne) = (self.p.r, self.ne);
+        self.bind(mu);
         self.p.start_matrix(&*self.full, mu, q, t, coef);
         if coef.stiffness != 0.0 || coef.damping != 0.0 {
             self.update_element_coordinates(q);

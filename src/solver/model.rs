@@ -175,6 +175,13 @@ impl<M: ParametricModel + ?Sized> DynamicModel for Bound<'_, M> {
 /// (gravity, entering with a minus sign) and `g_l` the state- or time-dependent nodal loads
 /// on the dofs `load_dofs()`. Both are affine in the load scale `λ` of the parameters μ:
 /// `g₀(μ) = g₀,fixed + λ g₀,scaled`, and `g_l` takes μ.
+///
+/// The element terms are those of the model file's own values. A parameter may scale an
+/// element's stiffness (Young's modulus as a parameter): then the model's force at μ holds
+/// `sₑ(μ) fₑ` and its tangent `sₑ(μ) ∂fₑ/∂qₑ`, with `sₑ` = [`ElementModel::stiffness_factor`];
+/// such a model has no damping (`Cₑ = 0`), so `fₑ` is elastic alone and the model stays
+/// affine in `sₑ`: a reduction sums the elements that share a parameter apart and scales
+/// each sum at μ.
 pub trait ElementModel: ParametricModel {
     fn n_elements(&self) -> usize;
     /// Global dofs of element `e`; every element has the same number of them.
@@ -197,6 +204,39 @@ pub trait ElementModel: ParametricModel {
     fn load_force(&self, mu: &Parameters, ql: &[f64], t: f64, out: &mut [f64]);
     /// `∂g_l/∂q_l` at μ (column-major, `load_dofs().len()` square).
     fn load_jacobian(&self, mu: &Parameters, ql: &[f64], t: f64, out: &mut [f64]);
+    /// The parameter that scales element `e`'s stiffness, if any (elements that name the
+    /// same parameter scale alike).
+    fn stiffness_parameter(&self, _e: usize) -> Option<&str> {
+        None
+    }
+    /// `sₑ(μ)`, the factor of element `e`'s force and tangent at μ (1 at the model file's
+    /// values, and for an element no parameter scales).
+    fn stiffness_factor(&self, _e: usize, _mu: &Parameters) -> f64 {
+        1.0
+    }
+}
+
+/// The elements of `model` by the parameter that scales their stiffness: `None` (no
+/// parameter) first when any element has none, then each parameter in the order its first
+/// element comes; empty when no element's stiffness is a parameter (every element then
+/// scales by 1, and a reduction need not split its sums).
+pub fn stiffness_groups<M: ElementModel + ?Sized>(model: &M) -> Vec<(Option<String>, Vec<usize>)> {
+    let n = model.n_elements();
+    if (0..n).all(|e| model.stiffness_parameter(e).is_none()) {
+        return Vec::new();
+    }
+    let mut groups: Vec<(Option<String>, Vec<usize>)> = Vec::new();
+    if (0..n).any(|e| model.stiffness_parameter(e).is_none()) {
+        groups.push((None, Vec::new()));
+    }
+    for e in 0..n {
+        let name = model.stiffness_parameter(e).map(str::to_string);
+        match groups.iter_mut().find(|(g, _)| *g == name) {
+            Some((_, members)) => members.push(e),
+            None => groups.push((name, vec![e])),
+        }
+    }
+    groups
 }
 
 /// An [`ElementModel`] whose element forces are a constant linear part plus a part that

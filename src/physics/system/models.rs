@@ -15,7 +15,7 @@ impl ElementModel for FlexibleSystem {
     }
 
     fn element_force(&self, e: usize, qe: &[f64], ve: &[f64], out: &mut [f64]) {
-        let f = self.element_force_vec(e, &Vec8::from_column_slice(qe), &Vec8::from_column_slice(ve));
+        let f = self.element_force_vec(self.element(e), e, &Vec8::from_column_slice(qe), &Vec8::from_column_slice(ve));
         out.copy_from_slice(f.as_slice());
     }
 
@@ -57,6 +57,14 @@ impl ElementModel for FlexibleSystem {
                 }
             }
         }
+    }
+
+    fn stiffness_parameter(&self, e: usize) -> Option<&str> {
+        self.bodies[self.elements[e].0].youngs_modulus_parameter.as_deref()
+    }
+
+    fn stiffness_factor(&self, e: usize, mu: &Parameters) -> f64 {
+        self.body_stiffness_factor(self.elements[e].0, mu)
     }
 }
 
@@ -111,9 +119,11 @@ impl ParametricModel for FlexibleSystem {
     }
 
     fn force(&mut self, mu: &Parameters, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
+        self.bind(mu);
         self.gravity_into(mu, out);
         for e in 0..self.elements.len() {
-            let f = self.element_force_vec(e, &self.gather(e, q), &self.gather(e, v));
+            let el = &self.bound[self.elements[e].0];
+            let f = self.element_force_vec(el, e, &self.gather(e, q), &self.gather(e, v));
             for (i, &d) in self.elements[e].1.iter().enumerate() {
                 out[d] += f[i];
             }
@@ -134,12 +144,13 @@ impl ParametricModel for FlexibleSystem {
         out: (&mut [f64], &mut [f64]),
     ) {
         let (force, inertia) = out;
+        self.bind(mu);
         self.gravity_into(mu, force);
         inertia.iter_mut().for_each(|x| *x = 0.0);
         let damped = self.damping != Rayleigh::default();
         for (e, (b, dofs)) in self.elements.iter().enumerate() {
             let d0 = dofs[0];
-            let el = &self.prototypes[*b];
+            let el = &self.bound[*b];
             let qe: &[f64; 8] = q[d0..d0 + 8].try_into().expect("8 consecutive dofs");
             let ae: &[f64; 8] = a[d0..d0 + 8].try_into().expect("8 consecutive dofs");
             let (mut f, m) = el.force_and_inertia(qe, ae);
@@ -179,10 +190,11 @@ impl ParametricModel for FlexibleSystem {
         t: f64,
         coef: IterationCoefficients,
     ) -> Result<f64, String> {
+        self.bind(mu);
         if self.iteration_coef != Some(coef) {
             let damped = coef.damping != 0.0 && self.damping != Rayleigh::default();
             self.iteration_constant = self
-                .prototypes
+                .bound
                 .iter()
                 .map(|el| {
                     let mut c = el.mass() * coef.mass + el.bending_stiffness() * coef.stiffness;
@@ -197,7 +209,7 @@ impl ParametricModel for FlexibleSystem {
         }
         let diag_max = crate::linalg::simd::dispatch(IterationBlocks {
             elements: &self.elements,
-            prototypes: &self.prototypes,
+            prototypes: &self.bound,
             constants: &self.iteration_constant,
             stiffness: coef.stiffness,
             q,
@@ -288,14 +300,26 @@ mod tests {
     use super::*;
     use crate::physics::element::Section;
 
+    /// A 1 m aluminium beam of `n` elements, at 0.3 rad: the test systems' body.
+    fn aluminium_body(name: &str, n: usize) -> BeamBody {
+        BeamBody {
+            name: name.into(),
+            start: [0.0, 0.0],
+            angle: 0.3,
+            length: 1.0,
+            n_elements: n,
+            section: Section { density: 2700.0, area: 1e-3, inertia: 1e-7, youngs_modulus: 7e9 },
+            youngs_modulus_parameter: None,
+        }
+    }
+
     /// The iteration blocks are symmetric to the bit, as `factor_symmetric` takes them to
     /// be (the band LDLᵀ then skips its check): with and without Rayleigh damping, with a
     /// moment load (its Jacobian enters two blocks' slope entries), at a strained state,
     /// for mass-only and full coefficients.
     #[test]
     fn iteration_blocks_are_symmetric_to_the_bit() {
-        let section = Section { density: 2700.0, area: 1e-3, inertia: 1e-7, youngs_modulus: 7e9 };
-        let body = BeamBody { name: "b".into(), start: [0.0, 0.0], angle: 0.3, length: 1.0, n_elements: 5, section };
+        let body = aluminium_body("b", 5);
         let gravity = [
             Load::Gravity { g: [0.0, -9.81], scaled: Scaling::LoadScale },
             Load::Moment { node: (0, 2), function: TimeFunction::Constant { value: 3.0 }, scaled: Scaling::LoadScale },
@@ -333,15 +357,7 @@ mod tests {
     /// a nodal force, on two bodies (their elements' dofs consecutive in each).
     #[test]
     fn one_pass_residual_equals_force_and_mass_product_to_the_bit() {
-        let section = Section { density: 2700.0, area: 1e-3, inertia: 1e-7, youngs_modulus: 7e9 };
-        let body = |name: &str, n| BeamBody {
-            name: name.into(),
-            start: [0.0, 0.0],
-            angle: 0.3,
-            length: 1.0,
-            n_elements: n,
-            section,
-        };
+        let body = aluminium_body;
         let loads = [
             Load::Gravity { g: [0.5, -9.81], scaled: Scaling::LoadScale },
             Load::Gravity { g: [0.0, -1.0], scaled: Scaling::Fixed },
@@ -381,8 +397,7 @@ mod tests {
     /// `L e + C ė + 2ψ S_l e` and `L + 2ψ S_l + 4ψ' (S_l e)(S_l e)ᵀ`.
     #[test]
     fn invariant_form_rebuilds_element_force_and_tangent() {
-        let section = Section { density: 2700.0, area: 1e-3, inertia: 1e-7, youngs_modulus: 7e9 };
-        let body = BeamBody { name: "b".into(), start: [0.0, 0.0], angle: 0.3, length: 1.0, n_elements: 2, section };
+        let body = aluminium_body("b", 2);
         let sys = FlexibleSystem::new(
             vec![body],
             &[],
