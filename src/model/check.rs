@@ -11,6 +11,43 @@ use crate::physics::system::{BeamBody, Joint, Load, NodeId, Probe};
 use crate::solver::generalized_alpha::{IntegratorParams, JacobianReuse, Predictor};
 use crate::solver::parameters::{Scaling, LOAD_SCALE};
 
+/// A body property that may be a parameter.
+#[derive(Clone, Copy)]
+enum Property {
+    YoungsModulus,
+    Density,
+}
+
+impl Property {
+    fn key(self) -> &'static str {
+        match self {
+            Property::YoungsModulus => "youngs_modulus",
+            Property::Density => "density",
+        }
+    }
+
+    fn noun(self) -> &'static str {
+        match self {
+            Property::YoungsModulus => "Young's modulus",
+            Property::Density => "density",
+        }
+    }
+
+    fn other(self) -> Property {
+        match self {
+            Property::YoungsModulus => Property::Density,
+            Property::Density => Property::YoungsModulus,
+        }
+    }
+
+    fn of(self, body: &BodySpec) -> &PropertySpec {
+        match self {
+            Property::YoungsModulus => &body.youngs_modulus,
+            Property::Density => &body.density,
+        }
+    }
+}
+
 /// Relative tolerance for a joint to count as closed in the initial configuration.
 const CLOSURE_TOL: f64 = 1e-6;
 
@@ -61,13 +98,8 @@ impl Model {
             ] {
                 self.positive(&p(&k), v)?;
             }
-            if b.density.parameter().is_some() {
-                return Err(self.err(
-                    p("density"),
-                    "cannot be a parameter yet (Young's modulus can): give a number, density = VALUE",
-                ));
-            }
-            let youngs_modulus_parameter = self.youngs_modulus_parameter(&f, i)?;
+            let youngs_modulus_parameter = self.checked_property_parameter(&f, i, Property::YoungsModulus)?;
+            let density_parameter = self.checked_property_parameter(&f, i, Property::Density)?;
             let (angle, length) = match (b.angle, b.end) {
                 (Some(_), Some(_)) => return Err(self.err(p("end"), "give either `angle` or `end`, not both")),
                 (None, None) => return Err(self.err(p("angle"), "missing: give `angle` (rad) with `length`, or `end`")),
@@ -110,6 +142,7 @@ impl Model {
                     youngs_modulus: b.youngs_modulus.value(),
                 },
                 youngs_modulus_parameter,
+                density_parameter,
             });
         }
         let lmax = self.bodies.iter().map(|b| b.length).fold(0.0, f64::max);
@@ -395,43 +428,56 @@ impl Model {
         }
     }
 
-    /// The parameter that body `i`'s `youngs_modulus = { value, parameter }` names, if any:
-    /// a parameter name that no load scales (a load's parameter is a factor, a modulus's
-    /// its value), the same value wherever bodies share it, and an undamped model (Rayleigh
-    /// damping's stiffness part would change with the modulus, its mass part would not: the
-    /// affine split a reduced model relies on holds without it).
-    fn youngs_modulus_parameter(&self, f: &ModelFile, i: usize) -> Result<Option<String>> {
-        let field = format!("bodies[{i}].youngs_modulus.parameter");
-        let Some(name) = f.bodies[i].youngs_modulus.parameter() else { return Ok(None) };
+    /// The parameter that body `i`'s `youngs_modulus` or `density = { value, parameter }`
+    /// names, if any: a parameter name that no load scales (a load's parameter is a factor,
+    /// a property's its value) and no other kind of property takes, the same value wherever
+    /// bodies share it, and an undamped model (Rayleigh damping `a M + b K` would change
+    /// with the property only in part: the affine split a reduced model relies on holds
+    /// without it).
+    fn checked_property_parameter(&self, f: &ModelFile, i: usize, which: Property) -> Result<Option<String>> {
+        let key = which.key();
+        let field = format!("bodies[{i}].{key}.parameter");
+        let Some(name) = which.of(&f.bodies[i]).parameter() else { return Ok(None) };
         if !crate::solver::parameters::is_parameter_name(name) || name == LOAD_SCALE {
             return Err(self.err(
                 field,
                 format!("`{name}` is not a parameter name: use letters, digits and `_`, starting with a letter (and not `{LOAD_SCALE}`, the load scale)"),
             ));
         }
-        let value = f.bodies[i].youngs_modulus.value();
-        if let Some(other) = f.bodies[..i].iter().find(|o| o.youngs_modulus.parameter() == Some(name)) {
-            if other.youngs_modulus.value() != value {
+        let value = which.of(&f.bodies[i]).value();
+        if let Some(other) = f.bodies[..i].iter().find(|o| which.of(o).parameter() == Some(name)) {
+            if which.of(other).value() != value {
                 return Err(self.err(
-                    format!("bodies[{i}].youngs_modulus.value"),
+                    format!("bodies[{i}].{key}.value"),
                     format!(
                         "is {value}, but body `{}` gives the parameter `{name}` the value {}: a parameter has one value",
                         other.name,
-                        other.youngs_modulus.value()
+                        which.of(other).value()
                     ),
                 ));
             }
         }
+        let other_kind = which.other();
+        if let Some(other) = f.bodies.iter().find(|o| other_kind.of(o).parameter() == Some(name)) {
+            return Err(self.err(
+                field,
+                format!(
+                    "`{name}` is also body `{}`'s {}: give the two properties different names",
+                    other.name,
+                    other_kind.key()
+                ),
+            ));
+        }
         if let Some((k, _)) = f.loads.iter().enumerate().find(|(_, l)| l.scaled_parameter() == Some(name)) {
             return Err(self.err(
                 field,
-                format!("`{name}` also scales loads[{k}]: a load's parameter multiplies it, a modulus's is its value; give them different names"),
+                format!("`{name}` also scales loads[{k}]: a load's parameter multiplies it, a {key} parameter is its value; give them different names"),
             ));
         }
         if f.damping.as_ref().is_some_and(|d| d.mass != 0.0 || d.stiffness != 0.0) {
             return Err(self.err(
                 field,
-                "a Young's modulus parameter needs a model without [damping] (Rayleigh damping with a parameter modulus is not supported)",
+                format!("a {} parameter needs a model without [damping] (Rayleigh damping with a parameter {} is not supported)", which.noun(), which.noun()),
             ));
         }
         Ok(Some(name.to_string()))

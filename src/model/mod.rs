@@ -113,17 +113,27 @@ impl Model {
                 }
             }
         }
-        for name in self.bodies.iter().filter_map(|b| b.youngs_modulus_parameter.as_deref()) {
-            if !names.contains(&name) {
-                names.push(name);
+        for body in &self.bodies {
+            for name in [&body.youngs_modulus_parameter, &body.density_parameter].into_iter().flatten() {
+                if !names.contains(&name.as_str()) {
+                    names.push(name);
+                }
             }
         }
         names
     }
 
-    /// Whether `name` is a body's Young's modulus (a value in Pa, not a factor).
-    pub fn is_modulus_parameter(&self, name: &str) -> bool {
-        self.bodies.iter().any(|b| b.youngs_modulus_parameter.as_deref() == Some(name))
+    /// What `name` sets when it is a body's property, "Young's modulus (Pa)" or "density
+    /// (kg/m³)" (a value, not a factor), or `None`.
+    pub fn property_parameter(&self, name: &str) -> Option<&'static str> {
+        let named = |p: &Option<String>| p.as_deref() == Some(name);
+        if self.bodies.iter().any(|b| named(&b.youngs_modulus_parameter)) {
+            Some("Young's modulus (Pa)")
+        } else if self.bodies.iter().any(|b| named(&b.density_parameter)) {
+            Some("density (kg/m³)")
+        } else {
+            None
+        }
     }
 
     /// Refuses parameters the model does not have (a `--param` misspelt, or one of another
@@ -133,13 +143,15 @@ impl Model {
         if let Some(problem) = mu.named().find_map(|(name, _)| self.unknown_parameter(name)) {
             return Err(Error::Usage(format!("{}: {problem}", self.path.display())));
         }
-        match mu.named().find(|&(name, value)| self.is_modulus_parameter(name) && !(value > 0.0)) {
-            Some((name, value)) => Err(Error::Usage(format!(
-                "{}: parameter {name} is a Young's modulus and must be positive, got {value}",
-                self.path.display()
-            ))),
-            None => Ok(()),
+        for (name, value) in mu.named() {
+            if let Some(what) = self.property_parameter(name).filter(|_| !(value > 0.0)) {
+                return Err(Error::Usage(format!(
+                    "{}: parameter {name} is a {what} and must be positive, got {value}",
+                    self.path.display()
+                )));
+            }
         }
+        Ok(())
     }
 
     /// The warning for load scales other than 1 on a model none of whose loads is `scaled =
@@ -184,7 +196,7 @@ impl Model {
             return None;
         }
         let have = if names.is_empty() {
-            "none: no load is scaled, no Young's modulus is a parameter".to_string()
+            "none: no load is scaled, no body's property is a parameter".to_string()
         } else {
             names.join(", ")
         };

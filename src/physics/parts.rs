@@ -19,6 +19,9 @@ pub struct BeamBody {
     /// the parameter that sets the body's Young's modulus, if any: at μ the modulus is
     /// `μ[name]` (the file's `section.youngs_modulus` where μ does not set it)
     pub youngs_modulus_parameter: Option<String>,
+    /// the parameter that sets the body's density, if any: at μ the density is `μ[name]`
+    /// (the file's `section.density` where μ does not set it); mass and weight scale with it
+    pub density_parameter: Option<String>,
 }
 
 impl BeamBody {

@@ -23,6 +23,16 @@ struct MomentLoad {
     scaled: Scaling,
 }
 
+/// The weight of the bodies whose density is the parameter `parameter` (file value
+/// `density`), in the parts `fixed + λ scaled + Σ μ_name named`, at the file's density.
+struct DensityGravity {
+    parameter: String,
+    density: f64,
+    fixed: Vec<f64>,
+    scaled: Vec<f64>,
+    named: Vec<(String, Vec<f64>)>,
+}
+
 struct ForceLoad {
     dofs: [usize; 2],
     value: [f64; 2],
@@ -39,9 +49,10 @@ pub struct FlexibleSystem {
     /// one element prototype per body, at the model file's values
     prototypes: Vec<BeamElement>,
     /// one element prototype per body at the parameters of the last evaluation (the
-    /// bodies' Young's moduli), and each body's factor `E(μ)/E_file` in it
+    /// bodies' Young's moduli and densities), and each body's factors `E(μ)/E_file` and
+    /// `ρ(μ)/ρ_file` in it
     bound: Vec<BeamElement>,
-    bound_factors: Vec<f64>,
+    bound_factors: Vec<(f64, f64)>,
     pub constraints: Vec<Constraint>,
     pub probes: Vec<Probe>,
     damping: Rayleigh,
@@ -49,6 +60,9 @@ pub struct FlexibleSystem {
     gravity_scaled: Vec<f64>,
     /// gravity multiplied by a named parameter (`scaled = "name"`), one vector per name
     gravity_named: Vec<(String, Vec<f64>)>,
+    /// the gravity of the bodies whose density is a parameter, by parameter (the vectors
+    /// above hold the other bodies'), at the file's density
+    gravity_density: Vec<DensityGravity>,
     moments: Vec<MomentLoad>,
     forces: Vec<ForceLoad>,
     /// the dofs that moments and nodal forces act on, sorted
@@ -120,6 +134,20 @@ impl FlexibleSystem {
         let mut gravity_fixed = vec![0.0; n_dof];
         let mut gravity_scaled = vec![0.0; n_dof];
         let mut gravity_named: Vec<(String, Vec<f64>)> = Vec::new();
+        let mut gravity_density: Vec<DensityGravity> = Vec::new();
+        for body in &bodies {
+            if let Some(name) = &body.density_parameter {
+                if !gravity_density.iter().any(|d| &d.parameter == name) {
+                    gravity_density.push(DensityGravity {
+                        parameter: name.clone(),
+                        density: body.section.density,
+                        fixed: vec![0.0; n_dof],
+                        scaled: vec![0.0; n_dof],
+                        named: Vec::new(),
+                    });
+                }
+            }
+        }
         let mut moments = Vec::new();
         let mut forces = Vec::new();
         // the element that holds a node: the one it starts, or the last of its body
@@ -134,21 +162,32 @@ impl FlexibleSystem {
         for load in loads {
             match load {
                 Load::Gravity { g, scaled } => {
-                    let target = match scaled {
-                        Scaling::Fixed => &mut gravity_fixed,
-                        Scaling::LoadScale => &mut gravity_scaled,
-                        Scaling::Named(name) => {
-                            let i = match gravity_named.iter().position(|(n, _)| n == name) {
-                                Some(i) => i,
-                                None => {
-                                    gravity_named.push((name.clone(), vec![0.0; n_dof]));
-                                    gravity_named.len() - 1
-                                }
-                            };
-                            &mut gravity_named[i].1
-                        }
-                    };
                     for (b, dofs) in &elements {
+                        // a body whose density is a parameter weighs in its own group
+                        let group = bodies[*b].density_parameter.as_ref().map(|name| {
+                            gravity_density.iter().position(|d| &d.parameter == name).expect("listed above")
+                        });
+                        let (fixed, scaled_part, named) = match group {
+                            None => (&mut gravity_fixed, &mut gravity_scaled, &mut gravity_named),
+                            Some(i) => {
+                                let d = &mut gravity_density[i];
+                                (&mut d.fixed, &mut d.scaled, &mut d.named)
+                            }
+                        };
+                        let target = match scaled {
+                            Scaling::Fixed => fixed,
+                            Scaling::LoadScale => scaled_part,
+                            Scaling::Named(name) => {
+                                let i = match named.iter().position(|(n, _)| n == name) {
+                                    Some(i) => i,
+                                    None => {
+                                        named.push((name.clone(), vec![0.0; n_dof]));
+                                        named.len() - 1
+                                    }
+                                };
+                                &mut named[i].1
+                            }
+                        };
                         let qg = prototypes[*b].gravity_force(*g);
                         for i in 0..8 {
                             target[dofs[i]] += qg[i];
@@ -200,12 +239,13 @@ impl FlexibleSystem {
             gravity_fixed,
             gravity_scaled,
             gravity_named,
+            gravity_density,
             moments,
             forces,
             load_dofs,
             n_dof,
             bound: prototypes.clone(),
-            bound_factors: vec![1.0; n_bodies],
+            bound_factors: vec![(1.0, 1.0); n_bodies],
             kkt: make_solver(solver, pattern),
             blocks: vec![Mat8::zeros(); n_el],
             iteration_constant: Vec::new(),
@@ -239,21 +279,34 @@ impl FlexibleSystem {
         }
     }
 
+    /// Body `b`'s mass factor `ρ(μ)/ρ_file` at `mu`, as [`Self::body_stiffness_factor`].
+    fn body_mass_factor(&self, b: usize, mu: &Parameters) -> f64 {
+        let body = &self.bodies[b];
+        match body.density_parameter.as_deref().and_then(|name| mu.get(name)) {
+            Some(rho) => rho / body.section.density,
+            None => 1.0,
+        }
+    }
+
     /// Makes the element prototypes the evaluations use those at `mu`: a body whose Young's
-    /// modulus is a parameter gets a prototype at `E = μ[name]` (its elastic force and
-    /// stiffness scale by `E(μ)/E_file`; its mass does not change) whenever that changes.
-    fn bind(&mut self, mu: &Parameters) {
+    /// modulus or density is a parameter gets a prototype at `E = μ[name]`, `ρ = μ[name]`
+    /// (its elastic force and stiffness scale by `E(μ)/E_file`, its mass by `ρ(μ)/ρ_file`)
+    /// whenever that changes.
+    fn bind_parameters(&mut self, mu: &Parameters) {
         for b in 0..self.bodies.len() {
-            let factor = self.body_stiffness_factor(b, mu);
-            if factor != self.bound_factors[b] {
+            let factors = (self.body_stiffness_factor(b, mu), self.body_mass_factor(b, mu));
+            if factors != self.bound_factors[b] {
                 let body = &self.bodies[b];
                 let mut section = body.section;
                 if let Some(e) = body.youngs_modulus_parameter.as_deref().and_then(|name| mu.get(name)) {
                     section.youngs_modulus = e;
                 }
+                if let Some(rho) = body.density_parameter.as_deref().and_then(|name| mu.get(name)) {
+                    section.density = rho;
+                }
                 self.bound[b] = BeamElement::new(body.length / body.n_elements as f64, section);
-                self.bound_factors[b] = factor;
-                // the iteration matrix's constant part holds the bending stiffness
+                self.bound_factors[b] = factors;
+                // the iteration matrix's constant part holds the mass and bending stiffness
                 self.iteration_coef = None;
             }
         }
@@ -418,7 +471,8 @@ impl FlexibleSystem {
     }
 
     /// `out = −g₀(μ)`: gravity, the fixed part, the scaled part times the load scale, and
-    /// each named part times its parameter.
+    /// each named part times its parameter; the bodies whose density is a parameter, each
+    /// part times `ρ(μ)/ρ_file` as well.
     fn gravity_into(&self, mu: &Parameters, out: &mut [f64]) {
         for (o, (gf, gs)) in out.iter_mut().zip(self.gravity_fixed.iter().zip(&self.gravity_scaled)) {
             *o = -(gf + mu.scale() * gs);
@@ -427,6 +481,16 @@ impl FlexibleSystem {
             // a parameter the run does not set keeps the file's load
             let x = mu.get(name).unwrap_or(1.0);
             out.iter_mut().zip(g).for_each(|(o, g)| *o -= x * g);
+        }
+        for d in &self.gravity_density {
+            let m = mu.get(&d.parameter).map_or(1.0, |rho| rho / d.density);
+            for (o, (gf, gs)) in out.iter_mut().zip(d.fixed.iter().zip(&d.scaled)) {
+                *o -= m * (gf + mu.scale() * gs);
+            }
+            for (name, g) in &d.named {
+                let x = m * mu.get(name).unwrap_or(1.0);
+                out.iter_mut().zip(g).for_each(|(o, g)| *o -= x * g);
+            }
         }
     }
 

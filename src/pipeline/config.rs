@@ -225,13 +225,10 @@ impl Pipeline {
             if let Err(e) = range.validate() {
                 return bad(&field, e);
             }
-            if self.model.is_modulus_parameter(name) && !(range.lower > 0.0) {
+            if let Some(what) = self.model.property_parameter(name).filter(|_| !(range.lower > 0.0)) {
                 return bad(
                     &field,
-                    format!(
-                        "is a Young's modulus (Pa); its range must be positive, got {} … {}",
-                        range.lower, range.upper
-                    ),
+                    format!("is a {what}; its range must be positive, got {} … {}", range.lower, range.upper),
                 );
             }
         }

@@ -218,9 +218,11 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
         })
     }
 
-    /// Sets the linear parts and the sampled weights to the elements' stiffness at `mu`
-    /// (nothing to do for a model without stiffness parameters, or at the same factors).
-    fn bind(&mut self, mu: &Parameters) {
+    /// Sets the mass to the elements' mass at `mu`, the linear parts and the sampled weights
+    /// to their stiffness (nothing to do for a model without such parameters, or at the
+    /// same factors).
+    fn bind_parameters(&mut self, mu: &Parameters) {
+        self.p.bind(&*self.full, mu);
         let Some(split) = &mut self.stiffness else { return };
         let factors: Vec<f64> = split.groups.iter().map(|(e, ..)| self.full.stiffness_factor(*e, mu)).collect();
         if factors == split.factors {
@@ -245,8 +247,12 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
 impl<M: InvariantElementModel> ParametricModel for HyperReducedModel<M> {
     forward_to_projection!();
 
+    fn bind(&mut self, mu: &Parameters) {
+        self.bind_parameters(mu);
+    }
+
     fn force(&mut self, mu: &Parameters, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
-        self.bind(mu);
+        self.bind_parameters(mu);
         self.p.constant_and_load_force(&*self.full, mu, q, t, out);
         self.l_rows.mul(q, out, true);
         out.iter_mut().zip(&self.l0).for_each(|(o, l)| *o += l);
@@ -266,7 +272,7 @@ impl<M: InvariantElementModel> ParametricModel for HyperReducedModel<M> {
         coef: IterationCoefficients,
     ) -> Result<f64, String> {
         // m M_r + k (L_r + J_l,r) + c C_r
-        self.bind(mu);
+        self.bind_parameters(mu);
         self.p.start_matrix(&*self.full, mu, q, t, coef);
         if coef.stiffness != 0.0 {
             self.update(q);

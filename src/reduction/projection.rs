@@ -11,7 +11,10 @@
 //! ```
 //!
 //! Both parts of the constant force are projected once, unscaled, and combined at the load
-//! scale `λ` of each evaluation's parameters μ: one reduced model runs at every load.
+//! scale `λ` of each evaluation's parameters μ: one reduced model runs at every load. Where
+//! a parameter scales some elements' mass (a body's density), the mass and the constant
+//! force are projected per group `g` of such elements, `M_r(μ) = Σ_g m_g(μ) M_r,g` and
+//! `g₀,r(μ) = Σ_g m_g(μ) g₀,r,g(μ)`, and summed again when μ changes ([`Projection::bind`]).
 //!
 //! Joints: *constraint-preserving* keeps `B V q = b − B x_ref` with exact multipliers
 //! (`B V = [0, B_c]`), and solves each Newton system in the null space of its joint rows
@@ -28,7 +31,7 @@ use super::joint_elimination::JointElimination;
 use crate::linalg::dense_lu::DenseLu;
 use crate::linalg::sparse_rows::SparseRows;
 pub(crate) use crate::linalg::vec_ops::{axpy, dot, mat_vec};
-use crate::solver::model::{ElementModel, IterationCoefficients, Parameters};
+use crate::solver::model::{mass_groups, ConstantForces, ElementModel, IterationCoefficients, Parameters};
 use ndarray::{s, Array1, Array2, ArrayView1, Axis};
 use ndarray_linalg::SVD;
 
@@ -91,6 +94,11 @@ pub(crate) struct Projection {
     g0_scaled: Array1<f64>,
     /// `Vᵀg₀,name` of each named parameter's constant force ([`ElementModel::named_constant_forces`])
     g0_named: Vec<(String, Array1<f64>)>,
+    /// for a model whose elements' mass is a parameter: the mass and the constant forces by
+    /// group, `M_r(μ) = Σ m_g(μ) M_r,g` and `g₀,r(μ)` alike (the fields above then hold the
+    /// sum at the factors of the last [`Projection::bind`], and the constant forces are read
+    /// from here)
+    mass_split: Option<MassSplit>,
     /// B V and B x_ref − b (reduced rows)
     b_r: Array2<f64>,
     c_r: Array1<f64>,
@@ -120,6 +128,31 @@ pub(crate) struct Projection {
     symmetric: bool,
 }
 
+/// The groups of [`Projection::mass_split`]: per group an element of it (to ask its
+/// factor), `M_r,g` and its projected constant forces; and the factors the mass is set to.
+struct MassSplit {
+    groups: Vec<(usize, Array2<f64>, ProjectedForces)>,
+    factors: Vec<f64>,
+}
+
+/// `Vᵀg₀,fixed`, `Vᵀg₀,scaled` and each `Vᵀg₀,name`.
+struct ProjectedForces {
+    fixed: Array1<f64>,
+    scaled: Array1<f64>,
+    named: Vec<(String, Array1<f64>)>,
+}
+
+impl ProjectedForces {
+    fn of(v: &Array2<f64>, g: ConstantForces) -> Self {
+        let project = |x: &[f64]| v.t().dot(&ArrayView1::from(x));
+        ProjectedForces {
+            fixed: project(&g.fixed),
+            scaled: project(&g.scaled),
+            named: g.named.iter().map(|(name, x)| (name.clone(), project(x))).collect(),
+        }
+    }
+}
+
 impl Projection {
     pub fn new<M: ElementModel>(full: &M, basis: &Basis) -> Result<Self, String> {
         let (n, nc_full) = (full.n_dof(), full.n_constraints());
@@ -147,6 +180,26 @@ impl Projection {
             .into_iter()
             .map(|(name, g)| (name, v.t().dot(&ArrayView1::from(&g))))
             .collect();
+        let groups = mass_groups(full);
+        let mass_split = (!groups.is_empty()).then(|| {
+            let groups: Vec<_> = groups
+                .iter()
+                .map(|(name, members)| {
+                    let mut mv = Array2::zeros((n, r));
+                    for j in 0..r {
+                        full.group_mass_mul(name.as_deref(), &v.column(j).to_vec(), &mut col);
+                        mv.column_mut(j).assign(&ArrayView1::from(&col));
+                    }
+                    (members[0], v.t().dot(&mv), ProjectedForces::of(v, full.group_constant_forces(name.as_deref())))
+                })
+                .collect();
+            MassSplit { factors: vec![1.0; groups.len()], groups }
+        });
+        // the same mass from the groups (the file's values, whatever the model was last bound to)
+        let mass = match &mass_split {
+            Some(split) => split.groups.iter().fold(Array2::zeros((r, r)), |acc, (_, m, _)| acc + m),
+            None => mass,
+        };
 
         // constraints are linear: B y − b, so B V_j = res(V_j) − res(0)
         let mut res0 = vec![0.0; nc_full];
@@ -214,6 +267,7 @@ impl Projection {
             g0_fixed,
             g0_scaled,
             g0_named,
+            mass_split,
             b_r,
             c_r,
             coupling,
@@ -246,6 +300,24 @@ impl Projection {
         }
     }
 
+    /// Sets the mass to the elements' mass at `mu` (nothing to do for a model without mass
+    /// parameters, or at the same factors).
+    pub fn bind<M: ElementModel>(&mut self, full: &M, mu: &Parameters) {
+        let Some(split) = &mut self.mass_split else { return };
+        let factors: Vec<f64> = split.groups.iter().map(|(e, ..)| full.mass_factor(*e, mu)).collect();
+        if factors == split.factors {
+            return;
+        }
+        let mut mass = Array2::zeros((self.r, self.r));
+        for ((_, m, _), &f) in split.groups.iter().zip(&factors) {
+            mass.scaled_add(f, m);
+        }
+        self.mass_rows = SparseRows::new(&mass);
+        self.mass = mass;
+        self.base_coef = None;
+        split.factors = factors;
+    }
+
     /// `out = M_r a`
     pub fn mass_mul(&self, a: &[f64], out: &mut [f64]) {
         self.mass_rows.mul(a, out, false);
@@ -261,12 +333,29 @@ impl Projection {
         out: &mut [f64],
     ) {
         let x = mu.scale();
-        for (o, (f, s)) in out.iter_mut().zip(self.g0_fixed.iter().zip(&self.g0_scaled)) {
-            *o = f + x * s;
-        }
-        for (name, g) in &self.g0_named {
-            let x = mu.get(name).unwrap_or(1.0);
-            out.iter_mut().zip(g).for_each(|(o, g)| *o += x * g);
+        match &self.mass_split {
+            None => {
+                for (o, (f, s)) in out.iter_mut().zip(self.g0_fixed.iter().zip(&self.g0_scaled)) {
+                    *o = f + x * s;
+                }
+                for (name, g) in &self.g0_named {
+                    let x = mu.get(name).unwrap_or(1.0);
+                    out.iter_mut().zip(g).for_each(|(o, g)| *o += x * g);
+                }
+            }
+            Some(split) => {
+                out.fill(0.0);
+                for ((e, _, g0), m) in split.groups.iter().zip(&split.factors) {
+                    debug_assert_eq!(*m, full.mass_factor(*e, mu), "bind() before evaluating");
+                    for (o, (f, s)) in out.iter_mut().zip(g0.fixed.iter().zip(&g0.scaled)) {
+                        *o += m * (f + x * s);
+                    }
+                    for (name, g) in &g0.named {
+                        let x = m * mu.get(name).unwrap_or(1.0);
+                        out.iter_mut().zip(g).for_each(|(o, g)| *o += x * g);
+                    }
+                }
+            }
         }
         if !self.load_dofs.is_empty() {
             expand(&self.v_load, Some(&self.x_ref_load), 0, q, &mut self.xl);

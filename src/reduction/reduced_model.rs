@@ -3,7 +3,7 @@
 //! model. With `x = x_ref + V q` (SPEC §3, thesis eqs. 11–12, 18–21):
 //!
 //! ```text
-//!     M_r = VᵀMV (once),   g₀,r(μ) = Vᵀg₀,fixed + λ Vᵀg₀,scaled (both parts once),
+//!     M_r = VᵀMV (once; per group where density is a parameter),   g₀,r(μ) = Vᵀg₀,fixed + λ Vᵀg₀,scaled (both parts once),
 //!     g_r(q, q̇, t; μ) = g₀,r(μ) + Σ_e wₑ Vₑᵀ fₑ(xₑ, ẋₑ) + V_lᵀ g_l(x_l, t),   xₑ = x_ref,ₑ + Vₑ q,
 //!     S_r = m M_r + Σ_e wₑ Vₑᵀ (c Cₑ + k Kₑ) Vₑ + k V_lᵀ J_l V_l,
 //! ```
@@ -104,8 +104,10 @@ impl<M: ElementModel> ReducedModel<M> {
         })
     }
 
-    /// Sets the weights to the elements' stiffness at `mu` (see the module documentation).
-    fn bind(&mut self, mu: &Parameters) {
+    /// Sets the mass to the elements' mass at `mu` and the weights to their stiffness (see
+    /// the module documentation).
+    fn bind_parameters(&mut self, mu: &Parameters) {
+        self.p.bind(&*self.full, mu);
         match &self.bound {
             Some(at) if at != mu => {}
             _ => return,
@@ -131,8 +133,12 @@ impl<M: ElementModel> ReducedModel<M> {
 impl<M: ElementModel> ParametricModel for ReducedModel<M> {
     forward_to_projection!();
 
+    fn bind(&mut self, mu: &Parameters) {
+        self.bind_parameters(mu);
+    }
+
     fn force(&mut self, mu: &Parameters, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
-        self.bind(mu);
+        self.bind_parameters(mu);
         self.p.constant_and_load_force(&*self.full, mu, q, t, out);
         let ne = self.ne;
         self.update_element_coordinates(q);
@@ -153,7 +159,7 @@ impl<M: ElementModel> ParametricModel for ReducedModel<M> {
         coef: IterationCoefficients,
     ) -> Result<f64, String> {
         let (r, ne) = (self.p.r, self.ne);
-        self.bind(mu);
+        self.bind_parameters(mu);
         self.p.start_matrix(&*self.full, mu, q, t, coef);
         if coef.stiffness != 0.0 || coef.damping != 0.0 {
             self.update_element_coordinates(q);

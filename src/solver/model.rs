@@ -67,6 +67,10 @@ pub trait DynamicModel {
 /// parallel sweep keeps one model per thread. No parameter-dependent value is cached
 /// between calls, so nothing of one run's parameters leaks into the next.
 pub trait ParametricModel {
+    /// Sets what the model keeps between evaluations to the parameters `mu` (a body's
+    /// density changes its mass, which [`Self::mass_mul`] applies without taking μ); the
+    /// integrator's [`Bound`] calls it first. Nothing to do by default.
+    fn bind(&mut self, _mu: &Parameters) {}
     fn n_dof(&self) -> usize;
     fn n_constraints(&self) -> usize;
     /// `out = M a`
@@ -117,6 +121,7 @@ pub struct Bound<'a, M: ?Sized> {
 
 impl<'a, M: ParametricModel + ?Sized> Bound<'a, M> {
     pub fn new(model: &'a mut M, mu: &Parameters) -> Self {
+        model.bind(mu);
         Bound { model, mu: mu.clone() }
     }
 }
@@ -181,7 +186,10 @@ impl<M: ParametricModel + ?Sized> DynamicModel for Bound<'_, M> {
 /// `sₑ(μ) fₑ` and its tangent `sₑ(μ) ∂fₑ/∂qₑ`, with `sₑ` = [`ElementModel::stiffness_factor`];
 /// such a model has no damping (`Cₑ = 0`), so `fₑ` is elastic alone and the model stays
 /// affine in `sₑ`: a reduction sums the elements that share a parameter apart and scales
-/// each sum at μ.
+/// each sum at μ. A parameter may scale an element's mass likewise (density as a
+/// parameter, [`ElementModel::mass_factor`]): its mass and its share of `g₀` (gravity)
+/// scale by `mₑ(μ)`, and a reduction projects them per group ([`ElementModel::group_mass_mul`],
+/// [`ElementModel::group_constant_forces`]).
 pub trait ElementModel: ParametricModel {
     fn n_elements(&self) -> usize;
     /// Global dofs of element `e`; every element has the same number of them.
@@ -214,6 +222,39 @@ pub trait ElementModel: ParametricModel {
     fn stiffness_factor(&self, _e: usize, _mu: &Parameters) -> f64 {
         1.0
     }
+    /// The parameter that scales element `e`'s mass (and weight), if any.
+    fn mass_parameter(&self, _e: usize) -> Option<&str> {
+        None
+    }
+    /// `mₑ(μ)`, the factor of element `e`'s mass and weight at μ (1 at the file's values).
+    fn mass_factor(&self, _e: usize, _mu: &Parameters) -> f64 {
+        1.0
+    }
+    /// `out = M_g a` at the model file's values, `M_g` the mass of the elements whose
+    /// [`Self::mass_parameter`] is `group` (`None`: those no parameter scales).
+    fn group_mass_mul(&self, group: Option<&str>, a: &[f64], out: &mut [f64]) {
+        assert!(group.is_none(), "a model with mass parameters implements group_mass_mul");
+        self.mass_mul(a, out);
+    }
+    /// The parts of `g₀` of the elements whose mass parameter is `group`, at the model file's
+    /// values: `g₀,fixed`, `g₀,scaled` and the named parts, as
+    /// [`Self::constant_force_parts`] and [`Self::named_constant_forces`] give them for the
+    /// whole model.
+    fn group_constant_forces(&self, group: Option<&str>) -> ConstantForces {
+        assert!(group.is_none(), "a model with mass parameters implements group_constant_forces");
+        let n = self.n_dof();
+        let (mut fixed, mut scaled) = (vec![0.0; n], vec![0.0; n]);
+        self.constant_force_parts(&mut fixed, &mut scaled);
+        ConstantForces { fixed, scaled, named: self.named_constant_forces() }
+    }
+}
+
+/// The constant forces `g₀` of a model, or of a group of its elements, in parts:
+/// `g₀(μ) = fixed + λ scaled + Σ μ_name named_name`.
+pub struct ConstantForces {
+    pub fixed: Vec<f64>,
+    pub scaled: Vec<f64>,
+    pub named: Vec<(String, Vec<f64>)>,
 }
 
 /// The elements of `model` by the parameter that scales their stiffness: `None` (no
@@ -221,16 +262,25 @@ pub trait ElementModel: ParametricModel {
 /// element comes; empty when no element's stiffness is a parameter (every element then
 /// scales by 1, and a reduction need not split its sums).
 pub fn stiffness_groups<M: ElementModel + ?Sized>(model: &M) -> Vec<(Option<String>, Vec<usize>)> {
-    let n = model.n_elements();
-    if (0..n).all(|e| model.stiffness_parameter(e).is_none()) {
+    groups_by(model.n_elements(), |e| model.stiffness_parameter(e))
+}
+
+/// The elements of `model` by the parameter that scales their mass, as
+/// [`stiffness_groups`] by stiffness.
+pub fn mass_groups<M: ElementModel + ?Sized>(model: &M) -> Vec<(Option<String>, Vec<usize>)> {
+    groups_by(model.n_elements(), |e| model.mass_parameter(e))
+}
+
+fn groups_by<'a>(n: usize, parameter: impl Fn(usize) -> Option<&'a str>) -> Vec<(Option<String>, Vec<usize>)> {
+    if (0..n).all(|e| parameter(e).is_none()) {
         return Vec::new();
     }
     let mut groups: Vec<(Option<String>, Vec<usize>)> = Vec::new();
-    if (0..n).any(|e| model.stiffness_parameter(e).is_none()) {
+    if (0..n).any(|e| parameter(e).is_none()) {
         groups.push((None, Vec::new()));
     }
     for e in 0..n {
-        let name = model.stiffness_parameter(e).map(str::to_string);
+        let name = parameter(e).map(str::to_string);
         match groups.iter_mut().find(|(g, _)| *g == name) {
             Some((_, members)) => members.push(e),
             None => groups.push((name, vec![e])),

@@ -56,3 +56,24 @@ pub fn cantilever_with_density(
         minus_p = -p
     ))
 }
+
+/// `flexrom validate p.toml --json --no-dense` in `dir` (a pipeline over a box: the box's
+/// four random held-out points), each point checked within `tolerance`, covered by its error
+/// estimate and inside the box; returns the points' JSON objects.
+pub fn held_out_points_within(dir: &std::path::Path, tolerance: f64) -> Vec<serde_json::Value> {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_flexrom"))
+        .args(["validate", "p.toml", "--json", "--no-dense"])
+        .current_dir(dir)
+        .env("HDF5_USE_FILE_LOCKING", "FALSE")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let vs: Vec<serde_json::Value> = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(vs.len(), 4);
+    for v in &vs {
+        let (e, est) = (v["rel_error"].as_f64().unwrap(), v["error_estimate"].as_f64().unwrap());
+        assert!(e <= tolerance && est >= e, "{v}");
+        assert_eq!(v["extrapolated"], false, "{v}");
+    }
+    vs
+}

@@ -3,7 +3,7 @@
 //! [`crate::solver::model::DynamicModel`].
 
 use super::*;
-use crate::solver::model::{ElementModel, InvariantElementModel};
+use crate::solver::model::{ConstantForces, ElementModel, InvariantElementModel};
 
 impl ElementModel for FlexibleSystem {
     fn n_elements(&self) -> usize {
@@ -23,6 +23,7 @@ impl ElementModel for FlexibleSystem {
         out.copy_from_slice(self.element_matrix_mat(e, &Vec8::from_column_slice(qe), coef).as_slice());
     }
 
+    /// The bodies' whose density no parameter sets (all, in a model with no such parameter).
     fn constant_force_parts(&self, fixed: &mut [f64], scaled: &mut [f64]) {
         for (o, g) in fixed.iter_mut().zip(&self.gravity_fixed) {
             *o = -g;
@@ -66,6 +67,43 @@ impl ElementModel for FlexibleSystem {
     fn stiffness_factor(&self, e: usize, mu: &Parameters) -> f64 {
         self.body_stiffness_factor(self.elements[e].0, mu)
     }
+
+    fn mass_parameter(&self, e: usize) -> Option<&str> {
+        self.bodies[self.elements[e].0].density_parameter.as_deref()
+    }
+
+    fn mass_factor(&self, e: usize, mu: &Parameters) -> f64 {
+        self.body_mass_factor(self.elements[e].0, mu)
+    }
+
+    fn group_mass_mul(&self, group: Option<&str>, a: &[f64], out: &mut [f64]) {
+        out.iter_mut().for_each(|x| *x = 0.0);
+        for (e, (b, dofs)) in self.elements.iter().enumerate() {
+            if self.bodies[*b].density_parameter.as_deref() == group {
+                let f = self.element(e).mass_product(&self.gather(e, a));
+                for (i, &d) in dofs.iter().enumerate() {
+                    out[d] += f[i];
+                }
+            }
+        }
+    }
+
+    fn group_constant_forces(&self, group: Option<&str>) -> ConstantForces {
+        let negated = |g: &[f64]| g.iter().map(|x| -x).collect::<Vec<f64>>();
+        let named = |n: &[(String, Vec<f64>)]| n.iter().map(|(name, g)| (name.clone(), negated(g))).collect();
+        match group.and_then(|name| self.gravity_density.iter().find(|d| d.parameter == name)) {
+            Some(d) => ConstantForces { fixed: negated(&d.fixed), scaled: negated(&d.scaled), named: named(&d.named) },
+            None if group.is_some() => {
+                let zero = vec![0.0; self.n_dof];
+                ConstantForces { fixed: zero.clone(), scaled: zero, named: Vec::new() }
+            }
+            None => ConstantForces {
+                fixed: negated(&self.gravity_fixed),
+                scaled: negated(&self.gravity_scaled),
+                named: named(&self.gravity_named),
+            },
+        }
+    }
 }
 
 /// Berzeri–Shabana in invariant form (SPEC §1): `L = K_t`, `C = a M + b K_t`, one invariant
@@ -108,10 +146,15 @@ impl ParametricModel for FlexibleSystem {
         self.constraints.len()
     }
 
+    fn bind(&mut self, mu: &Parameters) {
+        self.bind_parameters(mu);
+    }
+
+    /// At the parameters of the last [`ParametricModel::bind`] or evaluation.
     fn mass_mul(&self, a: &[f64], out: &mut [f64]) {
         out.iter_mut().for_each(|x| *x = 0.0);
         for e in 0..self.elements.len() {
-            let f = self.element(e).mass_product(&self.gather(e, a));
+            let f = self.bound[self.elements[e].0].mass_product(&self.gather(e, a));
             for (i, &d) in self.elements[e].1.iter().enumerate() {
                 out[d] += f[i];
             }
@@ -119,7 +162,7 @@ impl ParametricModel for FlexibleSystem {
     }
 
     fn force(&mut self, mu: &Parameters, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
-        self.bind(mu);
+        self.bind_parameters(mu);
         self.gravity_into(mu, out);
         for e in 0..self.elements.len() {
             let el = &self.bound[self.elements[e].0];
@@ -144,7 +187,7 @@ impl ParametricModel for FlexibleSystem {
         out: (&mut [f64], &mut [f64]),
     ) {
         let (force, inertia) = out;
-        self.bind(mu);
+        self.bind_parameters(mu);
         self.gravity_into(mu, force);
         inertia.iter_mut().for_each(|x| *x = 0.0);
         let damped = self.damping != Rayleigh::default();
@@ -190,7 +233,7 @@ impl ParametricModel for FlexibleSystem {
         t: f64,
         coef: IterationCoefficients,
     ) -> Result<f64, String> {
-        self.bind(mu);
+        self.bind_parameters(mu);
         if self.iteration_coef != Some(coef) {
             let damped = coef.damping != 0.0 && self.damping != Rayleigh::default();
             self.iteration_constant = self
@@ -310,6 +353,7 @@ mod tests {
             n_elements: n,
             section: Section { density: 2700.0, area: 1e-3, inertia: 1e-7, youngs_modulus: 7e9 },
             youngs_modulus_parameter: None,
+            density_parameter: None,
         }
     }
 
