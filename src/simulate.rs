@@ -58,6 +58,8 @@ impl Settings {
         }
         mu.validate()?;
         model.check_parameters(&mu)?;
+        // a body property the run does not set is the file's value: say so in the result
+        let mu = model.with_property_values(&mu);
         let params = IntegratorParams { rho_inf, ..model.integrator_params() };
         params.validate().map_err(|e| Error::Usage(format!("--rho-inf: {e}")))?;
         // the number of whole steps that fit (SPEC §4: 1.1 s at 0.007 s is 157 steps),

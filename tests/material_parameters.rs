@@ -322,6 +322,16 @@ fn greedy_training_over_a_load_and_a_modulus_converges_and_covers_held_out_point
     let (ok, err) = flexrom(d, &["online", "p.toml", "--param", "E_lower=3e11", "--param", "g=1", "-o", "o.h5"]);
     assert!(ok, "{err}");
     assert!(err.contains("E_lower = 3e11 (trained over [2e10, 2e11])"), "{err}");
+    // a modulus not given is the file's 7e10, inside the box: not extrapolated, and the
+    // result says the value it ran at; validate's neighbouring run moves 7e10, not 1
+    let (ok, err) = flexrom(d, &["online", "p.toml", "--param", "g=1", "-o", "o2.h5"]);
+    assert!(ok && !err.contains("trained over"), "{err}");
+    let f = hdf5::File::open(d.join("o2.h5")).unwrap();
+    assert_eq!(f.attr("parameter:E_lower").unwrap().read_scalar::<f64>().unwrap(), 7e10);
+    assert_eq!(f.attr("extrapolated").unwrap().read_scalar::<u64>().unwrap(), 0);
+    drop(f);
+    let (ok, err) = flexrom(d, &["validate", "p.toml", "--param", "g=1", "--no-dense"]);
+    assert!(ok && !err.contains("trained over"), "{err}");
 }
 
 /// The parametric four-bar with the coupler's density a parameter too (`rho_coupler`,
@@ -377,4 +387,34 @@ fn greedy_training_over_a_load_and_a_density_converges_and_covers_held_out_point
     greedy_over_gravity_and(d, "density", "2700.0", "rho_lower", "[1350, 5400]");
     let (ok, err) = flexrom(d, &["online", "p.toml", "--param", "rho_lower=0", "-o", "o.h5"]);
     assert!(!ok && err.contains("parameter rho_lower is a density (kg/m³) and must be positive, got 0"), "{err}");
+}
+
+/// A basis trained over the load scale alone, on a model whose coupler modulus is a
+/// parameter: training ran at the file's modulus, so a run that leaves it (or sets it to
+/// that value) is not extrapolated, in the command's output and in the result file alike,
+/// and one at another modulus is, named against the file's value.
+#[test]
+fn a_property_training_did_not_vary_counts_as_trained_at_the_file_value() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("m.toml"), short_fourbar_stiffness()).unwrap();
+    std::fs::write(
+        d.join("p.toml"),
+        "model = \"m.toml\"\nbasis = \"b.h5\"\nreport = \"r\"\n[train]\nload_scales = [0.9, 1.0]\n\
+         [reduction]\nvariant = \"constraint-preserving\"\nmodes = { count = 20 }\n",
+    )
+    .unwrap();
+    let (ok, err) = flexrom(d, &["train", "p.toml", "-q"]);
+    assert!(ok, "{err}");
+    let extrapolated =
+        |f: &str| hdf5::File::open(d.join(f)).unwrap().attr("extrapolated").unwrap().read_scalar::<u64>().unwrap();
+    for (out, args) in [("o1.h5", &[][..]), ("o2.h5", &["--param", "E_coupler=5e6"][..])] {
+        let (ok, err) = flexrom(d, &[&["online", "p.toml", "--load-scale", "0.95", "-o", out][..], args].concat());
+        assert!(ok && !err.contains("trained at"), "{err}");
+        assert_eq!(extrapolated(out), 0, "{out}");
+    }
+    let (ok, err) =
+        flexrom(d, &["online", "p.toml", "--load-scale", "0.95", "--param", "E_coupler=7e6", "-o", "o3.h5"]);
+    assert!(ok && err.contains("E_coupler = 7e6 (trained at 5e6, the model file's value)"), "{err}");
+    assert_eq!(extrapolated("o3.h5"), 1);
 }

@@ -132,6 +132,8 @@ fn online_at_a_named_parameter_says_the_basis_was_not_trained_over_it() {
     assert!(out.status.success(), "{stderr}");
     assert!(stderr.contains("outside what the basis was trained on: push = 1.5 (trained at 1"), "{stderr}");
     assert!(stdout.contains("\"extrapolated\":true"), "{stdout}");
+    // the record names the run's parameters, last, as a sweep's table does
+    assert!(stdout.contains("\"parameter:push\":1.5}"), "{stdout}");
     let out = flexrom(&["online", "p.toml", "--param", "push=1", "--load-scale", "1.1", "-o", "a2.h5", "--json"]);
     let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
     assert!(out.status.success() && !stderr.contains("outside"), "{stderr}");

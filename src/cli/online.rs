@@ -43,6 +43,9 @@ impl Args {
         let mu = params.parameters(load_scale, 1.0)?;
         p.model.check_parameters(&mu)?;
         p.model.refuse_load_scale(std::iter::once(mu.scale()))?;
+        // a body property not given is the file's value, which the checks against the
+        // training box must read too
+        let mu = p.model.with_property_values(&mu);
         let load_scale = mu.scale();
         let path = basis.unwrap_or_else(|| p.basis_path.clone());
         check_output(
@@ -74,6 +77,9 @@ impl Args {
         let mut cols = vec!["load_scale", "n_modes"];
         cols.extend(flexrom::pipeline::tables::RUN_COLUMNS);
         cols.extend(["error_estimate", "extrapolated", "output", "error_estimate_displacement"]);
+        // the named parameters last, as a sweep's table has them
+        let named: Vec<String> = mu.named().map(|(name, _)| format!("parameter:{name}")).collect();
+        cols.extend(named.iter().map(String::as_str));
         let mut t = Table::new(&cols);
         let mut row: Vec<Cell> = vec![load_scale.into(), stored.basis.n_reduced().into()];
         row.extend(flexrom::pipeline::tables::run_cells(&run.result));
@@ -83,6 +89,7 @@ impl Args {
             output.display().to_string().into(),
             estimate.as_ref().map(|e| e.error_estimate_displacement).into(),
         ]);
+        row.extend(mu.named().map(|(_, value)| value.into()));
         t.push(row);
         print_table(&t, format.format(), true)?;
         warn(notice.as_slice());

@@ -232,5 +232,6 @@ fn sweep_points(
         p.model.check_parameters(mu)?;
     }
     p.model.refuse_load_scale(points.iter().map(Parameters::scale))?;
-    Ok(points)
+    // a body property not given is the file's value (online's reason)
+    Ok(points.iter().map(|mu| p.model.with_property_values(mu)).collect())
 }

@@ -53,6 +53,8 @@ impl Args {
         if let Some(mu) = points.first() {
             p.model.check_parameters(mu)?;
         }
+        // a body property not given is the file's value (online's reason)
+        let points: Vec<Parameters> = points.iter().map(|mu| p.model.with_property_values(mu)).collect();
         p.model.refuse_load_scale(points.iter().map(|mu| mu.scale()))?;
         let path = basis.unwrap_or_else(|| p.basis_path.clone());
         let (_, rom, warnings) = load_rom(&p, &path, estimate.method(), false)?;

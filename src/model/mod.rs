@@ -136,6 +136,38 @@ impl Model {
         }
     }
 
+    /// The model file's value of the body property the parameter `name` sets (its
+    /// `youngs_modulus` or `density = { value, … }`), or `None` when `name` is no property.
+    pub fn property_value(&self, name: &str) -> Option<f64> {
+        self.bodies.iter().find_map(|b| {
+            if b.youngs_modulus_parameter.as_deref() == Some(name) {
+                Some(b.section.youngs_modulus)
+            } else if b.density_parameter.as_deref() == Some(name) {
+                Some(b.section.density)
+            } else {
+                None
+            }
+        })
+    }
+
+    /// `mu` with every body property that is a parameter set: where `mu` does not set one,
+    /// at the model file's value (what a run then uses), so that a check against a box or
+    /// its candidates reads the value the run has.
+    pub fn with_property_values(&self, mu: &Parameters) -> Parameters {
+        let mut names: Vec<&str> = Vec::new();
+        for b in &self.bodies {
+            names.extend(b.youngs_modulus_parameter.as_deref());
+            names.extend(b.density_parameter.as_deref());
+        }
+        names.into_iter().fold(mu.clone(), |m, name| match m.get(name) {
+            Some(_) => m,
+            None => {
+                let value = self.property_value(name).expect("a property of the model");
+                m.with(name, value)
+            }
+        })
+    }
+
     /// Refuses parameters the model does not have (a `--param` misspelt, or one of another
     /// model), and a Young's modulus that is not positive: the error names the model file
     /// and the parameters it has.

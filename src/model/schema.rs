@@ -88,8 +88,8 @@ pub struct BodySpec {
 
 /// A material property: a number, or `{ value = …, parameter = "name" }`, which makes the
 /// property the parameter `name` (`value` where a run does not set it).
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
-#[serde(untagged, expecting = "a number, or { value = NUMBER, parameter = \"NAME\" }")]
+#[derive(Clone, Debug, Serialize, PartialEq)]
+#[serde(untagged)]
 pub enum PropertySpec {
     Value(f64),
     Parameter(ParameterProperty),
@@ -101,6 +101,26 @@ pub enum PropertySpec {
 pub struct ParameterProperty {
     pub value: f64,
     pub parameter: String,
+}
+
+/// A number, or a table whose own errors name its key (`missing field `parameter``,
+/// `unknown field `paramter``), which an untagged enum would swallow.
+impl<'de> Deserialize<'de> for PropertySpec {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        use serde::de::Error as _;
+        let v = toml::Value::deserialize(d)?;
+        match v {
+            toml::Value::Float(x) => Ok(PropertySpec::Value(x)),
+            toml::Value::Integer(i) => Ok(PropertySpec::Value(i as f64)),
+            toml::Value::Table(_) => {
+                v.try_into().map(PropertySpec::Parameter).map_err(|e| D::Error::custom(e.message()))
+            }
+            _ => Err(D::Error::custom(format!(
+                "is a {}; expected a number, or {{ value = NUMBER, parameter = \"NAME\" }}",
+                v.type_str()
+            ))),
+        }
+    }
 }
 
 impl PropertySpec {

@@ -49,10 +49,8 @@ pub struct FlexibleSystem {
     /// one element prototype per body, at the model file's values
     prototypes: Vec<BeamElement>,
     /// one element prototype per body at the parameters of the last evaluation (the
-    /// bodies' Young's moduli and densities), and each body's factors `E(μ)/E_file` and
-    /// `ρ(μ)/ρ_file` in it
+    /// bodies' Young's moduli and densities)
     bound: Vec<BeamElement>,
-    bound_factors: Vec<(f64, f64)>,
     pub constraints: Vec<Constraint>,
     pub probes: Vec<Probe>,
     damping: Rayleigh,
@@ -227,7 +225,6 @@ impl FlexibleSystem {
             moments.iter().flat_map(|m| m.slope_dofs).chain(forces.iter().flat_map(|f| f.dofs)).collect();
         load_dofs.sort_unstable();
         load_dofs.dedup();
-        let n_bodies = bodies.len();
         FlexibleSystem {
             bodies,
             first_node,
@@ -245,7 +242,6 @@ impl FlexibleSystem {
             load_dofs,
             n_dof,
             bound: prototypes.clone(),
-            bound_factors: vec![(1.0, 1.0); n_bodies],
             kkt: make_solver(solver, pattern),
             blocks: vec![Mat8::zeros(); n_el],
             iteration_constant: Vec::new(),
@@ -294,18 +290,18 @@ impl FlexibleSystem {
     /// whenever that changes.
     fn bind_parameters(&mut self, mu: &Parameters) {
         for b in 0..self.bodies.len() {
-            let factors = (self.body_stiffness_factor(b, mu), self.body_mass_factor(b, mu));
-            if factors != self.bound_factors[b] {
-                let body = &self.bodies[b];
-                let mut section = body.section;
-                if let Some(e) = body.youngs_modulus_parameter.as_deref().and_then(|name| mu.get(name)) {
-                    section.youngs_modulus = e;
-                }
-                if let Some(rho) = body.density_parameter.as_deref().and_then(|name| mu.get(name)) {
-                    section.density = rho;
-                }
+            let body = &self.bodies[b];
+            let mut section = body.section;
+            if let Some(e) = body.youngs_modulus_parameter.as_deref().and_then(|name| mu.get(name)) {
+                section.youngs_modulus = e;
+            }
+            if let Some(rho) = body.density_parameter.as_deref().and_then(|name| mu.get(name)) {
+                section.density = rho;
+            }
+            // the values themselves, not their ratios to the file's (two values a ratio
+            // cannot tell apart still build two prototypes)
+            if section != self.bound[b].section {
                 self.bound[b] = BeamElement::new(body.length / body.n_elements as f64, section);
-                self.bound_factors[b] = factors;
                 // the iteration matrix's constant part holds the mass and bending stiffness
                 self.iteration_coef = None;
             }

@@ -95,7 +95,7 @@ pub fn online_to_file(p: &Pipeline, rom: &Rom, basis_path: &Path, mu: &Parameter
         attr_str(f, "basis", &basis_name).map_err(e)?;
         attr_str(f, "variant", basis.variant.name()).map_err(e)?;
         attr_u64(f, "n_modes", basis.n_reduced() as u64).map_err(e)?;
-        write_run_attributes(f, estimate.as_ref(), rom.method(), &trust, mu).map_err(e)
+        write_run_attributes(f, estimate.as_ref(), rom.method(), &trust, mu, extrapolated).map_err(e)
     })?;
     Ok(OnlineRun { run, estimate, extrapolated })
 }

@@ -283,9 +283,9 @@ impl Validation {
             self.effectivity_displacement = Some(e.error_estimate_displacement / self.displacement_error);
             self.error_estimate_displacement_by_time = Some(e.displacement_by_time.to_vec());
         }
-        if let Some(t) = rom.and_then(|r| r.trust()) {
+        if let Some((rom, t)) = rom.and_then(|r| Some((r, r.trust()?))) {
             let mu = self.mu();
-            self.extrapolated = t.extrapolated(&mu);
+            self.extrapolated = rom.is_extrapolated(&mu);
             self.training_range = Some([t.range.0, t.range.1]);
             self.training_box = Some(t.space.describe()).filter(|_| !t.space.is_empty());
             self.sensitivity_near = t.sensitivity.as_ref().and_then(|s| s.near(&mu));

@@ -18,7 +18,10 @@
 //! Where elements' stiffness is a parameter ([`stiffness_groups`]), each group `g` of
 //! elements that share one gets rows of its own, `b_g = Σ_{e∈g} c_{·,e}`: the weighted sum
 //! then reproduces each group's force apart, so that it stays right when the groups scale
-//! differently at another μ (the model is affine in each group's factor).
+//! differently at another μ (the model is affine in each group's factor). The tolerance
+//! bounds the stacked residual: a group whose force is small against the others' is fitted
+//! to the same absolute residual, so relatively more loosely, and that part scales with its
+//! factor at μ (the error estimate sees it like any other).
 
 use super::basis::Basis;
 use super::sample::Hyper;

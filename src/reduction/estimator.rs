@@ -157,7 +157,7 @@ impl DefectsCalibration {
     pub fn factors_at(&self, mu: &Parameters) -> ByFifth {
         if let Some(s) = &self.scattered {
             // outside the box, as beyond a line's ends, no candidate brackets the point
-            if !s.space.outside(mu).is_empty() {
+            if !s.space.holds(mu) {
                 return self.factors;
             }
             let near = s.around(&s.space.unit_of(mu), None);

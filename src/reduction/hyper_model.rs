@@ -224,10 +224,11 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
     fn bind_parameters(&mut self, mu: &Parameters) {
         self.p.bind(&*self.full, mu);
         let Some(split) = &mut self.stiffness else { return };
-        let factors: Vec<f64> = split.groups.iter().map(|(e, ..)| self.full.stiffness_factor(*e, mu)).collect();
-        if factors == split.factors {
+        // the same factors (every evaluation of a run): nothing to do, nothing allocated
+        if split.groups.iter().zip(&split.factors).all(|((e, ..), &f)| self.full.stiffness_factor(*e, mu) == f) {
             return;
         }
+        let factors: Vec<f64> = split.groups.iter().map(|(e, ..)| self.full.stiffness_factor(*e, mu)).collect();
         let r = self.p.r;
         let (mut l_r, mut l0) = (Array2::zeros((r, r)), Array1::zeros(r));
         for ((_, lg, l0g), &f) in split.groups.iter().zip(&factors) {

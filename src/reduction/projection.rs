@@ -304,10 +304,11 @@ impl Projection {
     /// parameters, or at the same factors).
     pub fn bind<M: ElementModel>(&mut self, full: &M, mu: &Parameters) {
         let Some(split) = &mut self.mass_split else { return };
-        let factors: Vec<f64> = split.groups.iter().map(|(e, ..)| full.mass_factor(*e, mu)).collect();
-        if factors == split.factors {
+        // the same factors (every evaluation of a run): nothing to do, nothing allocated
+        if split.groups.iter().zip(&split.factors).all(|((e, ..), &f)| full.mass_factor(*e, mu) == f) {
             return;
         }
+        let factors: Vec<f64> = split.groups.iter().map(|(e, ..)| full.mass_factor(*e, mu)).collect();
         let mut mass = Array2::zeros((self.r, self.r));
         for ((_, m, _), &f) in split.groups.iter().zip(&factors) {
             mass.scaled_add(f, m);

@@ -151,18 +151,18 @@ impl Rom {
     /// Whether `mu` lies outside the parameters the basis was trained on (false when they
     /// are not known).
     pub fn is_extrapolated(&self, mu: &Parameters) -> bool {
-        match &self.trust {
-            Some(t) => t.extrapolated(mu),
-            None => !self.named_outside(mu).is_empty(),
-        }
+        self.trust.as_ref().is_some_and(|t| trust::is_extrapolated(t.range, mu.scale()))
+            || !self.named_outside(mu).is_empty()
     }
 
     /// The parameters of `mu` other than the load scale outside what the basis was trained
-    /// on, one line each ([`Trust::named_outside`]).
+    /// on, one line each ([`ParameterSpace::outside_named_of`]: a body's property the box
+    /// does not hold counts as trained at the model file's value).
     pub fn named_outside(&self, mu: &Parameters) -> Vec<String> {
+        let file_value = |name: &str| self.model.property_value(name);
         match &self.trust {
-            Some(t) => t.named_outside(mu),
-            None => ParameterSpace::default().outside_named(mu),
+            Some(t) => t.space.outside_named_of(mu, &file_value),
+            None => ParameterSpace::default().outside_named_of(mu, &file_value),
         }
     }
 

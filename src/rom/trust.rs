@@ -39,18 +39,6 @@ impl Trust {
         }
     }
 
-    /// Whether `mu` lies outside what the basis was trained on: the load scale outside the
-    /// training range, or a named parameter outside the box ([`Self::named_outside`]).
-    pub fn extrapolated(&self, mu: &Parameters) -> bool {
-        is_extrapolated(self.range, mu.scale()) || !self.named_outside(mu).is_empty()
-    }
-
-    /// The named parameters of `mu` outside what the basis was trained on, one line each
-    /// ([`ParameterSpace::outside_named`]; the load scale is the range checks' to say).
-    pub fn named_outside(&self, mu: &Parameters) -> Vec<String> {
-        self.space.outside_named(mu)
-    }
-
     /// The sensitivity near `mu` when the model amplifies changes of the load
     /// there beyond what `estimate` (in the trust's measure; `None`: no estimate) can see:
     /// above the tolerance, above [`AMPLIFYING`]` · δ` and above the estimate
@@ -192,8 +180,8 @@ pub fn write_run_attributes(
     method: Option<&str>,
     trust: &Trust,
     mu: &Parameters,
+    extrapolated: bool,
 ) -> hdf5::Result<()> {
-    let extrapolated = trust.extrapolated(mu);
     let sensitivity_near = trust.sensitivity.as_ref().and_then(|s| s.near(mu));
     use crate::io::h5::{attr_f64, attr_u64};
     use crate::reduction::estimator::FIFTHS;

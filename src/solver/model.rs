@@ -64,8 +64,10 @@ pub trait DynamicModel {
 ///
 /// The methods take `&mut self` where the model keeps its Newton work space (the KKT
 /// factorization, cached element coordinates): one model serves one run at a time, so a
-/// parallel sweep keeps one model per thread. No parameter-dependent value is cached
-/// between calls, so nothing of one run's parameters leaks into the next.
+/// parallel sweep keeps one model per thread. What depends on the parameters and is kept
+/// between calls (a body property's element prototypes, a reduced model's mass) is set by
+/// [`ParametricModel::bind`] and again by every evaluation that takes μ, so nothing of one
+/// run's parameters leaks into the next.
 pub trait ParametricModel {
     /// Sets what the model keeps between evaluations to the parameters `mu` (a body's
     /// density changes its mass, which [`Self::mass_mul`] applies without taking μ); the
@@ -88,6 +90,8 @@ pub trait ParametricModel {
         out: (&mut [f64], &mut [f64]),
     ) {
         let (force, inertia) = out;
+        // the mass at μ (a density parameter), before mass_mul, which does not take μ
+        self.bind(mu);
         self.mass_mul(a, inertia);
         self.force(mu, q, v, t, force);
     }

@@ -213,18 +213,38 @@ impl ParameterSpace {
     /// kept it at the model file's load). `λ` outside the box is said by the load-scale
     /// checks when the box does not hold it.
     pub fn outside(&self, mu: &Parameters) -> Vec<String> {
-        self.outside_of(mu, true)
+        self.outside_of(mu, true, &|_| None)
     }
 
     /// [`Self::outside`] without the load scale (the range checks of λ say that one).
     pub fn outside_named(&self, mu: &Parameters) -> Vec<String> {
-        self.outside_of(mu, false)
+        self.outside_of(mu, false, &|_| None)
     }
 
-    fn outside_of(&self, mu: &Parameters, with_load_scale: bool) -> Vec<String> {
+    /// Whether `mu` lies in the box: each of its parameters within its range (one `mu` does
+    /// not set counts as 1). Parameters the box does not hold are not looked at (a
+    /// calibration over the box reads its position in the box alone).
+    pub fn holds(&self, mu: &Parameters) -> bool {
+        self.ranges.iter().all(|r| !r.excludes(mu.get(&r.name).unwrap_or(1.0)))
+    }
+
+    /// [`Self::outside_named`] for a model some of whose parameters are bodies' properties:
+    /// `file_value(name)` is the value such a parameter has where μ does not set it (the
+    /// model file's modulus or density; `None` for a load's factor, 1), the value a box
+    /// that does not hold it was trained at.
+    pub fn outside_named_of(&self, mu: &Parameters, file_value: &dyn Fn(&str) -> Option<f64>) -> Vec<String> {
+        self.outside_of(mu, false, file_value)
+    }
+
+    fn outside_of(
+        &self,
+        mu: &Parameters,
+        with_load_scale: bool,
+        file_value: &dyn Fn(&str) -> Option<f64>,
+    ) -> Vec<String> {
         let mut out = Vec::new();
         for r in self.ranges.iter().filter(|r| with_load_scale || r.name != LOAD_SCALE) {
-            let x = mu.get(&r.name).unwrap_or(1.0);
+            let x = mu.get(&r.name).or_else(|| file_value(&r.name)).unwrap_or(1.0);
             if r.excludes(x) {
                 out.push(format!(
                     "{} = {} (trained over [{}, {}])",
@@ -236,8 +256,16 @@ impl ParameterSpace {
             }
         }
         for (name, x) in mu.named() {
-            if x != 1.0 && !self.names().any(|n| n == name) {
-                out.push(format!("{name} = {} (trained at 1, the model file's load)", show_number(x)));
+            let (trained, what) = match file_value(name) {
+                Some(v) => (v, "value"),
+                None => (1.0, "load"),
+            };
+            if x != trained && !self.names().any(|n| n == name) {
+                out.push(format!(
+                    "{name} = {} (trained at {}, the model file's {what})",
+                    show_number(x),
+                    show_number(trained)
+                ));
             }
         }
         out
@@ -369,6 +397,21 @@ mod tests {
         assert!(with_lambda.outside_named(&Parameters::load_scale(2.0)).is_empty());
         // round-off at an end is inside
         assert!(s.outside(&Parameters::default().with("drive", 1.5 * (1.0 + 1e-12)).with("stiff", 4e8)).is_empty());
+        // a body's property is trained at the model file's value: unset, it reads that
+        // value (inside the box), and set outside a box that does not hold it, it is named
+        // against that value, not against 1
+        let file_value = |name: &str| match name {
+            "stiff" => Some(2e8),
+            "rho" => Some(2700.0),
+            _ => None,
+        };
+        assert!(s.outside_named_of(&Parameters::default().with("drive", 1.0), &file_value).is_empty());
+        assert_eq!(s.outside_named(&Parameters::default().with("drive", 1.0)), ["stiff = 1 (trained over [1e8, 4e8])"]);
+        assert!(s.outside_named_of(&Parameters::default().with("rho", 2700.0), &file_value).is_empty());
+        assert_eq!(
+            s.outside_named_of(&Parameters::default().with("rho", 1.0), &file_value),
+            ["rho = 1 (trained at 2700, the model file's value)"]
+        );
         assert!(ParameterRange { name: "x".into(), lower: 0.0, upper: 1.0, spacing: Spacing::Log }.validate().is_err());
         assert!(ParameterRange { name: "x".into(), lower: 1.0, upper: 1.0, spacing: Spacing::Linear }
             .validate()
