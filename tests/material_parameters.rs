@@ -23,7 +23,8 @@
 //!   `reduction::ecsw`);
 //! - a property parameter with damping, a name shared with a load or with the other property or
 //!   given two values, a non-positive modulus or density on the command line or in a box
-//!   are refused, naming the file and the field.
+//!   are refused, naming the file and the field; a value or a box two orders of magnitude
+//!   from the file's value is warned about (a factor meant, `model::FACTOR_LIKE`).
 
 mod common;
 
@@ -302,6 +303,26 @@ fn a_material_parameter_the_model_cannot_take_is_refused_naming_the_field() {
     let (ok, err) = flexrom(d, &["train", "p.toml"]);
     assert!(!ok && !d.join("b.h5").exists(), "{err}");
     assert!(err.contains("parameters.E_coupler: is a Young's modulus (Pa); its range must be positive"), "{err}");
+
+    // a factor meant for a value (two orders of magnitude or more from the file's 5e6) is
+    // warned about, on the command line and in a box; a value near the file's is not
+    let far = "E_coupler = 0.5 is far from the model file's value 5e6: it sets the body's Young's modulus (Pa) itself, not a factor of it";
+    let (_, err) = flexrom(d, &["simulate", "m.toml", "-o", "far.h5", "--param", "E_coupler=0.5", "--t-end", "0.007"]);
+    assert!(err.contains(far), "{err}");
+    let (ok, err) =
+        flexrom(d, &["simulate", "m.toml", "-o", "near.h5", "--param", "E_coupler=3e6", "--t-end", "0.007"]);
+    assert!(ok && !err.contains("is far from"), "{err}");
+    std::fs::write(
+        d.join("p.toml"),
+        "model = \"m.toml\"\nbasis = \"b.h5\"\nreport = \"r\"\n[parameters]\nE_coupler = [0.5, 2.0]\n[train]\ngreedy = { tolerance = 1e-2, max_runs = 4 }\n",
+    )
+    .unwrap();
+    let (_, err) = flexrom(d, &["train", "p.toml"]);
+    assert!(
+        err.contains("E_coupler = [0.5, 2] is far from the model file's value 5e6")
+            && err.contains("(parameters.E_coupler)"),
+        "{err}"
+    );
 }
 
 /// The tutorial's double pendulum (data/models/double_pendulum.toml) with gravity scaled by

@@ -28,6 +28,7 @@ impl Args {
     pub fn run(self, limits: &Limits) -> flexrom::Result<()> {
         let Args { pipeline, strict, dense, estimate, format } = self;
         let p = Pipeline::load_with(&pipeline, limits.clone())?;
+        super::warn(&p.property_warnings());
         let (dir, warnings) =
             flexrom::pipeline::report::run_with(&p, output::show_progress(), dense.choice(), estimate.method())?;
         super::warn(&warnings);

@@ -42,6 +42,7 @@ impl Args {
     pub fn run(self, limits: &Limits) -> flexrom::Result<()> {
         let Args { pipeline, basis, snapshots_only, load_scale, shard, output, from_snapshots, format } = self;
         let p = Pipeline::load_with(&pipeline, limits.clone())?;
+        super::warn(&p.property_warnings());
         if snapshots_only {
             let out = output.expect("clap: --snapshots-only requires -o");
             check_output(&out, Origin::Flag("-o"), &[(&p.path, "pipeline file"), (&p.model.path, "model file")])?;

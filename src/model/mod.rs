@@ -29,6 +29,17 @@ pub struct Sizes {
     pub n_probe_values: f64,
 }
 
+/// How far from the model file's value a body property's parameter may lie before a run
+/// warns that a factor may have been meant ([`Model::property_warnings`]): two orders of
+/// magnitude, beyond what a study of a material around its nominal value spans, and below
+/// the distance of a factor near 1 from any modulus (1e6–1e11 Pa) or density (≥ 100 kg/m³).
+pub const FACTOR_LIKE: f64 = 100.0;
+
+/// Whether a property's ratio to the file's value lies beyond [`FACTOR_LIKE`] either way.
+pub fn far_from(ratio: f64) -> bool {
+    !(1.0 / FACTOR_LIKE..=FACTOR_LIKE).contains(&ratio)
+}
+
 /// A validated model file.
 #[derive(Clone, Debug)]
 pub struct Model {
@@ -148,6 +159,28 @@ impl Model {
                 None
             }
         })
+    }
+
+    /// Warnings for body properties set far from the model file's value, more than
+    /// [`FACTOR_LIKE`] times above or below it: such a value is most often a factor meant
+    /// (`--param E=0.5` for half the modulus), while the parameter is the value itself.
+    pub fn property_warnings(&self, mu: &Parameters) -> Vec<String> {
+        mu.named()
+            .filter_map(|(name, x)| {
+                let file = self.property_value(name)?;
+                far_from(x / file).then(|| self.factor_like(name, &crate::error::show_number(x), file))
+            })
+            .collect()
+    }
+
+    /// The warning of [`Self::property_warnings`] for the parameter `name` given as `given`.
+    pub fn factor_like(&self, name: &str, given: &str, file: f64) -> String {
+        let what = self.property_parameter(name).unwrap_or("property");
+        format!(
+            "{}: {name} = {given} is far from the model file's value {}: it sets the body's {what} itself, not a factor of it",
+            self.path.display(),
+            crate::error::show_number(file)
+        )
     }
 
     /// `mu` with every body property that is a parameter set: where `mu` does not set one,

@@ -211,6 +211,23 @@ impl Pipeline {
         Ok(())
     }
 
+    /// Warnings for a `[parameters]` range of a body's property that lies, both ends on one
+    /// side, farther than [`crate::model::FACTOR_LIKE`] from the model file's value: most
+    /// often factors meant (`E = [0.5, 2.0]`) for a parameter that is the value itself.
+    pub fn property_warnings(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        for (name, spec) in &self.file.parameters {
+            let Some(file) = self.model.property_value(name) else { continue };
+            let r = spec.range(name);
+            let (lo, hi) = (r.lower / file, r.upper / file);
+            if crate::model::far_from(lo) && crate::model::far_from(hi) && (hi < 1.0) == (lo < 1.0) {
+                let given = format!("[{}, {}]", crate::error::show_number(r.lower), crate::error::show_number(r.upper));
+                out.push(format!("{} (parameters.{name})", self.model.factor_like(name, &given, file)));
+            }
+        }
+        out
+    }
+
     /// `[parameters]` against the model and `[train]`: every name one of the model's
     /// parameters, every range one a sample can be drawn from, and training that samples the
     /// box (`points`) exactly when there is one.
