@@ -43,7 +43,7 @@ impl Args {
         let mu = params.parameters(load_scale, 1.0)?;
         p.model.check_parameters(&mu)?;
         p.model.refuse_load_scale(std::iter::once(mu.scale()))?;
-        warn(&p.model.property_warnings(&mu));
+        warn(&p.model.property_warnings([&mu]));
         // a body property not given is the file's value, which the checks against the
         // training box must read too
         let mu = p.model.with_property_values(&mu);

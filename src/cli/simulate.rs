@@ -36,7 +36,7 @@ impl Args {
         let overrides = run.overrides()?;
         let mu = overrides.mu.clone().unwrap_or_default();
         super::warn(model.load_scale_warning(std::iter::once(mu.scale())).as_slice());
-        super::warn(&model.property_warnings(&mu));
+        super::warn(&model.property_warnings([&mu]));
         let compute = || simulate(&model, &overrides).map_err(|e| e.at_stage("simulate", &mu));
         let r = match &output {
             // the result file's fixed part is written on a second thread while the run computes

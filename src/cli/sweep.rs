@@ -227,20 +227,11 @@ fn sweep_points(
         }
         grid(&axes)?
     };
-    let (mut far, mut warned) = (Vec::new(), Vec::new());
     for mu in &points {
         mu.validate()?;
         p.model.check_parameters(mu)?;
-        // once per parameter, at the first point that is far, not once per point
-        for (name, x) in mu.named() {
-            let Some(file) = p.model.property_value(name) else { continue };
-            if flexrom::model::far_from(x / file) && !warned.contains(&name) {
-                warned.push(name);
-                far.push(p.model.factor_like(name, &flexrom::error::show_number(x), file));
-            }
-        }
     }
-    super::warn(&far);
+    super::warn(&p.model.property_warnings(&points));
     p.model.refuse_load_scale(points.iter().map(Parameters::scale))?;
     // a body property not given is the file's value (online's reason)
     Ok(points.iter().map(|mu| p.model.with_property_values(mu)).collect())

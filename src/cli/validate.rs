@@ -52,8 +52,8 @@ impl Args {
         };
         if let Some(mu) = points.first() {
             p.model.check_parameters(mu)?;
-            warn(&p.model.property_warnings(mu));
         }
+        warn(&p.model.property_warnings(&points));
         // a body property not given is the file's value (online's reason)
         let points: Vec<Parameters> = points.iter().map(|mu| p.model.with_property_values(mu)).collect();
         p.model.refuse_load_scale(points.iter().map(|mu| mu.scale()))?;

@@ -163,14 +163,20 @@ impl Model {
 
     /// Warnings for body properties set far from the model file's value, more than
     /// [`FACTOR_LIKE`] times above or below it: such a value is most often a factor meant
-    /// (`--param E=0.5` for half the modulus), while the parameter is the value itself.
-    pub fn property_warnings(&self, mu: &Parameters) -> Vec<String> {
-        mu.named()
-            .filter_map(|(name, x)| {
-                let file = self.property_value(name)?;
-                far_from(x / file).then(|| self.factor_like(name, &crate::error::show_number(x), file))
-            })
-            .collect()
+    /// (`--param E=0.5` for half the modulus), while the parameter is the value itself. One
+    /// warning per parameter, at the first of `points` where it is far.
+    pub fn property_warnings<'a>(&self, points: impl IntoIterator<Item = &'a Parameters>) -> Vec<String> {
+        let (mut out, mut warned) = (Vec::new(), Vec::new());
+        for mu in points {
+            for (name, x) in mu.named() {
+                let Some(file) = self.property_value(name) else { continue };
+                if far_from(x / file) && !warned.contains(&name) {
+                    warned.push(name);
+                    out.push(self.factor_like(name, &crate::error::show_number(x), file));
+                }
+            }
+        }
+        out
     }
 
     /// The warning of [`Self::property_warnings`] for the parameter `name` given as `given`.

@@ -71,12 +71,11 @@ pub struct HyperReducedModel<M: InvariantElementModel> {
     stiffness: Option<StiffnessSplit>,
 }
 
-/// `L_r,g`, `l_r,g` and `C_r` of the module documentation, with the sampled weights at
-/// `s = 1` and the factors the model is set to.
+/// `L_r,g` and `l_r,g` of the module documentation, with the sampled weights at `s = 1` and
+/// the factors the model is set to.
 struct StiffnessSplit {
     /// per group: an element of it (to ask its factor), `L_r,g`, `l_r,g`
     groups: Vec<(usize, Array2<f64>, Array1<f64>)>,
-    c_r: Option<Array2<f64>>,
     /// per sampled element: its group and its weight at `s = 1`
     sample_group: Vec<usize>,
     weights: Vec<f64>,
@@ -146,7 +145,6 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
         let c_r = if c_r.iter().any(|&x| x != 0.0) { Some(c_r) } else { None };
         let stiffness = (!split.is_empty()).then(|| StiffnessSplit {
             groups: split.iter().zip(group_l).map(|((_, members), (lg, l0g))| (members[0], lg, l0g)).collect(),
-            c_r: c_r.clone(),
             sample_group: hyper.elements.iter().map(|&e| group_of[e]).collect(),
             weights: hyper.weights.clone(),
             factors: vec![1.0; split.len()],
@@ -237,7 +235,7 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
         }
         self.l_rows = SparseRows::new(&l_r);
         self.l0 = l0;
-        self.p.set_linear_terms(Some(l_r), split.c_r.clone());
+        self.p.set_linear_stiffness(l_r);
         for (k, (w, &g)) in split.weights.iter().zip(&split.sample_group).enumerate() {
             self.sampled.weights[k] = factors[g] * w;
         }

@@ -89,16 +89,11 @@ pub(crate) struct Projection {
     pub mass: Array2<f64>,
     /// `mass` by runs of nonzeros, for products
     mass_rows: SparseRows,
-    /// `Vᵀg₀,fixed` and `Vᵀg₀,scaled`: `g₀,r(μ) = g0_fixed + λ g0_scaled`
-    g0_fixed: Array1<f64>,
-    g0_scaled: Array1<f64>,
-    /// `Vᵀg₀,name` of each named parameter's constant force ([`ElementModel::named_constant_forces`])
-    g0_named: Vec<(String, Array1<f64>)>,
-    /// for a model whose elements' mass is a parameter: the mass and the constant forces by
-    /// group, `M_r(μ) = Σ m_g(μ) M_r,g` and `g₀,r(μ)` alike (the fields above then hold the
-    /// sum at the factors of the last [`Projection::bind`], and the constant forces are read
-    /// from here)
-    mass_split: Option<MassSplit>,
+    /// the mass and the constant forces by group of elements whose mass one parameter scales
+    /// (one group, every element, for a model without such parameters): `M_r(μ) = Σ m_g(μ)
+    /// M_r,g` (`mass` holds the sum at the factors of the last [`Projection::bind`]) and
+    /// `g₀,r(μ) = Σ m_g(μ) g₀,r,g(μ)`
+    mass_split: MassSplit,
     /// B V and B x_ref − b (reduced rows)
     b_r: Array2<f64>,
     c_r: Array1<f64>,
@@ -129,13 +124,15 @@ pub(crate) struct Projection {
 }
 
 /// The groups of [`Projection::mass_split`]: per group an element of it (to ask its
-/// factor), `M_r,g` and its projected constant forces; and the factors the mass is set to.
+/// factor; `None`: no parameter, factor 1), `M_r,g` and its projected constant forces; and
+/// the factors the mass is set to.
 struct MassSplit {
-    groups: Vec<(usize, Array2<f64>, ProjectedForces)>,
+    groups: Vec<(Option<usize>, Array2<f64>, ProjectedForces)>,
     factors: Vec<f64>,
 }
 
-/// `Vᵀg₀,fixed`, `Vᵀg₀,scaled` and each `Vᵀg₀,name`.
+/// `Vᵀg₀,fixed`, `Vᵀg₀,scaled` and each `Vᵀg₀,name` ([`ElementModel::group_constant_forces`]):
+/// `g₀,r(μ) = fixed + λ scaled + Σ μ_name named_name`.
 struct ProjectedForces {
     fixed: Array1<f64>,
     scaled: Array1<f64>,
@@ -163,42 +160,29 @@ impl Projection {
         let v_load = v.select(Axis(0), &load_dofs);
         let x_ref_load = basis.reference.select(Axis(0), &load_dofs);
 
-        // constant parts, projected once
-        let mut mv = Array2::zeros((n, r));
-        let mut col = vec![0.0; n];
-        for j in 0..r {
-            full.mass_mul(&v.column(j).to_vec(), &mut col);
-            mv.column_mut(j).assign(&ArrayView1::from(&col));
+        // constant parts, projected once per group of elements whose mass one parameter scales
+        let mut groups: Vec<(Option<String>, Option<usize>)> =
+            mass_groups(full).into_iter().map(|(name, members)| (name, Some(members[0]))).collect();
+        if groups.is_empty() {
+            groups.push((None, None));
         }
-        let mass = v.t().dot(&mv);
-        let mut col_scaled = vec![0.0; n];
-        full.constant_force_parts(&mut col, &mut col_scaled);
-        let g0_fixed = v.t().dot(&ArrayView1::from(&col));
-        let g0_scaled = v.t().dot(&ArrayView1::from(&col_scaled));
-        let g0_named = full
-            .named_constant_forces()
+        let mut col = vec![0.0; n];
+        let groups: Vec<_> = groups
             .into_iter()
-            .map(|(name, g)| (name, v.t().dot(&ArrayView1::from(&g))))
+            .map(|(name, member)| {
+                let mut mv = Array2::zeros((n, r));
+                for j in 0..r {
+                    full.group_mass_mul(name.as_deref(), &v.column(j).to_vec(), &mut col);
+                    mv.column_mut(j).assign(&ArrayView1::from(&col));
+                }
+                (member, v.t().dot(&mv), ProjectedForces::of(v, full.group_constant_forces(name.as_deref())))
+            })
             .collect();
-        let groups = mass_groups(full);
-        let mass_split = (!groups.is_empty()).then(|| {
-            let groups: Vec<_> = groups
-                .iter()
-                .map(|(name, members)| {
-                    let mut mv = Array2::zeros((n, r));
-                    for j in 0..r {
-                        full.group_mass_mul(name.as_deref(), &v.column(j).to_vec(), &mut col);
-                        mv.column_mut(j).assign(&ArrayView1::from(&col));
-                    }
-                    (members[0], v.t().dot(&mv), ProjectedForces::of(v, full.group_constant_forces(name.as_deref())))
-                })
-                .collect();
-            MassSplit { factors: vec![1.0; groups.len()], groups }
-        });
-        // the same mass from the groups (the file's values, whatever the model was last bound to)
-        let mass = match &mass_split {
-            Some(split) => split.groups.iter().fold(Array2::zeros((r, r)), |acc, (_, m, _)| acc + m),
-            None => mass,
+        let mass_split = MassSplit { factors: vec![1.0; groups.len()], groups };
+        // the file's values, whatever the model was last bound to (one group: its own mass)
+        let mass = match &mass_split.groups[..] {
+            [(_, m, _)] => m.clone(),
+            all => all.iter().fold(Array2::zeros((r, r)), |acc, (_, m, _)| acc + m),
         };
 
         // constraints are linear: B y − b, so B V_j = res(V_j) − res(0)
@@ -264,9 +248,6 @@ impl Projection {
             nc,
             mass_rows: SparseRows::new(&mass),
             mass,
-            g0_fixed,
-            g0_scaled,
-            g0_named,
             mass_split,
             b_r,
             c_r,
@@ -303,12 +284,13 @@ impl Projection {
     /// Sets the mass to the elements' mass at `mu` (nothing to do for a model without mass
     /// parameters, or at the same factors).
     pub fn bind<M: ElementModel>(&mut self, full: &M, mu: &Parameters) {
-        let Some(split) = &mut self.mass_split else { return };
+        let split = &mut self.mass_split;
+        let factor = |e: &Option<usize>| e.map_or(1.0, |e| full.mass_factor(e, mu));
         // the same factors (every evaluation of a run): nothing to do, nothing allocated
-        if split.groups.iter().zip(&split.factors).all(|((e, ..), &f)| full.mass_factor(*e, mu) == f) {
+        if split.groups.iter().zip(&split.factors).all(|((e, ..), &f)| factor(e) == f) {
             return;
         }
-        let factors: Vec<f64> = split.groups.iter().map(|(e, ..)| full.mass_factor(*e, mu)).collect();
+        let factors: Vec<f64> = split.groups.iter().map(|(e, ..)| factor(e)).collect();
         let mut mass = Array2::zeros((self.r, self.r));
         for ((_, m, _), &f) in split.groups.iter().zip(&factors) {
             mass.scaled_add(f, m);
@@ -334,28 +316,18 @@ impl Projection {
         out: &mut [f64],
     ) {
         let x = mu.scale();
-        match &self.mass_split {
-            None => {
-                for (o, (f, s)) in out.iter_mut().zip(self.g0_fixed.iter().zip(&self.g0_scaled)) {
-                    *o = f + x * s;
-                }
-                for (name, g) in &self.g0_named {
-                    let x = mu.get(name).unwrap_or(1.0);
-                    out.iter_mut().zip(g).for_each(|(o, g)| *o += x * g);
-                }
+        let split = &self.mass_split;
+        for (k, ((e, _, g0), &m)) in split.groups.iter().zip(&split.factors).enumerate() {
+            debug_assert_eq!(m, e.map_or(1.0, |e| full.mass_factor(e, mu)), "bind() before evaluating");
+            // the first group is assigned, the others added (one group at factor 1: `f + λ s`
+            // to the bit)
+            for (o, (f, s)) in out.iter_mut().zip(g0.fixed.iter().zip(&g0.scaled)) {
+                let part = m * (f + x * s);
+                *o = if k == 0 { part } else { *o + part };
             }
-            Some(split) => {
-                out.fill(0.0);
-                for ((e, _, g0), m) in split.groups.iter().zip(&split.factors) {
-                    debug_assert_eq!(*m, full.mass_factor(*e, mu), "bind() before evaluating");
-                    for (o, (f, s)) in out.iter_mut().zip(g0.fixed.iter().zip(&g0.scaled)) {
-                        *o += m * (f + x * s);
-                    }
-                    for (name, g) in &g0.named {
-                        let x = m * mu.get(name).unwrap_or(1.0);
-                        out.iter_mut().zip(g).for_each(|(o, g)| *o += x * g);
-                    }
-                }
+            for (name, g) in &g0.named {
+                let x = m * mu.get(name).unwrap_or(1.0);
+                out.iter_mut().zip(g).for_each(|(o, g)| *o += x * g);
             }
         }
         if !self.load_dofs.is_empty() {

@@ -202,14 +202,6 @@ pub trait ElementModel: ParametricModel {
     fn element_force(&self, e: usize, qe: &[f64], ve: &[f64], out: &mut [f64]);
     /// `c Cₑ + k ∂Qₑ/∂qₑ` (no mass term), column-major.
     fn element_matrix(&self, e: usize, qe: &[f64], coef: IterationCoefficients, out: &mut [f64]);
-    /// `g₀,fixed` and `g₀,scaled` of `g₀(μ) = g₀,fixed + λ g₀,scaled`, the part of `g`
-    /// that depends on neither `q`, `q̇` nor `t`: a reduction projects each once.
-    fn constant_force_parts(&self, fixed: &mut [f64], scaled: &mut [f64]);
-    /// The parts of `g₀` multiplied by named parameters (`scaled = "name"`), one per name:
-    /// `g₀(μ)` adds `μ_name g₀,name` for each (`μ_name = 1` where μ does not set it).
-    fn named_constant_forces(&self) -> Vec<(String, Vec<f64>)> {
-        Vec::new()
-    }
     /// The dofs the state- or time-dependent loads act on (and depend on).
     fn load_dofs(&self) -> Vec<usize>;
     /// `g_l(q_l, t; μ)` on `load_dofs()`, given `q` on the same dofs.
@@ -235,22 +227,14 @@ pub trait ElementModel: ParametricModel {
         1.0
     }
     /// `out = M_g a` at the model file's values, `M_g` the mass of the elements whose
-    /// [`Self::mass_parameter`] is `group` (`None`: those no parameter scales).
-    fn group_mass_mul(&self, group: Option<&str>, a: &[f64], out: &mut [f64]) {
-        assert!(group.is_none(), "a model with mass parameters implements group_mass_mul");
-        self.mass_mul(a, out);
-    }
-    /// The parts of `g₀` of the elements whose mass parameter is `group`, at the model file's
-    /// values: `g₀,fixed`, `g₀,scaled` and the named parts, as
-    /// [`Self::constant_force_parts`] and [`Self::named_constant_forces`] give them for the
-    /// whole model.
-    fn group_constant_forces(&self, group: Option<&str>) -> ConstantForces {
-        assert!(group.is_none(), "a model with mass parameters implements group_constant_forces");
-        let n = self.n_dof();
-        let (mut fixed, mut scaled) = (vec![0.0; n], vec![0.0; n]);
-        self.constant_force_parts(&mut fixed, &mut scaled);
-        ConstantForces { fixed, scaled, named: self.named_constant_forces() }
-    }
+    /// [`Self::mass_parameter`] is `group` (`None`: those no parameter scales, every element
+    /// of a model without mass parameters).
+    fn group_mass_mul(&self, group: Option<&str>, a: &[f64], out: &mut [f64]);
+    /// The part of `g₀` (what depends on neither `q`, `q̇` nor `t`) of the elements whose mass
+    /// parameter is `group`, at the model file's values, in the parts `g₀,fixed`, `g₀,scaled`
+    /// (times `λ`) and one per named parameter (`scaled = "name"`, times `μ_name`, 1 where μ
+    /// does not set it): a reduction projects each once.
+    fn group_constant_forces(&self, group: Option<&str>) -> ConstantForces;
 }
 
 /// The constant forces `g₀` of a model, or of a group of its elements, in parts:

@@ -23,20 +23,6 @@ impl ElementModel for FlexibleSystem {
         out.copy_from_slice(self.element_matrix_mat(e, &Vec8::from_column_slice(qe), coef).as_slice());
     }
 
-    /// The bodies' whose density no parameter sets (all, in a model with no such parameter).
-    fn constant_force_parts(&self, fixed: &mut [f64], scaled: &mut [f64]) {
-        for (o, g) in fixed.iter_mut().zip(&self.gravity_fixed) {
-            *o = -g;
-        }
-        for (o, g) in scaled.iter_mut().zip(&self.gravity_scaled) {
-            *o = -g;
-        }
-    }
-
-    fn named_constant_forces(&self) -> Vec<(String, Vec<f64>)> {
-        self.gravity_named.iter().map(|(name, g)| (name.clone(), g.iter().map(|x| -x).collect())).collect()
-    }
-
     fn load_dofs(&self) -> Vec<usize> {
         self.load_dofs.clone()
     }

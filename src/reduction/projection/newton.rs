@@ -30,6 +30,13 @@ impl Projection {
         self.base_coef = None;
     }
 
+    /// Replaces the constant stiffness term, keeping the damping term (a stiffness parameter
+    /// changed).
+    pub fn set_linear_stiffness(&mut self, stiffness: Array2<f64>) {
+        self.linear.0 = Some(stiffness);
+        self.base_coef = None;
+    }
+
     /// The buffer the iteration matrix is assembled in (column-major) and its leading
     /// dimension: `S` (r × r) when the joints are eliminated, else the KKT matrix.
     fn matrix(&mut self) -> (&mut [f64], usize) {
