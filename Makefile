@@ -5,8 +5,9 @@
 # The system libraries (HDF5, OpenBLAS) are installed through apt when missing, as root or
 # through sudo; they are linked statically (build.rs, docs/startup.md), and gfortran brings
 # libgfortran.a for OpenBLAS's LAPACK (without it the shared libgfortran.so.5 is linked).
-# h5py (for the Python read-back test and the README's plotting example) is installed with
-# pip when python3 is there and h5py is not; without network it is skipped.
+# h5py, matplotlib, pytest and maturin (the Python package's build and tests, the read-back
+# tests, the README's plotting example) are installed with pip when python3 is there and
+# they are not.
 
 SYSTEM_PACKAGES := libhdf5-dev libopenblas-dev pkg-config gfortran
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
@@ -21,8 +22,8 @@ deps:
 		$(SUDO) apt-get update -qq && \
 		DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends $$missing; \
 	fi
-	@if command -v python3 >/dev/null && ! python3 -c "import h5py, numpy, matplotlib" 2>/dev/null; then \
-		python3 -m pip install --quiet h5py numpy matplotlib 2>/dev/null || echo "note: h5py/matplotlib not installed; the Python read-back tests will be skipped"; \
+	@if command -v python3 >/dev/null && ! python3 -c "import h5py, numpy, matplotlib, pytest, maturin" 2>/dev/null; then \
+		python3 -m pip install --quiet --root-user-action=ignore h5py numpy matplotlib pytest "maturin>=1.9,<2" 2>/dev/null || echo "note: h5py/matplotlib/pytest/maturin not installed; the Python tests will fail or be skipped"; \
 	fi
 
 run: deps
@@ -37,6 +38,10 @@ test: deps
 	# one OpenBLAS thread in the test binaries too (the flexrom binary sets it itself): idle
 	# BLAS workers poll with sched_yield and would take CPU from the tests
 	HDF5_USE_FILE_LOCKING=FALSE OPENBLAS_NUM_THREADS=1 cargo test --release
+	# the Python package (python/, docs/python.md): built with maturin and installed from this
+	# folder, then its tests against the binary just built and the example script
+	python3 -m pip install --quiet --root-user-action=ignore --no-build-isolation .
+	python3 -m pytest -q python/tests
 
 bench: deps
 	cargo build --release

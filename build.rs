@@ -22,6 +22,12 @@ const OPENBLAS_DIR: &str = "/usr/lib/x86_64-linux-gnu/openblas-pthread";
 
 fn main() {
     println!("cargo::rerun-if-changed=build.rs");
+    link_native_libraries();
+}
+
+/// Emits the link arguments above (also called by the Python module's build script,
+/// python/build.rs, which links HDF5 itself).
+pub fn link_native_libraries() {
     let target = std::env::var("TARGET").unwrap_or_default();
     if target != "x86_64-unknown-linux-gnu" {
         // other systems: leave it to the user's link flags (docs/startup.md)

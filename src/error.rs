@@ -64,6 +64,11 @@ pub enum Error {
         source: Box<Error>,
     },
 
+    /// The host program asked the computation to stop ([`crate::interrupt`]: Ctrl-C in
+    /// Python); temporary files begun are removed as the error travels up.
+    #[error("interrupted")]
+    Interrupted,
+
     /// Standard output was closed by the reader (`| head`): not an error of the run, the
     /// program ends quietly.
     #[error("standard output closed")]

@@ -11,6 +11,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
 
 pub mod error;
+pub mod interrupt;
 pub mod io;
 pub mod limits;
 pub mod linalg;

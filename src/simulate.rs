@@ -163,6 +163,7 @@ pub fn integrate_guided<M: DynamicModel>(
     let mut watch = BlowUpWatch::new(params, s.allow_blowup);
     record(0, &state);
     for k in 1..=n_steps {
+        crate::interrupt::check()?;
         let guessed = guess(k, &mut increment);
         integ.step_guided(model, &mut state, dt, guessed.then_some(increment.as_slice()))?;
         // keep t on the nominal grid despite round-off in sub-steps

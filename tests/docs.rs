@@ -269,7 +269,8 @@ fn the_files_speak_of_the_project_not_of_its_making() {
         ("src", &["rs"][..]),
         ("scripts", &["py", "sh", "sbatch"][..]),
         ("benches", &["rs", "py"][..]),
-        ("examples", &["rs"][..]),
+        ("examples", &["rs", "py"][..]),
+        ("python", &["rs", "py", "pyi", "md", "toml"][..]),
         ("tests", &["rs"][..]),
     ] {
         text_files(&root().join(dir), exts, &mut files);

@@ -8,7 +8,7 @@
 //!   layer order, top to bottom:
 //!
 //!   `main` → `cli` → `pipeline` → `rom` → `io` → `simulate` → `model` → `reduction` | `physics`
-//!   → `solver` → `linalg` → `output` → `limits` → `error`
+//!   → `solver` → `linalg` → `output` → `limits` | `interrupt` → `error`
 //!
 //!   (`cli` is the binary's command handlers, below `main.rs`'s parsing and dispatch;
 //!   `reduction` and `physics` share a layer and must not see each other: the reduction
@@ -35,7 +35,7 @@ const LAYERS: &[&[&str]] = &[
     &["solver"],
     &["linalg"],
     &["output"],
-    &["limits"],
+    &["limits", "interrupt"],
     &["error"],
 ];
 

@@ -199,15 +199,31 @@ pub fn write_basis_with(
     })
 }
 
+/// The load scales of the full runs a basis file's snapshots come from, in run order
+/// (`/snapshot_load_scale`, each run's once).
+pub fn read_training_loads(path: &Path) -> Result<Vec<f64>> {
+    let f = hdf5::File::open(path).map_err(|e| Error::hdf5(path, e))?;
+    let all: Vec<f64> = f
+        .dataset("snapshot_load_scale")
+        .and_then(|d| d.read_raw::<f64>())
+        .map_err(|e| Error::input(path, "snapshot_load_scale", format!("cannot be read: {e}")))?;
+    let mut runs: Vec<f64> = Vec::new();
+    for x in all {
+        // snapshots of one run are contiguous: a change of value is the next run
+        if runs.last() != Some(&x) {
+            runs.push(x);
+        }
+    }
+    Ok(runs)
+}
+
 /// Reads a basis file; every missing or malformed part is reported with the file and the
 /// dataset or attribute it concerns.
 pub fn read_basis(path: &Path) -> Result<StoredBasis> {
     if !path.is_file() {
         return Err(Error::input(path, "(file)", "does not exist; run `flexrom train` first"));
     }
-    let f = hdf5::File::open(path).map_err(|e| {
-        Error::input(path, "(file)", format!("is not a readable HDF5 file (truncated or of another format?): {e}"))
-    })?;
+    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
     let field = |name: &str, problem: String| Error::input(path, name, problem);
     // layouts 1 and 2 store a basis alike (snapshots and modes one column each); a newer
     // one is refused

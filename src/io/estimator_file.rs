@@ -88,8 +88,7 @@ pub fn write_estimator(f: &hdf5::File, est: &Estimator) -> hdf5::Result<()> {
 /// reference, kept coordinates are the basis's). `None` when the file has none (trained
 /// before the estimator existed).
 pub fn read_estimator(path: &Path, basis: &Basis) -> Result<Option<Estimator>> {
-    let f = hdf5::File::open(path)
-        .map_err(|e| Error::input(path, "(file)", format!("is not a readable HDF5 file: {e}")))?;
+    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
     let Ok(g) = f.group("estimator") else { return Ok(None) };
     let field = |name: &str, problem: String| Error::input(path, format!("estimator/{name}"), problem);
     let modes = g
@@ -275,8 +274,7 @@ fn read_defects(path: &Path, dg: &hdf5::Group, field: &dyn Fn(&str, String) -> E
 /// `[min, max]` of the training load scales: `/training/range` when present (greedy
 /// training), else the extremes of `/snapshot_load_scale`.
 pub fn read_training_range(path: &Path) -> Result<(f64, f64)> {
-    let f = hdf5::File::open(path)
-        .map_err(|e| Error::input(path, "(file)", format!("is not a readable HDF5 file: {e}")))?;
+    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
     if let Ok(d) = f.dataset("training/range") {
         let r = d.read_1d::<f64>().map_err(|e| Error::input(path, "training/range", format!("cannot be read: {e}")))?;
         if r.len() != 2 || !(r[0].is_finite() && r[1].is_finite() && r[0] <= r[1]) {
@@ -299,8 +297,7 @@ pub fn read_training_range(path: &Path) -> Result<(f64, f64)> {
 /// The loads of the full runs whose snapshots the basis holds, sorted, each once:
 /// `/training/load_scales` (greedy training), else the values of `/snapshot_load_scale`.
 pub fn read_training_loads(path: &Path) -> Result<Vec<f64>> {
-    let f = hdf5::File::open(path)
-        .map_err(|e| Error::input(path, "(file)", format!("is not a readable HDF5 file: {e}")))?;
+    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
     let mut l: Vec<f64> = match f.dataset("training/load_scales") {
         Ok(d) => d.read_1d::<f64>().map_err(|e| Error::input(path, "training/load_scales", e.to_string()))?.to_vec(),
         Err(_) => f
@@ -319,8 +316,7 @@ pub fn read_training_loads(path: &Path) -> Result<Vec<f64>> {
 /// `/training/sensitivity`); `None` without greedy training or in files written before the
 /// sensitivity was recorded.
 pub fn read_training_sensitivity(path: &Path) -> Result<Option<(Vec<f64>, Vec<f64>)>> {
-    let f = hdf5::File::open(path)
-        .map_err(|e| Error::input(path, "(file)", format!("is not a readable HDF5 file: {e}")))?;
+    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
     let Ok(g) = f.group("training") else { return Ok(None) };
     let (Ok(c), Ok(s)) = (g.dataset("candidates"), g.dataset("sensitivity")) else { return Ok(None) };
     let c =
@@ -358,8 +354,7 @@ pub fn read_training_box_sensitivity(
     path: &Path,
     space: &crate::solver::parameter_space::ParameterSpace,
 ) -> Result<Option<BoxSensitivity>> {
-    let f = hdf5::File::open(path)
-        .map_err(|e| Error::input(path, "(file)", format!("is not a readable HDF5 file: {e}")))?;
+    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
     let Ok(g) = f.group("training") else { return Ok(None) };
     let (Ok(c), Ok(s)) = (g.dataset("candidate_points"), g.dataset("sensitivity")) else { return Ok(None) };
     let bad = |field: &str, problem: String| Error::input(path, field, problem);
@@ -398,8 +393,7 @@ pub fn read_training_box_sensitivity(
 /// Greedy training's tolerance: the dataset `/training/tolerance` or the attribute
 /// `tolerance` on `/training`; `None` without greedy training.
 pub fn read_training_tolerance(path: &Path) -> Result<Option<f64>> {
-    let f = hdf5::File::open(path)
-        .map_err(|e| Error::input(path, "(file)", format!("is not a readable HDF5 file: {e}")))?;
+    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
     let Ok(g) = f.group("training") else { return Ok(None) };
     let t = if let Ok(d) = g.dataset("tolerance") {
         d.read_scalar::<f64>().or_else(|_| d.read_1d::<f64>().map(|a| a.first().copied().unwrap_or(f64::NAN)))
@@ -418,8 +412,7 @@ pub fn read_training_tolerance(path: &Path) -> Result<Option<f64>> {
 /// The error greedy training's tolerance is on: the attribute `measure` on `/training`;
 /// relative without one (files written before the attribute, bases of fixed loads).
 pub fn read_training_measure(path: &Path) -> Result<ErrorMeasure> {
-    let f = hdf5::File::open(path)
-        .map_err(|e| Error::input(path, "(file)", format!("is not a readable HDF5 file: {e}")))?;
+    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
     let Ok(g) = f.group("training") else { return Ok(ErrorMeasure::Relative) };
     if g.attr("measure").is_err() {
         return Ok(ErrorMeasure::Relative);

@@ -190,6 +190,18 @@ pub fn read_attr_f64(loc: &hdf5::Location, name: &str) -> hdf5::Result<f64> {
     loc.attr(name)?.read_scalar::<f64>()
 }
 
+/// Why an HDF5 file could not be opened, for a message that follows the file's name: a lock
+/// held by another open handle (an h5py `File` in the same Python process, another program
+/// writing it) said as such, anything else as a file that is not readable HDF5.
+pub fn unreadable(e: &hdf5::Error) -> String {
+    let text = e.to_string();
+    if text.contains("unable to lock file") {
+        format!("is locked by another open handle (an h5py File still open, or a program writing it): close it first, or set HDF5_USE_FILE_LOCKING=FALSE to share it read-only ({text})")
+    } else {
+        format!("is not a readable HDF5 file (truncated or of another format?): {text}")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     /// `attr_str` writes what the crate's own attribute writer writes: read back equal

@@ -30,8 +30,7 @@ pub fn write_parameter_space(f: &hdf5::File, space: &ParameterSpace, points: &[P
 /// A range that is not `[lower, upper]` with lower < upper, or an unknown scale, is an
 /// error naming the dataset.
 pub fn read_parameter_space(path: &Path) -> Result<Option<ParameterSpace>> {
-    let f = hdf5::File::open(path)
-        .map_err(|e| Error::input(path, "(file)", format!("is not a readable HDF5 file: {e}")))?;
+    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
     let Ok(g) = f.group("parameters") else { return Ok(None) };
     let mut names = g.member_names().map_err(|e| Error::hdf5(path, e))?;
     names.sort();

@@ -64,8 +64,7 @@ pub fn append_timing(path: &Path, t: &RouteTiming) -> Result<()> {
 /// `/timing` of the basis file at `path`; `None` for a file written before it. A timing
 /// that is there but unreadable, or not positive where it must be, is an error naming it.
 pub fn read_timing(path: &Path) -> Result<Option<RouteTiming>> {
-    let f = hdf5::File::open(path)
-        .map_err(|e| Error::input(path, "(file)", format!("is not a readable HDF5 file: {e}")))?;
+    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
     let Ok(g) = f.group("timing") else { return Ok(None) };
     let bad = |field: &str, problem: String| Error::input(path, format!("timing/{field}"), problem);
     let mut seconds = [f64::NAN; 3];

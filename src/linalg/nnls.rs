@@ -92,6 +92,10 @@ pub fn nnls(a: ArrayView2<f64>, b: ArrayView1<f64>, params: &NnlsParams) -> Resu
     let mut iterations = 0;
     let tol = params.tolerance * b_norm;
     loop {
+        // a fit of a refined mesh takes seconds: a stop asked for ends it ([`crate::interrupt`])
+        if crate::interrupt::requested() {
+            return Err("interrupted".into());
+        }
         let res_norm = residual.dot(&residual).sqrt();
         if res_norm <= tol || iterations >= params.max_iterations {
             break;

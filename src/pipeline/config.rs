@@ -70,11 +70,32 @@ impl Pipeline {
         let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
         let file: PipelineFile = crate::model::parse_toml(&text, path)?;
         let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
-        let stem = path.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_else(|| "pipeline".into());
         let model = Model::load_with(dir.join(&file.model), limits).map_err(|e| match e {
             Error::Io { .. } => Error::input(path, "model", format!("cannot read `{}`: {e}", file.model.display())),
             other => other,
         })?;
+        Pipeline::of_parts(path, text, file, model)
+    }
+
+    /// The pipeline a basis file was trained with, from the pipeline and model texts the
+    /// file stores (`pipeline`, `model`, `model_path` attributes): a basis file is enough to
+    /// run its reduced model wherever it was moved. Paths the pipeline names (its `basis`,
+    /// `report`) are read relative to `path`, the pipeline file's path at training.
+    pub fn from_texts(
+        path: &Path,
+        text: &str,
+        model_text: &str,
+        model_path: &Path,
+        limits: Limits,
+    ) -> Result<Pipeline> {
+        let file: PipelineFile = crate::model::parse_toml(text, path)?;
+        let model = Model::from_text_with(model_text, model_path, limits)?;
+        Pipeline::of_parts(path, text.to_string(), file, model)
+    }
+
+    fn of_parts(path: &Path, text: String, file: PipelineFile, model: Model) -> Result<Pipeline> {
+        let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        let stem = path.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_else(|| "pipeline".into());
         let basis_path =
             dir.join(file.basis.clone().unwrap_or_else(|| PathBuf::from(format!("../data/bases/{stem}.h5"))));
         let report_dir = dir.join(file.report.clone().unwrap_or_else(|| PathBuf::from(format!("../reports/{stem}"))));

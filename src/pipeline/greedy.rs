@@ -138,6 +138,7 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
     let mut method = EstimateMethod::Corrected;
     let converged;
     let chosen = loop {
+        crate::interrupt::check()?;
         let data = training_data(&runs);
         let previous_energy = iterations.last().map(|i: &Iteration| i.energy);
         let prior = iterations.last().map(|i: &Iteration| i.estimates.as_slice());

@@ -57,7 +57,7 @@ struct PartBasis {
 
 fn read_part(path: &Path) -> Result<Part> {
     let bad = |field: &str, problem: String| Error::input(path, field, problem);
-    let f = hdf5::File::open(path).map_err(|e| bad("(file)", format!("is not a readable HDF5 file: {e}")))?;
+    let f = hdf5::File::open(path).map_err(|e| bad("(file)", crate::io::h5::unreadable(&e)))?;
     let g = f.group("shard").map_err(|_| {
         bad(
             "shard",

@@ -3,7 +3,7 @@
 use super::config::Pipeline;
 use crate::error::{Error, Result};
 use crate::io::basis_file::StoredBasis;
-use crate::io::h5::{attr_str, attr_u64};
+use crate::io::h5::{attr_str, attr_u64, read_attr_str};
 use crate::io::result_file::{begin_alongside, RunPlan};
 use crate::rom::estimator::{Estimate, EstimateMethod};
 use crate::rom::trust::write_run_attributes;
@@ -15,6 +15,23 @@ use std::path::Path;
 /// settings ([`crate::io::basis_check::check`]).
 pub fn load_basis(p: &Pipeline, path: &Path) -> Result<StoredBasis> {
     crate::io::basis_check::check(path, &p.model, Some(&p.settings_hash()))
+}
+
+/// The pipeline a basis file was trained with, rebuilt from the pipeline and model texts
+/// the file stores ([`Pipeline::from_texts`]; messages about it name the basis file).
+pub fn pipeline_of_basis(path: &Path, limits: crate::limits::Limits) -> Result<Pipeline> {
+    if !path.is_file() {
+        return Err(Error::input(path, "(file)", "does not exist; run `flexrom train` first"));
+    }
+    let file = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
+    let text = |name: &str| {
+        read_attr_str(&file, name).map_err(|e| {
+            Error::input(path, name, format!("cannot be read ({e}); is this a basis file of `flexrom train`?"))
+        })
+    };
+    let (pipeline, model, model_path) = (text("pipeline")?, text("model")?, text("model_path")?);
+    drop(file);
+    Pipeline::from_texts(path, &pipeline, &model, Path::new(&model_path), limits)
 }
 
 /// Reads and checks the basis file at `path` and builds its reduced model with the error

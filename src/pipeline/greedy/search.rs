@@ -132,6 +132,10 @@ pub(super) fn search(r: &Round, g: &GreedySpec, previous_energy: Option<f64>) ->
         _ => (0..candidates.len()).collect(),
     };
     let mut attempt = |modes: ModeRule, eps: f64, tau: f64| -> Option<Level> {
+        // a stop asked for: no more rungs (their runs would fail at once and read as ∞)
+        if crate::interrupt::requested() {
+            return None;
+        }
         match level(r, modes, eps, Some(tau), &order) {
             Ok(l) => {
                 order = worst_first(&l.estimates, &l.evaluated);
@@ -212,6 +216,7 @@ pub(super) fn search(r: &Round, g: &GreedySpec, previous_energy: Option<f64>) ->
             }
         }
     }
+    crate::interrupt::check()?;
     let mut best = best.ok_or_else(|| {
         let (f, e) = last_error.unwrap_or(("reduction", "no basis could be built".into()));
         Error::input(&p.path, f, format!("greedy training, iteration {n}: {e}"))

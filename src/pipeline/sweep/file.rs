@@ -303,7 +303,7 @@ pub fn read_sweep(
     let cannot = |field: &str, problem: String| {
         Error::input(path, field, format!("{problem}; cannot resume from it (remove it, or run without --resume)"))
     };
-    let f = hdf5::File::open(path).map_err(|e| cannot("(file)", format!("is not a readable HDF5 file: {e}")))?;
+    let f = hdf5::File::open(path).map_err(|e| cannot("(file)", crate::io::h5::unreadable(&e)))?;
     // layout 1 stored /reduced_q as (N, r, n_t): converted below; newer layouts are refused
     let layout = check_layout(&f, path, "flexrom sweep")?;
     let text = |name: &str| {

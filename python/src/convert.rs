@@ -1,0 +1,114 @@
+//! Between the library's values and Python's: parameters from keywords, arrays time first,
+//! warnings through Python's `warnings`, a sweep as a dict of arrays.
+
+use crate::errors::{model_error, FlexromWarning};
+use flexrom::pipeline::sweep::{Outcome, Sweep};
+use flexrom::solver::parameters::Parameters;
+use numpy::{IntoPyArray, PyArray2};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::collections::HashMap;
+
+/// The run's parameters: the load scale (default 1) and the named ones, checked finite.
+/// `load_scale` may also come as a named parameter, not both.
+pub fn parameters(load_scale: Option<f64>, named: &HashMap<String, f64>) -> PyResult<Parameters> {
+    use flexrom::solver::parameters::LOAD_SCALE;
+    if load_scale.is_some() && named.contains_key(LOAD_SCALE) {
+        return Err(model_error("load_scale given twice (as load_scale and in params)"));
+    }
+    // sorted: a dict's order must not change which parameter a message names first
+    let mut names: Vec<&String> = named.keys().collect();
+    names.sort();
+    let mut mu = Parameters::load_scale(load_scale.unwrap_or(1.0));
+    for name in names {
+        mu = mu.with(name, named[name]);
+    }
+    mu.validate().map_err(crate::errors::to_py)?;
+    Ok(mu)
+}
+
+/// The named parameters of a call's keywords (`drive=1.1, E_lower=2.5e8`), each a number.
+pub fn named(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Option<HashMap<String, f64>>> {
+    let Some(kwargs) = kwargs else { return Ok(None) };
+    let mut out = HashMap::new();
+    for (k, v) in kwargs.iter() {
+        let name: String = k.extract()?;
+        let value: f64 = v.extract().map_err(|_| model_error(&format!("parameter `{name}`: `{v}` is not a number")))?;
+        out.insert(name, value);
+    }
+    Ok(Some(out))
+}
+
+/// `a` (n × n_t: a column per instant, as the solver keeps it) as an (n_t, n) array.
+pub fn time_first<'py>(py: Python<'py>, a: &ndarray::Array2<f64>) -> Bound<'py, PyArray2<f64>> {
+    a.t().as_standard_layout().into_owned().into_pyarray(py)
+}
+
+/// name → (n_t) array.
+pub fn dict_of_series<'py>(py: Python<'py>, s: &flexrom::simulate::Series) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    for (name, v) in s {
+        d.set_item(name, v.clone().into_pyarray(py))?;
+    }
+    Ok(d)
+}
+
+/// Each line through `warnings.warn` as a `FlexromWarning` (shown once per place by
+/// Python's default filter; an error under `-W error`).
+pub fn warn(py: Python<'_>, lines: &[String]) -> PyResult<()> {
+    for line in lines {
+        let msg = std::ffi::CString::new(line.replace('\0', " ")).expect("NULs replaced");
+        PyErr::warn(py, &py.get_type::<FlexromWarning>(), &msg, 1)?;
+    }
+    Ok(())
+}
+
+/// A sweep as arrays with the load axis first; a failed point's entries are NaN and its
+/// message is in `failed`.
+pub fn sweep_dict<'py>(py: Python<'py>, s: &Sweep, points: &[Parameters]) -> PyResult<Bound<'py, PyDict>> {
+    let (n, n_t) = (s.scales.len(), s.t.len());
+    let d = PyDict::new(py);
+    d.set_item("load_scale", points.iter().map(|mu| mu.scale()).collect::<Vec<_>>().into_pyarray(py))?;
+    let named = PyDict::new(py);
+    for name in
+        points.iter().flat_map(|mu| mu.named().map(|(k, _)| k.to_string())).collect::<std::collections::BTreeSet<_>>()
+    {
+        let v: Vec<f64> = points.iter().map(|mu| mu.get(&name).unwrap_or(f64::NAN)).collect();
+        named.set_item(name, v.into_pyarray(py))?;
+    }
+    d.set_item("parameters", named)?;
+    d.set_item("t", s.t.clone().into_pyarray(py))?;
+    let mut estimate = vec![f64::NAN; n];
+    let mut by_time = ndarray::Array2::from_elem((n, 5), f64::NAN);
+    let mut extrapolated = vec![false; n];
+    let mut failed: Vec<Option<String>> = vec![None; n];
+    let mut probes: Vec<ndarray::Array3<f64>> =
+        vec![ndarray::Array3::from_elem((n, n_t, 2), f64::NAN); s.probe_names.len()];
+    for (i, sr) in s.scales.iter().enumerate() {
+        match &sr.outcome {
+            Outcome::Done(p) => {
+                if let Some(e) = &p.estimate {
+                    estimate[i] = e.error_estimate;
+                    by_time.row_mut(i).assign(&ndarray::ArrayView1::from(&e.by_time[..]));
+                }
+                extrapolated[i] = p.extrapolated;
+                for (k, (_, xy)) in p.run.result.probes.iter().enumerate() {
+                    probes[k].index_axis_mut(ndarray::Axis(0), i).assign(xy);
+                }
+            }
+            Outcome::Failed(msg) => failed[i] = Some(msg.clone()),
+            Outcome::Pending => failed[i] = Some("not run".into()),
+        }
+    }
+    let pd = PyDict::new(py);
+    for (name, a) in s.probe_names.iter().zip(probes) {
+        pd.set_item(name, a.into_pyarray(py))?;
+    }
+    d.set_item("probes", pd)?;
+    d.set_item("error_estimate", estimate.into_pyarray(py))?;
+    d.set_item("error_estimate_by_time", by_time.into_pyarray(py))?;
+    d.set_item("extrapolated", extrapolated.into_pyarray(py))?;
+    d.set_item("failed", failed)?;
+    d.set_item("wall_seconds", s.wall_seconds)?;
+    Ok(d)
+}

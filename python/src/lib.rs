@@ -1,0 +1,681 @@
+//! The native module of the Python package `flexrom` (`flexrom._flexrom`): thin wrappers
+//! over the library's model, run, basis, sweep, training and validation, numpy arrays in
+//! and out. Every array is a copy in the files' layout (time first); the Python side
+//! (`python/flexrom/__init__.py`) re-exports these names and adds nothing computational.
+//!
+//! Long work runs on a thread of its own without the GIL while the calling thread waits in
+//! slices of [`SIGNAL_POLL`], taking the GIL between them only to let Python run its signal
+//! handlers: a Ctrl-C there sets [`flexrom::interrupt`], every run stops at its next time
+//! step, the temporary files it had begun are dropped, and `KeyboardInterrupt` is raised.
+
+mod convert;
+mod errors;
+
+use convert::{dict_of_series, parameters, time_first, warn};
+use errors::{to_py, FlexromWarning};
+use flexrom::io::labels::Labels;
+use flexrom::io::output::{check_output, Origin};
+use flexrom::io::result_file::{ResultFile, RunPlan};
+use flexrom::model::Model;
+use flexrom::pipeline::online::{load_rom, pipeline_of_basis};
+use flexrom::pipeline::Pipeline;
+use flexrom::rom::estimator::{Estimate, EstimateMethod};
+use flexrom::rom::{Output, Rom, Trust};
+use flexrom::simulate::{Overrides, SimulationResult};
+use flexrom::solver::parameters::Parameters;
+use numpy::{IntoPyArray, PyArray1, PyArray2};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Duration;
+
+/// How often the waiting thread lets Python look at its signals (Ctrl-C is answered within
+/// this and one time step).
+const SIGNAL_POLL: Duration = Duration::from_millis(50);
+
+/// Runs `work` on a thread of its own without the GIL, answering Ctrl-C (see the module).
+fn interruptible<T: Send>(py: Python<'_>, work: impl FnOnce() -> flexrom::Result<T> + Send) -> PyResult<T> {
+    flexrom::interrupt::clear();
+    let (done_tx, done_rx) = std::sync::mpsc::channel::<()>();
+    let mut interrupted: Option<PyErr> = None;
+    let out = std::thread::scope(|s| {
+        let worker = std::thread::Builder::new()
+            .name("flexrom-work".into())
+            .spawn_scoped(s, move || {
+                let out = work();
+                let _ = done_tx.send(());
+                out
+            })
+            .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(format!("cannot start a thread: {e}")))?;
+        let mut done_rx = done_rx;
+        loop {
+            // the receiver travels into the GIL-free closure and back (it is Send, not Sync)
+            let (rx, waited) = py.detach(move || {
+                let waited = done_rx.recv_timeout(SIGNAL_POLL);
+                (done_rx, waited)
+            });
+            done_rx = rx;
+            if !matches!(waited, Err(std::sync::mpsc::RecvTimeoutError::Timeout)) {
+                break;
+            }
+            if interrupted.is_none() {
+                if let Err(e) = py.check_signals() {
+                    flexrom::interrupt::request();
+                    interrupted = Some(e);
+                }
+            }
+        }
+        worker.join().map_err(|_| pyo3::exceptions::PyRuntimeError::new_err("flexrom: the computation panicked"))
+    })?;
+    flexrom::interrupt::clear();
+    match (interrupted, out) {
+        (Some(e), _) => Err(e),
+        (None, out) => out.map_err(to_py),
+    }
+}
+
+/// A model file: the system of bodies, joints and loads, run by [`PyModel::simulate`].
+#[pyclass(name = "Model", module = "flexrom._flexrom", frozen)]
+struct PyModel {
+    model: Arc<Model>,
+}
+
+#[pymethods]
+impl PyModel {
+    /// Reads and checks the model file at `path` (TOML, docs/model-format.md).
+    #[staticmethod]
+    fn from_file(path: PathBuf) -> PyResult<Self> {
+        Ok(PyModel { model: Arc::new(Model::load(&path).map_err(to_py)?) })
+    }
+
+    /// A model from the text of a model file; `path` names it in messages and results.
+    #[staticmethod]
+    #[pyo3(signature = (text, path = None))]
+    fn from_toml(text: &str, path: Option<PathBuf>) -> PyResult<Self> {
+        let path = path.unwrap_or_else(|| PathBuf::from("<string>"));
+        Ok(PyModel { model: Arc::new(Model::from_text(text, &path).map_err(to_py)?) })
+    }
+
+    #[getter]
+    fn path(&self) -> String {
+        self.model.path.display().to_string()
+    }
+
+    /// The model file's text.
+    #[getter]
+    fn text(&self) -> String {
+        self.model.text.clone()
+    }
+
+    /// The named parameters (`scaled = "NAME"` loads, `{ value, parameter }` properties).
+    #[getter]
+    fn parameter_names(&self) -> Vec<String> {
+        self.model.parameter_names().into_iter().map(String::from).collect()
+    }
+
+    #[getter]
+    fn n_dof(&self) -> usize {
+        self.model.sizes().n_dof as usize
+    }
+
+    #[getter]
+    fn n_constraints(&self) -> usize {
+        self.model.sizes().n_constraints as usize
+    }
+
+    #[getter]
+    fn probe_names(&self) -> Vec<String> {
+        self.model.probe_names()
+    }
+
+    /// One full run (`flexrom simulate`): the load scale and named parameters, and the time
+    /// settings over the model file's.
+    #[pyo3(signature = (load_scale = None, *, dt = None, t_end = None, rho_inf = None, **params))]
+    fn simulate(
+        &self,
+        py: Python<'_>,
+        load_scale: Option<f64>,
+        dt: Option<f64>,
+        t_end: Option<f64>,
+        rho_inf: Option<f64>,
+        params: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<PyRunResult> {
+        let params = convert::named(params)?;
+        let model = &self.model;
+        // as `simulate --load-scale X`: no parameters at all leaves the model file's
+        let mu = match (&params, load_scale) {
+            (Some(p), _) if !p.is_empty() => Some(parameters(load_scale, p)?),
+            (_, Some(x)) => Some(parameters(Some(x), &HashMap::new())?),
+            _ => None,
+        };
+        let shown = mu.clone().unwrap_or_default();
+        model.check_parameters(&shown).map_err(to_py)?;
+        let mut warnings: Vec<String> = model.load_scale_warning(std::iter::once(shown.scale())).into_iter().collect();
+        warnings.extend(model.property_warnings([&shown]));
+        warn(py, &warnings)?;
+        let overrides = Overrides { dt, t_end, rho_inf, mu, ..Default::default() };
+        let r = interruptible(py, || {
+            flexrom::simulate::simulate(model, &overrides).map_err(|e| e.at_stage("simulate", &shown))
+        })?;
+        Ok(PyRunResult { model: Arc::clone(model), r, reduced: None })
+    }
+
+    fn __repr__(&self) -> String {
+        let z = self.model.sizes();
+        format!("Model('{}': {} coordinates, {} constraints)", self.model.path.display(), z.n_dof, z.n_constraints)
+    }
+}
+
+/// What a reduced run adds to its result: what `online` writes beside the run.
+struct ReducedPart {
+    /// r × n_t
+    reduced_q: ndarray::Array2<f64>,
+    basis_name: String,
+    variant: &'static str,
+    n_modes: usize,
+    estimate: Option<Estimate>,
+    method: Option<&'static str>,
+    trust: Trust,
+    mu: Parameters,
+    extrapolated: bool,
+}
+
+/// A run's result, full (`Model.simulate`) or reduced (`Basis.online`), in the layout of a
+/// result file: time first.
+#[pyclass(name = "Result", module = "flexrom._flexrom", frozen)]
+struct PyRunResult {
+    model: Arc<Model>,
+    r: SimulationResult,
+    reduced: Option<ReducedPart>,
+}
+
+#[pymethods]
+impl PyRunResult {
+    /// (n_t) time, s
+    #[getter]
+    fn t<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.r.t.clone().into_pyarray(py)
+    }
+
+    /// (n_t, n_dof) the coordinates at every instant (m, slopes 1)
+    #[getter]
+    fn q<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        time_first(py, &self.r.q)
+    }
+
+    /// (n_t, n_dof) their velocities
+    #[getter]
+    fn qd<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        time_first(py, &self.r.qd)
+    }
+
+    /// (n_t, n_c) the Lagrange multipliers (N; N·m on clamp slope rows)
+    #[getter]
+    fn multipliers<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        time_first(py, &self.r.multipliers)
+    }
+
+    /// probe name → (n_t, 2) its x, y, m
+    #[getter]
+    fn probes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (name, xy) in &self.r.probes {
+            d.set_item(name, xy.clone().into_pyarray(py))?;
+        }
+        Ok(d)
+    }
+
+    /// probe name → (n_t) axial strain, for the probes that record it
+    #[getter]
+    fn strains<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        dict_of_series(py, &self.r.strains)
+    }
+
+    /// probe name → (n_t) curvature, 1/m, for the probes that record it
+    #[getter]
+    fn curvatures<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        dict_of_series(py, &self.r.curvatures)
+    }
+
+    /// names of the coordinates (`dof`), constraint rows (`multiplier`) and bodies, as a
+    /// result file's `/labels`
+    #[getter]
+    fn labels<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let l = Labels::of(&self.model);
+        let d = PyDict::new(py);
+        d.set_item("dof", l.dof_names())?;
+        d.set_item("multiplier", l.multipliers.iter().map(|(_, s)| s.clone()).collect::<Vec<_>>())?;
+        d.set_item("body", l.bodies.clone())?;
+        Ok(d)
+    }
+
+    /// dataset → unit, as the result file's `units` attributes
+    #[getter]
+    fn units<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        use flexrom::io::attrs::{units_of, Kind};
+        let d = PyDict::new(py);
+        for name in ["t", "q", "qd", "multipliers", "probes/*", "probe_strain/*", "probe_curvature/*", "reduced/q"] {
+            let probe = name.replace('*', "p");
+            if let Some((units, _)) = units_of(Kind::Result, &probe) {
+                d.set_item(name.trim_end_matches("/*"), units)?;
+            }
+        }
+        Ok(d)
+    }
+
+    /// the load scale λ of the run
+    #[getter]
+    fn load_scale(&self) -> f64 {
+        self.r.settings.parameters().scale()
+    }
+
+    /// the named parameters the run set
+    #[getter]
+    fn parameters(&self) -> HashMap<String, f64> {
+        self.r.settings.parameters().named().map(|(k, v)| (k.to_string(), v)).collect()
+    }
+
+    /// the integrator's statistics and the time loop's wall time
+    #[getter]
+    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let s = &self.r.stats;
+        let d = PyDict::new(py);
+        d.set_item("steps", s.steps)?;
+        d.set_item("newton_iterations", s.newton_iterations)?;
+        d.set_item("factorizations", s.factorizations)?;
+        d.set_item("step_cuts", s.step_cuts)?;
+        d.set_item("wall_seconds", self.r.wall_seconds)?;
+        Ok(d)
+    }
+
+    /// whether this is a reduced run
+    #[getter]
+    fn reduced(&self) -> bool {
+        self.reduced.is_some()
+    }
+
+    /// (n_t, r) the reduced coordinates (reduced runs; None for a full run)
+    #[getter]
+    fn reduced_q<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray2<f64>>> {
+        self.reduced.as_ref().map(|x| time_first(py, &x.reduced_q))
+    }
+
+    /// the estimate of the run's relative error against the full model (None: a full run,
+    /// or no estimator)
+    #[getter]
+    fn error_estimate(&self) -> Option<f64> {
+        self.estimate().map(|e| e.error_estimate)
+    }
+
+    /// (5) the estimate over the instants up to the end of each fifth of the run
+    #[getter]
+    fn error_estimate_by_time<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
+        self.estimate().map(|e| e.by_time.to_vec().into_pyarray(py))
+    }
+
+    /// the estimate of the error relative to the displacement X − X₀
+    #[getter]
+    fn error_estimate_displacement(&self) -> Option<f64> {
+        self.estimate().map(|e| e.error_estimate_displacement)
+    }
+
+    /// the estimate's method (`corrected`, `enriched`, `defects`, …)
+    #[getter]
+    fn estimate_method(&self) -> Option<&'static str> {
+        self.reduced.as_ref().and_then(|x| x.method)
+    }
+
+    /// whether the run's parameters left those the basis was trained over (False for a
+    /// full run)
+    #[getter]
+    fn extrapolated(&self) -> bool {
+        self.reduced.as_ref().is_some_and(|x| x.extrapolated)
+    }
+
+    /// the reduced coordinates r (None for a full run)
+    #[getter]
+    fn n_modes(&self) -> Option<usize> {
+        self.reduced.as_ref().map(|x| x.n_modes)
+    }
+
+    /// Writes the result file `flexrom simulate -o` (full) or `flexrom online -o` (reduced)
+    /// writes, to a temporary file renamed into place; refuses a path that is the model
+    /// file, or not a regular file.
+    fn to_hdf5(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        check_output(&path, Origin::Flag("path"), &[(&self.model.path, "model file")]).map_err(to_py)?;
+        py.detach(|| self.write(&path)).map_err(to_py)
+    }
+
+    fn __repr__(&self) -> String {
+        let kind = if self.reduced.is_some() { "reduced" } else { "full" };
+        format!(
+            "Result({kind} run at {}: {} instants, {} coordinates)",
+            self.r.settings.parameters(),
+            self.r.t.len(),
+            self.r.q.nrows()
+        )
+    }
+}
+
+impl PyRunResult {
+    fn estimate(&self) -> Option<&Estimate> {
+        self.reduced.as_ref().and_then(|x| x.estimate.as_ref())
+    }
+
+    fn write(&self, path: &Path) -> flexrom::Result<()> {
+        let r = &self.r;
+        let file = ResultFile::begin(path, &r.model_text, &r.model_path, &RunPlan::of_result(r))?;
+        file.finish(r, |f| {
+            let Some(x) = &self.reduced else { return Ok(()) };
+            let e = |err: hdf5_error::Error| flexrom::Error::hdf5(path, err);
+            flexrom::io::result_file::write_reduced(f, &x.reduced_q).map_err(e)?;
+            flexrom::io::h5::attr_str(f, "basis", &x.basis_name).map_err(e)?;
+            flexrom::io::h5::attr_str(f, "variant", x.variant).map_err(e)?;
+            flexrom::io::h5::attr_u64(f, "n_modes", x.n_modes as u64).map_err(e)?;
+            flexrom::rom::trust::write_run_attributes(f, x.estimate.as_ref(), x.method, &x.trust, &x.mu, x.extrapolated)
+                .map_err(e)
+        })
+    }
+}
+
+/// The hdf5 crate's error type, as the library's result files use it.
+mod hdf5_error {
+    pub use hdf5::Error;
+}
+
+/// A trained basis and its reduced model, ready to run at new loads.
+#[pyclass(name = "Basis", module = "flexrom._flexrom", frozen)]
+struct PyBasis {
+    pipeline: Pipeline,
+    path: PathBuf,
+    stored: flexrom::io::basis_file::StoredBasis,
+    rom: Arc<Rom>,
+    training_loads: Vec<f64>,
+}
+
+#[pymethods]
+impl PyBasis {
+    /// Reads and checks the basis file at `path` and builds its reduced model. `pipeline`:
+    /// the pipeline file it is checked against (default: the pipeline and model the basis
+    /// file stores); `estimate`: the error estimate's method over the pipeline's; with
+    /// `no_estimate`, none.
+    #[staticmethod]
+    #[pyo3(signature = (path, pipeline = None, estimate = None, no_estimate = false))]
+    fn load(
+        py: Python<'_>,
+        path: PathBuf,
+        pipeline: Option<PathBuf>,
+        estimate: Option<&str>,
+        no_estimate: bool,
+    ) -> PyResult<Self> {
+        let method = estimate.map(parse_method).transpose()?;
+        let b = py.detach(|| Self::open(&path, pipeline.as_deref(), method, no_estimate));
+        let (b, warnings) = b.map_err(errors::basis_error)?;
+        warn(py, &warnings)?;
+        Ok(b)
+    }
+
+    #[getter]
+    fn path(&self) -> String {
+        self.path.display().to_string()
+    }
+
+    /// (n_dof, r) V: the modes, one column each (as the basis file's `/basis/modes`)
+    #[getter]
+    fn modes<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        self.stored.basis.modes.clone().into_pyarray(py)
+    }
+
+    /// every singular value of the POD, non-increasing
+    #[getter]
+    fn singular_values<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.stored.singular_values.clone().into_pyarray(py)
+    }
+
+    /// the load scales of the full runs the snapshots come from, in run order
+    #[getter]
+    fn training_loads<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.training_loads.clone().into_pyarray(py)
+    }
+
+    /// the reduced coordinates r (modes and kept joint coordinates)
+    #[getter]
+    fn n_modes(&self) -> usize {
+        self.stored.basis.n_reduced()
+    }
+
+    /// the reduction variant (`per-body`, `whole-system`, …)
+    #[getter]
+    fn variant(&self) -> &'static str {
+        self.stored.basis.variant.name()
+    }
+
+    /// the sampled elements of the hyper-reduction (None: every element)
+    #[getter]
+    fn sampled_elements(&self) -> Option<Vec<usize>> {
+        self.stored.basis.hyper.as_ref().map(|h| h.elements.clone())
+    }
+
+    /// the error estimate's method (None: no estimate)
+    #[getter]
+    fn estimate_method(&self) -> Option<&'static str> {
+        self.rom.method()
+    }
+
+    /// the tolerance runs are held to (None: no tolerance)
+    #[getter]
+    fn tolerance(&self) -> Option<f64> {
+        self.rom.trust().and_then(|t| t.tolerance)
+    }
+
+    /// the model the basis reduces
+    #[getter]
+    fn model(&self) -> PyModel {
+        PyModel { model: Arc::clone(self.rom.model()) }
+    }
+
+    /// One reduced run (`flexrom online`) with its error estimate; warns when the load
+    /// leaves the training range or the estimate exceeds the tolerance.
+    #[pyo3(signature = (load_scale = None, **params))]
+    fn online(
+        &self,
+        py: Python<'_>,
+        load_scale: Option<f64>,
+        params: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<PyRunResult> {
+        let params = convert::named(params)?;
+        let mu = self.point(py, load_scale, params.as_ref())?;
+        let rom = &self.rom;
+        let (run, estimate) = interruptible(py, || {
+            rom.solve_and_estimate(&mu, Output::Full, &[]).map_err(|e| e.at_stage("online", &mu))
+        })?;
+        let extrapolated = rom.is_extrapolated(&mu);
+        let mut warnings =
+            self.run_warnings(&[(mu.clone(), estimate.map(|e| e.in_measure(rom.tolerance_measure())))])?;
+        warnings.extend(rom.untrained_parameters(&mu));
+        warn(py, &warnings)?;
+        let basis = rom.basis();
+        let reduced = ReducedPart {
+            reduced_q: run.reduced_q,
+            basis_name: flexrom::io::output::resolve(&self.path).display().to_string(),
+            variant: basis.variant.name(),
+            n_modes: basis.n_reduced(),
+            estimate,
+            method: rom.method(),
+            trust: rom.trust().cloned().unwrap_or_else(|| Trust::range((f64::NAN, f64::NAN))),
+            mu,
+            extrapolated,
+        };
+        Ok(PyRunResult { model: Arc::clone(rom.model()), r: run.result, reduced: Some(reduced) })
+    }
+
+    /// Reduced runs at many loads in parallel (`flexrom sweep`): a dict of arrays with the
+    /// load axis first (`load_scale`, `t`, `probes` name → (n, n_t, 2), `error_estimate`,
+    /// `error_estimate_by_time` (n, 5), `extrapolated`, `failed`: each point's error
+    /// message or None). `points`: a list of dicts of named parameters instead.
+    #[pyo3(signature = (load_scales = None, points = None, continuation = false))]
+    fn sweep<'py>(
+        &self,
+        py: Python<'py>,
+        load_scales: Option<Vec<f64>>,
+        points: Option<Vec<HashMap<String, f64>>>,
+        continuation: bool,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let mus: Vec<Parameters> = match (load_scales, points) {
+            (Some(s), None) => s.into_iter().map(|x| self.point(py, Some(x), None)).collect::<PyResult<_>>()?,
+            (None, Some(p)) => p.iter().map(|p| self.point(py, None, Some(p))).collect::<PyResult<_>>()?,
+            _ => return Err(errors::model_error("sweep: give exactly one of load_scales and points")),
+        };
+        let o = flexrom::pipeline::sweep::SweepOptions { continuation, ..Default::default() };
+        let rom = &self.rom;
+        let s = interruptible(py, || flexrom::pipeline::sweep::sweep(rom, &mus, o))?;
+        let measure = rom.tolerance_measure();
+        let runs: Vec<(Parameters, Option<f64>)> = s
+            .scales
+            .iter()
+            .filter_map(|x| x.point().map(|p| (x.mu.clone(), p.estimate.map(|e| e.in_measure(measure)))))
+            .collect();
+        let mut warnings = self.run_warnings(&runs)?;
+        let mut outside: Vec<String> = mus.iter().flat_map(|mu| rom.untrained_parameters(mu)).collect();
+        outside.dedup();
+        warnings.extend(outside);
+        warn(py, &warnings)?;
+        convert::sweep_dict(py, &s, &mus)
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Basis('{}': {} {} modes)", self.path.display(), self.n_modes(), self.variant())
+    }
+}
+
+impl PyBasis {
+    fn open(
+        path: &Path,
+        pipeline: Option<&Path>,
+        method: Option<EstimateMethod>,
+        no_estimate: bool,
+    ) -> flexrom::Result<(Self, Vec<String>)> {
+        let p = match pipeline {
+            Some(pipeline) => Pipeline::load(pipeline)?,
+            None => pipeline_of_basis(path, flexrom::limits::Limits::from_env_or_defaults())?,
+        };
+        let (stored, rom, warnings) = load_rom(&p, path, method, no_estimate)?;
+        let training_loads = flexrom::io::basis_file::read_training_loads(path)?;
+        let b = PyBasis { pipeline: p, path: path.to_path_buf(), stored, rom: Arc::new(rom), training_loads };
+        Ok((b, warnings))
+    }
+
+    /// The checked parameters of a run, with the file's value for a property not given
+    /// (as `online` reads them); warns of a value far from a property's.
+    fn point(
+        &self,
+        py: Python<'_>,
+        load_scale: Option<f64>,
+        params: Option<&HashMap<String, f64>>,
+    ) -> PyResult<Parameters> {
+        let model = &self.pipeline.model;
+        let mu = parameters(load_scale, params.unwrap_or(&HashMap::new()))?;
+        model.check_parameters(&mu).map_err(to_py)?;
+        model.refuse_load_scale(std::iter::once(mu.scale())).map_err(to_py)?;
+        warn(py, &model.property_warnings([&mu]))?;
+        Ok(model.with_property_values(&mu))
+    }
+
+    /// The command line's warnings about finished runs (extrapolation, estimates above the
+    /// tolerance): `(parameters, estimate in the tolerance's measure)` each.
+    fn run_warnings(&self, runs: &[(Parameters, Option<f64>)]) -> PyResult<Vec<String>> {
+        let Some(trust) = self.rom.trust() else { return Ok(Vec::new()) };
+        flexrom::rom::trust::check_runs(trust, self.rom.estimator().is_some(), runs, false).map_err(to_py)
+    }
+}
+
+fn parse_method(name: &str) -> PyResult<EstimateMethod> {
+    use clap::ValueEnum;
+    EstimateMethod::from_str(name, true).map_err(|_| {
+        let names: Vec<String> = EstimateMethod::value_variants()
+            .iter()
+            .filter_map(|m| m.to_possible_value())
+            .map(|v| v.get_name().to_string())
+            .collect();
+        errors::model_error(&format!("estimate: `{name}` is not a method; one of {}", names.join(", ")))
+    })
+}
+
+/// Trains the pipeline's basis (`flexrom train`) and writes it to `output` (default: the
+/// pipeline's `basis`); returns the basis, loaded.
+#[pyfunction]
+#[pyo3(signature = (pipeline, output = None))]
+fn train(py: Python<'_>, pipeline: PathBuf, output: Option<PathBuf>) -> PyResult<PyBasis> {
+    let p = Pipeline::load(&pipeline).map_err(to_py)?;
+    warn(py, &p.property_warnings())?;
+    let out = output.clone().unwrap_or_else(|| p.basis_path.clone());
+    let summary = interruptible(py, || {
+        let origin = match &output {
+            Some(_) => Origin::Flag("output"),
+            None => Origin::Key { pipeline: &p.path, key: "basis" },
+        };
+        flexrom::pipeline::train::train_to_file(&p, &out, origin, &[])
+    })?;
+    warn(py, &summary.warnings)?;
+    let (b, warnings) = PyBasis::open(&out, Some(&pipeline), None, false).map_err(errors::basis_error)?;
+    warn(py, &warnings)?;
+    Ok(b)
+}
+
+/// Full and reduced runs compared (`flexrom validate --json`): the JSON text of one
+/// record (one point given) or of a list (the pipeline's validation points).
+#[pyfunction]
+#[pyo3(signature = (pipeline, load_scale = None, params = None, basis = None))]
+fn validate_json(
+    py: Python<'_>,
+    pipeline: PathBuf,
+    load_scale: Option<f64>,
+    params: Option<HashMap<String, f64>>,
+    basis: Option<PathBuf>,
+) -> PyResult<String> {
+    let p = Pipeline::load(&pipeline).map_err(to_py)?;
+    let params = params.unwrap_or_default();
+    let one = load_scale.is_some() || !params.is_empty();
+    let points = if one { vec![parameters(load_scale, &params)?] } else { p.validation_points() };
+    if let Some(mu) = points.first() {
+        p.model.check_parameters(mu).map_err(to_py)?;
+    }
+    warn(py, &p.model.property_warnings(&points))?;
+    let points: Vec<Parameters> = points.iter().map(|mu| p.model.with_property_values(mu)).collect();
+    p.model.refuse_load_scale(points.iter().map(|mu| mu.scale())).map_err(to_py)?;
+    let path = basis.unwrap_or_else(|| p.basis_path.clone());
+    let (_, rom, warnings) = py.detach(|| load_rom(&p, &path, None, false)).map_err(errors::basis_error)?;
+    warn(py, &warnings)?;
+    let with_dense = flexrom::pipeline::dense::decide(Default::default(), &p.model).map_err(to_py)?;
+    let vs = interruptible(py, || {
+        points
+            .iter()
+            .map(|mu| flexrom::pipeline::validate::validate(&rom, mu, with_dense).map(|v| v.0))
+            .collect::<flexrom::Result<Vec<_>>>()
+    })?;
+    let text = match vs.as_slice() {
+        [v] if one => serde_json::to_string(v),
+        _ => serde_json::to_string(&vs),
+    };
+    text.map_err(|e| errors::model_error(&format!("cannot write the JSON: {e}")))
+}
+
+#[pymodule]
+fn _flexrom(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // the library's progress and warning lines through Python's `logging` (logger
+    // "flexrom"); a failure here (a logger already set) leaves them off
+    let _ = pyo3_log::try_init();
+    // one OpenBLAS thread, as in the command line: parallel sweeps run a thread per point
+    flexrom::single_threaded_blas();
+    m.add_class::<PyModel>()?;
+    m.add_class::<PyRunResult>()?;
+    m.add_class::<PyBasis>()?;
+    m.add_function(wrap_pyfunction!(train, m)?)?;
+    m.add_function(wrap_pyfunction!(validate_json, m)?)?;
+    errors::add(m)?;
+    m.add("FlexromWarning", m.py().get_type::<FlexromWarning>())?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

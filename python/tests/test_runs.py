@@ -1,0 +1,145 @@
+"""The package's runs against the command line's files: the same computation, so the same
+numbers to the bit (both call the library's one solver with the same inputs)."""
+
+import warnings
+
+import h5py
+import numpy as np
+import pytest
+
+import flexrom
+from conftest import ROOT
+
+PENDULUM = ROOT / "data" / "models" / "pendulum.toml"
+DP_PIPELINE = ROOT / "pipelines" / "double_pendulum.toml"
+
+
+def same(a, b):
+    """Equal to the bit (NaN where NaN), and of the same shape."""
+    a, b = np.asarray(a), np.asarray(b)
+    assert a.shape == b.shape, (a.shape, b.shape)
+    assert np.array_equal(a.view(np.uint64), b.view(np.uint64))
+
+
+def test_simulate_equals_cli_file(cli, tmp_path):
+    """Model.simulate at λ = 1.1 gives the arrays `flexrom simulate --load-scale 1.1` writes."""
+    out = tmp_path / "cli.h5"
+    cli("simulate", PENDULUM, "--load-scale", "1.1", "-o", out)
+    r = flexrom.Model.from_file(PENDULUM).simulate(load_scale=1.1)
+    with h5py.File(out, "r") as f:
+        for name in ["t", "q", "qd", "multipliers"]:
+            same(getattr(r, name), f[name][()])
+        for name, xy in r.probes.items():
+            same(xy, f["probes"][name][()])
+        assert r.labels["dof"] == [s.decode() if isinstance(s, bytes) else s for s in f["labels/dof"][()]]
+        assert f["q"].attrs["units"] == r.units["q"]
+    assert r.load_scale == 1.1 and not r.reduced and r.error_estimate is None
+
+
+def test_to_hdf5_writes_the_cli_layout(cli, tmp_path):
+    """Result.to_hdf5 writes the file `flexrom simulate -o` writes: same datasets, same
+    values, same attributes except the run's wall time."""
+    cli("simulate", PENDULUM, "--load-scale", "0.9", "-o", tmp_path / "cli.h5")
+    r = flexrom.Model.from_file(PENDULUM).simulate(load_scale=0.9)
+    r.to_hdf5(tmp_path / "py.h5")
+    with h5py.File(tmp_path / "cli.h5", "r") as a, h5py.File(tmp_path / "py.h5", "r") as b:
+        names = []
+        a.visit(names.append)
+        other = []
+        b.visit(other.append)
+        assert sorted(names) == sorted(other)
+        for n in names:
+            if isinstance(a[n], h5py.Dataset):
+                x, y = a[n][()], b[n][()]
+                if x.dtype.kind == "f":
+                    same(x, y)
+                else:
+                    assert (x == y).all()
+        skip = {"wall_seconds", "model_path"}
+        assert {k for k in a.attrs} == {k for k in b.attrs}
+        for k in a.attrs:
+            if k not in skip:
+                assert np.all(a.attrs[k] == b.attrs[k]), k
+    # written through a temporary file: nothing else is left in the folder
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cli.h5", "py.h5"]
+
+
+def test_named_parameters_as_keywords(cli, tmp_path):
+    """simulate(E_coupler=6e6) is `--param E_coupler=6e6` (the four-bar with a stiffness
+    parameter, data/models/fourbar_stiffness.toml), over a shortened run."""
+    model = ROOT / "data" / "models" / "fourbar_stiffness.toml"
+    out = tmp_path / "cli.h5"
+    cli("simulate", model, "--param", "E_coupler=6e6", "--t-end", "0.05", "-o", out)
+    r = flexrom.Model.from_file(model).simulate(t_end=0.05, E_coupler=6e6)
+    with h5py.File(out, "r") as f:
+        same(r.q, f["q"][()])
+    assert r.parameters == {"E_coupler": 6e6}
+
+
+def test_online_equals_cli_file(cli, dp_basis, tmp_path):
+    """Basis.online at λ = 1.05 gives the reduced run, its reduced coordinates and its error
+    estimate that `flexrom online --load-scale 1.05` writes with the same basis."""
+    out = tmp_path / "online.h5"
+    cli("online", DP_PIPELINE, "--basis", dp_basis, "--load-scale", "1.05", "-o", out)
+    basis = flexrom.Basis.load(dp_basis, pipeline=DP_PIPELINE)
+    r = basis.online(load_scale=1.05)
+    with h5py.File(out, "r") as f:
+        for name in ["t", "q", "qd", "multipliers"]:
+            same(getattr(r, name), f[name][()])
+        same(r.reduced_q, f["reduced/q"][()])
+        same(r.error_estimate, f.attrs["error_estimate"])
+        assert r.estimate_method == f.attrs["error_estimate_method"]
+        assert bool(f.attrs["extrapolated"]) is r.extrapolated is False
+    assert r.error_estimate_by_time.shape == (5,)
+    assert r.n_modes == basis.n_modes == basis.modes.shape[1]
+    # the basis file alone (its stored pipeline and model) gives the same run
+    same(flexrom.Basis.load(dp_basis).online(load_scale=1.05).q, r.q)
+
+
+def test_basis_contents(dp_basis):
+    """The basis's arrays as /basis/modes, /basis/singular_values and the training loads of
+    greedy training (/training/load_scales) hold them."""
+    b = flexrom.Basis.load(dp_basis)
+    with h5py.File(dp_basis, "r") as f:
+        same(b.modes, f["basis/modes"][()])
+        same(b.singular_values, f["basis/singular_values"][()])
+        same(b.training_loads, f["training/load_scales"][()])
+    assert np.allclose(b.modes.T @ b.modes, np.eye(b.n_modes), atol=1e-10)  # orthonormal columns
+
+
+def test_sweep_equals_online(dp_basis):
+    """Basis.sweep runs each load as online does (independent runs): the probes and
+    estimates at each load equal online's, load axis first."""
+    b = flexrom.Basis.load(dp_basis)
+    loads = [0.6, 1.0, 1.4]
+    s = b.sweep(loads)
+    assert s["load_scale"].tolist() == loads and s["failed"] == [None] * 3
+    for i, x in enumerate(loads):
+        r = b.online(load_scale=x)
+        for name, xy in r.probes.items():
+            same(s["probes"][name][i], xy)
+        same(s["error_estimate"][i], r.error_estimate)
+        same(s["error_estimate_by_time"][i], r.error_estimate_by_time)
+    assert s["probes"]["tip"].shape == (3, len(s["t"]), 2)
+
+
+def test_outside_the_training_range_warns(dp_basis):
+    """A load outside the trained range [0.5, 1.5] is marked extrapolated and warns."""
+    b = flexrom.Basis.load(dp_basis)
+    with pytest.warns(flexrom.FlexromWarning, match="outside"):
+        r = b.online(load_scale=1.7)
+    assert r.extrapolated
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert not b.online(load_scale=1.2).extrapolated
+
+
+def test_validate_as_cli_json(cli, dp_basis):
+    """flexrom.validate returns the record `flexrom validate --json` prints (all but times)."""
+    import json
+
+    p = cli("validate", DP_PIPELINE, "--basis", dp_basis, "--load-scale", "0.8", "--json", "--no-dense")
+    want = json.loads(p.stdout)
+    got = flexrom.validate(DP_PIPELINE, load_scale=0.8, basis=dp_basis)
+    for key in ["rel_error", "error_estimate", "max_probe_error", "n_modes", "load_scale"]:
+        assert got[key] == want[key], key
