@@ -1,13 +1,16 @@
 # Type stubs of the native module (python/src/lib.rs). Arrays are float64 numpy arrays in
 # the layout of flexrom's HDF5 files: time first.
 from os import PathLike
-from typing import Any, Dict, List, Optional, Sequence, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
 
 _Path = Union[str, PathLike[str]]
 _F = npt.NDArray[np.float64]
+# None or False: no progress; True: a text bar on stderr; a callable: called as
+# callback(label, done, total) on the calling thread as items finish
+_Progress = Union[None, bool, Callable[[str, int, int], Any]]
 
 __version__: str
 
@@ -22,6 +25,8 @@ class Model:
     def from_file(path: _Path) -> Model: ...
     @staticmethod
     def from_toml(text: str, path: Optional[_Path] = None) -> Model: ...
+    @staticmethod
+    def from_dict(model: Dict[str, Any], path: Optional[_Path] = None) -> Model: ...
     @property
     def path(self) -> str: ...
     @property
@@ -63,6 +68,10 @@ class Result:
     def labels(self) -> Dict[str, List[str]]: ...
     @property
     def units(self) -> Dict[str, str]: ...
+    @property
+    def model_path(self) -> str: ...
+    @property
+    def basis_path(self) -> Optional[str]: ...
     @property
     def load_scale(self) -> float: ...
     @property
@@ -121,12 +130,15 @@ class Basis:
         load_scales: Optional[Sequence[float]] = None,
         points: Optional[Sequence[Dict[str, float]]] = None,
         continuation: bool = False,
+        progress: _Progress = None,
     ) -> Dict[str, Any]: ...
 
-def train(pipeline: _Path, output: Optional[_Path] = None) -> Basis: ...
+def train(pipeline: _Path, output: Optional[_Path] = None, progress: _Progress = None) -> Basis: ...
 def validate_json(
     pipeline: _Path,
     load_scale: Optional[float] = None,
     params: Optional[Dict[str, float]] = None,
     basis: Optional[_Path] = None,
+    estimate: Optional[str] = None,
+    dense: Optional[bool] = None,
 ) -> str: ...

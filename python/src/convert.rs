@@ -68,7 +68,7 @@ pub fn warn(py: Python<'_>, lines: &[String]) -> PyResult<()> {
 pub fn sweep_dict<'py>(py: Python<'py>, s: &Sweep, points: &[Parameters]) -> PyResult<Bound<'py, PyDict>> {
     let (n, n_t) = (s.scales.len(), s.t.len());
     let d = PyDict::new(py);
-    d.set_item("load_scale", points.iter().map(|mu| mu.scale()).collect::<Vec<_>>().into_pyarray(py))?;
+    d.set_item("load_scales", points.iter().map(|mu| mu.scale()).collect::<Vec<_>>().into_pyarray(py))?;
     let named = PyDict::new(py);
     for name in
         points.iter().flat_map(|mu| mu.named().map(|(k, _)| k.to_string())).collect::<std::collections::BTreeSet<_>>()

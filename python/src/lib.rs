@@ -37,12 +37,84 @@ const SIGNAL_POLL: Duration = Duration::from_millis(50);
 
 /// Runs `work` on a thread of its own without the GIL, answering Ctrl-C (see the module).
 fn interruptible<T: Send>(py: Python<'_>, work: impl FnOnce() -> flexrom::Result<T> + Send) -> PyResult<T> {
+    interruptible_with(py, None, work)
+}
+
+/// One computing call at a time in the process: the stop request ([`flexrom::interrupt`])
+/// and the progress count ([`flexrom::output::ticker::latest`]) are the process's, so two
+/// Python threads calling flexrom take turns (each call still uses every core inside).
+static BUSY: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// The turn of one call ([`BUSY`] held until dropped).
+struct Turn;
+
+thread_local! {
+    /// This thread holds the turn (a progress callback calling flexrom again would wait for
+    /// itself).
+    static HOLDS_TURN: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+impl Turn {
+    /// Waits, without the GIL, until no other call computes.
+    fn take(py: Python<'_>) -> PyResult<Turn> {
+        use std::sync::atomic::Ordering;
+        if HOLDS_TURN.get() {
+            return Err(pyo3::exceptions::PyRuntimeError::new_err(
+                "flexrom cannot be called from inside a progress callback of flexrom",
+            ));
+        }
+        while BUSY.compare_exchange(false, true, Ordering::Acquire, Ordering::Relaxed).is_err() {
+            py.detach(|| std::thread::sleep(Duration::from_millis(5)));
+        }
+        HOLDS_TURN.set(true);
+        Ok(Turn)
+    }
+}
+
+impl Drop for Turn {
+    fn drop(&mut self) {
+        HOLDS_TURN.set(false);
+        BUSY.store(false, std::sync::atomic::Ordering::Release);
+    }
+}
+
+/// The worker's stack: the command line's main thread has 8 MiB.
+const WORKER_STACK: usize = 8 << 20;
+
+/// [`interruptible`], calling `progress(label, done, total)` on the calling thread whenever
+/// the library's count of finished items ([`flexrom::output::ticker::latest`]) moved (looked
+/// at every [`SIGNAL_POLL`]). An exception in the callback stops the work as Ctrl-C does
+/// and is raised.
+fn interruptible_with<T: Send>(
+    py: Python<'_>,
+    progress: Option<&Bound<'_, PyAny>>,
+    work: impl FnOnce() -> flexrom::Result<T> + Send,
+) -> PyResult<T> {
+    let _turn = Turn::take(py)?;
     flexrom::interrupt::clear();
+    flexrom::output::ticker::forget();
+    // `logging` configured since the last call applies to this one
+    if let Some(h) = LOG_RESET.get() {
+        h.reset();
+    }
+    let mut shown: Option<flexrom::output::ticker::Progress> = None;
+    let mut tell = || -> PyResult<()> {
+        let Some(cb) = progress else { return Ok(()) };
+        let now = flexrom::output::ticker::latest();
+        if now != shown {
+            if let Some(p) = &now {
+                cb.call1((p.label.as_str(), p.done, p.total))?;
+            }
+            shown = now;
+        }
+        Ok(())
+    };
     let (done_tx, done_rx) = std::sync::mpsc::channel::<()>();
-    let mut interrupted: Option<PyErr> = None;
-    let out = std::thread::scope(|s| {
+    let mut stopped: Option<PyErr> = None;
+    let joined = std::thread::scope(|s| {
         let worker = std::thread::Builder::new()
             .name("flexrom-work".into())
+            .stack_size(WORKER_STACK)
             .spawn_scoped(s, move || {
                 let out = work();
                 let _ = done_tx.send(());
@@ -57,23 +129,50 @@ fn interruptible<T: Send>(py: Python<'_>, work: impl FnOnce() -> flexrom::Result
                 (done_rx, waited)
             });
             done_rx = rx;
+            // done, or the worker ended without sending (a panic)
             if !matches!(waited, Err(std::sync::mpsc::RecvTimeoutError::Timeout)) {
                 break;
             }
-            if interrupted.is_none() {
-                if let Err(e) = py.check_signals() {
+            if stopped.is_none() {
+                if let Err(e) = py.check_signals().and_then(|_| tell()) {
                     flexrom::interrupt::request();
-                    interrupted = Some(e);
+                    stopped = Some(e);
                 }
             }
         }
-        worker.join().map_err(|_| pyo3::exceptions::PyRuntimeError::new_err("flexrom: the computation panicked"))
-    })?;
+        PyResult::Ok(worker.join())
+    });
     flexrom::interrupt::clear();
-    match (interrupted, out) {
-        (Some(e), _) => Err(e),
-        (None, out) => out.map_err(to_py),
+    let out = match joined? {
+        Ok(out) => out,
+        Err(_) => return Err(pyo3::exceptions::PyRuntimeError::new_err("flexrom: the computation panicked")),
+    };
+    if let Some(e) = stopped {
+        return Err(e);
     }
+    let out = out.map_err(to_py)?;
+    // the last count (the work may end between two looks)
+    tell()?;
+    Ok(out)
+}
+
+/// Resets pyo3-log's cache of Python loggers and levels.
+static LOG_RESET: std::sync::OnceLock<pyo3_log::ResetHandle> = std::sync::OnceLock::new();
+
+/// The progress callback a call's `progress` argument asks for: None or False, none; True,
+/// a text bar on stderr (`flexrom._support.TextBar`); a callable, itself.
+fn progress_callback<'py>(py: Python<'py>, progress: Option<Bound<'py, PyAny>>) -> PyResult<Option<Bound<'py, PyAny>>> {
+    let Some(p) = progress else { return Ok(None) };
+    if p.is_none() {
+        return Ok(None);
+    }
+    if let Ok(on) = p.extract::<bool>() {
+        return if on { Ok(Some(py.import("flexrom._support")?.getattr("TextBar")?.call0()?)) } else { Ok(None) };
+    }
+    if !p.is_callable() {
+        return Err(errors::model_error("progress: give True, False, None or a callable(label, done, total)"));
+    }
+    Ok(Some(p))
 }
 
 /// A model file: the system of bodies, joints and loads, run by [`PyModel::simulate`].
@@ -96,6 +195,22 @@ impl PyModel {
     fn from_toml(text: &str, path: Option<PathBuf>) -> PyResult<Self> {
         let path = path.unwrap_or_else(|| PathBuf::from("<string>"));
         Ok(PyModel { model: Arc::new(Model::from_text(text, &path).map_err(to_py)?) })
+    }
+
+    /// A model from a dict of the model file's tables and keys (as `tomllib.load` gives
+    /// them); written out as TOML, so messages quote that text's lines.
+    #[staticmethod]
+    #[pyo3(signature = (model, path = None))]
+    fn from_dict(py: Python<'_>, model: &Bound<'_, PyDict>, path: Option<PathBuf>) -> PyResult<Self> {
+        // numpy numbers and arrays as plain ones
+        let kw = PyDict::new(py);
+        kw.set_item("default", py.import("flexrom._support")?.getattr("plain")?)?;
+        let json: String = py.import("json")?.call_method("dumps", (model,), Some(&kw))?.extract()?;
+        let value: serde_json::Value =
+            serde_json::from_str(&json).map_err(|e| errors::model_error(&format!("model dict: {e}")))?;
+        let text = toml::to_string(&value)
+            .map_err(|e| errors::model_error(&format!("model dict: cannot be written as TOML: {e}")))?;
+        Self::from_toml(&text, Some(path.unwrap_or_else(|| PathBuf::from("<dict>"))))
     }
 
     #[getter]
@@ -173,6 +288,10 @@ struct ReducedPart {
     /// r × n_t
     reduced_q: ndarray::Array2<f64>,
     basis_name: String,
+    /// the basis file and the pipeline file it was checked against (none: the one the
+    /// basis stores), which a result must never be written over
+    basis_path: PathBuf,
+    pipeline_path: Option<PathBuf>,
     variant: &'static str,
     n_modes: usize,
     estimate: Option<Estimate>,
@@ -265,6 +384,18 @@ impl PyRunResult {
         Ok(d)
     }
 
+    /// the model file the run is of (as the result file's `model_path`)
+    #[getter]
+    fn model_path(&self) -> String {
+        self.r.model_path.clone()
+    }
+
+    /// the basis file of a reduced run (None for a full run)
+    #[getter]
+    fn basis_path(&self) -> Option<String> {
+        self.reduced.as_ref().map(|x| x.basis_name.clone())
+    }
+
     /// the load scale λ of the run
     #[getter]
     fn load_scale(&self) -> f64 {
@@ -344,7 +475,14 @@ impl PyRunResult {
     /// writes, to a temporary file renamed into place; refuses a path that is the model
     /// file, or not a regular file.
     fn to_hdf5(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
-        check_output(&path, Origin::Flag("path"), &[(&self.model.path, "model file")]).map_err(to_py)?;
+        let mut inputs: Vec<(&Path, &str)> = vec![(&self.model.path, "model file")];
+        if let Some(x) = &self.reduced {
+            inputs.push((&x.basis_path, "basis file"));
+            if let Some(p) = &x.pipeline_path {
+                inputs.push((p, "pipeline file"));
+            }
+        }
+        check_output(&path, Origin::Flag("path"), &inputs).map_err(to_py)?;
         py.detach(|| self.write(&path)).map_err(to_py)
     }
 
@@ -389,6 +527,8 @@ mod hdf5_error {
 #[pyclass(name = "Basis", module = "flexrom._flexrom", frozen)]
 struct PyBasis {
     pipeline: Pipeline,
+    /// the pipeline file given to `load` (none: the pipeline the basis file stores)
+    pipeline_file: Option<PathBuf>,
     path: PathBuf,
     stored: flexrom::io::basis_file::StoredBasis,
     rom: Arc<Rom>,
@@ -411,7 +551,12 @@ impl PyBasis {
         no_estimate: bool,
     ) -> PyResult<Self> {
         let method = estimate.map(parse_method).transpose()?;
-        let b = py.detach(|| Self::open(&path, pipeline.as_deref(), method, no_estimate));
+        // a pipeline file that is wrong is the pipeline's error, not the basis's
+        let p = match &pipeline {
+            Some(file) => Some(py.detach(|| Pipeline::load(file)).map_err(to_py)?),
+            None => None,
+        };
+        let b = py.detach(|| Self::open(&path, p, pipeline.clone(), method, no_estimate));
         let (b, warnings) = b.map_err(errors::basis_error)?;
         warn(py, &warnings)?;
         Ok(b)
@@ -500,6 +645,8 @@ impl PyBasis {
         let reduced = ReducedPart {
             reduced_q: run.reduced_q,
             basis_name: flexrom::io::output::resolve(&self.path).display().to_string(),
+            basis_path: self.path.clone(),
+            pipeline_path: self.pipeline_file.clone(),
             variant: basis.variant.name(),
             n_modes: basis.n_reduced(),
             estimate,
@@ -515,14 +662,16 @@ impl PyBasis {
     /// load axis first (`load_scale`, `t`, `probes` name → (n, n_t, 2), `error_estimate`,
     /// `error_estimate_by_time` (n, 5), `extrapolated`, `failed`: each point's error
     /// message or None). `points`: a list of dicts of named parameters instead.
-    #[pyo3(signature = (load_scales = None, points = None, continuation = false))]
+    #[pyo3(signature = (load_scales = None, points = None, continuation = false, progress = None))]
     fn sweep<'py>(
         &self,
         py: Python<'py>,
         load_scales: Option<Vec<f64>>,
         points: Option<Vec<HashMap<String, f64>>>,
         continuation: bool,
+        progress: Option<Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        let progress = progress_callback(py, progress)?;
         let mus: Vec<Parameters> = match (load_scales, points) {
             (Some(s), None) => s.into_iter().map(|x| self.point(py, Some(x), None)).collect::<PyResult<_>>()?,
             (None, Some(p)) => p.iter().map(|p| self.point(py, None, Some(p))).collect::<PyResult<_>>()?,
@@ -530,7 +679,7 @@ impl PyBasis {
         };
         let o = flexrom::pipeline::sweep::SweepOptions { continuation, ..Default::default() };
         let rom = &self.rom;
-        let s = interruptible(py, || flexrom::pipeline::sweep::sweep(rom, &mus, o))?;
+        let s = interruptible_with(py, progress.as_ref(), || flexrom::pipeline::sweep::sweep(rom, &mus, o))?;
         let measure = rom.tolerance_measure();
         let runs: Vec<(Parameters, Option<f64>)> = s
             .scales
@@ -551,19 +700,23 @@ impl PyBasis {
 }
 
 impl PyBasis {
+    /// The basis at `path` checked against the pipeline `p` (loaded from `pipeline_file`),
+    /// or, without one, against the pipeline and model the basis file stores.
     fn open(
         path: &Path,
-        pipeline: Option<&Path>,
+        p: Option<Pipeline>,
+        pipeline_file: Option<PathBuf>,
         method: Option<EstimateMethod>,
         no_estimate: bool,
     ) -> flexrom::Result<(Self, Vec<String>)> {
-        let p = match pipeline {
-            Some(pipeline) => Pipeline::load(pipeline)?,
+        let p = match p {
+            Some(p) => p,
             None => pipeline_of_basis(path, flexrom::limits::Limits::from_env_or_defaults())?,
         };
         let (stored, rom, warnings) = load_rom(&p, path, method, no_estimate)?;
         let training_loads = flexrom::io::basis_file::read_training_loads(path)?;
-        let b = PyBasis { pipeline: p, path: path.to_path_buf(), stored, rom: Arc::new(rom), training_loads };
+        let rom = Arc::new(rom);
+        let b = PyBasis { pipeline: p, pipeline_file, path: path.to_path_buf(), stored, rom, training_loads };
         Ok((b, warnings))
     }
 
@@ -606,12 +759,18 @@ fn parse_method(name: &str) -> PyResult<EstimateMethod> {
 /// Trains the pipeline's basis (`flexrom train`) and writes it to `output` (default: the
 /// pipeline's `basis`); returns the basis, loaded.
 #[pyfunction]
-#[pyo3(signature = (pipeline, output = None))]
-fn train(py: Python<'_>, pipeline: PathBuf, output: Option<PathBuf>) -> PyResult<PyBasis> {
+#[pyo3(signature = (pipeline, output = None, progress = None))]
+fn train<'py>(
+    py: Python<'py>,
+    pipeline: PathBuf,
+    output: Option<PathBuf>,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<PyBasis> {
+    let progress = progress_callback(py, progress)?;
     let p = Pipeline::load(&pipeline).map_err(to_py)?;
     warn(py, &p.property_warnings())?;
     let out = output.clone().unwrap_or_else(|| p.basis_path.clone());
-    let summary = interruptible(py, || {
+    let summary = interruptible_with(py, progress.as_ref(), || {
         let origin = match &output {
             Some(_) => Origin::Flag("output"),
             None => Origin::Key { pipeline: &p.path, key: "basis" },
@@ -619,26 +778,42 @@ fn train(py: Python<'_>, pipeline: PathBuf, output: Option<PathBuf>) -> PyResult
         flexrom::pipeline::train::train_to_file(&p, &out, origin, &[])
     })?;
     warn(py, &summary.warnings)?;
-    let (b, warnings) = PyBasis::open(&out, Some(&pipeline), None, false).map_err(errors::basis_error)?;
+    let (b, warnings) =
+        py.detach(|| PyBasis::open(&out, Some(p), Some(pipeline), None, false)).map_err(errors::basis_error)?;
     warn(py, &warnings)?;
     Ok(b)
 }
 
-/// Full and reduced runs compared (`flexrom validate --json`): the JSON text of one
-/// record (one point given) or of a list (the pipeline's validation points).
+/// Full and reduced runs compared (`flexrom validate --json`): the JSON text the command
+/// prints, its points chosen as the command chooses them (one record where a load scale or
+/// a named parameter is given and names one point, else a list: the pipeline's validation
+/// points, or the named values at each of its `[validate]` loads). `dense`: None as the
+/// command's default (skipped above 256 MiB), True `--dense`, False `--no-dense`.
 #[pyfunction]
-#[pyo3(signature = (pipeline, load_scale = None, params = None, basis = None))]
+#[pyo3(signature = (pipeline, load_scale = None, params = None, basis = None, estimate = None, dense = None))]
 fn validate_json(
     py: Python<'_>,
     pipeline: PathBuf,
     load_scale: Option<f64>,
     params: Option<HashMap<String, f64>>,
     basis: Option<PathBuf>,
+    estimate: Option<&str>,
+    dense: Option<bool>,
 ) -> PyResult<String> {
-    let p = Pipeline::load(&pipeline).map_err(to_py)?;
+    use flexrom::pipeline::dense::DenseChoice;
+    let method = estimate.map(parse_method).transpose()?;
+    let p = py.detach(|| Pipeline::load(&pipeline)).map_err(to_py)?;
     let params = params.unwrap_or_default();
-    let one = load_scale.is_some() || !params.is_empty();
-    let points = if one { vec![parameters(load_scale, &params)?] } else { p.validation_points() };
+    let named = !params.is_empty();
+    let sets_load_scale = params.contains_key(flexrom::solver::parameters::LOAD_SCALE);
+    let points: Vec<Parameters> = match (load_scale, named) {
+        (Some(_), _) => vec![parameters(load_scale, &params)?],
+        (None, false) => p.validation_points(),
+        (None, true) if !p.space().is_empty() || sets_load_scale => vec![parameters(None, &params)?],
+        (None, true) => {
+            p.validate_scales().into_iter().map(|x| parameters(Some(x), &params)).collect::<PyResult<_>>()?
+        }
+    };
     if let Some(mu) = points.first() {
         p.model.check_parameters(mu).map_err(to_py)?;
     }
@@ -646,17 +821,34 @@ fn validate_json(
     let points: Vec<Parameters> = points.iter().map(|mu| p.model.with_property_values(mu)).collect();
     p.model.refuse_load_scale(points.iter().map(|mu| mu.scale())).map_err(to_py)?;
     let path = basis.unwrap_or_else(|| p.basis_path.clone());
-    let (_, rom, warnings) = py.detach(|| load_rom(&p, &path, None, false)).map_err(errors::basis_error)?;
+    let (_, rom, warnings) = py.detach(|| load_rom(&p, &path, method, false)).map_err(errors::basis_error)?;
     warn(py, &warnings)?;
-    let with_dense = flexrom::pipeline::dense::decide(Default::default(), &p.model).map_err(to_py)?;
+    let choice = match dense {
+        None => DenseChoice::Auto,
+        Some(true) => DenseChoice::Always,
+        Some(false) => DenseChoice::Never,
+    };
+    let with_dense = flexrom::pipeline::dense::decide(choice, &p.model).map_err(to_py)?;
     let vs = interruptible(py, || {
         points
             .iter()
             .map(|mu| flexrom::pipeline::validate::validate(&rom, mu, with_dense).map(|v| v.0))
             .collect::<flexrom::Result<Vec<_>>>()
     })?;
+    // the command's warnings after its runs: estimates over the tolerance, extrapolation,
+    // parameters the basis was not trained over
+    let measure = rom.tolerance_measure();
+    if let Some(trust) = rom.trust() {
+        let runs: Vec<(Parameters, Option<f64>)> =
+            points.iter().cloned().zip(vs.iter().map(|v| v.estimate_in(measure))).collect();
+        let lines = flexrom::rom::trust::check_runs(trust, rom.estimator().is_some(), &runs, false).map_err(to_py)?;
+        warn(py, &lines)?;
+    }
+    let mut outside: Vec<String> = points.iter().flat_map(|mu| rom.untrained_parameters(mu)).collect();
+    outside.dedup();
+    warn(py, &outside)?;
     let text = match vs.as_slice() {
-        [v] if one => serde_json::to_string(v),
+        [v] if load_scale.is_some() || named => serde_json::to_string(v),
         _ => serde_json::to_string(&vs),
     };
     text.map_err(|e| errors::model_error(&format!("cannot write the JSON: {e}")))
@@ -666,7 +858,9 @@ fn validate_json(
 fn _flexrom(m: &Bound<'_, PyModule>) -> PyResult<()> {
     // the library's progress and warning lines through Python's `logging` (logger
     // "flexrom"); a failure here (a logger already set) leaves them off
-    let _ = pyo3_log::try_init();
+    if let Ok(h) = pyo3_log::try_init() {
+        let _ = LOG_RESET.set(h);
+    }
     // one OpenBLAS thread, as in the command line: parallel sweeps run a thread per point
     flexrom::single_threaded_blas();
     m.add_class::<PyModel>()?;

@@ -41,6 +41,9 @@ def test_basis_of_another_model(dp_basis, tmp_path):
         flexrom.Basis.load(dp_basis, pipeline=ROOT / "pipelines" / "pendulum.toml")
     with pytest.raises(flexrom.BasisMismatchError, match="does not exist"):
         flexrom.Basis.load(tmp_path / "none.h5")
+    # a pipeline file that is wrong is the pipeline's error, not the basis's
+    with pytest.raises(flexrom.ModelError, match="missing.toml"):
+        flexrom.Basis.load(dp_basis, pipeline=tmp_path / "missing.toml")
     junk = tmp_path / "junk.h5"
     junk.write_text("not HDF5")
     with pytest.raises(flexrom.BasisMismatchError, match="junk.h5"):

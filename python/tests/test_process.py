@@ -104,6 +104,9 @@ def test_ctrl_c_stops_training_and_leaves_no_file(tmp_path):
         flexrom.train("pipelines/fourbar.toml", output={str(out / "fourbar.h5")!r})
     except KeyboardInterrupt:
         print("interrupted", time.perf_counter(), flush=True)
+    # the stop does not outlive the call
+    r = flexrom.Model.from_file("data/models/pendulum.toml").simulate(t_end=0.02)
+    print("after", r.stats["steps"], flush=True)
     """
     p = subprocess.Popen(
         [sys.executable, "-c", textwrap.dedent(code)], cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
@@ -119,6 +122,7 @@ def test_ctrl_c_stops_training_and_leaves_no_file(tmp_path):
     # perf_counter is CLOCK_MONOTONIC: comparable across the two processes
     assert float(words[1]) - sent < 0.5, float(words[1]) - sent  # measured 14-63 ms
     assert list(out.iterdir()) == []
+    assert words[2] == "after" and int(words[3]) > 0, stdout
 
 
 def test_file_held_by_h5py_is_named_as_locked(dp_basis, tmp_path):

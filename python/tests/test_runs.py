@@ -26,6 +26,7 @@ def test_simulate_equals_cli_file(cli, tmp_path):
     out = tmp_path / "cli.h5"
     cli("simulate", PENDULUM, "--load-scale", "1.1", "-o", out)
     r = flexrom.Model.from_file(PENDULUM).simulate(load_scale=1.1)
+    assert r.probes, "the pendulum has a tip probe"
     with h5py.File(out, "r") as f:
         for name in ["t", "q", "qd", "multipliers"]:
             same(getattr(r, name), f[name][()])
@@ -113,7 +114,7 @@ def test_sweep_equals_online(dp_basis):
     b = flexrom.Basis.load(dp_basis)
     loads = [0.6, 1.0, 1.4]
     s = b.sweep(loads)
-    assert s["load_scale"].tolist() == loads and s["failed"] == [None] * 3
+    assert s["load_scales"].tolist() == loads and s["failed"] == [None] * 3 and s["parameters"] == {}
     for i, x in enumerate(loads):
         r = b.online(load_scale=x)
         for name, xy in r.probes.items():
@@ -121,6 +122,10 @@ def test_sweep_equals_online(dp_basis):
         same(s["error_estimate"][i], r.error_estimate)
         same(s["error_estimate_by_time"][i], r.error_estimate_by_time)
     assert s["probes"]["tip"].shape == (3, len(s["t"]), 2)
+    # the same points given as dicts of parameters
+    p = b.sweep(points=[{"load_scale": x} for x in loads])
+    same(p["probes"]["tip"], s["probes"]["tip"])
+    same(p["error_estimate"], s["error_estimate"])
 
 
 def test_outside_the_training_range_warns(dp_basis):
@@ -143,3 +148,75 @@ def test_validate_as_cli_json(cli, dp_basis):
     got = flexrom.validate(DP_PIPELINE, load_scale=0.8, basis=dp_basis)
     for key in ["rel_error", "error_estimate", "max_probe_error", "n_modes", "load_scale"]:
         assert got[key] == want[key], key
+    # no point given: the pipeline's [validate] loads, a list as the command prints
+    p = cli("validate", DP_PIPELINE, "--basis", dp_basis, "--json", "--no-dense")
+    want = json.loads(p.stdout)
+    got = flexrom.validate(DP_PIPELINE, basis=dp_basis, dense=False)
+    assert [v["load_scale"] for v in got] == [v["load_scale"] for v in want] == [0.8, 1.3]
+    assert [v["rel_error"] for v in got] == [v["rel_error"] for v in want]
+
+
+def test_progress_callback_counts_every_run(dp_basis):
+    """progress=callback is called on the calling thread with the sweep's count, ending at
+    every load done; an exception in it stops the sweep and is raised."""
+    import threading
+
+    b = flexrom.Basis.load(dp_basis)
+    loads = [0.6 + 0.01 * i for i in range(40)]
+    seen = []
+    main = threading.get_ident()
+    b.sweep(loads, progress=lambda label, done, total: seen.append((done, total, threading.get_ident())))
+    assert seen and seen[-1][:2] == (40, 40), seen[-3:]
+    assert all(t == main for _, _, t in seen)
+    assert [d for d, _, _ in seen] == sorted(d for d, _, _ in seen)
+
+    calls = []
+
+    def refuse(label, done, total):
+        calls.append(done)
+        raise RuntimeError("enough")
+
+    with pytest.raises(RuntimeError, match="enough"):
+        b.sweep(loads, progress=refuse)
+    # raised at its first call, which stopped the sweep: no call at the end
+    assert len(calls) == 1 and calls[0] < 40, calls
+    with pytest.raises(flexrom.ModelError, match="progress"):
+        b.sweep([1.0], progress="yes")
+    # the stop does not outlive the call
+    assert b.sweep(loads[:4])["failed"] == [None] * 4
+
+
+def test_model_from_dict_is_the_file():
+    """A model given as the dict tomllib reads from the file runs as the file does, numpy
+    numbers in it too."""
+    tomllib = pytest.importorskip("tomllib")  # Python >= 3.11
+
+    d = tomllib.loads(PENDULUM.read_text())
+    a = flexrom.Model.from_dict(d).simulate(load_scale=1.1, t_end=0.05)
+    b = flexrom.Model.from_file(PENDULUM).simulate(load_scale=1.1, t_end=0.05)
+    same(a.q, b.q)
+    d["bodies"][0]["length"] = np.float64(d["bodies"][0]["length"])
+    same(flexrom.Model.from_dict(d).simulate(load_scale=1.1, t_end=0.05).q, b.q)
+    d["bodies"][0]["length"] = -1.0
+    with pytest.raises(flexrom.ModelError, match=r"bodies\[0\]\.length"):
+        flexrom.Model.from_dict(d)
+
+
+def test_reduced_to_hdf5_is_the_online_file(cli, dp_basis, tmp_path):
+    """A reduced Result written with to_hdf5 holds what `flexrom online -o` writes (reduced
+    coordinates, estimate attributes); the basis and pipeline files are refused as paths."""
+    out = tmp_path / "cli.h5"
+    cli("online", DP_PIPELINE, "--basis", dp_basis, "--load-scale", "0.9", "-o", out)
+    r = flexrom.Basis.load(dp_basis, pipeline=DP_PIPELINE).online(load_scale=0.9)
+    r.to_hdf5(tmp_path / "py.h5")
+    with h5py.File(out, "r") as a, h5py.File(tmp_path / "py.h5", "r") as b:
+        for name in ["q", "reduced/q", "multipliers"]:
+            same(a[name][()], b[name][()])
+        for k in ["error_estimate", "error_estimate_method", "extrapolated", "n_modes", "variant", "basis"]:
+            assert np.all(a.attrs[k] == b.attrs[k]), k
+    before = dp_basis.read_bytes()
+    with pytest.raises(flexrom.ModelError, match="basis file"):
+        r.to_hdf5(dp_basis)
+    with pytest.raises(flexrom.ModelError, match="pipeline file"):
+        r.to_hdf5(DP_PIPELINE)
+    assert dp_basis.read_bytes() == before

@@ -199,10 +199,17 @@ pub fn write_basis_with(
     })
 }
 
-/// The load scales of the full runs a basis file's snapshots come from, in run order
-/// (`/snapshot_load_scale`, each run's once).
+/// The load scales of the full runs a basis file's snapshots come from, in run order:
+/// greedy training's `/training/load_scales`, else `/snapshot_load_scale` with each run's
+/// once (a run's snapshots are contiguous; two runs in a row at one load scale, as a
+/// `[parameters]` box at a fixed λ has, read as one).
 pub fn read_training_loads(path: &Path) -> Result<Vec<f64>> {
-    let f = hdf5::File::open(path).map_err(|e| Error::hdf5(path, e))?;
+    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", super::h5::unreadable(&e)))?;
+    if let Ok(d) = f.dataset("training/load_scales") {
+        return d
+            .read_raw::<f64>()
+            .map_err(|e| Error::input(path, "training/load_scales", format!("cannot be read: {e}")));
+    }
     let all: Vec<f64> = f
         .dataset("snapshot_load_scale")
         .and_then(|d| d.read_raw::<f64>())

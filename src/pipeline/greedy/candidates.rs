@@ -73,6 +73,8 @@ pub(super) fn estimate_candidates(
             .progress_chars("=> "),
     );
     bar.set_prefix(label.to_string());
+    // no log lines of its own (the loop says what each iteration did): the count for a host
+    let ticker = crate::output::ticker::Ticker::new(label, cands.len() as u64, false);
     let Ok(rom) = training_rom(model, basis, est, method) else { return vec![FAILED; cands.len()] };
     let Ok(physics) = model.physics() else { return vec![FAILED; cands.len()] };
     let x0 = ndarray::ArrayView1::from(&physics.x0[..]);
@@ -81,6 +83,7 @@ pub(super) fn estimate_candidates(
         .map(|i| {
             let r = candidate_run(&rom, cands, i, measure, x0);
             bar.inc(1);
+            ticker.tick();
             r
         })
         .collect();
