@@ -286,3 +286,18 @@ fn a_closed_or_full_stdout_is_not_a_panic() {
     assert_eq!(code, Some(0), "{err}");
     assert!(!err.contains("panicked"), "{err}");
 }
+
+/// A point is two numbers: a third (`start = [0, 0, 5]`, a 3-D habit) is refused with the
+/// key and its line, not dropped (serde's fixed-size arrays would take the first two).
+#[test]
+fn a_point_with_three_coordinates_is_refused() {
+    let text = pendulum();
+    let start = text.lines().find(|l| l.starts_with("start = ")).expect("the pendulum has a start").to_string();
+    let three = start.replace(']', ", 5.0]");
+    let bad = text.replace(&start, &three);
+    let err = flexrom::model::Model::from_text(&bad, "m.toml").unwrap_err().to_string();
+    let line = bad.lines().position(|l| l == three).unwrap() + 1;
+    assert!(err.contains(&format!("bodies[0].start (line {line})")) && err.contains("invalid length 3"), "{err}");
+    // the two-number form still reads
+    flexrom::model::Model::from_text(&text, "m.toml").unwrap();
+}

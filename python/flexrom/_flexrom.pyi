@@ -133,12 +133,17 @@ class Basis:
         progress: _Progress = None,
     ) -> Dict[str, Any]: ...
 
-def train(pipeline: _Path, output: Optional[_Path] = None, progress: _Progress = None) -> Basis: ...
-def validate_json(
+def train(pipeline: _Path, output: Optional[_Path] = None, progress: _Progress = None) -> Basis:
+    """Trains the pipeline's basis (`flexrom train`) into `output` (default: the pipeline's
+    `basis`) and returns it, loaded."""
+
+def validate(
     pipeline: _Path,
     load_scale: Optional[float] = None,
-    params: Optional[Dict[str, float]] = None,
     basis: Optional[_Path] = None,
     estimate: Optional[str] = None,
     dense: Optional[bool] = None,
-) -> str: ...
+    **params: float,
+) -> Union[Dict[str, Any], List[Dict[str, Any]]]:
+    """Full and reduced runs compared (`flexrom validate --json`): a dict at one point, else
+    a list at the command's points."""

@@ -33,7 +33,11 @@ pub fn named(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Option<HashMap<Stri
     let mut out = HashMap::new();
     for (k, v) in kwargs.iter() {
         let name: String = k.extract()?;
-        let value: f64 = v.extract().map_err(|_| model_error(&format!("parameter `{name}`: `{v}` is not a number")))?;
+        let value: f64 = v.extract().map_err(|_| {
+            pyo3::exceptions::PyTypeError::new_err(format!(
+                "`{name}={v}`: keywords beyond the call's own are the model's named parameters, and a parameter is a number"
+            ))
+        })?;
         out.insert(name, value);
     }
     Ok(Some(out))

@@ -30,9 +30,18 @@ create_exception!(
     "A run outside the training range, an estimate over the tolerance, a value that looks like a factor."
 );
 
+/// The command line's option names in the library's messages, as a Python call names them.
+const OPTION_NAMES: [(&str, &str); 5] =
+    [("--load-scale", "load_scale"), ("--t-end", "t_end"), ("--rho-inf", "rho_inf"), ("--dt", "dt"), ("--param ", "")];
+
 /// The exception of a library error.
 pub fn to_py(e: Error) -> PyErr {
-    let msg = e.to_string();
+    let mut msg = e.to_string();
+    if matches!(root(&e), Error::Usage(_)) {
+        for (option, keyword) in OPTION_NAMES {
+            msg = msg.replace(option, keyword);
+        }
+    }
     match root(&e) {
         Error::Interrupted => pyo3::exceptions::PyKeyboardInterrupt::new_err(msg),
         Error::NewtonFailed { .. } | Error::LinearSolve { .. } | Error::BlowUp { .. } => SolverError::new_err(msg),

@@ -205,7 +205,16 @@ impl PyModel {
         // numpy numbers and arrays as plain ones
         let kw = PyDict::new(py);
         kw.set_item("default", py.import("flexrom._support")?.getattr("plain")?)?;
-        let json: String = py.import("json")?.call_method("dumps", (model,), Some(&kw))?.extract()?;
+        kw.set_item("allow_nan", false)?;
+        let json: String = py
+            .import("json")?
+            .call_method("dumps", (model,), Some(&kw))
+            .map_err(|e| {
+                errors::model_error(&format!(
+                    "model dict: {e} (a value NaN or infinite has no TOML form a model file accepts)"
+                ))
+            })?
+            .extract()?;
         let value: serde_json::Value =
             serde_json::from_str(&json).map_err(|e| errors::model_error(&format!("model dict: {e}")))?;
         let text = toml::to_string(&value)
@@ -483,7 +492,11 @@ impl PyRunResult {
             }
         }
         check_output(&path, Origin::Flag("path"), &inputs).map_err(to_py)?;
-        py.detach(|| self.write(&path)).map_err(to_py)
+        py.detach(|| {
+            flexrom::io::output::check_replaces_own_result(&path)?;
+            self.write(&path)
+        })
+        .map_err(to_py)
     }
 
     fn __repr__(&self) -> String {
@@ -784,23 +797,24 @@ fn train<'py>(
     Ok(b)
 }
 
-/// Full and reduced runs compared (`flexrom validate --json`): the JSON text the command
-/// prints, its points chosen as the command chooses them (one record where a load scale or
+/// Full and reduced runs compared (`flexrom validate --json`): what the command prints, as
+/// Python's `json.loads` reads it (a dict, or a list of dicts), its points chosen as the command chooses them (one record where a load scale or
 /// a named parameter is given and names one point, else a list: the pipeline's validation
 /// points, or the named values at each of its `[validate]` loads). `dense`: None as the
 /// command's default (skipped above 256 MiB), True `--dense`, False `--no-dense`.
 #[pyfunction]
-#[pyo3(signature = (pipeline, load_scale = None, params = None, basis = None, estimate = None, dense = None))]
-fn validate_json(
-    py: Python<'_>,
+#[pyo3(signature = (pipeline, load_scale = None, basis = None, estimate = None, dense = None, **params))]
+fn validate<'py>(
+    py: Python<'py>,
     pipeline: PathBuf,
     load_scale: Option<f64>,
-    params: Option<HashMap<String, f64>>,
     basis: Option<PathBuf>,
     estimate: Option<&str>,
     dense: Option<bool>,
-) -> PyResult<String> {
+    params: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyAny>> {
     use flexrom::pipeline::dense::DenseChoice;
+    let params = convert::named(params)?;
     let method = estimate.map(parse_method).transpose()?;
     let p = py.detach(|| Pipeline::load(&pipeline)).map_err(to_py)?;
     let params = params.unwrap_or_default();
@@ -851,7 +865,8 @@ fn validate_json(
         [v] if load_scale.is_some() || named => serde_json::to_string(v),
         _ => serde_json::to_string(&vs),
     };
-    text.map_err(|e| errors::model_error(&format!("cannot write the JSON: {e}")))
+    let text = text.map_err(|e| errors::model_error(&format!("cannot write the JSON: {e}")))?;
+    py.import("json")?.call_method1("loads", (text,))
 }
 
 #[pymodule]
@@ -867,7 +882,7 @@ fn _flexrom(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyRunResult>()?;
     m.add_class::<PyBasis>()?;
     m.add_function(wrap_pyfunction!(train, m)?)?;
-    m.add_function(wrap_pyfunction!(validate_json, m)?)?;
+    m.add_function(wrap_pyfunction!(validate, m)?)?;
     errors::add(m)?;
     m.add("FlexromWarning", m.py().get_type::<FlexromWarning>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

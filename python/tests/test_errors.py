@@ -29,8 +29,6 @@ def test_unknown_parameter_and_non_number():
     m = flexrom.Model.from_file(PENDULUM)
     with pytest.raises(flexrom.ModelError, match="dirve"):
         m.simulate(dirve=1.1)
-    with pytest.raises(flexrom.ModelError, match="not a number"):
-        m.simulate(drive="fast")
     assert issubclass(flexrom.ModelError, flexrom.FlexromError)
 
 
@@ -70,3 +68,34 @@ def test_output_path_refused_never_overwritten(tmp_path):
     with pytest.raises(flexrom.ModelError):
         r.to_hdf5(tmp_path / "folder")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["folder", "pendulum.toml"]
+
+
+def test_to_hdf5_replaces_only_its_own_results(tmp_path):
+    """An existing file that is not a result flexrom wrote (notes, a TOML file) is refused
+    and left as it was; a result written before is replaced."""
+    r = flexrom.Model.from_file(PENDULUM).simulate(t_end=0.02)
+    notes = tmp_path / "notes.toml"
+    notes.write_text("keep me")
+    with pytest.raises(flexrom.ModelError, match="not a result file flexrom wrote"):
+        r.to_hdf5(notes)
+    assert notes.read_text() == "keep me"
+    r.to_hdf5(tmp_path / "r.h5")
+    flexrom.Model.from_file(PENDULUM).simulate(t_end=0.04).to_hdf5(tmp_path / "r.h5")
+    import h5py
+
+    with h5py.File(tmp_path / "r.h5", "r") as f:
+        assert f["t"].shape[0] == 9  # the second run's 0.04 s / 0.005 s + 1 instants
+
+
+def test_python_names_in_messages():
+    """Messages name the call's keywords, not the command line's options; a keyword that is
+    not a number is a TypeError; a NaN in a model dict is named."""
+    m = flexrom.Model.from_file(PENDULUM)
+    with pytest.raises(flexrom.ModelError) as e:
+        m.simulate(load_scale=float("nan"))
+    assert "load_scale" in str(e.value) and "--" not in str(e.value), str(e.value)
+    with pytest.raises(TypeError, match="drive=fast"):
+        m.simulate(drive="fast")
+    d = {"time": {"t_end": float("nan")}}
+    with pytest.raises(flexrom.ModelError, match="NaN"):
+        flexrom.Model.from_dict(d)

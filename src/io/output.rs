@@ -129,6 +129,29 @@ pub fn check_output(output: &Path, origin: Origin, inputs: &[(&Path, &str)]) -> 
     Ok(())
 }
 
+/// Refuses an existing `path` that is not a result file flexrom wrote (an HDF5 file whose
+/// `flexrom_file` attribute is `result`): the rule of the Python package's `to_hdf5`, whose
+/// results may come from a basis file alone, which cannot name every input to protect (its
+/// model path is relative to where training ran, its pipeline's path is not stored).
+pub fn check_replaces_own_result(path: &Path) -> Result<()> {
+    if std::fs::symlink_metadata(path).is_err() {
+        return Ok(());
+    }
+    let ours = hdf5::File::open(path)
+        .ok()
+        .and_then(|f| super::h5::read_attr_str(&f, "flexrom_file").ok())
+        .is_some_and(|kind| kind == "result");
+    if ours {
+        Ok(())
+    } else {
+        Err(Error::input(
+            path,
+            "path",
+            "exists and is not a result file flexrom wrote; only those are replaced here: remove it or choose another path",
+        ))
+    }
+}
+
 /// The nearest existing ancestor of a missing `path` must be a folder for the missing
 /// ones to be made.
 fn creatable(path: &Path, origin: Origin) -> Result<()> {

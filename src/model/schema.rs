@@ -66,16 +66,33 @@ pub struct DampingSpec {
     pub stiffness: f64,
 }
 
+/// `[x, y]` read as exactly two numbers: serde's fixed-size arrays take the first two of a
+/// longer list and drop the rest (`start = [0, 0, 5]`, a 3-D habit, would lose its `5`
+/// silently).
+pub mod pair {
+    use serde::de::{Deserialize, Deserializer, Error};
+
+    pub fn exactly<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+        let v: Vec<f64> = Vec::deserialize(d)?;
+        <[f64; 2]>::try_from(v.as_slice()).map_err(|_| D::Error::invalid_length(v.len(), &"two numbers, [x, y]"))
+    }
+
+    pub fn optional<'de, D: Deserializer<'de>>(d: D) -> Result<Option<[f64; 2]>, D::Error> {
+        exactly(d).map(Some)
+    }
+}
+
 /// A straight beam: `start` and either `angle` (rad) with `length`, or `end` (then
 /// `length`, if given, must agree with it and is used as the exact length).
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct BodySpec {
     pub name: String,
+    #[serde(deserialize_with = "pair::exactly")]
     pub start: [f64; 2],
     #[serde(default)]
     pub angle: Option<f64>,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "pair::optional")]
     pub end: Option<[f64; 2]>,
     #[serde(default)]
     pub length: Option<f64>,
@@ -163,7 +180,7 @@ pub enum JointSpec {
     GroundPin {
         body: String,
         node: NodeRef,
-        #[serde(default)]
+        #[serde(default, deserialize_with = "pair::optional")]
         point: Option<[f64; 2]>,
     },
     /// two bodies' nodes share their position

@@ -63,6 +63,7 @@ impl<'de> Deserialize<'de> for ParameterSpec {
 #[derive(Clone, Debug, Deserialize, serde::Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ParameterTable {
+    #[serde(deserialize_with = "crate::model::schema::pair::exactly")]
     pub range: [f64; 2],
     #[serde(default)]
     pub scale: Spacing,
