@@ -92,6 +92,7 @@ use crate::reduction::Basis;
 use crate::rom::estimator::norms::rel_error_by_time;
 use crate::rom::estimator::training::{calibrate, CalibrationPoint};
 use crate::rom::estimator::{ByFifth, ErrorMeasure, EstimateMethod, FIFTHS};
+use crate::rom::trust::AMPLIFYING;
 use crate::rom::Rom;
 use crate::simulate::{simulate, Overrides, SimulationResult};
 use crate::solver::model::Parameters;
@@ -438,6 +439,10 @@ fn why_not_converged(tolerance: f64, iterations: &[Iteration], candidates: &Cand
     }
     let sensitive_held_out =
         iterations.iter().filter(|it| it.true_error > tolerance && it.true_score <= tolerance).count();
+    // the full model amplifies changes of the load: above T, and above what a response
+    // proportional to the load moves for the step δ (δ itself) by `AMPLIFYING` (the rule
+    // of the online warning, `rom::trust`); a tolerance below δ meets every linear response
+    let amplifies = s_max > tolerance.max(AMPLIFYING * SENSITIVITY_STEP);
     // every score within T, but neighbours far apart: the loads between them are not certified
     let bound = search::between_candidates(
         &last.estimates,
@@ -455,14 +460,14 @@ fn why_not_converged(tolerance: f64, iterations: &[Iteration], candidates: &Cand
         return format!(
             "every candidate's score is within it, but neighbouring scores differ by up to {ratio:.0}× (from {}), which leaves the loads between them uncertified{}; more candidates (`[train] greedy candidates = N`) resolve an error that varies smoothly with the load, not one that jumps",
             candidates.label_of(at),
-            if s_max > tolerance {
+            if amplifies {
                 format!(" (the full model is sensitive to the load: a 0.1 % change moves its answer by up to {s_max:.1e}, at {at_max})")
             } else {
                 String::new()
             }
         );
     }
-    if s_max > tolerance {
+    if amplifies {
         return format!(
             "the full model is sensitive to the load (a 0.1 % change moves its answer by up to {s_max:.1e} over the run, at {at_max}{}): there the tolerance asks more than the load determines; a looser tolerance, a shorter run (`[time] t_end`) or a narrower range certifies, and `error_estimate_by_time` shows the early part of the run",
             if sensitive_held_out > 0 { format!("; {sensitive_held_out} held-out errors above T were within it") } else { String::new() }
@@ -479,8 +484,32 @@ fn why_not_converged(tolerance: f64, iterations: &[Iteration], candidates: &Cand
             "at {off} of its held-out runs the estimate read outside 1–{MAX_HELD_OUT_OVERESTIMATE}× the true error (the lines above); validate a few loads before trusting the basis"
         );
     }
+    // the last runs left the basis as it was and the worst score nearly so: their snapshots
+    // held little the basis did not (as when the response is proportional to the load)
+    let tail = &iterations[iterations.len().saturating_sub(STALLED_RUNS)..];
+    let (first, last_score) = (tail[0].worst_estimate, tail[tail.len() - 1].worst_estimate);
+    if tail.len() == STALLED_RUNS
+        && tail.iter().all(|it| it.block_modes == tail[0].block_modes)
+        && last_score > STALLED_FALL * first
+    {
+        return format!(
+            "its last {STALLED_RUNS} iterations kept the basis at {} and lowered the worst score only from {first:.2e} to {last_score:.2e}: the full runs added little the basis did not hold (as when the response is proportional to the load), so more runs are unlikely to help; a looser tolerance certifies{}",
+            modes_text(&tail[0].block_modes),
+            if s_max > tolerance {
+                format!(" (a 0.1 % change of the load moves the answer by up to {s_max:.1e}, no more than a response proportional to it: the measure, not the dynamics)")
+            } else {
+                String::new()
+            }
+        );
+    }
     "each full run lowered the worst estimate less than the tolerance needs; raise max_runs (or the tolerance)".into()
 }
+
+/// Iterations in a row with the same modes after which the stop line calls the runs
+/// stalled, and the fraction of the first's worst score the last must still be above (the
+/// runs took off less than half of it).
+const STALLED_RUNS: usize = 3;
+const STALLED_FALL: f64 = 0.5;
 
 /// The true errors of a basis at a held-out point: rel_error (what calibrates the estimator)
 /// and both measures by fifth of the run.
@@ -573,5 +602,18 @@ mod tests {
         assert!(why.contains("differ by up to 50×") && why.contains("λ = 0.5"), "{why}");
         let slow = iteration(vec![1e-3, 2e-2, 1e-3], vec![1e-3; 3], 1.5);
         assert!(why_not_converged(t, &[slow], &loads, &[]).contains("raise max_runs"));
+        // a cantilever whose displacement is proportional to the load, held to 1e-4 in the
+        // displacement measure: its sensitivity is δ = 1e-3 exactly, above T but no
+        // amplification; three runs left 4 modes and took 8 % off the worst score
+        let t = 1e-4;
+        let linear = |worst: f64| iteration(vec![worst, 1e-4, 5e-5], vec![1e-3; 3], 1.2);
+        let why = why_not_converged(t, &[linear(1.83e-4), linear(1.77e-4), linear(1.68e-4)], &loads, &[]);
+        assert!(!why.contains("sensitive to the load") && why.contains("kept the basis at 4 modes"), "{why}");
+        assert!(why.contains("the measure, not the dynamics"), "{why}");
+        // the same with modes growing: not stalled
+        let mut grown = linear(1.68e-4);
+        grown.block_modes = vec![6];
+        let why = why_not_converged(t, &[linear(1.83e-4), linear(1.77e-4), grown], &loads, &[]);
+        assert!(why.contains("raise max_runs"), "{why}");
     }
 }
