@@ -23,7 +23,7 @@ use flexrom::rom::estimator::{Estimate, EstimateMethod};
 use flexrom::rom::{Output, Rom, Trust};
 use flexrom::simulate::{Overrides, SimulationResult};
 use flexrom::solver::parameters::Parameters;
-use numpy::{IntoPyArray, PyArray1, PyArray2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArrayDyn};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::collections::HashMap;
@@ -379,6 +379,27 @@ impl PyRunResult {
         Ok(d)
     }
 
+    /// body name → (n_t, n_nodes, 2): each node's x, y, m, time first (the deformed shape:
+    /// `plt.plot(*nodes["crank"][k].T)` draws the crank at instant k)
+    #[getter]
+    fn nodes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        let n_t = self.r.t.len();
+        let mut row = 0;
+        for body in self.model.bodies() {
+            let n_nodes = body.n_elements + 1;
+            let mut xy = ndarray::Array3::zeros((n_t, n_nodes, 2));
+            for k in 0..n_nodes {
+                for c in 0..2 {
+                    xy.slice_mut(ndarray::s![.., k, c]).assign(&self.r.q.row(row + 4 * k + c));
+                }
+            }
+            row += 4 * n_nodes;
+            d.set_item(&body.name, xy.into_pyarray(py))?;
+        }
+        Ok(d)
+    }
+
     /// dataset → unit, as the result file's `units` attributes
     #[getter]
     fn units<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
@@ -584,6 +605,60 @@ impl PyBasis {
     #[getter]
     fn modes<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         self.stored.basis.modes.clone().into_pyarray(py)
+    }
+
+    /// (n_dof) x_ref: the configuration the modes are taken from (`/basis/reference`)
+    #[getter]
+    fn reference<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.stored.basis.reference.clone().into_pyarray(py)
+    }
+
+    /// Full coordinates from reduced ones, `x = x_ref + V z`: `z` of shape (r) gives (n_dof),
+    /// (n_t, r) gives (n_t, n_dof) (a reduced run's `reduced_q`, time first).
+    fn reconstruct<'py>(&self, py: Python<'py>, z: PyReadonlyArrayDyn<'py, f64>) -> PyResult<Bound<'py, PyAny>> {
+        let b = &self.stored.basis;
+        let z = z.as_array();
+        let r = b.n_reduced();
+        match z.ndim() {
+            1 if z.len() == r => {
+                Ok(b.reconstruct(z.into_dimensionality::<ndarray::Ix1>().expect("1-D")).into_pyarray(py).into_any())
+            }
+            2 if z.shape()[1] == r => {
+                let z = z.into_dimensionality::<ndarray::Ix2>().expect("2-D");
+                let x = z.dot(&b.modes.t()) + &b.reference;
+                Ok(x.into_pyarray(py).into_any())
+            }
+            _ => Err(errors::model_error(&format!(
+                "reconstruct: z has shape {:?}; it must be ({r},) or (n_t, {r})",
+                z.shape()
+            ))),
+        }
+    }
+
+    /// Reduced coordinates of full ones, `z = Vᵀ(x − x_ref)` (least squares where V is not
+    /// orthonormal): `x` of shape (n_dof) or (n_t, n_dof).
+    fn reduce<'py>(&self, py: Python<'py>, x: PyReadonlyArrayDyn<'py, f64>) -> PyResult<Bound<'py, PyAny>> {
+        let b = &self.stored.basis;
+        let x = x.as_array();
+        let n = b.modes.nrows();
+        match x.ndim() {
+            1 if x.len() == n => {
+                Ok(b.reduce(x.into_dimensionality::<ndarray::Ix1>().expect("1-D")).into_pyarray(py).into_any())
+            }
+            2 if x.shape()[1] == n => {
+                let x = x.into_dimensionality::<ndarray::Ix2>().expect("2-D");
+                let rows: Vec<ndarray::Array1<f64>> = x.rows().into_iter().map(|row| b.reduce(row)).collect();
+                let mut z = ndarray::Array2::zeros((rows.len(), b.n_reduced()));
+                for (mut out, row) in z.rows_mut().into_iter().zip(rows) {
+                    out.assign(&row);
+                }
+                Ok(z.into_pyarray(py).into_any())
+            }
+            _ => Err(errors::model_error(&format!(
+                "reduce: x has shape {:?}; it must be ({n},) or (n_t, {n})",
+                x.shape()
+            ))),
+        }
     }
 
     /// every singular value of the POD, non-increasing

@@ -226,3 +226,24 @@ def test_reduced_to_hdf5_is_the_online_file(cli, dp_basis, tmp_path):
     with pytest.raises(flexrom.ModelError, match="pipeline file"):
         r.to_hdf5(DP_PIPELINE)
     assert dp_basis.read_bytes() == before
+
+
+def test_reconstruct_reduce_and_nodes(dp_basis):
+    """reconstruct(reduced_q) is the run's q (x_ref + V z, as the reduced run maps back; to
+    round-off of the product), reduce inverts it on the basis's span; nodes are the rows of
+    q per body and node, the tip probe's track among them."""
+    b = flexrom.Basis.load(dp_basis)
+    r = b.online(load_scale=1.2)
+    x = b.reconstruct(r.reduced_q)
+    assert x.shape == r.q.shape
+    assert np.abs(x - r.q).max() <= 1e-12 * np.abs(r.q).max()
+    assert np.allclose(b.reconstruct(r.reduced_q[7]), x[7], rtol=0, atol=1e-12)
+    z = b.reduce(x)
+    assert np.abs(z - r.reduced_q).max() <= 1e-10 * np.abs(r.reduced_q).max()
+    with pytest.raises(flexrom.ModelError, match="shape"):
+        b.reconstruct(np.zeros(3))
+    nodes = r.nodes
+    assert list(nodes) == r.labels["body"]
+    lower = nodes["lower"]
+    assert lower.shape == (len(r.t), 9, 2)  # 8 elements, 9 nodes
+    same(lower[:, -1, :], r.probes["tip"])
