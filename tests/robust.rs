@@ -301,3 +301,13 @@ fn a_point_with_three_coordinates_is_refused() {
     // the two-number form still reads
     flexrom::model::Model::from_text(&text, "m.toml").unwrap();
 }
+
+/// A model file given where a pipeline belongs (`flexrom train model.toml`, a new user's first
+/// slip) is named as a model file, with what to give instead, not by the first key a
+/// pipeline does not know; a pipeline still loads.
+#[test]
+fn a_model_file_given_as_a_pipeline_is_named() {
+    let err = flexrom::pipeline::Pipeline::load(root().join("data/models/pendulum.toml")).unwrap_err().to_string();
+    assert!(err.contains("pendulum.toml: bodies: this is a model file") && err.contains("model = "), "{err}");
+    flexrom::pipeline::Pipeline::load(root().join("pipelines/pendulum.toml")).unwrap();
+}

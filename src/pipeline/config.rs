@@ -57,6 +57,20 @@ pub struct Pipeline {
     pub report_dir: PathBuf,
 }
 
+/// A model file given where a pipeline belongs (`flexrom train model.toml`) is named as such,
+/// rather than by the first of its keys a pipeline does not know (`unknown field bodies`).
+fn refuse_model_file(text: &str, path: &Path) -> Result<()> {
+    let is_model = text.parse::<toml::Table>().is_ok_and(|t| t.contains_key("bodies") && !t.contains_key("model"));
+    if is_model {
+        return Err(Error::input(
+            path,
+            "bodies",
+            "this is a model file; train, online, validate, sweep and run take a pipeline file that names its model (`model = \"path/to/model.toml\"`, docs/model-format.md \"Pipeline files\"); `flexrom simulate` runs a model file itself",
+        ));
+    }
+    Ok(())
+}
+
 impl Pipeline {
     /// [`Pipeline::load_with`] the environment's bounds or the defaults.
     pub fn load(path: impl AsRef<Path>) -> Result<Pipeline> {
@@ -68,6 +82,7 @@ impl Pipeline {
     pub fn load_with(path: impl AsRef<Path>, limits: Limits) -> Result<Pipeline> {
         let path = path.as_ref();
         let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        refuse_model_file(&text, path)?;
         let file: PipelineFile = crate::model::parse_toml(&text, path)?;
         let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
         let model = Model::load_with(dir.join(&file.model), limits).map_err(|e| match e {
