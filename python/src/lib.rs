@@ -647,10 +647,9 @@ impl PyBasis {
             }
             2 if x.shape()[1] == n => {
                 let x = x.into_dimensionality::<ndarray::Ix2>().expect("2-D");
-                let rows: Vec<ndarray::Array1<f64>> = x.rows().into_iter().map(|row| b.reduce(row)).collect();
-                let mut z = ndarray::Array2::zeros((rows.len(), b.n_reduced()));
-                for (mut out, row) in z.rows_mut().into_iter().zip(rows) {
-                    out.assign(&row);
+                let mut z = ndarray::Array2::zeros((x.nrows(), b.n_reduced()));
+                for (mut out, row) in z.rows_mut().into_iter().zip(x.rows()) {
+                    out.assign(&b.reduce(row));
                 }
                 Ok(z.into_pyarray(py).into_any())
             }
@@ -667,7 +666,7 @@ impl PyBasis {
         self.stored.singular_values.clone().into_pyarray(py)
     }
 
-    /// the load scales of the full runs the snapshots come from, in run order
+    /// the load scales of the full runs the snapshots come from, sorted, each once
     #[getter]
     fn training_loads<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         self.training_loads.clone().into_pyarray(py)
@@ -802,7 +801,7 @@ impl PyBasis {
             None => pipeline_of_basis(path, flexrom::limits::Limits::from_env_or_defaults())?,
         };
         let (stored, rom, warnings) = load_rom(&p, path, method, no_estimate)?;
-        let training_loads = flexrom::io::basis_file::read_training_loads(path)?;
+        let training_loads = flexrom::io::estimator_file::read_training_loads(path)?;
         let rom = Arc::new(rom);
         let b = PyBasis { pipeline: p, pipeline_file, path: path.to_path_buf(), stored, rom, training_loads };
         Ok((b, warnings))
@@ -895,14 +894,7 @@ fn validate<'py>(
     let params = params.unwrap_or_default();
     let named = !params.is_empty();
     let sets_load_scale = params.contains_key(flexrom::solver::parameters::LOAD_SCALE);
-    let points: Vec<Parameters> = match (load_scale, named) {
-        (Some(_), _) => vec![parameters(load_scale, &params)?],
-        (None, false) => p.validation_points(),
-        (None, true) if !p.space().is_empty() || sets_load_scale => vec![parameters(None, &params)?],
-        (None, true) => {
-            p.validate_scales().into_iter().map(|x| parameters(Some(x), &params)).collect::<PyResult<_>>()?
-        }
-    };
+    let points = p.validation_points_given(load_scale, (named, sets_load_scale), |x| parameters(x, &params))?;
     if let Some(mu) = points.first() {
         p.model.check_parameters(mu).map_err(to_py)?;
     }

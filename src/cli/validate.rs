@@ -40,16 +40,9 @@ impl Args {
         let Args { pipeline, load_scale, params, format, basis, dense, strict, estimate } = self;
         let p = Pipeline::load_with(&pipeline, limits.clone())?;
         // --param with the pipeline's loads: the named values at each of them
-        let points: Vec<Parameters> = match (load_scale, params.any()) {
-            (Some(_), _) => vec![params.parameters(load_scale, 1.0)?],
-            // the pipeline's validation points: [validate] load_scales, or points of the box
-            (None, false) => p.validation_points(),
-            // named values at each of the [validate] loads (a box: at the point given)
-            (None, true) if !p.space().is_empty() || params.sets_load_scale() => vec![params.parameters(None, 1.0)?],
-            (None, true) => {
-                p.validate_scales().into_iter().map(|x| params.parameters(Some(x), x)).collect::<Result<_, _>>()?
-            }
-        };
+        let points = p.validation_points_given(load_scale, (params.any(), params.sets_load_scale()), |x| {
+            params.parameters(x, 1.0)
+        })?;
         if let Some(mu) = points.first() {
             p.model.check_parameters(mu)?;
         }

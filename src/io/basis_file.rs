@@ -199,31 +199,6 @@ pub fn write_basis_with(
     })
 }
 
-/// The load scales of the full runs a basis file's snapshots come from, in run order:
-/// greedy training's `/training/load_scales`, else `/snapshot_load_scale` with each run's
-/// once (a run's snapshots are contiguous; two runs in a row at one load scale, as a
-/// `[parameters]` box at a fixed λ has, read as one).
-pub fn read_training_loads(path: &Path) -> Result<Vec<f64>> {
-    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", super::h5::unreadable(&e)))?;
-    if let Ok(d) = f.dataset("training/load_scales") {
-        return d
-            .read_raw::<f64>()
-            .map_err(|e| Error::input(path, "training/load_scales", format!("cannot be read: {e}")));
-    }
-    let all: Vec<f64> = f
-        .dataset("snapshot_load_scale")
-        .and_then(|d| d.read_raw::<f64>())
-        .map_err(|e| Error::input(path, "snapshot_load_scale", format!("cannot be read: {e}")))?;
-    let mut runs: Vec<f64> = Vec::new();
-    for x in all {
-        // snapshots of one run are contiguous: a change of value is the next run
-        if runs.last() != Some(&x) {
-            runs.push(x);
-        }
-    }
-    Ok(runs)
-}
-
 /// Reads a basis file; every missing or malformed part is reported with the file and the
 /// dataset or attribute it concerns.
 pub fn read_basis(path: &Path) -> Result<StoredBasis> {

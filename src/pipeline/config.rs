@@ -329,6 +329,27 @@ impl Pipeline {
         self.space().sample(4, crate::solver::parameter_space::Sampling::Random, self.box_seed().wrapping_add(1))
     }
 
+    /// The points `validate` runs at, given a load scale (`load_scale`) and whether named
+    /// parameters were given (`named`, `sets_load_scale`: one of them is `load_scale`):
+    /// the one point `at(load_scale)` where a load scale is given, or named values in a box
+    /// or with their own load scale; the named values at each `[validate]` load scale on a
+    /// line (`at(Some(x))`); nothing given, [`Self::validation_points`]. `at` builds a
+    /// point from a load scale and the caller's named values (the command line's
+    /// `--param`, Python's keywords).
+    pub fn validation_points_given<E>(
+        &self,
+        load_scale: Option<f64>,
+        (named, sets_load_scale): (bool, bool),
+        at: impl Fn(Option<f64>) -> std::result::Result<Parameters, E>,
+    ) -> std::result::Result<Vec<Parameters>, E> {
+        match (load_scale, named) {
+            (Some(_), _) => Ok(vec![at(load_scale)?]),
+            (None, false) => Ok(self.validation_points()),
+            (None, true) if !self.space().is_empty() || sets_load_scale => Ok(vec![at(None)?]),
+            (None, true) => self.validate_scales().into_iter().map(|x| at(Some(x))).collect(),
+        }
+    }
+
     /// Where `run` sweeps: `[online] load_scales` (or the training scales), or for a
     /// `[parameters]` box sixteen points drawn at random from it (seed: the training
     /// points' plus two), neither training nor `validate`'s points.
