@@ -93,7 +93,7 @@ const RESULT: [Entry; 8] = [
     ("reduced/q", REDUCED_UNITS, "time, mode"),
 ];
 
-const BASIS: [Entry; 52] = [
+const BASIS: [Entry; 54] = [
     ("snapshots", COORDINATE_UNITS, "dof, snapshot"),
     ("snapshot_multipliers", MULTIPLIER_UNITS, "constraint, snapshot"),
     ("snapshot_load_scale", "1", "snapshot"),
@@ -142,6 +142,8 @@ const BASIS: [Entry; 52] = [
     ("training/whole_run_estimates", "1", "iteration, candidate"),
     ("training/sensitivity", "1", "iteration, candidate"),
     ("training/true_score", "1", "iteration"),
+    ("training/bound", "1", "iteration"),
+    ("training/between_points", "1", "iteration"),
     ("training/held_out_effectivity", "1", "iteration"),
     ("timing/full_seconds", "s", ""),
     ("timing/reduced_seconds", "s", ""),

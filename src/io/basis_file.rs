@@ -31,7 +31,8 @@
 //!   worst_estimate, worst_load, run_load (where its full run was: the worst candidate
 //!   without a run yet), true_error (rel_error of that iteration's basis at run_load from
 //!   the full run there; both NaN without a run), energy_tolerance ε,
-//!   hyper_tolerance τ, n_modes, n_elements; estimates (iterations, N) every candidate's
+//!   hyper_tolerance τ, n_modes, n_elements, bound (between the candidates),
+//!   between_points; estimates (iterations, N) every candidate's
 //!   estimate; attributes: method = "greedy", iterations, max_runs, full_runs, converged
 //! /labels/...                            names of the coordinates and constraint rows
 //!                                         (src/io/labels.rs)

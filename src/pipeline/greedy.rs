@@ -72,6 +72,7 @@
 //! The loop is here; the mode and hyper-reduction search of one iteration is in `search.rs`,
 //! the estimates, sensitivities and scores at the candidates in `candidates.rs`.
 
+mod between;
 mod candidate_set;
 mod candidates;
 mod search;
@@ -173,6 +174,8 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
             true_score: f64::NAN,
             held_out_effectivity: f64::NAN,
             method,
+            bound: level.between_candidates(g.tolerance),
+            between_points: level.between_points,
         };
         let shape = format!(
             "{}{}, {} elements",
@@ -189,7 +192,7 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
                 "every candidate has a full run".into()
             };
             // the same test as the stop below, without a held-out run to recalibrate with
-            let bound = level.between_candidates(g.tolerance);
+            let bound = it.bound;
             log::info!(
                 "iteration {n}: {why}, worst estimate {worst:.2e} {cmp} {:e} at {} (bound between candidates {bound:.2e}), {shape}",
                 g.tolerance,
@@ -238,12 +241,13 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
                 it.estimates = level.estimates.clone();
                 it.whole_run_estimates = level.whole.clone();
                 it.method = method;
+                (it.bound, it.between_points) = (level.between_candidates(g.tolerance), level.between_points);
             }
         }
         // the held-out pair may have raised the calibration factor: the estimates this
         // basis will report are the candidates' scaled by it (the estimate is linear in c)
         let rescale = calibrate(points.clone()).factor / level.estimator.calibration.factor;
-        let bound = level.between_candidates(g.tolerance) * rescale.max(1.0);
+        let bound = it.bound * rescale.max(1.0);
         let done = bound <= g.tolerance && e_score <= g.tolerance;
         let sens = level.sensitivity[ni][4];
         if done {
@@ -268,19 +272,13 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         runs.push(truth);
     };
     if !converged {
-        let settled = settled(&candidates, &runs);
         warnings.push(format!(
             "greedy training stopped after {full_runs} full runs (max_runs = {}) above its tolerance {:e} (worst score {:.2e}, bound between candidates {:.2e}): {}",
             g.max_runs,
             g.tolerance,
             iterations.last().map_or(f64::NAN, |i| i.worst_estimate),
-            iterations.last().map_or(f64::NAN, |i| search::between_candidates(
-                &i.estimates,
-                &sensitive(&i.sensitivity, g.tolerance),
-                &settled,
-                &candidates.pairs
-            )),
-            why_not_converged(g.tolerance, &iterations, &candidates, &settled)
+            iterations.last().map_or(f64::NAN, |i| i.bound),
+            why_not_converged(g.tolerance, &iterations, &candidates)
         ));
     }
     let Level { trained, mut estimator, .. } = chosen;
@@ -400,11 +398,6 @@ fn check_method(
     Some(MethodCheck { switch, raw: reading.raw, message })
 }
 
-/// Which candidates are sensitive: a whole-run sensitivity above the tolerance.
-fn sensitive(sensitivity: &[f64], tolerance: f64) -> Vec<bool> {
-    sensitivity.iter().map(|&s| s > tolerance).collect()
-}
-
 /// In a box, which candidates have a full run among `runs` ([`search::between_candidates`]);
 /// none on a line.
 fn settled(candidates: &CandidateSet, runs: &[SimulationResult]) -> Vec<bool> {
@@ -419,7 +412,7 @@ fn settled(candidates: &CandidateSet, runs: &[SimulationResult]) -> Vec<bool> {
 /// load (where a 0.1 % change of the load moves the answer by more than T, the held-out
 /// errors and the estimates there measure the dynamics as much as the basis); held-out
 /// checks that found the estimate off by more than its method allows; else too few runs.
-fn why_not_converged(tolerance: f64, iterations: &[Iteration], candidates: &CandidateSet, settled: &[bool]) -> String {
+fn why_not_converged(tolerance: f64, iterations: &[Iteration], candidates: &CandidateSet) -> String {
     let Some(last) = iterations.last() else { return "no iteration ran".into() };
     let n = candidates.len();
     let failed = last.estimates.iter().filter(|e| e.is_infinite() || e.is_nan()).count();
@@ -444,13 +437,7 @@ fn why_not_converged(tolerance: f64, iterations: &[Iteration], candidates: &Cand
     // of the online warning, `rom::trust`); a tolerance below δ meets every linear response
     let amplifies = s_max > tolerance.max(AMPLIFYING * SENSITIVITY_STEP);
     // every score within T, but neighbours far apart: the loads between them are not certified
-    let bound = search::between_candidates(
-        &last.estimates,
-        &sensitive(&last.sensitivity, tolerance),
-        settled,
-        &candidates.pairs,
-    );
-    if last.worst_estimate <= tolerance && bound > tolerance {
+    if last.worst_estimate <= tolerance && last.bound > tolerance {
         let e = &last.estimates;
         let (ratio, at) = candidates
             .pairs
@@ -458,13 +445,16 @@ fn why_not_converged(tolerance: f64, iterations: &[Iteration], candidates: &Cand
             .map(|&(i, j)| (e[i].max(e[j]) / e[i].min(e[j]), i))
             .fold((0.0_f64, 0), |a, b| if b.0 > a.0 { b } else { a });
         return format!(
-            "every candidate's score is within it, but neighbouring scores differ by up to {ratio:.0}× (from {}), which leaves the loads between them uncertified{}; more candidates (`[train] greedy candidates = N`) resolve an error that varies smoothly with the load, not one that jumps",
+            "every candidate's score is within it, but neighbouring scores differ by up to {ratio:.0}× (from {}), and the {} point{} looked at between such neighbours left the loads between them uncertified{}; there the error changes faster with the load than {} bisections of the candidates' spacing resolve: a narrower range or a looser tolerance certifies",
             candidates.label_of(at),
+            last.between_points,
+            if last.between_points == 1 { "" } else { "s" },
             if amplifies {
                 format!(" (the full model is sensitive to the load: a 0.1 % change moves its answer by up to {s_max:.1e}, at {at_max})")
             } else {
                 String::new()
-            }
+            },
+            between::MAX_BISECTIONS
         );
     }
     if amplifies {
@@ -578,6 +568,23 @@ mod tests {
             true_score: 2e-3,
             held_out_effectivity,
             method: EstimateMethod::Corrected,
+            bound: f64::NAN,
+            between_points: 0,
+        }
+        .with_bound()
+    }
+
+    impl Iteration {
+        /// The bound between the candidates of a line of three, as the loop would have it
+        /// without looking between them (the stop line reads it from the iteration).
+        fn with_bound(mut self) -> Self {
+            self.bound = search::between_candidates(
+                &self.estimates,
+                &self.sensitivity.iter().map(|&s| s > 1e-2).collect::<Vec<_>>(),
+                &[],
+                &search::line_pairs(self.estimates.len()),
+            );
+            self
         }
     }
 
@@ -591,29 +598,29 @@ mod tests {
         let loads = CandidateSet::line(&[0.5, 1.0, 1.5]);
         let t = 1e-2;
         let failed = iteration(vec![1e-3, f64::INFINITY, 2e-2], vec![1e-3; 3], 1.5);
-        assert!(why_not_converged(t, &[failed], &loads, &[]).contains("no estimate could be computed at 1 of 3"));
+        assert!(why_not_converged(t, &[failed], &loads).contains("no estimate could be computed at 1 of 3"));
         let sensitive = iteration(vec![1e-3, 2e-2, 1e-3], vec![1e-3, 1.6e-1, 1e-3], 1.5);
-        let why = why_not_converged(t, &[sensitive], &loads, &[]);
+        let why = why_not_converged(t, &[sensitive], &loads);
         assert!(why.contains("sensitive to the load") && why.contains("1.6e-1") && why.contains("λ = 1"), "{why}");
         let off = iteration(vec![1e-3, 2e-2, 1e-3], vec![1e-3; 3], 250.0);
-        assert!(why_not_converged(t, &[off], &loads, &[]).contains("at 1 of its held-out runs"));
+        assert!(why_not_converged(t, &[off], &loads).contains("at 1 of its held-out runs"));
         let jumpy = iteration(vec![1e-3, 2e-5, 1e-3], vec![1e-3; 3], 1.5);
-        let why = why_not_converged(t, &[jumpy], &loads, &[]);
+        let why = why_not_converged(t, &[jumpy], &loads);
         assert!(why.contains("differ by up to 50×") && why.contains("λ = 0.5"), "{why}");
         let slow = iteration(vec![1e-3, 2e-2, 1e-3], vec![1e-3; 3], 1.5);
-        assert!(why_not_converged(t, &[slow], &loads, &[]).contains("raise max_runs"));
+        assert!(why_not_converged(t, &[slow], &loads).contains("raise max_runs"));
         // a cantilever whose displacement is proportional to the load, held to 1e-4 in the
         // displacement measure: its sensitivity is δ = 1e-3 exactly, above T but no
         // amplification; three runs left 4 modes and took 8 % off the worst score
         let t = 1e-4;
         let linear = |worst: f64| iteration(vec![worst, 1e-4, 5e-5], vec![1e-3; 3], 1.2);
-        let why = why_not_converged(t, &[linear(1.83e-4), linear(1.77e-4), linear(1.68e-4)], &loads, &[]);
+        let why = why_not_converged(t, &[linear(1.83e-4), linear(1.77e-4), linear(1.68e-4)], &loads);
         assert!(!why.contains("sensitive to the load") && why.contains("kept the basis at 4 modes"), "{why}");
         assert!(why.contains("the measure, not the dynamics"), "{why}");
         // the same with modes growing: not stalled
         let mut grown = linear(1.68e-4);
         grown.block_modes = vec![6];
-        let why = why_not_converged(t, &[linear(1.83e-4), linear(1.77e-4), grown], &loads, &[]);
+        let why = why_not_converged(t, &[linear(1.83e-4), linear(1.77e-4), grown], &loads);
         assert!(why.contains("raise max_runs"), "{why}");
     }
 }

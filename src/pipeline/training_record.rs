@@ -93,6 +93,11 @@ pub struct Iteration {
     pub held_out_effectivity: f64,
     /// the method the candidates' estimates were made with
     pub method: EstimateMethod,
+    /// what the estimate may reach between the candidates (the greedy module
+    /// documentation, "Meeting T over the range"), after looking between them
+    pub bound: f64,
+    /// the points between candidates the bound looked at
+    pub between_points: usize,
 }
 
 /// What the greedy loop did: written under `/training` in the basis file.
@@ -207,6 +212,10 @@ pub fn write_training(f: &hdf5::File, r: &GreedyRecord) -> hdf5::Result<()> {
     g.new_dataset_builder().with_data(&table(&|i| &i.whole_run_estimates)).create("whole_run_estimates")?;
     g.new_dataset_builder().with_data(&table(&|i| &i.sensitivity)).create("sensitivity")?;
     g.new_dataset_builder().with_data(&col(&|i| i.true_score)).create("true_score")?;
+    g.new_dataset_builder().with_data(&col(&|i| i.bound)).create("bound")?;
+    g.new_dataset_builder()
+        .with_data(&Array1::from_iter(r.iterations.iter().map(|i| i.between_points as u64)))
+        .create("between_points")?;
     g.new_dataset_builder().with_data(&col(&|i| i.held_out_effectivity)).create("held_out_effectivity")?;
     attr_str(&g, "estimate_method", r.method.name())?;
     attr_str(&g, "measure", r.measure.name())?;

@@ -135,7 +135,23 @@ impl CandidateSet {
     /// The neighbouring run of a sensitivity check at candidate `i`: every parameter of the
     /// box (λ on a line) times `1 + step`.
     pub fn moved(&self, i: usize, step: f64) -> Parameters {
-        self.space.moved(&self.points[i], 1.0 + step)
+        self.moved_point(&self.points[i], step)
+    }
+
+    /// Any point `mu` moved as [`Self::moved`] moves a candidate.
+    pub fn moved_point(&self, mu: &Parameters, step: f64) -> Parameters {
+        self.space.moved(mu, 1.0 + step)
+    }
+
+    /// The point at `u` in the candidates' unit coordinates ([`Self::unit`]): on a line the
+    /// load `a + u (b − a)` between the first and the last candidate, in a box its point
+    /// (log-spaced parameters stay log-spaced).
+    pub fn at_unit(&self, u: &[f64]) -> Parameters {
+        if self.is_box() {
+            return self.space.at(u);
+        }
+        let (a, b) = (self.points[0].scale(), self.points[self.len() - 1].scale());
+        Parameters::load_scale(a + u[0] * (b - a))
     }
 }
 

@@ -13,6 +13,7 @@ use crate::rom::estimator::{
     self, ByFifth, DefectsCalibration, ErrorEstimator, ErrorMeasure, EstimateMethod, Estimator, FIFTHS,
 };
 use crate::rom::{Output, Rom};
+use crate::solver::parameters::Parameters;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -95,9 +96,7 @@ pub(super) fn estimate_candidates(
 const FAILED: CandidateRun =
     CandidateRun { by_time: [f64::INFINITY; FIFTHS], raw: f64::INFINITY, sensitivity: [0.0; FIFTHS] };
 
-/// One candidate, `i`: the reduced run there with its estimate, and the run at its
-/// parameters times `1 + δ` ([`CandidateSet::moved`]), in `measure` (`x0`: the initial
-/// configuration X₀ of the displacement measure).
+/// One candidate, `i`: [`point_run`] at its parameters.
 fn candidate_run(
     rom: &Rom,
     cands: &CandidateSet,
@@ -105,12 +104,24 @@ fn candidate_run(
     measure: ErrorMeasure,
     x0: ndarray::ArrayView1<f64>,
 ) -> CandidateRun {
-    match rom.solve_and_estimate(&cands.points[i], Output::ReducedAndProbes, &[]) {
+    point_run(rom, &cands.points[i], &cands.moved(i, SENSITIVITY_STEP), measure, x0)
+}
+
+/// One point `mu`: the reduced run there with its estimate, and the run at `moved` (its
+/// parameters times `1 + δ`, [`CandidateSet::moved_point`]), in `measure` (`x0`: the
+/// initial configuration X₀ of the displacement measure).
+fn point_run(
+    rom: &Rom,
+    mu: &Parameters,
+    moved: &Parameters,
+    measure: ErrorMeasure,
+    x0: ndarray::ArrayView1<f64>,
+) -> CandidateRun {
+    match rom.solve_and_estimate(mu, Output::ReducedAndProbes, &[]) {
         Ok((run, Some(e))) => {
             // the same reduced model at μ(1 + δ): how much its answer moves
-            let moved = cands.moved(i, SENSITIVITY_STEP);
             let basis = rom.basis();
-            let sensitivity = match rom.solve_with(&moved, Output::ReducedAndProbes, &[]) {
+            let sensitivity = match rom.solve_with(moved, Output::ReducedAndProbes, &[]) {
                 Ok(moved) => *raw_by_time(basis, basis, &moved.reduced_q, &run.reduced_q, x0).get(measure),
                 Err(_) => [0.0; FIFTHS],
             };
@@ -118,6 +129,30 @@ fn candidate_run(
         }
         _ => FAILED,
     }
+}
+
+/// What the loop knows at points between the candidates (in the candidates' unit
+/// coordinates, [`CandidateSet::at_unit`]), as [`estimate_candidates`] at candidates:
+/// reduced runs in parallel, a run that fails as ∞.
+pub(super) fn estimate_points(
+    model: &Arc<Model>,
+    basis: &Basis,
+    est: &Estimator,
+    cands: &CandidateSet,
+    units: &[Vec<f64>],
+    (method, measure): (EstimateMethod, ErrorMeasure),
+) -> Vec<CandidateRun> {
+    let (Ok(rom), Ok(physics)) = (training_rom(model, basis, est, method), model.physics()) else {
+        return vec![FAILED; units.len()];
+    };
+    let x0 = ndarray::ArrayView1::from(&physics.x0[..]);
+    units
+        .par_iter()
+        .map(|u| {
+            let mu = cands.at_unit(u);
+            point_run(&rom, &mu, &cands.moved_point(&mu, SENSITIVITY_STEP), measure, x0)
+        })
+        .collect()
 }
 
 /// [`estimate_candidates`] in the order `order`, a few at a time (as many as there are

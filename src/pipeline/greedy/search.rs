@@ -4,7 +4,7 @@
 //! ([`Level::between_candidates`]); each rung a `Level`.
 
 use super::candidate_set::CandidateSet;
-use super::candidates::{estimate_candidates, score, screen_candidates, CandidateRun};
+use super::candidates::{estimate_candidates, estimate_points, score, screen_candidates, CandidateRun};
 use crate::error::{Error, Result};
 use crate::io::basis_file::TrainingData;
 use crate::pipeline::basis_build::build_basis;
@@ -42,6 +42,12 @@ pub(super) struct Level {
     pairs: Vec<(usize, usize)>,
     /// the candidates whose error is settled by a full run in the snapshots ([`Round::settled`])
     settled: Vec<bool>,
+    /// the bound of every pair once looked at between its candidates ([`super::between`]),
+    /// `pairs` order; `None` before
+    pair_bounds: Option<Vec<f64>>,
+    /// the points between candidates that looking took (reduced runs with an estimate, and
+    /// as many for their sensitivity)
+    pub(super) between_points: usize,
 }
 
 impl Level {
@@ -59,9 +65,14 @@ impl Level {
     /// What the estimate may reach between the candidates, which are all the loop sees of
     /// the range: [`between_candidates`] of the scores (∞ for a rung not run everywhere),
     /// with the candidates where the model's whole-run sensitivity exceeds `tolerance`.
+    /// Pairs whose bound alone would reject the rung were looked at between their
+    /// candidates ([`Self::look_between`]).
     pub(super) fn between_candidates(&self, tolerance: f64) -> f64 {
         if !self.complete() {
             return f64::INFINITY;
+        }
+        if let Some(b) = &self.pair_bounds {
+            return b.iter().fold(0.0, |m, &x| if x.is_nan() { f64::INFINITY } else { m.max(x) });
         }
         let sensitive: Vec<bool> = self.sensitivity.iter().map(|s| s[FIFTHS - 1] > tolerance).collect();
         between_candidates(&self.estimates, &sensitive, &self.settled, &self.pairs)
@@ -280,6 +291,13 @@ fn rung_text(r: &Round, l: &Level, eps: f64, tau: f64, tolerance: f64) -> String
             l.between_candidates(tolerance)
         )
     };
+    if l.between_points > 0 {
+        verdict += &format!(
+            "; {} point{} looked at between candidates whose bound alone was above it",
+            l.between_points,
+            if l.between_points == 1 { "" } else { "s" }
+        );
+    }
     if !poor.is_empty() {
         // the search stops at such a rung: a tighter one would have nothing to be checked against
         verdict +=
@@ -330,15 +348,23 @@ pub(crate) fn between_candidates(e: &[f64], sensitive: &[bool], settled: &[bool]
     let is_settled = |i: usize| settled.get(i).copied().unwrap_or(false);
     pairs
         .iter()
-        .map(|&(i, j)| {
-            let (hi, lo) = (e[i].max(e[j]), e[i].min(e[j]));
-            if is_sensitive(i) && is_sensitive(j) || is_settled(i) || is_settled(j) {
-                hi
-            } else {
-                hi * (hi / lo)
-            }
-        })
+        .map(|&(i, j)| pair_bound(e[i], e[j], is_sensitive(i) && is_sensitive(j), is_settled(i) || is_settled(j)))
         .fold(0.0, f64::max)
+}
+
+/// [`between_candidates`] of one pair with estimates `a` and `b`: `max(a, b)² / min(a, b)`,
+/// or the larger alone where both are sensitive or one is settled; ∞ where either is not
+/// a positive finite number.
+pub(crate) fn pair_bound(a: f64, b: f64, both_sensitive: bool, settled: bool) -> f64 {
+    if !(a.is_finite() && a > 0.0 && b.is_finite() && b > 0.0) {
+        return f64::INFINITY;
+    }
+    let (hi, lo) = (a.max(b), a.min(b));
+    if both_sensitive || settled {
+        hi
+    } else {
+        hi * (hi / lo)
+    }
 }
 
 /// The neighbours of a line of `n` candidates: `(i, i + 1)`.
@@ -375,6 +401,8 @@ fn level(
         evaluated: Vec::new(),
         pairs: candidates.pairs.clone(),
         settled: r.settled.to_vec(),
+        pair_bounds: None,
+        between_points: 0,
     };
     l.screen(p, candidates, order, method);
     Ok(l)
@@ -392,6 +420,7 @@ impl Level {
             (method, measure_of(p)),
         );
         self.record(p, runs.into_iter().map(Some).collect());
+        self.look_between(p, candidates, method);
     }
 
     /// [`Self::estimate`] in `order` until a candidate scores above the tolerance
@@ -401,6 +430,35 @@ impl Level {
         let (basis, est) = (&self.trained.basis, &self.estimator);
         let runs = screen_candidates(&p.model, basis, est, candidates, order, (method, measure_of(p)), p_tolerance(p));
         self.record(p, runs);
+        self.look_between(p, candidates, method);
+    }
+
+    /// Where every candidate's score is within the tolerance but the bound between two of
+    /// them is not, looks between them ([`super::between`]): at most as many points as there
+    /// are candidates, read as the candidates are (`method`, the training's measure).
+    fn look_between(&mut self, p: &Pipeline, candidates: &CandidateSet, method: EstimateMethod) {
+        (self.pair_bounds, self.between_points) = (None, 0);
+        if !self.complete() {
+            return;
+        }
+        let tolerance = p_tolerance(p);
+        let sensitive: Vec<bool> = self.sensitivity.iter().map(|s| s[FIFTHS - 1] > tolerance).collect();
+        let (basis, est, measure) = (&self.trained.basis, &self.estimator, measure_of(p));
+        let mut look = |units: &[Vec<f64>]| -> Vec<(f64, bool)> {
+            estimate_points(&p.model, basis, est, candidates, units, (method, measure))
+                .iter()
+                .map(|r| (score(tolerance, &r.by_time, &r.sensitivity), r.sensitivity[FIFTHS - 1] > tolerance))
+                .collect()
+        };
+        let (bounds, used) = super::between::resolve(
+            (&self.estimates, &sensitive, &self.settled),
+            &self.pairs,
+            &candidates.unit,
+            tolerance,
+            candidates.len(),
+            &mut look,
+        );
+        (self.pair_bounds, self.between_points) = (Some(bounds), used);
     }
 
     fn record(&mut self, p: &Pipeline, runs: Vec<Option<CandidateRun>>) {
