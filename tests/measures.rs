@@ -18,6 +18,17 @@
 //!   tip's error over its travel; the sweep file holds `/displacement_error` and
 //!   `/error_estimate_displacement`; summary.md has the section on the errors against the
 //!   motion and names the held-out run.
+//! - `a_tolerance_below_the_loads_own_change_is_held`: the shipped clamped beam made ten
+//!   times stiffer (E = 70 GPa: its tip deflects by about 3 % of its length, a response
+//!   proportional to the load) trained greedily over [0.5, 2] with the displacement measure
+//!   at T = 1e-4. A 0.1 % change of the load moves such a response by δ = 1e-3 in this
+//!   measure (`/training/sensitivity` reads it), ten times T and no amplification: the loop
+//!   must hold the estimate to T itself (`rom::trust::amplifying`), and the energy ladder
+//!   must go far enough to meet it (the beam needs ε ≈ 1e-12, 20 modes). It converges, and
+//!   `validate` at three loads that are neither training nor candidate loads finds
+//!   displacement errors ≤ T with the estimate above each. (With the sensitivity relaxing
+//!   every score above T, it "converged" at 13 modes with a held-out error of 3.0e-4; with
+//!   the ladder ending at 1e-10 it spent its 8 runs at 15 modes and 2e-4.)
 //! - `bad_measures_and_methods_are_refused`: a greedy `measure` that is not one of the two
 //!   fails `train` naming the pipeline file and `train.greedy.measure`; `[online]
 //!   tolerance_measure` without `[online] tolerance` and with a bad value name
@@ -174,6 +185,48 @@ fn greedy_on_the_displacement_measure() {
         "{md}"
     );
     assert!(md.contains(&format!("({in_basis} training runs) + 1 held-out check at λ = ")), "{md}");
+}
+
+#[test]
+fn a_tolerance_below_the_loads_own_change_is_held() {
+    let dir = tempfile::tempdir().unwrap();
+    let beam = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("data/models/clamped_beam.toml"))
+        .unwrap()
+        .replace("youngs_modulus = 7.0e9", "youngs_modulus = 7.0e10");
+    assert!(beam.contains("7.0e10"));
+    std::fs::write(dir.path().join("model.toml"), beam).unwrap();
+    let pipe = dir.path().join("pipe.toml");
+    std::fs::write(
+        &pipe,
+        r#"model = "model.toml"
+basis = "basis.h5"
+report = "report"
+[train]
+greedy = { range = [0.5, 2.0], tolerance = 1e-4, max_runs = 8, measure = "displacement" }
+[validate]
+load_scales = [0.6, 1.3, 1.9]
+"#,
+    )
+    .unwrap();
+    let p = pipe.to_str().unwrap();
+    let o = flexrom(&["train", p]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let f = hdf5::File::open(dir.path().join("basis.h5")).unwrap();
+    let g = f.group("training").unwrap();
+    let converged: u64 = g.attr("converged").unwrap().read_scalar().unwrap();
+    assert_eq!(converged, 1, "{}", text(&o.stderr));
+    // the sensitivity of a response proportional to the load, in the displacement measure: δ
+    let s = g.dataset("sensitivity").unwrap().read_2d::<f64>().unwrap();
+    let last = s.row(s.nrows() - 1);
+    assert!(last.iter().all(|&x| (0.9e-3..1.1e-3).contains(&x)), "{last}");
+    let v = json(&flexrom(&["validate", p, "--json", "--no-dense"]));
+    let points = v.as_array().expect("three loads");
+    assert_eq!(points.len(), 3);
+    for x in points {
+        let (e, est) = (x["displacement_error"].as_f64().unwrap(), x["error_estimate_displacement"].as_f64().unwrap());
+        assert!(e <= 1e-4, "displacement error above T: {x}");
+        assert!(est >= e, "estimate below the error: {x}");
+    }
 }
 
 #[test]

@@ -30,7 +30,7 @@
 //!   neighbours in the unit cube): the tolerance is a promise for every load of the
 //!   range, and between two candidates the estimate is taken to rise above the larger by
 //!   as much as it changes between them (a few per cent for a smooth estimate, 33
-//!   candidates); between two *sensitive* candidates (sensitivity above T, below) the
+//!   candidates); between two *sensitive* candidates (amplifying, below) the
 //!   larger of the two alone, as their scores jump with the dynamics. The search and the stopping test hold the same bound to T: an earlier
 //!   fixed T / 2 in the search chose bases twice as costly as needed (the pendulum: 23
 //!   sampled elements where 10 keep every estimate within T).
@@ -51,20 +51,26 @@
 //! - what the loop holds to T is the *score* of a candidate, not its whole-run estimate:
 //!
 //!   ```text
-//!       score(λ) = T · max_i η_i(λ) / max(T, s_i(λ)),     i = 1 … 5 (fifths of the run)
+//!       score(λ) = T · max_i η_i(λ) / h_i(λ),     i = 1 … 5 (fifths of the run)
+//!       h_i = s_i  where s_i > max(T, 10 δ) (the model amplifies changes of the load),
+//!       h_i = T    elsewhere
 //!   ```
 //!
 //!   with `η_i` the estimate and `s_i` the reduced model's own *sensitivity* over the run
 //!   up to the end of fifth `i`: `s_i(λ) = ‖X_r(λ(1 + δ)) − X_r(λ)‖ / ‖X_r(λ)‖` over those
 //!   instants, δ = [`SENSITIVITY_STEP`] (0.1 %; in a box every parameter of the box
-//!   times 1 + δ). Where the model is not
-//!   sensitive (`s_i ≤ T`) the score is the estimate itself. Where its answer changes by
-//!   more than T when the load changes by 0.1 % (the four-bar after t ≈ 0.7 s), the
+//!   times 1 + δ). Where the model does not amplify the score is the estimate itself. Where
+//!   its answer changes by more than T and more than 10 δ when the load changes by δ (the
+//!   four-bar after t ≈ 0.7 s; `rom::trust::amplifying`, the rule of the online warning), the
 //!   estimate there is held to `s_i` instead: any estimate compares two trajectories of
 //!   the same chaotic dynamics, so below `s_i` it measures how the dynamics amplify small
 //!   differences (the estimator's own among them) more than the reduction error, and full
 //!   runs spent there do not make the basis better. The whole-run estimate is still what
-//!   every reduced run reports; `/training/whole_run_estimates` keeps it.
+//!   every reduced run reports; `/training/whole_run_estimates` keeps it. A response
+//!   proportional to the load moves by about δ (in the displacement measure by δ exactly):
+//!   that is no amplification, and a tolerance below it is held as given (until
+//!   2026-11-27 any `s_i > T` relaxed it, and a clamped beam held to 1e-4 in the
+//!   displacement measure "converged" with a held-out error of 3.0e-4).
 //!
 //! Nothing here is fitted to a model: the ladder, √ε and the bound B are the same for
 //! every model; a reduced run that fails (Newton diverges) counts as an infinite estimate.
@@ -93,7 +99,7 @@ use crate::reduction::Basis;
 use crate::rom::estimator::norms::rel_error_by_time;
 use crate::rom::estimator::training::{calibrate, CalibrationPoint};
 use crate::rom::estimator::{ByFifth, ErrorMeasure, EstimateMethod, FIFTHS};
-use crate::rom::trust::AMPLIFYING;
+use crate::rom::trust::amplifying;
 use crate::rom::Rom;
 use crate::simulate::{simulate, Overrides, SimulationResult};
 use crate::solver::model::Parameters;
@@ -435,7 +441,7 @@ fn why_not_converged(tolerance: f64, iterations: &[Iteration], candidates: &Cand
     // the full model amplifies changes of the load: above T, and above what a response
     // proportional to the load moves for the step δ (δ itself) by `AMPLIFYING` (the rule
     // of the online warning, `rom::trust`); a tolerance below δ meets every linear response
-    let amplifies = s_max > tolerance.max(AMPLIFYING * SENSITIVITY_STEP);
+    let amplifies = amplifying(s_max, tolerance);
     // every score within T, but neighbours far apart: the loads between them are not certified
     if last.worst_estimate <= tolerance && last.bound > tolerance {
         let e = &last.estimates;

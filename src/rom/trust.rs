@@ -53,8 +53,16 @@ impl Trust {
     /// [`AMPLIFYING`]` · δ` and above the estimate. False without a tolerance.
     pub fn amplifies(&self, s: f64, estimate: Option<f64>) -> bool {
         let Some(tol) = self.tolerance else { return false };
-        s > tol.max(AMPLIFYING * SENSITIVITY_STEP) && estimate.is_none_or(|e| !(e >= s))
+        amplifying(s, tol) && estimate.is_none_or(|e| !(e >= s))
     }
+}
+
+/// Whether the model amplifies changes of the load where its sensitivity is `s`, for a
+/// tolerance `tol`: `s` above the tolerance and above [`AMPLIFYING`]` · δ`. Only there does
+/// greedy training hold an error to the sensitivity instead of the tolerance (a response
+/// proportional to the load moves by about δ, which a tolerance below δ asks to resolve).
+pub fn amplifying(s: f64, tol: f64) -> bool {
+    s > tol.max(AMPLIFYING * SENSITIVITY_STEP)
 }
 
 /// δ of the sensitivity `s(λ) = ‖X_r(λ(1 + δ)) − X_r(λ)‖ / ‖X_r(λ)‖`: how much the answer

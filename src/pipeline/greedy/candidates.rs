@@ -18,16 +18,18 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use std::sync::Arc;
 
+use crate::rom::trust::amplifying;
 pub use crate::rom::trust::SENSITIVITY_STEP;
 
-/// The score of one candidate (the greedy module documentation): `T · max_i η_i / max(T, s_i)`; NaN
-/// counts as ∞.
+/// The score of one candidate (the greedy module documentation): `max_i η_i · T / s_i` over
+/// the fifths `i` of the run, `s_i` the sensitivity where the model amplifies changes of the
+/// load ([`amplifying`]: above T and 10 δ) and T elsewhere; NaN counts as ∞.
 pub fn score(tolerance: f64, estimate_by_time: &ByFifth, sensitivity_by_time: &ByFifth) -> f64 {
     let mut worst = 0.0_f64;
     for (&e, &s) in estimate_by_time.iter().zip(sensitivity_by_time) {
         let e = if e.is_nan() { f64::INFINITY } else { e };
-        let s = if s.is_finite() { s } else { 0.0 };
-        worst = worst.max(tolerance * e / tolerance.max(s));
+        let held_to = if amplifying(s, tolerance) { s } else { tolerance };
+        worst = worst.max(tolerance * e / held_to);
     }
     worst
 }
@@ -246,5 +248,10 @@ mod tests {
         // above the sensitivity it still counts, scaled: 0.4 against 0.2 scores 2 T
         assert!((score(t, &[1e-3, 2e-3, 6e-3, 0.1, 0.4], &s) - 2e-2).abs() < 1e-15);
         assert!(score(t, &[f64::NAN, 0.0, 0.0, 0.0, 0.0], &calm).is_infinite());
+        // a sensitivity above T but no more than 10 δ = 1e-2 is a response that follows the
+        // load, not amplification: at T = 1e-4 an estimate of 3e-4 where s = 1e-3 (a linear
+        // beam in the displacement measure) scores 3e-4, above T, not T · 3e-4 / 1e-3
+        let linear = [1e-3; 5];
+        assert_eq!(score(1e-4, &[1e-4, 1e-4, 2e-4, 3e-4, 3e-4], &linear), 3e-4);
     }
 }
