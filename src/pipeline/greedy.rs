@@ -404,12 +404,8 @@ fn check_method(
     Some(MethodCheck { switch, raw: reading.raw, message })
 }
 
-/// In a box, which candidates have a full run among `runs` ([`search::between_candidates`]);
-/// none on a line.
+/// Which candidates have a full run among `runs` ([`search::between_candidates`]).
 fn settled(candidates: &CandidateSet, runs: &[SimulationResult]) -> Vec<bool> {
-    if !candidates.is_box() {
-        return Vec::new();
-    }
     (0..candidates.len()).map(|i| runs.iter().any(|r| candidates.is_at(i, &r.settings.mu))).collect()
 }
 
