@@ -17,7 +17,20 @@
 //! was 1.0e-1, within that load's sensitivity of 1.8e-1 but 50× the basis kept without it).
 //! Nothing here is fitted: the rule, the tolerance and the midpoints are the loop's own.
 
-use super::search::pair_bound;
+/// [`super::search::between_candidates`] of one pair with estimates `a` and `b`: `max(a, b)² / min(a, b)`,
+/// or the larger alone where both are sensitive or one is settled; ∞ where either is not
+/// a positive finite number.
+pub(crate) fn pair_bound(a: f64, b: f64, both_sensitive: bool, settled: bool) -> f64 {
+    if !(a.is_finite() && a > 0.0 && b.is_finite() && b > 0.0) {
+        return f64::INFINITY;
+    }
+    let (hi, lo) = (a.max(b), a.min(b));
+    if both_sensitive || settled {
+        hi
+    } else {
+        hi * (hi / lo)
+    }
+}
 
 /// What looking at a batch of points (unit coordinates) gives at each: the score, and
 /// whether the model is sensitive there.

@@ -3,6 +3,7 @@
 //! then the loosest τ whose estimates still meet T between the candidates
 //! ([`Level::between_candidates`]); each rung a `Level`.
 
+use super::between::pair_bound;
 use super::candidate_set::CandidateSet;
 use super::candidates::{estimate_candidates, estimate_points, score, screen_candidates, CandidateRun};
 use crate::error::{Error, Result};
@@ -357,21 +358,6 @@ pub(crate) fn between_candidates(e: &[f64], sensitive: &[bool], settled: &[bool]
         .iter()
         .map(|&(i, j)| pair_bound(e[i], e[j], is_sensitive(i) && is_sensitive(j), is_settled(i) || is_settled(j)))
         .fold(0.0, f64::max)
-}
-
-/// [`between_candidates`] of one pair with estimates `a` and `b`: `max(a, b)² / min(a, b)`,
-/// or the larger alone where both are sensitive or one is settled; ∞ where either is not
-/// a positive finite number.
-pub(crate) fn pair_bound(a: f64, b: f64, both_sensitive: bool, settled: bool) -> f64 {
-    if !(a.is_finite() && a > 0.0 && b.is_finite() && b > 0.0) {
-        return f64::INFINITY;
-    }
-    let (hi, lo) = (a.max(b), a.min(b));
-    if both_sensitive || settled {
-        hi
-    } else {
-        hi * (hi / lo)
-    }
 }
 
 /// The neighbours of a line of `n` candidates: `(i, i + 1)`.
