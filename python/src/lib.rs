@@ -624,8 +624,9 @@ impl PyBasis {
                 Ok(b.reconstruct(z.into_dimensionality::<ndarray::Ix1>().expect("1-D")).into_pyarray(py).into_any())
             }
             2 if z.shape()[1] == r => {
+                // time first: the columns of Zᵀ are the instants
                 let z = z.into_dimensionality::<ndarray::Ix2>().expect("2-D");
-                let x = z.dot(&b.modes.t()) + &b.reference;
+                let x = b.reconstruct_columns(z.t()).reversed_axes().as_standard_layout().into_owned();
                 Ok(x.into_pyarray(py).into_any())
             }
             _ => Err(errors::model_error(&format!(

@@ -139,8 +139,8 @@ pub fn check_replaces_own_result(path: &Path) -> Result<()> {
     }
     let ours = hdf5::File::open(path)
         .ok()
-        .and_then(|f| super::h5::read_attr_str(&f, "flexrom_file").ok())
-        .is_some_and(|kind| kind == "result");
+        .and_then(|f| super::h5::read_attr_str(&f, super::attrs::KIND_ATTR).ok())
+        .is_some_and(|kind| kind == super::attrs::Kind::Result.name());
     if ours {
         Ok(())
     } else {

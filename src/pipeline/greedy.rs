@@ -26,7 +26,7 @@
 //!   snapshots by ε, ECSW's τ bounds a relative force error in norm; √ε puts both at the
 //!   same relative size, so neither dominates the other as the search tightens.
 //! - B(η) = max over neighbouring candidates of max(ηᵢ, ηᵢ₊₁)² / min(ηᵢ, ηᵢ₊₁)
-//!   (`search::between_candidates`; in a box over each candidate and its d + 1 nearest
+//!   (`between::pair_bound`; in a box over each candidate and its d + 1 nearest
 //!   neighbours in the unit cube): the tolerance is a promise for every load of the
 //!   range, and between two candidates the estimate is taken to rise above the larger by
 //!   as much as it changes between them (a few per cent for a smooth estimate, 33
@@ -180,7 +180,7 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
             true_score: f64::NAN,
             held_out_effectivity: f64::NAN,
             method,
-            bound: level.between_candidates(g.tolerance),
+            bound: level.between_candidates(),
             between_points: level.between_points,
         };
         let shape = format!(
@@ -247,7 +247,7 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
                 it.estimates = level.estimates.clone();
                 it.whole_run_estimates = level.whole.clone();
                 it.method = method;
-                (it.bound, it.between_points) = (level.between_candidates(g.tolerance), level.between_points);
+                (it.bound, it.between_points) = (level.between_candidates(), level.between_points);
             }
         }
         // the held-out pair may have raised the calibration factor: the estimates this
@@ -404,7 +404,7 @@ fn check_method(
     Some(MethodCheck { switch, raw: reading.raw, message })
 }
 
-/// Which candidates have a full run among `runs` ([`search::between_candidates`]).
+/// Which candidates have a full run among `runs` ([`between::pair_bound`]).
 fn settled(candidates: &CandidateSet, runs: &[SimulationResult]) -> Vec<bool> {
     (0..candidates.len()).map(|i| runs.iter().any(|r| candidates.is_at(i, &r.settings.mu))).collect()
 }
@@ -580,11 +580,11 @@ mod tests {
         /// The bound between the candidates of a line of three, as the loop would have it
         /// without looking between them (the stop line reads it from the iteration).
         fn with_bound(mut self) -> Self {
-            self.bound = search::between_candidates(
+            self.bound = between::between_candidates(
                 &self.estimates,
                 &self.sensitivity.iter().map(|&s| s > 1e-2).collect::<Vec<_>>(),
                 &[],
-                &search::line_pairs(self.estimates.len()),
+                &between::line_pairs(self.estimates.len()),
             );
             self
         }

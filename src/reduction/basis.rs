@@ -10,7 +10,7 @@
 
 use super::pod::{ModeRule, Pod};
 use super::sample::Hyper;
-use ndarray::{Array1, Array2, ArrayView1};
+use ndarray::{Array1, Array2, ArrayView1, ArrayView2};
 
 /// Which reduction (SPEC §3).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize, clap::ValueEnum)]
@@ -170,6 +170,11 @@ impl Basis {
     /// `x = x_ref + V q`.
     pub fn reconstruct(&self, q: ArrayView1<f64>) -> Array1<f64> {
         &self.reference + &self.modes.dot(&q)
+    }
+
+    /// [`Self::reconstruct`] of every column of `z` (one instant each): `X = x_ref 1ᵀ + V Z`.
+    pub fn reconstruct_columns(&self, z: ArrayView2<f64>) -> Array2<f64> {
+        self.modes.dot(&z) + self.reference.view().insert_axis(ndarray::Axis(1))
     }
 
     /// Checks sizes and values; `what(field)` names a field for the message.

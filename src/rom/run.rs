@@ -179,7 +179,7 @@ fn run<R: Reduced<FlexibleSystem>>(
     let n_c = full.n_constraints();
     let (q, qd, multipliers) = match output {
         Output::Full => {
-            let q = basis.reference.view().insert_axis(ndarray::Axis(1)).to_owned() + basis.modes.dot(&zq);
+            let q = basis.reconstruct_columns(zq.view());
             // q̇ = V ż: the reference is constant
             let qd = basis.modes.dot(&zv);
             let mut multipliers = Array2::from_elem((n_c, nt), f64::NAN);

@@ -28,7 +28,8 @@ pub fn score(tolerance: f64, estimate_by_time: &ByFifth, sensitivity_by_time: &B
     let mut worst = 0.0_f64;
     for (&e, &s) in estimate_by_time.iter().zip(sensitivity_by_time) {
         let e = if e.is_nan() { f64::INFINITY } else { e };
-        let held_to = if amplifying(s, tolerance) { s } else { tolerance };
+        // an infinite sensitivity (the moved run could not be compared) holds nothing
+        let held_to = if s.is_finite() && amplifying(s, tolerance) { s } else { tolerance };
         worst = worst.max(tolerance * e / held_to);
     }
     worst

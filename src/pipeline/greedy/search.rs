@@ -3,7 +3,6 @@
 //! then the loosest τ whose estimates still meet T between the candidates
 //! ([`Level::between_candidates`]); each rung a `Level`.
 
-use super::between::pair_bound;
 use super::candidate_set::CandidateSet;
 use super::candidates::{estimate_candidates, estimate_points, score, screen_candidates, CandidateRun};
 use crate::error::{Error, Result};
@@ -71,19 +70,11 @@ impl Level {
     }
 
     /// What the estimate may reach between the candidates, which are all the loop sees of
-    /// the range: [`between_candidates`] of the scores (∞ for a rung not run everywhere),
-    /// with the candidates where the model's whole-run sensitivity exceeds `tolerance`.
-    /// Pairs whose bound alone would reject the rung were looked at between their
-    /// candidates ([`Self::look_between`]).
-    pub(super) fn between_candidates(&self, tolerance: f64) -> f64 {
-        if !self.complete() {
-            return f64::INFINITY;
-        }
-        if let Some(b) = &self.pair_bounds {
-            return b.iter().fold(0.0, |m, &x| if x.is_nan() { f64::INFINITY } else { m.max(x) });
-        }
-        let sensitive: Vec<bool> = self.sensitivity.iter().map(|s| amplifying(s[FIFTHS - 1], tolerance)).collect();
-        between_candidates(&self.estimates, &sensitive, &self.settled, &self.pairs)
+    /// the range: the largest of the pairs' bounds ([`super::between::pair_bound`], pairs
+    /// whose bound alone would reject the rung looked at between their candidates,
+    /// [`Self::look_between`]); ∞ for a rung not run everywhere.
+    pub(super) fn between_candidates(&self) -> f64 {
+        self.pair_bounds.as_ref().map_or(f64::INFINITY, |b| super::between::largest(&self.estimates, b))
     }
 
     /// [`Self::worst`] among the candidates `keep` accepts (and that were run).
@@ -113,7 +104,7 @@ pub(super) struct Round<'a> {
     /// the scores the previous iteration's basis had at the candidates: where a rung is
     /// screened first
     pub(super) prior: Option<&'a [f64]>,
-    /// the candidates at which a full run is in the snapshots: [`between_candidates`]
+    /// the candidates at which a full run is in the snapshots: [`super::between::pair_bound`]
     pub(super) settled: &'a [bool],
 }
 
@@ -143,7 +134,7 @@ pub(super) fn search(r: &Round, g: &GreedySpec, previous_energy: Option<f64>) ->
     let (p, candidates, n) = (r.p, r.candidates, r.n);
     let given_hyper = p.file.reduction.hyper.as_ref().map(|h| h.tolerance);
     // what the tolerance promises is every load of the range, not the candidates alone
-    let accepts = |l: &Level| l.between_candidates(g.tolerance) <= g.tolerance;
+    let accepts = |l: &Level| l.between_candidates() <= g.tolerance;
     let mut last_error: Option<(&'static str, String)> = None;
     let mut order = match r.prior {
         Some(s) if s.len() == candidates.len() => worst_first(s, &vec![true; s.len()]),
@@ -287,16 +278,10 @@ fn rung_text(r: &Round, l: &Level, eps: f64, tau: f64, tolerance: f64) -> String
             r.candidates.label_of(wi),
             r.candidates.len()
         )
-    } else if l.between_candidates(tolerance) > tolerance {
-        format!(
-            "above the tolerance {tolerance:e} between the candidates (bound {:.2e})",
-            l.between_candidates(tolerance)
-        )
+    } else if l.between_candidates() > tolerance {
+        format!("above the tolerance {tolerance:e} between the candidates (bound {:.2e})", l.between_candidates())
     } else {
-        format!(
-            "within the tolerance {tolerance:e} (bound between the candidates {:.2e})",
-            l.between_candidates(tolerance)
-        )
+        format!("within the tolerance {tolerance:e} (bound between the candidates {:.2e})", l.between_candidates())
     };
     if l.between_points > 0 {
         verdict += &format!(
@@ -318,52 +303,6 @@ fn rung_text(r: &Round, l: &Level, eps: f64, tau: f64, tolerance: f64) -> String
         modes_text(&l.estimator.block_modes),
         r.candidates.label_of(wi)
     )
-}
-
-/// A bound of an estimate between the candidates from its values `e` at them: between
-/// neighbours `i`, `j` (the `pairs`: `i`, `i + 1` on a line of evenly spaced loads, each
-/// point and its d + 1 nearest in a box, [`CandidateSet`]) the estimate is taken to rise above the
-/// larger of the two by as much as it changes from one to the other,
-///
-/// ```text
-///     max_(i,j)  max(eᵢ, eⱼ)² / min(eᵢ, eⱼ)
-/// ```
-///
-/// so a smooth estimate is held to its largest value times the local step ratio (a few per
-/// cent with the default 33 candidates), a jumpy one to much more. Nothing in it is fitted:
-/// a spike narrower than the spacing is what more candidates would find. Between two
-/// candidates that are both `sensitive` (the model's answer moves by more than the
-/// tolerance for a 0.1 % change of the load, so their scores are already held to that
-/// sensitivity, the greedy module documentation) the pair counts with its larger value
-/// only: there the scores jump because the dynamics do, not along a trend a ratio could
-/// extrapolate, and no number of candidates would resolve them. A non-finite or
-/// non-positive estimate (a failed run, a basis with no extra modes to estimate from) gives
-/// ∞, as does an empty list. A pair with a `settled` candidate — one whose full
-/// run is in the snapshots, so that its estimate measures only what the basis truncates
-/// there, not a trend — counts with its larger value too: between a point the basis holds
-/// and its neighbour the error rises from about nothing towards the neighbour's, and a
-/// ratio against that nothing says nothing. (Until 2026-11-27 only in a box; on a line the
-/// zoo's `18-n-pendulum` then stayed unconverged at scores within T because a training
-/// load's 2.3e-6 stood beside a neighbour's 7.8e-3.)
-pub(crate) fn between_candidates(e: &[f64], sensitive: &[bool], settled: &[bool], pairs: &[(usize, usize)]) -> f64 {
-    if e.is_empty() || e.iter().any(|&x| !(x.is_finite() && x > 0.0)) {
-        return f64::INFINITY;
-    }
-    if e.len() == 1 {
-        return e[0];
-    }
-    let is_sensitive = |i: usize| sensitive.get(i).copied().unwrap_or(false);
-    let is_settled = |i: usize| settled.get(i).copied().unwrap_or(false);
-    pairs
-        .iter()
-        .map(|&(i, j)| pair_bound(e[i], e[j], is_sensitive(i) && is_sensitive(j), is_settled(i) || is_settled(j)))
-        .fold(0.0, f64::max)
-}
-
-/// The neighbours of a line of `n` candidates: `(i, i + 1)`.
-#[cfg(test)]
-pub(crate) fn line_pairs(n: usize) -> Vec<(usize, usize)> {
-    (1..n).map(|i| (i - 1, i)).collect()
 }
 
 /// Builds the basis and estimator of one rung and estimates at every candidate.
@@ -476,62 +415,4 @@ fn p_tolerance(p: &Pipeline) -> f64 {
 /// The error measure greedy's tolerance is on (`[train] greedy.measure`).
 fn measure_of(p: &Pipeline) -> ErrorMeasure {
     p.file.train.greedy.as_ref().map_or(ErrorMeasure::Relative, |g| g.measure)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::{between_candidates, line_pairs};
-
-    fn between(e: &[f64], sensitive: &[bool]) -> f64 {
-        between_candidates(e, sensitive, &[], &line_pairs(e.len()))
-    }
-
-    /// A flat estimate is its value; a rising one is held to its largest value times the
-    /// last step ratio (1.1 × 1.1 / 1.0 → 1.21 between the last two); a jump between two
-    /// neighbours counts in full (1e-3 next to 1e-4 bounds the gap by 1e-2); a failed
-    /// estimate, a zero one and no estimates at all are ∞.
-    #[test]
-    fn the_bound_between_candidates_follows_the_neighbours() {
-        let calm = [false; 3];
-        assert_eq!(between(&[2e-4, 2e-4, 2e-4], &calm), 2e-4);
-        assert!((between(&[1.0, 1.0, 1.1], &calm) - 1.21).abs() < 1e-12);
-        assert!((between(&[1e-4, 1e-3, 1e-4], &calm) - 1e-2).abs() < 1e-15);
-        assert!(between(&[1e-4, f64::INFINITY], &calm).is_infinite());
-        assert!(between(&[1e-4, f64::NAN], &calm).is_infinite());
-        assert!(between(&[1e-4, 0.0], &calm).is_infinite());
-        assert!(between(&[], &calm).is_infinite());
-    }
-
-    /// Between two sensitive candidates a jump counts with its larger value (1e-3, not
-    /// 1e-2); a pair with one calm candidate keeps the ratio (1e-4 next to 1e-3: 1e-2);
-    /// a failed estimate is ∞ whatever the sensitivity.
-    #[test]
-    fn sensitive_neighbours_are_not_extrapolated() {
-        assert_eq!(between(&[1e-4, 1e-3, 1e-4], &[true; 3]), 1e-3);
-        assert!((between(&[1e-4, 1e-3, 1e-4], &[false, true, true]) - 1e-2).abs() < 1e-15);
-        assert!(between(&[1e-4, f64::INFINITY], &[true; 2]).is_infinite());
-    }
-
-    /// In a box the bound runs over the given pairs only: 1e-4 and 1e-3 that are not
-    /// neighbours do not bound each other (1.1e-4 · 1.1 between 0 and 2, 1.1e-3 · 1.1
-    /// between 1 and 3).
-    #[test]
-    fn the_bound_runs_over_the_pairs() {
-        let e = [1e-4, 1e-3, 1.1e-4, 1.1e-3];
-        let b = between_candidates(&e, &[false; 4], &[], &[(0, 2), (1, 3)]);
-        assert!((b - 1.1e-3 * 1.1).abs() < 1e-15, "{b}");
-    }
-
-    /// A pair with a settled candidate (its full run in the snapshots, its estimate the
-    /// basis's truncation there, 1e-7) counts with its larger value, 1e-3, not 1e-3 · 1e4;
-    /// the other pairs keep the ratio (1e-3 next to 2e-3: 4e-3).
-    #[test]
-    fn a_settled_candidate_bounds_its_pairs_by_the_larger_value() {
-        let e = [1e-7, 1e-3, 2e-3];
-        let pairs = [(0, 1), (1, 2)];
-        assert!((between_candidates(&e, &[false; 3], &[], &pairs[..1]) - 10.0).abs() < 1e-9);
-        assert_eq!(between_candidates(&e, &[false; 3], &[true, false, false], &pairs[..1]), 1e-3);
-        let b = between_candidates(&e, &[false; 3], &[true, false, false], &pairs);
-        assert!((b - 4e-3).abs() < 1e-15, "{b}");
-    }
 }

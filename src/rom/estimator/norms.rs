@@ -129,8 +129,7 @@ impl NormProjection {
         let (diff2, norm2, disp2): (Array1<f64>, Array1<f64>, Array1<f64>) = match &self.orthonormal {
             None => {
                 // V is not orthonormal: reconstruct x_ref + V q of both
-                let full = |b: &Basis, z: &Array2<f64>| b.modes.dot(z) + b.reference.view().insert_axis(Axis(1));
-                let (a, b) = (full(basis, q), full(enriched, qp));
+                let (a, b) = (basis.reconstruct_columns(q.view()), enriched.reconstruct_columns(qp.view()));
                 let moved = &b - &x0.insert_axis(Axis(1));
                 (
                     (&a - &b).mapv(|v| v * v).sum_axis(Axis(0)),
@@ -249,9 +248,7 @@ mod tests {
             let b = mk(small);
             let q = Array2::from_shape_fn((b.n_reduced(), nt), |(i, k)| (i as f64 + 1.0) * (k as f64 * 0.5).cos());
             let qp = Array2::from_shape_fn((5, nt), |(i, k)| (i as f64 - 1.0) * (k as f64 * 0.3).sin());
-            let full =
-                |basis: &Basis, z: &Array2<f64>| basis.modes.dot(z) + basis.reference.view().insert_axis(Axis(1));
-            let (x1, x2) = (full(&b, &q), full(&plus, &qp));
+            let (x1, x2) = (b.reconstruct_columns(q.view()), plus.reconstruct_columns(qp.view()));
             let want = (&x1 - &x2).mapv(|v| v * v).sum().sqrt() / x2.mapv(|v| v * v).sum().sqrt();
             let got = raw_estimate_reduced(&b, &plus, &q, &qp);
             assert!((got - want).abs() < 1e-12 * want.max(1.0), "{got} vs {want}");
