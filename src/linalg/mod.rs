@@ -10,4 +10,5 @@ pub mod kkt_pattern;
 pub mod nnls;
 pub mod simd;
 pub(crate) mod sparse_rows;
+pub mod tall_qr;
 pub(crate) mod vec_ops;

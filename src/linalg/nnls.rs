@@ -54,19 +54,8 @@ pub struct NnlsSolution {
 
 /// Solves `min ‖A x − b‖, x ≥ 0` (see the module documentation).
 pub fn nnls(a: ArrayView2<f64>, b: ArrayView1<f64>, params: &NnlsParams) -> Result<NnlsSolution, String> {
-    params.validate()?;
+    check(a, b, params)?;
     let (m, n) = a.dim();
-    if b.len() != m {
-        return Err(format!("A has {m} rows but b has {} entries", b.len()));
-    }
-    if a.iter().chain(b.iter()).any(|v| !v.is_finite()) {
-        return Err("A or b holds non-finite values".into());
-    }
-    let b_norm = b.dot(&b).sqrt();
-    let mut x = Array1::<f64>::zeros(n);
-    if b_norm == 0.0 {
-        return Ok(NnlsSolution { x, relative_residual: 0.0, iterations: 0 });
-    }
     // unit-norm columns (zero columns can never help and stay out), copied once into
     // column-major storage: every iteration reads whole columns (the new column's products
     // with the passive ones, the residual), which a row-major A would give strided
@@ -76,6 +65,69 @@ pub fn nnls(a: ArrayView2<f64>, b: ArrayView1<f64>, params: &NnlsParams) -> Resu
         if norms[j] > 0.0 {
             c.zip_mut_with(&a.column(j), |u, &v| *u = v / norms[j]);
         }
+    }
+    let (x, _, iterations) = solve_unit(unit.view(), &norms, b, params)?;
+    let b_norm = b.dot(&b).sqrt();
+    if b_norm == 0.0 {
+        return Ok(NnlsSolution { x, relative_residual: 0.0, iterations });
+    }
+    let r = &a.dot(&x) - &b;
+    Ok(NnlsSolution { relative_residual: r.dot(&r).sqrt() / b_norm, x, iterations })
+}
+
+/// [`nnls`] on a column-major `a` it may scale in place (no copy of `a`: ECSW's matrices
+/// run to gigabytes on refined meshes): returns the solution, `a` with its columns scaled to
+/// unit norm (zero columns as they were), and the columns' norms. The residual is the
+/// iteration's own, `b − Σ aⱼ xⱼ` in the scaled columns.
+pub fn nnls_scaling(
+    mut a: Array2<f64>,
+    b: ArrayView1<f64>,
+    params: &NnlsParams,
+) -> Result<(NnlsSolution, Array2<f64>, Vec<f64>), String> {
+    check(a.view(), b, params)?;
+    if !a.t().is_standard_layout() {
+        let mut f = Array2::zeros(a.raw_dim().f());
+        f.assign(&a);
+        a = f;
+    }
+    let n = a.ncols();
+    let norms: Vec<f64> = (0..n).map(|j| a.column(j).dot(&a.column(j)).sqrt()).collect();
+    for (j, mut c) in a.columns_mut().into_iter().enumerate() {
+        if norms[j] > 0.0 {
+            c.mapv_inplace(|v| v / norms[j]);
+        }
+    }
+    let (x, residual, iterations) = solve_unit(a.view(), &norms, b, params)?;
+    let b_norm = b.dot(&b).sqrt();
+    let relative_residual = if b_norm == 0.0 { 0.0 } else { residual.dot(&residual).sqrt() / b_norm };
+    Ok((NnlsSolution { x, relative_residual, iterations }, a, norms))
+}
+
+fn check(a: ArrayView2<f64>, b: ArrayView1<f64>, params: &NnlsParams) -> Result<(), String> {
+    params.validate()?;
+    if b.len() != a.nrows() {
+        return Err(format!("A has {} rows but b has {} entries", a.nrows(), b.len()));
+    }
+    if a.iter().chain(b.iter()).any(|v| !v.is_finite()) {
+        return Err("A or b holds non-finite values".into());
+    }
+    Ok(())
+}
+
+/// The active-set iteration on `unit` (column-major, unit-norm columns of `A`, zero ones
+/// where `norms` is 0): the solution `x` (in `A`'s scaling), the last residual
+/// `b − A x`, and the iterations; an error where a stop was asked for.
+fn solve_unit(
+    unit: ArrayView2<f64>,
+    norms: &[f64],
+    b: ArrayView1<f64>,
+    params: &NnlsParams,
+) -> Result<(Array1<f64>, Array1<f64>, usize), String> {
+    let n = unit.ncols();
+    let b_norm = b.dot(&b).sqrt();
+    let mut x = Array1::<f64>::zeros(n);
+    if b_norm == 0.0 {
+        return Ok((x, b.to_owned(), 0));
     }
     let col = |j: usize| unit.column(j);
     let mut passive: Vec<usize> = Vec::new();
@@ -173,8 +225,7 @@ pub fn nnls(a: ArrayView2<f64>, b: ArrayView1<f64>, params: &NnlsParams) -> Resu
     for &p in &passive {
         x[p] = z[p] / norms[p];
     }
-    let r = &a.dot(&x) - &b;
-    Ok(NnlsSolution { relative_residual: r.dot(&r).sqrt() / b_norm, x, iterations })
+    Ok((x, residual, iterations))
 }
 
 fn remove(passive: &mut Vec<usize>, gram: &mut Vec<Vec<f64>>, atb: &mut Vec<f64>, in_p: &mut [bool], k: usize) {
@@ -241,6 +292,32 @@ mod tests {
         assert!(early.relative_residual <= 0.3);
         assert!(early.x.iter().all(|&v| v >= 0.0));
         assert!(early.x.iter().filter(|&&v| v > 0.0).count() < 12);
+    }
+
+    /// `nnls_scaling` is `nnls` without the copy: the same columns enter, the weights and
+    /// the residual agree to round-off (the norms are summed over a contiguous copy of this
+    /// row-major `A`, in another order), and it hands back the columns scaled to unit norm
+    /// with their norms.
+    #[test]
+    fn scaling_in_place_solves_the_same_problem() {
+        let a = Array2::from_shape_fn((40, 12), |(i, j)| {
+            1.0 + ((i * 7 + j * 13) % 11) as f64 / 5.0 + if i % 12 == j { 3.0 } else { 0.0 }
+        });
+        let b = a.dot(&Array1::ones(12));
+        for tol in [0.3, 1e-3, 0.0] {
+            let p = NnlsParams { tolerance: tol, ..Default::default() };
+            let plain = nnls(a.view(), b.view(), &p).unwrap();
+            let (s, unit, norms) = nnls_scaling(a.clone(), b.view(), &p).unwrap();
+            assert_eq!(s.iterations, plain.iterations, "τ = {tol}");
+            for (x, y) in s.x.iter().zip(plain.x.iter()) {
+                assert!((x > &0.0) == (y > &0.0) && (x - y).abs() <= 1e-12 * (1.0 + y.abs()), "τ = {tol}: {x} vs {y}");
+            }
+            assert!((s.relative_residual - plain.relative_residual).abs() <= 1e-12, "τ = {tol}");
+            for j in 0..12 {
+                assert!((norms[j] - a.column(j).dot(&a.column(j)).sqrt()).abs() <= 1e-12 * norms[j]);
+                assert!((unit.column(j).dot(&unit.column(j)) - 1.0).abs() <= 1e-12);
+            }
+        }
     }
 
     #[test]

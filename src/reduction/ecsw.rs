@@ -8,10 +8,11 @@
 //!     b = Σ_e c_{·,e},      min ‖C w − b‖₂, w ≥ 0,  stopped at ‖C w − b‖ ≤ τ ‖b‖,
 //! ```
 //!
-//! with `q_k` the reduced coordinates of snapshot `k` (the training trajectory as the basis
-//! sees it) and `f̂ₑ = fₑ − Lₑ xₑ` the part of the element force that is not linear in the
-//! coordinates: the linear part (bending, damping), the mass and the loads are projected
-//! exactly over every element and need no sampling. Positive weights keep each sampled
+//! (once the iterations cost as much as factoring `C`, solved in its triangular factor `R`:
+//! `‖C w − b‖ = ‖R w − R 1‖` since `b = C 1`, `linalg::tall_qr`), with `q_k` the reduced coordinates of snapshot `k` (the training
+//! trajectory as the basis sees it) and `f̂ₑ = fₑ − Lₑ xₑ` the part of the element force
+//! that is not linear in the coordinates: the linear part (bending, damping), the mass and
+//! the loads are projected exactly over every element and need no sampling. Positive weights keep each sampled
 //! term a true element force, so the hyper-reduced model keeps the energy structure
 //! (symmetric tangent, conservative internal forces).
 //!
@@ -25,9 +26,10 @@
 
 use super::basis::Basis;
 use super::sample::Hyper;
-use crate::linalg::nnls::{nnls, NnlsParams};
+use crate::linalg::nnls::NnlsParams;
+use crate::linalg::tall_qr::nnls_of_column_sum;
 use crate::solver::model::{stiffness_groups, InvariantElementModel};
-use ndarray::{Array1, Array2, ArrayView2};
+use ndarray::{Array2, ArrayView2, ShapeBuilder};
 
 /// The ECSW training matrix `C` (n_groups·n_snapshots·r × n_elements) of the module
 /// documentation: element `e`'s column holds its terms in the rows of its stiffness group
@@ -47,7 +49,8 @@ pub fn training_matrix<M: InvariantElementModel>(full: &M, basis: &Basis, snapsh
         q.column_mut(k).assign(&basis.reduce(snapshots.column(k)));
     }
     let x = v.dot(&q) + basis.reference.view().insert_axis(ndarray::Axis(1));
-    let mut c = Array2::zeros((groups.len().max(1) * ns * r, n_el));
+    // column-major: an element's terms fill its column, and the QR of `ecsw` reads it so
+    let mut c = Array2::zeros((groups.len().max(1) * ns * r, n_el).f());
     let (mut xe, ve, mut fe, mut l, mut d) =
         (vec![0.0; ne], vec![0.0; ne], vec![0.0; ne], vec![0.0; ne * ne], vec![0.0; ne * ne]);
     for e in 0..n_el {
@@ -84,9 +87,10 @@ pub fn ecsw<M: InvariantElementModel>(
     if snapshots.ncols() == 0 {
         return Err("no training snapshots".into());
     }
+    // b = C 1 lies in C's range: once NNLS has taken as long as factoring C would, it goes
+    // on in C's triangular factor R (n_elements², not rows × n_elements, per iteration)
     let c = training_matrix(full, basis, snapshots);
-    let b: Array1<f64> = c.sum_axis(ndarray::Axis(1));
-    let sol = nnls(c.view(), b.view(), &NnlsParams { tolerance, max_iterations: full.n_elements().max(1) })?;
+    let sol = nnls_of_column_sum(c, &NnlsParams { tolerance, max_iterations: full.n_elements().max(1) })?;
     let elements: Vec<usize> = (0..sol.x.len()).filter(|&e| sol.x[e] > 0.0).collect();
     let weights = elements.iter().map(|&e| sol.x[e]).collect();
     if elements.is_empty() {
