@@ -66,11 +66,29 @@ pub(super) fn estimate_candidates(
     est: &Estimator,
     cands: &CandidateSet,
     label: &str,
-    (method, measure): (EstimateMethod, ErrorMeasure),
+    how: (EstimateMethod, ErrorMeasure),
 ) -> Vec<CandidateRun> {
+    let all: Vec<usize> = (0..cands.len()).collect();
+    estimate_candidates_at(model, basis, est, cands, label, how, &all)
+        .into_iter()
+        .map(|r| r.unwrap_or(FAILED))
+        .collect()
+}
+
+/// [`estimate_candidates`] at the candidates `which` only (`None` at the others).
+pub(super) fn estimate_candidates_at(
+    model: &Arc<Model>,
+    basis: &Basis,
+    est: &Estimator,
+    cands: &CandidateSet,
+    label: &str,
+    (method, measure): (EstimateMethod, ErrorMeasure),
+    which: &[usize],
+) -> Vec<Option<CandidateRun>> {
+    let mut out = vec![None; cands.len()];
     let target =
         if crate::output::progress_wanted() { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() };
-    let bar = ProgressBar::with_draw_target(Some(cands.len() as u64), target);
+    let bar = ProgressBar::with_draw_target(Some(which.len() as u64), target);
     bar.set_style(
         ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} candidates, {elapsed}")
             .expect("valid template")
@@ -78,13 +96,15 @@ pub(super) fn estimate_candidates(
     );
     bar.set_prefix(label.to_string());
     // no log lines of its own (the loop says what each iteration did): the count for a host
-    let ticker = crate::output::ticker::Ticker::new(label, cands.len() as u64, false);
-    let Ok(rom) = training_rom(model, basis, est, method) else { return vec![FAILED; cands.len()] };
-    let Ok(physics) = model.physics() else { return vec![FAILED; cands.len()] };
+    let ticker = crate::output::ticker::Ticker::new(label, which.len() as u64, false);
+    let (Ok(rom), Ok(physics)) = (training_rom(model, basis, est, method), model.physics()) else {
+        which.iter().for_each(|&i| out[i] = Some(FAILED));
+        return out;
+    };
     let x0 = ndarray::ArrayView1::from(&physics.x0[..]);
-    let out: Vec<CandidateRun> = (0..cands.len())
-        .into_par_iter()
-        .map(|i| {
+    let runs: Vec<CandidateRun> = which
+        .par_iter()
+        .map(|&i| {
             let r = candidate_run(&rom, cands, i, measure, x0);
             bar.inc(1);
             ticker.tick();
@@ -92,6 +112,9 @@ pub(super) fn estimate_candidates(
         })
         .collect();
     bar.finish_and_clear();
+    for (&i, r) in which.iter().zip(runs) {
+        out[i] = Some(r);
+    }
     out
 }
 

@@ -4,7 +4,9 @@
 //! ([`Level::between_candidates`]); each rung a `Level`.
 
 use super::candidate_set::CandidateSet;
-use super::candidates::{estimate_candidates, estimate_points, score, screen_candidates, CandidateRun};
+use super::candidates::{
+    estimate_candidates, estimate_candidates_at, estimate_points, score, screen_candidates, CandidateRun,
+};
 use crate::error::{Error, Result};
 use crate::io::basis_file::TrainingData;
 use crate::pipeline::basis_build::build_basis;
@@ -55,6 +57,8 @@ pub(super) struct Level {
     /// the points between candidates that looking took (reduced runs with an estimate, and
     /// as many for their sensitivity)
     pub(super) between_points: usize,
+    /// the candidates' runs the scores above come from (`None`: not run)
+    runs: Vec<Option<CandidateRun>>,
 }
 
 impl Level {
@@ -232,7 +236,7 @@ pub(super) fn search(r: &Round, g: &GreedySpec, previous_energy: Option<f64>) ->
     })?;
     // no rung met T: the one kept was screened, and the loop needs it everywhere
     if !best.complete() {
-        best.estimate(p, candidates, &format!("iteration {n}"), r.method);
+        best.complete_screening(p, candidates, &format!("iteration {n}"), r.method);
     }
     log::debug!(
         "  iteration {n} keeps rung {}: {}{}",
@@ -335,6 +339,7 @@ fn level(
         settled: r.settled.to_vec(),
         pair_bounds: None,
         between_points: 0,
+        runs: Vec::new(),
     };
     l.screen(p, candidates, order, method);
     Ok(l)
@@ -352,6 +357,18 @@ impl Level {
             (method, measure_of(p)),
         );
         self.record(p, runs.into_iter().map(Some).collect());
+        self.look_between(p, candidates, method);
+    }
+
+    /// [`Self::estimate`] at the candidates a screening did not run, keeping the runs it did
+    /// with the same `method` (a reduced run and its estimate are deterministic: the same
+    /// numbers as running every candidate again).
+    fn complete_screening(&mut self, p: &Pipeline, candidates: &CandidateSet, label: &str, method: EstimateMethod) {
+        let missing: Vec<usize> = (0..candidates.len()).filter(|&i| !self.evaluated[i]).collect();
+        let (basis, est) = (&self.trained.basis, &self.estimator);
+        let new = estimate_candidates_at(&p.model, basis, est, candidates, label, (method, measure_of(p)), &missing);
+        let runs = self.runs.iter().zip(new).map(|(old, new)| new.or(*old)).collect();
+        self.record(p, runs);
         self.look_between(p, candidates, method);
     }
 
@@ -396,6 +413,7 @@ impl Level {
     }
 
     fn record(&mut self, p: &Pipeline, runs: Vec<Option<CandidateRun>>) {
+        self.runs = runs.clone();
         let get = |f: &dyn Fn(&CandidateRun) -> f64| -> Vec<f64> {
             runs.iter().map(|r| r.as_ref().map_or(f64::NAN, f)).collect()
         };
