@@ -17,6 +17,9 @@
 //!   load_scales/greedy, A ≥ B, a range of one value, T ≤ 0 or NaN, K = 0, N = 1, an unknown
 //!   key, load_scales without reduction.modes) fails `flexrom train` with a non-zero exit, no
 //!   panic, and a message naming the pipeline file and the field (`train.greedy.range`, …).
+//! - `a_basis_no_held_out_run_checked_says_so`: the same pendulum with max_runs = 3 (the
+//!   three first runs) converges on its estimates alone, and training warns that no held-out
+//!   full run checked the basis.
 //! - `greedy_defaults_follow_the_model`: without `[reduction]`, the four-bar (pins between
 //!   bodies, three bodies) gets the constraint-preserving variant and one POD per body, the
 //!   one-body pendulum (a ground pin only) galerkin and one POD (SPEC §3).
@@ -146,6 +149,23 @@ fn bad_greedy_tables_are_refused() {
         }
         assert!(!d.join("basis.h5").exists(), "nothing written");
     }
+}
+/// With no full run left to hold out (max_runs = 3, the three first runs), a basis that meets
+/// T by its estimates is kept, and training says that no held-out run checked it. The
+/// pendulum of `greedy_pendulum_meets_its_tolerance` converges at its first iteration with
+/// those three runs (there the held-out run then confirms it).
+#[test]
+fn a_basis_no_held_out_run_checked_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let body = "[train]\ngreedy = { range = [0.5, 1.5], tolerance = 1e-3, max_runs = 3 }\n";
+    let p = Pipeline::load(setup(dir.path(), &pendulum_text(20, 0.4), body)).unwrap();
+    let s = train_and_write(&p, &p.basis_path).unwrap();
+    let g = s.greedy.as_ref().expect("greedy record");
+    assert!(g.converged && g.full_runs == 3, "{g:?}");
+    assert!(g.iterations.iter().all(|i| i.run_candidate.is_none()), "no held-out run: {g:?}");
+    let w: Vec<&String> = s.warnings.iter().filter(|w| w.contains("no held-out full run checked")).collect();
+    assert_eq!(w.len(), 1, "{:?}", s.warnings);
+    assert!(w[0].contains("max_runs = 3") && w[0].contains("validate"), "{}", w[0]);
 }
 
 #[test]

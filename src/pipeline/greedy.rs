@@ -205,6 +205,13 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
                 candidates.label_of(wi)
             );
             converged = bound <= g.tolerance;
+            if converged {
+                // the basis kept is built from every run: none is left to hold out against it
+                warnings.push(format!(
+                    "greedy training met its tolerance {:e} with its last basis, which no held-out full run checked ({why}): its estimates alone certify it; `validate` a few loads of the range",
+                    g.tolerance
+                ));
+            }
             iterations.push(it);
             break level;
         };
