@@ -449,38 +449,51 @@ fn main() {
         return;
     }
 
-    // 2. train and validate every model at every tolerance, the largest first
+    // 2. train and validate every model at every tolerance, the largest first: each of the
+    // `--jobs` workers takes the next job of the list (longest first, so the long ones do
+    // not start last and leave one worker idle at the end)
     let mut jobs: Vec<(usize, f64)> =
         (0..models.len()).flat_map(|i| a.tolerances.iter().map(move |&t| (i, t))).collect();
     jobs.sort_by_key(|&(i, _)| std::cmp::Reverse(models[i].mechanism.n_coordinates));
-    let mut entries: Vec<(usize, Entry)> = pool.install(|| {
-        jobs.par_iter()
-            .map(|&(i, t)| {
-                let name = infos[i].name.clone();
-                let t0 = Instant::now();
-                let mut e = run_entry(&fx, &models_dir.join(&name), &name, t);
-                if a.methods && e.training.is_ok() && estimate_fails(&e.stats) {
-                    run_methods(&fx, &models_dir.join(&name), &mut e);
-                }
-                e.wall_seconds = t0.elapsed().as_secs_f64();
-                eprintln!(
-                    "zoo: {name} at {}: {} ({:.0} s)",
-                    tol_tag(t),
-                    match &e.training {
-                        Ok(tr) => format!(
-                            "{}, covered {}/{}, effectivity ≤ {}",
-                            short_reason(tr),
-                            e.stats.covered_pairs,
-                            e.stats.loads,
-                            g3(e.stats.effectivity_max)
-                        ),
-                        Err(m) => format!("training failed: {m}"),
-                    },
-                    t0.elapsed().as_secs_f64()
-                );
-                (i, e)
+    let run_job = |(i, t): (usize, f64)| -> (usize, Entry) {
+        let name = infos[i].name.clone();
+        let t0 = Instant::now();
+        let mut e = run_entry(&fx, &models_dir.join(&name), &name, t);
+        if a.methods && e.training.is_ok() && estimate_fails(&e.stats) {
+            run_methods(&fx, &models_dir.join(&name), &mut e);
+        }
+        e.wall_seconds = t0.elapsed().as_secs_f64();
+        eprintln!(
+            "zoo: {name} at {}: {} ({:.0} s)",
+            tol_tag(t),
+            match &e.training {
+                Ok(tr) => format!(
+                    "{}, covered {}/{}, effectivity ≤ {}",
+                    short_reason(tr),
+                    e.stats.covered_pairs,
+                    e.stats.loads,
+                    g3(e.stats.effectivity_max)
+                ),
+                Err(m) => format!("training failed: {m}"),
+            },
+            t0.elapsed().as_secs_f64()
+        );
+        (i, e)
+    };
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let mut entries: Vec<(usize, Entry)> = std::thread::scope(|scope| {
+        let workers: Vec<_> = (0..a.jobs)
+            .map(|_| {
+                scope.spawn(|| {
+                    let mut mine = Vec::new();
+                    while let Some(&job) = jobs.get(next.fetch_add(1, std::sync::atomic::Ordering::SeqCst)) {
+                        mine.push(run_job(job));
+                    }
+                    mine
+                })
             })
-            .collect()
+            .collect();
+        workers.into_iter().flat_map(|w| w.join().expect("a zoo worker")).collect()
     });
     entries.sort_by(|x, y| x.0.cmp(&y.0).then(x.1.tolerance.total_cmp(&y.1.tolerance)));
     let wall = start.elapsed().as_secs_f64();
