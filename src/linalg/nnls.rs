@@ -55,17 +55,12 @@ pub struct NnlsSolution {
 /// Solves `min ‖A x − b‖, x ≥ 0` (see the module documentation).
 pub fn nnls(a: ArrayView2<f64>, b: ArrayView1<f64>, params: &NnlsParams) -> Result<NnlsSolution, String> {
     check(a, b, params)?;
-    let (m, n) = a.dim();
-    // unit-norm columns (zero columns can never help and stay out), copied once into
-    // column-major storage: every iteration reads whole columns (the new column's products
-    // with the passive ones, the residual), which a row-major A would give strided
-    let norms: Vec<f64> = (0..n).map(|j| a.column(j).dot(&a.column(j)).sqrt()).collect();
-    let mut unit = Array2::<f64>::zeros((m, n).f());
-    for (j, mut c) in unit.columns_mut().into_iter().enumerate() {
-        if norms[j] > 0.0 {
-            c.zip_mut_with(&a.column(j), |u, &v| *u = v / norms[j]);
-        }
-    }
+    // unit-norm columns, copied once into column-major storage: every iteration reads whole
+    // columns (the gains, the new column's products with the passive ones, the residual),
+    // which a row-major A would give strided
+    let norms = column_norms(a);
+    let mut unit = column_major(a);
+    scale_columns(&mut unit, &norms);
     let (x, _, iterations) = solve_unit(unit.view(), &norms, b, params)?;
     let b_norm = b.dot(&b).sqrt();
     if b_norm == 0.0 {
@@ -75,32 +70,44 @@ pub fn nnls(a: ArrayView2<f64>, b: ArrayView1<f64>, params: &NnlsParams) -> Resu
     Ok(NnlsSolution { relative_residual: r.dot(&r).sqrt() / b_norm, x, iterations })
 }
 
-/// [`nnls`] on a column-major `a` it may scale in place (no copy of `a`: ECSW's matrices
-/// run to gigabytes on refined meshes): returns the solution, `a` with its columns scaled to
-/// unit norm (zero columns as they were), and the columns' norms. The residual is the
-/// iteration's own, `b − Σ aⱼ xⱼ` in the scaled columns.
+/// [`nnls`] on an `a` it scales in place (no copy of a column-major `a`: ECSW's matrices run
+/// to gigabytes on refined meshes): returns the solution, `a` column-major with its columns
+/// scaled to unit norm, and the columns' norms. The residual is the iteration's own,
+/// `b − Σ aⱼ xⱼ`.
 pub fn nnls_scaling(
-    mut a: Array2<f64>,
+    a: Array2<f64>,
     b: ArrayView1<f64>,
     params: &NnlsParams,
 ) -> Result<(NnlsSolution, Array2<f64>, Vec<f64>), String> {
     check(a.view(), b, params)?;
-    if !a.t().is_standard_layout() {
-        let mut f = Array2::zeros(a.raw_dim().f());
-        f.assign(&a);
-        a = f;
-    }
-    let n = a.ncols();
-    let norms: Vec<f64> = (0..n).map(|j| a.column(j).dot(&a.column(j)).sqrt()).collect();
+    let mut a = if a.t().is_standard_layout() { a } else { column_major(a.view()) };
+    let norms = column_norms(a.view());
+    scale_columns(&mut a, &norms);
+    let (x, residual, iterations) = solve_unit(a.view(), &norms, b, params)?;
+    let b_norm = b.dot(&b).sqrt();
+    let relative_residual = if b_norm == 0.0 { 0.0 } else { residual.dot(&residual).sqrt() / b_norm };
+    Ok((NnlsSolution { x, relative_residual, iterations }, a, norms))
+}
+
+/// A column-major copy of `a` (what LAPACK-style kernels and column sweeps read).
+pub(crate) fn column_major(a: ArrayView2<f64>) -> Array2<f64> {
+    let mut f = Array2::zeros(a.raw_dim().f());
+    f.assign(&a);
+    f
+}
+
+fn column_norms(a: ArrayView2<f64>) -> Vec<f64> {
+    (0..a.ncols()).map(|j| a.column(j).dot(&a.column(j)).sqrt()).collect()
+}
+
+/// Divides each column by its norm; zero columns, which can never help, stay as they are
+/// (and out of the passive set).
+fn scale_columns(a: &mut Array2<f64>, norms: &[f64]) {
     for (j, mut c) in a.columns_mut().into_iter().enumerate() {
         if norms[j] > 0.0 {
             c.mapv_inplace(|v| v / norms[j]);
         }
     }
-    let (x, residual, iterations) = solve_unit(a.view(), &norms, b, params)?;
-    let b_norm = b.dot(&b).sqrt();
-    let relative_residual = if b_norm == 0.0 { 0.0 } else { residual.dot(&residual).sqrt() / b_norm };
-    Ok((NnlsSolution { x, relative_residual, iterations }, a, norms))
 }
 
 fn check(a: ArrayView2<f64>, b: ArrayView1<f64>, params: &NnlsParams) -> Result<(), String> {

@@ -13,11 +13,11 @@
 //! thousands of rows (snapshots × modes), where every NNLS iteration otherwise streams the
 //! whole matrix from memory.
 
-use crate::linalg::nnls::{nnls, nnls_scaling, NnlsParams, NnlsSolution};
+use crate::linalg::nnls::{column_major, nnls, nnls_scaling, NnlsParams, NnlsSolution};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::qr::no_pivoting::factor::{qr_in_place, qr_in_place_scratch, recommended_block_size};
 use faer::{Mat, MatMut, Par};
-use ndarray::{Array1, Array2, Axis, ShapeBuilder};
+use ndarray::{Array1, Array2, Axis};
 
 /// `R` (n × n, upper triangular) of `a = Q R` for `a` with at least as many rows as columns;
 /// `a` is consumed (factored in place, in column-major order). Column norms and products
@@ -26,13 +26,7 @@ pub fn triangular_factor(a: Array2<f64>) -> Array2<f64> {
     let (m, n) = a.dim();
     assert!(m >= n, "triangular_factor: {m} rows < {n} columns");
     // column-major storage, as faer (and LAPACK) factor it; a copy only if `a` is row-major
-    let mut a = if a.t().is_standard_layout() {
-        a
-    } else {
-        let mut f = Array2::zeros((m, n).f());
-        f.assign(&a);
-        f
-    };
+    let mut a = if a.t().is_standard_layout() { a } else { column_major(a.view()) };
     if n == 0 {
         return Array2::zeros((0, 0));
     }
@@ -93,7 +87,7 @@ pub fn nnls_of_column_sum(a: Array2<f64>, params: &NnlsParams) -> Result<NnlsSol
 mod tests {
     use super::*;
     use crate::linalg::nnls::{nnls, NnlsParams};
-    use ndarray::{Array1, Axis};
+    use ndarray::{Array1, Axis, ShapeBuilder};
 
     /// A deterministic tall matrix with entries in [−1, 1] (a linear congruential stream).
     fn tall(m: usize, n: usize, seed: u64) -> Array2<f64> {

@@ -56,27 +56,11 @@ pub(super) fn training_rom(model: &Arc<Model>, basis: &Basis, est: &Estimator, m
 }
 
 /// The seam to the error estimator: the estimate and the reduced model's sensitivity of
-/// `basis` at every candidate in `measure` (the sensitivity's displacement form divides by
-/// `‖X_r(λ) − X₀‖`), reduced runs in parallel (one reduced model and its estimator's per
-/// worker, as `sweep` does); a run that fails gives ∞ estimates (and sensitivity 0, which
-/// holds its estimate to T).
+/// `basis` at the candidates `which` (`None` at the others) in `measure` (the sensitivity's
+/// displacement form divides by `‖X_r(λ) − X₀‖`), reduced runs in parallel (one reduced
+/// model and its estimator's per worker, as `sweep` does); a run that fails gives ∞
+/// estimates (and sensitivity 0, which holds its estimate to T).
 pub(super) fn estimate_candidates(
-    model: &Arc<Model>,
-    basis: &Basis,
-    est: &Estimator,
-    cands: &CandidateSet,
-    label: &str,
-    how: (EstimateMethod, ErrorMeasure),
-) -> Vec<CandidateRun> {
-    let all: Vec<usize> = (0..cands.len()).collect();
-    estimate_candidates_at(model, basis, est, cands, label, how, &all)
-        .into_iter()
-        .map(|r| r.unwrap_or(FAILED))
-        .collect()
-}
-
-/// [`estimate_candidates`] at the candidates `which` only (`None` at the others).
-pub(super) fn estimate_candidates_at(
     model: &Arc<Model>,
     basis: &Basis,
     est: &Estimator,

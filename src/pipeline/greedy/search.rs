@@ -4,9 +4,7 @@
 //! ([`Level::between_candidates`]); each rung a `Level`.
 
 use super::candidate_set::CandidateSet;
-use super::candidates::{
-    estimate_candidates, estimate_candidates_at, estimate_points, score, screen_candidates, CandidateRun,
-};
+use super::candidates::{estimate_candidates, estimate_points, score, screen_candidates, CandidateRun};
 use crate::error::{Error, Result};
 use crate::io::basis_file::TrainingData;
 use crate::pipeline::basis_build::build_basis;
@@ -348,16 +346,8 @@ fn level(
 impl Level {
     /// The estimates, scores and sensitivities at every candidate, with `method`.
     pub(super) fn estimate(&mut self, p: &Pipeline, candidates: &CandidateSet, label: &str, method: EstimateMethod) {
-        let runs = estimate_candidates(
-            &p.model,
-            &self.trained.basis,
-            &self.estimator,
-            candidates,
-            label,
-            (method, measure_of(p)),
-        );
-        self.record(p, runs.into_iter().map(Some).collect());
-        self.look_between(p, candidates, method);
+        (self.runs, self.evaluated) = (vec![None; candidates.len()], vec![false; candidates.len()]);
+        self.complete_screening(p, candidates, label, method);
     }
 
     /// [`Self::estimate`] at the candidates a screening did not run, keeping the runs it did
@@ -366,7 +356,7 @@ impl Level {
     fn complete_screening(&mut self, p: &Pipeline, candidates: &CandidateSet, label: &str, method: EstimateMethod) {
         let missing: Vec<usize> = (0..candidates.len()).filter(|&i| !self.evaluated[i]).collect();
         let (basis, est) = (&self.trained.basis, &self.estimator);
-        let new = estimate_candidates_at(&p.model, basis, est, candidates, label, (method, measure_of(p)), &missing);
+        let new = estimate_candidates(&p.model, basis, est, candidates, label, (method, measure_of(p)), &missing);
         let runs = self.runs.iter().zip(new).map(|(old, new)| new.or(*old)).collect();
         self.record(p, runs);
         self.look_between(p, candidates, method);
