@@ -37,6 +37,12 @@
 //!   modes than the basis (24 × 204), `factor` 1.5 and `calibrated` 0 (load_scales training
 //!   has no held-out runs).
 //! - `a_bad_online_tolerance_is_refused`: `[online] tolerance = -1` is a clear input error.
+//! - `a_corrected_trajectory_that_blows_up_reads_the_enriched_model`: a reduced run at
+//!   λ = 1.1 with one step's reduced coordinates set to 1e150 (a run the correction cannot
+//!   follow: the enriched residual there is not finite) gets the `enriched` method's reading
+//!   from `corrected`, to the bit (the documented fallback; it was an infinite estimate), a
+//!   finite estimate and no failure; the untouched run's corrected estimate stays finite and
+//!   different from it.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -265,4 +271,27 @@ fn a_bad_online_tolerance_is_refused() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("bad.toml") && err.contains("online.tolerance") && err.contains("positive"), "{err}");
     assert!(!dir.path().join("b.h5").exists());
+}
+
+#[test]
+fn a_corrected_trajectory_that_blows_up_reads_the_enriched_model() {
+    use flexrom::pipeline::online::load_rom;
+    use flexrom::pipeline::Pipeline;
+    use flexrom::rom::estimator::EstimateMethod;
+    let (_dir, p, _) = setup(None);
+    let p = Pipeline::load(&p).unwrap();
+    let (_, corrected, _) = load_rom(&p, &p.basis_path, Some(EstimateMethod::Corrected), false).unwrap();
+    let (_, enriched, _) = load_rom(&p, &p.basis_path, Some(EstimateMethod::Enriched), false).unwrap();
+    assert_eq!((corrected.method(), enriched.method()), (Some("corrected"), Some("enriched")));
+    let mu = flexrom::solver::model::Parameters::load_scale(1.1);
+    let (mut run, fine) = corrected.solve_and_estimate(&mu, flexrom::rom::Output::ReducedAndProbes, &[]).unwrap();
+    let fine = fine.unwrap();
+    assert!(fine.error_estimate.is_finite() && fine.failure.is_none(), "{fine:?}");
+    let step = run.reduced_q.ncols() / 2;
+    run.reduced_q.column_mut(step).fill(1e150);
+    let c = corrected.estimate_error(&run, &mu).unwrap();
+    let e = enriched.estimate_error(&run, &mu).unwrap();
+    assert!(c.failure.is_none() && c.error_estimate.is_finite(), "{c:?}");
+    assert_eq!(c.by_time, e.by_time, "the enriched reading, to the bit");
+    assert_ne!(c.error_estimate, fine.error_estimate);
 }

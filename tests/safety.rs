@@ -8,6 +8,9 @@
 //!   every file of the temporary tree (listing and bytes) exactly as before;
 //! - outputs that are an input (the same path, through `..`, a symlink, a hard link) or not a
 //!   regular file (fifo, folder, /dev/null): refused, the inputs byte for byte unchanged;
+//! - an existing output file that flexrom did not write (a text file, an HDF5 file of
+//!   another program), or wrote as another kind (a basis named as a result's `-o`): refused,
+//!   every file byte for byte unchanged; flexrom's own file of the same kind is replaced;
 //! - missing output folders are created by every writing command;
 //! - SIGTERM / SIGINT during `run`: exit 143 / 130, no temporary file or folder left, the
 //!   previous basis and report unchanged;
@@ -198,15 +201,29 @@ fn a_marked_report_is_replaced_and_a_failed_later_stage_keeps_the_previous_basis
     assert_eq!(snapshot(root), expected, "basis changed by a failed train");
 }
 
+/// [`project`] (report `rep`, online at 1.0, 0.05 s of the pendulum) trained: the pipeline,
+/// model and basis paths.
+fn trained_project(root: &Path) -> (PathBuf, PathBuf, PathBuf) {
+    let p = project(root, "rep", "[1.0]", &model_text(0.05, ""));
+    let proj = root.join("proj");
+    let o = run(&[Path::new("train"), &p]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    (p, proj.join("m.toml"), proj.join("b.h5"))
+}
+
+/// Every case failed with its words, in an error of at most two lines.
+fn refused_in_at_most_two_lines(cases: &[(Output, &[&str])]) {
+    for (i, (o, words)) in cases.iter().enumerate() {
+        let err = fails_with(o, words);
+        assert!(err.lines().count() <= 2, "case {i}: {err}");
+    }
+}
+
 #[test]
 fn outputs_that_are_inputs_or_not_regular_files_are_refused() {
     let d = tempfile::tempdir().unwrap();
     let root = d.path();
-    let p = project(root, "rep", "[1.0]", &model_text(0.05, ""));
-    let proj = root.join("proj");
-    let (model, basis) = (proj.join("m.toml"), proj.join("b.h5"));
-    let o = run(&[Path::new("train"), &p]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (p, model, basis) = trained_project(root);
     std::os::unix::fs::symlink(&model, root.join("to_model.h5")).unwrap();
     std::os::unix::fs::symlink("proj/b.h5", root.join("to_basis.h5")).unwrap();
     std::os::unix::fs::symlink(root.join("data"), root.join("to_dir.h5")).unwrap();
@@ -220,7 +237,7 @@ fn outputs_that_are_inputs_or_not_regular_files_are_refused() {
         |out: &Path| run(&[Path::new("online"), &p, Path::new("--load-scale"), Path::new("1"), Path::new("-o"), out]);
     let cases: Vec<(Output, &[&str])> = vec![
         (sim(&model), &["-o", "model file"]),
-        (sim(&proj.join("../proj/./m.toml")), &["model file"]),
+        (sim(&root.join("proj/../proj/./m.toml")), &["model file"]),
         (sim(&root.join("to_model.h5")), &["model file"]),
         (sim(&root.join("hard.h5")), &["model file"]),
         (sim(&root.join("fifo")), &["a fifo"]),
@@ -238,10 +255,7 @@ fn outputs_that_are_inputs_or_not_regular_files_are_refused() {
         (run(&[Path::new("train"), &p, Path::new("--basis"), &model]), &["--basis", "model file"]),
         (run(&[Path::new("train"), &p, Path::new("--basis"), &root.join("fifo")]), &["a fifo"]),
     ];
-    for (i, (o, words)) in cases.iter().enumerate() {
-        let err = fails_with(o, words);
-        assert!(err.lines().count() <= 2, "case {i}: {err}");
-    }
+    refused_in_at_most_two_lines(&cases);
     assert_eq!(snapshot(root), before, "an input or another file changed");
     // a basis path in the pipeline that is the model file
     std::fs::write(&p, std::fs::read_to_string(&p).unwrap().replace("basis = \"b.h5\"", "basis = \"m.toml\"")).unwrap();
@@ -250,6 +264,60 @@ fn outputs_that_are_inputs_or_not_regular_files_are_refused() {
         fails_with(&run(&[Path::new(cmd), &p]), &["pipe.toml", "basis", "model file"]);
         assert_eq!(snapshot(root), before);
     }
+}
+
+#[test]
+fn existing_files_flexrom_did_not_write_or_wrote_as_another_kind_are_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let root = d.path();
+    let (p, model, basis) = trained_project(root);
+    let result = root.join("result.h5");
+    assert!(run(&[Path::new("simulate"), &model, Path::new("-o"), &result]).status.success());
+    let sweep = root.join("sweep.h5");
+    assert!(run(&[Path::new("sweep"), &p, Path::new("-o"), &sweep]).status.success());
+    let notes = root.join("notes.txt");
+    std::fs::write(&notes, "the user's notes").unwrap();
+    let empty = root.join("empty.h5");
+    std::fs::write(&empty, "").unwrap();
+    // an HDF5 file of another program: no `flexrom_file`, no `program_version` on its root
+    let foreign = root.join("theirs.h5");
+    let f = hdf5::File::create(&foreign).unwrap();
+    f.new_dataset::<f64>().shape(3).create("data").unwrap().write(&[1.0, 2.0, 3.0]).unwrap();
+    drop(f);
+    let before = snapshot(root);
+    let sim = |out: &Path| run(&[Path::new("simulate"), &model, Path::new("-o"), out]);
+    let online =
+        |out: &Path| run(&[Path::new("online"), &p, Path::new("--load-scale"), Path::new("1"), Path::new("-o"), out]);
+    let cases: Vec<(Output, &[&str])> = vec![
+        (sim(&notes), &["-o", "not an HDF5 file flexrom wrote", "result files"]),
+        (sim(&empty), &["not an HDF5 file flexrom wrote"]),
+        (sim(&foreign), &["flexrom did not write"]),
+        (sim(&basis), &["is a basis file", "only its own result files"]),
+        (online(&sweep), &["is a sweep file", "result files"]),
+        (run(&[Path::new("sweep"), &p, Path::new("-o"), &result]), &["is a result file", "sweep files"]),
+        (run(&[Path::new("sweep"), &p, Path::new("-o"), &notes]), &["not an HDF5 file flexrom wrote"]),
+        (run(&[Path::new("merge"), &sweep, Path::new("-o"), &foreign]), &["flexrom did not write"]),
+        (
+            run(&[Path::new("train"), &p, Path::new("--basis"), &result]),
+            &["--basis", "is a result file", "basis files"],
+        ),
+        (run(&[Path::new("train"), &p, Path::new("--basis"), &notes]), &["--basis", "not an HDF5 file"]),
+    ];
+    refused_in_at_most_two_lines(&cases);
+    assert_eq!(snapshot(root), before, "a file flexrom was told to replace changed");
+    // a pipeline whose `basis` names the user's file: `train` and `run` refuse it
+    std::fs::write(&p, std::fs::read_to_string(&p).unwrap().replace("basis = \"b.h5\"", "basis = \"../notes.txt\""))
+        .unwrap();
+    let before = snapshot(root);
+    for cmd in ["train", "run"] {
+        fails_with(&run(&[Path::new(cmd), &p]), &["pipe.toml", "basis", "not an HDF5 file flexrom wrote"]);
+        assert_eq!(snapshot(root), before);
+    }
+    // flexrom's own files of the kind a command writes are replaced, as every rerun needs
+    assert!(sim(&result).status.success());
+    assert!(run(&[Path::new("sweep"), &p, Path::new("--basis"), &basis, Path::new("-o"), &sweep]).status.success());
+    assert!(run(&[Path::new("train"), &p, Path::new("--basis"), &basis]).status.success());
+    assert!(leftovers(root).is_empty(), "{:?}", leftovers(root));
 }
 
 #[test]
@@ -375,7 +443,9 @@ fn a_killed_simulate_keeps_the_previous_result() {
     assert!(text.contains("elements = 50\n"), "the shipped pendulum's mesh");
     std::fs::write(&model, text.replace("elements = 50\n", "elements = 400\n")).unwrap();
     let out = root.join("out.h5");
-    std::fs::write(&out, b"previous result").unwrap();
+    // the previous result: flexrom's own (it replaces no other file), 0.01 s of the same model
+    let short = flexrom().arg("simulate").arg(&model).arg("-o").arg(&out).args(["--t-end", "0.01"]).output().unwrap();
+    assert!(short.status.success(), "{}", String::from_utf8_lossy(&short.stderr));
     let before = snapshot(root);
     let mut child = flexrom().arg("simulate").arg(&model).arg("-o").arg(&out).stderr(Stdio::piped()).spawn().unwrap();
     std::thread::sleep(Duration::from_millis(300));

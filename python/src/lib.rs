@@ -13,6 +13,7 @@ mod errors;
 
 use convert::{dict_of_series, parameters, time_first, warn};
 use errors::{to_py, FlexromWarning};
+use flexrom::io::attrs::Kind;
 use flexrom::io::labels::Labels;
 use flexrom::io::output::{check_output, Origin};
 use flexrom::io::result_file::{ResultFile, RunPlan};
@@ -482,6 +483,12 @@ impl PyRunResult {
         self.estimate().map(|e| e.error_estimate_displacement)
     }
 
+    /// why the estimator's own run failed, when it did (`error_estimate` is then inf)
+    #[getter]
+    fn estimate_failure(&self) -> Option<String> {
+        self.estimate().and_then(|e| e.failure.clone())
+    }
+
     /// the estimate's method (`corrected`, `enriched`, `defects`, …)
     #[getter]
     fn estimate_method(&self) -> Option<&'static str> {
@@ -502,8 +509,8 @@ impl PyRunResult {
     }
 
     /// Writes the result file `flexrom simulate -o` (full) or `flexrom online -o` (reduced)
-    /// writes, to a temporary file renamed into place; refuses a path that is the model
-    /// file, or not a regular file.
+    /// writes, to a temporary file renamed into place; refuses a path that is an input of
+    /// the run, not a regular file, or an existing file that is not a result flexrom wrote.
     fn to_hdf5(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         let mut inputs: Vec<(&Path, &str)> = vec![(&self.model.path, "model file")];
         if let Some(x) = &self.reduced {
@@ -512,12 +519,8 @@ impl PyRunResult {
                 inputs.push((p, "pipeline file"));
             }
         }
-        check_output(&path, Origin::Flag("path"), &inputs).map_err(to_py)?;
-        py.detach(|| {
-            flexrom::io::output::check_replaces_own_result(&path)?;
-            self.write(&path)
-        })
-        .map_err(to_py)
+        check_output(&path, Origin::Flag("path"), &inputs, &[Kind::Result]).map_err(to_py)?;
+        py.detach(|| self.write(&path)).map_err(to_py)
     }
 
     fn __repr__(&self) -> String {
@@ -725,8 +728,14 @@ impl PyBasis {
             rom.solve_and_estimate(&mu, Output::Full, &[]).map_err(|e| e.at_stage("online", &mu))
         })?;
         let extrapolated = rom.is_extrapolated(&mu);
-        let mut warnings =
-            self.run_warnings(&[(mu.clone(), estimate.map(|e| e.in_measure(rom.tolerance_measure())))])?;
+        let mut warnings: Vec<String> = estimate
+            .as_ref()
+            .and_then(|e| flexrom::rom::trust::estimate_failed(&format!("{mu}"), e))
+            .into_iter()
+            .collect();
+        warnings.extend(
+            self.run_warnings(&[(mu.clone(), estimate.as_ref().map(|e| e.in_measure(rom.tolerance_measure())))])?,
+        );
         warnings.extend(rom.untrained_parameters(&mu));
         warn(py, &warnings)?;
         let basis = rom.basis();
@@ -772,7 +781,7 @@ impl PyBasis {
         let runs: Vec<(Parameters, Option<f64>)> = s
             .scales
             .iter()
-            .filter_map(|x| x.point().map(|p| (x.mu.clone(), p.estimate.map(|e| e.in_measure(measure)))))
+            .filter_map(|x| x.point().map(|p| (x.mu.clone(), p.estimate.as_ref().map(|e| e.in_measure(measure)))))
             .collect();
         let mut warnings = self.run_warnings(&runs)?;
         let mut outside: Vec<String> = mus.iter().flat_map(|mu| rom.untrained_parameters(mu)).collect();

@@ -76,7 +76,7 @@ def test_to_hdf5_replaces_only_its_own_results(tmp_path):
     r = flexrom.Model.from_file(PENDULUM).simulate(t_end=0.02)
     notes = tmp_path / "notes.toml"
     notes.write_text("keep me")
-    with pytest.raises(flexrom.ModelError, match="not a result file flexrom wrote"):
+    with pytest.raises(flexrom.ModelError, match="not an HDF5 file flexrom wrote"):
         r.to_hdf5(notes)
     assert notes.read_text() == "keep me"
     r.to_hdf5(tmp_path / "r.h5")

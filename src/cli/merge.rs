@@ -1,6 +1,7 @@
 //! `flexrom merge`: the part files of `sweep --shard` joined into one sweep file.
 
 use super::{print_table, FormatArgs};
+use flexrom::io::attrs::Kind;
 use flexrom::io::output::{check_output, Origin};
 use flexrom::limits::Limits;
 use flexrom::output::info;
@@ -27,7 +28,7 @@ impl Args {
     pub fn run(self, limits: &Limits) -> flexrom::Result<()> {
         let Args { parts, output, partial, format } = self;
         let inputs: Vec<(&std::path::Path, &str)> = parts.iter().map(|p| (p.as_path(), "part file")).collect();
-        check_output(&output, Origin::Flag("-o"), &inputs)?;
+        check_output(&output, Origin::Flag("-o"), &inputs, &[Kind::Sweep])?;
         let m = flexrom::pipeline::merge::merge(&parts, &output, partial, limits)?;
         print_table(&flexrom::pipeline::tables::sweep_table(&m.sweep), format.format(), false)?;
         info(&format!(

@@ -1,6 +1,7 @@
 //! `flexrom online`: one reduced run at one load scale, written to a result file.
 
 use super::{print_table, run_details, warn, EstimateArgs, FormatArgs};
+use flexrom::io::attrs::Kind;
 use flexrom::io::output::{check_output, Origin};
 use flexrom::limits::Limits;
 use flexrom::output::info;
@@ -53,6 +54,7 @@ impl Args {
             &output,
             Origin::Flag("-o"),
             &[(&p.path, "pipeline file"), (&p.model.path, "model file"), (&path, "basis file")],
+            &[Kind::Result],
         )?;
         let (stored, rom, warnings) = load_rom(&p, &path, estimate.method(), false)?;
         warn(&warnings);
@@ -96,6 +98,9 @@ impl Args {
         warn(notice.as_slice());
         let measure = rom.tolerance_measure();
         warn(&rom.untrained_parameters(&mu));
-        super::check_runs(&rom, &[(mu.clone(), estimate.map(|e| e.in_measure(measure)))], strict)
+        if let Some(w) = estimate.as_ref().and_then(|e| flexrom::rom::trust::estimate_failed(&format!("{mu}"), e)) {
+            warn(&[w]);
+        }
+        super::check_runs(&rom, &[(mu.clone(), estimate.as_ref().map(|e| e.in_measure(measure)))], strict)
     }
 }

@@ -1,6 +1,7 @@
 //! `flexrom simulate`: one full-order run of a model file, written to an HDF5 result file.
 
 use super::{print_table, run_details, FormatArgs};
+use flexrom::io::attrs::Kind;
 use flexrom::io::output::{check_output, Origin};
 use flexrom::io::result_file::{begin_alongside, RunPlan};
 use flexrom::limits::Limits;
@@ -30,7 +31,7 @@ impl Args {
     pub fn run(self, limits: &Limits) -> flexrom::Result<()> {
         let Args { model, output, run, format } = self;
         if let Some(output) = &output {
-            check_output(output, Origin::Flag("-o"), &[(&model, "model file")])?;
+            check_output(output, Origin::Flag("-o"), &[(&model, "model file")], &[Kind::Result])?;
         }
         let model = Model::load_with(&model, limits.clone())?;
         let overrides = run.overrides()?;

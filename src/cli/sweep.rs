@@ -2,6 +2,7 @@
 //! sweep file and a table (optionally one shard of the list, resumed, or validated).
 
 use super::{print_table, warn, EstimateArgs, FormatArgs};
+use flexrom::io::attrs::Kind;
 use flexrom::io::output::{check_output, Origin};
 use flexrom::limits::Limits;
 use flexrom::output::table::Format;
@@ -103,7 +104,7 @@ impl Args {
             inputs.push((path.as_path(), "basis file"));
         }
         let out = output;
-        check_output(&out, Origin::Flag("-o"), &inputs)?;
+        check_output(&out, Origin::Flag("-o"), &inputs, &[Kind::Sweep])?;
         if no_estimate && strict {
             return Err(flexrom::Error::Usage("--strict needs the error estimate; drop --no-estimate".into()));
         }
@@ -172,7 +173,9 @@ impl Args {
             .scales
             .iter()
             .filter_map(|x| x.point())
-            .map(|q| (q.run.result.settings.mu.clone(), q.estimate.map(|e| e.in_measure(rom.tolerance_measure()))))
+            .map(|q| {
+                (q.run.result.settings.mu.clone(), q.estimate.as_ref().map(|e| e.in_measure(rom.tolerance_measure())))
+            })
             .collect();
         super::check_runs(rom, &runs, strict)
     }

@@ -3,6 +3,7 @@
 //! that apart.
 
 use super::{print_table, FormatArgs};
+use flexrom::io::attrs::Kind;
 use flexrom::io::output::{check_output, Origin};
 use flexrom::limits::Limits;
 use flexrom::output::info;
@@ -45,7 +46,12 @@ impl Args {
         super::warn(&p.property_warnings());
         if snapshots_only {
             let out = output.expect("clap: --snapshots-only requires -o");
-            check_output(&out, Origin::Flag("-o"), &[(&p.path, "pipeline file"), (&p.model.path, "model file")])?;
+            check_output(
+                &out,
+                Origin::Flag("-o"),
+                &[(&p.path, "pipeline file"), (&p.model.path, "model file")],
+                &[Kind::Snapshots],
+            )?;
             let points = flexrom::pipeline::snapshots::job_points(&p, load_scale, shard)?;
             let (n, secs) = flexrom::pipeline::snapshots::write_snapshots(&p, &points, &out)?;
             let scales: Vec<f64> = points.iter().map(|mu| mu.scale()).collect();

@@ -1,6 +1,7 @@
 //! The checks every command makes before it writes anything: an output never is (nor
 //! resolves to, through symlinks, `..` or a hard link) one of the command's inputs, an
-//! existing output is a regular file, and a report folder is flexrom's own.
+//! existing output file is one flexrom wrote, of the kind the command writes, and a report
+//! folder is flexrom's own.
 //!
 //! Report folders carry a mark, [`MARKER`], a text file whose first line is [`MARKER_HEAD`]
 //! and whose other lines name the files flexrom wrote into the folder. flexrom replaces an
@@ -9,6 +10,7 @@
 //! refused with an error naming the folder and the pipeline key `report`.
 
 use super::atomic::{kind_of, names_an_entry, swap_in_dir, write_new, TempPath};
+use super::attrs::{Kind, KIND_ATTR};
 use crate::error::{Error, Result};
 use std::os::unix::fs::MetadataExt;
 use std::path::{Component, Path, PathBuf};
@@ -71,10 +73,11 @@ fn identity(p: &Path) -> Option<(u64, u64)> {
 /// Refuses `output` when it is, or leads to, one of `inputs` (path and what it is, e.g.
 /// `(model, "model file")`): compared by (device, inode) when it exists, which covers
 /// symlinks, `..` and hard links, and by resolved path otherwise. Refuses an existing
-/// output that is not a regular file (nor a symlink to one), a dangling symlink, and a
-/// path whose nearest existing ancestor is not a folder. Missing folders are created at
-/// write time ([`super::atomic::TempPath::file_for`]), for every command alike.
-pub fn check_output(output: &Path, origin: Origin, inputs: &[(&Path, &str)]) -> Result<()> {
+/// output that is not a regular file (nor a symlink to one), an existing file that is not
+/// flexrom's own of one of the `kinds` the command writes ([`check_own_file`]), a dangling
+/// symlink, and a path whose nearest existing ancestor is not a folder. Missing folders are
+/// created at write time ([`super::atomic::TempPath::file_for`]), for every command alike.
+pub fn check_output(output: &Path, origin: Origin, inputs: &[(&Path, &str)], kinds: &[Kind]) -> Result<()> {
     if !names_an_entry(output) {
         return Err(origin.error(output, "does not name a file"));
     }
@@ -126,29 +129,33 @@ pub fn check_output(output: &Path, origin: Origin, inputs: &[(&Path, &str)]) -> 
             ));
         }
     }
+    if std::fs::metadata(output).is_ok() {
+        check_own_file(output, origin, kinds)?;
+    }
     Ok(())
 }
 
-/// Refuses an existing `path` that is not a result file flexrom wrote (an HDF5 file whose
-/// `flexrom_file` attribute is `result`): the rule of the Python package's `to_hdf5`, whose
-/// results may come from a basis file alone, which cannot name every input to protect (its
-/// model path is relative to where training ran, its pipeline's path is not stored).
-pub fn check_replaces_own_result(path: &Path) -> Result<()> {
-    if std::fs::symlink_metadata(path).is_err() {
-        return Ok(());
-    }
-    let ours = hdf5::File::open(path)
-        .ok()
-        .and_then(|f| super::h5::read_attr_str(&f, super::attrs::KIND_ATTR).ok())
-        .is_some_and(|kind| kind == super::attrs::Kind::Result.name());
-    if ours {
-        Ok(())
-    } else {
-        Err(Error::input(
-            path,
-            "path",
-            "exists and is not a result file flexrom wrote; only those are replaced here: remove it or choose another path",
+/// Refuses an existing file at `output` that flexrom did not write as one of `kinds`: only an
+/// HDF5 file whose root attribute `flexrom_file` names one of them is replaced (a result by
+/// a result, a basis by a basis, …), so a path mistyped in a pipeline or on the command line
+/// never destroys a user's own file, nor a trained basis by a result. A file of a flexrom
+/// older than that attribute (2026-11-25) is recognised by its root `program_version`.
+pub fn check_own_file(output: &Path, origin: Origin, kinds: &[Kind]) -> Result<()> {
+    let names = kinds.iter().map(|k| k.name()).collect::<Vec<_>>().join(" or ");
+    let refuse = |what: String| {
+        Err(origin.error(
+            output,
+            format!("exists and {what}; flexrom replaces only its own {names} files: remove it or choose another path"),
         ))
+    };
+    let Ok(f) = hdf5::File::open(output) else {
+        return refuse("is not an HDF5 file flexrom wrote".into());
+    };
+    match super::h5::read_attr_str(&f, KIND_ATTR) {
+        Ok(kind) if kinds.iter().any(|k| k.name() == kind) => Ok(()),
+        Ok(kind) => refuse(format!("is a {kind} file flexrom wrote")),
+        Err(_) if f.attr("program_version").is_ok() => Ok(()),
+        Err(_) => refuse("is an HDF5 file flexrom did not write (no `flexrom_file` attribute)".into()),
     }
 }
 

@@ -27,7 +27,12 @@ fn inputs(p: &Pipeline) -> [(&Path, &'static str); 2] {
 /// report folder (see [`crate::io::output`]).
 pub fn check_outputs(p: &Pipeline) -> Result<()> {
     let [a, b] = inputs(p);
-    check_output(&p.basis_path, Origin::Key { pipeline: &p.path, key: "basis" }, &[a, b])?;
+    check_output(
+        &p.basis_path,
+        Origin::Key { pipeline: &p.path, key: "basis" },
+        &[a, b],
+        &[crate::io::attrs::Kind::Basis],
+    )?;
     check_report_dir(&p.report_dir, &p.path, &[a, b, (p.basis_path.as_path(), "basis file")])
 }
 
@@ -235,7 +240,7 @@ fn build(
     // the estimate over the sweep, the true errors of the sweep and of the validation runs
     let estimates: Vec<(f64, f64)> = (sw.scales.iter().enumerate())
         .filter_map(|(i, x)| Some((i, x.point()?)))
-        .filter_map(|(i, q)| q.estimate.map(|e| (along(i, &q.run.result.settings.mu), e.error_estimate)))
+        .filter_map(|(i, q)| q.estimate.as_ref().map(|e| (along(i, &q.run.result.settings.mu), e.error_estimate)))
         .collect();
     let mut errors = pts(&|v| v.rel_error);
     if !in_box {

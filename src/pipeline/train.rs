@@ -6,6 +6,7 @@ use super::config::Pipeline;
 pub use super::training_record::TrainSummary;
 use crate::error::{Error, Result};
 use crate::io::atomic::TempPath;
+use crate::io::attrs::Kind;
 use crate::io::basis_file::{write_basis_with, BasisMeta, TrainingData};
 use crate::io::output::{check_output, Origin};
 use crate::linalg::kkt::LinearSolverKind;
@@ -98,7 +99,7 @@ pub fn write_trained(p: &Pipeline, out: &Path, data: &TrainingData, summary: &Tr
 /// its `/timing` ([`super::route::time_and_store`]), and only then renames it over `out`:
 /// a failure at any stage leaves the previous basis as it was.
 pub fn train_to_file(p: &Pipeline, out: &Path, origin: Origin, from_snapshots: &[PathBuf]) -> Result<TrainSummary> {
-    check_output(out, origin, &[(&p.path, "pipeline file"), (&p.model.path, "model file")])?;
+    check_output(out, origin, &[(&p.path, "pipeline file"), (&p.model.path, "model file")], &[Kind::Basis])?;
     let staged = TempPath::file_for(out)?;
     let mut s = if from_snapshots.is_empty() {
         train_and_write(p, staged.path())?

@@ -119,6 +119,9 @@ pub struct Validation {
     pub probe_errors_over_travel: Vec<ProbeTravel>,
     /// how the estimate was computed (`corrected`, `defects`, `enriched`; null: no estimate)
     pub error_estimate_method: Option<String>,
+    /// why the estimator's own run failed, when it did (`error_estimate` is then ∞, which
+    /// JSON writes as null)
+    pub estimate_failure: Option<String>,
 }
 
 /// One probe's error against its own motion.
@@ -236,6 +239,7 @@ pub fn compare(
         max_error_over_travel_probe: worst_travel.map_or(String::new(), |w| w.1),
         probe_errors_over_travel: travels,
         error_estimate_method: None,
+        estimate_failure: None,
     }
     .with_timings(full.wall_seconds, r.wall_seconds)
 }
@@ -282,6 +286,7 @@ impl Validation {
             self.error_estimate_displacement = Some(e.error_estimate_displacement);
             self.effectivity_displacement = Some(e.error_estimate_displacement / self.displacement_error);
             self.error_estimate_displacement_by_time = Some(e.displacement_by_time.to_vec());
+            self.estimate_failure = e.failure.clone();
         }
         if let Some((rom, t)) = rom.and_then(|r| Some((r, r.trust()?))) {
             let mu = self.mu();

@@ -171,6 +171,17 @@ pub fn describe(e: &Estimate, method: &str, rom_seconds: f64) -> String {
     )
 }
 
+/// The warning for an estimate whose estimator's own model failed at `at` (a load, or a
+/// point of a box): the estimate reads ∞ and the reason is the estimator's error; `None`
+/// when the estimate was computed.
+pub fn estimate_failed(at: &str, e: &Estimate) -> Option<String> {
+    let why = e.failure.as_deref()?;
+    Some(format!(
+        "no error estimate at {at}: the estimator's own run failed ({why}); the estimate reads ∞ and nothing bounds \
+         this reduced answer's error: compare it with the full model there (`validate`, `sweep --full`)"
+    ))
+}
+
 /// Attributes of a reduced run's result file: `error_estimate` (NaN without an estimator),
 /// `error_estimate_by_time` (5 values: the estimate up to the end of each fifth of the run,
 /// the last = `error_estimate`; NaN without an estimator), `error_estimate_raw`,
@@ -181,7 +192,8 @@ pub fn describe(e: &Estimate, method: &str, rom_seconds: f64) -> String {
 /// `error_estimate_displacement` and `error_estimate_displacement_by_time` (the estimate of
 /// the displacement-relative error, NaN without an estimator), `sensitivity_near` (the
 /// reduced model's sensitivity at greedy training's candidates beside the load, NaN for
-/// other bases: [`LoadSensitivity`]).
+/// other bases: [`LoadSensitivity`]), `error_estimate_failure` (why the estimator's own run
+/// failed, when it did: the estimates are then ∞).
 pub fn write_run_attributes(
     f: &hdf5::File,
     e: Option<&Estimate>,
@@ -209,6 +221,9 @@ pub fn write_run_attributes(
     }
     if let (Some(_), Some(m)) = (e, method) {
         crate::io::h5::attr_str(f, "error_estimate_method", m)?;
+    }
+    if let Some(why) = e.and_then(|e| e.failure.as_deref()) {
+        crate::io::h5::attr_str(f, "error_estimate_failure", why)?;
     }
     attr_f64(f, "error_estimate_displacement", e.map_or(f64::NAN, |e| e.error_estimate_displacement))?;
     f.new_attr::<f64>()
@@ -310,6 +325,7 @@ pub fn check_runs(
         .map(|r| {
             let at = if trust.space.is_empty() { format!("{:.4}", r.0.scale()) } else { label(trust, &r.0) };
             match r.1 {
+                Some(e) if e.is_infinite() => format!("{at} (∞: the estimator's own run failed)"),
                 Some(e) => format!("{at} ({e:.2e})"),
                 None => format!("{at} (no estimate)"),
             }

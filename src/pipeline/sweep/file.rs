@@ -164,22 +164,22 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, basis: Option<SweepBasis>, extra
             .create("factorizations")
             .map_err(e)?;
         f.new_dataset_builder()
-            .with_data(&col(&|p| p.estimate.map_or(f64::NAN, |e| e.error_estimate)))
+            .with_data(&col(&|p| p.estimate.as_ref().map_or(f64::NAN, |e| e.error_estimate)))
             .create("error_estimate")
             .map_err(e)?;
         // (load, fifth) of an estimate's by-fifth figures; NaN where a load has none
         let by_fifth = |get: &dyn Fn(&crate::rom::estimator::Estimate) -> crate::rom::estimator::ByFifth| {
             let mut a = Array2::from_elem((n, 5), f64::NAN);
             for (k, x) in s.scales.iter().enumerate() {
-                if let Some(est) = x.point().and_then(|p| p.estimate) {
-                    a.row_mut(k).assign(&ndarray::ArrayView1::from(&get(&est)));
+                if let Some(est) = x.point().and_then(|p| p.estimate.as_ref()) {
+                    a.row_mut(k).assign(&ndarray::ArrayView1::from(&get(est)));
                 }
             }
             a
         };
         f.new_dataset_builder().with_data(&by_fifth(&|e| e.by_time)).create("error_estimate_by_time").map_err(e)?;
         f.new_dataset_builder()
-            .with_data(&col(&|p| p.estimate.map_or(f64::NAN, |e| e.error_estimate_displacement)))
+            .with_data(&col(&|p| p.estimate.as_ref().map_or(f64::NAN, |e| e.error_estimate_displacement)))
             .create("error_estimate_displacement")
             .map_err(e)?;
         f.new_dataset_builder()
@@ -187,7 +187,7 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, basis: Option<SweepBasis>, extra
             .create("error_estimate_displacement_by_time")
             .map_err(e)?;
         f.new_dataset_builder()
-            .with_data(&col(&|p| p.estimate.map_or(f64::NAN, |e| e.seconds)))
+            .with_data(&col(&|p| p.estimate.as_ref().map_or(f64::NAN, |e| e.seconds)))
             .create("estimate_seconds")
             .map_err(e)?;
         f.new_dataset_builder()
@@ -540,6 +540,7 @@ pub fn read_sweep(
             max_error_over_travel_probe: String::new(),
             probe_errors_over_travel: Vec::new(),
             error_estimate_method: None,
+            estimate_failure: None,
         });
         // the stored estimate: its value and cost (the factor it was made with is the basis's)
         let estimate = estimates.as_ref().map(|a| a[k]).filter(|e| !e.is_nan()).map(|error_estimate| Estimate {
@@ -553,6 +554,7 @@ pub fn read_sweep(
             displacement_by_time: displacement_by_time
                 .as_ref()
                 .map_or([f64::NAN; 5], |a| std::array::from_fn(|i| a[[k, i]])),
+            failure: None,
         });
         let extrapolated = extrapolated.as_ref().is_some_and(|a| a.get(k).is_some_and(|&v| v != 0));
         let v = v.map(|mut v| {

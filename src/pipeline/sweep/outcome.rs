@@ -122,7 +122,7 @@ pub(super) fn clone_point(p: &SweepPoint) -> SweepPoint {
         run: p.run.clone(),
         validation: p.validation.clone(),
         full_probes: p.full_probes.clone(),
-        estimate: p.estimate,
+        estimate: p.estimate.clone(),
         extrapolated: p.extrapolated,
     }
 }

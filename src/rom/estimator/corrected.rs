@@ -289,9 +289,10 @@ fn check_step<M: DynamicModel>(
 }
 
 /// The `corrected` method: η_raw from the corrected trajectory, times the calibrated `c`.
-/// A run whose corrections do not converge at some step is read by the enriched model on
-/// its own instead (the `enriched` method's reading, the reference the correction
-/// approximates).
+/// A run whose corrections do not converge at some step, or blow up (a trajectory no longer
+/// finite, a matrix that cannot be factored), is read by the enriched model on its own
+/// instead (the `enriched` method's reading, the reference the correction approximates,
+/// which integrates to convergence and halves its steps where it must).
 pub struct Corrected {
     model: Arc<Model>,
     basis: Arc<Basis>,
@@ -334,18 +335,25 @@ impl ErrorEstimator for Corrected {
         &self.data
     }
     fn raw(&self, run: &ReducedRun) -> Result<RawByFifth> {
-        let (qp, stats) = self.runners.with(|r| r.trajectory(run))??;
-        if stats.unconverged > 0 {
-            let fallback =
-                self.fallback.get_or_init(|| super::enriched::Enriched::new(&self.model, &self.basis, &self.data).ok());
-            return match fallback {
-                Some(e) => e.raw(run),
-                None => Err(crate::error::Error::Usage(
-                    "the corrected estimate did not converge and the enriched model cannot be built".into(),
-                )),
-            };
+        let why = match self.runners.with(|r| r.trajectory(run))? {
+            Ok((qp, stats)) if stats.unconverged == 0 => {
+                let x0 = ndarray::ArrayView1::from(&self.x0[..]);
+                return Ok(self.norms.raw_by_time(&self.basis, &self.data.enriched, &run.reduced_q, &qp, x0));
+            }
+            Ok(_) => "did not converge".to_string(),
+            Err(e) => format!("failed ({e})"),
+        };
+        let fallback =
+            self.fallback.get_or_init(|| super::enriched::Enriched::new(&self.model, &self.basis, &self.data).ok());
+        match fallback {
+            Some(e) => e.raw(run).map_err(|e| {
+                crate::error::Error::Usage(format!(
+                    "the corrected estimate {why}, and the enriched model run instead failed too ({e})"
+                ))
+            }),
+            None => Err(crate::error::Error::Usage(format!(
+                "the corrected estimate {why} and the enriched model cannot be built"
+            ))),
         }
-        let x0 = ndarray::ArrayView1::from(&self.x0[..]);
-        Ok(self.norms.raw_by_time(&self.basis, &self.data.enriched, &run.reduced_q, &qp, x0))
     }
 }

@@ -79,7 +79,7 @@ impl RawByFifth {
 }
 
 /// One estimate.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Estimate {
     /// `c · η_raw`; infinite when the enriched model failed to run
     pub error_estimate: f64,
@@ -98,6 +98,8 @@ pub struct Estimate {
     /// the same up to the end of each fifth of the run (as
     /// [`norms::displacement_error_by_time`] for the true error)
     pub displacement_by_time: ByFifth,
+    /// why the estimator's own model failed, when it did (the estimates are then ∞)
+    pub failure: Option<String>,
 }
 
 impl Estimate {
@@ -142,7 +144,10 @@ pub trait ErrorEstimator: Send + Sync {
     /// an infinite estimate, not an error: the reduced answer itself exists.
     fn estimate(&self, run: &ReducedRun, mu: &Parameters) -> Estimate {
         let start = std::time::Instant::now();
-        let raw = self.raw(run).unwrap_or(RawByFifth::INFINITE);
+        let (raw, failure) = match self.raw(run) {
+            Ok(raw) => (raw, None),
+            Err(e) => (RawByFifth::INFINITE, Some(e.to_string())),
+        };
         let factors = self.factors(mu);
         let by_time: ByFifth = std::array::from_fn(|i| factors[i] * raw.relative[i]);
         let displacement_by_time: ByFifth = std::array::from_fn(|i| factors[i] * raw.displacement[i]);
@@ -155,6 +160,7 @@ pub trait ErrorEstimator: Send + Sync {
             by_time,
             error_estimate_displacement: displacement_by_time[FIFTHS - 1],
             displacement_by_time,
+            failure,
         }
     }
 
