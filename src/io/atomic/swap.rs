@@ -18,6 +18,9 @@ pub fn swap_in_dir(mut tmp: TempPath, may_replace: impl Fn(&Path) -> Result<()>)
         _ => return Err(Error::Usage("internal: swap_in_dir needs a temporary folder".into())),
     };
     let (parent, name) = split(&target)?;
+    // a stop asked for: the folder's contents may come from runs the stop cut short
+    // ([`TempPath::commit`])
+    crate::interrupt::check()?;
     sync_tree(&src)?;
     if std::fs::symlink_metadata(&target).is_ok() {
         // checked again now, right before it is moved: it may have changed during the run

@@ -89,7 +89,12 @@ impl TempPath {
     /// 3. `fsync(folder)` makes the rename itself durable: without it a crash right after flexrom
     ///    reported success could bring back the previous file (never a broken one). It is the
     ///    cheapest of the three (~0.3 ms), and a night of sweeps must not lose finished runs.
+    ///
+    /// Nothing is committed once a stop was asked for ([`crate::interrupt`]): some loops read a
+    /// run the stop ended as a failed one (an infinite estimate) and go on, and what they
+    /// finish is not the file a complete run writes; the previous file stays.
     pub fn commit(mut self) -> Result<()> {
+        crate::interrupt::check()?;
         let tmp = self.path().to_path_buf();
         if matches!(self.live, Live::Dir(_)) {
             return Err(Error::Usage(format!(
