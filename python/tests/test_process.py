@@ -97,7 +97,10 @@ def test_ctrl_c_stops_training_and_leaves_no_file(tmp_path):
     out = tmp_path / "out"
     out.mkdir()
     code = f"""
-    import time, flexrom
+    import signal, time, flexrom
+    # a parent that ignores SIGINT (a background job of a non-interactive shell) hands
+    # SIG_IGN down, and Python keeps it: Ctrl-C needs Python's own handler here
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     print("start", flush=True)
     t0 = time.perf_counter()
     try:
