@@ -291,7 +291,7 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
             g.tolerance,
             iterations.last().map_or(f64::NAN, |i| i.worst_estimate),
             iterations.last().map_or(f64::NAN, |i| i.bound),
-            why_not_converged(g.tolerance, &iterations, &candidates)
+            why_not_converged(g.tolerance, &iterations, &candidates, &chosen.failures(), &settled(&candidates, &runs))
         ));
     }
     let Level { trained, mut estimator, .. } = chosen;
@@ -421,13 +421,28 @@ fn settled(candidates: &CandidateSet, runs: &[SimulationResult]) -> Vec<bool> {
 /// load (where a 0.1 % change of the load moves the answer by more than T, the held-out
 /// errors and the estimates there measure the dynamics as much as the basis); held-out
 /// checks that found the estimate off by more than its method allows; else too few runs.
-fn why_not_converged(tolerance: f64, iterations: &[Iteration], candidates: &CandidateSet) -> String {
+fn why_not_converged(
+    tolerance: f64,
+    iterations: &[Iteration],
+    candidates: &CandidateSet,
+    failures: &[(usize, &str)],
+    trained: &[bool],
+) -> String {
     let Some(last) = iterations.last() else { return "no iteration ran".into() };
     let n = candidates.len();
     let failed = last.estimates.iter().filter(|e| e.is_infinite() || e.is_nan()).count();
     if failed > 0 {
+        // the first failure named with its cause: a reduced run that fails at a load whose
+        // full run is in the snapshots is the reduced model's own instability there
+        let first = failures.first().map_or(String::new(), |&(i, why)| {
+            format!(
+                "; at {}{}, {why}",
+                candidates.label_of(i),
+                if trained[i] { " (a training load: its full run is in the snapshots)" } else { "" }
+            )
+        });
         return format!(
-            "no estimate could be computed at {failed} of {n} candidates (a reduced or richer-model run failed there; `train -v` names them); validate those loads with full runs, or narrow the range"
+            "no estimate could be computed at {failed} of {n} candidates (a reduced or richer-model run failed there; `train -v` names them){first}; validate those loads with full runs, or narrow the range"
         );
     }
     // the largest sensitivity the loop met, over the candidates of every iteration
@@ -607,29 +622,34 @@ mod tests {
         let loads = CandidateSet::line(&[0.5, 1.0, 1.5]);
         let t = 1e-2;
         let failed = iteration(vec![1e-3, f64::INFINITY, 2e-2], vec![1e-3; 3], 1.5);
-        assert!(why_not_converged(t, &[failed], &loads).contains("no estimate could be computed at 1 of 3"));
+        let blew_up = [(1, "the reduced run failed: blow-up at t = 1.48 s")];
+        let why = why_not_converged(t, std::slice::from_ref(&failed), &loads, &blew_up, &[true, true, false]);
+        assert!(why.contains("no estimate could be computed at 1 of 3"), "{why}");
+        assert!(why.contains("at λ = 1 (a training load: its full run is in the snapshots), the reduced run failed: blow-up at t = 1.48 s"), "{why}");
+        let why = why_not_converged(t, &[failed], &loads, &blew_up, &[false; 3]);
+        assert!(why.contains("; at λ = 1, the reduced run failed"), "{why}");
         let sensitive = iteration(vec![1e-3, 2e-2, 1e-3], vec![1e-3, 1.6e-1, 1e-3], 1.5);
-        let why = why_not_converged(t, &[sensitive], &loads);
+        let why = why_not_converged(t, &[sensitive], &loads, &[], &[false; 3]);
         assert!(why.contains("sensitive to the load") && why.contains("1.6e-1") && why.contains("λ = 1"), "{why}");
         let off = iteration(vec![1e-3, 2e-2, 1e-3], vec![1e-3; 3], 250.0);
-        assert!(why_not_converged(t, &[off], &loads).contains("at 1 of its held-out runs"));
+        assert!(why_not_converged(t, &[off], &loads, &[], &[false; 3]).contains("at 1 of its held-out runs"));
         let jumpy = iteration(vec![1e-3, 2e-5, 1e-3], vec![1e-3; 3], 1.5);
-        let why = why_not_converged(t, &[jumpy], &loads);
+        let why = why_not_converged(t, &[jumpy], &loads, &[], &[false; 3]);
         assert!(why.contains("differ by up to 50×") && why.contains("λ = 0.5"), "{why}");
         let slow = iteration(vec![1e-3, 2e-2, 1e-3], vec![1e-3; 3], 1.5);
-        assert!(why_not_converged(t, &[slow], &loads).contains("raise max_runs"));
+        assert!(why_not_converged(t, &[slow], &loads, &[], &[false; 3]).contains("raise max_runs"));
         // a cantilever whose displacement is proportional to the load, held to 1e-4 in the
         // displacement measure: its sensitivity is δ = 1e-3 exactly, above T but no
         // amplification; three runs left 4 modes and took 8 % off the worst score
         let t = 1e-4;
         let linear = |worst: f64| iteration(vec![worst, 1e-4, 5e-5], vec![1e-3; 3], 1.2);
-        let why = why_not_converged(t, &[linear(1.83e-4), linear(1.77e-4), linear(1.68e-4)], &loads);
+        let why = why_not_converged(t, &[linear(1.83e-4), linear(1.77e-4), linear(1.68e-4)], &loads, &[], &[false; 3]);
         assert!(!why.contains("sensitive to the load") && why.contains("kept the basis at 4 modes"), "{why}");
         assert!(why.contains("the measure, not the dynamics"), "{why}");
         // the same with modes growing: not stalled
         let mut grown = linear(1.68e-4);
         grown.block_modes = vec![6];
-        let why = why_not_converged(t, &[linear(1.83e-4), linear(1.77e-4), grown], &loads);
+        let why = why_not_converged(t, &[linear(1.83e-4), linear(1.77e-4), grown], &loads, &[], &[false; 3]);
         assert!(why.contains("raise max_runs"), "{why}");
     }
 }

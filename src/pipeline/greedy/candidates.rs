@@ -36,7 +36,7 @@ pub fn score(tolerance: f64, estimate_by_time: &ByFifth, sensitivity_by_time: &B
 }
 
 /// What the loop knows of one candidate, in the training's measure.
-#[derive(Clone, Copy)]
+#[derive(Clone)]
 pub(super) struct CandidateRun {
     /// the error estimate by fifth of the run (the last: the whole run's)
     pub(super) by_time: ByFifth,
@@ -44,6 +44,8 @@ pub(super) struct CandidateRun {
     pub(super) raw: f64,
     /// the reduced model's sensitivity by fifth of the run (the greedy module documentation)
     pub(super) sensitivity: ByFifth,
+    /// why no estimate could be computed, when none could (the estimates are then ∞)
+    pub(super) failure: Option<String>,
 }
 
 /// The reduced model training steers by: `basis` with the estimator of `est` by `method`
@@ -81,9 +83,12 @@ pub(super) fn estimate_candidates(
     bar.set_prefix(label.to_string());
     // no log lines of its own (the loop says what each iteration did): the count for a host
     let ticker = crate::output::ticker::Ticker::new(label, which.len() as u64, false);
-    let (Ok(rom), Ok(physics)) = (training_rom(model, basis, est, method), model.physics()) else {
-        which.iter().for_each(|&i| out[i] = Some(FAILED));
-        return out;
+    let (rom, physics) = match (training_rom(model, basis, est, method), model.physics()) {
+        (Ok(rom), Ok(physics)) => (rom, physics),
+        (Err(e), _) | (_, Err(e)) => {
+            which.iter().for_each(|&i| out[i] = Some(failed(format!("the reduced model cannot be built: {e}"))));
+            return out;
+        }
     };
     let x0 = ndarray::ArrayView1::from(&physics.x0[..]);
     let runs: Vec<CandidateRun> = which
@@ -102,9 +107,15 @@ pub(super) fn estimate_candidates(
     out
 }
 
-/// What a candidate whose reduced run fails counts as.
-const FAILED: CandidateRun =
-    CandidateRun { by_time: [f64::INFINITY; FIFTHS], raw: f64::INFINITY, sensitivity: [0.0; FIFTHS] };
+/// What a candidate whose reduced run or estimate fails counts as, and why.
+fn failed(why: String) -> CandidateRun {
+    CandidateRun {
+        by_time: [f64::INFINITY; FIFTHS],
+        raw: f64::INFINITY,
+        sensitivity: [0.0; FIFTHS],
+        failure: Some(why),
+    }
+}
 
 /// One candidate, `i`: [`point_run`] at its parameters.
 fn candidate_run(
@@ -135,9 +146,11 @@ fn point_run(
                 Ok(moved) => *raw_by_time(basis, basis, &moved.reduced_q, &run.reduced_q, x0).get(measure),
                 Err(_) => [0.0; FIFTHS],
             };
-            CandidateRun { by_time: *e.by_time_in(measure), raw: e.raw, sensitivity }
+            let failure = e.failure.as_ref().map(|why| format!("its error estimate failed: {why}"));
+            CandidateRun { by_time: *e.by_time_in(measure), raw: e.raw, sensitivity, failure }
         }
-        _ => FAILED,
+        Ok((_, None)) => failed("the reduced model has no estimator".into()),
+        Err(e) => failed(format!("the reduced run failed: {e}")),
     }
 }
 
@@ -152,8 +165,11 @@ pub(super) fn estimate_points(
     units: &[Vec<f64>],
     (method, measure): (EstimateMethod, ErrorMeasure),
 ) -> Vec<CandidateRun> {
-    let (Ok(rom), Ok(physics)) = (training_rom(model, basis, est, method), model.physics()) else {
-        return vec![FAILED; units.len()];
+    let (rom, physics) = match (training_rom(model, basis, est, method), model.physics()) {
+        (Ok(rom), Ok(physics)) => (rom, physics),
+        (Err(e), _) | (_, Err(e)) => {
+            return vec![failed(format!("the reduced model cannot be built: {e}")); units.len()]
+        }
     };
     let x0 = ndarray::ArrayView1::from(&physics.x0[..]);
     units
@@ -180,10 +196,13 @@ pub(super) fn screen_candidates(
     tolerance: f64,
 ) -> Vec<Option<CandidateRun>> {
     let mut out = vec![None; cands.len()];
-    let (Ok(rom), Ok(physics)) = (training_rom(model, basis, est, method), model.physics()) else {
-        // like a failed run at every candidate: one is enough to reject
-        out[order[0]] = Some(FAILED);
-        return out;
+    let (rom, physics) = match (training_rom(model, basis, est, method), model.physics()) {
+        (Ok(rom), Ok(physics)) => (rom, physics),
+        (Err(e), _) | (_, Err(e)) => {
+            // like a failed run at every candidate: one is enough to reject
+            out[order[0]] = Some(failed(format!("the reduced model cannot be built: {e}")));
+            return out;
+        }
     };
     let x0 = ndarray::ArrayView1::from(&physics.x0[..]);
     let chunk = rayon::current_num_threads().max(1);

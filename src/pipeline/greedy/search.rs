@@ -66,6 +66,11 @@ impl Level {
         self.worst_where(|_| true).expect("at least two candidates")
     }
 
+    /// The candidates whose reduced run or estimate failed, with why (the runs' order).
+    pub(super) fn failures(&self) -> Vec<(usize, &str)> {
+        (self.runs.iter().enumerate()).filter_map(|(i, r)| Some((i, r.as_ref()?.failure.as_deref()?))).collect()
+    }
+
     /// Every candidate has been run.
     pub(super) fn complete(&self) -> bool {
         self.evaluated.iter().all(|&e| e)
@@ -357,7 +362,7 @@ impl Level {
         let missing: Vec<usize> = (0..candidates.len()).filter(|&i| !self.evaluated[i]).collect();
         let (basis, est) = (&self.trained.basis, &self.estimator);
         let new = estimate_candidates(&p.model, basis, est, candidates, label, (method, measure_of(p)), &missing);
-        let runs = self.runs.iter().zip(new).map(|(old, new)| new.or(*old)).collect();
+        let runs = self.runs.iter().zip(new).map(|(old, new)| new.or_else(|| old.clone())).collect();
         self.record(p, runs);
         self.look_between(p, candidates, method);
     }
