@@ -148,8 +148,13 @@ pub fn check_own_file(output: &Path, origin: Origin, kinds: &[Kind]) -> Result<(
             format!("exists and {what}; flexrom replaces only its own {names} files: remove it or choose another path"),
         ))
     };
-    let Ok(f) = hdf5::File::open(output) else {
-        return refuse("is not an HDF5 file flexrom wrote".into());
+    let f = match hdf5::File::open(output) {
+        Ok(f) => f,
+        // flexrom's own file, perhaps, held open by another handle: say so, not "foreign"
+        Err(e) if e.to_string().contains("unable to lock file") => {
+            return Err(origin.error(output, format!("exists and {}", super::h5::unreadable(&e))))
+        }
+        Err(_) => return refuse("is not an HDF5 file flexrom wrote".into()),
     };
     match super::h5::read_attr_str(&f, KIND_ATTR) {
         Ok(kind) if kinds.iter().any(|k| k.name() == kind) => Ok(()),
