@@ -730,7 +730,7 @@ impl PyBasis {
         let extrapolated = rom.is_extrapolated(&mu);
         let mut warnings: Vec<String> = estimate
             .as_ref()
-            .and_then(|e| flexrom::rom::trust::estimate_failed(&format!("{mu}"), e))
+            .and_then(|e| flexrom::rom::trust::estimate_failed(&format!("{mu}"), e.failure.as_deref()))
             .into_iter()
             .collect();
         warnings.extend(

@@ -98,7 +98,9 @@ impl Args {
         warn(notice.as_slice());
         let measure = rom.tolerance_measure();
         warn(&rom.untrained_parameters(&mu));
-        if let Some(w) = estimate.as_ref().and_then(|e| flexrom::rom::trust::estimate_failed(&format!("{mu}"), e)) {
+        if let Some(w) =
+            estimate.as_ref().and_then(|e| flexrom::rom::trust::estimate_failed(&format!("{mu}"), e.failure.as_deref()))
+        {
             warn(&[w]);
         }
         super::check_runs(&rom, &[(mu.clone(), estimate.as_ref().map(|e| e.in_measure(measure)))], strict)

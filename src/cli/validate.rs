@@ -83,10 +83,7 @@ impl Args {
         let measure = rom.tolerance_measure();
         let runs: Vec<_> = points.iter().cloned().zip(vs.iter().map(|v| v.estimate_in(measure))).collect();
         let failed: Vec<String> = (points.iter().zip(&vs))
-            .filter_map(|(mu, v)| {
-                let why = v.estimate_failure.as_deref()?;
-                Some(format!("no error estimate at {mu}: the estimator's own run failed ({why})"))
-            })
+            .filter_map(|(mu, v)| flexrom::rom::trust::estimate_failed(&format!("{mu}"), v.estimate_failure.as_deref()))
             .collect();
         warn(&failed);
         let mut outside: Vec<String> = points.iter().flat_map(|mu| rom.untrained_parameters(mu)).collect();

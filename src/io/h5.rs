@@ -190,12 +190,17 @@ pub fn read_attr_f64(loc: &hdf5::Location, name: &str) -> hdf5::Result<f64> {
     loc.attr(name)?.read_scalar::<f64>()
 }
 
+/// Whether an HDF5 open failed on a lock another handle holds (HDF5's file locking).
+pub fn is_locked(e: &hdf5::Error) -> bool {
+    e.to_string().contains("unable to lock file")
+}
+
 /// Why an HDF5 file could not be opened, for a message that follows the file's name: a lock
 /// held by another open handle (an h5py `File` in the same Python process, another program
 /// writing it) said as such, anything else as a file that is not readable HDF5.
 pub fn unreadable(e: &hdf5::Error) -> String {
     let text = e.to_string();
-    if text.contains("unable to lock file") {
+    if is_locked(e) {
         format!("is locked by another open handle (an h5py File still open, or a program writing it): close it first, or set HDF5_USE_FILE_LOCKING=FALSE to share it read-only ({text})")
     } else {
         format!("is not a readable HDF5 file (truncated or of another format?): {text}")

@@ -151,7 +151,7 @@ pub fn check_own_file(output: &Path, origin: Origin, kinds: &[Kind]) -> Result<(
     let f = match hdf5::File::open(output) {
         Ok(f) => f,
         // flexrom's own file, perhaps, held open by another handle: say so, not "foreign"
-        Err(e) if e.to_string().contains("unable to lock file") => {
+        Err(e) if super::h5::is_locked(&e) => {
             return Err(origin.error(output, format!("exists and {}", super::h5::unreadable(&e))))
         }
         Err(_) => return refuse("is not an HDF5 file flexrom wrote".into()),

@@ -172,13 +172,13 @@ pub fn describe(e: &Estimate, method: &str, rom_seconds: f64) -> String {
 }
 
 /// The warning for an estimate whose estimator's own model failed at `at` (a load, or a
-/// point of a box): the estimate reads ∞ and the reason is the estimator's error; `None`
-/// when the estimate was computed.
-pub fn estimate_failed(at: &str, e: &Estimate) -> Option<String> {
-    let why = e.failure.as_deref()?;
+/// point of a box) for the reason `why` (the estimate's `failure`): the estimate reads ∞;
+/// `None` when it was computed.
+pub fn estimate_failed(at: &str, why: Option<&str>) -> Option<String> {
+    let why = why?;
     Some(format!(
         "no error estimate at {at}: the estimator's own run failed ({why}); the estimate reads ∞ and nothing bounds \
-         this reduced answer's error: compare it with the full model there (`validate`, `sweep --full`)"
+         this reduced answer's error but a full run there (`validate`, `sweep --full`)"
     ))
 }
 

@@ -57,6 +57,18 @@ pub(super) fn training_rom(model: &Arc<Model>, basis: &Basis, est: &Estimator, m
     Rom::new(model, &basis, Some(e), None)
 }
 
+/// [`training_rom`] and the model's physics (for X₀), or why they cannot be had, as the
+/// failure every candidate of the rung then reads.
+fn training_setup<'m>(
+    model: &'m Arc<Model>,
+    basis: &Basis,
+    est: &Estimator,
+    method: EstimateMethod,
+) -> std::result::Result<(Rom, &'m crate::model::SharedPhysics), CandidateRun> {
+    let cannot = |e: crate::error::Error| failed(format!("the reduced model cannot be built: {e}"));
+    Ok((training_rom(model, basis, est, method).map_err(cannot)?, model.physics().map_err(cannot)?))
+}
+
 /// The seam to the error estimator: the estimate and the reduced model's sensitivity of
 /// `basis` at the candidates `which` (`None` at the others) in `measure` (the sensitivity's
 /// displacement form divides by `‖X_r(λ) − X₀‖`), reduced runs in parallel (one reduced
@@ -83,10 +95,10 @@ pub(super) fn estimate_candidates(
     bar.set_prefix(label.to_string());
     // no log lines of its own (the loop says what each iteration did): the count for a host
     let ticker = crate::output::ticker::Ticker::new(label, which.len() as u64, false);
-    let (rom, physics) = match (training_rom(model, basis, est, method), model.physics()) {
-        (Ok(rom), Ok(physics)) => (rom, physics),
-        (Err(e), _) | (_, Err(e)) => {
-            which.iter().for_each(|&i| out[i] = Some(failed(format!("the reduced model cannot be built: {e}"))));
+    let (rom, physics) = match training_setup(model, basis, est, method) {
+        Ok(s) => s,
+        Err(f) => {
+            which.iter().for_each(|&i| out[i] = Some(f.clone()));
             return out;
         }
     };
@@ -165,11 +177,9 @@ pub(super) fn estimate_points(
     units: &[Vec<f64>],
     (method, measure): (EstimateMethod, ErrorMeasure),
 ) -> Vec<CandidateRun> {
-    let (rom, physics) = match (training_rom(model, basis, est, method), model.physics()) {
-        (Ok(rom), Ok(physics)) => (rom, physics),
-        (Err(e), _) | (_, Err(e)) => {
-            return vec![failed(format!("the reduced model cannot be built: {e}")); units.len()]
-        }
+    let (rom, physics) = match training_setup(model, basis, est, method) {
+        Ok(s) => s,
+        Err(f) => return vec![f; units.len()],
     };
     let x0 = ndarray::ArrayView1::from(&physics.x0[..]);
     units
@@ -196,11 +206,11 @@ pub(super) fn screen_candidates(
     tolerance: f64,
 ) -> Vec<Option<CandidateRun>> {
     let mut out = vec![None; cands.len()];
-    let (rom, physics) = match (training_rom(model, basis, est, method), model.physics()) {
-        (Ok(rom), Ok(physics)) => (rom, physics),
-        (Err(e), _) | (_, Err(e)) => {
+    let (rom, physics) = match training_setup(model, basis, est, method) {
+        Ok(s) => s,
+        Err(f) => {
             // like a failed run at every candidate: one is enough to reject
-            out[order[0]] = Some(failed(format!("the reduced model cannot be built: {e}")));
+            out[order[0]] = Some(f);
             return out;
         }
     };
