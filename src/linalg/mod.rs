@@ -5,6 +5,7 @@ pub mod banded;
 pub mod banded_ldlt;
 pub mod banded_order;
 pub mod dense_lu;
+pub(crate) mod incremental_product;
 pub mod kkt;
 pub mod kkt_pattern;
 pub mod nnls;

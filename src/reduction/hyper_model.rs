@@ -39,6 +39,7 @@ mod sampled;
 use super::basis::Basis;
 use super::projection::{forward_to_projection, impl_reduced, Projection};
 use super::sample::Hyper;
+use crate::linalg::incremental_product::IncrementalProduct;
 use crate::linalg::sparse_rows::SparseRows;
 use crate::solver::model::{
     stiffness_groups, InvariantElementModel, IterationCoefficients, Parameters, ParametricModel,
@@ -57,6 +58,10 @@ pub struct HyperReducedModel<M: InvariantElementModel> {
     l_rows: SparseRows,
     l0: Array1<f64>,
     c_rows: Option<SparseRows>,
+    /// `L_r q` and `C_r q̇`, kept by increments: with the rigid motion in `q` their direct
+    /// products round far above Newton's tolerance ([`IncrementalProduct`])
+    l_q: IncrementalProduct,
+    c_v: IncrementalProduct,
     /// the sampled elements by groups that see the same columns of `V`, with `Sⱼ`, `Gₑⱼ`
     /// and the invariants of the last update ([`Sampled`])
     sampled: Sampled,
@@ -205,6 +210,8 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
             l_rows,
             l0,
             c_rows,
+            l_q: IncrementalProduct::new(r, r),
+            c_v: IncrementalProduct::new(r, r),
             sampled,
             at: vec![0.0; r],
             valid: false,
@@ -234,6 +241,7 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
             l0.scaled_add(f, l0g);
         }
         self.l_rows = SparseRows::new(&l_r);
+        self.l_q.reset();
         self.l0 = l0;
         self.p.set_linear_stiffness(l_r);
         for (k, (w, &g)) in split.weights.iter().zip(&split.sample_group).enumerate() {
@@ -250,13 +258,18 @@ impl<M: InvariantElementModel> ParametricModel for HyperReducedModel<M> {
         self.bind_parameters(mu);
     }
 
+    fn start_run(&mut self) {
+        self.l_q.reset();
+        self.c_v.reset();
+    }
+
     fn force(&mut self, mu: &Parameters, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
         self.bind_parameters(mu);
         self.p.constant_and_load_force(&*self.full, mu, q, t, out);
-        self.l_rows.mul(q, out, true);
+        self.l_q.add_product(&self.l_rows, q, out);
         out.iter_mut().zip(&self.l0).for_each(|(o, l)| *o += l);
         if let Some(c) = &self.c_rows {
-            c.mul(v, out, true);
+            self.c_v.add_product(c, v, out);
         }
         self.update(q);
         self.add_force(out);

@@ -115,6 +115,9 @@ pub trait ParametricModel {
     fn max_strain(&self, _q: &[f64]) -> Option<(f64, usize)> {
         None
     }
+    /// A run starts: forget what was kept from earlier evaluations (products kept by
+    /// increments), so that a run does not depend on the runs before it. Nothing by default.
+    fn start_run(&mut self) {}
 }
 
 /// A model bound to the parameters of one run: what the integrator sees.
@@ -125,6 +128,7 @@ pub struct Bound<'a, M: ?Sized> {
 
 impl<'a, M: ParametricModel + ?Sized> Bound<'a, M> {
     pub fn new(model: &'a mut M, mu: &Parameters) -> Self {
+        model.start_run();
         model.bind(mu);
         Bound { model, mu: mu.clone() }
     }
