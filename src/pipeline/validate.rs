@@ -102,7 +102,8 @@ pub struct Validation {
     /// `rel_error_by_time` (the last is error_estimate; null: no estimator)
     pub error_estimate_by_time: Option<Vec<f64>>,
     /// `‖X_rom − X_full‖_F / ‖X_full − X₀‖_F`: the error against the motion from the
-    /// initial configuration X₀ (`ErrorMeasure::Displacement`)
+    /// initial configuration X₀ (`ErrorMeasure::Displacement`); NaN (JSON null) where the
+    /// full run does not move beyond the Newton tolerance, ∞ where the reduced one does
     pub displacement_error: f64,
     /// displacement_error up to the end of each fifth of the run (the last is displacement_error)
     pub displacement_error_by_time: Vec<f64>,
@@ -138,8 +139,9 @@ pub struct ProbeTravel {
 
 impl ProbeTravel {
     /// The error of the probe positions `rom` against `full` (n_t × 2 each) over the
-    /// full run's travel.
-    pub fn of(name: &str, full: &ndarray::Array2<f64>, rom: &ndarray::Array2<f64>) -> ProbeTravel {
+    /// full run's travel; none for a probe whose travel is within `resolution` (the
+    /// coordinates' resolution, the Newton tolerance `tol · L`).
+    pub fn of(name: &str, full: &ndarray::Array2<f64>, rom: &ndarray::Array2<f64>, resolution: f64) -> ProbeTravel {
         let dist = |a: [f64; 2], b: [f64; 2]| ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt();
         let at = |x: &ndarray::Array2<f64>, k: usize| [x[[k, 0]], x[[k, 1]]];
         let (mut max_error, mut travel) = (0.0_f64, 0.0_f64);
@@ -147,7 +149,7 @@ impl ProbeTravel {
             max_error = max_error.max(dist(at(rom, k), at(full, k)));
             travel = travel.max(dist(at(full, k), at(full, 0)));
         }
-        let error_over_travel = (travel > 0.0).then(|| max_error / travel);
+        let error_over_travel = (travel > resolution).then(|| max_error / travel);
         ProbeTravel { probe: name.to_string(), max_error, travel, error_over_travel }
     }
 }
@@ -180,14 +182,17 @@ pub fn compare(
             &owned
         }
     };
-    let travels: Vec<ProbeTravel> =
-        full.probes.iter().zip(&r.probes).map(|((name, a), (_, b))| ProbeTravel::of(name, a, b)).collect();
+    // the coordinates' resolution: the Newton tolerance, in length units
+    let resolution = full.settings.params.tolerance * sys.length_scale();
+    let travels: Vec<ProbeTravel> = (full.probes.iter().zip(&r.probes))
+        .map(|((name, a), (_, b))| ProbeTravel::of(name, a, b, resolution))
+        .collect();
     let worst_travel = travels
         .iter()
         .filter_map(|p| p.error_over_travel.map(|e| (e, p.probe.clone())))
         .fold(None::<(f64, String)>, |w, (e, n)| if w.as_ref().is_none_or(|w| e > w.0) { Some((e, n)) } else { w });
     let x0 = full.q.column(0);
-    let displacement_error_by_time = displacement_error_by_time(&r.q, &full.q, x0).to_vec();
+    let displacement_error_by_time = displacement_error_by_time(&r.q, &full.q, x0, resolution).to_vec();
     let mut res = vec![0.0; sys.n_constraints()];
     let mut viol = 0.0_f64;
     for k in 0..r.q.ncols() {
@@ -456,11 +461,18 @@ impl Validation {
     /// The lines of the errors against the motion: displacement_error (and its estimate),
     /// each probe's error over its travel.
     fn motion_lines(&self) -> String {
-        let mut s = format!(
-            "\n  displacement_error {:.3e} (against the motion from the initial configuration)",
-            self.displacement_error
-        );
-        if let (Some(e), Some(f)) = (self.error_estimate_displacement, self.effectivity_displacement) {
+        let mut s = if self.displacement_error.is_nan() {
+            "\n  displacement_error: none (the full run does not move beyond the Newton tolerance)".to_string()
+        } else {
+            format!(
+                "\n  displacement_error {:.3e} (against the motion from the initial configuration)",
+                self.displacement_error
+            )
+        };
+        // (no effectivity against an undefined error)
+        if let (Some(e), Some(f), false) =
+            (self.error_estimate_displacement, self.effectivity_displacement, self.displacement_error.is_nan())
+        {
             s.push_str(&format!(", error_estimate_displacement {e:.3e}, effectivity {f:.2}"));
         }
         for p in &self.probe_errors_over_travel {
@@ -469,7 +481,9 @@ impl Validation {
                 p.probe,
                 p.max_error,
                 p.travel,
-                p.error_over_travel.map_or("the probe does not move".to_string(), |e| format!("{e:.3e} of its travel"))
+                p.error_over_travel.map_or("the probe does not move (beyond the Newton tolerance)".to_string(), |e| {
+                    format!("{e:.3e} of its travel")
+                })
             ));
         }
         s
@@ -502,10 +516,14 @@ mod tests {
         let mut rom = full.clone();
         rom[[2, 0]] += 0.006;
         rom[[2, 1]] += 0.008;
-        let p = ProbeTravel::of("tip", &full, &rom);
+        let p = ProbeTravel::of("tip", &full, &rom, 1e-10);
         assert!((p.travel - 1.5).abs() < 1e-15 && (p.max_error - 0.01).abs() < 1e-15, "{p:?}");
         assert!((p.error_over_travel.unwrap() - 0.01 / 1.5).abs() < 1e-15, "{p:?}");
         let still = ndarray::Array2::from_elem((4, 2), 1.0);
-        assert_eq!(ProbeTravel::of("pin", &still, &(&still + 1e-3)).error_over_travel, None);
+        assert_eq!(ProbeTravel::of("pin", &still, &(&still + 1e-3), 1e-10).error_over_travel, None);
+        // nor one that moved within the resolution
+        let mut crawl = still.clone();
+        crawl[[3, 0]] += 1e-11;
+        assert_eq!(ProbeTravel::of("pin", &crawl, &(&still + 1e-3), 1e-10).error_over_travel, None);
     }
 }

@@ -188,9 +188,14 @@ pub fn rel_error_by_time(a: &Array2<f64>, b: &Array2<f64>) -> ByFifth {
 
 /// `displacement_error` of `a` against `b` over the instants `..k`, for the end of each
 /// fifth of the run: `‖A[:, ..k] − B[:, ..k]‖_F / ‖B[:, ..k] − X₀‖_F`, with the initial
-/// configuration `x0` subtracted from every column of `B` (a run that has not moved yet
-/// has no displacement to measure against: ∞, or NaN when it has no error either).
-pub fn displacement_error_by_time(a: &Array2<f64>, b: &Array2<f64>, x0: ArrayView1<f64>) -> ByFifth {
+/// configuration `x0` subtracted from every column of `B`.
+///
+/// A run that has not moved more than `resolution` (the coordinates' resolution, the
+/// Newton tolerance `tol · L`) in root mean square over those instants has no displacement
+/// to measure against: ∞ where the two runs differ by more than that, else NaN. Without
+/// the floor a run at rest divided one solver's noise by the other's (the pendulum at
+/// λ = 0 read 28).
+pub fn displacement_error_by_time(a: &Array2<f64>, b: &Array2<f64>, x0: ArrayView1<f64>, resolution: f64) -> ByFifth {
     let nt = b.ncols();
     let (mut diff, mut norm) = (Array1::<f64>::zeros(nt), Array1::<f64>::zeros(nt));
     for k in 0..nt {
@@ -199,7 +204,16 @@ pub fn displacement_error_by_time(a: &Array2<f64>, b: &Array2<f64>, x0: ArrayVie
     }
     std::array::from_fn(|i| {
         let end = fifth_end(nt, i);
-        (diff.slice(ndarray::s![..end]).sum() / norm.slice(ndarray::s![..end]).sum()).sqrt()
+        let (d, n) = (diff.slice(ndarray::s![..end]).sum(), norm.slice(ndarray::s![..end]).sum());
+        // the squared norm of `end` instants of coordinates each at the resolution
+        let floor = (end * b.nrows()) as f64 * resolution * resolution;
+        if n > floor {
+            (d / n).sqrt()
+        } else if d > floor {
+            f64::INFINITY
+        } else {
+            f64::NAN
+        }
     })
 }
 
@@ -297,7 +311,7 @@ mod tests {
         let w = Array1::from_shape_fn(n, |i| if i == 2 { 1.0 } else { 0.0 });
         let full = Array2::from_shape_fn((n, nt), |(i, k)| x0[i] + k as f64 * u[i]);
         let reduced = Array2::from_shape_fn((n, nt), |(i, k)| full[[i, k]] + c * w[i]);
-        let got = displacement_error_by_time(&reduced, &full, x0.view());
+        let got = displacement_error_by_time(&reduced, &full, x0.view(), 1e-10);
         for (i, g) in got.iter().enumerate() {
             let e = fifth_end(nt, i) as f64;
             let want = e.sqrt() * c / (0.5 * ((e - 1.0) * e * (2.0 * e - 1.0) / 6.0).sqrt());
@@ -306,10 +320,17 @@ mod tests {
         }
         let rel = rel_error_by_time(&reduced, &full);
         assert!(rel[4] < got[4] / 2.0, "rel_error {} against displacement_error {}", rel[4], got[4]);
-        // a run that has not moved has no displacement to measure against
+        // a run that has not moved has no displacement to measure against, nor one that
+        // moved less than the resolution (the pendulum at λ = 0 read 28 without the floor)
         let still = Array2::from_shape_fn((n, nt), |(i, _)| x0[i]);
-        assert!(displacement_error_by_time(&still, &still, x0.view())[4].is_nan());
-        assert!(displacement_error_by_time(&(&still + 1e-3), &still, x0.view())[4].is_infinite());
+        assert!(displacement_error_by_time(&still, &still, x0.view(), 1e-10)[4].is_nan());
+        assert!(displacement_error_by_time(&(&still + 1e-3), &still, x0.view(), 1e-10)[4].is_infinite());
+        let noise = |a: f64| Array2::from_shape_fn((n, nt), |(i, k)| x0[i] + a * ((i * nt + k) as f64).sin());
+        assert!(displacement_error_by_time(&noise(3e-11), &noise(-2e-11), x0.view(), 1e-10)[4].is_nan());
+        assert!(displacement_error_by_time(&noise(1e-9), &noise(-2e-11), x0.view(), 1e-10)[4].is_infinite());
+        // one resolved: a displacement of 1e-9 per coordinate against a resolution of 1e-10
+        let moved = displacement_error_by_time(&noise(1.1e-9), &noise(1e-9), x0.view(), 1e-10)[4];
+        assert!((moved - 0.1).abs() < 1e-6, "{moved}");
     }
 
     /// The estimate over prefixes of the run: zero while the two runs agree; non-decreasing
