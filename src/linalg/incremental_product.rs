@@ -10,8 +10,8 @@
 //! ε ‖|A||x − x_last|‖, which shrinks with Newton's corrections; the error already in `y`
 //! stays as it is, a bias of the direct product's size that Newton converges through.
 //! The product is formed directly again once the path `Σ ‖x_k − x_{k−1}‖∞` since the last
-//! direct product exceeds the `‖x‖∞` it was formed at: from there the rounding of the
-//! increments, summed, could exceed a direct product's.
+//! direct product exceeds the `‖x‖∞` it was formed at, or the current one: from there the
+//! rounding of the increments, summed, could exceed a direct product's.
 
 use super::sparse_rows::SparseRows;
 use super::vec_ops::max_abs;
@@ -48,14 +48,18 @@ impl IncrementalProduct {
 
     /// `out += A x`, `A` the matrix of every call since the last [`Self::reset`].
     pub(crate) fn add_product(&mut self, a: &SparseRows, x: &[f64], out: &mut [f64]) {
-        let mut step = 0.0_f64;
+        let mut step = f64::INFINITY;
         if self.valid {
             for ((d, &xi), &xl) in self.dx.iter_mut().zip(x).zip(&self.x) {
                 *d = xi - xl;
-                step = step.max(d.abs());
             }
+            // NaN reads as ∞ (max_abs): a non-finite x takes the direct product
+            step = max_abs(&self.dx);
         }
-        if !self.valid || self.path + step > self.scale {
+        // the smaller of ‖x‖∞ at the last direct product and now: a direct product at a
+        // far iterate (a Newton attempt that diverged, then the step retried from its start)
+        // must not license a long path back
+        if !(self.path + step <= self.scale.min(max_abs(x))) {
             a.mul(x, &mut self.y, false);
             (self.path, self.scale, self.valid) = (0.0, max_abs(x), true);
         } else if step > 0.0 {

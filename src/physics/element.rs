@@ -76,10 +76,11 @@ fn kron_i2_mul(b: &KronCols, e: &[f64; 8]) -> [f64; 8] {
 /// `e` less the rigid translation that puts node A at the origin. The elastic terms do not
 /// change (`K_t` and `S_l` annihilate translations), their rounding does: with absolute
 /// positions `K_t e` sums terms of size EI|x|/l³ that cancel to a curvature's force, and
-/// rounds at ε_mach EI|x|/l³ — 1e-4 N for the 5000-element pendulum's 0.24 mm elements a
-/// metre from the origin, where a 1e-13 m move changes the force by 0.06 N. That rounding
-/// changes with every iterate, so it, not the Newton tolerance, decided where Newton
-/// stopped (the "steps at the round-off floor" of `simulate -v`: 123 of 220 steps there).
+/// rounds at a few ε_mach EI|x|/l³ — 4e-4 N for the 5000-element pendulum's 0.24 mm
+/// elements a metre from the origin, where a 1e-13 m move of a node changes the force by
+/// 0.74 N (12 EI/l³ · 1e-13 m). That rounding changes with every iterate, so it, not the
+/// Newton tolerance, decided where Newton stopped (the "steps at the round-off floor" of
+/// `simulate -v`: 123 of that pendulum's 220 steps at λ = 1).
 /// The differences of nearby positions are exact (Sterbenz), and from them every term is
 /// of the size of the result.
 #[inline(always)]
@@ -435,11 +436,11 @@ mod tests {
     }
 
     /// A 0.24 mm element (the 5000-element pendulum's) a metre from the origin, bent and
-    /// stretched a little: moving one node by 1e-13 m changes its elastic force as the
-    /// tangent says, to 1e-6 of the change (measured 8e-9). The force summed over the
-    /// absolute coordinates, as computed before 2026-11-27, rounds at ε_mach |K_t||x| ≈
-    /// 1e-4 N and misses the change by 5e-4 of it: that noise, not the tolerance, decided
-    /// where Newton stopped on fine meshes. The test fails without [`without_translation`].
+    /// stretched a little: moving one node by 1e-13 m changes its elastic force (by 0.74 N)
+    /// as the tangent says, to 1e-6 of the change (measured 8e-9). The force summed over the
+    /// absolute coordinates, as computed before 2026-11-27, rounds at a few ε_mach |K_t||x|
+    /// and misses the change by 5e-4 of it: that noise, not the tolerance, decided where
+    /// Newton stopped on fine meshes. The test fails without [`without_translation`].
     #[test]
     fn the_force_of_a_small_element_far_from_the_origin_follows_its_tangent() {
         let (l, angle) = (1.2 / 5000.0, 0.6_f64);

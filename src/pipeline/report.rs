@@ -461,24 +461,26 @@ fn motion_section(
     let _ = writeln!(md, "| {head} | rel_error | displacement_error | error_estimate_displacement | effectivity | displacement_error by fifth of the run | probe error over its travel |");
     let _ = writeln!(md, "|---|---|---|---|---|---|---|");
     for (v, label) in validations.iter().zip(labels) {
-        let by: Vec<String> = v.displacement_error_by_time.iter().map(|e| format!("{e:.2e}")).collect();
+        // none: the full run has not moved beyond the Newton tolerance yet
+        let fmt = |e: f64| if e.is_nan() { "none".to_string() } else { format!("{e:.2e}") };
+        let by: Vec<String> = v.displacement_error_by_time.iter().map(|&e| fmt(e)).collect();
         let probes: Vec<String> = v
             .probe_errors_over_travel
             .iter()
             .map(|p| match p.error_over_travel {
                 Some(e) => format!("{} {e:.2e} ({:.2e} m of {:.3} m)", p.probe, p.max_error, p.travel),
-                None => format!("{} (does not move)", p.probe),
+                None => format!("{} (does not move beyond the Newton tolerance)", p.probe),
             })
             .collect();
         let o = |x: Option<f64>, f: &dyn Fn(f64) -> String| x.map_or("–".to_string(), f);
         let _ = writeln!(
             md,
-            "| {} | {:.3e} | {:.3e} | {} | {} | {} | {} |",
+            "| {} | {:.3e} | {} | {} | {} | {} | {} |",
             label,
             v.rel_error,
-            v.displacement_error,
+            fmt(v.displacement_error),
             o(v.error_estimate_displacement, &|x| format!("{x:.3e}")),
-            o(v.effectivity_displacement, &|x| format!("{x:.2}")),
+            o(v.effectivity_displacement.filter(|_| v.displacement_error.is_finite()), &|x| format!("{x:.2}")),
             by.join(", "),
             probes.join("; ")
         );

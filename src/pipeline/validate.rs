@@ -102,8 +102,9 @@ pub struct Validation {
     /// `rel_error_by_time` (the last is error_estimate; null: no estimator)
     pub error_estimate_by_time: Option<Vec<f64>>,
     /// `‖X_rom − X_full‖_F / ‖X_full − X₀‖_F`: the error against the motion from the
-    /// initial configuration X₀ (`ErrorMeasure::Displacement`); NaN (JSON null) where the
-    /// full run does not move beyond the Newton tolerance, ∞ where the reduced one does
+    /// initial configuration X₀ (`ErrorMeasure::Displacement`); NaN where the full run
+    /// does not move beyond the Newton tolerance, ∞ where only the reduced one does (JSON
+    /// writes both as null; `max_error_over_travel` and the probes tell them apart)
     pub displacement_error: f64,
     /// displacement_error up to the end of each fifth of the run (the last is displacement_error)
     pub displacement_error_by_time: Vec<f64>,
@@ -139,8 +140,9 @@ pub struct ProbeTravel {
 
 impl ProbeTravel {
     /// The error of the probe positions `rom` against `full` (n_t × 2 each) over the
-    /// full run's travel; none for a probe whose travel is within `resolution` (the
-    /// coordinates' resolution, the Newton tolerance `tol · L`).
+    /// full run's travel; for a probe whose travel is within `resolution` (the coordinates'
+    /// resolution, the Newton tolerance `tol · L`) none, or ∞ where the reduced one moved
+    /// by more than that.
     pub fn of(name: &str, full: &ndarray::Array2<f64>, rom: &ndarray::Array2<f64>, resolution: f64) -> ProbeTravel {
         let dist = |a: [f64; 2], b: [f64; 2]| ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt();
         let at = |x: &ndarray::Array2<f64>, k: usize| [x[[k, 0]], x[[k, 1]]];
@@ -149,7 +151,12 @@ impl ProbeTravel {
             max_error = max_error.max(dist(at(rom, k), at(full, k)));
             travel = travel.max(dist(at(full, k), at(full, 0)));
         }
-        let error_over_travel = (travel > resolution).then(|| max_error / travel);
+        // a probe at rest: no travel to measure against, unless the reduced one moved
+        let error_over_travel = if travel > resolution {
+            Some(max_error / travel)
+        } else {
+            (max_error > resolution).then_some(f64::INFINITY)
+        };
         ProbeTravel { probe: name.to_string(), max_error, travel, error_over_travel }
     }
 }
@@ -463,15 +470,18 @@ impl Validation {
     fn motion_lines(&self) -> String {
         let mut s = if self.displacement_error.is_nan() {
             "\n  displacement_error: none (the full run does not move beyond the Newton tolerance)".to_string()
+        } else if self.displacement_error.is_infinite() {
+            "\n  displacement_error: ∞ (the reduced run moves where the full one does not beyond the Newton tolerance)"
+                .to_string()
         } else {
             format!(
                 "\n  displacement_error {:.3e} (against the motion from the initial configuration)",
                 self.displacement_error
             )
         };
-        // (no effectivity against an undefined error)
-        if let (Some(e), Some(f), false) =
-            (self.error_estimate_displacement, self.effectivity_displacement, self.displacement_error.is_nan())
+        // (no effectivity against an undefined or infinite error)
+        if let (Some(e), Some(f), true) =
+            (self.error_estimate_displacement, self.effectivity_displacement, self.displacement_error.is_finite())
         {
             s.push_str(&format!(", error_estimate_displacement {e:.3e}, effectivity {f:.2}"));
         }
@@ -520,10 +530,11 @@ mod tests {
         assert!((p.travel - 1.5).abs() < 1e-15 && (p.max_error - 0.01).abs() < 1e-15, "{p:?}");
         assert!((p.error_over_travel.unwrap() - 0.01 / 1.5).abs() < 1e-15, "{p:?}");
         let still = ndarray::Array2::from_elem((4, 2), 1.0);
-        assert_eq!(ProbeTravel::of("pin", &still, &(&still + 1e-3), 1e-10).error_over_travel, None);
-        // nor one that moved within the resolution
+        assert_eq!(ProbeTravel::of("pin", &still, &still, 1e-10).error_over_travel, None);
+        // nor one that moved within the resolution; where the reduced one moved: ∞
         let mut crawl = still.clone();
         crawl[[3, 0]] += 1e-11;
-        assert_eq!(ProbeTravel::of("pin", &crawl, &(&still + 1e-3), 1e-10).error_over_travel, None);
+        assert_eq!(ProbeTravel::of("pin", &crawl, &(&still + 2e-11), 1e-10).error_over_travel, None);
+        assert_eq!(ProbeTravel::of("pin", &crawl, &(&still + 1e-3), 1e-10).error_over_travel, Some(f64::INFINITY));
     }
 }
