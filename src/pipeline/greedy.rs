@@ -403,10 +403,19 @@ fn check_method(
         )
     } else if switch {
         format!("{head}; the enriched model reads {eff_ref:.3}× there: the loop and this basis's estimates use `enriched` from here")
-    } else if eff < 1.0 {
-        format!("{head}, the enriched model {eff_ref:.3}×: the calibration factor is raised to cover it")
     } else {
-        format!("{head}, the enriched model {eff_ref:.3}×: on this model the estimate reads far above the error, and greedy training may spend its full runs where the basis is already good enough")
+        // the same reading to the last digits: the method read the enriched model itself
+        // there (a `corrected` run whose correction did not converge falls back to it)
+        let reference = if (eff - eff_ref).abs() <= 1e-12 * eff.abs() {
+            "the enriched model's own reading there, which it fell back to".to_string()
+        } else {
+            format!("the enriched model {eff_ref:.3}×")
+        };
+        if eff < 1.0 {
+            format!("{head}, {reference}: the calibration factor is raised to cover it")
+        } else {
+            format!("{head}, {reference}: on this model the estimate reads far above the error, and greedy training may spend its full runs where the basis is already good enough")
+        }
     };
     Some(MethodCheck { switch, raw: reading.raw, message })
 }
