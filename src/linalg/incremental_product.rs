@@ -21,10 +21,10 @@ pub(crate) struct IncrementalProduct {
     x: Vec<f64>,
     y: Vec<f64>,
     dx: Vec<f64>,
-    /// `Σ ‖x_k − x_{k−1}‖∞` since the last direct product, and `‖x‖∞` there
+    /// `Σ ‖x_k − x_{k−1}‖∞` since the last direct product (∞: none yet, or reset), and
+    /// `‖x‖∞` there
     path: f64,
     scale: f64,
-    valid: bool,
 }
 
 impl IncrementalProduct {
@@ -34,34 +34,30 @@ impl IncrementalProduct {
             x: vec![0.0; cols],
             y: vec![0.0; rows],
             dx: vec![0.0; cols],
-            path: 0.0,
+            path: f64::INFINITY,
             scale: 0.0,
-            valid: false,
         }
     }
 
     /// Forgets `y`: the next product is direct (after `A` changed, or where a run must not
     /// depend on the evaluations before it).
     pub(crate) fn reset(&mut self) {
-        self.valid = false;
+        self.path = f64::INFINITY;
     }
 
     /// `out += A x`, `A` the matrix of every call since the last [`Self::reset`].
     pub(crate) fn add_product(&mut self, a: &SparseRows, x: &[f64], out: &mut [f64]) {
-        let mut step = f64::INFINITY;
-        if self.valid {
-            for ((d, &xi), &xl) in self.dx.iter_mut().zip(x).zip(&self.x) {
-                *d = xi - xl;
-            }
-            // NaN reads as ∞ (max_abs): a non-finite x takes the direct product
-            step = max_abs(&self.dx);
+        for ((d, &xi), &xl) in self.dx.iter_mut().zip(x).zip(&self.x) {
+            *d = xi - xl;
         }
+        // NaN reads as ∞ (max_abs): a non-finite x takes the direct product
+        let (step, size) = (max_abs(&self.dx), max_abs(x));
         // the smaller of ‖x‖∞ at the last direct product and now: a direct product at a
         // far iterate (a Newton attempt that diverged, then the step retried from its start)
         // must not license a long path back
-        if !(self.path + step <= self.scale.min(max_abs(x))) {
+        if !(self.path + step <= self.scale.min(size)) {
             a.mul(x, &mut self.y, false);
-            (self.path, self.scale, self.valid) = (0.0, max_abs(x), true);
+            (self.path, self.scale) = (0.0, size);
         } else if step > 0.0 {
             a.mul(&self.dx, &mut self.y, true);
             self.path += step;

@@ -191,11 +191,18 @@ impl BeamElement {
     /// elements runs for several elements at once before it writes their blocks).
     #[inline(always)]
     pub fn iteration_scalars(&self, k: f64, e: &Vec8) -> (Vec8, f64, f64) {
-        let e = &Vec8::from(without_translation(&(*e).into()));
-        let sle = self.axial_product(e);
-        let eps = e.dot(&sle) / (2.0 * self.length) - 0.5;
+        let (_, sle, eps) = self.axial_state(e);
         let ea = self.section.ea();
         (sle, k * ea * eps, k * ea / self.length)
+    }
+
+    /// `e` without its translation ([`without_translation`]), `S_l e` and `ε̄` from it.
+    #[inline(always)]
+    fn axial_state(&self, e: &Vec8) -> (Vec8, Vec8, f64) {
+        let e = Vec8::from(without_translation(&(*e).into()));
+        let sle = self.axial_product(&e);
+        let eps = e.dot(&sle) / (2.0 * self.length) - 0.5;
+        (e, sle, eps)
     }
 
     /// The block `constant + a S_l + b (S_l e)(S_l e)ᵀ` from [`Self::iteration_scalars`].
@@ -220,14 +227,12 @@ impl BeamElement {
 
     /// Mean Green strain `ε̄ = eᵀS_l e/(2l) − ½`; zero under rigid motion.
     pub fn mean_axial_strain(&self, e: &Vec8) -> f64 {
-        let e = &Vec8::from(without_translation(&(*e).into()));
-        e.dot(&self.axial_product(e)) / (2.0 * self.length) - 0.5
+        self.axial_state(e).2
     }
 
     /// Strain energy `U = ½ eᵀK_t e + ½ EA l ε̄²`.
     pub fn strain_energy(&self, e: &Vec8) -> f64 {
-        let e = &Vec8::from(without_translation(&(*e).into()));
-        let eps = self.mean_axial_strain(e);
+        let (e, _, eps) = self.axial_state(e);
         0.5 * e.dot(&(self.bending * e)) + 0.5 * self.section.ea() * self.length * eps * eps
     }
 
@@ -257,9 +262,7 @@ impl BeamElement {
     /// Exact tangent `K_T = K_t + EA ε̄ S_l + (EA/l)(S_l e)(S_l e)ᵀ` alone (the Newton matrix
     /// needs no force: the residual has computed it already).
     pub fn tangent(&self, e: &Vec8) -> Mat8 {
-        let e = &Vec8::from(without_translation(&(*e).into()));
-        let sle = self.axial_product(e);
-        let eps = e.dot(&sle) / (2.0 * self.length) - 0.5;
+        let (_, sle, eps) = self.axial_state(e);
         let ea = self.section.ea();
         self.bending + self.axial * (ea * eps) + (sle * sle.transpose()) * (ea / self.length)
     }

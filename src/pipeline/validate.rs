@@ -24,7 +24,7 @@ use super::timing::{median, repeat_timing};
 use crate::error::Result;
 use crate::linalg::kkt::LinearSolverKind;
 use crate::model::Model;
-use crate::rom::estimator::norms::{displacement_error_by_time, distance_and_norm, rel_error_by_time};
+use crate::rom::estimator::norms::{against_motion, displacement_error_by_time, distance_and_norm, rel_error_by_time};
 use crate::rom::estimator::Estimate;
 use crate::rom::{Output, ReducedRun, Rom};
 use crate::simulate::{simulate, FullModel, Overrides, SimulationResult};
@@ -151,12 +151,8 @@ impl ProbeTravel {
             max_error = max_error.max(dist(at(rom, k), at(full, k)));
             travel = travel.max(dist(at(full, k), at(full, 0)));
         }
-        // a probe at rest: no travel to measure against, unless the reduced one moved
-        let error_over_travel = if travel > resolution {
-            Some(max_error / travel)
-        } else {
-            (max_error > resolution).then_some(f64::INFINITY)
-        };
+        let ratio = against_motion(travel > resolution, max_error > resolution, || max_error / travel);
+        let error_over_travel = (!ratio.is_nan()).then_some(ratio);
         ProbeTravel { probe: name.to_string(), max_error, travel, error_over_travel }
     }
 }

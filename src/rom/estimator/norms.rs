@@ -207,14 +207,22 @@ pub fn displacement_error_by_time(a: &Array2<f64>, b: &Array2<f64>, x0: ArrayVie
         let (d, n) = (diff.slice(ndarray::s![..end]).sum(), norm.slice(ndarray::s![..end]).sum());
         // the squared norm of `end` instants of coordinates each at the resolution
         let floor = (end * b.nrows()) as f64 * resolution * resolution;
-        if n > floor {
-            (d / n).sqrt()
-        } else if d > floor {
-            f64::INFINITY
-        } else {
-            f64::NAN
-        }
+        against_motion(n > floor, d > floor, || (d / n).sqrt())
     })
+}
+
+/// An error measured against a motion: `ratio()` where the motion is above the
+/// coordinates' resolution; where it is not, ∞ if the error is (only the other run moved),
+/// else NaN (nothing moved to measure against). `displacement_error` and a probe's error
+/// over its travel.
+pub fn against_motion(moved: bool, differs: bool, ratio: impl FnOnce() -> f64) -> f64 {
+    if moved {
+        ratio()
+    } else if differs {
+        f64::INFINITY
+    } else {
+        f64::NAN
+    }
 }
 
 #[cfg(test)]
