@@ -29,6 +29,12 @@
 //!   displacement errors ≤ T with the estimate above each. (With the sensitivity relaxing
 //!   every score above T, it "converged" at 13 modes with a held-out error of 3.0e-4; with
 //!   the ladder ending at 1e-10 it spent its 8 runs at 15 modes and 2e-4.)
+//! - `a_range_from_rest_trains_on_the_displacement_measure`: the same coarse pendulum
+//!   trained over [0, 1] (at λ = 0 it does not move) with the displacement measure at
+//!   T = 3e-3 converges (measured: 3 training runs and the held-out check); at λ = 0 the
+//!   displacement estimate is undefined like the error it estimates — NaN in the result file,
+//!   "displacement none" on the terminal — not a ratio of two runs' rounding (before
+//!   2026-11-27 it read 2.1 there, so greedy spent its 6 runs and stopped above T at λ = 0).
 //! - `bad_measures_and_methods_are_refused`: a greedy `measure` that is not one of the two
 //!   fails `train` naming the pipeline file and `train.greedy.measure`; `[online]
 //!   tolerance_measure` without `[online] tolerance` and with a bad value name
@@ -185,6 +191,33 @@ fn greedy_on_the_displacement_measure() {
         "{md}"
     );
     assert!(md.contains(&format!("({in_basis} training runs) + 1 held-out check at λ = ")), "{md}");
+}
+
+#[test]
+fn a_range_from_rest_trains_on_the_displacement_measure() {
+    let dir = tempfile::tempdir().unwrap();
+    let pipe = setup(
+        dir.path(),
+        "[train]\ngreedy = { range = [0.0, 1.0], tolerance = 3e-3, max_runs = 6, measure = \"displacement\" }\n",
+    );
+    let p = pipe.to_str().unwrap();
+    let o = flexrom(&["train", p]);
+    let err = text(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let f = hdf5::File::open(dir.path().join("basis.h5")).unwrap();
+    let converged: u64 = f.group("training").unwrap().attr("converged").unwrap().read_scalar().unwrap();
+    assert_eq!(converged, 1, "{err}");
+
+    let out = dir.path().join("rest.h5");
+    let o = flexrom(&["-v", "online", p, "--load-scale", "0", "-o", out.to_str().unwrap()]);
+    let err = text(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("displacement none ("), "{err}");
+    let r = hdf5::File::open(&out).unwrap();
+    let est: f64 = r.attr("error_estimate_displacement").unwrap().read_scalar().unwrap();
+    let rel: f64 = r.attr("error_estimate").unwrap().read_scalar().unwrap();
+    assert!(est.is_nan(), "{est}");
+    assert!(rel.is_finite() && rel < 1e-9, "the relative estimate at rest is rounding: {rel}");
 }
 
 #[test]

@@ -160,10 +160,14 @@ pub fn is_extrapolated(range: (f64, f64), load_scale: f64) -> bool {
 /// One line: the estimate, its method, whether calibrated, and its cost against the
 /// reduced run.
 pub fn describe(e: &Estimate, method: &str, rom_seconds: f64) -> String {
+    // undefined where nothing moved beyond the Newton tolerance (norms::against_motion)
+    let displacement = match e.error_estimate_displacement {
+        d if d.is_nan() => "none".to_string(),
+        d => format!("{d:.3e}"),
+    };
     format!(
-        "error_estimate {:.3e}, displacement {:.3e} ({method} method, {}, factor {:.3}), estimator {:.4} s ({:.0} % of the reduced run)",
+        "error_estimate {:.3e}, displacement {displacement} ({method} method, {}, factor {:.3}), estimator {:.4} s ({:.0} % of the reduced run)",
         e.error_estimate,
-        e.error_estimate_displacement,
         if e.calibrated { "calibrated" } else { "uncalibrated" },
         e.factor,
         e.seconds,

@@ -8,11 +8,12 @@ use crate::model::Model;
 use crate::reduction::Basis;
 use crate::rom::estimator::corrected::CorrectedRunner;
 use crate::rom::estimator::defects::Defects;
-use crate::rom::estimator::norms::raw_by_time;
+use crate::rom::estimator::norms::{raw_by_time, resolution};
 use crate::rom::estimator::{
     self, ByFifth, DefectsCalibration, ErrorEstimator, ErrorMeasure, EstimateMethod, Estimator, FIFTHS,
 };
 use crate::rom::{Output, Rom};
+use crate::solver::model::ParametricModel;
 use crate::solver::parameters::Parameters;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
@@ -154,16 +155,33 @@ fn point_run(
         Ok((run, Some(e))) => {
             // the same reduced model at μ(1 + δ): how much its answer moves
             let basis = rom.basis();
+            let res = rom.model().physics().map_or(0.0, |p| resolution(&run, ParametricModel::length_scale(&*p.sys)));
             let sensitivity = match rom.solve_with(moved, Output::ReducedAndProbes, &[]) {
-                Ok(moved) => *raw_by_time(basis, basis, &moved.reduced_q, &run.reduced_q, x0).get(measure),
+                Ok(moved) => *raw_by_time(basis, basis, &moved.reduced_q, &run.reduced_q, x0, res).get(measure),
                 Err(_) => [0.0; FIFTHS],
             };
             let failure = e.failure.as_ref().map(|why| format!("its error estimate failed: {why}"));
-            CandidateRun { by_time: *e.by_time_in(measure), raw: e.raw, sensitivity, failure }
+            CandidateRun {
+                by_time: at_rest_as_relative(e.by_time_in(measure), &e.by_time),
+                raw: e.raw,
+                sensitivity,
+                failure,
+            }
         }
         Ok((_, None)) => failed("the reduced model has no estimator".into()),
         Err(e) => failed(format!("the reduced run failed: {e}")),
     }
+}
+
+/// The estimate by fifth of a run for the loop. A displacement estimate is undefined (NaN)
+/// where neither run moved beyond the coordinates' resolution and they do not differ by
+/// more ([`crate::rom::estimator::norms::against_motion`]): a run at rest, which the loop
+/// must not take for a failed one (NaN counts as ∞, [`score`]). There the relative
+/// estimate (finite where the runs ran: rounding against ‖X‖) stands in — next to a
+/// training load a pair counts with its larger value ([`super::between::pair_bound`]),
+/// elsewhere the jump to its neighbours asks for a full run there, once.
+fn at_rest_as_relative(estimate: &ByFifth, relative: &ByFifth) -> ByFifth {
+    std::array::from_fn(|i| if estimate[i].is_nan() && relative[i].is_finite() { relative[i] } else { estimate[i] })
 }
 
 /// What the loop knows at points between the candidates (in the candidates' unit

@@ -304,6 +304,8 @@ pub struct Corrected {
     x0: Arc<Vec<f64>>,
     /// the norms' projections of the basis pair, made once
     norms: super::norms::NormProjection,
+    /// the model's length scale `L` (the displacement measure's resolution is `tol · L`)
+    length: f64,
 }
 
 impl Corrected {
@@ -313,9 +315,12 @@ impl Corrected {
         let (m, b, d) = (Arc::clone(model), Arc::clone(basis), Arc::clone(data));
         let runners = Pool::new(move || CorrectedRunner::new(&m, &b, &d));
         runners.put(CorrectedRunner::new(model, basis, data)?);
-        let x0 = Arc::clone(&model.physics()?.x0);
+        let physics = model.physics()?;
+        let x0 = Arc::clone(&physics.x0);
+        let length = crate::solver::model::ParametricModel::length_scale(&*physics.sys);
         let norms = super::norms::NormProjection::new(basis, &data.enriched, ndarray::ArrayView1::from(&x0[..]));
         Ok(Corrected {
+            length,
             model: Arc::clone(model),
             basis: Arc::clone(basis),
             data: Arc::clone(data),
@@ -338,7 +343,8 @@ impl ErrorEstimator for Corrected {
         let why = match self.runners.with(|r| r.trajectory(run))? {
             Ok((qp, stats)) if stats.unconverged == 0 => {
                 let x0 = ndarray::ArrayView1::from(&self.x0[..]);
-                return Ok(self.norms.raw_by_time(&self.basis, &self.data.enriched, &run.reduced_q, &qp, x0));
+                let res = super::norms::resolution(run, self.length);
+                return Ok(self.norms.raw_by_time(&self.basis, &self.data.enriched, &run.reduced_q, &qp, x0, res));
             }
             Ok(_) => "did not converge".to_string(),
             Err(e) => format!("failed ({e})"),

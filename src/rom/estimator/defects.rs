@@ -25,7 +25,7 @@
 //! numbers, not fitted.
 
 use super::corrected::CorrectedRunner;
-use super::norms::{fifth_end, ConfigurationNorms, RawByFifth};
+use super::norms::{resolution, ConfigurationNorms, RawByFifth};
 use super::{ByFifth, ErrorEstimator, Estimator, FIFTHS};
 use crate::error::Result;
 use crate::model::Model;
@@ -55,6 +55,8 @@ pub struct Defects {
     /// the configuration norms' constants, projected once: an estimate costs O(r n_t),
     /// not O(n_dof r)
     norms: ConfigurationNorms,
+    /// the model's length scale `L` (the displacement measure's resolution is `tol · L`)
+    length: f64,
 }
 
 impl Defects {
@@ -63,8 +65,10 @@ impl Defects {
         let (m, b, d) = (Arc::clone(model), Arc::clone(basis), Arc::clone(data));
         let runners = Pool::new(move || CorrectedRunner::new(&m, &b, &d));
         runners.put(CorrectedRunner::new(model, basis, data)?);
-        let norms = ConfigurationNorms::new(basis, ndarray::ArrayView1::from(&model.physics()?.x0[..]));
-        Ok(Defects { data: Arc::clone(data), runners, sample: DEFECT_SAMPLE, norms })
+        let physics = model.physics()?;
+        let norms = ConfigurationNorms::new(basis, ndarray::ArrayView1::from(&physics.x0[..]));
+        let length = crate::solver::model::ParametricModel::length_scale(&*physics.sys);
+        Ok(Defects { data: Arc::clone(data), runners, sample: DEFECT_SAMPLE, norms, length })
     }
 
     /// Another sampling interval (experiments: examples/estimate_table.rs).
@@ -102,14 +106,11 @@ impl ErrorEstimator for Defects {
             }
             err2[k] = acc * acc;
         }
-        let prefix = |per_instant: &[f64]| -> ByFifth {
-            std::array::from_fn(|i| {
-                let end = fifth_end(nt, i);
-                let (d, n): (f64, f64) = (err2[..end].iter().sum(), per_instant[..end].iter().sum());
-                d.sqrt() / n.max(0.0).sqrt()
-            })
-        };
-        Ok(RawByFifth { relative: prefix(&norm2), displacement: prefix(&disp2) })
+        let resolution = resolution(run, self.length);
+        Ok(RawByFifth::from_sums(nt, self.norms.n_dof(), resolution, |displacement, end| {
+            let per_instant = if displacement { &disp2 } else { &norm2 };
+            (err2[..end].iter().sum(), per_instant[..end].iter().sum::<f64>().max(0.0))
+        }))
     }
 
     /// The defect sum is a bound by itself: factor 1, raised in the proportion that

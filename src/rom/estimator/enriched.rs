@@ -22,6 +22,8 @@ pub struct Enriched {
     x0: Arc<Vec<f64>>,
     /// the norms' projections of the basis pair, made once
     norms: NormProjection,
+    /// the model's length scale `L` (the displacement measure's resolution is `tol · L`)
+    length: f64,
 }
 
 impl Enriched {
@@ -31,9 +33,11 @@ impl Enriched {
         let (m, e) = (Arc::clone(model), Arc::clone(&enriched));
         let runners = Pool::new(move || ReducedRunner::new(&m, &e));
         runners.put(ReducedRunner::new(model, &enriched)?);
-        let x0 = Arc::clone(&model.physics()?.x0);
+        let physics = model.physics()?;
+        let x0 = Arc::clone(&physics.x0);
+        let length = crate::solver::model::ParametricModel::length_scale(&*physics.sys);
         let norms = NormProjection::new(basis, &data.enriched, ndarray::ArrayView1::from(&x0[..]));
-        Ok(Enriched { basis: Arc::clone(basis), data: Arc::clone(data), runners, x0, norms })
+        Ok(Enriched { basis: Arc::clone(basis), data: Arc::clone(data), runners, x0, norms, length })
     }
 }
 
@@ -48,6 +52,7 @@ impl ErrorEstimator for Enriched {
         let mu = run.result.settings.parameters();
         let e = self.runners.with(|r| r.solve(mu, Output::ReducedAndProbes, &[]))??;
         let x0 = ndarray::ArrayView1::from(&self.x0[..]);
-        Ok(self.norms.raw_by_time(&self.basis, &self.data.enriched, &run.reduced_q, &e.reduced_q, x0))
+        let res = super::norms::resolution(run, self.length);
+        Ok(self.norms.raw_by_time(&self.basis, &self.data.enriched, &run.reduced_q, &e.reduced_q, x0, res))
     }
 }

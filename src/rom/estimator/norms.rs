@@ -11,11 +11,17 @@
 //! ```text
 //!     ‖V q − V⁺ q⁺‖² = ‖M q − q⁺‖² + qᵀ(I − MᵀM) q,
 //!     ‖x_ref + V⁺ q⁺‖² = ‖x_ref‖² + 2 (V⁺ᵀx_ref)·q⁺ + ‖q⁺‖²,
-//!     ‖x_ref + V⁺ q⁺ − x₀‖² = ‖d‖² + 2 (V⁺ᵀd)·q⁺ + ‖q⁺‖²,
+//!     ‖x_ref + V⁺ q⁺ − x₀‖² = ‖V⁺ᵀd + q⁺‖² + (‖d‖² − ‖V⁺ᵀd‖²),
 //! ```
 //!
-//! the last two by expanding the square (`V⁺ᵀV⁺ = I`): the displacement norm is the
-//! configuration's with the reference shifted by the initial configuration.
+//! the last two by expanding the square (`V⁺ᵀV⁺ = I`). The displacement norm keeps the
+//! in-span part as one square: expanded like the configuration's, `‖d‖² + 2 (V⁺ᵀd)·q⁺ +
+//! ‖q⁺‖²` would cancel where the motion is small against the configuration, and read the
+//! rounding of `‖d‖²` as motion. Its out-of-span part `‖d‖² − ‖V⁺ᵀd‖²` is the same at every
+//! instant.
+//!
+//! Where neither run has moved beyond the coordinates' resolution (the Newton tolerance
+//! `tol · L`), the displacement measures have nothing to divide by: [`against_motion`].
 
 pub use super::RawByFifth;
 use super::{ByFifth, FIFTHS};
@@ -37,22 +43,24 @@ pub fn raw_estimate_reduced(basis: &Basis, enriched: &Basis, q: &Array2<f64>, qp
 /// `η_raw` (relative) over the instants up to the end of each fifth of the run: [`raw_by_time`]'s
 /// `relative`.
 pub fn raw_estimate_by_time(basis: &Basis, enriched: &Basis, q: &Array2<f64>, qp: &Array2<f64>) -> ByFifth {
-    raw_by_time(basis, enriched, q, qp, enriched.reference.view()).relative
+    raw_by_time(basis, enriched, q, qp, enriched.reference.view(), 0.0).relative
 }
 
 /// `η_raw` in both measures over the instants up to the end of each fifth of the run (the
 /// last entry is the whole run's), as [`rel_error_by_time`] and
 /// [`displacement_error_by_time`] split the true errors; `x0` is the initial configuration
-/// X₀ (n_dof). ∞ when the shapes differ. An estimator that reads many runs of one basis
-/// pair projects once ([`NormProjection`]).
+/// X₀ (n_dof) and `resolution` the coordinates' ([`displacement_ratio`]). ∞ when the shapes
+/// differ. An estimator that reads many runs of one basis pair projects once
+/// ([`NormProjection`]).
 pub fn raw_by_time(
     basis: &Basis,
     enriched: &Basis,
     q: &Array2<f64>,
     qp: &Array2<f64>,
     x0: ArrayView1<f64>,
+    resolution: f64,
 ) -> RawByFifth {
-    NormProjection::new(basis, enriched, x0).raw_by_time(basis, enriched, q, qp, x0)
+    NormProjection::new(basis, enriched, x0).raw_by_time(basis, enriched, q, qp, x0, resolution)
 }
 
 /// What [`raw_by_time`] projects for a pair of orthonormal bases, the same for every run:
@@ -71,30 +79,43 @@ struct Projected {
 }
 
 /// The constants of the configuration and displacement norms of `x = x_ref + V z` from the
-/// reduced coordinates of an orthonormal `V`: `‖x‖² = ‖x_ref‖² + 2 (Vᵀx_ref)·z + ‖z‖²` and
-/// `‖x − x₀‖²`, the same with the reference shifted by the initial configuration X₀.
+/// reduced coordinates of an orthonormal `V` (module documentation): `‖x‖² = ‖x_ref‖² +
+/// 2 (Vᵀx_ref)·z + ‖z‖²` and `‖x − x₀‖² = ‖Vᵀd + z‖² + (‖d‖² − ‖Vᵀd‖²)`, `d = x_ref − x₀`.
 pub struct ConfigurationNorms {
     vtx: Array1<f64>,
     xr2: f64,
+    /// `Vᵀd`
     vts: Array1<f64>,
-    shift2: f64,
+    /// `‖d‖² − ‖Vᵀd‖²`, the shift's part outside the span of `V`
+    outside2: f64,
+    /// rows of `V`: a displacement at the resolution in every coordinate has `n_dof res²`
+    n_dof: usize,
 }
 
 impl ConfigurationNorms {
     pub fn new(basis: &Basis, x0: ArrayView1<f64>) -> Self {
         let (v, xr) = (&basis.modes, &basis.reference);
         let shift = xr - &x0;
-        ConfigurationNorms { vtx: v.t().dot(xr), xr2: xr.dot(xr), vts: v.t().dot(&shift), shift2: shift.dot(&shift) }
+        let vts = v.t().dot(&shift);
+        let outside2 = (shift.dot(&shift) - vts.dot(&vts)).max(0.0);
+        ConfigurationNorms { vtx: v.t().dot(xr), xr2: xr.dot(xr), vts, outside2, n_dof: v.nrows() }
     }
 
     /// `‖x‖²` and `‖x − x₀‖²` at one instant `z` whose `‖z‖²` is `z2`.
     pub fn at(&self, z: ArrayView1<f64>, z2: f64) -> (f64, f64) {
-        (self.xr2 + 2.0 * self.vtx.dot(&z) + z2, self.shift2 + 2.0 * self.vts.dot(&z) + z2)
+        let moved2: f64 = self.vts.iter().zip(z).map(|(s, z)| (s + z) * (s + z)).sum();
+        (self.xr2 + 2.0 * self.vtx.dot(&z) + z2, moved2 + self.outside2)
     }
 
     /// [`Self::at`] at every instant (column) of `z`, whose squared norms are `z2`.
     fn per_instant(&self, z: &Array2<f64>, z2: &Array1<f64>) -> (Array1<f64>, Array1<f64>) {
-        (self.xr2 + 2.0 * self.vtx.dot(z) + z2, self.shift2 + 2.0 * self.vts.dot(z) + z2)
+        let moved = z + &self.vts.view().insert_axis(Axis(1));
+        (self.xr2 + 2.0 * self.vtx.dot(z) + z2, moved.mapv(|v| v * v).sum_axis(Axis(0)) + self.outside2)
+    }
+
+    /// The coordinates of the configurations these norms are of.
+    pub fn n_dof(&self) -> usize {
+        self.n_dof
     }
 }
 
@@ -120,6 +141,7 @@ impl NormProjection {
         q: &Array2<f64>,
         qp: &Array2<f64>,
         x0: ArrayView1<f64>,
+        resolution: f64,
     ) -> RawByFifth {
         let nt = qp.ncols();
         if q.ncols() != nt || nt == 0 {
@@ -147,14 +169,30 @@ impl NormProjection {
                 (d, norm, disp)
             }
         };
-        let prefix = |per_instant: &Array1<f64>| -> ByFifth {
-            std::array::from_fn(|i| {
+        let upto = |per_instant: &Array1<f64>, end: usize| per_instant.slice(ndarray::s![..end]).sum().max(0.0);
+        RawByFifth::from_sums(nt, enriched.modes.nrows(), resolution, |displacement, end| {
+            (upto(&diff2, end), upto(if displacement { &disp2 } else { &norm2 }, end))
+        })
+    }
+}
+
+impl RawByFifth {
+    /// Both measures up to the end of each fifth of a run of `nt` instants of `n_dof`
+    /// coordinates, from `sums(displacement, end)`: the squared distance and the squared
+    /// norm (the configuration's, or with `displacement` the motion's) summed over the
+    /// instants `..end`. The displacement measure has the floor of [`displacement_ratio`].
+    pub fn from_sums(nt: usize, n_dof: usize, resolution: f64, sums: impl Fn(bool, usize) -> (f64, f64)) -> Self {
+        RawByFifth {
+            relative: std::array::from_fn(|i| {
+                let (d, n) = sums(false, fifth_end(nt, i));
+                d.sqrt() / n.sqrt()
+            }),
+            displacement: std::array::from_fn(|i| {
                 let end = fifth_end(nt, i);
-                let (d, n) = (diff2.slice(ndarray::s![..end]).sum(), per_instant.slice(ndarray::s![..end]).sum());
-                d.max(0.0).sqrt() / n.max(0.0).sqrt()
-            })
-        };
-        RawByFifth { relative: prefix(&norm2), displacement: prefix(&disp2) }
+                let (d, n) = sums(true, end);
+                displacement_ratio(d, n, end * n_dof, resolution)
+            }),
+        }
     }
 }
 
@@ -205,10 +243,23 @@ pub fn displacement_error_by_time(a: &Array2<f64>, b: &Array2<f64>, x0: ArrayVie
     std::array::from_fn(|i| {
         let end = fifth_end(nt, i);
         let (d, n) = (diff.slice(ndarray::s![..end]).sum(), norm.slice(ndarray::s![..end]).sum());
-        // the squared norm of `end` instants of coordinates each at the resolution
-        let floor = (end * b.nrows()) as f64 * resolution * resolution;
-        against_motion(n > floor, d > floor, || (d / n).sqrt())
+        displacement_ratio(d, n, end * b.nrows(), resolution)
     })
+}
+
+/// `(d2 / n2)^½`, a distance over a displacement from their squared sums over `values`
+/// coordinate values, where the displacement is above the coordinates' `resolution` in root
+/// mean square ([`against_motion`]: ∞ where only the distance is, NaN where neither is).
+pub fn displacement_ratio(d2: f64, n2: f64, values: usize, resolution: f64) -> f64 {
+    // the squared norm of `values` coordinate values each at the resolution
+    let floor = values as f64 * resolution * resolution;
+    against_motion(n2 > floor, d2 > floor, || (d2 / n2).sqrt())
+}
+
+/// The coordinates' resolution of `run`: its Newton tolerance in length units, `tol · L`
+/// (`length` the model's length scale, `L`).
+pub fn resolution(run: &crate::rom::run::ReducedRun, length: f64) -> f64 {
+    run.result.settings.params.tolerance * length
 }
 
 /// An error measured against a motion: `ratio()` where the motion is above the
@@ -279,7 +330,7 @@ mod tests {
             let x0 = Array1::from_shape_fn(n, |i| 1.0 + 0.1 * i as f64 + 0.05 * (i as f64 * 1.3).sin());
             let moved = &x2 - &x0.view().insert_axis(Axis(1));
             let want_d = (&x1 - &x2).mapv(|v| v * v).sum().sqrt() / moved.mapv(|v| v * v).sum().sqrt();
-            let both = raw_by_time(&b, &plus, &q, &qp, x0.view());
+            let both = raw_by_time(&b, &plus, &q, &qp, x0.view(), 0.0);
             assert!(
                 (both.displacement[4] - want_d).abs() < 1e-12 * want_d.max(1.0),
                 "{} vs {want_d}",
@@ -299,6 +350,35 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// The displacement form of the estimate when the motion is small against the
+    /// reference's distance from X₀ (here 1e3 against 1e-7 per instant): the expanded
+    /// square `‖d‖² + 2 (V⁺ᵀd)·q⁺ + ‖q⁺‖²` rounds at ε · 1e6 ≈ 2e-10 and reads noise; the
+    /// in-span square reads the closed form `√e · c / √(Σ_{k<e} (1e-7 k)²)` (the runs
+    /// differ by `c` in one coordinate at every instant). Where the enriched run does not
+    /// move beyond the resolution the measure is undefined (NaN), or ∞ where the reduced
+    /// run differs by more than it.
+    #[test]
+    fn displacement_estimate_of_a_small_motion_far_from_the_reference() {
+        let (n, nt, c) = (6, 10, 1e-9);
+        let eye = Array2::from_shape_fn((n, 3), |(i, j)| if i == j { 1.0 } else { 0.0 });
+        // x₀ is zero in the modes' coordinates, so x_ref + V q⁺ − x₀ is exact there
+        let x0 = Array1::from_shape_fn(n, |i| if i < 3 { 0.0 } else { 2.0 + i as f64 });
+        let reference = &x0 + &Array1::from_shape_fn(n, |i| if i == 0 { 1e3 } else { 0.0 });
+        let b = galerkin(eye, reference);
+        let qp = Array2::from_shape_fn((3, nt), |(i, k)| [-1e3, 1e-7 * k as f64, 0.0][i]);
+        let q = Array2::from_shape_fn((3, nt), |(i, k)| qp[[i, k]] + if i == 2 { c } else { 0.0 });
+        let got = raw_by_time(&b, &b, &q, &qp, x0.view(), 1e-12).displacement;
+        for (i, g) in got.iter().enumerate() {
+            let e = fifth_end(nt, i);
+            let travel2: f64 = (0..e).map(|k| (1e-7 * k as f64).powi(2)).sum();
+            let want = (e as f64).sqrt() * c / travel2.sqrt();
+            assert!((g - want).abs() < 1e-12 * want, "fifth {i}: {g} vs {want}");
+        }
+        let still = Array2::from_shape_fn((3, nt), |(i, _)| [-1e3, 0.0, 0.0][i]);
+        assert!(raw_by_time(&b, &b, &still, &still, x0.view(), 1e-12).displacement[4].is_nan());
+        assert!(raw_by_time(&b, &b, &(&still + 1e-6), &still, x0.view(), 1e-12).displacement[4].is_infinite());
     }
 
     /// A run against the same run shifted by a known displacement field: X_f(t_k) = X₀ + k u
