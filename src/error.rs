@@ -64,6 +64,14 @@ pub enum Error {
         source: Box<Error>,
     },
 
+    /// A failure with what the user can do about it, after the failure's own text.
+    #[error("{source}; {hint}")]
+    Hinted {
+        #[source]
+        source: Box<Error>,
+        hint: String,
+    },
+
     /// The host program asked the computation to stop ([`crate::interrupt`]: Ctrl-C in
     /// Python); temporary files begun are removed as the error travels up.
     #[error("interrupted")]
@@ -122,6 +130,27 @@ impl Error {
         match self {
             Error::NewtonFailed { .. } | Error::LinearSolve { .. } | Error::BlowUp { .. } => {
                 Error::Stage { stage: stage.to_string(), parameters: mu.to_string(), source: Box::new(self) }
+            }
+            other => other,
+        }
+    }
+
+    /// [`Self::at_stage`] for a reduced run, with the way on after its failure: a reduced
+    /// model can fail (blow up, or Newton not converge) where the full one does not — its
+    /// basis lacks this load's motion —, and the full model is the exact route. `full_ran`:
+    /// the full model has just run at these parameters (`validate`), so that is known.
+    pub fn at_reduced_stage(self, stage: &str, mu: &impl std::fmt::Display, full_ran: bool) -> Self {
+        match self {
+            Error::NewtonFailed { .. } | Error::LinearSolve { .. } | Error::BlowUp { .. } => {
+                let hint = if full_ran {
+                    "the full model ran here, so the basis lacks this load's motion: a training run near it \
+                     puts it in"
+                } else {
+                    "a reduced model can fail where the full one does not (its basis lacks this load's motion): \
+                     `flexrom simulate` runs the full model at this load, `flexrom sweep --full` at many, and a \
+                     training run near it puts its motion into the basis"
+                };
+                Error::Hinted { source: Box::new(self.at_stage(stage, mu)), hint: hint.to_string() }
             }
             other => other,
         }

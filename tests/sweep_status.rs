@@ -4,8 +4,9 @@
 //! - a load scale that makes Newton fail (1e20 × gravity on a coarse pendulum: measured to
 //!   fail at the first step after 8 halvings; 1e12 still runs) does not stop the sweep: the
 //!   good scales are written, `/status` is 0 for them and 1 for the failed ones with the
-//!   error in `/message`, their rows are NaN, the exit code is 3 and stderr ends with one
-//!   line "2 of 5 load scales failed: …";
+//!   error in `/message` (with the way on: the full model is the exact route there), their
+//!   rows are NaN, the exit code is 3 and stderr ends with one line "2 of 5 load scales
+//!   failed: …";
 //! - a good scale's probe trajectory in the sweep file is bit-for-bit the one `online`
 //!   writes at the same load scale (without --continuation a sweep runs each scale exactly
 //!   as `online` does);
@@ -94,6 +95,8 @@ fn a_failing_load_scale_is_recorded_and_the_others_written() {
     assert_eq!(messages[0], "");
     assert!(messages[1].starts_with("sweep (reduced run) at load scale 1e20: Newton failed at t = "), "{messages:?}");
     assert!(messages[4].starts_with("sweep (reduced run) at load scale 5e19: Newton failed"), "{messages:?}");
+    // and the way on: the full model is the exact route where a reduced one fails
+    assert!(messages[1].contains("`flexrom simulate` runs the full model at this load"), "{messages:?}");
     assert_eq!(f.attr("n_failed").unwrap().read_scalar::<u64>().unwrap(), 2);
     let tip = f.dataset("probes/tip").unwrap().read::<f64, ndarray::Ix3>().unwrap();
     let rom_seconds = column(&out, "rom_seconds");

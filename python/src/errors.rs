@@ -67,7 +67,7 @@ pub fn model_error(msg: &str) -> PyErr {
 /// The error under a stage's context (the kind decides the exception).
 fn root(e: &Error) -> &Error {
     match e {
-        Error::Stage { source, .. } => root(source),
+        Error::Stage { source, .. } | Error::Hinted { source, .. } => root(source),
         other => other,
     }
 }

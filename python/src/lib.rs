@@ -725,7 +725,7 @@ impl PyBasis {
         let mu = self.point(py, load_scale, params.as_ref())?;
         let rom = &self.rom;
         let (run, estimate) = interruptible(py, || {
-            rom.solve_and_estimate(&mu, Output::Full, &[]).map_err(|e| e.at_stage("online", &mu))
+            rom.solve_and_estimate(&mu, Output::Full, &[]).map_err(|e| e.at_reduced_stage("online", &mu, false))
         })?;
         let extrapolated = rom.is_extrapolated(&mu);
         let mut warnings: Vec<String> = estimate

@@ -99,7 +99,7 @@ pub fn online_to_file(p: &Pipeline, rom: &Rom, basis_path: &Path, mu: &Parameter
     let plan = RunPlan::of(&p.model, &settings);
     let model_path = p.model.path.display().to_string();
     let (file, (run, estimate)) = begin_alongside(out, &p.model.text, &model_path, &plan, || {
-        rom.solve_and_estimate(mu, Output::Full, &[]).map_err(|e| e.at_stage("online", mu))
+        rom.solve_and_estimate(mu, Output::Full, &[]).map_err(|e| e.at_reduced_stage("online", mu, false))
     })?;
     let extrapolated = rom.is_extrapolated(mu);
     let basis = rom.basis();

@@ -221,8 +221,9 @@ fn run_reduced(rom: &Rom, state: Sweep, o: SweepOptions, checkpoint: Option<Chec
     let output = if o.validate { Output::Full } else { Output::ReducedAndProbes };
     crate::rom::check_reduced_memory(model, basis.n_reduced(), n_steps, output, state.n_todo() as f64)?;
     let point = |mu: &Parameters, previous: &[&ReducedRun]| -> Result<SweepPoint> {
-        let (run, estimate) =
-            rom.solve_and_estimate(mu, output, previous).map_err(|e| e.at_stage("sweep (reduced run)", mu))?;
+        let (run, estimate) = rom
+            .solve_and_estimate(mu, output, previous)
+            .map_err(|e| e.at_reduced_stage("sweep (reduced run)", mu, false))?;
         let (validation, full_probes) = if o.validate {
             let full = simulate(model, &Overrides::at(mu)).map_err(|e| e.at_stage("sweep (full run)", mu))?;
             let v = compare(model, &full, &run, None, basis.n_reduced(), basis.variant.name())

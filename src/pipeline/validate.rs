@@ -342,7 +342,9 @@ pub fn validate(rom: &Rom, mu: &Parameters, with_dense: bool) -> Result<(Validat
     let moved = rom.trust().map_or_else(|| mu.scaled_by(1.001), |t| t.space.moved(mu, 1.001));
     let nearby =
         full_model.simulate(&Overrides { mu: Some(moved), ..o }).map_err(stage("validate (full run at 1.001 μ)"))?;
-    let (run, estimate) = rom.solve_and_estimate(mu, Output::Full, &[]).map_err(stage("validate (reduced run)"))?;
+    let (run, estimate) = rom
+        .solve_and_estimate(mu, Output::Full, &[])
+        .map_err(|e| e.at_reduced_stage("validate (reduced run)", mu, true))?;
     // the time loops again, interleaved, for the medians that `speedup` compares
     let (mut full_times, mut rom_times) = (vec![full.wall_seconds], vec![run.result.wall_seconds]);
     while repeat_timing(&[&full_times, &rom_times]) {
