@@ -485,6 +485,26 @@ fn motion_section(
             probes.join("; ")
         );
     }
+    if validations.iter().all(|v| v.probe_quantity_errors.is_empty()) {
+        return;
+    }
+    let _ = writeln!(
+        md,
+        "\nStrains and curvatures at the probes that record them: derivatives of the coordinates along the beam, less accurate than the coordinates rel_error and the estimate are of (docs/error-estimate.md).\n"
+    );
+    let _ = writeln!(md, "| {head} | probe | quantity | max error | largest value (full run) | error over it |");
+    let _ = writeln!(md, "|---|---|---|---|---|---|");
+    for (v, label) in validations.iter().zip(labels) {
+        for q in &v.probe_quantity_errors {
+            let unit = if q.quantity == "curvature" { " 1/m" } else { "" };
+            let rel = q.relative.map_or("none".to_string(), |e| format!("{e:.2e}"));
+            let _ = writeln!(
+                md,
+                "| {label} | {} | {} | {:.2e}{unit} | {:.2e}{unit} | {rel} |",
+                q.probe, q.quantity, q.max_error, q.largest
+            );
+        }
+    }
 }
 
 /// After `run`: the warnings of the report's basis and sweep (read back from its

@@ -119,6 +119,8 @@ pub struct Validation {
     pub max_error_over_travel_probe: String,
     /// every probe's error over its travel
     pub probe_errors_over_travel: Vec<ProbeTravel>,
+    /// the strain and curvature of the probes that record them, against the full run's
+    pub probe_quantity_errors: Vec<ProbeQuantityError>,
     /// how the estimate was computed (`corrected`, `defects`, `enriched`; null: no estimate)
     pub error_estimate_method: Option<String>,
     /// why the estimator's own run failed, when it did (`error_estimate` is then ∞, which
@@ -154,6 +156,59 @@ impl ProbeTravel {
         let ratio = against_motion(travel > resolution, max_error > resolution, || max_error / travel);
         let error_over_travel = (!ratio.is_nan()).then_some(ratio);
         ProbeTravel { probe: name.to_string(), max_error, travel, error_over_travel }
+    }
+}
+
+/// One probe's strain or curvature (`quantities` in the model file) against the full
+/// run's. Derivatives of the coordinates along the beam, they are less accurate than the
+/// coordinates `rel_error` and the estimate are of (docs/error-estimate.md).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct ProbeQuantityError {
+    pub probe: String,
+    /// `"strain"` (1) or `"curvature"` (1/m)
+    pub quantity: String,
+    /// `max_k |v_rom(t_k) − v_full(t_k)|`
+    pub max_error: f64,
+    /// `max_k |v_full(t_k)|`: the largest value of the full run
+    pub largest: f64,
+    /// `max_error / largest` (null where the full run's value stays within the
+    /// coordinates' resolution, [`against_motion`]; ∞ where only the reduced one leaves it)
+    pub relative: Option<f64>,
+}
+
+impl ProbeQuantityError {
+    /// The error of the series `rom` against `full` over the full run's largest value;
+    /// `resolution` is the coordinates' (the Newton tolerance `tol · L`).
+    pub fn of(
+        probe: &str,
+        quantity: &str,
+        full: &ndarray::Array1<f64>,
+        rom: &ndarray::Array1<f64>,
+        resolution: f64,
+    ) -> Self {
+        let max_error = full.iter().zip(rom).fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+        let largest = full.iter().fold(0.0_f64, |m, a| m.max(a.abs()));
+        let ratio = against_motion(largest > resolution, max_error > resolution, || max_error / largest);
+        ProbeQuantityError {
+            probe: probe.to_string(),
+            quantity: quantity.to_string(),
+            max_error,
+            largest,
+            relative: (!ratio.is_nan()).then_some(ratio),
+        }
+    }
+
+    /// Every probe's strain and curvature of `rom` against `full`.
+    fn all(full: &SimulationResult, rom: &SimulationResult, resolution: f64) -> Vec<Self> {
+        let mut out = Vec::new();
+        for (quantity, f, r) in
+            [("strain", &full.strains, &rom.strains), ("curvature", &full.curvatures, &rom.curvatures)]
+        {
+            for ((name, a), (_, b)) in f.iter().zip(r) {
+                out.push(Self::of(name, quantity, a, b, resolution));
+            }
+        }
+        out
     }
 }
 
@@ -246,6 +301,7 @@ pub fn compare(
         max_error_over_travel: worst_travel.as_ref().map(|w| w.0),
         max_error_over_travel_probe: worst_travel.map_or(String::new(), |w| w.1),
         probe_errors_over_travel: travels,
+        probe_quantity_errors: ProbeQuantityError::all(full, r, resolution),
         error_estimate_method: None,
         estimate_failure: None,
     }
@@ -494,13 +550,24 @@ impl Validation {
                 })
             ));
         }
+        for q in &self.probe_quantity_errors {
+            let unit = if q.quantity == "curvature" { " 1/m" } else { "" };
+            s.push_str(&format!(
+                "\n  probe {} {}: max error {:.3e}{unit} against a largest value of {:.3e}{unit}: {}",
+                q.probe,
+                q.quantity,
+                q.max_error,
+                q.largest,
+                q.relative.map_or("none (it stays at zero)".to_string(), |e| format!("{e:.3e} of it")),
+            ));
+        }
         s
     }
 }
 
 #[cfg(test)]
 mod tests {
-    use super::{first_different_step, ProbeTravel};
+    use super::{first_different_step, ProbeQuantityError, ProbeTravel};
 
     /// Which step the runs first took differently: a cut only one of them made, the
     /// earlier of two such, and none when both halved the same steps.
@@ -534,5 +601,21 @@ mod tests {
         crawl[[3, 0]] += 1e-11;
         assert_eq!(ProbeTravel::of("pin", &crawl, &(&still + 2e-11), 1e-10).error_over_travel, None);
         assert_eq!(ProbeTravel::of("pin", &crawl, &(&still + 1e-3), 1e-10).error_over_travel, Some(f64::INFINITY));
+    }
+
+    /// A curvature series against a reduced one off by 0.02 and 0.03 at two instants: the
+    /// largest error 0.03 over the largest |κ| of the full run, 1.0 (closed form); a series
+    /// that stays at zero has none, or ∞ where only the reduced one leaves it.
+    #[test]
+    fn a_probe_quantity_against_its_largest_value() {
+        let full = ndarray::array![0.0, 0.5, -1.0, 0.25];
+        let rom = ndarray::array![0.0, 0.52, -0.97, 0.25];
+        let q = ProbeQuantityError::of("root", "curvature", &full, &rom, 1e-10);
+        assert!((q.max_error - 0.03).abs() < 1e-15 && q.largest == 1.0, "{q:?}");
+        assert!((q.relative.unwrap() - 0.03).abs() < 1e-15, "{q:?}");
+        let zero = ndarray::Array1::zeros(4);
+        assert_eq!(ProbeQuantityError::of("tip", "strain", &zero, &zero, 1e-10).relative, None);
+        let off = ProbeQuantityError::of("tip", "strain", &zero, &(&zero + 1e-3), 1e-10);
+        assert_eq!(off.relative, Some(f64::INFINITY));
     }
 }

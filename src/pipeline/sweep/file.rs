@@ -539,6 +539,7 @@ pub fn read_sweep(
             max_error_over_travel: None,
             max_error_over_travel_probe: String::new(),
             probe_errors_over_travel: Vec::new(),
+            probe_quantity_errors: Vec::new(),
             error_estimate_method: None,
             estimate_failure: None,
         });
