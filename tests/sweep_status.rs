@@ -14,7 +14,9 @@
 //!   and the 3 reused rows keep their `/rom_seconds` bit for bit: a rerun would measure a
 //!   new time), reruns failed scales, and refuses a file of another basis;
 //! - a sweep killed (SIGKILL) while it runs leaves a valid file at the final path (statuses
-//!   0 and 2 only), from which `--resume` finishes the sweep.
+//!   0 and 2 only), from which `--resume` finishes the sweep;
+//! - a sweep stopped by SIGINT exits 130 and says which file keeps the finished scales and
+//!   that the same command with `--resume` runs the others.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -204,4 +206,32 @@ fn a_killed_sweep_leaves_a_valid_file_to_resume_from() {
     );
     assert_eq!(status(&out), vec![0; 300]);
     assert!(column(&out, "rom_seconds").iter().all(|v| v.is_finite()));
+}
+
+#[test]
+fn an_interrupted_sweep_names_the_file_it_keeps_and_how_to_go_on() {
+    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let p = setup(d, 50, 1.1, 14, "\"0.5:1.5:300\"");
+    let out = d.join("s.h5");
+    let child = flexrom()
+        .args(["sweep", p.to_str().unwrap(), "-o", out.to_str().unwrap()])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while !out.exists() && start.elapsed().as_secs() < 120 {
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let kill = Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
+    assert!(kill.success());
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert_eq!(o.status.code(), Some(130), "{err}");
+    assert!(err.contains("stopped by SIGINT"), "{err}");
+    assert!(err.contains(&format!("{} keeps the load scales finished by its last checkpoint", out.display())), "{err}");
+    assert!(err.contains("the same command with --resume runs the others"), "{err}");
+    assert!(status(&out).contains(&0));
 }

@@ -178,13 +178,24 @@ pub fn sweep_to_file(route: Route, points: &[Parameters], o: SweepOptions, f: Sw
         }
     }
     let basis = route.basis();
-    let write = |s: &Sweep| write_sweep_with(out, s, basis, extra);
-    let sw = match route {
-        Route::Reduced { rom, .. } => run_reduced(rom, start, o, Some(&write))?,
-        Route::Full(model) => run_full(model, start, o, Some(&write))?,
+    let runs = runs_noun(points);
+    let write = |s: &Sweep| {
+        write_sweep_with(out, s, basis, extra)?;
+        // a stop from now on leaves this file: say what it keeps and how to go on
+        crate::io::atomic::set_stop_note(Some(format!(
+            "{} keeps the {runs} finished by its last checkpoint (written every few seconds); \
+             the same command with --resume runs the others",
+            out.display()
+        )));
+        Ok(())
     };
-    write(&sw)?;
-    Ok(sw)
+    let sw = match route {
+        Route::Reduced { rom, .. } => run_reduced(rom, start, o, Some(&write)),
+        Route::Full(model) => run_full(model, start, o, Some(&write)),
+    };
+    let written = sw.and_then(|sw| write(&sw).map(|()| sw));
+    crate::io::atomic::set_stop_note(None);
+    written
 }
 
 /// Every scale pending, with the model's time grid and probe names.

@@ -21,6 +21,14 @@ pub(super) enum Live {
 }
 
 static LIVE: Mutex<Vec<Live>> = Mutex::new(Vec::new());
+/// What a stopped process should say about the work it kept ([`set_stop_note`]).
+static STOP_NOTE: Mutex<Option<String>> = Mutex::new(None);
+
+/// The line the signal handler prints after its own when the process is stopped (a sweep:
+/// which file keeps the finished runs, and how to go on); `None` withdraws it.
+pub fn set_stop_note(note: Option<String>) {
+    *STOP_NOTE.lock().unwrap_or_else(|e| e.into_inner()) = note;
+}
 pub(super) static COUNTER: AtomicU64 = AtomicU64::new(0);
 
 /// The registry, also after a thread panicked while holding it (the list stays valid).
@@ -96,6 +104,9 @@ pub fn install_signal_handler() -> Result<()> {
                 eprintln!(
                     "flexrom: stopped by {name}; {n} temporary path(s) removed, previous outputs left as they were"
                 );
+                if let Some(note) = STOP_NOTE.lock().unwrap_or_else(|e| e.into_inner()).as_ref() {
+                    eprintln!("flexrom: {note}");
+                }
                 signal_hook::low_level::exit(128 + sig);
             }
         })
