@@ -54,6 +54,9 @@ pub struct Validation {
     pub rom_seconds: f64,
     pub speedup: f64,
     pub speedup_vs_dense: Option<f64>,
+    /// `full_seconds / (rom_seconds + estimate_seconds)`: the reduced route as `online` and
+    /// `sweep` run it, estimate included (null: no estimate)
+    pub speedup_with_estimate: Option<f64>,
     pub full_newton_iterations: usize,
     pub rom_newton_iterations: usize,
     pub rom_step_cuts: usize,
@@ -274,6 +277,7 @@ pub fn compare(
         rom_seconds: f64::NAN,
         speedup: f64::NAN,
         speedup_vs_dense: None,
+        speedup_with_estimate: None,
         full_newton_iterations: full.stats.newton_iterations,
         rom_newton_iterations: r.stats.newton_iterations,
         rom_step_cuts: r.stats.step_cuts,
@@ -335,6 +339,7 @@ impl Validation {
         self.rom_seconds = rom_seconds;
         self.speedup = full_seconds / rom_seconds;
         self.speedup_vs_dense = self.full_dense_seconds.map(|d| d / rom_seconds);
+        self.speedup_with_estimate = self.estimate_seconds.map(|e| full_seconds / (rom_seconds + e));
         self
     }
 
@@ -346,6 +351,7 @@ impl Validation {
             self.effectivity = Some(e.error_estimate / self.rel_error);
             self.estimate_calibrated = Some(e.calibrated);
             self.estimate_seconds = Some(e.seconds);
+            self.speedup_with_estimate = Some(self.full_seconds / (self.rom_seconds + e.seconds));
             self.error_estimate_by_time = Some(e.by_time.to_vec());
             self.error_estimate_displacement = Some(e.error_estimate_displacement);
             self.effectivity_displacement = Some(e.error_estimate_displacement / self.displacement_error);
@@ -463,9 +469,10 @@ impl Validation {
                 self.error_estimate_method.as_ref().map_or(String::new(), |m| format!(", {m} method")),
                 f,
                 self.estimate_seconds.map_or(String::new(), |t| format!(
-                    ", estimator {:.4} s ({:.0} % of the reduced run)",
+                    ", estimator {:.4} s ({:.0} % of the reduced run; speedup with it {:.2}×)",
                     t,
-                    100.0 * t / self.rom_seconds
+                    100.0 * t / self.rom_seconds,
+                    self.full_seconds / (self.rom_seconds + t)
                 ))
             )),
             _ => s.push_str("\n  error_estimate: none (the basis file has no /estimator; train again)"),

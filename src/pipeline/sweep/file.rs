@@ -511,6 +511,7 @@ pub fn read_sweep(
             rom_seconds: rom_seconds[k],
             speedup: c[4][k],
             speedup_vs_dense: None,
+            speedup_with_estimate: None,
             full_newton_iterations: 0,
             rom_newton_iterations: newton[k] as usize,
             rom_step_cuts: 0,
