@@ -69,7 +69,19 @@ impl Settings {
         model.limits.check_steps(steps, dt, t_end)?;
         let n_steps = steps as usize;
         if n_steps == 0 {
-            return Err(Error::Usage(format!("dt = {dt} is longer than t_end = {t_end}")));
+            // name where each value came from: an option, or the model file
+            let from = |given: bool, option: &str, key: &str| {
+                if given {
+                    format!("--{option}")
+                } else {
+                    format!("{}: time.{key}", model.path.display())
+                }
+            };
+            return Err(Error::Usage(format!(
+                "the time step ({} = {dt}) is longer than the run ({} = {t_end}): no step fits",
+                from(o.dt.is_some(), "dt", "dt"),
+                from(o.t_end.is_some(), "t-end", "t_end"),
+            )));
         }
         Ok(Settings {
             dt,

@@ -205,3 +205,20 @@ fn missing_model_file_is_named() {
     assert!(!o.status.success());
     assert!(String::from_utf8(o.stderr).unwrap().contains("/no/such/model.toml"));
 }
+
+/// A time step longer than the run names where each value came from (the option or the
+/// model file's key), and an output where no file can be made names that output, not the
+/// temporary file beside it that the user never gave.
+#[test]
+fn a_step_longer_than_the_run_and_an_unwritable_output_are_named() {
+    let model = data("pendulum.toml");
+    let o = flexrom().args(["simulate", model.to_str().unwrap(), "-o", "/tmp/x.h5", "--dt", "2"]).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert!(!o.status.success());
+    assert!(err.contains("--dt = 2") && err.contains("pendulum.toml: time.t_end = 1.1"), "{err}");
+    // /proc takes no new files
+    let o = flexrom().args(["simulate", model.to_str().unwrap(), "-o", "/proc/flexrom-x.h5"]).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert!(!o.status.success());
+    assert!(err.starts_with("error: /proc/flexrom-x.h5: cannot write there"), "{err}");
+}

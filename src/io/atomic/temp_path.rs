@@ -57,7 +57,14 @@ impl TempPath {
                     return Ok(TempPath { live: l, target, armed: true });
                 }
                 Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
-                Err(e) => return Err(Error::io(&tmp, e)),
+                // the output named, not the temporary name the user never gave
+                Err(e) => {
+                    return Err(Error::Usage(format!(
+                        "{}: cannot write there: creating its temporary file {} failed: {e}",
+                        target.display(),
+                        tmp.display()
+                    )))
+                }
             }
         }
     }
