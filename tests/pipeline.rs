@@ -359,7 +359,7 @@ fn bad_input_is_refused_clearly() {
         .success());
     fails_with(
         &["online", ps, "--load-scale", "1", "-o", os, "--basis", foreign.to_str().unwrap()],
-        &["foreign.h5", "schema_version", "not a flexrom basis"],
+        &["foreign.h5", "schema_version", "not a flexrom basis", "it is a flexrom result file"],
     );
     assert!(!out.exists(), "no output from failed runs");
 

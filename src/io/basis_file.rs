@@ -211,10 +211,12 @@ pub fn read_basis(path: &Path) -> Result<StoredBasis> {
     // layouts 1 and 2 store a basis alike (snapshots and modes one column each); a newer
     // one is refused
     check_layout(&f, path, "flexrom train")?;
-    let version = f
-        .attr("schema_version")
-        .and_then(|a| a.read_scalar::<u64>())
-        .map_err(|_| field("schema_version", "is missing: this is not a flexrom basis file".into()))?;
+    let version = f.attr("schema_version").and_then(|a| a.read_scalar::<u64>()).map_err(|_| {
+        // another flexrom file says what it is (`flexrom_file`): name it
+        let kind = crate::io::h5::read_attr_str(&f, "flexrom_file")
+            .map_or(String::new(), |k| format!(" (it is a flexrom {k} file)"));
+        field("schema_version", format!("is missing: this is not a flexrom basis file{kind}"))
+    })?;
     if version == 1 {
         return Err(field("schema_version", format!("is 1 (an older flexrom's basis, without a content hash); this program reads version {SCHEMA_VERSION}: run `flexrom train` again")));
     }
