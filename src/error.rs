@@ -104,6 +104,16 @@ pub fn show_number(x: f64) -> String {
     }
 }
 
+/// What to do after a reduced run failed ([`Error::at_reduced_stage`]; a sweep says it once
+/// after its failures).
+pub const REDUCED_RUN_FAILED: &str =
+    "a reduced model can fail where the full one does not (its basis lacks this load's \
+     motion): `flexrom simulate` runs the full model at this load, `flexrom sweep --full` at many, and a training run \
+     near it puts its motion into the basis";
+/// The same where the full model has just run at those parameters (`validate`).
+pub const REDUCED_RUN_FAILED_FULL_RAN: &str =
+    "the full model ran here, so the basis lacks this load's motion: a training run near it puts it in";
+
 impl Error {
     /// The process exit code for this error: 3 when only part of the work failed
     /// ([`Error::PartlyFailed`]), 4 when an error estimate exceeded the tolerance under
@@ -142,14 +152,7 @@ impl Error {
     pub fn at_reduced_stage(self, stage: &str, mu: &impl std::fmt::Display, full_ran: bool) -> Self {
         match self {
             Error::NewtonFailed { .. } | Error::LinearSolve { .. } | Error::BlowUp { .. } => {
-                let hint = if full_ran {
-                    "the full model ran here, so the basis lacks this load's motion: a training run near it \
-                     puts it in"
-                } else {
-                    "a reduced model can fail where the full one does not (its basis lacks this load's motion): \
-                     `flexrom simulate` runs the full model at this load, `flexrom sweep --full` at many, and a \
-                     training run near it puts its motion into the basis"
-                };
+                let hint = if full_ran { REDUCED_RUN_FAILED_FULL_RAN } else { REDUCED_RUN_FAILED };
                 Error::Hinted { source: Box::new(self.at_stage(stage, mu)), hint: hint.to_string() }
             }
             other => other,

@@ -33,7 +33,8 @@
 //!   trained over [0, 1] (at λ = 0 it does not move) with the displacement measure at
 //!   T = 3e-3 converges (measured: 3 training runs and the held-out check); at λ = 0 the
 //!   displacement estimate is undefined like the error it estimates — NaN in the result file,
-//!   "displacement none" on the terminal — not a ratio of two runs' rounding (before
+//!   "displacement none" on the terminal, no "above the tolerance" warning and `--strict`
+//!   passing — not a ratio of two runs' rounding (before
 //!   2026-11-27 it read 2.1 there, so greedy spent its 6 runs and stopped above T at λ = 0).
 //! - `bad_measures_and_methods_are_refused`: a greedy `measure` that is not one of the two
 //!   fails `train` naming the pipeline file and `train.greedy.measure`; `[online]
@@ -213,6 +214,10 @@ fn a_range_from_rest_trains_on_the_displacement_measure() {
     let err = text(&o.stderr);
     assert!(o.status.success(), "{err}");
     assert!(err.contains("displacement none ("), "{err}");
+    // nothing to hold to the tolerance there: no warning, and --strict passes
+    assert!(!err.contains("above the tolerance"), "{err}");
+    let o = flexrom(&["online", p, "--load-scale", "0", "-o", out.to_str().unwrap(), "--strict"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
     let r = hdf5::File::open(&out).unwrap();
     let est: f64 = r.attr("error_estimate_displacement").unwrap().read_scalar().unwrap();
     let rel: f64 = r.attr("error_estimate").unwrap().read_scalar().unwrap();

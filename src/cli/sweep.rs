@@ -153,8 +153,11 @@ impl Args {
         warn(notice.as_slice());
         // the good runs are written; the exit code (3) says that some failed
         if let Some(s) = sw.failure_summary() {
+            // the way on after failed reduced runs, once for all of them
+            let hint =
+                if loaded.is_some() { format!("\n{}", flexrom::error::REDUCED_RUN_FAILED) } else { String::new() };
             return Err(flexrom::Error::PartlyFailed(format!(
-                "{s} (the others are in {}; /status and /message say which)",
+                "{s} (the others are in {}; /status and /message say which){hint}",
                 out.display()
             )));
         }

@@ -225,7 +225,9 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         // rel_error `e` calibrates the estimator; the error in the training's measure is held to T
         let truth_error = true_error(&p.model, &level.trained.basis, &truth, &mu);
         let (e, e_measured) = (truth_error.rel_error, truth_error.in_measure(g.measure));
-        let e_score = score(g.tolerance, truth_error.by_time_in(g.measure), &level.sensitivity[ni]);
+        let by_time =
+            candidates::at_rest_as_relative(truth_error.by_time_in(g.measure), &truth_error.rel_error_by_time);
+        let e_score = score(g.tolerance, &by_time, &level.sensitivity[ni]);
         let c = level.estimator.calibration.factor;
         (it.run_candidate, it.true_error, it.true_score) = (Some(ni), e_measured, e_score);
         it.held_out_effectivity = c * level.raws[ni] / e;

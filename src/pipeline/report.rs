@@ -479,7 +479,7 @@ fn motion_section(
             label,
             v.rel_error,
             fmt(v.displacement_error),
-            o(v.error_estimate_displacement, &|x| format!("{x:.3e}")),
+            o(v.error_estimate_displacement, &|x| fmt(x)),
             o(v.effectivity_displacement.filter(|_| v.displacement_error.is_finite()), &|x| format!("{x:.2}")),
             by.join(", "),
             probes.join("; ")

@@ -179,14 +179,16 @@ pub fn sweep_to_file(route: Route, points: &[Parameters], o: SweepOptions, f: Sw
     }
     let basis = route.basis();
     let runs = runs_noun(points);
+    // a stop once a checkpoint is written leaves that file: say what it keeps and how to go
+    // on (set after the first write, it stands through the later ones)
+    let note = format!(
+        "{} is this sweep's last checkpoint (written every few seconds): it keeps the {runs} \
+         finished by then, and the same command with --resume runs the others",
+        out.display()
+    );
     let write = |s: &Sweep| {
         write_sweep_with(out, s, basis, extra)?;
-        // a stop from now on leaves this file: say what it keeps and how to go on
-        crate::io::atomic::set_stop_note(Some(format!(
-            "{} keeps the {runs} finished by its last checkpoint (written every few seconds); \
-             the same command with --resume runs the others",
-            out.display()
-        )));
+        crate::io::atomic::set_stop_note(Some(note.clone()));
         Ok(())
     };
     let sw = match route {
@@ -232,9 +234,8 @@ fn run_reduced(rom: &Rom, state: Sweep, o: SweepOptions, checkpoint: Option<Chec
     let output = if o.validate { Output::Full } else { Output::ReducedAndProbes };
     crate::rom::check_reduced_memory(model, basis.n_reduced(), n_steps, output, state.n_todo() as f64)?;
     let point = |mu: &Parameters, previous: &[&ReducedRun]| -> Result<SweepPoint> {
-        let (run, estimate) = rom
-            .solve_and_estimate(mu, output, previous)
-            .map_err(|e| e.at_reduced_stage("sweep (reduced run)", mu, false))?;
+        let (run, estimate) =
+            rom.solve_and_estimate(mu, output, previous).map_err(|e| e.at_stage("sweep (reduced run)", mu))?;
         let (validation, full_probes) = if o.validate {
             let full = simulate(model, &Overrides::at(mu)).map_err(|e| e.at_stage("sweep (full run)", mu))?;
             let v = compare(model, &full, &run, None, basis.n_reduced(), basis.variant.name())

@@ -55,7 +55,8 @@ pub struct Validation {
     pub speedup: f64,
     pub speedup_vs_dense: Option<f64>,
     /// `full_seconds / (rom_seconds + estimate_seconds)`: the reduced route as `online` and
-    /// `sweep` run it, estimate included (null: no estimate)
+    /// `sweep` run it, estimate included (null: no estimate). The time loops are medians of
+    /// interleaved runs, the estimate's time that of its one run
     pub speedup_with_estimate: Option<f64>,
     pub full_newton_iterations: usize,
     pub rom_newton_iterations: usize,
@@ -174,14 +175,16 @@ pub struct ProbeQuantityError {
     pub max_error: f64,
     /// `max_k |v_full(t_k)|`: the largest value of the full run
     pub largest: f64,
-    /// `max_error / largest` (null where the full run's value stays within the
-    /// coordinates' resolution, [`against_motion`]; ∞ where only the reduced one leaves it)
+    /// `max_error / largest`; none where the full run's value stays within its resolution
+    /// (the Newton tolerance carried to the quantity, [`against_motion`]); ∞ where only the
+    /// reduced one leaves it (JSON writes ∞ as null too: `max_error` tells them apart)
     pub relative: Option<f64>,
 }
 
 impl ProbeQuantityError {
     /// The error of the series `rom` against `full` over the full run's largest value;
-    /// `resolution` is the coordinates' (the Newton tolerance `tol · L`).
+    /// `resolution` is the quantity's: the Newton tolerance `tol` for a strain (slopes
+    /// resolve to `tol`), `tol / L` for a curvature.
     pub fn of(
         probe: &str,
         quantity: &str,
@@ -201,12 +204,14 @@ impl ProbeQuantityError {
         }
     }
 
-    /// Every probe's strain and curvature of `rom` against `full`.
-    fn all(full: &SimulationResult, rom: &SimulationResult, resolution: f64) -> Vec<Self> {
+    /// Every probe's strain and curvature of `rom` against `full`, at the Newton tolerance
+    /// `tol` of a model of length scale `length`.
+    fn all(full: &SimulationResult, rom: &SimulationResult, tol: f64, length: f64) -> Vec<Self> {
         let mut out = Vec::new();
-        for (quantity, f, r) in
-            [("strain", &full.strains, &rom.strains), ("curvature", &full.curvatures, &rom.curvatures)]
-        {
+        for (quantity, f, r, resolution) in [
+            ("strain", &full.strains, &rom.strains, tol),
+            ("curvature", &full.curvatures, &rom.curvatures, tol / length),
+        ] {
             for ((name, a), (_, b)) in f.iter().zip(r) {
                 out.push(Self::of(name, quantity, a, b, resolution));
             }
@@ -305,7 +310,7 @@ pub fn compare(
         max_error_over_travel: worst_travel.as_ref().map(|w| w.0),
         max_error_over_travel_probe: worst_travel.map_or(String::new(), |w| w.1),
         probe_errors_over_travel: travels,
-        probe_quantity_errors: ProbeQuantityError::all(full, r, resolution),
+        probe_quantity_errors: ProbeQuantityError::all(full, r, full.settings.params.tolerance, sys.length_scale()),
         error_estimate_method: None,
         estimate_failure: None,
     }
@@ -541,9 +546,11 @@ impl Validation {
             )
         };
         // (no effectivity against an undefined or infinite error)
-        if let (Some(e), Some(f), true) =
-            (self.error_estimate_displacement, self.effectivity_displacement, self.displacement_error.is_finite())
-        {
+        if let (Some(e), Some(f), true) = (
+            self.error_estimate_displacement,
+            self.effectivity_displacement,
+            self.displacement_error.is_finite() && self.error_estimate_displacement.is_some_and(|e| !e.is_nan()),
+        ) {
             s.push_str(&format!(", error_estimate_displacement {e:.3e}, effectivity {f:.2}"));
         }
         for p in &self.probe_errors_over_travel {
@@ -565,7 +572,8 @@ impl Validation {
                 q.quantity,
                 q.max_error,
                 q.largest,
-                q.relative.map_or("none (it stays at zero)".to_string(), |e| format!("{e:.3e} of it")),
+                q.relative
+                    .map_or("none (it stays within the Newton tolerance)".to_string(), |e| format!("{e:.3e} of it")),
             ));
         }
         s

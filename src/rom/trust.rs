@@ -325,11 +325,20 @@ pub fn check_runs(
     };
     let over: Vec<String> = runs
         .iter()
-        .filter(|r| r.1.is_none_or(|e| !(e <= tol)))
+        // NaN: a displacement estimate where nothing moved beyond the Newton tolerance
+        // (norms::against_motion): nothing to hold to the tolerance
+        .filter(|r| r.1.is_none_or(|e| !e.is_nan() && !(e <= tol)))
         .map(|r| {
             let at = if trust.space.is_empty() { format!("{:.4}", r.0.scale()) } else { label(trust, &r.0) };
             match r.1 {
-                Some(e) if e.is_infinite() => format!("{at} (∞: the estimator's own run failed)"),
+                Some(e) if e.is_infinite() => format!(
+                    "{at} (∞: the estimator's own run failed{})",
+                    if trust.measure == ErrorMeasure::Displacement {
+                        ", or only the reduced run moved beyond the Newton tolerance"
+                    } else {
+                        ""
+                    }
+                ),
                 Some(e) => format!("{at} ({e:.2e})"),
                 None => format!("{at} (no estimate)"),
             }

@@ -60,7 +60,7 @@ impl TempPath {
                 // the output named, not the temporary name the user never gave
                 Err(e) => {
                     return Err(Error::Usage(format!(
-                        "{}: cannot write there: creating its temporary file {} failed: {e}",
+                        "{}: cannot write there: creating its temporary sibling {} failed: {e}",
                         target.display(),
                         tmp.display()
                     )))

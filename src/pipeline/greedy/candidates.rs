@@ -179,8 +179,9 @@ fn point_run(
 /// must not take for a failed one (NaN counts as ∞, [`score`]). There the relative
 /// estimate (finite where the runs ran: rounding against ‖X‖) stands in — next to a
 /// training load a pair counts with its larger value ([`super::between::pair_bound`]),
-/// elsewhere the jump to its neighbours asks for a full run there, once.
-fn at_rest_as_relative(estimate: &ByFifth, relative: &ByFifth) -> ByFifth {
+/// elsewhere the jump to its neighbours asks for a full run there, once. The held-out
+/// check reads the true errors of a run at rest alike.
+pub(super) fn at_rest_as_relative(estimate: &ByFifth, relative: &ByFifth) -> ByFifth {
     std::array::from_fn(|i| if estimate[i].is_nan() && relative[i].is_finite() { relative[i] } else { estimate[i] })
 }
 

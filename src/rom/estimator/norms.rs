@@ -14,8 +14,8 @@
 //!     ‖x_ref + V⁺ q⁺ − x₀‖² = ‖V⁺ᵀd + q⁺‖² + (‖d‖² − ‖V⁺ᵀd‖²),
 //! ```
 //!
-//! the last two by expanding the square (`V⁺ᵀV⁺ = I`). The displacement norm keeps the
-//! in-span part as one square: expanded like the configuration's, `‖d‖² + 2 (V⁺ᵀd)·q⁺ +
+//! the last two by expanding the square (`V⁺ᵀV⁺ = I`; the constant `‖d‖² − ‖V⁺ᵀd‖²` formed
+//! once as `‖d − V⁺V⁺ᵀd‖²`). The displacement norm keeps the in-span part as one square: expanded like the configuration's, `‖d‖² + 2 (V⁺ᵀd)·q⁺ +
 //! ‖q⁺‖²` would cancel where the motion is small against the configuration, and read the
 //! rounding of `‖d‖²` as motion. Its out-of-span part `‖d‖² − ‖V⁺ᵀd‖²` is the same at every
 //! instant.
@@ -86,7 +86,7 @@ pub struct ConfigurationNorms {
     xr2: f64,
     /// `Vᵀd`
     vts: Array1<f64>,
-    /// `‖d‖² − ‖Vᵀd‖²`, the shift's part outside the span of `V`
+    /// `‖d − V Vᵀd‖²` (= `‖d‖² − ‖Vᵀd‖²`), the shift's part outside the span of `V`
     outside2: f64,
     /// rows of `V`: a displacement at the resolution in every coordinate has `n_dof res²`
     n_dof: usize,
@@ -97,7 +97,10 @@ impl ConfigurationNorms {
         let (v, xr) = (&basis.modes, &basis.reference);
         let shift = xr - &x0;
         let vts = v.t().dot(&shift);
-        let outside2 = (shift.dot(&shift) - vts.dot(&vts)).max(0.0);
+        // from the residual itself: ‖d‖² − ‖Vᵀd‖² would cancel where d lies nearly in the
+        // span (raw snapshots: d = −x₀), at ε‖d‖², far above a resolution-sized motion
+        let outside = &shift - &v.dot(&vts);
+        let outside2 = outside.dot(&outside);
         ConfigurationNorms { vtx: v.t().dot(xr), xr2: xr.dot(xr), vts, outside2, n_dof: v.nrows() }
     }
 
