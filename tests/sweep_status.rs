@@ -173,24 +173,31 @@ fn resume_runs_only_the_missing_scales_of_the_same_basis() {
     assert_eq!(std::fs::read(&out).unwrap(), bytes);
 }
 
-#[test]
-fn a_killed_sweep_leaves_a_valid_file_to_resume_from() {
-    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
-    let tmp = tempfile::tempdir().unwrap();
-    let d = tmp.path();
-    // ~10 ms per reduced run: 300 of them take seconds, long enough to be killed midway
+/// A sweep of 300 load scales in `d` (~10 ms per reduced run: seconds, long enough to be
+/// stopped midway) whose file has just been written for the first time: its pipeline, the
+/// sweep file and the running process (stderr to `stderr`).
+fn sweep_under_way(d: &Path, stderr: std::process::Stdio) -> (PathBuf, PathBuf, std::process::Child) {
     let p = setup(d, 50, 1.1, 14, "\"0.5:1.5:300\"");
     let out = d.join("s.h5");
-    let mut child = flexrom()
+    let child = flexrom()
         .args(["sweep", p.to_str().unwrap(), "-o", out.to_str().unwrap()])
         .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
+        .stderr(stderr)
         .spawn()
         .unwrap();
     let start = std::time::Instant::now();
     while !out.exists() && start.elapsed().as_secs() < 120 {
         std::thread::sleep(std::time::Duration::from_millis(5));
     }
+    (p, out, child)
+}
+
+#[test]
+fn a_killed_sweep_leaves_a_valid_file_to_resume_from() {
+    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let (p, out, mut child) = sweep_under_way(d, std::process::Stdio::null());
     child.kill().unwrap();
     child.wait().unwrap();
     assert!(out.exists(), "the first finished scale is written at once");
@@ -214,18 +221,7 @@ fn an_interrupted_sweep_names_the_file_it_keeps_and_how_to_go_on() {
     let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
     let tmp = tempfile::tempdir().unwrap();
     let d = tmp.path();
-    let p = setup(d, 50, 1.1, 14, "\"0.5:1.5:300\"");
-    let out = d.join("s.h5");
-    let child = flexrom()
-        .args(["sweep", p.to_str().unwrap(), "-o", out.to_str().unwrap()])
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let start = std::time::Instant::now();
-    while !out.exists() && start.elapsed().as_secs() < 120 {
-        std::thread::sleep(std::time::Duration::from_millis(5));
-    }
+    let (_, out, child) = sweep_under_way(d, std::process::Stdio::piped());
     // past the first checkpoint's rename, after which the note is set
     std::thread::sleep(std::time::Duration::from_millis(300));
     let kill = Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();

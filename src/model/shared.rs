@@ -7,6 +7,11 @@ use crate::linalg::kkt::LinearSolverKind;
 use std::sync::Arc;
 
 impl SharedPhysics {
+    /// The model's length scale `L`: coordinates resolve to `tol · L` at Newton tolerance `tol`.
+    pub fn length_scale(&self) -> f64 {
+        crate::solver::model::ParametricModel::length_scale(&*self.sys)
+    }
+
     /// Assembles the system of `model` and closes the joints of its initial state.
     pub fn assemble(model: &Model) -> Result<Self> {
         let mut sys = model.system(LinearSolverKind::Banded);

@@ -496,7 +496,7 @@ fn motion_section(
     let _ = writeln!(md, "|---|---|---|---|---|---|");
     for (v, label) in validations.iter().zip(labels) {
         for q in &v.probe_quantity_errors {
-            let unit = if q.quantity == "curvature" { " 1/m" } else { "" };
+            let unit = q.unit();
             let rel = q.relative.map_or("none".to_string(), |e| format!("{e:.2e}"));
             let _ = writeln!(
                 md,

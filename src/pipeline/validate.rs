@@ -204,6 +204,15 @@ impl ProbeQuantityError {
         }
     }
 
+    /// The quantity's unit as printed after a value (strain: none).
+    pub fn unit(&self) -> &'static str {
+        if self.quantity == "curvature" {
+            " 1/m"
+        } else {
+            ""
+        }
+    }
+
     /// Every probe's strain and curvature of `rom` against `full`, at the Newton tolerance
     /// `tol` of a model of length scale `length`.
     fn all(full: &SimulationResult, rom: &SimulationResult, tol: f64, length: f64) -> Vec<Self> {
@@ -342,9 +351,14 @@ impl Validation {
     pub fn with_timings(mut self, full_seconds: f64, rom_seconds: f64) -> Self {
         self.full_seconds = full_seconds;
         self.rom_seconds = rom_seconds;
-        self.speedup = full_seconds / rom_seconds;
-        self.speedup_vs_dense = self.full_dense_seconds.map(|d| d / rom_seconds);
-        self.speedup_with_estimate = self.estimate_seconds.map(|e| full_seconds / (rom_seconds + e));
+        self.with_speedups()
+    }
+
+    /// The speedups, from the seconds measured so far (the estimate's once it is known).
+    fn with_speedups(mut self) -> Self {
+        self.speedup = self.full_seconds / self.rom_seconds;
+        self.speedup_vs_dense = self.full_dense_seconds.map(|d| d / self.rom_seconds);
+        self.speedup_with_estimate = self.estimate_seconds.map(|e| self.full_seconds / (self.rom_seconds + e));
         self
     }
 
@@ -356,7 +370,6 @@ impl Validation {
             self.effectivity = Some(e.error_estimate / self.rel_error);
             self.estimate_calibrated = Some(e.calibrated);
             self.estimate_seconds = Some(e.seconds);
-            self.speedup_with_estimate = Some(self.full_seconds / (self.rom_seconds + e.seconds));
             self.error_estimate_by_time = Some(e.by_time.to_vec());
             self.error_estimate_displacement = Some(e.error_estimate_displacement);
             self.effectivity_displacement = Some(e.error_estimate_displacement / self.displacement_error);
@@ -375,7 +388,7 @@ impl Validation {
         if estimate.is_some() {
             self.error_estimate_method = rom.and_then(|r| r.method()).map(str::to_string);
         }
-        self
+        self.with_speedups()
     }
 }
 
@@ -473,11 +486,10 @@ impl Validation {
                 if self.estimate_calibrated == Some(true) { "calibrated" } else { "uncalibrated" },
                 self.error_estimate_method.as_ref().map_or(String::new(), |m| format!(", {m} method")),
                 f,
-                self.estimate_seconds.map_or(String::new(), |t| format!(
-                    ", estimator {:.4} s ({:.0} % of the reduced run; speedup with it {:.2}×)",
+                self.estimate_seconds.zip(self.speedup_with_estimate).map_or(String::new(), |(t, s)| format!(
+                    ", estimator {:.4} s ({:.0} % of the reduced run; speedup with it {s:.2}×)",
                     t,
                     100.0 * t / self.rom_seconds,
-                    self.full_seconds / (self.rom_seconds + t)
                 ))
             )),
             _ => s.push_str("\n  error_estimate: none (the basis file has no /estimator; train again)"),
@@ -565,7 +577,7 @@ impl Validation {
             ));
         }
         for q in &self.probe_quantity_errors {
-            let unit = if q.quantity == "curvature" { " 1/m" } else { "" };
+            let unit = q.unit();
             s.push_str(&format!(
                 "\n  probe {} {}: max error {:.3e}{unit} against a largest value of {:.3e}{unit}: {}",
                 q.probe,

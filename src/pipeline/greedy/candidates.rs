@@ -13,7 +13,6 @@ use crate::rom::estimator::{
     self, ByFifth, DefectsCalibration, ErrorEstimator, ErrorMeasure, EstimateMethod, Estimator, FIFTHS,
 };
 use crate::rom::{Output, Rom};
-use crate::solver::model::ParametricModel;
 use crate::solver::parameters::Parameters;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
@@ -155,7 +154,7 @@ fn point_run(
         Ok((run, Some(e))) => {
             // the same reduced model at μ(1 + δ): how much its answer moves
             let basis = rom.basis();
-            let res = rom.model().physics().map_or(0.0, |p| resolution(&run, ParametricModel::length_scale(&*p.sys)));
+            let res = rom.model().physics().map_or(0.0, |p| resolution(&run, p.length_scale()));
             let sensitivity = match rom.solve_with(moved, Output::ReducedAndProbes, &[]) {
                 Ok(moved) => *raw_by_time(basis, basis, &moved.reduced_q, &run.reduced_q, x0, res).get(measure),
                 Err(_) => [0.0; FIFTHS],

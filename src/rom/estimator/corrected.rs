@@ -350,7 +350,7 @@ impl Corrected {
         runners.put(CorrectedRunner::new(model, basis, data)?);
         let physics = model.physics()?;
         let x0 = Arc::clone(&physics.x0);
-        let length = crate::solver::model::ParametricModel::length_scale(&*physics.sys);
+        let length = physics.length_scale();
         let norms = super::norms::NormProjection::new(basis, &data.enriched, ndarray::ArrayView1::from(&x0[..]));
         Ok(Corrected {
             length,

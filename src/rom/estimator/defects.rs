@@ -67,7 +67,7 @@ impl Defects {
         runners.put(CorrectedRunner::new(model, basis, data)?);
         let physics = model.physics()?;
         let norms = ConfigurationNorms::new(basis, ndarray::ArrayView1::from(&physics.x0[..]));
-        let length = crate::solver::model::ParametricModel::length_scale(&*physics.sys);
+        let length = physics.length_scale();
         Ok(Defects { data: Arc::clone(data), runners, sample: DEFECT_SAMPLE, norms, length })
     }
 

@@ -35,7 +35,7 @@ impl Enriched {
         runners.put(ReducedRunner::new(model, &enriched)?);
         let physics = model.physics()?;
         let x0 = Arc::clone(&physics.x0);
-        let length = crate::solver::model::ParametricModel::length_scale(&*physics.sys);
+        let length = physics.length_scale();
         let norms = NormProjection::new(basis, &data.enriched, ndarray::ArrayView1::from(&x0[..]));
         Ok(Enriched { basis: Arc::clone(basis), data: Arc::clone(data), runners, x0, norms, length })
     }
