@@ -28,7 +28,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use zoo::drive::{Flexrom, Training, Validation};
-use zoo::metrics::{aggregate, estimate_fails, model_stats, Aggregate, ModelStats};
+use zoo::metrics::{aggregate, estimate_fails, fallback_stats, model_stats, Aggregate, ModelStats};
 use zoo::{accepted, pipeline_toml, validation_loads, Replacement, ZooModel};
 
 const METHODS: [&str; 3] = ["corrected", "defects", "enriched"];
@@ -524,12 +524,23 @@ fn main() {
         } else {
             let _ = writeln!(md, "Targets missed: {}.\n", missed.join("; "));
         }
+        // what a sweep with `--fallback full` gives at the same loads (docs/basis-and-sweep.md)
+        let fb: Vec<ModelStats> = at.iter().map(|(_, e)| fallback_stats(&e.validations, t)).collect();
+        let fagg = aggregate(&at.iter().zip(&fb).map(|((_, e), s)| (e.training.as_ref().ok(), s)).collect::<Vec<_>>());
+        let _ = writeln!(
+            md,
+            "With `sweep --fallback full`: the full model's exact answer at {} of {} loads, in {} models; the others as above.\n\n{AGG_HEAD}\n{}\n",
+            fagg.fallbacks,
+            fagg.pairs,
+            fb.iter().filter(|s| s.fallbacks > 0).count(),
+            aggregate_row(&fagg)
+        );
         let _ = writeln!(md, "{MODEL_HEAD}");
         for (i, e) in &at {
             let _ = writeln!(md, "{}", model_row(&infos[*i], e));
         }
         let _ = writeln!(md);
-        aggregates.push((t, agg));
+        aggregates.push((t, agg, fagg));
     }
     let failing: Vec<&(usize, Entry)> = entries.iter().filter(|(_, e)| !e.methods.is_empty()).collect();
     if !failing.is_empty() {
@@ -582,7 +593,7 @@ fn main() {
         "jobs": a.jobs,
         "models": infos,
         "replaced": replaced_json(&replaced),
-        "aggregates": aggregates.iter().map(|(t, g)| serde_json::json!({"tolerance": t, "aggregate": g, "missed": g.missed()})).collect::<Vec<_>>(),
+        "aggregates": aggregates.iter().map(|(t, g, f)| serde_json::json!({"tolerance": t, "aggregate": g, "missed": g.missed(), "with_fallback": f, "with_fallback_missed": f.missed()})).collect::<Vec<_>>(),
         "entries": entries.iter().map(|(_, e)| e).collect::<Vec<_>>(),
     });
     write_atomic(&a.out.join("zoo.json"), &serde_json::to_string_pretty(&json).expect("JSON"));

@@ -234,3 +234,131 @@ fn an_interrupted_sweep_names_the_file_it_keeps_and_how_to_go_on() {
     assert!(err.contains("the same command with --resume runs the others"), "{err}");
     assert!(status(&out).contains(&0));
 }
+
+fn messages(f: &Path) -> Vec<String> {
+    let f = hdf5::File::open(f).unwrap();
+    let m = f.dataset("message").unwrap().read_raw::<hdf5::types::VarLenUnicode>().unwrap();
+    m.iter().map(|m| m.to_string()).collect()
+}
+
+fn tip(f: &Path) -> ndarray::Array3<f64> {
+    hdf5::File::open(f).unwrap().dataset("probes/tip").unwrap().read::<f64, ndarray::Ix3>().unwrap()
+}
+
+/// `--fallback full` where every estimate is above the tolerance (an `[online] tolerance`
+/// of 1e-12 against estimates of about 1e-3 for 4 POD modes on the coarse pendulum): every
+/// point is the full model's answer — its tip trajectory bit for bit that of `sweep
+/// --full` (the same full model, one per worker) —, `/fallback` 1, `/error_estimate` 0,
+/// `/reduced_q` NaN, why in `/message`, one summary line, exit 0 and no warning about the
+/// tolerance (the answers are exact). `--resume` keeps those points as they are; the
+/// pipeline's `[online] fallback = "full"` does the same without the flag, and `--fallback
+/// none` overrides it: the reduced answers with the warning, `/fallback` 0.
+#[test]
+fn a_fallback_answers_with_the_full_model_where_the_estimate_exceeds_the_tolerance() {
+    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let p = setup(d, 8, 0.1, 4, "[0.9, 1.0, 1.1]\ntolerance = 1e-12");
+    let ps = p.to_str().unwrap();
+    let (fb, full, plain) = (d.join("fb.h5"), d.join("full.h5"), d.join("plain.h5"));
+    let (o, err) = run(&["sweep", ps, "--fallback", "full", "-o", fb.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("the full model answered 3 of 3 load scales in place of the reduced one (3: error estimate above the tolerance;"),
+        "{err}"
+    );
+    assert!(!err.contains("warning: error estimate above"), "{err}");
+    let (o, err) = run(&["sweep", ps, "--full", "-o", full.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert_eq!(tip(&fb), tip(&full), "the fallback's answers are the full model's");
+    let f = hdf5::File::open(&fb).unwrap();
+    assert_eq!(f.dataset("fallback").unwrap().read_raw::<u8>().unwrap(), vec![1, 1, 1]);
+    assert!(f.dataset("reduced_q").unwrap().read_raw::<f64>().unwrap().iter().all(|x| x.is_nan()));
+    drop(f);
+    assert_eq!(column(&fb, "error_estimate"), vec![0.0; 3]);
+    for m in messages(&fb) {
+        assert!(m.starts_with("full model in place of the reduced one: error estimate "), "{m}");
+        assert!(m.ends_with(" above the tolerance 1e-12"), "{m}");
+    }
+    // resumed: nothing runs again, and the points stay the full model's
+    let before = column(&fb, "rom_seconds");
+    let (o, err) = run(&["sweep", ps, "--fallback", "full", "--resume", "-o", fb.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(err.contains("3 of 3 load scales already finished, running 0"), "{err}");
+    assert_eq!(column(&fb, "rom_seconds"), before);
+    assert!(messages(&fb).iter().all(|m| m.starts_with("full model in place")));
+    // the pipeline's key, and the flag over it
+    let text = std::fs::read_to_string(&p).unwrap();
+    std::fs::write(&p, text.replace("tolerance = 1e-12", "tolerance = 1e-12\nfallback = \"full\"")).unwrap();
+    let keyed = d.join("keyed.h5");
+    let (o, err) = run(&["sweep", ps, "-o", keyed.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert_eq!(tip(&keyed), tip(&full));
+    let (o, err) = run(&["sweep", ps, "--fallback", "none", "-o", plain.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(err.contains("warning: error estimate above the tolerance 1e-12"), "{err}");
+    let f = hdf5::File::open(&plain).unwrap();
+    assert_eq!(f.dataset("fallback").unwrap().read_raw::<u8>().unwrap(), vec![0, 0, 0]);
+    drop(f);
+    assert!(column(&plain, "error_estimate").iter().all(|&e| e > 1e-12));
+    assert_ne!(tip(&plain), tip(&full), "4 modes are not the full model");
+    assert_eq!(messages(&plain), vec![""; 3]);
+}
+
+/// Where the full model fails too (1e20 × gravity: Newton fails in both after 8 halvings,
+/// see the first test), the point is failed and its message holds both failures; the
+/// others are the reduced answers (the tolerance of the pipeline is the training one:
+/// none for a fixed-load basis, so nothing else falls back).
+#[test]
+fn a_fallback_whose_full_run_fails_too_says_both() {
+    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let p = setup(d, 8, 0.1, 4, "[1.0, 1e20]");
+    let out = d.join("s.h5");
+    let (o, err) = run(&["sweep", p.to_str().unwrap(), "--fallback", "full", "-o", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(3), "{err}");
+    assert_eq!(status(&out), vec![0, 1]);
+    let m = messages(&out);
+    assert_eq!(m[0], "");
+    assert!(m[1].starts_with("sweep (full run) at load scale 1e20: Newton failed"), "{m:?}");
+    assert!(
+        m[1].contains("; the full model ran in place of the reduced one, which had failed: sweep (reduced run) at load scale 1e20: Newton failed"),
+        "{m:?}"
+    );
+    let f = hdf5::File::open(&out).unwrap();
+    assert_eq!(f.dataset("fallback").unwrap().read_raw::<u8>().unwrap(), vec![0, 0]);
+}
+
+/// Where the full model fails too at a point the fallback would take, the reduced answer
+/// stands as it would without the fallback, with a note in `/message`. The shipped
+/// four-bar at λ = 1.34, outside its basis's range [0.7, 1.2] (measured 2026-11-27): the
+/// reduced run finishes, its estimator's richer run fails (estimate ∞, above the
+/// tolerance 1e-2), and the full run blows up at t = 1.064 s (strain 0.87 in the coupler).
+#[test]
+fn where_the_full_model_fails_too_the_reduced_answer_stands_with_a_note() {
+    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("s.h5");
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("pipelines/fourbar.toml");
+    let (o, err) = run(&[
+        "sweep",
+        p.to_str().unwrap(),
+        "--load-scales",
+        "1.34:1.34:1",
+        "--fallback",
+        "full",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(err.contains("warning: error estimate above the tolerance 1e-2 at load scale 1.34"), "{err}");
+    assert_eq!(status(&out), vec![0]);
+    let f = hdf5::File::open(&out).unwrap();
+    assert_eq!(f.dataset("fallback").unwrap().read_raw::<u8>().unwrap(), vec![0]);
+    assert!(f.dataset("reduced_q").unwrap().read_raw::<f64>().unwrap().iter().all(|x| x.is_finite()));
+    drop(f);
+    let m = &messages(&out)[0];
+    assert!(m.starts_with(flexrom::pipeline::sweep::fallback::FULL_TRIED), "{m}");
+    assert!(m.contains("failed: sweep (full run) at load scale 1.34: blow-up"), "{m}");
+}

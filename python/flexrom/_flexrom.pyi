@@ -139,6 +139,7 @@ class Basis:
         points: Optional[Sequence[Dict[str, float]]] = None,
         continuation: bool = False,
         progress: _Progress = None,
+        fallback: Optional[str] = None,
     ) -> Dict[str, Any]: ...
 
 def train(pipeline: _Path, output: Optional[_Path] = None, progress: _Progress = None) -> Basis:

@@ -86,6 +86,7 @@ pub fn sweep_dict<'py>(py: Python<'py>, s: &Sweep, points: &[Parameters]) -> PyR
     let mut by_time = ndarray::Array2::from_elem((n, 5), f64::NAN);
     let mut extrapolated = vec![false; n];
     let mut failed: Vec<Option<String>> = vec![None; n];
+    let mut fallback: Vec<Option<String>> = vec![None; n];
     let mut probes: Vec<ndarray::Array3<f64>> =
         vec![ndarray::Array3::from_elem((n, n_t, 2), f64::NAN); s.probe_names.len()];
     for (i, sr) in s.scales.iter().enumerate() {
@@ -96,6 +97,7 @@ pub fn sweep_dict<'py>(py: Python<'py>, s: &Sweep, points: &[Parameters]) -> PyR
                     by_time.row_mut(i).assign(&ndarray::ArrayView1::from(&e.by_time[..]));
                 }
                 extrapolated[i] = p.extrapolated;
+                fallback[i] = p.fallback.clone();
                 for (k, (_, xy)) in p.run.result.probes.iter().enumerate() {
                     probes[k].index_axis_mut(ndarray::Axis(0), i).assign(xy);
                 }
@@ -113,6 +115,7 @@ pub fn sweep_dict<'py>(py: Python<'py>, s: &Sweep, points: &[Parameters]) -> PyR
     d.set_item("error_estimate_by_time", by_time.into_pyarray(py))?;
     d.set_item("extrapolated", extrapolated.into_pyarray(py))?;
     d.set_item("failed", failed)?;
+    d.set_item("fallback", fallback)?;
     d.set_item("wall_seconds", s.wall_seconds)?;
     Ok(d)
 }

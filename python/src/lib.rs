@@ -758,8 +758,11 @@ impl PyBasis {
     /// Reduced runs at many loads in parallel (`flexrom sweep`): a dict of arrays with the
     /// load axis first (`load_scale`, `t`, `probes` name → (n, n_t, 2), `error_estimate`,
     /// `error_estimate_by_time` (n, 5), `extrapolated`, `failed`: each point's error
-    /// message or None). `points`: a list of dicts of named parameters instead.
-    #[pyo3(signature = (load_scales = None, points = None, continuation = false, progress = None))]
+    /// message or None, `fallback`: why the full model answered a point in place of the
+    /// reduced one, or None). `points`: a list of dicts of named parameters instead.
+    /// `fallback`: "full" runs the full model where the reduced answer cannot be trusted
+    /// (`sweep --fallback full`), "none" keeps it; default the pipeline's `[online] fallback`.
+    #[pyo3(signature = (load_scales = None, points = None, continuation = false, progress = None, fallback = None))]
     fn sweep<'py>(
         &self,
         py: Python<'py>,
@@ -767,21 +770,37 @@ impl PyBasis {
         points: Option<Vec<HashMap<String, f64>>>,
         continuation: bool,
         progress: Option<Bound<'py, PyAny>>,
+        fallback: Option<String>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        use flexrom::pipeline::sweep::Fallback;
+        let fallback = match fallback.as_deref() {
+            None => self.pipeline.online_fallback().unwrap_or_default(),
+            Some("none") => Fallback::None,
+            Some("full") => Fallback::Full,
+            Some(other) => {
+                return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                    "sweep: fallback is \"{other}\"; expected \"none\" or \"full\""
+                )))
+            }
+        };
         let progress = progress_callback(py, progress)?;
         let mus: Vec<Parameters> = match (load_scales, points) {
             (Some(s), None) => s.into_iter().map(|x| self.point(py, Some(x), None)).collect::<PyResult<_>>()?,
             (None, Some(p)) => p.iter().map(|p| self.point(py, None, Some(p))).collect::<PyResult<_>>()?,
             _ => return Err(errors::model_error("sweep: give exactly one of load_scales and points")),
         };
-        let o = flexrom::pipeline::sweep::SweepOptions { continuation, ..Default::default() };
+        let o = flexrom::pipeline::sweep::SweepOptions { continuation, fallback, ..Default::default() };
         let rom = &self.rom;
         let s = interruptible_with(py, progress.as_ref(), || flexrom::pipeline::sweep::sweep(rom, &mus, o))?;
         let measure = rom.tolerance_measure();
         let runs: Vec<(Parameters, Option<f64>)> = s
             .scales
             .iter()
-            .filter_map(|x| x.point().map(|p| (x.mu.clone(), p.estimate.as_ref().map(|e| e.in_measure(measure)))))
+            .filter_map(|x| {
+                x.point()
+                    .filter(|p| p.fallback.is_none())
+                    .map(|p| (x.mu.clone(), p.estimate.as_ref().map(|e| e.in_measure(measure))))
+            })
             .collect();
         let mut warnings = self.run_warnings(&runs)?;
         let mut outside: Vec<String> = mus.iter().flat_map(|mu| rom.untrained_parameters(mu)).collect();

@@ -128,6 +128,27 @@ def test_sweep_equals_online(dp_basis):
     same(p["error_estimate"], s["error_estimate"])
 
 
+def test_sweep_falls_back_to_the_full_model(dp_basis):
+    """fallback="full" (`sweep --fallback full`): at λ = 2.5, outside the range [0.5, 1.5],
+    the estimate reads 5.2e-3 against greedy's tolerance 1e-3 (measured 2026-11-27), so the
+    answer there is the full model's, bit for bit Model.simulate's, with error estimate 0
+    and the reason; at 1.0 it is the reduced answer, as without the fallback."""
+    b = flexrom.Basis.load(dp_basis)
+    s = b.sweep([1.0, 2.5], fallback="full")
+    assert s["fallback"][0] is None, s["fallback"]
+    assert s["fallback"][1].startswith("full model in place of the reduced one: error estimate "), s["fallback"]
+    assert s["error_estimate"][1] == 0 and not s["extrapolated"][1]
+    same(s["probes"]["tip"][0], b.sweep([1.0])["probes"]["tip"][0])
+    full = flexrom.Model.from_file(ROOT / "data" / "models" / "double_pendulum.toml").simulate(load_scale=2.5)
+    same(s["probes"]["tip"][1], full.probes["tip"])
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        assert b.sweep([2.5], fallback="none")["fallback"] == [None]
+    assert any("above the tolerance" in str(w.message) for w in seen), [str(w.message) for w in seen]
+    with pytest.raises(ValueError, match="fallback"):
+        b.sweep([1.0], fallback="bogus")
+
+
 def test_outside_the_training_range_warns(dp_basis):
     """A load outside the trained range [0.5, 1.5] is marked extrapolated and warns."""
     b = flexrom.Basis.load(dp_basis)

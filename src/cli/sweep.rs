@@ -48,6 +48,13 @@ pub struct Args {
     /// its own, exactly as `online`
     #[arg(long)]
     continuation: bool,
+    /// where the reduced answer cannot be trusted — its run fails, its error estimate
+    /// exceeds the tolerance ([online] tolerance, else the training tolerance), or the model
+    /// amplifies load changes beyond it — `full` runs the full model there and keeps its
+    /// exact answer (`/fallback` 1, why in `/message`); over the pipeline's [online]
+    /// fallback, default none
+    #[arg(long, value_enum, value_name = "WHAT", conflicts_with_all = ["validate", "full"])]
+    fallback: Option<flexrom::pipeline::sweep::Fallback>,
     /// skip the error estimate (about 2× faster; `/error_estimate` is then NaN)
     #[arg(long, conflicts_with = "estimate")]
     no_estimate: bool,
@@ -86,6 +93,7 @@ impl Args {
             validate,
             full,
             continuation,
+            fallback,
             no_estimate,
             output,
             basis,
@@ -128,8 +136,13 @@ impl Args {
             },
             None => Route::Full(&p.model),
         };
-        let options =
-            flexrom::pipeline::sweep::SweepOptions { validate, continuation, progress: output::show_progress() };
+        let fallback = fallback.or(p.online_fallback()).unwrap_or_default();
+        let options = flexrom::pipeline::sweep::SweepOptions {
+            validate,
+            continuation,
+            progress: output::show_progress(),
+            fallback,
+        };
         let file = SweepFile { out: &out, resume, extra: &|_| Ok(()) };
         let sw = match shard {
             Some(k) => flexrom::pipeline::shard::sweep_shard(&p, route, &points, k, options, file)?,
@@ -151,11 +164,18 @@ impl Args {
             out.display()
         ));
         warn(notice.as_slice());
+        if let Some(line) = fallback_summary(&sw) {
+            info(&line);
+        }
         // the good runs are written; the exit code (3) says that some failed
         if let Some(s) = sw.failure_summary() {
-            // the way on after failed reduced runs, once for all of them
-            let hint =
-                if loaded.is_some() { format!("\n{}", flexrom::error::REDUCED_RUN_FAILED) } else { String::new() };
+            // the way on after failed reduced runs, once for all of them (with the fallback a
+            // failed point is one where the full model failed too)
+            let hint = if loaded.is_some() && fallback == flexrom::pipeline::sweep::Fallback::None {
+                format!("\n{}", flexrom::error::REDUCED_RUN_FAILED)
+            } else {
+                String::new()
+            };
             return Err(flexrom::Error::PartlyFailed(format!(
                 "{s} (the others are in {}; /status and /message say which){hint}",
                 out.display()
@@ -172,16 +192,46 @@ impl Args {
                 first.join(", ")
             )]);
         }
+        // a point the full model answered is exact: nothing to warn about
         let runs: Vec<_> = sw
             .scales
             .iter()
             .filter_map(|x| x.point())
+            .filter(|q| q.fallback.is_none())
             .map(|q| {
                 (q.run.result.settings.mu.clone(), q.estimate.as_ref().map(|e| e.in_measure(rom.tolerance_measure())))
             })
             .collect();
         super::check_runs(rom, &runs, strict)
     }
+}
+
+/// One line when the full model answered some points in place of the reduced one: how
+/// many, why (by kind), and the first few.
+fn fallback_summary(sw: &flexrom::pipeline::sweep::Sweep) -> Option<String> {
+    let fell: Vec<&flexrom::pipeline::sweep::ScaleResult> =
+        sw.scales.iter().filter(|x| x.point().is_some_and(|p| p.fallback.is_some())).collect();
+    if fell.is_empty() {
+        return None;
+    }
+    use flexrom::pipeline::sweep::fallback::{FULL_IN_PLACE, KINDS};
+    let why = |x: &flexrom::pipeline::sweep::ScaleResult| {
+        x.message().strip_prefix(FULL_IN_PLACE).unwrap_or_default().trim_start_matches(": ").to_string()
+    };
+    let count = |start: &str| fell.iter().filter(|x| why(x).starts_with(start)).count();
+    let kinds: Vec<String> = KINDS
+        .iter()
+        .filter_map(|(key, name)| Some(count(key)).filter(|&c| c > 0).map(|c| format!("{c}: {name}")))
+        .collect();
+    let first: Vec<String> = fell.iter().take(3).map(|x| x.mu.to_string()).collect();
+    Some(format!(
+        "the full model answered {} of {} {} in place of the reduced one ({}; the first: {}): exact there, error estimate 0, `/fallback` 1 and why in `/message`",
+        fell.len(),
+        sw.scales.len(),
+        flexrom::pipeline::sweep::runs_noun(sw.scales.iter().map(|x| &x.mu)),
+        kinds.join(", "),
+        first.join("; ")
+    ))
 }
 
 /// The points of the sweep: `--points FILE`; or the grid of `--param` axes after the load

@@ -150,7 +150,7 @@ const BASIS: [Entry; 54] = [
     ("timing/estimate_seconds", "s", ""),
 ];
 
-const SWEEP: [Entry; 29] = [
+const SWEEP: [Entry; 30] = [
     ("load_scales", "1", "load"),
     ("points", "1", "load, parameter"),
     ("status", "1", "load"),
@@ -169,6 +169,8 @@ const SWEEP: [Entry; 29] = [
     ("error_estimate_displacement_by_time", "1", "load, fifth"),
     ("estimate_seconds", "s", "load"),
     ("extrapolated", "1", "load"),
+    // 1 where the full model answered in place of the reduced one
+    ("fallback", "1", "load"),
     ("sensitivity_near", "1", "load"),
     ("rel_error", "1", "load"),
     ("max_probe_error", "m", "load"),

@@ -426,6 +426,11 @@ impl Pipeline {
         self.file.online.as_ref().and_then(|o| o.tolerance)
     }
 
+    /// `[online] fallback`, when given.
+    pub fn online_fallback(&self) -> Option<crate::pipeline::sweep::Fallback> {
+        self.file.online.as_ref().and_then(|o| o.fallback)
+    }
+
     /// `[online] tolerance_measure`, when given (only with `[online] tolerance`).
     pub fn online_tolerance_measure(&self) -> Option<ErrorMeasure> {
         self.file.online.as_ref().and_then(|o| o.tolerance_measure)

@@ -96,7 +96,7 @@ fn build(
 
     let points = p.online_points();
     log::info!("[2/3] sweep: {} reduced and full runs", points.len());
-    let sw = sweep(&rom, &points, SweepOptions { validate: true, continuation: false, progress })?;
+    let sw = sweep(&rom, &points, SweepOptions { validate: true, progress, ..Default::default() })?;
     write_sweep(
         &out.join("sweep.h5"),
         &sw,

@@ -13,10 +13,12 @@
 //! file's layout and its writing and reading (`--resume`) in `file.rs`, the table printed
 //! on stdout in `table.rs`.
 
+pub mod fallback;
 pub mod file;
 mod outcome;
 mod table;
 
+pub use fallback::Fallback;
 pub use file::{point_names, read_sweep, write_sweep, write_sweep_with, Extra, SweepBasis};
 pub use outcome::{Outcome, ScaleResult, Sweep, SweepPoint, STATUS_FAILED, STATUS_OK, STATUS_PENDING};
 pub use table::table;
@@ -25,6 +27,7 @@ use super::validate::compare;
 use crate::error::Result;
 use crate::linalg::kkt::LinearSolverKind;
 use crate::model::Model;
+use crate::rom::estimator::Estimate;
 use crate::rom::pool::Pool;
 use crate::rom::{Output, ReducedRun, Rom};
 use crate::simulate::{simulate, FullModel, Overrides, Settings};
@@ -55,6 +58,9 @@ pub struct SweepOptions {
     pub continuation: bool,
     /// a progress bar on stderr
     pub progress: bool,
+    /// what a reduced sweep does at a point whose reduced answer it cannot stand behind
+    /// ([`fallback`]); a full or validated sweep has no such point
+    pub fallback: Fallback,
 }
 
 /// The chains of a continuation sweep over `n` scales, by thread: the list cut into `2 T`
@@ -141,7 +147,12 @@ pub fn sweep_to_file(route: Route, points: &[Parameters], o: SweepOptions, f: Sw
     let SweepFile { out, resume, extra } = f;
     let model = route.model();
     let full = matches!(route, Route::Full(_));
-    let o = if full { SweepOptions { validate: false, continuation: false, ..o } } else { o };
+    // a validated sweep measures the reduced model everywhere: nothing to fall back from
+    let o = match (full, o.validate) {
+        (true, _) => SweepOptions { validate: false, continuation: false, fallback: Fallback::None, ..o },
+        (false, true) => SweepOptions { fallback: Fallback::None, ..o },
+        (false, false) => o,
+    };
     let n_reduced = match route {
         Route::Reduced { rom, .. } => rom.basis().n_reduced(),
         Route::Full(_) => 0,
@@ -233,9 +244,45 @@ fn run_reduced(rom: &Rom, state: Sweep, o: SweepOptions, checkpoint: Option<Chec
     let n_steps = Settings::resolve(model, &Overrides::default())?.n_steps;
     let output = if o.validate { Output::Full } else { Output::ReducedAndProbes };
     crate::rom::check_reduced_memory(model, basis.n_reduced(), n_steps, output, state.n_todo() as f64)?;
+    // the fallback's full runs, one full model per worker that needs one
+    let full_models = Pool::new(|| FullModel::new(model, LinearSolverKind::Banded));
     let point = |mu: &Parameters, previous: &[&ReducedRun]| -> Result<SweepPoint> {
-        let (run, estimate) =
-            rom.solve_and_estimate(mu, output, previous).map_err(|e| e.at_stage("sweep (reduced run)", mu))?;
+        let reduced = rom.solve_and_estimate(mu, output, previous).map_err(|e| e.at_stage("sweep (reduced run)", mu));
+        let why = match (&reduced, o.fallback) {
+            (_, Fallback::None) => None,
+            (Err(e), Fallback::Full) => Some(format!("the reduced run failed: {e}")),
+            (Ok((_, estimate)), Fallback::Full) => fallback::reason(rom.trust(), mu, estimate.as_ref()),
+        };
+        // where the full run fails too, a reduced answer stands as it would without the
+        // fallback, with a note; a reduced failure fails the point with both messages
+        let mut note = None;
+        if let Some(why) = why {
+            match models_run(&full_models, mu) {
+                Ok(run) => {
+                    let seconds = reduced.as_ref().ok().and_then(|(_, e)| e.as_ref()).map_or(0.0, |e| e.seconds);
+                    return Ok(SweepPoint {
+                        run,
+                        validation: None,
+                        full_probes: None,
+                        estimate: Some(Estimate::exact(seconds)),
+                        // exact: nothing extrapolated, as in a full sweep
+                        extrapolated: false,
+                        fallback: Some(format!("{}: {why}", fallback::FULL_IN_PLACE)),
+                        note: None,
+                    });
+                }
+                Err(e) => match &reduced {
+                    Err(r) => {
+                        return Err(crate::error::Error::Hinted {
+                            source: Box::new(e),
+                            hint: format!("the full model ran in place of the reduced one, which had failed: {r}"),
+                        })
+                    }
+                    Ok(_) => note = Some(format!("{} ({why}) failed: {e}", fallback::FULL_TRIED)),
+                },
+            }
+        }
+        let (run, estimate) = reduced?;
         let (validation, full_probes) = if o.validate {
             let full = simulate(model, &Overrides::at(mu)).map_err(|e| e.at_stage("sweep (full run)", mu))?;
             let v = compare(model, &full, &run, None, basis.n_reduced(), basis.variant.name())
@@ -245,7 +292,7 @@ fn run_reduced(rom: &Rom, state: Sweep, o: SweepOptions, checkpoint: Option<Chec
             (None, None)
         };
         let extrapolated = rom.is_extrapolated(mu);
-        Ok(SweepPoint { run, validation, full_probes, estimate, extrapolated })
+        Ok(SweepPoint { run, validation, full_probes, estimate, extrapolated, fallback: None, note })
     };
     let label = if o.validate { "sweep + validate" } else { "sweep" };
     run_pending(state, o, label, &point, checkpoint)
@@ -263,16 +310,30 @@ fn run_full(model: &Model, state: Sweep, o: SweepOptions, checkpoint: Option<Che
     model.limits.check_memory(&format!("the probes of {} full runs of {n_steps} steps", state.n_todo()), kept)?;
     let models = Pool::new(|| FullModel::new(model, LinearSolverKind::Banded));
     let point = |mu: &Parameters, _: &[&ReducedRun]| -> Result<SweepPoint> {
-        let run = models.with(|full| full.simulate(&Overrides::at(mu)));
-        let mut r = run.and_then(|r| r).map_err(|e| e.at_stage("sweep (full run)", mu))?;
-        // the sweep file holds no coordinates: drop them now, not after the whole sweep
-        let nt = r.t.len();
-        (r.q, r.qd, r.multipliers) = (Array2::zeros((0, nt)), Array2::zeros((0, nt)), Array2::zeros((0, nt)));
-        (r.strains, r.curvatures) = (Vec::new(), Vec::new());
-        let run = ReducedRun { result: r, reduced_q: Array2::zeros((0, nt)) };
-        Ok(SweepPoint { run, validation: None, full_probes: None, estimate: None, extrapolated: false })
+        let run = models_run(&models, mu)?;
+        Ok(SweepPoint {
+            run,
+            validation: None,
+            full_probes: None,
+            estimate: None,
+            extrapolated: false,
+            fallback: None,
+            note: None,
+        })
     };
     run_pending(state, o, "full sweep", &point, checkpoint)
+}
+
+/// The full run at `mu` on one of `models` (what `simulate` gives there), kept as a sweep
+/// keeps it: its probes and statistics, no coordinates (dropped now, not after the whole
+/// sweep).
+fn models_run(models: &Pool<'_, FullModel>, mu: &Parameters) -> Result<ReducedRun> {
+    let run = models.with(|full| full.simulate(&Overrides::at(mu)));
+    let mut r = run.and_then(|r| r).map_err(|e| e.at_stage("sweep (full run)", mu))?;
+    let nt = r.t.len();
+    (r.q, r.qd, r.multipliers) = (Array2::zeros((0, nt)), Array2::zeros((0, nt)), Array2::zeros((0, nt)));
+    (r.strains, r.curvatures) = (Vec::new(), Vec::new());
+    Ok(ReducedRun { result: r, reduced_q: Array2::zeros((0, nt)) })
 }
 
 /// Runs `point` at the pending scales of `state`, in parallel; after each one,
@@ -339,7 +400,8 @@ fn run_pending(
                     ticker.tick();
                     match run {
                         Ok(p) => {
-                            if o.continuation {
+                            // a fallback's full run has no reduced steps to continue from
+                            if o.continuation && p.fallback.is_none() {
                                 previous.push(p.run.clone());
                                 if previous.len() > 2 {
                                     previous.remove(0);

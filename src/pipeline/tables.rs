@@ -35,6 +35,8 @@ pub fn sweep_table(s: &Sweep) -> Table {
     if s.validated {
         cols.push("displacement_error");
     }
+    // true where the full model answered in place of the reduced one (`--fallback full`)
+    cols.push("fallback");
     let base = cols.len();
     let named = named_columns(s);
     cols.extend(named.iter().map(|(c, _)| c.as_str()));
@@ -66,6 +68,7 @@ pub fn sweep_table(s: &Sweep) -> Table {
                 if s.validated {
                     row.push(p.validation.as_ref().map(|v| v.displacement_error).into());
                 }
+                row.push(p.fallback.is_some().into());
             }
             None => row.resize(base, Cell::Null),
         }

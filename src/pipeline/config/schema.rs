@@ -286,6 +286,11 @@ pub struct OnlineSpec {
     /// "enriched" (docs/error-estimate.md)
     #[serde(default)]
     pub estimate: Option<EstimateMethod>,
+    /// what `sweep` does where it cannot stand behind a reduced answer: "none" (keep it with
+    /// its warning, or the failure; the default) or "full" (run the full model there and
+    /// keep its exact answer; docs/basis-and-sweep.md)
+    #[serde(default)]
+    pub fallback: Option<crate::pipeline::sweep::Fallback>,
 }
 
 #[derive(Clone, Debug, Deserialize)]

@@ -145,8 +145,9 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, basis: Option<SweepBasis>, extra
         if !s.full {
             // time first: (load, time, mode); the runs keep r × n_t
             let mut zq = Array3::from_elem((n, nt, r), f64::NAN);
+            // NaN where the full model answered in place of the reduced one (no reduced q)
             for (k, x) in s.scales.iter().enumerate() {
-                if let Some(p) = x.point() {
+                if let Some(p) = x.point().filter(|p| p.fallback.is_none()) {
                     zq.index_axis_mut(ndarray::Axis(0), k).assign(&p.run.reduced_q.t());
                 }
             }
@@ -154,6 +155,14 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, basis: Option<SweepBasis>, extra
             // trajectories for 0.15 s of a 1.5 s four-bar sweep
             f.new_dataset_builder().chunk((1, nt.max(1), r.max(1))).with_data(&zq).create("reduced_q").map_err(e)?;
             f.new_dataset_builder().with_data(&col(&|p| p.run.result.wall_seconds)).create("rom_seconds").map_err(e)?;
+            // 1 where the full model answered in place of the reduced one (`--fallback full`;
+            // why: /message); its probes, seconds and iterations are then the full run's
+            f.new_dataset_builder()
+                .with_data(&Array1::from_iter(
+                    s.scales.iter().map(|x| x.point().is_some_and(|p| p.fallback.is_some()) as u8),
+                ))
+                .create("fallback")
+                .map_err(e)?;
         }
         f.new_dataset_builder()
             .with_data(&count(&|p| p.run.result.stats.newton_iterations))
@@ -412,6 +421,27 @@ pub fn read_sweep(
             None
         },
     );
+    // files written before /fallback hold reduced answers only; a fallback's reason is its
+    // /message
+    let fallback = if f.link_exists("fallback") {
+        let flags = f
+            .dataset("fallback")
+            .and_then(|d| d.read_1d::<u8>())
+            .map_err(|e| cannot("fallback", format!("cannot be read: {e}")))?;
+        let messages = f
+            .dataset("message")
+            .and_then(|d| d.read_1d::<VarLenUnicode>())
+            .map_err(|e| cannot("message", format!("cannot be read: {e}")))?;
+        if flags.len() != n || messages.len() != n {
+            return Err(cannot(
+                "fallback",
+                format!("has {} entries (/message {}) for {n} load scales", flags.len(), messages.len()),
+            ));
+        }
+        flags.iter().zip(&messages).map(|(&x, m)| (x != 0, m.as_str().to_string())).collect()
+    } else {
+        vec![(false, String::new()); n]
+    };
     let by_fifth = |name: &str| -> Result<Option<Array2<f64>>> {
         if !f.link_exists(name) {
             return Ok(None);
@@ -572,9 +602,18 @@ pub fn read_sweep(
             v.extrapolated = extrapolated;
             v
         });
-        let run = ReducedRun { result, reduced_q: zq.index_axis(ndarray::Axis(0), k).to_owned() };
+        // a fallback's full run has no reduced coordinates (NaN in the file)
+        let (full, message) = &fallback[k];
+        let reduced_q = if *full { Array2::zeros((0, nt)) } else { zq.index_axis(ndarray::Axis(0), k).to_owned() };
+        let run = ReducedRun { result, reduced_q };
         let full_probes = full_probes.as_deref().map(|p| at(p, k));
-        out.push((mu, Some(SweepPoint { run, validation: v, full_probes, estimate, extrapolated })));
+        // a finished point's message: why the full model answered, or a reduced answer's note
+        let (fallback, note) = match (full, message.is_empty()) {
+            (true, _) => (Some(message.clone()), None),
+            (false, false) => (None, Some(message.clone())),
+            (false, true) => (None, None),
+        };
+        out.push((mu, Some(SweepPoint { run, validation: v, full_probes, estimate, extrapolated, fallback, note })));
     }
     Ok(out)
 }

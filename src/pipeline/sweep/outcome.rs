@@ -23,6 +23,13 @@ pub struct SweepPoint {
     pub estimate: Option<Estimate>,
     /// outside the training range
     pub extrapolated: bool,
+    /// `Some(why)`: the full model answered this point in place of the reduced one
+    /// ([`super::Fallback::Full`]): `run` is the full run (its probes; no reduced
+    /// coordinates), `estimate` [`Estimate::exact`]
+    pub fallback: Option<String>,
+    /// a reduced answer's note: the full model was run in its place and failed
+    /// ([`super::fallback::FULL_TRIED`])
+    pub note: Option<String>,
 }
 
 /// What became of one load scale.
@@ -60,7 +67,7 @@ impl ScaleResult {
 
     pub fn message(&self) -> &str {
         match &self.outcome {
-            Outcome::Done(_) => "",
+            Outcome::Done(p) => p.fallback.as_deref().or(p.note.as_deref()).unwrap_or(""),
             Outcome::Failed(m) => m,
             Outcome::Pending => "not run yet",
         }
@@ -102,6 +109,11 @@ impl Sweep {
         self.scales.iter().filter(|s| s.status() == STATUS_FAILED).count()
     }
 
+    /// The finished points the full model answered in place of the reduced one.
+    pub fn n_fallback(&self) -> usize {
+        self.done().filter(|p| p.fallback.is_some()).count()
+    }
+
     /// One line when some load scale failed, naming the first few and their errors:
     /// "2 of 100 load scales failed: load scale 1e20: Newton failed at …; …".
     pub fn failure_summary(&self) -> Option<String> {
@@ -124,5 +136,7 @@ pub(super) fn clone_point(p: &SweepPoint) -> SweepPoint {
         full_probes: p.full_probes.clone(),
         estimate: p.estimate.clone(),
         extrapolated: p.extrapolated,
+        fallback: p.fallback.clone(),
+        note: p.note.clone(),
     }
 }

@@ -14,6 +14,11 @@ pub fn table(s: &Sweep) -> String {
     if s.validated {
         out.push_str("   rel_error  probe_err_m  full_ms  speedup");
     }
+    // which model answered, where the full one stood in for the reduced one somewhere
+    let fell_back = s.n_fallback() > 0;
+    if fell_back {
+        out.push_str("   answer");
+    }
     // the named parameters of the points, where there are any, lead each line
     let named: Vec<String> = super::file::point_names(s.scales.iter().map(|x| &x.mu)).into_iter().skip(1).collect();
     let lead = |values: Vec<String>| values.into_iter().map(|v| format!("{v}  ")).collect::<String>();
@@ -59,6 +64,9 @@ pub fn table(s: &Sweep) -> String {
                 1e3 * v.full_seconds,
                 v.speedup
             ));
+        }
+        if fell_back {
+            out.push_str(if p.fallback.is_some() { "     full" } else { "  reduced" });
         }
         out.push('\n');
     }

@@ -103,6 +103,23 @@ pub struct Estimate {
 }
 
 impl Estimate {
+    /// The estimate of an answer that is the full model's own (a sweep's fallback): its
+    /// error against the full model is zero in both measures; `seconds` is what the
+    /// estimate of the reduced attempt cost before it was set aside (0 when it had none).
+    pub fn exact(seconds: f64) -> Self {
+        Estimate {
+            error_estimate: 0.0,
+            raw: 0.0,
+            factor: 1.0,
+            calibrated: false,
+            seconds,
+            by_time: [0.0; 5],
+            error_estimate_displacement: 0.0,
+            displacement_by_time: [0.0; 5],
+            failure: None,
+        }
+    }
+
     /// The whole run's estimate in `measure`.
     pub fn in_measure(&self, measure: ErrorMeasure) -> f64 {
         match measure {

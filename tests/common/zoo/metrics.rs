@@ -79,6 +79,8 @@ pub struct ModelStats {
     pub rel_error_max: f64,
     pub error_estimate_max: f64,
     pub modes: usize,
+    /// loads `sweep --fallback full` answers with the full model ([`fallback_stats`])
+    pub fallbacks: usize,
 }
 
 fn ratio(e: f64, t: f64) -> f64 {
@@ -136,6 +138,35 @@ pub fn model_stats(runs: &[Result<Validation, String>]) -> ModelStats {
     s
 }
 
+/// Whether `sweep --fallback full` answers a validation's load with the full model (docs/
+/// basis-and-sweep.md): the reduced run failed, its estimate is above the tolerance `tol`
+/// (the zoo's pipelines hold it to the training tolerance, relative measure), or it warned
+/// that the model amplifies changes of the load beyond the estimate — the rule of
+/// `flexrom::pipeline::sweep::fallback::reason`, read from what `validate` reports.
+pub fn falls_back(r: &Result<Validation, String>, tol: f64) -> bool {
+    match r {
+        Err(_) => true,
+        Ok(v) => !within(v.error_estimate, tol) || v.amplifying,
+    }
+}
+
+/// What a sweep with `--fallback full` gives at the validation loads: the loads that fall
+/// back ([`falls_back`]) are the full model's answers, exact (covered over the run and in
+/// every fifth, no effectivity), the others the reduced answers as [`model_stats`] counts
+/// them.
+pub fn fallback_stats(runs: &[Result<Validation, String>], tol: f64) -> ModelStats {
+    let kept: Vec<Result<Validation, String>> = runs.iter().filter(|r| !falls_back(r, tol)).cloned().collect();
+    let exact = runs.len() - kept.len();
+    let mut s = model_stats(&kept);
+    let n = runs.len().max(1) as f64;
+    s.coverage_by_fifth = s.coverage_by_fifth.map(|c| (c * kept.len() as f64 + exact as f64) / n);
+    s.loads = runs.len();
+    s.covered_pairs += exact;
+    s.covered_triples += 5 * exact;
+    s.fallbacks = exact;
+    s
+}
+
 /// The numbers over all models together.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Aggregate {
@@ -151,6 +182,8 @@ pub struct Aggregate {
     pub effectivity_p95: f64,
     pub effectivity_max: f64,
     pub cost_median: f64,
+    /// loads answered by the full model (the statistics of [`fallback_stats`])
+    pub fallbacks: usize,
 }
 
 impl Aggregate {
@@ -228,6 +261,7 @@ pub fn aggregate(models: &[(Option<&Training>, &ModelStats)]) -> Aggregate {
         effectivity_p95: f64::NAN,
         effectivity_max: f64::NAN,
         cost_median: f64::NAN,
+        fallbacks: 0,
     };
     for (t, s) in models {
         a.converged += usize::from(t.is_some_and(|t| t.converged));
@@ -238,6 +272,7 @@ pub fn aggregate(models: &[(Option<&Training>, &ModelStats)]) -> Aggregate {
         a.covered_pairs += s.covered_pairs;
         a.silent_under_pairs += s.silent_under_pairs;
         a.covered_triples += s.covered_triples;
+        a.fallbacks += s.fallbacks;
         eff.extend(&s.effectivities);
         if t.is_none() {
             eff.extend(std::iter::repeat_n(f64::INFINITY, loads));
@@ -290,5 +325,23 @@ mod tests {
         assert_eq!(percentile(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0, 10.0], 95.0), 10.0);
         assert_eq!(percentile(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0, 10.0], 50.0), 5.0);
         assert_eq!(median(&[4.0, 1.0, 3.0, 2.0]), 2.5);
+    }
+
+    /// Hand-counted: at tolerance 1e-2 the failed run, the one reading 2e-2 and the one that
+    /// warned of amplification fall back and count as exact (covered in every fifth, no
+    /// effectivity); the one reading 2e-3 against 1e-3 stays, covered over the run and in
+    /// four fifths.
+    #[test]
+    fn a_fallback_answers_exactly_where_it_falls_back() {
+        let amplifying = Validation { amplifying: true, ..v(1e-3, 2e-3) };
+        let runs = [Ok(v(2e-3, 1e-3)), Ok(v(2e-2, 1e-3)), Ok(amplifying), Err("failed".into())];
+        assert_eq!(runs.iter().map(|r| falls_back(r, 1e-2)).collect::<Vec<_>>(), [false, true, true, true]);
+        let s = fallback_stats(&runs, 1e-2);
+        assert_eq!((s.loads, s.fallbacks, s.covered_pairs, s.under_pairs, s.failed_loads), (4, 3, 4, 0, 0));
+        assert_eq!((s.covered_triples, s.under_triples), (19, 1));
+        assert_eq!(s.coverage_by_fifth, [1.0, 1.0, 1.0, 1.0, 0.75]);
+        assert_eq!(s.effectivities, vec![2.0]);
+        let a = aggregate(&[(None, &s)]);
+        assert_eq!((a.fallbacks, a.covered_pairs), (3, 4));
     }
 }
