@@ -250,9 +250,11 @@ fn tip(f: &Path) -> ndarray::Array3<f64> {
 /// point is the full model's answer — its tip trajectory bit for bit that of `sweep
 /// --full` (the same full model, one per worker) —, `/fallback` 1, `/error_estimate` 0,
 /// `/reduced_q` NaN, why in `/message`, one summary line, exit 0 and no warning about the
-/// tolerance (the answers are exact). `--resume` keeps those points as they are; the
-/// pipeline's `[online] fallback = "full"` does the same without the flag, and `--fallback
-/// none` overrides it: the reduced answers with the warning, `/fallback` 0.
+/// tolerance (the answers are exact). `online --fallback full` writes the full run's
+/// result file (q bit for bit `simulate`'s) with the reason and no reduced coordinates.
+/// `--resume` keeps those points as they are; the pipeline's `[online] fallback = "full"`
+/// does the same without the flag (for `online` too), and `--fallback none` overrides it:
+/// the reduced answers with the warning, `/fallback` 0.
 #[test]
 fn a_fallback_answers_with_the_full_model_where_the_estimate_exceeds_the_tolerance() {
     let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
@@ -280,6 +282,24 @@ fn a_fallback_answers_with_the_full_model_where_the_estimate_exceeds_the_toleran
         assert!(m.starts_with("full model in place of the reduced one: error estimate "), "{m}");
         assert!(m.ends_with(" above the tolerance 1e-12"), "{m}");
     }
+    // `online` takes the same way: the result file is the full run's (q bit for bit that of
+    // `simulate`), with the reason and without reduced coordinates
+    let (one, sim) = (d.join("one.h5"), d.join("sim.h5"));
+    let (o, err) =
+        run(&["online", ps, "--load-scale", "1.1", "--fallback", "full", "-o", one.to_str().unwrap(), "--json"]);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(String::from_utf8_lossy(&o.stdout).contains("\"n_modes\":null"), "{}", String::from_utf8_lossy(&o.stdout));
+    let model = d.join("model.toml");
+    let (o, err) = run(&["simulate", model.to_str().unwrap(), "--load-scale", "1.1", "-o", sim.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    let q = |f: &Path| hdf5::File::open(f).unwrap().dataset("q").unwrap().read_raw::<f64>().unwrap();
+    assert_eq!(q(&one), q(&sim));
+    let f = hdf5::File::open(&one).unwrap();
+    let why = f.attr("fallback").unwrap().read_scalar::<hdf5::types::VarLenUnicode>().unwrap().to_string();
+    assert!(why.starts_with("full model in place of the reduced one: error estimate "), "{why}");
+    assert_eq!(f.attr("error_estimate").unwrap().read_scalar::<f64>().unwrap(), 0.0);
+    assert!(!f.link_exists("reduced"));
+    drop(f);
     // resumed: nothing runs again, and the points stay the full model's
     let before = column(&fb, "rom_seconds");
     let (o, err) = run(&["sweep", ps, "--fallback", "full", "--resume", "-o", fb.to_str().unwrap()]);
@@ -294,6 +314,9 @@ fn a_fallback_answers_with_the_full_model_where_the_estimate_exceeds_the_toleran
     let (o, err) = run(&["sweep", ps, "-o", keyed.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(0), "{err}");
     assert_eq!(tip(&keyed), tip(&full));
+    let (o, err) = run(&["online", ps, "--load-scale", "1.1", "-o", one.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(err.contains("full model in place of the reduced one"), "the key holds for online too: {err}");
     let (o, err) = run(&["sweep", ps, "--fallback", "none", "-o", plain.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(0), "{err}");
     assert!(err.contains("warning: error estimate above the tolerance 1e-12"), "{err}");

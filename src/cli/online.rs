@@ -30,6 +30,12 @@ pub struct Args {
     /// tolerance ([online] tolerance, default the training tolerance)
     #[arg(long)]
     strict: bool,
+    /// `full`: where the reduced answer cannot be trusted — its run fails, its error
+    /// estimate exceeds the tolerance, or the model amplifies load changes beyond it — run
+    /// the full model and write its exact result (attribute `fallback`: why); over the
+    /// pipeline's [online] fallback, default none
+    #[arg(long, value_enum, value_name = "WHAT")]
+    fallback: Option<flexrom::pipeline::sweep::Fallback>,
     #[command(flatten)]
     estimate: EstimateArgs,
     #[command(flatten)]
@@ -38,7 +44,7 @@ pub struct Args {
 
 impl Args {
     pub fn run(self, limits: &Limits) -> flexrom::Result<()> {
-        let Args { pipeline, load_scale, params, output, basis, strict, estimate, format } = self;
+        let Args { pipeline, load_scale, params, output, basis, strict, fallback, estimate, format } = self;
         let p = Pipeline::load_with(&pipeline, limits.clone())?;
         // λ checked finite with the named values
         let mu = params.parameters(load_scale, 1.0)?;
@@ -60,42 +66,56 @@ impl Args {
         warn(&warnings);
         // read before the run (a damaged /timing fails now), said after it
         let notice = flexrom::pipeline::route::speed_notice_of(&path, &rom)?;
-        let done = online_to_file(&p, &rom, &path, &mu, &output)?;
+        let fallback = fallback.or(p.online_fallback()).unwrap_or_default();
+        let done = online_to_file(&p, &rom, &path, &mu, &output, fallback)?;
         let (run, estimate) = (&done.run, &done.estimate);
         let st = &run.result.stats;
         info(&format!(
-            "{}: reduced run ({} modes) at {mu}: {} steps in {:.4} s ({} Newton iterations, {} step cuts) -> {}",
+            "{}: {} at {mu}: {} steps in {:.4} s ({} Newton iterations, {} step cuts) -> {}",
             p.path.display(),
-            stored.basis.n_reduced(),
+            match &done.fallback {
+                Some(why) => format!("{why}; the full run"),
+                None => format!("reduced run ({} modes)", stored.basis.n_reduced()),
+            },
             st.steps,
             run.result.wall_seconds,
             st.newton_iterations,
             st.step_cuts,
             output.display()
         ));
-        if let (Some(e), Some(method)) = (estimate, rom.method()) {
+        if let (Some(e), Some(method), None) = (estimate, rom.method(), &done.fallback) {
             info(&format!("  {}", flexrom::rom::trust::describe(e, method, run.result.wall_seconds)));
         }
         run_details(&run.result);
         let mut cols = vec!["load_scale", "n_modes"];
         cols.extend(flexrom::pipeline::tables::RUN_COLUMNS);
-        cols.extend(["error_estimate", "extrapolated", "output", "error_estimate_displacement"]);
+        cols.extend(["error_estimate", "extrapolated", "output", "error_estimate_displacement", "fallback"]);
         // the named parameters last, as a sweep's table has them
         let named: Vec<String> = mu.named().map(|(name, _)| format!("parameter:{name}")).collect();
         cols.extend(named.iter().map(String::as_str));
         let mut t = Table::new(&cols);
-        let mut row: Vec<Cell> = vec![load_scale.into(), stored.basis.n_reduced().into()];
+        // a full answer has no modes
+        let modes = if done.fallback.is_some() { Cell::Null } else { stored.basis.n_reduced().into() };
+        let mut row: Vec<Cell> = vec![load_scale.into(), modes];
         row.extend(flexrom::pipeline::tables::run_cells(&run.result));
         row.extend([
             estimate.as_ref().map(|e| e.error_estimate).into(),
             done.extrapolated.into(),
             output.display().to_string().into(),
             estimate.as_ref().map(|e| e.error_estimate_displacement).into(),
+            done.fallback.as_deref().map_or(Cell::Null, Cell::from),
         ]);
         row.extend(mu.named().map(|(_, value)| value.into()));
         t.push(row);
         print_table(&t, format.format(), true)?;
         warn(notice.as_slice());
+        if let Some(note) = &done.note {
+            warn(std::slice::from_ref(note));
+        }
+        // the full model's answer is exact: nothing to hold to the tolerance
+        if done.fallback.is_some() {
+            return Ok(());
+        }
         let measure = rom.tolerance_measure();
         warn(&rom.untrained_parameters(&mu));
         if let Some(w) =

@@ -5,6 +5,7 @@ use crate::error::{Error, Result};
 use crate::io::basis_file::StoredBasis;
 use crate::io::h5::{attr_str, attr_u64, read_attr_str};
 use crate::io::result_file::{begin_alongside, RunPlan};
+use crate::pipeline::sweep::fallback::{why, Fallback, FULL_IN_PLACE, FULL_TRIED};
 use crate::rom::estimator::{Estimate, EstimateMethod};
 use crate::rom::trust::write_run_attributes;
 use crate::rom::{check_reduced_memory, settings_at, LoadOptions, Output, ReducedRun, Rom, Trust};
@@ -83,36 +84,102 @@ pub fn load_rom(
 
 /// What `online` produced: the run, its estimate and whether it left the training range.
 pub struct OnlineRun {
+    /// the reduced run, or with `fallback` the full one (no reduced coordinates)
     pub run: ReducedRun,
     pub estimate: Option<Estimate>,
     pub extrapolated: bool,
+    /// `Some(why)`: the full model answered in place of the reduced one (`--fallback full`)
+    pub fallback: Option<String>,
+    /// the full model was run in place of this reduced answer and failed
+    pub note: Option<String>,
 }
 
 /// Runs `rom` at `mu` and writes the result file `out` ([`crate::io::result_file`]: its
 /// fixed part on a second thread while the run computes, the file renamed into place only
 /// when complete) with the reduced coordinates, the basis it came from (`basis_path`) and
-/// the estimate's attributes ([`crate::rom::trust::write_run_attributes`]).
-pub fn online_to_file(p: &Pipeline, rom: &Rom, basis_path: &Path, mu: &Parameters, out: &Path) -> Result<OnlineRun> {
+/// the estimate's attributes ([`crate::rom::trust::write_run_attributes`]). With
+/// [`Fallback::Full`], where the reduced answer cannot be trusted
+/// ([`crate::pipeline::sweep::fallback::reason`], or the reduced run failed) the full
+/// model runs and the file is its result (as `simulate` writes it) with the attribute
+/// `fallback` (why), the basis, and the estimate's attributes of an exact answer (0);
+/// where the full run fails too, a reduced answer stands with the attribute
+/// `fallback_failed`.
+pub fn online_to_file(
+    p: &Pipeline,
+    rom: &Rom,
+    basis_path: &Path,
+    mu: &Parameters,
+    out: &Path,
+    fallback: Fallback,
+) -> Result<OnlineRun> {
     // a run too large for the memory bound is refused before the file is begun
     let settings = settings_at(&p.model, mu)?;
     check_reduced_memory(&p.model, rom.basis().n_reduced(), settings.n_steps, Output::Full, 1.0)?;
+    if fallback == Fallback::Full {
+        p.model.check_full_run_memory(settings.n_steps, false)?;
+    }
     let plan = RunPlan::of(&p.model, &settings);
     let model_path = p.model.path.display().to_string();
-    let (file, (run, estimate)) = begin_alongside(out, &p.model.text, &model_path, &plan, || {
-        rom.solve_and_estimate(mu, Output::Full, &[]).map_err(|e| e.at_reduced_stage("online", mu, false))
+    let (file, done) = begin_alongside(out, &p.model.text, &model_path, &plan, || {
+        let reduced = rom.solve_and_estimate(mu, Output::Full, &[]);
+        // the way on after a failed reduced run is said unless the fallback takes it
+        let reduced = reduced.map_err(|e| match fallback {
+            Fallback::None => e.at_reduced_stage("online", mu, false),
+            Fallback::Full => e.at_stage("online (reduced run)", mu),
+        });
+        let Some(why) = why(&reduced, fallback, rom.trust(), mu) else {
+            let (run, estimate) = reduced?;
+            return Ok(OnlineRun { run, estimate, extrapolated: rom.is_extrapolated(mu), fallback: None, note: None });
+        };
+        match crate::simulate::simulate(&p.model, &crate::simulate::Overrides::at(mu)) {
+            Ok(full) => {
+                let seconds = reduced.as_ref().ok().and_then(|(_, e)| e.as_ref()).map_or(0.0, |e| e.seconds);
+                let nt = full.t.len();
+                Ok(OnlineRun {
+                    run: ReducedRun { result: full, reduced_q: ndarray::Array2::zeros((0, nt)) },
+                    estimate: Some(Estimate::exact(seconds)),
+                    extrapolated: false,
+                    fallback: Some(format!("{FULL_IN_PLACE}: {why}")),
+                    note: None,
+                })
+            }
+            Err(e) => {
+                let e = e.at_stage("online (full run)", mu);
+                match reduced {
+                    Ok((run, estimate)) => Ok(OnlineRun {
+                        run,
+                        estimate,
+                        extrapolated: rom.is_extrapolated(mu),
+                        fallback: None,
+                        note: Some(format!("{FULL_TRIED} ({why}) failed: {e}")),
+                    }),
+                    Err(r) => Err(Error::Hinted {
+                        source: Box::new(e),
+                        hint: format!("the full model ran in place of the reduced one, which had failed: {r}"),
+                    }),
+                }
+            }
+        }
     })?;
-    let extrapolated = rom.is_extrapolated(mu);
     let basis = rom.basis();
     // absolute, so that the file names its basis wherever it is read from
     let basis_name = crate::io::output::resolve(basis_path).display().to_string();
     let trust = rom.trust().cloned().unwrap_or_else(|| Trust::range((f64::NAN, f64::NAN)));
+    let (run, estimate) = (&done.run, done.estimate.as_ref());
     file.finish(&run.result, |f| {
         let e = |err: hdf5::Error| Error::hdf5(out, err);
-        crate::io::result_file::write_reduced(f, &run.reduced_q).map_err(e)?;
         attr_str(f, "basis", &basis_name).map_err(e)?;
-        attr_str(f, "variant", basis.variant.name()).map_err(e)?;
-        attr_u64(f, "n_modes", basis.n_reduced() as u64).map_err(e)?;
-        write_run_attributes(f, estimate.as_ref(), rom.method(), &trust, mu, extrapolated).map_err(e)
+        if let Some(why) = &done.fallback {
+            attr_str(f, "fallback", why).map_err(e)?;
+        } else {
+            crate::io::result_file::write_reduced(f, &run.reduced_q).map_err(e)?;
+            attr_str(f, "variant", basis.variant.name()).map_err(e)?;
+            attr_u64(f, "n_modes", basis.n_reduced() as u64).map_err(e)?;
+        }
+        if let Some(note) = &done.note {
+            attr_str(f, "fallback_failed", note).map_err(e)?;
+        }
+        write_run_attributes(f, estimate, rom.method(), &trust, mu, done.extrapolated).map_err(e)
     })?;
-    Ok(OnlineRun { run, estimate, extrapolated })
+    Ok(done)
 }

@@ -248,11 +248,7 @@ fn run_reduced(rom: &Rom, state: Sweep, o: SweepOptions, checkpoint: Option<Chec
     let full_models = Pool::new(|| FullModel::new(model, LinearSolverKind::Banded));
     let point = |mu: &Parameters, previous: &[&ReducedRun]| -> Result<SweepPoint> {
         let reduced = rom.solve_and_estimate(mu, output, previous).map_err(|e| e.at_stage("sweep (reduced run)", mu));
-        let why = match (&reduced, o.fallback) {
-            (_, Fallback::None) => None,
-            (Err(e), Fallback::Full) => Some(format!("the reduced run failed: {e}")),
-            (Ok((_, estimate)), Fallback::Full) => fallback::reason(rom.trust(), mu, estimate.as_ref()),
-        };
+        let why = fallback::why(&reduced, o.fallback, rom.trust(), mu);
         // where the full run fails too, a reduced answer stands as it would without the
         // fallback, with a note; a reduced failure fails the point with both messages
         let mut note = None;

@@ -7,6 +7,7 @@
 //! and `/fallback`, so that an overnight sweep has an answer within the tolerance (by its
 //! estimate) or an exact one at every point.
 
+use crate::error::Result;
 use crate::rom::estimator::Estimate;
 use crate::rom::Trust;
 use crate::solver::parameters::Parameters;
@@ -43,6 +44,22 @@ pub const KINDS: [(&str, &str); 4] = [
     ("the error estimate could not", "no estimate"),
     ("the model amplifies", "the model amplifies load changes"),
 ];
+
+/// Why the full model answers at `mu` in place of the reduced run `reduced` (its result,
+/// its estimate): none under [`Fallback::None`]; under [`Fallback::Full`] the reduced
+/// run's failure, or [`reason`].
+pub fn why<T>(
+    reduced: &Result<(T, Option<Estimate>)>,
+    fallback: Fallback,
+    trust: Option<&Trust>,
+    mu: &Parameters,
+) -> Option<String> {
+    match (reduced, fallback) {
+        (_, Fallback::None) => None,
+        (Err(e), Fallback::Full) => Some(format!("the reduced run failed: {e}")),
+        (Ok((_, estimate)), Fallback::Full) => reason(trust, mu, estimate.as_ref()),
+    }
+}
 
 /// Why the reduced answer at `mu` is not kept under [`Fallback::Full`], when it is not:
 /// its estimate (`estimate`, in the trust's measure) is above the tolerance or infinite
