@@ -134,6 +134,17 @@ impl Error {
         Error::Io { file: file.as_ref().display().to_string(), source }
     }
 
+    /// Whether this is a run's numerical failure (Newton, a linear solve, a blow-up), also
+    /// with its stage or hint added: what a model can do at some parameters and not at
+    /// others, as opposed to a stop asked for, a limit, or a file's problem.
+    pub fn is_numerical(&self) -> bool {
+        match self {
+            Error::NewtonFailed { .. } | Error::LinearSolve { .. } | Error::BlowUp { .. } => true,
+            Error::Stage { source, .. } | Error::Hinted { source, .. } => source.is_numerical(),
+            _ => false,
+        }
+    }
+
     /// Adds the stage and the parameters to a numerical failure (Newton, linear solve,
     /// blow-up); other errors already name their file or option and pass unchanged.
     pub fn at_stage(self, stage: &str, mu: &impl std::fmt::Display) -> Self {

@@ -15,8 +15,9 @@
 //!   new time), reruns failed scales, and refuses a file of another basis;
 //! - a sweep killed (SIGKILL) while it runs leaves a valid file at the final path (statuses
 //!   0 and 2 only), from which `--resume` finishes the sweep;
-//! - a sweep stopped by SIGINT exits 130 and says which file keeps the finished scales and
-//!   that the same command with `--resume` runs the others.
+//! - a sweep stopped by SIGINT stops its runs, writes every scale finished by then (not
+//!   only those of its last checkpoint), exits 130, says which file keeps how many and that
+//!   the same command with `--resume` runs the others, which it then does.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -221,7 +222,7 @@ fn an_interrupted_sweep_names_the_file_it_keeps_and_how_to_go_on() {
     let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
     let tmp = tempfile::tempdir().unwrap();
     let d = tmp.path();
-    let (_, out, child) = sweep_under_way(d, std::process::Stdio::piped());
+    let (p, out, child) = sweep_under_way(d, std::process::Stdio::piped());
     // past the first checkpoint's rename, after which the note is set
     std::thread::sleep(std::time::Duration::from_millis(300));
     let kill = Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
@@ -229,10 +230,25 @@ fn an_interrupted_sweep_names_the_file_it_keeps_and_how_to_go_on() {
     let o = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&o.stderr).to_string();
     assert_eq!(o.status.code(), Some(130), "{err}");
-    assert!(err.contains("stopped by SIGINT"), "{err}");
-    assert!(err.contains(&format!("{} is this sweep's last checkpoint", out.display())), "{err}");
-    assert!(err.contains("the same command with --resume runs the others"), "{err}");
-    assert!(status(&out).contains(&0));
+    assert!(err.contains("flexrom: SIGINT: stopping the runs under way to write the finished ones"), "{err}");
+    assert!(err.contains("flexrom: stopped by SIGINT; the runs finished before it are written"), "{err}");
+    // the file holds every scale finished before the stop, and says how many
+    let st = status(&out);
+    let finished = st.iter().filter(|&&s| s == 0).count();
+    assert!(st.iter().all(|&s| s == 0 || s == 2), "{st:?}");
+    assert!((1..300).contains(&finished), "stopped midway: {finished}");
+    assert!(
+        err.contains(&format!(
+            "{} keeps the {finished} load scales finished; the same command with --resume runs the other {}",
+            out.display(),
+            300 - finished
+        )),
+        "{err}"
+    );
+    let (o, err) = run(&["sweep", p.to_str().unwrap(), "-o", out.to_str().unwrap(), "--resume"]);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains(&format!("{finished} of 300 load scales already finished")), "{err}");
+    assert_eq!(status(&out), vec![0; 300]);
 }
 
 fn messages(f: &Path) -> Vec<String> {
@@ -354,7 +370,8 @@ fn a_fallback_whose_full_run_fails_too_says_both() {
 }
 
 /// Where the full model fails too at a point the fallback would take, the reduced answer
-/// stands as it would without the fallback, with a note in `/message`. The shipped
+/// stands as it would without the fallback, with a note in `/message`, `/fallback` 2 and
+/// a summary line that says so. The shipped
 /// four-bar at λ = 1.34, outside its basis's range [0.7, 1.2] (measured 2026-11-27): the
 /// reduced run finishes, its estimator's richer run fails (estimate ∞, above the
 /// tolerance 1e-2), and the full run blows up at t = 1.064 s (strain 0.87 in the coupler).
@@ -376,12 +393,71 @@ fn where_the_full_model_fails_too_the_reduced_answer_stands_with_a_note() {
     ]);
     assert_eq!(o.status.code(), Some(0), "{err}");
     assert!(err.contains("warning: error estimate above the tolerance 1e-2 at load scale 1.34"), "{err}");
+    assert!(
+        err.contains(
+            "at 1 load scales the full model was tried in place of the reduced answer and failed too (1: no estimate;"
+        ),
+        "{err}"
+    );
     assert_eq!(status(&out), vec![0]);
     let f = hdf5::File::open(&out).unwrap();
-    assert_eq!(f.dataset("fallback").unwrap().read_raw::<u8>().unwrap(), vec![0]);
+    assert_eq!(f.dataset("fallback").unwrap().read_raw::<u8>().unwrap(), vec![2]);
     assert!(f.dataset("reduced_q").unwrap().read_raw::<f64>().unwrap().iter().all(|x| x.is_finite()));
     drop(f);
     let m = &messages(&out)[0];
     assert!(m.starts_with(flexrom::pipeline::sweep::fallback::FULL_TRIED), "{m}");
     assert!(m.contains("failed: sweep (full run) at load scale 1.34: blow-up"), "{m}");
+}
+
+/// What a fallback sweep keeps and refuses, on the coarse pendulum of the first fallback
+/// test (every estimate above an `[online] tolerance` of 1e-12):
+/// - `--resume --fallback full` on a file of a sweep without the fallback runs again the
+///   points it would not keep (all 3 here), and answers them with the full model;
+/// - `merge` refuses parts of sweeps with different `--fallback`, naming the attribute;
+/// - `--fallback full --no-estimate` is refused (exit 1, as `--strict --no-estimate`):
+///   nothing could judge the answers;
+/// - the pipeline's `[online] fallback = "full"` does not apply to `--validate`, which
+///   says so and measures the reduced model at every point (`/fallback` 0).
+#[test]
+fn a_fallback_sweep_resumes_merges_and_refuses_what_it_cannot_judge() {
+    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let p = setup(d, 8, 0.1, 4, "[0.9, 1.0, 1.1]\ntolerance = 1e-12");
+    let ps = p.to_str().unwrap();
+    let out = d.join("s.h5");
+    let o = out.to_str().unwrap();
+    let (r, err) = run(&["sweep", ps, "-o", o]);
+    assert_eq!(r.status.code(), Some(0), "{err}");
+    let (r, err) = run(&["sweep", ps, "--fallback", "full", "--resume", "-o", o]);
+    assert_eq!(r.status.code(), Some(0), "{err}");
+    assert!(err.contains("0 of 3 load scales already finished, running 3"), "{err}");
+    let fb = |f: &Path| hdf5::File::open(f).unwrap().dataset("fallback").unwrap().read_raw::<u8>().unwrap();
+    assert_eq!(fb(&out), vec![1, 1, 1]);
+    // parts of different fallbacks
+    let (a, b, m) = (d.join("a.h5"), d.join("b.h5"), d.join("m.h5"));
+    let (r, err) = run(&["sweep", ps, "--shard", "1/2", "--fallback", "full", "-o", a.to_str().unwrap()]);
+    assert_eq!(r.status.code(), Some(0), "{err}");
+    let (r, err) = run(&["sweep", ps, "--shard", "2/2", "-o", b.to_str().unwrap()]);
+    assert_eq!(r.status.code(), Some(0), "{err}");
+    let (r, err) = run(&["merge", a.to_str().unwrap(), b.to_str().unwrap(), "-o", m.to_str().unwrap()]);
+    assert_eq!(r.status.code(), Some(1), "{err}");
+    assert!(err.contains("fallback") && err.contains("another --fallback"), "{err}");
+    assert!(!m.exists());
+    let (r, err) = run(&["sweep", ps, "--shard", "2/2", "--fallback", "full", "-o", b.to_str().unwrap()]);
+    assert_eq!(r.status.code(), Some(0), "{err}");
+    let (r, err) = run(&["merge", a.to_str().unwrap(), b.to_str().unwrap(), "-o", m.to_str().unwrap()]);
+    assert_eq!(r.status.code(), Some(0), "{err}");
+    assert_eq!(fb(&m), vec![1, 1, 1]);
+    // nothing to judge with, and a validated sweep
+    let (r, err) = run(&["sweep", ps, "--fallback", "full", "--no-estimate", "-o", d.join("n.h5").to_str().unwrap()]);
+    assert_eq!(r.status.code(), Some(1), "{err}");
+    assert!(err.contains("--fallback full needs the error estimate"), "{err}");
+    let text = std::fs::read_to_string(&p).unwrap();
+    std::fs::write(&p, text.replace("tolerance = 1e-12", "tolerance = 1e-12\nfallback = \"full\"")).unwrap();
+    let v = d.join("v.h5");
+    let (r, err) = run(&["sweep", ps, "--validate", "-o", v.to_str().unwrap()]);
+    assert_eq!(r.status.code(), Some(0), "{err}");
+    assert!(err.contains("[online] fallback = \"full\" does not apply to a validated sweep"), "{err}");
+    assert_eq!(fb(&v), vec![0, 0, 0]);
 }

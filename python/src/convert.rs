@@ -87,6 +87,7 @@ pub fn sweep_dict<'py>(py: Python<'py>, s: &Sweep, points: &[Parameters]) -> PyR
     let mut extrapolated = vec![false; n];
     let mut failed: Vec<Option<String>> = vec![None; n];
     let mut fallback: Vec<Option<String>> = vec![None; n];
+    let mut fallback_failed: Vec<Option<String>> = vec![None; n];
     let mut probes: Vec<ndarray::Array3<f64>> =
         vec![ndarray::Array3::from_elem((n, n_t, 2), f64::NAN); s.probe_names.len()];
     for (i, sr) in s.scales.iter().enumerate() {
@@ -98,6 +99,7 @@ pub fn sweep_dict<'py>(py: Python<'py>, s: &Sweep, points: &[Parameters]) -> PyR
                 }
                 extrapolated[i] = p.extrapolated;
                 fallback[i] = p.fallback.clone();
+                fallback_failed[i] = p.note.clone();
                 for (k, (_, xy)) in p.run.result.probes.iter().enumerate() {
                     probes[k].index_axis_mut(ndarray::Axis(0), i).assign(xy);
                 }
@@ -116,6 +118,7 @@ pub fn sweep_dict<'py>(py: Python<'py>, s: &Sweep, points: &[Parameters]) -> PyR
     d.set_item("extrapolated", extrapolated.into_pyarray(py))?;
     d.set_item("failed", failed)?;
     d.set_item("fallback", fallback)?;
+    d.set_item("fallback_failed", fallback_failed)?;
     d.set_item("wall_seconds", s.wall_seconds)?;
     Ok(d)
 }

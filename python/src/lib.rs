@@ -759,7 +759,8 @@ impl PyBasis {
     /// load axis first (`load_scale`, `t`, `probes` name → (n, n_t, 2), `error_estimate`,
     /// `error_estimate_by_time` (n, 5), `extrapolated`, `failed`: each point's error
     /// message or None, `fallback`: why the full model answered a point in place of the
-    /// reduced one, or None). `points`: a list of dicts of named parameters instead.
+    /// reduced one, or None, `fallback_failed`: why it was tried there and how it failed,
+    /// the reduced answer kept, or None). `points`: a list of dicts of named parameters instead.
     /// `fallback`: "full" runs the full model where the reduced answer cannot be trusted
     /// (`sweep --fallback full`), "none" keeps it; default the pipeline's `[online] fallback`.
     #[pyo3(signature = (load_scales = None, points = None, continuation = false, progress = None, fallback = None))]
@@ -783,6 +784,11 @@ impl PyBasis {
                 )))
             }
         };
+        if fallback == Fallback::Full && self.rom.trust().is_some_and(|t| t.skipped) {
+            return Err(pyo3::exceptions::PyValueError::new_err(
+                "sweep: fallback \"full\" needs the error estimate to judge each reduced answer; this basis was loaded with no_estimate=True",
+            ));
+        }
         let progress = progress_callback(py, progress)?;
         let mus: Vec<Parameters> = match (load_scales, points) {
             (Some(s), None) => s.into_iter().map(|x| self.point(py, Some(x), None)).collect::<PyResult<_>>()?,
@@ -803,7 +809,13 @@ impl PyBasis {
             })
             .collect();
         let mut warnings = self.run_warnings(&runs)?;
-        let mut outside: Vec<String> = mus.iter().flat_map(|mu| rom.untrained_parameters(mu)).collect();
+        // the full model's answers extrapolate nothing
+        let mut outside: Vec<String> = s
+            .scales
+            .iter()
+            .filter(|x| x.point().is_none_or(|p| p.fallback.is_none()))
+            .flat_map(|x| rom.untrained_parameters(&x.mu))
+            .collect();
         outside.dedup();
         warnings.extend(outside);
         warn(py, &warnings)?;

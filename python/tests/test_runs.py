@@ -138,6 +138,7 @@ def test_sweep_falls_back_to_the_full_model(dp_basis):
     assert s["fallback"][0] is None, s["fallback"]
     assert s["fallback"][1].startswith("full model in place of the reduced one: error estimate "), s["fallback"]
     assert s["error_estimate"][1] == 0 and not s["extrapolated"][1]
+    assert s["fallback_failed"] == [None, None]
     same(s["probes"]["tip"][0], b.sweep([1.0])["probes"]["tip"][0])
     full = flexrom.Model.from_file(ROOT / "data" / "models" / "double_pendulum.toml").simulate(load_scale=2.5)
     same(s["probes"]["tip"][1], full.probes["tip"])
@@ -147,6 +148,8 @@ def test_sweep_falls_back_to_the_full_model(dp_basis):
     assert any("above the tolerance" in str(w.message) for w in seen), [str(w.message) for w in seen]
     with pytest.raises(ValueError, match="fallback"):
         b.sweep([1.0], fallback="bogus")
+    with pytest.raises(ValueError, match="needs the error estimate"):
+        flexrom.Basis.load(dp_basis, no_estimate=True).sweep([1.0], fallback="full")
 
 
 def test_outside_the_training_range_warns(dp_basis):

@@ -116,6 +116,28 @@ impl Args {
         if no_estimate && strict {
             return Err(flexrom::Error::Usage("--strict needs the error estimate; drop --no-estimate".into()));
         }
+        // the fallback this sweep runs with: none for a full or a validated sweep (which
+        // measures the reduced model at every point)
+        use flexrom::pipeline::sweep::Fallback;
+        let keyed = fallback.is_none() && p.online_fallback() == Some(Fallback::Full);
+        let fallback =
+            if full || validate { Fallback::None } else { fallback.or(p.online_fallback()).unwrap_or_default() };
+        if keyed && validate {
+            info(&format!(
+                "{}: [online] fallback = \"full\" does not apply to a validated sweep, which measures the reduced model at every point",
+                p.path.display()
+            ));
+        }
+        if fallback == Fallback::Full && no_estimate {
+            let given = if keyed {
+                format!("{}'s [online] fallback = \"full\"", p.path.display())
+            } else {
+                "--fallback full".into()
+            };
+            return Err(flexrom::Error::Usage(format!(
+                "{given} needs the error estimate to judge each reduced answer; drop --no-estimate (or pass --fallback none)"
+            )));
+        }
         let loaded = if full { None } else { Some(load_rom(&p, &path, estimate.method(), no_estimate)?) };
         if let Some((_, _, warnings)) = &loaded {
             warn(warnings);
@@ -136,7 +158,11 @@ impl Args {
             },
             None => Route::Full(&p.model),
         };
-        let fallback = fallback.or(p.online_fallback()).unwrap_or_default();
+        if let (Fallback::Full, Some((_, rom, _))) = (fallback, &loaded) {
+            if rom.estimator().is_none() {
+                warn(&["the basis has no error estimator: --fallback full acts only where a reduced run fails or the model amplifies load changes (train again for an estimator)".to_string()]);
+            }
+        }
         let options = flexrom::pipeline::sweep::SweepOptions {
             validate,
             continuation,
@@ -171,7 +197,7 @@ impl Args {
         if let Some(s) = sw.failure_summary() {
             // the way on after failed reduced runs, once for all of them (with the fallback a
             // failed point is one where the full model failed too)
-            let hint = if loaded.is_some() && fallback == flexrom::pipeline::sweep::Fallback::None {
+            let hint = if loaded.is_some() && fallback == Fallback::None {
                 format!("\n{}", flexrom::error::REDUCED_RUN_FAILED)
             } else {
                 String::new()
@@ -182,8 +208,14 @@ impl Args {
             )));
         }
         let Some((_, rom, _)) = &loaded else { return Ok(()) };
-        let outside: Vec<Vec<String>> =
-            points.iter().map(|mu| rom.named_outside(mu)).filter(|w| !w.is_empty()).collect();
+        // the full model's answers extrapolate nothing
+        let outside: Vec<Vec<String>> = sw
+            .scales
+            .iter()
+            .filter(|x| x.point().is_none_or(|p| p.fallback.is_none()))
+            .map(|x| rom.named_outside(&x.mu))
+            .filter(|w| !w.is_empty())
+            .collect();
         if let Some(first) = outside.first() {
             warn(&[format!(
                 "{} of {} points lie outside what the basis was trained on (the first: {}); the reduced model extrapolates there",
@@ -206,32 +238,47 @@ impl Args {
     }
 }
 
-/// One line when the full model answered some points in place of the reduced one: how
-/// many, why (by kind), and the first few.
+/// One line when the full model answered some points in place of the reduced one, or was
+/// tried and failed: how many, why (by kind), the first few, and that the warnings after it
+/// are about the reduced answers kept.
 fn fallback_summary(sw: &flexrom::pipeline::sweep::Sweep) -> Option<String> {
-    let fell: Vec<&flexrom::pipeline::sweep::ScaleResult> =
-        sw.scales.iter().filter(|x| x.point().is_some_and(|p| p.fallback.is_some())).collect();
-    if fell.is_empty() {
+    use flexrom::pipeline::sweep::{fallback::kind, runs_noun, ScaleResult};
+    let (answered, tried) = (sw.n_fallback(), sw.n_fallback_failed());
+    if answered + tried == 0 {
         return None;
     }
-    use flexrom::pipeline::sweep::fallback::{FULL_IN_PLACE, KINDS};
-    let why = |x: &flexrom::pipeline::sweep::ScaleResult| {
-        x.message().strip_prefix(FULL_IN_PLACE).unwrap_or_default().trim_start_matches(": ").to_string()
+    let of = |pick: &dyn Fn(&ScaleResult) -> bool| -> (String, String) {
+        let them: Vec<&ScaleResult> = sw.scales.iter().filter(|x| pick(x)).collect();
+        let mut kinds: Vec<(&str, usize)> = Vec::new();
+        for k in them.iter().filter_map(|x| kind(x.message())) {
+            match kinds.iter_mut().find(|(name, _)| *name == k) {
+                Some((_, c)) => *c += 1,
+                None => kinds.push((k, 1)),
+            }
+        }
+        let kinds = kinds.iter().map(|(name, c)| format!("{c}: {name}")).collect::<Vec<_>>().join(", ");
+        let first = them.iter().take(3).map(|x| x.mu.to_string()).collect::<Vec<_>>().join("; ");
+        (kinds, first)
     };
-    let count = |start: &str| fell.iter().filter(|x| why(x).starts_with(start)).count();
-    let kinds: Vec<String> = KINDS
-        .iter()
-        .filter_map(|(key, name)| Some(count(key)).filter(|&c| c > 0).map(|c| format!("{c}: {name}")))
-        .collect();
-    let first: Vec<String> = fell.iter().take(3).map(|x| x.mu.to_string()).collect();
-    Some(format!(
-        "the full model answered {} of {} {} in place of the reduced one ({}; the first: {}): exact there, error estimate 0, `/fallback` 1 and why in `/message`",
-        fell.len(),
-        sw.scales.len(),
-        flexrom::pipeline::sweep::runs_noun(sw.scales.iter().map(|x| &x.mu)),
-        kinds.join(", "),
-        first.join("; ")
-    ))
+    let noun = runs_noun(sw.scales.iter().map(|x| &x.mu));
+    let kept = sw.done().filter(|p| p.fallback.is_none()).count();
+    let mut line = String::new();
+    if answered > 0 {
+        let (kinds, first) = of(&|x| x.point().is_some_and(|p| p.fallback.is_some()));
+        line += &format!(
+            "the full model answered {answered} of {} {noun} in place of the reduced one ({kinds}; the first: {first}): exact there, error estimate 0, `/fallback` 1 and why in `/message`",
+            sw.scales.len()
+        );
+    }
+    if tried > 0 {
+        let (kinds, first) = of(&|x| x.point().is_some_and(|p| p.note.is_some()));
+        line += &format!(
+            "{}at {tried} {noun} the full model was tried in place of the reduced answer and failed too ({kinds}; the first: {first}): the reduced answer stands there, `/fallback` 2 and both reasons in `/message`",
+            if line.is_empty() { "" } else { "; " }
+        );
+    }
+    line += &format!("; the warnings below are about the {kept} reduced answers kept");
+    Some(line)
 }
 
 /// The points of the sweep: `--points FILE`; or the grid of `--param` axes after the load

@@ -17,7 +17,7 @@ mod temp_path;
 
 use crate::error::{Error, Result};
 pub use fs::{check_replaceable, create_dirs, kind_of, names_an_entry, sync_file_data, sync_path, sync_tree};
-pub use registry::{install_signal_handler, live_paths, set_stop_note};
+pub use registry::{install_signal_handler, live_paths, set_stop_note, stop_note, stopped_by, GracefulStop};
 use std::path::Path;
 pub use swap::swap_in_dir;
 pub use temp_path::TempPath;

@@ -16,7 +16,9 @@
 use super::config::Pipeline;
 use super::online::load_basis;
 use super::shard::point_list_hash;
-use super::sweep::{read_sweep, write_sweep, Outcome, ScaleResult, Sweep, SweepBasis, STATUS_FAILED, STATUS_OK};
+use super::sweep::{
+    read_sweep, write_sweep, Fallback, Outcome, ScaleResult, Sweep, SweepBasis, STATUS_FAILED, STATUS_OK,
+};
 use crate::error::{Error, Result};
 use crate::io::h5::{read_attr_f64, read_attr_str};
 use crate::limits::Limits;
@@ -44,6 +46,8 @@ struct Part {
     model_fingerprint: String,
     validated: bool,
     continuation: bool,
+    /// `--fallback` (attribute `fallback`; "none" in files written before it)
+    fallback: String,
     wall_seconds: f64,
     threads: u64,
     pipeline: PathBuf,
@@ -191,6 +195,7 @@ fn read_part(path: &Path) -> Result<Part> {
         model_fingerprint: s(&f, "model_fingerprint")?,
         validated: flag("validated")?,
         continuation: flag("continuation")?,
+        fallback: if f.attr("fallback").is_ok() { s(&f, "fallback")? } else { "none".into() },
         wall_seconds: read_attr_f64(&f, "wall_seconds").unwrap_or(f64::NAN),
         threads: f.attr("threads").and_then(|a| a.read_scalar::<u64>()).unwrap_or(1),
         pipeline: PathBuf::from(s(&g, "pipeline")?),
@@ -273,6 +278,12 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool, limits: &Limits) -> R
         if p.continuation != first.continuation {
             return Err(differ("continuation", "was run with another --continuation"));
         }
+        if p.fallback != first.fallback {
+            return Err(differ(
+                "fallback",
+                &format!("is \"{}\", not \"{}\" (another --fallback)", p.fallback, first.fallback),
+            ));
+        }
     }
     // who holds each shard
     let mut holder: Vec<Option<usize>> = vec![None; first.count];
@@ -352,6 +363,7 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool, limits: &Limits) -> R
         full: first.full,
         model_fingerprint: model.fingerprint(),
         validated: first.validated,
+        fallback: if first.fallback == "full" { Fallback::Full } else { Fallback::None },
         wall_seconds: parts.iter().map(|p| p.wall_seconds).fold(0.0, f64::max),
         threads: parts.iter().map(|p| p.threads as usize).sum(),
         continuation: first.continuation,

@@ -63,6 +63,19 @@ pub struct SweepOptions {
     pub fallback: Fallback,
 }
 
+impl SweepOptions {
+    /// The options a sweep runs with: a full sweep (`full`) is neither validated nor
+    /// continued, and neither it nor a validated sweep (which measures the reduced model at
+    /// every point) falls back.
+    pub fn settled(self, full: bool) -> Self {
+        match (full, self.validate) {
+            (true, _) => SweepOptions { validate: false, continuation: false, fallback: Fallback::None, ..self },
+            (false, true) => SweepOptions { fallback: Fallback::None, ..self },
+            (false, false) => self,
+        }
+    }
+}
+
 /// The chains of a continuation sweep over `n` scales, by thread: the list cut into `2 T`
 /// contiguous blocks, thread t taking block t and block 2T − 1 − t (one from each end).
 /// The cost of a run usually grows or falls along the list with the load, so each thread
@@ -125,8 +138,12 @@ pub fn runs_noun<'a>(points: impl IntoIterator<Item = &'a Parameters>) -> &'stat
 /// A point whose run fails is recorded as failed and the others go on. Every point gets the
 /// reduced model's error estimate (when it has an estimator) and extrapolation flag.
 pub fn sweep(rom: &Rom, points: &[Parameters], o: SweepOptions) -> Result<Sweep> {
+    let o = o.settled(false);
     let start = pending(rom.model(), rom.basis().n_reduced(), false, points, o)?;
-    run_reduced(rom, start, o, None)
+    let sw = run_reduced(rom, start, o, None)?;
+    // a stop asked for left the points it reached pending: the caller's stop
+    crate::interrupt::check()?;
+    Ok(sw)
 }
 
 /// Where and how a sweep is written as it goes ([`sweep_to_file`]).
@@ -147,12 +164,7 @@ pub fn sweep_to_file(route: Route, points: &[Parameters], o: SweepOptions, f: Sw
     let SweepFile { out, resume, extra } = f;
     let model = route.model();
     let full = matches!(route, Route::Full(_));
-    // a validated sweep measures the reduced model everywhere: nothing to fall back from
-    let o = match (full, o.validate) {
-        (true, _) => SweepOptions { validate: false, continuation: false, fallback: Fallback::None, ..o },
-        (false, true) => SweepOptions { fallback: Fallback::None, ..o },
-        (false, false) => o,
-    };
+    let o = o.settled(full);
     let n_reduced = match route {
         Route::Reduced { rom, .. } => rom.basis().n_reduced(),
         Route::Full(_) => 0,
@@ -164,7 +176,7 @@ pub fn sweep_to_file(route: Route, points: &[Parameters], o: SweepOptions, f: Sw
             let mut reused = 0;
             for s in start.scales.iter_mut() {
                 if let Some(i) = old.iter().position(|(x, _)| *x == s.mu) {
-                    if let Some(p) = old[i].1.as_ref() {
+                    if let Some(p) = old[i].1.as_ref().filter(|p| !falls_back_now(&route, o, &s.mu, p)) {
                         s.outcome = Outcome::Done(clone_point(p));
                         reused += 1;
                     }
@@ -202,13 +214,42 @@ pub fn sweep_to_file(route: Route, points: &[Parameters], o: SweepOptions, f: Sw
         crate::io::atomic::set_stop_note(Some(note.clone()));
         Ok(())
     };
+    // a first signal stops the runs, and what is finished is written below (the command line)
+    let graceful = crate::io::atomic::GracefulStop::on();
     let sw = match route {
         Route::Reduced { rom, .. } => run_reduced(rom, start, o, Some(&write)),
         Route::Full(model) => run_full(model, start, o, Some(&write)),
     };
+    drop(graceful);
+    let stopped = crate::interrupt::requested() && crate::io::atomic::stopped_by().is_some();
+    if stopped {
+        // the runs have stopped; the final write commits only once the request is withdrawn
+        crate::interrupt::clear();
+    }
     let written = sw.and_then(|sw| write(&sw).map(|()| sw));
     crate::io::atomic::set_stop_note(None);
-    written
+    let sw = written?;
+    if stopped {
+        let done = sw.done().count();
+        crate::io::atomic::set_stop_note(Some(format!(
+            "{} keeps the {done} {runs} finished; the same command with --resume runs the other {}",
+            out.display(),
+            sw.scales.len() - done
+        )));
+        return Err(crate::error::Error::Interrupted);
+    }
+    Ok(sw)
+}
+
+/// Whether a finished reduced answer read back for `--resume` is one this sweep's
+/// fallback would not keep (the earlier sweep ran without it, or with another tolerance):
+/// it runs again, and falls back.
+fn falls_back_now(route: &Route, o: SweepOptions, mu: &Parameters, p: &SweepPoint) -> bool {
+    let Route::Reduced { rom, .. } = route else { return false };
+    o.fallback == Fallback::Full
+        && p.fallback.is_none()
+        && p.note.is_none()
+        && fallback::reason(rom.trust(), mu, p.estimate.as_ref()).is_some()
 }
 
 /// Every scale pending, with the model's time grid and probe names.
@@ -223,6 +264,7 @@ fn pending(model: &Model, n_reduced: usize, full: bool, points: &[Parameters], o
         full,
         model_fingerprint: model.fingerprint(),
         validated: o.validate,
+        fallback: o.fallback,
         wall_seconds: 0.0,
         threads: rayon::current_num_threads().max(1),
         continuation: o.continuation,
@@ -373,7 +415,8 @@ fn run_pending(
         let mut guard = shared.lock().unwrap_or_else(|e| e.into_inner());
         let (sw, due) = &mut *guard;
         sw.scales[todo[i]].outcome = outcome;
-        if let Some(write) = checkpoint {
+        // once a stop was asked for, nothing is committed before the runs have stopped
+        if let Some(write) = checkpoint.filter(|_| !crate::interrupt::requested()) {
             if due.is_none_or(|d| std::time::Instant::now() >= d) {
                 sw.wall_seconds = start.elapsed().as_secs_f64();
                 let began = std::time::Instant::now();
@@ -391,10 +434,16 @@ fn run_pending(
                 // the last two good runs of this chain (continuation only)
                 let mut previous: Vec<ReducedRun> = Vec::new();
                 for i in chain.clone() {
+                    // a stop asked for: the points not begun stay pending
+                    if crate::interrupt::requested() {
+                        break;
+                    }
                     let run = point(&points[i], &previous.iter().collect::<Vec<_>>());
                     bar.inc(1);
                     ticker.tick();
                     match run {
+                        // finished as the stop came: parts of it (its estimate) may have been cut
+                        Ok(_) if crate::interrupt::requested() => record(i, Outcome::Pending)?,
                         Ok(p) => {
                             // a fallback's full run has no reduced steps to continue from
                             if o.continuation && p.fallback.is_none() {
@@ -405,6 +454,8 @@ fn run_pending(
                             }
                             record(i, Outcome::Done(p))?;
                         }
+                        // a run the stop ended is not failed: it has not run
+                        Err(crate::error::Error::Interrupted) => record(i, Outcome::Pending)?,
                         Err(e) => record(i, Outcome::Failed(e.to_string()))?,
                     }
                 }

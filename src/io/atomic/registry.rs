@@ -5,7 +5,7 @@
 
 use crate::error::{Error, Result};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicI32, AtomicU64, Ordering};
 use std::sync::{Mutex, MutexGuard};
 
 /// What the signal handler does with a registered path.
@@ -29,7 +29,55 @@ static STOP_NOTE: Mutex<Option<String>> = Mutex::new(None);
 pub fn set_stop_note(note: Option<String>) {
     *STOP_NOTE.lock().unwrap_or_else(|e| e.into_inner()) = note;
 }
+
+/// The line [`set_stop_note`] set, if any.
+pub fn stop_note() -> Option<String> {
+    STOP_NOTE.lock().unwrap_or_else(|e| e.into_inner()).clone()
+}
 pub(super) static COUNTER: AtomicU64 = AtomicU64::new(0);
+
+/// While set ([`GracefulStop`]), the first signal asks the computation to stop instead of
+/// ending the process.
+static GRACEFUL: AtomicBool = AtomicBool::new(false);
+/// The signal that asked a graceful stop (0: none).
+static STOPPED_BY: AtomicI32 = AtomicI32::new(0);
+
+/// While it lives, the first SIGINT/SIGTERM/SIGHUP asks every run to stop at its next time
+/// step ([`crate::interrupt`]) instead of ending the process, so that the work finished so
+/// far can be written (a sweep's last checkpoint, with every point finished by then); the
+/// same or another signal again ends the process at once, as without it. Held by a sweep
+/// while its runs go on, dropped before its final write.
+pub struct GracefulStop(());
+
+impl GracefulStop {
+    pub fn on() -> Self {
+        GRACEFUL.store(true, Ordering::SeqCst);
+        GracefulStop(())
+    }
+}
+
+impl Drop for GracefulStop {
+    fn drop(&mut self) {
+        GRACEFUL.store(false, Ordering::SeqCst);
+    }
+}
+
+/// The signal that asked a graceful stop, by number and name, when one did.
+pub fn stopped_by() -> Option<(i32, &'static str)> {
+    match STOPPED_BY.load(Ordering::SeqCst) {
+        0 => None,
+        sig => Some((sig, signal_name(sig))),
+    }
+}
+
+fn signal_name(sig: i32) -> &'static str {
+    use signal_hook::consts::{SIGHUP, SIGINT};
+    match sig {
+        SIGINT => "SIGINT",
+        SIGHUP => "SIGHUP",
+        _ => "SIGTERM",
+    }
+}
 
 /// The registry, also after a thread panicked while holding it (the list stays valid).
 pub(super) fn live() -> MutexGuard<'static, Vec<Live>> {
@@ -92,15 +140,21 @@ pub fn install_signal_handler() -> Result<()> {
     std::thread::Builder::new()
         .name("flexrom-signals".into())
         .spawn(move || {
-            if let Some(sig) = signals.forever().next() {
+            for sig in signals.forever() {
+                let name = signal_name(sig);
+                // the first signal during a graceful stop's reach: stop the runs, not the process
+                if GRACEFUL.load(Ordering::SeqCst)
+                    && STOPPED_BY.compare_exchange(0, sig, Ordering::SeqCst, Ordering::SeqCst).is_ok()
+                {
+                    crate::interrupt::request();
+                    eprintln!(
+                        "flexrom: {name}: stopping the runs under way to write the finished ones (send it again to stop at once)"
+                    );
+                    continue;
+                }
                 let mut v = live();
                 let n = v.len();
                 clean_up(&mut v);
-                let name = match sig {
-                    SIGINT => "SIGINT",
-                    SIGHUP => "SIGHUP",
-                    _ => "SIGTERM",
-                };
                 eprintln!(
                     "flexrom: stopped by {name}; {n} temporary path(s) removed, previous outputs left as they were"
                 );

@@ -28,6 +28,16 @@ pub enum Fallback {
     Full,
 }
 
+impl Fallback {
+    /// The value in a pipeline, on the command line and in a sweep file's `fallback`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Fallback::None => "none",
+            Fallback::Full => "full",
+        }
+    }
+}
+
 /// The prefix of a point's `/message` when the full model answered it in place of the
 /// reduced one; what follows says why.
 pub const FULL_IN_PLACE: &str = "full model in place of the reduced one";
@@ -36,18 +46,29 @@ pub const FULL_IN_PLACE: &str = "full model in place of the reduced one";
 /// and failed (the reduced answer then stands, as without the fallback).
 pub const FULL_TRIED: &str = "the full model, run in place of this reduced answer";
 
-/// The kinds of [`reason`] (and a reduced run's failure), as a sweep's summary counts
-/// them: (how the reason starts, what the summary calls it).
-pub const KINDS: [(&str, &str); 4] = [
+/// The kinds of [`why`], as a sweep's summary counts them: (how the reason starts, what
+/// the summary calls it).
+const KINDS: [(&str, &str); 4] = [
     ("the reduced run failed", "reduced run failed"),
     ("error estimate ", "error estimate above the tolerance"),
     ("the error estimate could not", "no estimate"),
     ("the model amplifies", "the model amplifies load changes"),
 ];
 
+/// What a sweep's summary calls the reason of a point's `/message` (a fallback's, starting
+/// [`FULL_IN_PLACE`], or a tried one's, starting [`FULL_TRIED`]).
+pub fn kind(message: &str) -> Option<&'static str> {
+    let why = message
+        .strip_prefix(FULL_IN_PLACE)
+        .map(|m| m.trim_start_matches(": "))
+        .or_else(|| message.strip_prefix(FULL_TRIED).map(|m| m.trim_start_matches(" (")))?;
+    KINDS.iter().find(|(start, _)| why.starts_with(start)).map(|&(_, name)| name)
+}
+
 /// Why the full model answers at `mu` in place of the reduced run `reduced` (its result,
 /// its estimate): none under [`Fallback::None`]; under [`Fallback::Full`] the reduced
-/// run's failure, or [`reason`].
+/// run's numerical failure (Newton, a linear solve, a blow-up: not a stop that was asked
+/// for, a limit or a file), or [`reason`].
 pub fn why<T>(
     reduced: &Result<(T, Option<Estimate>)>,
     fallback: Fallback,
@@ -56,7 +77,7 @@ pub fn why<T>(
 ) -> Option<String> {
     match (reduced, fallback) {
         (_, Fallback::None) => None,
-        (Err(e), Fallback::Full) => Some(format!("the reduced run failed: {e}")),
+        (Err(e), Fallback::Full) => e.is_numerical().then(|| format!("the reduced run failed: {e}")),
         (Ok((_, estimate)), Fallback::Full) => reason(trust, mu, estimate.as_ref()),
     }
 }
@@ -124,6 +145,41 @@ mod tests {
         trust.measure = ErrorMeasure::Displacement;
         assert!(reason(Some(&trust), &mu, Some(&estimate(1e-3, 2e-2))).is_some(), "displacement 2e-2");
         assert_eq!(reason(Some(&trust), &mu, Some(&estimate(1.0, f64::NAN))), None, "at rest");
+    }
+
+    /// A fallback runs on a reduced run's numerical failure, not on a stop that was asked
+    /// for; and the summary names each reason [`why`] gives by its own kind (the words of
+    /// one reason must not read as another's).
+    #[test]
+    fn the_reasons_and_their_kinds() {
+        let mu = Parameters::load_scale(1.0);
+        let failed: Result<((), Option<Estimate>)> = Err(crate::error::Error::Interrupted);
+        assert_eq!(why(&failed, Fallback::Full, None, &mu), None, "a stop asked for");
+        let newton = crate::error::Error::NewtonFailed {
+            t: 0.5,
+            dt: 1e-3,
+            cuts: 8,
+            iterations: 25,
+            increment: 1.0,
+            residual: 1.0,
+        };
+        let failed: Result<((), Option<Estimate>)> = Err(newton.at_stage("sweep (reduced run)", &mu));
+        let w = why(&failed, Fallback::Full, None, &mu).expect("Newton failed");
+        assert_eq!(why(&failed, Fallback::None, None, &mu), None);
+        let mut trust = Trust::range((0.5, 1.5));
+        trust.tolerance = Some(5e-3);
+        trust.sensitivity = Some(crate::rom::trust::LoadSensitivity::new(vec![1.0], vec![0.2]));
+        let reasons = [
+            (w, "reduced run failed"),
+            (reason(Some(&trust), &mu, Some(&estimate(1e-2, 1e-2))).unwrap(), "error estimate above the tolerance"),
+            (reason(Some(&trust), &mu, Some(&estimate(f64::INFINITY, f64::INFINITY))).unwrap(), "no estimate"),
+            (reason(Some(&trust), &mu, Some(&estimate(1e-3, 1e-3))).unwrap(), "the model amplifies load changes"),
+        ];
+        for (r, name) in reasons {
+            assert_eq!(kind(&format!("{FULL_IN_PLACE}: {r}")), Some(name), "{r}");
+            assert_eq!(kind(&format!("{FULL_TRIED} ({r}) failed: …")), Some(name), "{r}");
+        }
+        assert_eq!(kind("sweep (reduced run) at load scale 2: Newton failed"), None);
     }
 
     /// Where training measured a sensitivity above the tolerance and above the estimate

@@ -8,13 +8,18 @@
 //!                                    value at each point (attribute `parameters`: the d names,
 //!                                    comma-separated, load_scale first)
 //! /status             (N)            0 = ok, 1 = failed, 2 = not run yet
-//! /message            (N)            why it failed ("" when ok)
+//! /message            (N)            why it failed; for a finished point, why the full model
+//!                                    answered (or was tried) in its place ("" otherwise)
 //! /t                  (n_t)
 //! /probes/<name>      (N, n_t, 2)    probe positions of each run (reduced; --full: full), m
 //! /full_probes/<name> (N, n_t, 2)    with --validate: the full runs' probe positions, m
 //! /reduced_q          (N, n_t, r)    reduced coordinates (time first; layout 1: (N, r, n_t));
 //!                                    not in a full sweep
-//! /rom_seconds        (N)            reduced time loop of each run (not in a full sweep)
+//! /rom_seconds        (N)            reduced time loop of each run (not in a full sweep; the
+//!                                    full run's where /fallback is 1)
+//! /fallback           (N)            reduced sweeps: 0 the reduced answer, 1 the full model's
+//!                                    in its place (`--fallback full`), 2 the reduced answer
+//!                                    kept where the full model was tried and failed
 //! /newton_iterations  (N)
 //! /factorizations     (N)            iteration matrices factorized
 //! /error_estimate     (N)            the estimate of rel_error of each run (NaN: no estimator)
@@ -156,11 +161,10 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, basis: Option<SweepBasis>, extra
             f.new_dataset_builder().chunk((1, nt.max(1), r.max(1))).with_data(&zq).create("reduced_q").map_err(e)?;
             f.new_dataset_builder().with_data(&col(&|p| p.run.result.wall_seconds)).create("rom_seconds").map_err(e)?;
             // 1 where the full model answered in place of the reduced one (`--fallback full`;
-            // why: /message); its probes, seconds and iterations are then the full run's
+            // why: /message; its probes, seconds and iterations are then the full run's), 2
+            // where it was tried and failed and the reduced answer stands
             f.new_dataset_builder()
-                .with_data(&Array1::from_iter(
-                    s.scales.iter().map(|x| x.point().is_some_and(|p| p.fallback.is_some()) as u8),
-                ))
+                .with_data(&Array1::from_iter(s.scales.iter().map(|x| x.point().map_or(0, SweepPoint::fallback_code))))
                 .create("fallback")
                 .map_err(e)?;
         }
@@ -254,6 +258,7 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, basis: Option<SweepBasis>, extra
             attr_str(f, "model_fingerprint", &s.model_fingerprint).map_err(e)?;
         }
         attr_u64(f, "validated", s.validated as u64).map_err(e)?;
+        attr_str(f, "fallback", s.fallback.name()).map_err(e)?;
         attr_f64(f, "wall_seconds", s.wall_seconds).map_err(e)?;
         attr_u64(f, "threads", s.threads as u64).map_err(e)?;
         attr_u64(f, "continuation", s.continuation as u64).map_err(e)?;
@@ -438,9 +443,9 @@ pub fn read_sweep(
                 format!("has {} entries (/message {}) for {n} load scales", flags.len(), messages.len()),
             ));
         }
-        flags.iter().zip(&messages).map(|(&x, m)| (x != 0, m.as_str().to_string())).collect()
+        flags.iter().zip(&messages).map(|(&x, m)| (x, m.as_str().to_string())).collect()
     } else {
-        vec![(false, String::new()); n]
+        vec![(0, String::new()); n]
     };
     let by_fifth = |name: &str| -> Result<Option<Array2<f64>>> {
         if !f.link_exists(name) {
@@ -603,15 +608,16 @@ pub fn read_sweep(
             v
         });
         // a fallback's full run has no reduced coordinates (NaN in the file)
-        let (full, message) = &fallback[k];
-        let reduced_q = if *full { Array2::zeros((0, nt)) } else { zq.index_axis(ndarray::Axis(0), k).to_owned() };
+        let (code, message) = &fallback[k];
+        let reduced_q = if *code == 1 { Array2::zeros((0, nt)) } else { zq.index_axis(ndarray::Axis(0), k).to_owned() };
         let run = ReducedRun { result, reduced_q };
         let full_probes = full_probes.as_deref().map(|p| at(p, k));
-        // a finished point's message: why the full model answered, or a reduced answer's note
-        let (fallback, note) = match (full, message.is_empty()) {
-            (true, _) => (Some(message.clone()), None),
-            (false, false) => (None, Some(message.clone())),
-            (false, true) => (None, None),
+        // a finished point's message: why the full model answered (1), or why it was tried
+        // in place of the reduced answer kept and how it failed (2)
+        let (fallback, note) = match code {
+            1 => (Some(message.clone()), None),
+            2 => (None, Some(message.clone())),
+            _ => (None, None),
         };
         out.push((mu, Some(SweepPoint { run, validation: v, full_probes, estimate, extrapolated, fallback, note })));
     }

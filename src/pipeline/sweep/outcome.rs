@@ -49,6 +49,18 @@ pub struct ScaleResult {
     pub outcome: Outcome,
 }
 
+impl SweepPoint {
+    /// The value of `/fallback`: 0 the reduced answer, 1 the full model's in its place, 2
+    /// the reduced answer kept where the full model was tried and failed.
+    pub fn fallback_code(&self) -> u8 {
+        match (&self.fallback, &self.note) {
+            (Some(_), _) => 1,
+            (None, Some(_)) => 2,
+            (None, None) => 0,
+        }
+    }
+}
+
 impl ScaleResult {
     pub fn point(&self) -> Option<&SweepPoint> {
         match &self.outcome {
@@ -87,6 +99,9 @@ pub struct Sweep {
     /// the model's fingerprint ([`crate::model::Model::fingerprint`])
     pub model_fingerprint: String,
     pub validated: bool,
+    /// what the sweep did where it could not stand behind a reduced answer (attribute
+    /// `fallback`; always `None` for full and validated sweeps)
+    pub fallback: super::Fallback,
     pub wall_seconds: f64,
     pub threads: usize,
     pub continuation: bool,
@@ -112,6 +127,12 @@ impl Sweep {
     /// The finished points the full model answered in place of the reduced one.
     pub fn n_fallback(&self) -> usize {
         self.done().filter(|p| p.fallback.is_some()).count()
+    }
+
+    /// The finished points where the full model was tried in place of the reduced answer
+    /// and failed (the reduced answer kept, with its note).
+    pub fn n_fallback_failed(&self) -> usize {
+        self.done().filter(|p| p.note.is_some()).count()
     }
 
     /// One line when some load scale failed, naming the first few and their errors:

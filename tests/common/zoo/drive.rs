@@ -60,6 +60,9 @@ pub struct Validation {
     /// the run warned that the model amplifies changes of the load beyond what the estimate
     /// sees (`amplifying` of `validate --json`; false when absent)
     pub amplifying: bool,
+    /// training's sensitivity beside the load (`sensitivity_near`; NaN when absent): what a
+    /// sweep reads, where `validate`'s `amplifying` may also read its own full runs
+    pub sensitivity_near: f64,
 }
 
 /// The last line of a process's stderr that says something (its error).
@@ -219,6 +222,7 @@ impl Flexrom {
             estimate_seconds: number(&v, "estimate_seconds"),
             speedup: number(&v, "speedup"),
             amplifying: v.get("amplifying").and_then(Value::as_bool).unwrap_or(false),
+            sensitivity_near: number(&v, "sensitivity_near"),
         })
     }
 }

@@ -139,14 +139,19 @@ pub fn model_stats(runs: &[Result<Validation, String>]) -> ModelStats {
 }
 
 /// Whether `sweep --fallback full` answers a validation's load with the full model (docs/
-/// basis-and-sweep.md): the reduced run failed, its estimate is above the tolerance `tol`
-/// (the zoo's pipelines hold it to the training tolerance, relative measure), or it warned
-/// that the model amplifies changes of the load beyond the estimate — the rule of
-/// `flexrom::pipeline::sweep::fallback::reason`, read from what `validate` reports.
+/// basis-and-sweep.md), by the rule of `flexrom::pipeline::sweep::fallback`: the reduced
+/// run failed (the zoo validates only where the full model runs: its models are replaced
+/// otherwise), its estimate is above the tolerance `tol` (the zoo's pipelines hold it to the
+/// training tolerance, relative measure), or training's sensitivity beside the load
+/// amplifies beyond the tolerance and the estimate (`Trust::amplifies`; not `validate`'s
+/// `amplifying`, which may also read its own full runs, as a sweep does not).
 pub fn falls_back(r: &Result<Validation, String>, tol: f64) -> bool {
     match r {
         Err(_) => true,
-        Ok(v) => !within(v.error_estimate, tol) || v.amplifying,
+        Ok(v) => {
+            let trust = flexrom::rom::Trust { tolerance: Some(tol), ..flexrom::rom::Trust::range((0.5, 1.5)) };
+            !within(v.error_estimate, tol) || trust.amplifies(v.sensitivity_near, Some(v.error_estimate))
+        }
     }
 }
 
@@ -305,6 +310,7 @@ mod tests {
             estimate_seconds: 0.25,
             speedup: 2.0,
             amplifying: false,
+            sensitivity_near: f64::NAN,
         }
     }
 
@@ -327,15 +333,21 @@ mod tests {
         assert_eq!(median(&[4.0, 1.0, 3.0, 2.0]), 2.5);
     }
 
-    /// Hand-counted: at tolerance 1e-2 the failed run, the one reading 2e-2 and the one that
-    /// warned of amplification fall back and count as exact (covered in every fifth, no
-    /// effectivity); the one reading 2e-3 against 1e-3 stays, covered over the run and in
-    /// four fifths.
+    /// Hand-counted: at tolerance 1e-2 the failed run, the one reading 2e-2 and the one whose
+    /// training sensitivity (3e-2) exceeds the tolerance, `AMPLIFYING · δ` = 1e-2 and its
+    /// estimate fall back and count as exact (covered in every fifth, no effectivity); the
+    /// one reading 2e-3 against 1e-3 stays, covered over the run and in four fifths. A
+    /// sensitivity of 9.9e-3 (below 1e-2) or one the estimate reaches does not fall back,
+    /// whatever `validate`'s own `amplifying` says.
     #[test]
     fn a_fallback_answers_exactly_where_it_falls_back() {
-        let amplifying = Validation { amplifying: true, ..v(1e-3, 2e-3) };
+        let amplifying = Validation { sensitivity_near: 3e-2, ..v(1e-3, 2e-3) };
         let runs = [Ok(v(2e-3, 1e-3)), Ok(v(2e-2, 1e-3)), Ok(amplifying), Err("failed".into())];
         assert_eq!(runs.iter().map(|r| falls_back(r, 1e-2)).collect::<Vec<_>>(), [false, true, true, true]);
+        let below = Validation { sensitivity_near: 9.9e-3, amplifying: true, ..v(1e-3, 2e-3) };
+        let reached = Validation { sensitivity_near: 3e-2, ..v(5e-2, 2e-3) };
+        assert!(!falls_back(&Ok(below), 1e-2));
+        assert!(!falls_back(&Ok(reached), 1.0), "an estimate of 5e-2 ≥ the sensitivity 3e-2, below the tolerance 1");
         let s = fallback_stats(&runs, 1e-2);
         assert_eq!((s.loads, s.fallbacks, s.covered_pairs, s.under_pairs, s.failed_loads), (4, 3, 4, 0, 0));
         assert_eq!((s.covered_triples, s.under_triples), (19, 1));
