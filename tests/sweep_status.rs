@@ -86,6 +86,8 @@ fn a_failing_load_scale_is_recorded_and_the_others_written() {
     );
     assert!(last.contains("s.h5"), "{err}");
     assert_eq!(status(&out), vec![0, 1, 0, 0, 1]);
+    // the answers kept are warned about too (0.9 and 1.1 outside the range [1, 1])
+    assert!(err.contains("outside the basis's training range [1, 1]"), "{err}");
     let f = hdf5::File::open(&out).unwrap();
     let messages: Vec<String> = f
         .dataset("message")
@@ -390,12 +392,15 @@ fn where_the_full_model_fails_too_the_reduced_answer_stands_with_a_note() {
         "full",
         "-o",
         out.to_str().unwrap(),
+        "--csv",
     ]);
     assert_eq!(o.status.code(), Some(0), "{err}");
+    let csv = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(csv.lines().next().unwrap().ends_with(",fallback") && csv.lines().nth(1).unwrap().ends_with(",2"), "{csv}");
     assert!(err.contains("warning: error estimate above the tolerance 1e-2 at load scale 1.34"), "{err}");
     assert!(
         err.contains(
-            "at 1 load scales the full model was tried in place of the reduced answer and failed too (1: no estimate;"
+            "at 1 load scale the full model was tried in place of the reduced answer and failed too (1: no estimate;"
         ),
         "{err}"
     );
@@ -412,7 +417,8 @@ fn where_the_full_model_fails_too_the_reduced_answer_stands_with_a_note() {
 /// What a fallback sweep keeps and refuses, on the coarse pendulum of the first fallback
 /// test (every estimate above an `[online] tolerance` of 1e-12):
 /// - `--resume --fallback full` on a file of a sweep without the fallback runs again the
-///   points it would not keep (all 3 here), and answers them with the full model;
+///   points it would not keep (all 3 here), and answers them with the full model; the
+///   file is not resumed without the fallback (refused, left as it is);
 /// - `merge` refuses parts of sweeps with different `--fallback`, naming the attribute;
 /// - `--fallback full --no-estimate` is refused (exit 1, as `--strict --no-estimate`):
 ///   nothing could judge the answers;
@@ -433,6 +439,11 @@ fn a_fallback_sweep_resumes_merges_and_refuses_what_it_cannot_judge() {
     assert_eq!(r.status.code(), Some(0), "{err}");
     assert!(err.contains("0 of 3 load scales already finished, running 3"), "{err}");
     let fb = |f: &Path| hdf5::File::open(f).unwrap().dataset("fallback").unwrap().read_raw::<u8>().unwrap();
+    assert_eq!(fb(&out), vec![1, 1, 1]);
+    // and not resumed without it: its full answers would stand in a file that says none
+    let (r, err) = run(&["sweep", ps, "--resume", "-o", o]);
+    assert_eq!(r.status.code(), Some(1), "{err}");
+    assert!(err.contains("fallback: is \"full\": the sweep was written with --fallback full"), "{err}");
     assert_eq!(fb(&out), vec![1, 1, 1]);
     // parts of different fallbacks
     let (a, b, m) = (d.join("a.h5"), d.join("b.h5"), d.join("m.h5"));

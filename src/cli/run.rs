@@ -29,6 +29,12 @@ impl Args {
         let Args { pipeline, strict, dense, estimate, format } = self;
         let p = Pipeline::load_with(&pipeline, limits.clone())?;
         super::warn(&p.property_warnings());
+        if p.online_fallback() == Some(flexrom::pipeline::sweep::Fallback::Full) {
+            info(&format!(
+                "{}: [online] fallback = \"full\" applies to `sweep` and `online`; the report's sweep is validated and measures the reduced model at every load",
+                p.path.display()
+            ));
+        }
         let (dir, warnings) =
             flexrom::pipeline::report::run_with(&p, output::show_progress(), dense.choice(), estimate.method())?;
         super::warn(&warnings);

@@ -161,6 +161,8 @@ impl Args {
         if let (Fallback::Full, Some((_, rom, _))) = (fallback, &loaded) {
             if rom.estimator().is_none() {
                 warn(&["the basis has no error estimator: --fallback full acts only where a reduced run fails or the model amplifies load changes (train again for an estimator)".to_string()]);
+            } else if rom.trust().and_then(|t| t.tolerance).is_none() {
+                warn(&["no tolerance to hold the estimates to (a basis trained at fixed loads, and no [online] tolerance in the pipeline): --fallback full acts only where a reduced run fails".to_string()]);
             }
         }
         let options = flexrom::pipeline::sweep::SweepOptions {
@@ -193,8 +195,43 @@ impl Args {
         if let Some(line) = fallback_summary(&sw) {
             info(&line);
         }
+        // the answers kept are warned about also when some points failed (exit 3 below)
+        let failure = sw.failure_summary();
+        let checked = match &loaded {
+            Some((_, rom, _)) => {
+                // the full model's answers extrapolate nothing
+                let outside: Vec<Vec<String>> = sw
+                    .scales
+                    .iter()
+                    .filter(|x| x.point().is_none_or(|p| p.fallback.is_none()))
+                    .map(|x| rom.named_outside(&x.mu))
+                    .filter(|w| !w.is_empty())
+                    .collect();
+                if let Some(first) = outside.first() {
+                    warn(&[format!(
+                        "{} of {} points lie outside what the basis was trained on (the first: {}); the reduced model extrapolates there",
+                        outside.len(),
+                        points.len(),
+                        first.join(", ")
+                    )]);
+                }
+                // a point the full model answered is exact: nothing to warn about
+                let runs: Vec<_> = sw
+                    .scales
+                    .iter()
+                    .filter_map(|x| x.point())
+                    .filter(|q| q.fallback.is_none())
+                    .map(|q| {
+                        let e = q.estimate.as_ref().map(|e| e.in_measure(rom.tolerance_measure()));
+                        (q.run.result.settings.mu.clone(), e)
+                    })
+                    .collect();
+                super::check_runs(rom, &runs, strict && failure.is_none())
+            }
+            None => Ok(()),
+        };
         // the good runs are written; the exit code (3) says that some failed
-        if let Some(s) = sw.failure_summary() {
+        if let Some(s) = failure {
             // the way on after failed reduced runs, once for all of them (with the fallback a
             // failed point is one where the full model failed too)
             let hint = if loaded.is_some() && fallback == Fallback::None {
@@ -207,34 +244,7 @@ impl Args {
                 out.display()
             )));
         }
-        let Some((_, rom, _)) = &loaded else { return Ok(()) };
-        // the full model's answers extrapolate nothing
-        let outside: Vec<Vec<String>> = sw
-            .scales
-            .iter()
-            .filter(|x| x.point().is_none_or(|p| p.fallback.is_none()))
-            .map(|x| rom.named_outside(&x.mu))
-            .filter(|w| !w.is_empty())
-            .collect();
-        if let Some(first) = outside.first() {
-            warn(&[format!(
-                "{} of {} points lie outside what the basis was trained on (the first: {}); the reduced model extrapolates there",
-                outside.len(),
-                points.len(),
-                first.join(", ")
-            )]);
-        }
-        // a point the full model answered is exact: nothing to warn about
-        let runs: Vec<_> = sw
-            .scales
-            .iter()
-            .filter_map(|x| x.point())
-            .filter(|q| q.fallback.is_none())
-            .map(|q| {
-                (q.run.result.settings.mu.clone(), q.estimate.as_ref().map(|e| e.in_measure(rom.tolerance_measure())))
-            })
-            .collect();
-        super::check_runs(rom, &runs, strict)
+        checked
     }
 }
 
@@ -257,27 +267,42 @@ fn fallback_summary(sw: &flexrom::pipeline::sweep::Sweep) -> Option<String> {
             }
         }
         let kinds = kinds.iter().map(|(name, c)| format!("{c}: {name}")).collect::<Vec<_>>().join(", ");
-        let first = them.iter().take(3).map(|x| x.mu.to_string()).collect::<Vec<_>>().join("; ");
+        let first = them
+            .iter()
+            .take(3)
+            .map(|x| match x.mu.named().next() {
+                None => flexrom::rom::trust::short(x.mu.scale()),
+                Some(_) => x.mu.to_string(),
+            })
+            .collect::<Vec<_>>()
+            .join(", ");
         (kinds, first)
     };
     let noun = runs_noun(sw.scales.iter().map(|x| &x.mu));
+    let one = if noun == "points" { "point" } else { "load scale" };
+    let count = |k: usize| format!("{k} {}", if k == 1 { one } else { noun });
     let kept = sw.done().filter(|p| p.fallback.is_none()).count();
     let mut line = String::new();
     if answered > 0 {
         let (kinds, first) = of(&|x| x.point().is_some_and(|p| p.fallback.is_some()));
         line += &format!(
-            "the full model answered {answered} of {} {noun} in place of the reduced one ({kinds}; the first: {first}): exact there, error estimate 0, `/fallback` 1 and why in `/message`",
-            sw.scales.len()
+            "the full model answered {answered} of {} in place of the reduced one ({kinds}; first at {first}): exact there, error estimate 0, `/fallback` 1 and why in `/message`",
+            count(sw.scales.len())
         );
     }
     if tried > 0 {
         let (kinds, first) = of(&|x| x.point().is_some_and(|p| p.note.is_some()));
         line += &format!(
-            "{}at {tried} {noun} the full model was tried in place of the reduced answer and failed too ({kinds}; the first: {first}): the reduced answer stands there, `/fallback` 2 and both reasons in `/message`",
-            if line.is_empty() { "" } else { "; " }
+            "{}at {} the full model was tried in place of the reduced answer and failed too ({kinds}; first at {first}): the reduced answer stands there, `/fallback` 2 and both reasons in `/message`",
+            if line.is_empty() { "" } else { "; " },
+            count(tried)
         );
     }
     line += &format!("; the warnings below are about the {kept} reduced answers kept");
+    // where most points need the full model, running it everywhere is cheaper
+    if 2 * answered > sw.scales.len() {
+        line += "; most points fell back: `sweep --full` runs the full model at every point without the reduced runs and estimates first";
+    }
     Some(line)
 }
 

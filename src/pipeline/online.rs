@@ -179,7 +179,9 @@ pub fn online_to_file(
         if let Some(note) = &done.note {
             attr_str(f, "fallback_failed", note).map_err(e)?;
         }
-        write_run_attributes(f, estimate, rom.method(), &trust, mu, done.extrapolated).map_err(e)
+        // the full model's answer has no estimate method: it is exact
+        let method = if done.fallback.is_some() { None } else { rom.method() };
+        write_run_attributes(f, estimate, method, &trust, mu, done.extrapolated).map_err(e)
     })?;
     Ok(done)
 }

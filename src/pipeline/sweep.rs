@@ -172,6 +172,14 @@ pub fn sweep_to_file(route: Route, points: &[Parameters], o: SweepOptions, f: Sw
     let mut start = pending(model, n_reduced, full, points, o)?;
     if resume {
         if out.exists() {
+            // its full answers would stand in a file that says it has none
+            if !full && !o.validate && o.fallback == Fallback::None && file::fallback_of(out)? == Fallback::Full {
+                return Err(crate::error::Error::input(
+                    out,
+                    "fallback",
+                    "is \"full\": the sweep was written with --fallback full; resume it with --fallback full (or the pipeline's [online] fallback), or write another file",
+                ));
+            }
             let old = read_sweep(out, model, route.basis().map(|b| b.stored), o.validate)?;
             let mut reused = 0;
             for s in start.scales.iter_mut() {

@@ -35,7 +35,8 @@ pub fn sweep_table(s: &Sweep) -> Table {
     if s.validated {
         cols.push("displacement_error");
     }
-    // true where the full model answered in place of the reduced one (`--fallback full`)
+    // `/fallback`: 1 where the full model answered in place of the reduced one (`--fallback
+    // full`), 2 where it was tried and failed too, 0 elsewhere
     cols.push("fallback");
     let base = cols.len();
     let named = named_columns(s);
@@ -68,7 +69,7 @@ pub fn sweep_table(s: &Sweep) -> Table {
                 if s.validated {
                     row.push(p.validation.as_ref().map(|v| v.displacement_error).into());
                 }
-                row.push(p.fallback.is_some().into());
+                row.push((p.fallback_code() as u64).into());
             }
             None => row.resize(base, Cell::Null),
         }

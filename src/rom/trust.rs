@@ -239,7 +239,7 @@ pub fn write_run_attributes(
 }
 
 /// A load scale in a list of a message: four decimals at most, no trailing zeros.
-fn short(x: f64) -> String {
+pub fn short(x: f64) -> String {
     format!("{x:.4}").trim_end_matches('0').trim_end_matches('.').to_string()
 }
 

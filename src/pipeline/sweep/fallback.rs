@@ -48,9 +48,10 @@ pub const FULL_TRIED: &str = "the full model, run in place of this reduced answe
 
 /// The kinds of [`why`], as a sweep's summary counts them: (how the reason starts, what
 /// the summary calls it).
-const KINDS: [(&str, &str); 4] = [
+const KINDS: [(&str, &str); 5] = [
     ("the reduced run failed", "reduced run failed"),
     ("error estimate ", "error estimate above the tolerance"),
+    ("displacement error estimate ", "error estimate above the tolerance"),
     ("the error estimate could not", "no estimate"),
     ("the model amplifies", "the model amplifies load changes"),
 ];
@@ -93,10 +94,14 @@ pub fn reason(trust: Option<&Trust>, mu: &Parameters, estimate: Option<&Estimate
     let tol = trust.tolerance?;
     let e = estimate.map(|e| e.in_measure(trust.measure));
     if let Some(e) = e.filter(|e| !e.is_nan() && !(*e <= tol)) {
+        let what = match trust.measure {
+            crate::reduction::estimator::ErrorMeasure::Relative => "",
+            crate::reduction::estimator::ErrorMeasure::Displacement => "displacement ",
+        };
         return Some(if e.is_infinite() {
             format!("the error estimate could not be computed (its own run failed), tolerance {tol:e}")
         } else {
-            format!("error estimate {e:.2e} above the tolerance {tol:e}")
+            format!("{what}error estimate {e:.2e} above the tolerance {tol:e}")
         });
     }
     trust.amplifying_near(mu, e).map(|s| {
@@ -143,7 +148,9 @@ mod tests {
         assert!(failed.contains("could not be computed"), "{failed}");
         assert_eq!(reason(Some(&trust), &mu, None), None, "no estimate, no sensitivity record");
         trust.measure = ErrorMeasure::Displacement;
-        assert!(reason(Some(&trust), &mu, Some(&estimate(1e-3, 2e-2))).is_some(), "displacement 2e-2");
+        let displacement = reason(Some(&trust), &mu, Some(&estimate(1e-3, 2e-2))).expect("displacement 2e-2");
+        assert!(displacement.starts_with("displacement error estimate 2.00e-2 above"), "{displacement}");
+        assert_eq!(kind(&format!("{FULL_IN_PLACE}: {displacement}")), Some("error estimate above the tolerance"));
         assert_eq!(reason(Some(&trust), &mu, Some(&estimate(1.0, f64::NAN))), None, "at rest");
     }
 

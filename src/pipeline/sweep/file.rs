@@ -304,6 +304,19 @@ pub fn read_point_table(d: &hdf5::Dataset, rows: usize) -> std::result::Result<(
     Ok((names.clone(), points.collect()))
 }
 
+/// The `fallback` a sweep file was written with (files before the attribute: `none`).
+pub fn fallback_of(path: &Path) -> Result<super::Fallback> {
+    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
+    if f.attr("fallback").is_err() {
+        return Ok(super::Fallback::None);
+    }
+    match read_attr_str(&f, "fallback").map_err(|e| Error::input(path, "fallback", format!("cannot be read: {e}")))? {
+        s if s == "full" => Ok(super::Fallback::Full),
+        s if s == "none" => Ok(super::Fallback::None),
+        s => Err(Error::input(path, "fallback", format!("is \"{s}\", expected \"none\" or \"full\""))),
+    }
+}
+
 /// Reads an earlier sweep file for `--resume`: (parameters, the finished run) for every
 /// point it holds, `None` for those that failed or did not run. `stored` is the basis of a
 /// reduced sweep, `None` for a full one. Refuses a file of another route, basis or model,
