@@ -21,7 +21,7 @@ use flexrom::model::Model;
 use flexrom::pipeline::online::{load_rom, pipeline_of_basis};
 use flexrom::pipeline::Pipeline;
 use flexrom::rom::estimator::{Estimate, EstimateMethod};
-use flexrom::rom::{Output, Rom, Trust};
+use flexrom::rom::{Rom, Trust};
 use flexrom::simulate::{Overrides, SimulationResult};
 use flexrom::solver::parameters::Parameters;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArrayDyn};
@@ -284,7 +284,7 @@ impl PyModel {
         let r = interruptible(py, || {
             flexrom::simulate::simulate(model, &overrides).map_err(|e| e.at_stage("simulate", &shown))
         })?;
-        Ok(PyRunResult { model: Arc::clone(model), r, reduced: None })
+        Ok(PyRunResult { model: Arc::clone(model), r, reduced: None, fallback: None, fallback_failed: None })
     }
 
     fn __repr__(&self) -> String {
@@ -318,6 +318,10 @@ struct PyRunResult {
     model: Arc<Model>,
     r: SimulationResult,
     reduced: Option<ReducedPart>,
+    /// why the full model answered in place of the reduced one (`online(fallback="full")`)
+    fallback: Option<String>,
+    /// why the full model was tried in place of this reduced answer and how it failed
+    fallback_failed: Option<String>,
 }
 
 #[pymethods]
@@ -458,6 +462,20 @@ impl PyRunResult {
         self.reduced.is_some()
     }
 
+    /// why the full model answered in place of the reduced one (`Basis.online(…,
+    /// fallback="full")`), else None
+    #[getter]
+    fn fallback(&self) -> Option<String> {
+        self.fallback.clone()
+    }
+
+    /// why the full model was tried in place of this reduced answer and how it failed,
+    /// else None
+    #[getter]
+    fn fallback_failed(&self) -> Option<String> {
+        self.fallback_failed.clone()
+    }
+
     /// (n_t, r) the reduced coordinates (reduced runs; None for a full run)
     #[getter]
     fn reduced_q<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray2<f64>>> {
@@ -543,8 +561,14 @@ impl PyRunResult {
         let r = &self.r;
         let file = ResultFile::begin(path, &r.model_text, &r.model_path, &RunPlan::of_result(r))?;
         file.finish(r, |f| {
-            let Some(x) = &self.reduced else { return Ok(()) };
             let e = |err: hdf5_error::Error| flexrom::Error::hdf5(path, err);
+            if let Some(why) = &self.fallback {
+                flexrom::io::h5::attr_str(f, "fallback", why).map_err(e)?;
+            }
+            if let Some(note) = &self.fallback_failed {
+                flexrom::io::h5::attr_str(f, "fallback_failed", note).map_err(e)?;
+            }
+            let Some(x) = &self.reduced else { return Ok(()) };
             flexrom::io::result_file::write_reduced(f, &x.reduced_q).map_err(e)?;
             flexrom::io::h5::attr_str(f, "basis", &x.basis_name).map_err(e)?;
             flexrom::io::h5::attr_str(f, "variant", x.variant).map_err(e)?;
@@ -714,19 +738,34 @@ impl PyBasis {
 
     /// One reduced run (`flexrom online`) with its error estimate; warns when the load
     /// leaves the training range or the estimate exceeds the tolerance.
-    #[pyo3(signature = (load_scale = None, **params))]
+    /// `fallback="full"` (`online --fallback full`): where the reduced answer cannot be
+    /// trusted the full model's run is returned in its place (`reduced` False, `fallback` the
+    /// reason); default the pipeline's `[online] fallback`.
+    #[pyo3(signature = (load_scale = None, *, fallback = None, **params))]
     fn online(
         &self,
         py: Python<'_>,
         load_scale: Option<f64>,
+        fallback: Option<String>,
         params: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<PyRunResult> {
+        let fallback = self.fallback_choice(fallback, "online")?;
         let params = convert::named(params)?;
         let mu = self.point(py, load_scale, params.as_ref())?;
         let rom = &self.rom;
-        let (run, estimate) = interruptible(py, || {
-            rom.solve_and_estimate(&mu, Output::Full, &[]).map_err(|e| e.at_reduced_stage("online", &mu, false))
-        })?;
+        let done = interruptible(py, || flexrom::pipeline::online::answer(rom, &mu, fallback))?;
+        if done.fallback.is_some() {
+            // the full model's answer: exact, nothing to warn about
+            let r = done.run.result;
+            return Ok(PyRunResult {
+                model: Arc::clone(rom.model()),
+                r,
+                reduced: None,
+                fallback: done.fallback,
+                fallback_failed: None,
+            });
+        }
+        let (run, estimate) = (done.run, done.estimate);
         let extrapolated = rom.is_extrapolated(&mu);
         let mut warnings: Vec<String> = estimate
             .as_ref()
@@ -737,6 +776,7 @@ impl PyBasis {
             self.run_warnings(&[(mu.clone(), estimate.as_ref().map(|e| e.in_measure(rom.tolerance_measure())))])?,
         );
         warnings.extend(rom.untrained_parameters(&mu));
+        warnings.extend(done.note.clone());
         warn(py, &warnings)?;
         let basis = rom.basis();
         let reduced = ReducedPart {
@@ -752,7 +792,13 @@ impl PyBasis {
             mu,
             extrapolated,
         };
-        Ok(PyRunResult { model: Arc::clone(rom.model()), r: run.result, reduced: Some(reduced) })
+        Ok(PyRunResult {
+            model: Arc::clone(rom.model()),
+            r: run.result,
+            reduced: Some(reduced),
+            fallback: None,
+            fallback_failed: done.note,
+        })
     }
 
     /// Reduced runs at many loads in parallel (`flexrom sweep`): a dict of arrays with the
@@ -773,22 +819,7 @@ impl PyBasis {
         progress: Option<Bound<'py, PyAny>>,
         fallback: Option<String>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        use flexrom::pipeline::sweep::Fallback;
-        let fallback = match fallback.as_deref() {
-            None => self.pipeline.online_fallback().unwrap_or_default(),
-            Some("none") => Fallback::None,
-            Some("full") => Fallback::Full,
-            Some(other) => {
-                return Err(pyo3::exceptions::PyValueError::new_err(format!(
-                    "sweep: fallback is \"{other}\"; expected \"none\" or \"full\""
-                )))
-            }
-        };
-        if fallback == Fallback::Full && self.rom.trust().is_some_and(|t| t.skipped) {
-            return Err(pyo3::exceptions::PyValueError::new_err(
-                "sweep: fallback \"full\" needs the error estimate to judge each reduced answer; this basis was loaded with no_estimate=True",
-            ));
-        }
+        let fallback = self.fallback_choice(fallback, "sweep")?;
         let progress = progress_callback(py, progress)?;
         let mus: Vec<Parameters> = match (load_scales, points) {
             (Some(s), None) => s.into_iter().map(|x| self.point(py, Some(x), None)).collect::<PyResult<_>>()?,
@@ -828,6 +859,29 @@ impl PyBasis {
 }
 
 impl PyBasis {
+    /// The `fallback` argument of `online` and `sweep` (`what` names the method in
+    /// errors): "none" or "full", default the pipeline's `[online] fallback`; "full" needs
+    /// the error estimate to judge each reduced answer.
+    fn fallback_choice(&self, given: Option<String>, what: &str) -> PyResult<flexrom::pipeline::sweep::Fallback> {
+        use flexrom::pipeline::sweep::Fallback;
+        let fallback = match given.as_deref() {
+            None => self.pipeline.online_fallback().unwrap_or_default(),
+            Some("none") => Fallback::None,
+            Some("full") => Fallback::Full,
+            Some(other) => {
+                return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                    "{what}: fallback is \"{other}\"; expected \"none\" or \"full\""
+                )))
+            }
+        };
+        if fallback == Fallback::Full && self.rom.trust().is_some_and(|t| t.skipped) {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "{what}: fallback \"full\" needs the error estimate to judge each reduced answer; this basis was loaded with no_estimate=True"
+            )));
+        }
+        Ok(fallback)
+    }
+
     /// The basis at `path` checked against the pipeline `p` (loaded from `pipeline_file`),
     /// or, without one, against the pipeline and model the basis file stores.
     fn open(

@@ -132,7 +132,8 @@ def test_sweep_falls_back_to_the_full_model(dp_basis):
     """fallback="full" (`sweep --fallback full`): at λ = 2.5, outside the range [0.5, 1.5],
     the estimate reads 5.2e-3 against greedy's tolerance 1e-3 (measured 2026-11-27), so the
     answer there is the full model's, bit for bit Model.simulate's, with error estimate 0
-    and the reason; at 1.0 it is the reduced answer, as without the fallback."""
+    and the reason; at 1.0 it is the reduced answer, as without the fallback. Basis.online
+    takes the same way."""
     b = flexrom.Basis.load(dp_basis)
     s = b.sweep([1.0, 2.5], fallback="full")
     assert s["fallback"][0] is None, s["fallback"]
@@ -150,6 +151,12 @@ def test_sweep_falls_back_to_the_full_model(dp_basis):
         b.sweep([1.0], fallback="bogus")
     with pytest.raises(ValueError, match="needs the error estimate"):
         flexrom.Basis.load(dp_basis, no_estimate=True).sweep([1.0], fallback="full")
+    # online takes the same way: the full run, its reason, no reduced coordinates
+    r = b.online(load_scale=2.5, fallback="full")
+    assert not r.reduced and r.reduced_q is None and r.fallback == s["fallback"][1]
+    same(r.q, full.q)
+    kept = b.online(load_scale=1.0, fallback="full")
+    assert kept.reduced and kept.fallback is None and kept.fallback_failed is None
 
 
 def test_outside_the_training_range_warns(dp_basis):

@@ -94,6 +94,53 @@ pub struct OnlineRun {
     pub note: Option<String>,
 }
 
+/// The answer of `online` at `mu`: the reduced run with its estimate, or with
+/// [`Fallback::Full`], where the reduced answer cannot be trusted
+/// ([`crate::pipeline::sweep::fallback::why`]), the full model's run in its place (no
+/// reduced coordinates, the estimate of an exact answer); where the full run fails too, the
+/// reduced answer with a note, or both failures when the reduced run had failed.
+pub fn answer(rom: &Rom, mu: &Parameters, fallback: Fallback) -> Result<OnlineRun> {
+    let reduced = rom.solve_and_estimate(mu, Output::Full, &[]);
+    // the way on after a failed reduced run is said unless the fallback takes it
+    let reduced = reduced.map_err(|e| match fallback {
+        Fallback::None => e.at_reduced_stage("online", mu, false),
+        Fallback::Full => e.at_stage("online (reduced run)", mu),
+    });
+    let Some(why) = why(&reduced, fallback, rom.trust(), mu) else {
+        let (run, estimate) = reduced?;
+        return Ok(OnlineRun { run, estimate, extrapolated: rom.is_extrapolated(mu), fallback: None, note: None });
+    };
+    match crate::simulate::simulate(rom.model(), &crate::simulate::Overrides::at(mu)) {
+        Ok(full) => {
+            let seconds = reduced.as_ref().ok().and_then(|(_, e)| e.as_ref()).map_or(0.0, |e| e.seconds);
+            let nt = full.t.len();
+            Ok(OnlineRun {
+                run: ReducedRun { result: full, reduced_q: ndarray::Array2::zeros((0, nt)) },
+                estimate: Some(Estimate::exact(seconds)),
+                extrapolated: false,
+                fallback: Some(format!("{FULL_IN_PLACE}: {why}")),
+                note: None,
+            })
+        }
+        Err(e) => {
+            let e = e.at_stage("online (full run)", mu);
+            match reduced {
+                Ok((run, estimate)) => Ok(OnlineRun {
+                    run,
+                    estimate,
+                    extrapolated: rom.is_extrapolated(mu),
+                    fallback: None,
+                    note: Some(format!("{FULL_TRIED} ({why}) failed: {e}")),
+                }),
+                Err(r) => Err(Error::Hinted {
+                    source: Box::new(e),
+                    hint: format!("the full model ran in place of the reduced one, which had failed: {r}"),
+                }),
+            }
+        }
+    }
+}
+
 /// Runs `rom` at `mu` and writes the result file `out` ([`crate::io::result_file`]: its
 /// fixed part on a second thread while the run computes, the file renamed into place only
 /// when complete) with the reduced coordinates, the basis it came from (`basis_path`) and
@@ -120,47 +167,7 @@ pub fn online_to_file(
     }
     let plan = RunPlan::of(&p.model, &settings);
     let model_path = p.model.path.display().to_string();
-    let (file, done) = begin_alongside(out, &p.model.text, &model_path, &plan, || {
-        let reduced = rom.solve_and_estimate(mu, Output::Full, &[]);
-        // the way on after a failed reduced run is said unless the fallback takes it
-        let reduced = reduced.map_err(|e| match fallback {
-            Fallback::None => e.at_reduced_stage("online", mu, false),
-            Fallback::Full => e.at_stage("online (reduced run)", mu),
-        });
-        let Some(why) = why(&reduced, fallback, rom.trust(), mu) else {
-            let (run, estimate) = reduced?;
-            return Ok(OnlineRun { run, estimate, extrapolated: rom.is_extrapolated(mu), fallback: None, note: None });
-        };
-        match crate::simulate::simulate(&p.model, &crate::simulate::Overrides::at(mu)) {
-            Ok(full) => {
-                let seconds = reduced.as_ref().ok().and_then(|(_, e)| e.as_ref()).map_or(0.0, |e| e.seconds);
-                let nt = full.t.len();
-                Ok(OnlineRun {
-                    run: ReducedRun { result: full, reduced_q: ndarray::Array2::zeros((0, nt)) },
-                    estimate: Some(Estimate::exact(seconds)),
-                    extrapolated: false,
-                    fallback: Some(format!("{FULL_IN_PLACE}: {why}")),
-                    note: None,
-                })
-            }
-            Err(e) => {
-                let e = e.at_stage("online (full run)", mu);
-                match reduced {
-                    Ok((run, estimate)) => Ok(OnlineRun {
-                        run,
-                        estimate,
-                        extrapolated: rom.is_extrapolated(mu),
-                        fallback: None,
-                        note: Some(format!("{FULL_TRIED} ({why}) failed: {e}")),
-                    }),
-                    Err(r) => Err(Error::Hinted {
-                        source: Box::new(e),
-                        hint: format!("the full model ran in place of the reduced one, which had failed: {r}"),
-                    }),
-                }
-            }
-        }
-    })?;
+    let (file, done) = begin_alongside(out, &p.model.text, &model_path, &plan, || answer(rom, mu, fallback))?;
     let basis = rom.basis();
     // absolute, so that the file names its basis wherever it is read from
     let basis_name = crate::io::output::resolve(basis_path).display().to_string();
