@@ -117,7 +117,8 @@ pub fn answer(rom: &Rom, mu: &Parameters, fallback: Fallback) -> Result<OnlineRu
             Ok(OnlineRun {
                 run: ReducedRun { result: full, reduced_q: ndarray::Array2::zeros((0, nt)) },
                 estimate: Some(Estimate::exact(seconds)),
-                extrapolated: false,
+                // where the load lies against the basis's range, whichever model answered
+                extrapolated: rom.is_extrapolated(mu),
                 fallback: Some(format!("{FULL_IN_PLACE}: {why}")),
                 note: None,
             })

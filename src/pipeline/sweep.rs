@@ -311,8 +311,8 @@ fn run_reduced(rom: &Rom, state: Sweep, o: SweepOptions, checkpoint: Option<Chec
                         validation: None,
                         full_probes: None,
                         estimate: Some(Estimate::exact(seconds)),
-                        // exact: nothing extrapolated, as in a full sweep
-                        extrapolated: false,
+                        // where the load lies against the basis's range, whichever model answered
+                        extrapolated: rom.is_extrapolated(mu),
                         fallback: Some(format!("{}: {why}", fallback::FULL_IN_PLACE)),
                         note: None,
                     });
