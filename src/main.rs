@@ -249,10 +249,10 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         // the reader of stdout went away (`| head`): nothing to say, and no one to say it to
         Err(flexrom::Error::StdoutClosed) => ExitCode::SUCCESS,
-        // a first signal stopped a sweep's runs and what was finished is written
+        // a first signal stopped a sweep's runs; the note says what its file keeps
         Err(flexrom::Error::Interrupted) if flexrom::io::atomic::stopped_by().is_some() => {
             let (sig, name) = flexrom::io::atomic::stopped_by().expect("checked");
-            note(&format!("flexrom: stopped by {name}; the runs finished before it are written"));
+            note(&format!("flexrom: stopped by {name}"));
             if let Some(line) = flexrom::io::atomic::stop_note() {
                 note(&format!("flexrom: {line}"));
             }

@@ -284,7 +284,14 @@ impl PyModel {
         let r = interruptible(py, || {
             flexrom::simulate::simulate(model, &overrides).map_err(|e| e.at_stage("simulate", &shown))
         })?;
-        Ok(PyRunResult { model: Arc::clone(model), r, reduced: None, fallback: None, fallback_failed: None })
+        Ok(PyRunResult {
+            model: Arc::clone(model),
+            r,
+            reduced: None,
+            fallback: None,
+            fallback_failed: None,
+            exact: None,
+        })
     }
 
     fn __repr__(&self) -> String {
@@ -322,6 +329,9 @@ struct PyRunResult {
     fallback: Option<String>,
     /// why the full model was tried in place of this reduced answer and how it failed
     fallback_failed: Option<String>,
+    /// where the full model answered in place of the reduced one: the estimate of an exact
+    /// answer (0) and whether the load lies outside the basis's range
+    exact: Option<(Estimate, bool)>,
 }
 
 #[pymethods]
@@ -483,7 +493,7 @@ impl PyRunResult {
     }
 
     /// the estimate of the run's relative error against the full model (None: a full run,
-    /// or no estimator)
+    /// or no estimator; 0 where the full model answered in place of the reduced one)
     #[getter]
     fn error_estimate(&self) -> Option<f64> {
         self.estimate().map(|e| e.error_estimate)
@@ -514,10 +524,10 @@ impl PyRunResult {
     }
 
     /// whether the run's parameters left those the basis was trained over (False for a
-    /// full run)
+    /// full run of `Model.simulate`)
     #[getter]
     fn extrapolated(&self) -> bool {
-        self.reduced.as_ref().is_some_and(|x| x.extrapolated)
+        self.reduced.as_ref().is_some_and(|x| x.extrapolated) || self.exact.as_ref().is_some_and(|(_, x)| *x)
     }
 
     /// the reduced coordinates r (None for a full run)
@@ -553,8 +563,10 @@ impl PyRunResult {
 }
 
 impl PyRunResult {
+    /// The run's estimate: a reduced run's, or the exact one (0) of the full model's answer
+    /// in place of the reduced one.
     fn estimate(&self) -> Option<&Estimate> {
-        self.reduced.as_ref().and_then(|x| x.estimate.as_ref())
+        self.reduced.as_ref().and_then(|x| x.estimate.as_ref()).or(self.exact.as_ref().map(|(e, _)| e))
     }
 
     fn write(&self, path: &Path) -> flexrom::Result<()> {
@@ -564,6 +576,10 @@ impl PyRunResult {
             let e = |err: hdf5_error::Error| flexrom::Error::hdf5(path, err);
             if let Some(why) = &self.fallback {
                 flexrom::io::h5::attr_str(f, "fallback", why).map_err(e)?;
+            }
+            if let Some((exact, extrapolated)) = &self.exact {
+                flexrom::io::h5::attr_f64(f, "error_estimate", exact.error_estimate).map_err(e)?;
+                flexrom::io::h5::attr_u64(f, "extrapolated", *extrapolated as u64).map_err(e)?;
             }
             if let Some(note) = &self.fallback_failed {
                 flexrom::io::h5::attr_str(f, "fallback_failed", note).map_err(e)?;
@@ -763,6 +779,7 @@ impl PyBasis {
                 reduced: None,
                 fallback: done.fallback,
                 fallback_failed: None,
+                exact: done.estimate.map(|e| (e, done.extrapolated)),
             });
         }
         let (run, estimate) = (done.run, done.estimate);
@@ -798,6 +815,7 @@ impl PyBasis {
             reduced: Some(reduced),
             fallback: None,
             fallback_failed: done.note,
+            exact: None,
         })
     }
 
@@ -844,7 +862,7 @@ impl PyBasis {
         let mut outside: Vec<String> = s
             .scales
             .iter()
-            .filter(|x| x.point().is_none_or(|p| p.fallback.is_none()))
+            .filter(|x| x.point().is_some_and(|p| p.fallback.is_none()))
             .flat_map(|x| rom.untrained_parameters(&x.mu))
             .collect();
         outside.dedup();

@@ -154,6 +154,7 @@ def test_sweep_falls_back_to_the_full_model(dp_basis):
     # online takes the same way: the full run, its reason, no reduced coordinates
     r = b.online(load_scale=2.5, fallback="full")
     assert not r.reduced and r.reduced_q is None and r.fallback == s["fallback"][1]
+    assert r.error_estimate == 0 and r.extrapolated  # exact, at a load outside [0.5, 1.5]
     same(r.q, full.q)
     kept = b.online(load_scale=1.0, fallback="full")
     assert kept.reduced and kept.fallback is None and kept.fallback_failed is None

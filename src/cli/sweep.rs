@@ -199,11 +199,11 @@ impl Args {
         let failure = sw.failure_summary();
         let checked = match &loaded {
             Some((_, rom, _)) => {
-                // the full model's answers extrapolate nothing
+                // of the reduced answers: the full model's do not extrapolate
                 let outside: Vec<Vec<String>> = sw
                     .scales
                     .iter()
-                    .filter(|x| x.point().is_none_or(|p| p.fallback.is_none()))
+                    .filter(|x| x.point().is_some_and(|p| p.fallback.is_none()))
                     .map(|x| rom.named_outside(&x.mu))
                     .filter(|w| !w.is_empty())
                     .collect();
@@ -211,7 +211,7 @@ impl Args {
                     warn(&[format!(
                         "{} of {} points lie outside what the basis was trained on (the first: {}); the reduced model extrapolates there",
                         outside.len(),
-                        points.len(),
+                        sw.scales.len(),
                         first.join(", ")
                     )]);
                 }

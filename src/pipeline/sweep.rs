@@ -217,32 +217,53 @@ pub fn sweep_to_file(route: Route, points: &[Parameters], o: SweepOptions, f: Sw
          finished by then, and the same command with --resume runs the others",
         out.display()
     );
+    // whether this sweep has written its output yet (a checkpoint)
+    let wrote = std::sync::atomic::AtomicBool::new(false);
     let write = |s: &Sweep| {
         write_sweep_with(out, s, basis, extra)?;
+        wrote.store(true, std::sync::atomic::Ordering::SeqCst);
         crate::io::atomic::set_stop_note(Some(note.clone()));
         Ok(())
     };
+    let resumed = start.resumed;
     // a first signal stops the runs, and what is finished is written below (the command line)
     let graceful = crate::io::atomic::GracefulStop::on();
     let sw = match route {
         Route::Reduced { rom, .. } => run_reduced(rom, start, o, Some(&write)),
         Route::Full(model) => run_full(model, start, o, Some(&write)),
     };
-    drop(graceful);
-    let stopped = crate::interrupt::requested() && crate::io::atomic::stopped_by().is_some();
+    let stopped = graceful.release();
     if stopped {
-        // the runs have stopped; the final write commits only once the request is withdrawn
+        // the runs have stopped (the request was set before the stop was claimed); the final
+        // write commits only once it is withdrawn
         crate::interrupt::clear();
     }
-    let written = sw.and_then(|sw| write(&sw).map(|()| sw));
+    let sw = sw?;
+    let pending = sw.scales.iter().filter(|x| x.status() == STATUS_PENDING).count();
+    let finished_here = sw.done().count() - resumed;
+    // stopped before this sweep first wrote its output: an earlier file there is left as
+    // it was (as a stop without a graceful reach would leave it), and none is begun for
+    // nothing
+    if stopped && !wrote.load(std::sync::atomic::Ordering::SeqCst) && (out.exists() || finished_here == 0) {
+        crate::io::atomic::set_stop_note(Some(if out.exists() {
+            format!(
+                "the stop came before this sweep first wrote {}: it is left as it was ({finished_here} {runs} finished here are not kept)",
+                out.display()
+            )
+        } else {
+            format!("nothing was finished before the stop; no {} written", out.display())
+        }));
+        return Err(crate::error::Error::Interrupted);
+    }
+    let written = write(&sw);
     crate::io::atomic::set_stop_note(None);
-    let sw = written?;
-    if stopped {
+    written?;
+    // a stop that came once every point had run changes nothing
+    if stopped && pending > 0 {
         let done = sw.done().count();
         crate::io::atomic::set_stop_note(Some(format!(
-            "{} keeps the {done} {runs} finished; the same command with --resume runs the other {}",
-            out.display(),
-            sw.scales.len() - done
+            "{} keeps the {done} {runs} finished; the same command with --resume runs the other {pending}",
+            out.display()
         )));
         return Err(crate::error::Error::Interrupted);
     }
@@ -428,7 +449,12 @@ fn run_pending(
             if due.is_none_or(|d| std::time::Instant::now() >= d) {
                 sw.wall_seconds = start.elapsed().as_secs_f64();
                 let began = std::time::Instant::now();
-                write(sw)?;
+                match write(sw) {
+                    // a stop came during this write, which did not commit: the final write
+                    // after the runs takes its place
+                    Err(crate::error::Error::Interrupted) => {}
+                    r => r?,
+                }
                 let wait = CHECKPOINT_SECONDS.max(CHECKPOINT_COST_FACTOR * began.elapsed().as_secs_f64());
                 *due = Some(std::time::Instant::now() + std::time::Duration::from_secs_f64(wait));
             }
@@ -462,8 +488,9 @@ fn run_pending(
                             }
                             record(i, Outcome::Done(p))?;
                         }
-                        // a run the stop ended is not failed: it has not run
-                        Err(crate::error::Error::Interrupted) => record(i, Outcome::Pending)?,
+                        // a run the stop ended is not failed: it has not run (also where the
+                        // error that reached here wraps the stop: a fallback's full run)
+                        Err(_) if crate::interrupt::requested() => record(i, Outcome::Pending)?,
                         Err(e) => record(i, Outcome::Failed(e.to_string()))?,
                     }
                 }

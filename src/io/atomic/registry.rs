@@ -4,8 +4,9 @@
 //! moved aside) before the process exits with 128 + the signal number.
 
 use crate::error::{Error, Result};
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, AtomicI32, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicI32, AtomicU64, AtomicU8, Ordering};
 use std::sync::{Mutex, MutexGuard};
 
 /// What the signal handler does with a registered path.
@@ -36,29 +37,45 @@ pub fn stop_note() -> Option<String> {
 }
 pub(super) static COUNTER: AtomicU64 = AtomicU64::new(0);
 
-/// While set ([`GracefulStop`]), the first signal asks the computation to stop instead of
-/// ending the process.
-static GRACEFUL: AtomicBool = AtomicBool::new(false);
+/// Where a graceful stop stands ([`GracefulStop`]): [`OFF`], [`ON`] (a first signal stops
+/// the runs), [`STOPPING`] (one did). One atomic, so that the handler's claim and the
+/// guard's release cannot both succeed.
+static GRACEFUL: AtomicU8 = AtomicU8::new(OFF);
+const OFF: u8 = 0;
+const ON: u8 = 1;
+const STOPPING: u8 = 2;
 /// The signal that asked a graceful stop (0: none).
 static STOPPED_BY: AtomicI32 = AtomicI32::new(0);
 
 /// While it lives, the first SIGINT/SIGTERM/SIGHUP asks every run to stop at its next time
 /// step ([`crate::interrupt`]) instead of ending the process, so that the work finished so
-/// far can be written (a sweep's last checkpoint, with every point finished by then); the
-/// same or another signal again ends the process at once, as without it. Held by a sweep
-/// while its runs go on, dropped before its final write.
+/// far can be written (a sweep's final file, with every point finished by then); the same
+/// or another signal again ends the process at once, as without it. Held by a sweep while
+/// its runs go on; [`GracefulStop::release`] ends it before the final write and says
+/// whether a stop came.
 pub struct GracefulStop(());
 
 impl GracefulStop {
     pub fn on() -> Self {
-        GRACEFUL.store(true, Ordering::SeqCst);
+        STOPPED_BY.store(0, Ordering::SeqCst);
+        GRACEFUL.store(ON, Ordering::SeqCst);
         GracefulStop(())
+    }
+
+    /// Ends the graceful reach (a later signal ends the process at once) and says whether a
+    /// signal asked a stop while it lasted. When it did, the stop request was set before
+    /// the claim ([`install_signal_handler`]), so it is there to be withdrawn.
+    pub fn release(self) -> bool {
+        let stopped = GRACEFUL.compare_exchange(ON, OFF, Ordering::SeqCst, Ordering::SeqCst).is_err();
+        std::mem::forget(self);
+        GRACEFUL.store(OFF, Ordering::SeqCst);
+        stopped
     }
 }
 
 impl Drop for GracefulStop {
     fn drop(&mut self) {
-        GRACEFUL.store(false, Ordering::SeqCst);
+        GRACEFUL.store(OFF, Ordering::SeqCst);
     }
 }
 
@@ -142,24 +159,31 @@ pub fn install_signal_handler() -> Result<()> {
         .spawn(move || {
             for sig in signals.forever() {
                 let name = signal_name(sig);
-                // the first signal during a graceful stop's reach: stop the runs, not the process
-                if GRACEFUL.load(Ordering::SeqCst)
-                    && STOPPED_BY.compare_exchange(0, sig, Ordering::SeqCst, Ordering::SeqCst).is_ok()
-                {
+                // the first signal during a graceful stop's reach: stop the runs, not the process.
+                // The request goes first, so that a claimed stop always has it; where the
+                // claim fails (the reach just ended) the process ends below anyway
+                if GRACEFUL.load(Ordering::SeqCst) == ON {
                     crate::interrupt::request();
-                    eprintln!(
-                        "flexrom: {name}: stopping the runs under way to write the finished ones (send it again to stop at once)"
-                    );
-                    continue;
+                    if GRACEFUL.compare_exchange(ON, STOPPING, Ordering::SeqCst, Ordering::SeqCst).is_ok() {
+                        STOPPED_BY.store(sig, Ordering::SeqCst);
+                        let _ = writeln!(
+                            std::io::stderr(),
+                            "flexrom: {name}: stopping the runs under way to write the finished ones (send it again to stop at once)"
+                        );
+                        continue;
+                    }
                 }
                 let mut v = live();
                 let n = v.len();
                 clean_up(&mut v);
-                eprintln!(
+                // an unwritable stderr (a hung-up terminal) must not end this thread
+                let mut err = std::io::stderr();
+                let _ = writeln!(
+                    err,
                     "flexrom: stopped by {name}; {n} temporary path(s) removed, previous outputs left as they were"
                 );
                 if let Some(note) = STOP_NOTE.lock().unwrap_or_else(|e| e.into_inner()).as_ref() {
-                    eprintln!("flexrom: {note}");
+                    let _ = writeln!(err, "flexrom: {note}");
                 }
                 signal_hook::low_level::exit(128 + sig);
             }
