@@ -374,7 +374,7 @@ fn a_fallback_whose_full_run_fails_too_says_both() {
 /// Where the full model fails too at a point the fallback would take, the reduced answer
 /// stands as it would without the fallback, with a note in `/message`, `/fallback` 2 and
 /// a summary line that says so. The shipped
-/// four-bar at λ = 1.34, outside its basis's range [0.7, 1.2] (measured 2026-11-27): the
+/// four-bar (its pipeline trained here) at λ = 1.34, outside its basis's range [0.7, 1.2] (measured 2026-11-27): the
 /// reduced run finishes, its estimator's richer run fails (estimate ∞, above the
 /// tolerance 1e-2), and the full run blows up at t = 1.064 s (strain 0.87 in the coupler).
 #[test]
@@ -383,9 +383,15 @@ fn where_the_full_model_fails_too_the_reduced_answer_stands_with_a_note() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("s.h5");
     let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("pipelines/fourbar.toml");
+    // the shipped pipeline's basis, trained here (a clean clone has no data/bases)
+    let basis = tmp.path().join("fourbar.h5");
+    let (o, err) = run(&["-q", "train", p.to_str().unwrap(), "--basis", basis.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{err}");
     let (o, err) = run(&[
         "sweep",
         p.to_str().unwrap(),
+        "--basis",
+        basis.to_str().unwrap(),
         "--load-scales",
         "1.34:1.34:1",
         "--fallback",
