@@ -373,10 +373,10 @@ fn a_fallback_whose_full_run_fails_too_says_both() {
 
 /// Where the full model fails too at a point the fallback would take, the reduced answer
 /// stands as it would without the fallback, with a note in `/message`, `/fallback` 2 and
-/// a summary line that says so. The shipped
-/// four-bar (its pipeline trained here) at λ = 1.34, outside its basis's range [0.7, 1.2] (measured 2026-11-27): the
-/// reduced run finishes, its estimator's richer run fails (estimate ∞, above the
-/// tolerance 1e-2), and the full run blows up at t = 1.064 s (strain 0.87 in the coupler).
+/// a summary line that says so. The shipped four-bar (its pipeline trained here) at
+/// λ = 1.34, outside its basis's range [0.7, 1.2] (measured 2026-11-27): the reduced run
+/// finishes, its estimator's richer run fails (estimate ∞, above the tolerance 1e-2), and
+/// the full run blows up at t = 1.064 s (strain 0.87 in the coupler).
 #[test]
 fn where_the_full_model_fails_too_the_reduced_answer_stands_with_a_note() {
     let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
