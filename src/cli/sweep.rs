@@ -120,8 +120,14 @@ impl Args {
         // measures the reduced model at every point)
         use flexrom::pipeline::sweep::Fallback;
         let keyed = fallback.is_none() && p.online_fallback() == Some(Fallback::Full);
-        let fallback =
-            if full || validate { Fallback::None } else { fallback.or(p.online_fallback()).unwrap_or_default() };
+        let options = flexrom::pipeline::sweep::SweepOptions {
+            validate,
+            continuation,
+            progress: output::show_progress(),
+            fallback: fallback.or(p.online_fallback()).unwrap_or_default(),
+        }
+        .settled(full);
+        let fallback = options.fallback;
         if keyed && validate {
             info(&format!(
                 "{}: [online] fallback = \"full\" does not apply to a validated sweep, which measures the reduced model at every point",
@@ -165,12 +171,6 @@ impl Args {
                 warn(&["no tolerance to hold the estimates to (a basis trained at fixed loads, and no [online] tolerance in the pipeline): --fallback full acts only where a reduced run fails".to_string()]);
             }
         }
-        let options = flexrom::pipeline::sweep::SweepOptions {
-            validate,
-            continuation,
-            progress: output::show_progress(),
-            fallback,
-        };
         let file = SweepFile { out: &out, resume, extra: &|_| Ok(()) };
         let sw = match shard {
             Some(k) => flexrom::pipeline::shard::sweep_shard(&p, route, &points, k, options, file)?,

@@ -5,7 +5,7 @@ use crate::error::{Error, Result};
 use crate::io::basis_file::StoredBasis;
 use crate::io::h5::{attr_str, attr_u64, read_attr_str};
 use crate::io::result_file::{begin_alongside, RunPlan};
-use crate::pipeline::sweep::fallback::{why, Fallback, FULL_IN_PLACE, FULL_TRIED};
+use crate::pipeline::sweep::fallback::{settle, Fallback};
 use crate::rom::estimator::{Estimate, EstimateMethod};
 use crate::rom::trust::write_run_attributes;
 use crate::rom::{check_reduced_memory, settings_at, LoadOptions, Output, ReducedRun, Rom, Trust};
@@ -96,7 +96,7 @@ pub struct OnlineRun {
 
 /// The answer of `online` at `mu`: the reduced run with its estimate, or with
 /// [`Fallback::Full`], where the reduced answer cannot be trusted
-/// ([`crate::pipeline::sweep::fallback::why`]), the full model's run in its place (no
+/// ([`crate::pipeline::sweep::fallback::settle`]), the full model's run in its place (no
 /// reduced coordinates, the estimate of an exact answer); where the full run fails too, the
 /// reduced answer with a note, or both failures when the reduced run had failed.
 pub fn answer(rom: &Rom, mu: &Parameters, fallback: Fallback) -> Result<OnlineRun> {
@@ -106,40 +106,17 @@ pub fn answer(rom: &Rom, mu: &Parameters, fallback: Fallback) -> Result<OnlineRu
         Fallback::None => e.at_reduced_stage("online", mu, false),
         Fallback::Full => e.at_stage("online (reduced run)", mu),
     });
-    let Some(why) = why(&reduced, fallback, rom.trust(), mu) else {
-        let (run, estimate) = reduced?;
-        return Ok(OnlineRun { run, estimate, extrapolated: rom.is_extrapolated(mu), fallback: None, note: None });
+    // the full run as `simulate` makes it: the result file holds its coordinates
+    let full = || {
+        let r = crate::simulate::simulate(rom.model(), &crate::simulate::Overrides::at(mu))
+            .map_err(|e| e.at_stage("online (full run)", mu))?;
+        let nt = r.t.len();
+        Ok(ReducedRun { result: r, reduced_q: ndarray::Array2::zeros((0, nt)) })
     };
-    match crate::simulate::simulate(rom.model(), &crate::simulate::Overrides::at(mu)) {
-        Ok(full) => {
-            let seconds = reduced.as_ref().ok().and_then(|(_, e)| e.as_ref()).map_or(0.0, |e| e.seconds);
-            let nt = full.t.len();
-            Ok(OnlineRun {
-                run: ReducedRun { result: full, reduced_q: ndarray::Array2::zeros((0, nt)) },
-                estimate: Some(Estimate::exact(seconds)),
-                // where the load lies against the basis's range, whichever model answered
-                extrapolated: rom.is_extrapolated(mu),
-                fallback: Some(format!("{FULL_IN_PLACE}: {why}")),
-                note: None,
-            })
-        }
-        Err(e) => {
-            let e = e.at_stage("online (full run)", mu);
-            match reduced {
-                Ok((run, estimate)) => Ok(OnlineRun {
-                    run,
-                    estimate,
-                    extrapolated: rom.is_extrapolated(mu),
-                    fallback: None,
-                    note: Some(format!("{FULL_TRIED} ({why}) failed: {e}")),
-                }),
-                Err(r) => Err(Error::Hinted {
-                    source: Box::new(e),
-                    hint: format!("the full model ran in place of the reduced one, which had failed: {r}"),
-                }),
-            }
-        }
-    }
+    let s = settle(reduced, fallback, rom.trust(), mu, full)?;
+    // where the load lies against the basis's range, whichever model answered
+    let extrapolated = rom.is_extrapolated(mu);
+    Ok(OnlineRun { run: s.run, estimate: s.estimate, extrapolated, fallback: s.fallback, note: s.note })
 }
 
 /// Runs `rom` at `mu` and writes the result file `out` ([`crate::io::result_file`]: its
@@ -147,7 +124,7 @@ pub fn answer(rom: &Rom, mu: &Parameters, fallback: Fallback) -> Result<OnlineRu
 /// when complete) with the reduced coordinates, the basis it came from (`basis_path`) and
 /// the estimate's attributes ([`crate::rom::trust::write_run_attributes`]). With
 /// [`Fallback::Full`], where the reduced answer cannot be trusted
-/// ([`crate::pipeline::sweep::fallback::reason`], or the reduced run failed) the full
+/// ([`crate::pipeline::sweep::fallback::settle`]) the full
 /// model runs and the file is its result (as `simulate` writes it) with the attribute
 /// `fallback` (why), the basis, and the estimate's attributes of an exact answer (0);
 /// where the full run fails too, a reduced answer stands with the attribute

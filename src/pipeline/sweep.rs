@@ -27,7 +27,6 @@ use super::validate::compare;
 use crate::error::Result;
 use crate::linalg::kkt::LinearSolverKind;
 use crate::model::Model;
-use crate::rom::estimator::Estimate;
 use crate::rom::pool::Pool;
 use crate::rom::{Output, ReducedRun, Rom};
 use crate::simulate::{simulate, FullModel, Overrides, Settings};
@@ -319,37 +318,10 @@ fn run_reduced(rom: &Rom, state: Sweep, o: SweepOptions, checkpoint: Option<Chec
     let full_models = Pool::new(|| FullModel::new(model, LinearSolverKind::Banded));
     let point = |mu: &Parameters, previous: &[&ReducedRun]| -> Result<SweepPoint> {
         let reduced = rom.solve_and_estimate(mu, output, previous).map_err(|e| e.at_stage("sweep (reduced run)", mu));
-        let why = fallback::why(&reduced, o.fallback, rom.trust(), mu);
-        // where the full run fails too, a reduced answer stands as it would without the
-        // fallback, with a note; a reduced failure fails the point with both messages
-        let mut note = None;
-        if let Some(why) = why {
-            match models_run(&full_models, mu) {
-                Ok(run) => {
-                    let seconds = reduced.as_ref().ok().and_then(|(_, e)| e.as_ref()).map_or(0.0, |e| e.seconds);
-                    return Ok(SweepPoint {
-                        run,
-                        validation: None,
-                        full_probes: None,
-                        estimate: Some(Estimate::exact(seconds)),
-                        // where the load lies against the basis's range, whichever model answered
-                        extrapolated: rom.is_extrapolated(mu),
-                        fallback: Some(format!("{}: {why}", fallback::FULL_IN_PLACE)),
-                        note: None,
-                    });
-                }
-                Err(e) => match &reduced {
-                    Err(r) => {
-                        return Err(crate::error::Error::Hinted {
-                            source: Box::new(e),
-                            hint: format!("the full model ran in place of the reduced one, which had failed: {r}"),
-                        })
-                    }
-                    Ok(_) => note = Some(format!("{} ({why}) failed: {e}", fallback::FULL_TRIED)),
-                },
-            }
-        }
-        let (run, estimate) = reduced?;
+        let full = || models_run(&full_models, mu);
+        let fallback::Settled { run, estimate, fallback, note } =
+            fallback::settle(reduced, o.fallback, rom.trust(), mu, full)?;
+        // a validated sweep does not fall back (`SweepOptions::settled`)
         let (validation, full_probes) = if o.validate {
             let full = simulate(model, &Overrides::at(mu)).map_err(|e| e.at_stage("sweep (full run)", mu))?;
             let v = compare(model, &full, &run, None, basis.n_reduced(), basis.variant.name())
@@ -358,8 +330,9 @@ fn run_reduced(rom: &Rom, state: Sweep, o: SweepOptions, checkpoint: Option<Chec
         } else {
             (None, None)
         };
+        // where the load lies against the basis's range, whichever model answered
         let extrapolated = rom.is_extrapolated(mu);
-        Ok(SweepPoint { run, validation, full_probes, estimate, extrapolated, fallback: None, note })
+        Ok(SweepPoint { run, validation, full_probes, estimate, extrapolated, fallback, note })
     };
     let label = if o.validate { "sweep + validate" } else { "sweep" };
     run_pending(state, o, label, &point, checkpoint)

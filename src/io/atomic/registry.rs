@@ -66,10 +66,7 @@ impl GracefulStop {
     /// signal asked a stop while it lasted. When it did, the stop request was set before
     /// the claim ([`install_signal_handler`]), so it is there to be withdrawn.
     pub fn release(self) -> bool {
-        let stopped = GRACEFUL.compare_exchange(ON, OFF, Ordering::SeqCst, Ordering::SeqCst).is_err();
-        std::mem::forget(self);
-        GRACEFUL.store(OFF, Ordering::SeqCst);
-        stopped
+        GRACEFUL.swap(OFF, Ordering::SeqCst) == STOPPING
     }
 }
 

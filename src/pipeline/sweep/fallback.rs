@@ -7,9 +7,9 @@
 //! and `/fallback`, so that an overnight sweep has an answer within the tolerance (by its
 //! estimate) or an exact one at every point.
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::rom::estimator::Estimate;
-use crate::rom::Trust;
+use crate::rom::{ReducedRun, Trust};
 use crate::solver::parameters::Parameters;
 
 /// What a sweep does at a point whose reduced answer it cannot stand behind
@@ -66,11 +66,54 @@ pub fn kind(message: &str) -> Option<&'static str> {
     KINDS.iter().find(|(start, _)| why.starts_with(start)).map(|&(_, name)| name)
 }
 
+/// A point's answer under a [`Fallback`]: the reduced run and its estimate (with `note`
+/// where the full model was tried in its place and failed too), or the full model's run in
+/// its place (`fallback`: why; no reduced coordinates, the estimate of an exact answer).
+pub struct Settled {
+    pub run: ReducedRun,
+    pub estimate: Option<Estimate>,
+    pub fallback: Option<String>,
+    pub note: Option<String>,
+}
+
+/// The answer at `mu` from the reduced run `reduced` (its failure already named with its
+/// stage) under `fallback`: where `why` gives a reason, `full` runs the full model there
+/// (its failure named too). Where the full run fails as well, a reduced answer stands with
+/// a note, and a failed reduced run fails the point with both messages: never worse than
+/// without the fallback. One rule for `sweep` and `online`.
+pub fn settle(
+    reduced: Result<(ReducedRun, Option<Estimate>)>,
+    fallback: Fallback,
+    trust: Option<&Trust>,
+    mu: &Parameters,
+    full: impl FnOnce() -> Result<ReducedRun>,
+) -> Result<Settled> {
+    let Some(why) = why(&reduced, fallback, trust, mu) else {
+        let (run, estimate) = reduced?;
+        return Ok(Settled { run, estimate, fallback: None, note: None });
+    };
+    match (full(), reduced) {
+        (Ok(run), reduced) => {
+            // what the estimate of the reduced attempt cost before it was set aside
+            let seconds = reduced.ok().and_then(|(_, e)| e).map_or(0.0, |e| e.seconds);
+            let estimate = Some(Estimate::exact(seconds));
+            Ok(Settled { run, estimate, fallback: Some(format!("{FULL_IN_PLACE}: {why}")), note: None })
+        }
+        (Err(e), Ok((run, estimate))) => {
+            Ok(Settled { run, estimate, fallback: None, note: Some(format!("{FULL_TRIED} ({why}) failed: {e}")) })
+        }
+        (Err(e), Err(r)) => Err(Error::Hinted {
+            source: Box::new(e),
+            hint: format!("the full model ran in place of the reduced one, which had failed: {r}"),
+        }),
+    }
+}
+
 /// Why the full model answers at `mu` in place of the reduced run `reduced` (its result,
 /// its estimate): none under [`Fallback::None`]; under [`Fallback::Full`] the reduced
 /// run's numerical failure (Newton, a linear solve, a blow-up: not a stop that was asked
 /// for, a limit or a file), or [`reason`].
-pub fn why<T>(
+fn why<T>(
     reduced: &Result<(T, Option<Estimate>)>,
     fallback: Fallback,
     trust: Option<&Trust>,
