@@ -401,10 +401,11 @@ impl Model {
             p.predictor = match r.as_str() {
                 "zero-acceleration" => Predictor::ZeroAcceleration,
                 "constant-velocity" => Predictor::ConstantVelocity,
+                "adaptive" => Predictor::Adaptive,
                 _ => {
                     return Err(self.err(
                         "time.predictor",
-                        format!("must be \"zero-acceleration\" or \"constant-velocity\", got \"{r}\""),
+                        format!("must be \"adaptive\", \"zero-acceleration\" or \"constant-velocity\", got \"{r}\""),
                     ))
                 }
             };

@@ -43,7 +43,8 @@ pub struct TimeSettings {
     /// fast) or "never" (a fresh matrix at every iteration: full Newton)
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub jacobian_reuse: Option<String>,
-    /// where Newton starts a step: "zero-acceleration" (the default) or
+    /// where Newton starts a step: "adaptive" (the default: each step, whichever of the
+    /// other two came closer to the last step's solution), "zero-acceleration" or
     /// "constant-velocity" (q_n + h q̇_n; docs/reduced-speed.md)
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub predictor: Option<String>,

@@ -86,6 +86,8 @@ pub struct GeneralizedAlpha {
     rhs: Vec<f64>,
     work: Vec<f64>,
     backup: Option<State>,
+    /// [`Predictor::Adaptive`]'s record of the step in progress
+    starts: AdaptiveStart,
     pub stats: Stats,
 }
 
@@ -107,6 +109,7 @@ impl GeneralizedAlpha {
             rhs: Vec::new(),
             work: Vec::new(),
             backup: None,
+            starts: AdaptiveStart::default(),
             stats: Stats::default(),
         })
     }
@@ -131,14 +134,22 @@ impl GeneralizedAlpha {
     /// scheme's update gives, `Δq₀ + h²βc q̈_{n+1}` (`d` to round-off); `q` is not moved.
     #[inline]
     fn start_coordinate(&self, st: &mut State, i: usize, k: &StepConstants, d: Option<f64>) -> f64 {
-        let (am, af, g, b, h, c) = (self.alpha_m, self.alpha_f, self.gamma, self.beta, k.h, k.c);
-        let a0 = (af * st.qdd[i] - am * st.a[i]) / (1.0 - am);
-        let dq0 = h * st.v[i] + h * h * ((0.5 - b) * st.a[i] + b * a0);
+        let (g, b, h, c) = (self.gamma, self.beta, k.h, k.c);
+        let (a0, dq0) = self.zero_acceleration_start(st, i, k);
         let qdd = d.map_or(0.0, |d| (d - dq0) / (h * h * b * c));
         st.v[i] += h * ((1.0 - g) * st.a[i] + g * (a0 + c * qdd));
         st.a[i] = a0;
         st.qdd[i] = qdd;
         dq0 + h * h * b * c * qdd
+    }
+
+    /// `(a₀, Δq₀)` of coordinate `i`: the part of `a_{n+1}` that does not depend on
+    /// `q̈_{n+1}`, and the increment at `q̈_{n+1} = 0`.
+    #[inline]
+    fn zero_acceleration_start(&self, st: &State, i: usize, k: &StepConstants) -> (f64, f64) {
+        let (am, af, b, h) = (self.alpha_m, self.alpha_f, self.beta, k.h);
+        let a0 = (af * st.qdd[i] - am * st.a[i]) / (1.0 - am);
+        (a0, h * st.v[i] + h * h * ((0.5 - b) * st.a[i] + b * a0))
     }
 
     /// Starts the step to `t + h` at the increment `d` exactly (`q ← q + d`), with `q̇`, `q̈`
@@ -320,10 +331,20 @@ impl GeneralizedAlpha {
         // the q̈_{n+1} that puts q_{n+1} there; else q̈_{n+1} = 0, and a_{n+1} from the α
         // relation (Self::start_coordinate)
         assert!(guess.is_none_or(|d| d.len() == n), "a guessed increment needs {n} entries");
-        let predictor = self.params.predictor;
+        let adaptive = guess.is_none() && self.params.predictor == Predictor::Adaptive;
+        let predictor = if adaptive { self.starts.choice } else { self.params.predictor };
+        if adaptive {
+            let mut starts = std::mem::take(&mut self.starts);
+            starts.record(st, h, |i| self.zero_acceleration_start(st, i, &k).1);
+            self.starts = starts;
+        }
         // ‖guess‖∞, for keeping the first matrix of a good guess (below)
         let guess_size = match guess {
             Some(d) => Some(max_abs(d)),
+            // the adaptive start keeps no first matrix: on a swinging pendulum the kept
+            // matrix of a constant-velocity start costs two more iterations a step than the
+            // factorization it saves
+            None if adaptive => None,
             None => predictor.increment_size(h, &st.v),
         };
         for i in 0..n {
@@ -381,6 +402,9 @@ impl GeneralizedAlpha {
             let judged_fresh = fresh_before && (!reuse || policy == JacobianReuse::AcrossSteps);
             let stagnated = !converged && judged_fresh && it > 3 && theta > 0.5 && inc <= floor;
             if converged || stagnated {
+                if adaptive {
+                    self.starts.judge(&st.q);
+                }
                 self.stats.steps_at_round_off += stagnated as usize;
                 self.finish_step(st, &k);
                 st.t = t;
@@ -417,6 +441,56 @@ impl GeneralizedAlpha {
     }
 }
 
+/// [`Predictor::Adaptive`]: both starts of a step, kept until its solution is known, and
+/// the one to use next. A step starts where the start that came closer to the previous
+/// step's solution (in ‖·‖∞, Newton's own measure) puts it. Both are cheap to form; what
+/// separates them is the acceleration term `h²((½ − β) a_n + β a₀)` of the
+/// zero-acceleration start: close to the motion where the accelerations are smooth (a
+/// swinging pendulum), far
+/// from it where undamped vibrations of stiff elements (`rho_inf` near 1) make `q̈`
+/// alternate from step to step at amplitudes the positions never reach.
+#[derive(Debug)]
+struct AdaptiveStart {
+    q: Vec<f64>,
+    zero_acceleration: Vec<f64>,
+    constant_velocity: Vec<f64>,
+    /// the next step's start: one of the two fixed ones
+    choice: Predictor,
+}
+
+impl Default for AdaptiveStart {
+    /// A run's first step starts at zero acceleration (a run starts at rest, where the
+    /// constant-velocity start would not move).
+    fn default() -> Self {
+        AdaptiveStart {
+            q: Vec::new(),
+            zero_acceleration: Vec::new(),
+            constant_velocity: Vec::new(),
+            choice: Predictor::ZeroAcceleration,
+        }
+    }
+}
+
+impl AdaptiveStart {
+    /// Records the step's start `q_n` and both guesses of its increment.
+    fn record(&mut self, st: &State, h: f64, zero_acceleration: impl Fn(usize) -> f64) {
+        let n = st.q.len();
+        self.q.clone_from(&st.q);
+        self.zero_acceleration.clear();
+        self.zero_acceleration.extend((0..n).map(zero_acceleration));
+        self.constant_velocity.clear();
+        self.constant_velocity.extend(st.v.iter().map(|v| h * v));
+    }
+
+    /// The step ended at `q`: the start that was closer is the next step's.
+    fn judge(&mut self, q: &[f64]) {
+        let miss =
+            |guess: &[f64]| q.iter().zip(&self.q).zip(guess).map(|((q, q0), d)| (q - q0 - d).abs()).fold(0.0, f64::max);
+        let (za, cv) = (miss(&self.zero_acceleration), miss(&self.constant_velocity));
+        self.choice = if cv < za { Predictor::ConstantVelocity } else { Predictor::ZeroAcceleration };
+    }
+}
+
 /// Whether a kept matrix contracting at `theta` (last increment `inc`) should be refreshed:
 /// when `θ > ½` (the error estimate `θ/(1−θ)‖Δq‖` no longer holds, and the matrix may be
 /// diverging), or when reaching the tolerance at that rate would take more than
@@ -440,6 +514,23 @@ const KEPT_ITERATIONS: f64 = 3.0;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The adaptive start takes, for the next step, the start that came closer to this
+    /// step's solution in the largest coordinate, and starts a run at zero acceleration.
+    #[test]
+    fn the_adaptive_start_keeps_the_closer_guess() {
+        let mut a = AdaptiveStart::default();
+        assert_eq!(a.choice, Predictor::ZeroAcceleration);
+        let st =
+            State { t: 0.0, q: vec![1.0, 2.0], v: vec![10.0, 0.0], a: vec![0.0; 2], qdd: vec![0.0; 2], lambda: vec![] };
+        // guesses: zero acceleration (0.3, 0.05), constant velocity h v = (0.1, 0)
+        a.record(&st, 0.01, |i| [0.3, 0.05][i]);
+        a.judge(&[1.12, 2.0]); // misses: 0.18 against 0.02
+        assert_eq!(a.choice, Predictor::ConstantVelocity);
+        a.record(&st, 0.01, |i| [0.3, 0.05][i]);
+        a.judge(&[1.29, 2.04]); // misses: 0.01 against 0.19
+        assert_eq!(a.choice, Predictor::ZeroAcceleration);
+    }
 
     /// One mass on a spring, `q̈ + k q + c q³ + A sin(10¹² q) = 0`. The noise term stands
     /// for the round-off of a residual summed from large terms that cancel (chaotic in q, of

@@ -11,31 +11,42 @@
 //! so any predicted `q̈_{n+1}` is a predicted position, and a predicted position `q_n + d`
 //! is the `q̈_{n+1} = (d − Δq₀)/(h² β c)` with `Δq₀` the position change at `q̈_{n+1} = 0`.
 //!
-//! - [`Predictor::ZeroAcceleration`] (the default): `q̈_{n+1} = 0` (the classic choice, Géradin & Cardona,
-//!   *Flexible Multibody Dynamics*, §10.5). Its error is `h² β c |q̈_{n+1}|`: large where the
-//!   accelerations are (a fast crank, a soft body's vibrations).
-//! - [`Predictor::ConstantVelocity`] (`[time] predictor = "constant-velocity"`): `q_{n+1} = q_n + h q̇_n`, i.e. the guess
-//!   `d = h q̇_n`, treated like any other guess of the step: Newton starts there, and the
-//!   first iteration's matrix is kept when its correction is small next to the guessed step
-//!   (`JacobianReuse::WithinStep`). Its error is `h² |½ q̈|` averaged over the step, with no
-//!   `q̈_{n+1}` in it, and it needs no history (halved steps use it too).
+//! - [`Predictor::ZeroAcceleration`] (`"zero-acceleration"`): `q̈_{n+1} = 0` (the classic
+//!   choice, Géradin & Cardona, *Flexible Multibody Dynamics*, §10.5). Its error is
+//!   `h² β c |q̈_{n+1}|` plus what the history terms carry: close to the motion where the
+//!   accelerations are smooth (a swinging pendulum), far from it where undamped vibrations
+//!   of stiff elements (`rho_inf` near 1) make `q̈` alternate from step to step at
+//!   amplitudes the positions never reach (a first increment of 10³ on a one-metre
+//!   four-bar, 25 iterations a step, step halvings).
+//! - [`Predictor::ConstantVelocity`] (`"constant-velocity"`): `q_{n+1} = q_n + h q̇_n`, i.e.
+//!   the guess `d = h q̇_n`, treated like any other guess of the step: Newton starts there,
+//!   and the first iteration's matrix is kept when its correction is small next to the
+//!   guessed step (`JacobianReuse::WithinStep`). Its error is `h² |½ q̈|` averaged over the
+//!   step, with no `q̈_{n+1}` in it, and it needs no history (halved steps use it too). On a
+//!   swinging pendulum it costs twice the iterations (660 → 1240).
+//! - [`Predictor::Adaptive`] (`"adaptive"`, the default since 2026-11-27): every step
+//!   records both starts and, once the step's solution is known, which came closer to it
+//!   (‖·‖∞, Newton's own measure); the next step starts there. No first matrix is kept (the
+//!   pendulum's two extra iterations). Neither fixed start is right for every model and
+//!   the choice costs two vectors a step; on the zoo's first draws (tests/adaptive_start.rs)
+//!   it completes every run either fixed start completes (67 of 72, against 62 for
+//!   zero acceleration) at 0.99× the better one's iterations.
 //!
 //! Only the starting point changes: every step still stops on the same Newton tolerance
-//! (tests/predictor.rs checks it step by step). Measured (docs/reduced-speed.md) on the
-//! four-bar, full and reduced: 10–25 % fewer factorizations than `ZeroAcceleration`; on the
-//! pendulum fewer factorizations (441 → 317) but twice the iterations (660 → 1240) and
-//! 10–55 % more CPU for the whole `simulate`. Not the default for that reason: the
-//! four-bar's gain is the same for the full and the reduced model, so it does not move
-//! the reduced model's speedup either.
+//! (tests/predictor.rs checks it step by step). Measured (docs/reduced-speed.md): the full
+//! 5000-element pendulum 2.5× faster than with the zero-acceleration start, the ×10 four-bar
+//! 1.25×, the zoo's stiff undamped models 1.7–5×, the shipped pendulum 6 % slower.
 
 /// Newton's starting point for a step without a guess.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Predictor {
     /// `q̈_{n+1} = 0`
-    #[default]
     ZeroAcceleration,
     /// `q_{n+1} = q_n + h q̇_n`, handled as a guessed increment
     ConstantVelocity,
+    /// each step, whichever of the two starts above came closer to the last step's solution
+    #[default]
+    Adaptive,
 }
 
 impl Predictor {
@@ -44,7 +55,7 @@ impl Predictor {
     #[inline]
     pub fn increment(self, h: f64, v: f64) -> Option<f64> {
         match self {
-            Predictor::ZeroAcceleration => None,
+            Predictor::ZeroAcceleration | Predictor::Adaptive => None,
             Predictor::ConstantVelocity => Some(h * v),
         }
     }
@@ -53,7 +64,7 @@ impl Predictor {
     /// rule that keeps the first iteration's matrix when the guess was good.
     pub fn increment_size(self, h: f64, v: &[f64]) -> Option<f64> {
         match self {
-            Predictor::ZeroAcceleration => None,
+            Predictor::ZeroAcceleration | Predictor::Adaptive => None,
             Predictor::ConstantVelocity => Some(h * crate::linalg::vec_ops::max_abs(v)),
         }
     }
