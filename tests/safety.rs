@@ -436,12 +436,13 @@ fn a_killed_simulate_keeps_the_previous_result() {
     let d = tempfile::tempdir().unwrap();
     let root = d.path();
     let model = root.join("m.toml");
-    // 1200 steps of a 400-element pendulum: about a second of work (1.0 s measured), stopped
-    // after 300 ms (a long run of the 50-element one is no good: it stops itself by
-    // t ≈ 7 s, its step halvings over budget, in under 300 ms on a fast build)
+    // 1200 steps of a 1600-element pendulum: about a second of work (1.0 s measured with
+    // the adaptive Newton start, 2026-11-27; 400 elements took 0.27 s with it), stopped after
+    // 300 ms (a longer run is no good: the pendulum stops itself by t ≈ 7–10 s, its step
+    // halvings over budget)
     let text = model_text(6.0, "");
     assert!(text.contains("elements = 50\n"), "the shipped pendulum's mesh");
-    std::fs::write(&model, text.replace("elements = 50\n", "elements = 400\n")).unwrap();
+    std::fs::write(&model, text.replace("elements = 50\n", "elements = 1600\n")).unwrap();
     let out = root.join("out.h5");
     // the previous result: flexrom's own (it replaces no other file), 0.01 s of the same model
     let short = flexrom().arg("simulate").arg(&model).arg("-o").arg(&out).args(["--t-end", "0.01"]).output().unwrap();
