@@ -9,7 +9,7 @@
 //! * it completes more of them than the zero-acceleration start, the default before
 //!   2026-11-27 (measured: 67 of 72 against 62; the constant-velocity start 67: the
 //!   zero-acceleration start's failures are step halvings past the run's budget and strain
-//!   blow-ups on stiff bodies without numerical damping, `rho_inf` near 1);
+//!   blow-ups, mostly on stiff bodies without numerical damping, `rho_inf` = 1);
 //! * over the runs all three complete, its Newton iterations are within 5 % of the better
 //!   fixed start's, run by run, summed (measured: 0.99×; the wrong fixed start takes up to
 //!   3.8× them, zero acceleration on a frame, and 1.8×, constant velocity on a pendulum);

@@ -42,7 +42,7 @@ fn repo(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
 }
 
-/// Runs `steps` steps of `dt` with the constant-velocity predictor on `run` and, from each step's
+/// Runs `steps` steps of `dt` with the `tested` predictor on `run` and, from each step's
 /// start, a zero-acceleration step on `check` and a full-Newton step to 1e-3 of the
 /// tolerance (the reference root) on `exact`; returns the largest distances of the two
 /// predictors' step ends from the reference, over the length scale, and their stats.

@@ -12,12 +12,14 @@
 //! is the `q̈_{n+1} = (d − Δq₀)/(h² β c)` with `Δq₀` the position change at `q̈_{n+1} = 0`.
 //!
 //! - [`Predictor::ZeroAcceleration`] (`"zero-acceleration"`): `q̈_{n+1} = 0` (the classic
-//!   choice, Géradin & Cardona, *Flexible Multibody Dynamics*, §10.5). Its error is
-//!   `h² β c |q̈_{n+1}|` plus what the history terms carry: close to the motion where the
-//!   accelerations are smooth (a swinging pendulum), far from it where undamped vibrations
-//!   of stiff elements (`rho_inf` near 1) make `q̈` alternate from step to step at
-//!   amplitudes the positions never reach (a first increment of 10³ on a one-metre
-//!   four-bar, 25 iterations a step, step halvings).
+//!   choice, Géradin & Cardona, *Flexible Multibody Dynamics*, §10.5). Its error is exactly
+//!   `h² β c |q̈_{n+1}|`; with ρ∞ = 1 that is `h²/4 |q̈_{n+1}|`, where the constant-velocity
+//!   start misses by `h²/4 |q̈_n + q̈_{n+1}|`. Where the accelerations are smooth (a swinging
+//!   pendulum, `q̈_{n+1} ≈ q̈_n`) zero acceleration misses by half as much; where undamped
+//!   vibrations of stiff elements make `q̈` alternate from step to step (`q̈_{n+1} ≈ −q̈_n`)
+//!   at amplitudes the positions never reach, it misses by all of `h²/4 |q̈|` and constant
+//!   velocity by little (a first increment of 10³ on a one-metre four-bar, 25 iterations a
+//!   step, step halvings).
 //! - [`Predictor::ConstantVelocity`] (`"constant-velocity"`): `q_{n+1} = q_n + h q̇_n`, i.e.
 //!   the guess `d = h q̇_n`, treated like any other guess of the step: Newton starts there,
 //!   and the first iteration's matrix is kept when its correction is small next to the
@@ -28,14 +30,15 @@
 //!   records both starts and, once the step's solution is known, which came closer to it
 //!   (‖·‖∞, Newton's own measure); the next step starts there. No first matrix is kept (the
 //!   pendulum's two extra iterations). Neither fixed start is right for every model and
-//!   the choice costs two vectors a step; on the zoo's first draws (tests/adaptive_start.rs)
+//!   the choice costs three vectors a step; on the zoo's first draws (tests/adaptive_start.rs)
 //!   it completes every run either fixed start completes (67 of 72, against 62 for
 //!   zero acceleration) at 0.99× the better one's iterations.
 //!
 //! Only the starting point changes: every step still stops on the same Newton tolerance
 //! (tests/predictor.rs checks it step by step). Measured (docs/reduced-speed.md): the full
-//! 5000-element pendulum 2.5× faster than with the zero-acceleration start, the ×10 four-bar
-//! 1.25×, the zoo's stiff undamped models 1.7–5×, the shipped pendulum 6 % slower.
+//! 5000-element pendulum 2.35× faster than with the zero-acceleration start, the ×10
+//! four-bar 1.24×, the zoo's models where zero acceleration is the wrong start 1.4–4.9×, the
+//! shipped pendulum 6 % slower.
 
 /// Newton's starting point for a step without a guess.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
