@@ -159,16 +159,17 @@ pub fn print_table(t: &Table, format: Format, single: bool) -> flexrom::Result<(
 pub fn run_details(r: &flexrom::simulate::SimulationResult) {
     let (s, st) = (&r.settings, &r.stats);
     detail(&format!(
-        "  settings: dt {} s, t_end {} s, rho_inf {}, {}, solver {:?}, {} coordinates",
+        "  settings: dt {} s, t_end {} s, rho_inf {}, {}, solver {:?}, Newton start {}, {} coordinates",
         s.dt,
         s.t_end,
         s.rho_inf,
         s.mu,
         s.solver,
+        s.params.predictor.name(),
         r.q.nrows()
     ));
     detail(&format!(
-        "  Newton: {:.2} iterations per step (at most {} in one step), {} factorizations, {} step cuts, {} steps at the round-off floor; {:.3} ms per step",
+        "  Newton: {:.2} iterations per step (halved steps' attempts included; at most {} in one attempt), {} factorizations, {} step cuts, {} steps at the round-off floor; {:.3} ms per step",
         st.newton_iterations as f64 / st.steps.max(1) as f64,
         st.max_iterations_in_a_step,
         st.factorizations,
@@ -176,4 +177,12 @@ pub fn run_details(r: &flexrom::simulate::SimulationResult) {
         st.steps_at_round_off,
         1e3 * r.wall_seconds / st.steps.max(1) as f64
     ));
+    if s.params.predictor == flexrom::solver::generalized_alpha::Predictor::Adaptive {
+        // which guess the adaptive start took (docs/reduced-speed.md): a model that always
+        // takes one may as well name it in `[time] predictor`
+        detail(&format!(
+            "  Newton's start: constant velocity at {} of {} steps, zero acceleration at the others",
+            st.constant_velocity_starts, st.steps
+        ));
+    }
 }

@@ -50,6 +50,9 @@ pub struct Stats {
     pub max_iterations_in_a_step: usize,
     /// steps accepted at the round-off floor ([`IntegratorParams::stagnation`])
     pub steps_at_round_off: usize,
+    /// steps (halved ones each) whose Newton started at the constant-velocity guess, by
+    /// [`Predictor::ConstantVelocity`] or by the adaptive start's choice
+    pub constant_velocity_starts: usize,
     /// the start time of every step that was halved, once per step however deep its cuts
     /// went: where a run's time grid left the regular one (two runs compared step by step,
     /// e.g. full and reduced, solve different discretizations after a cut one of them
@@ -411,6 +414,8 @@ impl GeneralizedAlpha {
                     self.starts.judge(&st.q);
                 }
                 self.stats.steps_at_round_off += stagnated as usize;
+                self.stats.constant_velocity_starts +=
+                    (guess.is_none() && predictor == Predictor::ConstantVelocity) as usize;
                 self.finish_step(st, &k);
                 st.t = t;
                 self.stats.max_iterations_in_a_step = self.stats.max_iterations_in_a_step.max(it);
@@ -451,8 +456,7 @@ impl GeneralizedAlpha {
 /// step's solution (in ‖·‖∞, Newton's own measure) puts it. Both are cheap to form; what
 /// separates them is the acceleration term `h²((½ − β) a_n + β a₀)` of the
 /// zero-acceleration start (`super::predictor`): close to the motion where the accelerations
-/// are smooth (a swinging pendulum), far
-/// from it where undamped vibrations of stiff elements (`rho_inf` near 1) make `q̈`
+/// are smooth (damped, `rho_inf` < 1), far from it where undamped vibrations of stiff elements (`rho_inf` near 1) make `q̈`
 /// alternate from step to step at amplitudes the positions never reach.
 #[derive(Debug)]
 struct AdaptiveStart {
@@ -609,6 +613,13 @@ mod tests {
             ad < za && ad as f64 <= 1.05 * cv as f64,
             "adaptive {ad}, zero acceleration {za}, constant velocity {cv}"
         );
+        // which start each step took: the adaptive one, all but a few from constant velocity
+        let starts = |p| run(spring(), 1e-2, 1e-2, with(p)).1.constant_velocity_starts;
+        assert_eq!(starts(Predictor::ZeroAcceleration), 0);
+        assert_eq!(starts(Predictor::ConstantVelocity), 50);
+        let adaptive = starts(Predictor::Adaptive);
+        eprintln!("adaptive: {adaptive} of 50 steps from constant velocity");
+        assert!((40..50).contains(&adaptive), "{adaptive}");
         // a guided step (a continuation sweep's) judges too: the run's first choice, zero
         // acceleration, gives way after one (measured: q₁ = −9.3e-3 from q₀ = 1e-2 at rest)
         let (mut m, mut integ) = (spring(), GeneralizedAlpha::new(with(Predictor::Adaptive)).unwrap());
