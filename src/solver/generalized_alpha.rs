@@ -89,8 +89,9 @@ pub struct GeneralizedAlpha {
     rhs: Vec<f64>,
     work: Vec<f64>,
     backup: Option<State>,
-    /// [`Predictor::Adaptive`]'s record of the step in progress
-    starts: AdaptiveStart,
+    /// [`Predictor::Adaptive`]'s start for the next step without a guess: one of the two
+    /// fixed ones ([`Self::closer_start`])
+    next_start: Predictor,
     pub stats: Stats,
 }
 
@@ -112,7 +113,7 @@ impl GeneralizedAlpha {
             rhs: Vec::new(),
             work: Vec::new(),
             backup: None,
-            starts: AdaptiveStart::default(),
+            next_start: Predictor::ZeroAcceleration,
             stats: Stats::default(),
         })
     }
@@ -153,6 +154,29 @@ impl GeneralizedAlpha {
         let (am, af, b, h) = (self.alpha_m, self.alpha_f, self.beta, k.h);
         let a0 = (af * st.qdd[i] - am * st.a[i]) / (1.0 - am);
         (a0, h * st.v[i] + h * h * ((0.5 - b) * st.a[i] + b * a0))
+    }
+
+    /// [`Predictor::Adaptive`]'s choice after a step from `start` (the state the step began
+    /// at, which [`Self::advance`] keeps) that ended at `q`: the fixed start whose guess of
+    /// the increment came closer to `q − q_n`, in ‖·‖∞ (Newton's own measure). What
+    /// separates the two is the acceleration term `h²((½ − β) a_n + β a₀)` of the
+    /// zero-acceleration guess: close to the motion where the accelerations are smooth
+    /// (damped, `rho_inf` < 1), far from it where undamped vibrations of stiff elements
+    /// (`rho_inf` near 1) make `q̈` alternate from step to step at amplitudes the positions
+    /// never reach. One pass over the coordinates; both guesses are formed again from the
+    /// start rather than kept.
+    fn closer_start(&self, start: &State, q: &[f64], k: &StepConstants) -> Predictor {
+        let (mut zero_acceleration, mut constant_velocity) = (0.0_f64, 0.0_f64);
+        for (i, &qi) in q.iter().enumerate() {
+            let d = qi - start.q[i];
+            zero_acceleration = zero_acceleration.max((d - self.zero_acceleration_start(start, i, k).1).abs());
+            constant_velocity = constant_velocity.max((d - k.h * start.v[i]).abs());
+        }
+        if constant_velocity < zero_acceleration {
+            Predictor::ConstantVelocity
+        } else {
+            Predictor::ZeroAcceleration
+        }
     }
 
     /// Starts the step to `t + h` at the increment `d` exactly (`q ← q + d`), with `q̇`, `q̈`
@@ -238,8 +262,9 @@ impl GeneralizedAlpha {
         assert_eq!(v0.len(), n);
         self.rhs = vec![0.0; n + nc];
         self.work = vec![0.0; n];
-        // a run starts its adaptive start afresh, whatever an earlier run chose
-        self.starts = AdaptiveStart::default();
+        // a run starts at rest, where the constant-velocity start would not move: its first
+        // step starts at zero acceleration, whatever an earlier run chose
+        self.next_start = Predictor::ZeroAcceleration;
         let coef = IterationCoefficients { mass: 1.0, damping: 0.0, stiffness: 0.0 };
         let s = model.factor(&q0, &v0, t0, coef).map_err(|p| Error::LinearSolve { t: t0, problem: p })?;
         self.factored = None;
@@ -340,12 +365,7 @@ impl GeneralizedAlpha {
         // sub-steps start from its choice); it chooses only where no guess is given
         let judging = self.params.predictor == Predictor::Adaptive;
         let adaptive = judging && guess.is_none();
-        let predictor = if adaptive { self.starts.choice } else { self.params.predictor };
-        if judging {
-            let mut starts = std::mem::take(&mut self.starts);
-            starts.record(st, h, |i| self.zero_acceleration_start(st, i, &k).1);
-            self.starts = starts;
-        }
+        let predictor = if adaptive { self.next_start } else { self.params.predictor };
         // ‖guess‖∞, for keeping the first matrix of a good guess (below)
         let guess_size = match guess {
             Some(d) => Some(max_abs(d)),
@@ -411,7 +431,8 @@ impl GeneralizedAlpha {
             let stagnated = !converged && judged_fresh && it > 3 && theta > 0.5 && inc <= floor;
             if converged || stagnated {
                 if judging {
-                    self.starts.judge(&st.q);
+                    let start = self.backup.as_ref().expect("advance keeps the step's start");
+                    self.next_start = self.closer_start(start, &st.q, &k);
                 }
                 self.stats.steps_at_round_off += stagnated as usize;
                 self.stats.constant_velocity_starts +=
@@ -451,55 +472,6 @@ impl GeneralizedAlpha {
     }
 }
 
-/// [`Predictor::Adaptive`]: both starts of a step, kept until its solution is known, and
-/// the one to use next. A step starts where the start that came closer to the previous
-/// step's solution (in ‖·‖∞, Newton's own measure) puts it. Both are cheap to form; what
-/// separates them is the acceleration term `h²((½ − β) a_n + β a₀)` of the
-/// zero-acceleration start (`super::predictor`): close to the motion where the accelerations
-/// are smooth (damped, `rho_inf` < 1), far from it where undamped vibrations of stiff elements (`rho_inf` near 1) make `q̈`
-/// alternate from step to step at amplitudes the positions never reach.
-#[derive(Debug)]
-struct AdaptiveStart {
-    q: Vec<f64>,
-    zero_acceleration: Vec<f64>,
-    constant_velocity: Vec<f64>,
-    /// the next step's start: one of the two fixed ones
-    choice: Predictor,
-}
-
-impl Default for AdaptiveStart {
-    /// A run's first step starts at zero acceleration (a run starts at rest, where the
-    /// constant-velocity start would not move).
-    fn default() -> Self {
-        AdaptiveStart {
-            q: Vec::new(),
-            zero_acceleration: Vec::new(),
-            constant_velocity: Vec::new(),
-            choice: Predictor::ZeroAcceleration,
-        }
-    }
-}
-
-impl AdaptiveStart {
-    /// Records the step's start `q_n` and both guesses of its increment.
-    fn record(&mut self, st: &State, h: f64, zero_acceleration: impl Fn(usize) -> f64) {
-        let n = st.q.len();
-        self.q.clone_from(&st.q);
-        self.zero_acceleration.clear();
-        self.zero_acceleration.extend((0..n).map(zero_acceleration));
-        self.constant_velocity.clear();
-        self.constant_velocity.extend(st.v.iter().map(|v| h * v));
-    }
-
-    /// The step ended at `q`: the start that was closer is the next step's.
-    fn judge(&mut self, q: &[f64]) {
-        let miss =
-            |guess: &[f64]| q.iter().zip(&self.q).zip(guess).map(|((q, q0), d)| (q - q0 - d).abs()).fold(0.0, f64::max);
-        let (za, cv) = (miss(&self.zero_acceleration), miss(&self.constant_velocity));
-        self.choice = if cv < za { Predictor::ConstantVelocity } else { Predictor::ZeroAcceleration };
-    }
-}
-
 /// Whether a kept matrix contracting at `theta` (last increment `inc`) should be refreshed:
 /// when `θ > ½` (the error estimate `θ/(1−θ)‖Δq‖` no longer holds, and the matrix may be
 /// diverging), or when reaching the tolerance at that rate would take more than
@@ -528,17 +500,24 @@ mod tests {
     /// step's solution in the largest coordinate, and starts a run at zero acceleration.
     #[test]
     fn the_adaptive_start_keeps_the_closer_guess() {
-        let mut a = AdaptiveStart::default();
-        assert_eq!(a.choice, Predictor::ZeroAcceleration);
-        let st =
-            State { t: 0.0, q: vec![1.0, 2.0], v: vec![10.0, 0.0], a: vec![0.0; 2], qdd: vec![0.0; 2], lambda: vec![] };
-        // guesses: zero acceleration (0.3, 0.05), constant velocity h v = (0.1, 0)
-        a.record(&st, 0.01, |i| [0.3, 0.05][i]);
-        a.judge(&[1.12, 2.0]); // misses: 0.18 against 0.02
-        assert_eq!(a.choice, Predictor::ConstantVelocity);
-        a.record(&st, 0.01, |i| [0.3, 0.05][i]);
-        a.judge(&[1.29, 2.04]); // misses: 0.01 against 0.19
-        assert_eq!(a.choice, Predictor::ZeroAcceleration);
+        let params = IntegratorParams { rho_inf: 1.0, predictor: Predictor::Adaptive, ..IntegratorParams::default() };
+        let integ = GeneralizedAlpha::new(params).unwrap();
+        assert_eq!(integ.next_start, Predictor::ZeroAcceleration);
+        let k = integ.step_constants(0.01);
+        // ρ∞ = 1: a₀ = q̈_n − a_n = 0, so the zero-acceleration guess is h v + h²/4 a_n =
+        // (0.3, 0.05); the constant-velocity guess h v = (0.1, 0)
+        let start = State {
+            t: 0.0,
+            q: vec![1.0, 2.0],
+            v: vec![10.0, 0.0],
+            a: vec![8000.0, 2000.0],
+            qdd: vec![8000.0, 2000.0],
+            lambda: vec![],
+        };
+        // misses: 0.18 against 0.02
+        assert_eq!(integ.closer_start(&start, &[1.12, 2.0], &k), Predictor::ConstantVelocity);
+        // misses: 0.01 against 0.19
+        assert_eq!(integ.closer_start(&start, &[1.29, 2.04], &k), Predictor::ZeroAcceleration);
     }
 
     /// One mass on a spring, `q̈ + k q + c q³ + A sin(10¹² q) = 0`. The noise term stands
@@ -624,9 +603,9 @@ mod tests {
         // acceleration, gives way after one (measured: q₁ = −9.3e-3 from q₀ = 1e-2 at rest)
         let (mut m, mut integ) = (spring(), GeneralizedAlpha::new(with(Predictor::Adaptive)).unwrap());
         let mut st = integ.initialize(&mut m, vec![1e-2], vec![0.0], 0.0).unwrap();
-        assert_eq!(integ.starts.choice, Predictor::ZeroAcceleration);
+        assert_eq!(integ.next_start, Predictor::ZeroAcceleration);
         integ.step_guided(&mut m, &mut st, 1e-2, Some(&[0.0])).unwrap();
-        assert_eq!(integ.starts.choice, Predictor::ConstantVelocity);
+        assert_eq!(integ.next_start, Predictor::ConstantVelocity);
     }
 
     /// 50 steps of `h` from q = q₀ at rest; the positions after each step and the stats.

@@ -32,9 +32,9 @@
 //!   pendulum's two extra iterations). With ρ∞ = 1 the steps start almost all from
 //!   constant velocity (the shipped pendulum 219 of 220), with ρ∞ = 0.7–0.9 mostly from
 //!   zero acceleration (90–95 % on the zoo's pendulums), and some models mix (the ×10
-//!   four-bar, ρ∞ = 0.8: 87 of 157 from constant velocity). Neither fixed start is right for every model and
-//!   the choice costs three vectors a step; on the zoo's first draws (tests/adaptive_start.rs)
-//!   it completes every run either fixed start completes (67 of 72, against 62 for
+//!   four-bar, ρ∞ = 0.8: 87 of 157 from constant velocity). Neither fixed start is right
+//!   for every model, and the choice costs one pass over the coordinates a step; on the
+//!   zoo's first draws (tests/adaptive_start.rs) it completes every run either fixed start completes (67 of 72, against 62 for
 //!   zero acceleration) at 0.99× the better one's iterations.
 //!
 //! Only the starting point changes: every step still stops on the same Newton tolerance
