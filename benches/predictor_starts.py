@@ -1,11 +1,11 @@
 #!/usr/bin/env python3
 """Where Newton starts a step: the full run of each model with each `[time] predictor`.
 
-For every model file given, the script writes three copies that differ only in `[time]
-predictor` ("zero-acceleration", "constant-velocity", "adaptive"; any predictor line of the
-model is replaced) into a work folder, then runs `flexrom simulate COPY -v --threads 1`
-`--rounds` times, the three starts in turn within each round so a busy spell of the host
-falls on all three, and prints a markdown table: Newton iterations per step and
+For every model file given, the script writes four copies that differ only in `[time]
+predictor` ("zero-acceleration", "constant-velocity", "constant-position", "adaptive"; any
+predictor line of the model is replaced) into a work folder, then runs `flexrom simulate COPY -v --threads 1`
+`--rounds` times, the four starts in turn within each round so a busy spell of the host
+falls on all four, and prints a markdown table: Newton iterations per step and
 factorizations (the same in every round), and the median time per step (the time loop as
 `simulate -v` reports it). A run that fails shows its error's first words.
 
@@ -24,7 +24,7 @@ import subprocess
 import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-STARTS = ["zero-acceleration", "constant-velocity", "adaptive"]
+STARTS = ["zero-acceleration", "constant-velocity", "constant-position", "adaptive"]
 NEWTON = re.compile(r"Newton: ([0-9.]+) iterations per step .*?, (\d+) factorizations.*?; ([0-9.]+) ms per step")
 
 

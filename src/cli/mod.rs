@@ -181,8 +181,8 @@ pub fn run_details(r: &flexrom::simulate::SimulationResult) {
         // which guess the adaptive start took (docs/reduced-speed.md): a model that always
         // takes one may as well name it in `[time] predictor`
         detail(&format!(
-            "  Newton's start: constant velocity at {} of {} steps, zero acceleration at the others",
-            st.constant_velocity_starts, st.steps
+            "  Newton's start: constant velocity at {} of {} steps, constant position at {}, zero acceleration at the others",
+            st.constant_velocity_starts, st.steps, st.constant_position_starts
         ));
     }
 }

@@ -401,11 +401,14 @@ impl Model {
             p.predictor = match r.as_str() {
                 "zero-acceleration" => Predictor::ZeroAcceleration,
                 "constant-velocity" => Predictor::ConstantVelocity,
+                "constant-position" => Predictor::ConstantPosition,
                 "adaptive" => Predictor::Adaptive,
                 _ => {
                     return Err(self.err(
                         "time.predictor",
-                        format!("must be \"adaptive\", \"zero-acceleration\" or \"constant-velocity\", got \"{r}\""),
+                        format!(
+                            "must be \"adaptive\", \"zero-acceleration\", \"constant-velocity\" or \"constant-position\", got \"{r}\""
+                        ),
                     ))
                 }
             };

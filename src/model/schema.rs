@@ -44,8 +44,9 @@ pub struct TimeSettings {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub jacobian_reuse: Option<String>,
     /// where Newton starts a step: "adaptive" (the default: each step, whichever of the
-    /// other two came closer to the last step's solution), "zero-acceleration" or
-    /// "constant-velocity" (q_n + h q̇_n; docs/reduced-speed.md)
+    /// other three came closest to the last step's solution), "zero-acceleration",
+    /// "constant-velocity" (q_n + h q̇_n) or "constant-position" (q_n;
+    /// docs/reduced-speed.md)
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub predictor: Option<String>,
     /// blow-up check: the largest mean axial strain |ε̄| a run may reach (default 0.5)

@@ -26,16 +26,30 @@
 //!   guessed step (`JacobianReuse::WithinStep`). Its error is `h² |½ q̈|` averaged over the
 //!   step, with no `q̈_{n+1}` in it, and it needs no history (halved steps use it too). On
 //!   the shipped pendulum its kept first matrix costs twice the iterations (660 → 1240).
-//! - [`Predictor::Adaptive`] (`"adaptive"`, the default since 2026-11-27): every step
-//!   records both starts and, once the step's solution is known, which came closer to it
-//!   (‖·‖∞, Newton's own measure); the next step starts there. No first matrix is kept (the
-//!   pendulum's two extra iterations). With ρ∞ = 1 the steps start almost all from
+//! - [`Predictor::ConstantPosition`] (`"constant-position"`): `q_{n+1} = q_n`, the guess
+//!   `d = 0`: Newton's first step is the linearized step from where the step starts. It
+//!   misses by the step's whole motion `|q_{n+1} − q_n|`, so it needs more iterations where
+//!   the motion is resolved (the shipped pendulum 5.45 a step against 3.0), but it carries
+//!   neither the velocities nor the accelerations of vibrations the step does not resolve,
+//!   whose positions stay small: on a stiff arm driven from rest by a moment the velocity
+//!   guess lands in the cubic range of the axial force (residual 3e7, Newton crawling at
+//!   θ = ⅔), the position guess at a residual of 1e2.
+//! - [`Predictor::Adaptive`] (`"adaptive"`, the default since 2026-11-27): once a step's
+//!   solution is known, it judges which of the three starts came closest to it (‖·‖∞,
+//!   Newton's own measure; ties to zero acceleration, then constant velocity); the next
+//!   step starts there. A run's first step, with no step before it to judge by, starts from
+//!   constant velocity (at rest: where the run starts): the consistent initial
+//!   accelerations of a load applied at t₀ are largest in the stiffest parts, which the
+//!   step resolves least. A step that fails from the chosen start is retried once, with
+//!   full Newton as before, from constant position, before it is halved. No first matrix
+//!   is kept (the pendulum's two extra iterations). With ρ∞ = 1 most steps start from
 //!   constant velocity (the shipped pendulum 219 of 220), with ρ∞ = 0.7–0.9 mostly from
-//!   zero acceleration (90–95 % on the zoo's pendulums), and some models mix (the ×10
-//!   four-bar, ρ∞ = 0.8: 87 of 157 from constant velocity). Neither fixed start is right
-//!   for every model, and the choice costs one pass over the coordinates a step; on the
-//!   zoo's first draws (tests/adaptive_start.rs) it completes every run either fixed start completes (67 of 72, against 62 for
-//!   zero acceleration) at 0.99× the better one's iterations.
+//!   zero acceleration (90–95 % on the zoo's pendulums), stiff vibrating models from
+//!   constant position, and some mix. No fixed start is right for every model, and the
+//!   choice costs one pass over the coordinates a step; on the zoo's first draws
+//!   (tests/adaptive_start.rs) it completes every run any fixed start completes (67 of 72,
+//!   against 62 for zero acceleration) at 0.98× the best one's iterations, and halves no
+//!   step where all four complete (zero acceleration 41, constant velocity 11).
 //!
 //! Only the starting point changes: every step still stops on the same Newton tolerance
 //! (tests/predictor.rs checks it step by step). Measured (docs/reduced-speed.md): the full
@@ -50,6 +64,8 @@ pub enum Predictor {
     ZeroAcceleration,
     /// `q_{n+1} = q_n + h q̇_n`, handled as a guessed increment
     ConstantVelocity,
+    /// `q_{n+1} = q_n`, handled as a guessed increment of zero
+    ConstantPosition,
     /// each step, whichever of the two starts above came closer to the last step's solution
     #[default]
     Adaptive,
@@ -61,6 +77,7 @@ impl Predictor {
         match self {
             Predictor::ZeroAcceleration => "zero-acceleration",
             Predictor::ConstantVelocity => "constant-velocity",
+            Predictor::ConstantPosition => "constant-position",
             Predictor::Adaptive => "adaptive",
         }
     }
@@ -72,6 +89,7 @@ impl Predictor {
         match self {
             Predictor::ZeroAcceleration | Predictor::Adaptive => None,
             Predictor::ConstantVelocity => Some(h * v),
+            Predictor::ConstantPosition => Some(0.0),
         }
     }
 
@@ -81,6 +99,7 @@ impl Predictor {
         match self {
             Predictor::ZeroAcceleration | Predictor::Adaptive => None,
             Predictor::ConstantVelocity => Some(h * crate::linalg::vec_ops::max_abs(v)),
+            Predictor::ConstantPosition => Some(0.0),
         }
     }
 }
