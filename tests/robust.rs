@@ -105,6 +105,32 @@ fn errors_inside_array_of_tables_entries_name_the_key_and_its_line() {
     assert!(err.contains(&format!("loads[0].type (line {line})")), "{err}");
 }
 
+/// Errors of the model's own checks (values the parser accepts: an unknown predictor, a
+/// zero element count, a key that is missing, a body named twice) name their field with the
+/// line it is written on, as parse errors do; a missing key takes its entry's line.
+#[test]
+fn check_errors_name_the_line_of_their_field() {
+    let line_of = |text: &str, start: &str| text.lines().position(|l| l.starts_with(start)).unwrap() + 1;
+    let check = |text: &str| flexrom::model::Model::from_text(text, "m.toml").unwrap_err().to_string();
+    let text = pendulum().replace("rho_inf = 1.0", "rho_inf = 1.0\npredictor = \"constant-acceleration\"");
+    let err = check(&text);
+    assert!(err.contains(&format!("time.predictor (line {}): must be", line_of(&text, "predictor ="))), "{err}");
+    let text = pendulum().replace("elements = 50", "elements = 0");
+    let err = check(&text);
+    assert!(err.contains(&format!("bodies[0].elements (line {}): must be", line_of(&text, "elements ="))), "{err}");
+    // `angle` removed: the body's `[[bodies]]` header
+    let text = pendulum().replace("angle = 0.0\n", "");
+    let err = check(&text);
+    assert!(err.contains(&format!("bodies[0].angle (line {}): missing", line_of(&text, "[[bodies]]"))), "{err}");
+    // the second of two bodies of one name
+    let second = "\n[[bodies]]\nname = \"beam\"\nstart = [0.0, 0.0]\nangle = 1.0\nlength = 1.0\nelements = 2\n\
+                  density = 1.0\narea = 1.0\ninertia = 1.0\nyoungs_modulus = 1.0\n";
+    let text = pendulum() + second;
+    let err = check(&text);
+    let line = text.lines().enumerate().filter(|(_, l)| l.starts_with("name = \"beam\"")).nth(1).unwrap().0 + 1;
+    assert!(err.contains(&format!("bodies[1].name (line {line}): body `beam` is defined twice")), "{err}");
+}
+
 /// An error inside a nested table of an entry (the four-bar's piecewise crank moment, a pin's
 /// `a`) names the whole path and the offending key's own line, not the line where the entry
 /// or its table opens.

@@ -11,12 +11,12 @@ PENDULUM = ROOT / "data" / "models" / "pendulum.toml"
 
 
 def test_bad_model_names_file_and_field(tmp_path):
-    """A negative length is a ModelError naming the file and the field (as the CLI's)."""
+    """A negative length is a ModelError naming the file, the field and its line (as the CLI's)."""
     text = PENDULUM.read_text().replace("length = 1.2", "length = -1.2", 1)
     assert text != PENDULUM.read_text(), "the pendulum's length line moved: update the test"
     path = tmp_path / "bad.toml"
     path.write_text(text)
-    with pytest.raises(flexrom.ModelError, match=r"bad\.toml: bodies\[0\]\.length: "):
+    with pytest.raises(flexrom.ModelError, match=r"bad\.toml: bodies\[0\]\.length \(line 14\): "):
         flexrom.Model.from_file(path)
     with pytest.raises(flexrom.ModelError, match=r"bodies\[0\]\.length"):
         flexrom.Model.from_toml(text)

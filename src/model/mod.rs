@@ -95,7 +95,7 @@ impl Model {
     }
 
     fn err(&self, field: impl Into<String>, problem: impl Into<String>) -> Error {
-        Error::input(&self.path, field, problem)
+        Error::input(&self.path, toml_errors::field_with_line(&self.text, &field.into()), problem)
     }
 
     /// SHA-256 of the model's canonical form: the parsed file as JSON, without the free

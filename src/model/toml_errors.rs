@@ -133,6 +133,32 @@ fn step_line(text: &str, path: &[Step]) -> Option<usize> {
     Some(text.as_bytes()[..start?.min(text.len())].iter().filter(|&&b| b == b'\n').count() + 1)
 }
 
+/// A checked field's name (`time.dt`, `bodies[2].elements`, `joints[0].b.body`) with the
+/// line it is written on, as parse errors name theirs: `bodies[2].elements (line 14)`. A
+/// field not written (a missing key, a default) takes the line of the nearest enclosing
+/// entry or table that is; a name that is no path of the text stays as it is.
+pub(super) fn field_with_line(text: &str, field: &str) -> String {
+    let mut path = Vec::new();
+    for part in field.split('.') {
+        let (key, rest) = part.split_once('[').unwrap_or((part, ""));
+        if key.is_empty() {
+            return field.to_string();
+        }
+        path.push(Step::Key(key.to_string()));
+        for index in rest.split('[') {
+            match index.strip_suffix(']').and_then(|i| i.parse().ok()) {
+                Some(i) => path.push(Step::Index(i)),
+                None if index.is_empty() => {}
+                None => return field.to_string(),
+            }
+        }
+    }
+    match (1..=path.len()).rev().find_map(|n| step_line(text, &path[..n])) {
+        Some(line) => format!("{field} (line {line})"),
+        None => field.to_string(),
+    }
+}
+
 /// The line (1-based) of the `[[name]]` header of entry `i`, if written that way.
 pub(super) fn entry_line(text: &str, name: &str, i: usize) -> Option<usize> {
     let is_header =
@@ -235,7 +261,29 @@ fn inline_key_path(prefix: &str) -> Vec<String> {
 
 #[cfg(test)]
 mod tests {
-    use super::{inline_key_path, locate};
+    use super::{field_with_line, inline_key_path, locate};
+
+    /// A checked field's line: a key of a table, a key of an array-of-tables entry, a key
+    /// inside an inline table, a missing key (its entry's line), and names that are no path
+    /// of the text (unchanged).
+    #[test]
+    fn a_checked_field_takes_the_line_it_is_written_on() {
+        let text = "[time]\ndt = 0.1\n\n[[bodies]]\nname = \"a\"\n\n[[bodies]]\nname = \"b\"\n\
+                    youngs_modulus = { value = 1e9, parameter = \"E\" }\n";
+        assert_eq!(field_with_line(text, "time.dt"), "time.dt (line 2)");
+        assert_eq!(field_with_line(text, "bodies[1].name"), "bodies[1].name (line 8)");
+        assert_eq!(
+            field_with_line(text, "bodies[1].youngs_modulus.parameter"),
+            "bodies[1].youngs_modulus.parameter (line 9)"
+        );
+        assert_eq!(field_with_line(text, "bodies[0].angle"), "bodies[0].angle (line 4)");
+        assert_eq!(field_with_line(text, "time.t_end"), "time.t_end (line 1)");
+        // an entry past the last: the array's first line
+        assert_eq!(field_with_line(text, "bodies[3].name"), "bodies[3].name (line 4)");
+        for field in ["joints", "joints[0].body", "joints[1] (line 25)", "(file)", ""] {
+            assert_eq!(field_with_line(text, field), field);
+        }
+    }
 
     /// The key path through inline tables to an error's position: nested tables, arrays and
     /// strings holding `=`, `,` or `{` passed over; none after a closed entry.
