@@ -453,7 +453,7 @@ impl Validation {
             _ => String::new(),
         };
         format!(
-            "load scale {}{}: {} reduction, {} of {} coordinates\n  rel_error {:.3e}, max probe error {:.3e} m ({} at t = {:.4} s), max constraint violation {:.3e}\n  full {:.4} s, reduced {:.4} s, speedup {:.2}×{}{}",
+            "load scale {}{}: {} reduction, {} of {} coordinates\n  rel_error {:.3e}, max probe error {:.3e} m ({} at t = {:.4} s), max constraint violation {:.3e}\n  full {:.4} s, reduced {:.4} s, speedup {:.2}×{}{}{}",
             self.load_scale,
             self.parameters
                 .iter()
@@ -472,8 +472,13 @@ impl Validation {
             self.rom_seconds,
             self.speedup,
             dense,
+            self.slower_line(),
             self.trust_lines()
         )
+    }
+
+    fn slower_line(&self) -> String {
+        slower_line(self.speedup, self.speedup_with_estimate)
     }
 
     /// The estimate, extrapolation, sensitivity and error-by-time lines of `describe`.
@@ -592,9 +597,40 @@ impl Validation {
     }
 }
 
+/// The line `validate` adds where the route `online` and `sweep` take — the reduced run
+/// with its estimate, or without one where the basis has none — is not faster than the
+/// full run (`speedup`, `speedup_with_estimate`: full time over reduced), else nothing.
+fn slower_line(speedup: f64, speedup_with_estimate: Option<f64>) -> String {
+    let (ratio, what) = match speedup_with_estimate {
+        Some(s) => (s, "the reduced run with its estimate"),
+        None => (speedup, "the reduced run"),
+    };
+    if ratio >= 1.0 {
+        return String::new();
+    }
+    format!(
+        "\n  {what} is not faster than the full run here ({ratio:.2}×): the full model is exact, \
+         `flexrom sweep --full` runs it at every load (docs/basis-and-sweep.md)"
+    )
+}
+
 #[cfg(test)]
 mod tests {
-    use super::{first_different_step, ProbeQuantityError, ProbeTravel};
+    /// The slower-route line: only below 1×, judged on the route with the estimate where
+    /// there is one (a reduced run 1.36× faster that its estimate brings to 0.9× is slower).
+    #[test]
+    fn the_slower_route_is_named_only_where_it_is_slower() {
+        assert_eq!(slower_line(1.36, Some(1.14)), "");
+        assert_eq!(slower_line(2.0, None), "");
+        let l = slower_line(1.36, Some(0.9));
+        assert!(
+            l.contains("with its estimate is not faster") && l.contains("(0.90×)") && l.contains("sweep --full"),
+            "{l}"
+        );
+        assert!(slower_line(0.63, None).contains("the reduced run is not faster than the full run here (0.63×)"));
+    }
+
+    use super::{first_different_step, slower_line, ProbeQuantityError, ProbeTravel};
 
     /// Which step the runs first took differently: a cut only one of them made, the
     /// earlier of two such, and none when both halved the same steps.
