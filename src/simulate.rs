@@ -174,14 +174,33 @@ pub fn integrate_guided<M: DynamicModel>(
     let mut increment = vec![0.0; state.q.len()];
     let mut watch = BlowUpWatch::new(params, s.allow_blowup);
     record(0, &state);
-    for k in 1..=n_steps {
-        crate::interrupt::check()?;
-        let guessed = guess(k, &mut increment);
-        integ.step_guided(model, &mut state, dt, guessed.then_some(increment.as_slice()))?;
-        // keep t on the nominal grid despite round-off in sub-steps
-        state.t = k as f64 * dt;
-        watch.check(model, &state, &integ.stats, k == n_steps || k % STRAIN_CHECK_EVERY == 0)?;
-        record(k, &state);
+    let mut steps = || -> Result<()> {
+        for k in 1..=n_steps {
+            crate::interrupt::check()?;
+            let guessed = guess(k, &mut increment);
+            integ.step_guided(model, &mut state, dt, guessed.then_some(increment.as_slice()))?;
+            // keep t on the nominal grid despite round-off in sub-steps
+            state.t = k as f64 * dt;
+            watch.check(model, &state, &integ.stats, k == n_steps || k % STRAIN_CHECK_EVERY == 0)?;
+            record(k, &state);
+        }
+        Ok(())
+    };
+    if let Err(e) = steps() {
+        // what `-v` prints of a run that ends, for one that failed (the error says where)
+        let st = &integ.stats;
+        log::debug!(
+            "  Newton until the run failed: {} steps done, {} iterations (at most {} in one attempt), {} \
+             factorizations, {} step cuts; starts from constant velocity {}, constant position {}",
+            st.steps,
+            st.newton_iterations,
+            st.max_iterations_in_a_step,
+            st.factorizations,
+            st.step_cuts,
+            st.constant_velocity_starts,
+            st.constant_position_starts
+        );
+        return Err(e);
     }
     Ok(integ.stats)
 }

@@ -337,3 +337,23 @@ fn a_model_file_given_as_a_pipeline_is_named() {
     assert!(err.contains("pendulum.toml: bodies: this is a model file") && err.contains("model = "), "{err}");
     flexrom::pipeline::Pipeline::load(root().join("pipelines/pendulum.toml")).unwrap();
 }
+
+/// `-v` on a run that fails still shows its Newton statistics up to the failure (a run that
+/// ends prints its Newton line; the failed one printed nothing): the shipped pendulum at
+/// 10⁴ times its gravity, which stretches the beam past the strain bound within 0.06 s.
+#[test]
+fn a_failed_run_under_verbose_shows_newton_until_the_failure() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.h5");
+    let m = root().join("data/models/pendulum.toml");
+    let (code, err) =
+        run(&["-v", "simulate", m.to_str().unwrap(), "--load-scale", "10000", "-o", out.to_str().unwrap()]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("blow-up"), "{err}");
+    let line = err.lines().find(|l| l.contains("Newton until the run failed")).unwrap_or_else(|| panic!("{err}"));
+    assert!(line.contains("steps done") && line.contains("step cuts"), "{line}");
+    assert!(!out.exists());
+    // without -v, the error alone
+    let (_, err) = run(&["simulate", m.to_str().unwrap(), "--load-scale", "10000", "-o", out.to_str().unwrap()]);
+    assert!(!err.contains("Newton until"), "{err}");
+}
