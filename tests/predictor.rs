@@ -1,6 +1,6 @@
 //! The constant-velocity predictor (`Predictor::ConstantVelocity`, `[time] predictor =
-//! "constant-velocity"`; see src/solver/predictor.rs) and the adaptive one (the default,
-//! which picks either start step by step) change where Newton starts a step, not where it
+//! "constant-velocity"`; see src/solver/predictor.rs), the constant-position one and the
+//! adaptive one (the default, which picks a start step by step) change where Newton starts a step, not where it
 //! stops, and on the four-bar they start closer: fewer factorizations than the
 //! zero-acceleration predictor.
 //!
@@ -14,8 +14,8 @@
 //! matrix's θ predicts the next iteration only roughly; tests/jacobian_reuse.rs measured 3.7
 //! tol on the pendulum). Measured here: the zero-acceleration predictor (the old default) up
 //! to 21.5 tol (full) and 7.1 tol (reduced), the constant-velocity one 4.1 and 11.8 tol,
-//! the adaptive one 8.0 and 7.2 tol; hence 30 tol for all: the new starts stop as close to
-//! the root as the old one did.
+//! the adaptive one 8.0 and 7.2 tol, the constant-position one 1.9 and 1.6 tol; hence 30
+//! tol for all: the new starts stop as close to the root as the old one did.
 //!
 //! Models: the full thesis four-bar (data/models/fourbar.toml, all 157 steps, λ = 0.85, a
 //! load no basis is trained at) and its hyper-reduced model with one POD per body
@@ -23,8 +23,9 @@
 //! The factorization counts must be strictly lower with the constant-velocity and the
 //! adaptive predictor; measured on whole runs at λ = 0.74, 0.85, 1.0, 1.1
 //! (docs/reduced-speed.md): full 537–565 against 569–656, greedy-trained shipped basis
-//! 516–543 against 565–720; here, at 0.85, adaptive 526 (full) and 562 (reduced) against
-//! 608 and 605.
+//! 516–543 against 565–720; here, at 0.85, adaptive 522 (full) and 553 (reduced) against
+//! 608 and 605. The constant-position start (a start for stiff vibrations; 561 and 546) is
+//! held to the bound only.
 
 use flexrom::physics::system::FlexibleSystem;
 use flexrom::pipeline::train::train;
@@ -101,6 +102,11 @@ fn check<M: ParametricModel>(name: &str, make: impl Fn() -> M, s: &Settings, q0:
     assert!(cv_err <= bound, "{name}: a step ends {cv_err:.3e} L from the root > {bound:.1e} L");
     assert!(za_err <= bound, "{name}: the old predictor ends {za_err:.3e} L from the root > {bound:.1e} L");
     assert_eq!((cv.step_cuts, za.step_cuts), (0, 0), "{name}");
+    if tested == Predictor::ConstantPosition {
+        // a start for stiff vibrations: where the motion is resolved it misses by the whole
+        // step, so only where it stops is held to the bound here
+        return;
+    }
     assert!(
         cv.factorizations < za.factorizations,
         "{name}: factorizations {} vs {}",
@@ -118,7 +124,7 @@ fn the_predictor_moves_no_full_order_step_end_and_saves_factorizations() {
     let p = Pipeline::load(repo("pipelines/thesis/fourbar_blocks.toml")).unwrap();
     let s = settings(&p, 0.85);
     let q0 = prepare(&p.model, &s).unwrap().1;
-    for tested in [Predictor::ConstantVelocity, Predictor::Adaptive] {
+    for tested in [Predictor::ConstantVelocity, Predictor::ConstantPosition, Predictor::Adaptive] {
         check("full four-bar", || prepare(&p.model, &s).unwrap().0, &s, q0.clone(), tested);
     }
 }
@@ -133,7 +139,7 @@ fn the_predictor_moves_no_reduced_step_end_and_saves_factorizations() {
     let (sys, x0) = prepare(&p.model, &s).unwrap();
     let q0 = basis.reduce(ndarray::ArrayView1::from(&x0)).to_vec();
     let full = std::sync::Arc::new(sys);
-    for tested in [Predictor::ConstantVelocity, Predictor::Adaptive] {
+    for tested in [Predictor::ConstantVelocity, Predictor::ConstantPosition, Predictor::Adaptive] {
         check(
             "reduced four-bar",
             || HyperReducedModel::<FlexibleSystem>::new(full.clone(), &basis, &hyper).unwrap(),

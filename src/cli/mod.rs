@@ -180,9 +180,11 @@ pub fn run_details(r: &flexrom::simulate::SimulationResult) {
     if s.params.predictor == flexrom::solver::generalized_alpha::Predictor::Adaptive {
         // which guess the adaptive start took (docs/reduced-speed.md): a model that always
         // takes one may as well name it in `[time] predictor`
+        // a halved step's parts count each, so the three may sum past the steps
         detail(&format!(
-            "  Newton's start: constant velocity at {} of {} steps, constant position at {}, zero acceleration at the others",
-            st.constant_velocity_starts, st.steps, st.constant_position_starts
+            "  Newton's start: constant velocity at {}, constant position at {}, zero acceleration at {} of the steps \
+             solved ({} steps, a halved step's parts counted each)",
+            st.constant_velocity_starts, st.constant_position_starts, st.zero_acceleration_starts, st.steps
         ));
     }
 }

@@ -32,8 +32,8 @@
 //!   the motion is resolved (the shipped pendulum 5.45 a step against 3.0), but it carries
 //!   neither the velocities nor the accelerations of vibrations the step does not resolve,
 //!   whose positions stay small: on a stiff arm driven from rest by a moment the velocity
-//!   guess lands in the cubic range of the axial force (residual 3e7, Newton crawling at
-//!   θ = ⅔), the position guess at a residual of 1e2.
+//!   guess of its second step lands in the cubic range of the axial force (residual 2.6e7,
+//!   Newton crawling at θ = ⅔), the position guess at a residual of 1.4e2.
 //! - [`Predictor::Adaptive`] (`"adaptive"`, the default since 2026-11-27): once a step's
 //!   solution is known, it judges which of the three starts came closest to it (‖·‖∞,
 //!   Newton's own measure; ties to zero acceleration, then constant velocity); the next
@@ -41,9 +41,9 @@
 //!   constant velocity (at rest: where the run starts): the consistent initial
 //!   accelerations of a load applied at t₀ are largest in the stiffest parts, which the
 //!   step resolves least. A step that fails from the chosen start is retried once, with
-//!   full Newton as before, from constant position, before it is halved. No first matrix
+//!   full Newton as before, from constant position, and its halves start there too. No first matrix
 //!   is kept (the pendulum's two extra iterations). With ρ∞ = 1 most steps start from
-//!   constant velocity (the shipped pendulum 219 of 220), with ρ∞ = 0.7–0.9 mostly from
+//!   constant velocity (the shipped pendulum 220 of 220), with ρ∞ = 0.7–0.9 mostly from
 //!   zero acceleration (90–95 % on the zoo's pendulums), stiff vibrating models from
 //!   constant position, and some mix. No fixed start is right for every model, and the
 //!   choice costs one pass over the coordinates a step; on the zoo's first draws
@@ -66,7 +66,9 @@ pub enum Predictor {
     ConstantVelocity,
     /// `q_{n+1} = q_n`, handled as a guessed increment of zero
     ConstantPosition,
-    /// each step, whichever of the two starts above came closer to the last step's solution
+    /// each step, whichever of the three starts above came closest to the last step's
+    /// solution (a run's first step from constant velocity, a failed step's retry and
+    /// halves from constant position)
     #[default]
     Adaptive,
 }
