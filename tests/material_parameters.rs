@@ -304,7 +304,11 @@ fn a_material_parameter_the_model_cannot_take_is_refused_naming_the_field() {
     .unwrap();
     let (ok, err) = flexrom(d, &["train", "p.toml"]);
     assert!(!ok && !d.join("b.h5").exists(), "{err}");
-    assert!(err.contains("parameters.E_coupler: is a Young's modulus (Pa); its range must be positive"), "{err}");
+    // (line 5: the pipeline's `E_coupler = [-1e6, 8e6]`)
+    assert!(
+        err.contains("parameters.E_coupler (line 5): is a Young's modulus (Pa); its range must be positive"),
+        "{err}"
+    );
 
     // a factor meant for a value (two orders of magnitude or more from the file's 5e6) is
     // warned about, on the command line and in a box; a value near the file's is not

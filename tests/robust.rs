@@ -357,3 +357,28 @@ fn a_failed_run_under_verbose_shows_newton_until_the_failure() {
     let (_, err) = run(&["simulate", m.to_str().unwrap(), "--load-scale", "10000", "-o", out.to_str().unwrap()]);
     assert!(!err.contains("Newton until"), "{err}");
 }
+
+/// A pipeline file's checks name the line of their field too (the shipped pendulum's
+/// pipeline with a negative greedy tolerance; `modes` missing names its table's line).
+#[test]
+fn pipeline_check_errors_name_the_line_of_their_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = root().join("data/models/pendulum.toml");
+    let text = std::fs::read_to_string(root().join("pipelines/pendulum.toml"))
+        .unwrap()
+        .replace("model = \"../data/models/pendulum.toml\"", &format!("model = {:?}", model.display().to_string()));
+    let line_of = |text: &str, start: &str| text.lines().position(|l| l.starts_with(start)).unwrap() + 1;
+    let bad = text.replace("tolerance = 1e-3, max_runs", "tolerance = -1e-3, max_runs");
+    assert_ne!(bad, text, "the shipped pipeline's greedy line moved: update the test");
+    let p = write(dir.path(), "p.toml", &bad);
+    let err = flexrom::pipeline::Pipeline::load(&p).unwrap_err().to_string();
+    assert!(err.contains(&format!("train.greedy.tolerance (line {}): is -0.001", line_of(&bad, "greedy ="))), "{err}");
+    let bad = text
+        .lines()
+        .map(|l| if l.starts_with("greedy =") { "load_scales = [1.0]" } else { l })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let p = write(dir.path(), "p.toml", &bad);
+    let err = flexrom::pipeline::Pipeline::load(&p).unwrap_err().to_string();
+    assert!(err.contains(&format!("reduction.modes (line {}): is missing", line_of(&bad, "[reduction]"))), "{err}");
+}

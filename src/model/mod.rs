@@ -15,7 +15,7 @@ use crate::solver::parameters::Parameters;
 use schema::*;
 use std::path::{Path, PathBuf};
 use toml_errors::entry_error;
-pub(crate) use toml_errors::parse_toml;
+pub(crate) use toml_errors::{parse_toml, with_field_line};
 
 /// Sizes of a model's system (see [`Model::sizes`]).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -159,6 +159,18 @@ pub(super) fn field_with_line(text: &str, field: &str) -> String {
     }
 }
 
+/// An input error about the TOML file `file` whose `text` is given, with the line of its
+/// field added where the field is a path of that text and names no line yet
+/// (`train.load_scales (line 7)`); any other error as it is.
+pub(crate) fn with_field_line(e: Error, file: &Path, text: &str) -> Error {
+    match e {
+        Error::Input { file: f, field, problem } if f == file.display().to_string() && !field.contains("(line ") => {
+            Error::Input { field: field_with_line(text, &field), file: f, problem }
+        }
+        other => other,
+    }
+}
+
 /// The line (1-based) of the `[[name]]` header of entry `i`, if written that way.
 pub(super) fn entry_line(text: &str, name: &str, i: usize) -> Option<usize> {
     let is_header =

@@ -122,7 +122,8 @@ impl Pipeline {
             basis_path,
             report_dir,
         };
-        p.check()?;
+        // the checks name fields; the text knows their lines
+        p.check().map_err(|e| crate::model::with_field_line(e, &p.path, &p.text))?;
         Ok(p)
     }
 
