@@ -330,7 +330,7 @@ impl GeneralizedAlpha {
             // a stale matrix may be what failed: retry once with full Newton before halving
             state.clone_from(self.backup.as_ref().expect("backup taken"));
             self.factored = None;
-            self.start_failed_steps_at_rest();
+            self.restart_failed_step_from_its_position();
             result = self.try_step(model, state, h, JacobianReuse::Never, guess);
         }
         match result {
@@ -339,7 +339,7 @@ impl GeneralizedAlpha {
                 state.clone_from(self.backup.as_ref().expect("backup taken"));
                 self.factored = None;
                 // the halves too (with `JacobianReuse::Never` there was no retry)
-                self.start_failed_steps_at_rest();
+                self.restart_failed_step_from_its_position();
                 if depth >= self.params.max_cuts {
                     return Err(Error::NewtonFailed {
                         t: state.t + h,
@@ -366,7 +366,7 @@ impl GeneralizedAlpha {
     /// into, and the step's start is off by no more than the step's own motion
     /// (docs/reduced-speed.md, "The adaptive start"). A guided step's retry keeps its
     /// guess; its halves start here too. The next converged step chooses again.
-    fn start_failed_steps_at_rest(&mut self) {
+    fn restart_failed_step_from_its_position(&mut self) {
         if self.params.predictor == Predictor::Adaptive {
             self.next_start = Predictor::ConstantPosition;
         }
