@@ -191,14 +191,16 @@ pub fn integrate_guided<M: DynamicModel>(
         let st = &integ.stats;
         log::debug!(
             "  Newton until the run failed: {} steps done, {} iterations (at most {} in one attempt), {} \
-             factorizations, {} step cuts; starts from constant velocity {}, constant position {}",
+             factorizations, {} step cuts; starts from constant velocity {}, constant position {}, zero \
+             acceleration {}",
             st.steps,
             st.newton_iterations,
             st.max_iterations_in_a_step,
             st.factorizations,
             st.step_cuts,
             st.constant_velocity_starts,
-            st.constant_position_starts
+            st.constant_position_starts,
+            st.zero_acceleration_starts
         );
         return Err(e);
     }

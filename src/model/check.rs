@@ -398,20 +398,11 @@ impl Model {
             };
         }
         if let Some(r) = &t.predictor {
-            p.predictor = match r.as_str() {
-                "zero-acceleration" => Predictor::ZeroAcceleration,
-                "constant-velocity" => Predictor::ConstantVelocity,
-                "constant-position" => Predictor::ConstantPosition,
-                "adaptive" => Predictor::Adaptive,
-                _ => {
-                    return Err(self.err(
-                        "time.predictor",
-                        format!(
-                            "must be \"adaptive\", \"zero-acceleration\", \"constant-velocity\" or \"constant-position\", got \"{r}\""
-                        ),
-                    ))
-                }
-            };
+            p.predictor = Predictor::from_name(r).ok_or_else(|| {
+                let names: Vec<String> = Predictor::ALL.iter().map(|p| format!("\"{}\"", p.name())).collect();
+                let (last, rest) = names.split_last().expect("four starts");
+                self.err("time.predictor", format!("must be {} or {last}, got \"{r}\"", rest.join(", ")))
+            })?;
         }
         Ok(p)
     }

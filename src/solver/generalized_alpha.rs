@@ -173,17 +173,18 @@ impl GeneralizedAlpha {
     /// small — there the position the step started from is the closest guess. One pass over
     /// the coordinates; the guesses are formed again from the start rather than kept.
     fn closer_start(&self, start: &State, q: &[f64], k: &StepConstants) -> Predictor {
-        let (mut zero_acceleration, mut constant_velocity, mut constant_position) = (0.0_f64, 0.0_f64, 0.0_f64);
+        // in order of preference on a tie; each guess as the start itself makes it
+        const STARTS: [Predictor; 3] =
+            [Predictor::ZeroAcceleration, Predictor::ConstantVelocity, Predictor::ConstantPosition];
+        let mut misses = [0.0_f64; 3];
         for (i, &qi) in q.iter().enumerate() {
             let d = qi - start.q[i];
-            zero_acceleration = zero_acceleration.max((d - self.zero_acceleration_start(start, i, k).1).abs());
-            constant_velocity = constant_velocity.max((d - k.h * start.v[i]).abs());
-            constant_position = constant_position.max(d.abs());
+            for (miss, p) in misses.iter_mut().zip(STARTS) {
+                let guess = p.increment(k.h, start.v[i]).unwrap_or_else(|| self.zero_acceleration_start(start, i, k).1);
+                *miss = miss.max((d - guess).abs());
+            }
         }
-        [(Predictor::ConstantVelocity, constant_velocity), (Predictor::ConstantPosition, constant_position)]
-            .into_iter()
-            .fold((Predictor::ZeroAcceleration, zero_acceleration), |best, x| if x.1 < best.1 { x } else { best })
-            .0
+        STARTS[(1..3).fold(0, |best, j| if misses[j] < misses[best] { j } else { best })]
     }
 
     /// Starts the step to `t + h` at the increment `d` exactly (`q ← q + d`), with `q̇`, `q̈`
@@ -326,11 +327,13 @@ impl GeneralizedAlpha {
         }
         let reuse = self.params.reuse;
         let mut result = self.try_step(model, state, h, reuse, guess);
+        if result.is_err() {
+            self.restart_failed_step_from_its_position();
+        }
         if result.is_err() && reuse != JacobianReuse::Never {
             // a stale matrix may be what failed: retry once with full Newton before halving
             state.clone_from(self.backup.as_ref().expect("backup taken"));
             self.factored = None;
-            self.restart_failed_step_from_its_position();
             result = self.try_step(model, state, h, JacobianReuse::Never, guess);
         }
         match result {
@@ -338,8 +341,6 @@ impl GeneralizedAlpha {
             Err(fail) => {
                 state.clone_from(self.backup.as_ref().expect("backup taken"));
                 self.factored = None;
-                // the halves too (with `JacobianReuse::Never` there was no retry)
-                self.restart_failed_step_from_its_position();
                 if depth >= self.params.max_cuts {
                     return Err(Error::NewtonFailed {
                         t: state.t + h,
@@ -461,12 +462,14 @@ impl GeneralizedAlpha {
                     self.next_start = self.closer_start(start, &st.q, &k);
                 }
                 self.stats.steps_at_round_off += stagnated as usize;
-                self.stats.constant_velocity_starts +=
-                    (guess.is_none() && predictor == Predictor::ConstantVelocity) as usize;
-                self.stats.constant_position_starts +=
-                    (guess.is_none() && predictor == Predictor::ConstantPosition) as usize;
-                self.stats.zero_acceleration_starts +=
-                    (guess.is_none() && predictor == Predictor::ZeroAcceleration) as usize;
+                if guess.is_none() {
+                    *match predictor {
+                        Predictor::ZeroAcceleration => &mut self.stats.zero_acceleration_starts,
+                        Predictor::ConstantVelocity => &mut self.stats.constant_velocity_starts,
+                        Predictor::ConstantPosition => &mut self.stats.constant_position_starts,
+                        Predictor::Adaptive => unreachable!("the adaptive start chose one of the others"),
+                    } += 1;
+                }
                 self.finish_step(st, &k);
                 st.t = t;
                 self.stats.max_iterations_in_a_step = self.stats.max_iterations_in_a_step.max(it);

@@ -74,6 +74,15 @@ pub enum Predictor {
 }
 
 impl Predictor {
+    /// Every start, the default first (the order the model file's error lists them in).
+    pub const ALL: [Predictor; 4] =
+        [Predictor::Adaptive, Predictor::ZeroAcceleration, Predictor::ConstantVelocity, Predictor::ConstantPosition];
+
+    /// The start the model file's spelling names ([`Self::name`]).
+    pub fn from_name(name: &str) -> Option<Predictor> {
+        Predictor::ALL.into_iter().find(|p| p.name() == name)
+    }
+
     /// The model file's spelling (`[time] predictor`).
     pub fn name(self) -> &'static str {
         match self {
