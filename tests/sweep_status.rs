@@ -346,6 +346,75 @@ fn a_fallback_answers_with_the_full_model_where_the_estimate_exceeds_the_toleran
     assert_eq!(messages(&plain), vec![""; 3]);
 }
 
+/// `--fallback full` where the reduced runs fail and the full ones do not: the ×10 four-bar
+/// (data/models/fourbar_x10.toml, shortened to t_end = 0.4 s) on a basis too poor for it
+/// (2 + 10 + 2 POD modes, ECSW at τ = 0.1, trained at 0.7 and 1.2; measured 2026-11-28:
+/// every reduced run blows up at t = 0.168 s, a mean axial strain of 0.51–0.59 in the
+/// coupler, while the full runs finish). Every point is the full model's answer (its probes
+/// bit for bit those of `sweep --full`), `/status` 0, `/fallback` 1, `/error_estimate` 0,
+/// the reduced run's failure named in `/message`, exit 0; without the fallback the same
+/// sweep fails at every point (exit 3) and says that the full model is the way on.
+#[test]
+fn a_fallback_answers_with_the_full_model_where_the_reduced_run_fails() {
+    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let model = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("data/models/fourbar_x10.toml"))
+        .unwrap()
+        .replace("t_end = 1.1", "t_end = 0.4");
+    assert!(model.contains("t_end = 0.4"));
+    std::fs::write(d.join("model.toml"), model).unwrap();
+    let p = d.join("pipe.toml");
+    std::fs::write(
+        &p,
+        "model = \"model.toml\"\nbasis = \"basis.h5\"\n[train]\nload_scales = [0.7, 1.2]\n[reduction]\nvariant = \"constraint-preserving\"\nblocks = \"bodies\"\nmodes = { counts = [2, 10, 2] }\nhyper = { tolerance = 0.1 }\n",
+    )
+    .unwrap();
+    let ps = p.to_str().unwrap();
+    let (o, err) = run(&["train", ps]);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    let (fb, full, plain) = (d.join("fb.h5"), d.join("full.h5"), d.join("plain.h5"));
+    let loads = ["--load-scales", "0.8:1.0:3"];
+    let (o, err) = run(&[&["sweep", ps, "--fallback", "full", "-o", fb.to_str().unwrap()][..], &loads].concat());
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("the full model answered 3 of 3 load scales in place of the reduced one (3: reduced run failed;"),
+        "{err}"
+    );
+    let (o, err) = run(&[&["sweep", ps, "--full", "-o", full.to_str().unwrap()][..], &loads].concat());
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    let probes = |f: &Path| {
+        let f = hdf5::File::open(f).unwrap();
+        let g = f.group("probes").unwrap();
+        let mut names = g.member_names().unwrap();
+        names.sort();
+        names.into_iter().map(|n| (g.dataset(&n).unwrap().read_raw::<f64>().unwrap(), n)).collect::<Vec<_>>()
+    };
+    let answers = probes(&fb);
+    assert_eq!(answers.len(), 3, "the model's three probes");
+    assert_eq!(answers, probes(&full), "the fallback's answers are the full model's");
+    assert_eq!(status(&fb), vec![0, 0, 0]);
+    let f = hdf5::File::open(&fb).unwrap();
+    assert_eq!(f.dataset("fallback").unwrap().read_raw::<u8>().unwrap(), vec![1, 1, 1]);
+    drop(f);
+    assert_eq!(column(&fb, "error_estimate"), vec![0.0; 3]);
+    for m in messages(&fb) {
+        assert!(
+            m.starts_with(
+                "full model in place of the reduced one: the reduced run failed: sweep (reduced run) at load scale "
+            ),
+            "{m}"
+        );
+        assert!(m.contains("blow-up at t = "), "{m}");
+    }
+    // without the fallback the same points fail, and the way on is named
+    let (o, err) = run(&[&["sweep", ps, "-o", plain.to_str().unwrap()][..], &loads].concat());
+    assert_eq!(o.status.code(), Some(3), "{err}");
+    assert_eq!(status(&plain), vec![1, 1, 1]);
+    assert!(err.contains("3 of 3 load scales failed"), "{err}");
+    assert!(err.contains("`flexrom sweep --full` at many"), "{err}");
+}
+
 /// Where the full model fails too (1e20 × gravity: Newton fails in both after 8 halvings,
 /// see the first test), the point is failed and its message holds both failures; the
 /// others are the reduced answers (the tolerance of the pipeline is the training one:
