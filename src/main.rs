@@ -259,6 +259,9 @@ fn main() -> ExitCode {
             ExitCode::from((128 + sig) as u8)
         }
         Err(e) => {
+            // a check made while a stage ran names its field without the line load-time
+            // checks give: the line from the file
+            let e = flexrom::model::with_field_line_from_file(e);
             note(&format!("error: {e}"));
             ExitCode::from(e.exit_code())
         }

@@ -359,7 +359,9 @@ fn a_failed_run_under_verbose_shows_newton_until_the_failure() {
 }
 
 /// A pipeline file's checks name the line of their field too (the shipped pendulum's
-/// pipeline with a negative greedy tolerance; `modes` missing names its table's line).
+/// pipeline with a negative greedy tolerance; `modes` missing names its table's line), and
+/// so does a check a stage makes after loading it (`train --snapshots-only --shard` of a
+/// greedy pipeline).
 #[test]
 fn pipeline_check_errors_name_the_line_of_their_field() {
     let dir = tempfile::tempdir().unwrap();
@@ -381,4 +383,15 @@ fn pipeline_check_errors_name_the_line_of_their_field() {
     let p = write(dir.path(), "p.toml", &bad);
     let err = flexrom::pipeline::Pipeline::load(&p).unwrap_err().to_string();
     assert!(err.contains(&format!("reduction.modes (line {}): is missing", line_of(&bad, "[reduction]"))), "{err}");
+    // a check a stage makes while it runs (sharding a greedy pipeline's training runs),
+    // after the file loaded: the command's error names the line too, exit 1
+    let p = write(dir.path(), "greedy.toml", &text);
+    let out = dir.path().join("snaps.h5");
+    let (code, err) = run(&["train", &p, "--snapshots-only", "--shard", "1/2", "-o", out.to_str().unwrap()]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains(&format!("train.greedy (line {}): greedy training is sequential", line_of(&text, "greedy ="))),
+        "{err}"
+    );
+    assert!(!out.exists());
 }

@@ -15,6 +15,7 @@ use crate::solver::parameters::Parameters;
 use schema::*;
 use std::path::{Path, PathBuf};
 use toml_errors::entry_error;
+pub use toml_errors::with_field_line_from_file;
 pub(crate) use toml_errors::{parse_toml, with_field_line};
 
 /// Sizes of a model's system (see [`Model::sizes`]).

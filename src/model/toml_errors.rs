@@ -171,6 +171,22 @@ pub(crate) fn with_field_line(e: Error, file: &Path, text: &str) -> Error {
     }
 }
 
+/// `with_field_line` for an error found after the file was loaded (a check a stage makes
+/// while it runs, e.g. `train --snapshots-only` on a greedy pipeline): the field of an input
+/// error about a TOML file gets its line from the file as it is now; any other error, or a
+/// file that can no longer be read, as it is.
+pub fn with_field_line_from_file(e: Error) -> Error {
+    let Error::Input { file, field, .. } = &e else { return e };
+    if !file.ends_with(".toml") || field.contains("(line ") {
+        return e;
+    }
+    let file = std::path::PathBuf::from(file);
+    match std::fs::read_to_string(&file) {
+        Ok(text) => with_field_line(e, &file, &text),
+        Err(_) => e,
+    }
+}
+
 /// The line (1-based) of the `[[name]]` header of entry `i`, if written that way.
 pub(super) fn entry_line(text: &str, name: &str, i: usize) -> Option<usize> {
     let is_header =
@@ -273,7 +289,26 @@ fn inline_key_path(prefix: &str) -> Vec<String> {
 
 #[cfg(test)]
 mod tests {
-    use super::{field_with_line, inline_key_path, locate};
+    use super::{field_with_line, inline_key_path, locate, with_field_line_from_file};
+    use crate::error::Error;
+
+    /// A stage's input error about a TOML file gets its field's line from the file; one
+    /// that has a line, one about another kind of file, and one whose file is gone stay.
+    #[test]
+    fn a_stage_error_takes_its_line_from_the_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let toml = dir.path().join("p.toml");
+        std::fs::write(&toml, "[train]\n# comment\ngreedy = { range = [0.5, 1.5] }\n").unwrap();
+        let shown = |e: Error| with_field_line_from_file(e).to_string();
+        assert!(shown(Error::input(&toml, "train.greedy", "no")).ends_with("train.greedy (line 3): no"));
+        assert!(shown(Error::input(&toml, "train.greedy (line 9)", "no")).ends_with("train.greedy (line 9): no"));
+        let h5 = dir.path().join("b.h5");
+        std::fs::write(&h5, "[train]\ngreedy = 1\n").unwrap();
+        assert!(shown(Error::input(&h5, "train.greedy", "no")).ends_with("train.greedy: no"));
+        let gone = dir.path().join("gone.toml");
+        assert!(shown(Error::input(&gone, "train.greedy", "no")).ends_with("train.greedy: no"));
+        assert_eq!(shown(Error::Usage("x".into())), "x");
+    }
 
     /// A checked field's line: a key of a table, a key of an array-of-tables entry, a key
     /// inside an inline table, a missing key (its entry's line), and names that are no path
