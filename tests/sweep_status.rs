@@ -375,6 +375,13 @@ fn a_fallback_answers_with_the_full_model_where_the_reduced_run_fails() {
     assert_eq!(o.status.code(), Some(0), "{err}");
     let (fb, full, plain) = (d.join("fb.h5"), d.join("full.h5"), d.join("plain.h5"));
     let loads = ["--load-scales", "0.8:1.0:3"];
+    // first that the setup still does what the test is about: without the fallback every
+    // reduced run fails, and the way on is named
+    let (o, err) = run(&[&["sweep", ps, "-o", plain.to_str().unwrap()][..], &loads].concat());
+    assert_eq!(o.status.code(), Some(3), "{err}");
+    assert_eq!(status(&plain), vec![1, 1, 1]);
+    assert!(err.contains("3 of 3 load scales failed"), "{err}");
+    assert!(err.contains("`flexrom sweep --full` at many"), "{err}");
     let (o, err) = run(&[&["sweep", ps, "--fallback", "full", "-o", fb.to_str().unwrap()][..], &loads].concat());
     assert_eq!(o.status.code(), Some(0), "{err}");
     assert!(
@@ -407,12 +414,6 @@ fn a_fallback_answers_with_the_full_model_where_the_reduced_run_fails() {
         );
         assert!(m.contains("blow-up at t = "), "{m}");
     }
-    // without the fallback the same points fail, and the way on is named
-    let (o, err) = run(&[&["sweep", ps, "-o", plain.to_str().unwrap()][..], &loads].concat());
-    assert_eq!(o.status.code(), Some(3), "{err}");
-    assert_eq!(status(&plain), vec![1, 1, 1]);
-    assert!(err.contains("3 of 3 load scales failed"), "{err}");
-    assert!(err.contains("`flexrom sweep --full` at many"), "{err}");
 }
 
 /// Where the full model fails too (1e20 × gravity: Newton fails in both after 8 halvings,

@@ -236,15 +236,15 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         }
         // the held-out check of the estimate itself: off by more than the method assumes, the
         // loop reads the candidates with the enriched model (the reference the correction
-        // approximates) from here on, when that reads closer at this point
-        // where the model amplifies load changes by more than the error found, the error is
-        // the dynamics', which no estimate of the reduction sees: no ground to change method
+        // approximates) from here on, when that reads closer at this point; not for an
+        // under-reading the dynamics explain (check_method)
         let sens = level.sensitivity[ni][FIFTHS - 1];
-        let dynamics = dynamics_error(sens, g.tolerance, e_measured);
-        let found = (e, it.held_out_effectivity, dynamics);
+        let under = it.held_out_effectivity < 1.0;
+        let dynamics = if under { dynamics_error(sens, g.tolerance, e_measured) } else { None };
+        let found = (e, it.held_out_effectivity, dynamics.map(|s| (s, e_measured)));
         if let Some(checked) = check_method(p, &level, method, (&mu, &at), found) {
             log::info!("{}", checked.message);
-            if !checked.switch && dynamics.is_none() && it.held_out_effectivity > MAX_HELD_OUT_OVERESTIMATE {
+            if !checked.switch && it.held_out_effectivity > MAX_HELD_OUT_OVERESTIMATE {
                 over_reading.push(checked.message);
             } else if checked.switch {
                 over_reading.clear();
@@ -354,11 +354,12 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
 pub const MAX_HELD_OUT_OVERESTIMATE: f64 = 10.0;
 
 /// The sensitivity `s` of a held-out point (how much a 0.1 % change of the load moves the
-/// answer there) where the model amplifies load changes (`amplifying(s, tolerance)`) by
-/// at least the `error` found there: that error is then the dynamics', and no estimate of
-/// the reduction can be judged by it ([`check_method`]). `None` otherwise.
+/// answer there, in the training's measure) where the model amplifies load changes
+/// (`amplifying(s, tolerance)`, as greedy's scores judge it) by at least the `error` found
+/// there; `None` otherwise, and for an infinite `s` (the moved run could not be compared:
+/// it holds nothing, as in the scores).
 fn dynamics_error(s: f64, tolerance: f64, error: f64) -> Option<f64> {
-    (amplifying(s, tolerance) && error <= s).then_some(s)
+    (s.is_finite() && amplifying(s, tolerance) && error <= s).then_some(s)
 }
 
 /// What a held-out check found of the estimate's method ([`check_method`]).
@@ -374,17 +375,19 @@ struct MethodCheck {
 /// where the full run gave the true error `e`, the estimate by `method` read `eff` times it. Outside
 /// `[1, MAX_HELD_OUT_OVERESTIMATE]` the enriched model (integrated to convergence, the
 /// reference the `corrected` method approximates) reads the same load; when it is closer
-/// to that range, the loop switches to it. Not where the model amplifies load changes by
-/// more than the error found (`dynamics`: its sensitivity there): the error is then the
-/// dynamics', which neither method sees (a 0.1 % change of the load moves the answer by as
-/// much), so a reading closer to it is luck, not a better method; the calibration still
-/// takes the point. `None`: nothing to check or nothing found.
+/// to that range, the loop switches to it. Not for an estimate below the error at a point
+/// where the model amplifies load changes by at least that error (`dynamics`: the
+/// sensitivity there and the error, both in the training's measure): a 0.1 % change of the
+/// load moves the answer by as much, so how close either method comes to that error says
+/// little about the method, and switching would make every later estimate cost an enriched
+/// run; the calibration factor takes the point instead, as at any held-out run. `None`:
+/// nothing to check or nothing found.
 fn check_method(
     p: &Pipeline,
     level: &search::Level,
     method: EstimateMethod,
     (mu, at): (&Parameters, &str),
-    (e, eff, dynamics): (f64, f64, Option<f64>),
+    (e, eff, dynamics): (f64, f64, Option<(f64, f64)>),
 ) -> Option<MethodCheck> {
     if method == EstimateMethod::Enriched || !(e.is_finite() && e > 0.0) {
         return None;
@@ -392,11 +395,10 @@ fn check_method(
     if (1.0..=MAX_HELD_OUT_OVERESTIMATE).contains(&eff) {
         return None;
     }
-    if let Some(s) = dynamics {
+    if let Some((s, error)) = dynamics {
         let message = format!(
-            "held-out check at {at}: the {} estimate read {eff:.3}× the true error {e:.2e} (1–{MAX_HELD_OUT_OVERESTIMATE}× expected), where a 0.1 % change of the load moves the answer by {s:.1e}: an error of the dynamics, which no estimate of the reduction sees; the method stays{}",
-            method.name(),
-            if eff < 1.0 { ", the calibration factor is raised to cover it" } else { "" }
+            "held-out check at {at}: the {} estimate read {eff:.3}× the true error {e:.2e} (1–{MAX_HELD_OUT_OVERESTIMATE}× expected), where a 0.1 % change of the load moves the answer by {s:.1e}, at least the error ({error:.2e} in the training's measure): the error is the dynamics' there; the method stays, the calibration factor is raised to cover it",
+            method.name()
         );
         return Some(MethodCheck { switch: false, raw: f64::NAN, message });
     }
@@ -612,7 +614,8 @@ mod tests {
     /// The gate of the held-out method check: the ×20 four-bar's held-out point at
     /// λ = 1.175 (2026-11-28: sensitivity 0.13, true error 3.2e-2, T = 1e-2) is the
     /// dynamics'; an error above the sensitivity, a sensitivity within the tolerance or
-    /// within 10 δ = 1e-2 (a response that follows the load), and NaNs are not.
+    /// within 10 δ = 1e-2 (a response that follows the load), an infinite one and NaNs are
+    /// not.
     #[test]
     fn a_held_out_error_within_an_amplifying_sensitivity_is_the_dynamics() {
         assert_eq!(dynamics_error(0.13, 1e-2, 3.2e-2), Some(0.13));
@@ -621,6 +624,7 @@ mod tests {
         assert_eq!(dynamics_error(8e-3, 1e-2, 1e-3), None, "within the tolerance");
         assert_eq!(dynamics_error(8e-3, 1e-4, 1e-3), None, "within 10 δ: the load's own response");
         assert_eq!(dynamics_error(f64::NAN, 1e-2, 1e-3), None);
+        assert_eq!(dynamics_error(f64::INFINITY, 1e-2, 1e-3), None, "a sensitivity that could not be measured");
         assert_eq!(dynamics_error(0.13, 1e-2, f64::NAN), None);
     }
 
