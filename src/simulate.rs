@@ -191,16 +191,13 @@ pub fn integrate_guided<M: DynamicModel>(
         let st = &integ.stats;
         log::debug!(
             "  Newton until the run failed: {} steps done, {} iterations (at most {} in one attempt), {} \
-             factorizations, {} step cuts; starts from constant velocity {}, constant position {}, zero \
-             acceleration {}",
+             factorizations, {} step cuts; started from {}",
             st.steps,
             st.newton_iterations,
             st.max_iterations_in_a_step,
             st.factorizations,
             st.step_cuts,
-            st.constant_velocity_starts,
-            st.constant_position_starts,
-            st.zero_acceleration_starts
+            st.starts()
         );
         return Err(e);
     }

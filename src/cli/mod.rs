@@ -182,9 +182,9 @@ pub fn run_details(r: &flexrom::simulate::SimulationResult) {
         // takes one may as well name it in `[time] predictor`
         // a halved step's parts count each, so the three may sum past the steps
         detail(&format!(
-            "  Newton's start: constant velocity at {}, constant position at {}, zero acceleration at {} of the steps \
-             solved ({} steps, a halved step's parts counted each)",
-            st.constant_velocity_starts, st.constant_position_starts, st.zero_acceleration_starts, st.steps
+            "  Newton's start: {} of the steps solved ({} steps, a halved step's parts counted each)",
+            st.starts(),
+            st.steps
         ));
     }
 }

@@ -472,13 +472,9 @@ impl Validation {
             self.rom_seconds,
             self.speedup,
             dense,
-            self.slower_line(),
+            slower_line(self.speedup, self.speedup_with_estimate),
             self.trust_lines()
         )
-    }
-
-    fn slower_line(&self) -> String {
-        slower_line(self.speedup, self.speedup_with_estimate)
     }
 
     /// The estimate, extrapolation, sensitivity and error-by-time lines of `describe`.
@@ -616,6 +612,8 @@ fn slower_line(speedup: f64, speedup_with_estimate: Option<f64>) -> String {
 
 #[cfg(test)]
 mod tests {
+    use super::{first_different_step, slower_line, ProbeQuantityError, ProbeTravel};
+
     /// The slower-route line: only below 1×, judged on the route with the estimate where
     /// there is one (a reduced run 1.36× faster that its estimate brings to 0.9× is slower).
     #[test]
@@ -629,8 +627,6 @@ mod tests {
         );
         assert!(slower_line(0.63, None).contains("the reduced run is not faster than the full run here (0.63×)"));
     }
-
-    use super::{first_different_step, slower_line, ProbeQuantityError, ProbeTravel};
 
     /// Which step the runs first took differently: a cut only one of them made, the
     /// earlier of two such, and none when both halved the same steps.

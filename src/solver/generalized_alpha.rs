@@ -64,6 +64,17 @@ pub struct Stats {
     pub step_cut_times: Vec<f64>,
 }
 
+impl Stats {
+    /// Which guess Newton started from, for `-v` (a halved step's parts count each):
+    /// `constant velocity at 3, constant position at 0, zero acceleration at 217`.
+    pub fn starts(&self) -> String {
+        format!(
+            "constant velocity at {}, constant position at {}, zero acceleration at {}",
+            self.constant_velocity_starts, self.constant_position_starts, self.zero_acceleration_starts
+        )
+    }
+}
+
 struct Failure {
     iterations: usize,
     increment: f64,
