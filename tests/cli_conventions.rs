@@ -169,7 +169,7 @@ fn every_result_prints_as_csv_and_json() {
 fn parse_errors_show_the_whole_clap_message() {
     let model = root().join("data/models/pendulum.toml");
     let pipeline = root().join("pipelines/pendulum.toml");
-    let cases: [(&[&str], &[&str]); 4] = [
+    let cases: [(&[&str], &[&str]); 5] = [
         (
             &["simulate", s(&model)],
             &["required arguments were not provided", "--output <OUTPUT>", "Usage: flexrom simulate"],
@@ -180,6 +180,11 @@ fn parse_errors_show_the_whole_clap_message() {
             &["'--loadscales'", "tip: a similar argument exists: '--load-scales'", "Usage: flexrom sweep"],
         ),
         (&["simulate", s(&model), "-o", "x.h5", "--threads", "-1"], &["invalid value '-1' for '--threads <N>'"]),
+        // a malformed list of load scales is a malformed argument too (a list `X,Y,Z` is one)
+        (
+            &["sweep", s(&pipeline), "--load-scales", "0.5:1.0", "-o", "x.h5"],
+            &["invalid value '0.5:1.0' for '--load-scales <A:B:N>'", "is not of the form A:B:N"],
+        ),
     ];
     for (args, needles) in cases {
         let o = flexrom(args);

@@ -244,6 +244,13 @@ fn strict_exits_4_after_writing_its_output() {
     let o = run(&["sweep", p.to_str().unwrap(), "-o", sw.to_str().unwrap(), "--strict"]);
     assert_eq!(o.status.code(), Some(4), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(sw.is_file());
+    // outside the training range (1.4, as in the sweep above): the extrapolation is said
+    // too, before the strict error, which names the load as other messages do
+    let o = run(&["online", p.to_str().unwrap(), "--load-scale", "1.4", "-o", out.to_str().unwrap(), "--strict"]);
+    assert_eq!(o.status.code(), Some(4), "{}", String::from_utf8_lossy(&o.stderr));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(warnings(&o).iter().any(|w| w.contains("outside the basis's training range")), "{err}");
+    assert!(err.contains("above the tolerance 1e-12 at load scale 1.4 ("), "{err}");
 
     let (dir, p, _) = setup(Some(0.5));
     let out = dir.path().join("r.h5");

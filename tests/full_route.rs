@@ -149,6 +149,17 @@ fn a_full_sweep_is_simulate_at_every_load() {
         assert_eq!((newton[k], factorizations[k]), (attr("newton_iterations"), attr("factorizations")), "{x}");
     }
 
+    // the same loads given as a list, in another order: the same runs, in the list's order
+    let listed = d.join("listed.h5");
+    ok(&["sweep", s(&p), "--full", "--load-scales", &format!("{},{}", loads[2], loads[0]), "-o", s(&listed)]);
+    let g = hdf5::File::open(&listed).unwrap();
+    assert_eq!(bits(&g.dataset("load_scales").unwrap().read_raw::<f64>().unwrap()), bits(&[loads[2], loads[0]]));
+    let probe = |file: &hdf5::File, k: usize| {
+        let p = file.dataset(&format!("probes/{}", names[0])).unwrap().read::<f64, ndarray::Ix3>().unwrap();
+        bits(p.index_axis(ndarray::Axis(0), k).to_owned().as_slice().unwrap())
+    };
+    assert_eq!((probe(&g, 0), probe(&g, 1)), (probe(&f, 2), probe(&f, 0)));
+
     // nothing to validate, no basis, no estimate: refused before any run
     for extra in [&["--validate"][..], &["--basis", "b.h5"], &["--continuation"], &["--no-estimate"], &["--strict"]] {
         let mut args = vec!["sweep", s(&p), "--full", "-o", s(&out)];

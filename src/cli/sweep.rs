@@ -18,10 +18,10 @@ use std::path::PathBuf;
 pub struct Args {
     /// pipeline file (TOML)
     pipeline: PathBuf,
-    /// `A:B:N`: N load scales from A to B (default: the pipeline's [online] load_scales, else
-    /// its training loads); A may be negative (`-1:1:21`)
-    #[arg(long, allow_hyphen_values = true, value_name = "A:B:N")]
-    load_scales: Option<String>,
+    /// `A:B:N`: N load scales from A to B, or a list `X,Y,Z` (default: the pipeline's
+    /// [online] load_scales, else its training loads); A may be negative (`-1:1:21`)
+    #[arg(long, allow_hyphen_values = true, value_name = "A:B:N", value_parser = scale_list)]
+    load_scales: Option<ScaleList>,
     /// an axis of a grid of named parameters: `NAME=A:B:N`, `NAME=A:B:N:log` or `NAME=X`;
     /// repeat it for several (with --load-scales, or the pipeline's loads, as the first
     /// axis); the grid runs every combination, the first axis slowest
@@ -83,6 +83,15 @@ pub struct Args {
     format: FormatArgs,
 }
 
+/// The values of `--load-scales` (a type of its own: clap would read a `Vec` as a repeated
+/// option); parsed by clap, so a malformed one exits with code 2 as other bad arguments do.
+#[derive(Clone, Debug)]
+pub struct ScaleList(Vec<f64>);
+
+fn scale_list(s: &str) -> std::result::Result<ScaleList, String> {
+    flexrom::pipeline::config::parse_scales(s).map(ScaleList)
+}
+
 impl Args {
     pub fn run(self, limits: &Limits) -> flexrom::Result<()> {
         let Args {
@@ -104,7 +113,7 @@ impl Args {
             format,
         } = self;
         let p = Pipeline::load_with(&pipeline, limits.clone())?;
-        let points = sweep_points(&p, load_scales.as_deref(), &params, points.as_deref())?;
+        let points = sweep_points(&p, load_scales.map(|l| l.0), &params, points.as_deref())?;
         let named = points.iter().any(|mu| mu.named().next().is_some());
         let path = basis.unwrap_or_else(|| p.basis_path.clone());
         let mut inputs = vec![(p.path.as_path(), "pipeline file"), (p.model.path.as_path(), "model file")];
@@ -311,14 +320,11 @@ fn fallback_summary(sw: &flexrom::pipeline::sweep::Sweep) -> Option<String> {
 /// not have: it needs `--param` or `--points`); or the line of load scales alone.
 fn sweep_points(
     p: &Pipeline,
-    load_scales: Option<&str>,
+    load_scales: Option<Vec<f64>>,
     params: &[String],
     file: Option<&std::path::Path>,
 ) -> flexrom::Result<Vec<Parameters>> {
     use flexrom::pipeline::points::{grid, parse_axis, read_points_csv};
-    let range = |s: &str| {
-        flexrom::pipeline::config::parse_range(s).map_err(|e| flexrom::Error::Usage(format!("--load-scales: {e}")))
-    };
     let points = if let Some(f) = file {
         let points = read_points_csv(f)?;
         // a misspelt column is the CSV's problem: name its header
@@ -330,7 +336,7 @@ fn sweep_points(
         points
     } else if params.is_empty() && p.space().is_empty() {
         let scales = match load_scales {
-            Some(s) => range(s)?,
+            Some(v) => v,
             None => p.online_scales(),
         };
         scales.into_iter().map(Parameters::load_scale).collect()
@@ -340,7 +346,7 @@ fn sweep_points(
             .map(|spec| parse_axis(spec).map_err(|e| flexrom::Error::Usage(format!("--param: {e}"))))
             .collect::<flexrom::Result<Vec<_>>>()?;
         let first = match load_scales {
-            Some(s) => Some(range(s)?),
+            Some(v) => Some(v),
             // the pipeline's loads, unless --param gives the load scale
             None if p.space().is_empty() && !named.iter().any(|(n, _)| n == LOAD_SCALE) => Some(p.online_scales()),
             None => None,

@@ -39,7 +39,7 @@ use crate::reduction::{ModeRule, Variant};
 use crate::solver::parameter_space::ParameterSpace;
 use crate::solver::parameters::Parameters;
 use scales::check_scales;
-pub use scales::{parse_range, Scales, MAX_LOAD_SCALES};
+pub use scales::{parse_range, parse_scales, Scales, MAX_LOAD_SCALES};
 pub use schema::{
     Blocks, GreedySpec, HyperSpec, OnlineSpec, ParameterSpec, PipelineFile, PointsSpec, ReductionSpec, ScalesSpec,
     TrainSpec, DEFAULT_BOX_CANDIDATES_PER_PARAMETER, DEFAULT_LINE_CANDIDATES,

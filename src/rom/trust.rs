@@ -329,7 +329,7 @@ pub fn check_runs(
         // (norms::against_motion): nothing to hold to the tolerance
         .filter(|r| r.1.is_none_or(|e| !e.is_nan() && !(e <= tol)))
         .map(|r| {
-            let at = if trust.space.is_empty() { format!("{:.4}", r.0.scale()) } else { label(trust, &r.0) };
+            let at = label(trust, &r.0);
             match r.1 {
                 Some(e) if e.is_infinite() => format!(
                     "{at} (∞: the estimator's own run failed{})",
@@ -354,6 +354,11 @@ pub fn check_runs(
     };
     let msg = format!("{kind} above the tolerance {tol:e} at {what}");
     if strict {
+        // the error ends the command: the other warnings (extrapolation, amplification)
+        // are said first, as without --strict
+        for w in &warnings {
+            crate::output::note(&format!("warning: {w}"));
+        }
         return Err(Error::Strict(format!("--strict: {msg}")));
     }
     warnings.push(msg);

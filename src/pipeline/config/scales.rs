@@ -1,4 +1,5 @@
-//! Lists of load scales in a pipeline file: a list, or `"A:B:N"` (also the CLI's form).
+//! Lists of load scales in a pipeline file: a list, or `"A:B:N"` (also the CLI's form, which
+//! takes a list as `X,Y,Z` too).
 
 use serde::Deserialize;
 
@@ -45,6 +46,27 @@ pub fn parse_range(s: &str) -> std::result::Result<Vec<f64>, String> {
     Ok(v)
 }
 
+/// `"A:B:N"` ([`parse_range`]) or a list `"X,Y,Z"` of load scales (the command line's
+/// `--load-scales`; a pipeline file writes its list as a TOML array).
+pub fn parse_scales(s: &str) -> std::result::Result<Vec<f64>, String> {
+    if s.contains(':') {
+        return parse_range(s);
+    }
+    let v = s
+        .split(',')
+        .map(|x| {
+            x.trim()
+                .parse::<f64>()
+                .map_err(|_| format!("`{}` in `{s}` is not a number (give A:B:N or a list X,Y,Z)", x.trim()))
+        })
+        .collect::<std::result::Result<Vec<f64>, String>>()?;
+    if v.len() > MAX_LOAD_SCALES {
+        return Err(format!("`{s}` lists {} load scales, more than the {MAX_LOAD_SCALES} one sweep takes", v.len()));
+    }
+    check_scales(&v)?;
+    Ok(v)
+}
+
 pub(super) fn check_scales(v: &[f64]) -> std::result::Result<(), String> {
     if v.is_empty() {
         return Err("the list of load scales is empty".into());
@@ -53,4 +75,23 @@ pub(super) fn check_scales(v: &[f64]) -> std::result::Result<(), String> {
         return Err(format!("load scale {x} is not finite"));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The command line's two forms: `A:B:N` (N values, both ends included) and a list;
+    /// anything else names the part that is not a number.
+    #[test]
+    fn a_range_or_a_list_of_load_scales() {
+        assert_eq!(parse_scales("0.5:1.5:3").unwrap(), [0.5, 1.0, 1.5]);
+        assert_eq!(parse_scales("0.3, 0.5,1.7").unwrap(), [0.3, 0.5, 1.7]);
+        assert_eq!(parse_scales("-1.2").unwrap(), [-1.2]);
+        let e = parse_scales("0.5,x").unwrap_err();
+        assert!(e.contains("`x` in `0.5,x` is not a number") && e.contains("A:B:N or a list"), "{e}");
+        assert!(parse_scales("0.5:1.0").unwrap_err().contains("is not of the form A:B:N"));
+        assert!(parse_scales("0.5,inf").unwrap_err().contains("not finite"));
+        assert!(parse_scales("").is_err());
+    }
 }
