@@ -206,6 +206,15 @@ fn pendulum_pipeline_end_to_end_within_the_error_bound() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(String::from_utf8_lossy(&o.stdout).lines().count(), 4, "header and three rows");
     let f = hdf5::File::open(&sweep).unwrap();
+    // the points' speedups are one run each: their median is said, and how they were timed
+    let mut speedups = f.dataset("speedup").unwrap().read_raw::<f64>().unwrap();
+    speedups.sort_by(f64::total_cmp);
+    let line = format!("median {:.2}× over 3 points, each from one run", speedups[1]);
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains(&line),
+        "`{line}` not in {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
     assert_eq!(f.dataset("probes/tip").unwrap().shape(), vec![3, 121, 2]);
     let err = f.dataset("rel_error").unwrap().read_1d::<f64>().unwrap();
     assert!(err.iter().all(|&e| e <= 1e-3), "{err}");

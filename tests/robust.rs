@@ -103,6 +103,12 @@ fn errors_inside_array_of_tables_entries_name_the_key_and_its_line() {
     let err = flexrom::model::Model::from_text(&text, "m.toml").unwrap_err().to_string();
     let line = text.lines().position(|l| l.contains("\"gravitation\"")).unwrap() + 1;
     assert!(err.contains(&format!("loads[0].type (line {line})")), "{err}");
+    // a missing key: named as its entry's key, on the line where the entry opens (not as a
+    // key beside it, whose removal changes the message too)
+    let text = pendulum() + "\n[[loads]]\ntype = \"moment\"\nbody = \"beam\"\nnode = \"start\"\n";
+    let err = flexrom::model::Model::from_text(&text, "m.toml").unwrap_err().to_string();
+    let line = text.lines().enumerate().filter(|(_, l)| l.starts_with("[[loads]]")).nth(1).unwrap().0 + 1;
+    assert!(err.contains(&format!("loads[1].function (line {line}): missing field `function`")), "{err}");
 }
 
 /// Errors of the model's own checks (values the parser accepts: an unknown predictor, a

@@ -83,6 +83,26 @@ pub struct Args {
     format: FormatArgs,
 }
 
+/// With `--validate`: the median of the points' speedups, and what they are (one run of each
+/// model, timed while the other threads ran theirs: one point's figure is noisy).
+fn speedup_summary(sw: &flexrom::pipeline::sweep::Sweep) -> Option<String> {
+    let mut v: Vec<f64> = sw
+        .scales
+        .iter()
+        .filter_map(|x| x.point().and_then(|p| p.validation.as_ref()).map(|v| v.speedup))
+        .filter(|x| x.is_finite())
+        .collect();
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(f64::total_cmp);
+    let median = if v.len() % 2 == 1 { v[v.len() / 2] } else { 0.5 * (v[v.len() / 2 - 1] + v[v.len() / 2]) };
+    Some(format!(
+        "speedup (reduced run without its estimate): median {median:.2}× over {} points, each from one run of either model beside the sweep's other runs; `validate` times medians of interleaved runs",
+        v.len()
+    ))
+}
+
 /// The values of `--load-scales` (a type of its own: clap would read a `Vec` as a repeated
 /// option); parsed by clap, so a malformed one exits with code 2 as other bad arguments do.
 #[derive(Clone, Debug)]
@@ -200,6 +220,9 @@ impl Args {
             sw.wall_seconds,
             out.display()
         ));
+        if let Some(line) = speedup_summary(&sw) {
+            info(&line);
+        }
         warn(notice.as_slice());
         if let Some(line) = fallback_summary(&sw) {
             info(&line);

@@ -26,10 +26,20 @@ pub(super) fn entry_error(text: &str, path: &Path) -> Option<Error> {
         let Some(toml::Value::Array(items)) = doc.get(name) else { continue };
         for (i, item) in items.iter().enumerate() {
             let Some(message) = parse(item) else { continue };
-            let fault = fault_path(item, |v| parse(v).as_deref() == Some(message.as_str()));
+            let mut fault = fault_path(item, |v| parse(v).as_deref() == Some(message.as_str()));
+            // a missing key belongs to the table that lacks it (removing a sibling changes
+            // the error too, to that sibling missing): named as that table's key, on the
+            // line where the table opens, as the model's own checks name a missing key
+            let missing = message.strip_prefix("missing field `").and_then(|m| m.strip_suffix('`'));
+            if missing.is_some() && value_at(item, &fault).is_some_and(|v| !v.is_table()) {
+                fault.pop();
+            }
             let mut full = vec![Step::Key(name.to_string()), Step::Index(i)];
             full.extend(fault.iter().cloned());
             let line = step_line(text, &full).or_else(|| entry_line(text, name, i));
+            if let Some(key) = missing {
+                fault.push(Step::Key(key.to_string()));
+            }
             let mut field = format!("{name}[{i}]");
             for step in &fault {
                 match step {

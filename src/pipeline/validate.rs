@@ -535,7 +535,10 @@ impl Validation {
             ));
         }
         let by: Vec<String> = self.rel_error_by_time.iter().map(|e| format!("{e:.2e}")).collect();
-        s.push_str(&format!("\n  rel_error up to each fifth of the run: {}", by.join(", ")));
+        s.push_str(&format!(
+            "\n  rel_error up to each fifth of the run (each over the motion so far, so it can fall): {}",
+            by.join(", ")
+        ));
         if let Some(e) = &self.error_estimate_by_time {
             let by: Vec<String> = e.iter().map(|e| format!("{e:.2e}")).collect();
             s.push_str(&format!("\n  error_estimate up to each fifth of the run: {}", by.join(", ")));
