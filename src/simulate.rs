@@ -5,7 +5,7 @@ use crate::error::{Error, Result};
 use crate::linalg::kkt::LinearSolverKind;
 use crate::model::Model;
 use crate::physics::system::{FlexibleSystem, Probe};
-use crate::solver::generalized_alpha::{GeneralizedAlpha, IntegratorParams, State, Stats};
+use crate::solver::generalized_alpha::{GeneralizedAlpha, IntegratorParams, LargestStrain, State, Stats};
 use crate::solver::model::{Bound, DynamicModel, Parameters, ParametricModel};
 use ndarray::{Array1, Array2};
 
@@ -181,7 +181,7 @@ pub fn integrate_guided<M: DynamicModel>(
             integ.step_guided(model, &mut state, dt, guessed.then_some(increment.as_slice()))?;
             // keep t on the nominal grid despite round-off in sub-steps
             state.t = k as f64 * dt;
-            watch.check(model, &state, &integ.stats, k == n_steps || k % STRAIN_CHECK_EVERY == 0)?;
+            watch.check(model, &state, &mut integ.stats, k == n_steps || k % STRAIN_CHECK_EVERY == 0)?;
             record(k, &state);
         }
         Ok(())
@@ -207,7 +207,7 @@ pub fn integrate_guided<M: DynamicModel>(
 /// The strain check runs every this many steps (and at the last): a full model pays one
 /// pass over its elements for it (~a quarter of a force evaluation), and a blow-up that
 /// grows for four steps is still caught long before the end of a run.
-const STRAIN_CHECK_EVERY: usize = 4;
+pub const STRAIN_CHECK_EVERY: usize = 4;
 
 /// Blow-up detection: a run whose largest mean axial strain |ε̄| exceeds `max_strain` or
 /// whose step halvings exceed `max_total_cuts` stops with [`Error::BlowUp`], naming what,
@@ -231,7 +231,7 @@ impl BlowUpWatch {
         }
     }
 
-    fn check<M: DynamicModel>(&mut self, model: &M, st: &State, stats: &Stats, strain_now: bool) -> Result<()> {
+    fn check<M: DynamicModel>(&mut self, model: &M, st: &State, stats: &mut Stats, strain_now: bool) -> Result<()> {
         if stats.step_cuts > self.max_cuts && !self.warned_cuts {
             let problem = format!(
                 "{} step halvings so far, over the budget of {} per run (`[time] max_total_step_cuts` in the model file raises it; --allow-blowup only warns)",
@@ -241,6 +241,9 @@ impl BlowUpWatch {
         }
         if strain_now && !self.warned_strain {
             if let Some((eps, e)) = model.max_strain(&st.q) {
+                if stats.largest_strain.is_none_or(|l| !(eps <= l.strain)) {
+                    stats.largest_strain = Some(LargestStrain { strain: eps, element: e, t: st.t });
+                }
                 if !(eps <= self.max_strain) {
                     let problem = format!(
                         "mean axial strain |ε̄| = {eps:.3e} in element {e}, over the plausible bound {} (`[time] max_strain` in the model file raises it; --allow-blowup only warns)",

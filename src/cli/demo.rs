@@ -25,7 +25,7 @@ impl Args {
         for path in models {
             let model = Model::load_with(&path, limits.clone())?;
             let r = simulate(&model, &Overrides::default()).map_err(|e| e.at_stage("demo", &Parameters::default()))?;
-            run_details(&r);
+            run_details(&r, false);
             let nt = r.t.len();
             if format.format() != Format::Text {
                 for k in [0, nt / 4, nt / 2, 3 * nt / 4, nt - 1] {

@@ -155,8 +155,9 @@ pub fn print_table(t: &Table, format: Format, single: bool) -> flexrom::Result<(
     }
 }
 
-/// `-v`: the settings and Newton statistics of one run.
-pub fn run_details(r: &flexrom::simulate::SimulationResult) {
+/// `-v`: the settings and Newton statistics of one run (`reduced`: of a reduced model, whose
+/// strain check sees its sampled elements only).
+pub fn run_details(r: &flexrom::simulate::SimulationResult, reduced: bool) {
     let (s, st) = (&r.settings, &r.stats);
     detail(&format!(
         "  settings: dt {} s, t_end {} s, rho_inf {}, {}, solver {:?}, Newton start {}, {} coordinates",
@@ -177,6 +178,19 @@ pub fn run_details(r: &flexrom::simulate::SimulationResult) {
         st.steps_at_round_off,
         1e3 * r.wall_seconds / st.steps.max(1) as f64
     ));
+    if let Some(l) = st.largest_strain {
+        // how hard the run pulled the beams: flexrom fails a run only above the blow-up bound
+        // (`[time] max_strain`), far above what most structural materials stay elastic at
+        detail(&format!(
+            "  largest mean axial strain |ε̄| = {:.2e} (element {}{}, t = {:.4} s; checked every {} steps), blow-up bound {}",
+            l.strain,
+            l.element,
+            if reduced { ", of the sampled ones" } else { "" },
+            l.t,
+            flexrom::simulate::STRAIN_CHECK_EVERY,
+            s.params.max_strain
+        ));
+    }
     if s.params.predictor == flexrom::solver::generalized_alpha::Predictor::Adaptive {
         // which guess the adaptive start took (docs/reduced-speed.md): a model that always
         // takes one may as well name it in `[time] predictor`

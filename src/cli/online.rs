@@ -86,7 +86,7 @@ impl Args {
         if let (Some(e), Some(method), None) = (estimate, rom.method(), &done.fallback) {
             info(&format!("  {}", flexrom::rom::trust::describe(e, method, run.result.wall_seconds)));
         }
-        run_details(&run.result);
+        run_details(&run.result, true);
         let mut cols = vec!["load_scale", "n_modes"];
         cols.extend(flexrom::pipeline::tables::RUN_COLUMNS);
         cols.extend(["error_estimate", "extrapolated", "output", "error_estimate_displacement", "fallback"]);

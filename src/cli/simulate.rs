@@ -66,7 +66,7 @@ impl Args {
             r.stats.step_cuts,
             written
         ));
-        run_details(&r);
+        run_details(&r, false);
         print_table(&flexrom::pipeline::tables::probe_table(&r), format.format(), false)
     }
 }

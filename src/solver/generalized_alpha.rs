@@ -62,6 +62,21 @@ pub struct Stats {
     /// e.g. full and reduced, solve different discretizations after a cut one of them
     /// alone took)
     pub step_cut_times: Vec<f64>,
+    /// the largest mean axial strain `|ε̄|` the blow-up checks met (every few steps and the
+    /// last), with its element and time (a hyper-reduced run: over its sampled elements);
+    /// `None` where the model cannot tell
+    pub largest_strain: Option<LargestStrain>,
+}
+
+/// Where a run strained most, as far as its blow-up checks saw ([`Stats::largest_strain`]).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct LargestStrain {
+    /// `|ε̄|`, the element's mean axial strain
+    pub strain: f64,
+    /// the element's index over the whole model (bodies in file order)
+    pub element: usize,
+    /// s
+    pub t: f64,
 }
 
 impl Stats {
