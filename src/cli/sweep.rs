@@ -98,8 +98,9 @@ fn speedup_summary(sw: &flexrom::pipeline::sweep::Sweep) -> Option<String> {
     v.sort_by(f64::total_cmp);
     let median = if v.len() % 2 == 1 { v[v.len() / 2] } else { 0.5 * (v[v.len() / 2 - 1] + v[v.len() / 2]) };
     Some(format!(
-        "speedup (reduced run without its estimate): median {median:.2}× over {} points, each from one run of either model beside the sweep's other runs; `validate` times medians of interleaved runs",
-        v.len()
+        "speedup (reduced run without its estimate): median {median:.2}× over {} points, each from one run of either model{}; `validate` times medians of interleaved runs",
+        v.len(),
+        if sw.threads > 1 { format!(", timed beside the sweep's other runs on {} threads", sw.threads) } else { String::new() }
     ))
 }
 
