@@ -120,8 +120,8 @@ then NAME_strain (1) and NAME_curvature (1/m) of the probes that record them; wi
 
 Without --load-scale every load of the pipeline's [validate] load_scales is validated in
 turn (default: the training loads). The full run with a dense LU (the thesis's reference
-timing) is skipped, with one line on stderr, when its matrix would exceed 256 MiB or the
-memory bound; --dense forces it. --json prints one object (null where not measured) for
+timing) is skipped, with one line on stderr, when its matrix would exceed 256 MiB, its work
+half a minute (steps · n³/3 > 2e11 flops) or the memory bound; --dense forces it. --json prints one object (null where not measured) for
 --load-scale, else an array of them, one per load, as the report's validation.json; --csv
 one header line and one row per load (arrays as NAME_1, NAME_2, ...).
 
@@ -178,7 +178,8 @@ extrapolated (and rel_error, max_probe_error (m), full_seconds, speedup with --v
 
 The summary (summary.md) is printed on stdout; --csv/--json print the validation rows
 instead (as the report's validation.json). The dense-LU timing is skipped, with one line on
-stderr, when its matrix would exceed 256 MiB or the memory bound; --dense forces it.
+stderr, when its matrix would exceed 256 MiB, its work half a minute (steps · n³/3 > 2e11
+flops) or the memory bound; --dense forces it.
 
 ",
         exit_codes!()

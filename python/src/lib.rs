@@ -988,7 +988,7 @@ fn train<'py>(
 /// Python's `json.loads` reads it (a dict, or a list of dicts), its points chosen as the command chooses them (one record where a load scale or
 /// a named parameter is given and names one point, else a list: the pipeline's validation
 /// points, or the named values at each of its `[validate]` loads). `dense`: None as the
-/// command's default (skipped above 256 MiB), True `--dense`, False `--no-dense`.
+/// command's default (skipped above 256 MiB or half a minute of work), True `--dense`, False `--no-dense`.
 #[pyfunction]
 #[pyo3(signature = (pipeline, load_scale = None, basis = None, estimate = None, dense = None, **params))]
 fn validate<'py>(
