@@ -239,12 +239,13 @@ impl BlowUpWatch {
             );
             self.report(st.t, problem, true)?;
         }
-        if strain_now && !self.warned_strain {
+        // the largest strain is kept after a warned blow-up too (`-v` reports it)
+        if strain_now {
             if let Some((eps, e)) = model.max_strain(&st.q) {
                 if stats.largest_strain.is_none_or(|l| !(eps <= l.strain)) {
                     stats.largest_strain = Some(LargestStrain { strain: eps, element: e, t: st.t });
                 }
-                if !(eps <= self.max_strain) {
+                if !(eps <= self.max_strain) && !self.warned_strain {
                     let problem = format!(
                         "mean axial strain |ε̄| = {eps:.3e} in element {e}, over the plausible bound {} (`[time] max_strain` in the model file raises it; --allow-blowup only warns)",
                         self.max_strain

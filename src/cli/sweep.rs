@@ -95,8 +95,7 @@ fn speedup_summary(sw: &flexrom::pipeline::sweep::Sweep) -> Option<String> {
     if v.is_empty() {
         return None;
     }
-    v.sort_by(f64::total_cmp);
-    let median = if v.len() % 2 == 1 { v[v.len() / 2] } else { 0.5 * (v[v.len() / 2 - 1] + v[v.len() / 2]) };
+    let median = flexrom::pipeline::timing::median(&mut v);
     Some(format!(
         "speedup (reduced run without its estimate): median {median:.2}× over {} points, each from one run of either model{}; `validate` times medians of interleaved runs",
         v.len(),
