@@ -12,18 +12,20 @@
 //! ```
 //!
 //! The rows follow [`crate::physics::system::FlexibleSystem::new`]: coordinates node by node,
-//! body after body, `(x, y, x', y')` per node; constraint rows first those of the ground
-//! pins (x, y) and clamps (x, y, x', y') in file order, then those of the pins (x, y) in file
-//! order (a unit test checks the labels against the assembled constraint rows).
+//! body after body, `(x, y, x', y')` per node; constraint rows as
+//! [`crate::physics::joints::lower`] orders them, the joints that hold a node to the ground
+//! first, then those that couple bodies, each in file order (a unit test checks the labels
+//! against the assembled constraint rows).
 
 use super::attrs::Labelled;
 use crate::model::Model;
-use crate::physics::system::{Joint, NodeId};
+use crate::physics::joints::lower;
+use crate::physics::system::NodeId;
 use hdf5::types::VarLenUnicode;
 use ndarray::Array1;
 
 /// Names of the four coordinates of a node.
-pub const COORDINATES: [&str; 4] = ["x", "y", "x'", "y'"];
+pub use crate::physics::joints::COORDINATES;
 
 /// The row names of one model.
 #[derive(Clone, Debug, PartialEq)]
@@ -44,28 +46,18 @@ impl Labels {
             .flat_map(|(b, body)| (0..=body.n_elements).flat_map(move |k| (0..4).map(move |c| (b, k, c))))
             .collect();
         let node = |(b, k): NodeId| format!("{} node {k}", bodies[b].name);
-        let mut multipliers = Vec::new();
-        let mut pins = Vec::new();
-        for (j, joint) in model.joints().iter().enumerate() {
-            match *joint {
-                Joint::GroundPin { node: n, .. } => {
-                    for c in &COORDINATES[..2] {
-                        multipliers.push((j, format!("joint {j} (ground_pin {}) {c}", node(n))));
-                    }
-                }
-                Joint::Clamp { node: n, .. } => {
-                    for c in &COORDINATES {
-                        multipliers.push((j, format!("joint {j} (clamp {}) {c}", node(n))));
-                    }
-                }
-                Joint::Pin { a, b } => pins.push((j, a, b)),
-            }
+        let mut first_node = Vec::with_capacity(bodies.len());
+        let mut n = 0;
+        for body in bodies {
+            first_node.push(n);
+            n += body.n_elements + 1;
         }
-        for (j, a, b) in pins {
-            for c in &COORDINATES[..2] {
-                multipliers.push((j, format!("joint {j} (pin {} – {}) {c}", node(a), node(b))));
-            }
-        }
+        let first = |(b, k): NodeId| 4 * (first_node[b] + k);
+        let joints = model.joints();
+        let multipliers = lower(joints, &first)
+            .into_iter()
+            .map(|(j, row)| (j, format!("joint {j} ({}) {}", joints[j].describe(&node), row.component)))
+            .collect();
         Labels { bodies: bodies.iter().map(|b| b.name.clone()).collect(), dofs, multipliers }
     }
 

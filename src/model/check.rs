@@ -7,7 +7,8 @@ use super::toml_errors::entry_line;
 use super::Model;
 use crate::error::Result;
 use crate::physics::element::Section;
-use crate::physics::system::{BeamBody, Joint, Load, NodeId, Probe};
+use crate::physics::joints::{Clamp, GroundPin, Joint, Pin};
+use crate::physics::system::{BeamBody, Load, NodeId, Probe};
 use crate::solver::generalized_alpha::{IntegratorParams, JacobianReuse, Predictor};
 use crate::solver::parameters::{Scaling, LOAD_SCALE};
 
@@ -167,7 +168,7 @@ impl Model {
                         }
                         None => at,
                     };
-                    Joint::GroundPin { node: id, point }
+                    Joint::GroundPin(GroundPin { node: id, point })
                 }
                 JointSpec::Pin { a, b } => {
                     let ia = self.node_id(&p("a.body"), &p("a.node"), &a.body, &a.node)?;
@@ -180,16 +181,16 @@ impl Model {
                     if gap > CLOSURE_TOL * lmax {
                         return Err(self.err(p("b"), format!("the two nodes start {gap:.3e} m apart ({pa:?} and {pb:?}); the initial configuration must satisfy every joint")));
                     }
-                    Joint::Pin { a: ia, b: ib }
+                    Joint::Pin(Pin { a: ia, b: ib })
                 }
                 JointSpec::Clamp { body, node } => {
                     let id = self.node_id(&p("body"), &p("node"), body, node)?;
                     let bd = &self.bodies[id.0];
-                    Joint::Clamp {
+                    Joint::Clamp(Clamp {
                         node: id,
                         point: node_pos(id, &self.bodies),
                         slope: [bd.angle.cos(), bd.angle.sin()],
-                    }
+                    })
                 }
             };
             self.joints.push(joint);
@@ -262,10 +263,10 @@ impl Model {
         Ok(())
     }
 
-    /// Refuses joints whose constraint rows `B` are linearly dependent (a node pinned twice,
-    /// a clamp plus a pin on its node, a loop of pins closing on one point): the KKT matrix
-    /// is then singular. Elimination row by row in joint order (B has entries ±1, so it is
-    /// exact); each row keeps the set of joints it was combined from, so a row that
+    /// Refuses joints whose constraint rows `B` (as each joint kind builds them) are
+    /// linearly dependent (a node pinned twice, a clamp plus a pin on its node, a loop of
+    /// pins closing on one point): the KKT matrix is then singular. Elimination row by row in
+    /// joint order (B has entries ±1, so it is exact); each row keeps the set of joints it was combined from, so a row that
     /// reduces to zero names exactly the joints whose constraints it repeats.
     fn check_joint_rank(&self) -> Result<()> {
         use std::collections::{BTreeMap, BTreeSet, HashMap};
@@ -275,18 +276,13 @@ impl Model {
             first.push(n);
             n += b.n_elements + 1;
         }
-        let g = |(b, k): NodeId| first[b] + k;
+        let g = |(b, k): NodeId| 4 * (first[b] + k);
         // reduced rows with their pivot column and the joints they combine
         let mut basis: Vec<(BTreeMap<usize, f64>, BTreeSet<usize>)> = Vec::new();
         let mut pivot_of: HashMap<usize, usize> = HashMap::new();
         for (j, joint) in self.joints.iter().enumerate() {
-            let rows: Vec<Vec<(usize, f64)>> = match *joint {
-                Joint::GroundPin { node, .. } => (0..2).map(|c| vec![(4 * g(node) + c, 1.0)]).collect(),
-                Joint::Clamp { node, .. } => (0..4).map(|c| vec![(4 * g(node) + c, 1.0)]).collect(),
-                Joint::Pin { a, b } => (0..2).map(|c| vec![(4 * g(a) + c, 1.0), (4 * g(b) + c, -1.0)]).collect(),
-            };
-            for row in rows {
-                let mut r: BTreeMap<usize, f64> = row.into_iter().collect();
+            for row in joint.kind().rows(&g) {
+                let mut r: BTreeMap<usize, f64> = row.terms.into_iter().collect();
                 let mut used = BTreeSet::from([j]);
                 // eliminate the earliest basis row first: a basis row holds only pivot
                 // columns of later rows, so this ends

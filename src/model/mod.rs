@@ -302,7 +302,8 @@ impl Model {
     pub fn sizes(&self) -> Sizes {
         let n_elements: f64 = self.bodies.iter().map(|b| b.n_elements as f64).sum();
         let n_dof = 4.0 * self.bodies.iter().map(|b| b.n_elements as f64 + 1.0).sum::<f64>();
-        let n_constraints = self.joints.iter().map(|j| if matches!(j, Joint::Clamp { .. }) { 4.0 } else { 2.0 }).sum();
+        // rows do not depend on where a node's coordinates sit
+        let n_constraints = self.joints.iter().map(|j| j.kind().rows(&|_| 0).len() as f64).sum();
         let sections: usize = self.probes.iter().map(|p| p.strain as usize + p.curvature as usize).sum();
         let n_probes = self.probes.len() as f64;
         Sizes { n_dof, n_constraints, n_elements, n_probes, n_probe_values: 2.0 * n_probes + sections as f64 }

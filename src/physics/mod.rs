@@ -1,6 +1,7 @@
 //! The mechanics: element, loads, time functions and the assembled system. Knows nothing of
 //! reduction.
 pub mod element;
+pub mod joints;
 pub mod loads;
 pub mod parts;
 pub mod section;

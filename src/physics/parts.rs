@@ -1,5 +1,5 @@
-//! What a planar flexible multibody system is made of: beams, joints, loads, probes,
-//! damping and the scalar constraints the joints become.
+//! What a planar flexible multibody system is made of: beams, loads, probes, damping and
+//! the scalar constraints the joints become (the joints themselves: [`super::joints`]).
 
 use super::element::Section;
 use super::time_function::TimeFunction;
@@ -35,16 +35,6 @@ impl BeamBody {
 
 /// A node is addressed by body index and node index within the body (0..=n_elements).
 pub type NodeId = (usize, usize);
-
-#[derive(Clone, Debug)]
-pub enum Joint {
-    /// `r_node − point = 0`
-    GroundPin { node: NodeId, point: [f64; 2] },
-    /// `r_a − r_b = 0`
-    Pin { a: NodeId, b: NodeId },
-    /// `r_node − point = 0`, `r'_node − slope = 0`
-    Clamp { node: NodeId, point: [f64; 2], slope: [f64; 2] },
-}
 
 #[derive(Clone, Debug)]
 pub enum Load {

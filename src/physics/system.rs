@@ -1,17 +1,20 @@
 //! A planar flexible multibody system: straight ANCF beams meshed into equal elements,
-//! linear joints on nodal coordinates, external loads. Implements [`ParametricModel`]: the
-//! load scale is an argument of each evaluation ([`Parameters`]), not part of the system.
+//! linear joints on nodal coordinates (the rows of [`super::joints::lower`]), external
+//! loads. Implements [`ParametricModel`]: the load scale is an argument of each evaluation
+//! ([`Parameters`]), not part of the system.
 //!
 //! Coordinates: node `k` (numbered body after body) owns `q[4k..4k+4] = (x, y, x', y')`.
 
 use super::element::{BeamElement, Mat8, Vec8};
+use super::joints::lower;
 use super::loads::{moment_force, moment_jacobian};
 use super::time_function::TimeFunction;
 use crate::linalg::kkt::{make_solver, KktPattern, KktSolver, LinearSolverKind};
 use crate::solver::model::{IterationCoefficients, Parameters, ParametricModel};
 use crate::solver::parameters::Scaling;
 
-pub use super::parts::{BeamBody, Constraint, Joint, Load, NodeId, Probe, Rayleigh};
+pub use super::joints::Joint;
+pub use super::parts::{BeamBody, Constraint, Load, NodeId, Probe, Rayleigh};
 
 mod models;
 
@@ -103,31 +106,9 @@ impl FlexibleSystem {
         let n_dof = 4 * node;
         let gnode = |(b, k): NodeId| first_node[b] + k;
 
-        let mut constraints = Vec::new();
-        let mut fix = |dof: usize, value: f64| constraints.push(Constraint { terms: vec![(dof, 1.0)], rhs: value });
-        let mut pins = Vec::new();
-        for joint in joints {
-            match *joint {
-                Joint::GroundPin { node, point } => {
-                    let n = gnode(node);
-                    fix(4 * n, point[0]);
-                    fix(4 * n + 1, point[1]);
-                }
-                Joint::Clamp { node, point, slope } => {
-                    let n = gnode(node);
-                    fix(4 * n, point[0]);
-                    fix(4 * n + 1, point[1]);
-                    fix(4 * n + 2, slope[0]);
-                    fix(4 * n + 3, slope[1]);
-                }
-                Joint::Pin { a, b } => pins.push((gnode(a), gnode(b))),
-            }
-        }
-        for (a, b) in pins {
-            for c in 0..2 {
-                constraints.push(Constraint { terms: vec![(4 * a + c, 1.0), (4 * b + c, -1.0)], rhs: 0.0 });
-            }
-        }
+        let first = |id: NodeId| 4 * gnode(id);
+        let constraints: Vec<Constraint> =
+            lower(joints, &first).into_iter().map(|(_, row)| Constraint { terms: row.terms, rhs: row.rhs }).collect();
 
         let mut gravity_fixed = vec![0.0; n_dof];
         let mut gravity_scaled = vec![0.0; n_dof];

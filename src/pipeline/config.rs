@@ -380,13 +380,11 @@ impl Pipeline {
     /// The reduction variant: the file's, or constraint-preserving when the model has
     /// joints between bodies, galerkin when it has none or only ground joints.
     pub fn variant(&self) -> Variant {
-        self.file.reduction.variant.unwrap_or(
-            if self.model.file.joints.iter().any(|j| matches!(j, crate::model::schema::JointSpec::Pin { .. })) {
-                Variant::ConstraintPreserving
-            } else {
-                Variant::Galerkin
-            },
-        )
+        self.file.reduction.variant.unwrap_or(if self.model.joints().iter().any(|j| j.kind().couples_bodies()) {
+            Variant::ConstraintPreserving
+        } else {
+            Variant::Galerkin
+        })
     }
 
     /// The block split: the file's; with `train.greedy` and none given, one block per body
