@@ -8,7 +8,8 @@ use super::Model;
 use crate::error::Result;
 use crate::physics::element::Section;
 use crate::physics::joints::{Clamp, GroundPin, Joint, Pin};
-use crate::physics::system::{BeamBody, Load, NodeId, Probe};
+use crate::physics::loads::{Force, Gravity, Load, Moment};
+use crate::physics::system::{BeamBody, NodeId, Probe};
 use crate::solver::generalized_alpha::{IntegratorParams, JacobianReuse, Predictor};
 use crate::solver::parameters::{Scaling, LOAD_SCALE};
 
@@ -201,12 +202,16 @@ impl Model {
             let load = match l {
                 LoadSpec::Gravity { g, scaled } => {
                     self.finite2(&p("g"), *g)?;
-                    Load::Gravity { g: *g, scaled: self.scaling(&p("scaled"), scaled)? }
+                    Load::Gravity(Gravity { g: *g, scaled: self.scaling(&p("scaled"), scaled)? })
                 }
                 LoadSpec::Moment { body, node, function, scaled } => {
                     let id = self.node_id(&p("body"), &p("node"), body, node)?;
                     function.check().map_err(|e| self.err(p("function"), e))?;
-                    Load::Moment { node: id, function: function.clone(), scaled: self.scaling(&p("scaled"), scaled)? }
+                    Load::Moment(Moment {
+                        node: id,
+                        function: function.clone(),
+                        scaled: self.scaling(&p("scaled"), scaled)?,
+                    })
                 }
                 LoadSpec::Force { body, node, value, function, scaled } => {
                     let id = self.node_id(&p("body"), &p("node"), body, node)?;
@@ -215,7 +220,7 @@ impl Model {
                         func.check().map_err(|e| self.err(p("function"), e))?;
                     }
                     let scaled = self.scaling(&p("scaled"), scaled)?;
-                    Load::Force { node: id, value: *value, function: function.clone(), scaled }
+                    Load::Force(Force { node: id, value: *value, function: function.clone(), scaled })
                 }
             };
             self.loads.push(load);

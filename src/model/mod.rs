@@ -9,7 +9,8 @@ mod toml_errors;
 use crate::error::{Error, Result};
 use crate::limits::Limits;
 use crate::linalg::kkt::LinearSolverKind;
-use crate::physics::system::{BeamBody, FlexibleSystem, Joint, Load, Probe, Rayleigh};
+use crate::physics::loads::Load;
+use crate::physics::system::{BeamBody, FlexibleSystem, Joint, Probe, Rayleigh};
 use crate::solver::generalized_alpha::IntegratorParams;
 use crate::solver::parameters::Parameters;
 use schema::*;
@@ -116,10 +117,7 @@ impl Model {
     pub fn parameter_names(&self) -> Vec<&str> {
         let mut names: Vec<&str> = Vec::new();
         for l in &self.loads {
-            let scaling = match l {
-                Load::Gravity { scaled, .. } | Load::Moment { scaled, .. } | Load::Force { scaled, .. } => scaled,
-            };
-            if let Some(name) = scaling.parameter() {
+            if let Some(name) = l.scaling().parameter() {
                 if !names.contains(&name) {
                     names.push(name);
                 }

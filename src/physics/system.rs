@@ -7,41 +7,14 @@
 
 use super::element::{BeamElement, Mat8, Vec8};
 use super::joints::lower;
-use super::loads::{moment_force, moment_jacobian};
-use super::time_function::TimeFunction;
+use super::loads::{assemble_weight, Gravity, Load, NodalLoad, Weight};
 use crate::linalg::kkt::{make_solver, KktPattern, KktSolver, LinearSolverKind};
 use crate::solver::model::{IterationCoefficients, Parameters, ParametricModel};
-use crate::solver::parameters::Scaling;
 
 pub use super::joints::Joint;
-pub use super::parts::{BeamBody, Constraint, Load, NodeId, Probe, Rayleigh};
+pub use super::parts::{BeamBody, Constraint, NodeId, Probe, Rayleigh};
 
 mod models;
-
-struct MomentLoad {
-    slope_dofs: [usize; 2],
-    element: usize,
-    local: usize,
-    function: TimeFunction,
-    scaled: Scaling,
-}
-
-/// The weight of the bodies whose density is the parameter `parameter` (file value
-/// `density`), in the parts `fixed + λ scaled + Σ μ_name named`, at the file's density.
-struct DensityGravity {
-    parameter: String,
-    density: f64,
-    fixed: Vec<f64>,
-    scaled: Vec<f64>,
-    named: Vec<(String, Vec<f64>)>,
-}
-
-struct ForceLoad {
-    dofs: [usize; 2],
-    value: [f64; 2],
-    function: Option<TimeFunction>,
-    scaled: Scaling,
-}
 
 pub struct FlexibleSystem {
     pub bodies: Vec<BeamBody>,
@@ -57,16 +30,13 @@ pub struct FlexibleSystem {
     pub constraints: Vec<Constraint>,
     pub probes: Vec<Probe>,
     damping: Rayleigh,
-    gravity_fixed: Vec<f64>,
-    gravity_scaled: Vec<f64>,
-    /// gravity multiplied by a named parameter (`scaled = "name"`), one vector per name
-    gravity_named: Vec<(String, Vec<f64>)>,
-    /// the gravity of the bodies whose density is a parameter, by parameter (the vectors
-    /// above hold the other bodies'), at the file's density
-    gravity_density: Vec<DensityGravity>,
-    moments: Vec<MomentLoad>,
-    forces: Vec<ForceLoad>,
-    /// the dofs that moments and nodal forces act on, sorted
+    /// the weight of the bodies, in parts by what multiplies it ([`super::loads::Gravity`])
+    weight: Weight,
+    /// the loads on a few coordinates (moments, nodal forces), in file order
+    nodal: Vec<Box<dyn NodalLoad>>,
+    /// per nodal load, the element whose iteration block holds its Jacobian (its first dof)
+    nodal_blocks: Vec<Option<(usize, usize)>>,
+    /// the dofs the nodal loads act on, sorted
     load_dofs: Vec<usize>,
     n_dof: usize,
     kkt: Box<dyn KktSolver>,
@@ -110,91 +80,12 @@ impl FlexibleSystem {
         let constraints: Vec<Constraint> =
             lower(joints, &first).into_iter().map(|(_, row)| Constraint { terms: row.terms, rhs: row.rhs }).collect();
 
-        let mut gravity_fixed = vec![0.0; n_dof];
-        let mut gravity_scaled = vec![0.0; n_dof];
-        let mut gravity_named: Vec<(String, Vec<f64>)> = Vec::new();
-        let mut gravity_density: Vec<DensityGravity> = Vec::new();
-        for body in &bodies {
-            if let Some(name) = &body.density_parameter {
-                if !gravity_density.iter().any(|d| &d.parameter == name) {
-                    gravity_density.push(DensityGravity {
-                        parameter: name.clone(),
-                        density: body.section.density,
-                        fixed: vec![0.0; n_dof],
-                        scaled: vec![0.0; n_dof],
-                        named: Vec::new(),
-                    });
-                }
-            }
-        }
-        let mut moments = Vec::new();
-        let mut forces = Vec::new();
-        // the element that holds a node: the one it starts, or the last of its body
-        let element_of = |(b, k): NodeId| -> (usize, usize) {
-            let first_el: usize = bodies[..b].iter().map(|x| x.n_elements).sum();
-            if k < bodies[b].n_elements {
-                (first_el + k, 0)
-            } else {
-                (first_el + k - 1, 4)
-            }
-        };
-        for load in loads {
-            match load {
-                Load::Gravity { g, scaled } => {
-                    for (b, dofs) in &elements {
-                        // a body whose density is a parameter weighs in its own group
-                        let group = bodies[*b].density_parameter.as_ref().map(|name| {
-                            gravity_density.iter().position(|d| &d.parameter == name).expect("listed above")
-                        });
-                        let (fixed, scaled_part, named) = match group {
-                            None => (&mut gravity_fixed, &mut gravity_scaled, &mut gravity_named),
-                            Some(i) => {
-                                let d = &mut gravity_density[i];
-                                (&mut d.fixed, &mut d.scaled, &mut d.named)
-                            }
-                        };
-                        let target = match scaled {
-                            Scaling::Fixed => fixed,
-                            Scaling::LoadScale => scaled_part,
-                            Scaling::Named(name) => {
-                                let i = match named.iter().position(|(n, _)| n == name) {
-                                    Some(i) => i,
-                                    None => {
-                                        named.push((name.clone(), vec![0.0; n_dof]));
-                                        named.len() - 1
-                                    }
-                                };
-                                &mut named[i].1
-                            }
-                        };
-                        let qg = prototypes[*b].gravity_force(*g);
-                        for i in 0..8 {
-                            target[dofs[i]] += qg[i];
-                        }
-                    }
-                }
-                Load::Moment { node, function, scaled } => {
-                    let n = gnode(*node);
-                    let (element, local) = element_of(*node);
-                    moments.push(MomentLoad {
-                        slope_dofs: [4 * n + 2, 4 * n + 3],
-                        element,
-                        local: local + 2,
-                        function: function.clone(),
-                        scaled: scaled.clone(),
-                    });
-                }
-                Load::Force { node, value, function, scaled } => {
-                    let n = gnode(*node);
-                    forces.push(ForceLoad {
-                        dofs: [4 * n, 4 * n + 1],
-                        value: *value,
-                        function: function.clone(),
-                        scaled: scaled.clone(),
-                    });
-                }
-            }
-        }
+        let gravities: Vec<&Gravity> =
+            loads.iter().filter_map(|l| if let Load::Gravity(g) = l { Some(g) } else { None }).collect();
+        let weight = assemble_weight(&gravities, &bodies, &elements, &prototypes, n_dof);
+        let nodal: Vec<Box<dyn NodalLoad>> = loads.iter().filter_map(|l| l.lower(&first)).collect();
+        let nodal_blocks =
+            nodal.iter().map(|l| l.has_stiffness().then(|| block_holding(&elements, l.dofs()))).collect();
         let pattern = KktPattern {
             n_dof,
             element_dofs: elements.iter().map(|(_, d)| *d).collect(),
@@ -202,8 +93,7 @@ impl FlexibleSystem {
         };
         let length_scale = bodies.iter().map(|b| b.length).fold(0.0, f64::max);
         let n_el = elements.len();
-        let mut load_dofs: Vec<usize> =
-            moments.iter().flat_map(|m| m.slope_dofs).chain(forces.iter().flat_map(|f| f.dofs)).collect();
+        let mut load_dofs: Vec<usize> = nodal.iter().flat_map(|l| l.dofs().iter().copied()).collect();
         load_dofs.sort_unstable();
         load_dofs.dedup();
         FlexibleSystem {
@@ -214,12 +104,9 @@ impl FlexibleSystem {
             constraints,
             probes,
             damping,
-            gravity_fixed,
-            gravity_scaled,
-            gravity_named,
-            gravity_density,
-            moments,
-            forces,
+            weight,
+            nodal,
+            nodal_blocks,
             load_dofs,
             n_dof,
             bound: prototypes.clone(),
@@ -451,20 +338,21 @@ impl FlexibleSystem {
     /// each named part times its parameter; the bodies whose density is a parameter, each
     /// part times `ρ(μ)/ρ_file` as well.
     fn gravity_into(&self, mu: &Parameters, out: &mut [f64]) {
-        for (o, (gf, gs)) in out.iter_mut().zip(self.gravity_fixed.iter().zip(&self.gravity_scaled)) {
+        let plain = &self.weight.plain;
+        for (o, (gf, gs)) in out.iter_mut().zip(plain.fixed.iter().zip(&plain.scaled)) {
             *o = -(gf + mu.scale() * gs);
         }
-        for (name, g) in &self.gravity_named {
+        for (name, g) in &plain.named {
             // a parameter the run does not set keeps the file's load
             let x = mu.get(name).unwrap_or(1.0);
             out.iter_mut().zip(g).for_each(|(o, g)| *o -= x * g);
         }
-        for d in &self.gravity_density {
+        for d in &self.weight.by_density {
             let m = mu.get(&d.parameter).map_or(1.0, |rho| rho / d.density);
-            for (o, (gf, gs)) in out.iter_mut().zip(d.fixed.iter().zip(&d.scaled)) {
+            for (o, (gf, gs)) in out.iter_mut().zip(d.parts.fixed.iter().zip(&d.parts.scaled)) {
                 *o -= m * (gf + mu.scale() * gs);
             }
-            for (name, g) in &d.named {
+            for (name, g) in &d.parts.named {
                 let x = m * mu.get(name).unwrap_or(1.0);
                 out.iter_mut().zip(g).for_each(|(o, g)| *o -= x * g);
             }
@@ -484,29 +372,43 @@ impl FlexibleSystem {
         blk
     }
 
-    /// Jacobian of the moment's contribution `−Q_M` to `g`.
-    fn moment_load_jacobian(mu: &Parameters, m: &MomentLoad, t: f64, slope: [f64; 2]) -> [[f64; 2]; 2] {
-        let j = moment_jacobian(mu.factor(&m.scaled) * m.function.eval(t), slope);
-        // g carries −Q_ext, so its Jacobian enters with a minus sign
-        [[-j[0][0], -j[0][1]], [-j[1][0], -j[1][1]]]
+    /// Calls `add(dof, value)` with the contributions `−Q_ext` of the nodal loads, in file
+    /// order; `q(dof)` reads the coordinates they depend on.
+    fn add_nodal_loads(&self, mu: &Parameters, t: f64, q: impl Fn(usize) -> f64, mut add: impl FnMut(usize, f64)) {
+        for load in &self.nodal {
+            load.add_force(mu.factor(load.scaling()), t, &q, &mut add);
+        }
     }
 
-    /// Calls `add(dof, value)` with the contributions `−Q_ext` of moments and nodal forces;
-    /// `q(dof)` reads the coordinates they depend on.
-    fn add_nodal_loads(&self, mu: &Parameters, t: f64, q: impl Fn(usize) -> f64, mut add: impl FnMut(usize, f64)) {
-        for m in &self.moments {
-            let qm = moment_force(mu.factor(&m.scaled) * m.function.eval(t), [q(m.slope_dofs[0]), q(m.slope_dofs[1])]);
-            add(m.slope_dofs[0], -qm[0]);
-            add(m.slope_dofs[1], -qm[1]);
-        }
-        for f in &self.forces {
-            let ft = mu.factor(&f.scaled) * f.function.as_ref().map_or(1.0, |func| func.eval(t));
-            add(f.dofs[0], -ft * f.value[0]);
-            add(f.dofs[1], -ft * f.value[1]);
+    /// Adds `k ∂(−Q_ext)/∂q` of the nodal loads to the element blocks that hold them.
+    fn add_nodal_stiffness(&mut self, mu: &Parameters, t: f64, q: &[f64], k: f64) {
+        for (load, slot) in self.nodal.iter().zip(&self.nodal_blocks) {
+            if let Some((e, d0)) = *slot {
+                let block = &mut self.blocks[e];
+                load.add_stiffness(mu.factor(load.scaling()), t, &|d| q[d], &mut |r, c, v| {
+                    block[(r - d0, c - d0)] += k * v
+                });
+            }
         }
     }
 
     fn local_load_index(&self, dof: usize) -> usize {
         self.load_dofs.binary_search(&dof).expect("load dof listed")
     }
+}
+
+/// The element whose 8 consecutive dofs hold every one of `dofs`, and its first dof: the one
+/// that starts at the lowest node, or the last of its body (the block a nodal load's
+/// Jacobian is added to). A load whose coordinates span two elements has no such block.
+fn block_holding(elements: &[(usize, [usize; 8])], dofs: &[usize]) -> (usize, usize) {
+    let (lo, hi) = (dofs.iter().min().copied().unwrap_or(0), dofs.iter().max().copied().unwrap_or(0));
+    let node_start = 4 * (lo / 4);
+    let e = match elements.iter().position(|(_, d)| d[0] == node_start) {
+        Some(e) => e,
+        // the last node of a body: the element that ends there
+        None => elements.iter().position(|(_, d)| d[4] == node_start).expect("a node of the mesh"),
+    };
+    let d0 = elements[e].1[0];
+    assert!(hi < d0 + 8, "a load's Jacobian spans more than one element: no block of the iteration matrix holds it");
+    (e, d0)
 }

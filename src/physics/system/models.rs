@@ -35,14 +35,11 @@ impl ElementModel for FlexibleSystem {
     fn load_jacobian(&self, mu: &Parameters, ql: &[f64], t: f64, out: &mut [f64]) {
         let nl = self.load_dofs.len();
         out.iter_mut().for_each(|x| *x = 0.0);
-        for m in &self.moments {
-            let idx = m.slope_dofs.map(|d| self.local_load_index(d));
-            let j = Self::moment_load_jacobian(mu, m, t, [ql[idx[0]], ql[idx[1]]]);
-            for r in 0..2 {
-                for c in 0..2 {
-                    out[idx[c] * nl + idx[r]] += j[r][c];
-                }
-            }
+        let q = |d: usize| ql[self.local_load_index(d)];
+        for load in &self.nodal {
+            load.add_stiffness(mu.factor(load.scaling()), t, &q, &mut |r, c, v| {
+                out[self.local_load_index(c) * nl + self.local_load_index(r)] += v
+            });
         }
     }
 
@@ -77,16 +74,20 @@ impl ElementModel for FlexibleSystem {
     fn group_constant_forces(&self, group: Option<&str>) -> ConstantForces {
         let negated = |g: &[f64]| g.iter().map(|x| -x).collect::<Vec<f64>>();
         let named = |n: &[(String, Vec<f64>)]| n.iter().map(|(name, g)| (name.clone(), negated(g))).collect();
-        match group.and_then(|name| self.gravity_density.iter().find(|d| d.parameter == name)) {
-            Some(d) => ConstantForces { fixed: negated(&d.fixed), scaled: negated(&d.scaled), named: named(&d.named) },
+        match group.and_then(|name| self.weight.by_density.iter().find(|d| d.parameter == name)) {
+            Some(d) => ConstantForces {
+                fixed: negated(&d.parts.fixed),
+                scaled: negated(&d.parts.scaled),
+                named: named(&d.parts.named),
+            },
             None if group.is_some() => {
                 let zero = vec![0.0; self.n_dof];
                 ConstantForces { fixed: zero.clone(), scaled: zero, named: Vec::new() }
             }
             None => ConstantForces {
-                fixed: negated(&self.gravity_fixed),
-                scaled: negated(&self.gravity_scaled),
-                named: named(&self.gravity_named),
+                fixed: negated(&self.weight.plain.fixed),
+                scaled: negated(&self.weight.plain.scaled),
+                named: named(&self.weight.plain.named),
             },
         }
     }
@@ -245,14 +246,7 @@ impl ParametricModel for FlexibleSystem {
             blocks: &mut self.blocks,
         });
         if coef.stiffness != 0.0 {
-            for m in &self.moments {
-                let j = Self::moment_load_jacobian(mu, m, t, [q[m.slope_dofs[0]], q[m.slope_dofs[1]]]);
-                for r in 0..2 {
-                    for c in 0..2 {
-                        self.blocks[m.element][(m.local + r, m.local + c)] += coef.stiffness * j[r][c];
-                    }
-                }
-            }
+            self.add_nodal_stiffness(mu, t, q, coef.stiffness);
         }
         let scale = if diag_max > 0.0 { diag_max } else { 1.0 };
         // sums of symmetric element matrices, each entry and its mirror computed alike
@@ -328,6 +322,9 @@ impl crate::linalg::simd::Kernel for IterationBlocks<'_> {
 mod tests {
     use super::*;
     use crate::physics::element::Section;
+    use crate::physics::loads::{Force, Gravity, Moment};
+    use crate::physics::time_function::TimeFunction;
+    use crate::solver::parameters::Scaling;
 
     /// A 1 m aluminium beam of `n` elements, at 0.3 rad: the test systems' body.
     fn aluminium_body(name: &str, n: usize) -> BeamBody {
@@ -351,9 +348,17 @@ mod tests {
     fn iteration_blocks_are_symmetric_to_the_bit() {
         let body = aluminium_body("b", 5);
         let gravity = [
-            Load::Gravity { g: [0.0, -9.81], scaled: Scaling::LoadScale },
-            Load::Moment { node: (0, 2), function: TimeFunction::Constant { value: 3.0 }, scaled: Scaling::LoadScale },
-            Load::Moment { node: (0, 5), function: TimeFunction::Constant { value: -1.5 }, scaled: Scaling::Fixed },
+            Load::Gravity(Gravity { g: [0.0, -9.81], scaled: Scaling::LoadScale }),
+            Load::Moment(Moment {
+                node: (0, 2),
+                function: TimeFunction::Constant { value: 3.0 },
+                scaled: Scaling::LoadScale,
+            }),
+            Load::Moment(Moment {
+                node: (0, 5),
+                function: TimeFunction::Constant { value: -1.5 },
+                scaled: Scaling::Fixed,
+            }),
         ];
         for damping in [Rayleigh::default(), Rayleigh { mass: 0.3, stiffness: 2e-3 }] {
             let mut sys =
@@ -389,12 +394,21 @@ mod tests {
     fn one_pass_residual_equals_force_and_mass_product_to_the_bit() {
         let body = aluminium_body;
         let loads = [
-            Load::Gravity { g: [0.5, -9.81], scaled: Scaling::LoadScale },
-            Load::Gravity { g: [0.0, -1.0], scaled: Scaling::Fixed },
-            Load::Moment { node: (1, 2), function: TimeFunction::Constant { value: 3.0 }, scaled: Scaling::LoadScale },
-            Load::Force { node: (0, 1), value: [1.0, 2.0], function: None, scaled: Scaling::Fixed },
-            Load::Gravity { g: [0.2, 0.0], scaled: Scaling::Named("wind".into()) },
-            Load::Force { node: (1, 1), value: [0.5, -1.0], function: None, scaled: Scaling::Named("push".into()) },
+            Load::Gravity(Gravity { g: [0.5, -9.81], scaled: Scaling::LoadScale }),
+            Load::Gravity(Gravity { g: [0.0, -1.0], scaled: Scaling::Fixed }),
+            Load::Moment(Moment {
+                node: (1, 2),
+                function: TimeFunction::Constant { value: 3.0 },
+                scaled: Scaling::LoadScale,
+            }),
+            Load::Force(Force { node: (0, 1), value: [1.0, 2.0], function: None, scaled: Scaling::Fixed }),
+            Load::Gravity(Gravity { g: [0.2, 0.0], scaled: Scaling::Named("wind".into()) }),
+            Load::Force(Force {
+                node: (1, 1),
+                value: [0.5, -1.0],
+                function: None,
+                scaled: Scaling::Named("push".into()),
+            }),
         ];
         for damping in [Rayleigh::default(), Rayleigh { mass: 0.3, stiffness: 2e-3 }] {
             let mut sys = FlexibleSystem::new(

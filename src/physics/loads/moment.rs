@@ -1,4 +1,67 @@
-//! External loads that are not element integrals: a moment applied at a node.
+//! A moment `M(t)` at a node, acting on its slope (SPEC §1): the node angle is
+//! `θ = atan2(y', x')`, so `δW = M δθ` with `δθ = (x' δy' − y' δx')/|r'|²`, giving
+//! `Q = M/|r'|² · (−y', x')`, which depends on the slope: the load has a stiffness.
+
+use super::{NodalLoad, NodeIndex, Scaling};
+use crate::physics::parts::NodeId;
+use crate::physics::time_function::TimeFunction;
+
+/// A moment on a node, as the model file gives it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Moment {
+    pub node: NodeId,
+    /// `M(t)` in N m, counter-clockwise
+    pub function: TimeFunction,
+    pub scaled: Scaling,
+}
+
+impl Moment {
+    /// The moment on the global slope coordinates of its node.
+    pub fn lower(&self, first: NodeIndex) -> NodalMoment {
+        let d = first(self.node);
+        NodalMoment { slope: [d + 2, d + 3], function: self.function.clone(), scaled: self.scaled.clone() }
+    }
+}
+
+/// [`Moment`] on global coordinates.
+#[derive(Clone, Debug)]
+pub struct NodalMoment {
+    /// the node's `x'` and `y'`
+    slope: [usize; 2],
+    function: TimeFunction,
+    scaled: Scaling,
+}
+
+impl NodalLoad for NodalMoment {
+    fn dofs(&self) -> &[usize] {
+        &self.slope
+    }
+
+    fn scaling(&self) -> &Scaling {
+        &self.scaled
+    }
+
+    fn add_force(&self, factor: f64, t: f64, q: &dyn Fn(usize) -> f64, add: &mut dyn FnMut(usize, f64)) {
+        let [a, b] = self.slope;
+        let qm = moment_force(factor * self.function.eval(t), [q(a), q(b)]);
+        add(a, -qm[0]);
+        add(b, -qm[1]);
+    }
+
+    fn has_stiffness(&self) -> bool {
+        true
+    }
+
+    fn add_stiffness(&self, factor: f64, t: f64, q: &dyn Fn(usize) -> f64, add: &mut dyn FnMut(usize, usize, f64)) {
+        let j = moment_jacobian(factor * self.function.eval(t), [q(self.slope[0]), q(self.slope[1])]);
+        // g carries −Q_ext, so its Jacobian enters with a minus sign
+        for (r, &dr) in self.slope.iter().enumerate() {
+            for (c, &dc) in self.slope.iter().enumerate() {
+                add(dr, dc, -j[r][c]);
+            }
+        }
+    }
+}
 
 /// Generalized force of a moment `M` on a node's slope `r' = (x', y')`.
 ///
