@@ -214,7 +214,7 @@ impl FlexibleSystem {
         use nalgebra::{DMatrix, DVector};
         let (n, nb, nc) = (self.n_dof, self.bodies.len(), self.constraints.len());
         let mut res = vec![0.0; nc];
-        self.constraint_residual(q, &mut res);
+        self.constraint_residual(q, 0.0, &mut res);
         let mut change = 0.0_f64;
         if res.iter().any(|r| *r != 0.0) {
             // ∂q_d/∂(t_x, t_y, θ̂) with θ = θ̂/L: all three in metres
@@ -255,7 +255,7 @@ impl FlexibleSystem {
         self.blocks.iter_mut().for_each(|b| *b = Mat8::identity());
         self.kkt.factor(&self.blocks, 1.0)?;
         let mut rhs = vec![0.0; n + nc];
-        self.constraint_residual(q, &mut rhs[n..]);
+        self.constraint_residual(q, 0.0, &mut rhs[n..]);
         rhs[n..].iter_mut().for_each(|r| *r = -*r);
         self.kkt.solve(&mut rhs)?;
         for i in 0..n {

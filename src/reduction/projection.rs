@@ -49,7 +49,7 @@ macro_rules! forward_to_projection {
         fn mass_mul(&self, a: &[f64], out: &mut [f64]) {
             self.p.mass_mul(a, out);
         }
-        fn constraint_residual(&self, q: &[f64], out: &mut [f64]) {
+        fn constraint_residual(&self, q: &[f64], _t: f64, out: &mut [f64]) {
             self.p.constraint_residual(q, out);
         }
         fn add_constraint_force(&self, lambda: &[f64], out: &mut [f64]) {
@@ -185,18 +185,19 @@ impl Projection {
             all => all.iter().fold(Array2::zeros((r, r)), |acc, (_, m, _)| acc + m),
         };
 
-        // constraints are linear: B y − b, so B V_j = res(V_j) − res(0)
+        // constraints are linear: B y − b, so B V_j = res(V_j) − res(0); taken at t = 0, as
+        // every joint kind's rows are constant in time (physics::joints)
         let mut res0 = vec![0.0; nc_full];
-        full.constraint_residual(&vec![0.0; n], &mut res0);
+        full.constraint_residual(&vec![0.0; n], 0.0, &mut res0);
         let mut bv = Array2::<f64>::zeros((nc_full, r));
         let mut res = vec![0.0; nc_full];
         for j in 0..r {
-            full.constraint_residual(&v.column(j).to_vec(), &mut res);
+            full.constraint_residual(&v.column(j).to_vec(), 0.0, &mut res);
             for c in 0..nc_full {
                 bv[[c, j]] = res[c] - res0[c];
             }
         }
-        full.constraint_residual(basis.reference.as_slice().expect("contiguous"), &mut res);
+        full.constraint_residual(basis.reference.as_slice().expect("contiguous"), 0.0, &mut res);
         let mut c_ref = Array1::from(res);
 
         let (nc, coupling, multiplier_map) = match basis.variant {

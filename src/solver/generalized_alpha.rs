@@ -249,7 +249,7 @@ impl GeneralizedAlpha {
     /// is (momentum by `1/β'`, constraints by `s`),
     ///
     /// ```text
-    ///     [S, Bᵀ; B, 0] [Δq; Δμ] = −[r_q / β'; s (B q − b)]        (rhs ← [Δq; Δμ])
+    ///     [S, Bᵀ; B, 0] [Δq; Δμ] = −[r_q / β'; s (B(t) q − b(t))]        (rhs ← [Δq; Δμ])
     /// ```
     ///
     /// and, with `apply`, the update of [`Self::apply_correction`]. Returns `‖Δq‖∞` (NaN
@@ -257,6 +257,7 @@ impl GeneralizedAlpha {
     pub fn correction<M: DynamicModel>(
         model: &mut M,
         st: &mut State,
+        t: f64,
         k: &StepConstants,
         s: f64,
         rhs: &mut [f64],
@@ -265,7 +266,7 @@ impl GeneralizedAlpha {
         let n = st.q.len();
         let (rq, rc) = rhs.split_at_mut(n);
         rq.iter_mut().for_each(|x| *x *= -1.0 / k.beta_p);
-        model.constraint_residual(&st.q, rc);
+        model.constraint_residual(&st.q, t, rc);
         rc.iter_mut().for_each(|x| *x *= -s);
         model.solve(rhs)?;
         if apply {
@@ -289,7 +290,8 @@ impl GeneralizedAlpha {
     }
 
     /// Consistent initial accelerations and multipliers from
-    /// `[M, Bᵀ; B, 0] [q̈₀; λ₀] = [−g(q₀, q̇₀, t₀); 0]` (B constant, so `B q̈ = 0`).
+    /// `[M, Bᵀ; B, 0] [q̈₀; λ₀] = [−g(q₀, q̇₀, t₀); c(q₀, q̇₀, t₀)]`, `c` the constraints'
+    /// acceleration level ([`DynamicModel::constraint_acceleration_rhs`]; 0 for constant ones).
     pub fn initialize<M: DynamicModel>(&mut self, model: &mut M, q0: Vec<f64>, v0: Vec<f64>, t0: f64) -> Result<State> {
         let (n, nc) = (model.n_dof(), model.n_constraints());
         assert_eq!(q0.len(), n);
@@ -310,7 +312,9 @@ impl GeneralizedAlpha {
         for i in 0..n {
             self.rhs[i] = -self.work[i];
         }
-        self.rhs[n..].iter_mut().for_each(|x| *x = 0.0);
+        // the constraint rows are factored as s B: their right-hand side is s c
+        model.constraint_acceleration_rhs(&q0, &v0, t0, &mut self.rhs[n..]);
+        self.rhs[n..].iter_mut().for_each(|x| *x *= s);
         model.solve(&mut self.rhs).map_err(|p| Error::LinearSolve { t: t0, problem: p })?;
         let qdd = self.rhs[..n].to_vec();
         let lambda = self.rhs[n..].iter().map(|m| m * s).collect();
@@ -460,7 +464,7 @@ impl GeneralizedAlpha {
                 self.factored = Some((h, s));
                 s
             };
-            let inc = Self::correction(model, st, &k, s, &mut self.rhs, true).map_err(|_| Failure {
+            let inc = Self::correction(model, st, t, &k, s, &mut self.rhs, true).map_err(|_| Failure {
                 iterations: it,
                 increment: last_increment,
                 residual,
@@ -614,7 +618,7 @@ mod tests {
                 out[0] = f64::NAN;
             }
         }
-        fn constraint_residual(&self, _q: &[f64], _out: &mut [f64]) {}
+        fn constraint_residual(&self, _q: &[f64], _t: f64, _out: &mut [f64]) {}
         fn add_constraint_force(&self, _lambda: &[f64], _out: &mut [f64]) {}
         fn factor(
             &mut self,
@@ -714,6 +718,88 @@ mod tests {
     }
 
     /// 50 steps of `h` from q = q₀ at rest; the positions after each step and the stats.
+    /// A mass `m` on a spring `k` whose one coordinate a moving constraint prescribes,
+    /// `q − b(t) = 0` with `b = v₀ t + ½ a t²`: the rheonomic seam of [`DynamicModel`].
+    /// The KKT matrix `[S, s; s, 0]` is solved in closed form.
+    struct Prescribed {
+        m: f64,
+        k: f64,
+        v0: f64,
+        a: f64,
+        s: f64,
+        diag: f64,
+    }
+
+    impl DynamicModel for Prescribed {
+        fn n_dof(&self) -> usize {
+            1
+        }
+        fn n_constraints(&self) -> usize {
+            1
+        }
+        fn mass_mul(&self, a: &[f64], out: &mut [f64]) {
+            out[0] = self.m * a[0];
+        }
+        fn force(&mut self, q: &[f64], _v: &[f64], _t: f64, out: &mut [f64]) {
+            out[0] = self.k * q[0];
+        }
+        fn constraint_residual(&self, q: &[f64], t: f64, out: &mut [f64]) {
+            out[0] = q[0] - (self.v0 * t + 0.5 * self.a * t * t);
+        }
+        fn constraint_velocity_rhs(&self, _q: &[f64], t: f64, out: &mut [f64]) {
+            out[0] = self.v0 + self.a * t;
+        }
+        fn constraint_acceleration_rhs(&self, _q: &[f64], _v: &[f64], _t: f64, out: &mut [f64]) {
+            out[0] = self.a;
+        }
+        fn add_constraint_force(&self, lambda: &[f64], out: &mut [f64]) {
+            out[0] += lambda[0];
+        }
+        fn factor(
+            &mut self,
+            _q: &[f64],
+            _v: &[f64],
+            _t: f64,
+            c: IterationCoefficients,
+        ) -> std::result::Result<f64, String> {
+            self.diag = c.mass * self.m + c.stiffness * self.k;
+            Ok(self.s)
+        }
+        fn solve(&mut self, rhs: &mut [f64]) -> std::result::Result<(), String> {
+            // [d, s; s, 0] [x; y] = [f; g]: x = g/s, y = (f − d x)/s
+            let (f, g) = (rhs[0], rhs[1]);
+            let x = g / self.s;
+            rhs[0] = x;
+            rhs[1] = (f - self.diag * x) / self.s;
+            Ok(())
+        }
+        fn length_scale(&self) -> f64 {
+            1.0
+        }
+    }
+
+    /// The start takes the constraint's acceleration level (`q̈₀ = a`, the multiplier
+    /// `λ₀ = −(m a + k q₀)` from `m q̈ + k q + λ = 0`) and each step its position level at
+    /// the step's end time: `q(tₙ) = v₀ tₙ + ½ a tₙ²` to round-off (a constraint read at
+    /// the step's start would lag a step behind).
+    #[test]
+    fn a_moving_constraint_is_met_at_each_step_s_end_and_at_the_start_s_acceleration_level() {
+        let mut m = Prescribed { m: 2.0, k: 50.0, v0: 0.3, a: -1.5, s: 4.0, diag: 0.0 };
+        let mut integ = GeneralizedAlpha::new(IntegratorParams::default()).unwrap();
+        let mut st = integ.initialize(&mut m, vec![0.0], vec![0.3], 0.0).unwrap();
+        assert!((st.qdd[0] - -1.5).abs() < 1e-15, "{}", st.qdd[0]);
+        assert!((st.lambda[0] - 3.0).abs() < 1e-14, "{}", st.lambda[0]);
+        let h = 0.01;
+        for n in 1..=20 {
+            integ.step(&mut m, &mut st, h).unwrap();
+            let t = n as f64 * h;
+            let b = 0.3 * t - 0.75 * t * t;
+            assert!((st.q[0] - b).abs() < 1e-14, "step {n}: q {} against b {b}", st.q[0]);
+            // the multiplier holds the mass on its path: λ = −(m a + k b)
+            assert!((st.lambda[0] - (3.0 - 50.0 * b)).abs() < 1e-9, "step {n}: λ {}", st.lambda[0]);
+        }
+    }
+
     fn run(mut m: Spring, q0: f64, h: f64, params: IntegratorParams) -> (Vec<f64>, Stats) {
         let mut integ = GeneralizedAlpha::new(params).unwrap();
         let mut st = integ.initialize(&mut m, vec![q0], vec![0.0], 0.0).unwrap();

@@ -4,11 +4,19 @@
 //! The model describes the index-3 DAE
 //!
 //! ```text
-//!     M q̈ + g(q, q̇, t) + Bᵀλ = 0,      B q − b = 0,
+//!     M q̈ + g(q, q̇, t) + Bᵀλ = 0,      B(t) q − b(t) = 0,
 //!     g(q, q̇, t) = C q̇ + Q_e(q) − Q_ext(q, t)
 //! ```
 //!
-//! with constant `M`, `B`, `b` (joints are linear in ANCF coordinates, SPEC §2). A model's
+//! with constant `M` and joints linear in ANCF coordinates (SPEC §2), whose rows may move
+//! with time (a prescribed motion). Differentiating the constraints gives the velocity and
+//! acceleration levels the start of a run needs:
+//!
+//! ```text
+//!     B q̇ = ḃ − Ḃ q,        B q̈ = b̈ − Ḃ q̇ − (d/dt)(Ḃ q) = b̈ − 2Ḃ q̇ − B̈ q =: c(q, q̇, t)
+//! ```
+//!
+//! (both right-hand sides vanish for constant `B`, `b`, the default). A model's
 //! loads depend on the run's parameters μ ([`super::parameters`]): models implement
 //! [`ParametricModel`], and the integrator sees one bound to a run's μ.
 
@@ -37,8 +45,17 @@ pub trait DynamicModel {
         self.mass_mul(a, inertia);
         self.force(q, v, t, force);
     }
-    /// `out = B q − b`
-    fn constraint_residual(&self, q: &[f64], out: &mut [f64]);
+    /// `out = B(t) q − b(t)`
+    fn constraint_residual(&self, q: &[f64], t: f64, out: &mut [f64]);
+    /// `out = ḃ − Ḃ q`, what `B q̇` must equal at `t`: zero for constant constraints.
+    fn constraint_velocity_rhs(&self, _q: &[f64], _t: f64, out: &mut [f64]) {
+        out.iter_mut().for_each(|x| *x = 0.0);
+    }
+    /// `out = c(q, q̇, t) = b̈ − 2Ḃ q̇ − B̈ q`, what `B q̈` must equal: zero for constant
+    /// constraints.
+    fn constraint_acceleration_rhs(&self, _q: &[f64], _v: &[f64], _t: f64, out: &mut [f64]) {
+        out.iter_mut().for_each(|x| *x = 0.0);
+    }
     /// `out += Bᵀ λ`
     fn add_constraint_force(&self, lambda: &[f64], out: &mut [f64]);
     /// Assembles and factors `[S, s Bᵀ; s B, 0]` with `S = m M + c ∂g/∂q̇ + k ∂g/∂q`
@@ -95,8 +112,17 @@ pub trait ParametricModel {
         self.mass_mul(a, inertia);
         self.force(mu, q, v, t, force);
     }
-    /// `out = B q − b`
-    fn constraint_residual(&self, q: &[f64], out: &mut [f64]);
+    /// `out = B(t) q − b(t)`
+    fn constraint_residual(&self, q: &[f64], t: f64, out: &mut [f64]);
+    /// `out = ḃ − Ḃ q`, what `B q̇` must equal at `t`: zero for constant constraints.
+    fn constraint_velocity_rhs(&self, _q: &[f64], _t: f64, out: &mut [f64]) {
+        out.iter_mut().for_each(|x| *x = 0.0);
+    }
+    /// `out = c(q, q̇, t) = b̈ − 2Ḃ q̇ − B̈ q`, what `B q̈` must equal: zero for constant
+    /// constraints.
+    fn constraint_acceleration_rhs(&self, _q: &[f64], _v: &[f64], _t: f64, out: &mut [f64]) {
+        out.iter_mut().for_each(|x| *x = 0.0);
+    }
     /// `out += Bᵀ λ`
     fn add_constraint_force(&self, lambda: &[f64], out: &mut [f64]);
     /// [`DynamicModel::factor`] at the parameters `mu`.
@@ -150,8 +176,14 @@ impl<M: ParametricModel + ?Sized> DynamicModel for Bound<'_, M> {
     fn force_and_inertia(&mut self, q: &[f64], v: &[f64], a: &[f64], t: f64, out: (&mut [f64], &mut [f64])) {
         self.model.force_and_inertia(&self.mu, q, v, a, t, out)
     }
-    fn constraint_residual(&self, q: &[f64], out: &mut [f64]) {
-        self.model.constraint_residual(q, out)
+    fn constraint_residual(&self, q: &[f64], t: f64, out: &mut [f64]) {
+        self.model.constraint_residual(q, t, out)
+    }
+    fn constraint_velocity_rhs(&self, q: &[f64], t: f64, out: &mut [f64]) {
+        self.model.constraint_velocity_rhs(q, t, out)
+    }
+    fn constraint_acceleration_rhs(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
+        self.model.constraint_acceleration_rhs(q, v, t, out)
     }
     fn add_constraint_force(&self, lambda: &[f64], out: &mut [f64]) {
         self.model.add_constraint_force(lambda, out)

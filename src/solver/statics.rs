@@ -32,7 +32,7 @@ pub fn solve_static<M: DynamicModel>(
         let s = model.factor(q, &zero, t, coef).map_err(|p| Error::LinearSolve { t, problem: p })?;
         let (rq, rc) = rhs.split_at_mut(n);
         rq.iter_mut().for_each(|x| *x = -*x);
-        model.constraint_residual(q, rc);
+        model.constraint_residual(q, t, rc);
         rc.iter_mut().for_each(|x| *x *= -s);
         model.solve(&mut rhs).map_err(|p| Error::LinearSolve { t, problem: p })?;
         inc = crate::linalg::vec_ops::max_abs(&rhs[..n]);

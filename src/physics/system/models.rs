@@ -198,7 +198,8 @@ impl ParametricModel for FlexibleSystem {
         self.add_nodal_loads(mu, t, |d| q[d], |d, value| force[d] += value);
     }
 
-    fn constraint_residual(&self, q: &[f64], out: &mut [f64]) {
+    /// The joints' rows are constant ([`crate::physics::joints`]): `t` does not enter.
+    fn constraint_residual(&self, q: &[f64], _t: f64, out: &mut [f64]) {
         for (o, c) in out.iter_mut().zip(&self.constraints) {
             *o = c.terms.iter().map(|&(d, k)| k * q[d]).sum::<f64>() - c.rhs;
         }

@@ -236,7 +236,7 @@ impl CorrectedRunner {
                 }
                 GeneralizedAlpha::residual(rom, &st, t, &mut rhs, &mut work);
                 let sc = rom.factor(&st.q, &st.v, t, k.coef).map_err(|p| fail(t, p))?;
-                let inc = GeneralizedAlpha::correction(rom, &mut st, &k, sc, &mut rhs, sample == 0)
+                let inc = GeneralizedAlpha::correction(rom, &mut st, t, &k, sc, &mut rhs, sample == 0)
                     .map_err(|p| fail(t, p))?;
                 if record {
                     if !rhs[..n].iter().all(|x| x.is_finite()) {
@@ -291,7 +291,7 @@ fn check_step<M: DynamicModel>(
     let mut last = first;
     for it in 2..=c.max_iterations.max(2) {
         GeneralizedAlpha::residual(rom, st, c.t, rhs, work);
-        let next = GeneralizedAlpha::correction(rom, st, &c.k, s, rhs, false)?;
+        let next = GeneralizedAlpha::correction(rom, st, c.t, &c.k, s, rhs, false)?;
         if !next.is_finite() {
             return Err("the corrected trajectory is no longer finite".into());
         }
