@@ -7,8 +7,9 @@ use super::toml_errors::entry_line;
 use super::Model;
 use crate::error::Result;
 use crate::physics::element::Section;
-use crate::physics::joints::{Clamp, GroundPin, Joint, Pin};
+use crate::physics::joints::{Clamp, GroundPin, Joint, Pin, Slider, Weld};
 use crate::physics::loads::{Force, Gravity, Load, Moment};
+use crate::physics::masses::PointMass;
 use crate::physics::system::{BeamBody, NodeId, Probe};
 use crate::solver::generalized_alpha::{IntegratorParams, JacobianReuse, Predictor};
 use crate::solver::parameters::{Scaling, LOAD_SCALE};
@@ -193,6 +194,35 @@ impl Model {
                         slope: [bd.angle.cos(), bd.angle.sin()],
                     })
                 }
+                JointSpec::Slider { body, node, direction, lock_rotation } => {
+                    let id = self.node_id(&p("body"), &p("node"), body, node)?;
+                    self.finite2(&p("direction"), *direction)?;
+                    if direction[0].hypot(direction[1]) == 0.0 {
+                        return Err(
+                            self.err(p("direction"), "has zero length; give the line's direction, e.g. [1.0, 0.0]")
+                        );
+                    }
+                    let angle = self.bodies[id.0].angle;
+                    Joint::Slider(Slider {
+                        node: id,
+                        point: node_pos(id, &self.bodies),
+                        direction: *direction,
+                        locked_slope: lock_rotation.then(|| [angle.cos(), angle.sin()]),
+                    })
+                }
+                JointSpec::Weld { a, b } => {
+                    let ia = self.node_id(&p("a.body"), &p("a.node"), &a.body, &a.node)?;
+                    let ib = self.node_id(&p("b.body"), &p("b.node"), &b.body, &b.node)?;
+                    if ia.0 == ib.0 {
+                        return Err(self.err(p("b.body"), "a weld joins two different bodies"));
+                    }
+                    let (pa, pb) = (node_pos(ia, &self.bodies), node_pos(ib, &self.bodies));
+                    let gap = (pa[0] - pb[0]).hypot(pa[1] - pb[1]);
+                    if gap > CLOSURE_TOL * lmax {
+                        return Err(self.err(p("b"), format!("the two nodes start {gap:.3e} m apart ({pa:?} and {pb:?}); the initial configuration must satisfy every joint")));
+                    }
+                    Joint::Weld(Weld { a: ia, b: ib, angle: self.bodies[ib.0].angle - self.bodies[ia.0].angle })
+                }
             };
             self.joints.push(joint);
         }
@@ -224,6 +254,12 @@ impl Model {
                 }
             };
             self.loads.push(load);
+        }
+        for (i, m) in f.masses.iter().enumerate() {
+            let p = |k: &str| format!("masses[{i}].{k}");
+            let node = self.node_id(&p("body"), &p("node"), &m.body, &m.node)?;
+            self.positive(&p("mass"), m.mass)?;
+            self.masses.push(PointMass { node, mass: m.mass });
         }
         for (i, pr) in f.probes.iter().enumerate() {
             let p = |k: &str| format!("probes[{i}].{k}");
@@ -271,7 +307,8 @@ impl Model {
     /// Refuses joints whose constraint rows `B` (as each joint kind builds them) are
     /// linearly dependent (a node pinned twice, a clamp plus a pin on its node, a loop of
     /// pins closing on one point): the KKT matrix is then singular. Elimination row by row in
-    /// joint order (B has entries ±1, so it is exact); each row keeps the set of joints it was combined from, so a row that
+    /// joint order (entries of B are ±1 or direction cosines: a row that reduces below 1e-9 is
+    /// dependent); each row keeps the set of joints it was combined from, so a row that
     /// reduces to zero names exactly the joints whose constraints it repeats.
     fn check_joint_rank(&self) -> Result<()> {
         use std::collections::{BTreeMap, BTreeSet, HashMap};
@@ -343,6 +380,8 @@ impl Model {
             JointSpec::GroundPin { body, node: n, .. } => format!("ground_pin on `{body}` {}", node(n)),
             JointSpec::Clamp { body, node: n } => format!("clamp on `{body}` {}", node(n)),
             JointSpec::Pin { a, b } => format!("pin `{}` {} – `{}` {}", a.body, node(&a.node), b.body, node(&b.node)),
+            JointSpec::Slider { body, node: n, .. } => format!("slider on `{body}` {}", node(n)),
+            JointSpec::Weld { a, b } => format!("weld `{}` {} – `{}` {}", a.body, node(&a.node), b.body, node(&b.node)),
         }
     }
 

@@ -10,6 +10,7 @@ use crate::error::{Error, Result};
 use crate::limits::Limits;
 use crate::linalg::kkt::LinearSolverKind;
 use crate::physics::loads::Load;
+use crate::physics::masses::PointMass;
 use crate::physics::system::{BeamBody, FlexibleSystem, Joint, Probe, Rayleigh};
 use crate::solver::generalized_alpha::IntegratorParams;
 use crate::solver::parameters::Parameters;
@@ -52,6 +53,7 @@ pub struct Model {
     bodies: Vec<BeamBody>,
     joints: Vec<Joint>,
     loads: Vec<Load>,
+    masses: Vec<PointMass>,
     probes: Vec<Probe>,
     /// the physics, assembled at the first [`Model::physics`] call ([`shared`])
     physics: std::sync::OnceLock<SharedPhysics>,
@@ -88,6 +90,7 @@ impl Model {
             bodies: vec![],
             joints: vec![],
             loads: vec![],
+            masses: vec![],
             probes: vec![],
             physics: std::sync::OnceLock::new(),
             limits,
@@ -292,7 +295,15 @@ impl Model {
             .damping
             .as_ref()
             .map_or(Rayleigh::default(), |d| Rayleigh { mass: d.mass, stiffness: d.stiffness });
-        FlexibleSystem::new(self.bodies.clone(), &self.joints, &self.loads, self.probes.clone(), damping, solver)
+        FlexibleSystem::new(
+            self.bodies.clone(),
+            &self.joints,
+            &self.loads,
+            &self.masses,
+            self.probes.clone(),
+            damping,
+            solver,
+        )
     }
 
     /// The sizes of the system this model builds, from the file alone (nothing is

@@ -17,8 +17,20 @@ pub struct ModelFile {
     pub joints: Vec<JointSpec>,
     #[serde(default)]
     pub loads: Vec<LoadSpec>,
+    /// point masses at nodes
+    #[serde(default)]
+    pub masses: Vec<MassSpec>,
     #[serde(default)]
     pub probes: Vec<ProbeSpec>,
+}
+
+/// A point mass at a node, kg (gravity acts on it).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct MassSpec {
+    pub body: String,
+    pub node: NodeRef,
+    pub mass: f64,
 }
 
 #[derive(Clone, Debug, Deserialize, Serialize)]
@@ -189,6 +201,18 @@ pub enum JointSpec {
     Pin { a: NodeSpec, b: NodeSpec },
     /// position and slope of the node fixed at their initial values
     Clamp { body: String, node: NodeRef },
+    /// the node stays on the ground line through its initial position along `direction`;
+    /// with `lock_rotation` its slope keeps its direction too (a prismatic joint)
+    Slider {
+        body: String,
+        node: NodeRef,
+        #[serde(deserialize_with = "pair::exactly")]
+        direction: [f64; 2],
+        #[serde(default)]
+        lock_rotation: bool,
+    },
+    /// two bodies' nodes rigidly joined: the same position, slopes at their initial angle
+    Weld { a: NodeSpec, b: NodeSpec },
 }
 
 /// `scaled` of a load: `true` (times the load scale), `false` (fixed), or the name of the

@@ -16,10 +16,11 @@ pub(super) fn entry_error(text: &str, path: &Path) -> Option<Error> {
     }
     let doc: toml::Table = toml::from_str(text).ok()?;
     type FirstError = fn(&toml::Value) -> Option<String>;
-    let kinds: [(&str, FirstError); 4] = [
+    let kinds: [(&str, FirstError); 5] = [
         ("bodies", first_error::<BodySpec>),
         ("joints", first_error::<JointSpec>),
         ("loads", first_error::<LoadSpec>),
+        ("masses", first_error::<MassSpec>),
         ("probes", first_error::<ProbeSpec>),
     ];
     for (name, parse) in kinds {

@@ -3,6 +3,7 @@
 pub mod element;
 pub mod joints;
 pub mod loads;
+pub mod masses;
 pub mod parts;
 pub mod section;
 pub mod system;

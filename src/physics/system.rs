@@ -8,6 +8,7 @@
 use super::element::{BeamElement, Mat8, Vec8};
 use super::joints::lower;
 use super::loads::{assemble_weight, Gravity, Load, NodalLoad, Weight};
+use super::masses::PointMass;
 use crate::linalg::kkt::{make_solver, KktPattern, KktSolver, LinearSolverKind};
 use crate::solver::model::{IterationCoefficients, Parameters, ParametricModel};
 
@@ -36,6 +37,9 @@ pub struct FlexibleSystem {
     nodal: Vec<Box<dyn NodalLoad>>,
     /// per nodal load, the element whose iteration block holds its Jacobian (its first dof)
     nodal_blocks: Vec<Option<(usize, usize)>>,
+    /// point masses: the node's position coordinates, the mass, and the element whose
+    /// iteration block holds it (its first dof)
+    point_masses: Vec<([usize; 2], f64, (usize, usize))>,
     /// the dofs the nodal loads act on, sorted
     load_dofs: Vec<usize>,
     n_dof: usize,
@@ -55,6 +59,7 @@ impl FlexibleSystem {
         bodies: Vec<BeamBody>,
         joints: &[Joint],
         loads: &[Load],
+        masses: &[PointMass],
         probes: Vec<Probe>,
         damping: Rayleigh,
         solver: LinearSolverKind,
@@ -82,7 +87,15 @@ impl FlexibleSystem {
 
         let gravities: Vec<&Gravity> =
             loads.iter().filter_map(|l| if let Load::Gravity(g) = l { Some(g) } else { None }).collect();
-        let weight = assemble_weight(&gravities, &bodies, &elements, &prototypes, n_dof);
+        let point_masses: Vec<_> = masses
+            .iter()
+            .map(|m| {
+                let (dofs, mass) = m.lower(&first);
+                (dofs, mass, block_holding(&elements, &dofs))
+            })
+            .collect();
+        let lumped: Vec<([usize; 2], f64)> = point_masses.iter().map(|&(d, m, _)| (d, m)).collect();
+        let weight = assemble_weight(&gravities, &bodies, &elements, &prototypes, &lumped, n_dof);
         let nodal: Vec<Box<dyn NodalLoad>> = loads.iter().filter_map(|l| l.lower(&first)).collect();
         let nodal_blocks =
             nodal.iter().map(|l| l.has_stiffness().then(|| block_holding(&elements, l.dofs()))).collect();
@@ -107,6 +120,7 @@ impl FlexibleSystem {
             weight,
             nodal,
             nodal_blocks,
+            point_masses,
             load_dofs,
             n_dof,
             bound: prototypes.clone(),
@@ -315,6 +329,11 @@ impl FlexibleSystem {
                 }
             }
         }
+        for &(dofs, mass, _) in &self.point_masses {
+            for d in dofs {
+                m[d * n + d] += mass;
+            }
+        }
         (m, k)
     }
 
@@ -377,6 +396,29 @@ impl FlexibleSystem {
     fn add_nodal_loads(&self, mu: &Parameters, t: f64, q: impl Fn(usize) -> f64, mut add: impl FnMut(usize, f64)) {
         for load in &self.nodal {
             load.add_force(mu.factor(load.scaling()), t, &q, &mut add);
+        }
+    }
+
+    /// `out += M_p a`, the point masses' part of the mass matrix.
+    fn add_point_mass_product(&self, a: &[f64], out: &mut [f64]) {
+        for &(dofs, mass, _) in &self.point_masses {
+            for d in dofs {
+                out[d] += mass * a[d];
+            }
+        }
+    }
+
+    /// Whether the model has point masses (mass outside its elements).
+    pub fn has_point_masses(&self) -> bool {
+        !self.point_masses.is_empty()
+    }
+
+    /// Adds `m_c M_p` to the element blocks that hold the point masses.
+    fn add_point_mass_blocks(&mut self, coef_mass: f64) {
+        for &(dofs, mass, (e, d0)) in &self.point_masses {
+            for d in dofs {
+                self.blocks[e][(d - d0, d - d0)] += coef_mass * mass;
+            }
         }
     }
 

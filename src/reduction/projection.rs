@@ -162,7 +162,7 @@ impl Projection {
 
         // constant parts, projected once per group of elements whose mass one parameter scales
         let mut groups: Vec<(Option<String>, Option<usize>)> =
-            mass_groups(full).into_iter().map(|(name, members)| (name, Some(members[0]))).collect();
+            mass_groups(full).into_iter().map(|(name, members)| (name, members.first().copied())).collect();
         if groups.is_empty() {
             groups.push((None, None));
         }

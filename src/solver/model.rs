@@ -271,6 +271,12 @@ pub trait ElementModel: ParametricModel {
     /// (times `λ`) and one per named parameter (`scaled = "name"`, times `μ_name`, 1 where μ
     /// does not set it): a reduction projects each once.
     fn group_constant_forces(&self, group: Option<&str>) -> ConstantForces;
+    /// Whether the model has mass outside its elements that no parameter scales (point
+    /// masses): [`Self::group_mass_mul`] and [`Self::group_constant_forces`] of the group
+    /// `None` then carry it even where every element's mass is a parameter's.
+    fn has_lumped_mass(&self) -> bool {
+        false
+    }
 }
 
 /// The constant forces `g₀` of a model, or of a group of its elements, in parts:
@@ -292,7 +298,12 @@ pub fn stiffness_groups<M: ElementModel + ?Sized>(model: &M) -> Vec<(Option<Stri
 /// The elements of `model` by the parameter that scales their mass, as
 /// [`stiffness_groups`] by stiffness.
 pub fn mass_groups<M: ElementModel + ?Sized>(model: &M) -> Vec<(Option<String>, Vec<usize>)> {
-    groups_by(model.n_elements(), |e| model.mass_parameter(e))
+    let mut groups = groups_by(model.n_elements(), |e| model.mass_parameter(e));
+    // lumped mass belongs to the group `None`, which may then have no element
+    if model.has_lumped_mass() && !groups.is_empty() && groups[0].0.is_some() {
+        groups.insert(0, (None, Vec::new()));
+    }
+    groups
 }
 
 fn groups_by<'a>(n: usize, parameter: impl Fn(usize) -> Option<&'a str>) -> Vec<(Option<String>, Vec<usize>)> {

@@ -2,7 +2,7 @@
 //! (x, y, x', y'). Holding the whole slope vector, not only its direction, also fixes the
 //! axial stretch at the node: the rows stay linear and constant in ANCF coordinates (SPEC §2).
 
-use super::{fixed_coordinate, JointKind, NodeIndex, Row};
+use super::row::{fixed_coordinate, JointKind, NodeIndex, Row};
 use crate::physics::parts::NodeId;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -37,7 +37,7 @@ impl JointKind for Clamp {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::physics::joints::RowKind;
+    use crate::physics::joints::row::RowKind;
 
     #[test]
     fn holds_position_and_slope() {

@@ -1,7 +1,7 @@
 //! A node pinned to the ground: `r_node − point = 0`, two rows (x, y). The node's slope stays
 //! free, so the body turns about the point.
 
-use super::{fixed_coordinate, JointKind, NodeIndex, Row};
+use super::row::{fixed_coordinate, JointKind, NodeIndex, Row};
 use crate::physics::parts::NodeId;
 
 #[derive(Clone, Debug, PartialEq)]

@@ -15,73 +15,18 @@
 mod clamp;
 mod ground_pin;
 mod pin;
+mod row;
+mod slider;
+mod weld;
 
 pub use clamp::Clamp;
 pub use ground_pin::GroundPin;
 pub use pin::Pin;
+pub use row::{JointKind, NodeIndex, Row, RowKind, COORDINATES};
+pub use slider::Slider;
+pub use weld::Weld;
 
 use super::parts::NodeId;
-
-/// What a constraint row holds fixed, which sets the units of its residual and multiplier.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum RowKind {
-    /// a position coordinate: residual in m, multiplier a force in N
-    Position,
-    /// a slope coordinate (dimensionless): multiplier a moment-like force in N m
-    Slope,
-}
-
-impl RowKind {
-    /// Unit of the row's residual.
-    pub fn residual_unit(self) -> &'static str {
-        match self {
-            RowKind::Position => "m",
-            RowKind::Slope => "1",
-        }
-    }
-
-    /// Unit of the row's Lagrange multiplier (the generalized force the joint transmits).
-    pub fn multiplier_unit(self) -> &'static str {
-        match self {
-            RowKind::Position => "N",
-            RowKind::Slope => "N m",
-        }
-    }
-}
-
-/// One scalar constraint `Σ coef · q[dof] = rhs` as a joint builds it.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Row {
-    pub terms: Vec<(usize, f64)>,
-    pub rhs: f64,
-    /// the coordinate the row is about: `x`, `y`, `x'` or `y'`
-    pub component: &'static str,
-    pub kind: RowKind,
-}
-
-/// The global coordinate index of a node's first coordinate: `4 · node` (SPEC §1 numbering).
-pub type NodeIndex<'a> = &'a dyn Fn(NodeId) -> usize;
-
-/// Names of the four coordinates of a node, in their order.
-pub const COORDINATES: [&str; 4] = ["x", "y", "x'", "y'"];
-
-/// Row `c` (0..4) of a node held at `value`: one unit coefficient on the coordinate.
-pub(crate) fn fixed_coordinate(first: usize, c: usize, value: f64) -> Row {
-    let kind = if c < 2 { RowKind::Position } else { RowKind::Slope };
-    Row { terms: vec![(first + c, 1.0)], rhs: value, component: COORDINATES[c], kind }
-}
-
-/// A kind of joint: its rows and what the rest of the program asks of it.
-pub trait JointKind {
-    /// The model file's `type` of this kind (`ground_pin`).
-    fn type_name(&self) -> &'static str;
-    /// The nodes it acts on, in the order its description names them.
-    fn nodes(&self) -> Vec<NodeId>;
-    /// Its constraint rows; `first` gives a node's first global coordinate.
-    fn rows(&self, first: NodeIndex) -> Vec<Row>;
-    /// Whether it joins two bodies (a reduction then keeps multipliers of its own).
-    fn couples_bodies(&self) -> bool;
-}
 
 /// A joint of a model, one variant per kind.
 #[derive(Clone, Debug)]
@@ -89,6 +34,8 @@ pub enum Joint {
     GroundPin(GroundPin),
     Pin(Pin),
     Clamp(Clamp),
+    Slider(Slider),
+    Weld(Weld),
 }
 
 impl Joint {
@@ -98,6 +45,8 @@ impl Joint {
             Joint::GroundPin(j) => j,
             Joint::Pin(j) => j,
             Joint::Clamp(j) => j,
+            Joint::Slider(j) => j,
+            Joint::Weld(j) => j,
         }
     }
 

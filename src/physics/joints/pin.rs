@@ -1,7 +1,7 @@
 //! Two bodies' nodes pinned together: `r_a − r_b = 0`, two rows (x, y); both slopes stay
 //! free, so the bodies turn relative to each other.
 
-use super::{JointKind, NodeIndex, Row, RowKind, COORDINATES};
+use super::row::{JointKind, NodeIndex, Row, RowKind, COORDINATES};
 use crate::physics::parts::NodeId;
 
 #[derive(Clone, Debug, PartialEq)]

@@ -1,7 +1,7 @@
 //! A force `F f(t)` at a node, on its position coordinates (`f = 1` without a function): a
 //! dead load, the same whatever the node's position, so it has no stiffness.
 
-use super::{NodalLoad, NodeIndex, Scaling};
+use super::nodal::{NodalLoad, NodeIndex, Scaling};
 use crate::physics::parts::NodeId;
 use crate::physics::time_function::TimeFunction;
 

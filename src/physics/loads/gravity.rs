@@ -3,9 +3,9 @@
 //! load scale, a named parameter — and, for the bodies whose density is a parameter, by that
 //! parameter as well (their weight scales with their mass).
 
-use super::Scaling;
 use crate::physics::element::BeamElement;
 use crate::physics::parts::BeamBody;
+use crate::solver::parameters::Scaling;
 
 /// Gravity as the model file gives it.
 #[derive(Clone, Debug, PartialEq)]
@@ -65,12 +65,14 @@ pub struct Weight {
 }
 
 /// Assembles the weight of `gravities` on the elements `elements` (body, 8 dofs), with one
-/// element prototype per body at the file's values.
+/// element prototype per body at the file's values, and on the point masses `lumped`
+/// (position coordinates, kg: `m g`, in the plain group, as no parameter scales them).
 pub fn assemble(
     gravities: &[&Gravity],
     bodies: &[BeamBody],
     elements: &[(usize, [usize; 8])],
     prototypes: &[BeamElement],
+    lumped: &[([usize; 2], f64)],
     n_dof: usize,
 ) -> Weight {
     let mut by_density: Vec<DensityWeight> = Vec::new();
@@ -98,6 +100,11 @@ pub fn assemble(
             for i in 0..8 {
                 target[dofs[i]] += qg[i];
             }
+        }
+        let target = plain.part(&gravity.scaled, n_dof);
+        for &([x, y], m) in lumped {
+            target[x] += m * gravity.g[0];
+            target[y] += m * gravity.g[1];
         }
     }
     Weight { plain, by_density }
@@ -132,7 +139,7 @@ mod tests {
             Gravity { g: [0.0, -9.81], scaled: Scaling::LoadScale },
             Gravity { g: [0.0, -1.0], scaled: Scaling::Named("tilt".into()) },
         );
-        let w = assemble(&[&g1, &g2], &bodies, &elements, &protos, 16);
+        let w = assemble(&[&g1, &g2], &bodies, &elements, &protos, &[], 16);
         let weight_y = |v: &[f64], first: usize| v[first + 1] + v[first + 5];
         let rho_a = 2700.0 * 1e-4;
         assert!((weight_y(&w.plain.scaled, 0) + rho_a * 9.81).abs() < 1e-12);

@@ -2,7 +2,7 @@
 //! `θ = atan2(y', x')`, so `δW = M δθ` with `δθ = (x' δy' − y' δx')/|r'|²`, giving
 //! `Q = M/|r'|² · (−y', x')`, which depends on the slope: the load has a stiffness.
 
-use super::{NodalLoad, NodeIndex, Scaling};
+use super::nodal::{NodalLoad, NodeIndex, Scaling};
 use crate::physics::parts::NodeId;
 use crate::physics::time_function::TimeFunction;
 

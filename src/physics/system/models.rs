@@ -69,6 +69,14 @@ impl ElementModel for FlexibleSystem {
                 }
             }
         }
+        // the point masses: no parameter scales them
+        if group.is_none() {
+            self.add_point_mass_product(a, out);
+        }
+    }
+
+    fn has_lumped_mass(&self) -> bool {
+        self.has_point_masses()
     }
 
     fn group_constant_forces(&self, group: Option<&str>) -> ConstantForces {
@@ -146,6 +154,7 @@ impl ParametricModel for FlexibleSystem {
                 out[d] += f[i];
             }
         }
+        self.add_point_mass_product(a, out);
     }
 
     fn force(&mut self, mu: &Parameters, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
@@ -195,6 +204,7 @@ impl ParametricModel for FlexibleSystem {
                 *o += mi;
             }
         }
+        self.add_point_mass_product(a, inertia);
         self.add_nodal_loads(mu, t, |d| q[d], |d, value| force[d] += value);
     }
 
@@ -246,6 +256,9 @@ impl ParametricModel for FlexibleSystem {
             q,
             blocks: &mut self.blocks,
         });
+        if coef.mass != 0.0 {
+            self.add_point_mass_blocks(coef.mass);
+        }
         if coef.stiffness != 0.0 {
             self.add_nodal_stiffness(mu, t, q, coef.stiffness);
         }
@@ -363,7 +376,7 @@ mod tests {
         ];
         for damping in [Rayleigh::default(), Rayleigh { mass: 0.3, stiffness: 2e-3 }] {
             let mut sys =
-                FlexibleSystem::new(vec![body.clone()], &[], &gravity, vec![], damping, LinearSolverKind::Banded);
+                FlexibleSystem::new(vec![body.clone()], &[], &gravity, &[], vec![], damping, LinearSolverKind::Banded);
             let n = ParametricModel::n_dof(&sys);
             let q: Vec<f64> =
                 sys.initial_state().iter().enumerate().map(|(i, x)| x + 0.03 * (i as f64 * 0.7).sin()).collect();
@@ -416,6 +429,7 @@ mod tests {
                 vec![body("a", 3), body("b", 2)],
                 &[],
                 &loads,
+                &[],
                 vec![],
                 damping,
                 LinearSolverKind::Banded,
@@ -445,6 +459,7 @@ mod tests {
         let body = aluminium_body("b", 2);
         let sys = FlexibleSystem::new(
             vec![body],
+            &[],
             &[],
             &[],
             vec![],
