@@ -130,20 +130,20 @@ pub struct SimulationResult {
 
 /// The one solve of every run, full or reduced (`simulate`, `online`, `sweep`, `validate`,
 /// greedy training and the error estimate all come here): integrates `model` at the
-/// settings' parameters over its `n_steps` steps of `dt` from `q0` at rest, with the
+/// settings' parameters over its `n_steps` steps of `dt` from `(q0, v0)`, with the
 /// optional increment guess of [`integrate_guided`], calling `record` at t₀ and after every
 /// step. The model is not changed by the parameters: the same model runs at λ₁, λ₂, λ₁ and
 /// gives what three fresh models give (tests/parameters.rs).
 pub fn solve<M: ParametricModel + ?Sized>(
     model: &mut M,
     s: &Settings,
-    q0: Vec<f64>,
+    (q0, v0): (Vec<f64>, Vec<f64>),
     guess: impl FnMut(usize, &mut [f64]) -> bool,
     record: impl FnMut(usize, &State),
 ) -> Result<Stats> {
     let mu = s.parameters();
     mu.validate()?;
-    integrate_guided(&mut Bound::new(model, mu), s, q0, guess, record)
+    integrate_guided(&mut Bound::new(model, mu), s, (q0, v0), guess, record)
 }
 
 /// Integrates any [`DynamicModel`] (a model bound to its parameters) with the settings'
@@ -155,7 +155,8 @@ pub fn integrate<M: DynamicModel>(
     q0: Vec<f64>,
     record: impl FnMut(usize, &State),
 ) -> Result<Stats> {
-    integrate_guided(model, s, q0, |_, _| false, record)
+    let v0 = vec![0.0; q0.len()];
+    integrate_guided(model, s, (q0, v0), |_, _| false, record)
 }
 
 /// [`integrate`] with a guess of each step's increment: `guess(k, out)` fills `out` with
@@ -163,13 +164,12 @@ pub fn integrate<M: DynamicModel>(
 pub fn integrate_guided<M: DynamicModel>(
     model: &mut M,
     s: &Settings,
-    q0: Vec<f64>,
+    (q0, v0): (Vec<f64>, Vec<f64>),
     mut guess: impl FnMut(usize, &mut [f64]) -> bool,
     mut record: impl FnMut(usize, &State),
 ) -> Result<Stats> {
     let (params, dt, n_steps) = (&s.params, s.dt, s.n_steps);
     let mut integ = GeneralizedAlpha::new(params.clone()).map_err(Error::Usage)?;
-    let v0 = vec![0.0; q0.len()];
     let mut state = integ.initialize(model, q0, v0, 0.0)?;
     let mut increment = vec![0.0; state.q.len()];
     let mut watch = BlowUpWatch::new(params, s.allow_blowup);
@@ -332,11 +332,12 @@ fn run_full(model: &Model, sys: &mut FlexibleSystem, q0: Vec<f64>, s: Settings) 
         sys.probes.iter().map(|p| (p.name.clone(), Array2::zeros((nt, 2)))).collect();
     let probe_defs = sys.probes.clone();
     let start = std::time::Instant::now();
+    let v0 = sys.initial_velocity(&q0);
     // the probes are evaluated after the loop, from the stored coordinates
     let stats = solve(
         sys,
         &s,
-        q0,
+        (q0, v0),
         |_, _| false,
         |k, st| {
             t[k] = st.t;

@@ -120,12 +120,18 @@ fn every_element_at_weight_one_equals_plain_galerkin_with(modes: &str) {
     // within 1e-10 · L of its solution, independently in the two models, so over 43 steps
     // they may drift apart by ~43 · 1e-10 relative; a modelling difference would not stay
     // below 1e-8 (the force check above already pins it to round-off)
-    let q0 = basis.reduce(data.x.column(0)).to_vec();
+    let (q0, v0) = (basis.reduce(data.x.column(0)).to_vec(), vec![0.0; r]);
     let mut a = Array2::zeros((r, s.n_steps + 1));
-    solve(&mut galerkin, &s, q0.clone(), |_, _| false, |k, st| a.column_mut(k).assign(&ArrayView1::from(&st.q)))
-        .unwrap();
+    solve(
+        &mut galerkin,
+        &s,
+        (q0.clone(), v0.clone()),
+        |_, _| false,
+        |k, st| a.column_mut(k).assign(&ArrayView1::from(&st.q)),
+    )
+    .unwrap();
     let mut b = Array2::zeros((r, s.n_steps + 1));
-    solve(&mut hyper, &s, q0, |_, _| false, |k, st| b.column_mut(k).assign(&ArrayView1::from(&st.q))).unwrap();
+    solve(&mut hyper, &s, (q0, v0), |_, _| false, |k, st| b.column_mut(k).assign(&ArrayView1::from(&st.q))).unwrap();
     let e = rel(b.as_slice().unwrap(), a.as_slice().unwrap());
     assert!(e < 1e-8, "trajectories differ by {e:e}");
 }

@@ -146,6 +146,20 @@ impl Model {
                 },
                 youngs_modulus_parameter,
                 density_parameter,
+                velocity: match b.velocity {
+                    Some(v) => {
+                        self.finite2(&p("velocity"), v)?;
+                        v
+                    }
+                    None => [0.0; 2],
+                },
+                angular_velocity: match b.angular_velocity {
+                    Some(w) => {
+                        self.finite(&p("angular_velocity"), w)?;
+                        w
+                    }
+                    None => 0.0,
+                },
             });
         }
         let lmax = self.bodies.iter().map(|b| b.length).fold(0.0, f64::max);
@@ -227,6 +241,7 @@ impl Model {
             self.joints.push(joint);
         }
         self.check_joint_rank()?;
+        self.check_initial_velocities()?;
         for (i, l) in f.loads.iter().enumerate() {
             let p = |k: &str| format!("loads[{i}].{k}");
             let load = match l {
@@ -365,6 +380,46 @@ impl Model {
                             ),
                         ));
                     }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Refuses initial velocities that move a joint: every row must hold at the velocity
+    /// level, `B q̇₀ = ḃ` (0 for today's joints), at the undeformed configuration. The bound
+    /// is relative to the fastest point of the bodies (round-off of `ω × r`).
+    fn check_initial_velocities(&self) -> Result<()> {
+        let mut first = Vec::with_capacity(self.bodies.len());
+        let mut v0 = Vec::new();
+        for b in &self.bodies {
+            first.push(v0.len());
+            for k in 0..=b.n_elements {
+                v0.extend(b.rigid_velocity(b.undeformed_node(k)));
+            }
+        }
+        let speed = v0.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        if speed == 0.0 {
+            return Ok(());
+        }
+        let g = |(b, k): NodeId| first[b] + 4 * k;
+        for (j, joint) in self.joints.iter().enumerate() {
+            for row in joint.kind().rows(&g) {
+                let rate: f64 = row.terms.iter().map(|&(d, c)| c * v0[d]).sum();
+                if rate.abs() > 1e-9 * speed {
+                    let field = match entry_line(&self.text, "joints", j) {
+                        Some(l) => format!("joints[{j}] (line {l})"),
+                        None => format!("joints[{j}]"),
+                    };
+                    let unit = if row.kind == crate::physics::joints::RowKind::Position { "m/s" } else { "1/s" };
+                    return Err(self.err(
+                        field,
+                        format!(
+                            "the bodies' initial velocities move {} ({} changes at {rate:.3e} {unit}); give `velocity` and `angular_velocity` the joints allow",
+                            self.describe_joint(j),
+                            row.component
+                        ),
+                    ));
                 }
             }
         }

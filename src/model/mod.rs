@@ -358,11 +358,13 @@ impl Model {
     }
 }
 
-/// The assembled system (banded KKT solver) and its consistent initial state `x₀`.
+/// The assembled system (banded KKT solver), its consistent initial state `x₀` and the
+/// bodies' initial velocities `v₀` there.
 #[derive(Clone)]
 pub struct SharedPhysics {
     pub sys: std::sync::Arc<FlexibleSystem>,
     pub x0: std::sync::Arc<Vec<f64>>,
+    pub v0: std::sync::Arc<Vec<f64>>,
 }
 
 impl std::fmt::Debug for SharedPhysics {

@@ -115,6 +115,12 @@ pub struct BodySpec {
     pub area: f64,
     pub inertia: f64,
     pub youngs_modulus: PropertySpec,
+    /// initial velocity of the body's start, m/s
+    #[serde(default, deserialize_with = "pair::optional")]
+    pub velocity: Option<[f64; 2]>,
+    /// initial angular velocity about the body's start, rad/s, counter-clockwise
+    #[serde(default)]
+    pub angular_velocity: Option<f64>,
 }
 
 /// A material property: a number, or `{ value = …, parameter = "name" }`, which makes the

@@ -12,13 +12,15 @@ impl SharedPhysics {
         crate::solver::model::ParametricModel::length_scale(&*self.sys)
     }
 
-    /// Assembles the system of `model` and closes the joints of its initial state.
+    /// Assembles the system of `model`, closes the joints of its initial state and takes the
+    /// bodies' initial velocities there.
     pub fn assemble(model: &Model) -> Result<Self> {
         let mut sys = model.system(LinearSolverKind::Banded);
         let mut x0 = sys.initial_state();
         sys.make_consistent(&mut x0)
             .map_err(|p| Error::LinearSolve { t: 0.0, problem: format!("initial joint projection: {p}") })?;
-        Ok(SharedPhysics { sys: Arc::new(sys), x0: Arc::new(x0) })
+        let v0 = sys.initial_velocity(&x0);
+        Ok(SharedPhysics { sys: Arc::new(sys), x0: Arc::new(x0), v0: Arc::new(v0) })
     }
 }
 

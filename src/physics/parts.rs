@@ -22,9 +22,21 @@ pub struct BeamBody {
     /// the parameter that sets the body's density, if any: at μ the density is `μ[name]`
     /// (the file's `section.density` where μ does not set it); mass and weight scale with it
     pub density_parameter: Option<String>,
+    /// the initial velocity of the body's start, m/s
+    pub velocity: [f64; 2],
+    /// the initial angular velocity about the body's start, rad/s
+    pub angular_velocity: f64,
 }
 
 impl BeamBody {
+    /// The initial rigid-body velocity at a node of position `r` and slope `r'` (SPEC §6):
+    /// `ṙ = v₀ + ω × (r − r_start)`, `ṙ' = ω × r'`, with `ω × a = (−ω a_y, ω a_x)`.
+    pub fn rigid_velocity(&self, node: [f64; 4]) -> [f64; 4] {
+        let w = self.angular_velocity;
+        let (dx, dy) = (node[0] - self.start[0], node[1] - self.start[1]);
+        [self.velocity[0] - w * dy, self.velocity[1] + w * dx, -w * node[3], w * node[2]]
+    }
+
     /// Position and slope `(x, y, x', y')` of node `k` in the straight, undeformed body.
     pub fn undeformed_node(&self, k: usize) -> [f64; 4] {
         let (c, s) = (self.angle.cos(), self.angle.sin());

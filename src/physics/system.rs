@@ -218,6 +218,23 @@ impl FlexibleSystem {
         q
     }
 
+    /// The bodies' initial rigid-body velocities ([`BeamBody::rigid_velocity`]) at the
+    /// nodes of `q` (the consistent initial state): zero for bodies that start at rest.
+    pub fn initial_velocity(&self, q: &[f64]) -> Vec<f64> {
+        let mut v = vec![0.0; self.n_dof];
+        // a body at rest keeps exact zeros (no signed zeros from ω × r)
+        let moving =
+            self.bodies.iter().enumerate().filter(|(_, b)| b.velocity != [0.0; 2] || b.angular_velocity != 0.0);
+        for (b, body) in moving {
+            for k in 0..=body.n_elements {
+                let d = 4 * (self.first_node[b] + k);
+                let node = [q[d], q[d + 1], q[d + 2], q[d + 3]];
+                v[d..d + 4].copy_from_slice(&body.rigid_velocity(node));
+            }
+        }
+        v
+    }
+
     /// Closes the joints of `q` (given to finitely many digits in a model file): first by
     /// the smallest rigid motion of each body (translation `t` and rotation `θ` about its
     /// start), which strains no element; then whatever is left (round-off, or a gap no rigid

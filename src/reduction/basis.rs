@@ -155,8 +155,13 @@ impl Basis {
     /// `q` with `x_ref + V q` closest to `x` in the least-squares sense (`Vᵀ(x − x_ref)`
     /// when `V` is orthonormal).
     pub fn reduce(&self, x: ArrayView1<f64>) -> Array1<f64> {
-        let d = &x - &self.reference;
-        let vtd = self.modes.t().dot(&d);
+        self.reduce_increment((&x - &self.reference).view())
+    }
+
+    /// The reduced coordinates of a change `dx` of the full ones (a velocity): as
+    /// [`Self::reduce`] without the reference.
+    pub fn reduce_increment(&self, dx: ArrayView1<f64>) -> Array1<f64> {
+        let vtd = self.modes.t().dot(&dx);
         match self.variant {
             Variant::WholeSystem => {
                 use ndarray_linalg::Solve;

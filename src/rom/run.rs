@@ -38,6 +38,8 @@ pub struct ReducedRunner {
     /// every run, projected once (O(n_dof r), what a run of a refined mesh would otherwise
     /// spend most of its time on)
     q0: Vec<f64>,
+    /// the initial velocities' reduced coordinates
+    v0: Vec<f64>,
 }
 
 /// The hyper-reduced model when the basis carries a sampled set; without one, every element
@@ -60,6 +62,7 @@ impl ReducedRunner {
     pub fn with_physics(model: &Arc<Model>, basis: &Arc<Basis>, physics: &SharedPhysics) -> Result<Self> {
         let sys = Arc::clone(&physics.sys);
         let q0 = basis.reduce(ArrayView1::from(&physics.x0[..])).to_vec();
+        let v0 = basis.reduce_increment(ArrayView1::from(&physics.v0[..])).to_vec();
         let (model, basis) = (Arc::clone(model), Arc::clone(basis));
         let cannot = |e: String| Error::Usage(format!("cannot build the reduced model: {e}"));
         let rom = match &basis.hyper {
@@ -70,7 +73,7 @@ impl ReducedRunner {
             }
             None => Kind::Generic(Box::new(ReducedModel::new(sys, &basis).map_err(cannot)?)),
         };
-        Ok(ReducedRunner { model, basis, rom, q0 })
+        Ok(ReducedRunner { model, basis, rom, q0, v0 })
     }
 
     /// Runs at `load_scale` with the model's time settings. With `previous` runs (a
@@ -91,7 +94,7 @@ impl ReducedRunner {
     pub fn solve(&mut self, mu: &Parameters, output: Output, previous: &[&ReducedRun]) -> Result<ReducedRun> {
         let s = settings_at(&self.model, mu)?;
         let previous = &previous[previous.len().saturating_sub(2)..];
-        let (model, basis, q0) = (&*self.model, &*self.basis, &self.q0);
+        let (model, basis, q0) = (&*self.model, &*self.basis, (&self.q0[..], &self.v0[..]));
         let result = match &mut self.rom {
             Kind::Invariant(rom) => run(rom.as_mut(), model, basis, s, q0, output, previous),
             Kind::Generic(rom) => run(rom.as_mut(), model, basis, s, q0, output, previous),
@@ -131,11 +134,11 @@ fn run<R: Reduced<FlexibleSystem>>(
     model: &Model,
     basis: &Basis,
     s: Settings,
-    q0: &[f64],
+    (q0, v0): (&[f64], &[f64]),
     output: Output,
     previous: &[&ReducedRun],
 ) -> Result<ReducedRun> {
-    let q0 = q0.to_vec();
+    let (q0, v0) = (q0.to_vec(), v0.to_vec());
     let (r, nt) = (rom.n_dof(), s.n_steps + 1);
     check_reduced_memory(model, r, s.n_steps, output, 1.0)?;
     let mut zq = Array2::zeros((r, nt));
@@ -167,7 +170,7 @@ fn run<R: Reduced<FlexibleSystem>>(
         }
     };
     let start = std::time::Instant::now();
-    let stats = crate::simulate::solve(rom, &s, q0, guess, |k, st| {
+    let stats = crate::simulate::solve(rom, &s, (q0, v0), guess, |k, st| {
         t[k] = st.t;
         zq.column_mut(k).assign(&ArrayView1::from(&st.q));
         zv.column_mut(k).assign(&ArrayView1::from(&st.v));

@@ -126,6 +126,8 @@ mod tests {
             section,
             youngs_modulus_parameter: None,
             density_parameter: density_parameter.map(str::to_string),
+            velocity: [0.0; 2],
+            angular_velocity: 0.0,
         }
     }
 

@@ -351,6 +351,8 @@ mod tests {
             section: Section { density: 2700.0, area: 1e-3, inertia: 1e-7, youngs_modulus: 7e9 },
             youngs_modulus_parameter: None,
             density_parameter: None,
+            velocity: [0.0; 2],
+            angular_velocity: 0.0,
         }
     }
 

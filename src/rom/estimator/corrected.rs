@@ -124,6 +124,8 @@ pub struct CorrectedRunner {
     /// the initial configuration in the enriched coordinates, `V⁺ᵀ(x₀ − x_ref)`, projected
     /// once (O(n_dof r⁺): on a refined mesh, most of a run's estimate otherwise)
     q0: Vec<f64>,
+    /// the initial velocities in the enriched coordinates
+    v0: Vec<f64>,
     /// [`ACCEPT`]; ∞ keeps one iteration per step whatever it leaves (experiments)
     accept: f64,
 }
@@ -157,7 +159,8 @@ impl CorrectedRunner {
             .map_err(|e| Error::Usage(format!("cannot build the estimator's reduced model: {e}")))?;
         let lift = enriched.modes.t().dot(&basis.modes);
         let q0 = enriched.reduce(ArrayView1::from(&physics.x0[..])).to_vec();
-        Ok(CorrectedRunner { model: Arc::clone(model), rom: Box::new(rom), lift, q0, accept: ACCEPT })
+        let v0 = enriched.reduce_increment(ArrayView1::from(&physics.v0[..])).to_vec();
+        Ok(CorrectedRunner { model: Arc::clone(model), rom: Box::new(rom), lift, q0, v0, accept: ACCEPT })
     }
 
     /// Another acceptance ratio ([`ACCEPT`]; ∞: one iteration per step, unchecked).
@@ -203,9 +206,8 @@ impl CorrectedRunner {
         let h = s.dt;
         let k = integ.step_constants(h);
 
-        // consistent start: [M, Bᵀ; B, 0][q̈; λ] = [−g; 0]
-        let q0 = self.q0.clone();
-        let mut st: State = integ.initialize(rom, q0, vec![0.0; n], 0.0)?;
+        // consistent start: [M, Bᵀ; B, 0][q̈; λ] = [−g; c]
+        let mut st: State = integ.initialize(rom, self.q0.clone(), self.v0.clone(), 0.0)?;
         let mut rhs = vec![0.0; n + nc];
         let mut work = vec![0.0; n];
 
