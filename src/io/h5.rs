@@ -190,6 +190,40 @@ pub fn read_attr_f64(loc: &hdf5::Location, name: &str) -> hdf5::Result<f64> {
     loc.attr(name)?.read_scalar::<f64>()
 }
 
+/// Opens dataset `name` of `loc` with its shape checked before anything is read: a crafted
+/// or damaged shape must neither size an allocation nor leave an index out of bounds later.
+/// `Err(problem)`, for a message after the file and the dataset.
+pub fn dataset_of_shape(loc: &hdf5::Group, name: &str, want: &[usize]) -> std::result::Result<hdf5::Dataset, String> {
+    let d = loc.dataset(name).map_err(|e| format!("cannot be read: {e}"))?;
+    let shape = d.shape();
+    if shape != want {
+        return Err(format!("has shape {} where {} is expected", show_shape(&shape), show_shape(want)));
+    }
+    Ok(d)
+}
+
+/// The length of the one-dimensional dataset `name` of `loc`, refused before anything is
+/// read when what reading it brings along, `bytes_per_entry` for each entry, would exceed
+/// the memory bound: the file alone sizes it, so a flipped bit must not size an allocation.
+pub fn bounded_len(
+    loc: &hdf5::Group,
+    name: &str,
+    bytes_per_entry: f64,
+    limits: &crate::limits::Limits,
+) -> std::result::Result<usize, String> {
+    let d = loc.dataset(name).map_err(|e| format!("cannot be read: {e}"))?;
+    let shape = d.shape();
+    let &[n] = shape.as_slice() else {
+        return Err(format!("has shape {}, expected one dimension", show_shape(&shape)));
+    };
+    limits.check_memory(&format!("its {n} entries"), n as f64 * bytes_per_entry).map_err(|e| e.to_string())?;
+    Ok(n)
+}
+
+fn show_shape(s: &[usize]) -> String {
+    format!("({})", s.iter().map(usize::to_string).collect::<Vec<_>>().join(", "))
+}
+
 /// Whether an HDF5 open failed on a lock another handle holds (HDF5's file locking).
 pub fn is_locked(e: &hdf5::Error) -> bool {
     e.to_string().contains("unable to lock file")

@@ -1,0 +1,146 @@
+//! Damaged sweep, part and basis files: each is refused with one line naming the file and the
+//! dataset, a non-zero exit that is neither a panic (101) nor an abort or a signal, and the
+//! file a command would have written left as it was.
+//!
+//! Where the cases come from: a mutation campaign against the release binary (files edited
+//! with h5py and byte by byte) found each of them; here they are crafted with the hdf5 crate
+//! from files the program wrote:
+//! - a sweep or part file whose `/factorizations` (or `/newton_iterations`) is one entry
+//!   short of its load list: `sweep --resume` and `merge` indexed past its end;
+//! - a dataset whose declared shape is 2³¹ entries (what one flipped bit in a dataspace
+//!   gives): `/load_scales` of a sweep under `--resume`, `/shard/all_load_scales` and
+//!   `/load_scales` of a part, `/reduced_q` of a part: reading it needs 16 GiB, so each is
+//!   refused before reading. The children run under a 4 GiB address-space limit (`ulimit -v`),
+//!   so an unbounded read aborts ("memory allocation failed", exit 134) instead of taking the
+//!   machine's memory.
+
+use ndarray::Array1;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// The tests of this file run one at a time: a child forked while another test has an HDF5
+/// file open inherits its descriptor and HDF5's lock on it.
+static SERIAL: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+/// `flexrom args…` under a 4 GiB address-space limit; asserts it exited by itself, without a
+/// panic or an abort.
+fn flexrom(args: &[&str]) -> (Output, String) {
+    let o = Command::new("sh")
+        .args(["-c", "ulimit -v 4194304; exec \"$0\" \"$@\"", env!("CARGO_BIN_EXE_flexrom")])
+        .args(args)
+        .env("HDF5_USE_FILE_LOCKING", "FALSE")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert!(o.status.code().is_some(), "{args:?}: killed by a signal: {err}");
+    assert!(![101, 134].contains(&o.status.code().unwrap()), "{args:?}: panic or abort: {err}");
+    (o, err)
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// A coarse pendulum pipeline in `dir` (8 elements, 0.1 s), trained at [0.9, 1.1] with 4
+/// modes into `basis.h5`.
+fn setup(dir: &Path) -> PathBuf {
+    let model = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("data/models/pendulum.toml"))
+        .unwrap()
+        .replace("elements = 50", "elements = 8")
+        .replace("t_end = 1.1", "t_end = 0.1");
+    std::fs::write(dir.join("model.toml"), model).unwrap();
+    let p = dir.join("pipe.toml");
+    std::fs::write(
+        &p,
+        "model = \"model.toml\"\nbasis = \"basis.h5\"\nreport = \"report\"\n[train]\nload_scales = [0.9, 1.1]\n[reduction]\nvariant = \"galerkin\"\nmodes = { count = 4 }\n",
+    )
+    .unwrap();
+    let (o, err) = flexrom(&["train", "-q", s(&p)]);
+    assert!(o.status.success(), "{err}");
+    p
+}
+
+/// A copy of `good` named `name`, edited by `edit` through the hdf5 crate.
+fn craft(good: &Path, name: &str, edit: impl FnOnce(&hdf5::File)) -> PathBuf {
+    let bad = good.with_file_name(name);
+    std::fs::copy(good, &bad).unwrap();
+    let f = hdf5::File::open_rw(&bad).unwrap();
+    edit(&f);
+    f.close().unwrap();
+    bad
+}
+
+/// Dataset `name` one entry shorter (u64 entries).
+fn one_short(f: &hdf5::File, name: &str) {
+    let a = f.dataset(name).unwrap().read_1d::<u64>().unwrap();
+    f.unlink(name).unwrap();
+    let short = Array1::from_iter(a.iter().skip(1).copied());
+    f.new_dataset_builder().with_data(&short).create(name).unwrap();
+}
+
+/// Dataset `name` replaced by one that declares 2³¹ entries (f64, chunked, never written).
+fn huge(f: &hdf5::File, name: &str) {
+    let rank = f.dataset(name).unwrap().ndim();
+    f.unlink(name).unwrap();
+    let b = f.new_dataset::<f64>();
+    match rank {
+        1 => b.chunk(1024).shape(1usize << 31).create(name),
+        _ => b.chunk((1, 1024, 4)).shape((1usize << 20, 1usize << 11, 4)).create(name),
+    }
+    .unwrap();
+}
+
+/// The command fails with one line naming `file` and every one of `needles`, and `out` keeps
+/// its bytes (`None`: no file there).
+fn refused(args: &[&str], file: &Path, needles: &[&str], out: &Path, before: Option<&[u8]>) {
+    let (o, err) = flexrom(args);
+    assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+    assert!(err.contains(s(file)), "{args:?}: not naming {}: {err}", file.display());
+    for n in needles {
+        assert!(err.contains(n), "{args:?}: not naming {n}: {err}");
+    }
+    assert_eq!(std::fs::read(out).ok().as_deref(), before, "{args:?}: {} changed", out.display());
+}
+
+#[test]
+fn damaged_sweep_and_part_files_are_refused_naming_the_dataset() {
+    let _one = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let p = setup(d);
+    let list = "0.9:1.1:3";
+    let sweep = d.join("sweep.h5");
+    let (o, err) = flexrom(&["sweep", "-q", s(&p), "--load-scales", list, "-o", s(&sweep)]);
+    assert!(o.status.success(), "{err}");
+    let parts: Vec<PathBuf> = (1..=2).map(|k| d.join(format!("part{k}.h5"))).collect();
+    for (k, part) in parts.iter().enumerate() {
+        let shard = format!("{}/2", k + 1);
+        let (o, err) = flexrom(&["sweep", "-q", s(&p), "--load-scales", list, "--shard", &shard, "-o", s(part)]);
+        assert!(o.status.success(), "{err}");
+    }
+    // control: the files as written resume and merge
+    let merged = d.join("merged.h5");
+    let (o, err) = flexrom(&["merge", "-q", s(&parts[0]), s(&parts[1]), "-o", s(&merged)]);
+    assert!(o.status.success(), "{err}");
+
+    for (name, edit) in [
+        ("factorizations", one_short as fn(&hdf5::File, &str)),
+        ("newton_iterations", one_short),
+        ("load_scales", huge),
+        ("reduced_q", huge),
+    ] {
+        // --resume rewrites the file it reads: a copy of it, whose bytes must stay
+        let bad = craft(&sweep, &format!("sweep_{name}.h5"), |f| edit(f, name));
+        let bytes = std::fs::read(&bad).unwrap();
+        let args = ["sweep", "-q", s(&p), "--load-scales", list, "--resume", "-o", s(&bad)];
+        refused(&args, &bad, &[name], &bad, Some(&bytes));
+
+        let bad = craft(&parts[1], &format!("part_{name}.h5"), |f| edit(f, name));
+        let out = d.join("out.h5");
+        refused(&["merge", "-q", s(&parts[0]), s(&bad), "-o", s(&out)], &bad, &[name], &out, None);
+    }
+    let bad = craft(&parts[1], "part_all.h5", |f| huge(f, "shard/all_load_scales"));
+    let out = d.join("out.h5");
+    refused(&["merge", "-q", s(&parts[0]), s(&bad), "-o", s(&out)], &bad, &["shard/all_load_scales"], &out, None);
+}
