@@ -64,8 +64,8 @@ pub fn run_with(
     mark_new_report(report.path())?;
     // checked again: the folder or the basis path may have changed during a long run
     check_outputs(p)?;
-    basis.commit()?;
-    swap_in_report(report, &p.path)?;
+    // the basis and the report together: a signal leaves both old or both new
+    swap_in_report(report, vec![basis], &p.path)?;
     Ok((dir, warnings))
 }
 
