@@ -144,3 +144,35 @@ fn damaged_sweep_and_part_files_are_refused_naming_the_dataset() {
     let out = d.join("out.h5");
     refused(&["merge", "-q", s(&parts[0]), s(&bad), "-o", s(&out)], &bad, &["shard/all_load_scales"], &out, None);
 }
+
+/// `train --from-snapshots` with an altered snapshot file names that file and dataset (the
+/// check of the basis built from it named the basis's temporary name); the basis at
+/// `--basis` keeps its bytes. The alterations: a NaN, and a run's first column (the model's
+/// initial state x₀ in every run) shifted by 1e-3 m, over the 1e-9 relative tolerance the
+/// basis check holds a basis's reference to.
+#[test]
+fn altered_snapshot_files_are_named() {
+    let _one = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let p = setup(d);
+    let snaps = d.join("snaps.h5");
+    let (o, err) = flexrom(&["train", "-q", s(&p), "--snapshots-only", "--shard", "1/1", "-o", s(&snaps)]);
+    assert!(o.status.success(), "{err}");
+    let basis = d.join("basis.h5");
+    let before = std::fs::read(&basis).unwrap();
+    let edit = |at: (usize, usize), v: f64| {
+        move |f: &hdf5::File| {
+            let mut x = f.dataset("x").unwrap().read_2d::<f64>().unwrap();
+            x[at] = if v.is_nan() { v } else { x[at] + v };
+            f.unlink("x").unwrap();
+            f.new_dataset_builder().with_data(&x).create("x").unwrap();
+        }
+    };
+    for (name, at, v, needle) in
+        [("nan.h5", (3, 5), f64::NAN, "entry (3, 5) is NaN"), ("shifted.h5", (0, 0), 1e-3, "column 0")]
+    {
+        let bad = craft(&snaps, name, edit(at, v));
+        refused(&["train", "-q", s(&p), "--from-snapshots", s(&bad)], &bad, &["x", needle], &basis, Some(&before));
+    }
+}

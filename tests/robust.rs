@@ -480,3 +480,24 @@ fn absurd_thread_counts_are_refused_and_large_ones_cut_to_the_cores() {
         assert!(err.contains(&format!("on {cores} thread(s)")), "{flags:?} {env:?}: {err}");
     }
 }
+
+/// A body or probe name with a control character is refused when the model is loaded,
+/// naming the entry's key (a NUL passed the checks and failed at the end of the run, as
+/// `InternalNull` from the labels' writer, naming no key).
+#[test]
+fn names_with_control_characters_are_refused_naming_the_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o.h5");
+    for (text, key) in [
+        (pendulum().replace("\"beam\"", "\"be\\u0000am\""), "bodies[0].name"),
+        (pendulum().replace("\"beam\"", "\"be\\nam\""), "bodies[0].name"),
+        (pendulum().replace("name = \"tip\"", "name = \"t\\u0000ip\""), "probes[0].name"),
+    ] {
+        let m = write(dir.path(), "m.toml", &text);
+        let (code, err) = run(&["simulate", &m, "-o", out.to_str().unwrap()]);
+        assert_eq!(code, 1, "{key}: {err}");
+        assert!(err.contains(key) && err.contains("control character"), "{key}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(!out.exists());
+    }
+}
