@@ -22,12 +22,14 @@ use std::process::{Command, Output};
 /// file open inherits its descriptor and HDF5's lock on it.
 static SERIAL: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
-/// `flexrom args…` under a 4 GiB address-space limit; asserts it exited by itself, without a
-/// panic or an abort.
+/// `flexrom args…` under a 4 GiB address-space limit and `--max-memory 2G` (the default
+/// bound, half the machine's memory, may be above the address-space limit); asserts it
+/// exited by itself, without a panic or an abort.
 fn flexrom(args: &[&str]) -> (Output, String) {
     let o = Command::new("sh")
         .args(["-c", "ulimit -v 4194304; exec \"$0\" \"$@\"", env!("CARGO_BIN_EXE_flexrom")])
         .args(args)
+        .args(["--max-memory", "2G"])
         .env("HDF5_USE_FILE_LOCKING", "FALSE")
         .output()
         .unwrap();
@@ -78,13 +80,17 @@ fn one_short(f: &hdf5::File, name: &str) {
     f.new_dataset_builder().with_data(&short).create(name).unwrap();
 }
 
-/// Dataset `name` replaced by one that declares 2³¹ entries (f64, chunked, never written).
+/// Dataset `name` replaced by (or created as) one that declares 2³¹ entries (f64, chunked,
+/// never written), in the rank it had (2: 2³¹ rows of 4).
 fn huge(f: &hdf5::File, name: &str) {
-    let rank = f.dataset(name).unwrap().ndim();
-    f.unlink(name).unwrap();
+    let rank = f.dataset(name).map_or(1, |d| d.ndim());
+    if f.link_exists(name) {
+        f.unlink(name).unwrap();
+    }
     let b = f.new_dataset::<f64>();
     match rank {
         1 => b.chunk(1024).shape(1usize << 31).create(name),
+        2 => b.chunk((1024, 4)).shape((1usize << 31, 4)).create(name),
         _ => b.chunk((1, 1024, 4)).shape((1usize << 20, 1usize << 11, 4)).create(name),
     }
     .unwrap();
@@ -174,5 +180,39 @@ fn altered_snapshot_files_are_named() {
     {
         let bad = craft(&snaps, name, edit(at, v));
         refused(&["train", "-q", s(&p), "--from-snapshots", s(&bad)], &bad, &["x", needle], &basis, Some(&before));
+    }
+}
+
+/// A basis whose datasets the model does not size (the estimator's calibration, the training
+/// record, the snapshot loads) or does (the estimator's modes) declaring 2³¹ entries: `online`
+/// refuses it naming the dataset, before reading it.
+#[test]
+fn basis_datasets_declaring_huge_shapes_are_refused_unread() {
+    let _one = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let p = setup(d);
+    let good = d.join("basis.h5");
+    let out = d.join("out.h5");
+    let (o, err) = flexrom(&["online", "-q", s(&p), "--load-scale", "1", "-o", s(&out)]);
+    assert!(o.status.success(), "{err}");
+    std::fs::remove_file(&out).unwrap();
+    for name in [
+        "estimator/modes",
+        "estimator/calibration/load_scale",
+        "estimator/multiplier_modes",
+        "training/range",
+        "snapshot_load_scale",
+    ] {
+        let bad = craft(&good, &format!("{}.h5", name.replace('/', "_")), |f| {
+            if let Some((group, _)) = name.rsplit_once('/') {
+                if f.group(group).is_err() {
+                    f.create_group(group).unwrap();
+                }
+            }
+            huge(f, name)
+        });
+        let args = ["online", "-q", s(&p), "--load-scale", "1", "-o", s(&out), "--basis", s(&bad)];
+        refused(&args, &bad, &[name], &out, None);
     }
 }

@@ -220,6 +220,30 @@ pub fn bounded_len(
     Ok(n)
 }
 
+/// Every dataset below `g` (groups followed; the caller has refused links other than hard
+/// ones): its path from `g`, its shape and the bytes reading it takes.
+pub fn datasets_below(g: &hdf5::Group) -> hdf5::Result<Vec<(String, Vec<usize>, f64)>> {
+    let mut out = Vec::new();
+    walk(g, "", &mut out)?;
+    Ok(out)
+}
+
+fn walk(g: &hdf5::Group, prefix: &str, out: &mut Vec<(String, Vec<usize>, f64)>) -> hdf5::Result<()> {
+    for name in g.member_names()? {
+        let path = if prefix.is_empty() { name.clone() } else { format!("{prefix}/{name}") };
+        if let Ok(sub) = g.group(&name) {
+            walk(&sub, &path, out)?;
+        } else if let Ok(d) = g.dataset(&name) {
+            let shape = d.shape();
+            // a variable-length string reads as a pointer and a length at least
+            let each = d.dtype().map_or(16, |t| t.size().max(8)) as f64;
+            let bytes = shape.iter().fold(each, |b, &n| b * n as f64);
+            out.push((path, shape, bytes));
+        }
+    }
+    Ok(())
+}
+
 fn show_shape(s: &[usize]) -> String {
     format!("({})", s.iter().map(usize::to_string).collect::<Vec<_>>().join(", "))
 }
