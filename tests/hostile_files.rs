@@ -149,6 +149,41 @@ fn damaged_sweep_and_part_files_are_refused_naming_the_dataset() {
     let bad = craft(&parts[1], "part_all.h5", |f| huge(f, "shard/all_load_scales"));
     let out = d.join("out.h5");
     refused(&["merge", "-q", s(&parts[0]), s(&bad), "-o", s(&out)], &bad, &["shard/all_load_scales"], &out, None);
+
+    // the paths a part records: a basis moved away names the part that points there, an
+    // empty one is named as the part's attribute; a value with a newline stays on one line
+    let moved = d.join("moved.h5");
+    let reset = |loc: &hdf5::Location, name: &str, value: &str| {
+        loc.delete_attr(name).unwrap();
+        let v: hdf5::types::VarLenUnicode = value.parse().unwrap();
+        loc.new_attr::<hdf5::types::VarLenUnicode>().create(name).unwrap().write_scalar(&v).unwrap();
+    };
+    let parts_with = |name: &str, edit: &dyn Fn(&hdf5::File)| -> Vec<PathBuf> {
+        (0..2).map(|k| craft(&parts[k], &format!("{name}{k}.h5"), |f| edit(f))).collect()
+    };
+    for (name, edit, needles) in [
+        (
+            "moved",
+            Box::new(|f: &hdf5::File| reset(&f.group("shard").unwrap(), "basis", s(&moved)))
+                as Box<dyn Fn(&hdf5::File)>,
+            vec![s(&moved), "shard/basis"],
+        ),
+        (
+            "empty",
+            Box::new(|f: &hdf5::File| reset(&f.group("shard").unwrap(), "basis", "")),
+            vec!["shard/basis", "not a path"],
+        ),
+        ("newline", Box::new(|f: &hdf5::File| reset(f, "fallback", "no\nne")), vec!["fallback", "\"no\\nne\""]),
+    ] {
+        let mut edited = parts_with(name, &*edit);
+        if name == "newline" {
+            // differing from the other part's: compared, and the edited one named
+            edited[0] = parts[0].clone();
+        }
+        // the part read first names the paths; the second is the one compared with it
+        let named = if name == "newline" { &edited[1] } else { &edited[0] };
+        refused(&["merge", "-q", s(&edited[0]), s(&edited[1]), "-o", s(&out)], named, &needles, &out, None);
+    }
 }
 
 /// `train --from-snapshots` with an altered snapshot file names that file and dataset (the

@@ -19,7 +19,7 @@ use super::shard::point_list_hash;
 use super::sweep::{
     read_sweep, write_sweep, Fallback, Outcome, ScaleResult, Sweep, SweepBasis, STATUS_FAILED, STATUS_OK,
 };
-use crate::error::{Error, Result};
+use crate::error::{show_text, Error, Result};
 use crate::io::h5::{bounded_len, dataset_of_shape, read_attr_f64, read_attr_str};
 use crate::limits::Limits;
 use crate::simulate::{Overrides, Settings};
@@ -186,7 +186,7 @@ fn read_part(path: &Path, limits: &Limits) -> Result<Part> {
     } else {
         Some(PartBasis {
             hash: s(&f, "basis_content_hash")?,
-            path: PathBuf::from(s(&g, "basis")?),
+            path: recorded_path(&g, "basis").map_err(|p| bad("shard/basis", p))?,
             attr: s(&f, "basis")?,
         })
     };
@@ -207,8 +207,30 @@ fn read_part(path: &Path, limits: &Limits) -> Result<Part> {
         fallback: if f.attr("fallback").is_ok() { s(&f, "fallback")? } else { "none".into() },
         wall_seconds: read_attr_f64(&f, "wall_seconds").unwrap_or(f64::NAN),
         threads: f.attr("threads").and_then(|a| a.read_scalar::<u64>()).unwrap_or(1),
-        pipeline: PathBuf::from(s(&g, "pipeline")?),
+        pipeline: recorded_path(&g, "pipeline").map_err(|p| bad("shard/pipeline", p))?,
     })
+}
+
+/// A path a part records for `merge` (attribute `name` on `/shard`; `sweep --shard` writes
+/// it absolute). `Err(problem)`.
+fn recorded_path(g: &hdf5::Group, name: &str) -> std::result::Result<PathBuf, String> {
+    let v = read_attr_str(g, name).map_err(|e| format!("cannot be read ({e}): not a flexrom part file?"))?;
+    if v.trim().is_empty() {
+        return Err(format!("is `{}`, not a path (`sweep --shard` records one): a damaged part file", show_text(&v)));
+    }
+    Ok(PathBuf::from(v))
+}
+
+/// A failure to read a file at the path a part records (`key`): says where the path came
+/// from, since the user gave only the part files.
+fn recorded_in(e: Error, part: &Part, key: &str) -> Error {
+    Error::Hinted {
+        source: Box::new(e),
+        hint: format!(
+            "that path is the one {} records in `{key}` (moved since the sweep? put it back there, or sweep again)",
+            part.path.display()
+        ),
+    }
 }
 
 /// A few runs for a message: "load scales 0.5, 0.53, 0.56 and 13 more", or for named
@@ -344,11 +366,12 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool, limits: &Limits) -> R
         }
     }
     // the model and basis the parts were run with, checked against the parts' basis hash
-    let pipeline = Pipeline::load_with(&first.pipeline, limits.clone())?;
+    let pipeline =
+        Pipeline::load_with(&first.pipeline, limits.clone()).map_err(|e| recorded_in(e, first, "shard/pipeline"))?;
     let stored = match &first.basis {
         None => None,
         Some(b) => {
-            let stored = load_basis(&pipeline, &b.path)?;
+            let stored = load_basis(&pipeline, &b.path).map_err(|e| recorded_in(e, first, "shard/basis"))?;
             if stored.content_hash != b.hash {
                 return Err(Error::input(
                     &b.path,
