@@ -251,3 +251,38 @@ fn basis_datasets_declaring_huge_shapes_are_refused_unread() {
         refused(&args, &bad, &[name], &out, None);
     }
 }
+
+/// Cases the campaign (scripts/fuzz/campaign.py) found, kept in tests/fuzz_cases/<name>/ with
+/// the files it mutated, each run as it ran then (in a copy, as `online` writes beside its
+/// basis): `heap_object_size`, bits flipped in a basis's global heap (`--seed 3 --bytes`,
+/// case 122) so that an object claims 206 933 470 768 bytes of a 4 096-byte collection:
+/// `online` died by SIGSEGV inside libhdf5 (`H5HG_read`) reading the attribute `variant`.
+#[test]
+fn cases_the_campaign_found_are_refused() {
+    let _one = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let cases = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz_cases");
+    for (name, args, needles) in [(
+        "heap_object_size",
+        &["online", "-q", "pipe.toml", "--load-scale", "1", "-o", "out.h5"],
+        &["basis.h5", "global heap", "damaged"],
+    )] {
+        let tmp = tempfile::tempdir().unwrap();
+        for f in std::fs::read_dir(cases.join(name)).unwrap() {
+            let f = f.unwrap().path();
+            std::fs::copy(&f, tmp.path().join(f.file_name().unwrap())).unwrap();
+        }
+        let o = Command::new(env!("CARGO_BIN_EXE_flexrom"))
+            .args(args)
+            .current_dir(tmp.path())
+            .env("HDF5_USE_FILE_LOCKING", "FALSE")
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{name}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{name}: {err}");
+        for n in needles {
+            assert!(err.contains(n), "{name}: not naming {n}: {err}");
+        }
+        assert!(!tmp.path().join("out.h5").exists(), "{name}");
+    }
+}
