@@ -104,6 +104,13 @@ pub fn show_number(x: f64) -> String {
     }
 }
 
+/// A text from a file or the environment as a message shows it: control characters (a
+/// newline, a NUL, an escape sequence) escaped as `\n`, `\0`, `\u{1b}`, so an error stays
+/// one line and a file cannot write to the terminal through it; everything else as it is.
+pub fn show_text(s: &str) -> String {
+    s.chars().map(|c| if c.is_control() { c.escape_default().to_string() } else { c.to_string() }).collect()
+}
+
 /// What to do after a reduced run failed ([`Error::at_reduced_stage`]; a sweep says it once
 /// after its failures).
 pub const REDUCED_RUN_FAILED: &str =

@@ -263,7 +263,9 @@ fn main() -> ExitCode {
             // a check made while a stage ran names its field without the line load-time
             // checks give: the line from the file
             let e = flexrom::model::with_field_line_from_file(e);
-            note(&format!("error: {e}"));
+            // one line whatever a file's text put into it (an attribute's newline, an
+            // escape sequence)
+            note(&format!("error: {}", flexrom::error::show_text(&e.to_string())));
             ExitCode::from(e.exit_code())
         }
     }

@@ -291,6 +291,24 @@ fn run_writes_a_report() {
     assert!(png.starts_with(b"\x89PNG\r\n\x1a\n"), "singular_values.png is not a PNG");
 }
 
+/// A model without probes: the report has no probe figures and the summary links none (the
+/// run failed at its end, naming a file in its temporary folder: "nothing to plot").
+#[test]
+fn run_writes_a_report_for_a_model_without_probes() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = pendulum_text(10, 0.3);
+    let model = &model[..model.find("[[probes]]").expect("the pendulum has a probe")];
+    let pipe = setup(dir.path(), model, PENDULUM_PIPE);
+    let o = flexrom().args(["run", "-q", pipe.to_str().unwrap()]).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let report = dir.path().join("report");
+    for f in ["summary.md", "validation.json", "sweep.h5", "singular_values.svg", "error_vs_load.svg"] {
+        assert!(report.join(f).is_file(), "{f} missing");
+    }
+    assert!(!report.join("probes_0.svg").exists());
+    assert!(!std::fs::read_to_string(report.join("summary.md")).unwrap().contains("probes_"));
+}
+
 #[test]
 fn constraint_preserving_fourbar_keeps_the_joints() {
     let dir = tempfile::tempdir().unwrap();

@@ -422,3 +422,83 @@ fn verbose_runs_say_their_largest_axial_strain() {
     let line = err.lines().find(|l| l.contains("largest mean axial strain")).unwrap_or_else(|| panic!("{err}"));
     assert!(line.contains("|ε̄| = 1.00e-4") && line.contains("blow-up bound 0.5"), "{line}");
 }
+
+/// Worker counts: an absurd one (from the option or either variable) is refused naming where
+/// it came from, before any run, and leaves no file; one above the cores is cut to them. The
+/// cores are what `std::thread::available_parallelism` says here, the figure the program
+/// reads too; 1024 is `pipeline::shard::MOST_THREADS`.
+#[test]
+fn absurd_thread_counts_are_refused_and_large_ones_cut_to_the_cores() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o.h5");
+    let (o, m) = (out.to_str().unwrap(), root().join("data/models/pendulum.toml"));
+    let m = m.to_str().unwrap();
+    let clean = |c: &mut Command| {
+        c.env_remove("RAYON_NUM_THREADS").env_remove("SLURM_CPUS_PER_TASK");
+    };
+    // (flags, environment, what the message names)
+    let cases = [
+        ("--threads 100000", None, "--threads 100000"),
+        ("--threads 4294967297", None, "--threads 4294967297"),
+        ("--threads 1025", None, "--threads 1025"),
+        ("", Some(("RAYON_NUM_THREADS", "100000")), "RAYON_NUM_THREADS=`100000`"),
+        ("", Some(("SLURM_CPUS_PER_TASK", "100000")), "SLURM_CPUS_PER_TASK=`100000`"),
+        ("", Some(("RAYON_NUM_THREADS", "99999999999999999999999")), "RAYON_NUM_THREADS=`99999999999999999999999`"),
+    ];
+    for (flags, env, named) in cases {
+        let mut c = flexrom();
+        clean(&mut c);
+        c.args(["simulate", m, "-o", o]).args(flags.split_whitespace());
+        if let Some((k, v)) = env {
+            c.env(k, v);
+        }
+        let r = c.output().unwrap();
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert_eq!(r.status.code(), Some(1), "{named}: {err}");
+        assert!(err.contains(named) && err.contains("at most 1024"), "{named}: {err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(!out.exists(), "{named}");
+    }
+    let bad = flexrom().args(["simulate", m, "-o", o]).env("RAYON_NUM_THREADS", "four\nthreads").output().unwrap();
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert_eq!(bad.status.code(), Some(1), "{err}");
+    assert!(err.contains("RAYON_NUM_THREADS=`four\\nthreads` is not a positive whole number"), "{err}");
+
+    let cores = std::thread::available_parallelism().unwrap().get();
+    let wide = (cores + 62).to_string();
+    for (flags, env) in
+        [(vec!["--threads", wide.as_str()], None), (vec![], Some(("SLURM_CPUS_PER_TASK", wide.as_str())))]
+    {
+        let mut c = flexrom();
+        clean(&mut c);
+        c.args(["simulate", m, "-o", o, "-v"]).args(&flags);
+        if let Some((k, v)) = env {
+            c.env(k, v);
+        }
+        let r = c.output().unwrap();
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert_eq!(r.status.code(), Some(0), "{err}");
+        assert!(err.contains(&format!("on {cores} thread(s)")), "{flags:?} {env:?}: {err}");
+    }
+}
+
+/// A body or probe name with a control character is refused when the model is loaded,
+/// naming the entry's key (a NUL passed the checks and failed at the end of the run, as
+/// `InternalNull` from the labels' writer, naming no key).
+#[test]
+fn names_with_control_characters_are_refused_naming_the_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o.h5");
+    for (text, key) in [
+        (pendulum().replace("\"beam\"", "\"be\\u0000am\""), "bodies[0].name"),
+        (pendulum().replace("\"beam\"", "\"be\\nam\""), "bodies[0].name"),
+        (pendulum().replace("name = \"tip\"", "name = \"t\\u0000ip\""), "probes[0].name"),
+    ] {
+        let m = write(dir.path(), "m.toml", &text);
+        let (code, err) = run(&["simulate", &m, "-o", out.to_str().unwrap()]);
+        assert_eq!(code, 1, "{key}: {err}");
+        assert!(err.contains(key) && err.contains("control character"), "{key}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(!out.exists());
+    }
+}

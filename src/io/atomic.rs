@@ -17,9 +17,11 @@ mod temp_path;
 
 use crate::error::{Error, Result};
 pub use fs::{check_replaceable, create_dirs, kind_of, names_an_entry, sync_file_data, sync_path, sync_tree};
-pub use registry::{install_signal_handler, live_paths, set_stop_note, stop_note, stopped_by, GracefulStop};
+pub use registry::{
+    clean_up_for_stop, install_signal_handler, live_paths, set_stop_note, stop_note, stopped_by, GracefulStop,
+};
 use std::path::Path;
-pub use swap::swap_in_dir;
+pub use swap::{swap_in_dir, swap_in_dir_with};
 pub use temp_path::TempPath;
 
 /// Writes `target` atomically: `fill` writes the temporary path it is given; on success

@@ -62,7 +62,7 @@ pub fn check(path: &Path, model: &Model, settings_hash: Option<&str>) -> Result<
         let sys = &*model.physics()?.sys;
         let (n, nc, ne) = (sys.n_dof(), sys.n_constraints(), sys.n_elements());
         let (cols, values) = (n + nc, n + nc);
-        let limits: [(&str, &[usize]); 11] = [
+        let limits: [(&str, &[usize]); 16] = [
             ("basis/modes", &[n, cols]),
             ("basis/reference", &[n]),
             ("basis/multiplier_modes", &[nc, cols]),
@@ -74,6 +74,11 @@ pub fn check(path: &Path, model: &Model, settings_hash: Option<&str>) -> Result<
             ("basis/kept_dofs", &[n]),
             ("hyper/elements", &[ne]),
             ("hyper/weights", &[ne]),
+            ("estimator/modes", &[n, cols]),
+            ("estimator/multiplier_modes", &[nc, cols]),
+            ("estimator/block_modes", &[values]),
+            ("estimator/hyper/elements", &[ne]),
+            ("estimator/hyper/weights", &[ne]),
         ];
         for (name, max) in limits {
             let Ok(d) = f.dataset(name) else { continue };
@@ -92,6 +97,7 @@ pub fn check(path: &Path, model: &Model, settings_hash: Option<&str>) -> Result<
                 ));
             }
         }
+        bounded_by_memory(&f, path, model)?;
     }
     let mut stored = read_basis(path)?;
     // the model first: a basis of another model is the commonest mistake, and the shape
@@ -134,6 +140,21 @@ pub fn check(path: &Path, model: &Model, settings_hash: Option<&str>) -> Result<
         }
     }
     Ok(stored)
+}
+
+/// Every dataset of the file within the memory bound before any is read: those the model
+/// does not size (the estimator's calibration, the training record, the snapshot loads, the
+/// routes' timing) have only the file's word for their length, which a flipped bit makes 2³¹.
+fn bounded_by_memory(f: &hdf5::File, path: &Path, model: &Model) -> Result<()> {
+    let all =
+        super::h5::datasets_below(f).map_err(|e| Error::input(path, "(file)", format!("cannot be listed: {e}")))?;
+    for (name, shape, bytes) in all {
+        model
+            .limits
+            .check_memory(&format!("its shape {shape:?}"), bytes)
+            .map_err(|e| Error::input(path, &name, e.to_string()))?;
+    }
+    Ok(())
 }
 
 fn short(h: &str) -> &str {

@@ -183,11 +183,134 @@ unsafe fn scalar_attr(
 }
 
 pub fn read_attr_str(loc: &hdf5::Location, name: &str) -> hdf5::Result<String> {
+    heaps_checked(loc)?;
     Ok(loc.attr(name)?.read_scalar::<VarLenUnicode>()?.as_str().to_string())
+}
+
+/// [`check_global_heaps`] for the file of `loc`, once per file as it is on disk (path, size,
+/// modification time), before its first text is read; files open for writing are flexrom's
+/// own, in the making, and not read from disk.
+pub fn heaps_checked(loc: &hdf5::Location) -> hdf5::Result<()> {
+    static CHECKED: std::sync::Mutex<Vec<(String, u64, std::time::SystemTime)>> = std::sync::Mutex::new(Vec::new());
+    if !loc.file()?.is_read_only() {
+        return Ok(());
+    }
+    let name = loc.filename();
+    let Ok(m) = std::fs::metadata(&name) else { return Ok(()) };
+    let key = (name.clone(), m.len(), m.modified().unwrap_or(std::time::UNIX_EPOCH));
+    if CHECKED.lock().unwrap_or_else(|e| e.into_inner()).contains(&key) {
+        return Ok(());
+    }
+    check_global_heaps(Path::new(&name)).map_err(hdf5::Error::from)?;
+    CHECKED.lock().unwrap_or_else(|e| e.into_inner()).push(key);
+    Ok(())
 }
 
 pub fn read_attr_f64(loc: &hdf5::Location, name: &str) -> hdf5::Result<f64> {
     loc.attr(name)?.read_scalar::<f64>()
+}
+
+/// Opens dataset `name` of `loc` with its shape checked before anything is read: a crafted
+/// or damaged shape must neither size an allocation nor leave an index out of bounds later.
+/// `Err(problem)`, for a message after the file and the dataset.
+pub fn dataset_of_shape(loc: &hdf5::Group, name: &str, want: &[usize]) -> std::result::Result<hdf5::Dataset, String> {
+    let d = loc.dataset(name).map_err(|e| format!("cannot be read: {e}"))?;
+    let shape = d.shape();
+    if shape != want {
+        return Err(format!("has shape {} where {} is expected", show_shape(&shape), show_shape(want)));
+    }
+    Ok(d)
+}
+
+/// The length of the one-dimensional dataset `name` of `loc`, refused before anything is
+/// read when what reading it brings along, `bytes_per_entry` for each entry, would exceed
+/// the memory bound: the file alone sizes it, so a flipped bit must not size an allocation.
+pub fn bounded_len(
+    loc: &hdf5::Group,
+    name: &str,
+    bytes_per_entry: f64,
+    limits: &crate::limits::Limits,
+) -> std::result::Result<usize, String> {
+    let d = loc.dataset(name).map_err(|e| format!("cannot be read: {e}"))?;
+    let shape = d.shape();
+    let &[n] = shape.as_slice() else {
+        return Err(format!("has shape {}, expected one dimension", show_shape(&shape)));
+    };
+    limits.check_memory(&format!("its {n} entries"), n as f64 * bytes_per_entry).map_err(|e| e.to_string())?;
+    Ok(n)
+}
+
+/// Every dataset below `g` (groups followed; the caller has refused links other than hard
+/// ones): its path from `g`, its shape and the bytes reading it takes.
+pub fn datasets_below(g: &hdf5::Group) -> hdf5::Result<Vec<(String, Vec<usize>, f64)>> {
+    let mut out = Vec::new();
+    walk(g, "", &mut out)?;
+    Ok(out)
+}
+
+fn walk(g: &hdf5::Group, prefix: &str, out: &mut Vec<(String, Vec<usize>, f64)>) -> hdf5::Result<()> {
+    for name in g.member_names()? {
+        let path = if prefix.is_empty() { name.clone() } else { format!("{prefix}/{name}") };
+        if let Ok(sub) = g.group(&name) {
+            walk(&sub, &path, out)?;
+        } else if let Ok(d) = g.dataset(&name) {
+            let shape = d.shape();
+            // a variable-length string reads as a pointer and a length at least
+            let each = d.dtype().map_or(16, |t| t.size().max(8)) as f64;
+            let bytes = shape.iter().fold(each, |b, &n| b * n as f64);
+            out.push((path, shape, bytes));
+        }
+    }
+    Ok(())
+}
+
+fn show_shape(s: &[usize]) -> String {
+    format!("({})", s.iter().map(usize::to_string).collect::<Vec<_>>().join(", "))
+}
+
+/// Refuses a file whose global heap collections (where HDF5 keeps variable-length strings:
+/// every text attribute, a sweep's `/message`) do not hold together: an object whose size
+/// runs past its collection, or a collection past the end of the file. libhdf5 1.10 trusts
+/// those sizes, and reading a text from a damaged collection crashed the process
+/// (`memcpy` in `H5HG_read`) or never returned; checked here, before any text is read.
+///
+/// A collection is found by its signature, `GCOL`, version 1 and three zero bytes (file
+/// format, "Global Heap"); its size and each object's are 8-byte lengths, as in every file
+/// flexrom and h5py write. `Err(problem)`.
+pub fn check_global_heaps(path: &Path) -> std::result::Result<(), String> {
+    let b = std::fs::read(path).map_err(|e| format!("cannot be read: {e}"))?;
+    let u64_at = |i: usize| u64::from_le_bytes(b[i..i + 8].try_into().expect("8 bytes"));
+    let mut from = 0;
+    while let Some(k) = b[from..].windows(8).position(|w| w == b"GCOL\x01\0\0\0") {
+        let at = from + k;
+        from = at + 8;
+        if at + 16 > b.len() {
+            return Err(format!("global heap at byte {at} is cut off by the end of the file: a damaged file"));
+        }
+        let size = u64_at(at + 8);
+        let end = (at as u64).checked_add(size).filter(|&e| e <= b.len() as u64 && size >= 16);
+        let Some(end) = end.map(|e| e as usize) else {
+            return Err(format!(
+                "global heap at byte {at} claims {size} bytes, past the end of the file: a damaged file"
+            ));
+        };
+        let mut p = at + 16;
+        while p + 16 <= end {
+            let (index, object) = (u16::from_le_bytes([b[p], b[p + 1]]), u64_at(p + 8));
+            // index 0: the collection's free space, which ends it
+            let need = if index == 0 { object } else { object.saturating_add(16 + 7) / 8 * 8 };
+            if need > (end - p) as u64 {
+                return Err(format!(
+                    "global heap at byte {at}: object {index} claims {object} bytes, past the end of its collection: a damaged file"
+                ));
+            }
+            if index == 0 {
+                break;
+            }
+            p += need as usize;
+        }
+    }
+    Ok(())
 }
 
 /// Whether an HDF5 open failed on a lock another handle holds (HDF5's file locking).

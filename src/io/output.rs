@@ -9,7 +9,7 @@
 //! its mark lists (and flexrom's own temporary files); anything else is the user's and is
 //! refused with an error naming the folder and the pipeline key `report`.
 
-use super::atomic::{kind_of, names_an_entry, swap_in_dir, write_new, TempPath};
+use super::atomic::{kind_of, names_an_entry, swap_in_dir_with, write_new, TempPath};
 use super::attrs::{Kind, KIND_ATTR};
 use crate::error::{Error, Result};
 use std::os::unix::fs::MetadataExt;
@@ -298,11 +298,11 @@ pub fn mark_new_report(dir: &Path) -> Result<()> {
     write_new(&dir.join(MARKER), marker_text(&names).as_bytes())
 }
 
-/// Replaces the report folder `target` by the finished temporary folder `tmp`: re-checks
-/// that the existing folder (if any) is still flexrom's, then swaps (see
-/// [`super::atomic::swap_in_dir`]).
-pub fn swap_in_report(tmp: TempPath, pipeline: &Path) -> Result<()> {
-    swap_in_dir(tmp, |d| check_marked(d, Origin::Key { pipeline, key: "report" }))
+/// Replaces the report folder `target` by the finished temporary folder `tmp`, and the
+/// files `with` (`run`'s basis) in the same step: re-checks that the existing folder (if any)
+/// is still flexrom's, then swaps (see [`super::atomic::swap_in_dir_with`]).
+pub fn swap_in_report(tmp: TempPath, with: Vec<TempPath>, pipeline: &Path) -> Result<()> {
+    swap_in_dir_with(tmp, with, |d| check_marked(d, Origin::Key { pipeline, key: "report" }))
 }
 
 #[cfg(test)]

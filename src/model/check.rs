@@ -79,6 +79,13 @@ impl Model {
             if b.name.trim().is_empty() {
                 return Err(self.err(p("name"), "must not be empty"));
             }
+            if b.name.chars().any(char::is_control) {
+                // the result files' labels store it as HDF5 text, which ends at a NUL
+                return Err(self.err(
+                    p("name"),
+                    format!("`{}` holds a control character (a NUL, a newline, …): names are written into the result files' labels", crate::error::show_text(&b.name)),
+                ));
+            }
             if f.bodies[..i].iter().any(|o| o.name == b.name) {
                 return Err(self.err(p("name"), format!("body `{}` is defined twice", b.name)));
             }
@@ -281,8 +288,11 @@ impl Model {
             if f.probes[..i].iter().any(|o| o.name == pr.name) {
                 return Err(self.err(p("name"), format!("probe `{}` is defined twice", pr.name)));
             }
-            if pr.name.is_empty() || pr.name.contains('/') {
-                return Err(self.err(p("name"), "must be non-empty and contain no `/` (it names an HDF5 dataset)"));
+            if pr.name.is_empty() || pr.name.contains('/') || pr.name.chars().any(char::is_control) {
+                return Err(self.err(
+                    p("name"),
+                    "must be non-empty and contain no `/` and no control character (a NUL, a newline, …): it names an HDF5 dataset",
+                ));
             }
             let b = self.body_index(&p("body"), &pr.body)?;
             let n_el = self.bodies[b].n_elements;

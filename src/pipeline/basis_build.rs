@@ -80,6 +80,7 @@ pub fn build_basis(
     if let Some(tol) = hyper_tolerance {
         let hyper = ecsw(sys, &trained.basis, data.x.view(), tol)
             .map_err(|e| ("reduction.hyper", format!("ECSW training failed: {e}")))?;
+        within_weight_bound(&hyper, sys.n_elements())?;
         trained.basis.hyper = Some(hyper);
     }
     let snapshots =
@@ -87,6 +88,26 @@ pub fn build_basis(
     let estimator = build_estimator(sys, &trained, &spec, &snapshots, hyper_tolerance, DEFAULT_EXTRA_MODES)
         .map_err(|e| ("reduction", format!("cannot build the error estimator: {e}")))?;
     Ok((trained, estimator))
+}
+
+/// Refuses an ECSW set the basis check would refuse on reading it back (a weight above
+/// [`crate::io::basis_check::MAX_WEIGHT_PER_ELEMENT`] per element): said here, as the
+/// pipeline's setting, rather than as a defect of the file just written.
+fn within_weight_bound(
+    h: &crate::reduction::Hyper,
+    n_elements: usize,
+) -> std::result::Result<(), (&'static str, String)> {
+    let max = crate::io::basis_check::MAX_WEIGHT_PER_ELEMENT * n_elements as f64;
+    match h.weights.iter().zip(&h.elements).find(|(w, _)| !(**w <= max)) {
+        None => Ok(()),
+        Some((w, e)) => Err((
+            "reduction.hyper",
+            format!(
+                "ECSW gave element {e} the weight {w:.3e}, above the {max:.0e} ({:.0e} per element) a basis may hold: the training runs barely load that element, so its force would stand in for many; train with more modes or load scales, a smaller hyper tolerance, or without hyper-reduction",
+                crate::io::basis_check::MAX_WEIGHT_PER_ELEMENT
+            ),
+        )),
+    }
 }
 
 /// The basis and estimator of fixed-load training (`train.load_scales`, the pipeline's
@@ -112,4 +133,31 @@ pub(crate) fn basis_from_snapshots(
         warnings: Vec::new(),
     };
     Ok((data, summary))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The bound training holds its ECSW set to is the one the basis check reads it back
+    /// with (1e4 per element): a weight of 3.8e8 on a 50-element model, as a campaign's
+    /// training wrote and then refused on reading it back, is refused as the pipeline's
+    /// `reduction.hyper`; the largest weight the check takes passes.
+    #[test]
+    fn ecsw_weights_beyond_the_basis_check_are_refused_at_training() {
+        let set = |w: f64| crate::reduction::Hyper {
+            elements: vec![0, 7],
+            weights: vec![w, 1.0],
+            tolerance: 1e-3,
+            training_residual: 0.0,
+            n_training: 10,
+        };
+        let max = crate::io::basis_check::MAX_WEIGHT_PER_ELEMENT * 50.0;
+        assert!(within_weight_bound(&set(max), 50).is_ok());
+        for w in [3.8e8, f64::INFINITY, f64::NAN] {
+            let (field, problem) = within_weight_bound(&set(w), 50).unwrap_err();
+            assert_eq!(field, "reduction.hyper");
+            assert!(problem.contains("element 0") && problem.contains("5e5"), "{problem}");
+        }
+    }
 }

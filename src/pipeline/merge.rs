@@ -19,14 +19,19 @@ use super::shard::point_list_hash;
 use super::sweep::{
     read_sweep, write_sweep, Fallback, Outcome, ScaleResult, Sweep, SweepBasis, STATUS_FAILED, STATUS_OK,
 };
-use crate::error::{Error, Result};
-use crate::io::h5::{read_attr_f64, read_attr_str};
+use crate::error::{show_text, Error, Result};
+use crate::io::h5::{bounded_len, dataset_of_shape, read_attr_f64, read_attr_str};
 use crate::limits::Limits;
 use crate::simulate::{Overrides, Settings};
 use crate::solver::parameters::{Parameters, LOAD_SCALE};
 use hdf5::types::VarLenUnicode;
 use ndarray::Array1;
 use std::path::{Path, PathBuf};
+
+/// What a listed point may take in memory while parts are merged: its value, its
+/// `Parameters` and its row of the merged sweep before any run is read (a generous figure: a
+/// list a file claims longer than the memory bound allows at it is refused unread).
+const BYTES_PER_LISTED_POINT: f64 = 256.0;
 
 /// What one part file says about itself.
 struct Part {
@@ -59,7 +64,7 @@ struct PartBasis {
     attr: String,
 }
 
-fn read_part(path: &Path) -> Result<Part> {
+fn read_part(path: &Path, limits: &Limits) -> Result<Part> {
     let bad = |field: &str, problem: String| Error::input(path, field, problem);
     let f = hdf5::File::open(path).map_err(|e| bad("(file)", crate::io::h5::unreadable(&e)))?;
     let g = f.group("shard").map_err(|_| {
@@ -80,9 +85,17 @@ fn read_part(path: &Path) -> Result<Part> {
     if index == 0 || index > count {
         return Err(bad("shard/index", format!("is {index} of {count}: need 1 ≤ index ≤ count")));
     }
-    let scales_all = g
-        .dataset("all_load_scales")
-        .and_then(|d| d.read_1d::<f64>())
+    // the lists' lengths are the file's own: bounded before anything is read (each point
+    // becomes a `Parameters` and a row of the merged sweep), every other shape checked
+    // against them
+    let n_all = bounded_len(&g, "all_load_scales", BYTES_PER_LISTED_POINT, limits)
+        .map_err(|p| bad("shard/all_load_scales", p))?;
+    let shaped = |loc: &hdf5::Group, name: &str, want: &[usize]| {
+        let field = if loc.name() == "/shard" { format!("shard/{name}") } else { name.to_string() };
+        dataset_of_shape(loc, name, want).map_err(|p| bad(&field, p))
+    };
+    let scales_all = shaped(&g, "all_load_scales", &[n_all])?
+        .read_1d::<f64>()
         .map_err(|e| bad("shard/all_load_scales", format!("cannot be read: {e}")))?
         .to_vec();
     // a sweep over named parameters: the points, as /points holds them
@@ -106,30 +119,26 @@ fn read_part(path: &Path) -> Result<Part> {
             "does not match shard/all_load_scales and shard/all_points (a damaged file)".into(),
         ));
     }
-    let indices: Vec<usize> = g
-        .dataset("indices")
-        .and_then(|d| d.read_1d::<u64>())
+    let n = bounded_len(&f, "load_scales", BYTES_PER_LISTED_POINT, limits).map_err(|p| bad("load_scales", p))?;
+    let indices: Vec<usize> = shaped(&g, "indices", &[n])?
+        .read_1d::<u64>()
         .map_err(|e| bad("shard/indices", format!("cannot be read: {e}")))?
         .iter()
         .map(|&i| i as usize)
         .collect();
-    let scales = f
-        .dataset("load_scales")
-        .and_then(|d| d.read_1d::<f64>())
+    let scales = shaped(&f, "load_scales", &[n])?
+        .read_1d::<f64>()
         .map_err(|e| bad("load_scales", format!("cannot be read: {e}")))?;
-    let status = f
-        .dataset("status")
-        .and_then(|d| d.read_1d::<u8>())
+    let status = shaped(&f, "status", &[n])?
+        .read_1d::<u8>()
         .map_err(|e| bad("status", format!("cannot be read: {e}")))?
         .to_vec();
-    let message: Vec<String> = f
-        .dataset("message")
-        .and_then(|d| d.read_1d::<VarLenUnicode>())
+    let message: Vec<String> = shaped(&f, "message", &[n])?
+        .read_1d::<VarLenUnicode>()
         .map_err(|e| bad("message", format!("cannot be read: {e}")))?
         .iter()
         .map(|m| m.as_str().to_string())
         .collect();
-    let n = scales.len();
     let noun = if names.len() > 1 { "points" } else { "load scales" };
     if indices.len() != n || status.len() != n || message.len() != n {
         return Err(bad(
@@ -177,7 +186,7 @@ fn read_part(path: &Path) -> Result<Part> {
     } else {
         Some(PartBasis {
             hash: s(&f, "basis_content_hash")?,
-            path: PathBuf::from(s(&g, "basis")?),
+            path: recorded_path(&g, "basis").map_err(|p| bad("shard/basis", p))?,
             attr: s(&f, "basis")?,
         })
     };
@@ -198,8 +207,30 @@ fn read_part(path: &Path) -> Result<Part> {
         fallback: if f.attr("fallback").is_ok() { s(&f, "fallback")? } else { "none".into() },
         wall_seconds: read_attr_f64(&f, "wall_seconds").unwrap_or(f64::NAN),
         threads: f.attr("threads").and_then(|a| a.read_scalar::<u64>()).unwrap_or(1),
-        pipeline: PathBuf::from(s(&g, "pipeline")?),
+        pipeline: recorded_path(&g, "pipeline").map_err(|p| bad("shard/pipeline", p))?,
     })
+}
+
+/// A path a part records for `merge` (attribute `name` on `/shard`; `sweep --shard` writes
+/// it absolute). `Err(problem)`.
+fn recorded_path(g: &hdf5::Group, name: &str) -> std::result::Result<PathBuf, String> {
+    let v = read_attr_str(g, name).map_err(|e| format!("cannot be read ({e}): not a flexrom part file?"))?;
+    if v.trim().is_empty() {
+        return Err(format!("is `{}`, not a path (`sweep --shard` records one): a damaged part file", show_text(&v)));
+    }
+    Ok(PathBuf::from(v))
+}
+
+/// A failure to read a file at the path a part records (`key`): says where the path came
+/// from, since the user gave only the part files.
+fn recorded_in(e: Error, part: &Part, key: &str) -> Error {
+    Error::Hinted {
+        source: Box::new(e),
+        hint: format!(
+            "that path is the one {} records in `{key}` (moved since the sweep? put it back there, or sweep again)",
+            part.path.display()
+        ),
+    }
 }
 
 /// A few runs for a message: "load scales 0.5, 0.53, 0.56 and 13 more", or for named
@@ -233,7 +264,7 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool, limits: &Limits) -> R
     if parts.is_empty() {
         return Err(Error::Usage("merge: no part files given".into()));
     }
-    let parts: Vec<Part> = parts.iter().map(|p| read_part(p)).collect::<Result<_>>()?;
+    let parts: Vec<Part> = parts.iter().map(|p| read_part(p, limits)).collect::<Result<_>>()?;
     let first = &parts[0];
     for p in &parts[1..] {
         let differ = |field: &str, what: &str| {
@@ -335,11 +366,12 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool, limits: &Limits) -> R
         }
     }
     // the model and basis the parts were run with, checked against the parts' basis hash
-    let pipeline = Pipeline::load_with(&first.pipeline, limits.clone())?;
+    let pipeline =
+        Pipeline::load_with(&first.pipeline, limits.clone()).map_err(|e| recorded_in(e, first, "shard/pipeline"))?;
     let stored = match &first.basis {
         None => None,
         Some(b) => {
-            let stored = load_basis(&pipeline, &b.path)?;
+            let stored = load_basis(&pipeline, &b.path).map_err(|e| recorded_in(e, first, "shard/basis"))?;
             if stored.content_hash != b.hash {
                 return Err(Error::input(
                     &b.path,

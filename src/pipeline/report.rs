@@ -64,8 +64,8 @@ pub fn run_with(
     mark_new_report(report.path())?;
     // checked again: the folder or the basis path may have changed during a long run
     check_outputs(p)?;
-    basis.commit()?;
-    swap_in_report(report, &p.path)?;
+    // the basis and the report together: a signal leaves both old or both new
+    swap_in_report(report, vec![basis], &p.path)?;
     Ok((dir, warnings))
 }
 
@@ -78,7 +78,9 @@ fn build(
     progress: bool,
     (dense, method): (bool, Option<EstimateMethod>),
 ) -> Result<Vec<String>> {
-    let plot_err = |e: String| Error::io(out, std::io::Error::other(e));
+    // named by the report's own path: the temporary folder is gone by the time the user reads it
+    let plot_err =
+        |stem: &str, e: String| Error::io(p.report_dir.join(format!("{stem}.svg")), std::io::Error::other(e));
     let space = p.space();
     let in_box = !space.is_empty();
     // how the report names a run: its load scale, or its point of the box
@@ -117,6 +119,11 @@ fn build(
     let mut validations: Vec<Validation> = Vec::new();
     for (i, mu) in vpoints.iter().enumerate() {
         let (v, full, reduced) = validate(&rom, mu, dense)?;
+        validations.push(v);
+        // a model without probes has nothing to draw here
+        if full.probes.is_empty() {
+            continue;
+        }
         // x and y of every probe, full (line) and reduced (dashed), and their difference
         let t = &full.t;
         let mut panels: Vec<Panel> = ["x (m)", "y (m)"]
@@ -169,8 +176,7 @@ fn build(
             marker_label: String::new(),
         }
         .save(&out.join(format!("probes_{i}")))
-        .map_err(plot_err)?;
-        validations.push(v);
+        .map_err(|e| plot_err(&format!("probes_{i}"), e))?;
     }
     // one curve per block of a block basis (per body), each indexed from 1
     let mut sv = stored.singular_values.iter();
@@ -192,7 +198,7 @@ fn build(
             marker_label: "training load".into(),
         }
         .save(&out.join(stem))
-        .map_err(plot_err)
+        .map_err(|e| plot_err(stem, e))
     };
     single(
         "POD singular values",
@@ -285,7 +291,8 @@ fn build(
         "error_by_time",
     )?;
     let json = serde_json::to_string_pretty(&validations).expect("serializable");
-    std::fs::write(out.join("validation.json"), json).map_err(|e| Error::io(out, e))?;
+    std::fs::write(out.join("validation.json"), json)
+        .map_err(|e| Error::io(p.report_dir.join("validation.json"), e))?;
 
     let b = &trained.trained.basis;
     let mut md = String::new();
@@ -427,7 +434,8 @@ fn build(
     }
     let _ = writeln!(md, "\n## Sweep\n\n```text\n{swept}```\n");
     let _ = writeln!(md, "## Plots\n");
-    for (i, x) in labels.iter().enumerate() {
+    // a model without probes has no probe figures
+    for (i, x) in labels.iter().enumerate().filter(|_| !p.model.probe_names().is_empty()) {
         let _ = writeln!(md, "![probes at {x}](probes_{i}.svg)");
     }
     let _ = writeln!(
@@ -438,7 +446,7 @@ fn build(
         let _ = writeln!(md, "![error estimate](estimate_vs_load.svg)");
     }
     let _ = writeln!(md, "![error by time](error_by_time.svg)");
-    std::fs::write(out.join("summary.md"), md).map_err(|e| Error::io(out, e))?;
+    std::fs::write(out.join("summary.md"), md).map_err(|e| Error::io(p.report_dir.join("summary.md"), e))?;
     Ok(warnings)
 }
 

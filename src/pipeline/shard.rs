@@ -23,7 +23,7 @@
 
 use super::config::Pipeline;
 use super::sweep::{sweep_to_file, Route, Sweep, SweepFile, SweepOptions};
-use crate::error::{Error, Result};
+use crate::error::{show_text, Error, Result};
 use crate::io::h5::{attr_str, attr_u64};
 use crate::solver::parameters::Parameters;
 use ndarray::Array1;
@@ -158,30 +158,68 @@ pub fn sweep_shard(
     sweep_to_file(route, &points, o, SweepFile { extra: &extra, ..f })
 }
 
-/// Sets the size of the worker pool: `--threads` when given, else `RAYON_NUM_THREADS` (read
-/// by rayon itself), else `SLURM_CPUS_PER_TASK` (a Slurm job step gets that many CPUs,
-/// however many the node has), else one per core. A bad value is a usage error naming it.
+/// Most worker threads any setting may ask for: each thread reserves a stack (2 MiB of
+/// address space) and starts at once, so `--threads 100000` spent minutes starting threads
+/// for a 0.02 s run and, under an address-space limit, panicked inside rayon.
+pub const MOST_THREADS: usize = 1024;
+
+/// Sets the size of the worker pool: `--threads` when given, else `RAYON_NUM_THREADS` (0 or
+/// empty: one per core, as rayon reads it), else `SLURM_CPUS_PER_TASK` (a Slurm job step gets
+/// that many CPUs, however many the node has), else one per core. A count above the cores this
+/// process may use is cut to them (the runs compute and never block, so more threads than
+/// cores only wait on each other); 0, a count above [`MOST_THREADS`] or one that is not a
+/// whole number is a usage error naming the option or variable.
 pub fn configure_threads(flag: Option<usize>) -> Result<()> {
-    let from_env = |name: &str| -> Result<Option<usize>> {
-        match std::env::var(name) {
-            Ok(v) if !v.trim().is_empty() => match v.trim().parse::<usize>() {
-                Ok(n) if n > 0 => Ok(Some(n)),
-                _ => Err(Error::Usage(format!("environment variable {name}=`{v}` is not a positive whole number"))),
-            },
-            _ => Ok(None),
-        }
-    };
-    let n = match flag {
+    let asked = match flag {
         Some(0) => return Err(Error::Usage("--threads must be at least 1".into())),
-        Some(n) => Some(n),
-        None if std::env::var_os("RAYON_NUM_THREADS").is_some() => None,
-        None => from_env("SLURM_CPUS_PER_TASK")?,
+        Some(n) if n > MOST_THREADS => return Err(too_many_threads("--threads", &n.to_string())),
+        Some(n) => Some(("--threads", n)),
+        None if std::env::var_os("RAYON_NUM_THREADS").is_some() => threads_from_env("RAYON_NUM_THREADS", true)?,
+        None => threads_from_env("SLURM_CPUS_PER_TASK", false)?,
     };
-    if let Some(n) = n {
-        // fails only when the pool was built already (it is not: this runs first in main)
-        let _ = rayon::ThreadPoolBuilder::new().num_threads(n).build_global();
+    // nothing asked: rayon starts its one-per-core pool when first used (not at all for a
+    // command that runs nothing in parallel)
+    let Some((source, n)) = asked else { return Ok(()) };
+    let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
+    let n = capped_threads(source, n, cores);
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(n)
+        .build_global()
+        .map_err(|e| Error::Usage(format!("{source}: could not start {n} worker threads: {e}")))
+}
+
+/// The count an environment variable asks for; `None` when unset or empty (and for 0 where
+/// that means "one per core").
+fn threads_from_env(name: &'static str, zero_is_default: bool) -> Result<Option<(&'static str, usize)>> {
+    let Some(raw) = std::env::var_os(name) else { return Ok(None) };
+    let raw = raw.to_string_lossy();
+    let v = raw.trim();
+    let shown = format!("environment variable {name}=`{}`", show_text(&raw));
+    match v.parse::<u64>() {
+        _ if v.is_empty() => Ok(None),
+        Ok(0) if zero_is_default => Ok(None),
+        Ok(n) if n > 0 && n <= MOST_THREADS as u64 => Ok(Some((name, n as usize))),
+        // a row of digits too large for u64 is as absurd as 100000
+        Ok(n) if n > 0 => Err(too_many_threads(&shown, "")),
+        Err(_) if v.bytes().all(|b| b.is_ascii_digit()) => Err(too_many_threads(&shown, "")),
+        _ => Err(Error::Usage(format!("{shown} is not a positive whole number"))),
     }
-    Ok(())
+}
+
+fn too_many_threads(what: &str, value: &str) -> Error {
+    let what = if value.is_empty() { what.to_string() } else { format!("{what} {value}") };
+    Error::Usage(format!(
+        "{what}: more worker threads than flexrom starts (at most {MOST_THREADS}; the default is one per core)"
+    ))
+}
+
+/// `asked` cut to the cores, with a detail line saying so.
+fn capped_threads(source: &str, asked: usize, cores: usize) -> usize {
+    if asked <= cores {
+        return asked;
+    }
+    log::debug!("flexrom: {source} asks for {asked} worker threads; using the {cores} cores this process may use");
+    cores
 }
 
 #[cfg(test)]

@@ -187,6 +187,11 @@ fn read_runs(p: &Pipeline, path: &Path, n_t: usize) -> Result<(Vec<Run>, f64)> {
     if sm != [n_c, cols] {
         return Err(bad("multipliers", format!("is {sm:?}, expected [{n_c}, {cols}]")));
     }
+    // the file alone sets the number of columns: bounded before they are read
+    p.model
+        .limits
+        .check_memory(&format!("its {cols} snapshots"), 8.0 * cols as f64 * (n_dof + n_c + 2) as f64)
+        .map_err(|e| bad("x", e.to_string()))?;
     let read2 = |name: &str| {
         f.dataset(name).and_then(|d| d.read_2d::<f64>()).map_err(|e| bad(name, format!("cannot be read: {e}")))
     };
@@ -207,6 +212,7 @@ fn read_runs(p: &Pipeline, path: &Path, n_t: usize) -> Result<(Vec<Run>, f64)> {
         }
         Err(_) => None,
     };
+    check_values(p, &x, &mult, n_t).map_err(|(field, problem)| bad(field, problem))?;
     let mut runs = Vec::new();
     for k in 0..cols / n_t {
         let c = s![.., k * n_t..(k + 1) * n_t];
@@ -224,6 +230,38 @@ fn read_runs(p: &Pipeline, path: &Path, n_t: usize) -> Result<(Vec<Run>, f64)> {
         });
     }
     Ok((runs, read_attr_f64(&f, "full_seconds").unwrap_or(f64::NAN)))
+}
+
+/// The snapshots' values as a run makes them: finite, and each run starting from the model's
+/// consistent initial state (to the tolerance the basis check holds the basis's reference to):
+/// an altered file is named here, not by the check of the basis built from it.
+fn check_values(
+    p: &Pipeline,
+    x: &ndarray::Array2<f64>,
+    mult: &ndarray::Array2<f64>,
+    n_t: usize,
+) -> std::result::Result<(), (&'static str, String)> {
+    for (name, a) in [("x", x), ("multipliers", mult)] {
+        if let Some(((i, j), v)) = a.indexed_iter().find(|(_, v)| !v.is_finite()) {
+            return Err((name, format!("entry ({i}, {j}) is {v}: snapshots of a run are finite")));
+        }
+    }
+    let physics = p.model.physics().map_err(|e| ("x", format!("cannot compute the model's initial state: {e}")))?;
+    let x0: &[f64] = &physics.x0;
+    let tol = crate::io::basis_check::REFERENCE_TOLERANCE * x0.iter().fold(1.0_f64, |a, v| a.max(v.abs()));
+    for k in 0..x.ncols() / n_t {
+        let first = x.column(k * n_t);
+        if let Some((i, d)) = first.iter().zip(x0).map(|(a, b)| (a - b).abs()).enumerate().find(|(_, d)| !(*d <= tol)) {
+            return Err((
+                "x",
+                format!(
+                    "column {} (the start of run {k}) differs from the model's initial state by {d:.3e} at coordinate {i} (limit {tol:.1e}): not the snapshots of a run of this model",
+                    k * n_t
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Builds the basis from snapshot files: every run of `train.load_scales` (or of a box's

@@ -101,6 +101,13 @@ pub fn write_trained(p: &Pipeline, out: &Path, data: &TrainingData, summary: &Tr
 pub fn train_to_file(p: &Pipeline, out: &Path, origin: Origin, from_snapshots: &[PathBuf]) -> Result<TrainSummary> {
     check_output(out, origin, &[(&p.path, "pipeline file"), (&p.model.path, "model file")], &[Kind::Basis])?;
     let staged = TempPath::file_for(out)?;
+    let s = stage(p, &staged, out, from_snapshots).map_err(|e| as_written(e, staged.path(), out))?;
+    staged.commit()?;
+    Ok(s)
+}
+
+/// Trains into the temporary file `staged`, reads it back and times both routes.
+fn stage(p: &Pipeline, staged: &TempPath, out: &Path, from_snapshots: &[PathBuf]) -> Result<TrainSummary> {
     let mut s = if from_snapshots.is_empty() {
         train_and_write(p, staged.path())?
     } else {
@@ -116,6 +123,21 @@ pub fn train_to_file(p: &Pipeline, out: &Path, origin: Origin, from_snapshots: &
     // read back and checked as every reader does, then both routes timed as users run them
     let (_, rom, _) = super::online::load_rom(p, staged.path(), None, false)?;
     s.warnings.extend(super::route::time_and_store(&rom, staged.path())?);
-    staged.commit()?;
     Ok(s)
+}
+
+/// An error about the temporary basis names the basis the user asked for, which keeps its
+/// previous content: the temporary name is gone by the time the message is read.
+fn as_written(e: Error, tmp: &Path, out: &Path) -> Error {
+    let tmp = tmp.display().to_string();
+    let named = || format!("{} (the basis just trained; not written)", out.display());
+    match e {
+        Error::Input { file, field, problem } if file == tmp => Error::Input { file: named(), field, problem },
+        Error::Hdf5 { file, problem } if file == tmp => Error::Hdf5 { file: named(), problem },
+        Error::Io { file, source } if file == tmp => Error::Io { file: named(), source },
+        Error::Hinted { source, hint } => {
+            Error::Hinted { source: Box::new(as_written(*source, tmp.as_ref(), out)), hint }
+        }
+        other => other,
+    }
 }

@@ -22,6 +22,10 @@ pub(super) enum Live {
 }
 
 static LIVE: Mutex<Vec<Live>> = Mutex::new(Vec::new());
+/// The outputs renamed into place so far (each path once), so that a stop says which outputs
+/// are new rather than "left as they were". Taken only under [`LIVE`]'s lock: a rename and
+/// its record are one step for the signal's clean-up.
+static COMMITTED: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 /// What a stopped process should say about the work it kept ([`set_stop_note`]).
 static STOP_NOTE: Mutex<Option<String>> = Mutex::new(None);
 
@@ -105,6 +109,41 @@ pub(super) fn unregister(l: &Live) {
     }
 }
 
+/// Records that `target` was renamed into place; called with the registry lock held
+/// (`_held`), in the same step as the rename.
+pub(super) fn record_commit(_held: &MutexGuard<'static, Vec<Live>>, target: &Path) {
+    let mut c = COMMITTED.lock().unwrap_or_else(|e| e.into_inner());
+    if !c.iter().any(|p| p == target) {
+        c.push(target.to_path_buf());
+    }
+}
+
+/// What a signal's clean-up does before the process ends, as the handler does it: under the
+/// registry lock (no new temporary path is made, and no rename is half recorded), removes
+/// every live temporary path (putting back a report folder moved aside) and says what it did
+/// and which outputs were already complete and in place.
+pub fn clean_up_for_stop(signal: &str) -> String {
+    stop_locked(&mut live(), signal)
+}
+
+fn stop_locked(v: &mut Vec<Live>, signal: &str) -> String {
+    let n = v.len();
+    clean_up(v);
+    let done = COMMITTED.lock().unwrap_or_else(|e| e.into_inner()).clone();
+    stop_message(signal, n, &done)
+}
+
+fn stop_message(signal: &str, removed: usize, done: &[PathBuf]) -> String {
+    if done.is_empty() {
+        return format!("stopped by {signal}; {removed} temporary path(s) removed, previous outputs left as they were");
+    }
+    let names: Vec<String> = done.iter().map(|p| crate::error::show_text(&p.display().to_string())).collect();
+    format!(
+        "stopped by {signal} after {} had been written in full (complete and in place, replacing what was there); {removed} temporary path(s) removed, other outputs left as they were",
+        names.join(", ")
+    )
+}
+
 /// Removes (or puts back) every registered path; used by the signal handler.
 pub(super) fn clean_up(v: &mut Vec<Live>) {
     for l in v.drain(..) {
@@ -170,15 +209,12 @@ pub fn install_signal_handler() -> Result<()> {
                         continue;
                     }
                 }
+                // the lock is kept until the exit: nothing is made or renamed after the clean-up
                 let mut v = live();
-                let n = v.len();
-                clean_up(&mut v);
+                let said = stop_locked(&mut v, name);
                 // an unwritable stderr (a hung-up terminal) must not end this thread
                 let mut err = std::io::stderr();
-                let _ = writeln!(
-                    err,
-                    "flexrom: stopped by {name}; {n} temporary path(s) removed, previous outputs left as they were"
-                );
+                let _ = writeln!(err, "flexrom: {said}");
                 if let Some(note) = STOP_NOTE.lock().unwrap_or_else(|e| e.into_inner()).as_ref() {
                     let _ = writeln!(err, "flexrom: {note}");
                 }

@@ -2,7 +2,7 @@
 //! removed when dropped, renamed over the target when committed.
 
 use super::fs::{check_replaceable, create_dirs, follow_symlink, split, sync_file_data, sync_path};
-use super::registry::{live, unique_sibling, unregister, Live};
+use super::registry::{live, record_commit, unique_sibling, unregister, Live};
 use crate::error::{Error, Result};
 use std::path::{Path, PathBuf};
 
@@ -109,19 +109,31 @@ impl TempPath {
                 tmp.display()
             )));
         }
-        sync_file_data(&tmp)?;
-        // checked again right before the rename: something may have appeared meanwhile
-        check_replaceable(&self.target)?;
-        std::fs::rename(&tmp, &self.target).map_err(|e| Error::io(&self.target, e))?;
-        self.disarm();
+        self.prepare_commit()?;
+        // the rename, its record and the temporary's leaving the registry are one step for a
+        // signal's clean-up (which takes the lock): it says the output is new exactly when it is
+        let mut v = live();
+        self.rename_locked(&mut v)?;
+        drop(v);
         sync_path(&split(&self.target)?.0)
     }
 
-    fn disarm(&mut self) {
-        if self.armed {
-            unregister(&self.live);
-            self.armed = false;
+    /// What comes before a file's rename: its data on disk, the target checked again (it
+    /// may have changed meanwhile). For a folder use [`super::swap_in_dir`].
+    pub(super) fn prepare_commit(&self) -> Result<()> {
+        sync_file_data(self.path())?;
+        check_replaceable(&self.target)
+    }
+
+    /// Renames the file over its target and takes it off the registry, whose lock `v` is.
+    pub(super) fn rename_locked(&mut self, v: &mut std::sync::MutexGuard<'static, Vec<Live>>) -> Result<()> {
+        std::fs::rename(self.path(), &self.target).map_err(|e| Error::io(&self.target, e))?;
+        record_commit(v, &self.target);
+        if let Some(i) = v.iter().position(|x| x == &self.live) {
+            v.swap_remove(i);
         }
+        self.armed = false;
+        Ok(())
     }
 }
 

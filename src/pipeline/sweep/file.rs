@@ -49,7 +49,7 @@ use super::outcome::{ScaleResult, Sweep, SweepPoint, STATUS_OK, STATUS_PENDING};
 use crate::error::{Error, Result};
 use crate::io::attrs::{check_layout, write_atomically_as, Kind};
 use crate::io::basis_file::StoredBasis;
-use crate::io::h5::{attr_f64, attr_str, attr_u64, read_attr_str};
+use crate::io::h5::{attr_f64, attr_str, attr_u64, bounded_len, dataset_of_shape, read_attr_str};
 use crate::model::Model;
 use crate::pipeline::validate::Validation;
 use crate::rom::estimator::Estimate;
@@ -293,12 +293,13 @@ pub fn points_of(f: &hdf5::File, scales: &[f64]) -> std::result::Result<Vec<Para
 /// `parameters`): the names and one `Parameters` per row; `Err(problem)` when it cannot be
 /// read or has not `rows` rows and a column per name.
 pub fn read_point_table(d: &hdf5::Dataset, rows: usize) -> std::result::Result<(Vec<String>, Vec<Parameters>), String> {
-    let a = d.read::<f64, ndarray::Ix2>().map_err(|e| format!("cannot be read: {e}"))?;
     let names = read_attr_str(d, "parameters").map_err(|e| format!("has no readable attribute `parameters`: {e}"))?;
     let names: Vec<String> = names.split(',').map(str::to_string).collect();
-    if a.dim() != (rows, names.len()) {
-        return Err(format!("is {:?}, expected ({rows}, {}) for its parameters {names:?}", a.dim(), names.len()));
+    // the shape before the values: a damaged one must not size the allocation
+    if d.shape() != [rows, names.len()] {
+        return Err(format!("is {:?}, expected ({rows}, {}) for its parameters {names:?}", d.shape(), names.len()));
     }
+    let a = d.read::<f64, ndarray::Ix2>().map_err(|e| format!("cannot be read: {e}"))?;
     let points =
         a.rows().into_iter().map(|row| names.iter().zip(row).fold(Parameters::default(), |mu, (n, &v)| mu.with(n, v)));
     Ok((names.clone(), points.collect()))
@@ -357,46 +358,32 @@ pub fn read_sweep(
     if text("model_fingerprint")? != model.fingerprint() {
         return Err(cannot("model_fingerprint", "comes from another model than the pipeline's".into()));
     }
-    let vec = |name: &str| {
-        f.dataset(name).and_then(|d| d.read_1d::<f64>()).map_err(|e| cannot(name, format!("cannot be read: {e}")))
-    };
-    let ints = |name: &str| {
-        f.dataset(name).and_then(|d| d.read_1d::<u64>()).map_err(|e| cannot(name, format!("cannot be read: {e}")))
-    };
+    let s = Settings::resolve(model, &Overrides::default())?;
+    let (nt, r) = (s.n_steps + 1, stored.map_or(0, |b| b.basis.n_reduced()));
+    // the number of runs is the file's own: bounded by what holding them takes (coordinates,
+    // reduced and full probes, the per-run columns) before anything is read, and every
+    // dataset's shape checked against it before that dataset is read
+    let per_run = 8.0 * (nt as f64 * (r + 4 * model.probe_names().len()) as f64 + 32.0);
+    let n = bounded_len(&f, "load_scales", per_run, &model.limits).map_err(|p| cannot("load_scales", p))?;
+    let shaped = |name: &str, want: &[usize]| dataset_of_shape(&f, name, want).map_err(|p| cannot(name, p));
+    let read = |name: &str, e: hdf5::Error| cannot(name, format!("cannot be read: {e}"));
+    let vec = |name: &str| shaped(name, &[n])?.read_1d::<f64>().map_err(|e| read(name, e));
+    let ints = |name: &str| shaped(name, &[n])?.read_1d::<u64>().map_err(|e| read(name, e));
+    let flags = |name: &str| shaped(name, &[n])?.read_1d::<u8>().map_err(|e| read(name, e));
     let scales = vec("load_scales")?;
     let points = points_of(&f, &scales.to_vec()).map_err(|(field, problem)| cannot(field, problem))?;
-    let status = f
-        .dataset("status")
-        .and_then(|d| d.read_1d::<u8>())
-        .map_err(|e| cannot("status", format!("cannot be read: {e}")))?;
-    let t = vec("t")?;
-    let s = Settings::resolve(model, &Overrides::default())?;
-    let (n, nt, r) = (scales.len(), s.n_steps + 1, stored.map_or(0, |b| b.basis.n_reduced()));
-    if status.len() != n || t.len() != nt {
-        return Err(cannot(
-            "status",
-            format!("has {} entries for {n} load scales, or /t {} for {nt} instants", status.len(), t.len()),
-        ));
-    }
+    let status = flags("status")?;
+    let t = shaped("t", &[nt])?.read_1d::<f64>().map_err(|e| read("t", e))?;
     let zq = if file_full {
         // a full sweep keeps no coordinates
         Array3::zeros((n, 0, nt))
     } else {
-        f.dataset("reduced_q")
-            .and_then(|d| d.read::<f64, ndarray::Ix3>())
-            .map_err(|e| cannot("reduced_q", format!("cannot be read: {e}")))?
+        let want = if layout == 1 { [n, r, nt] } else { [n, nt, r] };
+        shaped("reduced_q", &want)?.read::<f64, ndarray::Ix3>().map_err(|e| read("reduced_q", e))?
     };
-    let zq = if file_full {
-        zq
-    } else if layout == 1 {
-        if zq.dim() != (n, r, nt) {
-            return Err(cannot("reduced_q", format!("is {:?}, expected ({n}, {r}, {nt}) (layout 1)", zq.dim())));
-        }
+    let zq = if file_full || layout == 1 {
         zq
     } else {
-        if zq.dim() != (n, nt, r) {
-            return Err(cannot("reduced_q", format!("is {:?}, expected ({n}, {nt}, {r})", zq.dim())));
-        }
         // back to the runs' r × n_t
         zq.permuted_axes([0, 2, 1]).as_standard_layout().to_owned()
     };
@@ -404,13 +391,7 @@ pub fn read_sweep(
         let mut probes = Vec::new();
         for name in model.probe_names() {
             let path = format!("{group}/{name}");
-            let a = f
-                .dataset(&path)
-                .and_then(|d| d.read::<f64, ndarray::Ix3>())
-                .map_err(|e| cannot(&path, format!("cannot be read: {e}")))?;
-            if a.dim() != (n, nt, 2) {
-                return Err(cannot(&path, format!("is {:?}, expected ({n}, {nt}, 2)", a.dim())));
-            }
+            let a = shaped(&path, &[n, nt, 2])?.read::<f64, ndarray::Ix3>().map_err(|e| read(&path, e))?;
             probes.push((name, a));
         }
         Ok(probes)
@@ -429,27 +410,13 @@ pub fn read_sweep(
     let (estimates, estimate_seconds, extrapolated) = (
         optional("error_estimate")?,
         optional("estimate_seconds")?,
-        if f.link_exists("extrapolated") {
-            Some(
-                f.dataset("extrapolated")
-                    .and_then(|d| d.read_1d::<u8>())
-                    .map_err(|e| cannot("extrapolated", format!("cannot be read: {e}")))?,
-            )
-        } else {
-            None
-        },
+        if f.link_exists("extrapolated") { Some(flags("extrapolated")?) } else { None },
     );
     // files written before /fallback hold reduced answers only; a fallback's reason is its
     // /message
     let fallback = if f.link_exists("fallback") {
-        let flags = f
-            .dataset("fallback")
-            .and_then(|d| d.read_1d::<u8>())
-            .map_err(|e| cannot("fallback", format!("cannot be read: {e}")))?;
-        let messages = f
-            .dataset("message")
-            .and_then(|d| d.read_1d::<VarLenUnicode>())
-            .map_err(|e| cannot("message", format!("cannot be read: {e}")))?;
+        let flags = flags("fallback")?;
+        let messages = shaped("message", &[n])?.read_1d::<VarLenUnicode>().map_err(|e| read("message", e))?;
         if flags.len() != n || messages.len() != n {
             return Err(cannot(
                 "fallback",
@@ -464,14 +431,7 @@ pub fn read_sweep(
         if !f.link_exists(name) {
             return Ok(None);
         }
-        let a = f
-            .dataset(name)
-            .and_then(|d| d.read::<f64, ndarray::Ix2>())
-            .map_err(|e| cannot(name, format!("cannot be read: {e}")))?;
-        if a.dim() != (n, 5) {
-            return Err(cannot(name, format!("is {:?}, expected ({n}, 5)", a.dim())));
-        }
-        Ok(Some(a))
+        shaped(name, &[n, 5])?.read::<f64, ndarray::Ix2>().map(Some).map_err(|e| read(name, e))
     };
     let by_time = by_fifth("error_estimate_by_time")?;
     // files written before the displacement measure have neither: NaN
