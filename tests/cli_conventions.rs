@@ -342,7 +342,7 @@ fn dense_comparison_flags_and_auto_skip() {
 fn every_help_has_examples_and_exit_codes() {
     let top = String::from_utf8(ok(&["--help"]).stdout).unwrap();
     assert!(top.contains("Exit codes:") && top.contains("Examples:"), "{top}");
-    for cmd in ["simulate", "train", "online", "validate", "sweep", "merge", "run", "demo"] {
+    for cmd in ["simulate", "statics", "modes", "train", "online", "validate", "sweep", "merge", "run", "demo"] {
         let h = String::from_utf8(ok(&[cmd, "--help"]).stdout).unwrap();
         assert!(h.contains("Examples:\n  flexrom ") && h.contains(&format!("flexrom {cmd} ")), "{cmd}: {h}");
         for code in ["  0 ", "  1 ", "  2 ", "  3 ", "  4 ", "129/130/143"] {

@@ -14,7 +14,7 @@
 //! them and takes the Ritz pairs of `Yᵀ K_T Y z = ω² z` (LAPACK's `dsyev` through
 //! ndarray-linalg). Mode `i` converges at the rate `(ω_i² − σ)/(ω_{p+1}² − σ)` per
 //! iteration. Each Ritz vector's `ω²` is then taken from the next solve, `σ + xᵀMx / xᵀMy`
-//! ([`inverse_quotient`]: accurate where `xᵀK_T x` loses digits); the loop stops when every
+//! (`inverse_quotient`: accurate where `xᵀK_T x` loses digits); the loop stops when every
 //! wanted `ω²` changes by less than `10⁻⁹ (|ω²| + |σ|) + 10 ε d` from one iteration to the
 //! next. The last term is the round-off floor: `K_T` is known to `ε ‖K_T‖`, so every `ω²`
 //! only to about `ε d` (s⁻²; [`Modes::roundoff`]), which fine meshes feel in their lowest
@@ -22,7 +22,7 @@
 //! Where `p = n_free` (small models) the subspace is all of `ker B` and the first Ritz
 //! pairs are exact: a dense solve.
 //!
-//! The shift `σ = −10⁻¹² d`, `d` about the largest `ω²` ([`stiffest_ratio`]), keeps the
+//! The shift `σ = −10⁻¹² d`, `d` about the largest `ω²` (`stiffest_ratio`), keeps the
 //! matrix regular where `K_T` has rigid-body modes (`ω = 0`, amplified by `1/|σ|` in each
 //! solve) and stays below the lowest elastic `ω²` of the shipped meshes (the 5000-element
 //! pendulum: `σ ≈ −12 s⁻²` against `ω₂² = 97.8 s⁻²`; a larger `|σ|` slows the lowest

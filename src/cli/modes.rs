@@ -86,6 +86,10 @@ impl Args {
             modes.iterations,
             q.len()
         ));
+        flexrom::output::detail(&format!(
+            "  round-off of every ω²: about {:.2e} 1/s² (ε times the mesh's largest ω²)",
+            modes.roundoff
+        ));
         for (i, f) in modes.frequencies.iter().enumerate() {
             let kind = if modes.rigid[i] { " (rigid-body motion)" } else { "" };
             info(&format!("  mode {}: {f:.6} Hz{kind}", i + 1));
