@@ -10,6 +10,7 @@
 // kernels follow the equations' indices (several arrays indexed alike)
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
 
+pub mod analysis;
 pub mod error;
 pub mod interrupt;
 pub mod io;

@@ -84,6 +84,42 @@ then NAME_strain (1) and NAME_curvature (1/m) of the probes that record them; wi
         exit_codes!()
     ))]
     Simulate(cli::simulate::Args),
+    /// Static equilibrium under the model's loads (load stepping), written as a result file.
+    #[command(after_help = concat!(
+        "Examples:
+  flexrom statics data/models/pendulum.toml -o out/pendulum_static.h5
+  flexrom statics cantilever.toml -o s.h5 --steps 10 --load-scale 2
+  flexrom statics data/models/fourbar.toml -o s.h5 --time 0.3 --csv
+
+The loads (gravity, forces, moments at --time T, default 0) are applied in --steps equal
+steps, each solved by Newton from the last equilibrium and halved where Newton fails. The
+result file has one row per load step (the equilibrium last; /load_factor says which), with
+the probes, multipliers and energies. A mechanism whose loads drive a free motion has no
+equilibrium: the error names the motion. --csv/--json print one row per load step: t (s),
+load_factor, the probes' NAME_x, NAME_y (m) (strain, curvature), energy_* (J).
+
+",
+        exit_codes!()
+    ))]
+    Statics(cli::statics::Args),
+    /// Natural frequencies and mode shapes, linearized at the initial or static configuration.
+    #[command(after_help = concat!(
+        "Examples:
+  flexrom modes data/models/pendulum.toml --count 6
+  flexrom modes cantilever.toml --count 3 --json
+  flexrom modes data/models/pendulum.toml --at static --count 4 -o out/modes.h5
+  flexrom modes data/models/pendulum_5000.toml --count 10 --csv
+
+K_T φ = ω² M φ in the null space of the constraints (K_T the tangent stiffness with its
+geometric part), the lowest --count modes by shift-invert subspace iteration; rigid-body
+modes have frequency 0. --json prints {\"frequencies\": [Hz, ascending], \"omega_squared\",
+\"rigid\", \"iterations\", \"seconds\"}; --csv one row per mode: mode, frequency (Hz),
+omega_squared (1/s²), rigid (0/1). -o writes the modes file (docs/file-formats.md).
+
+",
+        exit_codes!()
+    ))]
+    Modes(cli::modes::Args),
     /// Run the full model at the pipeline's training load scales and write the POD basis (HDF5).
     #[command(after_help = concat!(
         "Examples:
@@ -274,6 +310,8 @@ fn main() -> ExitCode {
 fn run(cli: Cli, limits: &flexrom::limits::Limits) -> flexrom::Result<()> {
     match cli.command {
         Command::Simulate(a) => a.run(limits),
+        Command::Statics(a) => a.run(limits),
+        Command::Modes(a) => a.run(limits),
         Command::Train(a) => a.run(limits),
         Command::Online(a) => a.run(limits),
         Command::Validate(a) => a.run(limits),

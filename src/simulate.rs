@@ -1,6 +1,8 @@
 //! Full-order simulation of a model file: the first stage of the flow
 //! model file → full simulation → snapshots → POD basis → reduced runs → validation.
 
+use crate::analysis::energy::{energies, Energies};
+use crate::analysis::statics::{StaticOptions, StaticSolution};
 use crate::error::{Error, Result};
 use crate::linalg::kkt::LinearSolverKind;
 use crate::model::Model;
@@ -126,6 +128,8 @@ pub struct SimulationResult {
     pub stats: Stats,
     /// wall time of the time loop alone
     pub wall_seconds: f64,
+    /// the energies at every instant (`None` for reduced runs)
+    pub energy: Option<Energies>,
 }
 
 /// The one solve of every run, full or reduced (`simulate`, `online`, `sweep`, `validate`,
@@ -321,6 +325,7 @@ pub fn simulate(model: &Model, overrides: &Overrides) -> Result<SimulationResult
 
 fn run_full(model: &Model, sys: &mut FlexibleSystem, q0: Vec<f64>, s: Settings) -> Result<SimulationResult> {
     model.check_full_run_memory(s.n_steps, s.solver == LinearSolverKind::Dense)?;
+    let q0 = if model.file.initial.as_ref().is_some_and(|i| i.r#static) { static_start(sys, q0, &s)? } else { q0 };
     let (n, nc, nt) = (ParametricModel::n_dof(sys), ParametricModel::n_constraints(sys), s.n_steps + 1);
     // column-major: each instant's column is contiguous, so recording a step is one copy
     // and the result file's time-first rows are the memory as it is (no transposition)
@@ -356,6 +361,8 @@ fn run_full(model: &Model, sys: &mut FlexibleSystem, q0: Vec<f64>, s: Settings) 
     }
     let (strains, curvatures) =
         probe_sections(&probe_defs, |p| (0..nt).map(|k| sys.probe_section(p, &q.column(k).to_vec())).collect());
+    let energy =
+        energies(sys, &s.mu, t.as_slice().expect("contiguous"), |k| q.column(k).to_vec(), |k| qd.column(k).to_vec());
     Ok(SimulationResult {
         model_text: model.text.clone(),
         model_path: model.path.display().to_string(),
@@ -369,7 +376,91 @@ fn run_full(model: &Model, sys: &mut FlexibleSystem, q0: Vec<f64>, s: Settings) 
         curvatures,
         stats,
         wall_seconds,
+        energy: Some(energy),
     })
+}
+
+/// The static equilibrium under the run's loads at t = 0 (`[initial] static = true`), from
+/// the consistent undeformed state `q0`: where a dynamic run starts, at rest.
+fn static_start(sys: &mut FlexibleSystem, q0: Vec<f64>, s: &Settings) -> Result<Vec<f64>> {
+    let o = StaticOptions { mu: s.mu.clone(), t: 0.0, steps: 1, solver: s.solver };
+    let solution = crate::analysis::statics::solve(sys, q0, &o)?;
+    log::debug!(
+        "  initial static equilibrium: {} Newton iterations, {} load-step cuts",
+        solution.newton_iterations,
+        solution.step_cuts
+    );
+    Ok(solution.equilibrium().q.clone())
+}
+
+/// The static equilibrium of `model` under `o`'s loads ([`crate::analysis::statics`]) as a
+/// result: one instant per load step (all at the time `o.t` of the loads), the
+/// equilibrium last, its probes, multipliers and energies; the velocities are zero.
+/// `--time` outside `[0, t_end]` of the model's run is refused.
+pub fn statics(model: &Model, o: &StaticOptions) -> Result<(SimulationResult, StaticSolution)> {
+    let t_end = model.file.time.t_end;
+    if !(o.t >= 0.0 && o.t <= t_end) {
+        return Err(Error::Usage(format!(
+            "--time {}: outside the model's run, [0, {}] s ({}: time.t_end)",
+            crate::error::show_number(o.t),
+            crate::error::show_number(t_end),
+            model.path.display()
+        )));
+    }
+    if o.steps == 0 || o.steps as u64 > model.limits.max_steps {
+        return Err(Error::Usage(format!("--steps {}: give 1 to {} load steps", o.steps, model.limits.max_steps)));
+    }
+    o.mu.validate()?;
+    model.check_parameters(&o.mu)?;
+    let mu = model.with_property_values(&o.mu);
+    let o = StaticOptions { mu, ..o.clone() };
+    let settings =
+        Settings::resolve(model, &Overrides { mu: Some(o.mu.clone()), solver: o.solver, ..Default::default() })?;
+    let (mut sys, q0) = prepare(model, &settings)?;
+    let start = std::time::Instant::now();
+    let solution = crate::analysis::statics::solve(&mut sys, q0, &o)?;
+    let wall_seconds = start.elapsed().as_secs_f64();
+    let rows = &solution.steps;
+    let (n, nc, nt) = (ParametricModel::n_dof(&sys), ParametricModel::n_constraints(&sys), rows.len());
+    let q = Array2::from_shape_fn(ndarray::ShapeBuilder::f((n, nt)), |(i, k)| rows[k].q[i]);
+    let qd = Array2::zeros(ndarray::ShapeBuilder::f((n, nt)));
+    let multipliers = Array2::from_shape_fn(ndarray::ShapeBuilder::f((nc, nt)), |(i, k)| rows[k].lambda[i]);
+    let t = Array1::from_elem(nt, o.t);
+    let probe_defs = sys.probes.clone();
+    let probes = probe_defs
+        .iter()
+        .map(|p| {
+            let xy = Array2::from_shape_fn((nt, 2), |(k, c)| sys.probe_position(p, &rows[k].q)[c]);
+            (p.name.clone(), xy)
+        })
+        .collect();
+    let (strains, curvatures) =
+        probe_sections(&probe_defs, |p| rows.iter().map(|r| sys.probe_section(p, &r.q)).collect());
+    // a static state's energies: no motion, no work along a path of equilibria counted
+    let energy = energies(&mut sys, &o.mu, t.as_slice().expect("contiguous"), |k| rows[k].q.clone(), |_| vec![0.0; n]);
+    let stats = Stats {
+        steps: nt,
+        newton_iterations: solution.newton_iterations,
+        factorizations: solution.factorizations,
+        step_cuts: solution.step_cuts,
+        ..Default::default()
+    };
+    let result = SimulationResult {
+        model_text: model.text.clone(),
+        model_path: model.path.display().to_string(),
+        settings: Settings { n_steps: nt.saturating_sub(1), ..settings },
+        t,
+        q,
+        qd,
+        multipliers,
+        probes,
+        strains,
+        curvatures,
+        stats,
+        wall_seconds,
+        energy: Some(energy),
+    };
+    Ok((result, solution))
 }
 
 /// The strain and the curvature series (each `(name, values at every instant)`) of the

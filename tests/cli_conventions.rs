@@ -76,7 +76,13 @@ fn every_result_prints_as_csv_and_json() {
     let out = dir.join("sim/deep/p.h5");
     let o = ok(&["simulate", s(&model), "-o", s(&out), "--t-end", "0.02", "--csv"]);
     let (head, rows) = csv_rows(&o);
-    assert_eq!(head, ["t", "tip_x", "tip_y"]);
+    let energy = ["kinetic", "strain", "strain_axial", "strain_bending", "gravity", "springs", "external_work"];
+    let expected: Vec<String> = ["t", "tip_x", "tip_y"]
+        .iter()
+        .map(|s| s.to_string())
+        .chain(energy.iter().map(|e| format!("energy_{e}")))
+        .collect();
+    assert_eq!(head, expected);
     assert_eq!(rows.len(), 5, "t = 0 and 4 steps of 0.005 s");
     let o = ok(&["simulate", s(&model), "-o", s(&out), "--t-end", "0.02", "--json"]);
     let j = json(&o);
@@ -336,7 +342,7 @@ fn dense_comparison_flags_and_auto_skip() {
 fn every_help_has_examples_and_exit_codes() {
     let top = String::from_utf8(ok(&["--help"]).stdout).unwrap();
     assert!(top.contains("Exit codes:") && top.contains("Examples:"), "{top}");
-    for cmd in ["simulate", "train", "online", "validate", "sweep", "merge", "run", "demo"] {
+    for cmd in ["simulate", "statics", "modes", "train", "online", "validate", "sweep", "merge", "run", "demo"] {
         let h = String::from_utf8(ok(&[cmd, "--help"]).stdout).unwrap();
         assert!(h.contains("Examples:\n  flexrom ") && h.contains(&format!("flexrom {cmd} ")), "{cmd}: {h}");
         for code in ["  0 ", "  1 ", "  2 ", "  3 ", "  4 ", "129/130/143"] {

@@ -320,6 +320,7 @@ fn the_documented_tables_are_the_written_ones() {
     check("Basis file", table(Kind::Basis));
     check("Sweep file", table(Kind::Sweep));
     check("Snapshot file", table(Kind::Snapshots));
+    check("Modes file", table(Kind::Modes));
     // /labels: the result's table of names is every file's
     let labels: Vec<_> = flexrom::io::attrs::LABELS.to_vec();
     check("Labels", &labels);

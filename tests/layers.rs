@@ -7,7 +7,7 @@
 //! * an import running upward, or sideways between two top-level modules of one layer, in the
 //!   layer order, top to bottom:
 //!
-//!   `main` → `cli` → `pipeline` → `rom` → `io` → `simulate` → `model` → `reduction` | `physics`
+//!   `main` → `cli` → `pipeline` → `rom` → `io` → `simulate` → `analysis` → `model` → `reduction` | `physics`
 //!   → `solver` → `linalg` → `output` → `limits` | `interrupt` → `error`
 //!
 //!   (`cli` is the binary's command handlers, below `main.rs`'s parsing and dispatch;
@@ -30,6 +30,7 @@ const LAYERS: &[&[&str]] = &[
     &["rom"],
     &["io"],
     &["simulate"],
+    &["analysis"],
     &["model"],
     &["reduction", "physics"],
     &["solver"],

@@ -4,9 +4,11 @@
 
 pub mod demo;
 pub mod merge;
+pub mod modes;
 pub mod online;
 pub mod run;
 pub mod simulate;
+pub mod statics;
 pub mod sweep;
 pub mod train;
 pub mod validate;

@@ -55,6 +55,8 @@ pub enum Kind {
     Sweep,
     /// `train --snapshots-only`
     Snapshots,
+    /// `modes -o`
+    Modes,
 }
 
 impl Kind {
@@ -64,6 +66,7 @@ impl Kind {
             Kind::Basis => "basis",
             Kind::Sweep => "sweep",
             Kind::Snapshots => "snapshots",
+            Kind::Modes => "modes",
         }
     }
 }
@@ -82,7 +85,18 @@ pub const LABELS: [Entry; 7] = [
     ("labels/multiplier_joint", "1", "constraint"),
 ];
 
-const RESULT: [Entry; 8] = [
+/// Mode shapes normalized to unit modal mass, `φᵀMφ = 1 kg·(m or 1)²`.
+pub const MODE_SHAPE_UNITS: &str = "m/√kg (positions x, y), 1/√kg (slopes x', y')";
+
+const MODES: [Entry; 5] = [
+    ("frequencies", "Hz", "mode"),
+    ("omega_squared", "1/s²", "mode"),
+    ("rigid", "1", "mode"),
+    ("shapes", MODE_SHAPE_UNITS, "mode, dof"),
+    ("q", COORDINATE_UNITS, "dof"),
+];
+
+const RESULT: [Entry; 10] = [
     ("t", "s", "time"),
     ("q", COORDINATE_UNITS, "time, dof"),
     ("qd", VELOCITY_UNITS, "time, dof"),
@@ -90,6 +104,8 @@ const RESULT: [Entry; 8] = [
     ("probes/*", "m", "time, xy"),
     ("probe_strain/*", "1", "time"),
     ("probe_curvature/*", "1/m", "time"),
+    ("energy/*", "J", "time"),
+    ("load_factor", "1", "time"),
     ("reduced/q", REDUCED_UNITS, "time, mode"),
 ];
 
@@ -201,6 +217,7 @@ pub fn table(kind: Kind) -> &'static [Entry] {
         Kind::Basis => &BASIS,
         Kind::Sweep => &SWEEP,
         Kind::Snapshots => &SNAPSHOTS,
+        Kind::Modes => &MODES,
     }
 }
 

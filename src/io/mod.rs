@@ -10,6 +10,7 @@ pub mod estimator_file;
 pub mod h5;
 pub mod h5_text;
 pub mod labels;
+pub mod modes_file;
 pub mod output;
 pub mod parameter_space_file;
 pub mod result_file;

@@ -9,6 +9,9 @@
 //! /probes/<name>          (n_t, 2)       x, y of each probe, m
 //! /probe_strain/<name>    (n_t)          axial strain at the probes that record it, 1
 //! /probe_curvature/<name> (n_t)          curvature at the probes that record it, 1/m
+//! /energy/<name>          (n_t)          energies, J: kinetic, strain, strain_axial,
+//!                                        strain_bending, gravity, springs, external_work
+//!                                        (full runs and statics)
 //! /reduced/q              (n_t, r)       `online` only: the reduced coordinates
 //! /labels/...                            names of the coordinates and constraint rows
 //! every dataset: attributes units, dims (src/io/attrs.rs)
@@ -212,6 +215,9 @@ impl ResultFile {
         attr_u64(f, "max_iterations_in_a_step", r.stats.max_iterations_in_a_step as u64).map_err(e)?;
         attr_u64(f, "steps_at_round_off", r.stats.steps_at_round_off as u64).map_err(e)?;
         attr_f64(f, "wall_seconds", r.wall_seconds).map_err(e)?;
+        if let Some(energy) = &r.energy {
+            write_energy(f, energy).map_err(e)?;
+        }
         extra(f).map_err(shorten)?;
         annotate_rest(f, &self.labelled).map_err(e)
     }
@@ -310,6 +316,15 @@ fn transposed(a: &ndarray::Array2<f64>, start: usize, end: usize) -> ndarray::Ar
     ndarray::Array2::from_shape_vec((rows, n), out).expect("rows × n entries")
 }
 
+/// Writes `/energy/<name>` (J, one value per instant) of a run's energies.
+fn write_energy(f: &hdf5::File, energy: &crate::analysis::energy::Energies) -> hdf5::Result<()> {
+    let g = f.create_group("energy")?;
+    for (name, values) in energy.named() {
+        g.new_dataset_builder().with_data(values).create(name)?;
+    }
+    Ok(())
+}
+
 /// Writes `/reduced/q`, time first, from the reduced coordinates `zq` (r × n_t, one column
 /// per instant as the solver keeps them).
 pub fn write_reduced(f: &hdf5::File, zq: &ndarray::Array2<f64>) -> hdf5::Result<()> {
@@ -357,6 +372,7 @@ mod tests {
             curvatures: vec![],
             stats: Default::default(),
             wall_seconds: 0.0,
+            energy: None,
         };
         let plan = super::RunPlan::of_result(&r);
         assert_eq!((plan.n_t, plan.n_dof, plan.n_c, plan.dt), (1, 8, 0, 0.1));

@@ -22,6 +22,19 @@ pub struct ModelFile {
     pub masses: Vec<MassSpec>,
     #[serde(default)]
     pub probes: Vec<ProbeSpec>,
+    /// how a dynamic run starts (absent: from the undeformed configuration at rest; left
+    /// out of the serialized file then, so that older files keep their fingerprint)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial: Option<InitialSpec>,
+}
+
+/// `[initial]`: the state a dynamic run starts from.
+#[derive(Clone, Debug, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct InitialSpec {
+    /// start from the static equilibrium under the loads at t = 0 (at rest)
+    #[serde(default)]
+    pub r#static: bool,
 }
 
 /// A point mass at a node, kg (gravity acts on it).

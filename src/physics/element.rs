@@ -236,6 +236,12 @@ impl BeamElement {
         0.5 * e.dot(&(self.bending * e)) + 0.5 * self.section.ea() * self.length * eps * eps
     }
 
+    /// The strain energy's parts `(½ eᵀK_t e, ½ EA l ε̄²)`: bending, axial.
+    pub fn strain_energy_parts(&self, e: &Vec8) -> (f64, f64) {
+        let (e, _, eps) = self.axial_state(e);
+        (0.5 * e.dot(&(self.bending * e)), 0.5 * self.section.ea() * self.length * eps * eps)
+    }
+
     /// Elastic force `Q_e = K_t e + EA ε̄ S_l e` (thesis eq. 7).
     pub fn elastic_force(&self, e: &Vec8) -> Vec8 {
         Vec8::from(self.elastic(&(*e).into()))

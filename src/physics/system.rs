@@ -425,6 +425,13 @@ impl FlexibleSystem {
         }
     }
 
+    /// The point masses as diagonal entries of element blocks: `(element, local index, m)`
+    /// for each position coordinate a point mass sits on (the block that holds it, as the
+    /// iteration matrix's), for callers that assemble their own block matrices.
+    pub fn point_mass_entries(&self) -> impl Iterator<Item = (usize, usize, f64)> + '_ {
+        self.point_masses.iter().flat_map(|&(dofs, mass, (e, d0))| dofs.map(|d| (e, d - d0, mass)))
+    }
+
     /// Whether the model has point masses (mass outside its elements).
     pub fn has_point_masses(&self) -> bool {
         !self.point_masses.is_empty()

@@ -111,7 +111,9 @@ fn full_sweep_table(s: &Sweep) -> Table {
 
 /// `simulate --csv/--json`: one row per instant, `t` (s) and every probe's `NAME_x`,
 /// `NAME_y` (m), then `NAME_strain` (1) and `NAME_curvature` (1/m) of the probes that
-/// record them.
+/// record them, then a full run's energies `energy_kinetic`, `energy_strain`,
+/// `energy_strain_axial`, `energy_strain_bending`, `energy_gravity`, `energy_springs`,
+/// `energy_external_work` (J).
 pub fn probe_table(r: &SimulationResult) -> Table {
     let mut cols = vec!["t".to_string()];
     for (n, _) in &r.probes {
@@ -120,6 +122,9 @@ pub fn probe_table(r: &SimulationResult) -> Table {
     }
     cols.extend(r.strains.iter().map(|(n, _)| format!("{n}_strain")));
     cols.extend(r.curvatures.iter().map(|(n, _)| format!("{n}_curvature")));
+    // the energies of a full run (J), as its result file's /energy/<name>
+    let energy: Vec<(&str, &ndarray::Array1<f64>)> = r.energy.as_ref().map_or(Vec::new(), |e| e.named().to_vec());
+    cols.extend(energy.iter().map(|(n, _)| format!("energy_{n}")));
     let mut t = Table { columns: cols, rows: Vec::new() };
     for k in 0..r.t.len() {
         let mut row = vec![Cell::from(r.t[k])];
@@ -128,6 +133,7 @@ pub fn probe_table(r: &SimulationResult) -> Table {
             row.push(xy[[k, 1]].into());
         }
         row.extend(r.strains.iter().chain(&r.curvatures).map(|(_, v)| Cell::from(v[k])));
+        row.extend(energy.iter().map(|(_, v)| Cell::from(v[k])));
         t.push(row);
     }
     t

@@ -240,6 +240,8 @@ fn run<R: Reduced<FlexibleSystem>>(
             curvatures,
             stats,
             wall_seconds,
+            // a reduced run's energies would need its own reduced quantities
+            energy: None,
         },
         reduced_q: zq,
     })

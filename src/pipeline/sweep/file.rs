@@ -502,6 +502,7 @@ pub fn read_sweep(
             curvatures: Vec::new(),
             stats,
             wall_seconds: rom_seconds[k],
+            energy: None,
         };
         let v = validation.as_ref().zip(stored).map(|(c, stored)| Validation {
             load_scale: mu.scale(),

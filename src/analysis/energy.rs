@@ -1,0 +1,124 @@
+//! The energies of a state (SPEC §6), at the parameters `μ`:
+//!
+//! ```text
+//! kinetic          T = ½ q̇ᵀ M q̇
+//! strain           U = Σ_e (½ eᵀ K_t e + ½ EA l ε̄²)   (bending, then axial; E = E(μ))
+//! gravity          V = −g₀(μ)ᵀ q                       (−Σ ∫ ρA g · r ds)
+//! springs          0 (no spring part exists yet)
+//! external work    W(t) = ∫₀ᵗ Q_extᵀ q̇ dt              (forces and moments, not gravity)
+//! ```
+//!
+//! `W` is integrated by the trapezoidal rule over the recorded instants (second order,
+//! as the integrator at `ρ∞ = 1`). Without damping `T + U + V − W` stays constant to the
+//! integrator's order; Rayleigh damping makes it decrease (the dissipated energy).
+
+use crate::physics::element::Vec8;
+use crate::physics::system::FlexibleSystem;
+use crate::solver::model::{ElementModel, Parameters, ParametricModel};
+use ndarray::Array1;
+
+/// One series per energy, one value per instant, J.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Energies {
+    pub kinetic: Array1<f64>,
+    pub strain: Array1<f64>,
+    pub strain_axial: Array1<f64>,
+    pub strain_bending: Array1<f64>,
+    pub gravity: Array1<f64>,
+    pub springs: Array1<f64>,
+    pub external_work: Array1<f64>,
+}
+
+impl Energies {
+    /// The series by name, as the result file's `/energy/<name>` and the CSV columns
+    /// `energy_<name>`.
+    pub fn named(&self) -> [(&'static str, &Array1<f64>); 7] {
+        [
+            ("kinetic", &self.kinetic),
+            ("strain", &self.strain),
+            ("strain_axial", &self.strain_axial),
+            ("strain_bending", &self.strain_bending),
+            ("gravity", &self.gravity),
+            ("springs", &self.springs),
+            ("external_work", &self.external_work),
+        ]
+    }
+
+    /// `T + U + V + springs − W` at each instant: constant without damping.
+    pub fn total(&self) -> Array1<f64> {
+        &self.kinetic + &self.strain + &self.gravity + &self.springs - &self.external_work
+    }
+}
+
+/// `(bending, axial)` strain energy of the whole system at `q`.
+pub fn strain_parts(sys: &FlexibleSystem, mu: &Parameters, q: &[f64]) -> (f64, f64) {
+    let (mut bending, mut axial) = (0.0, 0.0);
+    for e in 0..sys.n_elements() {
+        let d = sys.element_dofs(e);
+        let qe = Vec8::from_fn(|i, _| q[d[i]]);
+        let el = sys.element(e);
+        let k = sys.stiffness_factor(e, mu);
+        let (b, a) = el.strain_energy_parts(&qe);
+        bending += k * b;
+        axial += k * a;
+    }
+    (bending, axial)
+}
+
+/// The potential of gravity `−g₀(μ)ᵀ q`: the potential energy less the strain energy.
+fn gravity(sys: &FlexibleSystem, mu: &Parameters, q: &[f64], strain: f64) -> f64 {
+    sys.potential_energy(mu, q) - strain
+}
+
+/// `Q_ext(q, t)ᵀ q̇` of the forces and moments (not gravity).
+fn load_power(sys: &FlexibleSystem, mu: &Parameters, q: &[f64], v: &[f64], t: f64) -> f64 {
+    let dofs = sys.load_dofs();
+    if dofs.is_empty() {
+        return 0.0;
+    }
+    let ql: Vec<f64> = dofs.iter().map(|&d| q[d]).collect();
+    let mut g = vec![0.0; dofs.len()];
+    // g = −Q_ext on the load dofs
+    sys.load_force(mu, &ql, t, &mut g);
+    -dofs.iter().zip(&g).map(|(&d, g)| g * v[d]).sum::<f64>()
+}
+
+/// The energies of the states `(t_k, q_k, q̇_k)` of a run at `μ` (`q` and `v` give the
+/// state at instant `k`).
+pub fn energies(
+    sys: &mut FlexibleSystem,
+    mu: &Parameters,
+    t: &[f64],
+    q: impl Fn(usize) -> Vec<f64>,
+    v: impl Fn(usize) -> Vec<f64>,
+) -> Energies {
+    let nt = t.len();
+    sys.bind(mu);
+    let mut out = Energies {
+        kinetic: Array1::zeros(nt),
+        strain: Array1::zeros(nt),
+        strain_axial: Array1::zeros(nt),
+        strain_bending: Array1::zeros(nt),
+        gravity: Array1::zeros(nt),
+        springs: Array1::zeros(nt),
+        external_work: Array1::zeros(nt),
+    };
+    let mut last_power = 0.0;
+    for k in 0..nt {
+        let (qk, vk) = (q(k), v(k));
+        let mut mv = vec![0.0; qk.len()];
+        sys.mass_mul(&vk, &mut mv);
+        out.kinetic[k] = 0.5 * vk.iter().zip(&mv).map(|(a, b)| a * b).sum::<f64>();
+        let (b, a) = strain_parts(sys, mu, &qk);
+        out.strain_bending[k] = b;
+        out.strain_axial[k] = a;
+        out.strain[k] = a + b;
+        out.gravity[k] = gravity(sys, mu, &qk, a + b);
+        let power = load_power(sys, mu, &qk, &vk, t[k]);
+        if k > 0 {
+            out.external_work[k] = out.external_work[k - 1] + 0.5 * (t[k] - t[k - 1]) * (power + last_power);
+        }
+        last_power = power;
+    }
+    out
+}
