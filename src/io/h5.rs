@@ -2,6 +2,7 @@
 
 use crate::error::{Error, Result};
 use hdf5::types::VarLenUnicode;
+use hdf5_sys::h5t::{H5Tcopy, H5Tset_size, H5T_VARIABLE};
 use std::path::Path;
 
 /// Creates `path` atomically and durably: `fill` writes into a temporary file beside it
@@ -90,9 +91,7 @@ fn short_write_error(problem: &str) -> String {
 /// checked, handles validated on drop): the attributes were a sixth of writing a result
 /// file (docs/process-speed.md). The same bytes reach the file (a test reads both back).
 pub fn attr_str(loc: &hdf5::Location, name: &str, value: &str) -> hdf5::Result<()> {
-    use hdf5_sys::h5t::{
-        H5T_cset_t, H5T_str_t, H5Tclose, H5Tcopy, H5Tset_cset, H5Tset_size, H5Tset_strpad, H5T_VARIABLE,
-    };
+    use hdf5_sys::h5t::{H5T_cset_t, H5T_str_t, H5Tclose, H5Tset_cset, H5Tset_strpad};
     // the checks of `VarLenUnicode`'s parser: no NUL inside (HDF5 would cut the text there)
     let v: VarLenUnicode = value.parse().map_err(|e| hdf5::Error::from(format!("{e:?}")))?;
     let cname = attr_name(name)?;
@@ -182,28 +181,183 @@ unsafe fn scalar_attr(
     r
 }
 
+/// Reads the text attribute `name` of `loc`. In a file read from disk, the attribute's heap
+/// references are checked first ([`check_heap_references`]) against the file's global heap
+/// collections ([`heaps_checked`]): libhdf5 follows a reference as it is, and a damaged one
+/// crashed the process. Files open for writing are flexrom's own and take the fast path.
 pub fn read_attr_str(loc: &hdf5::Location, name: &str) -> hdf5::Result<String> {
-    heaps_checked(loc)?;
-    Ok(loc.attr(name)?.read_scalar::<VarLenUnicode>()?.as_str().to_string())
+    let attr = loc.attr(name)?;
+    if let Some(heaps) = heaps_checked(loc)? {
+        check_heap_references(&attr, &heaps).map_err(hdf5::Error::from)?;
+    }
+    Ok(attr.read_scalar::<VarLenUnicode>()?.as_str().to_string())
+}
+
+/// The objects of a file's global heap collections, as [`check_global_heaps`] found them:
+/// (collection address, object index) → object size in bytes.
+pub type HeapObjects = std::collections::HashMap<(u64, u32), u64>;
+
+/// The tag of the opaque memory type [`check_heap_references`] reads a text attribute as.
+const RAW_VLEN_TAG: &std::ffi::CStr = c"flexrom raw variable-length reference";
+
+/// Size in bytes of a variable-length value as stored in an attribute (file format,
+/// "Variable-length data"): a 4-byte length, then the heap reference, an 8-byte collection
+/// address and a 4-byte object index; the only layout [`check_heap_references`] accepts.
+const RAW_VLEN_SIZE: usize = 16;
+
+/// A conversion from a variable-length string as stored in the file to the opaque type
+/// tagged [`RAW_VLEN_TAG`] that leaves the bytes as they are, so that the stored heap
+/// references can be read without libhdf5 following them (its own conversion reads each
+/// referenced object with `H5HG_read`, trusting address, index and length). Registered as
+/// a soft conversion, it is offered every variable-length to opaque path and accepts only
+/// that one: source of [`RAW_VLEN_SIZE`] bytes (the file's layout; in memory a text is a
+/// pointer), destination of the same size with the tag.
+extern "C" fn keep_raw_vlen(
+    src: hdf5_sys::h5i::hid_t,
+    dst: hdf5_sys::h5i::hid_t,
+    cdata: *mut hdf5_sys::h5t::H5T_cdata_t,
+    _n: usize,
+    _buf_stride: usize,
+    _bkg_stride: usize,
+    _buf: *mut std::ffi::c_void,
+    _bkg: *mut std::ffi::c_void,
+    _dxpl: hdf5_sys::h5i::hid_t,
+) -> hdf5_sys::h5::herr_t {
+    use hdf5_sys::h5t::{H5T_bkg_t, H5T_cmd_t, H5Tget_size, H5Tget_tag, H5Tis_variable_str};
+    // SAFETY: libhdf5 calls this with a valid `cdata` and type ids for the call; the tag is
+    // a string libhdf5 allocates, compared and freed here
+    unsafe {
+        match (*cdata).command {
+            H5T_cmd_t::H5T_CONV_INIT => {
+                if H5Tis_variable_str(src) <= 0
+                    || H5Tget_size(src) != RAW_VLEN_SIZE
+                    || H5Tget_size(dst) != RAW_VLEN_SIZE
+                {
+                    return -1;
+                }
+                let tag = H5Tget_tag(dst);
+                if tag.is_null() {
+                    return -1;
+                }
+                let ours = std::ffi::CStr::from_ptr(tag) == RAW_VLEN_TAG;
+                hdf5_sys::h5::H5free_memory(tag.cast());
+                if !ours {
+                    return -1;
+                }
+                (*cdata).need_bkg = H5T_bkg_t::H5T_BKG_NO;
+                0
+            }
+            // same size, bytes kept: nothing to do
+            H5T_cmd_t::H5T_CONV_CONV | H5T_cmd_t::H5T_CONV_FREE => 0,
+        }
+    }
+}
+
+/// Refuses the text attribute `attr` if a heap reference stored in it does not name an
+/// object of `heaps` (the file's global heap collections, checked) whose size is the
+/// stored length: libhdf5 1.10 follows a reference as it is, and a damaged collection
+/// address or object index crashed the process (`H5HG_read`), a length shorter than the
+/// object overran the buffer sized by it. The stored bytes are read through a conversion
+/// that keeps them as they are (`keep_raw_vlen`), with no heap dereference. An attribute
+/// that is not a variable-length string is left to the typed read that follows.
+/// `Err(problem)`.
+pub fn check_heap_references(attr: &hdf5::Attribute, heaps: &HeapObjects) -> std::result::Result<(), String> {
+    use hdf5_sys::h5a::{H5Aget_type, H5Aread};
+    use hdf5_sys::h5t::{H5T_class_t, H5T_pers_t, H5Tclose, H5Tcreate, H5Tis_variable_str, H5Tregister, H5Tset_tag};
+    static REGISTERED: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    let name = attr.name();
+    let n = attr.size();
+    let raw = hdf5::sync::sync(|| -> std::result::Result<Option<Vec<u8>>, String> {
+        // SAFETY: plain calls under the library lock; every type created here is closed
+        // here; `H5Aread` writes `n` values of the 16-byte opaque type into a buffer of
+        // that size (the conversion keeps the size)
+        unsafe {
+            let ft = H5Aget_type(attr.id());
+            if ft < 0 {
+                return Err(format!("attribute `{name}`: its type cannot be read"));
+            }
+            let vlen_str = H5Tis_variable_str(ft) > 0;
+            H5Tclose(ft);
+            if !vlen_str {
+                return Ok(None);
+            }
+            let t = H5Tcreate(H5T_class_t::H5T_OPAQUE, RAW_VLEN_SIZE);
+            if t < 0 {
+                return Err("cannot create a memory type".into());
+            }
+            let r = (|| {
+                if H5Tset_tag(t, RAW_VLEN_TAG.as_ptr()) < 0 {
+                    return Err("cannot tag a memory type".to_string());
+                }
+                let registered = *REGISTERED.get_or_init(|| {
+                    let src = H5Tcopy(*hdf5::globals::H5T_C_S1);
+                    let ok = src >= 0
+                        && H5Tset_size(src, H5T_VARIABLE) >= 0
+                        && H5Tregister(
+                            H5T_pers_t::H5T_PERS_SOFT,
+                            c"flexrom_keep_raw_vlen".as_ptr(),
+                            src,
+                            t,
+                            Some(keep_raw_vlen),
+                        ) >= 0;
+                    if src >= 0 {
+                        H5Tclose(src);
+                    }
+                    ok
+                });
+                if !registered {
+                    return Err("cannot register the raw reading of texts".to_string());
+                }
+                let mut buf = vec![0u8; n * RAW_VLEN_SIZE];
+                if H5Aread(attr.id(), t, buf.as_mut_ptr().cast()) < 0 {
+                    return Err(format!("attribute `{name}`: its stored text references cannot be read"));
+                }
+                Ok(Some(buf))
+            })();
+            H5Tclose(t);
+            r
+        }
+    })?;
+    let Some(raw) = raw else { return Ok(()) };
+    for v in raw.chunks_exact(RAW_VLEN_SIZE) {
+        let len = u32::from_le_bytes(v[0..4].try_into().expect("4 bytes")) as u64;
+        let collection = u64::from_le_bytes(v[4..12].try_into().expect("8 bytes"));
+        let index = u32::from_le_bytes(v[12..16].try_into().expect("4 bytes"));
+        match heaps.get(&(collection, index)) {
+            Some(&size) if size == len => {}
+            Some(&size) => {
+                return Err(format!(
+                    "attribute `{name}` claims a text of {len} bytes where its heap object holds {size}: a damaged file"
+                ))
+            }
+            None => {
+                return Err(format!(
+                    "attribute `{name}` refers to object {index} of a global heap at address {collection}, which the file does not hold: a damaged file"
+                ))
+            }
+        }
+    }
+    Ok(())
 }
 
 /// [`check_global_heaps`] for the file of `loc`, once per file as it is on disk (path, size,
-/// modification time), before its first text is read; files open for writing are flexrom's
-/// own, in the making, and not read from disk.
-pub fn heaps_checked(loc: &hdf5::Location) -> hdf5::Result<()> {
-    static CHECKED: std::sync::Mutex<Vec<(String, u64, std::time::SystemTime)>> = std::sync::Mutex::new(Vec::new());
+/// modification time), before its first text is read: the heap objects found, or `None` for
+/// a file open for writing, flexrom's own, in the making, not read from disk.
+pub fn heaps_checked(loc: &hdf5::Location) -> hdf5::Result<Option<std::sync::Arc<HeapObjects>>> {
+    type Checked = Vec<((String, u64, std::time::SystemTime), std::sync::Arc<HeapObjects>)>;
+    static CHECKED: std::sync::Mutex<Checked> = std::sync::Mutex::new(Vec::new());
     if !loc.file()?.is_read_only() {
-        return Ok(());
+        return Ok(None);
     }
     let name = loc.filename();
-    let Ok(m) = std::fs::metadata(&name) else { return Ok(()) };
+    let m = std::fs::metadata(&name).map_err(|e| hdf5::Error::from(format!("cannot be read: {e}")))?;
     let key = (name.clone(), m.len(), m.modified().unwrap_or(std::time::UNIX_EPOCH));
-    if CHECKED.lock().unwrap_or_else(|e| e.into_inner()).contains(&key) {
-        return Ok(());
+    if let Some((_, h)) = CHECKED.lock().unwrap_or_else(|e| e.into_inner()).iter().find(|(k, _)| *k == key) {
+        return Ok(Some(h.clone()));
     }
-    check_global_heaps(Path::new(&name)).map_err(hdf5::Error::from)?;
-    CHECKED.lock().unwrap_or_else(|e| e.into_inner()).push(key);
-    Ok(())
+    let heaps = std::sync::Arc::new(check_global_heaps(Path::new(&name)).map_err(hdf5::Error::from)?);
+    CHECKED.lock().unwrap_or_else(|e| e.into_inner()).push((key, heaps.clone()));
+    Ok(Some(heaps))
 }
 
 pub fn read_attr_f64(loc: &hdf5::Location, name: &str) -> hdf5::Result<f64> {
@@ -276,9 +430,17 @@ fn show_shape(s: &[usize]) -> String {
 ///
 /// A collection is found by its signature, `GCOL`, version 1 and three zero bytes (file
 /// format, "Global Heap"); its size and each object's are 8-byte lengths, as in every file
-/// flexrom and h5py write. `Err(problem)`.
-pub fn check_global_heaps(path: &Path) -> std::result::Result<(), String> {
+/// flexrom and h5py write. A collection's address is its byte offset less the base address,
+/// taken as where the superblock's signature is (0, or 512, 1024, … after a user block).
+/// The objects found, for [`check_heap_references`]; `Err(problem)`.
+pub fn check_global_heaps(path: &Path) -> std::result::Result<HeapObjects, String> {
     let b = std::fs::read(path).map_err(|e| format!("cannot be read: {e}"))?;
+    let base = std::iter::once(0)
+        .chain((9..63).map(|k| 1usize << k))
+        .take_while(|&o| o + 8 <= b.len())
+        .find(|&o| &b[o..o + 8] == b"\x89HDF\r\n\x1a\n")
+        .unwrap_or(0);
+    let mut objects = HeapObjects::new();
     let u64_at = |i: usize| u64::from_le_bytes(b[i..i + 8].try_into().expect("8 bytes"));
     let mut from = 0;
     while let Some(k) = b[from..].windows(8).position(|w| w == b"GCOL\x01\0\0\0") {
@@ -307,10 +469,13 @@ pub fn check_global_heaps(path: &Path) -> std::result::Result<(), String> {
             if index == 0 {
                 break;
             }
+            if at >= base {
+                objects.insert(((at - base) as u64, u32::from(index)), object);
+            }
             p += need as usize;
         }
     }
-    Ok(())
+    Ok(objects)
 }
 
 /// Whether an HDF5 open failed on a lock another handle holds (HDF5's file locking).
@@ -360,6 +525,14 @@ mod tests {
         assert!(super::attr_str(&f, "nul", "a\0b").is_err());
         assert!(super::attr_str(&f, "nul\0name", "a").is_err());
         assert!(f.attr_names().unwrap().iter().all(|n| !n.starts_with("nul")));
+        // read back from disk, through the check of heap references: both writers' texts pass
+        drop(f);
+        let f = hdf5::File::open(d.path().join("a.h5")).unwrap();
+        for (i, text) in ["", "N·m (slope rows)", long.as_str()].iter().enumerate() {
+            for who in ["mine", "theirs"] {
+                assert_eq!(super::read_attr_str(&f, &format!("{who} {i} é")).unwrap(), *text, "{who} {i}");
+            }
+        }
     }
 
     /// `attr_f64` and `attr_u64` write what the crate's own builder writes: the same value,
