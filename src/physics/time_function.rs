@@ -20,6 +20,11 @@ pub enum TimeFunction {
     Ramp { amplitude: f64, duration: f64 },
     /// The first piece whose `until` is ≥ t applies; the last piece has no `until`.
     Piecewise { pieces: Vec<Piece> },
+    /// `f(t) = c₀ + c₁ t + c₂ t² + …`
+    Polynomial { coefficients: Vec<f64> },
+    /// `f(t) = Σ_k f_k(t)`: smooth starts such as the spin-up profile are sums of a
+    /// polynomial, a sine and a constant
+    Sum { terms: Vec<TimeFunction> },
 }
 
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
@@ -43,6 +48,9 @@ impl TimeFunction {
                 .find(|p| p.until.is_none_or(|u| t <= u))
                 .or(pieces.last())
                 .map_or(0.0, |p| p.function.eval(t)),
+            // Horner's rule from the highest coefficient
+            TimeFunction::Polynomial { coefficients } => coefficients.iter().rev().fold(0.0, |acc, c| acc * t + c),
+            TimeFunction::Sum { terms } => terms.iter().map(|f| f.eval(t)).sum(),
         }
     }
 
@@ -88,6 +96,21 @@ impl TimeFunction {
                 }
                 Ok(())
             }
+            TimeFunction::Polynomial { coefficients } => {
+                if coefficients.is_empty() {
+                    return Err("coefficients must not be empty (give [c0, c1, ...])".into());
+                }
+                coefficients.iter().enumerate().try_for_each(|(i, c)| finite(&format!("coefficients[{i}]"), *c))
+            }
+            TimeFunction::Sum { terms } => {
+                if terms.is_empty() {
+                    return Err("terms must not be empty".into());
+                }
+                for (i, f) in terms.iter().enumerate() {
+                    f.check().map_err(|e| format!("terms[{i}]: {e}"))?;
+                }
+                Ok(())
+            }
         }
     }
 }
@@ -113,6 +136,73 @@ mod tests {
         let (a, b) = (f.eval(0.2778), f.eval(0.2778 + 1e-12));
         assert!((a - b).abs() < 1e-2 * a.abs(), "{a} vs {b}");
         assert!((f.eval(0.1) - 10.0 * (0.3 * std::f64::consts::PI).sin()).abs() < 1e-12);
+    }
+
+    /// Simo and Vu-Quoc's spin-up profile (SPEC §6, issue's syntax), ωs = 4 rad/s, Ts = 15 s:
+    /// θ(t) = (ωs/Ts)(t²/2 + (Ts/2π)²(cos 2πt/Ts − 1)) for t ≤ Ts, then ωs(t − Ts/2), written
+    /// as a piecewise of a sum (polynomial, sine at phase π/2 for the cosine, constant) and a
+    /// polynomial; the two pieces meet with equal value and rate at Ts (θ = ωs Ts/2, θ' = ωs).
+    #[test]
+    fn the_spin_up_profile_is_written_with_polynomials_and_sums() {
+        let (ws, ts) = (4.0_f64, 15.0_f64);
+        let a = (ws / ts) * (ts / (2.0 * std::f64::consts::PI)).powi(2);
+        let text = format!(
+            r#"type = "piecewise"
+            [[pieces]]
+            until = {ts}
+            function = {{ type = "sum", terms = [
+                {{ type = "polynomial", coefficients = [0.0, 0.0, {c2}] }},
+                {{ type = "sine", amplitude = {a}, frequency = {f}, phase = {p} }},
+                {{ type = "constant", value = {m} }} ] }}
+            [[pieces]]
+            function = {{ type = "polynomial", coefficients = [{d0}, {ws}] }}"#,
+            c2 = ws / (2.0 * ts),
+            f = 1.0 / ts,
+            p = std::f64::consts::FRAC_PI_2,
+            m = -a,
+            d0 = -ws * ts / 2.0,
+        );
+        let f: TimeFunction = toml::from_str(&text).unwrap();
+        f.check().unwrap();
+        let exact = |t: f64| {
+            if t <= ts {
+                (ws / ts)
+                    * (t * t / 2.0
+                        + (ts / (2.0 * std::f64::consts::PI)).powi(2)
+                            * ((2.0 * std::f64::consts::PI * t / ts).cos() - 1.0))
+            } else {
+                ws * (t - ts / 2.0)
+            }
+        };
+        for t in [0.0, 1.0, 7.5, 14.9, 15.0, 20.0] {
+            assert!(
+                (f.eval(t) - exact(t)).abs() < 1e-12 * (1.0 + exact(t).abs()),
+                "t = {t}: {} vs {}",
+                f.eval(t),
+                exact(t)
+            );
+        }
+        let h = 1e-6;
+        let rate = |t: f64| (f.eval(t + h) - f.eval(t - h)) / (2.0 * h);
+        assert!((f.eval(ts) - ws * ts / 2.0).abs() < 1e-12 * ws * ts);
+        assert!(
+            (rate(ts - 1e-3) - ws).abs() < 1e-5 && (rate(ts + 1e-3) - ws).abs() < 1e-6,
+            "{} {}",
+            rate(ts - 1e-3),
+            rate(ts + 1e-3)
+        );
+        // and it starts at rest: θ(0) = 0, θ'(0) = 0
+        assert!(f.eval(0.0).abs() < 1e-15 && rate(1e-3).abs() < 1e-5);
+    }
+
+    #[test]
+    fn empty_polynomials_and_sums_are_refused() {
+        let p: TimeFunction = toml::from_str("type = \"polynomial\"\ncoefficients = []").unwrap();
+        assert!(p.check().unwrap_err().contains("coefficients"));
+        let s: TimeFunction = toml::from_str("type = \"sum\"\nterms = []").unwrap();
+        assert!(s.check().unwrap_err().contains("terms"));
+        let bad: TimeFunction = toml::from_str("type = \"polynomial\"\ncoefficients = [1.0, nan]").unwrap();
+        assert!(bad.check().unwrap_err().contains("coefficients[1]"));
     }
 
     #[test]
