@@ -361,8 +361,6 @@ fn run_full(model: &Model, sys: &mut FlexibleSystem, q0: Vec<f64>, s: Settings) 
     }
     let (strains, curvatures) =
         probe_sections(&probe_defs, |p| (0..nt).map(|k| sys.probe_section(p, &q.column(k).to_vec())).collect());
-    let energy =
-        energies(sys, &s.mu, t.as_slice().expect("contiguous"), |k| q.column(k).to_vec(), |k| qd.column(k).to_vec());
     Ok(SimulationResult {
         model_text: model.text.clone(),
         model_path: model.path.display().to_string(),
@@ -376,8 +374,20 @@ fn run_full(model: &Model, sys: &mut FlexibleSystem, q0: Vec<f64>, s: Settings) 
         curvatures,
         stats,
         wall_seconds,
-        energy: Some(energy),
+        // computed where they are written ([`with_energies`]): training and validation runs
+        // do not pay a pass over the elements per instant for them
+        energy: None,
     })
+}
+
+/// `r` with its energies ([`crate::analysis::energy`]), from its recorded states: what the
+/// result files and tables of `simulate` show.
+pub fn with_energies(model: &Model, mut r: SimulationResult) -> Result<SimulationResult> {
+    let mut sys = model.system(LinearSolverKind::Banded);
+    let (q, qd) = (&r.q, &r.qd);
+    let t = r.t.to_vec();
+    r.energy = Some(energies(&mut sys, &r.settings.mu, &t, |k| q.column(k).to_vec(), |k| qd.column(k).to_vec()));
+    Ok(r)
 }
 
 /// The static equilibrium under the run's loads at t = 0 (`[initial] static = true`), from

@@ -1,4 +1,4 @@
-//! The energies of a full run (`SimulationResult::energy`, src/analysis/energy.rs) against
+//! The energies of a full run (`simulate::with_energies`, src/analysis/energy.rs) against
 //! the energy balance of SPEC §6, on the shipped pendulum (data/models/pendulum.toml:
 //! gravity only, ρ∞ = 1, no damping) over its first 0.2 s, where it falls from rest:
 //!
@@ -11,7 +11,7 @@
 //!   up to 1e-9 of the energy released) and ends below the undamped run's.
 
 use flexrom::model::Model;
-use flexrom::simulate::{simulate, Overrides};
+use flexrom::simulate::{simulate, with_energies, Overrides};
 
 fn pendulum(damping: bool) -> Model {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/data/models/pendulum.toml");
@@ -25,6 +25,7 @@ fn pendulum(damping: bool) -> Model {
 /// (largest |total − total₀| / energy released, final total) of a run to 0.2 s at `dt`.
 fn drift(model: &Model, dt: f64) -> (f64, Vec<f64>) {
     let r = simulate(model, &Overrides { dt: Some(dt), t_end: Some(0.2), ..Default::default() }).unwrap();
+    let r = with_energies(model, r).unwrap();
     let e = r.energy.expect("a full run records its energies");
     assert_eq!(e.kinetic[0], 0.0, "at rest at t = 0");
     assert!(e.springs.iter().all(|&s| s == 0.0) && e.external_work.iter().all(|&w| w == 0.0), "gravity only");
@@ -49,7 +50,9 @@ fn total_energy_is_conserved_to_second_order_without_damping() {
 #[test]
 fn damping_only_dissipates() {
     let (_, free) = drift(&pendulum(false), 0.005);
-    let r = simulate(&pendulum(true), &Overrides { t_end: Some(0.2), ..Default::default() }).unwrap();
+    let damped = pendulum(true);
+    let r = with_energies(&damped, simulate(&damped, &Overrides { t_end: Some(0.2), ..Default::default() }).unwrap())
+        .unwrap();
     let e = r.energy.unwrap();
     let total = e.total();
     let released = e.gravity[0] - e.gravity[e.gravity.len() - 1];

@@ -32,7 +32,7 @@
 //!   field.
 
 use flexrom::model::Model;
-use flexrom::simulate::{simulate, Overrides, SimulationResult};
+use flexrom::simulate::{simulate, with_energies, Overrides, SimulationResult};
 use ndarray::Array2;
 use std::path::Path;
 use std::process::Command;
@@ -139,7 +139,7 @@ fn a_pendulum_with_a_tip_mass_swings_with_the_physical_pendulum_period() {
 fn a_thrown_tip_mass_pendulum_keeps_its_energy() {
     let text = tip_mass_pendulum(1.0, 0.001, 0.3)
         .replace("youngs_modulus = 2.1e13\n", "youngs_modulus = 2.1e13\nangular_velocity = 1.5\n");
-    let r = run(&text);
+    let r = with_energies(&model(&text), run(&text)).unwrap();
     let e = r.energy.as_ref().expect("a full run's energies");
     let peak = e.kinetic.iter().fold(0.0_f64, |m, v| m.max(*v));
     assert!(peak > 1.0, "kinetic peak {peak} J");

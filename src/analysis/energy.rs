@@ -65,11 +65,6 @@ pub fn strain_parts(sys: &FlexibleSystem, mu: &Parameters, q: &[f64]) -> (f64, f
     (bending, axial)
 }
 
-/// The potential of gravity `−g₀(μ)ᵀ q`: the potential energy less the strain energy.
-fn gravity(sys: &FlexibleSystem, mu: &Parameters, q: &[f64], strain: f64) -> f64 {
-    sys.potential_energy(mu, q) - strain
-}
-
 /// `Q_ext(q, t)ᵀ q̇` of the forces and moments (not gravity).
 fn load_power(sys: &FlexibleSystem, mu: &Parameters, q: &[f64], v: &[f64], t: f64) -> f64 {
     let dofs = sys.load_dofs();
@@ -104,16 +99,18 @@ pub fn energies(
         external_work: Array1::zeros(nt),
     };
     let mut last_power = 0.0;
+    // gravity's potential −g₀(μ)ᵀ q: its gradient is constant, taken once
+    let weight = sys.gravity_potential_gradient(mu);
+    let mut mv = vec![0.0; weight.len()];
     for k in 0..nt {
         let (qk, vk) = (q(k), v(k));
-        let mut mv = vec![0.0; qk.len()];
         sys.mass_mul(&vk, &mut mv);
         out.kinetic[k] = 0.5 * vk.iter().zip(&mv).map(|(a, b)| a * b).sum::<f64>();
         let (b, a) = strain_parts(sys, mu, &qk);
         out.strain_bending[k] = b;
         out.strain_axial[k] = a;
         out.strain[k] = a + b;
-        out.gravity[k] = gravity(sys, mu, &qk, a + b);
+        out.gravity[k] = weight.iter().zip(&qk).map(|(g, q)| g * q).sum();
         let power = load_power(sys, mu, &qk, &vk, t[k]);
         if k > 0 {
             out.external_work[k] = out.external_work[k - 1] + 0.5 * (t[k] - t[k - 1]) * (power + last_power);

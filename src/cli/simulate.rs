@@ -8,7 +8,7 @@ use flexrom::limits::Limits;
 use flexrom::linalg::kkt::LinearSolverKind;
 use flexrom::model::Model;
 use flexrom::output::info;
-use flexrom::simulate::{simulate, Overrides, Settings};
+use flexrom::simulate::{simulate, with_energies, Overrides, Settings};
 use flexrom::solver::parameters::Parameters;
 use std::path::PathBuf;
 
@@ -38,7 +38,9 @@ impl Args {
         let mu = overrides.mu.clone().unwrap_or_default();
         super::warn(model.load_scale_warning(std::iter::once(mu.scale())).as_slice());
         super::warn(&model.property_warnings([&mu]));
-        let compute = || simulate(&model, &overrides).map_err(|e| e.at_stage("simulate", &mu));
+        let compute = || {
+            simulate(&model, &overrides).and_then(|r| with_energies(&model, r)).map_err(|e| e.at_stage("simulate", &mu))
+        };
         let r = match &output {
             // the result file's fixed part is written on a second thread while the run computes
             Some(output) => {

@@ -314,6 +314,14 @@ impl FlexibleSystem {
         0.5 * v.iter().zip(&mv).map(|(a, b)| a * b).sum::<f64>()
     }
 
+    /// The gradient of gravity's potential at `mu`, `−g₀(μ)` (the weight, point masses'
+    /// included, with a minus sign): gravity's potential energy at `q` is its dot with `q`.
+    pub fn gravity_potential_gradient(&self, mu: &Parameters) -> Vec<f64> {
+        let mut g = vec![0.0; self.n_dof];
+        self.gravity_into(mu, &mut g);
+        g
+    }
+
     /// Potential energy at the parameters `mu`: strain energy plus that of the (constant)
     /// gravity loads.
     pub fn potential_energy(&self, mu: &Parameters, q: &[f64]) -> f64 {
