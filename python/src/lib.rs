@@ -282,7 +282,10 @@ impl PyModel {
         warn(py, &warnings)?;
         let overrides = Overrides { dt, t_end, rho_inf, mu, ..Default::default() };
         let r = interruptible(py, || {
-            flexrom::simulate::simulate(model, &overrides).map_err(|e| e.at_stage("simulate", &shown))
+            // with its energies, as `simulate`'s result file (to_hdf5 writes that layout)
+            flexrom::simulate::simulate(model, &overrides)
+                .and_then(|r| flexrom::simulate::with_energies(model, r))
+                .map_err(|e| e.at_stage("simulate", &shown))
         })?;
         Ok(PyRunResult {
             model: Arc::clone(model),
