@@ -323,6 +323,37 @@ pub fn simulate(model: &Model, overrides: &Overrides) -> Result<SimulationResult
     run_full(model, &mut sys, q0, s)
 }
 
+/// Warns about each prescribed motion whose rate at t = 0 the bodies' initial velocities do
+/// not have (`B q̇₀ ≠ ḃ − Ḃ q₀`, a drive started at speed from rest): the first step
+/// absorbs the jump, with a spike in the accelerations and the joint forces.
+fn warn_on_drive_jumps(model: &Model, sys: &FlexibleSystem, mu: &Parameters, q0: &[f64], v0: &[f64]) {
+    if !sys.has_moving_constraints() {
+        return;
+    }
+    let nc = ParametricModel::n_constraints(sys);
+    let (mut want, mut bv, mut b0) = (vec![0.0; nc], vec![0.0; nc], vec![0.0; nc]);
+    sys.constraint_velocity_rhs(mu, q0, 0.0, &mut want);
+    // B v₀ as the residual at v₀ less the residual at 0
+    sys.constraint_residual(mu, v0, 0.0, &mut bv);
+    sys.constraint_residual(mu, &vec![0.0; q0.len()], 0.0, &mut b0);
+    let first = |(b, k): crate::physics::system::NodeId| 4 * sys.node_index(b, k);
+    let rows = crate::physics::joints::lower(model.joints(), &first);
+    let speed = v0.iter().chain(&want).fold(0.0_f64, |m, v| m.max(v.abs()));
+    for (c, (j, row)) in rows.iter().enumerate() {
+        let jump = want[c] - (bv[c] - b0[c]);
+        if row.motion.is_some() && jump.abs() > 1e-9 * speed {
+            let joint = model.joints()[*j].describe(&|(b, k)| format!("{} node {k}", model.file.bodies[b].name));
+            log::warn!(
+                "joints[{j}] ({joint}) starts at a rate the bodies do not have at t = 0 ({} off by {jump:.3e} {}/s): \
+                 the first step absorbs the jump, with a spike in the accelerations and the joint forces; start the \
+                 drive at rest (a smooth profile such as the spin-up's) or give the bodies its initial velocity",
+                row.component,
+                row.kind.residual_unit()
+            );
+        }
+    }
+}
+
 fn run_full(model: &Model, sys: &mut FlexibleSystem, q0: Vec<f64>, s: Settings) -> Result<SimulationResult> {
     model.check_full_run_memory(s.n_steps, s.solver == LinearSolverKind::Dense)?;
     let q0 = if model.file.initial.as_ref().is_some_and(|i| i.r#static) { static_start(sys, q0, &s)? } else { q0 };
@@ -338,6 +369,7 @@ fn run_full(model: &Model, sys: &mut FlexibleSystem, q0: Vec<f64>, s: Settings) 
     let probe_defs = sys.probes.clone();
     let start = std::time::Instant::now();
     let v0 = sys.initial_velocity(&q0);
+    warn_on_drive_jumps(model, sys, &s.mu, &q0, &v0);
     // the probes are evaluated after the loop, from the stored coordinates
     let stats = solve(
         sys,

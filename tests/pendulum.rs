@@ -91,7 +91,7 @@ fn every_step_satisfies_the_equations_of_motion() {
         let mut mq = vec![0.0; n];
         check.force(mu, &st.q, &st.v, st.t, &mut r);
         check.mass_mul(&st.qdd, &mut mq);
-        check.add_constraint_force(&st.lambda, &mut r);
+        check.add_constraint_force(mu, &st.lambda, st.t, &mut r);
         for i in 0..n {
             worst = worst.max((r[i] + mq[i]).abs());
         }

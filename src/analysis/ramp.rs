@@ -97,11 +97,11 @@ impl DynamicModel for Ramped<'_> {
     }
 
     fn constraint_residual(&self, q: &[f64], t: f64, out: &mut [f64]) {
-        self.sys.constraint_residual(q, t, out)
+        self.sys.constraint_residual(&self.mu, q, t, out)
     }
 
-    fn add_constraint_force(&self, lambda: &[f64], out: &mut [f64]) {
-        self.sys.add_constraint_force(lambda, out)
+    fn add_constraint_force(&self, lambda: &[f64], t: f64, out: &mut [f64]) {
+        self.sys.add_constraint_force(&self.mu, lambda, t, out)
     }
 
     /// `c_k K_s(q) + c_m M` (statics asks for `c_k = 1`, `c_m = 0`); the constraint rows are
@@ -117,6 +117,7 @@ impl DynamicModel for Ramped<'_> {
             }
         }
         let scale = diagonal_scale(&blocks);
+        self.sys.set_moving_rows(&self.mu, t, &mut *self.kkt);
         self.kkt.factor(&blocks, scale)?;
         Ok(scale)
     }

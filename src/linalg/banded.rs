@@ -173,6 +173,9 @@ impl KktSolver for BandedKkt {
         let (ab, n, band, ldab, ipiv, ubw) = (&self.ab, self.n, self.band, self.ldab, &self.ipiv, self.ubw);
         solve_permuted(&self.new_of, &mut self.work, rhs, |w| band_lu_solve(ab, n, band, ldab, ipiv, ubw, w))
     }
+    fn set_constraint_row(&mut self, c: usize, coefs: &[f64]) {
+        self.slots.set_row(c, coefs);
+    }
 }
 
 /// Threshold for row interchanges: keep the diagonal pivot unless it is smaller than this

@@ -53,6 +53,8 @@ pub struct BandedLdlt {
     elem_start: Vec<usize>,
     /// per constraint entry: (slot, coefficient)
     cons: Vec<(usize, f64)>,
+    /// where each constraint row's entries start in `cons`
+    row_offsets: Vec<usize>,
     /// whether each new row is a coordinate (true) or a constraint row
     is_dof: Vec<bool>,
     work: Vec<f64>,
@@ -130,6 +132,7 @@ impl BandedLdlt {
             elem,
             elem_start,
             cons,
+            row_offsets: pattern.row_offsets(),
             is_dof,
             work: vec![0.0; n],
             diag: vec![0.0; n],
@@ -245,6 +248,15 @@ impl KktSolver for BandedLdlt {
         }
         let (ab, n, band) = (&self.ab, self.n, self.band);
         solve_permuted(&self.new_of, &mut self.work, rhs, |w| band_ldlt_solve(ab, n, band, w))
+    }
+
+    fn set_constraint_row(&mut self, c: usize, coefs: &[f64]) {
+        let start = self.row_offsets[c];
+        self.cons[start..start + coefs.len()].iter_mut().zip(coefs).for_each(|(e, &k)| e.1 = k);
+        self.pattern.set_row(c, coefs);
+        if let Some(lu) = self.fallback.as_mut() {
+            lu.set_constraint_row(c, coefs);
+        }
     }
 }
 

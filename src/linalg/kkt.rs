@@ -114,6 +114,11 @@ impl KktSolver for SparseKkt {
         Ok(())
     }
 
+    fn set_constraint_row(&mut self, c: usize, coefs: &[f64]) {
+        self.pattern.set_row(c, coefs);
+        self.slots.set_row(c, coefs);
+    }
+
     fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {
         if !self.factored {
             return Err("solve called without a valid factorization".into());
@@ -167,6 +172,10 @@ impl KktSolver for DenseKkt {
 
     fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {
         dense_lu_solve(self.lu.as_ref(), rhs)
+    }
+
+    fn set_constraint_row(&mut self, c: usize, coefs: &[f64]) {
+        self.pattern.set_row(c, coefs);
     }
 }
 
@@ -241,6 +250,46 @@ mod tests {
         for i in 0..15 {
             let ax: f64 = (0..15).map(|j| a[i][j] * x1[j]).sum();
             assert!((ax - rhs[i]).abs() < 1e-12);
+        }
+    }
+
+    /// A row whose coefficients move (a driven angle's (−sin θ, cos θ)): every solver, built
+    /// with the row at θ = 0 and then set to θ = 0.7, solves as a dense solver built with the
+    /// row at 0.7 does (same matrix: agreement to round-off, 1e-12).
+    #[test]
+    fn a_row_set_after_building_solves_as_one_built_with_it() {
+        let row = |th: f64| vec![(2, -th.sin()), (3, th.cos())];
+        let pattern = |th: f64| KktPattern {
+            n_dof: 12,
+            element_dofs: vec![[0, 1, 2, 3, 4, 5, 6, 7], [4, 5, 6, 7, 8, 9, 10, 11]],
+            constraint_rows: vec![vec![(0, 1.0)], vec![(1, 1.0)], row(th)],
+        };
+        let blocks: Vec<Block> = (0..2)
+            .map(|e| {
+                let r = Block::from_fn(|i, j| ((i * 5 + j * 3 + e) % 7) as f64 * 0.1);
+                r * r.transpose() + Block::identity() * 2.0
+            })
+            .collect();
+        let rhs: Vec<f64> = (0..15).map(|i| (i as f64 * 0.61).cos()).collect();
+        let mut reference = DenseKkt::new(pattern(0.7));
+        reference.factor(&blocks, 2.0).unwrap();
+        let mut want = rhs.clone();
+        reference.solve(&mut want).unwrap();
+        let solvers: Vec<Box<dyn KktSolver>> = vec![
+            Box::new(SparseKkt::new(pattern(0.0))),
+            Box::new(DenseKkt::new(pattern(0.0))),
+            Box::new(super::super::banded::BandedKkt::new(pattern(0.0))),
+            Box::new(super::super::banded_ldlt::BandedLdlt::new(pattern(0.0))),
+        ];
+        let coefs: Vec<f64> = row(0.7).iter().map(|t| t.1).collect();
+        for mut s in solvers {
+            s.set_constraint_row(2, &coefs);
+            s.factor(&blocks, 2.0).unwrap();
+            let mut x = rhs.clone();
+            s.solve(&mut x).unwrap();
+            for i in 0..15 {
+                assert!((x[i] - want[i]).abs() < 1e-12, "{i}: {} vs {}", x[i], want[i]);
+            }
         }
     }
 }

@@ -18,6 +18,26 @@ impl KktPattern {
     pub fn size(&self) -> usize {
         self.n_dof + self.constraint_rows.len()
     }
+
+    /// Where each constraint row's entries start in a list of all rows' entries in order.
+    pub(crate) fn row_offsets(&self) -> Vec<usize> {
+        let mut start = 0;
+        self.constraint_rows
+            .iter()
+            .map(|row| {
+                let s = start;
+                start += row.len();
+                s
+            })
+            .collect()
+    }
+
+    /// Sets row `c`'s coefficients (its coordinates unchanged), in the order of its terms.
+    pub(crate) fn set_row(&mut self, c: usize, coefs: &[f64]) {
+        let row = &mut self.constraint_rows[c];
+        debug_assert_eq!(row.len(), coefs.len());
+        row.iter_mut().zip(coefs).for_each(|(term, &k)| term.1 = k);
+    }
 }
 
 /// Which linear solver the full-order model uses.
@@ -44,6 +64,8 @@ pub(crate) struct SlotMap {
     elem: Vec<usize>,
     /// per constraint entry: the slots of (row c, dof) and (dof, row c), and the coefficient
     cons: Vec<(usize, usize, f64)>,
+    /// where each row's entries start in `cons`
+    row_offsets: Vec<usize>,
 }
 
 impl SlotMap {
@@ -64,7 +86,13 @@ impl SlotMap {
                 cons.push((slot(nd + c, dof), slot(dof, nd + c), coef));
             }
         }
-        SlotMap { elem, cons }
+        SlotMap { elem, cons, row_offsets: pattern.row_offsets() }
+    }
+
+    /// Sets constraint row `c`'s coefficients ([`KktPattern::set_row`]).
+    pub(crate) fn set_row(&mut self, c: usize, coefs: &[f64]) {
+        let start = self.row_offsets[c];
+        self.cons[start..start + coefs.len()].iter_mut().zip(coefs).for_each(|(e, &k)| e.2 = k);
     }
 
     /// Adds the blocks and `scale ×` the constraint entries into `values` (zeroed first).
@@ -94,4 +122,7 @@ pub trait KktSolver: Send + Sync {
     }
     /// Solves in place with the last factorization; `rhs` has `n_dof + n_c` entries.
     fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String>;
+    /// Sets constraint row `c`'s coefficients for the next factorization, its coordinates
+    /// unchanged (rows that move with time, `B(t)`): the pattern and ordering stay.
+    fn set_constraint_row(&mut self, c: usize, coefs: &[f64]);
 }

@@ -7,10 +7,11 @@ use super::toml_errors::entry_line;
 use super::Model;
 use crate::error::Result;
 use crate::physics::element::Section;
-use crate::physics::joints::{Clamp, GroundPin, Joint, Pin, Slider, Weld};
+use crate::physics::joints::{Clamp, Drive, DrivenAngle, DrivenPoint, GroundPin, Joint, Pin, Slider, Weld};
 use crate::physics::loads::{Force, Gravity, Load, Moment};
 use crate::physics::masses::PointMass;
 use crate::physics::system::{BeamBody, NodeId, Probe};
+use crate::physics::time_function::TimeFunction;
 use crate::solver::generalized_alpha::{IntegratorParams, JacobianReuse, Predictor};
 use crate::solver::parameters::{Scaling, LOAD_SCALE};
 
@@ -244,6 +245,19 @@ impl Model {
                     }
                     Joint::Weld(Weld { a: ia, b: ib, angle: self.bodies[ib.0].angle - self.bodies[ia.0].angle })
                 }
+                JointSpec::DrivenAngle { body, node, function, scaled } => {
+                    let id = self.node_id(&p("body"), &p("node"), body, node)?;
+                    let drive = self.drive(&p("function"), Some(function), &p("scaled"), scaled)?;
+                    Joint::DrivenAngle(DrivenAngle { node: id, theta0: self.bodies[id.0].angle, drive })
+                }
+                JointSpec::DrivenPoint { body, node, x, y, scaled } => {
+                    let id = self.node_id(&p("body"), &p("node"), body, node)?;
+                    let path = [
+                        self.drive(&p("x"), x.as_ref(), &p("scaled"), scaled)?,
+                        self.drive(&p("y"), y.as_ref(), &p("scaled"), scaled)?,
+                    ];
+                    Joint::DrivenPoint(DrivenPoint { node: id, point: node_pos(id, &self.bodies), path })
+                }
             };
             self.joints.push(joint);
         }
@@ -414,7 +428,8 @@ impl Model {
         }
         let g = |(b, k): NodeId| first[b] + 4 * k;
         for (j, joint) in self.joints.iter().enumerate() {
-            for row in joint.kind().rows(&g) {
+            // a prescribed motion sets its own rate (its factor is a run's: checked when it starts)
+            for row in joint.kind().rows(&g).into_iter().filter(|r| r.motion.is_none()) {
                 let rate: f64 = row.terms.iter().map(|&(d, c)| c * v0[d]).sum();
                 if rate.abs() > 1e-9 * speed {
                     let field = match entry_line(&self.text, "joints", j) {
@@ -447,6 +462,8 @@ impl Model {
             JointSpec::Pin { a, b } => format!("pin `{}` {} – `{}` {}", a.body, node(&a.node), b.body, node(&b.node)),
             JointSpec::Slider { body, node: n, .. } => format!("slider on `{body}` {}", node(n)),
             JointSpec::Weld { a, b } => format!("weld `{}` {} – `{}` {}", a.body, node(&a.node), b.body, node(&b.node)),
+            JointSpec::DrivenAngle { body, node: n, .. } => format!("driven_angle on `{body}` {}", node(n)),
+            JointSpec::DrivenPoint { body, node: n, .. } => format!("driven_point on `{body}` {}", node(n)),
         }
     }
 
@@ -585,6 +602,29 @@ impl Model {
 
     /// `scaled = true | false | "name"`; a name is a parameter's: letters, digits and `_`,
     /// not starting with a digit (it becomes `--param name=…` and an HDF5 attribute).
+    /// A prescribed motion's function (none: 0) checked, and starting at 0: the model's
+    /// initial configuration is where every drive starts.
+    fn drive(
+        &self,
+        field: &str,
+        function: Option<&TimeFunction>,
+        scaled_field: &str,
+        scaled: &ScaledSpec,
+    ) -> Result<Drive> {
+        let function = function.cloned().unwrap_or(TimeFunction::Constant { value: 0.0 });
+        function.check().map_err(|e| self.err(field, e))?;
+        let start = function.eval(0.0);
+        if start != 0.0 {
+            return Err(self.err(
+                field,
+                format!(
+                    "is {start} at t = 0; a prescribed motion starts where the model places the node (shift the function so that it starts at 0)"
+                ),
+            ));
+        }
+        Ok(Drive { function, scaled: self.scaling(scaled_field, scaled)? })
+    }
+
     fn scaling(&self, field: &str, spec: &ScaledSpec) -> Result<Scaling> {
         match spec {
             ScaledSpec::Flag(false) => Ok(Scaling::Fixed),

@@ -114,13 +114,14 @@ impl Model {
         Sha256::digest(json.as_bytes()).iter().map(|b| format!("{b:02x}")).collect()
     }
 
-    /// The model's parameters, each once: those its loads are scaled by (`scaled = true` is
-    /// [`crate::solver::parameters::LOAD_SCALE`]) in the order of the loads, then the
+    /// The model's parameters, each once: those its loads and then its drives are scaled by
+    /// (`scaled = true` is [`crate::solver::parameters::LOAD_SCALE`]) in file order, then the
     /// bodies' Young's moduli that are parameters, in the order of the bodies.
     pub fn parameter_names(&self) -> Vec<&str> {
         let mut names: Vec<&str> = Vec::new();
-        for l in &self.loads {
-            if let Some(name) = l.scaling().parameter() {
+        let drives = self.joints.iter().filter_map(|j| j.kind().drive_scaling());
+        for scaling in self.loads.iter().map(|l| l.scaling()).chain(drives) {
+            if let Some(name) = scaling.parameter() {
                 if !names.contains(&name) {
                     names.push(name);
                 }

@@ -232,6 +232,27 @@ pub enum JointSpec {
     },
     /// two bodies' nodes rigidly joined: the same position, slopes at their initial angle
     Weld { a: NodeSpec, b: NodeSpec },
+    /// the node's slope turns by `function(t)` rad from its initial direction (a motor by
+    /// angle with a ground pin at the node); `scaled` as for loads
+    DrivenAngle {
+        body: String,
+        node: NodeRef,
+        function: TimeFunction,
+        #[serde(default = "yes")]
+        scaled: ScaledSpec,
+    },
+    /// the node's position is its initial position plus `(x(t), y(t))`, m; a missing
+    /// component stays 0; `scaled` as for loads
+    DrivenPoint {
+        body: String,
+        node: NodeRef,
+        #[serde(default)]
+        x: Option<TimeFunction>,
+        #[serde(default)]
+        y: Option<TimeFunction>,
+        #[serde(default = "yes")]
+        scaled: ScaledSpec,
+    },
 }
 
 /// `scaled` of a load: `true` (times the load scale), `false` (fixed), or the name of the

@@ -6,7 +6,7 @@
 //! Coordinates: node `k` (numbered body after body) owns `q[4k..4k+4] = (x, y, x', y')`.
 
 use super::element::{BeamElement, Mat8, Vec8};
-use super::joints::lower;
+use super::joints::{lower, Row};
 use super::loads::{assemble_weight, Gravity, Load, NodalLoad, Weight};
 use super::masses::PointMass;
 use crate::linalg::kkt::{make_solver, KktPattern, KktSolver, LinearSolverKind};
@@ -16,6 +16,9 @@ pub use super::joints::Joint;
 pub use super::parts::{BeamBody, Constraint, NodeId, Probe, Rayleigh};
 
 mod models;
+
+/// The most terms a moving row has (a turning slope row: two).
+const MOVING_TERMS: usize = 2;
 
 pub struct FlexibleSystem {
     pub bodies: Vec<BeamBody>,
@@ -28,7 +31,11 @@ pub struct FlexibleSystem {
     /// one element prototype per body at the parameters of the last evaluation (the
     /// bodies' Young's moduli and densities)
     bound: Vec<BeamElement>,
+    /// every constraint row's coefficients and right-hand side at the start (t = 0, where
+    /// a prescribed motion has not moved: the model checks its functions start at 0)
     pub constraints: Vec<Constraint>,
+    /// the rows that move with time, each with its index in `constraints`
+    moving: Vec<(usize, Row)>,
     pub probes: Vec<Probe>,
     damping: Rayleigh,
     /// the weight of the bodies, in parts by what multiplies it ([`super::loads::Gravity`])
@@ -82,8 +89,11 @@ impl FlexibleSystem {
         let gnode = |(b, k): NodeId| first_node[b] + k;
 
         let first = |id: NodeId| 4 * gnode(id);
+        let rows: Vec<Row> = lower(joints, &first).into_iter().map(|(_, row)| row).collect();
         let constraints: Vec<Constraint> =
-            lower(joints, &first).into_iter().map(|(_, row)| Constraint { terms: row.terms, rhs: row.rhs }).collect();
+            rows.iter().map(|row| Constraint { terms: row.terms.clone(), rhs: row.rhs }).collect();
+        let moving: Vec<(usize, Row)> = rows.into_iter().enumerate().filter(|(_, r)| r.motion.is_some()).collect();
+        debug_assert!(moving.iter().all(|(_, r)| r.terms.len() <= MOVING_TERMS));
 
         let gravities: Vec<&Gravity> =
             loads.iter().filter_map(|l| if let Load::Gravity(g) = l { Some(g) } else { None }).collect();
@@ -115,6 +125,7 @@ impl FlexibleSystem {
             elements,
             prototypes: prototypes.clone(),
             constraints,
+            moving,
             probes,
             damping,
             weight,
@@ -245,7 +256,7 @@ impl FlexibleSystem {
         use nalgebra::{DMatrix, DVector};
         let (n, nb, nc) = (self.n_dof, self.bodies.len(), self.constraints.len());
         let mut res = vec![0.0; nc];
-        self.constraint_residual(q, 0.0, &mut res);
+        self.initial_constraint_residual(q, &mut res);
         let mut change = 0.0_f64;
         if res.iter().any(|r| *r != 0.0) {
             // ∂q_d/∂(t_x, t_y, θ̂) with θ = θ̂/L: all three in metres
@@ -284,9 +295,14 @@ impl FlexibleSystem {
             }
         }
         self.blocks.iter_mut().for_each(|b| *b = Mat8::identity());
+        // the rows at the start (a run leaves the moving ones at its last time)
+        for (c, _) in &self.moving {
+            let coefs: Vec<f64> = self.constraints[*c].terms.iter().map(|t| t.1).collect();
+            self.kkt.set_constraint_row(*c, &coefs);
+        }
         self.kkt.factor(&self.blocks, 1.0)?;
         let mut rhs = vec![0.0; n + nc];
-        self.constraint_residual(q, 0.0, &mut rhs[n..]);
+        self.initial_constraint_residual(q, &mut rhs[n..]);
         rhs[n..].iter_mut().for_each(|r| *r = -*r);
         self.kkt.solve(&mut rhs)?;
         for i in 0..n {
@@ -294,6 +310,32 @@ impl FlexibleSystem {
             change = change.max(rhs[i].abs());
         }
         Ok(change)
+    }
+
+    /// `out = B(0) q − b(0)`, the rows where every prescribed motion starts.
+    fn initial_constraint_residual(&self, q: &[f64], out: &mut [f64]) {
+        for (o, c) in out.iter_mut().zip(&self.constraints) {
+            *o = c.terms.iter().map(|&(d, k)| k * q[d]).sum::<f64>() - c.rhs;
+        }
+    }
+
+    /// Moving row `k`'s `order`-th time derivative at μ and `t` ([`row_at`]).
+    fn moving_row(&self, mu: &Parameters, k: usize, t: f64, order: u32) -> ([f64; MOVING_TERMS], f64) {
+        row_at(&self.moving[k].1, mu, t, order)
+    }
+
+    /// Sets the moving rows of a KKT solver built on this system's pattern to their
+    /// coefficients at μ and `t` (the others never change).
+    pub fn set_moving_rows(&self, mu: &Parameters, t: f64, kkt: &mut dyn KktSolver) {
+        for (c, row) in &self.moving {
+            let (b, _) = row_at(row, mu, t, 0);
+            kkt.set_constraint_row(*c, &b[..row.terms.len()]);
+        }
+    }
+
+    /// Whether any constraint row moves with time.
+    pub fn has_moving_constraints(&self) -> bool {
+        !self.moving.is_empty()
     }
 
     /// Position of a probe.
@@ -474,6 +516,15 @@ impl FlexibleSystem {
 /// The element whose 8 consecutive dofs hold every one of `dofs`, and its first dof: the one
 /// that starts at the lowest node, or the last of its body (the block a nodal load's
 /// Jacobian is added to). A load whose coordinates span two elements has no such block.
+/// A moving row's `order`-th time derivative at μ and `t` ([`Row::at`] with its drive's
+/// factor at μ): its coefficients (the first `terms.len()` entries) and right-hand side.
+fn row_at(row: &Row, mu: &Parameters, t: f64, order: u32) -> ([f64; MOVING_TERMS], f64) {
+    let s = row.scaling().map_or(1.0, |sc| mu.factor(sc));
+    let mut b = [0.0; MOVING_TERMS];
+    let rhs = row.at(s, t, order, &mut b[..row.terms.len()]);
+    (b, rhs)
+}
+
 fn block_holding(elements: &[(usize, [usize; 8])], dofs: &[usize]) -> (usize, usize) {
     let (lo, hi) = (dofs.iter().min().copied().unwrap_or(0), dofs.iter().max().copied().unwrap_or(0));
     let node_start = 4 * (lo / 4);

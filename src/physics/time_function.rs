@@ -54,6 +54,48 @@ impl TimeFunction {
         }
     }
 
+    /// The `order`-th time derivative `f⁽ᵏ⁾(t)` (`order` 0 is [`Self::eval`]), in closed form:
+    /// what a prescribed motion's velocity and acceleration levels need. A ramp's kink and a
+    /// piecewise function's switch take the derivative of the piece that applies at `t` (the
+    /// left one at the switch, as [`Self::eval`] does).
+    pub fn derivative(&self, t: f64, order: u32) -> f64 {
+        if order == 0 {
+            return self.eval(t);
+        }
+        let tau = 2.0 * std::f64::consts::PI;
+        match self {
+            TimeFunction::Constant { .. } => 0.0,
+            TimeFunction::Sine { amplitude, frequency, phase } => {
+                // each derivative multiplies by ω and advances the phase by π/2
+                let w = tau * frequency;
+                let turn = f64::from(order) * std::f64::consts::FRAC_PI_2;
+                amplitude * w.powi(order as i32) * (w * t + phase + turn).sin()
+            }
+            TimeFunction::Exponential { amplitude, rate } => amplitude * rate.powi(order as i32) * (rate * t).exp(),
+            TimeFunction::Ramp { amplitude, duration } => {
+                if order == 1 && t < *duration {
+                    amplitude / duration
+                } else {
+                    0.0
+                }
+            }
+            TimeFunction::Piecewise { pieces } => pieces
+                .iter()
+                .find(|p| p.until.is_none_or(|u| t <= u))
+                .or(pieces.last())
+                .map_or(0.0, |p| p.function.derivative(t, order)),
+            TimeFunction::Polynomial { coefficients } => {
+                // the derivative's coefficients k!/(k − order)! c_k, then Horner's rule
+                let k0 = order as usize;
+                coefficients.iter().enumerate().skip(k0).rev().fold(0.0, |acc, (k, c)| {
+                    let falling: f64 = (k + 1 - k0..=k).map(|j| j as f64).product();
+                    acc * t + falling * c
+                })
+            }
+            TimeFunction::Sum { terms } => terms.iter().map(|f| f.derivative(t, order)).sum(),
+        }
+    }
+
     /// Checks that every number is finite and the pieces are ordered; returns the problem.
     pub fn check(&self) -> Result<(), String> {
         let finite =
@@ -193,6 +235,38 @@ mod tests {
         );
         // and it starts at rest: θ(0) = 0, θ'(0) = 0
         assert!(f.eval(0.0).abs() < 1e-15 && rate(1e-3).abs() < 1e-5);
+    }
+
+    /// Every kind's first and second derivatives against central differences of `eval`
+    /// (step 1e-4: truncation O(h²) ≈ 1e-8 relative, round-off ≈ 1e-16/h² ≈ 1e-8 on the
+    /// second; bounds 1e-6 and 1e-4 relative to the function's scale), away from kinks.
+    #[test]
+    fn derivatives_match_finite_differences() {
+        let fs: Vec<TimeFunction> = [
+            "type = \"constant\"\nvalue = 2.0",
+            "type = \"sine\"\namplitude = 0.3\nfrequency = 1.7\nphase = 0.4",
+            "type = \"exponential\"\namplitude = 2.0\nrate = -1.3",
+            "type = \"ramp\"\namplitude = 3.0\nduration = 2.0",
+            "type = \"polynomial\"\ncoefficients = [1.0, -2.0, 0.5, 0.25]",
+            "type = \"sum\"\nterms = [{ type = \"polynomial\", coefficients = [0.0, 150.0] }, \
+             { type = \"sine\", amplitude = 1.0, frequency = 0.5 }]",
+        ]
+        .iter()
+        .map(|s| toml::from_str(s).unwrap())
+        .collect();
+        let h = 1e-4;
+        for f in &fs {
+            for t in [0.3, 1.1, 2.7] {
+                let d1 = (f.eval(t + h) - f.eval(t - h)) / (2.0 * h);
+                let d2 = (f.eval(t + h) - 2.0 * f.eval(t) + f.eval(t - h)) / (h * h);
+                let scale = 1.0 + f.eval(t).abs() + f.derivative(t, 1).abs() + f.derivative(t, 2).abs();
+                assert!((f.derivative(t, 1) - d1).abs() < 1e-6 * scale, "{f:?} at {t}: {} vs {d1}", f.derivative(t, 1));
+                assert!((f.derivative(t, 2) - d2).abs() < 1e-4 * scale, "{f:?} at {t}: {} vs {d2}", f.derivative(t, 2));
+            }
+        }
+        // p = 1 − 2t + t²/2 + t³/4 at t = 2: p' = −2 + t + 3t²/4 = 3, p'' = 1 + 3t/2 = 4, p''' = 3/2
+        let p = &fs[4];
+        assert_eq!((p.derivative(2.0, 1), p.derivative(2.0, 2), p.derivative(2.0, 3)), (3.0, 4.0, 1.5));
     }
 
     #[test]

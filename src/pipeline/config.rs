@@ -185,6 +185,16 @@ impl Pipeline {
             }
             _ => {}
         }
+        if self.has_drives() && self.variant() != Variant::ConstraintPreserving {
+            return bad(
+                "reduction.variant",
+                format!(
+                    "is {}, but the model prescribes motions (driven_angle or driven_point joints), whose rows move \
+                     with time: only the constraint-preserving variant keeps them exact",
+                    self.variant().name()
+                ),
+            );
+        }
         if self.blocks().is_some() && matches!(self.variant(), Variant::WholeSystem | Variant::WholeSystemStabilized) {
             return bad(
                 "reduction.blocks",
@@ -378,13 +388,21 @@ impl Pipeline {
     }
 
     /// The reduction variant: the file's, or constraint-preserving when the model has
-    /// joints between bodies, galerkin when it has none or only ground joints.
+    /// joints between bodies or prescribed motions, galerkin when it has none or only
+    /// ground joints.
     pub fn variant(&self) -> Variant {
-        self.file.reduction.variant.unwrap_or(if self.model.joints().iter().any(|j| j.kind().couples_bodies()) {
+        let joints = self.model.joints();
+        let keeps_joints = joints.iter().any(|j| j.kind().couples_bodies() || j.kind().drive_scaling().is_some());
+        self.file.reduction.variant.unwrap_or(if keeps_joints {
             Variant::ConstraintPreserving
         } else {
             Variant::Galerkin
         })
+    }
+
+    /// Whether the model prescribes a motion (a driven joint).
+    fn has_drives(&self) -> bool {
+        self.model.joints().iter().any(|j| j.kind().drive_scaling().is_some())
     }
 
     /// The block split: the file's; with `train.greedy` and none given, one block per body

@@ -271,7 +271,7 @@ pub fn compare(
     let mut res = vec![0.0; sys.n_constraints()];
     let mut viol = 0.0_f64;
     for k in 0..r.q.ncols() {
-        sys.constraint_residual(&r.q.column(k).to_vec(), r.t[k], &mut res);
+        sys.constraint_residual(&r.settings.mu, &r.q.column(k).to_vec(), r.t[k], &mut res);
         viol = res.iter().fold(viol, |m, v| m.max(v.abs()));
     }
     Validation {

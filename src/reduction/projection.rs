@@ -24,6 +24,7 @@
 //! `λ = w V_λ q` and the projected saddle point adds `Vᵀ Bᵀ λ + w V_λᵀ (B x − b)`, i.e.
 //! `(P + Pᵀ) q + c₀` with `P = w V_λᵀ B V`, `c₀ = w V_λᵀ (B x_ref − b)`.
 
+mod moving;
 mod newton;
 
 use super::basis::{Basis, Variant};
@@ -49,11 +50,19 @@ macro_rules! forward_to_projection {
         fn mass_mul(&self, a: &[f64], out: &mut [f64]) {
             self.p.mass_mul(a, out);
         }
-        fn constraint_residual(&self, q: &[f64], _t: f64, out: &mut [f64]) {
-            self.p.constraint_residual(q, out);
+        fn constraint_residual(&self, mu: &Parameters, q: &[f64], t: f64, out: &mut [f64]) {
+            self.p.constraint_residual_at(&*self.full, mu, q, t, out);
         }
-        fn add_constraint_force(&self, lambda: &[f64], out: &mut [f64]) {
-            self.p.add_constraint_force(lambda, out);
+        fn constraint_velocity_rhs(&self, mu: &Parameters, q: &[f64], t: f64, out: &mut [f64]) {
+            out.iter_mut().for_each(|x| *x = 0.0);
+            self.p.moving.velocity_rhs(&*self.full, mu, q, t, out);
+        }
+        fn constraint_acceleration_rhs(&self, mu: &Parameters, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
+            out.iter_mut().for_each(|x| *x = 0.0);
+            self.p.moving.acceleration_rhs(&*self.full, mu, q, v, t, out);
+        }
+        fn add_constraint_force(&self, mu: &Parameters, lambda: &[f64], t: f64, out: &mut [f64]) {
+            self.p.add_constraint_force_at(&*self.full, mu, lambda, t, out);
         }
         fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {
             self.p.solve(rhs)
@@ -94,9 +103,11 @@ pub(crate) struct Projection {
     /// M_r,g` (`mass` holds the sum at the factors of the last [`Projection::bind`]) and
     /// `g₀,r(μ) = Σ m_g(μ) g₀,r,g(μ)`
     mass_split: MassSplit,
-    /// B V and B x_ref − b (reduced rows)
+    /// B V and B x_ref − b (reduced rows; a moving row's at the last Newton matrix's time)
     b_r: Array2<f64>,
     c_r: Array1<f64>,
+    /// the rows that move with time, evaluated at each time
+    pub(crate) moving: moving::MovingRows,
     /// whole-system: P + Pᵀ and c₀
     coupling: Option<(Array2<f64>, Array1<f64>)>,
     /// whole-system: w V_λ (λ = w V_λ q); galerkin: Uₖ (λ = Uₖ λ̃), to recover the multipliers
@@ -185,19 +196,28 @@ impl Projection {
             all => all.iter().fold(Array2::zeros((r, r)), |acc, (_, m, _)| acc + m),
         };
 
-        // constraints are linear: B y − b, so B V_j = res(V_j) − res(0); taken at t = 0, as
-        // every joint kind's rows are constant in time (physics::joints)
+        // constraints are linear: B y − b, so B V_j = res(V_j) − res(0); taken at t = 0 (the
+        // rows that move with time are evaluated at each time instead, `moving`)
+        let mu0 = Parameters::load_scale(1.0);
         let mut res0 = vec![0.0; nc_full];
-        full.constraint_residual(&vec![0.0; n], 0.0, &mut res0);
+        full.constraint_residual(&mu0, &vec![0.0; n], 0.0, &mut res0);
         let mut bv = Array2::<f64>::zeros((nc_full, r));
         let mut res = vec![0.0; nc_full];
         for j in 0..r {
-            full.constraint_residual(&v.column(j).to_vec(), 0.0, &mut res);
+            full.constraint_residual(&mu0, &v.column(j).to_vec(), 0.0, &mut res);
             for c in 0..nc_full {
                 bv[[c, j]] = res[c] - res0[c];
             }
         }
-        full.constraint_residual(basis.reference.as_slice().expect("contiguous"), 0.0, &mut res);
+        full.constraint_residual(&mu0, basis.reference.as_slice().expect("contiguous"), 0.0, &mut res);
+        let moving = moving::MovingRows::new(full, v, &basis.reference, nc_full)?;
+        if !moving.is_empty() && basis.variant != Variant::ConstraintPreserving {
+            return Err(format!(
+                "the model prescribes motions (driven joints), whose rows move with time; the {} variant projects \
+                 the joint rows once: train with variant = \"constraint-preserving\"",
+                basis.variant.name()
+            ));
+        }
         let mut c_ref = Array1::from(res);
 
         let (nc, coupling, multiplier_map) = match basis.variant {
@@ -238,7 +258,12 @@ impl Projection {
         };
         let (b_r, c_r) = if nc > 0 { (bv, c_ref) } else { (Array2::zeros((0, r)), Array1::zeros(0)) };
         let nl = load_dofs.len();
-        let elim = if basis.variant == Variant::ConstraintPreserving { JointElimination::new(&b_r) } else { None };
+        // the null space of rows that move would move too: those models keep the KKT form
+        let elim = if basis.variant == Variant::ConstraintPreserving && moving.is_empty() {
+            JointElimination::new(&b_r)
+        } else {
+            None
+        };
         let (ld, dim) = match &elim {
             Some(e) => (r, e.dim()),
             None => (r + nc, r + nc),
@@ -252,6 +277,7 @@ impl Projection {
             mass_split,
             b_r,
             c_r,
+            moving,
             coupling,
             multiplier_map,
             load_dofs,

@@ -241,7 +241,7 @@ impl GeneralizedAlpha {
         for i in 0..n {
             rhs[i] += work[i];
         }
-        model.add_constraint_force(&st.lambda, &mut rhs[..n]);
+        model.add_constraint_force(&st.lambda, t, &mut rhs[..n]);
     }
 
     /// One Newton correction from the residual [`Self::residual`] left in `rhs[..n]`, with the
@@ -619,7 +619,7 @@ mod tests {
             }
         }
         fn constraint_residual(&self, _q: &[f64], _t: f64, _out: &mut [f64]) {}
-        fn add_constraint_force(&self, _lambda: &[f64], _out: &mut [f64]) {}
+        fn add_constraint_force(&self, _lambda: &[f64], _t: f64, _out: &mut [f64]) {}
         fn factor(
             &mut self,
             q: &[f64],
@@ -752,7 +752,7 @@ mod tests {
         fn constraint_acceleration_rhs(&self, _q: &[f64], _v: &[f64], _t: f64, out: &mut [f64]) {
             out[0] = self.a;
         }
-        fn add_constraint_force(&self, lambda: &[f64], out: &mut [f64]) {
+        fn add_constraint_force(&self, lambda: &[f64], _t: f64, out: &mut [f64]) {
             out[0] += lambda[0];
         }
         fn factor(

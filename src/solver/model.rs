@@ -56,8 +56,8 @@ pub trait DynamicModel {
     fn constraint_acceleration_rhs(&self, _q: &[f64], _v: &[f64], _t: f64, out: &mut [f64]) {
         out.iter_mut().for_each(|x| *x = 0.0);
     }
-    /// `out += Bᵀ λ`
-    fn add_constraint_force(&self, lambda: &[f64], out: &mut [f64]);
+    /// `out += B(t)ᵀ λ`
+    fn add_constraint_force(&self, lambda: &[f64], t: f64, out: &mut [f64]);
     /// Assembles and factors `[S, s Bᵀ; s B, 0]` with `S = m M + c ∂g/∂q̇ + k ∂g/∂q`
     /// at `(q, q̇, t)`, choosing the constraint scale `s` so that both block rows are of the
     /// same magnitude; returns `s`.
@@ -112,19 +112,19 @@ pub trait ParametricModel {
         self.mass_mul(a, inertia);
         self.force(mu, q, v, t, force);
     }
-    /// `out = B(t) q − b(t)`
-    fn constraint_residual(&self, q: &[f64], t: f64, out: &mut [f64]);
+    /// `out = B(t) q − b(t)` at the parameters `mu` (a prescribed motion's factor)
+    fn constraint_residual(&self, mu: &Parameters, q: &[f64], t: f64, out: &mut [f64]);
     /// `out = ḃ − Ḃ q`, what `B q̇` must equal at `t`: zero for constant constraints.
-    fn constraint_velocity_rhs(&self, _q: &[f64], _t: f64, out: &mut [f64]) {
+    fn constraint_velocity_rhs(&self, _mu: &Parameters, _q: &[f64], _t: f64, out: &mut [f64]) {
         out.iter_mut().for_each(|x| *x = 0.0);
     }
     /// `out = c(q, q̇, t) = b̈ − 2Ḃ q̇ − B̈ q`, what `B q̈` must equal: zero for constant
     /// constraints.
-    fn constraint_acceleration_rhs(&self, _q: &[f64], _v: &[f64], _t: f64, out: &mut [f64]) {
+    fn constraint_acceleration_rhs(&self, _mu: &Parameters, _q: &[f64], _v: &[f64], _t: f64, out: &mut [f64]) {
         out.iter_mut().for_each(|x| *x = 0.0);
     }
-    /// `out += Bᵀ λ`
-    fn add_constraint_force(&self, lambda: &[f64], out: &mut [f64]);
+    /// `out += B(t)ᵀ λ`
+    fn add_constraint_force(&self, mu: &Parameters, lambda: &[f64], t: f64, out: &mut [f64]);
     /// [`DynamicModel::factor`] at the parameters `mu`.
     fn factor(
         &mut self,
@@ -177,16 +177,16 @@ impl<M: ParametricModel + ?Sized> DynamicModel for Bound<'_, M> {
         self.model.force_and_inertia(&self.mu, q, v, a, t, out)
     }
     fn constraint_residual(&self, q: &[f64], t: f64, out: &mut [f64]) {
-        self.model.constraint_residual(q, t, out)
+        self.model.constraint_residual(&self.mu, q, t, out)
     }
     fn constraint_velocity_rhs(&self, q: &[f64], t: f64, out: &mut [f64]) {
-        self.model.constraint_velocity_rhs(q, t, out)
+        self.model.constraint_velocity_rhs(&self.mu, q, t, out)
     }
     fn constraint_acceleration_rhs(&self, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
-        self.model.constraint_acceleration_rhs(q, v, t, out)
+        self.model.constraint_acceleration_rhs(&self.mu, q, v, t, out)
     }
-    fn add_constraint_force(&self, lambda: &[f64], out: &mut [f64]) {
-        self.model.add_constraint_force(lambda, out)
+    fn add_constraint_force(&self, lambda: &[f64], t: f64, out: &mut [f64]) {
+        self.model.add_constraint_force(&self.mu, lambda, t, out)
     }
     fn factor(
         &mut self,
@@ -276,6 +276,20 @@ pub trait ElementModel: ParametricModel {
     /// `None` then carry it even where every element's mass is a parameter's.
     fn has_lumped_mass(&self) -> bool {
         false
+    }
+    /// The constraint rows whose coefficients or right-hand side move with time (prescribed
+    /// motions), each as (row index, the coordinates of its terms); none by default. A
+    /// reduction evaluates these rows through [`Self::moving_row_at`] and projects the
+    /// others once.
+    fn moving_rows(&self) -> Vec<(usize, Vec<usize>)> {
+        Vec::new()
+    }
+    /// The `order`-th time derivative (0, 1, 2) of moving row `k` (an index into
+    /// [`Self::moving_rows`]) at μ and `t`: its coefficients into `coefs`, in the order of its
+    /// coordinates; returns that of its right-hand side.
+    fn moving_row_at(&self, _mu: &Parameters, _k: usize, _t: f64, _order: u32, coefs: &mut [f64]) -> f64 {
+        coefs.iter_mut().for_each(|c| *c = 0.0);
+        0.0
     }
 }
 

@@ -23,7 +23,7 @@ pub fn solve_static<M: DynamicModel>(
     let mut residual = f64::NAN;
     for it in 1..=max_iterations {
         model.force(q, &zero, t, &mut rhs[..n]);
-        model.add_constraint_force(&lambda, &mut rhs[..n]);
+        model.add_constraint_force(&lambda, t, &mut rhs[..n]);
         residual = crate::linalg::vec_ops::max_abs(&rhs[..n]);
         if !residual.is_finite() {
             // diverged: no matrix to factor at a NaN or infinite state

@@ -1,7 +1,7 @@
 //! Joints, one file per kind. Each kind turns its nodes into scalar constraint rows
 //!
 //! ```text
-//!     Σ_d B_cd q_d = b_c          (one row c; B and b constant for these kinds)
+//!     Σ_d B_cd(t) q_d = b_c(t)          (one row c; constant but for the driven kinds)
 //! ```
 //!
 //! with a name and a unit per row, and says what a reduction needs to know (the coordinates
@@ -13,6 +13,8 @@
 //! the model file's schema (`model::schema::JointSpec`) and checks (`model::check`).
 
 mod clamp;
+mod driven_angle;
+mod driven_point;
 mod ground_pin;
 mod pin;
 mod row;
@@ -20,9 +22,11 @@ mod slider;
 mod weld;
 
 pub use clamp::Clamp;
+pub use driven_angle::DrivenAngle;
+pub use driven_point::DrivenPoint;
 pub use ground_pin::GroundPin;
 pub use pin::Pin;
-pub use row::{JointKind, NodeIndex, Row, RowKind, COORDINATES};
+pub use row::{Drive, JointKind, Motion, NodeIndex, Row, RowKind, COORDINATES};
 pub use slider::Slider;
 pub use weld::Weld;
 
@@ -36,6 +40,8 @@ pub enum Joint {
     Clamp(Clamp),
     Slider(Slider),
     Weld(Weld),
+    DrivenAngle(DrivenAngle),
+    DrivenPoint(DrivenPoint),
 }
 
 impl Joint {
@@ -47,6 +53,8 @@ impl Joint {
             Joint::Clamp(j) => j,
             Joint::Slider(j) => j,
             Joint::Weld(j) => j,
+            Joint::DrivenAngle(j) => j,
+            Joint::DrivenPoint(j) => j,
         }
     }
 

@@ -27,6 +27,7 @@ impl JointKind for Pin {
                 rhs: 0.0,
                 component: COORDINATES[c],
                 kind: RowKind::Position,
+                motion: None,
             })
             .collect()
     }

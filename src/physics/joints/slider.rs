@@ -49,9 +49,16 @@ impl JointKind for Slider {
             rhs: n[0] * self.point[0] + n[1] * self.point[1],
             component: "normal",
             kind: RowKind::Position,
+            motion: None,
         }];
         if let Some([c, s]) = self.locked_slope {
-            rows.push(Row { terms: vec![(d + 2, -s), (d + 3, c)], rhs: 0.0, component: "angle", kind: RowKind::Slope });
+            rows.push(Row {
+                terms: vec![(d + 2, -s), (d + 3, c)],
+                rhs: 0.0,
+                component: "angle",
+                kind: RowKind::Slope,
+                motion: None,
+            });
         }
         rows
     }

@@ -37,6 +37,7 @@ impl JointKind for Weld {
             rhs: 0.0,
             component: COORDINATES[k],
             kind: RowKind::Position,
+            motion: None,
         });
         // rows of R(Δθ) applied to (x'_a, y'_a), minus b's slope
         let rotation = [[c, -s], [s, c]];
@@ -45,6 +46,7 @@ impl JointKind for Weld {
             rhs: 0.0,
             component: COORDINATES[2 + k],
             kind: RowKind::Slope,
+            motion: None,
         });
         position.chain(slope).collect()
     }

@@ -75,6 +75,16 @@ impl ElementModel for FlexibleSystem {
         }
     }
 
+    fn moving_rows(&self) -> Vec<(usize, Vec<usize>)> {
+        self.moving.iter().map(|(c, row)| (*c, row.terms.iter().map(|t| t.0).collect())).collect()
+    }
+
+    fn moving_row_at(&self, mu: &Parameters, k: usize, t: f64, order: u32, coefs: &mut [f64]) -> f64 {
+        let (b, rhs) = self.moving_row(mu, k, t, order);
+        coefs.copy_from_slice(&b[..coefs.len()]);
+        rhs
+    }
+
     fn has_lumped_mass(&self) -> bool {
         self.has_point_masses()
     }
@@ -208,16 +218,46 @@ impl ParametricModel for FlexibleSystem {
         self.add_nodal_loads(mu, t, |d| q[d], |d, value| force[d] += value);
     }
 
-    /// The joints' rows are constant ([`crate::physics::joints`]): `t` does not enter.
-    fn constraint_residual(&self, q: &[f64], _t: f64, out: &mut [f64]) {
-        for (o, c) in out.iter_mut().zip(&self.constraints) {
-            *o = c.terms.iter().map(|&(d, k)| k * q[d]).sum::<f64>() - c.rhs;
+    /// The constant rows as built; the moving ones ([`crate::physics::joints::Motion`]) at
+    /// `t` and the drive's factor at μ.
+    fn constraint_residual(&self, mu: &Parameters, q: &[f64], t: f64, out: &mut [f64]) {
+        self.initial_constraint_residual(q, out);
+        for (k, (c, row)) in self.moving.iter().enumerate() {
+            let (b, rhs) = self.moving_row(mu, k, t, 0);
+            out[*c] = row.terms.iter().zip(&b).map(|(&(d, _), k)| k * q[d]).sum::<f64>() - rhs;
         }
     }
 
-    fn add_constraint_force(&self, lambda: &[f64], out: &mut [f64]) {
-        for (l, c) in lambda.iter().zip(&self.constraints) {
-            for &(d, k) in &c.terms {
+    /// `ḃ − Ḃ q`, nonzero on the moving rows only.
+    fn constraint_velocity_rhs(&self, mu: &Parameters, q: &[f64], t: f64, out: &mut [f64]) {
+        out.iter_mut().for_each(|x| *x = 0.0);
+        for (k, (c, row)) in self.moving.iter().enumerate() {
+            let (b1, rhs1) = self.moving_row(mu, k, t, 1);
+            out[*c] = rhs1 - row.terms.iter().zip(&b1).map(|(&(d, _), k)| k * q[d]).sum::<f64>();
+        }
+    }
+
+    /// `b̈ − 2 Ḃ q̇ − B̈ q`, nonzero on the moving rows only.
+    fn constraint_acceleration_rhs(&self, mu: &Parameters, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
+        out.iter_mut().for_each(|x| *x = 0.0);
+        for (k, (c, row)) in self.moving.iter().enumerate() {
+            let (b1, _) = self.moving_row(mu, k, t, 1);
+            let (b2, rhs2) = self.moving_row(mu, k, t, 2);
+            let terms = row.terms.iter().zip(b1.iter().zip(&b2));
+            out[*c] = rhs2 - terms.map(|(&(d, _), (k1, k2))| 2.0 * k1 * v[d] + k2 * q[d]).sum::<f64>();
+        }
+    }
+
+    fn add_constraint_force(&self, mu: &Parameters, lambda: &[f64], t: f64, out: &mut [f64]) {
+        // the moving rows (sorted by row) at t, the others as built
+        let mut moving = self.moving.iter().enumerate().peekable();
+        for (c, (l, con)) in lambda.iter().zip(&self.constraints).enumerate() {
+            if let Some((k, _)) = moving.next_if(|(_, (mc, _))| *mc == c) {
+                let (b, _) = self.moving_row(mu, k, t, 0);
+                con.terms.iter().zip(&b).for_each(|(&(d, _), k)| out[d] += k * l);
+                continue;
+            }
+            for &(d, k) in &con.terms {
                 out[d] += k * l;
             }
         }
@@ -261,6 +301,10 @@ impl ParametricModel for FlexibleSystem {
         }
         if coef.stiffness != 0.0 {
             self.add_nodal_stiffness(mu, t, q, coef.stiffness);
+        }
+        for (c, row) in &self.moving {
+            let (b, _) = row_at(row, mu, t, 0);
+            self.kkt.set_constraint_row(*c, &b[..row.terms.len()]);
         }
         let scale = if diag_max > 0.0 { diag_max } else { 1.0 };
         // sums of symmetric element matrices, each entry and its mirror computed alike

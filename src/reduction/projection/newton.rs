@@ -87,6 +87,9 @@ impl Projection {
             }
             self.base_coef = Some(coef);
         }
+        if !self.moving.is_empty() {
+            self.moving.set_rows(full, mu, t, &mut self.b_r);
+        }
         let (a, _) = matrix_of(&mut self.elim, &mut self.lu, r, self.nc);
         a.copy_from_slice(&self.base);
         if coef.stiffness != 0.0 && !self.load_dofs.is_empty() {
