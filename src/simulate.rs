@@ -6,6 +6,7 @@ use crate::analysis::statics::{StaticOptions, StaticSolution};
 use crate::error::{Error, Result};
 use crate::linalg::kkt::LinearSolverKind;
 use crate::model::Model;
+use crate::physics::joints::RowKind;
 use crate::physics::system::{FlexibleSystem, Probe};
 use crate::solver::generalized_alpha::{GeneralizedAlpha, IntegratorParams, LargestStrain, State, Stats};
 use crate::solver::model::{Bound, DynamicModel, Parameters, ParametricModel};
@@ -326,10 +327,15 @@ pub fn simulate(model: &Model, overrides: &Overrides) -> Result<SimulationResult
 /// Warns about each prescribed motion whose rate at t = 0 the bodies' initial velocities do
 /// not have (`B q̇₀ ≠ ḃ − Ḃ q₀`, a drive started at speed from rest): the first step
 /// absorbs the jump, with a spike in the accelerations and the joint forces.
-fn warn_on_drive_jumps(model: &Model, sys: &FlexibleSystem, mu: &Parameters, q0: &[f64], v0: &[f64]) {
+///
+/// A jump counts when it exceeds 1e-9 of the run's own rates (the bodies' and the drives'
+/// initial ones) or of the rate that moves the model's length (a slope: one radian) over the
+/// run, so that round-off of a drive starting at rest is not one.
+fn warn_on_drive_jumps(model: &Model, sys: &FlexibleSystem, s: &Settings, q0: &[f64], v0: &[f64]) {
     if !sys.has_moving_constraints() {
         return;
     }
+    let mu = &s.mu;
     let nc = ParametricModel::n_constraints(sys);
     let (mut want, mut bv, mut b0) = (vec![0.0; nc], vec![0.0; nc], vec![0.0; nc]);
     sys.constraint_velocity_rhs(mu, q0, 0.0, &mut want);
@@ -341,7 +347,8 @@ fn warn_on_drive_jumps(model: &Model, sys: &FlexibleSystem, mu: &Parameters, q0:
     let speed = v0.iter().chain(&want).fold(0.0_f64, |m, v| m.max(v.abs()));
     for (c, (j, row)) in rows.iter().enumerate() {
         let jump = want[c] - (bv[c] - b0[c]);
-        if row.motion.is_some() && jump.abs() > 1e-9 * speed {
+        let reach = if row.kind == RowKind::Position { sys.length_scale() } else { 1.0 } / s.t_end;
+        if row.motion.is_some() && jump.abs() > 1e-9 * speed.max(reach) {
             let joint = model.joints()[*j].describe(&|(b, k)| format!("{} node {k}", model.file.bodies[b].name));
             log::warn!(
                 "joints[{j}] ({joint}) starts at a rate the bodies do not have at t = 0 ({} off by {jump:.3e} {}/s): \
@@ -369,7 +376,7 @@ fn run_full(model: &Model, sys: &mut FlexibleSystem, q0: Vec<f64>, s: Settings) 
     let probe_defs = sys.probes.clone();
     let start = std::time::Instant::now();
     let v0 = sys.initial_velocity(&q0);
-    warn_on_drive_jumps(model, sys, &s.mu, &q0, &v0);
+    warn_on_drive_jumps(model, sys, &s, &q0, &v0);
     // the probes are evaluated after the loop, from the stored coordinates
     let stats = solve(
         sys,
