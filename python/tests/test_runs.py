@@ -242,6 +242,27 @@ def test_model_from_dict_is_the_file():
         flexrom.Model.from_dict(d)
 
 
+def test_a_motor_by_angle_from_a_dict_holds_its_drive():
+    """A crank written as a dict with a ground pin and a driven angle (the model file's
+    keys): the hub's slope turns with the drive, θ(t) = 0.4 + λ · 5 t², to round-off."""
+    d = {
+        "time": {"t_end": 0.2, "dt": 0.002, "rho_inf": 0.9},
+        "bodies": [
+            {"name": "crank", "start": [0.0, 0.0], "angle": 0.4, "length": 0.5, "elements": 4,
+             "density": 7850.0, "area": 1.0e-4, "inertia": 8.33e-10, "youngs_modulus": 2.1e11},
+        ],
+        "joints": [
+            {"type": "ground_pin", "body": "crank", "node": "start"},
+            {"type": "driven_angle", "body": "crank", "node": "start",
+             "function": {"type": "polynomial", "coefficients": [0.0, 0.0, 5.0]}},
+        ],
+    }
+    r = flexrom.Model.from_dict(d).simulate(load_scale=1.5)
+    q, t = np.asarray(r.q), np.asarray(r.t)
+    theta = 0.4 + 1.5 * 5.0 * t**2
+    assert np.abs(-np.sin(theta) * q[:, 2] + np.cos(theta) * q[:, 3]).max() < 1e-12
+
+
 def test_reduced_to_hdf5_is_the_online_file(cli, dp_basis, tmp_path):
     """A reduced Result written with to_hdf5 holds what `flexrom online -o` writes (reduced
     coordinates, estimate attributes); the basis and pipeline files are refused as paths."""
