@@ -456,3 +456,22 @@ fn a_killed_simulate_keeps_the_previous_result() {
     assert_eq!(o.status.code(), Some(143), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(snapshot(root), before);
 }
+
+/// An output named for another format is refused before anything runs (it would be HDF5
+/// whatever its name says), naming the option, the extension and, for `.csv`, `--csv`; no
+/// file appears. A name without an extension is the user's choice and is written.
+#[test]
+fn outputs_named_for_another_format_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("m.toml");
+    std::fs::write(&model, model_text(0.01, "")).unwrap();
+    for (name, words) in [("arm.csv", &["-o", ".csv", "HDF5", "--csv"][..]), ("arm.vtu", &["-o", ".vtu", "HDF5"][..])] {
+        let out = dir.path().join(name);
+        let o = flexrom().args(["simulate", "-q"]).arg(&model).arg("-o").arg(&out).output().unwrap();
+        fails_with(&o, words);
+        assert!(!out.exists(), "{name} was written");
+    }
+    let plain = dir.path().join("run1");
+    let o = flexrom().args(["simulate", "-q"]).arg(&model).arg("-o").arg(&plain).output().unwrap();
+    assert!(o.status.success() && plain.exists(), "{}", String::from_utf8_lossy(&o.stderr));
+}

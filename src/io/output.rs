@@ -132,7 +132,23 @@ pub fn check_output(output: &Path, origin: Origin, inputs: &[(&Path, &str)], kin
     if std::fs::metadata(output).is_ok() {
         check_own_file(output, origin, kinds)?;
     }
-    Ok(())
+    // after the checks that name an input or a file of the user's, which say more
+    check_extension(output, origin, kinds)
+}
+
+/// The extensions of an HDF5 file, which every kind of [`Kind`] is.
+const HDF5_EXTENSIONS: [&str; 4] = ["h5", "hdf5", "hdf", "he5"];
+
+/// Refuses an output whose extension names another format (`out.csv`, `out.vtu`): the file
+/// would be HDF5 whatever its name says. No extension is allowed (`-o run1`).
+fn check_extension(output: &Path, origin: Origin, kinds: &[Kind]) -> Result<()> {
+    let Some(ext) = output.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()) else { return Ok(()) };
+    if HDF5_EXTENSIONS.contains(&ext.as_str()) {
+        return Ok(());
+    }
+    let kind = kinds.first().map_or("an", |k| k.name());
+    let csv = if ext == "csv" { "; for CSV, the command's `--csv` prints it to stdout" } else { "" };
+    Err(origin.error(output, format!("ends in `.{ext}`, but flexrom writes {kind} files in HDF5 only (`.h5`){csv}")))
 }
 
 /// Refuses an existing file at `output` that flexrom did not write as one of `kinds`: only an
