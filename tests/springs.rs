@@ -9,6 +9,8 @@
 //! * two masses on sliders joined by a spring between two bodies (a coupling block of the
 //!   iteration matrix): their relative motion `u = (Δv₀/ω) sin ωt`, `ω = √(k (1/m₁ + 1/m₂))`,
 //!   with the banded, sparse and dense solvers;
+//! * `flexrom statics` of a bar hanging on a spring: the spring stretched by `m g / k`
+//!   (Hooke) and its energy `½ k (m g / k)²`;
 //! * `flexrom modes` of the mass on a spring: its lowest frequency `√(k/m)/2π`, and of a
 //!   bar pinned to a clamped stub with a torsional spring: `√(k/J)/2π`, `J = ρAL³/3`;
 //! * a stiff bar on a torsional spring to a clamped stub, started turning at ω₀: its angle
@@ -206,6 +208,30 @@ fn modes_include_the_springs_stiffness() {
 }
 
 const SPRING_PENDULUM: &str = include_str!("../data/models/spring_pendulum.toml");
+
+#[test]
+fn a_bar_hanging_on_a_spring_stretches_it_by_its_weight_over_k() {
+    // the example bar hanging straight down: at rest the spring holds the weight, stretched
+    // by m g / k (Hooke) from its free length, whatever the bar's own (negligible) stretch
+    let text = SPRING_PENDULUM.replace("angle = -1.2707963267948966", "angle = -1.5707963267948966");
+    let dir = tempfile::tempdir().unwrap();
+    let path = write(dir.path(), "m.toml", &text);
+    let out = Command::new(env!("CARGO_BIN_EXE_flexrom"))
+        .args(["statics", path.to_str().unwrap(), "--json", "-q"])
+        .env("HDF5_USE_FILE_LOCKING", "FALSE")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let top = v[0]["top_y"].as_f64().expect("the top node's height");
+    // m = ρAL = 2700 · 5e-5 · 0.5 kg; the spring from (0, 0.2) with L₀ = 0.15 m, k = 40 N/m
+    let stretch = 2700.0 * 5.0e-5 * 0.5 * 9.81 / 40.0;
+    let expected = 0.2 - 0.15 - stretch;
+    assert!((top - expected).abs() < 1e-9, "top node at {top} m against {expected} m");
+    // its energy ½ k (m g / k)²
+    let e = v[0]["energy_springs"].as_f64().expect("the springs' energy");
+    assert!((e - 0.5 * 40.0 * stretch * stretch).abs() < 1e-9, "spring energy {e} J");
+}
 
 /// The largest drift of `T + U + V + V_s − W` against the kinetic energy's peak, and the
 /// work `W` at the end.
