@@ -302,3 +302,21 @@ def test_reconstruct_reduce_and_nodes(dp_basis):
     lower = nodes["lower"]
     assert lower.shape == (len(r.t), 9, 2)  # 8 elements, 9 nodes
     same(lower[:, -1, :], r.probes["tip"])
+
+
+SPRING_PENDULUM = ROOT / "data" / "models" / "spring_pendulum.toml"
+
+
+def test_model_from_dict_takes_springs():
+    """`[[springs]]` reaches Model.from_dict through the schema: the dict runs as the file
+    does, and a bad spring is refused naming its key."""
+    tomllib = pytest.importorskip("tomllib")  # Python >= 3.11
+
+    d = tomllib.loads(SPRING_PENDULUM.read_text())
+    assert d["springs"][0]["stiffness"] == 40.0
+    a = flexrom.Model.from_dict(d).simulate(t_end=0.05)
+    b = flexrom.Model.from_file(SPRING_PENDULUM).simulate(t_end=0.05)
+    same(a.q, b.q)
+    d["springs"][0]["damping"] = -1.0
+    with pytest.raises(flexrom.ModelError, match=r"springs\[0\]\.damping"):
+        flexrom.Model.from_dict(d)

@@ -4,13 +4,17 @@
 //! kinetic          T = ½ q̇ᵀ M q̇
 //! strain           U = Σ_e (½ eᵀ K_t e + ½ EA l ε̄²)   (bending, then axial; E = E(μ))
 //! gravity          V = −g₀(μ)ᵀ q                       (−Σ ∫ ρA g · r ds)
-//! springs          0 (no spring part exists yet)
-//! external work    W(t) = ∫₀ᵗ Q_extᵀ q̇ dt              (forces and moments, not gravity)
+//! springs          V_s = Σ ½ k (L − L₀)² + Σ ½ k φ²   (translational, torsional)
+//! external work    W(t) = ∫₀ᵗ (Q_ext − Q_s)ᵀ q̇ dt     (forces, moments and the springs'
+//!                                                       dampers, not gravity)
 //! ```
 //!
-//! `W` is integrated by the trapezoidal rule over the recorded instants (second order,
-//! as the integrator at `ρ∞ = 1`). Without damping `T + U + V − W` stays constant to the
-//! integrator's order; Rayleigh damping makes it decrease (the dissipated energy).
+//! with `Q_s` the springs' elastic forces (`−Q_sᵀ q̇ = V̇_s`): the spring-dampers' dampers
+//! enter `W` as the negative work `−∫ c L̇² dt` (`−∫ c φ̇² dt`) they dissipate, so that
+//! `T + U + V + V_s − W` stays constant with them too. `W` is integrated by the trapezoidal
+//! rule over the recorded instants (second order, as the integrator at `ρ∞ = 1`). Without
+//! Rayleigh damping `T + U + V + V_s − W` stays constant to the integrator's order;
+//! Rayleigh damping makes it decrease (the dissipated energy).
 
 use crate::physics::element::Vec8;
 use crate::physics::system::FlexibleSystem;
@@ -65,17 +69,24 @@ pub fn strain_parts(sys: &FlexibleSystem, mu: &Parameters, q: &[f64]) -> (f64, f
     (bending, axial)
 }
 
-/// `Q_ext(q, t)ᵀ q̇` of the forces and moments (not gravity).
-fn load_power(sys: &FlexibleSystem, mu: &Parameters, q: &[f64], v: &[f64], t: f64) -> f64 {
+/// `(Q_ext − Q_s)ᵀ q̇` of the forces, moments and springs' dampers (not gravity), with
+/// `V̇_s` of the springs given as `spring_rate`.
+fn load_power(sys: &FlexibleSystem, mu: &Parameters, (q, v): (&[f64], &[f64]), t: f64, spring_rate: f64) -> f64 {
     let dofs = sys.load_dofs();
     if dofs.is_empty() {
         return 0.0;
     }
-    let ql: Vec<f64> = dofs.iter().map(|&d| q[d]).collect();
+    let (ql, vl): (Vec<f64>, Vec<f64>) = dofs.iter().map(|&d| (q[d], v[d])).unzip();
     let mut g = vec![0.0; dofs.len()];
-    // g = −Q_ext on the load dofs
-    sys.load_force(mu, &ql, t, &mut g);
-    -dofs.iter().zip(&g).map(|(&d, g)| g * v[d]).sum::<f64>()
+    // g = −Q_ext on the load dofs (the springs' forces in it)
+    sys.load_force(mu, &ql, &vl, t, &mut g);
+    let power = -dofs.iter().zip(&g).map(|(&d, g)| g * v[d]).sum::<f64>();
+    // the springs' elastic power −V̇_s is stored, not external, work
+    if spring_rate != 0.0 {
+        power + spring_rate
+    } else {
+        power
+    }
 }
 
 /// The energies of the states `(t_k, q_k, q̇_k)` of a run at `μ` (`q` and `v` give the
@@ -111,7 +122,9 @@ pub fn energies(
         out.strain_axial[k] = a;
         out.strain[k] = a + b;
         out.gravity[k] = weight.iter().zip(&qk).map(|(g, q)| g * q).sum();
-        let power = load_power(sys, mu, &qk, &vk, t[k]);
+        let (stored, rate) = sys.spring_energy(&qk, &vk);
+        out.springs[k] = stored;
+        let power = load_power(sys, mu, (&qk, &vk), t[k], rate);
         if k > 0 {
             out.external_work[k] = out.external_work[k - 1] + 0.5 * (t[k] - t[k - 1]) * (power + last_power);
         }

@@ -2,6 +2,8 @@
 //! exist, joints that close and whose constraint rows are independent, time settings that
 //! make a run; the validated bodies, joints, loads and probes are kept on the [`Model`].
 
+mod springs;
+
 use super::schema::*;
 use super::toml_errors::entry_line;
 use super::Model;
@@ -297,6 +299,7 @@ impl Model {
             self.positive(&p("mass"), m.mass)?;
             self.masses.push(PointMass { node, mass: m.mass });
         }
+        self.check_springs(&f.springs)?;
         for (i, pr) in f.probes.iter().enumerate() {
             let p = |k: &str| format!("probes[{i}].{k}");
             if f.probes[..i].iter().any(|o| o.name == pr.name) {

@@ -20,6 +20,10 @@ pub struct ModelFile {
     /// point masses at nodes
     #[serde(default)]
     pub masses: Vec<MassSpec>,
+    /// spring-dampers between nodes, or a node and the ground (absent: none; left out of
+    /// the serialized file then, so that older files keep their fingerprint)
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub springs: Vec<SpringSpec>,
     #[serde(default)]
     pub probes: Vec<ProbeSpec>,
     /// how a dynamic run starts (absent: from the undeformed configuration at rest; left
@@ -44,6 +48,50 @@ pub struct MassSpec {
     pub body: String,
     pub node: NodeRef,
     pub mass: f64,
+}
+
+/// A spring-damper (`[[springs]]`): translational between a node and a node or a ground
+/// point, or torsional between two nodes' slopes.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpringSpec {
+    /// shown in messages
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// translational (the default) or torsional
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub r#type: Option<SpringKind>,
+    pub a: NodeSpec,
+    pub b: SpringEndSpec,
+    /// N/m (translational) or N m/rad (torsional)
+    pub stiffness: f64,
+    /// N s/m (translational) or N m s/rad (torsional)
+    #[serde(default)]
+    pub damping: f64,
+    /// free length, m (translational; default: the initial distance)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub length: Option<f64>,
+}
+
+/// The kind of a [`SpringSpec`].
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum SpringKind {
+    Translational,
+    Torsional,
+}
+
+/// A spring's second end: `{ body, node }` or `{ point = [x, y] }` (one table, so that a
+/// misspelt key is named: the check tells which combination is missing).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpringEndSpec {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub node: Option<NodeRef>,
+    #[serde(default, deserialize_with = "pair::optional", skip_serializing_if = "Option::is_none")]
+    pub point: Option<[f64; 2]>,
 }
 
 #[derive(Clone, Debug, Deserialize, Serialize)]

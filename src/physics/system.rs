@@ -42,8 +42,17 @@ pub struct FlexibleSystem {
     weight: Weight,
     /// the loads on a few coordinates (moments, nodal forces), in file order
     nodal: Vec<Box<dyn NodalLoad>>,
-    /// per nodal load, the element whose iteration block holds its Jacobian (its first dof)
-    nodal_blocks: Vec<Option<(usize, usize)>>,
+    /// per nodal load with a Jacobian, the iteration block that holds it and that block's
+    /// dofs: an element's, or a coupling block's (`coupling`)
+    nodal_blocks: Vec<Option<(usize, [usize; 8])>>,
+    /// the blocks of the iteration matrix after the elements' (numbered from
+    /// `elements.len()`): the coordinates of two nodes no element holds together, which a
+    /// spring couples
+    coupling: Vec<[usize; 8]>,
+    /// whether every nodal load's Jacobian is symmetric to the bit (no damper)
+    symmetric_loads: bool,
+    /// whether some nodal load depends on the velocities (a damper)
+    load_damping: bool,
     /// point masses: the node's position coordinates, the mass, and the element whose
     /// iteration block holds it (its first dof)
     point_masses: Vec<([usize; 2], f64, (usize, usize))>,
@@ -101,21 +110,30 @@ impl FlexibleSystem {
             .iter()
             .map(|m| {
                 let (dofs, mass) = m.lower(&first);
-                (dofs, mass, block_holding(&elements, &dofs))
+                (dofs, mass, {
+                    // a node's position coordinates lie in an element of its
+                    let e = block_holding(&elements, &dofs).expect("a node of the mesh");
+                    (e, elements[e].1[0])
+                })
             })
             .collect();
         let lumped: Vec<([usize; 2], f64)> = point_masses.iter().map(|&(d, m, _)| (d, m)).collect();
         let weight = assemble_weight(&gravities, &bodies, &elements, &prototypes, &lumped, n_dof);
         let nodal: Vec<Box<dyn NodalLoad>> = loads.iter().filter_map(|l| l.lower(&first)).collect();
-        let nodal_blocks =
-            nodal.iter().map(|l| l.has_stiffness().then(|| block_holding(&elements, l.dofs()))).collect();
+        let mut coupling = Vec::new();
+        let nodal_blocks = nodal
+            .iter()
+            .map(|l| (l.has_stiffness() || l.has_damping()).then(|| load_block(&elements, &mut coupling, l.dofs())))
+            .collect();
+        let symmetric_loads = nodal.iter().all(|l| l.symmetric());
+        let load_damping = nodal.iter().any(|l| l.has_damping());
         let pattern = KktPattern {
             n_dof,
-            element_dofs: elements.iter().map(|(_, d)| *d).collect(),
+            element_dofs: elements.iter().map(|(_, d)| *d).chain(coupling.iter().copied()).collect(),
             constraint_rows: constraints.iter().map(|c| c.terms.clone()).collect(),
         };
         let length_scale = bodies.iter().map(|b| b.length).fold(0.0, f64::max);
-        let n_el = elements.len();
+        let n_blocks = elements.len() + coupling.len();
         let mut load_dofs: Vec<usize> = nodal.iter().flat_map(|l| l.dofs().iter().copied()).collect();
         load_dofs.sort_unstable();
         load_dofs.dedup();
@@ -131,12 +149,15 @@ impl FlexibleSystem {
             weight,
             nodal,
             nodal_blocks,
+            coupling,
+            symmetric_loads,
+            load_damping,
             point_masses,
             load_dofs,
             n_dof,
             bound: prototypes.clone(),
             kkt: make_solver(solver, pattern),
-            blocks: vec![Mat8::zeros(); n_el],
+            blocks: vec![Mat8::zeros(); n_blocks],
             iteration_constant: Vec::new(),
             iteration_coef: None,
             length_scale,
@@ -294,7 +315,9 @@ impl FlexibleSystem {
                 change = change.max(dq.abs());
             }
         }
-        self.blocks.iter_mut().for_each(|b| *b = Mat8::identity());
+        let n_el = self.elements.len();
+        self.blocks[..n_el].iter_mut().for_each(|b| *b = Mat8::identity());
+        self.blocks[n_el..].iter_mut().for_each(|b| *b = Mat8::zeros());
         // the rows at the start (a run leaves the moving ones at its last time)
         for (c, _) in &self.moving {
             let coefs: Vec<f64> = self.constraints[*c].terms.iter().map(|t| t.1).collect();
@@ -459,10 +482,40 @@ impl FlexibleSystem {
     }
 
     /// Calls `add(dof, value)` with the contributions `−Q_ext` of the nodal loads, in file
-    /// order; `q(dof)` reads the coordinates they depend on.
-    fn add_nodal_loads(&self, mu: &Parameters, t: f64, q: impl Fn(usize) -> f64, mut add: impl FnMut(usize, f64)) {
+    /// order; `q(dof)` and `v(dof)` read the coordinates and velocities they depend on.
+    fn add_nodal_loads(
+        &self,
+        mu: &Parameters,
+        t: f64,
+        q: impl Fn(usize) -> f64,
+        v: impl Fn(usize) -> f64,
+        mut add: impl FnMut(usize, f64),
+    ) {
         for load in &self.nodal {
-            load.add_force(mu.factor(load.scaling()), t, &q, &mut add);
+            load.add_force(mu.factor(load.scaling()), t, &q, &v, &mut add);
+        }
+    }
+
+    /// The springs' stored energy `Σ ½ k (L − L₀)² + Σ ½ k φ²` at `q` and its rate at `q̇`
+    /// (`loads::NodalLoad::stored_energy`); zeros without springs.
+    pub fn spring_energy(&self, q: &[f64], v: &[f64]) -> (f64, f64) {
+        self.nodal
+            .iter()
+            .filter_map(|l| l.stored_energy(&|d| q[d], &|d| v[d]))
+            .fold((0.0, 0.0), |(e, r), (le, lr)| (e + le, r + lr))
+    }
+
+    /// The number of blocks of the iteration matrix: the elements', then the coupling
+    /// blocks of springs between nodes no element holds together.
+    pub fn n_blocks(&self) -> usize {
+        self.elements.len() + self.coupling.len()
+    }
+
+    /// The global dofs of iteration block `k` ([`Self::n_blocks`]).
+    pub fn block_dofs(&self, k: usize) -> &[usize; 8] {
+        match self.elements.get(k) {
+            Some((_, d)) => d,
+            None => &self.coupling[k - self.elements.len()],
         }
     }
 
@@ -496,14 +549,20 @@ impl FlexibleSystem {
         }
     }
 
-    /// Adds `k ∂(−Q_ext)/∂q` of the nodal loads to the element blocks that hold them.
-    fn add_nodal_stiffness(&mut self, mu: &Parameters, t: f64, q: &[f64], k: f64) {
+    /// Adds `k ∂(−Q_ext)/∂q + c ∂(−Q_ext)/∂q̇` of the nodal loads to the blocks that hold
+    /// them (`c` only for the loads that depend on velocities).
+    fn add_nodal_jacobians(&mut self, mu: &Parameters, t: f64, (q, v): (&[f64], &[f64]), k: f64, c: f64) {
         for (load, slot) in self.nodal.iter().zip(&self.nodal_blocks) {
-            if let Some((e, d0)) = *slot {
-                let block = &mut self.blocks[e];
-                load.add_stiffness(mu.factor(load.scaling()), t, &|d| q[d], &mut |r, c, v| {
-                    block[(r - d0, c - d0)] += k * v
-                });
+            if let Some((e, dofs)) = slot {
+                let block = &mut self.blocks[*e];
+                let at = |d: usize| dofs.iter().position(|&x| x == d).expect("the block holds the load's dofs");
+                let (factor, q, v) = (mu.factor(load.scaling()), &|d| q[d], &|d| v[d]);
+                if k != 0.0 && load.has_stiffness() {
+                    load.add_stiffness(factor, t, q, v, &mut |r, col, x| block[(at(r), at(col))] += k * x);
+                }
+                if c != 0.0 && load.has_damping() {
+                    load.add_damping(factor, t, q, v, &mut |r, col, x| block[(at(r), at(col))] += c * x);
+                }
             }
         }
     }
@@ -513,9 +572,6 @@ impl FlexibleSystem {
     }
 }
 
-/// The element whose 8 consecutive dofs hold every one of `dofs`, and its first dof: the one
-/// that starts at the lowest node, or the last of its body (the block a nodal load's
-/// Jacobian is added to). A load whose coordinates span two elements has no such block.
 /// A moving row's `order`-th time derivative at μ and `t` ([`Row::at`] with its drive's
 /// factor at μ): its coefficients (the first `terms.len()` entries) and right-hand side.
 fn row_at(row: &Row, mu: &Parameters, t: f64, order: u32) -> ([f64; MOVING_TERMS], f64) {
@@ -525,7 +581,29 @@ fn row_at(row: &Row, mu: &Parameters, t: f64, order: u32) -> ([f64; MOVING_TERMS
     (b, rhs)
 }
 
-fn block_holding(elements: &[(usize, [usize; 8])], dofs: &[usize]) -> (usize, usize) {
+/// The iteration block a nodal load's Jacobian is added to and its dofs: the element that
+/// holds all its coordinates ([`block_holding`]), or else a coupling block over its two
+/// nodes' coordinates (numbered after the elements; one per pair of nodes, shared).
+fn load_block(elements: &[(usize, [usize; 8])], coupling: &mut Vec<[usize; 8]>, dofs: &[usize]) -> (usize, [usize; 8]) {
+    if let Some(e) = block_holding(elements, dofs) {
+        return (e, elements[e].1);
+    }
+    let mut nodes: Vec<usize> = dofs.iter().map(|d| d / 4).collect();
+    nodes.sort_unstable();
+    nodes.dedup();
+    let [a, b] = nodes[..] else { panic!("a load no element holds couples two nodes, not {}", nodes.len()) };
+    let block: [usize; 8] = std::array::from_fn(|i| 4 * if i < 4 { a } else { b } + i % 4);
+    let k = coupling.iter().position(|c| *c == block).unwrap_or_else(|| {
+        coupling.push(block);
+        coupling.len() - 1
+    });
+    (elements.len() + k, block)
+}
+
+/// The element whose 8 consecutive dofs hold every one of `dofs`: the one that starts at
+/// the lowest node, or the last of its body. A load whose coordinates span two elements
+/// has none.
+fn block_holding(elements: &[(usize, [usize; 8])], dofs: &[usize]) -> Option<usize> {
     let (lo, hi) = (dofs.iter().min().copied().unwrap_or(0), dofs.iter().max().copied().unwrap_or(0));
     let node_start = 4 * (lo / 4);
     let e = match elements.iter().position(|(_, d)| d[0] == node_start) {
@@ -533,7 +611,5 @@ fn block_holding(elements: &[(usize, [usize; 8])], dofs: &[usize]) -> (usize, us
         // the last node of a body: the element that ends there
         None => elements.iter().position(|(_, d)| d[4] == node_start).expect("a node of the mesh"),
     };
-    let d0 = elements[e].1[0];
-    assert!(hi < d0 + 8, "a load's Jacobian spans more than one element: no block of the iteration matrix holds it");
-    (e, d0)
+    (hi < elements[e].1[0] + 8).then_some(e)
 }

@@ -265,7 +265,7 @@ impl<M: InvariantElementModel> ParametricModel for HyperReducedModel<M> {
 
     fn force(&mut self, mu: &Parameters, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
         self.bind_parameters(mu);
-        self.p.constant_and_load_force(&*self.full, mu, q, t, out);
+        self.p.constant_and_load_force(&*self.full, mu, (q, v), t, out);
         self.l_q.add_product(&self.l_rows, q, out);
         out.iter_mut().zip(&self.l0).for_each(|(o, l)| *o += l);
         if let Some(c) = &self.c_rows {
@@ -279,13 +279,13 @@ impl<M: InvariantElementModel> ParametricModel for HyperReducedModel<M> {
         &mut self,
         mu: &Parameters,
         q: &[f64],
-        _v: &[f64],
+        v: &[f64],
         t: f64,
         coef: IterationCoefficients,
     ) -> Result<f64, String> {
         // m M_r + k (L_r + J_l,r) + c C_r
         self.bind_parameters(mu);
-        self.p.start_matrix(&*self.full, mu, q, t, coef);
+        self.p.start_matrix(&*self.full, mu, (q, v), t, coef);
         if coef.stiffness != 0.0 {
             self.update(q);
             self.tangent();

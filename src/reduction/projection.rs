@@ -117,6 +117,10 @@ pub(crate) struct Projection {
     v_load: Array2<f64>,
     x_ref_load: Array1<f64>,
     xl: Vec<f64>,
+    /// the velocities on the load dofs (zeros unless `load_damping`)
+    vl: Vec<f64>,
+    /// whether the loads read velocities (`ElementModel::load_has_damping`)
+    load_damping: bool,
     gl: Vec<f64>,
     jl: Vec<f64>,
     jv: Vec<f64>,
@@ -284,6 +288,8 @@ impl Projection {
             v_load,
             x_ref_load,
             xl: vec![0.0; nl],
+            vl: vec![0.0; nl],
+            load_damping: full.load_has_damping(),
             gl: vec![0.0; nl],
             jl: vec![0.0; nl * nl],
             jv: vec![0.0; nl * r],
@@ -333,12 +339,14 @@ impl Projection {
         self.mass_rows.mul(a, out, false);
     }
 
-    /// `out = g₀,r(μ) + g_l,r(q, t; μ)` (+ the whole-system coupling `(P + Pᵀ) q + c₀`)
+    /// `out = g₀,r(μ) + g_l,r(q, q̇, t; μ)` (+ the whole-system coupling `(P + Pᵀ) q + c₀`):
+    /// the loads evaluated exactly on the coordinates and velocities reconstructed on their
+    /// few dofs (`x_ref + V_l q`, `V_l q̇`; the velocities only for dampers).
     pub fn constant_and_load_force<M: ElementModel>(
         &mut self,
         full: &M,
         mu: &Parameters,
-        q: &[f64],
+        (q, v): (&[f64], &[f64]),
         t: f64,
         out: &mut [f64],
     ) {
@@ -359,7 +367,10 @@ impl Projection {
         }
         if !self.load_dofs.is_empty() {
             expand(&self.v_load, Some(&self.x_ref_load), 0, q, &mut self.xl);
-            full.load_force(mu, &self.xl, t, &mut self.gl);
+            if self.load_damping {
+                expand(&self.v_load, None, 0, v, &mut self.vl);
+            }
+            full.load_force(mu, &self.xl, &self.vl, t, &mut self.gl);
             project_add(&self.v_load, 0, &self.gl, out);
         }
         if let Some((pp, c0)) = &self.coupling {

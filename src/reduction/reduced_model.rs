@@ -139,7 +139,7 @@ impl<M: ElementModel> ParametricModel for ReducedModel<M> {
 
     fn force(&mut self, mu: &Parameters, q: &[f64], v: &[f64], t: f64, out: &mut [f64]) {
         self.bind_parameters(mu);
-        self.p.constant_and_load_force(&*self.full, mu, q, t, out);
+        self.p.constant_and_load_force(&*self.full, mu, (q, v), t, out);
         let ne = self.ne;
         self.update_element_coordinates(q);
         for (k, (&e, &w)) in self.elements.iter().zip(&self.weights).enumerate() {
@@ -154,13 +154,13 @@ impl<M: ElementModel> ParametricModel for ReducedModel<M> {
         &mut self,
         mu: &Parameters,
         q: &[f64],
-        _v: &[f64],
+        v: &[f64],
         t: f64,
         coef: IterationCoefficients,
     ) -> Result<f64, String> {
         let (r, ne) = (self.p.r, self.ne);
         self.bind_parameters(mu);
-        self.p.start_matrix(&*self.full, mu, q, t, coef);
+        self.p.start_matrix(&*self.full, mu, (q, v), t, coef);
         if coef.stiffness != 0.0 || coef.damping != 0.0 {
             self.update_element_coordinates(q);
             let ecoef = IterationCoefficients { mass: 0.0, ..coef };

@@ -213,12 +213,13 @@ impl<M: ParametricModel + ?Sized> DynamicModel for Bound<'_, M> {
 /// some elements). The physics implements it; the reduction knows nothing else about it.
 ///
 /// ```text
-///     g(q, q̇, t) = Σ_e Aₑᵀ fₑ(qₑ, q̇ₑ) + g₀ + A_lᵀ g_l(q_l, t)
+///     g(q, q̇, t) = Σ_e Aₑᵀ fₑ(qₑ, q̇ₑ) + g₀ + A_lᵀ g_l(q_l, q̇_l, t)
 /// ```
 ///
 /// with `fₑ` the element forces (internal and damping), `g₀` the constant applied loads
 /// (gravity, entering with a minus sign) and `g_l` the state- or time-dependent nodal loads
-/// on the dofs `load_dofs()`. Both are affine in the load scale `λ` of the parameters μ:
+/// on the dofs `load_dofs()` (moments, forces, and spring-dampers, which read the velocities
+/// too). Both are affine in the load scale `λ` of the parameters μ:
 /// `g₀(μ) = g₀,fixed + λ g₀,scaled`, and `g_l` takes μ.
 ///
 /// The element terms are those of the model file's own values. A parameter may scale an
@@ -240,10 +241,20 @@ pub trait ElementModel: ParametricModel {
     fn element_matrix(&self, e: usize, qe: &[f64], coef: IterationCoefficients, out: &mut [f64]);
     /// The dofs the state- or time-dependent loads act on (and depend on).
     fn load_dofs(&self) -> Vec<usize>;
-    /// `g_l(q_l, t; μ)` on `load_dofs()`, given `q` on the same dofs.
-    fn load_force(&self, mu: &Parameters, ql: &[f64], t: f64, out: &mut [f64]);
+    /// `g_l(q_l, q̇_l, t; μ)` on `load_dofs()`, given `q` and `q̇` on the same dofs (`q̇`
+    /// is read only when [`Self::load_has_damping`]: a caller may pass zeros otherwise).
+    fn load_force(&self, mu: &Parameters, ql: &[f64], vl: &[f64], t: f64, out: &mut [f64]);
     /// `∂g_l/∂q_l` at μ (column-major, `load_dofs().len()` square).
-    fn load_jacobian(&self, mu: &Parameters, ql: &[f64], t: f64, out: &mut [f64]);
+    fn load_jacobian(&self, mu: &Parameters, ql: &[f64], vl: &[f64], t: f64, out: &mut [f64]);
+    /// Whether `g_l` depends on the velocities (a damper between nodes).
+    fn load_has_damping(&self) -> bool {
+        false
+    }
+    /// `∂g_l/∂q̇_l` at μ (column-major, `load_dofs().len()` square), when
+    /// [`Self::load_has_damping`].
+    fn load_damping_jacobian(&self, _mu: &Parameters, _ql: &[f64], _vl: &[f64], _t: f64, out: &mut [f64]) {
+        out.iter_mut().for_each(|x| *x = 0.0);
+    }
     /// The parameter that scales element `e`'s stiffness, if any (elements that name the
     /// same parameter scale alike).
     fn stiffness_parameter(&self, _e: usize) -> Option<&str> {

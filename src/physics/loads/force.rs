@@ -1,7 +1,7 @@
 //! A force `F f(t)` at a node, on its position coordinates (`f = 1` without a function): a
 //! dead load, the same whatever the node's position, so it has no stiffness.
 
-use super::nodal::{NodalLoad, NodeIndex, Scaling};
+use super::nodal::{NodalLoad, NodeIndex, Read, Scaling};
 use crate::physics::parts::NodeId;
 use crate::physics::time_function::TimeFunction;
 
@@ -42,7 +42,7 @@ impl NodalLoad for NodalForce {
         &self.scaled
     }
 
-    fn add_force(&self, factor: f64, t: f64, _q: &dyn Fn(usize) -> f64, add: &mut dyn FnMut(usize, f64)) {
+    fn add_force(&self, factor: f64, t: f64, _q: Read, _v: Read, add: &mut dyn FnMut(usize, f64)) {
         let ft = factor * self.function.as_ref().map_or(1.0, |func| func.eval(t));
         add(self.dofs[0], -ft * self.value[0]);
         add(self.dofs[1], -ft * self.value[1]);
@@ -59,7 +59,7 @@ mod tests {
         let nodal = f.lower(&|(_, k)| 4 * k);
         assert_eq!(nodal.dofs(), &[8, 9]);
         let mut g = [0.0; 12];
-        nodal.add_force(1.5, 0.3, &|_| f64::NAN, &mut |d, v| g[d] += v);
+        nodal.add_force(1.5, 0.3, &|_| f64::NAN, &|_| f64::NAN, &mut |d, v| g[d] += v);
         // g carries −Q: −1.5 · (1, −2); the coordinates are not read (NaN would show)
         assert_eq!(&g[8..10], &[-1.5, 3.0]);
         assert!(!nodal.has_stiffness());

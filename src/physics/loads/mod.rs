@@ -1,5 +1,7 @@
 //! Loads, one file per kind: gravity (a body force, assembled once into the constant forces),
-//! moments and forces at nodes. A load that acts on a few coordinates is lowered to a
+//! moments and forces at nodes, and the spring-dampers between nodes (translational and
+//! torsional), which act on their nodes as loads that depend on the coordinates and
+//! velocities and store energy. A load that acts on a few coordinates is lowered to a
 //! [`NodalLoad`]: its generalized force `−Q_ext` and, where it depends on the coordinates,
 //! its Jacobian, over any set of global coordinates, times its amplitude factor (the load
 //! scale or a named parameter, [`Scaling`]): every load is affine in that factor.
@@ -11,12 +13,16 @@ mod force;
 mod gravity;
 mod moment;
 mod nodal;
+mod spring;
+mod torsional_spring;
 
 pub use force::{Force, NodalForce};
 pub use gravity::{assemble as assemble_weight, DensityWeight, Gravity, Weight, WeightParts};
 pub use moment::{moment_force, moment_jacobian, Moment, NodalMoment};
 
-pub use nodal::{NodalLoad, NodeIndex, Scaling};
+pub use nodal::{NodalLoad, NodeIndex, Read, Scaling};
+pub use spring::{NodalSpring, Spring, SpringEnd};
+pub use torsional_spring::{NodalTorsionalSpring, TorsionalSpring};
 
 /// A load of a model, one variant per kind.
 #[derive(Clone, Debug, PartialEq)]
@@ -24,7 +30,14 @@ pub enum Load {
     Gravity(Gravity),
     Moment(Moment),
     Force(Force),
+    /// a translational spring-damper (a `[[springs]]` entry)
+    Spring(Spring),
+    /// a torsional spring-damper (a `[[springs]]` entry of `type = "torsional"`)
+    TorsionalSpring(TorsionalSpring),
 }
+
+/// A spring is never scaled: neither the load scale nor a parameter stretches it.
+static FIXED: Scaling = Scaling::Fixed;
 
 impl Load {
     /// What multiplies the load: fixed, the load scale or a named parameter.
@@ -33,6 +46,7 @@ impl Load {
             Load::Gravity(l) => &l.scaled,
             Load::Moment(l) => &l.scaled,
             Load::Force(l) => &l.scaled,
+            Load::Spring(_) | Load::TorsionalSpring(_) => &FIXED,
         }
     }
 
@@ -43,6 +57,8 @@ impl Load {
             Load::Gravity(_) => None,
             Load::Moment(m) => Some(Box::new(m.lower(first))),
             Load::Force(f) => Some(Box::new(f.lower(first))),
+            Load::Spring(s) => Some(Box::new(s.lower(first))),
+            Load::TorsionalSpring(s) => Some(Box::new(s.lower(first))),
         }
     }
 }

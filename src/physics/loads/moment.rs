@@ -2,7 +2,7 @@
 //! `θ = atan2(y', x')`, so `δW = M δθ` with `δθ = (x' δy' − y' δx')/|r'|²`, giving
 //! `Q = M/|r'|² · (−y', x')`, which depends on the slope: the load has a stiffness.
 
-use super::nodal::{NodalLoad, NodeIndex, Scaling};
+use super::nodal::{NodalLoad, NodeIndex, Read, Scaling};
 use crate::physics::parts::NodeId;
 use crate::physics::time_function::TimeFunction;
 
@@ -41,7 +41,7 @@ impl NodalLoad for NodalMoment {
         &self.scaled
     }
 
-    fn add_force(&self, factor: f64, t: f64, q: &dyn Fn(usize) -> f64, add: &mut dyn FnMut(usize, f64)) {
+    fn add_force(&self, factor: f64, t: f64, q: Read, _v: Read, add: &mut dyn FnMut(usize, f64)) {
         let [a, b] = self.slope;
         let qm = moment_force(factor * self.function.eval(t), [q(a), q(b)]);
         add(a, -qm[0]);
@@ -52,7 +52,7 @@ impl NodalLoad for NodalMoment {
         true
     }
 
-    fn add_stiffness(&self, factor: f64, t: f64, q: &dyn Fn(usize) -> f64, add: &mut dyn FnMut(usize, usize, f64)) {
+    fn add_stiffness(&self, factor: f64, t: f64, q: Read, _v: Read, add: &mut dyn FnMut(usize, usize, f64)) {
         let j = moment_jacobian(factor * self.function.eval(t), [q(self.slope[0]), q(self.slope[1])]);
         // g carries −Q_ext, so its Jacobian enters with a minus sign
         for (r, &dr) in self.slope.iter().enumerate() {

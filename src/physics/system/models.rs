@@ -27,19 +27,33 @@ impl ElementModel for FlexibleSystem {
         self.load_dofs.clone()
     }
 
-    fn load_force(&self, mu: &Parameters, ql: &[f64], t: f64, out: &mut [f64]) {
+    fn load_force(&self, mu: &Parameters, ql: &[f64], vl: &[f64], t: f64, out: &mut [f64]) {
         out.iter_mut().for_each(|x| *x = 0.0);
-        self.add_nodal_loads(mu, t, |d| ql[self.local_load_index(d)], |d, v| out[self.local_load_index(d)] += v);
+        let at = |d| self.local_load_index(d);
+        self.add_nodal_loads(mu, t, |d| ql[at(d)], |d| vl[at(d)], |d, v| out[at(d)] += v);
     }
 
-    fn load_jacobian(&self, mu: &Parameters, ql: &[f64], t: f64, out: &mut [f64]) {
+    fn load_jacobian(&self, mu: &Parameters, ql: &[f64], vl: &[f64], t: f64, out: &mut [f64]) {
         let nl = self.load_dofs.len();
         out.iter_mut().for_each(|x| *x = 0.0);
-        let q = |d: usize| ql[self.local_load_index(d)];
+        let at = |d| self.local_load_index(d);
+        let (q, v) = (|d: usize| ql[at(d)], |d: usize| vl[at(d)]);
         for load in &self.nodal {
-            load.add_stiffness(mu.factor(load.scaling()), t, &q, &mut |r, c, v| {
-                out[self.local_load_index(c) * nl + self.local_load_index(r)] += v
-            });
+            load.add_stiffness(mu.factor(load.scaling()), t, &q, &v, &mut |r, c, x| out[at(c) * nl + at(r)] += x);
+        }
+    }
+
+    fn load_has_damping(&self) -> bool {
+        self.load_damping
+    }
+
+    fn load_damping_jacobian(&self, mu: &Parameters, ql: &[f64], vl: &[f64], t: f64, out: &mut [f64]) {
+        let nl = self.load_dofs.len();
+        out.iter_mut().for_each(|x| *x = 0.0);
+        let at = |d| self.local_load_index(d);
+        let (q, v) = (|d: usize| ql[at(d)], |d: usize| vl[at(d)]);
+        for load in self.nodal.iter().filter(|l| l.has_damping()) {
+            load.add_damping(mu.factor(load.scaling()), t, &q, &v, &mut |r, c, x| out[at(c) * nl + at(r)] += x);
         }
     }
 
@@ -177,7 +191,7 @@ impl ParametricModel for FlexibleSystem {
                 out[d] += f[i];
             }
         }
-        self.add_nodal_loads(mu, t, |d| q[d], |d, value| out[d] += value);
+        self.add_nodal_loads(mu, t, |d| q[d], |d| v[d], |d, value| out[d] += value);
     }
 
     /// [`Self::force`] and [`Self::mass_mul`] in one pass over the elements, each element's
@@ -215,7 +229,7 @@ impl ParametricModel for FlexibleSystem {
             }
         }
         self.add_point_mass_product(a, inertia);
-        self.add_nodal_loads(mu, t, |d| q[d], |d, value| force[d] += value);
+        self.add_nodal_loads(mu, t, |d| q[d], |d| v[d], |d, value| force[d] += value);
     }
 
     /// The constant rows as built; the moving ones ([`crate::physics::joints::Motion`]) at
@@ -267,7 +281,7 @@ impl ParametricModel for FlexibleSystem {
         &mut self,
         mu: &Parameters,
         q: &[f64],
-        _v: &[f64],
+        v: &[f64],
         t: f64,
         coef: IterationCoefficients,
     ) -> Result<f64, String> {
@@ -294,13 +308,16 @@ impl ParametricModel for FlexibleSystem {
             constants: &self.iteration_constant,
             stiffness: coef.stiffness,
             q,
-            blocks: &mut self.blocks,
+            blocks: &mut self.blocks[..self.elements.len()],
         });
         if coef.mass != 0.0 {
             self.add_point_mass_blocks(coef.mass);
         }
-        if coef.stiffness != 0.0 {
-            self.add_nodal_stiffness(mu, t, q, coef.stiffness);
+        let n_el = self.elements.len();
+        self.blocks[n_el..].iter_mut().for_each(|b| *b = Mat8::zeros());
+        let damping = if self.load_damping { coef.damping } else { 0.0 };
+        if coef.stiffness != 0.0 || damping != 0.0 {
+            self.add_nodal_jacobians(mu, t, (q, v), coef.stiffness, damping);
         }
         for (c, row) in &self.moving {
             let (b, _) = row_at(row, mu, t, 0);
@@ -309,9 +326,14 @@ impl ParametricModel for FlexibleSystem {
         let scale = if diag_max > 0.0 { diag_max } else { 1.0 };
         // sums of symmetric element matrices, each entry and its mirror computed alike
         // (BeamElement::iteration_block_from), plus the moments' Jacobians, whose two
-        // off-diagonal entries are one value (loads::moment_jacobian): symmetric to the bit
-        // (a test checks), so the solver need not check
-        self.kkt.factor_symmetric(&self.blocks, scale)?;
+        // off-diagonal entries are one value (loads::moment_jacobian), and undamped
+        // springs' (each entry and its mirror from the same products): symmetric to the bit
+        // (a test checks), so the solver need not check; a damper's Jacobian is not
+        if self.symmetric_loads {
+            self.kkt.factor_symmetric(&self.blocks, scale)?;
+        } else {
+            self.kkt.factor(&self.blocks, scale)?;
+        }
         Ok(scale)
     }
 
@@ -380,7 +402,7 @@ impl crate::linalg::simd::Kernel for IterationBlocks<'_> {
 mod tests {
     use super::*;
     use crate::physics::element::Section;
-    use crate::physics::loads::{Force, Gravity, Moment};
+    use crate::physics::loads::{Force, Gravity, Moment, Spring, SpringEnd, TorsionalSpring};
     use crate::physics::time_function::TimeFunction;
     use crate::solver::parameters::Scaling;
 
@@ -536,6 +558,122 @@ mod tests {
         let scale_k = k.amax();
         for (a, b) in k.as_slice().iter().zip(&k_ref) {
             assert!((a - b).abs() <= 1e-13 * scale_k, "tangent {a} vs {b}");
+        }
+    }
+
+    /// The springs' part of the iteration matrix (the blocks scattered through their dofs,
+    /// the elements' and the coupling blocks, less those of the system without springs) is
+    /// `c ∂g_s/∂q̇ + k ∂g_s/∂q` of their force by central differences, with springs between
+    /// two bodies (a coupling block), to the ground and within one element, a torsional
+    /// one, dampers on all; and the blocks are symmetric to the bit without dampers.
+    #[test]
+    fn springs_enter_the_iteration_matrix_as_the_force_s_jacobians() {
+        let springs = |c: f64| {
+            vec![
+                Load::Spring(Spring {
+                    a: (0, 3),
+                    b: SpringEnd::Node((1, 0)),
+                    stiffness: 400.0,
+                    damping: c,
+                    length: 0.4,
+                }),
+                Load::Spring(Spring {
+                    a: (1, 2),
+                    b: SpringEnd::Point([0.5, -0.3]),
+                    stiffness: 90.0,
+                    damping: c,
+                    length: 0.1,
+                }),
+                Load::Spring(Spring {
+                    a: (0, 1),
+                    b: SpringEnd::Node((0, 2)),
+                    stiffness: 50.0,
+                    damping: c,
+                    length: 0.2,
+                }),
+                Load::TorsionalSpring(TorsionalSpring { a: (0, 3), b: (1, 0), stiffness: 7.0, damping: c, angle: 0.2 }),
+            ]
+        };
+        let mut b = aluminium_body("b", 2);
+        b.start = [0.6, 0.1];
+        let system = |loads: &[Load]| {
+            FlexibleSystem::new(
+                vec![aluminium_body("a", 3), b.clone()],
+                &[],
+                loads,
+                &[],
+                vec![],
+                Rayleigh::default(),
+                LinearSolverKind::Banded,
+            )
+        };
+        let mu = Parameters::load_scale(1.0);
+        let coef = IterationCoefficients { mass: 0.0, damping: 0.7, stiffness: 1.3 };
+        // the dense iteration matrix and the force of a system
+        let matrix = |sys: &mut FlexibleSystem, q: &[f64], v: &[f64]| {
+            let n = q.len();
+            ParametricModel::factor(sys, &mu, q, v, 0.0, coef).unwrap();
+            let mut s = vec![0.0; n * n];
+            for k in 0..sys.n_blocks() {
+                let d = *sys.block_dofs(k);
+                for i in 0..8 {
+                    for j in 0..8 {
+                        s[d[i] * n + d[j]] += sys.blocks[k][(i, j)];
+                    }
+                }
+            }
+            s
+        };
+        let force = |sys: &mut FlexibleSystem, q: &[f64], v: &[f64]| {
+            let mut g = vec![0.0; q.len()];
+            ParametricModel::force(sys, &mu, q, v, 0.0, &mut g);
+            g
+        };
+        let mut bare = system(&[]);
+        for c in [0.0, 0.3] {
+            let mut sys = system(&springs(c));
+            // one coupling block: a's end and b's start are in no element together
+            assert_eq!(sys.n_blocks(), sys.n_elements() + 1);
+            let n = ParametricModel::n_dof(&sys);
+            let q: Vec<f64> =
+                sys.initial_state().iter().enumerate().map(|(i, x)| x + 0.02 * (i as f64 * 0.9).sin()).collect();
+            let v: Vec<f64> = (0..n).map(|i| 0.5 * (i as f64 * 0.4).cos()).collect();
+            let (with, without) = (matrix(&mut sys, &q, &v), matrix(&mut bare, &q, &v));
+            let s: Vec<f64> = with.iter().zip(&without).map(|(a, b)| a - b).collect();
+            let mut spring_force = |q: &[f64], v: &[f64]| -> Vec<f64> {
+                force(&mut sys, q, v).iter().zip(force(&mut bare, q, v)).map(|(a, b)| a - b).collect()
+            };
+            // the elements' forces (~1e5 N at this strain) leave a round-off of ~1e-11 N in
+            // the difference: h = 1e-5 keeps it at 1e-6 N/m, its truncation (h/L)² ~ 1e-9
+            let h = 1e-5;
+            let scale = s.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+            assert!(scale > 100.0, "the springs' part is there: {scale}");
+            for col in 0..n {
+                let mut fd = vec![0.0; n];
+                for (wrt, f) in [(0, coef.stiffness), (1, coef.damping)] {
+                    let (mut plus, mut minus) = ([q.clone(), v.clone()], [q.clone(), v.clone()]);
+                    plus[wrt][col] += h;
+                    minus[wrt][col] -= h;
+                    let (gp, gm) = (spring_force(&plus[0], &plus[1]), spring_force(&minus[0], &minus[1]));
+                    for r in 0..n {
+                        fd[r] += f * (gp[r] - gm[r]) / (2.0 * h);
+                    }
+                }
+                for r in 0..n {
+                    // 1e-6 of the largest entry: above the differences' truncation and round-off
+                    let want = s[r * n + col];
+                    assert!((fd[r] - want).abs() <= 1e-6 * scale, "c = {c}: ({r}, {col}) {} vs {want}", fd[r]);
+                }
+            }
+            if c == 0.0 {
+                for (k, blk) in sys.blocks.iter().enumerate() {
+                    for i in 0..8 {
+                        for j in 0..8 {
+                            assert_eq!(blk[(i, j)].to_bits(), blk[(j, i)].to_bits(), "block {k} ({i}, {j})");
+                        }
+                    }
+                }
+            }
         }
     }
 }

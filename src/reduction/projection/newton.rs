@@ -54,12 +54,13 @@ impl Projection {
 
     /// Starts the reduced iteration matrix (column-major, (r + nc)²): the constant part
     /// `m M_r + k (L_r + P + Pᵀ) + c C_r` (kept for the last coefficients, since they change
-    /// only with the step size) plus `k J_l,r(q, t)`; the model adds its element terms.
+    /// only with the step size) plus `k J_l,r(q, q̇, t)` and, for dampers between nodes,
+    /// `c D_l,r(q, q̇, t)` (the loads' velocity Jacobian); the model adds its element terms.
     pub fn start_matrix<M: ElementModel>(
         &mut self,
         full: &M,
         mu: &Parameters,
-        q: &[f64],
+        (q, v): (&[f64], &[f64]),
         t: f64,
         coef: IterationCoefficients,
     ) {
@@ -92,37 +93,25 @@ impl Projection {
         }
         let (a, _) = matrix_of(&mut self.elim, &mut self.lu, r, self.nc);
         a.copy_from_slice(&self.base);
-        if coef.stiffness != 0.0 && !self.load_dofs.is_empty() {
-            let nl = self.load_dofs.len();
-            expand(&self.v_load, Some(&self.x_ref_load), 0, q, &mut self.xl);
-            full.load_jacobian(mu, &self.xl, t, &mut self.jl);
-            if self.symmetric {
-                for a_ in 0..nl {
-                    for b in 0..a_ {
-                        let m = 0.5 * (self.jl[a_ * nl + b] + self.jl[b * nl + a_]);
-                        self.jl[a_ * nl + b] = m;
-                        self.jl[b * nl + a_] = m;
-                    }
-                }
-            }
-            // J V_l (nl × r, row-major), then V_lᵀ (J V_l)
-            for a_ in 0..nl {
-                let row = &mut self.jv[a_ * r..(a_ + 1) * r];
-                row.fill(0.0);
-                for b in 0..nl {
-                    axpy(self.jl[b * nl + a_], self.v_load.row(b).as_slice().expect("standard layout"), row);
-                }
-            }
-            // column by column (contiguous in the column-major matrix)
-            for a_ in 0..nl {
-                let (jv, vl) = (&self.jv[a_ * r..(a_ + 1) * r], self.v_load.row(a_));
-                let vl = vl.as_slice().expect("standard layout");
-                for (j, &x) in jv.iter().enumerate() {
-                    if x != 0.0 {
-                        axpy(coef.stiffness * x, vl, &mut a[n * j..n * j + r]);
-                    }
-                }
-            }
+        if self.load_dofs.is_empty() {
+            return;
+        }
+        let damping = if self.load_damping { coef.damping } else { 0.0 };
+        if coef.stiffness == 0.0 && damping == 0.0 {
+            return;
+        }
+        expand(&self.v_load, Some(&self.x_ref_load), 0, q, &mut self.xl);
+        if self.load_damping {
+            expand(&self.v_load, None, 0, v, &mut self.vl);
+        }
+        let loads = LoadBlock { v_load: &self.v_load, symmetric: self.symmetric, r, n };
+        if coef.stiffness != 0.0 {
+            full.load_jacobian(mu, &self.xl, &self.vl, t, &mut self.jl);
+            loads.add(&mut self.jl, &mut self.jv, coef.stiffness, a);
+        }
+        if damping != 0.0 {
+            full.load_damping_jacobian(mu, &self.xl, &self.vl, t, &mut self.jl);
+            loads.add(&mut self.jl, &mut self.jv, damping, a);
         }
     }
 
@@ -201,5 +190,49 @@ fn matrix_of<'a>(
     match elim {
         Some(e) => (&mut e.s, r),
         None => (lu.matrix_mut(), r + nc),
+    }
+}
+
+/// Projects a load Jacobian `J` (on the load dofs, column-major) into the iteration matrix:
+/// `a += f V_lᵀ J V_l` (with [`Projection::symmetric_newton_matrix`], of `J`'s symmetric
+/// part).
+struct LoadBlock<'a> {
+    v_load: &'a Array2<f64>,
+    symmetric: bool,
+    r: usize,
+    /// the leading dimension of `a`
+    n: usize,
+}
+
+impl LoadBlock<'_> {
+    fn add(&self, jl: &mut [f64], jv: &mut [f64], f: f64, a: &mut [f64]) {
+        let (r, n, nl) = (self.r, self.n, self.v_load.nrows());
+        if self.symmetric {
+            for a_ in 0..nl {
+                for b in 0..a_ {
+                    let m = 0.5 * (jl[a_ * nl + b] + jl[b * nl + a_]);
+                    jl[a_ * nl + b] = m;
+                    jl[b * nl + a_] = m;
+                }
+            }
+        }
+        // J V_l (nl × r, row-major), then V_lᵀ (J V_l)
+        for a_ in 0..nl {
+            let row = &mut jv[a_ * r..(a_ + 1) * r];
+            row.fill(0.0);
+            for b in 0..nl {
+                axpy(jl[b * nl + a_], self.v_load.row(b).as_slice().expect("standard layout"), row);
+            }
+        }
+        // column by column (contiguous in the column-major matrix)
+        for a_ in 0..nl {
+            let (jv, vl) = (&jv[a_ * r..(a_ + 1) * r], self.v_load.row(a_));
+            let vl = vl.as_slice().expect("standard layout");
+            for (j, &x) in jv.iter().enumerate() {
+                if x != 0.0 {
+                    axpy(f * x, vl, &mut a[n * j..n * j + r]);
+                }
+            }
+        }
     }
 }
