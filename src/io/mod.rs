@@ -14,4 +14,5 @@ pub mod modes_file;
 pub mod output;
 pub mod parameter_space_file;
 pub mod result_file;
+pub mod result_read;
 pub mod timing_file;
