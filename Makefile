@@ -5,7 +5,7 @@
 # The system libraries (HDF5, OpenBLAS) are installed through apt when missing, as root or
 # through sudo; they are linked statically (build.rs, docs/startup.md), and gfortran brings
 # libgfortran.a for OpenBLAS's LAPACK (without it the shared libgfortran.so.5 is linked).
-# h5py, matplotlib, pytest and maturin (the Python package's build and tests, the read-back
+# h5py, matplotlib, pytest, meshio and maturin (the Python package's build and tests, the read-back
 # tests, the README's plotting example) are installed with pip when python3 is there and
 # they are not.
 
@@ -22,8 +22,8 @@ deps:
 		$(SUDO) apt-get update -qq && \
 		DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends $$missing; \
 	fi
-	@if command -v python3 >/dev/null && ! python3 -c "import h5py, numpy, matplotlib, pytest, maturin" 2>/dev/null; then \
-		python3 -m pip install --quiet --root-user-action=ignore h5py numpy matplotlib pytest "maturin>=1.9,<2" 2>/dev/null || echo "note: h5py/matplotlib/pytest/maturin not installed; the Python tests will fail or be skipped"; \
+	@if command -v python3 >/dev/null && ! python3 -c "import h5py, numpy, matplotlib, pytest, maturin, meshio" 2>/dev/null; then \
+		python3 -m pip install --quiet --root-user-action=ignore h5py numpy matplotlib pytest meshio "maturin>=1.9,<2" 2>/dev/null || echo "note: h5py/matplotlib/pytest/meshio/maturin not installed; the Python tests will fail or be skipped"; \
 	fi
 
 run: deps

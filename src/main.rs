@@ -221,6 +221,24 @@ flops) or the memory bound; --dense forces it.
         exit_codes!()
     ))]
     Run(cli::run::Args),
+    /// Draw a result file's motion as an animated GIF (deformed centre lines, joints, probes).
+    #[command(after_help = concat!(
+        "Examples:
+  flexrom animate out/pendulum.h5 -o out/pendulum.gif
+  flexrom animate full.h5 --compare reduced.h5 -o compare.gif --fps 25 --size 800x500
+  flexrom animate out/p5000.h5 -o p5000.gif --max-frames 100 --size 480
+
+The centre lines are drawn from the elements' cubic interpolation (4 points an element; a
+big mesh evenly subsampled along its bodies), ground joints as triangles, joints between
+bodies as rings, point masses as discs, probes as crosses, on equal axes fitted to the whole
+motion. A long run is shown at --max-frames evenly spaced instants. A reduced result
+(`online`) holds its reconstructed coordinates and is drawn alike. -o must end in .gif; an
+existing file there is replaced only when it is an animation flexrom wrote.
+
+",
+        exit_codes!()
+    ))]
+    Animate(cli::animate::Args),
     /// Run each model and print its probe positions at a few times.
     #[command(after_help = concat!(
         "Examples:
@@ -319,6 +337,7 @@ fn run(cli: Cli, limits: &flexrom::limits::Limits) -> flexrom::Result<()> {
         Command::Merge(a) => a.run(limits),
         Command::Run(a) => a.run(limits),
         Command::Demo(a) => a.run(limits),
+        Command::Animate(a) => a.run(limits),
     }
 }
 

@@ -1,7 +1,7 @@
 # Type stubs of the native module (python/src/lib.rs). Arrays are float64 numpy arrays in
 # the layout of flexrom's HDF5 files: time first.
 from os import PathLike
-from typing import Any, Callable, Dict, List, Optional, Sequence, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -103,6 +103,13 @@ class Result:
     @property
     def n_modes(self) -> Optional[int]: ...
     def to_hdf5(self, path: _Path) -> None: ...
+    def animate(
+        self,
+        path: _Path,
+        fps: float = 20.0,
+        size: Optional[Tuple[int, int]] = None,
+        max_frames: int = 200,
+    ) -> None: ...
 
 class Basis:
     @staticmethod

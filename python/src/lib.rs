@@ -554,6 +554,32 @@ impl PyRunResult {
         py.detach(|| self.write(&path)).map_err(to_py)
     }
 
+    /// Draws the run's motion as an animated GIF at `path` (as `flexrom animate` does:
+    /// docs/cli.md): the result is written to a temporary file beside `path`, animated, and
+    /// removed. `path` must end in .gif; an existing file is replaced only when flexrom
+    /// wrote it.
+    #[pyo3(signature = (path, fps = 20.0, size = None, max_frames = 200))]
+    fn animate(
+        &self,
+        py: Python<'_>,
+        path: PathBuf,
+        fps: f64,
+        size: Option<(u32, u32)>,
+        max_frames: usize,
+    ) -> PyResult<()> {
+        use flexrom::pipeline::animate::{animate, check_own_gif, AnimateOptions};
+        check_own_gif(&path, "path", &[(&self.model.path, "model file")]).map_err(to_py)?;
+        let defaults = AnimateOptions::default();
+        let size = size.map_or(defaults.size, |(w, h)| (w, Some(h)));
+        let opts = AnimateOptions { fps, size, max_frames: max_frames.max(2) };
+        py.detach(|| {
+            let tmp = flexrom::io::atomic::TempPath::file_for(&path.with_extension("h5"))?;
+            self.write(tmp.path())?;
+            animate(tmp.path(), None, &path, &opts, &self.model.limits).map(|_| ())
+        })
+        .map_err(to_py)
+    }
+
     fn __repr__(&self) -> String {
         let kind = if self.reduced.is_some() { "reduced" } else { "full" };
         format!(

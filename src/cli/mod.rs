@@ -2,6 +2,7 @@
 //! what they share: the `--csv`/`--json` and `--dense`/`--no-dense` flags and the printing of
 //! tables and run details. `main.rs` parses the command line and dispatches here.
 
+pub mod animate;
 pub mod demo;
 pub mod merge;
 pub mod modes;

@@ -36,6 +36,11 @@ pub struct Args {
     /// pipeline's [online] fallback, default none
     #[arg(long, value_enum, value_name = "WHAT")]
     fallback: Option<flexrom::pipeline::sweep::Fallback>,
+    /// also write ParaView's view beside the result: the deformed centre lines at every
+    /// instant (4 points an element) with strain, curvature and velocity, in the result
+    /// file's /paraview and an XDMF file of the same stem (out.h5 → out.xdmf)
+    #[arg(long, requires = "output")]
+    paraview: bool,
     #[command(flatten)]
     estimate: EstimateArgs,
     #[command(flatten)]
@@ -44,7 +49,7 @@ pub struct Args {
 
 impl Args {
     pub fn run(self, limits: &Limits) -> flexrom::Result<()> {
-        let Args { pipeline, load_scale, params, output, basis, strict, fallback, estimate, format } = self;
+        let Args { pipeline, load_scale, params, output, basis, strict, fallback, paraview, estimate, format } = self;
         let p = Pipeline::load_with(&pipeline, limits.clone())?;
         // λ checked finite with the named values
         let mu = params.parameters(load_scale, 1.0)?;
@@ -62,12 +67,15 @@ impl Args {
             &[(&p.path, "pipeline file"), (&p.model.path, "model file"), (&path, "basis file")],
             &[Kind::Result],
         )?;
+        if paraview {
+            flexrom::io::paraview::check_xdmf_output(&output)?;
+        }
         let (stored, rom, warnings) = load_rom(&p, &path, estimate.method(), false)?;
         warn(&warnings);
         // read before the run (a damaged /timing fails now), said after it
         let notice = flexrom::pipeline::route::speed_notice_of(&path, &rom)?;
         let fallback = fallback.or(p.online_fallback()).unwrap_or_default();
-        let done = online_to_file(&p, &rom, &path, &mu, &output, fallback)?;
+        let done = online_to_file(&p, &rom, &path, &mu, &output, fallback, paraview)?;
         let (run, estimate) = (&done.run, &done.estimate);
         let st = &run.result.stats;
         info(&format!(

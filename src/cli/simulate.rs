@@ -21,6 +21,11 @@ pub struct Args {
     /// probes on stdout and write no file
     #[arg(short, long, required_unless_present_any = ["csv", "json"])]
     output: Option<PathBuf>,
+    /// also write ParaView's view beside the result: the deformed centre lines at every
+    /// instant (4 points an element) with strain, curvature and velocity, in the result
+    /// file's /paraview and an XDMF file of the same stem (out.h5 → out.xdmf)
+    #[arg(long, requires = "output")]
+    paraview: bool,
     #[command(flatten)]
     run: RunArgs,
     #[command(flatten)]
@@ -29,9 +34,12 @@ pub struct Args {
 
 impl Args {
     pub fn run(self, limits: &Limits) -> flexrom::Result<()> {
-        let Args { model, output, run, format } = self;
+        let Args { model, output, paraview, run, format } = self;
         if let Some(output) = &output {
             check_output(output, Origin::Flag("-o"), &[(&model, "model file")], &[Kind::Result])?;
+            if paraview {
+                flexrom::io::paraview::check_xdmf_output(output)?;
+            }
         }
         let model = Model::load_with(&model, limits.clone())?;
         let overrides = run.overrides()?;
@@ -51,7 +59,16 @@ impl Args {
                 let plan = RunPlan::of(&model, &settings);
                 let (file, r) =
                     begin_alongside(output, &model.text, &model.path.display().to_string(), &plan, compute)?;
-                file.finish(&r, |_| Ok(()))?;
+                let mut layout = None;
+                file.finish(&r, |f| {
+                    if paraview {
+                        layout = Some(flexrom::io::paraview::extra(f, output, model.bodies(), &r)?);
+                    }
+                    Ok(())
+                })?;
+                if let Some(layout) = layout {
+                    flexrom::io::paraview::write_xdmf(output, &layout)?;
+                }
                 r
             }
             // --csv or --json alone: the probes on stdout, no file

@@ -30,6 +30,11 @@ pub struct Args {
     /// linear solver
     #[arg(long, value_enum, default_value_t = LinearSolverKind::Banded)]
     solver: LinearSolverKind,
+    /// also write ParaView's view beside the result: the deformed centre lines at every
+    /// instant (4 points an element) with strain, curvature and velocity, in the result
+    /// file's /paraview and an XDMF file of the same stem (out.h5 → out.xdmf)
+    #[arg(long, requires = "output")]
+    paraview: bool,
     #[command(flatten)]
     format: FormatArgs,
 }
@@ -59,9 +64,12 @@ impl LoadArgs {
 
 impl Args {
     pub fn run(self, limits: &Limits) -> flexrom::Result<()> {
-        let Args { model, output, loads, steps, solver, format } = self;
+        let Args { model, output, loads, steps, solver, paraview, format } = self;
         if let Some(output) = &output {
             check_output(output, Origin::Flag("-o"), &[(&model, "model file")], &[Kind::Result])?;
+            if paraview {
+                flexrom::io::paraview::check_xdmf_output(output)?;
+            }
         }
         let model = Model::load_with(&model, limits.clone())?;
         let mu = loads.parameters()?;
@@ -72,7 +80,11 @@ impl Args {
             let file =
                 ResultFile::begin(output, &model.text, &model.path.display().to_string(), &RunPlan::of_result(&r))?;
             let factors: Vec<f64> = solution.steps.iter().map(|s| s.load_factor).collect();
+            let mut layout = None;
             file.finish(&r, |f| {
+                if paraview {
+                    layout = Some(flexrom::io::paraview::extra(f, output, model.bodies(), &r)?);
+                }
                 let e = |err: hdf5::Error| flexrom::Error::hdf5(output, err);
                 attr_str(f, "analysis", "statics").map_err(e)?;
                 attr_f64(f, "time", o.t).map_err(e)?;
@@ -80,6 +92,9 @@ impl Args {
                 f.new_dataset_builder().with_data(&factors).create("load_factor").map_err(e)?;
                 Ok(())
             })?;
+            if let Some(layout) = layout {
+                flexrom::io::paraview::write_xdmf(output, &layout)?;
+            }
         }
         let written = output.as_ref().map_or("no result file (-o not given)".to_string(), |o| o.display().to_string());
         info(&format!(

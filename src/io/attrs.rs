@@ -96,7 +96,7 @@ const MODES: [Entry; 5] = [
     ("q", COORDINATE_UNITS, "dof"),
 ];
 
-const RESULT: [Entry; 10] = [
+const RESULT: [Entry; 15] = [
     ("t", "s", "time"),
     ("q", COORDINATE_UNITS, "time, dof"),
     ("qd", VELOCITY_UNITS, "time, dof"),
@@ -107,6 +107,11 @@ const RESULT: [Entry; 10] = [
     ("energy/*", "J", "time"),
     ("load_factor", "1", "time"),
     ("reduced/q", REDUCED_UNITS, "time, mode"),
+    ("paraview/lines", "1", "segment, end"),
+    ("paraview/points/*", "m", "point, xyz"),
+    ("paraview/velocity/*", "m/s", "point, xyz"),
+    ("paraview/strain/*", "1", "point"),
+    ("paraview/curvature/*", "1/m", "point"),
 ];
 
 const BASIS: [Entry; 54] = [

@@ -13,5 +13,7 @@ pub mod labels;
 pub mod modes_file;
 pub mod output;
 pub mod parameter_space_file;
+pub mod paraview;
 pub mod result_file;
+pub mod result_read;
 pub mod timing_file;

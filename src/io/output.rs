@@ -78,6 +78,19 @@ fn identity(p: &Path) -> Option<(u64, u64)> {
 /// symlink, and a path whose nearest existing ancestor is not a folder. Missing folders are
 /// created at write time ([`super::atomic::TempPath::file_for`]), for every command alike.
 pub fn check_output(output: &Path, origin: Origin, inputs: &[(&Path, &str)], kinds: &[Kind]) -> Result<()> {
+    check_output_with(output, origin, inputs, |o| check_own_file(o, origin, kinds))?;
+    // after the checks that name an input or a file of the user's, which say more
+    check_extension(output, origin, kinds)
+}
+
+/// [`check_output`] with the check of an existing file's owner given: `own` refuses an
+/// existing file flexrom must not replace (an animation's GIF is no HDF5 file).
+pub fn check_output_with(
+    output: &Path,
+    origin: Origin,
+    inputs: &[(&Path, &str)],
+    own: impl FnOnce(&Path) -> Result<()>,
+) -> Result<()> {
     if !names_an_entry(output) {
         return Err(origin.error(output, "does not name a file"));
     }
@@ -130,10 +143,9 @@ pub fn check_output(output: &Path, origin: Origin, inputs: &[(&Path, &str)], kin
         }
     }
     if std::fs::metadata(output).is_ok() {
-        check_own_file(output, origin, kinds)?;
+        own(output)?;
     }
-    // after the checks that name an input or a file of the user's, which say more
-    check_extension(output, origin, kinds)
+    Ok(())
 }
 
 /// The extensions of an HDF5 file, which every kind of [`Kind`] is.

@@ -349,6 +349,11 @@ impl Model {
         &self.joints
     }
 
+    /// The validated point masses, in file order.
+    pub fn masses(&self) -> &[PointMass] {
+        &self.masses
+    }
+
     pub fn probe_names(&self) -> Vec<String> {
         self.probes.iter().map(|p| p.name.clone()).collect()
     }

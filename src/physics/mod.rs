@@ -1,5 +1,6 @@
 //! The mechanics: element, loads, time functions and the assembled system. Knows nothing of
 //! reduction.
+pub mod centre_line;
 pub mod element;
 pub mod joints;
 pub mod loads;

@@ -3,6 +3,7 @@
 //! runs) → `validate` (error norms, timings) → `sweep` (many load scales) → `run` (all of
 //! it, with a report).
 
+pub mod animate;
 pub mod basis_build;
 pub mod config;
 pub mod dense;

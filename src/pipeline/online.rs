@@ -128,7 +128,8 @@ pub fn answer(rom: &Rom, mu: &Parameters, fallback: Fallback) -> Result<OnlineRu
 /// model runs and the file is its result (as `simulate` writes it) with the attribute
 /// `fallback` (why), the basis, and the estimate's attributes of an exact answer (0);
 /// where the full run fails too, a reduced answer stands with the attribute
-/// `fallback_failed`.
+/// `fallback_failed`. With `paraview`, the file also holds ParaView's datasets and an
+/// XDMF file is written beside it ([`crate::io::paraview`]).
 pub fn online_to_file(
     p: &Pipeline,
     rom: &Rom,
@@ -136,6 +137,7 @@ pub fn online_to_file(
     mu: &Parameters,
     out: &Path,
     fallback: Fallback,
+    paraview: bool,
 ) -> Result<OnlineRun> {
     // a run too large for the memory bound is refused before the file is begun
     let settings = settings_at(&p.model, mu)?;
@@ -151,8 +153,12 @@ pub fn online_to_file(
     let basis_name = crate::io::output::resolve(basis_path).display().to_string();
     let trust = rom.trust().cloned().unwrap_or_else(|| Trust::range((f64::NAN, f64::NAN)));
     let (run, estimate) = (&done.run, done.estimate.as_ref());
+    let mut layout = None;
     file.finish(&run.result, |f| {
         let e = |err: hdf5::Error| Error::hdf5(out, err);
+        if paraview {
+            layout = Some(crate::io::paraview::extra(f, out, p.model.bodies(), &run.result)?);
+        }
         attr_str(f, "basis", &basis_name).map_err(e)?;
         if let Some(why) = &done.fallback {
             attr_str(f, "fallback", why).map_err(e)?;
@@ -168,5 +174,8 @@ pub fn online_to_file(
         let method = if done.fallback.is_some() { None } else { rom.method() };
         write_run_attributes(f, estimate, method, &trust, mu, done.extrapolated).map_err(e)
     })?;
+    if let Some(layout) = layout {
+        crate::io::paraview::write_xdmf(out, &layout)?;
+    }
     Ok(done)
 }

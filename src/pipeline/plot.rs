@@ -49,7 +49,7 @@ const WIDTH: u32 = 960;
 const LEGEND: u32 = 210;
 const PANEL_HEIGHT: u32 = 300;
 /// Colour-blind-safe palette (Okabe & Ito 2008), in order of use.
-const COLORS: [RGBColor; 7] = [
+pub const COLORS: [RGBColor; 7] = [
     RGBColor(0, 114, 178),
     RGBColor(213, 94, 0),
     RGBColor(0, 158, 115),
@@ -60,7 +60,7 @@ const COLORS: [RGBColor; 7] = [
 ];
 const MARKER_COLOR: RGBColor = RGBColor(120, 120, 120);
 
-fn register_font() {
+pub fn register_font() {
     // both backends measure (and the PNG one draws) text with this font, built into the
     // binary: no system fonts needed on a fresh machine
     static ONCE: std::sync::Once = std::sync::Once::new();
@@ -104,7 +104,7 @@ fn log_labels(lo: f64, hi: f64) -> impl Fn(&f64) -> String {
 /// for spans below 1e-3, where fixed decimals would print every tick as 0). A tick within
 /// 1e-9 of the span of zero is 0: plotters computes ticks as lo + k·step, so the tick at
 /// zero carries the round-off of the span (it printed as -2.7e-20 on a probe-error axis).
-fn linear_labels(lo: f64, hi: f64) -> impl Fn(&f64) -> String {
+pub fn linear_labels(lo: f64, hi: f64) -> impl Fn(&f64) -> String {
     let span = (hi - lo).abs();
     move |v: &f64| {
         let v = &if v.abs() <= 1e-9 * span { 0.0 } else { *v };

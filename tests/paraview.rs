@@ -1,0 +1,103 @@
+//! `--paraview`: the XDMF file beside a result is well-formed XML whose every `DataItem`
+//! names a dataset of the result file with the shape it states; the points are the
+//! centre line (the tip probe at ξ = 1 is the last sample, to round-off: both are S(1) e,
+//! the tip node), the pinned end does not move (velocity 0 at the pin), and without the
+//! option nothing is added.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn flexrom(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_flexrom")).args(args).env("HDF5_USE_FILE_LOCKING", "FALSE").output().unwrap()
+}
+
+fn ok(args: &[&str]) -> Output {
+    let o = flexrom(args);
+    assert!(o.status.success(), "flexrom {args:?}: {}", String::from_utf8_lossy(&o.stderr));
+    o
+}
+
+fn model(name: &str) -> String {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("data/models").join(name).display().to_string()
+}
+
+/// The tags of `xml`, checked to nest (every open tag closed in order, `<?...?>` and
+/// `<.../>` standing alone); returns (name, attributes text, text after it) per tag.
+fn well_formed(xml: &str) -> Vec<(String, String, String)> {
+    let mut stack: Vec<String> = Vec::new();
+    let mut tags = Vec::new();
+    let mut rest = xml;
+    while let Some(start) = rest.find('<') {
+        let end = rest[start..].find('>').expect("every < closed by >") + start;
+        let tag = &rest[start + 1..end];
+        let after = &rest[end + 1..];
+        let text = after[..after.find('<').unwrap_or(after.len())].trim().to_string();
+        if tag.starts_with('?') {
+            assert!(tag.ends_with('?'));
+        } else if let Some(name) = tag.strip_prefix('/') {
+            assert_eq!(stack.pop().as_deref(), Some(name), "closing tag </{name}> out of order");
+        } else {
+            let name: String = tag.chars().take_while(|c| !c.is_whitespace() && *c != '/').collect();
+            let attrs = tag[name.len()..].trim_end_matches('/').to_string();
+            assert_eq!(attrs.matches('"').count() % 2, 0, "quotes of <{tag}>");
+            if !tag.ends_with('/') {
+                stack.push(name.clone());
+            }
+            tags.push((name, attrs, text));
+        }
+        rest = &rest[end + 1..];
+    }
+    assert!(stack.is_empty(), "unclosed: {stack:?}");
+    tags
+}
+
+fn attr(attrs: &str, name: &str) -> String {
+    let key = format!("{name}=\"");
+    let s = &attrs[attrs.find(&key).unwrap_or_else(|| panic!("{name} in {attrs}")) + key.len()..];
+    s[..s.find('"').unwrap()].to_string()
+}
+
+#[test]
+fn the_xdmf_names_the_datasets_it_describes() {
+    let dir = tempfile::tempdir().unwrap();
+    let h5 = dir.path().join("p.h5");
+    // the pendulum (50 elements, one body) over 4 steps of 0.005 s: 5 instants, 201 points
+    ok(&["simulate", &model("pendulum.toml"), "-o", h5.to_str().unwrap(), "--t-end", "0.02", "--paraview", "-q"]);
+    let xml = std::fs::read_to_string(dir.path().join("p.xdmf")).unwrap();
+    let tags = well_formed(&xml);
+    assert_eq!(tags.iter().filter(|t| t.0 == "Time").count(), 5);
+    let f = hdf5::File::open(&h5).unwrap();
+    let mut items = 0;
+    for (_, attrs, text) in tags.iter().filter(|t| t.0 == "DataItem") {
+        let (file, path) = text.split_once(':').unwrap();
+        assert_eq!(file, "p.h5");
+        let dims: Vec<usize> = attr(attrs, "Dimensions").split(' ').map(|d| d.parse().unwrap()).collect();
+        assert_eq!(f.dataset(path).unwrap_or_else(|_| panic!("{path}")).shape(), dims, "{path}");
+        items += 1;
+    }
+    // per instant: lines, points, strain, curvature, velocity
+    assert_eq!(items, 5 * 5);
+    let n = 4 * 50 + 1;
+    assert_eq!(f.dataset("paraview/lines").unwrap().shape(), [n - 1, 2]);
+    let tip = f.dataset("probes/tip").unwrap().read_2d::<f64>().unwrap();
+    for k in 0..5 {
+        let p = f.dataset(&format!("paraview/points/{k:06}")).unwrap().read_2d::<f64>().unwrap();
+        let v = f.dataset(&format!("paraview/velocity/{k:06}")).unwrap().read_2d::<f64>().unwrap();
+        assert!((p[[n - 1, 0]] - tip[[k, 0]]).abs() < 1e-14 && (p[[n - 1, 1]] - tip[[k, 1]]).abs() < 1e-14);
+        assert!(v.row(0).iter().all(|x| x.abs() < 1e-12), "the pinned end does not move");
+        assert!(p.column(2).iter().all(|&z| z == 0.0));
+    }
+    // the units table labels every dataset
+    let d = f.dataset("paraview/curvature/000004").unwrap();
+    assert_eq!(d.attr("units").unwrap().read_scalar::<hdf5::types::VarLenUnicode>().unwrap().as_str(), "1/m");
+    // without --paraview: no group, no XDMF file; an XDMF file flexrom did not write is kept
+    let plain = dir.path().join("q.h5");
+    ok(&["simulate", &model("pendulum.toml"), "-o", plain.to_str().unwrap(), "--t-end", "0.01", "-q"]);
+    assert!(hdf5::File::open(&plain).unwrap().group("paraview").is_err());
+    assert!(!Path::new(&dir.path().join("q.xdmf")).exists());
+    std::fs::write(dir.path().join("q.xdmf"), "mine").unwrap();
+    let o = flexrom(&["simulate", &model("pendulum.toml"), "-o", plain.to_str().unwrap(), "--paraview", "-q"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.code() == Some(1) && err.contains("q.xdmf") && err.contains("--paraview"), "{err}");
+    assert_eq!(std::fs::read_to_string(dir.path().join("q.xdmf")).unwrap(), "mine");
+}
