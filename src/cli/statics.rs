@@ -4,9 +4,8 @@
 use super::{print_table, FormatArgs};
 use flexrom::analysis::statics::StaticOptions;
 use flexrom::io::attrs::Kind;
-use flexrom::io::h5::{attr_f64, attr_str, attr_u64};
 use flexrom::io::output::{check_output, Origin};
-use flexrom::io::result_file::{ResultFile, RunPlan};
+use flexrom::io::result_file::{write_statics, ResultFile, RunPlan};
 use flexrom::limits::Limits;
 use flexrom::linalg::kkt::LinearSolverKind;
 use flexrom::model::Model;
@@ -73,12 +72,7 @@ impl Args {
                 ResultFile::begin(output, &model.text, &model.path.display().to_string(), &RunPlan::of_result(&r))?;
             let factors: Vec<f64> = solution.steps.iter().map(|s| s.load_factor).collect();
             file.finish(&r, |f| {
-                let e = |err: hdf5::Error| flexrom::Error::hdf5(output, err);
-                attr_str(f, "analysis", "statics").map_err(e)?;
-                attr_f64(f, "time", o.t).map_err(e)?;
-                attr_u64(f, "load_steps", steps as u64).map_err(e)?;
-                f.new_dataset_builder().with_data(&factors).create("load_factor").map_err(e)?;
-                Ok(())
+                write_statics(f, o.t, steps, &factors).map_err(|err| flexrom::Error::hdf5(output, err))
             })?;
         }
         let written = output.as_ref().map_or("no result file (-o not given)".to_string(), |o| o.display().to_string());
@@ -101,6 +95,9 @@ impl Args {
         table.columns.insert(1, "load_factor".into());
         for (row, step) in table.rows.iter_mut().zip(&solution.steps) {
             row.insert(1, Cell::from(step.load_factor));
+        }
+        if format.format() != flexrom::output::table::Format::Text {
+            flexrom::pipeline::tables::add_reactions(&mut table, &model, &r);
         }
         print_table(&table, format.format(), false)
     }

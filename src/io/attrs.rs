@@ -96,7 +96,7 @@ const MODES: [Entry; 5] = [
     ("q", COORDINATE_UNITS, "dof"),
 ];
 
-const RESULT: [Entry; 10] = [
+const RESULT: [Entry; 14] = [
     ("t", "s", "time"),
     ("q", COORDINATE_UNITS, "time, dof"),
     ("qd", VELOCITY_UNITS, "time, dof"),
@@ -107,6 +107,10 @@ const RESULT: [Entry; 10] = [
     ("energy/*", "J", "time"),
     ("load_factor", "1", "time"),
     ("reduced/q", REDUCED_UNITS, "time, mode"),
+    ("reactions/force", "N", "time, reaction, xy"),
+    ("reactions/moment", "N·m", "time, reaction"),
+    ("labels/reaction", TEXT, "reaction"),
+    ("labels/reaction_joint", "1", "reaction"),
 ];
 
 const BASIS: [Entry; 54] = [
