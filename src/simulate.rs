@@ -128,7 +128,8 @@ pub struct SimulationResult {
     pub stats: Stats,
     /// wall time of the time loop alone
     pub wall_seconds: f64,
-    /// the energies at every instant (`None` for reduced runs)
+    /// the energies at every instant, where they are written ([`with_energies`],
+    /// [`with_reduced_energies`]); `None` otherwise
     pub energy: Option<Energies>,
 }
 
@@ -387,6 +388,29 @@ pub fn with_energies(model: &Model, mut r: SimulationResult) -> Result<Simulatio
     let (q, qd) = (&r.q, &r.qd);
     let t = r.t.to_vec();
     r.energy = Some(energies(&mut sys, &r.settings.mu, &t, |k| q.column(k).to_vec(), |k| qd.column(k).to_vec()));
+    Ok(r)
+}
+
+/// A reduced run's `r` with its energies from its reconstructed states
+/// ([`crate::analysis::energy::energies_over`]): the strain over the hyper-reduced model's
+/// sampled elements at their weights (`hyper`), else over every element.
+pub fn with_reduced_energies(
+    model: &Model,
+    mut r: SimulationResult,
+    hyper: Option<&crate::reduction::Hyper>,
+) -> Result<SimulationResult> {
+    let mut sys = model.system(LinearSolverKind::Banded);
+    let (q, qd) = (&r.q, &r.qd);
+    let t = r.t.to_vec();
+    let weights = hyper.map(|h| (&h.elements[..], &h.weights[..]));
+    r.energy = Some(crate::analysis::energy::energies_over(
+        &mut sys,
+        &r.settings.mu,
+        &t,
+        |k| q.column(k).to_vec(),
+        |k| qd.column(k).to_vec(),
+        weights,
+    ));
     Ok(r)
 }
 

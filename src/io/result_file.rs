@@ -11,7 +11,7 @@
 //! /probe_curvature/<name> (n_t)          curvature at the probes that record it, 1/m
 //! /energy/<name>          (n_t)          energies, J: kinetic, strain, strain_axial,
 //!                                        strain_bending, gravity, springs, external_work
-//!                                        (full runs and statics)
+//!                                        (simulate, statics, online)
 //! /reactions/force        (n_t, n_r, 2)  force each joint applies on the body at each of
 //!                                        its nodes, x and y, N (models with joints)
 //! /reactions/moment       (n_t, n_r)     its moment on the body, N m, counter-clockwise

@@ -265,7 +265,7 @@ fn run<R: Reduced<FlexibleSystem>>(
             curvatures,
             stats,
             wall_seconds,
-            // a reduced run's energies would need its own reduced quantities
+            // computed where written (pipeline::online::answer), not in every reduced run
             energy: None,
         },
         reduced_q: zq,
