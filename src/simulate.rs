@@ -129,7 +129,8 @@ pub struct SimulationResult {
     pub stats: Stats,
     /// wall time of the time loop alone
     pub wall_seconds: f64,
-    /// the energies at every instant (`None` for reduced runs)
+    /// the energies at every instant, where they are written ([`with_energies`],
+    /// [`with_reduced_energies`]); `None` otherwise
     pub energy: Option<Energies>,
 }
 
@@ -429,6 +430,29 @@ pub fn with_energies(model: &Model, mut r: SimulationResult) -> Result<Simulatio
     Ok(r)
 }
 
+/// A reduced run's `r` with its energies from its reconstructed states
+/// ([`crate::analysis::energy::energies_over`]): the strain over the hyper-reduced model's
+/// sampled elements at their weights (`hyper`), else over every element.
+pub fn with_reduced_energies(
+    model: &Model,
+    mut r: SimulationResult,
+    hyper: Option<&crate::reduction::Hyper>,
+) -> Result<SimulationResult> {
+    let mut sys = model.system(LinearSolverKind::Banded);
+    let (q, qd) = (&r.q, &r.qd);
+    let t = r.t.to_vec();
+    let weights = hyper.map(|h| (&h.elements[..], &h.weights[..]));
+    r.energy = Some(crate::analysis::energy::energies_over(
+        &mut sys,
+        &r.settings.mu,
+        &t,
+        |k| q.column(k).to_vec(),
+        |k| qd.column(k).to_vec(),
+        weights,
+    ));
+    Ok(r)
+}
+
 /// The static equilibrium under the run's loads at t = 0 (`[initial] static = true`), from
 /// the consistent undeformed state `q0`: where a dynamic run starts, at rest.
 fn static_start(sys: &mut FlexibleSystem, q0: Vec<f64>, s: &Settings) -> Result<Vec<f64>> {
@@ -510,6 +534,97 @@ pub fn statics(model: &Model, o: &StaticOptions) -> Result<(SimulationResult, St
         energy: Some(energy),
     };
     Ok((result, solution))
+}
+
+/// Where [`modes`] linearizes a model.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ModesAt {
+    /// the initial (undeformed, consistent) configuration
+    Initial,
+    /// the static equilibrium under the loads ([`statics`], one load step)
+    Static,
+}
+
+impl ModesAt {
+    /// `initial` or `static`, as `--at` and the modes file's `at` attribute spell it.
+    pub fn name(self) -> &'static str {
+        match self {
+            ModesAt::Initial => "initial",
+            ModesAt::Static => "static",
+        }
+    }
+}
+
+/// What [`modes`] is asked for (`flexrom modes`' options).
+#[derive(Clone, Debug)]
+pub struct ModesOptions {
+    /// how many of the lowest modes
+    pub count: usize,
+    pub at: ModesAt,
+    /// the loads' parameters (before the model's property values)
+    pub mu: Parameters,
+    /// the time of the loads, s
+    pub time: f64,
+    pub solver: LinearSolverKind,
+}
+
+/// The modes of a model and where they were computed.
+#[derive(Clone, Debug)]
+pub struct ModesAnalysis {
+    pub modes: crate::analysis::modes::Modes,
+    /// the configuration `q*` the model was linearized at
+    pub q: Vec<f64>,
+    /// the parameters with the model's property values
+    pub mu: Parameters,
+    /// wall time of the static solve (if any) and the eigensolver, s
+    pub seconds: f64,
+}
+
+/// The lowest `o.count` natural frequencies and mode shapes of `model`
+/// ([`crate::analysis::modes::compute`]) at `o.at`: `--count` above the unconstrained
+/// coordinates is refused naming the model file.
+pub fn modes(model: &Model, o: &ModesOptions) -> Result<ModesAnalysis> {
+    let mu = model.with_property_values(&o.mu);
+    model.check_parameters(&mu)?;
+    let settings =
+        Settings::resolve(model, &Overrides { mu: Some(mu.clone()), solver: o.solver, ..Default::default() })?;
+    let (sys, q0) = prepare(model, &settings)?;
+    let n_free = crate::analysis::modes::unconstrained(&sys);
+    if o.count == 0 || o.count > n_free {
+        return Err(Error::Usage(format!(
+            "--count {}: {} has {n_free} unconstrained coordinates ({} coordinates less {} constraint rows); ask for 1 to {n_free}",
+            o.count,
+            model.path.display(),
+            q0.len(),
+            q0.len() - n_free
+        )));
+    }
+    let start = std::time::Instant::now();
+    let q = match o.at {
+        ModesAt::Initial => q0,
+        ModesAt::Static => {
+            let so = StaticOptions { mu: mu.clone(), t: o.time, steps: 1, solver: o.solver };
+            let (r, _) = statics(model, &so).map_err(|e| e.at_stage("statics", &mu))?;
+            r.q.column(r.q.ncols() - 1).to_vec()
+        }
+    };
+    let modes = crate::analysis::modes::compute(&sys, &mu, &q, o.time, o.count, o.solver)
+        .map_err(|e| e.at_stage("modes", &mu))?;
+    Ok(ModesAnalysis { modes, q, mu, seconds: start.elapsed().as_secs_f64() })
+}
+
+/// The frequencies the basis `v` (n_dof × r, one column per mode) keeps of `model` at the
+/// configuration and parameters of `a` ([`crate::analysis::reduced_modes`]): the lowest
+/// `o.count` of the problem projected on it.
+pub fn reduced_modes(
+    model: &Model,
+    a: &ModesAnalysis,
+    v: ndarray::ArrayView2<f64>,
+    o: &ModesOptions,
+) -> Result<crate::analysis::reduced_modes::ReducedModes> {
+    let sys = model.system(o.solver);
+    crate::analysis::reduced_modes::compute(&sys, &a.mu, &a.q, o.time, v, o.count)
+        .map_err(|e| e.at_stage("modes --basis", &a.mu))
 }
 
 /// The strain and the curvature series (each `(name, values at every instant)`) of the

@@ -81,6 +81,7 @@ fn every_result_prints_as_csv_and_json() {
         .iter()
         .map(|s| s.to_string())
         .chain(energy.iter().map(|e| format!("energy_{e}")))
+        .chain(["Fx", "Fy", "M"].iter().map(|c| format!("joint 0 (ground_pin beam node 0) on beam node 0: {c}")))
         .collect();
     assert_eq!(head, expected);
     assert_eq!(rows.len(), 5, "t = 0 and 4 steps of 0.005 s");

@@ -48,6 +48,42 @@ class Model:
         rho_inf: Optional[float] = None,
         **params: float,
     ) -> Result: ...
+    def statics(
+        self, load_scale: Optional[float] = None, *, time: float = 0.0, steps: int = 1, **params: float
+    ) -> Result:
+        """The static equilibrium (`flexrom statics`): one row per load step, the
+        equilibrium last; `load_factor` gives each row's fraction of the loads."""
+    def modes(
+        self,
+        count: int = 6,
+        *,
+        at: str = "initial",
+        load_scale: Optional[float] = None,
+        time: float = 0.0,
+        **params: float,
+    ) -> Modes:
+        """The lowest `count` natural frequencies and mode shapes (`flexrom modes`), at the
+        initial configuration or (`at="static"`) the static equilibrium."""
+
+class Modes:
+    @property
+    def frequencies(self) -> _F: ...
+    @property
+    def omega_squared(self) -> _F: ...
+    @property
+    def rigid(self) -> List[bool]: ...
+    @property
+    def shapes(self) -> _F: ...
+    @property
+    def q(self) -> _F: ...
+    @property
+    def at(self) -> str: ...
+    @property
+    def labels(self) -> Dict[str, List[str]]: ...
+    @property
+    def iterations(self) -> int: ...
+    def to_hdf5(self, path: _Path) -> None: ...
+    def __len__(self) -> int: ...
 
 class Result:
     @property
@@ -66,6 +102,10 @@ class Result:
     def curvatures(self) -> Dict[str, _F]: ...
     @property
     def nodes(self) -> Dict[str, _F]: ...
+    @property
+    def reactions(self) -> Dict[str, _F]: ...
+    @property
+    def load_factor(self) -> Optional[_F]: ...
     @property
     def labels(self) -> Dict[str, List[str]]: ...
     @property

@@ -294,13 +294,83 @@ impl PyModel {
             fallback: None,
             fallback_failed: None,
             exact: None,
+            statics: None,
         })
+    }
+
+    /// The static equilibrium under the loads (`flexrom statics`): load stepping in `steps`
+    /// equal steps (each halved where Newton fails), the loads at `time`; a Result with one
+    /// instant per load step, the equilibrium last (`load_factor` says each row's fraction).
+    #[pyo3(signature = (load_scale = None, *, time = 0.0, steps = 1, **params))]
+    fn statics(
+        &self,
+        py: Python<'_>,
+        load_scale: Option<f64>,
+        time: f64,
+        steps: usize,
+        params: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<PyRunResult> {
+        let params = convert::named(params)?.unwrap_or_default();
+        let mu = parameters(load_scale, &params)?;
+        let model = &self.model;
+        warn(py, &model.property_warnings([&mu]))?;
+        let o = flexrom::analysis::statics::StaticOptions { mu: mu.clone(), t: time, steps, ..Default::default() };
+        let (r, solution) =
+            interruptible(py, || flexrom::simulate::statics(model, &o).map_err(|e| e.at_stage("statics", &mu)))?;
+        let load_factors = solution.steps.iter().map(|s| s.load_factor).collect();
+        Ok(PyRunResult {
+            model: Arc::clone(model),
+            r,
+            reduced: None,
+            fallback: None,
+            fallback_failed: None,
+            exact: None,
+            statics: Some(StaticsPart { time, steps, load_factors }),
+        })
+    }
+
+    /// The lowest `count` natural frequencies and mode shapes (`flexrom modes`), linearized
+    /// at the initial configuration (`at="initial"`) or the static equilibrium
+    /// (`at="static"`, the loads at `time`).
+    #[pyo3(signature = (count = 6, *, at = "initial", load_scale = None, time = 0.0, **params))]
+    fn modes(
+        &self,
+        py: Python<'_>,
+        count: usize,
+        at: &str,
+        load_scale: Option<f64>,
+        time: f64,
+        params: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<PyModes> {
+        use flexrom::simulate::ModesAt;
+        let at = match at {
+            "initial" => ModesAt::Initial,
+            "static" => ModesAt::Static,
+            other => return Err(errors::model_error(&format!("at: give \"initial\" or \"static\", got {other:?}"))),
+        };
+        let params = convert::named(params)?.unwrap_or_default();
+        let mu = parameters(load_scale, &params)?;
+        let model = &self.model;
+        warn(py, &model.property_warnings([&mu]))?;
+        let o = flexrom::simulate::ModesOptions { count, at, mu, time, solver: Default::default() };
+        let a = interruptible(py, || flexrom::simulate::modes(model, &o))?;
+        Ok(PyModes { model: Arc::clone(model), a, at, time })
     }
 
     fn __repr__(&self) -> String {
         let z = self.model.sizes();
         format!("Model('{}': {} coordinates, {} constraints)", self.model.path.display(), z.n_dof, z.n_constraints)
     }
+}
+
+/// What a static equilibrium adds to its result: what `statics` writes beside it.
+struct StaticsPart {
+    /// the time of the loads, s
+    time: f64,
+    /// the load steps asked for
+    steps: usize,
+    /// the fraction of the loads of each row
+    load_factors: Vec<f64>,
 }
 
 /// What a reduced run adds to its result: what `online` writes beside the run.
@@ -335,6 +405,8 @@ struct PyRunResult {
     /// where the full model answered in place of the reduced one: the estimate of an exact
     /// answer (0) and whether the load lies outside the basis's range
     exact: Option<(Estimate, bool)>,
+    /// a static equilibrium's load steps (`Model.statics`)
+    statics: Option<StaticsPart>,
 }
 
 #[pymethods]
@@ -394,7 +466,38 @@ impl PyRunResult {
         d.set_item("dof", l.dof_names())?;
         d.set_item("multiplier", l.multipliers.iter().map(|(_, s)| s.clone()).collect::<Vec<_>>())?;
         d.set_item("body", l.bodies.clone())?;
+        let reactions = flexrom::analysis::reactions::ReactionMap::of(&self.model);
+        d.set_item("reaction", reactions.names())?;
         Ok(d)
+    }
+
+    /// reaction name (as `labels["reaction"]`) → (n_t, 3): the force the joint applies on
+    /// the body at the node, Fx and Fy (N), and its moment M (N·m, counter-clockwise), as
+    /// the result file's `/reactions`
+    #[getter]
+    fn reactions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let map = flexrom::analysis::reactions::ReactionMap::of(&self.model);
+        let d = PyDict::new(py);
+        if map.n_rows() != self.r.multipliers.nrows() {
+            return Ok(d);
+        }
+        let v =
+            map.series((&self.r.settings.mu, self.r.t.as_slice().expect("contiguous")), &self.r.q, &self.r.multipliers);
+        for (p, name) in map.names().into_iter().enumerate() {
+            let mut a = ndarray::Array2::zeros((self.r.t.len(), 3));
+            a.column_mut(0).assign(&v.force.slice(ndarray::s![.., p, 0]));
+            a.column_mut(1).assign(&v.force.slice(ndarray::s![.., p, 1]));
+            a.column_mut(2).assign(&v.moment.column(p));
+            d.set_item(name, a.into_pyarray(py))?;
+        }
+        Ok(d)
+    }
+
+    /// (n_t) the fraction of the loads of each row of a static equilibrium (`Model.statics`;
+    /// None for a run)
+    #[getter]
+    fn load_factor<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
+        self.statics.as_ref().map(|s| s.load_factors.clone().into_pyarray(py))
     }
 
     /// body name → (n_t, n_nodes, 2): each node's x, y, m, time first (the deformed shape:
@@ -423,7 +526,19 @@ impl PyRunResult {
     fn units<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         use flexrom::io::attrs::{units_of, Kind};
         let d = PyDict::new(py);
-        for name in ["t", "q", "qd", "multipliers", "probes/*", "probe_strain/*", "probe_curvature/*", "reduced/q"] {
+        for name in [
+            "t",
+            "q",
+            "qd",
+            "multipliers",
+            "probes/*",
+            "probe_strain/*",
+            "probe_curvature/*",
+            "reduced/q",
+            "reactions/force",
+            "reactions/moment",
+            "load_factor",
+        ] {
             let probe = name.replace('*', "p");
             if let Some((units, _)) = units_of(Kind::Result, &probe) {
                 d.set_item(name.trim_end_matches("/*"), units)?;
@@ -581,6 +696,14 @@ impl PyRunResult {
     }
 
     fn __repr__(&self) -> String {
+        if self.statics.is_some() {
+            return format!(
+                "Result(static equilibrium at {}: {} load steps, {} coordinates)",
+                self.r.settings.parameters(),
+                self.r.t.len(),
+                self.r.q.nrows()
+            );
+        }
         let kind = if self.reduced.is_some() { "reduced" } else { "full" };
         format!(
             "Result({kind} run at {}: {} instants, {} coordinates)",
@@ -613,6 +736,9 @@ impl PyRunResult {
             if let Some(note) = &self.fallback_failed {
                 flexrom::io::h5::attr_str(f, "fallback_failed", note).map_err(e)?;
             }
+            if let Some(st) = &self.statics {
+                flexrom::io::result_file::write_statics(f, st.time, st.steps, &st.load_factors).map_err(e)?;
+            }
             let Some(x) = &self.reduced else { return Ok(()) };
             flexrom::io::result_file::write_reduced(f, &x.reduced_q).map_err(e)?;
             flexrom::io::h5::attr_str(f, "basis", &x.basis_name).map_err(e)?;
@@ -621,6 +747,100 @@ impl PyRunResult {
             flexrom::rom::trust::write_run_attributes(f, x.estimate.as_ref(), x.method, &x.trust, &x.mu, x.extrapolated)
                 .map_err(e)
         })
+    }
+}
+
+/// The lowest natural frequencies and mode shapes of a model (`Model.modes`), as the modes
+/// file of `flexrom modes -o`.
+#[pyclass(name = "Modes", module = "flexrom._flexrom", frozen)]
+struct PyModes {
+    model: Arc<Model>,
+    a: flexrom::simulate::ModesAnalysis,
+    at: flexrom::simulate::ModesAt,
+    time: f64,
+}
+
+#[pymethods]
+impl PyModes {
+    /// (N) the frequencies, Hz, ascending (0 for a rigid-body mode)
+    #[getter]
+    fn frequencies<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.a.modes.frequencies.clone().into_pyarray(py)
+    }
+
+    /// (N) ω², 1/s²: the eigenvalues of K_T φ = ω² M φ with B φ = 0
+    #[getter]
+    fn omega_squared<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.a.modes.omega_squared.clone().into_pyarray(py)
+    }
+
+    /// (N) whether each mode is a rigid-body motion
+    #[getter]
+    fn rigid(&self) -> Vec<bool> {
+        self.a.modes.rigid.clone()
+    }
+
+    /// (N, n_dof) row i = mode i laid out like q, φᵀMφ = 1
+    #[getter]
+    fn shapes<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        self.a.modes.shapes.clone().into_pyarray(py)
+    }
+
+    /// (n_dof) the configuration the model was linearized at
+    #[getter]
+    fn q<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.a.q.clone().into_pyarray(py)
+    }
+
+    /// "initial" or "static"
+    #[getter]
+    fn at(&self) -> &'static str {
+        self.at.name()
+    }
+
+    /// names of the coordinates (`dof`, the columns of `shapes`) and bodies
+    #[getter]
+    fn labels<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let l = Labels::of(&self.model);
+        let d = PyDict::new(py);
+        d.set_item("dof", l.dof_names())?;
+        d.set_item("body", l.bodies.clone())?;
+        Ok(d)
+    }
+
+    /// subspace iterations taken
+    #[getter]
+    fn iterations(&self) -> usize {
+        self.a.modes.iterations
+    }
+
+    /// Writes the modes file `flexrom modes -o` writes (atomically); refuses the model file's
+    /// path and an existing file that is not a modes file flexrom wrote.
+    fn to_hdf5(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        check_output(&path, Origin::Flag("path"), &[(&self.model.path, "model file")], &[Kind::Modes])
+            .map_err(to_py)?;
+        let record = flexrom::io::modes_file::ModesRecord {
+            model: &self.model,
+            modes: &self.a.modes,
+            q: &self.a.q,
+            at: self.at.name(),
+            mu: &self.a.mu,
+            time: self.time,
+        };
+        py.detach(|| flexrom::io::modes_file::write(&path, &record)).map_err(to_py)
+    }
+
+    fn __len__(&self) -> usize {
+        self.a.modes.len()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Modes({} modes at the {} configuration: {:?} Hz)",
+            self.a.modes.len(),
+            self.at.name(),
+            self.a.modes.frequencies
+        )
     }
 }
 
@@ -803,6 +1023,7 @@ impl PyBasis {
             // the full model's answer: exact, nothing to warn about
             let r = done.run.result;
             return Ok(PyRunResult {
+                statics: None,
                 model: Arc::clone(rom.model()),
                 r,
                 reduced: None,
@@ -845,6 +1066,7 @@ impl PyBasis {
             fallback: None,
             fallback_failed: done.note,
             exact: None,
+            statics: None,
         })
     }
 
@@ -1089,6 +1311,7 @@ fn _flexrom(m: &Bound<'_, PyModule>) -> PyResult<()> {
     flexrom::single_threaded_blas();
     m.add_class::<PyModel>()?;
     m.add_class::<PyRunResult>()?;
+    m.add_class::<PyModes>()?;
     m.add_class::<PyBasis>()?;
     m.add_function(wrap_pyfunction!(train, m)?)?;
     m.add_function(wrap_pyfunction!(validate, m)?)?;

@@ -54,19 +54,42 @@ impl Energies {
     }
 }
 
+/// The elements whose strain energy a model sums: every element at weight 1 (`None`, the
+/// full model and a reduced one without hyper-reduction), or a hyper-reduced model's
+/// sampled elements with their ECSW weights, `U ≈ Σ_{e∈S} w_e U_e`: the energy the reduced
+/// model itself conserves.
+pub type ElementWeights<'a> = Option<(&'a [usize], &'a [f64])>;
+
 /// `(bending, axial)` strain energy of the whole system at `q`.
 pub fn strain_parts(sys: &FlexibleSystem, mu: &Parameters, q: &[f64]) -> (f64, f64) {
     let (mut bending, mut axial) = (0.0, 0.0);
     for e in 0..sys.n_elements() {
-        let d = sys.element_dofs(e);
-        let qe = Vec8::from_fn(|i, _| q[d[i]]);
-        let el = sys.element(e);
-        let k = sys.stiffness_factor(e, mu);
-        let (b, a) = el.strain_energy_parts(&qe);
-        bending += k * b;
-        axial += k * a;
+        let (b, a) = element_strain(sys, mu, q, e);
+        bending += b;
+        axial += a;
     }
     (bending, axial)
+}
+
+/// [`strain_parts`] over the elements `weights` names (all of them for `None`).
+pub fn strain_parts_over(sys: &FlexibleSystem, mu: &Parameters, q: &[f64], weights: ElementWeights) -> (f64, f64) {
+    let Some((elements, w)) = weights else { return strain_parts(sys, mu, q) };
+    let (mut bending, mut axial) = (0.0, 0.0);
+    for (&e, &we) in elements.iter().zip(w) {
+        let (b, a) = element_strain(sys, mu, q, e);
+        bending += we * b;
+        axial += we * a;
+    }
+    (bending, axial)
+}
+
+/// Element `e`'s `(bending, axial)` strain energy at `q`, at `E(μ)`.
+fn element_strain(sys: &FlexibleSystem, mu: &Parameters, q: &[f64], e: usize) -> (f64, f64) {
+    let d = sys.element_dofs(e);
+    let qe = Vec8::from_fn(|i, _| q[d[i]]);
+    let k = sys.stiffness_factor(e, mu);
+    let (b, a) = sys.element(e).strain_energy_parts(&qe);
+    (k * b, k * a)
 }
 
 /// `(Q_ext − Q_s)ᵀ q̇` of the forces, moments and springs' dampers (not gravity), with
@@ -98,6 +121,20 @@ pub fn energies(
     q: impl Fn(usize) -> Vec<f64>,
     v: impl Fn(usize) -> Vec<f64>,
 ) -> Energies {
+    energies_over(sys, mu, t, q, v, None)
+}
+
+/// [`energies`] with the strain summed over the elements `weights` names: a reduced run's
+/// energies from its reconstructed states `x_ref + V z`, `V ż` (the kinetic energy
+/// `½ żᵀ VᵀMV ż`, the gravity's `−g₀ᵀ(x_ref + V z)`, the strain of its own sampled elements).
+pub fn energies_over(
+    sys: &mut FlexibleSystem,
+    mu: &Parameters,
+    t: &[f64],
+    q: impl Fn(usize) -> Vec<f64>,
+    v: impl Fn(usize) -> Vec<f64>,
+    weights: ElementWeights,
+) -> Energies {
     let nt = t.len();
     sys.bind(mu);
     let mut out = Energies {
@@ -117,7 +154,7 @@ pub fn energies(
         let (qk, vk) = (q(k), v(k));
         sys.mass_mul(&vk, &mut mv);
         out.kinetic[k] = 0.5 * vk.iter().zip(&mv).map(|(a, b)| a * b).sum::<f64>();
-        let (b, a) = strain_parts(sys, mu, &qk);
+        let (b, a) = strain_parts_over(sys, mu, &qk, weights);
         out.strain_bending[k] = b;
         out.strain_axial[k] = a;
         out.strain[k] = a + b;

@@ -3,8 +3,6 @@
 
 use super::statics::LoadArgs;
 use super::FormatArgs;
-use flexrom::analysis::modes::{compute, unconstrained};
-use flexrom::analysis::statics::StaticOptions;
 use flexrom::io::attrs::Kind;
 use flexrom::io::modes_file::{write, ModesRecord};
 use flexrom::io::output::{check_output, Origin};
@@ -13,7 +11,7 @@ use flexrom::linalg::kkt::LinearSolverKind;
 use flexrom::model::Model;
 use flexrom::output::info;
 use flexrom::output::table::{Cell, Format, Table};
-use flexrom::simulate::{prepare, Overrides, Settings};
+use flexrom::simulate::{ModesAnalysis, ModesAt, ModesOptions};
 use std::path::PathBuf;
 
 /// The configuration the model is linearized at.
@@ -41,6 +39,11 @@ pub struct Args {
     /// modes file (HDF5): frequencies and mode shapes laid out like q, with labels
     #[arg(short, long)]
     output: Option<PathBuf>,
+    /// a basis file (`flexrom train`): also the frequencies of its reduced model (the
+    /// stiffness and mass projected on its modes, the constraints held), beside the full
+    /// ones, to see which modes the POD kept
+    #[arg(long)]
+    basis: Option<PathBuf>,
     /// linear solver of the shift-invert factorization
     #[arg(long, value_enum, default_value_t = LinearSolverKind::Banded)]
     solver: LinearSolverKind,
@@ -50,39 +53,26 @@ pub struct Args {
 
 impl Args {
     pub fn run(self, limits: &Limits) -> flexrom::Result<()> {
-        let Args { model, count, at, loads, output, solver, format } = self;
+        let Args { model, count, at, loads, output, basis, solver, format } = self;
         if let Some(output) = &output {
             check_output(output, Origin::Flag("-o"), &[(&model, "model file")], &[Kind::Modes])?;
         }
         let model = Model::load_with(&model, limits.clone())?;
-        let mu = model.with_property_values(&loads.parameters()?);
-        model.check_parameters(&mu)?;
-        let settings = Settings::resolve(&model, &Overrides { mu: Some(mu.clone()), solver, ..Default::default() })?;
-        let (sys, q0) = prepare(&model, &settings)?;
-        let n_free = unconstrained(&sys);
-        if count == 0 || count > n_free {
-            return Err(flexrom::Error::Usage(format!(
-                "--count {count}: {} has {n_free} unconstrained coordinates ({} coordinates less {} constraint rows); ask for 1 to {n_free}",
-                model.path.display(),
-                q0.len(),
-                q0.len() - n_free
-            )));
-        }
-        let start = std::time::Instant::now();
-        let q = match at {
-            At::Initial => q0,
-            At::Static => {
-                let o = StaticOptions { mu: mu.clone(), t: loads.time(), steps: 1, solver };
-                let (r, _) = flexrom::simulate::statics(&model, &o).map_err(|e| e.at_stage("statics", &mu))?;
-                r.q.column(r.q.ncols() - 1).to_vec()
-            }
+        let at = match at {
+            At::Initial => ModesAt::Initial,
+            At::Static => ModesAt::Static,
         };
-        let modes = compute(&sys, &mu, &q, loads.time(), count, solver).map_err(|e| e.at_stage("modes", &mu))?;
-        let seconds = start.elapsed().as_secs_f64();
+        let o = ModesOptions { count, at, mu: loads.parameters()?, time: loads.time(), solver };
+        let analysis = flexrom::simulate::modes(&model, &o)?;
+        let reduced = match &basis {
+            Some(path) => Some(reduced_frequencies(&model, path, &analysis, &o)?),
+            None => None,
+        };
+        let ModesAnalysis { modes, q, mu, seconds } = analysis;
         info(&format!(
             "{}: {count} modes at the {} configuration in {seconds:.3} s ({} subspace iterations, {} coordinates)",
             model.path.display(),
-            if at == At::Initial { "initial" } else { "static" },
+            at.name(),
             modes.iterations,
             q.len()
         ));
@@ -92,36 +82,85 @@ impl Args {
         ));
         for (i, f) in modes.frequencies.iter().enumerate() {
             let kind = if modes.rigid[i] { " (rigid-body motion)" } else { "" };
-            info(&format!("  mode {}: {f:.6} Hz{kind}", i + 1));
+            let kept = match reduced.as_ref().map(|r| r.frequencies.get(i)) {
+                Some(Some(fr)) if *f != 0.0 => format!("; reduced {fr:.6} Hz ({:+.2e} relative)", (fr - f) / f),
+                Some(Some(fr)) => format!("; reduced {fr:.6} Hz"),
+                Some(None) => "; not in the reduced model".to_string(),
+                None => String::new(),
+            };
+            info(&format!("  mode {}: {f:.6} Hz{kind}{kept}", i + 1));
+        }
+        if let Some(r) = &reduced {
+            info(&format!("  the basis leaves {} coordinates once its constraint rows hold", r.dimension));
         }
         if let Some(output) = &output {
-            let at = if at == At::Initial { "initial" } else { "static" };
-            write(output, &ModesRecord { model: &model, modes: &modes, q: &q, at, mu: &mu, time: loads.time() })?;
+            write(output, &ModesRecord { model: &model, modes: &modes, q: &q, at: at.name(), mu: &mu, time: o.time })?;
         }
         match format.format() {
-            Format::Json => flexrom::output::println(
-                &serde_json::json!({
+            Format::Json => {
+                let mut v = serde_json::json!({
                     "frequencies": modes.frequencies,
                     "omega_squared": modes.omega_squared,
                     "rigid": modes.rigid,
                     "iterations": modes.iterations,
                     "seconds": seconds,
-                })
-                .to_string(),
-            ),
+                });
+                if let Some(r) = &reduced {
+                    v["reduced_frequencies"] = serde_json::json!(r.frequencies);
+                    v["reduced_omega_squared"] = serde_json::json!(r.omega_squared);
+                    v["reduced_dimension"] = serde_json::json!(r.dimension);
+                }
+                flexrom::output::println(&v.to_string())
+            }
             Format::Csv => {
-                let mut t = Table::new(&["mode", "frequency", "omega_squared", "rigid"]);
+                let mut cols = vec!["mode", "frequency", "omega_squared", "rigid"];
+                if reduced.is_some() {
+                    cols.push("reduced_frequency");
+                }
+                let mut t = Table::new(&cols);
                 for i in 0..modes.len() {
-                    t.push(vec![
+                    let mut row = vec![
                         Cell::from(i + 1),
                         Cell::from(modes.frequencies[i]),
                         Cell::from(modes.omega_squared[i]),
                         Cell::from(usize::from(modes.rigid[i])),
-                    ]);
+                    ];
+                    if let Some(r) = &reduced {
+                        row.push(r.frequencies.get(i).map_or(Cell::Null, |&f| Cell::from(f)));
+                    }
+                    t.push(row);
                 }
                 flexrom::output::print(&t.to_csv()?)
             }
             Format::Text => Ok(()),
         }
     }
+}
+
+/// The reduced model's frequencies of the basis file at `path` beside the full model's
+/// `analysis`: a basis of another model (another number of coordinates) is refused, one
+/// trained on another version of this model file is used with a warning.
+fn reduced_frequencies(
+    model: &Model,
+    path: &std::path::Path,
+    analysis: &ModesAnalysis,
+    o: &ModesOptions,
+) -> flexrom::Result<flexrom::analysis::reduced_modes::ReducedModes> {
+    let stored = flexrom::io::basis_file::read_basis(path)?;
+    let n = stored.basis.n_dof();
+    if n != analysis.q.len() {
+        return Err(flexrom::Error::input(
+            path,
+            "basis/modes",
+            format!("has {n} coordinates; {} has {}: a basis of another model", model.path.display(), analysis.q.len()),
+        ));
+    }
+    if stored.model_fingerprint != model.fingerprint() {
+        super::warn(&[format!(
+            "{}: trained on another version of {} (its model_fingerprint differs); its modes are projected all the same",
+            path.display(),
+            model.path.display()
+        )]);
+    }
+    flexrom::simulate::reduced_modes(model, analysis, stored.basis.modes.view(), o)
 }

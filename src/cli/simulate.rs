@@ -86,7 +86,11 @@ impl Args {
             written
         ));
         run_details(&r, false);
-        print_table(&flexrom::pipeline::tables::probe_table(&r), format.format(), false)
+        let mut table = flexrom::pipeline::tables::probe_table(&r);
+        if format.format() != flexrom::output::table::Format::Text {
+            flexrom::pipeline::tables::add_reactions(&mut table, &model, &r);
+        }
+        print_table(&table, format.format(), false)
     }
 }
 

@@ -4,9 +4,8 @@
 use super::{print_table, FormatArgs};
 use flexrom::analysis::statics::StaticOptions;
 use flexrom::io::attrs::Kind;
-use flexrom::io::h5::{attr_f64, attr_str, attr_u64};
 use flexrom::io::output::{check_output, Origin};
-use flexrom::io::result_file::{ResultFile, RunPlan};
+use flexrom::io::result_file::{write_statics, ResultFile, RunPlan};
 use flexrom::limits::Limits;
 use flexrom::linalg::kkt::LinearSolverKind;
 use flexrom::model::Model;
@@ -85,12 +84,7 @@ impl Args {
                 if paraview {
                     layout = Some(flexrom::io::paraview::extra(f, output, model.bodies(), &r)?);
                 }
-                let e = |err: hdf5::Error| flexrom::Error::hdf5(output, err);
-                attr_str(f, "analysis", "statics").map_err(e)?;
-                attr_f64(f, "time", o.t).map_err(e)?;
-                attr_u64(f, "load_steps", steps as u64).map_err(e)?;
-                f.new_dataset_builder().with_data(&factors).create("load_factor").map_err(e)?;
-                Ok(())
+                write_statics(f, o.t, steps, &factors).map_err(|err| flexrom::Error::hdf5(output, err))
             })?;
             if let Some(layout) = layout {
                 flexrom::io::paraview::write_xdmf(output, &layout)?;
@@ -116,6 +110,9 @@ impl Args {
         table.columns.insert(1, "load_factor".into());
         for (row, step) in table.rows.iter_mut().zip(&solution.steps) {
             row.insert(1, Cell::from(step.load_factor));
+        }
+        if format.format() != flexrom::output::table::Format::Text {
+            flexrom::pipeline::tables::add_reactions(&mut table, &model, &r);
         }
         print_table(&table, format.format(), false)
     }

@@ -96,7 +96,7 @@ const MODES: [Entry; 5] = [
     ("q", COORDINATE_UNITS, "dof"),
 ];
 
-const RESULT: [Entry; 15] = [
+const RESULT: [Entry; 19] = [
     ("t", "s", "time"),
     ("q", COORDINATE_UNITS, "time, dof"),
     ("qd", VELOCITY_UNITS, "time, dof"),
@@ -112,6 +112,10 @@ const RESULT: [Entry; 15] = [
     ("paraview/velocity/*", "m/s", "point, xyz"),
     ("paraview/strain/*", "1", "point"),
     ("paraview/curvature/*", "1/m", "point"),
+    ("reactions/force", "N", "time, reaction, xy"),
+    ("reactions/moment", "N·m", "time, reaction"),
+    ("labels/reaction", TEXT, "reaction"),
+    ("labels/reaction_joint", "1", "reaction"),
 ];
 
 const BASIS: [Entry; 54] = [

@@ -11,9 +11,14 @@
 //! /probe_curvature/<name> (n_t)          curvature at the probes that record it, 1/m
 //! /energy/<name>          (n_t)          energies, J: kinetic, strain, strain_axial,
 //!                                        strain_bending, gravity, springs, external_work
-//!                                        (full runs and statics)
+//!                                        (simulate, statics, online)
+//! /reactions/force        (n_t, n_r, 2)  force each joint applies on the body at each of
+//!                                        its nodes, x and y, N (models with joints)
+//! /reactions/moment       (n_t, n_r)     its moment on the body, N m, counter-clockwise
 //! /reduced/q              (n_t, r)       `online` only: the reduced coordinates
-//! /labels/...                            names of the coordinates and constraint rows
+//! /labels/...                            names of the coordinates and constraint rows;
+//!                                        labels/reaction and labels/reaction_joint name
+//!                                        the reactions (crate::analysis::reactions)
 //! every dataset: attributes units, dims (src/io/attrs.rs)
 //! attributes on /: flexrom_layout, flexrom_file = "result", model (TOML text), model_path,
 //!   load_scale, dt, t_end, rho_inf, linear_solver, newton_iterations, factorizations,
@@ -23,6 +28,7 @@
 
 use super::attrs::{annotate_rest, Kind, Labelled};
 use super::h5::{attr_f64, attr_str, attr_u64, shorten, StagedFile};
+use crate::analysis::reactions::{ReactionMap, Reactions};
 use crate::error::{Error, Result};
 use crate::linalg::kkt::LinearSolverKind;
 use crate::simulate::{Settings, SimulationResult};
@@ -106,6 +112,9 @@ pub struct ResultFile {
     probes: Vec<hdf5::Dataset>,
     /// the strain series, then the curvature series
     sections: Vec<hdf5::Dataset>,
+    /// the joints' reactions (force, moment) and the map from multipliers to them, where the
+    /// model has joints
+    reactions: Option<(hdf5::Dataset, hdf5::Dataset, ReactionMap)>,
     staged: StagedFile,
     labelled: Labelled,
     model_text: String,
@@ -131,7 +140,13 @@ impl ResultFile {
         attr_f64(f, "t_end", plan.t_end).map_err(e)?;
         attr_f64(f, "rho_inf", plan.rho_inf).map_err(e)?;
         attr_str(f, "linear_solver", &format!("{:?}", plan.solver).to_lowercase()).map_err(e)?;
-        super::labels::write_labels_of_text_labelled(f, model_text, model_path, Some(&mut labelled)).map_err(e)?;
+        // the model parsed once for the labels and the reactions (it parsed when the run
+        // started; a text that does not parse writes neither rather than failing the file)
+        let model = crate::model::Model::from_text(model_text, model_path).ok();
+        if let Some(m) = &model {
+            super::labels::Labels::of(m).write_labelled(f, Some(&mut labelled)).map_err(e)?;
+        }
+        let map = model.as_ref().map(ReactionMap::of).filter(|m| !m.points.is_empty() && m.n_rows() == plan.n_c);
         // the run's datasets, empty and labelled (units, dims), time first
         let mut create = |g: &hdf5::Group, path: &str, name: &str, dims: &[usize]| {
             let d = g.new_dataset::<f64>().shape(dims).create(name)?;
@@ -160,6 +175,16 @@ impl ResultFile {
                 sections.push(create(&g, &format!("{group}/{name}"), name, &[plan.n_t]).map_err(e)?);
             }
         }
+        let reactions = match map {
+            Some(map) => {
+                let g = f.create_group("reactions").map_err(e)?;
+                let force = create(&g, "reactions/force", "force", &[plan.n_t, map.points.len(), 2]).map_err(e)?;
+                let moment = create(&g, "reactions/moment", "moment", &[plan.n_t, map.points.len()]).map_err(e)?;
+                write_reaction_labels(f, &map, &mut labelled).map_err(e)?;
+                Some((force, moment, map))
+            }
+            None => None,
+        };
         Ok(ResultFile {
             t,
             q,
@@ -167,6 +192,7 @@ impl ResultFile {
             multipliers,
             probes,
             sections,
+            reactions,
             staged,
             labelled,
             model_text: model_text.to_string(),
@@ -189,8 +215,8 @@ impl ResultFile {
         }
         // on an error `self` is dropped whole: datasets, then the file, then its temporary
         self.write_run(r, extra)?;
-        let ResultFile { t, q, qd, multipliers, probes, sections, staged, .. } = self;
-        drop((t, q, qd, multipliers, probes, sections));
+        let ResultFile { t, q, qd, multipliers, probes, sections, reactions, staged, .. } = self;
+        drop((t, q, qd, multipliers, probes, sections, reactions));
         staged.commit()
     }
 
@@ -207,6 +233,12 @@ impl ResultFile {
         }
         for (d, (_, v)) in self.sections.iter().zip(r.strains.iter().chain(&r.curvatures)) {
             d.write(v).map_err(e)?;
+        }
+        if let Some((force, moment, map)) = &self.reactions {
+            let Reactions { force: f_values, moment: m_values } =
+                map.series((&r.settings.mu, r.t.as_slice().expect("contiguous")), &r.q, &r.multipliers);
+            force.write(&f_values).map_err(e)?;
+            moment.write(&m_values).map_err(e)?;
         }
         attr_u64(f, "steps", r.stats.steps as u64).map_err(e)?;
         attr_u64(f, "newton_iterations", r.stats.newton_iterations as u64).map_err(e)?;
@@ -316,6 +348,20 @@ fn transposed(a: &ndarray::Array2<f64>, start: usize, end: usize) -> ndarray::Ar
     ndarray::Array2::from_shape_vec((rows, n), out).expect("rows × n entries")
 }
 
+/// Writes `/labels/reaction` (each reaction's name) and `/labels/reaction_joint` (the
+/// model file's `joints[j]` it belongs to).
+fn write_reaction_labels(f: &hdf5::File, map: &ReactionMap, labelled: &mut Labelled) -> hdf5::Result<()> {
+    let g = f.group("labels")?;
+    let names = map
+        .names()
+        .into_iter()
+        .map(|s| s.parse::<hdf5::types::VarLenUnicode>().map_err(|e| hdf5::Error::from(format!("label `{s}`: {e:?}"))))
+        .collect::<hdf5::Result<Vec<_>>>()?;
+    labelled.label("labels/reaction", &super::h5_text::write_strings(&g, "reaction", &names)?)?;
+    let joints = ndarray::Array1::from_iter(map.points.iter().map(|p| p.joint as u64));
+    labelled.label("labels/reaction_joint", &g.new_dataset_builder().with_data(&joints).create("reaction_joint")?)
+}
+
 /// Writes `/energy/<name>` (J, one value per instant) of a run's energies.
 fn write_energy(f: &hdf5::File, energy: &crate::analysis::energy::Energies) -> hdf5::Result<()> {
     let g = f.create_group("energy")?;
@@ -323,6 +369,16 @@ fn write_energy(f: &hdf5::File, energy: &crate::analysis::energy::Energies) -> h
         g.new_dataset_builder().with_data(values).create(name)?;
     }
     Ok(())
+}
+
+/// Writes what a `statics` result file adds to a run's: the attributes `analysis =
+/// "statics"`, `time` (of the loads, s) and `load_steps`, and `/load_factor` (the fraction
+/// of the loads of each row).
+pub fn write_statics(f: &hdf5::File, time: f64, load_steps: usize, load_factors: &[f64]) -> hdf5::Result<()> {
+    attr_str(f, "analysis", "statics")?;
+    attr_f64(f, "time", time)?;
+    attr_u64(f, "load_steps", load_steps as u64)?;
+    f.new_dataset_builder().with_data(load_factors).create("load_factor").map(|_| ())
 }
 
 /// Writes `/reduced/q`, time first, from the reduced coordinates `zq` (r × n_t, one column

@@ -54,9 +54,13 @@ pub fn build_basis(
     hyper_tolerance: Option<f64>,
 ) -> std::result::Result<(Trained, Estimator), (&'static str, String)> {
     // the physics, assembled once for the blocks, the joint rows, ECSW and the estimator
-    let sys = &*p.model.physics().map_err(|e| ("model", e.to_string()))?.sys;
-    // every run starts from the same consistent, undeformed state
-    let x_ref = data.x.column(0).to_owned();
+    let physics = p.model.physics().map_err(|e| ("model", e.to_string()))?;
+    let sys = &*physics.sys;
+    // every run starts from the same consistent, undeformed state; with `[initial] static`
+    // from the equilibrium of its own loads, and the basis is centred on the undeformed
+    // state all the same (what reduced runs and the basis checks take as x₀)
+    let starts_static = p.model.file.initial.as_ref().is_some_and(|i| i.r#static);
+    let x_ref = if starts_static { Array1::from(physics.x0.to_vec()) } else { data.x.column(0).to_owned() };
     // whole-system: scale the multipliers so both blocks weigh alike in the POD
     let dx = (&data.x - &x_ref.view().insert_axis(Axis(1))).mapv(|v| v * v).sum().sqrt();
     let dl = data.multipliers.mapv(|v| v * v).sum().sqrt();

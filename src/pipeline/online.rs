@@ -114,9 +114,17 @@ pub fn answer(rom: &Rom, mu: &Parameters, fallback: Fallback) -> Result<OnlineRu
         Ok(ReducedRun { result: r, reduced_q: ndarray::Array2::zeros((0, nt)) })
     };
     let s = settle(reduced, fallback, rom.trust(), mu, full)?;
+    // the energies of the answer, after its run (its wall time without them): the full
+    // model's as `simulate` computes them, a reduced run's over its own sampled elements
+    let ReducedRun { result, reduced_q } = s.run;
+    let result = match s.fallback {
+        Some(_) => crate::simulate::with_energies(rom.model(), result)?,
+        None => crate::simulate::with_reduced_energies(rom.model(), result, rom.basis().hyper.as_ref())?,
+    };
+    let run = ReducedRun { result, reduced_q };
     // where the load lies against the basis's range, whichever model answered
     let extrapolated = rom.is_extrapolated(mu);
-    Ok(OnlineRun { run: s.run, estimate: s.estimate, extrapolated, fallback: s.fallback, note: s.note })
+    Ok(OnlineRun { run, estimate: s.estimate, extrapolated, fallback: s.fallback, note: s.note })
 }
 
 /// Runs `rom` at `mu` and writes the result file `out` ([`crate::io::result_file`]: its

@@ -139,6 +139,26 @@ pub fn probe_table(r: &SimulationResult) -> Table {
     t
 }
 
+/// Appends to a run's `table` ([`probe_table`], one row per instant) the reactions of
+/// `model`'s joints ([`crate::analysis::reactions`]): for each joint and node it acts on,
+/// `<name>: Fx` and `<name>: Fy` (N, the force on the body) and `<name>: M` (N m,
+/// counter-clockwise), `<name>` as `/labels/reaction` of the result file.
+pub fn add_reactions(table: &mut Table, model: &crate::model::Model, r: &SimulationResult) {
+    let map = crate::analysis::reactions::ReactionMap::of(model);
+    if map.n_rows() != r.multipliers.nrows() {
+        return;
+    }
+    let v = map.series((&r.settings.mu, r.t.as_slice().expect("contiguous")), &r.q, &r.multipliers);
+    for name in map.names() {
+        table.columns.extend(["Fx", "Fy", "M"].map(|c| format!("{name}: {c}")));
+    }
+    for (k, row) in table.rows.iter_mut().enumerate() {
+        for p in 0..map.points.len() {
+            row.extend([v.force[(k, p, 0)], v.force[(k, p, 1)], v.moment[(k, p)]].map(Cell::from));
+        }
+    }
+}
+
 /// One run's statistics as cells: `steps`, `seconds` (time loop), `newton_iterations`,
 /// `factorizations`, `step_cuts`, with the names [`RUN_COLUMNS`].
 pub fn run_cells(r: &SimulationResult) -> Vec<Cell> {
