@@ -54,7 +54,7 @@ bench-routes: deps
 	cargo build --release
 	python3 benches/sweep_routes.py
 
-# greedy training and the error estimate on 24 generated mechanisms (docs/zoo.md; ~1 h on 2 cores)
+# greedy training and the error estimate on 32 generated mechanisms (docs/zoo.md; ~1 h on 2 cores)
 zoo: deps
 	cargo build --release
 	cargo run --release --example zoo -- --out target/zoo

@@ -4,7 +4,7 @@
 //!
 //! ```text
 //! cargo build --release
-//! cargo run --release --example zoo -- [--seed S] [--models N] [--out DIR]
+//! cargo run --release --example zoo -- [--seed S] [--models N | --slots A..B] [--out DIR]
 //!     [--tolerances 5e-3,1e-2] [--subset] [--jobs 2] [--no-methods] [--draw-only] [--resume] [--flexrom PATH]
 //! ```
 //!
@@ -36,6 +36,8 @@ const METHODS: [&str; 3] = ["corrected", "defects", "enriched"];
 struct Args {
     seed: u64,
     models: usize,
+    /// `--slots A..B`: these slots only (the new kinds' slots: `--slots 24..32`)
+    slots: Option<std::ops::Range<usize>>,
     out: PathBuf,
     tolerances: Vec<f64>,
     subset: bool,
@@ -47,14 +49,15 @@ struct Args {
 }
 
 fn usage(msg: &str) -> ! {
-    eprintln!("zoo: {msg}\nusage: zoo [--seed S] [--models N] [--out DIR] [--tolerances 5e-3,1e-2] [--subset] [--jobs 1|2] [--no-methods] [--draw-only] [--resume] [--flexrom PATH]");
+    eprintln!("zoo: {msg}\nusage: zoo [--seed S] [--models N | --slots A..B] [--out DIR] [--tolerances 5e-3,1e-2] [--subset] [--jobs 1|2] [--no-methods] [--draw-only] [--resume] [--flexrom PATH]");
     std::process::exit(2)
 }
 
 fn args() -> Args {
     let mut a = Args {
         seed: zoo::DEFAULT_SEED,
-        models: 24,
+        models: zoo::SLOTS,
+        slots: None,
         out: PathBuf::from("target/zoo"),
         tolerances: vec![5e-3, 1e-2],
         subset: false,
@@ -70,6 +73,15 @@ fn args() -> Args {
         match k.as_str() {
             "--seed" => a.seed = value().parse().unwrap_or_else(|_| usage("--seed: not an integer")),
             "--models" => a.models = value().parse().unwrap_or_else(|_| usage("--models: not an integer")),
+            "--slots" => {
+                let v = value();
+                let r = v
+                    .split_once("..")
+                    .and_then(|(x, y)| Some(x.trim().parse::<usize>().ok()?..y.trim().parse::<usize>().ok()?))
+                    .filter(|r| r.start < r.end)
+                    .unwrap_or_else(|| usage("--slots: A..B with A < B (slots A to B − 1)"));
+                a.slots = Some(r)
+            }
             "--out" => a.out = PathBuf::from(value()),
             "--tolerances" => {
                 a.tolerances = value()
@@ -373,7 +385,11 @@ fn main() {
         eprintln!("zoo: {} exists and holds no earlier zoo run (zoo.json); choose another --out", a.out.display());
         std::process::exit(1);
     }
-    let slots: Vec<usize> = if a.subset { zoo::SUBSET.to_vec() } else { (0..a.models).collect() };
+    let slots: Vec<usize> = match (&a.slots, a.subset) {
+        (_, true) => zoo::SUBSET.to_vec(),
+        (Some(r), false) => r.clone().collect(),
+        (None, false) => (0..a.models).collect(),
+    };
     let pool = rayon::ThreadPoolBuilder::new().num_threads(a.jobs).build().expect("a thread pool");
     let models_dir = a.out.join("models");
 

@@ -1,11 +1,13 @@
 //! The zoo (tests/common/zoo, docs/zoo.md): mechanisms nobody tuned flexrom on.
 //!
 //! * The generator: a seed names the same models every time (two draws of every slot are
-//!   equal to the byte, another seed draws others); the first eight slots hold every kind;
-//!   every model parses and stays within the zoo's ranges (1–4 bodies, 10–60 elements per
-//!   body, E in [1e6, 1e11] Pa, some load follows the load scale, the kinds' joints); the
-//!   validation loads are neither greedy candidates nor the range's ends.
-//! * The subset (`zoo::SUBSET`, six models): greedy training at tolerance 1e-2 and
+//!   equal to the byte, another seed draws others); the first eight slots hold the first eight
+//!   kinds and slots 24–27 the four new ones; the first 24 slots are the models they were
+//!   before the new kinds (a fingerprint of their files); every model parses and stays within
+//!   the zoo's ranges (1–4 bodies, 10–60 elements per body, E in [1e6, 1e11] Pa, some load or
+//!   drive follows the load scale, the kinds' joints, positive point masses); the validation
+//!   loads are neither greedy candidates nor the range's ends.
+//! * The subset (`zoo::SUBSET`, seven models): greedy training at tolerance 1e-2 and
 //!   validation at the 8 held-out loads through the release binary, held to the
 //!   targets over the subset (`metrics::Aggregate::missed`: converged ≥ 90 %, coverage
 //!   ≥ 95 % of (model, load) pairs and ≥ 90 % of (model, load, fifth) triples, effectivity
@@ -21,7 +23,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use zoo::drive::Flexrom;
-use zoo::mechanisms::{Kind, KINDS};
+use zoo::mechanisms::{Kind, KINDS, NEW_KINDS};
 use zoo::metrics::{aggregate, model_stats, ModelStats};
 
 #[test]
@@ -35,12 +37,14 @@ fn a_seed_names_the_same_models() {
     }
     let kinds: Vec<Kind> = (0..KINDS.len()).map(|s| zoo::draw(zoo::DEFAULT_SEED, s, 0).kind).collect();
     assert_eq!(kinds, KINDS.to_vec());
+    let new: Vec<Kind> = (24..24 + NEW_KINDS.len()).map(|s| zoo::draw(zoo::DEFAULT_SEED, s, 0).kind).collect();
+    assert_eq!(new, NEW_KINDS.to_vec());
 }
 
 #[test]
 fn every_drawn_model_is_within_the_zoo_ranges() {
     for seed in [zoo::DEFAULT_SEED, 7, 12345] {
-        for slot in 0..24 {
+        for slot in 0..zoo::SLOTS {
             for attempt in 0..3 {
                 let m = zoo::draw(seed, slot, attempt);
                 let what = format!("seed {seed} slot {slot} attempt {attempt}");
@@ -61,13 +65,34 @@ fn every_drawn_model_is_within_the_zoo_ranges() {
                     | LoadSpec::Moment { scaled, .. }
                     | LoadSpec::Force { scaled, .. } => *scaled == ScaledSpec::Flag(true),
                 });
-                assert!(scaled, "{what}: no load follows the load scale");
                 let count = |p: fn(&JointSpec) -> bool| f.joints.iter().filter(|j| p(j)).count();
+                let drives = count(|j| matches!(j, JointSpec::DrivenAngle { scaled: ScaledSpec::Flag(true), .. }));
+                assert!(scaled || drives > 0, "{what}: no load or drive follows the load scale");
                 let ground = count(|j| matches!(j, JointSpec::GroundPin { .. }));
                 let clamps = count(|j| matches!(j, JointSpec::Clamp { .. }));
                 let pins = count(|j| matches!(j, JointSpec::Pin { .. }));
+                let sliders = count(|j| matches!(j, JointSpec::Slider { .. }));
+                let welds = count(|j| matches!(j, JointSpec::Weld { .. }));
+                let all = f.joints.len();
+                assert!(f.masses.iter().all(|p| p.mass > 0.0 && p.mass.is_finite()), "{what}: a mass");
                 let n = f.bodies.len();
                 match m.kind {
+                    // a crank driven by angle or by a moment (then no drive), the rod's end on a slider
+                    Kind::SliderCrank => {
+                        assert!(
+                            (ground, pins, sliders, n) == (1, 1, 1, 2) && drives <= 1 && all == 3 + drives,
+                            "{what}"
+                        )
+                    }
+                    Kind::AngleArm => assert_eq!((ground, pins, drives, all), (1, n - 1, 1, n + 1), "{what}"),
+                    // one weld per arm, at the clamped column's foot or the pinned corner
+                    Kind::WeldedFrame => {
+                        assert!((2..=3).contains(&n) && welds == n - 1 && ground + clamps == 1 && all == n, "{what}")
+                    }
+                    Kind::SpinningLink => {
+                        let spins = f.bodies[0].angular_velocity.is_some();
+                        assert!(ground == 1 && drives + usize::from(spins) == 1 && all == 1 + drives, "{what}")
+                    }
                     Kind::Pendulum => assert_eq!((ground, clamps, pins), (1, 0, 0), "{what}"),
                     Kind::Cantilever => assert!(clamps == 1 && ground <= 1 && pins == 0, "{what}"),
                     Kind::NPendulum | Kind::DrivenArm => assert_eq!((ground, clamps, pins), (1, 0, n - 1), "{what}"),
@@ -165,4 +190,24 @@ fn the_estimate_holds_on_the_zoo_subset() {
     let agg = aggregate(&outcomes.iter().map(|o| (o.training.as_ref().ok(), &o.stats)).collect::<Vec<_>>());
     let missed = agg.missed();
     assert!(missed.is_empty(), "targets missed on the zoo subset: {}\n{}", missed.join("; "), report.join("\n"));
+}
+
+/// FNV-1a of the model files of slots 0..24, attempts 0..4 of the default seed: the zoo's
+/// first 24 slots are the models of docs/zoo.md's earlier results, and growing the zoo must
+/// not change them (the value is the generator's before the new kinds were added).
+fn fingerprint_of_the_first_24_slots() -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for slot in 0..24 {
+        for attempt in 0..4 {
+            for b in zoo::draw(zoo::DEFAULT_SEED, slot, attempt).mechanism.toml.bytes() {
+                h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+            }
+        }
+    }
+    h
+}
+
+#[test]
+fn growing_the_zoo_keeps_its_first_24_slots() {
+    assert_eq!(fingerprint_of_the_first_24_slots(), 0x509b_750e_da70_7c77);
 }

@@ -1,10 +1,12 @@
 //! The kinds of mechanism in the zoo and how each is drawn from a random stream: what a user
 //! would build first (a pendulum, a cantilever, a chain, a driven arm, a clamped boom with
-//! links, a four-bar, a frame, a five-bar), with materials, sections, loads and time settings
+//! links, a four-bar, a frame, a five-bar), and what a user builds with sliders, welds, point
+//! masses, drives by angle and initial velocities (a slider-crank, an arm driven by angle, a
+//! welded frame, a spinning link), with materials, sections, loads, drives and time settings
 //! drawn over the ranges of the zoo's brief (tests/common/zoo/mod.rs).
 
 use super::parts::{
-    ahead, beam, material, model_toml, sig, time, unit_function, Beam, Func, Joint, Load, Material, Rng, Time, G,
+    ahead, beam, material, model_toml, sig, time, unit_function, Beam, Func, Joint, Load, Material, Parts, Rng, Time, G,
 };
 use std::f64::consts::PI;
 
@@ -26,6 +28,19 @@ pub enum Kind {
     Frame,
     /// a closed loop of four beams between two ground pins (two degrees of freedom)
     FiveBar,
+    /// a crank on a ground pin, a flexible rod whose far end slides on the x axis (sometimes
+    /// carrying a slider block's point mass); the crank driven by angle from rest to a rate,
+    /// or in some draws by a moment
+    SliderCrank,
+    /// 1–3 beams pinned in a chain, the first driven by angle at its ground pin (the
+    /// shoulder): a rest-to-rest move or a swing; sometimes a point mass at the tip
+    AngleArm,
+    /// an L or a T of beams welded at a corner, clamped at the column's foot or pinned at the
+    /// corner, with point masses at the arms' ends, under gravity or a force
+    WeldedFrame,
+    /// one beam on a ground pin spun up by angle from rest (the spin-up beam), or released
+    /// with an initial angular velocity under gravity; sometimes a tip mass
+    SpinningLink,
 }
 
 pub const KINDS: [Kind; 8] = [
@@ -39,6 +54,22 @@ pub const KINDS: [Kind; 8] = [
     Kind::FiveBar,
 ];
 
+/// The kinds of the slots after the first [`OLD_SLOTS`]: slot `i ≥ OLD_SLOTS` draws
+/// `NEW_KINDS[(i − OLD_SLOTS) mod 4]`, so that the first slots keep their models.
+pub const NEW_KINDS: [Kind; 4] = [Kind::SliderCrank, Kind::AngleArm, Kind::WeldedFrame, Kind::SpinningLink];
+
+/// The slots the zoo had before the kinds of [`NEW_KINDS`]: slot `i` below it draws `KINDS[i mod 8]`.
+pub const OLD_SLOTS: usize = 24;
+
+/// The kind of slot `slot`.
+pub fn kind_of(slot: usize) -> Kind {
+    if slot < OLD_SLOTS {
+        KINDS[slot % KINDS.len()]
+    } else {
+        NEW_KINDS[(slot - OLD_SLOTS) % NEW_KINDS.len()]
+    }
+}
+
 impl Kind {
     pub fn name(self) -> &'static str {
         match self {
@@ -50,6 +81,10 @@ impl Kind {
             Kind::FourBar => "four-bar",
             Kind::Frame => "frame",
             Kind::FiveBar => "five-bar",
+            Kind::SliderCrank => "slider-crank",
+            Kind::AngleArm => "angle-arm",
+            Kind::WeldedFrame => "welded-frame",
+            Kind::SpinningLink => "spinning-link",
         }
     }
 }
@@ -85,6 +120,10 @@ pub fn build(kind: Kind, rng: &mut Rng) -> Mechanism {
         Kind::FourBar => four_bar(rng, t),
         Kind::Frame => frame(rng, t),
         Kind::FiveBar => five_bar(rng, t),
+        Kind::SliderCrank => slider_crank(rng, t),
+        Kind::AngleArm => angle_arm(rng, t),
+        Kind::WeldedFrame => welded_frame(rng, t),
+        Kind::SpinningLink => spinning_link(rng, t),
     };
     // a light Rayleigh damping in one model of five, as some users add
     if rng.chance(0.2) {
@@ -94,8 +133,10 @@ pub fn build(kind: Kind, rng: &mut Rng) -> Mechanism {
             (0.0, sig(rng.log_uniform(1e-5, 1e-3), 2))
         });
     }
-    // at least one load follows the load scale, or λ would change nothing
-    if !m.loads.iter().any(Load::is_scaled) {
+    // at least one load or drive follows the load scale, or λ would change nothing (drives
+    // by angle always do: `Joint::DrivenAngle` is written with `scaled = true`)
+    let driven = m.joints.iter().any(|j| matches!(j, Joint::DrivenAngle { .. }));
+    if !driven && !m.loads.iter().any(Load::is_scaled) {
         match &mut m.loads[0] {
             Load::Gravity { scaled, .. } | Load::Moment { scaled, .. } | Load::Force { scaled, .. } => {
                 *scaled = Some(true)
@@ -111,13 +152,15 @@ struct Draft {
     joints: Vec<Joint>,
     loads: Vec<Load>,
     damping: Option<(f64, f64)>,
+    /// point masses: body, node, kg
+    masses: Vec<(String, String, f64)>,
     /// what the drive aims at, for the summary
     motion: String,
 }
 
 impl Draft {
     fn new(bodies: Vec<Beam>, joints: Vec<Joint>, loads: Vec<Load>, motion: String) -> Self {
-        Draft { bodies, joints, loads, damping: None, motion }
+        Draft { bodies, joints, loads, damping: None, masses: Vec::new(), motion }
     }
 
     fn finish(self, kind: Kind, t: Time) -> Mechanism {
@@ -137,7 +180,11 @@ impl Draft {
                 )
             })
             .collect();
-        let loads: Vec<String> = self.loads.iter().map(Load::describe).collect();
+        let mut loads: Vec<String> = self.loads.iter().map(Load::describe).collect();
+        loads.extend(self.masses.iter().map(|(b, n, m)| format!("mass {} kg at {b} {n}", sig(*m, 2))));
+        if loads.is_empty() {
+            loads.push("no loads".into());
+        }
         let damping = match self.damping {
             Some((a, 0.0)) => format!("; damping {a} M"),
             Some((_, b)) => format!("; damping {b:e} K"),
@@ -154,7 +201,8 @@ impl Draft {
             t.rho_inf,
             damping
         );
-        let toml = model_toml(&summary, t, self.damping, &self.bodies, &self.joints, &self.loads, &probes);
+        let parts = Parts { bodies: &self.bodies, joints: &self.joints, loads: &self.loads, masses: &self.masses };
+        let toml = model_toml(&summary, t, self.damping, &parts, &probes);
         let n_elements: usize = self.bodies.iter().map(|b| b.elements).sum();
         Mechanism {
             toml,
@@ -602,4 +650,267 @@ fn five_bar(rng: &mut Rng, t: Time) -> Draft {
         loads.push(gravity(rng, 0.3));
     }
     Draft::new(bodies, joints, loads, describe_rotation(theta))
+}
+
+/// The most a drive may turn at the top of the load range (λ = 1.5) in one step: 0.05 rad,
+/// 125 steps a turn, what a user resolving a driven motion picks `dt` for.
+fn rate_cap(t: Time) -> f64 {
+    0.05 / (1.5 * t.dt)
+}
+
+/// The rate at which a spinning body stretches by 1 % at the top of the load range
+/// (centrifugal strain ρ ω² L² / (2E) ≤ 0.01 at 1.5 ω): softer links spin slower.
+fn stretch_cap(b: &Beam) -> f64 {
+    (0.02 * b.youngs_modulus / b.density).sqrt() / b.length() / 1.5
+}
+
+/// A drive from rest to the rate `omega` (rad/s) reached at `ramp` s, then held: Simo and
+/// Vu-Quoc's spin-up θ = (ω/T)(t²/2 + (T/2π)²(cos 2πt/T − 1)) (peak θ̈ = 2ω/T), or the
+/// smooth-step polynomial θ = ω(t³/T² − t⁴/(2T³)) (peak θ̈ = 1.5 ω/T at T/2); both
+/// θ(T) = ωT/2, then ω(t − T/2). The function and its peak angular acceleration.
+fn spin_up(rng: &mut Rng, omega: f64, ramp: f64) -> (Func, f64) {
+    let tail = Func::Polynomial(vec![-0.5 * omega * ramp, omega]);
+    if rng.chance(0.5) {
+        let a = omega / ramp * (ramp / (2.0 * PI)).powi(2);
+        let start = Func::Sum(vec![
+            Func::Polynomial(vec![0.0, 0.0, 0.5 * omega / ramp]),
+            Func::Sine { amplitude: a, frequency: 1.0 / ramp, phase: 0.5 * PI },
+            Func::Constant(-a),
+        ]);
+        (Func::Piecewise(vec![(Some(ramp), start), (None, tail)]), 2.0 * omega / ramp)
+    } else {
+        let start = Func::Polynomial(vec![0.0, 0.0, 0.0, omega / ramp.powi(2), -0.5 * omega / ramp.powi(3)]);
+        (Func::Piecewise(vec![(Some(ramp), start), (None, tail)]), 1.5 * omega / ramp)
+    }
+}
+
+/// A rest-to-rest move by `theta` rad in `duration` s, θ = Θ(10s³ − 15s⁴ + 6s⁵), s = t/T,
+/// then held (peak rate 1.875 Θ/T, peak θ̈ = 10/√3 Θ/T²); or a swing θ = (Θ/2)(1 − cos 2πft)
+/// with f = 1/duration (peak rate πfΘ, peak θ̈ = 2π²f²Θ). Both start at rest. The function,
+/// its peak rate and its peak angular acceleration per unit Θ.
+fn move_by(rng: &mut Rng, duration: f64) -> (Func, f64, f64) {
+    let d = duration;
+    if rng.chance(0.6) {
+        let c = vec![0.0, 0.0, 0.0, 10.0 / d.powi(3), -15.0 / d.powi(4), 6.0 / d.powi(5)];
+        (Func::Piecewise(vec![(Some(d), Func::Polynomial(c)), (None, Func::Constant(1.0))]), 1.875 / d, 5.78 / (d * d))
+    } else {
+        let f = 1.0 / d;
+        let swing = Func::Sum(vec![Func::Constant(0.5), Func::Sine { amplitude: 0.5, frequency: f, phase: -0.5 * PI }]);
+        (swing, PI * f, 2.0 * PI * PI * f * f)
+    }
+}
+
+fn slider_crank(rng: &mut Rng, t: Time) -> Draft {
+    let a = sig(rng.uniform(0.1, 0.3), 2);
+    let b = sig(a * rng.uniform(2.0, 4.0), 2);
+    let theta0 = sig(rng.uniform(0.0, 2.0 * PI), 2);
+    let o = [0.0, 0.0];
+    let p = ahead(o, a, theta0);
+    // the rod's far end on the x axis, ahead of the crank
+    let end = [p[0] + (b * b - p[1] * p[1]).sqrt(), 0.0];
+    let stiff_crank = rng.chance(0.5);
+    let mc = material(rng, if stiff_crank { (1e10, 1e11) } else { E_ALL });
+    let mut crank = beam(rng, "crank", o, p, mc, FLEX_FREE);
+    let mr = material(rng, E_ALL);
+    let rod = beam(rng, "rod", p, end, mr, FLEX_HELD);
+    let mut joints = vec![
+        Joint::GroundPin { body: "crank".into(), node: "start".into() },
+        Joint::Pin { a: ("crank".into(), "end".into()), b: ("rod".into(), "start".into()) },
+        Joint::Slider { body: "rod".into(), node: "end".into(), direction: [1.0, 0.0] },
+    ];
+    let block = if rng.chance(0.7) { sig(rod.mass() * rng.log_uniform(0.2, 2.0), 3) } else { 0.0 };
+    // the crank's inertia with the rod and block moving at about the crank pin's speed
+    let j = crank.inertia_about(o) + (rod.mass() + block) * a * a;
+    let mut loads = Vec::new();
+    let motion = if rng.chance(0.3) {
+        let theta = rotation(rng);
+        loads.push(driving_moment(rng, t, &mut crank, "start", j, theta, 0.0));
+        format!("by a moment, {}", describe_rotation(theta))
+    } else {
+        let cap = rate_cap(t);
+        let omega = sig(rng.log_uniform(0.2 * cap, cap), 2);
+        let ramp = sig(rng.uniform(0.2, 0.8) * t.t_end, 2);
+        let (f, alpha) = spin_up(rng, omega, ramp);
+        crank.carry_moment(1.5 * j * alpha, DRIVE_BEND);
+        joints.push(Joint::DrivenAngle { body: "crank".into(), node: "start".into(), function: f });
+        format!("by angle from rest to {omega} rad/s in {ramp} s")
+    };
+    if rng.chance(0.5) {
+        loads.push(gravity(rng, 0.0));
+    }
+    let mut d = Draft::new(vec![crank, rod], joints, loads, motion);
+    if block > 0.0 {
+        d.masses.push(("rod".into(), "end".into(), block));
+    }
+    d
+}
+
+fn angle_arm(rng: &mut Rng, t: Time) -> Draft {
+    let n = rng.int(1, 3);
+    let specs: Vec<_> = (0..n)
+        .map(|_| (sig(rng.uniform(0.2, 0.8), 2), sig(rng.uniform(-PI, PI), 2), material(rng, E_ALL), FLEX_FREE))
+        .collect();
+    let (mut bodies, mut joints) = chain(rng, [0.0, 0.0], &specs);
+    joints.insert(0, Joint::GroundPin { body: "link1".into(), node: "start".into() });
+    let total: f64 = bodies.iter().map(Beam::mass).sum();
+    let tip = if rng.chance(0.5) { sig(total * rng.log_uniform(0.1, 1.0), 3) } else { 0.0 };
+    let last = bodies.last().expect("a link").end;
+    let j = bodies.iter().map(|b| b.inertia_about([0.0, 0.0])).sum::<f64>() + tip * last[0].hypot(last[1]).powi(2);
+    let with_gravity = rng.chance(0.5);
+    let duration = sig(rng.uniform(0.3, 0.8) * t.t_end, 2);
+    let (unit, rate, accel) = move_by(rng, duration);
+    // the move: from a tenth of a radian to a turn, no faster than a step resolves
+    let sign = if rng.chance(0.5) { 1.0 } else { -1.0 };
+    let theta = rng.log_uniform(0.1, 2.0 * PI).min(rate_cap(t) / rate);
+    let theta = sig(sign * theta, 2);
+    let weight = if with_gravity {
+        bodies.iter().map(|b| b.mass() * G * b.centre()[0].hypot(b.centre()[1])).sum::<f64>()
+            + tip * G * last[0].hypot(last[1])
+    } else {
+        0.0
+    };
+    bodies[0].carry_moment(1.5 * (j * accel * theta.abs() + weight), DRIVE_BEND);
+    joints.push(Joint::DrivenAngle { body: "link1".into(), node: "start".into(), function: unit.scaled(theta) });
+    let mut loads = Vec::new();
+    if with_gravity {
+        loads.push(gravity(rng, 0.0));
+    }
+    let what = if matches!(unit, Func::Sum(_)) { "swings" } else { "moves" };
+    let mut d = Draft::new(bodies, joints, loads, format!("shoulder {what} by {theta} rad in {duration} s"));
+    if tip > 0.0 {
+        d.masses.push((format!("link{n}"), "end".into(), tip));
+    }
+    d
+}
+
+fn welded_frame(rng: &mut Rng, t: Time) -> Draft {
+    let h = sig(rng.uniform(0.3, 1.0), 2);
+    let tee = rng.chance(0.5);
+    let clamped = rng.chance(0.5);
+    // the column from its foot to the corner: standing on a clamped foot, or hanging from a
+    // pinned corner, released tilted
+    let (foot, corner, up) = if clamped {
+        ([0.0, 0.0], [0.0, h], 0.5 * PI)
+    } else {
+        let tilt = sig(rng.uniform(-0.6, 0.6), 2);
+        (ahead([0.0, 0.0], h, -0.5 * PI + tilt), [0.0, 0.0], 0.5 * PI + tilt)
+    };
+    let mc = material(rng, E_ALL);
+    let mut column = beam(rng, "column", foot, corner, mc, if clamped { FLEX_CLAMPED } else { FLEX_FREE });
+    let arms: Vec<(String, f64)> = if tee {
+        vec![("left".into(), up + 0.5 * PI), ("right".into(), up - 0.5 * PI)]
+    } else {
+        vec![("arm".into(), up + if rng.chance(0.5) { 0.5 * PI } else { -0.5 * PI })]
+    };
+    let mut bodies = Vec::new();
+    let mut joints = vec![if clamped {
+        Joint::Clamp { body: "column".into(), node: "start".into() }
+    } else {
+        Joint::GroundPin { body: "column".into(), node: "end".into() }
+    }];
+    let mut masses = Vec::new();
+    let frame_mass = column.mass();
+    for (name, angle) in &arms {
+        let w = sig(rng.uniform(0.3, 1.0), 2);
+        let ma = if rng.chance(0.5) { mc } else { material(rng, E_ALL) };
+        let arm = beam(rng, name, corner, ahead(corner, w, *angle), ma, FLEX_CLAMPED);
+        joints.push(Joint::Weld { a: ("column".into(), "end".into()), b: (name.clone(), "start".into()) });
+        if rng.chance(0.7) {
+            masses.push((
+                name.clone(),
+                "end".to_string(),
+                sig((frame_mass + arm.mass()) * rng.log_uniform(0.1, 1.0), 3),
+            ));
+        }
+        bodies.push(arm);
+    }
+    let mut loads = Vec::new();
+    let by_force = clamped && rng.chance(0.5);
+    let motion = if by_force {
+        // a force at the first arm's end, P w²/EI from 0.02 to 0.5
+        let arm = &bodies[0];
+        let kappa = rng.log_uniform(0.02, 0.5);
+        let p = kappa * arm.bending_stiffness() / arm.length().powi(2);
+        let dir = rng.uniform(0.0, 2.0 * PI);
+        loads.push(Load::Force {
+            body: arm.name.clone(),
+            node: "end".into(),
+            value: [sig(p * dir.cos(), 3), sig(p * dir.sin(), 3)],
+            function: Some(unit_function(rng, t.t_end, t.dt)),
+            scaled: None,
+        });
+        if rng.chance(0.5) {
+            loads.push(gravity(rng, 0.0));
+        }
+        format!("{}, clamped, arm-end force P L²/EI up to {kappa:.2}", if tee { "T" } else { "L" })
+    } else {
+        loads.push(Load::Gravity { g: [0.0, -G], scaled: Some(true) });
+        format!(
+            "{}, {} under gravity",
+            if tee { "T" } else { "L" },
+            if clamped { "clamped" } else { "pinned at the corner" }
+        )
+    };
+    // each arm sized for its end's load, the column for the arms' moments (M L/EI ≤ 0.3 at λ = 1.5)
+    let end_load = |name: &str| -> f64 {
+        let m: f64 = masses.iter().filter(|(b, _, _)| b == name).map(|(_, _, m)| m * G).sum();
+        let f: f64 = loads
+            .iter()
+            .filter_map(|l| match l {
+                Load::Force { body, value, .. } if body == name => Some(value[0].hypot(value[1])),
+                _ => None,
+            })
+            .sum();
+        m + f
+    };
+    let mut corner_moment = 0.0;
+    for arm in &mut bodies {
+        let m = 1.5 * end_load(&arm.name) * arm.length();
+        arm.carry_moment(m, DRIVE_BEND);
+        corner_moment += m;
+    }
+    if clamped {
+        column.carry_moment(corner_moment, DRIVE_BEND);
+    }
+    bodies.insert(0, column);
+    let mut d = Draft::new(bodies, joints, loads, motion);
+    d.masses = masses;
+    d
+}
+
+fn spinning_link(rng: &mut Rng, t: Time) -> Draft {
+    let length = sig(rng.uniform(0.3, 1.5), 2);
+    let angle = sig(rng.uniform(-PI, PI), 2);
+    let m = material(rng, E_ALL);
+    let mut b = beam(rng, "beam", [0.0, 0.0], ahead([0.0, 0.0], length, angle), m, FLEX_FREE);
+    let tip = if rng.chance(0.4) { sig(b.mass() * rng.log_uniform(0.1, 1.0), 3) } else { 0.0 };
+    let j = b.inertia_about([0.0, 0.0]) + tip * length * length;
+    let joints_pin = Joint::GroundPin { body: "beam".into(), node: "start".into() };
+    let cap = rate_cap(t).min(stretch_cap(&b));
+    let mut loads = Vec::new();
+    let (joints, motion) = if rng.chance(0.3) {
+        // released spinning under gravity: over the top at every load when ½ J ω² exceeds
+        // 1.5 × the largest rise of its weight (centre by L, tip by 2L), or swinging back
+        let rise = G * length * (b.mass() + 2.0 * tip);
+        let over = (3.0 * rise / j).sqrt();
+        let omega = sig((over * rng.uniform(0.3, 2.0)).min(cap), 2);
+        b.angular_velocity = Some(omega);
+        loads.push(Load::Gravity { g: [0.0, -G], scaled: Some(true) });
+        (vec![joints_pin], format!("released at {omega} rad/s under gravity"))
+    } else {
+        let omega = sig(rng.log_uniform(0.2 * cap, cap), 2);
+        let ramp = sig(rng.uniform(0.3, 0.9) * t.t_end, 2);
+        let (f, alpha) = spin_up(rng, omega, ramp);
+        b.carry_moment(1.5 * j * alpha, DRIVE_BEND);
+        if rng.chance(0.5) {
+            loads.push(gravity(rng, 0.0));
+        }
+        let drive = Joint::DrivenAngle { body: "beam".into(), node: "start".into(), function: f };
+        (vec![joints_pin, drive], format!("spun up by angle from rest to {omega} rad/s in {ramp} s"))
+    };
+    let mut d = Draft::new(vec![b], joints, loads, motion);
+    if tip > 0.0 {
+        d.masses.push(("beam".into(), "end".into(), tip));
+    }
+    d
 }

@@ -73,6 +73,8 @@ pub struct Beam {
     pub area: f64,
     pub inertia: f64,
     pub youngs_modulus: f64,
+    /// the initial angular velocity about the start, rad/s (`angular_velocity`; None: at rest)
+    pub angular_velocity: Option<f64>,
 }
 
 impl Beam {
@@ -165,6 +167,7 @@ pub fn beam(rng: &mut Rng, name: &str, start: [f64; 2], end: [f64; 2], m: Materi
         area,
         inertia,
         youngs_modulus: m.youngs_modulus,
+        angular_velocity: None,
     }
 }
 
@@ -177,10 +180,23 @@ pub fn ahead(p: [f64; 2], length: f64, angle: f64) -> [f64; 2] {
 #[derive(Clone, Debug)]
 pub enum Func {
     Constant(f64),
-    Sine { amplitude: f64, frequency: f64, phase: f64 },
-    Exponential { amplitude: f64, rate: f64 },
-    Ramp { amplitude: f64, duration: f64 },
+    Sine {
+        amplitude: f64,
+        frequency: f64,
+        phase: f64,
+    },
+    Exponential {
+        amplitude: f64,
+        rate: f64,
+    },
+    Ramp {
+        amplitude: f64,
+        duration: f64,
+    },
     Piecewise(Vec<(Option<f64>, Func)>),
+    /// c0 + c1 t + c2 t² + …
+    Polynomial(Vec<f64>),
+    Sum(Vec<Func>),
 }
 
 impl Func {
@@ -193,6 +209,8 @@ impl Func {
             Func::Piecewise(pieces) => {
                 pieces.iter().find(|(u, _)| u.is_none_or(|u| t <= u)).map_or(0.0, |(_, f)| f.eval(t))
             }
+            Func::Polynomial(c) => c.iter().rev().fold(0.0, |acc, ci| acc * t + ci),
+            Func::Sum(terms) => terms.iter().map(|f| f.eval(t)).sum(),
         }
     }
 
@@ -208,6 +226,9 @@ impl Func {
             }
             Func::Ramp { amplitude, duration } => Func::Ramp { amplitude: sig(amplitude * k, 3), duration: *duration },
             Func::Piecewise(p) => Func::Piecewise(p.iter().map(|(u, f)| (*u, f.scaled(k))).collect()),
+            // not rounded: a polynomial piece must meet the next piece where it ends
+            Func::Polynomial(c) => Func::Polynomial(c.iter().map(|ci| ci * k).collect()),
+            Func::Sum(terms) => Func::Sum(terms.iter().map(|f| f.scaled(k)).collect()),
         }
     }
 
@@ -260,6 +281,14 @@ impl Func {
                     .collect();
                 format!("{{ type = \"piecewise\", pieces = [{}] }}", p.join(", "))
             }
+            Func::Polynomial(c) => {
+                let c: Vec<String> = c.iter().map(|x| format!("{x:?}")).collect();
+                format!("{{ type = \"polynomial\", coefficients = [{}] }}", c.join(", "))
+            }
+            Func::Sum(terms) => {
+                let t: Vec<String> = terms.iter().map(Func::toml).collect();
+                format!("{{ type = \"sum\", terms = [{}] }}", t.join(", "))
+            }
         }
     }
 
@@ -271,6 +300,8 @@ impl Func {
             Func::Exponential { .. } => "exponential",
             Func::Ramp { .. } => "ramp",
             Func::Piecewise(_) => "piecewise",
+            Func::Polynomial(_) => "polynomial",
+            Func::Sum(_) => "sum",
         }
     }
 }
@@ -363,9 +394,34 @@ impl Load {
 /// A joint of the model file.
 #[derive(Clone, Debug)]
 pub enum Joint {
-    GroundPin { body: String, node: String },
-    Clamp { body: String, node: String },
-    Pin { a: (String, String), b: (String, String) },
+    GroundPin {
+        body: String,
+        node: String,
+    },
+    Clamp {
+        body: String,
+        node: String,
+    },
+    Pin {
+        a: (String, String),
+        b: (String, String),
+    },
+    /// the node on the ground line through where it starts along `direction`
+    Slider {
+        body: String,
+        node: String,
+        direction: [f64; 2],
+    },
+    Weld {
+        a: (String, String),
+        b: (String, String),
+    },
+    /// the node's slope turned by `function` (rad), multiplied by the load scale
+    DrivenAngle {
+        body: String,
+        node: String,
+        function: Func,
+    },
 }
 
 /// The time settings a user would write.
@@ -397,16 +453,23 @@ fn node_toml(n: &str) -> String {
     }
 }
 
+/// What a mechanism is made of: its bodies, joints, loads and point masses (body, node, kg).
+pub struct Parts<'a> {
+    pub bodies: &'a [Beam],
+    pub joints: &'a [Joint],
+    pub loads: &'a [Load],
+    pub masses: &'a [(String, String, f64)],
+}
+
 /// The model file's text.
 pub fn model_toml(
     description: &str,
     time: Time,
     damping: Option<(f64, f64)>,
-    bodies: &[Beam],
-    joints: &[Joint],
-    loads: &[Load],
+    parts: &Parts,
     probes: &[(String, String, f64)],
 ) -> String {
+    let Parts { bodies, joints, loads, masses } = *parts;
     let mut s = String::new();
     let _ = writeln!(s, "description = {description:?}\n");
     let _ = writeln!(s, "[time]\nt_end = {:?}\ndt = {:?}\nrho_inf = {:?}", time.t_end, time.dt, time.rho_inf);
@@ -419,6 +482,9 @@ pub fn model_toml(
             "\n[[bodies]]\nname = {:?}\nstart = [{:?}, {:?}]\nend = [{:?}, {:?}]\nelements = {}\ndensity = {:?}\narea = {:?}\ninertia = {:?}\nyoungs_modulus = {:?}",
             b.name, b.start[0], b.start[1], b.end[0], b.end[1], b.elements, b.density, b.area, b.inertia, b.youngs_modulus
         );
+        if let Some(w) = b.angular_velocity {
+            let _ = writeln!(s, "angular_velocity = {w:?}");
+        }
     }
     for j in joints {
         match j {
@@ -428,14 +494,32 @@ pub fn model_toml(
             Joint::Clamp { body, node } => {
                 let _ = writeln!(s, "\n[[joints]]\ntype = \"clamp\"\nbody = {body:?}\nnode = {}", node_toml(node));
             }
-            Joint::Pin { a, b } => {
+            Joint::Pin { a, b } | Joint::Weld { a, b } => {
                 let _ = writeln!(
                     s,
-                    "\n[[joints]]\ntype = \"pin\"\na = {{ body = {:?}, node = {} }}\nb = {{ body = {:?}, node = {} }}",
+                    "\n[[joints]]\ntype = \"{}\"\na = {{ body = {:?}, node = {} }}\nb = {{ body = {:?}, node = {} }}",
+                    if matches!(j, Joint::Pin { .. }) { "pin" } else { "weld" },
                     a.0,
                     node_toml(&a.1),
                     b.0,
                     node_toml(&b.1)
+                );
+            }
+            Joint::Slider { body, node, direction } => {
+                let _ = writeln!(
+                    s,
+                    "\n[[joints]]\ntype = \"slider\"\nbody = {body:?}\nnode = {}\ndirection = [{:?}, {:?}]",
+                    node_toml(node),
+                    direction[0],
+                    direction[1]
+                );
+            }
+            Joint::DrivenAngle { body, node, function } => {
+                let _ = writeln!(
+                    s,
+                    "\n[[joints]]\ntype = \"driven_angle\"\nbody = {body:?}\nnode = {}\nscaled = true\nfunction = {}",
+                    node_toml(node),
+                    function.toml()
                 );
             }
         }
@@ -467,6 +551,9 @@ pub fn model_toml(
                 );
             }
         }
+    }
+    for (body, node, mass) in masses {
+        let _ = writeln!(s, "\n[[masses]]\nbody = {body:?}\nnode = {}\nmass = {mass:?}", node_toml(node));
     }
     for (name, body, at) in probes {
         let _ = writeln!(s, "\n[[probes]]\nname = {name:?}\nbody = {body:?}\nat = {at:?}");
