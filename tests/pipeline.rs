@@ -281,6 +281,7 @@ fn run_writes_a_report() {
         "speedup_vs_load.svg",
         "probes_0.png",
         "estimate_vs_load.png",
+        "energy_0.svg",
     ] {
         assert!(dir.path().join("report").join(f).is_file(), "{f} missing");
     }

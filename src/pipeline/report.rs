@@ -14,6 +14,8 @@ use super::validate::{validate, Validation};
 use crate::error::{Error, Result};
 use crate::io::atomic::TempPath;
 use crate::io::output::{check_output, check_report_dir, mark_new_report, swap_in_report, Origin};
+use crate::rom::Rom;
+use crate::simulate::SimulationResult;
 use crate::solver::parameters::Parameters;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -120,6 +122,13 @@ fn build(
     for (i, mu) in vpoints.iter().enumerate() {
         let (v, full, reduced) = validate(&rom, mu, dense)?;
         validations.push(v);
+        energy_figure(
+            &rom,
+            (&full, &reduced.result),
+            &format!("Energies, full and reduced, {}{}", if in_box { "" } else { "load scale " }, name(mu)),
+        )?
+        .save(&out.join(format!("energy_{i}")))
+        .map_err(|e| plot_err(&format!("energy_{i}"), e))?;
         // a model without probes has nothing to draw here
         if full.probes.is_empty() {
             continue;
@@ -438,6 +447,9 @@ fn build(
     for (i, x) in labels.iter().enumerate().filter(|_| !p.model.probe_names().is_empty()) {
         let _ = writeln!(md, "![probes at {x}](probes_{i}.svg)");
     }
+    for (i, x) in labels.iter().enumerate() {
+        let _ = writeln!(md, "![energies at {x}](energy_{i}.svg)");
+    }
     let _ = writeln!(
         md,
         "![singular values](singular_values.svg)\n![error](error_vs_load.svg)\n![speedup](speedup_vs_load.svg)"
@@ -453,6 +465,43 @@ fn build(
 /// The summary's section on the errors against the motion: displacement_error and its
 /// estimate, each probe's error over its travel (a row per validation, named by `labels`
 /// under the column `head`).
+/// The energies of a validated load, full (lines) and reduced (dashed, from its own reduced
+/// quantities: [`crate::simulate::with_reduced_energies`]): kinetic, strain, gravity and
+/// springs, and the balance `T + U + V + V_s − W` (constant without damping at ρ∞ = 1, else
+/// falling by what the damping and the numerical damping take).
+fn energy_figure(rom: &Rom, (full, reduced): (&SimulationResult, &SimulationResult), title: &str) -> Result<Figure> {
+    let full = crate::simulate::with_energies(rom.model(), full.clone())?;
+    let reduced = crate::simulate::with_reduced_energies(rom.model(), reduced.clone(), rom.basis().hyper.as_ref())?;
+    let (Some(ef), Some(er)) = (&full.energy, &reduced.energy) else { unreachable!("with_energies sets them") };
+    let curve = |t: &ndarray::Array1<f64>, v: &ndarray::Array1<f64>| t.iter().zip(v).map(|(t, v)| (*t, *v)).collect();
+    let mut series = Vec::new();
+    for (name, a, b) in [
+        ("kinetic", &ef.kinetic, &er.kinetic),
+        ("strain", &ef.strain, &er.strain),
+        ("gravity", &ef.gravity, &er.gravity),
+        ("springs", &ef.springs, &er.springs),
+    ] {
+        if a.iter().chain(b.iter()).any(|x| *x != 0.0) {
+            series.push(Series::new(format!("{name}, full"), curve(&full.t, a), Style::Line));
+            series.push(Series::new(format!("{name}, reduced"), curve(&reduced.t, b), Style::Dashed));
+        }
+    }
+    let balance = vec![
+        Series::new("balance, full", curve(&full.t, &ef.total()), Style::Line),
+        Series::new("balance, reduced", curve(&reduced.t, &er.total()), Style::Dashed),
+    ];
+    Ok(Figure {
+        title: title.to_string(),
+        x_label: "t (s)".into(),
+        panels: vec![
+            Panel { y_label: "energy (J)".into(), log_y: false, series },
+            Panel { y_label: "T + U + V − W (J)".into(), log_y: false, series: balance },
+        ],
+        markers: vec![],
+        marker_label: String::new(),
+    })
+}
+
 fn motion_section(
     md: &mut String,
     validations: &[Validation],
