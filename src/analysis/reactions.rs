@@ -65,12 +65,7 @@ impl ReactionMap {
     /// order its description names them.
     pub fn of(model: &Model) -> ReactionMap {
         let bodies = model.bodies();
-        let mut first_node = Vec::with_capacity(bodies.len());
-        let mut n = 0;
-        for body in bodies {
-            first_node.push(n);
-            n += body.n_elements + 1;
-        }
+        let first_node = model.first_nodes();
         let first = |(b, k): NodeId| 4 * (first_node[b] + k);
         let node_name = |(b, k): NodeId| format!("{} node {k}", bodies[b].name);
         let joints = model.joints();

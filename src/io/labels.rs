@@ -46,12 +46,7 @@ impl Labels {
             .flat_map(|(b, body)| (0..=body.n_elements).flat_map(move |k| (0..4).map(move |c| (b, k, c))))
             .collect();
         let node = |(b, k): NodeId| format!("{} node {k}", bodies[b].name);
-        let mut first_node = Vec::with_capacity(bodies.len());
-        let mut n = 0;
-        for body in bodies {
-            first_node.push(n);
-            n += body.n_elements + 1;
-        }
+        let first_node = model.first_nodes();
         let first = |(b, k): NodeId| 4 * (first_node[b] + k);
         let joints = model.joints();
         let multipliers = lower(joints, &first)

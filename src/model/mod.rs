@@ -114,6 +114,19 @@ impl Model {
         Sha256::digest(json.as_bytes()).iter().map(|b| format!("{b:02x}")).collect()
     }
 
+    /// Each body's first node in the global numbering (SPEC §1: node after node, body after
+    /// body); a node's first coordinate is `4 (first[b] + k)`.
+    pub fn first_nodes(&self) -> Vec<usize> {
+        self.bodies()
+            .iter()
+            .scan(0, |n, body| {
+                let first = *n;
+                *n += body.n_elements + 1;
+                Some(first)
+            })
+            .collect()
+    }
+
     /// The model's parameters, each once: those its loads and then its drives are scaled by
     /// (`scaled = true` is [`crate::solver::parameters::LOAD_SCALE`]) in file order, then the
     /// bodies' Young's moduli that are parameters, in the order of the bodies.
