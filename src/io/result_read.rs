@@ -26,7 +26,7 @@ impl ResultReader {
     /// Opens the result file at `path`, refusing a file that is not HDF5, another kind of
     /// flexrom file (a basis, a sweep: named), a newer layout, or a result whose `/t` and
     /// `/q` disagree; every message names the file and what is wrong.
-    pub fn open(path: &Path) -> Result<ResultReader> {
+    pub fn open(path: &Path, limits: &crate::limits::Limits) -> Result<ResultReader> {
         let f = hdf5::File::open(path).map_err(|e| {
             if super::h5::is_locked(&e) {
                 Error::hdf5(path, super::h5::unreadable(&e))
@@ -59,6 +59,8 @@ impl ResultReader {
         let text =
             |name: &str| read_attr_str(&f, name).map_err(|e| Error::input(path, name, format!("cannot be read: {e}")));
         let (model_text, model_path) = (text("model")?, text("model_path")?);
+        // the file alone sizes /t: bounded before it is read (8 bytes an instant)
+        super::h5::bounded_len(&f, "t", 8.0, limits).map_err(|e| Error::input(path, "t", e))?;
         let t: Vec<f64> = f
             .dataset("t")
             .and_then(|d| d.read_raw::<f64>())

@@ -67,7 +67,7 @@ struct Run {
 
 impl Run {
     fn open(path: &Path, limits: &crate::limits::Limits) -> Result<Run> {
-        let reader = ResultReader::open(path)?;
+        let reader = ResultReader::open(path, limits)?;
         let model = Model::from_text_with(&reader.model_text, &reader.model_path, limits.clone())
             .map_err(|e| Error::input(path, "model", format!("the model text it stores is not valid: {e}")))?;
         let n_dof = 4 * model.bodies().iter().map(|b| b.n_elements + 1).sum::<usize>();
