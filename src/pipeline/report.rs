@@ -547,18 +547,23 @@ fn motion_section(
     }
     let _ = writeln!(
         md,
-        "\nStrains and curvatures at the probes that record them: derivatives of the coordinates along the beam, less accurate than the coordinates rel_error and the estimate are of (docs/error-estimate.md).\n"
+        "\nWhat engineers read at the probes — position, and strain and curvature where a probe records them (a bending moment is E I κ: its error is the curvature's) — each against the full run, relative to the full run's range over the run, beside its own estimate (docs/error-estimate.md).\n"
     );
-    let _ = writeln!(md, "| {head} | probe | quantity | max error | largest value (full run) | error over it |");
-    let _ = writeln!(md, "|---|---|---|---|---|---|");
+    let _ =
+        writeln!(md, "| {head} | probe | quantity | max error | range (full run) | error over the range | estimate |");
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|");
     for (v, label) in validations.iter().zip(labels) {
         for q in &v.probe_quantity_errors {
-            let unit = q.unit();
+            let unit = q.quantity.unit();
             let rel = q.relative.map_or("none".to_string(), |e| format!("{e:.2e}"));
+            let est = q.estimate.map_or("—".to_string(), |e| format!("{e:.2e}"));
             let _ = writeln!(
                 md,
-                "| {label} | {} | {} | {:.2e}{unit} | {:.2e}{unit} | {rel} |",
-                q.probe, q.quantity, q.max_error, q.largest
+                "| {label} | {} | {} | {:.2e}{unit} | {:.2e}{unit} | {rel} | {est} |",
+                q.probe,
+                q.quantity.name(),
+                q.max_error,
+                q.range
             );
         }
     }

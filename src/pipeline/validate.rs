@@ -26,10 +26,12 @@ use crate::linalg::kkt::LinearSolverKind;
 use crate::model::Model;
 use crate::rom::estimator::norms::{against_motion, displacement_error_by_time, distance_and_norm, rel_error_by_time};
 use crate::rom::estimator::Estimate;
+use crate::rom::quantities::{self, Apart, Quantity};
 use crate::rom::{Output, ReducedRun, Rom};
 use crate::simulate::{simulate, FullModel, Overrides, SimulationResult};
 use crate::solver::model::Parameters;
 use crate::solver::model::ParametricModel;
+use ndarray::ArrayView2;
 
 /// The fixed keys of `validate --json`.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -163,69 +165,76 @@ impl ProbeTravel {
     }
 }
 
-/// One probe's strain or curvature (`quantities` in the model file) against the full
-/// run's. Derivatives of the coordinates along the beam, they are less accurate than the
-/// coordinates `rel_error` and the estimate are of (docs/error-estimate.md).
+/// One probe quantity — position, strain or curvature (`quantities` in the model file) —
+/// of the reduced run against the full run's, relative to the full run's range over the
+/// run ([`crate::rom::quantities`]): what an engineer reads off a link (its bending moment
+/// is `E I κ`, so its relative error is the curvature's). Derivatives of the coordinates
+/// along the beam, strain and curvature converge more slowly in the modes than the
+/// coordinates `rel_error` is of: each has its own estimate (docs/error-estimate.md).
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct ProbeQuantityError {
     pub probe: String,
-    /// `"strain"` (1) or `"curvature"` (1/m)
-    pub quantity: String,
-    /// `max_k |v_rom(t_k) − v_full(t_k)|`
+    pub quantity: Quantity,
+    /// `max_k ‖v_rom(t_k) − v_full(t_k)‖` (m, 1 or 1/m)
     pub max_error: f64,
-    /// `max_k |v_full(t_k)|`: the largest value of the full run
+    /// the full run's range, `‖max_k v_full − min_k v_full‖`
+    pub range: f64,
+    /// `max_k ‖v_full(t_k)‖`: the largest value of the full run
     pub largest: f64,
-    /// `max_error / largest`; none where the full run's value stays within its resolution
-    /// (the Newton tolerance carried to the quantity, [`against_motion`]); ∞ where only the
-    /// reduced one leaves it (JSON writes ∞ as null too: `max_error` tells them apart)
+    /// `max_error / range`; none where the full run's range stays within the quantity's
+    /// resolution (the Newton tolerance carried to it) and so does the error; ∞ where only
+    /// the error leaves it (JSON writes ∞ as null too: `max_error` tells them apart)
     pub relative: Option<f64>,
+    /// the estimate of `relative` (null: no estimator, or no swing to measure against)
+    pub estimate: Option<f64>,
+    /// `estimate / relative`
+    pub effectivity: Option<f64>,
 }
 
 impl ProbeQuantityError {
-    /// The error of the series `rom` against `full` over the full run's largest value;
-    /// `resolution` is the quantity's: the Newton tolerance `tol` for a strain (slopes
-    /// resolve to `tol`), `tol / L` for a curvature.
-    pub fn of(
-        probe: &str,
-        quantity: &str,
-        full: &ndarray::Array1<f64>,
-        rom: &ndarray::Array1<f64>,
-        resolution: f64,
-    ) -> Self {
-        let max_error = full.iter().zip(rom).fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
-        let largest = full.iter().fold(0.0_f64, |m, a| m.max(a.abs()));
-        let ratio = against_motion(largest > resolution, max_error > resolution, || max_error / largest);
+    /// The error of the series `rom` against `full` (n_t × components each) over the full
+    /// run's range; `resolution` is the quantity's ([`Quantity::resolution`]).
+    pub fn of(probe: &str, quantity: Quantity, full: ArrayView2<f64>, rom: ArrayView2<f64>, resolution: f64) -> Self {
+        let apart = Apart::of(rom, full, resolution);
+        let largest = full.outer_iter().map(|v| v.dot(&v).sqrt()).fold(0.0, f64::max);
         ProbeQuantityError {
             probe: probe.to_string(),
-            quantity: quantity.to_string(),
-            max_error,
+            quantity,
+            max_error: apart.distance,
+            range: apart.range,
             largest,
-            relative: (!ratio.is_nan()).then_some(ratio),
+            relative: (!apart.relative.is_nan()).then_some(apart.relative),
+            estimate: None,
+            effectivity: None,
         }
     }
 
-    /// The quantity's unit as printed after a value (strain: none).
-    pub fn unit(&self) -> &'static str {
-        if self.quantity == "curvature" {
-            " 1/m"
-        } else {
-            ""
-        }
-    }
-
-    /// Every probe's strain and curvature of `rom` against `full`, at the Newton tolerance
-    /// `tol` of a model of length scale `length`.
+    /// Every probe quantity of `rom` against `full`, at the Newton tolerance `tol` of a
+    /// model of length scale `length`.
     fn all(full: &SimulationResult, rom: &SimulationResult, tol: f64, length: f64) -> Vec<Self> {
-        let mut out = Vec::new();
-        for (quantity, f, r, resolution) in [
-            ("strain", &full.strains, &rom.strains, tol),
-            ("curvature", &full.curvatures, &rom.curvatures, tol / length),
-        ] {
-            for ((name, a), (_, b)) in f.iter().zip(r) {
-                out.push(Self::of(name, quantity, a, b, resolution));
-            }
+        quantities::readings(full)
+            .iter()
+            .zip(quantities::readings(rom))
+            .map(|(f, r)| Self::of(f.probe, f.quantity, f.values, r.values, f.quantity.resolution(tol, length)))
+            .collect()
+    }
+
+    /// With its estimate from `e` (matched by probe and quantity).
+    fn with_estimate(mut self, e: &Estimate) -> Self {
+        let found = e.quantities.iter().find(|q| q.probe == self.probe && q.quantity == self.quantity);
+        self.estimate = found.map(|q| q.estimate).filter(|x| !x.is_nan());
+        self.effectivity = self.estimate.zip(self.relative).map(|(e, r)| e / r);
+        self
+    }
+
+    /// Whether the estimate covers the error (an undefined error is covered; a missing
+    /// estimate is not).
+    pub fn covered(&self) -> bool {
+        match (self.relative, self.estimate) {
+            (None, _) => true,
+            (Some(r), Some(e)) => e >= r,
+            (Some(_), None) => false,
         }
-        out
     }
 }
 
@@ -375,6 +384,8 @@ impl Validation {
             self.effectivity_displacement = Some(e.error_estimate_displacement / self.displacement_error);
             self.error_estimate_displacement_by_time = Some(e.displacement_by_time.to_vec());
             self.estimate_failure = e.failure.clone();
+            self.probe_quantity_errors =
+                std::mem::take(&mut self.probe_quantity_errors).into_iter().map(|q| q.with_estimate(e)).collect();
         }
         if let Some((rom, t)) = rom.and_then(|r| Some((r, r.trust()?))) {
             let mu = self.mu();
@@ -581,15 +592,22 @@ impl Validation {
             ));
         }
         for q in &self.probe_quantity_errors {
-            let unit = q.unit();
+            let unit = q.quantity.unit();
+            let estimate = q.estimate.map_or(String::new(), |e| {
+                format!(
+                    ", estimate {e:.3e}{}",
+                    q.effectivity.map_or(String::new(), |f| format!(" (effectivity {f:.2})"))
+                )
+            });
             s.push_str(&format!(
-                "\n  probe {} {}: max error {:.3e}{unit} against a largest value of {:.3e}{unit}: {}",
+                "\n  probe {} {}: max error {:.3e}{unit} over a range of {:.3e}{unit}: {}{estimate}",
                 q.probe,
-                q.quantity,
+                q.quantity.name(),
                 q.max_error,
-                q.largest,
-                q.relative
-                    .map_or("none (it stays within the Newton tolerance)".to_string(), |e| format!("{e:.3e} of it")),
+                q.range,
+                q.relative.map_or("none (it stays within the Newton tolerance)".to_string(), |e| {
+                    format!("{e:.3e} of its range")
+                }),
             ));
         }
         s
@@ -615,7 +633,7 @@ fn slower_line(speedup: f64, speedup_with_estimate: Option<f64>) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::{first_different_step, slower_line, ProbeQuantityError, ProbeTravel};
+    use super::{first_different_step, slower_line, ProbeQuantityError, ProbeTravel, Quantity};
 
     /// The slower-route line: only below 1×, judged on the route with the estimate where
     /// there is one (a reduced run 1.36× faster that its estimate brings to 0.9× is slower).
@@ -666,18 +684,19 @@ mod tests {
     }
 
     /// A curvature series against a reduced one off by 0.02 and 0.03 at two instants: the
-    /// largest error 0.03 over the largest |κ| of the full run, 1.0 (closed form); a series
-    /// that stays at zero has none, or ∞ where only the reduced one leaves it.
+    /// largest error 0.03 over the full run's range 0.5 − (−1.0) = 1.5, i.e. 0.02 (closed
+    /// form); a series that stays at zero has none, or ∞ where only the reduced one leaves it.
     #[test]
-    fn a_probe_quantity_against_its_largest_value() {
-        let full = ndarray::array![0.0, 0.5, -1.0, 0.25];
-        let rom = ndarray::array![0.0, 0.52, -0.97, 0.25];
-        let q = ProbeQuantityError::of("root", "curvature", &full, &rom, 1e-10);
-        assert!((q.max_error - 0.03).abs() < 1e-15 && q.largest == 1.0, "{q:?}");
-        assert!((q.relative.unwrap() - 0.03).abs() < 1e-15, "{q:?}");
-        let zero = ndarray::Array1::zeros(4);
-        assert_eq!(ProbeQuantityError::of("tip", "strain", &zero, &zero, 1e-10).relative, None);
-        let off = ProbeQuantityError::of("tip", "strain", &zero, &(&zero + 1e-3), 1e-10);
+    fn a_probe_quantity_against_its_range() {
+        let col = |v: ndarray::Array1<f64>| v.insert_axis(ndarray::Axis(1));
+        let full = col(ndarray::array![0.0, 0.5, -1.0, 0.25]);
+        let rom = col(ndarray::array![0.0, 0.52, -0.97, 0.25]);
+        let q = ProbeQuantityError::of("root", Quantity::Curvature, full.view(), rom.view(), 1e-10);
+        assert!((q.max_error - 0.03).abs() < 1e-15 && q.largest == 1.0 && q.range == 1.5, "{q:?}");
+        assert!((q.relative.unwrap() - 0.02).abs() < 1e-15, "{q:?}");
+        let zero = ndarray::Array2::zeros((4, 1));
+        assert_eq!(ProbeQuantityError::of("tip", Quantity::Strain, zero.view(), zero.view(), 1e-10).relative, None);
+        let off = ProbeQuantityError::of("tip", Quantity::Strain, zero.view(), (&zero + 1e-3).view(), 1e-10);
         assert_eq!(off.relative, Some(f64::INFINITY));
     }
 }

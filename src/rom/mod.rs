@@ -10,6 +10,8 @@
 
 pub mod estimator;
 pub(crate) mod pool;
+pub mod probes;
+pub mod quantities;
 pub mod run;
 pub mod trust;
 

@@ -3,7 +3,6 @@
 
 use crate::error::{Error, Result};
 use crate::model::{Model, SharedPhysics};
-use crate::physics::element::Vec8;
 use crate::physics::system::FlexibleSystem;
 use crate::reduction::{Basis, Hyper, HyperReducedModel, Reduced, ReducedModel};
 use crate::simulate::{Overrides, Settings, SimulationResult};
@@ -220,37 +219,7 @@ fn run<R: Reduced<FlexibleSystem>>(
         }
         Output::ReducedAndProbes => (Array2::zeros((0, nt)), Array2::zeros((0, nt)), Array2::zeros((0, nt))),
     };
-    // probes from the rows of V on their element: x_e = x_ref,e + V_e q
-    let element_coordinates = |p: &crate::physics::system::Probe| {
-        let dofs = full.element_dofs(p.element);
-        let ve = basis.modes.select(ndarray::Axis(0), dofs);
-        let xe_ref = basis.reference.select(ndarray::Axis(0), dofs);
-        ve.dot(&zq) + &xe_ref.insert_axis(ndarray::Axis(1))
-    };
-    let probes = full
-        .probes
-        .iter()
-        .map(|p| {
-            let xe = element_coordinates(p);
-            let el = full.element(p.element);
-            let mut xy = Array2::zeros((nt, 2));
-            for k in 0..nt {
-                let r = el.position(&Vec8::from_iterator(xe.column(k).iter().copied()), p.xi);
-                xy[[k, 0]] = r[0];
-                xy[[k, 1]] = r[1];
-            }
-            (p.name.clone(), xy)
-        })
-        .collect();
-    let (strains, curvatures) = crate::simulate::probe_sections(&full.probes, |p| {
-        let (xe, el) = (element_coordinates(p), full.element(p.element));
-        (0..nt)
-            .map(|k| {
-                let e = Vec8::from_iterator(xe.column(k).iter().copied());
-                (el.axial_strain(&e, p.xi), el.curvature(&e, p.xi))
-            })
-            .collect()
-    });
+    let values = super::probes::probe_values(full, basis, zq.view());
     Ok(ReducedRun {
         result: SimulationResult {
             model_text: model.text.clone(),
@@ -260,9 +229,9 @@ fn run<R: Reduced<FlexibleSystem>>(
             q,
             qd,
             multipliers,
-            probes,
-            strains,
-            curvatures,
+            probes: values.positions,
+            strains: values.strains,
+            curvatures: values.curvatures,
             stats,
             wall_seconds,
             // computed where written (pipeline::online::answer), not in every reduced run

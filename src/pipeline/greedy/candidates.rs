@@ -274,7 +274,7 @@ pub(super) fn calibrate_defects(
                 return [f64::NAN; FIFTHS];
             };
             let Ok(raw) = d.raw(&run) else { return [f64::NAN; FIFTHS] };
-            std::array::from_fn(|i| e.by_time[i] / raw.relative[i])
+            std::array::from_fn(|i| e.by_time[i] / raw.norms.relative[i])
         })
         .collect();
     if cands.is_box() {

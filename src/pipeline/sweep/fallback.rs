@@ -171,6 +171,7 @@ mod tests {
             error_estimate_displacement: displacement,
             displacement_by_time: [displacement; 5],
             failure: None,
+            quantities: Vec::new(),
         }
     }
 

@@ -566,6 +566,7 @@ pub fn read_sweep(
                 .as_ref()
                 .map_or([f64::NAN; 5], |a| std::array::from_fn(|i| a[[k, i]])),
             failure: None,
+            quantities: Vec::new(),
         });
         let extrapolated = extrapolated.as_ref().is_some_and(|a| a.get(k).is_some_and(|&v| v != 0));
         let v = v.map(|mut v| {

@@ -67,8 +67,7 @@
 //! 9 of the 13 new ones had read within 1.2–3× of it. Where no step fell back `‖δ₂‖/‖δ₁‖`
 //! stayed ≤ 0.45.
 
-use super::norms::RawByFifth;
-use super::{ErrorEstimator, Estimator};
+use super::{ErrorEstimator, Estimator, QuantityRaw, Raw};
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::physics::system::FlexibleSystem;
@@ -374,12 +373,18 @@ impl ErrorEstimator for Corrected {
     fn data(&self) -> &Estimator {
         &self.data
     }
-    fn raw(&self, run: &ReducedRun) -> Result<RawByFifth> {
+    fn raw(&self, run: &ReducedRun) -> Result<Raw> {
         let why = match self.runners.with(|r| r.trajectory(run))? {
             Ok((qp, stats)) if stats.followed() => {
                 let x0 = ndarray::ArrayView1::from(&self.x0[..]);
                 let res = super::norms::resolution(run, self.length);
-                return Ok(self.norms.raw_by_time(&self.basis, &self.data.enriched, &run.reduced_q, &qp, x0, res));
+                let norms = self.norms.raw_by_time(&self.basis, &self.data.enriched, &run.reduced_q, &qp, x0, res);
+                let sys = &self.model.physics()?.sys;
+                let enriched = crate::rom::probes::probe_values(sys, &self.data.enriched, qp.view());
+                let reference = enriched.readings();
+                let tol = run.result.settings.params.tolerance;
+                let quantities = QuantityRaw::between(&run.result, &reference, tol, self.length);
+                return Ok(Raw { norms, quantities });
             }
             Ok((_, stats)) if stats.diverged > 0 => {
                 "left the reduced run's step (a step's first correction was not contracted)".to_string()

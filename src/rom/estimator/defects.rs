@@ -25,14 +25,18 @@
 //! numbers, not fitted.
 
 use super::corrected::CorrectedRunner;
-use super::norms::{resolution, ConfigurationNorms, RawByFifth};
-use super::{ByFifth, ErrorEstimator, Estimator, FIFTHS};
+use super::norms::{against_motion, resolution, ConfigurationNorms, RawByFifth};
+use super::{ByFifth, ErrorEstimator, Estimator, QuantityRaw, Raw, FIFTHS};
 use crate::error::Result;
 use crate::model::Model;
+use crate::physics::element::Vec8;
+use crate::physics::system::FlexibleSystem;
 use crate::reduction::Basis;
 use crate::rom::pool::Pool;
+use crate::rom::quantities::{range, readings, Quantity};
 use crate::rom::run::ReducedRun;
 use crate::solver::model::Parameters;
+use ndarray::Axis;
 use std::sync::Arc;
 
 /// `s`: reduced-run steps per sampled defect.
@@ -50,6 +54,8 @@ pub fn sample_for(steps: usize, sample: usize) -> usize {
 /// ([`crate::reduction::estimator::DefectsCalibration`]).
 pub struct Defects {
     data: Arc<Estimator>,
+    basis: Arc<Basis>,
+    sys: Arc<FlexibleSystem>,
     runners: Pool<'static, CorrectedRunner>,
     sample: usize,
     /// the configuration norms' constants, projected once: an estimate costs O(r n_t),
@@ -68,13 +74,79 @@ impl Defects {
         let physics = model.physics()?;
         let norms = ConfigurationNorms::new(basis, ndarray::ArrayView1::from(&physics.x0[..]));
         let length = physics.length_scale();
-        Ok(Defects { data: Arc::clone(data), runners, sample: DEFECT_SAMPLE, norms, length })
+        let sys = Arc::clone(&physics.sys);
+        Ok(Defects {
+            data: Arc::clone(data),
+            basis: Arc::clone(basis),
+            sys,
+            runners,
+            sample: DEFECT_SAMPLE,
+            norms,
+            length,
+        })
     }
 
     /// Another sampling interval (experiments: examples/estimate_table.rs).
     pub fn with_sample(mut self, sample: usize) -> Self {
         self.sample = sample.max(1);
         self
+    }
+}
+
+impl Defects {
+    /// The defect sum in each probe quantity: the change `Δv_n = v(x_n + V⁺δ_n) − v(x_n)`
+    /// the enriched correction `δ_n` makes to the quantity at the reduced run's state `x_n`
+    /// (on the probe's element alone), summed as the coordinates' defects are,
+    ///
+    /// ```text
+    ///     η_raw,q = s · Σ_n ‖Δv_n‖ / range_k v(x_k)
+    /// ```
+    ///
+    /// over the reduced run's own range (there is no enriched trajectory to take it from).
+    fn quantity_raws(&self, run: &ReducedRun, defects: &ndarray::Array2<f64>, s: usize) -> Vec<QuantityRaw> {
+        let (sys, z) = (&self.sys, &run.reduced_q);
+        let tol = run.result.settings.params.tolerance;
+        // per probe: the summed change in position, strain and curvature
+        let sums: Vec<[f64; 3]> = sys
+            .probes
+            .iter()
+            .map(|p| {
+                let dofs = sys.element_dofs(p.element);
+                let rows = |b: &Basis| b.modes.select(Axis(0), dofs);
+                let (ve, vpe) = (rows(&self.basis), rows(&self.data.enriched));
+                let xe_ref = self.basis.reference.select(Axis(0), dofs);
+                let el = sys.element(p.element);
+                let at = |e: &Vec8| {
+                    let r = el.position(e, p.xi);
+                    [r[0], r[1], el.axial_strain(e, p.xi), el.curvature(e, p.xi)]
+                };
+                let mut sum = [0.0; 3];
+                for k in (s..z.ncols()).step_by(s) {
+                    let x = Vec8::from_iterator((ve.dot(&z.column(k)) + &xe_ref).iter().copied());
+                    let d = Vec8::from_iterator(vpe.dot(&defects.column(k)).iter().copied());
+                    let (a, b) = (at(&x), at(&(x + d)));
+                    sum[0] += s as f64 * ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+                    sum[1] += s as f64 * (b[2] - a[2]).abs();
+                    sum[2] += s as f64 * (b[3] - a[3]).abs();
+                }
+                sum
+            })
+            .collect();
+        readings(&run.result)
+            .iter()
+            .map(|v| {
+                let i = sys.probes.iter().position(|p| p.name == v.probe).unwrap_or(0);
+                let slot = match v.quantity {
+                    Quantity::Position => 0,
+                    Quantity::Strain => 1,
+                    Quantity::Curvature => 2,
+                };
+                let (sum, range) = (sums.get(i).map_or(f64::NAN, |s| s[slot]), range(v.values));
+                let res = v.quantity.resolution(tol, self.length);
+                let raw = against_motion(range > res, sum > res, || sum / range);
+                QuantityRaw { probe: v.probe.to_string(), quantity: v.quantity, raw }
+            })
+            .collect()
     }
 }
 
@@ -88,7 +160,7 @@ impl ErrorEstimator for Defects {
 
     /// `η_raw` over the instants up to the end of each fifth of `run`, in both measures
     /// (module documentation).
-    fn raw(&self, run: &ReducedRun) -> Result<RawByFifth> {
+    fn raw(&self, run: &ReducedRun) -> Result<Raw> {
         let z = &run.reduced_q;
         let nt = z.ncols();
         let s = sample_for(nt.saturating_sub(1), self.sample);
@@ -107,10 +179,11 @@ impl ErrorEstimator for Defects {
             err2[k] = acc * acc;
         }
         let resolution = resolution(run, self.length);
-        Ok(RawByFifth::from_sums(nt, self.norms.n_dof(), resolution, |displacement, end| {
+        let norms = RawByFifth::from_sums(nt, self.norms.n_dof(), resolution, |displacement, end| {
             let per_instant = if displacement { &disp2 } else { &norm2 };
             (err2[..end].iter().sum(), per_instant[..end].iter().sum::<f64>().max(0.0))
-        }))
+        });
+        Ok(Raw { norms, quantities: self.quantity_raws(run, &defects, s) })
     }
 
     /// The defect sum is a bound by itself: factor 1, raised in the proportion that

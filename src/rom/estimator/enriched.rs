@@ -4,8 +4,8 @@
 //! cheaply; it is also what runs where they are not available (whole-system bases, models
 //! without the invariant-based reduced model).
 
-use super::norms::{NormProjection, RawByFifth};
-use super::{ErrorEstimator, Estimator};
+use super::norms::NormProjection;
+use super::{ErrorEstimator, Estimator, QuantityRaw, Raw};
 use crate::error::Result;
 use crate::model::Model;
 use crate::reduction::Basis;
@@ -48,11 +48,14 @@ impl ErrorEstimator for Enriched {
     fn data(&self) -> &Estimator {
         &self.data
     }
-    fn raw(&self, run: &ReducedRun) -> Result<RawByFifth> {
+    fn raw(&self, run: &ReducedRun) -> Result<Raw> {
         let mu = run.result.settings.parameters();
         let e = self.runners.with(|r| r.solve(mu, Output::ReducedAndProbes, &[]))??;
         let x0 = ndarray::ArrayView1::from(&self.x0[..]);
         let res = super::norms::resolution(run, self.length);
-        Ok(self.norms.raw_by_time(&self.basis, &self.data.enriched, &run.reduced_q, &e.reduced_q, x0, res))
+        let norms = self.norms.raw_by_time(&self.basis, &self.data.enriched, &run.reduced_q, &e.reduced_q, x0, res);
+        let reference = crate::rom::quantities::readings(&e.result);
+        let tol = run.result.settings.params.tolerance;
+        Ok(Raw { norms, quantities: QuantityRaw::between(&run.result, &reference, tol, self.length) })
     }
 }

@@ -45,7 +45,9 @@ pub use crate::reduction::estimator::{
     Calibration, CalibrationPoint, DefectsCalibration, ErrorMeasure, EstimateMethod, Estimator, DEFAULT_FACTOR,
 };
 use crate::reduction::Basis;
+use crate::rom::quantities::{self, Quantity};
 use crate::rom::run::ReducedRun;
+use crate::simulate::SimulationResult;
 use crate::solver::model::Parameters;
 use std::sync::Arc;
 
@@ -78,6 +80,61 @@ impl RawByFifth {
     }
 }
 
+/// What an estimator reads off a run before its factor: `η_raw` by fifth in both measures,
+/// and the distance in each quantity the probes record ([`QuantityRaw`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Raw {
+    pub norms: RawByFifth,
+    pub quantities: Vec<QuantityRaw>,
+}
+
+/// A probe quantity's `η_raw`: the reduced run's distance from the enriched model in it
+/// over the enriched model's range ([`crate::rom::quantities`]); NaN where neither moves
+/// beyond the quantity's resolution.
+#[derive(Clone, Debug, PartialEq)]
+pub struct QuantityRaw {
+    pub probe: String,
+    pub quantity: Quantity,
+    pub raw: f64,
+}
+
+impl QuantityRaw {
+    /// The raw distance of `run` from the reference `reference` in every quantity, over
+    /// the reference's ranges (the same probes, in [`quantities::readings`]'s order).
+    pub fn between(run: &SimulationResult, reference: &[quantities::Reading], tol: f64, length: f64) -> Vec<Self> {
+        quantities::readings(run)
+            .iter()
+            .zip(reference)
+            .map(|(v, w)| QuantityRaw {
+                probe: v.probe.to_string(),
+                quantity: v.quantity,
+                raw: quantities::Apart::of(v.values, w.values, v.quantity.resolution(tol, length)).relative,
+            })
+            .collect()
+    }
+
+    /// ∞ in every quantity of `run`: an estimator whose model failed.
+    pub fn infinite(run: &SimulationResult) -> Vec<Self> {
+        quantities::readings(run)
+            .iter()
+            .map(|v| QuantityRaw { probe: v.probe.to_string(), quantity: v.quantity, raw: f64::INFINITY })
+            .collect()
+    }
+}
+
+/// The estimate of a probe quantity's error over its range (the `rel_error` of the
+/// quantity `validate` measures, [`crate::rom::quantities`]): `c · η_raw,q`, the factor the
+/// run's estimate has.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct QuantityEstimate {
+    pub probe: String,
+    pub quantity: Quantity,
+    /// `c · η_raw,q`; ∞ where the estimator's model failed, NaN where the quantity does not
+    /// move beyond its resolution in either run
+    pub estimate: f64,
+    pub raw: f64,
+}
+
 /// One estimate.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Estimate {
@@ -100,6 +157,8 @@ pub struct Estimate {
     pub displacement_by_time: ByFifth,
     /// why the estimator's own model failed, when it did (the estimates are then ∞)
     pub failure: Option<String>,
+    /// each probe quantity's estimate, in [`crate::rom::quantities::readings`]'s order
+    pub quantities: Vec<QuantityEstimate>,
 }
 
 impl Estimate {
@@ -117,6 +176,7 @@ impl Estimate {
             error_estimate_displacement: 0.0,
             displacement_by_time: [0.0; 5],
             failure: None,
+            quantities: Vec::new(),
         }
     }
 
@@ -147,9 +207,9 @@ pub trait ErrorEstimator: Send + Sync {
     /// The data training made (enriched basis, calibration).
     fn data(&self) -> &Estimator;
 
-    /// `η_raw` of `run` by fifth of the run, in both measures. `Err` when the estimator's
-    /// model fails.
-    fn raw(&self, run: &ReducedRun) -> Result<RawByFifth>;
+    /// `η_raw` of `run` by fifth of the run, in both measures, and in each probe quantity.
+    /// `Err` when the estimator's model fails.
+    fn raw(&self, run: &ReducedRun) -> Result<Raw>;
 
     /// The factor each fifth's `η_raw` is multiplied by at the parameters `mu`: the
     /// calibrated `c` unless the method knows better.
@@ -161,11 +221,19 @@ pub trait ErrorEstimator: Send + Sync {
     /// an infinite estimate, not an error: the reduced answer itself exists.
     fn estimate(&self, run: &ReducedRun, mu: &Parameters) -> Estimate {
         let start = std::time::Instant::now();
-        let (raw, failure) = match self.raw(run) {
+        let (Raw { norms: raw, quantities }, failure) = match self.raw(run) {
             Ok(raw) => (raw, None),
-            Err(e) => (RawByFifth::INFINITE, Some(e.to_string())),
+            Err(e) => {
+                let infinite = Raw { norms: RawByFifth::INFINITE, quantities: QuantityRaw::infinite(&run.result) };
+                (infinite, Some(e.to_string()))
+            }
         };
         let factors = self.factors(mu);
+        let whole = factors[FIFTHS - 1];
+        let quantities = quantities
+            .into_iter()
+            .map(|q| QuantityEstimate { probe: q.probe, quantity: q.quantity, estimate: whole * q.raw, raw: q.raw })
+            .collect();
         let by_time: ByFifth = std::array::from_fn(|i| factors[i] * raw.relative[i]);
         let displacement_by_time: ByFifth = std::array::from_fn(|i| factors[i] * raw.displacement[i]);
         Estimate {
@@ -178,6 +246,7 @@ pub trait ErrorEstimator: Send + Sync {
             error_estimate_displacement: displacement_by_time[FIFTHS - 1],
             displacement_by_time,
             failure,
+            quantities,
         }
     }
 
