@@ -67,6 +67,57 @@ pub fn warn(py: Python<'_>, lines: &[String]) -> PyResult<()> {
     Ok(())
 }
 
+/// A sweep's strains and curvatures (`strains`, `curvatures`: probe name → (n, n_t)) and
+/// each probe quantity's error estimate (`quantity_error_estimates`: probe name → quantity →
+/// (n)), NaN where a point did not run to the end or has no estimate (0 where the full
+/// model answered).
+fn sweep_sections<'py>(py: Python<'py>, d: &Bound<'py, PyDict>, s: &Sweep) -> PyResult<()> {
+    let (n, n_t) = (s.scales.len(), s.t.len());
+    for (key, i) in [("strains", 0), ("curvatures", 1)] {
+        let out = PyDict::new(py);
+        for (j, name) in s.section_names[i].iter().enumerate() {
+            let mut a = ndarray::Array2::from_elem((n, n_t), f64::NAN);
+            for (k, sr) in s.scales.iter().enumerate() {
+                let Outcome::Done(p) = &sr.outcome else { continue };
+                let series = if i == 0 { &p.run.result.strains } else { &p.run.result.curvatures };
+                if let Some((_, v)) = series.get(j).filter(|(_, v)| v.len() == n_t) {
+                    a.row_mut(k).assign(v);
+                }
+            }
+            out.set_item(name, a.into_pyarray(py))?;
+        }
+        d.set_item(key, out)?;
+    }
+    let est = PyDict::new(py);
+    let mut columns: Vec<((String, &'static str), Vec<f64>)> = Vec::new();
+    for (k, sr) in s.scales.iter().enumerate() {
+        let Outcome::Done(p) = &sr.outcome else { continue };
+        for q in p.estimate.iter().flat_map(|e| &e.quantities) {
+            let key = (q.probe.clone(), q.quantity.name());
+            let i = match columns.iter().position(|(c, _)| *c == key) {
+                Some(i) => i,
+                None => {
+                    columns.push((key, vec![f64::NAN; n]));
+                    columns.len() - 1
+                }
+            };
+            columns[i].1[k] = if p.fallback.is_some() { 0.0 } else { q.estimate };
+        }
+    }
+    for ((probe, quantity), v) in columns {
+        let inner = match est.get_item(&probe)? {
+            Some(x) => x.cast_into::<PyDict>()?,
+            None => {
+                let x = PyDict::new(py);
+                est.set_item(&probe, &x)?;
+                x
+            }
+        };
+        inner.set_item(quantity, v.into_pyarray(py))?;
+    }
+    d.set_item("quantity_error_estimates", est)
+}
+
 /// A sweep as arrays with the load axis first; a failed point's entries are NaN and its
 /// message is in `failed`.
 pub fn sweep_dict<'py>(py: Python<'py>, s: &Sweep, points: &[Parameters]) -> PyResult<Bound<'py, PyDict>> {
@@ -113,6 +164,7 @@ pub fn sweep_dict<'py>(py: Python<'py>, s: &Sweep, points: &[Parameters]) -> PyR
         pd.set_item(name, a.into_pyarray(py))?;
     }
     d.set_item("probes", pd)?;
+    sweep_sections(py, &d, s)?;
     d.set_item("error_estimate", estimate.into_pyarray(py))?;
     d.set_item("error_estimate_by_time", by_time.into_pyarray(py))?;
     d.set_item("extrapolated", extrapolated.into_pyarray(py))?;

@@ -629,6 +629,27 @@ impl PyRunResult {
         self.estimate().map(|e| e.error_estimate_displacement)
     }
 
+    /// probe name → {quantity → the estimate of its error over its range over the run}
+    /// (quantities `position`, `strain`, `curvature`; docs/error-estimate.md); None: a
+    /// full run, or no estimator
+    #[getter]
+    fn quantity_error_estimates<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(e) = self.estimate() else { return Ok(None) };
+        let d = PyDict::new(py);
+        for q in &e.quantities {
+            let inner = match d.get_item(&q.probe)? {
+                Some(x) => x.cast_into::<PyDict>()?,
+                None => {
+                    let x = PyDict::new(py);
+                    d.set_item(&q.probe, &x)?;
+                    x
+                }
+            };
+            inner.set_item(q.quantity.name(), q.estimate)?;
+        }
+        Ok(Some(d))
+    }
+
     /// why the estimator's own run failed, when it did (`error_estimate` is then inf)
     #[getter]
     fn estimate_failure(&self) -> Option<String> {

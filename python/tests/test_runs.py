@@ -121,7 +121,14 @@ def test_sweep_equals_online(dp_basis):
             same(s["probes"][name][i], xy)
         same(s["error_estimate"][i], r.error_estimate)
         same(s["error_estimate_by_time"][i], r.error_estimate_by_time)
+        # each probe quantity's estimate (the tip's position: its error over its range)
+        assert set(r.quantity_error_estimates) == {"tip"}
+        for name, quantities in r.quantity_error_estimates.items():
+            for q, v in quantities.items():
+                same(s["quantity_error_estimates"][name][q][i], v)
     assert s["probes"]["tip"].shape == (3, len(s["t"]), 2)
+    # no probe records strain or curvature on the double pendulum
+    assert s["strains"] == {} and s["curvatures"] == {}
     # the same points given as dicts of parameters
     p = b.sweep(points=[{"load_scale": x} for x in loads])
     same(p["probes"]["tip"], s["probes"]["tip"])

@@ -118,7 +118,7 @@ const RESULT: [Entry; 19] = [
     ("labels/reaction_joint", "1", "reaction"),
 ];
 
-const BASIS: [Entry; 54] = [
+const BASIS: [Entry; 55] = [
     ("snapshots", COORDINATE_UNITS, "dof, snapshot"),
     ("snapshot_multipliers", MULTIPLIER_UNITS, "constraint, snapshot"),
     ("snapshot_load_scale", "1", "snapshot"),
@@ -146,6 +146,7 @@ const BASIS: [Entry; 54] = [
     ("estimator/defects/ratio", "1", "load, fifth"),
     ("estimator/defects/factor", "1", "fifth"),
     ("estimator/defects/unit_point", "1", "candidate, parameter"),
+    ("estimator/defects/quantity_ratio", "1", "load, quantity"),
     ("parameters/*", "1", "run"),
     ("training/range", "1", "bound"),
     ("training/tolerance", "1", ""),
@@ -175,7 +176,7 @@ const BASIS: [Entry; 54] = [
     ("timing/estimate_seconds", "s", ""),
 ];
 
-const SWEEP: [Entry; 30] = [
+const SWEEP: [Entry; 38] = [
     ("load_scales", "1", "load"),
     ("points", "1", "load, parameter"),
     ("status", "1", "load"),
@@ -183,6 +184,15 @@ const SWEEP: [Entry; 30] = [
     ("t", "s", "time"),
     ("probes/*", "m", "load, time, xy"),
     ("full_probes/*", "m", "load, time, xy"),
+    ("probe_strain/*", "1", "load, time"),
+    ("probe_curvature/*", "1/m", "load, time"),
+    // each probe quantity's error over its range: estimated, and measured with --validate
+    ("probe_error_estimate/position/*", "1", "load"),
+    ("probe_error_estimate/strain/*", "1", "load"),
+    ("probe_error_estimate/curvature/*", "1", "load"),
+    ("probe_error/position/*", "1", "load"),
+    ("probe_error/strain/*", "1", "load"),
+    ("probe_error/curvature/*", "1", "load"),
     ("reduced_q", REDUCED_UNITS, "load, time, mode"),
     ("rom_seconds", "s", "load"),
     ("newton_iterations", "1", "load"),

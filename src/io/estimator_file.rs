@@ -14,6 +14,9 @@
 //!                                          load_scale empty: the N candidates were points of a
 //!                                          parameter box, `unit_point` (N, d) where they lie in
 //!                                          its unit cube, attribute `parameters`);
+//! /estimator/defects/quantity_ratio (N, n_q)   each probe quantity's whole-run ratio at the
+//!                                          same candidates (attribute `quantities`: the keys
+//!                                          `quantity:probe`, one a line)
 //!   attribute on /estimator/defects: reliable (1: its leave-one-out check passed); factor and
 //!   reliable follow from load_scale and ratio and are recomputed when read
 //!   attributes on /estimator: method ("enriched": the estimators compare with an enriched
@@ -31,7 +34,7 @@
 use super::h5::{attr_f64, attr_str, attr_u64, read_attr_f64, read_attr_str};
 use crate::error::{Error, Result};
 use crate::reduction::estimator::{
-    Calibration, CalibrationPoint, DefectsCalibration, ErrorMeasure, EstimateMethod, Estimator,
+    Calibration, CalibrationPoint, DefectsCalibration, ErrorMeasure, EstimateMethod, Estimator, FIFTHS,
 };
 use crate::reduction::{Basis, Hyper};
 use ndarray::Array1;
@@ -74,6 +77,17 @@ pub fn write_estimator(f: &hdf5::File, est: &Estimator) -> hdf5::Result<()> {
             attr_str(&ds, "parameters", &sc.space.names().collect::<Vec<_>>().join(","))?;
         }
         attr_u64(&dg, "reliable", d.reliable as u64)?;
+        if !d.quantities.is_empty() {
+            // each quantity's whole-run ratio at the candidates, a column per quantity
+            let n = d.ratios.len();
+            let all = &d.quantities;
+            let q = ndarray::Array2::from_shape_fn((n, all.len()), |(j, k)| {
+                all[k].1.ratios.get(j).map_or(f64::NAN, |r| r[FIFTHS - 1])
+            });
+            let ds = dg.new_dataset_builder().with_data(&q).create("quantity_ratio")?;
+            let keys: Vec<&str> = all.iter().map(|(k, _)| k.as_str()).collect();
+            attr_str(&ds, "quantities", &keys.join("\n"))?;
+        }
     }
     attr_str(&g, "method", "enriched")?;
     attr_str(&g, "default_method", est.default_method().name())?;
@@ -268,7 +282,35 @@ fn read_defects(path: &Path, dg: &hdf5::Group, field: &dyn Fn(&str, String) -> E
     } else {
         DefectsCalibration::new(load_scales, ratios)
     };
-    c.ok_or_else(|| field("defects/ratio", "has a fifth of the run without one positive, finite ratio".into()))
+    let c =
+        c.ok_or_else(|| field("defects/ratio", "has a fifth of the run without one positive, finite ratio".into()))?;
+    read_quantity_ratios(dg, c, field)
+}
+
+/// `/estimator/defects/quantity_ratio` (N, n_q) and its attribute `quantities` (the keys
+/// `quantity:probe`, one a line): each probe quantity's calibration; files written before
+/// it have none.
+fn read_quantity_ratios(
+    dg: &hdf5::Group,
+    c: DefectsCalibration,
+    field: &dyn Fn(&str, String) -> Error,
+) -> Result<DefectsCalibration> {
+    let Ok(ds) = dg.dataset("quantity_ratio") else { return Ok(c) };
+    let name = "defects/quantity_ratio";
+    let keys = crate::io::h5::read_attr_str(&ds, "quantities")
+        .map_err(|e| field(name, format!("has no readable attribute quantities ({e})")))?;
+    let keys: Vec<String> = keys.lines().map(str::to_string).collect();
+    let want = (c.ratios.len(), keys.len());
+    let shape = ds.shape();
+    if shape != [want.0, want.1] {
+        return Err(field(
+            name,
+            format!("is {shape:?}; expected {want:?}, a row per candidate and a column per quantity"),
+        ));
+    }
+    let q = ds.read_2d::<f64>().map_err(|e| field(name, format!("cannot be read: {e}")))?;
+    let rows: Vec<Vec<f64>> = q.rows().into_iter().map(|r| r.to_vec()).collect();
+    Ok(c.with_quantities(&keys, &rows))
 }
 
 /// `[min, max]` of the training load scales: `/training/range` when present (greedy

@@ -9,6 +9,9 @@
 //! /probes/<name>          (n_t, 2)       x, y of each probe, m
 //! /probe_strain/<name>    (n_t)          axial strain at the probes that record it, 1
 //! /probe_curvature/<name> (n_t)          curvature at the probes that record it, 1/m
+//!                                        (`online`: each of these probe datasets carries the
+//!                                        attribute error_estimate, the estimate of its error
+//!                                        over its range over the run, crate::rom::quantities)
 //! /energy/<name>          (n_t)          energies, J: kinetic, strain, strain_axial,
 //!                                        strain_bending, gravity, springs, external_work
 //!                                        (simulate, statics, online)
@@ -58,10 +61,7 @@ impl RunPlan {
     /// and the start, whatever halving a step takes).
     pub fn of(model: &crate::model::Model, s: &Settings) -> RunPlan {
         let z = model.sizes();
-        let names = |f: fn(&crate::physics::system::Probe) -> bool| {
-            model.probes().iter().filter(|p| f(p)).map(|p| p.name.clone()).collect()
-        };
-        let series = [names(|p| p.strain), names(|p| p.curvature)];
+        let series = model.section_names();
         Self::new(s.n_steps + 1, z.n_dof as usize, z.n_constraints as usize, model.probe_names(), series, s)
     }
 

@@ -371,6 +371,23 @@ impl Model {
         self.probes.iter().map(|p| p.name.clone()).collect()
     }
 
+    /// The names of the probes that record strain, and of those that record curvature.
+    pub fn section_names(&self) -> [Vec<String>; 2] {
+        let names = |f: fn(&Probe) -> bool| self.probes.iter().filter(|p| f(p)).map(|p| p.name.clone()).collect();
+        [names(|p| p.strain), names(|p| p.curvature)]
+    }
+
+    /// The keys `quantity:probe` of every probe quantity, in the order runs report them
+    /// (every probe's position, then the strains, then the curvatures).
+    pub fn quantity_keys(&self) -> Vec<String> {
+        let [strains, curvatures] = self.section_names();
+        let keys = |q: &'static str, names: Vec<String>| names.into_iter().map(move |n| format!("{q}:{n}"));
+        keys("position", self.probe_names())
+            .chain(keys("strain", strains))
+            .chain(keys("curvature", curvatures))
+            .collect()
+    }
+
     /// The validated probes, in file order (element, ξ, what each records).
     pub fn probes(&self) -> &[Probe] {
         &self.probes

@@ -391,6 +391,7 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool, limits: &Limits) -> R
         scales: all.iter().map(|mu| ScaleResult { mu: mu.clone(), outcome: Outcome::Pending }).collect(),
         t: Array1::from_iter((0..=s.n_steps).map(|k| k as f64 * s.dt)),
         probe_names: model.probe_names(),
+        section_names: model.section_names(),
         n_reduced: stored.as_ref().map_or(0, |b| b.basis.n_reduced()),
         full: first.full,
         model_fingerprint: model.fingerprint(),

@@ -288,6 +288,7 @@ fn pending(model: &Model, n_reduced: usize, full: bool, points: &[Parameters], o
         scales: points.iter().map(|mu| ScaleResult { mu: mu.clone(), outcome: Outcome::Pending }).collect(),
         t,
         probe_names: model.probe_names(),
+        section_names: model.section_names(),
         n_reduced,
         full,
         model_fingerprint: model.fingerprint(),

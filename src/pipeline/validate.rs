@@ -209,6 +209,20 @@ impl ProbeQuantityError {
         }
     }
 
+    /// A quantity's error as a sweep file stores it: the relative error alone (NaN: none).
+    pub fn stored(probe: &str, quantity: Quantity, relative: f64) -> Self {
+        ProbeQuantityError {
+            probe: probe.to_string(),
+            quantity,
+            max_error: f64::NAN,
+            range: f64::NAN,
+            largest: f64::NAN,
+            relative: (!relative.is_nan()).then_some(relative),
+            estimate: None,
+            effectivity: None,
+        }
+    }
+
     /// Every probe quantity of `rom` against `full`, at the Newton tolerance `tol` of a
     /// model of length scale `length`.
     fn all(full: &SimulationResult, rom: &SimulationResult, tol: f64, length: f64) -> Vec<Self> {
@@ -347,6 +361,13 @@ fn first_different_step(a: &[f64], b: &[f64]) -> Option<f64> {
 }
 
 impl Validation {
+    /// With each probe quantity's estimate from `e`.
+    pub fn with_quantity_estimates(mut self, e: &Estimate) -> Self {
+        let errors = std::mem::take(&mut self.probe_quantity_errors);
+        self.probe_quantity_errors = errors.into_iter().map(|q| q.with_estimate(e)).collect();
+        self
+    }
+
     /// The estimate of the error in `measure` (`None` without an estimator).
     pub fn estimate_in(&self, measure: crate::rom::estimator::ErrorMeasure) -> Option<f64> {
         match measure {

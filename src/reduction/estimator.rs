@@ -77,6 +77,12 @@ pub struct DefectsCalibration {
     pub reliable: bool,
     /// scattered candidates (a parameter box): where they lie ([`Self::scattered`])
     pub scattered: Option<Scattered>,
+    /// the same calibration for each probe quantity's estimate (its key `quantity:probe`,
+    /// e.g. `curvature:root`), from the whole run's ratio at the same candidates (every
+    /// fifth holding it): the defect sum reads a quantity on a scale of its own — on a
+    /// clamped arm 0.6–0.8 of the corrected estimate where the coordinates read 1, on a
+    /// spun-up beam's root curvature 150–290 (docs/error-estimate.md)
+    pub quantities: Vec<(String, DefectsCalibration)>,
 }
 
 /// Where scattered candidates lie: the box and each candidate in its unit cube, in the
@@ -110,7 +116,35 @@ impl DefectsCalibration {
             }
         }
         let reliable = leave_one_out(&ratios);
-        Some(DefectsCalibration { load_scales, ratios, factors, reliable, scattered: None })
+        Some(DefectsCalibration { load_scales, ratios, factors, reliable, scattered: None, quantities: Vec::new() })
+    }
+
+    /// With the probe quantities' calibrations: `keys` (`quantity:probe`) and their whole-run
+    /// ratios at the same candidates (`ratios[j][q]`: candidate j, quantity q), each
+    /// calibrated as the coordinates are ([`Self::new`] or [`Self::scattered`] with the ratio
+    /// in every fifth); a quantity without a usable ratio has none.
+    pub fn with_quantities(mut self, keys: &[String], ratios: &[Vec<f64>]) -> Self {
+        self.quantities = keys
+            .iter()
+            .enumerate()
+            .filter_map(|(q, key)| {
+                let r: Vec<ByFifth> =
+                    ratios.iter().map(|row| [row.get(q).copied().unwrap_or(f64::NAN); FIFTHS]).collect();
+                let c = match &self.scattered {
+                    Some(s) => Self::scattered(s.space.clone(), s.unit.clone(), r),
+                    None => Self::new(self.load_scales.clone(), r),
+                };
+                c.map(|c| (key.clone(), c))
+            })
+            .collect();
+        self
+    }
+
+    /// The factor of the quantity `key`'s whole-run defect sum at `mu`: interpolated where
+    /// its calibration passed its check, else its largest ratio; `None` without one.
+    pub fn quantity_factor(&self, key: &str, mu: &Parameters) -> Option<f64> {
+        let (_, c) = self.quantities.iter().find(|(k, _)| k == key)?;
+        Some(if c.reliable { c.factors_at(mu)[FIFTHS - 1] } else { c.factors[FIFTHS - 1] })
     }
 
     /// From the ratios at scattered candidates (points `unit` of the box `space`'s unit

@@ -18,13 +18,6 @@ pub struct ProbeValues {
     pub curvatures: Series,
 }
 
-impl ProbeValues {
-    /// The quantities the probes record ([`crate::rom::quantities::readings_of`]).
-    pub fn readings(&self) -> Vec<crate::rom::quantities::Reading<'_>> {
-        crate::rom::quantities::readings_of(&self.positions, &self.strains, &self.curvatures)
-    }
-}
-
 /// The probes of `sys` along the reduced trajectory `z` (r × n_t) of `basis`.
 pub fn probe_values(sys: &FlexibleSystem, basis: &Basis, z: ArrayView2<f64>) -> ProbeValues {
     let nt = z.ncols();

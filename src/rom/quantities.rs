@@ -17,8 +17,9 @@
 //! number a link is sized by. Where the reference's range lies within the quantity's
 //! resolution (the Newton tolerance carried to it, [`Quantity::resolution`]) there is no
 //! swing to measure against: the ratio is undefined, or ∞ where the distance is above the
-//! resolution ([`super::estimator::norms::against_motion`]).
+//! resolution ([`against_motion`]).
 
+use super::probes::ProbeValues;
 use crate::simulate::{Series, SimulationResult};
 use ndarray::{Array2, ArrayView2, Axis};
 
@@ -92,6 +93,25 @@ pub fn readings_of<'a>(
 /// [`readings_of`] a run's result.
 pub fn readings(r: &SimulationResult) -> Vec<Reading<'_>> {
     readings_of(&r.probes, &r.strains, &r.curvatures)
+}
+
+/// An error measured against a motion: `ratio()` where the motion is above the
+/// coordinates' resolution; where it is not, ∞ if the error is (only the other run moved),
+/// else NaN (nothing moved to measure against). `displacement_error`, a probe's error over
+/// its travel, and each quantity's error over its range.
+pub fn against_motion(moved: bool, differs: bool, ratio: impl FnOnce() -> f64) -> f64 {
+    if moved {
+        ratio()
+    } else if differs {
+        f64::INFINITY
+    } else {
+        f64::NAN
+    }
+}
+
+/// The quantities the probes of a reduced trajectory record ([`readings_of`]).
+pub fn readings_of_probes(v: &ProbeValues) -> Vec<Reading<'_>> {
+    readings_of(&v.positions, &v.strains, &v.curvatures)
 }
 
 /// `max_k ‖a(t_k) − b(t_k)‖`.

@@ -2,7 +2,8 @@
 //! cost, whether the parameters left the training range, and whether the estimate stays
 //! within the tolerance (`--strict`). Warnings are returned as lines for the caller to show.
 
-use super::estimator::{ErrorMeasure, Estimate};
+use super::estimator::{ErrorMeasure, Estimate, QuantityEstimate};
+use super::quantities::Quantity;
 use crate::error::{Error, Result};
 use crate::solver::parameter_space::ParameterSpace;
 use crate::solver::parameters::Parameters;
@@ -235,6 +236,26 @@ pub fn write_run_attributes(
         .create("error_estimate_displacement_by_time")?
         .write(&e.map_or([f64::NAN; FIFTHS], |e| e.displacement_by_time))?;
     attr_f64(f, "sensitivity_near", sensitivity_near.unwrap_or(f64::NAN))?;
+    for q in e.map_or(&[][..], |e| &e.quantities[..]) {
+        write_quantity_estimate(f, q)?;
+    }
+    Ok(())
+}
+
+/// The estimate of a probe quantity's error over its range ([`crate::rom::quantities`]) as
+/// the attribute `error_estimate` of the quantity's dataset (`/probes/<name>`,
+/// `/probe_strain/<name>`, `/probe_curvature/<name>`), where the file holds it.
+fn write_quantity_estimate(f: &hdf5::File, q: &QuantityEstimate) -> hdf5::Result<()> {
+    let group = match q.quantity {
+        Quantity::Position => "probes",
+        Quantity::Strain => "probe_strain",
+        Quantity::Curvature => "probe_curvature",
+    };
+    let path = format!("{group}/{}", q.probe);
+    if f.link_exists(&path) {
+        let d = f.dataset(&path)?;
+        crate::io::h5::attr_f64(&d, "error_estimate", q.estimate)?;
+    }
     Ok(())
 }
 

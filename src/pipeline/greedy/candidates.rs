@@ -265,23 +265,34 @@ pub(super) fn calibrate_defects(
         Ok(true) => Defects::new(model, rom.basis(), &Arc::new(est.clone())).ok(),
         _ => None,
     };
-    let ratios: Vec<ByFifth> = cands
+    // per candidate: the ratio by fifth, and each probe quantity's whole-run ratio
+    let keys: Vec<String> = model.quantity_keys();
+    let unusable = || ([f64::NAN; FIFTHS], vec![f64::NAN; keys.len()]);
+    let measured: Vec<(ByFifth, Vec<f64>)> = cands
         .points
         .par_iter()
         .map(|mu| {
-            let Some(d) = &defects else { return [f64::NAN; FIFTHS] };
+            let Some(d) = &defects else { return unusable() };
             let Ok((run, Some(e))) = rom.solve_and_estimate(mu, Output::ReducedAndProbes, &[]) else {
-                return [f64::NAN; FIFTHS];
+                return unusable();
             };
-            let Ok(raw) = d.raw(&run) else { return [f64::NAN; FIFTHS] };
-            std::array::from_fn(|i| e.by_time[i] / raw.norms.relative[i])
+            let Ok(raw) = d.raw(&run) else { return unusable() };
+            let quantity = |key: &String| {
+                let r = raw.quantities.iter().find(|q| q.key() == *key)?;
+                let c = e.quantities.iter().find(|q| q.quantity == r.quantity && q.probe == r.probe)?;
+                Some(c.estimate / r.raw)
+            };
+            let by_fifth = std::array::from_fn(|i| e.by_time[i] / raw.norms.relative[i]);
+            (by_fifth, keys.iter().map(|k| quantity(k).unwrap_or(f64::NAN)).collect())
         })
         .collect();
-    if cands.is_box() {
+    let (ratios, quantity_ratios): (Vec<ByFifth>, Vec<Vec<f64>>) = measured.into_iter().unzip();
+    let c = if cands.is_box() {
         DefectsCalibration::scattered(cands.space.clone(), cands.unit.clone(), ratios)
     } else {
         DefectsCalibration::new(cands.loads(), ratios)
-    }
+    };
+    c.map(|c| c.with_quantities(&keys, &quantity_ratios))
 }
 
 #[cfg(test)]

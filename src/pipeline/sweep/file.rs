@@ -13,6 +13,13 @@
 //! /t                  (n_t)
 //! /probes/<name>      (N, n_t, 2)    probe positions of each run (reduced; --full: full), m
 //! /full_probes/<name> (N, n_t, 2)    with --validate: the full runs' probe positions, m
+//! /probe_strain/<name>    (N, n_t)   each run's axial strain at the probes that record it, 1
+//! /probe_curvature/<name> (N, n_t)   each run's curvature there, 1/m (bending moment E I κ)
+//! /probe_error_estimate/<quantity>/<name> (N)   the estimate of each probe quantity's error
+//!                                    (position, strain, curvature) over its range over the
+//!                                    run (crate::rom::quantities; 0 where the full model
+//!                                    answered); with --validate /probe_error/<quantity>/<name>
+//!                                    the error measured against the full run
 //! /reduced_q          (N, n_t, r)    reduced coordinates (time first; layout 1: (N, r, n_t));
 //!                                    not in a full sweep
 //! /rom_seconds        (N)            reduced time loop of each run (not in a full sweep; the
@@ -51,8 +58,9 @@ use crate::io::attrs::{check_layout, write_atomically_as, Kind};
 use crate::io::basis_file::StoredBasis;
 use crate::io::h5::{attr_f64, attr_str, attr_u64, bounded_len, dataset_of_shape, read_attr_str};
 use crate::model::Model;
-use crate::pipeline::validate::Validation;
-use crate::rom::estimator::Estimate;
+use crate::pipeline::validate::{ProbeQuantityError, Validation};
+use crate::rom::estimator::{Estimate, QuantityEstimate};
+use crate::rom::quantities::Quantity;
 use crate::rom::trust::LoadSensitivity;
 use crate::rom::ReducedRun;
 use crate::simulate::{Overrides, Settings, SimulationResult};
@@ -61,6 +69,9 @@ use crate::solver::parameters::Parameters;
 use hdf5::types::VarLenUnicode;
 use ndarray::{Array1, Array2, Array3};
 use std::path::Path;
+
+/// Named series of every run (name → load × time).
+type NamedRuns = Vec<(String, Array2<f64>)>;
 
 /// Extra content written into every version of a sweep file (a shard's `/shard` group).
 pub type Extra<'a> = &'a (dyn Fn(&hdf5::File) -> Result<()> + Sync);
@@ -81,6 +92,71 @@ fn route_name(full: bool) -> &'static str {
     } else {
         "reduced"
     }
+}
+
+/// The probe quantities of a sweep's model, in [`crate::rom::quantities::readings`]'
+/// order: every probe's position, then the strains, then the curvatures.
+fn quantity_keys(s: &Sweep) -> Vec<(Quantity, &str)> {
+    let [strains, curvatures] = &s.section_names;
+    s.probe_names
+        .iter()
+        .map(|n| (Quantity::Position, n.as_str()))
+        .chain(strains.iter().map(|n| (Quantity::Strain, n.as_str())))
+        .chain(curvatures.iter().map(|n| (Quantity::Curvature, n.as_str())))
+        .collect()
+}
+
+/// `/probe_strain/<name>` and `/probe_curvature/<name>` (load, time): each run's strain and
+/// curvature at the probes that record them; NaN where a load did not run to the end.
+fn write_sections(f: &hdf5::File, s: &Sweep) -> hdf5::Result<()> {
+    let (n, nt) = (s.scales.len(), s.t.len());
+    for (group, i) in [("probe_strain", 0), ("probe_curvature", 1)] {
+        if s.section_names[i].is_empty() {
+            continue;
+        }
+        let g = f.create_group(group)?;
+        for (j, name) in s.section_names[i].iter().enumerate() {
+            let mut a = Array2::from_elem((n, nt), f64::NAN);
+            for (k, x) in s.scales.iter().enumerate() {
+                let series = x.point().map(|p| if i == 0 { &p.run.result.strains } else { &p.run.result.curvatures });
+                if let Some((_, v)) = series.and_then(|v| v.get(j)).filter(|(_, v)| v.len() == nt) {
+                    a.row_mut(k).assign(v);
+                }
+            }
+            g.new_dataset_builder().with_data(&a).create(name.as_str())?;
+        }
+    }
+    Ok(())
+}
+
+/// `/probe_error_estimate/<quantity>/<name>` (load): each probe quantity's estimated error
+/// over its range (0 where the full model answered; NaN: no estimate), and with
+/// `--validate` `/probe_error/<quantity>/<name>`, the error measured against the full run.
+fn write_quantity_errors(f: &hdf5::File, s: &Sweep) -> hdf5::Result<()> {
+    let estimate = |p: &SweepPoint, q: Quantity, name: &str| {
+        if p.fallback.is_some() {
+            return 0.0;
+        }
+        let e = p.estimate.as_ref().and_then(|e| e.quantities.iter().find(|x| x.quantity == q && x.probe == name));
+        e.map_or(f64::NAN, |e| e.estimate)
+    };
+    let error = |p: &SweepPoint, q: Quantity, name: &str| {
+        let v = p.validation.as_ref().and_then(|v| {
+            v.probe_quantity_errors.iter().find(|x| x.quantity == q && x.probe == name).and_then(|x| x.relative)
+        });
+        v.unwrap_or(f64::NAN)
+    };
+    type Column = fn(&SweepPoint, Quantity, &str) -> f64;
+    let groups: [(&str, Column); 2] = [("probe_error_estimate", estimate), ("probe_error", error)];
+    for (group, value) in &groups[..if s.validated { 2 } else { 1 }] {
+        let top = f.create_group(group)?;
+        for (q, name) in quantity_keys(s) {
+            let g = if top.link_exists(q.name()) { top.group(q.name())? } else { top.create_group(q.name())? };
+            let col = Array1::from_iter(s.scales.iter().map(|x| x.point().map_or(f64::NAN, |p| value(p, q, name))));
+            g.new_dataset_builder().with_data(&col).create(name)?;
+        }
+    }
+    Ok(())
 }
 
 /// Writes the sweep file (atomically: a temporary file renamed over `path`); `basis` is
@@ -147,6 +223,8 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, basis: Option<SweepBasis>, extra
                 g.new_dataset_builder().with_data(&a).create(name.as_str()).map_err(e)?;
             }
         }
+        write_sections(f, s).map_err(e)?;
+        write_quantity_errors(f, s).map_err(e)?;
         if !s.full {
             // time first: (load, time, mode); the runs keep r × n_t
             let mut zq = Array3::from_elem((n, nt, r), f64::NAN);
@@ -363,7 +441,8 @@ pub fn read_sweep(
     // the number of runs is the file's own: bounded by what holding them takes (coordinates,
     // reduced and full probes, the per-run columns) before anything is read, and every
     // dataset's shape checked against it before that dataset is read
-    let per_run = 8.0 * (nt as f64 * (r + 4 * model.probe_names().len()) as f64 + 32.0);
+    let sections: usize = model.section_names().iter().map(Vec::len).sum();
+    let per_run = 8.0 * (nt as f64 * (r + 4 * model.probe_names().len() + sections) as f64 + 32.0);
     let n = bounded_len(&f, "load_scales", per_run, &model.limits).map_err(|p| cannot("load_scales", p))?;
     let shaped = |name: &str, want: &[usize]| dataset_of_shape(&f, name, want).map_err(|p| cannot(name, p));
     let read = |name: &str, e: hdf5::Error| cannot(name, format!("cannot be read: {e}"));
@@ -397,6 +476,41 @@ pub fn read_sweep(
         Ok(probes)
     };
     let probes = read_probes("probes")?;
+    // each run's strains and curvatures, the probe quantities' estimates and (validated)
+    // errors; files written before them have none, and their points read back without
+    let read_series = |group: &str, names: &[String]| -> Result<Option<NamedRuns>> {
+        if names.is_empty() || !f.link_exists(group) {
+            return Ok(None);
+        }
+        let series = names.iter().map(|name| {
+            let path = format!("{group}/{name}");
+            let a = shaped(&path, &[n, nt])?.read::<f64, ndarray::Ix2>().map_err(|e| read(&path, e))?;
+            Ok((name.clone(), a))
+        });
+        series.collect::<Result<Vec<_>>>().map(Some)
+    };
+    let [strain_names, curvature_names] = model.section_names();
+    let sections = [read_series("probe_strain", &strain_names)?, read_series("probe_curvature", &curvature_names)?];
+    let keys: Vec<(Quantity, String)> = model
+        .probe_names()
+        .into_iter()
+        .map(|p| (Quantity::Position, p))
+        .chain(strain_names.into_iter().map(|p| (Quantity::Strain, p)))
+        .chain(curvature_names.into_iter().map(|p| (Quantity::Curvature, p)))
+        .collect();
+    let read_quantities = |group: &str| -> Result<Option<Vec<Array1<f64>>>> {
+        if !f.link_exists(group) {
+            return Ok(None);
+        }
+        keys.iter().map(|(q, name)| vec(&format!("{group}/{}/{name}", q.name()))).collect::<Result<Vec<_>>>().map(Some)
+    };
+    let quantity_estimates = read_quantities("probe_error_estimate")?;
+    let quantity_errors = if validate { read_quantities("probe_error")? } else { None };
+    let section_at = |i: usize, k: usize| -> crate::simulate::Series {
+        sections[i]
+            .as_ref()
+            .map_or_else(Vec::new, |v| v.iter().map(|(n, a)| (n.clone(), a.row(k).to_owned())).collect())
+    };
     // files written before /full_probes hold validations without them: run again
     let full_probes = if validate && f.link_exists("full_probes") { Some(read_probes("full_probes")?) } else { None };
     let at = |probes: &[(String, Array3<f64>)], k: usize| -> Vec<(String, Array2<f64>)> {
@@ -498,8 +612,8 @@ pub fn read_sweep(
             qd: Array2::zeros((0, nt)),
             multipliers: Array2::zeros((0, nt)),
             probes: at(&probes, k),
-            strains: Vec::new(),
-            curvatures: Vec::new(),
+            strains: section_at(0, k),
+            curvatures: section_at(1, k),
             stats,
             wall_seconds: rom_seconds[k],
             energy: None,
@@ -549,7 +663,9 @@ pub fn read_sweep(
             max_error_over_travel: None,
             max_error_over_travel_probe: String::new(),
             probe_errors_over_travel: Vec::new(),
-            probe_quantity_errors: Vec::new(),
+            probe_quantity_errors: quantity_errors.as_ref().map_or_else(Vec::new, |cols| {
+                keys.iter().zip(cols).map(|((q, name), c)| ProbeQuantityError::stored(name, *q, c[k])).collect()
+            }),
             error_estimate_method: None,
             estimate_failure: None,
         });
@@ -566,7 +682,16 @@ pub fn read_sweep(
                 .as_ref()
                 .map_or([f64::NAN; 5], |a| std::array::from_fn(|i| a[[k, i]])),
             failure: None,
-            quantities: Vec::new(),
+            quantities: quantity_estimates.as_ref().map_or_else(Vec::new, |cols| {
+                let each = keys.iter().zip(cols);
+                each.map(|((q, name), c)| QuantityEstimate {
+                    probe: name.clone(),
+                    quantity: *q,
+                    estimate: c[k],
+                    raw: f64::NAN,
+                })
+                .collect()
+            }),
         });
         let extrapolated = extrapolated.as_ref().is_some_and(|a| a.get(k).is_some_and(|&v| v != 0));
         let v = v.map(|mut v| {
@@ -578,6 +703,7 @@ pub fn read_sweep(
                 v.error_estimate_displacement = Some(e.error_estimate_displacement);
                 v.effectivity_displacement = Some(e.error_estimate_displacement / v.displacement_error);
                 v.error_estimate_displacement_by_time = Some(e.displacement_by_time.to_vec());
+                v = v.with_quantity_estimates(e);
             }
             v.extrapolated = extrapolated;
             v

@@ -92,6 +92,8 @@ pub struct Sweep {
     /// the time grid and probe names every run shares (from the model)
     pub t: Array1<f64>,
     pub probe_names: Vec<String>,
+    /// the probes that record strain, and those that record curvature (from the model)
+    pub section_names: [Vec<String>; 2],
     /// reduced coordinates r (0 in a full sweep)
     pub n_reduced: usize,
     /// the full model at every load (`sweep --full`): exact, no estimate, no validation

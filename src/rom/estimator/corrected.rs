@@ -381,7 +381,7 @@ impl ErrorEstimator for Corrected {
                 let norms = self.norms.raw_by_time(&self.basis, &self.data.enriched, &run.reduced_q, &qp, x0, res);
                 let sys = &self.model.physics()?.sys;
                 let enriched = crate::rom::probes::probe_values(sys, &self.data.enriched, qp.view());
-                let reference = enriched.readings();
+                let reference = crate::rom::quantities::readings_of_probes(&enriched);
                 let tol = run.result.settings.params.tolerance;
                 let quantities = QuantityRaw::between(&run.result, &reference, tol, self.length);
                 return Ok(Raw { norms, quantities });

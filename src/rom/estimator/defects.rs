@@ -200,6 +200,14 @@ impl ErrorEstimator for Defects {
         }
     }
 
+    /// A quantity's defect sum on the corrected method's scale where greedy training
+    /// calibrated it (`DefectsCalibration::quantities`), else the bound it is (factor 1,
+    /// raised as calibration raised `c`).
+    fn quantity_factor(&self, mu: &Parameters, q: &QuantityRaw, _whole: f64) -> f64 {
+        let calibrated = self.data.defects.as_ref().and_then(|d| d.quantity_factor(&q.key(), mu));
+        calibrated.unwrap_or(self.data.calibration.factor / super::DEFAULT_FACTOR)
+    }
+
     fn self_check(&self) -> Option<String> {
         self.data.defects.as_ref().filter(|d| !d.reliable).map(|_| {
             "the defects calibration failed its check between the candidate loads (docs/error-estimate.md): the estimate uses the largest ratio measured and may read far above the error; \"corrected\" is the tighter choice here".to_string()

@@ -113,6 +113,11 @@ impl QuantityRaw {
             .collect()
     }
 
+    /// The quantity's key in calibrations and messages, `quantity:probe`.
+    pub fn key(&self) -> String {
+        format!("{}:{}", self.quantity.name(), self.probe)
+    }
+
     /// ∞ in every quantity of `run`: an estimator whose model failed.
     pub fn infinite(run: &SimulationResult) -> Vec<Self> {
         quantities::readings(run)
@@ -217,6 +222,12 @@ pub trait ErrorEstimator: Send + Sync {
         [self.data().calibration.factor; FIFTHS]
     }
 
+    /// The factor a probe quantity's `η_raw` is multiplied by at `mu`: the run's whole-run
+    /// factor `whole`, unless the method calibrated the quantity on its own.
+    fn quantity_factor(&self, _mu: &Parameters, _q: &QuantityRaw, whole: f64) -> f64 {
+        whole
+    }
+
     /// The estimate of `run` at its parameters `mu`. A failure of the estimator's model gives
     /// an infinite estimate, not an error: the reduced answer itself exists.
     fn estimate(&self, run: &ReducedRun, mu: &Parameters) -> Estimate {
@@ -232,7 +243,10 @@ pub trait ErrorEstimator: Send + Sync {
         let whole = factors[FIFTHS - 1];
         let quantities = quantities
             .into_iter()
-            .map(|q| QuantityEstimate { probe: q.probe, quantity: q.quantity, estimate: whole * q.raw, raw: q.raw })
+            .map(|q| {
+                let estimate = self.quantity_factor(mu, &q, whole) * q.raw;
+                QuantityEstimate { probe: q.probe, quantity: q.quantity, estimate, raw: q.raw }
+            })
             .collect();
         let by_time: ByFifth = std::array::from_fn(|i| factors[i] * raw.relative[i]);
         let displacement_by_time: ByFifth = std::array::from_fn(|i| factors[i] * raw.displacement[i]);

@@ -265,19 +265,9 @@ pub fn resolution(run: &crate::rom::run::ReducedRun, length: f64) -> f64 {
     run.result.settings.params.tolerance * length
 }
 
-/// An error measured against a motion: `ratio()` where the motion is above the
-/// coordinates' resolution; where it is not, ∞ if the error is (only the other run moved),
-/// else NaN (nothing moved to measure against). `displacement_error` and a probe's error
-/// over its travel.
-pub fn against_motion(moved: bool, differs: bool, ratio: impl FnOnce() -> f64) -> f64 {
-    if moved {
-        ratio()
-    } else if differs {
-        f64::INFINITY
-    } else {
-        f64::NAN
-    }
-}
+/// An error measured against a motion (its definition lives with the quantities, which
+/// measure against ranges the same way).
+pub use crate::rom::quantities::against_motion;
 
 #[cfg(test)]
 mod tests {
