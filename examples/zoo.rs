@@ -171,6 +171,8 @@ struct Entry {
     tolerance: f64,
     training: Result<Training, String>,
     validations: Vec<Result<Validation, String>>,
+    /// the method the validations used: `--estimate`'s, else training's choice
+    method: String,
     stats: ModelStats,
     /// the other estimate methods, where the default failed
     methods: Vec<MethodRun>,
@@ -222,7 +224,17 @@ fn run_entry(fx: &Flexrom, dir: &Path, name: &str, tolerance: f64, estimate: Opt
     };
     let validations = if training.is_ok() { validate_all(fx, dir, &checked) } else { Vec::new() };
     let stats = model_stats(&validations);
-    Entry { model: name.into(), tolerance, training, validations, stats, methods: Vec::new(), wall_seconds: 0.0 }
+    let method = estimate.map(str::to_string).or_else(|| training.as_ref().ok().map(|t| t.method.clone()));
+    Entry {
+        model: name.into(),
+        tolerance,
+        training,
+        validations,
+        method: method.unwrap_or_else(|| "–".into()),
+        stats,
+        methods: Vec::new(),
+        wall_seconds: 0.0,
+    }
 }
 
 fn run_methods(fx: &Flexrom, dir: &Path, e: &mut Entry) {
@@ -323,7 +335,7 @@ fn model_row(info: &ModelInfo, e: &Entry) -> String {
             },
             t.elements.map_or("–".into(), |n| n.to_string()),
             g3(s.speedup_median),
-            t.method,
+            e.method,
             s.covered_pairs,
             s.loads,
             fifths(&s.coverage_by_fifth),
@@ -377,7 +389,7 @@ const FAIL_HEAD: &str = "| model | tolerance | default | loads under (whole run)
 /// fifth covered, effectivity ≤ 20: `metrics::estimate_fails` false).
 fn failure_row(name: &str, e: &Entry) -> String {
     let s = &e.stats;
-    let method = e.training.as_ref().map_or("–".to_string(), |t| t.method.clone());
+    let method = &e.method;
     let holds: Vec<&str> = e.methods.iter().filter(|m| !estimate_fails(&m.stats)).map(|m| m.method.as_str()).collect();
     format!(
         "| {name} | {} | {method} | {}/{} | {}/{} | {}, {} | {} | {} |",
