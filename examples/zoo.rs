@@ -5,14 +5,20 @@
 //! ```text
 //! cargo build --release
 //! cargo run --release --example zoo -- [--seed S] [--models N | --slots A..B] [--out DIR]
-//!     [--tolerances 5e-3,1e-2] [--subset] [--jobs 2] [--no-methods] [--draw-only] [--resume] [--flexrom PATH]
+//!     [--tolerances 5e-3,1e-2] [--subset] [--jobs 2] [--estimate METHOD] [--no-methods] [--draw-only] [--resume]
+//!     [--flexrom PATH]
 //! ```
 //!
 //! For every model and tolerance: `train` (greedy over [0.5, 1.5], `max_runs = 10`), then
 //! `validate --json` at 8 loads that are neither training nor candidate loads; per model the
 //! convergence and its reason, full runs, modes, sampled elements, speedup, the estimate
 //! method, coverage over the whole run and per fifth, effectivity and estimator cost; over
-//! all models the aggregate targets of docs/zoo.md (tests/common/zoo/metrics.rs). Where a model's
+//! all models the aggregate targets of docs/zoo.md (tests/common/zoo/metrics.rs), and the
+//! same for each probe quantity (the tip's position, the roots' strain and curvature:
+//! `probe_quantity_errors`, reported beside the targets, not held to them). `--estimate
+//! METHOD` validates with that method (`[online] estimate`) instead of the one training
+//! chose; the training is the same (`--resume` in a copy of a finished run's folder reuses
+//! it). Where a model's
 //! default estimate fails (reads under the error, or over it by more than 20×) it is
 //! validated again with each method (`[online] estimate`). Writes DIR/zoo.md (Markdown
 //! tables) and DIR/zoo.json (every number), DIR/models/NAME/ the model and pipelines.
@@ -28,7 +34,10 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use zoo::drive::{Flexrom, Training, Validation};
-use zoo::metrics::{aggregate, estimate_fails, fallback_stats, model_stats, Aggregate, ModelStats};
+use zoo::metrics::{
+    aggregate, estimate_fails, fallback_stats, model_stats, quantity_cases, quantity_stats, Aggregate, ModelStats,
+    QuantityCase, QuantityStats,
+};
 use zoo::{accepted, pipeline_toml, validation_loads, Replacement, ZooModel};
 
 const METHODS: [&str; 3] = ["corrected", "defects", "enriched"];
@@ -42,6 +51,8 @@ struct Args {
     tolerances: Vec<f64>,
     subset: bool,
     jobs: usize,
+    /// `--estimate METHOD`: validate with this method instead of training's choice
+    estimate: Option<String>,
     methods: bool,
     draw_only: bool,
     resume: bool,
@@ -49,7 +60,7 @@ struct Args {
 }
 
 fn usage(msg: &str) -> ! {
-    eprintln!("zoo: {msg}\nusage: zoo [--seed S] [--models N | --slots A..B] [--out DIR] [--tolerances 5e-3,1e-2] [--subset] [--jobs 1|2] [--no-methods] [--draw-only] [--resume] [--flexrom PATH]");
+    eprintln!("zoo: {msg}\nusage: zoo [--seed S] [--models N | --slots A..B] [--out DIR] [--tolerances 5e-3,1e-2] [--subset] [--jobs 1|2] [--estimate corrected|defects|enriched] [--no-methods] [--draw-only] [--resume] [--flexrom PATH]");
     std::process::exit(2)
 }
 
@@ -62,6 +73,7 @@ fn args() -> Args {
         tolerances: vec![5e-3, 1e-2],
         subset: false,
         jobs: 2,
+        estimate: None,
         methods: true,
         draw_only: false,
         resume: false,
@@ -92,6 +104,13 @@ fn args() -> Args {
             }
             "--jobs" => {
                 a.jobs = value().parse().ok().filter(|j| (1..=2).contains(j)).unwrap_or_else(|| usage("--jobs: 1 or 2"))
+            }
+            "--estimate" => {
+                let m = value();
+                if !METHODS.contains(&m.as_str()) {
+                    usage(&format!("--estimate: one of {}", METHODS.join(", ")));
+                }
+                a.estimate = Some(m)
             }
             "--subset" => a.subset = true,
             "--no-methods" => a.methods = false,
@@ -152,6 +171,8 @@ struct Entry {
     tolerance: f64,
     training: Result<Training, String>,
     validations: Vec<Result<Validation, String>>,
+    /// the method the validations used: `--estimate`'s, else training's choice
+    method: String,
     stats: ModelStats,
     /// the other estimate methods, where the default failed
     methods: Vec<MethodRun>,
@@ -186,14 +207,34 @@ fn tol_tag(t: f64) -> String {
     format!("{t:e}")
 }
 
-fn run_entry(fx: &Flexrom, dir: &Path, name: &str, tolerance: f64) -> Entry {
+/// Trains the model at `tolerance` and validates it with `estimate` (None: training's choice),
+/// through a pipeline of its own with the same basis (the one `run_methods` writes).
+fn run_entry(fx: &Flexrom, dir: &Path, name: &str, tolerance: f64, estimate: Option<&str>) -> Entry {
     let tag = tol_tag(tolerance);
-    let pipeline = format!("pipeline_{tag}.toml");
-    write_atomic(&dir.join(&pipeline), &pipeline_toml("model.toml", &format!("basis_{tag}.h5"), tolerance, None));
+    let (pipeline, basis) = (format!("pipeline_{tag}.toml"), format!("basis_{tag}.h5"));
+    write_atomic(&dir.join(&pipeline), &pipeline_toml("model.toml", &basis, tolerance, None));
     let training = fx.train(dir, &pipeline);
-    let validations = if training.is_ok() { validate_all(fx, dir, &pipeline) } else { Vec::new() };
+    let checked = match estimate {
+        Some(m) => {
+            let p = format!("pipeline_{tag}_{m}.toml");
+            write_atomic(&dir.join(&p), &pipeline_toml("model.toml", &basis, tolerance, Some(m)));
+            p
+        }
+        None => pipeline,
+    };
+    let validations = if training.is_ok() { validate_all(fx, dir, &checked) } else { Vec::new() };
     let stats = model_stats(&validations);
-    Entry { model: name.into(), tolerance, training, validations, stats, methods: Vec::new(), wall_seconds: 0.0 }
+    let method = estimate.map(str::to_string).or_else(|| training.as_ref().ok().map(|t| t.method.clone()));
+    Entry {
+        model: name.into(),
+        tolerance,
+        training,
+        validations,
+        method: method.unwrap_or_else(|| "–".into()),
+        stats,
+        methods: Vec::new(),
+        wall_seconds: 0.0,
+    }
 }
 
 fn run_methods(fx: &Flexrom, dir: &Path, e: &mut Entry) {
@@ -294,7 +335,7 @@ fn model_row(info: &ModelInfo, e: &Entry) -> String {
             },
             t.elements.map_or("–".into(), |n| n.to_string()),
             g3(s.speedup_median),
-            t.method,
+            e.method,
             s.covered_pairs,
             s.loads,
             fifths(&s.coverage_by_fifth),
@@ -348,7 +389,7 @@ const FAIL_HEAD: &str = "| model | tolerance | default | loads under (whole run)
 /// fifth covered, effectivity ≤ 20: `metrics::estimate_fails` false).
 fn failure_row(name: &str, e: &Entry) -> String {
     let s = &e.stats;
-    let method = e.training.as_ref().map_or("–".to_string(), |t| t.method.clone());
+    let method = &e.method;
     let holds: Vec<&str> = e.methods.iter().filter(|m| !estimate_fails(&m.stats)).map(|m| m.method.as_str()).collect();
     format!(
         "| {name} | {} | {method} | {}/{} | {}/{} | {}, {} | {} | {} |",
@@ -362,6 +403,60 @@ fn failure_row(name: &str, e: &Entry) -> String {
         g3(s.effectivity_max),
         if holds.is_empty() { "none".to_string() } else { holds.join(", ") }
     )
+}
+
+const QUANTITY_HEAD: &str = "| quantity | (model, load, probe) | no swing | covered | effectivity median | 95th pct | max |\n|---|---|---|---|---|---|---|";
+
+fn quantity_row(q: &QuantityStats) -> String {
+    format!(
+        "| {} | {} | {} | {}/{} ({:.1} %) | {} | {} | {} |",
+        q.quantity,
+        q.cases,
+        q.no_swing,
+        q.covered,
+        q.cases,
+        100.0 * q.coverage(),
+        g3(q.effectivity_median),
+        g3(q.effectivity_p95),
+        g3(q.effectivity_max)
+    )
+}
+
+fn case_line(c: &QuantityCase) -> String {
+    format!(
+        "{} λ = {} {} {}: error {}, estimate {}, effectivity {}",
+        c.model,
+        c.load_scale,
+        c.probe,
+        c.quantity,
+        g3(c.relative),
+        g3(c.estimate),
+        g3(c.effectivity)
+    )
+}
+
+/// The probe quantities' table, the targets they miss (reported, not held) and each
+/// quantity's extreme cases.
+fn quantity_section(qs: &[QuantityStats]) -> String {
+    let mut md =
+        format!("Probe quantities (error over the full run's range, `probe_quantity_errors`):\n\n{QUANTITY_HEAD}\n");
+    for q in qs {
+        let _ = writeln!(md, "{}", quantity_row(q));
+    }
+    let missed: Vec<String> = qs.iter().flat_map(QuantityStats::missed).collect();
+    let _ = writeln!(
+        md,
+        "\nTargets (coverage ≥ 95 %, median effectivity ≤ 3; reported, not held): {}.\n",
+        if missed.is_empty() { "met".to_string() } else { format!("missed: {}", missed.join("; ")) }
+    );
+    for q in qs.iter().filter(|q| q.cases > 0) {
+        let lowest: Vec<String> = q.lowest.iter().map(case_line).collect();
+        let highest: Vec<String> = q.highest.iter().map(case_line).collect();
+        let _ = writeln!(md, "- {} lowest: {}", q.quantity, lowest.join("; "));
+        let _ = writeln!(md, "- {} highest: {}", q.quantity, highest.join("; "));
+    }
+    md.push('\n');
+    md
 }
 
 fn commit() -> String {
@@ -474,7 +569,7 @@ fn main() {
     let run_job = |(i, t): (usize, f64)| -> (usize, Entry) {
         let name = infos[i].name.clone();
         let t0 = Instant::now();
-        let mut e = run_entry(&fx, &models_dir.join(&name), &name, t);
+        let mut e = run_entry(&fx, &models_dir.join(&name), &name, t, a.estimate.as_deref());
         if a.methods && e.training.is_ok() && estimate_fails(&e.stats) {
             run_methods(&fx, &models_dir.join(&name), &mut e);
         }
@@ -519,11 +614,12 @@ fn main() {
     let mut md = String::new();
     let _ = writeln!(
         md,
-        "Zoo seed {}, {} models ({} replaced), tolerances {}, commit {}; {:.0} s wall with {} jobs, {} CPU seconds in flexrom.\n",
+        "Zoo seed {}, {} models ({} replaced), tolerances {}, estimate {}, commit {}; {:.0} s wall with {} jobs, {} CPU seconds in flexrom.\n",
         a.seed,
         models.len(),
         replaced.len(),
         a.tolerances.iter().map(|t| tol_tag(*t)).collect::<Vec<_>>().join(", "),
+        a.estimate.as_deref().map_or("training's choice".to_string(), |m| format!("`{m}` (`--estimate`)")),
         commit(),
         wall,
         a.jobs,
@@ -556,7 +652,11 @@ fn main() {
             let _ = writeln!(md, "{}", model_row(&infos[*i], e));
         }
         let _ = writeln!(md);
-        aggregates.push((t, agg, fagg));
+        let runs: Vec<(&str, &[Result<Validation, String>])> =
+            at.iter().map(|(_, e)| (e.model.as_str(), e.validations.as_slice())).collect();
+        let quantities = quantity_stats(&quantity_cases(&runs));
+        md.push_str(&quantity_section(&quantities));
+        aggregates.push((t, agg, fagg, quantities));
     }
     let failing: Vec<&(usize, Entry)> = entries.iter().filter(|(_, e)| !e.methods.is_empty()).collect();
     if !failing.is_empty() {
@@ -609,7 +709,8 @@ fn main() {
         "jobs": a.jobs,
         "models": infos,
         "replaced": replaced_json(&replaced),
-        "aggregates": aggregates.iter().map(|(t, g, f)| serde_json::json!({"tolerance": t, "aggregate": g, "missed": g.missed(), "with_fallback": f, "with_fallback_missed": f.missed()})).collect::<Vec<_>>(),
+        "estimate": a.estimate,
+        "aggregates": aggregates.iter().map(|(t, g, f, q)| serde_json::json!({"tolerance": t, "aggregate": g, "missed": g.missed(), "with_fallback": f, "with_fallback_missed": f.missed(), "quantities": q, "quantities_missed": q.iter().flat_map(QuantityStats::missed).collect::<Vec<_>>()})).collect::<Vec<_>>(),
         "entries": entries.iter().map(|(_, e)| e).collect::<Vec<_>>(),
     });
     write_atomic(&a.out.join("zoo.json"), &serde_json::to_string_pretty(&json).expect("JSON"));

@@ -63,6 +63,41 @@ pub struct Validation {
     /// training's sensitivity beside the load (`sensitivity_near`; NaN when absent): what a
     /// sweep reads, where `validate`'s `amplifying` may also read its own full runs
     pub sensitivity_near: f64,
+    /// every probe quantity's error and estimate (`probe_quantity_errors`)
+    pub quantities: Vec<QuantityError>,
+}
+
+/// One probe quantity of a validation (`probe_quantity_errors` of `validate --json`,
+/// docs/cli.md): the reduced run's error relative to the full run's range, and its estimate.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct QuantityError {
+    pub probe: String,
+    /// "position", "strain" or "curvature"
+    pub quantity: String,
+    /// `relative`: NaN where the JSON has null (no swing to measure against: the full run's
+    /// range within the quantity's resolution; ∞ is written as null too, `max_error` and
+    /// `range` tell them apart)
+    pub relative: f64,
+    /// `estimate`; NaN where the JSON has null (no estimate, no swing, or ∞)
+    pub estimate: f64,
+    pub max_error: f64,
+    pub range: f64,
+}
+
+/// `probe_quantity_errors` of a `validate --json` (none when absent).
+fn quantity_errors(v: &Value) -> Vec<QuantityError> {
+    let Some(list) = v.get("probe_quantity_errors").and_then(Value::as_array) else { return Vec::new() };
+    let text = |q: &Value, k: &str| q.get(k).and_then(Value::as_str).unwrap_or("").to_string();
+    list.iter()
+        .map(|q| QuantityError {
+            probe: text(q, "probe"),
+            quantity: text(q, "quantity"),
+            relative: number(q, "relative"),
+            estimate: number(q, "estimate"),
+            max_error: number(q, "max_error"),
+            range: number(q, "range"),
+        })
+        .collect()
 }
 
 /// The last line of a process's stderr that says something (its error).
@@ -223,6 +258,7 @@ impl Flexrom {
             speedup: number(&v, "speedup"),
             amplifying: v.get("amplifying").and_then(Value::as_bool).unwrap_or(false),
             sensitivity_near: number(&v, "sensitivity_near"),
+            quantities: quantity_errors(&v),
         })
     }
 }
@@ -234,5 +270,26 @@ mod tests {
         let l = "iteration 1: worst score 8.04e-4 ≤ 1e-3; held-out check at λ = 1.4375 (score 7.74e-4): rel_error 1.06e-4 (score 9.79e-5, sensitivity 1.2e-3); 4 + 5 modes + 6 joint coordinates, 8 elements";
         assert_eq!(super::elements_of(l), Some(8));
         assert_eq!(super::elements_of("no count"), None);
+    }
+
+    /// A probe quantity's null `relative` (no swing) and null estimate read as NaN; an
+    /// output without the key has none.
+    #[test]
+    fn quantity_errors_are_read_from_validate_json() {
+        let v: serde_json::Value = serde_json::from_str(
+            r#"{"probe_quantity_errors": [
+                {"probe": "root", "quantity": "curvature", "max_error": 0.02, "range": 0.5, "largest": 0.3,
+                 "relative": 0.04, "estimate": 0.06, "effectivity": 1.5},
+                {"probe": "root", "quantity": "position", "max_error": 0.0, "range": 0.0, "largest": 1.0,
+                 "relative": null, "estimate": null, "effectivity": null}]}"#,
+        )
+        .expect("JSON");
+        let q = super::quantity_errors(&v);
+        assert_eq!(
+            (q[0].probe.as_str(), q[0].quantity.as_str(), q[0].relative, q[0].estimate),
+            ("root", "curvature", 0.04, 0.06)
+        );
+        assert!(q[1].relative.is_nan() && q[1].estimate.is_nan() && q[1].range == 0.0);
+        assert!(super::quantity_errors(&serde_json::json!({})).is_empty());
     }
 }

@@ -6,7 +6,8 @@
 //! drawn over the ranges of the zoo's brief (tests/common/zoo/mod.rs).
 
 use super::parts::{
-    ahead, beam, material, model_toml, sig, time, unit_function, Beam, Func, Joint, Load, Material, Parts, Rng, Time, G,
+    ahead, beam, material, model_toml, sig, time, unit_function, Beam, Func, Joint, Load, Material, Parts, Place,
+    Probe, Rng, Time, G,
 };
 use std::f64::consts::PI;
 
@@ -163,9 +164,51 @@ impl Draft {
         Draft { bodies, joints, loads, damping: None, masses: Vec::new(), motion }
     }
 
+    /// The nodes held against turning by the ground — clamped, driven by angle, or
+    /// ground-pinned and driven by a moment — in the order of the joints, then the loads;
+    /// each once. Where a link carries the largest bending moment of its motion.
+    fn roots(&self) -> Vec<(String, String)> {
+        let pinned = |b: &str, n: &str| {
+            self.joints.iter().any(|j| matches!(j, Joint::GroundPin { body, node } if body == b && node == n))
+        };
+        let mut roots: Vec<(String, String)> = Vec::new();
+        let joints = self.joints.iter().filter_map(|j| match j {
+            Joint::Clamp { body, node } | Joint::DrivenAngle { body, node, .. } => Some((body, node)),
+            _ => None,
+        });
+        let moments = self.loads.iter().filter_map(|l| match l {
+            Load::Moment { body, node, .. } if pinned(body, node) => Some((body, node)),
+            _ => None,
+        });
+        for (body, node) in joints.chain(moments) {
+            if !roots.iter().any(|(b, n)| b == body && n == node) {
+                roots.push((body.clone(), node.clone()));
+            }
+        }
+        roots
+    }
+
+    /// A probe recording strain and curvature (the bending moment E I κ) at every root
+    /// ([`Draft::roots`]): "root" at the first, "root_BODY" at the others. Probes record; the
+    /// dynamics are those of the model without them.
+    fn root_probes(&self) -> Vec<Probe> {
+        self.roots()
+            .into_iter()
+            .enumerate()
+            .map(|(i, (body, node))| Probe {
+                name: if i == 0 { "root".into() } else { format!("root_{body}") },
+                body,
+                place: Place::Node(node),
+                quantities: vec!["strain", "curvature"],
+            })
+            .collect()
+    }
+
     fn finish(self, kind: Kind, t: Time) -> Mechanism {
         let last = self.bodies.last().expect("a body");
-        let probes = vec![("tip".to_string(), last.name.clone(), 1.0)];
+        let mut probes =
+            vec![Probe { name: "tip".into(), body: last.name.clone(), place: Place::At(1.0), quantities: Vec::new() }];
+        probes.extend(self.root_probes());
         let bodies: Vec<String> = self
             .bodies
             .iter()

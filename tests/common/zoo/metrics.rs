@@ -293,6 +293,146 @@ pub fn aggregate(models: &[(Option<&Training>, &ModelStats)]) -> Aggregate {
     a
 }
 
+/// The quantities a zoo probe records: the tip's position, the roots' position, strain and
+/// curvature (tests/common/zoo/mechanisms.rs).
+pub const QUANTITIES: [&str; 3] = ["position", "strain", "curvature"];
+
+/// One probe quantity of one validation, with where it comes from.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct QuantityCase {
+    pub model: String,
+    pub load_scale: f64,
+    pub probe: String,
+    pub quantity: String,
+    /// the error relative to the full run's range (∞: the validation failed)
+    pub relative: f64,
+    /// its estimate (NaN: none)
+    pub estimate: f64,
+    /// estimate / relative; ∞ where the validation failed or gave no estimate (as for
+    /// `rel_error`, [`model_stats`])
+    pub effectivity: f64,
+}
+
+impl QuantityCase {
+    pub fn covered(&self) -> bool {
+        self.estimate >= self.relative
+    }
+}
+
+/// How the estimates of one probe quantity fare over (model, load, probe) triples:
+/// coverage (estimate ≥ error) and effectivity (estimate / error). Entries whose full run
+/// has no swing of the quantity (`relative` null: a clamped root's position) have no ratio
+/// and are counted apart.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct QuantityStats {
+    pub quantity: String,
+    /// (model, load, probe) triples with an error to measure
+    pub cases: usize,
+    pub covered: usize,
+    /// triples with no swing of the quantity in the full run (not in `cases`)
+    pub no_swing: usize,
+    pub effectivity_median: f64,
+    pub effectivity_p95: f64,
+    pub effectivity_max: f64,
+    /// the three cases of smallest effectivity (the worst under, when any is)
+    pub lowest: Vec<QuantityCase>,
+    /// the three of largest effectivity
+    pub highest: Vec<QuantityCase>,
+}
+
+impl QuantityStats {
+    pub fn coverage(&self) -> f64 {
+        self.covered as f64 / self.cases.max(1) as f64
+    }
+
+    /// The targets of a probe quantity's estimate missed (docs/zoo.md: coverage ≥
+    /// [`MIN_PAIR_COVERAGE`], median effectivity ≤ [`MAX_MEDIAN_EFFECTIVITY`], the targets of
+    /// `rel_error`'s estimate); empty: met.
+    pub fn missed(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        if self.cases == 0 {
+            return out;
+        }
+        if self.coverage() < MIN_PAIR_COVERAGE {
+            out.push(format!(
+                "{} coverage {:.1} % < {:.0} %",
+                self.quantity,
+                100.0 * self.coverage(),
+                100.0 * MIN_PAIR_COVERAGE
+            ));
+        }
+        if !within(self.effectivity_median, MAX_MEDIAN_EFFECTIVITY) {
+            out.push(format!(
+                "{} median effectivity {:.3} > {MAX_MEDIAN_EFFECTIVITY}",
+                self.quantity, self.effectivity_median
+            ));
+        }
+        out
+    }
+}
+
+/// Every probe quantity of the validations of `models` (each a model's name and its
+/// validations). A failed validation counts as uncovered, effectivity ∞, for every probe
+/// quantity the model's first answered validation measured (one with a swing).
+pub fn quantity_cases(models: &[(&str, &[Result<Validation, String>])]) -> Vec<QuantityCase> {
+    let mut out = Vec::new();
+    for (model, runs) in models {
+        let recorded: Vec<(String, String)> = runs
+            .iter()
+            .flatten()
+            .next()
+            .map(|v| {
+                v.quantities
+                    .iter()
+                    .filter(|q| !q.relative.is_nan())
+                    .map(|q| (q.probe.clone(), q.quantity.clone()))
+                    .collect()
+            })
+            .unwrap_or_default();
+        for (r, load) in runs.iter().zip(super::validation_loads()) {
+            let case = |probe: &str, quantity: &str, relative: f64, estimate: f64| QuantityCase {
+                model: model.to_string(),
+                load_scale: load,
+                probe: probe.into(),
+                quantity: quantity.into(),
+                relative,
+                estimate,
+                effectivity: if relative.is_infinite() { f64::INFINITY } else { ratio(estimate, relative) },
+            };
+            match r {
+                Ok(v) => out.extend(v.quantities.iter().map(|q| case(&q.probe, &q.quantity, q.relative, q.estimate))),
+                Err(_) => out.extend(recorded.iter().map(|(p, q)| case(p, q, f64::INFINITY, f64::NAN))),
+            }
+        }
+    }
+    out
+}
+
+/// [`QuantityStats`] of each of [`QUANTITIES`] over `cases`.
+pub fn quantity_stats(cases: &[QuantityCase]) -> Vec<QuantityStats> {
+    QUANTITIES
+        .iter()
+        .map(|&quantity| {
+            let of: Vec<&QuantityCase> = cases.iter().filter(|c| c.quantity == quantity).collect();
+            let mut measured: Vec<QuantityCase> =
+                of.iter().filter(|c| !c.relative.is_nan()).map(|&c| c.clone()).collect();
+            measured.sort_by(|a, b| a.effectivity.total_cmp(&b.effectivity));
+            let eff: Vec<f64> = measured.iter().map(|c| c.effectivity).collect();
+            QuantityStats {
+                quantity: quantity.into(),
+                cases: measured.len(),
+                covered: measured.iter().filter(|c| c.covered()).count(),
+                no_swing: of.len() - measured.len(),
+                effectivity_median: median(&eff),
+                effectivity_p95: percentile(&eff, 95.0),
+                effectivity_max: eff.last().copied().unwrap_or(f64::NAN),
+                lowest: measured.iter().take(3).cloned().collect(),
+                highest: measured.iter().rev().take(3).cloned().collect(),
+            }
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -311,7 +451,44 @@ mod tests {
             speedup: 2.0,
             amplifying: false,
             sensitivity_near: f64::NAN,
+            quantities: Vec::new(),
         }
+    }
+
+    fn q(quantity: &str, relative: f64, estimate: f64) -> super::super::drive::QuantityError {
+        super::super::drive::QuantityError {
+            probe: "root".into(),
+            quantity: quantity.into(),
+            relative,
+            estimate,
+            max_error: relative,
+            range: 1.0,
+        }
+    }
+
+    /// Hand-counted: curvature at three loads, effectivities 2 and 0.5 and a failed run
+    /// (∞, uncovered): coverage 1/3, median 2, max ∞; the position of no swing (null) is
+    /// counted apart; strain at two loads, 4 and 1 (covered: estimate = error).
+    #[test]
+    fn probe_quantities_are_counted_per_quantity() {
+        let with = |qs: Vec<super::super::drive::QuantityError>| Validation { quantities: qs, ..v(1.0, 1.0) };
+        let runs = [
+            Ok(with(vec![q("curvature", 0.1, 0.2), q("position", f64::NAN, f64::NAN), q("strain", 0.01, 0.04)])),
+            Ok(with(vec![q("curvature", 0.2, 0.1), q("strain", 0.02, 0.02)])),
+            Err("failed".into()),
+        ];
+        let cases = quantity_cases(&[("m", &runs)]);
+        assert_eq!(cases[0].load_scale, super::super::validation_loads()[0]);
+        let s = quantity_stats(&cases);
+        let (pos, strain, curv) = (&s[0], &s[1], &s[2]);
+        assert_eq!((pos.cases, pos.no_swing), (0, 1), "a failed run adds no quantity without a swing");
+        assert!(pos.missed().is_empty(), "nothing to measure, nothing missed");
+        assert_eq!((curv.cases, curv.covered, curv.no_swing), (3, 1, 0));
+        assert_eq!((curv.effectivity_median, curv.effectivity_max), (2.0, f64::INFINITY));
+        assert_eq!(curv.lowest[0].effectivity, 0.5);
+        assert_eq!(curv.missed().len(), 1, "coverage 33 % < 95 %; median 2 ≤ 3");
+        assert_eq!((strain.cases, strain.covered), (3, 2));
+        assert_eq!(strain.effectivity_median, 4.0, "1, 4, ∞");
     }
 
     /// Hand-counted: two loads, one covered with effectivity 2, one under (0.5); the last

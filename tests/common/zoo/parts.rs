@@ -461,13 +461,48 @@ pub struct Parts<'a> {
     pub masses: &'a [(String, String, f64)],
 }
 
+/// Where on its body a probe sits.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Place {
+    /// a fraction of the body's length (`at`)
+    At(f64),
+    /// a node (`node`: an index, `"start"` or `"end"`)
+    Node(String),
+}
+
+/// A probe of the model file: a point of a body and what it records besides its position
+/// (`quantities`: `"strain"`, `"curvature"`; empty leaves the key out, the format's default).
+#[derive(Clone, Debug)]
+pub struct Probe {
+    pub name: String,
+    pub body: String,
+    pub place: Place,
+    pub quantities: Vec<&'static str>,
+}
+
+impl Probe {
+    /// The `[[probes]]` table.
+    fn toml(&self) -> String {
+        let place = match &self.place {
+            Place::At(at) => format!("at = {at:?}"),
+            Place::Node(n) => format!("node = {}", node_toml(n)),
+        };
+        let mut s = format!("\n[[probes]]\nname = {:?}\nbody = {:?}\n{place}\n", self.name, self.body);
+        if !self.quantities.is_empty() {
+            let q: Vec<String> = self.quantities.iter().map(|q| format!("{q:?}")).collect();
+            let _ = writeln!(s, "quantities = [{}]", q.join(", "));
+        }
+        s
+    }
+}
+
 /// The model file's text.
 pub fn model_toml(
     description: &str,
     time: Time,
     damping: Option<(f64, f64)>,
     parts: &Parts,
-    probes: &[(String, String, f64)],
+    probes: &[Probe],
 ) -> String {
     let Parts { bodies, joints, loads, masses } = *parts;
     let mut s = String::new();
@@ -555,8 +590,8 @@ pub fn model_toml(
     for (body, node, mass) in masses {
         let _ = writeln!(s, "\n[[masses]]\nbody = {body:?}\nnode = {}\nmass = {mass:?}", node_toml(node));
     }
-    for (name, body, at) in probes {
-        let _ = writeln!(s, "\n[[probes]]\nname = {name:?}\nbody = {body:?}\nat = {at:?}");
+    for p in probes {
+        s.push_str(&p.toml());
     }
     s
 }
