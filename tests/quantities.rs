@@ -12,6 +12,9 @@
 //!   cheaper ones approximate), `corrected`, and `defects` on the scale greedy training
 //!   calibrated per quantity — every quantity's estimate is at least its error, at loads the
 //!   basis did not see (measured: effectivity 1.46–1.69 for all three).
+//! * `validate_measures_each_reaction_over_its_range`: with a constraint-preserving basis
+//!   (which keeps the clamp's multipliers), `reaction_errors` equal the errors recomputed
+//!   from the `/reactions` of `simulate`'s and `online`'s result files.
 //! * `a_sweep_carries_strains_curvatures_and_their_estimates`: a validated sweep's
 //!   `/probe_curvature/root` row is the online run's series at that load, its
 //!   `/probe_error_estimate` and `/probe_error` columns are `validate`'s, and `--resume`
@@ -89,11 +92,16 @@ fn flexrom(dir: &Path, args: &[&str]) -> Output {
 
 /// A trained arm in a fresh directory.
 fn trained(name: &str) -> std::path::PathBuf {
+    trained_with(name, PIPELINE)
+}
+
+/// The arm trained by `pipeline` in a fresh directory.
+fn trained_with(name: &str, pipeline: &str) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("flexrom-quantities-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join("arm.toml"), MODEL).unwrap();
-    std::fs::write(dir.join("p.toml"), PIPELINE).unwrap();
+    std::fs::write(dir.join("p.toml"), pipeline).unwrap();
     flexrom(&dir, &["train", "p.toml"]);
     dir
 }
@@ -147,6 +155,42 @@ fn validate_measures_each_quantity_over_its_range() {
             .unwrap();
         let estimate = q["estimate"].as_f64().unwrap();
         assert!((attr - estimate).abs() <= 1e-12 * estimate, "{quantity}: online {attr} vs validate {estimate}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn validate_measures_each_reaction_over_its_range() {
+    let pipeline = format!("{PIPELINE}[reduction]\nvariant = \"constraint-preserving\"\n");
+    let dir = trained_with("reactions", &pipeline);
+    let vs = validations(&dir, "corrected");
+    flexrom(&dir, &["simulate", "arm.toml", "--load-scale", "1.3", "-o", "full.h5"]);
+    flexrom(&dir, &["online", "p.toml", "--load-scale", "1.3", "-o", "rom.h5"]);
+    let v = vs.iter().find(|v| v["load_scale"] == 1.3).unwrap();
+    let read = |path: &str, name: &str| -> ndarray::ArrayD<f64> {
+        hdf5::File::open(dir.join(path)).unwrap().dataset(name).unwrap().read_dyn::<f64>().unwrap()
+    };
+    // the clamp's force (n_t, 1, 2) and moment (n_t, 1): max distance over the full run's range
+    let (ff, rf) = (read("full.h5", "reactions/force"), read("rom.h5", "reactions/force"));
+    let (fm, rm) = (read("full.h5", "reactions/moment"), read("rom.h5", "reactions/moment"));
+    let nt = ff.shape()[0];
+    let force = |a: &ndarray::ArrayD<f64>, k: usize, c: usize| a[[k, 0, c]];
+    let dist = (0..nt).map(|k| {
+        ((force(&ff, k, 0) - force(&rf, k, 0)).powi(2) + (force(&ff, k, 1) - force(&rf, k, 1)).powi(2)).sqrt()
+    });
+    let span = |c: usize| {
+        let v: Vec<f64> = (0..nt).map(|k| force(&ff, k, c)).collect();
+        v.iter().copied().fold(f64::NEG_INFINITY, f64::max) - v.iter().copied().fold(f64::INFINITY, f64::min)
+    };
+    let force_error = dist.fold(0.0, f64::max) / (span(0).powi(2) + span(1).powi(2)).sqrt();
+    let m: Vec<f64> = (0..nt).map(|k| fm[[k, 0]]).collect();
+    let moment_error = (0..nt).map(|k| (fm[[k, 0]] - rm[[k, 0]]).abs()).fold(0.0, f64::max)
+        / (m.iter().copied().fold(f64::NEG_INFINITY, f64::max) - m.iter().copied().fold(f64::INFINITY, f64::min));
+    let errors = v["reaction_errors"].as_array().unwrap();
+    assert_eq!(errors.len(), 2, "{errors:?}");
+    for (e, want) in errors.iter().zip([force_error, moment_error]) {
+        let got = e["relative"].as_f64().unwrap();
+        assert!((got - want).abs() <= 1e-9 * want, "{e}: recomputed {want}");
     }
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -21,6 +21,7 @@
 //! the error").
 
 use super::timing::{median, repeat_timing};
+use crate::analysis::reactions::ReactionMap;
 use crate::error::Result;
 use crate::linalg::kkt::LinearSolverKind;
 use crate::model::Model;
@@ -31,7 +32,7 @@ use crate::rom::{Output, ReducedRun, Rom};
 use crate::simulate::{simulate, FullModel, Overrides, SimulationResult};
 use crate::solver::model::Parameters;
 use crate::solver::model::ParametricModel;
-use ndarray::ArrayView2;
+use ndarray::{ArrayView2, Axis};
 
 /// The fixed keys of `validate --json`.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -125,8 +126,11 @@ pub struct Validation {
     pub max_error_over_travel_probe: String,
     /// every probe's error over its travel
     pub probe_errors_over_travel: Vec<ProbeTravel>,
-    /// the strain and curvature of the probes that record them, against the full run's
+    /// every probe quantity (position, strain, curvature) against the full run's, over its
+    /// range, with its estimate
     pub probe_quantity_errors: Vec<ProbeQuantityError>,
+    /// every joint's reaction force and moment against the full run's, over its range
+    pub reaction_errors: Vec<ReactionError>,
     /// how the estimate was computed (`corrected`, `defects`, `enriched`; null: no estimate)
     pub error_estimate_method: Option<String>,
     /// why the estimator's own run failed, when it did (`error_estimate` is then ∞, which
@@ -252,6 +256,65 @@ impl ProbeQuantityError {
     }
 }
 
+/// A joint's reaction on one node — its force (both components) or its moment — of the
+/// reduced run against the full run's, relative to the full run's range over the run
+/// (`crate::analysis::reactions`; as [`ProbeQuantityError`] for the probes). Not estimated:
+/// the estimators follow coordinates, not multipliers.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct ReactionError {
+    /// the reaction point, "joint 0 (clamp arm node 0) on arm node 0"
+    pub reaction: String,
+    /// `"force"` (N) or `"moment"` (N m)
+    pub quantity: &'static str,
+    /// `max_k ‖v_rom(t_k) − v_full(t_k)‖`
+    pub max_error: f64,
+    /// the full run's range, `‖max_k v_full − min_k v_full‖`
+    pub range: f64,
+    /// `max_error / range`; none where the full run's range is within the Newton tolerance
+    /// of its largest value and so is the error
+    pub relative: Option<f64>,
+}
+
+impl ReactionError {
+    /// Every joint's force and moment of `rom` against `full`, where both runs carry
+    /// coordinates and multipliers (a variant that computes none, or a sweep that kept no
+    /// coordinates, gives none).
+    fn all(model: &Model, full: &SimulationResult, rom: &SimulationResult) -> Vec<Self> {
+        let same = full.q.dim() == rom.q.dim() && full.multipliers.dim() == rom.multipliers.dim();
+        if !same || full.q.is_empty() || !rom.multipliers.iter().all(|x| x.is_finite()) {
+            return Vec::new();
+        }
+        let map = ReactionMap::of(model);
+        if map.n_rows() != full.multipliers.nrows() {
+            return Vec::new();
+        }
+        let mu = full.settings.parameters();
+        let (f, r) = (
+            map.series((mu, full.t.as_slice().unwrap_or(&[])), &full.q, &full.multipliers),
+            map.series((mu, rom.t.as_slice().unwrap_or(&[])), &rom.q, &rom.multipliers),
+        );
+        let tol = full.settings.params.tolerance;
+        let mut out = Vec::new();
+        for (p, name) in map.names().into_iter().enumerate() {
+            let force = (f.force.index_axis(Axis(1), p), r.force.index_axis(Axis(1), p));
+            let moment = (f.moment.column(p).insert_axis(Axis(1)), r.moment.column(p).insert_axis(Axis(1)));
+            for (quantity, (a, b)) in [("force", force), ("moment", moment)] {
+                // the Newton tolerance relative to the reaction's own size
+                let largest = a.outer_iter().map(|v| v.dot(&v).sqrt()).fold(0.0, f64::max);
+                let apart = Apart::of(b, a, tol * largest);
+                out.push(ReactionError {
+                    reaction: name.to_string(),
+                    quantity,
+                    max_error: apart.distance,
+                    range: apart.range,
+                    relative: (!apart.relative.is_nan()).then_some(apart.relative),
+                });
+            }
+        }
+        out
+    }
+}
+
 /// Compares a reduced run with a full run of the same model, load scale and Δt.
 pub fn compare(
     model: &Model,
@@ -343,6 +406,7 @@ pub fn compare(
         max_error_over_travel_probe: worst_travel.map_or(String::new(), |w| w.1),
         probe_errors_over_travel: travels,
         probe_quantity_errors: ProbeQuantityError::all(full, r, full.settings.params.tolerance, sys.length_scale()),
+        reaction_errors: ReactionError::all(model, full, r),
         error_estimate_method: None,
         estimate_failure: None,
     }
@@ -610,6 +674,19 @@ impl Validation {
                 p.error_over_travel.map_or("the probe does not move (beyond the Newton tolerance)".to_string(), |e| {
                     format!("{e:.3e} of its travel")
                 })
+            ));
+        }
+        for q in &self.reaction_errors {
+            let unit = if q.quantity == "force" { " N" } else { " N m" };
+            s.push_str(&format!(
+                "\n  {} {}: max error {:.3e}{unit} over a range of {:.3e}{unit}: {}",
+                q.reaction,
+                q.quantity,
+                q.max_error,
+                q.range,
+                q.relative.map_or("none (it stays within the Newton tolerance)".to_string(), |e| {
+                    format!("{e:.3e} of its range (not estimated)")
+                }),
             ));
         }
         for q in &self.probe_quantity_errors {

@@ -666,6 +666,7 @@ pub fn read_sweep(
             probe_quantity_errors: quantity_errors.as_ref().map_or_else(Vec::new, |cols| {
                 keys.iter().zip(cols).map(|((q, name), c)| ProbeQuantityError::stored(name, *q, c[k])).collect()
             }),
+            reaction_errors: Vec::new(),
             error_estimate_method: None,
             estimate_failure: None,
         });
