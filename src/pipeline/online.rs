@@ -79,6 +79,10 @@ pub fn load_rom(
     }
     let mut warnings = stored.warnings.clone();
     warnings.extend(more);
+    // what training said beside meeting its tolerance, once per command
+    for note in crate::io::estimator_file::read_training_notes(path)? {
+        warnings.push(format!("{}: greedy training: {note}", path.display()));
+    }
     Ok((stored, rom, warnings))
 }
 
