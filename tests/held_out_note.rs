@@ -47,7 +47,9 @@ fn the_note_is_recorded_only_when_the_check_was_above_t_and_repeated_once() {
     let o = flexrom(&["train", p]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     assert!(!text(&o.stderr).contains("is above the tolerance"), "{}", text(&o.stderr));
-    let notes = |path: &Path| flexrom::io::estimator_file::read_training_notes(path).unwrap();
+    let notes = |path: &Path| -> Vec<String> {
+        flexrom::io::estimator_file::read_training_notes(path).unwrap().into_iter().map(|n| n.1).collect()
+    };
     assert!(hdf5::File::open(&basis).unwrap().group("training").unwrap().attr("held_out_note").is_err());
     let o = flexrom(&["validate", p, "--no-dense"]);
     assert!(o.status.success(), "{}", text(&o.stderr));

@@ -1177,7 +1177,8 @@ impl PyBasis {
         };
         let (stored, rom, warnings) = load_rom(&p, path, method, no_estimate)?;
         let training_loads = flexrom::io::estimator_file::read_training_loads(path)?;
-        let training_notes = flexrom::io::estimator_file::read_training_notes(path)?;
+        let training_notes =
+            flexrom::io::estimator_file::read_training_notes(path)?.into_iter().map(|(_, note)| note).collect();
         let rom = Arc::new(rom);
         let b = PyBasis {
             pipeline: p,

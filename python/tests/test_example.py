@@ -31,4 +31,4 @@ def test_example_script(tmp_path):
     # estimate is above the tolerance training met (the sweep reads the estimate training
     # held to it)
     assert "training: the online default" in p.stdout, p.stdout
-    assert "above the tolerance" not in p.stderr, p.stderr
+    assert "error estimate above the tolerance" not in p.stderr, p.stderr

@@ -412,12 +412,12 @@ pub fn read_training_tolerance(path: &Path) -> Result<Option<f64>> {
     Ok(Some(t))
 }
 
-/// What greedy training said beside meeting its tolerance, in words, one sentence each: the
-/// attributes `held_out_note` (its converged held-out check's error above the tolerance)
-/// and `estimate_note` (the online default reading above it between the candidates) on
-/// `/training`, those present; empty without them (within the tolerance, other training,
-/// files written before the attributes).
-pub fn read_training_notes(path: &Path) -> Result<Vec<String>> {
+/// What greedy training said beside meeting its tolerance, in words, one sentence each with
+/// the attribute's name: `held_out_note` (its converged held-out check's error above the
+/// tolerance) and `estimate_note` (the online default, `defects`, reading above it between
+/// the candidates) on `/training`, those present; empty without them (within the
+/// tolerance, other training, files written before the attributes).
+pub fn read_training_notes(path: &Path) -> Result<Vec<(&'static str, String)>> {
     let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
     let Ok(g) = f.group("training") else { return Ok(Vec::new()) };
     let mut notes = Vec::new();
@@ -427,7 +427,7 @@ pub fn read_training_notes(path: &Path) -> Result<Vec<String>> {
         }
         let note = read_attr_str(&g, name)
             .map_err(|e| Error::input(path, format!("training/{name}"), format!("cannot be read: {e}")))?;
-        notes.push(note);
+        notes.push((name, note));
     }
     Ok(notes)
 }
