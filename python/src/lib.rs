@@ -880,6 +880,8 @@ struct PyBasis {
     stored: flexrom::io::basis_file::StoredBasis,
     rom: Arc<Rom>,
     training_loads: Vec<f64>,
+    /// what greedy training said beside meeting its tolerance, one sentence each
+    training_notes: Vec<String>,
 }
 
 #[pymethods]
@@ -984,6 +986,15 @@ impl PyBasis {
     #[getter]
     fn training_loads<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         self.training_loads.clone().into_pyarray(py)
+    }
+
+    /// what greedy training said beside meeting its tolerance, one sentence each: its
+    /// converged held-out check's error above the tolerance (within the model's own
+    /// sensitivity there), the online default estimate reading above it between the
+    /// candidates; empty when neither, or for a basis not trained greedily
+    #[getter]
+    fn training_notes(&self) -> Vec<String> {
+        self.training_notes.clone()
     }
 
     /// the reduced coordinates r (modes and kept joint coordinates)
@@ -1187,8 +1198,18 @@ impl PyBasis {
         };
         let (stored, rom, warnings) = load_rom(&p, path, method, no_estimate)?;
         let training_loads = flexrom::io::estimator_file::read_training_loads(path)?;
+        let training_notes =
+            flexrom::io::estimator_file::read_training_notes(path)?.into_iter().map(|(_, note)| note).collect();
         let rom = Arc::new(rom);
-        let b = PyBasis { pipeline: p, pipeline_file, path: path.to_path_buf(), stored, rom, training_loads };
+        let b = PyBasis {
+            pipeline: p,
+            pipeline_file,
+            path: path.to_path_buf(),
+            stored,
+            rom,
+            training_loads,
+            training_notes,
+        };
         Ok((b, warnings))
     }
 

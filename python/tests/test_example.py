@@ -1,5 +1,7 @@
 """The example script (examples/python_double_pendulum.py) runs as a user would run it and
-writes its basis and figure; the estimate it reports covers the true error it reports."""
+writes its basis and figure; the estimate it reports covers the true error it reports; it
+prints what training said beside meeting its tolerance, and no estimate of its sweep is
+then above that tolerance."""
 
 import re
 import subprocess
@@ -25,3 +27,8 @@ def test_example_script(tmp_path):
     assert len(pairs) == 2, p.stdout
     for err, est in pairs:
         assert float(err) <= float(est), p.stdout
+    # training said what it checked, and nothing after it contradicts it: no warning that an
+    # estimate is above the tolerance training met (the sweep reads the estimate training
+    # held to it)
+    assert "training: the online default" in p.stdout, p.stdout
+    assert "error estimate above the tolerance" not in p.stderr, p.stderr

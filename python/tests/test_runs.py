@@ -105,6 +105,9 @@ def test_basis_contents(dp_basis):
         same(b.modes, f["basis/modes"][()])
         same(b.singular_values, f["basis/singular_values"][()])
         same(b.training_loads, np.unique(f["training/load_scales"][()]))
+        notes = [f["training"].attrs[k] for k in ("held_out_note", "estimate_note") if k in f["training"].attrs]
+    # the /training attributes, as str, in that order
+    assert b.training_notes == [n.decode() if isinstance(n, bytes) else n for n in notes]
     assert np.allclose(b.modes.T @ b.modes, np.eye(b.n_modes), atol=1e-10)  # orthonormal columns
 
 

@@ -29,6 +29,9 @@
 //! /training/tolerance or attribute `tolerance` on /training: greedy's tolerance
 //!   attribute `measure` on /training: the error that tolerance is on ("relative" or
 //!   "displacement"; files written before 2026-11-26 have none: relative)
+//!   attributes `held_out_note`, `estimate_note` on /training: the converged held-out check's
+//!   error above the tolerance, the online default reading above it between the candidates,
+//!   in words (each absent when within it)
 //! ```
 
 use super::h5::{attr_f64, attr_str, attr_u64, read_attr_f64, read_attr_str};
@@ -449,6 +452,26 @@ pub fn read_training_tolerance(path: &Path) -> Result<Option<f64>> {
         return Err(Error::input(path, "training/tolerance", format!("is {t}; it must be positive and finite")));
     }
     Ok(Some(t))
+}
+
+/// What greedy training said beside meeting its tolerance, in words, one sentence each with
+/// the attribute's name: `held_out_note` (its converged held-out check's error above the
+/// tolerance) and `estimate_note` (the online default, `defects`, reading above it between
+/// the candidates) on `/training`, those present; empty without them (within the
+/// tolerance, other training, files written before the attributes).
+pub fn read_training_notes(path: &Path) -> Result<Vec<(&'static str, String)>> {
+    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
+    let Ok(g) = f.group("training") else { return Ok(Vec::new()) };
+    let mut notes = Vec::new();
+    for name in ["held_out_note", "estimate_note"] {
+        if g.attr(name).is_err() {
+            continue;
+        }
+        let note = read_attr_str(&g, name)
+            .map_err(|e| Error::input(path, format!("training/{name}"), format!("cannot be read: {e}")))?;
+        notes.push((name, note));
+    }
+    Ok(notes)
 }
 
 /// The error greedy training's tolerance is on: the attribute `measure` on `/training`;

@@ -79,6 +79,13 @@ pub fn load_rom(
     }
     let mut warnings = stored.warnings.clone();
     warnings.extend(more);
+    // what training said beside meeting its tolerance, once per command (of the online
+    // default's readings only where the runs read it)
+    for (name, note) in crate::io::estimator_file::read_training_notes(path)? {
+        if name != "estimate_note" || rom.method() == Some(EstimateMethod::Defects.name()) {
+            warnings.push(format!("{}: greedy training: {note}", path.display()));
+        }
+    }
     Ok((stored, rom, warnings))
 }
 

@@ -120,6 +120,14 @@ pub struct GreedyRecord {
     pub method: EstimateMethod,
     /// the error `tolerance`, the scores and the true errors are in
     pub measure: ErrorMeasure,
+    /// the converged held-out check's error above the tolerance, in words (within the
+    /// model's own sensitivity there; `/training` attribute `held_out_note`); `None` when it
+    /// was within the tolerance or no check ran
+    pub held_out_note: Option<String>,
+    /// the online default (`defects`) may read above the tolerance between the candidates
+    /// where training's own estimate met it, in words (`/training` attribute
+    /// `estimate_note`); `None` where it stays within
+    pub estimate_note: Option<String>,
 }
 
 impl GreedyRecord {
@@ -219,6 +227,11 @@ pub fn write_training(f: &hdf5::File, r: &GreedyRecord) -> hdf5::Result<()> {
     g.new_dataset_builder().with_data(&col(&|i| i.held_out_effectivity)).create("held_out_effectivity")?;
     attr_str(&g, "estimate_method", r.method.name())?;
     attr_str(&g, "measure", r.measure.name())?;
+    for (name, note) in [("held_out_note", &r.held_out_note), ("estimate_note", &r.estimate_note)] {
+        if let Some(note) = note {
+            attr_str(&g, name, note)?;
+        }
+    }
     attr_str(&g, "method", "greedy")?;
     attr_u64(&g, "iterations", ni as u64)?;
     attr_u64(&g, "max_runs", r.max_runs as u64)?;

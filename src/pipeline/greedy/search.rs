@@ -84,6 +84,12 @@ impl Level {
         self.pair_bounds.as_ref().map_or(f64::INFINITY, |b| super::between::largest(&self.estimates, b))
     }
 
+    /// The bound of every pair of neighbouring candidates ([`CandidateSet::pairs`] order),
+    /// after looking between them; `None` for a rung not run everywhere.
+    pub(super) fn pair_bounds(&self) -> Option<&[f64]> {
+        self.pair_bounds.as_deref()
+    }
+
     /// [`Self::worst`] among the candidates `keep` accepts (and that were run).
     pub(super) fn worst_where(&self, keep: impl Fn(usize) -> bool) -> Option<(usize, f64)> {
         let mut w: Option<(usize, f64)> = None;
@@ -170,7 +176,9 @@ pub(super) fn search(r: &Round, g: &GreedySpec, previous_energy: Option<f64>) ->
             }
         }
     };
-    let better = |best: &Option<Level>, l: &Level| best.as_ref().is_none_or(|b| l.worst().1 < b.worst().1);
+    // no rung met T: the tightest rung tried (the ladder goes loose → tight) whose screened
+    // runs did not fail; only where every rung's did, the smallest worst score ([`fallback`])
+    let better = |best: &Option<Level>, l: &Level| best.as_ref().is_none_or(|b| fallback(b.worst().1, l.worst().1));
     let mut best: Option<Level> = None;
     if let Some(m) = &p.file.reduction.modes {
         best = attempt(m.clone(), f64::NAN, given_hyper.unwrap_or(TAU_LADDER[TAU_LADDER.len() - 1]));
@@ -245,9 +253,30 @@ pub(super) fn search(r: &Round, g: &GreedySpec, previous_energy: Option<f64>) ->
         "  iteration {n} keeps rung {}: {}{}",
         rung_name(best.energy, best.hyper_tolerance.unwrap_or(f64::NAN)),
         modes_text(&best.trained.block_modes),
-        if accepts(&best) { "" } else { " (the lowest worst estimate; no rung met the tolerance)" }
+        if accepts(&best) { "" } else { " (no rung met the tolerance: the tightest whose reduced runs did not fail)" }
     );
     Ok(best)
+}
+
+/// Whether a tighter rung whose worst score is `tighter` replaces the rung kept so far
+/// (worst score `kept`) when no rung meets the tolerance: yes unless its screened runs
+/// failed somewhere (∞) where the kept one's did not; between two such rungs, the smaller
+/// worst score.
+///
+/// Not the smallest worst score alone: a rung's screening stops at its first candidate above
+/// T, so its worst score is over a few candidates, different ones at each rung and at each
+/// tolerance, and ranking rungs by it let a looser tolerance keep more modes than a tighter
+/// one on the same runs (docs/greedy-training.md, "A looser tolerance, a bigger basis": a
+/// two-link arm at 1e-2 kept ε = 1e-8 for a worst score 5 % below ε = 1e-7's, at 1e-3
+/// ε = 1e-7). With the tightest rung tried the choice does not depend on T where every rung
+/// fails it: the rungs tried end where the estimator is no richer than the basis, which
+/// the snapshots decide; and a rung that meets a looser T is no tighter than the last one tried.
+fn fallback(kept: f64, tighter: f64) -> bool {
+    match (kept.is_finite(), tighter.is_finite()) {
+        (_, true) => true,
+        (true, false) => false,
+        (false, false) => tighter < kept,
+    }
 }
 
 /// "ε = 1.0e-4, τ = 1.0e-2" (ε is NaN where the pipeline gives the modes).
@@ -428,4 +457,22 @@ fn p_tolerance(p: &Pipeline) -> f64 {
 /// The error measure greedy's tolerance is on (`[train] greedy.measure`).
 fn measure_of(p: &Pipeline) -> ErrorMeasure {
     p.file.train.greedy.as_ref().map_or(ErrorMeasure::Relative, |g| g.measure)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fallback;
+
+    /// With no rung meeting T, a tighter rung replaces the kept one unless its screened runs
+    /// failed (∞) where the kept one's did not; two failed rungs keep the looser; the worst
+    /// scores' sizes otherwise do not matter (the two-link arm's 1.54e-2 at ε = 1e-7 against
+    /// 1.47e-2 at ε = 1e-8, and the reverse).
+    #[test]
+    fn the_fallback_is_the_tightest_rung_whose_runs_did_not_fail() {
+        assert!(fallback(1.54e-2, 1.47e-2));
+        assert!(fallback(5.85e-3, 6.19e-3), "a larger worst score over other candidates");
+        assert!(fallback(f64::INFINITY, 6.19e-3));
+        assert!(!fallback(5.85e-3, f64::INFINITY), "a tighter rung whose runs failed");
+        assert!(!fallback(f64::INFINITY, f64::INFINITY));
+    }
 }
