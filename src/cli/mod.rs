@@ -158,6 +158,20 @@ pub fn print_table(t: &Table, format: Format, single: bool) -> flexrom::Result<(
     }
 }
 
+/// Prints a run's time series on stdout ([`flexrom::pipeline::tables::series_table`], one
+/// row per instant) as CSV or JSON; nothing in text mode. `simulate --csv/--json` and
+/// `online --csv` print it alike.
+pub fn print_series(
+    model: &flexrom::model::Model,
+    r: &flexrom::simulate::SimulationResult,
+    format: Format,
+) -> flexrom::Result<()> {
+    if format == Format::Text {
+        return Ok(());
+    }
+    print_table(&flexrom::pipeline::tables::series_table(model, r), format, false)
+}
+
 /// `-v`: the settings and Newton statistics of one run (`reduced`: of a reduced model, whose
 /// strain check sees its sampled elements only).
 pub fn run_details(r: &flexrom::simulate::SimulationResult, reduced: bool) {
