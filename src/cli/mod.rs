@@ -134,6 +134,14 @@ pub fn warn(warnings: &[String]) {
     }
 }
 
+/// The warnings of a model file's own `[time] dt` that does not resolve the model
+/// ([`flexrom::simulate::resolution_warnings`]): what `train` and `run` say before training.
+pub fn model_resolution(model: &flexrom::model::Model) -> Vec<String> {
+    let overrides = flexrom::simulate::Overrides::default();
+    flexrom::simulate::Settings::resolve(model, &overrides)
+        .map_or_else(|_| Vec::new(), |s| flexrom::simulate::resolution_warnings(model, &s))
+}
+
 /// The warnings about finished runs of `rom` (extrapolation, estimates above the
 /// tolerance), printed; with `strict`, an estimate above the tolerance is the error.
 pub fn check_runs(
