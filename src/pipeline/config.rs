@@ -45,7 +45,7 @@ pub use schema::{
     Blocks, GreedySpec, HyperSpec, OnlineSpec, ParameterSpec, PipelineFile, PointsSpec, ReductionSpec, ScalesSpec,
     TrainSpec, DEFAULT_BOX_CANDIDATES_PER_PARAMETER, DEFAULT_LINE_CANDIDATES,
 };
-use std::path::{Path, PathBuf};
+use std::path::{Component, Path, PathBuf};
 
 /// A loaded, checked pipeline with its model.
 #[derive(Clone, Debug)]
@@ -115,8 +115,10 @@ impl Pipeline {
         // `pipelines/../data/bases/x.h5` printed as `data/bases/x.h5` (the same file)
         let basis_path =
             tidy(&dir.join(file.basis.clone().unwrap_or_else(|| PathBuf::from(format!("../data/bases/{stem}.h5")))));
-        let report_dir =
-            tidy(&dir.join(file.report.clone().unwrap_or_else(|| PathBuf::from(format!("../reports/{stem}")))));
+        let report = file.report.clone().unwrap_or_else(|| PathBuf::from(format!("../reports/{stem}")));
+        // a report of `.` or `..` stays as written: its refusal names it
+        let ends_in_dots = matches!(report.components().next_back(), Some(Component::CurDir | Component::ParentDir));
+        let report_dir = if ends_in_dots { dir.join(&report) } else { tidy(&dir.join(&report)) };
         let p = Pipeline {
             path: path.to_path_buf(),
             text,
