@@ -205,13 +205,16 @@ extrapolated (and rel_error, max_probe_error (m), full_seconds, speedup with --v
         exit_codes!()
     ))]
     Merge(cli::merge::Args),
-    /// Train, sweep, validate and write a report folder (Markdown and SVG plots).
+    /// Train (or reuse a current basis), sweep, validate and write a report folder (Markdown,
+    /// SVG and PNG plots).
     #[command(after_help = concat!(
         "Examples:
   flexrom run pipelines/pendulum.toml                 report in reports/pendulum
   flexrom run pipelines/pendulum_5000.toml -q         the dense comparison is skipped (n > 5792)
   flexrom run pipelines/fourbar.toml --no-dense --json > validation.json
 
+A basis trained from this model with the pipeline's [train]/[reduction]/[parameters] keys,
+that passes its checks, is reused (one line says so); --retrain trains again.
 The summary (summary.md) is printed on stdout; --csv/--json print the validation rows
 instead (as the report's validation.json). The dense-LU timing is skipped, with one line on
 stderr, when its matrix would exceed 256 MiB, its work half a minute (steps · n³/3 > 2e11

@@ -287,6 +287,20 @@ pub fn prepare(model: &Model, s: &Settings) -> Result<(FlexibleSystem, Vec<f64>)
     Ok((sys, q0))
 }
 
+/// The warnings of a time step `s.dt` that does not resolve `model`'s lowest elastic
+/// natural period or its loads' sines ([`crate::analysis::resolution`]), one line each;
+/// none where that check is not cheap or the model cannot be prepared (the run says why).
+pub fn resolution_warnings(model: &Model, s: &Settings) -> Vec<String> {
+    // sized from the file before anything is assembled: a model too large for the check (or
+    // for the memory bound, which its run then names) costs nothing here
+    if model.sizes().n_dof > crate::analysis::resolution::MAX_DOF as f64 {
+        return Vec::new();
+    }
+    let Ok((sys, q0)) = prepare(model, s) else { return Vec::new() };
+    let mu = model.with_property_values(&s.mu);
+    crate::analysis::resolution::time_step_warnings(model, &sys, &mu, &q0, s.dt)
+}
+
 /// The full model of a model file, assembled once and run at as many parameters as wanted
 /// (training, validation): the system and its consistent initial state.
 pub struct FullModel<'a> {

@@ -107,9 +107,21 @@ fn every_result_prints_as_csv_and_json() {
     assert_eq!(j["load_scale"].as_f64(), Some(1.0));
     assert_eq!(j["steps"].as_u64(), Some(220), "t_end 1.1 s / dt 0.005 s");
     assert!(j["error_estimate"].as_f64().unwrap() > 0.0);
+    // online --csv: the time series, as simulate --csv prints it (one shared writer): every
+    // column of the reduced run is one of the full run's, under the same name, at the same
+    // instants (a reduced run has no energies)
     let (head, rows) = csv_rows(&ok(&["online", &p, "--load-scale", "1.0", "-o", s(&on), "--csv"]));
-    assert_eq!(head[..3], ["load_scale", "n_modes", "steps"]);
-    assert_eq!(&rows[0][2], "220");
+    assert_eq!(head[..3], ["t", "tip_x", "tip_y"]);
+    assert_eq!(rows.len(), 221, "t = 0 and 220 steps of 0.005 s");
+    let (full_head, full_rows) = csv_rows(&ok(&["simulate", s(&model), "--load-scale", "1.0", "--csv"]));
+    for h in &head {
+        assert!(full_head.contains(h), "online's column {h} is none of simulate's: {full_head:?}");
+    }
+    assert_eq!(rows[220][0], full_rows[220][0], "the same last instant");
+    let (tip, full_tip): (f64, f64) = (rows[220][2].parse().unwrap(), full_rows[220][2].parse().unwrap());
+    // the reduced tip within the basis's tolerance of the full one (1e-2 of the 1.2 m length
+    // is far above the pendulum pipeline's rel_error; a different series would miss it)
+    assert!((tip - full_tip).abs() < 1.2e-2, "reduced tip_y {tip} vs full {full_tip}");
 
     // validate: JSON object (arrays kept), CSV with one row and the arrays spread out
     let j = json(&ok(&["validate", &p, "--load-scale", "1.0", "--json", "--no-dense"]));

@@ -169,7 +169,9 @@ fn greedy_training_over_a_box_converges_and_its_estimate_covers_held_out_points(
     let stderr = text(&out).1;
     assert!(out.status.success(), "{stderr}");
     assert!(stderr.contains("greedy training over the box g ∈ [0.8, 1.2], push ∈ [0.2, 2] (log)"), "{stderr}");
-    assert!(!stderr.contains("warning"), "{stderr}");
+    // the double pendulum's dt = 0.005 s does not resolve its 75 Hz first bending mode: the
+    // one warning expected (src/analysis/resolution.rs); no other
+    assert!(!stderr.lines().any(|l| l.contains("warning") && !l.contains("does not resolve")), "{stderr}");
 
     let f = hdf5::File::open(d.join("b.h5")).unwrap();
     let t = f.group("training").unwrap();

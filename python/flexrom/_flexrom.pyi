@@ -154,6 +154,13 @@ class Result:
     ) -> None: ...
 
 class Basis:
+    def __init__(
+        self,
+        path: _Path,
+        pipeline: Optional[_Path] = None,
+        estimate: Optional[str] = None,
+        no_estimate: bool = False,
+    ) -> None: ...
     @staticmethod
     def load(
         path: _Path,

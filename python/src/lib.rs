@@ -220,7 +220,10 @@ impl PyModel {
             serde_json::from_str(&json).map_err(|e| errors::model_error(&format!("model dict: {e}")))?;
         let text = toml::to_string(&value)
             .map_err(|e| errors::model_error(&format!("model dict: cannot be written as TOML: {e}")))?;
-        Self::from_toml(&text, Some(path.unwrap_or_else(|| PathBuf::from("<dict>"))))
+        let path = path.unwrap_or_else(|| PathBuf::from("<dict>"));
+        // the text is flexrom's own rendering of the dict: its lines mean nothing to the caller
+        let model = Model::from_text(&text, &path).map_err(|e| to_py(without_lines(e)))?;
+        Ok(PyModel { model: Arc::new(model) })
     }
 
     #[getter]
@@ -393,6 +396,26 @@ struct ReducedPart {
 
 /// A run's result, full (`Model.simulate`) or reduced (`Basis.online`), in the layout of a
 /// result file: time first.
+/// An error about a model given as a dict, with the key path its field names and no
+/// `(line N)` of the TOML text flexrom wrote the dict as: `bodies[0].length (line 20)` reads
+/// `bodies[0].length`; a bare `line N` reads `(dict)`.
+fn without_lines(e: flexrom::Error) -> flexrom::Error {
+    match e {
+        flexrom::Error::Input { file, field, problem } => {
+            let field = match field.rsplit_once(" (line ") {
+                Some((key, rest)) if rest.ends_with(')') => key.to_string(),
+                _ if field.starts_with("line ") => "(dict)".to_string(),
+                _ => field,
+            };
+            flexrom::Error::Input { file, field, problem }
+        }
+        flexrom::Error::Hinted { source, hint } => {
+            flexrom::Error::Hinted { source: Box::new(without_lines(*source)), hint }
+        }
+        other => other,
+    }
+}
+
 #[pyclass(name = "Result", module = "flexrom._flexrom", frozen)]
 struct PyRunResult {
     model: Arc<Model>,
@@ -882,6 +905,9 @@ struct PyBasis {
     training_loads: Vec<f64>,
     /// what greedy training said beside meeting its tolerance, one sentence each
     training_notes: Vec<String>,
+    /// `load`'s `estimate` and `no_estimate`, for pickling (`__reduce__`)
+    estimate: Option<String>,
+    no_estimate: bool,
 }
 
 #[pymethods]
@@ -906,9 +932,34 @@ impl PyBasis {
             None => None,
         };
         let b = py.detach(|| Self::open(&path, p, pipeline.clone(), method, no_estimate));
-        let (b, warnings) = b.map_err(errors::basis_error)?;
+        let (mut b, warnings) = b.map_err(errors::basis_error)?;
         warn(py, &warnings)?;
+        b.estimate = estimate.map(str::to_string);
         Ok(b)
+    }
+
+    /// `Basis(path, …)` is `Basis.load(path, …)`: what unpickling calls.
+    #[new]
+    #[pyo3(signature = (path, pipeline = None, estimate = None, no_estimate = false))]
+    fn new(
+        py: Python<'_>,
+        path: PathBuf,
+        pipeline: Option<PathBuf>,
+        estimate: Option<&str>,
+        no_estimate: bool,
+    ) -> PyResult<Self> {
+        Self::load(py, path, pipeline, estimate, no_estimate)
+    }
+
+    /// Pickled as the file it was read from (absolute paths, so that another process or
+    /// folder finds it) with the arguments of `load`: unpickling reads and checks the basis
+    /// file again, which must still be there (joblib, multiprocessing).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let py = slf.py();
+        let b = slf.get();
+        let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+        let args = (absolute(&b.path), b.pipeline_file.as_deref().map(absolute), b.estimate.clone(), b.no_estimate);
+        Ok((slf.get_type().into_any(), args.into_pyobject(py)?.into_any()))
     }
 
     #[getter]
@@ -1209,6 +1260,8 @@ impl PyBasis {
             rom,
             training_loads,
             training_notes,
+            estimate: None,
+            no_estimate,
         };
         Ok((b, warnings))
     }

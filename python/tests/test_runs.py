@@ -1,6 +1,7 @@
 """The package's runs against the command line's files: the same computation, so the same
 numbers to the bit (both call the library's one solver with the same inputs)."""
 
+import pathlib
 import warnings
 
 import h5py
@@ -330,3 +331,36 @@ def test_model_from_dict_takes_springs():
     d["springs"][0]["damping"] = -1.0
     with pytest.raises(flexrom.ModelError, match=r"springs\[0\]\.damping"):
         flexrom.Model.from_dict(d)
+
+
+def test_a_basis_pickles_as_its_file(dp_basis, tmp_path, monkeypatch):
+    """A Basis pickles as its file's absolute path and `load`'s arguments (joblib and
+    multiprocessing send it so): unpickled in another folder it is the same basis, whose
+    online run gives the same bits."""
+    import pickle
+
+    b = flexrom.Basis.load(dp_basis, pipeline=DP_PIPELINE, estimate="corrected")
+    monkeypatch.chdir(tmp_path)
+    c = pickle.loads(pickle.dumps(b))
+    assert pathlib.Path(c.path).is_absolute() and pathlib.Path(c.path).samefile(dp_basis)
+    same(np.asarray(c.modes), np.asarray(b.modes))
+    ra, rb = b.online(load_scale=0.9), c.online(load_scale=0.9)
+    same(np.asarray(ra.q), np.asarray(rb.q))
+    assert ra.error_estimate == rb.error_estimate, "the same estimate method after the round trip"
+
+
+def test_model_from_dict_errors_name_the_key_path():
+    """An error in a model given as a dict names the key path (the dict has no lines: the
+    TOML text flexrom wrote it as is not the caller's)."""
+    tomllib = pytest.importorskip("tomllib")  # Python >= 3.11
+
+    d = tomllib.loads(PENDULUM.read_text())
+    d["bodies"][0]["elements"] = 0
+    with pytest.raises(flexrom.ModelError) as e:
+        flexrom.Model.from_dict(d)
+    assert "bodies[0].elements" in str(e.value) and "line" not in str(e.value), str(e.value)
+    d = tomllib.loads(PENDULUM.read_text())
+    d["time"]["dt"] = "fast"
+    with pytest.raises(flexrom.ModelError) as e:
+        flexrom.Model.from_dict(d)
+    assert "time.dt" in str(e.value) and "line" not in str(e.value), str(e.value)

@@ -134,6 +134,14 @@ pub fn warn(warnings: &[String]) {
     }
 }
 
+/// The warnings of a model file's own `[time] dt` that does not resolve the model
+/// ([`flexrom::simulate::resolution_warnings`]): what `train` and `run` say before training.
+pub fn model_resolution(model: &flexrom::model::Model) -> Vec<String> {
+    let overrides = flexrom::simulate::Overrides::default();
+    flexrom::simulate::Settings::resolve(model, &overrides)
+        .map_or_else(|_| Vec::new(), |s| flexrom::simulate::resolution_warnings(model, &s))
+}
+
 /// The warnings about finished runs of `rom` (extrapolation, estimates above the
 /// tolerance), printed; with `strict`, an estimate above the tolerance is the error.
 pub fn check_runs(
@@ -156,6 +164,20 @@ pub fn print_table(t: &Table, format: Format, single: bool) -> flexrom::Result<(
         Format::Json if single => output::println(&t.to_json_object()),
         Format::Json => output::println(&t.to_json()),
     }
+}
+
+/// Prints a run's time series on stdout ([`flexrom::pipeline::tables::series_table`], one
+/// row per instant) as CSV or JSON; nothing in text mode. `simulate --csv/--json` and
+/// `online --csv` print it alike.
+pub fn print_series(
+    model: &flexrom::model::Model,
+    r: &flexrom::simulate::SimulationResult,
+    format: Format,
+) -> flexrom::Result<()> {
+    if format == Format::Text {
+        return Ok(());
+    }
+    print_table(&flexrom::pipeline::tables::series_table(model, r), format, false)
 }
 
 /// `-v`: the settings and Newton statistics of one run (`reduced`: of a reduced model, whose

@@ -5,7 +5,7 @@ use flexrom::io::attrs::Kind;
 use flexrom::io::output::{check_output, Origin};
 use flexrom::limits::Limits;
 use flexrom::output::info;
-use flexrom::output::table::{Cell, Table};
+use flexrom::output::table::{Cell, Format, Table};
 use flexrom::pipeline::online::{load_rom, online_to_file};
 use flexrom::pipeline::Pipeline;
 use std::path::PathBuf;
@@ -115,7 +115,11 @@ impl Args {
         ]);
         row.extend(mu.named().map(|(_, value)| value.into()));
         t.push(row);
-        print_table(&t, format.format(), true)?;
+        match format.format() {
+            // the time series, as `simulate --csv` prints it (the summary is `--json`'s)
+            Format::Csv => super::print_series(&p.model, &run.result, Format::Csv)?,
+            f => print_table(&t, f, true)?,
+        }
         warn(notice.as_slice());
         if let Some(note) = &done.note {
             warn(std::slice::from_ref(note));

@@ -1,4 +1,5 @@
-//! `flexrom run`: the whole pipeline (train, sweep, validate) and its report folder.
+//! `flexrom run`: the whole pipeline (train, or reuse a current basis; sweep, validate) and
+//! its report folder.
 
 use super::{print_table, DenseArgs, EstimateArgs, FormatArgs};
 use flexrom::limits::Limits;
@@ -16,6 +17,11 @@ pub struct Args {
     /// tolerance ([online] tolerance, default the training tolerance)
     #[arg(long)]
     strict: bool,
+    /// train even where the pipeline's basis is current (without it, a basis trained from
+    /// this model with these [train]/[reduction]/[parameters] keys, that passes its checks,
+    /// is reused and said so)
+    #[arg(long)]
+    retrain: bool,
     #[command(flatten)]
     dense: DenseArgs,
     #[command(flatten)]
@@ -26,17 +32,23 @@ pub struct Args {
 
 impl Args {
     pub fn run(self, limits: &Limits) -> flexrom::Result<()> {
-        let Args { pipeline, strict, dense, estimate, format } = self;
+        let Args { pipeline, strict, retrain, dense, estimate, format } = self;
         let p = Pipeline::load_with(&pipeline, limits.clone())?;
         super::warn(&p.property_warnings());
+        super::warn(&super::model_resolution(&p.model));
         if p.online_fallback() == Some(flexrom::pipeline::sweep::Fallback::Full) {
             info(&format!(
                 "{}: [online] fallback = \"full\" applies to `sweep` and `online`; the report's sweep is validated and measures the reduced model at every load",
                 p.path.display()
             ));
         }
-        let (dir, warnings) =
-            flexrom::pipeline::report::run_with(&p, output::show_progress(), dense.choice(), estimate.method())?;
+        let (dir, warnings) = flexrom::pipeline::report::run_with(
+            &p,
+            output::show_progress(),
+            dense.choice(),
+            estimate.method(),
+            retrain,
+        )?;
         super::warn(&warnings);
         let read = |name: &str| {
             let f = dir.join(name);

@@ -1,6 +1,6 @@
 //! `flexrom simulate`: one full-order run of a model file, written to an HDF5 result file.
 
-use super::{print_table, run_details, FormatArgs};
+use super::{run_details, FormatArgs};
 use flexrom::io::attrs::Kind;
 use flexrom::io::output::{check_output, Origin};
 use flexrom::io::result_file::{begin_alongside, RunPlan};
@@ -46,34 +46,18 @@ impl Args {
         let mu = overrides.mu.clone().unwrap_or_default();
         super::warn(model.load_scale_warning(std::iter::once(mu.scale())).as_slice());
         super::warn(&model.property_warnings([&mu]));
-        let compute = || {
-            simulate(&model, &overrides).and_then(|r| with_energies(&model, r)).map_err(|e| e.at_stage("simulate", &mu))
-        };
-        let r = match &output {
-            // the result file's fixed part is written on a second thread while the run computes
-            Some(output) => {
-                let settings = Settings::resolve(&model, &overrides)?;
-                // a run too large for the memory bound is refused before the file is begun
-                // (its labels alone are a string per coordinate)
-                model.check_full_run_memory(settings.n_steps, settings.solver == LinearSolverKind::Dense)?;
-                let plan = RunPlan::of(&model, &settings);
-                let (file, r) =
-                    begin_alongside(output, &model.text, &model.path.display().to_string(), &plan, compute)?;
-                let mut layout = None;
-                file.finish(&r, |f| {
-                    if paraview {
-                        layout = Some(flexrom::io::paraview::extra(f, output, model.bodies(), &r)?);
-                    }
-                    Ok(())
-                })?;
-                if let Some(layout) = layout {
-                    flexrom::io::paraview::write_xdmf(output, &layout)?;
-                }
-                r
-            }
-            // --csv or --json alone: the probes on stdout, no file
-            None => compute()?,
-        };
+        // whether dt resolves the model, looked at on a second thread while the run computes
+        // (a modes analysis: the run's own time is not to grow by it), said after the run
+        let (r, resolution) = std::thread::scope(|s| {
+            let check = s.spawn(|| {
+                Settings::resolve(&model, &overrides)
+                    .map_or_else(|_| Vec::new(), |settings| flexrom::simulate::resolution_warnings(&model, &settings))
+            });
+            let r = run_and_write(&model, &overrides, output.as_deref(), paraview);
+            (r, check.join().unwrap_or_default())
+        });
+        super::warn(&resolution);
+        let r = r?;
         let written = output.as_ref().map_or("no result file (-o not given)".to_string(), |o| o.display().to_string());
         info(&format!(
             "{}: {} steps in {:.3} s ({} Newton iterations, {} factorizations, {} step cuts) -> {}",
@@ -86,12 +70,45 @@ impl Args {
             written
         ));
         run_details(&r, false);
-        let mut table = flexrom::pipeline::tables::probe_table(&r);
-        if format.format() != flexrom::output::table::Format::Text {
-            flexrom::pipeline::tables::add_reactions(&mut table, &model, &r);
-        }
-        print_table(&table, format.format(), false)
+        super::print_series(&model, &r, format.format())
     }
+}
+
+/// The run, written to `output` (with ParaView's view where asked) or, without it, only
+/// returned (`--csv`/`--json` print it).
+fn run_and_write(
+    model: &Model,
+    overrides: &Overrides,
+    output: Option<&std::path::Path>,
+    paraview: bool,
+) -> flexrom::Result<flexrom::simulate::SimulationResult> {
+    let mu = overrides.mu.clone().unwrap_or_default();
+    let compute =
+        || simulate(model, overrides).and_then(|r| with_energies(model, r)).map_err(|e| e.at_stage("simulate", &mu));
+    Ok(match output {
+        // the result file's fixed part is written on a second thread while the run computes
+        Some(output) => {
+            let settings = Settings::resolve(model, overrides)?;
+            // a run too large for the memory bound is refused before the file is begun
+            // (its labels alone are a string per coordinate)
+            model.check_full_run_memory(settings.n_steps, settings.solver == LinearSolverKind::Dense)?;
+            let plan = RunPlan::of(model, &settings);
+            let (file, r) = begin_alongside(output, &model.text, &model.path.display().to_string(), &plan, compute)?;
+            let mut layout = None;
+            file.finish(&r, |f| {
+                if paraview {
+                    layout = Some(flexrom::io::paraview::extra(f, output, model.bodies(), &r)?);
+                }
+                Ok(())
+            })?;
+            if let Some(layout) = layout {
+                flexrom::io::paraview::write_xdmf(output, &layout)?;
+            }
+            r
+        }
+        // --csv or --json alone: the probes on stdout, no file
+        None => compute()?,
+    })
 }
 
 #[derive(clap::Args)]

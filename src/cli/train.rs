@@ -44,6 +44,7 @@ impl Args {
         let Args { pipeline, basis, snapshots_only, load_scale, shard, output, from_snapshots, format } = self;
         let p = Pipeline::load_with(&pipeline, limits.clone())?;
         super::warn(&p.property_warnings());
+        super::warn(&super::model_resolution(&p.model));
         if snapshots_only {
             let out = output.expect("clap: --snapshots-only requires -o");
             check_output(

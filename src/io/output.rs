@@ -38,6 +38,43 @@ impl Origin<'_> {
     }
 }
 
+/// `p` with `.` left out and `name/..` folded away, lexically, where `name` is not a
+/// symbolic link (through a link, `..` is the parent of the link's target, which a lexical
+/// fold would miss; such a `..` stays): `pipelines/../data/x.h5` reads `data/x.h5`. Nothing
+/// is canonicalized: a link in the path stays a link. The paths a pipeline names are kept
+/// this way, so that messages and report lines print them as a user would write them.
+pub fn tidy(p: &Path) -> PathBuf {
+    let mut out = PathBuf::new();
+    // the trailing plain names of `out` a `..` may fold away
+    let mut foldable = 0usize;
+    for c in p.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir if foldable > 0 && !is_link(&out) => {
+                out.pop();
+                foldable -= 1;
+            }
+            Component::Normal(name) => {
+                out.push(name);
+                foldable += 1;
+            }
+            other => {
+                out.push(other.as_os_str());
+                foldable = 0;
+            }
+        }
+    }
+    if out.as_os_str().is_empty() {
+        PathBuf::from(".")
+    } else {
+        out
+    }
+}
+
+fn is_link(p: &Path) -> bool {
+    p.symlink_metadata().is_ok_and(|m| m.file_type().is_symlink())
+}
+
 /// `p` made absolute with its longest existing prefix canonicalized (symlinks and `..`
 /// resolved by the file system) and the rest applied lexically.
 pub fn resolve(p: &Path) -> PathBuf {
@@ -336,6 +373,22 @@ pub fn swap_in_report(tmp: TempPath, with: Vec<TempPath>, pipeline: &Path) -> Re
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn tidy_folds_dot_dot_lexically_but_not_through_a_link() {
+        assert_eq!(tidy(Path::new("pipelines/../data/models/p.toml")), PathBuf::from("data/models/p.toml"));
+        assert_eq!(tidy(Path::new("./a/./b/../c")), PathBuf::from("a/c"));
+        assert_eq!(tidy(Path::new("../a/..")), PathBuf::from(".."));
+        assert_eq!(tidy(Path::new("a/..")), PathBuf::from("."));
+        assert_eq!(tidy(Path::new("/x/../y")), PathBuf::from("/y"));
+        // through a link, `..` is the target's parent: the lexical fold would name another file
+        let d = tempfile::tempdir().unwrap();
+        let base = std::fs::canonicalize(d.path()).unwrap();
+        std::fs::create_dir_all(base.join("far/inner")).unwrap();
+        std::os::unix::fs::symlink(base.join("far/inner"), base.join("link")).unwrap();
+        assert_eq!(tidy(&base.join("link/../m.toml")), base.join("link/../m.toml"));
+        assert_eq!(tidy(&base.join("far/inner/../m.toml")), base.join("far/m.toml"));
+    }
 
     #[test]
     fn resolve_follows_dot_dot_and_keeps_missing_tails() {

@@ -96,6 +96,19 @@ impl TimeFunction {
         }
     }
 
+    /// The highest frequency (Hz) of the sines in it (through pieces and sums); 0 where it
+    /// has none. What a time step must resolve of it: its other kinds have no period.
+    pub fn highest_frequency(&self) -> f64 {
+        match self {
+            TimeFunction::Sine { frequency, .. } => frequency.abs(),
+            TimeFunction::Piecewise { pieces } => {
+                pieces.iter().map(|p| p.function.highest_frequency()).fold(0.0, f64::max)
+            }
+            TimeFunction::Sum { terms } => terms.iter().map(TimeFunction::highest_frequency).fold(0.0, f64::max),
+            _ => 0.0,
+        }
+    }
+
     /// Checks that every number is finite and the pieces are ordered; returns the problem.
     pub fn check(&self) -> Result<(), String> {
         let finite =

@@ -32,6 +32,7 @@ mod scales;
 mod schema;
 
 use crate::error::{Error, Result};
+use crate::io::output::tidy;
 use crate::limits::Limits;
 use crate::model::Model;
 pub use crate::reduction::estimator::{ErrorMeasure, EstimateMethod};
@@ -44,7 +45,7 @@ pub use schema::{
     Blocks, GreedySpec, HyperSpec, OnlineSpec, ParameterSpec, PipelineFile, PointsSpec, ReductionSpec, ScalesSpec,
     TrainSpec, DEFAULT_BOX_CANDIDATES_PER_PARAMETER, DEFAULT_LINE_CANDIDATES,
 };
-use std::path::{Path, PathBuf};
+use std::path::{Component, Path, PathBuf};
 
 /// A loaded, checked pipeline with its model.
 #[derive(Clone, Debug)]
@@ -85,7 +86,7 @@ impl Pipeline {
         refuse_model_file(&text, path)?;
         let file: PipelineFile = crate::model::parse_toml(&text, path)?;
         let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
-        let model = Model::load_with(dir.join(&file.model), limits).map_err(|e| match e {
+        let model = Model::load_with(tidy(&dir.join(&file.model)), limits).map_err(|e| match e {
             Error::Io { .. } => Error::input(path, "model", format!("cannot read `{}`: {e}", file.model.display())),
             other => other,
         })?;
@@ -111,9 +112,13 @@ impl Pipeline {
     fn of_parts(path: &Path, text: String, file: PipelineFile, model: Model) -> Result<Pipeline> {
         let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
         let stem = path.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_else(|| "pipeline".into());
+        // `pipelines/../data/bases/x.h5` printed as `data/bases/x.h5` (the same file)
         let basis_path =
-            dir.join(file.basis.clone().unwrap_or_else(|| PathBuf::from(format!("../data/bases/{stem}.h5"))));
-        let report_dir = dir.join(file.report.clone().unwrap_or_else(|| PathBuf::from(format!("../reports/{stem}"))));
+            tidy(&dir.join(file.basis.clone().unwrap_or_else(|| PathBuf::from(format!("../data/bases/{stem}.h5")))));
+        let report = file.report.clone().unwrap_or_else(|| PathBuf::from(format!("../reports/{stem}")));
+        // a report of `.` or `..` stays as written: its refusal names it
+        let ends_in_dots = matches!(report.components().next_back(), Some(Component::CurDir | Component::ParentDir));
+        let report_dir = if ends_in_dots { dir.join(&report) } else { tidy(&dir.join(&report)) };
         let p = Pipeline {
             path: path.to_path_buf(),
             text,

@@ -4,6 +4,8 @@
 //! numbered in the order of the summary's sweep table and the plots run along that number.
 //! The folder is built beside the target and renamed into place at the end, the basis
 //! written under a temporary name and renamed into place only when every stage succeeded.
+//! A current basis (trained from this model with these training keys, passing its checks:
+//! `current_basis`) is reused as it is: neither trained nor rewritten.
 
 use super::config::{EstimateMethod, Pipeline};
 use super::online::load_rom;
@@ -45,30 +47,104 @@ pub fn check_outputs(p: &Pipeline) -> Result<()> {
 /// were and the temporary ones removed. Returns the report folder and the training's
 /// warnings.
 pub fn run(p: &Pipeline, progress: bool) -> Result<(PathBuf, Vec<String>)> {
-    run_with(p, progress, super::dense::DenseChoice::Auto, None)
+    run_with(p, progress, super::dense::DenseChoice::Auto, None, true)
 }
 
 /// [`run`] with the choice of the dense-LU comparison ([`super::dense`]), decided before
-/// any work, and the error estimate's method (`--estimate`; `None`: the pipeline's
-/// `[online] estimate`, else the basis's default).
+/// any work, the error estimate's method (`--estimate`; `None`: the pipeline's
+/// `[online] estimate`, else the basis's default) and whether to train even where the
+/// pipeline's basis is current (`retrain`; else a current basis, trained from this model with
+/// these training keys and passing its checks, is reused).
 pub fn run_with(
     p: &Pipeline,
     progress: bool,
     dense: super::dense::DenseChoice,
     method: Option<EstimateMethod>,
+    retrain: bool,
 ) -> Result<(PathBuf, Vec<String>)> {
     check_outputs(p)?;
     let dense = super::dense::decide(dense, &p.model)?;
     let dir = p.report_dir.clone();
     let report = TempPath::dir_for(&dir)?;
-    let basis = TempPath::file_for(&p.basis_path)?;
-    let warnings = build(p, report.path(), basis.path(), progress, (dense, method))?;
+    let reused = if retrain { None } else { current_basis(p, method) };
+    let (warnings, basis) = match reused {
+        Some(current) => {
+            log::info!(
+                "{}: basis {} is current (model and training keys unchanged): reusing it; --retrain to train again",
+                p.path.display(),
+                p.basis_path.display()
+            );
+            (build(p, report.path(), &p.basis_path, progress, (dense, method), Some(current))?, None)
+        }
+        None => {
+            let basis = TempPath::file_for(&p.basis_path)?;
+            (build(p, report.path(), basis.path(), progress, (dense, method), None)?, Some(basis))
+        }
+    };
     mark_new_report(report.path())?;
     // checked again: the folder or the basis path may have changed during a long run
     check_outputs(p)?;
     // the basis and the report together: a signal leaves both old or both new
-    swap_in_report(report, vec![basis], &p.path)?;
+    swap_in_report(report, basis.into_iter().collect(), &p.path)?;
     Ok((dir, warnings))
+}
+
+/// The pipeline's basis read and checked as every reader of a basis does
+/// ([`load_rom`]: the model's fingerprint, the content hash, the file's schema version),
+/// when it is current: trained from this model (its fingerprint: the parsed file, not its
+/// comments) with this pipeline's training keys (`[train]`, `[reduction]`, `[parameters]`:
+/// [`Pipeline::settings_hash`]). `None` (train again) where it is missing, fails a check,
+/// or was trained from anything else; the training a current basis would repeat is
+/// deterministic (seeded sampling, the same full runs), so reusing it gives the same basis.
+fn current_basis(p: &Pipeline, method: Option<EstimateMethod>) -> Option<Reused> {
+    if !p.basis_path.is_file() {
+        return None;
+    }
+    let (stored, rom, _) = load_rom(p, &p.basis_path, method, false).ok()?;
+    if stored.settings_hash != p.settings_hash() || stored.model_fingerprint != p.model.fingerprint() {
+        return None;
+    }
+    let n_snapshots = hdf5::File::open(&p.basis_path)
+        .and_then(|f| f.dataset("snapshots"))
+        .ok()
+        .and_then(|d| d.shape().get(1).copied())?;
+    let runs = stored_runs(p, &p.basis_path).ok()?;
+    Some(Reused { stored, rom, n_snapshots, runs })
+}
+
+/// A current basis `run` uses as it is ([`current_basis`]), with what the summary says of
+/// its training.
+struct Reused {
+    stored: crate::io::basis_file::StoredBasis,
+    rom: Rom,
+    /// columns of its `/snapshots`
+    n_snapshots: usize,
+    /// the points of the full runs whose snapshots it holds
+    runs: Vec<Parameters>,
+}
+
+/// The points of the full runs a basis holds the snapshots of: in a box, `/parameters`
+/// (their values in run order); on a line, its training loads.
+fn stored_runs(p: &Pipeline, path: &Path) -> Result<Vec<Parameters>> {
+    let space = p.space();
+    if space.is_empty() {
+        let loads = crate::io::estimator_file::read_training_loads(path)?;
+        return Ok(loads.into_iter().map(Parameters::load_scale).collect());
+    }
+    let f = hdf5::File::open(path).map_err(|e| Error::hdf5(path, e))?;
+    let mut runs: Vec<Parameters> = Vec::new();
+    for name in space.names() {
+        let field = format!("parameters/{name}");
+        let values = f
+            .dataset(&field)
+            .and_then(|d| d.read_1d::<f64>())
+            .map_err(|e| Error::input(path, &field, format!("cannot be read: {e}")))?;
+        runs.resize(values.len(), Parameters::default());
+        for (mu, v) in runs.iter_mut().zip(values.iter()) {
+            *mu = std::mem::take(mu).with(name, *v);
+        }
+    }
+    Ok(runs)
 }
 
 /// Every stage, writing the basis to `basis_path` (a temporary name) and the report files
@@ -79,6 +155,7 @@ fn build(
     basis_path: &Path,
     progress: bool,
     (dense, method): (bool, Option<EstimateMethod>),
+    reused: Option<Reused>,
 ) -> Result<Vec<String>> {
     // named by the report's own path: the temporary folder is gone by the time the user reads it
     let plot_err =
@@ -87,16 +164,26 @@ fn build(
     let in_box = !space.is_empty();
     // how the report names a run: its load scale, or its point of the box
     let name = |mu: &Parameters| if in_box { space.label(mu) } else { mu.scale().to_string() };
-    match &p.file.train.greedy {
-        Some(_) if in_box => log::info!("[1/3] train: greedy over the box {}", space.describe()),
-        Some(g) => log::info!("[1/3] train: greedy over [{}, {}]", g.range().0, g.range().1),
-        None if in_box => log::info!("[1/3] train: {} full run(s)", p.training_points().len()),
-        None => log::info!("[1/3] train: {} full run(s)", p.training_scales().len()),
-    }
-    let mut trained = train_and_write(p, basis_path)?;
-    // the warnings of loading it come with `check_report`'s, once
-    let (stored, rom, _) = load_rom(p, basis_path, method, false)?;
-    trained.warnings.extend(super::route::time_and_store(&rom, basis_path)?);
+    let (stored, rom, trained) = match reused {
+        Some(r) => {
+            let trained = Training::reused(&r, &name);
+            (r.stored, r.rom, trained)
+        }
+        None => {
+            match &p.file.train.greedy {
+                Some(_) if in_box => log::info!("[1/3] train: greedy over the box {}", space.describe()),
+                Some(g) => log::info!("[1/3] train: greedy over [{}, {}]", g.range().0, g.range().1),
+                None if in_box => log::info!("[1/3] train: {} full run(s)", p.training_points().len()),
+                None => log::info!("[1/3] train: {} full run(s)", p.training_scales().len()),
+            }
+            let summary = train_and_write(p, basis_path)?;
+            // the warnings of loading it come with `check_report`'s, once
+            let (stored, rom, _) = load_rom(p, basis_path, method, false)?;
+            let mut trained = Training::trained(p, summary, &name);
+            trained.warnings.extend(super::route::time_and_store(&rom, basis_path)?);
+            (stored, rom, trained)
+        }
+    };
 
     let points = p.online_points();
     log::info!("[2/3] sweep: {} reduced and full runs", points.len());
@@ -303,7 +390,7 @@ fn build(
     std::fs::write(out.join("validation.json"), json)
         .map_err(|e| Error::io(p.report_dir.join("validation.json"), e))?;
 
-    let b = &trained.trained.basis;
+    let b = &*stored.basis;
     let mut md = String::new();
     let _ = writeln!(md, "# flexrom report: {}\n", p.path.display());
     if !p.file.description.is_empty() {
@@ -317,29 +404,27 @@ fn build(
         &p.model.fingerprint()[..12]
     );
     // a held-out check run is named as such: its load is not among the basis's
-    let held_out_loads: Vec<String> = trained.held_out_points().iter().map(&name).collect();
-    let held_out = match held_out_loads.as_slice() {
+    let held_out = match trained.held_out.as_slice() {
         [] => String::new(),
         loads => format!(
             " ({}) + {} held-out check at {}{} (not in the basis)",
-            if trained.n_training_runs() == 1 {
+            if trained.n_training_runs == 1 {
                 "1 training run".to_string()
             } else {
-                format!("{} training runs", trained.n_training_runs())
+                format!("{} training runs", trained.n_training_runs)
             },
             loads.len(),
             if in_box { "" } else { "λ = " },
             loads.join("; ")
         ),
     };
-    let runs: Vec<String> = match &trained.greedy {
-        Some(g) => g.runs.iter().map(&name).collect(),
-        None if in_box => p.training_points().iter().map(&name).collect(),
-        None => p.training_scales().iter().map(|x| x.to_string()).collect(),
-    };
+    let runs = &trained.runs;
+    let reused = trained.reused.as_ref().map_or(String::new(), |when| {
+        format!(" (reused: current, trained {when} from this model and these training keys)")
+    });
     let _ = writeln!(
         md,
-        "- basis: `{}`: {} reduction, {} snapshots, rule `{}` → {} POD modes{}, {} snapshots from {} [{}]{held_out}",
+        "- basis: `{}`{reused}: {} reduction, {} snapshots, rule `{}` → {} POD modes{}, {} snapshots from {} [{}]{held_out}",
         p.basis_path.display(),
         b.variant.name(),
         b.snapshots.name(),
@@ -442,6 +527,15 @@ fn build(
             .collect();
     }
     let _ = writeln!(md, "\n## Sweep\n\n```text\n{swept}```\n");
+    // what `run` says in one line each at its end, whole
+    let said = sweep_warnings(&rom, &out.join("sweep.h5"), false)?;
+    if !said.is_empty() {
+        let _ = writeln!(md, "## Warnings\n");
+        for w in &said {
+            let _ = writeln!(md, "- {w}");
+        }
+        let _ = writeln!(md);
+    }
     let _ = writeln!(md, "## Plots\n");
     // a model without probes has no probe figures
     for (i, x) in labels.iter().enumerate().filter(|_| !p.model.probe_names().is_empty()) {
@@ -460,6 +554,51 @@ fn build(
     let _ = writeln!(md, "![error by time](error_by_time.svg)");
     std::fs::write(out.join("summary.md"), md).map_err(|e| Error::io(p.report_dir.join("summary.md"), e))?;
     Ok(warnings)
+}
+
+/// What the summary says of the training: the training `run` just made, or the one a
+/// reused basis records.
+struct Training {
+    /// the full runs whose snapshots the basis holds
+    n_training_runs: usize,
+    /// the held-out check runs (not in the basis), named as the report names a run
+    held_out: Vec<String>,
+    /// the training runs, named as the report names a run
+    runs: Vec<String>,
+    /// columns of the snapshot matrix
+    n_snapshots: usize,
+    /// the reused basis's creation time (`None`: trained now)
+    reused: Option<String>,
+    warnings: Vec<String>,
+}
+
+impl Training {
+    fn trained(p: &Pipeline, t: super::train::TrainSummary, name: &dyn Fn(&Parameters) -> String) -> Training {
+        let runs: Vec<String> = match &t.greedy {
+            Some(g) => g.runs.iter().map(name).collect(),
+            None if !p.space().is_empty() => p.training_points().iter().map(name).collect(),
+            None => p.training_scales().iter().map(|x| x.to_string()).collect(),
+        };
+        Training {
+            n_training_runs: t.n_training_runs(),
+            held_out: t.held_out_points().iter().map(name).collect(),
+            runs,
+            n_snapshots: t.n_snapshots,
+            reused: None,
+            warnings: t.warnings,
+        }
+    }
+
+    fn reused(r: &Reused, name: &dyn Fn(&Parameters) -> String) -> Training {
+        Training {
+            n_training_runs: r.runs.len(),
+            held_out: Vec::new(),
+            runs: r.runs.iter().map(name).collect(),
+            n_snapshots: r.n_snapshots,
+            reused: Some(r.stored.creation_time.clone()),
+            warnings: Vec::new(),
+        }
+    }
 }
 
 /// The summary's section on the errors against the motion: displacement_error and its
@@ -574,12 +713,32 @@ fn motion_section(
 /// estimate exceeds the tolerance (`method`: the estimate's, as `run_with` was given it).
 pub fn check_report(p: &Pipeline, dir: &Path, strict: bool, method: Option<EstimateMethod>) -> Result<Vec<String>> {
     let (_, rom, mut warnings) = load_rom(p, &p.basis_path, method, false)?;
-    let path = dir.join("sweep.h5");
-    let f = hdf5::File::open(&path).map_err(|e| Error::hdf5(&path, e))?;
+    // one line each: the summary's Warnings section has them whole
+    let summary = dir.join("summary.md");
+    warnings.extend(
+        sweep_warnings(&rom, &dir.join("sweep.h5"), strict)?
+            .iter()
+            .map(|w| format!("{}; the detail in {}, Warnings", headline(w), summary.display())),
+    );
+    Ok(warnings)
+}
+
+/// A warning's first clause, up to its first `": "` (the whole of it without one): "the
+/// model amplifies changes of the load at 17 of 21 load scales".
+fn headline(w: &str) -> &str {
+    w.split_once(": ").map_or(w, |(head, _)| head)
+}
+
+/// The warnings about the runs of the sweep file at `path` (a report's `sweep.h5`) that
+/// `online` and `sweep` give ([`crate::rom::trust::check_runs`]: extrapolation, a model that
+/// amplifies changes of the load, estimates above the tolerance; with `strict`, the last is
+/// the error).
+fn sweep_warnings(rom: &Rom, path: &Path, strict: bool) -> Result<Vec<String>> {
+    let f = hdf5::File::open(path).map_err(|e| Error::hdf5(path, e))?;
     let read = |name: &str| {
         f.dataset(name)
             .and_then(|d| d.read_1d::<f64>())
-            .map_err(|e| Error::input(&path, name, format!("cannot be read: {e}")))
+            .map_err(|e| Error::input(path, name, format!("cannot be read: {e}")))
     };
     let trust = rom.trust().expect("read from its basis file");
     let estimates = match trust.measure {
@@ -588,11 +747,10 @@ pub fn check_report(p: &Pipeline, dir: &Path, strict: bool, method: Option<Estim
     };
     let (scales, est) = (read("load_scales")?, read(estimates)?);
     let points = super::sweep::file::points_of(&f, &scales.to_vec())
-        .map_err(|(field, problem)| Error::input(&path, field, problem))?;
+        .map_err(|(field, problem)| Error::input(path, field, problem))?;
     let runs: Vec<_> =
         points.into_iter().zip(&est).map(|(mu, &e)| (mu, if e.is_nan() { None } else { Some(e) })).collect();
-    warnings.extend(crate::rom::trust::check_runs(trust, rom.estimator().is_some(), &runs, strict)?);
-    Ok(warnings)
+    crate::rom::trust::check_runs(trust, rom.estimator().is_some(), &runs, strict)
 }
 
 /// The two routes' times per run from the validation's medians (the median over the

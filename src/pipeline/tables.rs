@@ -139,6 +139,16 @@ pub fn probe_table(r: &SimulationResult) -> Table {
     t
 }
 
+/// The time series of a run, one row per instant: [`probe_table`] with the joints'
+/// reactions ([`add_reactions`]) where the run has them. What `simulate --csv/--json` and
+/// `online --csv` print, so that a full and a reduced run read alike (a reduced run has no
+/// energy columns: they are a full run's).
+pub fn series_table(model: &crate::model::Model, r: &SimulationResult) -> Table {
+    let mut table = probe_table(r);
+    add_reactions(&mut table, model, r);
+    table
+}
+
 /// Appends to a run's `table` ([`probe_table`], one row per instant) the reactions of
 /// `model`'s joints ([`crate::analysis::reactions`]): for each joint and node it acts on,
 /// `<name>: Fx` and `<name>: Fy` (N, the force on the body) and `<name>: M` (N m,
