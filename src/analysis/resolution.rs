@@ -50,9 +50,10 @@ pub fn time_step_warnings(model: &Model, sys: &FlexibleSystem, mu: &Parameters, 
         return Vec::new();
     }
     vec![format!(
-        "{}: dt = {dt} s does not resolve {} (fewer than {STEPS_PER_PERIOD} steps a period: the integrator's period error exceeds 3 %); a smaller [time] dt or --dt",
+        "{}: dt = {dt} s does not resolve {} (fewer than {STEPS_PER_PERIOD} steps a period: the integrator's period error exceeds 3 %, and rho_inf = {} damps what it does not resolve); where that motion matters, a smaller [time] dt or --dt",
         model.path.display(),
-        missed.join(" nor ")
+        missed.join(" nor "),
+        model.file.time.rho_inf
     )]
 }
 
