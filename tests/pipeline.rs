@@ -290,6 +290,13 @@ fn run_writes_a_report() {
     // a PNG beside each figure (SVG for papers, PNG for slides), starting with the PNG signature
     let png = std::fs::read(dir.path().join("report/singular_values.png")).unwrap();
     assert!(png.starts_with(b"\x89PNG\r\n\x1a\n"), "singular_values.png is not a PNG");
+    // the motion, full against reduced at the worst validated load: a GIF summary.md shows,
+    // and nothing left of the result files it was drawn from
+    let gif = std::fs::read(dir.path().join("report/animation.gif")).unwrap();
+    assert!(gif.starts_with(b"GIF89a"), "animation.gif is not a GIF");
+    let summary = std::fs::read_to_string(dir.path().join("report/summary.md")).unwrap();
+    assert!(summary.contains("](animation.gif)"), "summary.md does not show the animation");
+    assert!(!dir.path().join("report/.animation").exists());
 }
 
 /// A model without probes: the report has no probe figures and the summary links none (the

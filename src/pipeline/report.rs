@@ -16,6 +16,7 @@ use super::validate::{validate, Validation};
 use crate::error::{Error, Result};
 use crate::io::atomic::TempPath;
 use crate::io::output::{check_output, check_report_dir, mark_new_report, swap_in_report, Origin};
+use crate::limits::Limits;
 use crate::rom::Rom;
 use crate::simulate::SimulationResult;
 use crate::solver::parameters::Parameters;
@@ -206,8 +207,13 @@ fn build(
     let with = if dense { ", with the dense full solve" } else { "" };
     log::info!("[3/3] validate at {} {}{with}", vpoints.len(), if in_box { "point(s)" } else { "load scale(s)" });
     let mut validations: Vec<Validation> = Vec::new();
+    // the validation with the largest rel_error, animated full against reduced
+    let mut worst: Option<(f64, String, SimulationResult, SimulationResult)> = None;
     for (i, mu) in vpoints.iter().enumerate() {
         let (v, full, reduced) = validate(&rom, mu, dense)?;
+        if worst.as_ref().is_none_or(|w| v.rel_error > w.0) {
+            worst = Some((v.rel_error, name(mu), full.clone(), reduced.result.clone()));
+        }
         validations.push(v);
         energy_figure(
             &rom,
@@ -274,14 +280,27 @@ fn build(
         .save(&out.join(format!("probes_{i}")))
         .map_err(|e| plot_err(&format!("probes_{i}"), e))?;
     }
-    // one curve per block of a block basis (per body), each indexed from 1
+    let animated = match &worst {
+        Some((_, at, full, reduced)) => animate_worst(out, full, reduced, &p.model.limits)
+            .map(|_| at.clone())
+            .map_err(|e| log::warn!("the report's animation was not written: {e}"))
+            .ok(),
+        None => None,
+    };
+    // one curve per block of a block basis (one POD per body: named by the body), each
+    // indexed from 1
+    let bodies = p.model.bodies();
+    let block_name = |b: usize| match bodies.get(b) {
+        Some(body) if stored.block_values.len() == bodies.len() => format!("σᵢ, {}", body.name),
+        _ => format!("σᵢ, block {}", b + 1),
+    };
     let mut sv = stored.singular_values.iter();
     let blocks: Vec<Series> = stored
         .block_values
         .iter()
         .enumerate()
         .map(|(b, &k)| {
-            let name = if stored.block_values.len() == 1 { "σᵢ".into() } else { format!("σᵢ, block {}", b + 1) };
+            let name = if stored.block_values.len() == 1 { "σᵢ".into() } else { block_name(b) };
             Series::new(name, sv.by_ref().take(k).enumerate().map(|(i, s)| ((i + 1) as f64, *s)).collect(), Style::Line)
         })
         .collect();
@@ -407,13 +426,14 @@ fn build(
     let held_out = match trained.held_out.as_slice() {
         [] => String::new(),
         loads => format!(
-            " ({}) + {} held-out check at {}{} (not in the basis)",
+            " ({}) + {} held-out check{} at {}{} (not in the basis)",
             if trained.n_training_runs == 1 {
                 "1 training run".to_string()
             } else {
                 format!("{} training runs", trained.n_training_runs)
             },
             loads.len(),
+            if loads.len() == 1 { "" } else { "s" },
             if in_box { "" } else { "λ = " },
             loads.join("; ")
         ),
@@ -537,6 +557,10 @@ fn build(
         let _ = writeln!(md);
     }
     let _ = writeln!(md, "## Plots\n");
+    if let Some(at) = &animated {
+        let at = if in_box { at.clone() } else { format!("load scale {at}") };
+        let _ = writeln!(md, "The motion at {at}, the validation with the largest rel_error: full (solid) against reduced (dashed).\n\n![full against reduced at {at}](animation.gif)\n");
+    }
     // a model without probes has no probe figures
     for (i, x) in labels.iter().enumerate().filter(|_| !p.model.probe_names().is_empty()) {
         let _ = writeln!(md, "![probes at {x}](probes_{i}.svg)");
@@ -554,6 +578,30 @@ fn build(
     let _ = writeln!(md, "![error by time](error_by_time.svg)");
     std::fs::write(out.join("summary.md"), md).map_err(|e| Error::io(p.report_dir.join("summary.md"), e))?;
     Ok(warnings)
+}
+
+/// `animation.gif` in the report folder `out`: the full run (solid) against the reduced one
+/// (dashed), drawn by `flexrom animate` from result files written beside it for the
+/// purpose and removed after (they are this function's own).
+fn animate_worst(out: &Path, full: &SimulationResult, reduced: &SimulationResult, limits: &Limits) -> Result<()> {
+    // named as the animation's title names the runs
+    let dir = out.join(".animation");
+    std::fs::create_dir(&dir).map_err(|e| Error::io(&dir, e))?;
+    let (f, r) = (dir.join("full.h5"), dir.join("reduced.h5"));
+    let write = |path: &Path, run: &SimulationResult| {
+        let plan = crate::io::result_file::RunPlan::of_result(run);
+        crate::io::result_file::ResultFile::begin(path, &run.model_text, &run.model_path, &plan)?
+            .finish(run, |_| Ok(()))
+    };
+    let made = write(&f, full).and_then(|_| write(&r, reduced)).and_then(|_| {
+        let opts = super::animate::AnimateOptions::default();
+        super::animate::animate(&f, Some(&r), &out.join("animation.gif"), &opts, limits).map(|_| ())
+    });
+    for path in [&f, &r] {
+        let _ = std::fs::remove_file(path);
+    }
+    let _ = std::fs::remove_dir(&dir);
+    made
 }
 
 /// What the summary says of the training: the training `run` just made, or the one a
@@ -579,9 +627,12 @@ impl Training {
             None if !p.space().is_empty() => p.training_points().iter().map(name).collect(),
             None => p.training_scales().iter().map(|x| x.to_string()).collect(),
         };
+        // a held-out check whose load greedy later added to the basis is a training run
+        // (its snapshots are in the basis), not a check the basis never saw
+        let held_out = t.held_out_points().iter().map(name).filter(|h| !runs.contains(h)).collect();
         Training {
             n_training_runs: t.n_training_runs(),
-            held_out: t.held_out_points().iter().map(name).collect(),
+            held_out,
             runs,
             n_snapshots: t.n_snapshots,
             reused: None,
