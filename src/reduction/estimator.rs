@@ -385,6 +385,23 @@ mod tests {
     use super::DefectsCalibration;
     use crate::solver::parameters::Parameters;
 
+    /// Each quantity is calibrated on its own ratios at the same candidates: at a candidate
+    /// its own ratio, between two the interpolation (0.2 and 0.4 → 0.3 midway); a quantity
+    /// without a usable ratio, or a key not calibrated, has no factor (no estimate).
+    #[test]
+    fn each_quantity_reads_its_own_ratios() {
+        let r = |a: f64| [a; 5];
+        let c = DefectsCalibration::new(vec![1.0, 2.0, 3.0], vec![r(0.1), r(0.3), r(0.2)]).unwrap();
+        let keys = ["curvature:root".to_string(), "strain:root".to_string()];
+        let c = c.with_quantities(&keys, &[vec![0.2, f64::NAN], vec![0.4, f64::NAN], vec![0.4, f64::NAN]]);
+        assert_eq!(c.quantities.len(), 1, "the strain has no usable ratio");
+        let at = |l: f64| c.quantity_factor("curvature:root", &Parameters::load_scale(l));
+        assert_eq!(at(2.0), Some(0.4));
+        assert!((at(1.5).unwrap() - 0.3).abs() < 1e-15);
+        assert_eq!(c.quantity_factor("strain:root", &Parameters::load_scale(1.5)), None);
+        assert_eq!(c.quantity_factor("position:tip", &Parameters::load_scale(1.5)), None);
+    }
+
     /// At a candidate its own ratio, between two the linear interpolation, outside the
     /// candidates the largest of all; a fifth without a usable ratio anywhere gives no
     /// calibration, an unusable one in a pair the largest.

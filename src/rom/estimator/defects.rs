@@ -201,11 +201,12 @@ impl ErrorEstimator for Defects {
     }
 
     /// A quantity's defect sum on the corrected method's scale where greedy training
-    /// calibrated it (`DefectsCalibration::quantities`), else the bound it is (factor 1,
-    /// raised as calibration raised `c`).
+    /// calibrated it (`DefectsCalibration::quantities`); NaN (no estimate) where it did not:
+    /// read as a bound, the uncalibrated sum fell below the error at most of the zoo's tip
+    /// positions (docs/error-estimate.md), and no estimate is better than a low one.
     fn quantity_factor(&self, mu: &Parameters, q: &QuantityRaw, _whole: f64) -> f64 {
         let calibrated = self.data.defects.as_ref().and_then(|d| d.quantity_factor(&q.key(), mu));
-        calibrated.unwrap_or(self.data.calibration.factor / super::DEFAULT_FACTOR)
+        calibrated.unwrap_or(f64::NAN)
     }
 
     fn self_check(&self) -> Option<String> {
