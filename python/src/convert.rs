@@ -67,6 +67,16 @@ pub fn warn(py: Python<'_>, lines: &[String]) -> PyResult<()> {
     Ok(())
 }
 
+/// `d[key]`, a dict, made empty where `d` has no such key (probe name → quantity → …).
+pub fn inner_dict<'py>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<Bound<'py, PyDict>> {
+    if let Some(x) = d.get_item(key)? {
+        return Ok(x.cast_into::<PyDict>()?);
+    }
+    let x = PyDict::new(d.py());
+    d.set_item(key, &x)?;
+    Ok(x)
+}
+
 /// A sweep's strains and curvatures (`strains`, `curvatures`: probe name → (n, n_t)) and
 /// each probe quantity's error estimate (`quantity_error_estimates`: probe name → quantity →
 /// (n)), NaN where a point did not run to the end or has no estimate (0 where the full
@@ -105,15 +115,7 @@ fn sweep_sections<'py>(py: Python<'py>, d: &Bound<'py, PyDict>, s: &Sweep) -> Py
         }
     }
     for ((probe, quantity), v) in columns {
-        let inner = match est.get_item(&probe)? {
-            Some(x) => x.cast_into::<PyDict>()?,
-            None => {
-                let x = PyDict::new(py);
-                est.set_item(&probe, &x)?;
-                x
-            }
-        };
-        inner.set_item(quantity, v.into_pyarray(py))?;
+        inner_dict(&est, &probe)?.set_item(quantity, v.into_pyarray(py))?;
     }
     d.set_item("quantity_error_estimates", est)
 }

@@ -660,15 +660,7 @@ impl PyRunResult {
         let Some(e) = self.estimate() else { return Ok(None) };
         let d = PyDict::new(py);
         for q in &e.quantities {
-            let inner = match d.get_item(&q.probe)? {
-                Some(x) => x.cast_into::<PyDict>()?,
-                None => {
-                    let x = PyDict::new(py);
-                    d.set_item(&q.probe, &x)?;
-                    x
-                }
-            };
-            inner.set_item(q.quantity.name(), q.estimate)?;
+            convert::inner_dict(&d, &q.probe)?.set_item(q.quantity.name(), q.estimate)?;
         }
         Ok(Some(d))
     }

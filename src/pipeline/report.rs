@@ -211,10 +211,6 @@ fn build(
     let mut worst: Option<(f64, String, SimulationResult, SimulationResult)> = None;
     for (i, mu) in vpoints.iter().enumerate() {
         let (v, full, reduced) = validate(&rom, mu, dense)?;
-        if worst.as_ref().is_none_or(|w| v.rel_error > w.0) {
-            worst = Some((v.rel_error, name(mu), full.clone(), reduced.result.clone()));
-        }
-        validations.push(v);
         energy_figure(
             &rom,
             (&full, &reduced.result),
@@ -223,62 +219,16 @@ fn build(
         .save(&out.join(format!("energy_{i}")))
         .map_err(|e| plot_err(&format!("energy_{i}"), e))?;
         // a model without probes has nothing to draw here
-        if full.probes.is_empty() {
-            continue;
+        if !full.probes.is_empty() {
+            let title = format!("Probes, full and reduced, {}{}", if in_box { "" } else { "load scale " }, name(mu));
+            probes_figure(&full, &reduced.result, title)
+                .save(&out.join(format!("probes_{i}")))
+                .map_err(|e| plot_err(&format!("probes_{i}"), e))?;
         }
-        // x and y of every probe, full (line) and reduced (dashed), and their difference
-        let t = &full.t;
-        let mut panels: Vec<Panel> = ["x (m)", "y (m)"]
-            .iter()
-            .enumerate()
-            .map(|(c, label)| Panel {
-                y_label: label.to_string(),
-                log_y: false,
-                series: full
-                    .probes
-                    .iter()
-                    .zip(&reduced.result.probes)
-                    .flat_map(|((name, a), (_, b))| {
-                        [
-                            Series::new(
-                                format!("{name}, full"),
-                                t.iter().zip(a.column(c)).map(|(t, v)| (*t, *v)).collect(),
-                                Style::Line,
-                            ),
-                            Series::new(
-                                format!("{name}, reduced"),
-                                t.iter().zip(b.column(c)).map(|(t, v)| (*t, *v)).collect(),
-                                Style::Dashed,
-                            ),
-                        ]
-                    })
-                    .collect(),
-            })
-            .collect();
-        panels.push(Panel {
-            y_label: "reduced − full (m)".into(),
-            log_y: false,
-            series: full
-                .probes
-                .iter()
-                .zip(&reduced.result.probes)
-                .flat_map(|((name, a), (_, b))| {
-                    (0..2).map(move |c| {
-                        let d = t.iter().zip(a.column(c)).zip(b.column(c)).map(|((t, f), r)| (*t, r - f)).collect();
-                        Series::new(format!("{name} {}, error", ["x", "y"][c]), d, Style::Line)
-                    })
-                })
-                .collect(),
-        });
-        Figure {
-            title: format!("Probes, full and reduced, {}{}", if in_box { "" } else { "load scale " }, name(mu)),
-            x_label: "t (s)".into(),
-            panels,
-            markers: vec![],
-            marker_label: String::new(),
+        if worst.as_ref().is_none_or(|w| v.rel_error > w.0) {
+            worst = Some((v.rel_error, name(mu), full, reduced.result));
         }
-        .save(&out.join(format!("probes_{i}")))
-        .map_err(|e| plot_err(&format!("probes_{i}"), e))?;
+        validations.push(v);
     }
     let animated = match &worst {
         Some((_, at, full, reduced)) => animate_worst(out, full, reduced, &p.model.limits)
@@ -578,6 +528,55 @@ fn build(
     let _ = writeln!(md, "![error by time](error_by_time.svg)");
     std::fs::write(out.join("summary.md"), md).map_err(|e| Error::io(p.report_dir.join("summary.md"), e))?;
     Ok(warnings)
+}
+
+/// The probes' x and y, full (line) and reduced (dashed), and their difference.
+fn probes_figure(full: &SimulationResult, reduced: &SimulationResult, title: String) -> Figure {
+    // x and y of every probe, full (line) and reduced (dashed), and their difference
+    let t = &full.t;
+    let mut panels: Vec<Panel> = ["x (m)", "y (m)"]
+        .iter()
+        .enumerate()
+        .map(|(c, label)| Panel {
+            y_label: label.to_string(),
+            log_y: false,
+            series: full
+                .probes
+                .iter()
+                .zip(&reduced.probes)
+                .flat_map(|((name, a), (_, b))| {
+                    [
+                        Series::new(
+                            format!("{name}, full"),
+                            t.iter().zip(a.column(c)).map(|(t, v)| (*t, *v)).collect(),
+                            Style::Line,
+                        ),
+                        Series::new(
+                            format!("{name}, reduced"),
+                            t.iter().zip(b.column(c)).map(|(t, v)| (*t, *v)).collect(),
+                            Style::Dashed,
+                        ),
+                    ]
+                })
+                .collect(),
+        })
+        .collect();
+    panels.push(Panel {
+        y_label: "reduced − full (m)".into(),
+        log_y: false,
+        series: full
+            .probes
+            .iter()
+            .zip(&reduced.probes)
+            .flat_map(|((name, a), (_, b))| {
+                (0..2).map(move |c| {
+                    let d = t.iter().zip(a.column(c)).zip(b.column(c)).map(|((t, f), r)| (*t, r - f)).collect();
+                    Series::new(format!("{name} {}, error", ["x", "y"][c]), d, Style::Line)
+                })
+            })
+            .collect(),
+    });
+    Figure { title, x_label: "t (s)".into(), panels, markers: vec![], marker_label: String::new() }
 }
 
 /// `animation.gif` in the report folder `out`: the full run (solid) against the reduced one

@@ -94,15 +94,17 @@ fn route_name(full: bool) -> &'static str {
     }
 }
 
-/// The probe quantities of a sweep's model, in [`crate::rom::quantities::readings`]'
-/// order: every probe's position, then the strains, then the curvatures.
-fn quantity_keys(s: &Sweep) -> Vec<(Quantity, &str)> {
-    let [strains, curvatures] = &s.section_names;
-    s.probe_names
-        .iter()
-        .map(|n| (Quantity::Position, n.as_str()))
-        .chain(strains.iter().map(|n| (Quantity::Strain, n.as_str())))
-        .chain(curvatures.iter().map(|n| (Quantity::Curvature, n.as_str())))
+/// The probe quantities of a model with these probes and section probes (strain,
+/// curvature), in [`crate::rom::quantities::readings`]' order: every probe's position, then
+/// the strains, then the curvatures.
+fn quantity_keys<'a>(
+    probe_names: &'a [String],
+    [strains, curvatures]: &'a [Vec<String>; 2],
+) -> Vec<(Quantity, &'a str)> {
+    let named = |q: Quantity, names: &'a [String]| names.iter().map(move |n| (q, n.as_str()));
+    named(Quantity::Position, probe_names)
+        .chain(named(Quantity::Strain, strains))
+        .chain(named(Quantity::Curvature, curvatures))
         .collect()
 }
 
@@ -150,7 +152,7 @@ fn write_quantity_errors(f: &hdf5::File, s: &Sweep) -> hdf5::Result<()> {
     let groups: [(&str, Column); 2] = [("probe_error_estimate", estimate), ("probe_error", error)];
     for (group, value) in &groups[..if s.validated { 2 } else { 1 }] {
         let top = f.create_group(group)?;
-        for (q, name) in quantity_keys(s) {
+        for (q, name) in quantity_keys(&s.probe_names, &s.section_names) {
             let g = if top.link_exists(q.name()) { top.group(q.name())? } else { top.create_group(q.name())? };
             let col = Array1::from_iter(s.scales.iter().map(|x| x.point().map_or(f64::NAN, |p| value(p, q, name))));
             g.new_dataset_builder().with_data(&col).create(name)?;
@@ -489,15 +491,10 @@ pub fn read_sweep(
         });
         series.collect::<Result<Vec<_>>>().map(Some)
     };
-    let [strain_names, curvature_names] = model.section_names();
-    let sections = [read_series("probe_strain", &strain_names)?, read_series("probe_curvature", &curvature_names)?];
-    let keys: Vec<(Quantity, String)> = model
-        .probe_names()
-        .into_iter()
-        .map(|p| (Quantity::Position, p))
-        .chain(strain_names.into_iter().map(|p| (Quantity::Strain, p)))
-        .chain(curvature_names.into_iter().map(|p| (Quantity::Curvature, p)))
-        .collect();
+    let (probe_names, section_names) = (model.probe_names(), model.section_names());
+    let sections =
+        [read_series("probe_strain", &section_names[0])?, read_series("probe_curvature", &section_names[1])?];
+    let keys = quantity_keys(&probe_names, &section_names);
     let read_quantities = |group: &str| -> Result<Option<Vec<Array1<f64>>>> {
         if !f.link_exists(group) {
             return Ok(None);
@@ -686,7 +683,7 @@ pub fn read_sweep(
             quantities: quantity_estimates.as_ref().map_or_else(Vec::new, |cols| {
                 let each = keys.iter().zip(cols);
                 each.map(|((q, name), c)| QuantityEstimate {
-                    probe: name.clone(),
+                    probe: name.to_string(),
                     quantity: *q,
                     estimate: c[k],
                     raw: f64::NAN,

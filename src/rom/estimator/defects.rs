@@ -135,13 +135,14 @@ impl Defects {
         readings(&run.result)
             .iter()
             .map(|v| {
-                let i = sys.probes.iter().position(|p| p.name == v.probe).unwrap_or(0);
                 let slot = match v.quantity {
                     Quantity::Position => 0,
                     Quantity::Strain => 1,
                     Quantity::Curvature => 2,
                 };
-                let (sum, range) = (sums.get(i).map_or(f64::NAN, |s| s[slot]), range(v.values));
+                let probe = sys.probes.iter().position(|p| p.name == v.probe);
+                let sum = probe.and_then(|i| sums.get(i)).map_or(f64::NAN, |s| s[slot]);
+                let range = range(v.values);
                 let res = v.quantity.resolution(tol, self.length);
                 let raw = against_motion(range > res, sum > res, || sum / range);
                 QuantityRaw { probe: v.probe.to_string(), quantity: v.quantity, raw }
