@@ -14,68 +14,14 @@
 //!   score, screened over 2–4 candidates: 33, 33 and 37 — ε = 1e-7 at 1e-3 and 3e-3, ε = 1e-8
 //!   at 1e-2, whose worst score over its two screened candidates was 5 % lower.)
 
+mod common;
+
 use std::path::Path;
 use std::process::{Command, Output};
 
 fn flexrom(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_flexrom")).args(args).env("HDF5_USE_FILE_LOCKING", "FALSE").output().unwrap()
 }
-
-const ARM: &str = r#"
-description = "Two aluminium links pinned together, swung by a shoulder moment, a payload at the tip"
-[time]
-t_end = 1.0
-dt = 0.005
-rho_inf = 0.9
-[[bodies]]
-name = "upper"
-start = [0.0, 0.0]
-angle = 0.0
-length = 0.5
-elements = 4
-density = 2700.0
-area = 1.0e-4
-inertia = 8.3e-10
-youngs_modulus = 7.0e10
-[[bodies]]
-name = "lower"
-start = [0.5, 0.0]
-angle = 0.0
-length = 0.5
-elements = 4
-density = 2700.0
-area = 1.0e-4
-inertia = 8.3e-10
-youngs_modulus = 7.0e10
-[[joints]]
-type = "ground_pin"
-body = "upper"
-node = "start"
-[[joints]]
-type = "pin"
-a = { body = "upper", node = "end" }
-b = { body = "lower", node = "start" }
-[[loads]]
-type = "gravity"
-g = [0.0, -9.81]
-scaled = false
-[[loads]]
-type = "moment"
-body = "upper"
-node = "start"
-function = { type = "sine", amplitude = 2.5, frequency = 2.0 }
-scaled = true
-[[loads]]
-type = "force"
-body = "lower"
-node = "end"
-value = [0.0, -2.0]
-scaled = "payload"
-[[probes]]
-name = "tip"
-body = "lower"
-node = "end"
-"#;
 
 /// The reduced coordinates `/training/n_modes` of the last iteration and the points of the
 /// full runs (`/training/points`, flattened) of a greedy training at `tolerance`.
@@ -102,7 +48,7 @@ fn train(dir: &Path, tolerance: &str) -> (u64, Vec<f64>) {
 #[test]
 fn a_looser_tolerance_keeps_no_more_coordinates_on_the_same_runs() {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("arm.toml"), ARM).unwrap();
+    std::fs::write(dir.path().join("arm.toml"), common::two_link_arm(4, 0.005)).unwrap();
     let ladder: Vec<(&str, (u64, Vec<f64>))> =
         ["1e-3", "3e-3", "1e-2"].iter().map(|t| (*t, train(dir.path(), t))).collect();
     for w in ladder.windows(2) {

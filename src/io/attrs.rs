@@ -118,7 +118,7 @@ const RESULT: [Entry; 19] = [
     ("labels/reaction_joint", "1", "reaction"),
 ];
 
-const BASIS: [Entry; 55] = [
+const BASIS: [Entry; 56] = [
     ("snapshots", COORDINATE_UNITS, "dof, snapshot"),
     ("snapshot_multipliers", MULTIPLIER_UNITS, "constraint, snapshot"),
     ("snapshot_load_scale", "1", "snapshot"),
@@ -127,6 +127,7 @@ const BASIS: [Entry; 55] = [
     ("basis/singular_values", SINGULAR_VALUE_UNITS, "singular value"),
     ("basis/energy", "1", "singular value"),
     ("basis/block_modes", "1", "block"),
+    ("basis/output_modes", "1", "block"),
     ("basis/block_values", "1", "block"),
     ("basis/reference", COORDINATE_UNITS, "dof"),
     ("basis/reduced_dofs", "1", "entry"),

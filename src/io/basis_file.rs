@@ -151,7 +151,11 @@ pub fn write_basis_with(
         g.new_dataset_builder().with_data(&cat(&|p| &p.energy)).create("energy").map_err(e)?;
         g.new_dataset_builder().with_data(&b.reference).create("reference").map_err(e)?;
         let idx = |v: &[usize]| Array1::from_iter(v.iter().map(|&d| d as u64));
-        g.new_dataset_builder().with_data(&idx(&trained.block_modes)).create("block_modes").map_err(e)?;
+        let block_columns = trained.block_columns();
+        g.new_dataset_builder().with_data(&idx(&block_columns)).create("block_modes").map_err(e)?;
+        if trained.output_modes.iter().any(|&k| k > 0) {
+            g.new_dataset_builder().with_data(&idx(&trained.output_modes)).create("output_modes").map_err(e)?;
+        }
         let values: Vec<usize> = trained.pods.iter().map(|p| p.singular_values.len()).collect();
         g.new_dataset_builder().with_data(&idx(&values)).create("block_values").map_err(e)?;
         g.new_dataset_builder().with_data(&idx(&trained.reduced_dofs)).create("reduced_dofs").map_err(e)?;
@@ -177,7 +181,7 @@ pub fn write_basis_with(
             basis: b,
             singular_values: sv.as_slice().expect("contiguous"),
             energy: en.as_slice().expect("contiguous"),
-            block_modes: &trained.block_modes,
+            block_modes: &block_columns,
             block_values: &values,
             reduced_dofs: &trained.reduced_dofs,
             model_fingerprint: &meta.model_fingerprint,

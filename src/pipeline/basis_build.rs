@@ -5,9 +5,12 @@ use super::config::{Blocks, Pipeline};
 use super::training_record::TrainSummary;
 use crate::error::{Error, Result};
 use crate::io::basis_file::TrainingData;
+use crate::physics::element::Vec8;
 use crate::physics::system::FlexibleSystem;
+use crate::reduction::output_modes::{add_output_modes, Output, Outputs, Stop};
 use crate::reduction::{ecsw, train_basis, BasisSpec, ModeRule, Trained};
 use crate::rom::estimator::training::{build_estimator, Estimator, Snapshots, DEFAULT_EXTRA_MODES};
+use crate::rom::quantities::Quantity;
 use crate::simulate::SimulationResult;
 use ndarray::{concatenate, Array1, Axis};
 
@@ -81,17 +84,74 @@ pub fn build_basis(
     let joints = joint_dofs_of(sys);
     let mut trained = train_basis(data.x.view(), data.multipliers.view(), &joints, x_ref.view(), &spec)
         .map_err(|e| ("reduction.modes", e))?;
+    let probe_tolerance = p.file.reduction.probe_modes.as_ref().map(|m| m.tolerance);
+    let eval = |o: usize, v: &[f64]| probe_output(sys, o, v);
+    let outputs =
+        probe_tolerance.map(|_| Outputs { outputs: probe_outputs(p, sys, physics.length_scale()), eval: &eval });
+    let rows = block_rows(&spec, &trained);
+    if let (Some(tol), Some(outputs)) = (probe_tolerance, &outputs) {
+        add_output_modes(&mut trained, &rows, data.x.view(), outputs, &[], Stop::Tolerance(tol))
+            .map_err(|e| ("reduction.probe_modes", e))?;
+    }
     if let Some(tol) = hyper_tolerance {
         let hyper = ecsw(sys, &trained.basis, data.x.view(), tol)
             .map_err(|e| ("reduction.hyper", format!("ECSW training failed: {e}")))?;
         within_weight_bound(&hyper, sys.n_elements())?;
         trained.basis.hyper = Some(hyper);
     }
-    let snapshots =
-        Snapshots { x: data.x.view(), multipliers: data.multipliers.view(), joint_dofs: &joints, x_ref: x_ref.view() };
+    let snapshots = Snapshots {
+        x: data.x.view(),
+        multipliers: data.multipliers.view(),
+        joint_dofs: &joints,
+        x_ref: x_ref.view(),
+        outputs: outputs.as_ref().map(|o| (o, rows.as_slice())),
+    };
     let estimator = build_estimator(sys, &trained, &spec, &snapshots, hyper_tolerance, DEFAULT_EXTRA_MODES)
         .map_err(|e| ("reduction", format!("cannot build the error estimator: {e}")))?;
     Ok((trained, estimator))
+}
+
+/// The rows each block's modes live on: the block's coordinates without the kept ones
+/// (one block of every reduced coordinate without blocks).
+fn block_rows(spec: &BasisSpec, trained: &Trained) -> Vec<Vec<usize>> {
+    if spec.blocks.is_empty() {
+        return vec![trained.reduced_dofs.clone()];
+    }
+    let kept = &trained.basis.kept;
+    spec.blocks.iter().map(|b| b.iter().copied().filter(|d| !kept.contains(d)).collect()).collect()
+}
+
+/// The outputs of `[reduction] probe_modes`: every strain and curvature a probe records,
+/// each reading its element's 8 coordinates, with the resolution of the quantity at the
+/// model's Newton tolerance ([`Quantity::resolution`]) as its floor. Output `2 i` is probe
+/// `i`'s strain, `2 i + 1` its curvature (a probe that records one of them only has the
+/// other left out).
+fn probe_outputs(p: &Pipeline, sys: &FlexibleSystem, length: f64) -> Vec<Output> {
+    let tol = p.model.integrator_params().tolerance;
+    let mut out = Vec::new();
+    for (i, probe) in sys.probes.iter().enumerate() {
+        let dofs = sys.element_dofs(probe.element).to_vec();
+        for (k, (wanted, q)) in
+            [(probe.strain, Quantity::Strain), (probe.curvature, Quantity::Curvature)].into_iter().enumerate()
+        {
+            if wanted {
+                out.push(Output { dofs: dofs.clone(), floor: q.resolution(tol, length), id: 2 * i + k });
+            }
+        }
+    }
+    out
+}
+
+/// Output `o` of [`probe_outputs`] at its element's coordinates `v`.
+fn probe_output(sys: &FlexibleSystem, o: usize, v: &[f64]) -> f64 {
+    let probe = &sys.probes[o / 2];
+    let e = Vec8::from_iterator(v.iter().copied());
+    let el = sys.element(probe.element);
+    if o % 2 == 0 {
+        el.axial_strain(&e, probe.xi)
+    } else {
+        el.curvature(&e, probe.xi)
+    }
 }
 
 /// Refuses an ECSW set the basis check would refuse on reading it back (a weight above

@@ -19,6 +19,8 @@
 //! blocks = "bodies"                         # one POD per body (modes = { counts = [..] }
 //!                                           # gives each its own); default: one POD
 //! hyper = { tolerance = 1e-3 }              # ECSW element sampling; omit for plain Galerkin
+//! probe_modes = { tolerance = 1e-3 }        # modes until the probes' strains and curvatures
+//!                                           # of the snapshots are reproduced (docs/error-estimate.md)
 //! [online]
 //! load_scales = "0.5:1.5:21"                # or a list
 //! tolerance = 1e-3                          # error estimates above it warn (--strict: exit 4);
@@ -132,6 +134,24 @@ impl Pipeline {
         Ok(p)
     }
 
+    /// `[reduction] probe_modes`: a tolerance in (0, 1), a variant that has blocks of modes,
+    /// and a probe that records what the modes are for.
+    fn check_probe_modes(&self, tolerance: f64) -> std::result::Result<(), String> {
+        if !(tolerance.is_finite() && tolerance > 0.0 && tolerance < 1.0) {
+            return Err(format!("has tolerance {tolerance}; it must lie strictly between 0 and 1"));
+        }
+        if matches!(self.variant(), Variant::WholeSystem | Variant::WholeSystemStabilized) {
+            return Err(format!(
+                "needs the galerkin or the constraint-preserving variant, not {}",
+                self.variant().name()
+            ));
+        }
+        if !self.model.probes().iter().any(|p| p.strain || p.curvature) {
+            return Err("is set, but no probe of the model records a strain or a curvature (`quantities = [\"strain\", \"curvature\"]` in a [[probes]] entry)".into());
+        }
+        Ok(())
+    }
+
     fn check(&self) -> Result<()> {
         let bad = |field: &str, problem: String| Err(Error::input(&self.path, field, problem));
         let red = &self.file.reduction;
@@ -228,6 +248,9 @@ impl Pipeline {
                     format!("is {}; it must lie strictly between 0 and 1", h.tolerance),
                 );
             }
+        }
+        if let Some(m) = &self.file.reduction.probe_modes {
+            self.check_probe_modes(m.tolerance).map_err(|e| Error::input(&self.path, "reduction.probe_modes", e))?;
         }
         for (name, scales) in [
             ("online", self.file.online.as_ref().and_then(|o| o.load_scales.as_ref())),

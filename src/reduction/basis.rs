@@ -96,13 +96,22 @@ pub struct Trained {
     /// the decompositions the modes come from (of the rows the variant reduces), one per
     /// block of the basis (one for a basis without blocks)
     pub pods: Vec<Pod>,
-    /// how many modes each block keeps (columns of `V` in this order, then the kept ones)
+    /// how many POD modes each block keeps (columns of `V` in this order, each block's
+    /// followed by its output modes, then the kept ones)
     pub block_modes: Vec<usize>,
+    /// how many output modes each block adds after its POD modes
+    /// ([`super::output_modes`]; zeros without them)
+    pub output_modes: Vec<usize>,
     /// the dofs whose snapshot rows entered the POD
     pub reduced_dofs: Vec<usize>,
 }
 
 impl Trained {
+    /// The columns of `V` each block holds: its POD modes and its output modes.
+    pub fn block_columns(&self) -> Vec<usize> {
+        self.block_modes.iter().zip(&self.output_modes).map(|(p, o)| p + o).collect()
+    }
+
     /// `1 − Σ_{i≤r} σᵢ² / Σ σᵢ²` of the worst block: the energy fraction the basis misses.
     pub fn uncaptured_energy(&self) -> f64 {
         self.pods.iter().zip(&self.block_modes).map(|(p, &r)| 1.0 - p.energy[r - 1]).fold(0.0, f64::max)

@@ -83,7 +83,7 @@ pub(crate) fn train_plain(
         hyper: None,
     };
     basis.set_kept_columns();
-    Ok(Trained { basis, pods: vec![p], block_modes: vec![r], reduced_dofs })
+    Ok(Trained { basis, pods: vec![p], block_modes: vec![r], output_modes: vec![0], reduced_dofs })
 }
 
 /// [`train_basis`] with blocks (galerkin or constraint-preserving).
@@ -150,7 +150,8 @@ fn train_blocks(
         hyper: None,
     };
     basis.set_kept_columns();
-    Ok(Trained { basis, pods, block_modes, reduced_dofs })
+    let output_modes = vec![0; block_modes.len()];
+    Ok(Trained { basis, pods, block_modes, output_modes, reduced_dofs })
 }
 
 #[cfg(test)]

@@ -18,6 +18,7 @@ pub mod ecsw;
 pub mod estimator;
 pub mod hyper_model;
 pub(crate) mod joint_elimination;
+pub mod output_modes;
 pub mod pod;
 pub(crate) mod projection;
 pub mod reduced;

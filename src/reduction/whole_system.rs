@@ -131,7 +131,7 @@ pub(crate) fn train_stabilized(
         n_pod_modes: r,
         hyper: None,
     };
-    Ok(Trained { basis, pods: vec![p], block_modes: vec![r], reduced_dofs: (0..n).collect() })
+    Ok(Trained { basis, pods: vec![p], block_modes: vec![r], output_modes: vec![0], reduced_dofs: (0..n).collect() })
 }
 
 /// A failed Newton solve (or singular matrix) of the plain whole-system variant, with the

@@ -77,3 +77,67 @@ pub fn held_out_points_within(dir: &std::path::Path, tolerance: f64) -> Vec<serd
     }
     vs
 }
+
+/// A two-link aluminium arm (links of 0.5 m pinned together, the upper on a ground pin)
+/// swung by a shoulder moment `2.5 sin(4π t)` N·m scaled by the load scale, under gravity,
+/// with a tip force `(0, −2)` N scaled by the parameter `payload` and a probe `tip`;
+/// `elements` a link, time step `dt`, 1 s.
+pub fn two_link_arm(elements: usize, dt: f64) -> String {
+    TWO_LINK_ARM.replace("ELEMENTS", &elements.to_string()).replace("DT", &dt.to_string())
+}
+
+const TWO_LINK_ARM: &str = r#"
+description = "Two aluminium links pinned together, swung by a shoulder moment, a payload at the tip"
+[time]
+t_end = 1.0
+dt = DT
+rho_inf = 0.9
+[[bodies]]
+name = "upper"
+start = [0.0, 0.0]
+angle = 0.0
+length = 0.5
+elements = ELEMENTS
+density = 2700.0
+area = 1.0e-4
+inertia = 8.3e-10
+youngs_modulus = 7.0e10
+[[bodies]]
+name = "lower"
+start = [0.5, 0.0]
+angle = 0.0
+length = 0.5
+elements = ELEMENTS
+density = 2700.0
+area = 1.0e-4
+inertia = 8.3e-10
+youngs_modulus = 7.0e10
+[[joints]]
+type = "ground_pin"
+body = "upper"
+node = "start"
+[[joints]]
+type = "pin"
+a = { body = "upper", node = "end" }
+b = { body = "lower", node = "start" }
+[[loads]]
+type = "gravity"
+g = [0.0, -9.81]
+scaled = false
+[[loads]]
+type = "moment"
+body = "upper"
+node = "start"
+function = { type = "sine", amplitude = 2.5, frequency = 2.0 }
+scaled = true
+[[loads]]
+type = "force"
+body = "lower"
+node = "end"
+value = [0.0, -2.0]
+scaled = "payload"
+[[probes]]
+name = "tip"
+body = "lower"
+node = "end"
+"#;

@@ -248,6 +248,11 @@ pub struct ReductionSpec {
     /// equations' count); absent: `whole_system::DEFAULT_MULTIPLIER_MODES`
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub multiplier_modes: Option<ModeRule>,
+    /// output modes: each block's POD enriched until the strains and curvatures the probes
+    /// record are reproduced on the training snapshots within `tolerance` of their range
+    /// (`crate::reduction::output_modes`); absent: none
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub probe_modes: Option<HyperSpec>,
 }
 
 /// How the coordinates are split into blocks with a POD each.
@@ -259,7 +264,8 @@ pub enum Blocks {
 }
 
 /// `[reduction.hyper]`: ECSW element sampling trained to a relative tolerance τ on the
-/// training snapshots (‖C w − b‖ ≤ τ ‖b‖; smaller τ: more elements, closer to Galerkin).
+/// training snapshots (‖C w − b‖ ≤ τ ‖b‖; smaller τ: more elements, closer to Galerkin);
+/// `[reduction.probe_modes]`: the output modes' tolerance.
 #[derive(Clone, Debug, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct HyperSpec {

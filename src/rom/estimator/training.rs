@@ -4,6 +4,7 @@
 
 use crate::physics::system::FlexibleSystem;
 pub use crate::reduction::estimator::{Calibration, CalibrationPoint, EstimateMethod, Estimator, DEFAULT_FACTOR};
+use crate::reduction::output_modes::{add_output_modes, output_columns, Outputs, Stop};
 use crate::reduction::{ecsw, train_basis, BasisSpec, ModeRule, Trained};
 use ndarray::{ArrayView1, ArrayView2};
 
@@ -66,17 +67,21 @@ fn enriched_rule(trained: &Trained, blocks: bool, extra: usize) -> ModeRule {
 }
 
 /// What a basis was trained from: snapshots `x` (n × m) and multipliers (n_c × m), the
-/// coordinates that appear in joints, and the reference state.
+/// coordinates that appear in joints, and the reference state; with output modes, the
+/// outputs and each block's rows ([`crate::reduction::output_modes`]).
 #[derive(Clone, Copy)]
 pub struct Snapshots<'a> {
     pub x: ArrayView2<'a, f64>,
     pub multipliers: ArrayView2<'a, f64>,
     pub joint_dofs: &'a [usize],
     pub x_ref: ArrayView1<'a, f64>,
+    pub outputs: Option<(&'a Outputs<'a>, &'a [Vec<usize>])>,
 }
 
 /// Builds the estimator at training time from the snapshots and spec the basis was built
-/// from: the POD again with `block_modes + extra` modes, and ECSW for `V⁺` at
+/// from: the POD again with `block_modes + extra` modes (with output modes: then the
+/// basis's own output modes and `extra` more, so that `V⁺` holds `V` and reads the outputs
+/// better than it), and ECSW for `V⁺` at
 /// `ENRICHED_HYPER_FACTOR · hyper_tolerance` when given (`hyper_tolerance` is the basis's
 /// own τ). Uncalibrated: see [`calibrate`].
 pub fn build_estimator(
@@ -87,10 +92,15 @@ pub fn build_estimator(
     hyper_tolerance: Option<f64>,
     extra: usize,
 ) -> std::result::Result<Estimator, String> {
-    let Snapshots { x, multipliers, joint_dofs, x_ref } = *snapshots;
+    let Snapshots { x, multipliers, joint_dofs, x_ref, outputs } = *snapshots;
     let spec = BasisSpec { modes: enriched_rule(trained, !spec.blocks.is_empty(), extra), ..spec.clone() };
     let mut richer =
         train_basis(x, multipliers, joint_dofs, x_ref, &spec).map_err(|e| format!("enriched basis: {e}"))?;
+    if let Some((outputs, blocks)) = outputs {
+        let seed: Vec<_> = (0..blocks.len()).map(|b| output_columns(trained, blocks, b)).collect();
+        add_output_modes(&mut richer, blocks, x, outputs, &seed, Stop::More(extra))
+            .map_err(|e| format!("output modes of the enriched basis: {e}"))?;
+    }
     if let Some(tol) = hyper_tolerance {
         richer.basis.hyper = Some(
             ecsw(sys, &richer.basis, x, ENRICHED_HYPER_FACTOR * tol)
@@ -98,8 +108,8 @@ pub fn build_estimator(
         );
     }
     Ok(Estimator {
+        block_modes: richer.block_columns(),
         enriched: richer.basis,
-        block_modes: richer.block_modes,
         extra_modes: extra,
         calibration: Calibration::default(),
         defects: None,
