@@ -5,7 +5,7 @@
 //! ```text
 //! cargo build --release
 //! cargo run --release --example zoo -- [--seed S] [--models N | --slots A..B] [--out DIR]
-//!     [--tolerances 5e-3,1e-2] [--subset] [--jobs 2] [--estimate METHOD] [--no-methods] [--draw-only] [--resume]
+//!     [--tolerances 5e-3,1e-2] [--subset] [--jobs 2] [--estimate METHOD] [--measure M] [--no-methods] [--draw-only] [--resume]
 //!     [--flexrom PATH]
 //! ```
 //!
@@ -38,7 +38,7 @@ use zoo::metrics::{
     aggregate, estimate_fails, fallback_stats, model_stats, quantity_cases, quantity_stats, Aggregate, ModelStats,
     QuantityCase, QuantityStats,
 };
-use zoo::{accepted, pipeline_toml, validation_loads, Replacement, ZooModel};
+use zoo::{accepted, pipeline_toml, validation_loads, Choices, Replacement, ZooModel};
 
 const METHODS: [&str; 3] = ["corrected", "defects", "enriched"];
 
@@ -53,6 +53,8 @@ struct Args {
     jobs: usize,
     /// `--estimate METHOD`: validate with this method instead of training's choice
     estimate: Option<String>,
+    /// `--measure M`: greedy's `measure` (`"probes"`: held to the root probes too)
+    measure: Option<String>,
     methods: bool,
     draw_only: bool,
     resume: bool,
@@ -60,7 +62,7 @@ struct Args {
 }
 
 fn usage(msg: &str) -> ! {
-    eprintln!("zoo: {msg}\nusage: zoo [--seed S] [--models N | --slots A..B] [--out DIR] [--tolerances 5e-3,1e-2] [--subset] [--jobs 1|2] [--estimate corrected|defects|enriched] [--no-methods] [--draw-only] [--resume] [--flexrom PATH]");
+    eprintln!("zoo: {msg}\nusage: zoo [--seed S] [--models N | --slots A..B] [--out DIR] [--tolerances 5e-3,1e-2] [--subset] [--jobs 1|2] [--estimate corrected|defects|enriched] [--measure relative|displacement|probes] [--no-methods] [--draw-only] [--resume] [--flexrom PATH]");
     std::process::exit(2)
 }
 
@@ -74,6 +76,7 @@ fn args() -> Args {
         subset: false,
         jobs: 2,
         estimate: None,
+        measure: None,
         methods: true,
         draw_only: false,
         resume: false,
@@ -111,6 +114,13 @@ fn args() -> Args {
                     usage(&format!("--estimate: one of {}", METHODS.join(", ")));
                 }
                 a.estimate = Some(m)
+            }
+            "--measure" => {
+                let m = value();
+                if !["relative", "displacement", "probes"].contains(&m.as_str()) {
+                    usage("--measure: relative, displacement or probes");
+                }
+                a.measure = Some(m)
             }
             "--subset" => a.subset = true,
             "--no-methods" => a.methods = false,
@@ -209,15 +219,19 @@ fn tol_tag(t: f64) -> String {
 
 /// Trains the model at `tolerance` and validates it with `estimate` (None: training's choice),
 /// through a pipeline of its own with the same basis (the one `run_methods` writes).
-fn run_entry(fx: &Flexrom, dir: &Path, name: &str, tolerance: f64, estimate: Option<&str>) -> Entry {
+fn run_entry(fx: &Flexrom, dir: &Path, name: &str, tolerance: f64, choices: Choices) -> Entry {
+    let (estimate, measure) = (choices.estimate, choices.measure);
     let tag = tol_tag(tolerance);
     let (pipeline, basis) = (format!("pipeline_{tag}.toml"), format!("basis_{tag}.h5"));
-    write_atomic(&dir.join(&pipeline), &pipeline_toml("model.toml", &basis, tolerance, None));
+    write_atomic(
+        &dir.join(&pipeline),
+        &pipeline_toml("model.toml", &basis, tolerance, Choices { estimate: None, measure }),
+    );
     let training = fx.train(dir, &pipeline);
     let checked = match estimate {
         Some(m) => {
             let p = format!("pipeline_{tag}_{m}.toml");
-            write_atomic(&dir.join(&p), &pipeline_toml("model.toml", &basis, tolerance, Some(m)));
+            write_atomic(&dir.join(&p), &pipeline_toml("model.toml", &basis, tolerance, choices));
             p
         }
         None => pipeline,
@@ -237,13 +251,18 @@ fn run_entry(fx: &Flexrom, dir: &Path, name: &str, tolerance: f64, estimate: Opt
     }
 }
 
-fn run_methods(fx: &Flexrom, dir: &Path, e: &mut Entry) {
+fn run_methods(fx: &Flexrom, dir: &Path, e: &mut Entry, measure: Option<&str>) {
     let tag = tol_tag(e.tolerance);
     for m in METHODS {
         let pipeline = format!("pipeline_{tag}_{m}.toml");
         write_atomic(
             &dir.join(&pipeline),
-            &pipeline_toml("model.toml", &format!("basis_{tag}.h5"), e.tolerance, Some(m)),
+            &pipeline_toml(
+                "model.toml",
+                &format!("basis_{tag}.h5"),
+                e.tolerance,
+                Choices { estimate: Some(m), measure },
+            ),
         );
         let validations = validate_all(fx, dir, &pipeline);
         let stats = model_stats(&validations);
@@ -542,7 +561,8 @@ fn main() {
             let dir = models_dir.join(&i.name);
             for &t in &a.tolerances {
                 let tag = tol_tag(t);
-                let text = pipeline_toml("model.toml", &format!("basis_{tag}.h5"), t, None);
+                let choices = Choices { estimate: None, measure: a.measure.as_deref() };
+                let text = pipeline_toml("model.toml", &format!("basis_{tag}.h5"), t, choices);
                 write_atomic(&dir.join(format!("pipeline_{tag}.toml")), &text);
             }
             println!(
@@ -569,9 +589,10 @@ fn main() {
     let run_job = |(i, t): (usize, f64)| -> (usize, Entry) {
         let name = infos[i].name.clone();
         let t0 = Instant::now();
-        let mut e = run_entry(&fx, &models_dir.join(&name), &name, t, a.estimate.as_deref());
+        let choices = Choices { estimate: a.estimate.as_deref(), measure: a.measure.as_deref() };
+        let mut e = run_entry(&fx, &models_dir.join(&name), &name, t, choices);
         if a.methods && e.training.is_ok() && estimate_fails(&e.stats) {
-            run_methods(&fx, &models_dir.join(&name), &mut e);
+            run_methods(&fx, &models_dir.join(&name), &mut e, a.measure.as_deref());
         }
         e.wall_seconds = t0.elapsed().as_secs_f64();
         eprintln!(

@@ -18,9 +18,16 @@
 //!   when written: the reduced dynamics, not the basis, is what is left — the basis
 //!   reproduces the training snapshots' root strain within 1e-3), and the error estimate
 //!   of each quantity at least its error (every estimate here read 1.5× its error).
+//! - `greedy_holds_the_probes_with_measure_probes`: `greedy = { measure = "probes" }` on
+//!   the arm of 4 elements a link (4 full runs, tolerance 1e-3): every basis of the loop gets
+//!   output modes for the root's strain and curvature (the upper link some, the lower none),
+//!   and training's lines name them (the held-out check's error in this measure, the larger
+//!   of rel_error and the worst probe quantity: `the_probes_measure_holds_the_worst_quantity`
+//!   in src/pipeline/greedy.rs).
 //! - `probe_modes_are_refused_where_they_cannot_apply`: a model whose probes record neither
 //!   quantity, a tolerance outside (0, 1) — each named as
-//!   `reduction.probe_modes`.
+//!   `reduction.probe_modes`; `measure = "probes"` on a model without probes, named as
+//!   `train.greedy.measure`.
 
 mod common;
 
@@ -103,6 +110,17 @@ fn probe_modes_are_refused_where_they_cannot_apply() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("arm.toml"), arm("[\"position\"]")).unwrap();
     std::fs::write(dir.path().join("arm_q.toml"), arm("[\"curvature\"]")).unwrap();
+    std::fs::write(dir.path().join("bare_model.toml"), arm("[\"position\"]").split("[[probes]]").next().unwrap())
+        .unwrap();
+    let p = pipeline(dir.path(), "bare", "bare_model.toml", "");
+    let text = std::fs::read_to_string(&p).unwrap().replace(
+        "points = { count = 5, sampling = \"sobol\" }",
+        "greedy = { tolerance = 1e-3, max_runs = 3, measure = \"probes\" }",
+    );
+    std::fs::write(&p, text.replace("modes = { energy = 1e-12 }\n", "")).unwrap();
+    let o = flexrom(&["train", &p]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && err.contains("train.greedy.measure") && err.contains("no [[probes]]"), "{err}");
     for (model, reduction, needle) in [
         ("arm.toml", "probe_modes = { tolerance = 1e-3 }", "no probe of the model records"),
         ("arm_q.toml", "probe_modes = { tolerance = 1.5 }", "strictly between 0 and 1"),
@@ -113,4 +131,25 @@ fn probe_modes_are_refused_where_they_cannot_apply() {
         assert!(!o.status.success(), "{reduction} on {model} was accepted");
         assert!(err.contains("reduction.probe_modes") && err.contains(needle), "{err}");
     }
+}
+
+#[test]
+fn greedy_holds_the_probes_with_measure_probes() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = common::two_link_arm(4, 0.005)
+        + "[[probes]]\nname = \"shoulder_root\"\nbody = \"upper\"\nnode = \"start\"\nquantities = [\"strain\", \"curvature\"]\n";
+    std::fs::write(dir.path().join("arm.toml"), model).unwrap();
+    let p = dir.path().join("greedy.toml");
+    std::fs::write(&p, "model = \"arm.toml\"\nbasis = \"greedy.h5\"\nreport = \"r\"\n[parameters]\nload_scale = [0.6, 1.4]\npayload = [0.0, 2.0]\n[train]\ngreedy = { tolerance = 1e-3, max_runs = 4, measure = \"probes\" }\n").unwrap();
+    let o = flexrom(&["train", p.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(err.lines().any(|l| l.starts_with("iteration 1") && l.contains("output modes")), "{err}");
+    let f = hdf5::File::open(dir.path().join("greedy.h5")).unwrap();
+    let added = f.dataset("basis/output_modes").unwrap().read_1d::<u64>().unwrap().to_vec();
+    assert!(added[0] > 0 && added[1] == 0, "output modes per link: {added:?}");
+    // the held-out checks hold the worst probe quantity too: at least rel_error's share
+    let g = f.group("training").unwrap();
+    let true_errors = g.dataset("true_error").unwrap().read_1d::<f64>().unwrap();
+    assert!(true_errors.iter().any(|e| e.is_finite() && *e > 0.0), "{true_errors:?}");
 }

@@ -142,8 +142,11 @@ fn evaluate(fx: &Flexrom, root: &Path, slot: usize, tolerance: f64) -> Outcome {
     })
     .expect("a model whose full runs complete");
     let dir = root.join(m.name());
-    std::fs::write(dir.join("pipeline.toml"), zoo::pipeline_toml("model.toml", "basis.h5", tolerance, None))
-        .expect("pipeline file");
+    std::fs::write(
+        dir.join("pipeline.toml"),
+        zoo::pipeline_toml("model.toml", "basis.h5", tolerance, zoo::Choices::default()),
+    )
+    .expect("pipeline file");
     let training = fx.train(&dir, "pipeline.toml");
     let validations: Vec<_> = if training.is_ok() {
         zoo::validation_loads().into_iter().map(|x| fx.validate(&dir, "pipeline.toml", x)).collect()

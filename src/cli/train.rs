@@ -80,14 +80,18 @@ impl Args {
         super::warn(&s.warnings);
         let b = &s.trained.basis;
         info(&format!(
-            "{}: {} snapshots from {} ({:.3} s); {} basis, {} snapshots, {} POD modes{} (captured energy 1 − {:.2e}) -> {}",
+            "{}: {} snapshots from {} ({:.3} s); {} basis, {} snapshots, {} POD modes{}{} (captured energy 1 − {:.2e}) -> {}",
             p.path.display(),
             s.n_snapshots,
             s.runs_text(),
             s.full_seconds,
             b.variant.name(),
             b.snapshots.name(),
-            b.n_pod_modes,
+            b.n_pod_modes - s.trained.output_modes.iter().sum::<usize>(),
+            match s.trained.output_modes.iter().sum::<usize>() {
+                0 => String::new(),
+                k => format!(" + {k} output modes"),
+            },
             if b.kept.is_empty() { String::new() } else { format!(" + {} joint coordinates", b.kept.len()) },
             s.trained.uncaptured_energy(),
             out.display()

@@ -47,14 +47,15 @@ pub fn training_data(runs: &[SimulationResult]) -> TrainingData {
     }
 }
 
-/// The basis of the pipeline's variant and blocks from `data` with `modes`, hyper-reduced
-/// by ECSW at `hyper_tolerance` when given, and its error estimator (uncalibrated: the same
+/// The basis of the pipeline's variant and blocks from `data` with `modes` (and output modes
+/// at `probe_tolerance` when given), hyper-reduced by ECSW at `hyper_tolerance` when given,
+/// and its error estimator (uncalibrated: the same
 /// POD with [`DEFAULT_EXTRA_MODES`] more modes per block); `Err((pipeline field, problem))`.
 pub fn build_basis(
     p: &Pipeline,
     data: &TrainingData,
     modes: ModeRule,
-    hyper_tolerance: Option<f64>,
+    (hyper_tolerance, probe_tolerance): (Option<f64>, Option<f64>),
 ) -> std::result::Result<(Trained, Estimator), (&'static str, String)> {
     // the physics, assembled once for the blocks, the joint rows, ECSW and the estimator
     let physics = p.model.physics().map_err(|e| ("model", e.to_string()))?;
@@ -84,7 +85,6 @@ pub fn build_basis(
     let joints = joint_dofs_of(sys);
     let mut trained = train_basis(data.x.view(), data.multipliers.view(), &joints, x_ref.view(), &spec)
         .map_err(|e| ("reduction.modes", e))?;
-    let probe_tolerance = p.file.reduction.probe_modes.as_ref().map(|m| m.tolerance);
     let eval = |o: usize, v: &[f64]| probe_output(sys, o, v);
     let outputs =
         probe_tolerance.map(|_| Outputs { outputs: probe_outputs(p, sys, physics.length_scale()), eval: &eval });
@@ -185,7 +185,8 @@ pub(crate) fn basis_from_snapshots(
 ) -> Result<(TrainingData, TrainSummary)> {
     let modes = p.file.reduction.modes.clone().ok_or_else(|| Error::input(&p.path, "reduction.modes", "is missing"))?;
     let tol = p.file.reduction.hyper.as_ref().map(|h| h.tolerance);
-    let (trained, estimator) = build_basis(p, &data, modes, tol).map_err(|(f, e)| Error::input(&p.path, f, e))?;
+    let (trained, estimator) = build_basis(p, &data, modes, (tol, p.probe_mode_tolerance(None)))
+        .map_err(|(f, e)| Error::input(&p.path, f, e))?;
     let n_snapshots = data.x.ncols();
     let summary = TrainSummary {
         trained,

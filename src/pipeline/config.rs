@@ -44,8 +44,8 @@ use crate::solver::parameters::Parameters;
 use scales::check_scales;
 pub use scales::{parse_range, parse_scales, Scales, MAX_LOAD_SCALES};
 pub use schema::{
-    Blocks, GreedySpec, HyperSpec, OnlineSpec, ParameterSpec, PipelineFile, PointsSpec, ReductionSpec, ScalesSpec,
-    TrainSpec, DEFAULT_BOX_CANDIDATES_PER_PARAMETER, DEFAULT_LINE_CANDIDATES,
+    Blocks, GreedyMeasure, GreedySpec, HyperSpec, OnlineSpec, ParameterSpec, PipelineFile, PointsSpec, ReductionSpec,
+    ScalesSpec, TrainSpec, DEFAULT_BOX_CANDIDATES_PER_PARAMETER, DEFAULT_LINE_CANDIDATES,
 };
 use std::path::{Component, Path, PathBuf};
 
@@ -132,6 +132,23 @@ impl Pipeline {
         // the checks name fields; the text knows their lines
         p.check().map_err(|e| crate::model::with_field_line(e, &p.path, &p.text))?;
         Ok(p)
+    }
+
+    /// The tolerance of the output modes of a basis of this pipeline: `[reduction]
+    /// probe_modes`; else, when greedy training holds the probes to its tolerance and a probe
+    /// records a strain or a curvature, `√ε` of the rung's POD energy tolerance `ε`
+    /// (`rung_energy`), as its ECSW tolerance is: the energy criterion bounds a squared
+    /// relative error, the output modes a relative one, and the ladder tightens both until
+    /// the scores meet the tolerance (with modes given, no ladder: the greedy tolerance).
+    pub fn probe_mode_tolerance(&self, rung_energy: Option<f64>) -> Option<f64> {
+        if let Some(m) = &self.file.reduction.probe_modes {
+            return Some(m.tolerance);
+        }
+        let greedy = self.file.train.greedy.as_ref().filter(|g| g.measure.probes())?;
+        // the whole-system variants pair each mode with multiplier modes: no output modes there
+        let quantities = self.model.probes().iter().any(|p| p.strain || p.curvature)
+            && !matches!(self.variant(), Variant::WholeSystem | Variant::WholeSystemStabilized);
+        rung_energy.filter(|_| quantities).map(|e| if e.is_finite() { e.sqrt() } else { greedy.tolerance })
     }
 
     /// `[reduction] probe_modes`: a tolerance in (0, 1), a variant that has blocks of modes,
@@ -248,6 +265,12 @@ impl Pipeline {
                     format!("is {}; it must lie strictly between 0 and 1", h.tolerance),
                 );
             }
+        }
+        if self.file.train.greedy.as_ref().is_some_and(|g| g.measure.probes()) && self.model.probes().is_empty() {
+            return bad(
+                "train.greedy.measure",
+                "is \"probes\", but the model has no [[probes]] entry to hold to the tolerance".into(),
+            );
         }
         if let Some(m) = &self.file.reduction.probe_modes {
             self.check_probe_modes(m.tolerance).map_err(|e| Error::input(&self.path, "reduction.probe_modes", e))?;

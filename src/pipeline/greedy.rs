@@ -89,7 +89,7 @@ pub use candidates::{score, SENSITIVITY_STEP};
 pub use search::{ENERGY_LADDER, TAU_LADDER};
 
 use super::basis_build::training_data;
-use super::config::{GreedySpec, Pipeline};
+use super::config::{GreedyMeasure, GreedySpec, Pipeline};
 use super::training_record::{modes_text, TrainSummary};
 pub use super::training_record::{write_training, GreedyRecord, Iteration};
 use super::validate::compare;
@@ -186,9 +186,15 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
             bound: level.between_candidates(),
             between_points: level.between_points,
         };
+        let outputs = &level.trained.output_modes;
         let shape = format!(
-            "{}{}, {} elements",
+            "{}{}{}, {} elements",
             modes_text(&it.block_modes),
+            if outputs.iter().all(|&k| k == 0) {
+                String::new()
+            } else {
+                format!(" + {} output modes", outputs.iter().map(|k| k.to_string()).collect::<Vec<_>>().join(" + "))
+            },
             if b.kept.is_empty() { String::new() } else { format!(" + {} joint coordinates", b.kept.len()) },
             it.n_elements
         );
@@ -229,7 +235,7 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         let truth_error = true_error(&p.model, &level.trained.basis, &truth, &mu);
         let (e, e_measured) = (truth_error.rel_error, truth_error.in_measure(g.measure));
         let by_time =
-            candidates::at_rest_as_relative(truth_error.by_time_in(g.measure), &truth_error.rel_error_by_time);
+            candidates::at_rest_as_relative(&truth_error.by_time_in(g.measure), &truth_error.rel_error_by_time);
         let e_score = score(g.tolerance, &by_time, &level.sensitivity[ni]);
         let c = level.estimator.calibration.factor;
         (it.run_candidate, it.true_error, it.true_score) = (Some(ni), e_measured, e_score);
@@ -352,7 +358,7 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         converged,
         full_runs,
         method,
-        measure: g.measure,
+        measure: g.measure.coordinates(),
         held_out_note,
         estimate_note,
     };
@@ -378,7 +384,7 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
 /// tolerance (`score ≤ T`, the module documentation), and the line says so instead of
 /// leaving "≤ T" to read as the error's; `None` when the error is within the tolerance.
 fn above_tolerance_note(
-    measure: ErrorMeasure,
+    measure: GreedyMeasure,
     tolerance: f64,
     (at, error): (&str, f64),
     (score, sensitivity): (f64, f64),
@@ -655,22 +661,32 @@ struct TrueError {
     rel_error: f64,
     rel_error_by_time: ByFifth,
     displacement_error_by_time: ByFifth,
+    /// the largest error of a probe quantity over its range (0 without probes)
+    quantities: f64,
 }
 
 impl TrueError {
-    /// The whole run's error in `measure` (rel_error as `validate` sums it).
-    fn in_measure(&self, measure: ErrorMeasure) -> f64 {
+    /// The whole run's error in `measure` (rel_error as `validate` sums it; with the probes'
+    /// measure the larger of it and the worst probe quantity's).
+    fn in_measure(&self, measure: GreedyMeasure) -> f64 {
         match measure {
-            ErrorMeasure::Relative => self.rel_error,
-            ErrorMeasure::Displacement => self.displacement_error_by_time[FIFTHS - 1],
+            GreedyMeasure::Relative => self.rel_error,
+            GreedyMeasure::Displacement => self.displacement_error_by_time[FIFTHS - 1],
+            GreedyMeasure::Probes => self.rel_error.max(self.quantities),
         }
     }
 
-    fn by_time_in(&self, measure: ErrorMeasure) -> &ByFifth {
-        match measure {
-            ErrorMeasure::Relative => &self.rel_error_by_time,
-            ErrorMeasure::Displacement => &self.displacement_error_by_time,
+    /// By fifth of the run; the probe quantities are measured over the whole run and enter
+    /// its last fifth, as the candidates' estimates do.
+    fn by_time_in(&self, measure: GreedyMeasure) -> ByFifth {
+        let mut e = match measure.coordinates() {
+            ErrorMeasure::Relative => self.rel_error_by_time,
+            ErrorMeasure::Displacement => self.displacement_error_by_time,
+        };
+        if measure.probes() {
+            e[FIFTHS - 1] = e[FIFTHS - 1].max(self.quantities);
         }
+        e
     }
 }
 
@@ -681,16 +697,19 @@ fn true_error(model: &Arc<Model>, basis: &Basis, truth: &SimulationResult, mu: &
     match run {
         Ok(rom) => {
             let v = compare(model, truth, &rom, None, basis.n_reduced(), basis.variant.name());
+            let quantities = v.probe_quantity_errors.iter().map(|q| q.relative.unwrap_or(f64::NAN));
             TrueError {
                 rel_error: v.rel_error,
                 rel_error_by_time: rel_error_by_time(&rom.result.q, &truth.q),
                 displacement_error_by_time: std::array::from_fn(|i| v.displacement_error_by_time[i]),
+                quantities: candidates::worst_quantity(quantities),
             }
         }
         Err(_) => TrueError {
             rel_error: f64::INFINITY,
             rel_error_by_time: [f64::INFINITY; FIFTHS],
             displacement_error_by_time: [f64::INFINITY; FIFTHS],
+            quantities: f64::INFINITY,
         },
     }
 }
@@ -716,20 +735,42 @@ mod tests {
         assert_eq!(dynamics_error(0.13, 1e-2, f64::NAN), None);
     }
 
+    /// The probes' measure holds the larger of rel_error and the worst probe quantity (over
+    /// its range) to the tolerance, in the whole run and in the run's last fifth (where the
+    /// candidates' quantity estimates enter too); the other measures ignore the quantities.
+    #[test]
+    fn the_probes_measure_holds_the_worst_quantity() {
+        let t = TrueError {
+            rel_error: 2e-5,
+            rel_error_by_time: [1e-5, 1e-5, 2e-5, 2e-5, 2.1e-5],
+            displacement_error_by_time: [3e-4; FIFTHS],
+            quantities: 1.2e-2,
+        };
+        assert_eq!(t.in_measure(GreedyMeasure::Probes), 1.2e-2);
+        assert_eq!(t.in_measure(GreedyMeasure::Relative), 2e-5);
+        assert_eq!(t.in_measure(GreedyMeasure::Displacement), 3e-4);
+        assert_eq!(t.by_time_in(GreedyMeasure::Probes), [1e-5, 1e-5, 2e-5, 2e-5, 1.2e-2]);
+        assert_eq!(t.by_time_in(GreedyMeasure::Relative), t.rel_error_by_time);
+        let none = TrueError { quantities: 0.0, ..t };
+        assert_eq!(none.in_measure(GreedyMeasure::Probes), 2e-5, "without probe quantities: rel_error");
+        assert_eq!(candidates::worst_quantity([f64::NAN, 3e-3, 1e-3].into_iter()), 3e-3, "NaN: no swing, says nothing");
+        assert_eq!(candidates::worst_quantity([f64::INFINITY, 1e-3].into_iter()), f64::INFINITY);
+    }
+
     /// The converged check's line in words: a two-link arm of 30 elements a link (T = 1e-3,
     /// held-out rel_error 2.93e-3, sensitivity 1.9e-2, score 1.55e-4 = T · 2.93e-3 / 1.9e-2,
     /// the score rule of the module documentation) says the error is above the tolerance and
     /// why the check passed; an error within T says nothing more.
     #[test]
     fn a_held_out_error_above_the_tolerance_is_said_in_words() {
-        let note = above_tolerance_note(ErrorMeasure::Relative, 1e-3, ("λ = 1.3", 2.93e-3), (1.55e-4, 1.9e-2));
+        let note = above_tolerance_note(GreedyMeasure::Relative, 1e-3, ("λ = 1.3", 2.93e-3), (1.55e-4, 1.9e-2));
         let note = note.expect("above T");
         assert!(note.starts_with("held-out rel_error 2.93e-3 at λ = 1.3 is above the tolerance 1e-3;"), "{note}");
         assert!(note.contains("sensitivity there is 1.9e-2") && note.contains("come from the dynamics"), "{note}");
         assert!(note.contains("score 1.55e-4 ≤ 1e-3"), "{note}");
-        let d = above_tolerance_note(ErrorMeasure::Displacement, 1e-3, ("λ = 1.3", 2.93e-3), (1.55e-4, 1.9e-2));
+        let d = above_tolerance_note(GreedyMeasure::Displacement, 1e-3, ("λ = 1.3", 2.93e-3), (1.55e-4, 1.9e-2));
         assert!(d.unwrap().starts_with("held-out displacement_error"));
-        assert_eq!(above_tolerance_note(ErrorMeasure::Relative, 1e-3, ("λ = 1.3", 9e-4), (9e-4, 1.9e-2)), None);
+        assert_eq!(above_tolerance_note(GreedyMeasure::Relative, 1e-3, ("λ = 1.3", 9e-4), (9e-4, 1.9e-2)), None);
     }
 
     /// The online default's reading between candidates: the tutorial's double pendulum

@@ -132,11 +132,12 @@ pub struct GreedySpec {
     /// optional), 32 per parameter in a box
     #[serde(default, serialize_with = "candidates_as_hashed")]
     pub candidates: Option<usize>,
-    /// the error `tolerance` is on: "relative" (rel_error, the default) or "displacement"
-    /// (displacement_error); left out of the settings hash when relative, so that a basis
-    /// trained before the key existed is not stale
-    #[serde(default, skip_serializing_if = "ErrorMeasure::is_relative")]
-    pub measure: ErrorMeasure,
+    /// the error `tolerance` is on: "relative" (rel_error, the default), "displacement"
+    /// (displacement_error) or "probes" (rel_error and every probe quantity over its range);
+    /// left out of the settings hash when relative, so that a basis trained before the key
+    /// existed is not stale
+    #[serde(default, skip_serializing_if = "GreedyMeasure::is_relative")]
+    pub measure: GreedyMeasure,
     /// how a box's candidates are drawn (a box only)
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sampling: Option<Sampling>,
@@ -147,6 +148,48 @@ pub struct GreedySpec {
 
 /// The candidates on a line of loads when `candidates` is not given.
 pub const DEFAULT_LINE_CANDIDATES: usize = 33;
+/// What greedy training holds to its tolerance (`[train] greedy.measure`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum GreedyMeasure {
+    /// rel_error (the default)
+    #[default]
+    Relative,
+    /// displacement_error
+    Displacement,
+    /// rel_error and every quantity the probes record — position, strain, curvature — each
+    /// over its range (`crate::rom::quantities`); every basis of the loop then carries
+    /// output modes for the strains and curvatures at the same tolerance
+    Probes,
+}
+
+impl GreedyMeasure {
+    pub fn is_relative(&self) -> bool {
+        *self == GreedyMeasure::Relative
+    }
+
+    /// The measure of the coordinates' error (the probes' measure holds rel_error).
+    pub fn coordinates(self) -> ErrorMeasure {
+        match self {
+            GreedyMeasure::Displacement => ErrorMeasure::Displacement,
+            GreedyMeasure::Relative | GreedyMeasure::Probes => ErrorMeasure::Relative,
+        }
+    }
+
+    /// Whether the probe quantities are held to the tolerance too.
+    pub fn probes(self) -> bool {
+        self == GreedyMeasure::Probes
+    }
+
+    /// The name of the error held to the tolerance, as messages print it.
+    pub fn error_name(self) -> &'static str {
+        match self {
+            GreedyMeasure::Probes => "error (rel_error and the probe quantities over their ranges)",
+            m => m.coordinates().error_name(),
+        }
+    }
+}
+
 /// A box's candidates per parameter when `candidates` is not given.
 pub const DEFAULT_BOX_CANDIDATES_PER_PARAMETER: usize = 32;
 

@@ -5,13 +5,12 @@
 use super::candidate_set::CandidateSet;
 use crate::error::Result;
 use crate::model::Model;
+use crate::pipeline::config::GreedyMeasure;
 use crate::reduction::Basis;
 use crate::rom::estimator::corrected::CorrectedRunner;
 use crate::rom::estimator::defects::Defects;
 use crate::rom::estimator::norms::{raw_by_time, resolution};
-use crate::rom::estimator::{
-    self, ByFifth, DefectsCalibration, ErrorEstimator, ErrorMeasure, EstimateMethod, Estimator, FIFTHS,
-};
+use crate::rom::estimator::{self, ByFifth, DefectsCalibration, ErrorEstimator, EstimateMethod, Estimator, FIFTHS};
 use crate::rom::{Output, Rom};
 use crate::solver::parameters::Parameters;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -80,7 +79,7 @@ pub(super) fn estimate_candidates(
     est: &Estimator,
     cands: &CandidateSet,
     label: &str,
-    (method, measure): (EstimateMethod, ErrorMeasure),
+    (method, measure): (EstimateMethod, GreedyMeasure),
     which: &[usize],
 ) -> Vec<Option<CandidateRun>> {
     let mut out = vec![None; cands.len()];
@@ -134,7 +133,7 @@ fn candidate_run(
     rom: &Rom,
     cands: &CandidateSet,
     i: usize,
-    measure: ErrorMeasure,
+    measure: GreedyMeasure,
     x0: ndarray::ArrayView1<f64>,
 ) -> CandidateRun {
     point_run(rom, &cands.points[i], &cands.moved(i, SENSITIVITY_STEP), measure, x0)
@@ -147,29 +146,35 @@ fn point_run(
     rom: &Rom,
     mu: &Parameters,
     moved: &Parameters,
-    measure: ErrorMeasure,
+    measure: GreedyMeasure,
     x0: ndarray::ArrayView1<f64>,
 ) -> CandidateRun {
+    let coordinates = measure.coordinates();
     match rom.solve_and_estimate(mu, Output::ReducedAndProbes, &[]) {
         Ok((run, Some(e))) => {
             // the same reduced model at μ(1 + δ): how much its answer moves
             let basis = rom.basis();
             let res = rom.model().physics().map_or(0.0, |p| resolution(&run, p.length_scale()));
             let sensitivity = match rom.solve_with(moved, Output::ReducedAndProbes, &[]) {
-                Ok(moved) => *raw_by_time(basis, basis, &moved.reduced_q, &run.reduced_q, x0, res).get(measure),
+                Ok(moved) => *raw_by_time(basis, basis, &moved.reduced_q, &run.reduced_q, x0, res).get(coordinates),
                 Err(_) => [0.0; FIFTHS],
             };
             let failure = e.failure.as_ref().map(|why| format!("its error estimate failed: {why}"));
-            CandidateRun {
-                by_time: at_rest_as_relative(e.by_time_in(measure), &e.by_time),
-                raw: e.raw,
-                sensitivity,
-                failure,
+            let mut by_time = at_rest_as_relative(e.by_time_in(coordinates), &e.by_time);
+            if measure.probes() {
+                by_time[FIFTHS - 1] = by_time[FIFTHS - 1].max(worst_quantity(e.quantities.iter().map(|q| q.estimate)));
             }
+            CandidateRun { by_time, raw: e.raw, sensitivity, failure }
         }
         Ok((_, None)) => failed("the reduced model has no estimator".into()),
         Err(e) => failed(format!("the reduced run failed: {e}")),
     }
+}
+
+/// The largest of the probe quantities' errors or estimates over their ranges; those
+/// undefined (NaN: no swing beyond the resolution in either run) say nothing, ∞ counts.
+pub(super) fn worst_quantity(values: impl Iterator<Item = f64>) -> f64 {
+    values.filter(|v| !v.is_nan()).fold(0.0, f64::max)
 }
 
 /// The estimate by fifth of a run for the loop. A displacement estimate is undefined (NaN)
@@ -193,7 +198,7 @@ pub(super) fn estimate_points(
     est: &Estimator,
     cands: &CandidateSet,
     units: &[Vec<f64>],
-    (method, measure): (EstimateMethod, ErrorMeasure),
+    (method, measure): (EstimateMethod, GreedyMeasure),
 ) -> Vec<CandidateRun> {
     let (rom, physics) = match training_setup(model, basis, est, method) {
         Ok(s) => s,
@@ -220,7 +225,7 @@ pub(super) fn screen_candidates(
     est: &Estimator,
     cands: &CandidateSet,
     order: &[usize],
-    (method, measure): (EstimateMethod, ErrorMeasure),
+    (method, measure): (EstimateMethod, GreedyMeasure),
     tolerance: f64,
 ) -> Vec<Option<CandidateRun>> {
     let mut out = vec![None; cands.len()];

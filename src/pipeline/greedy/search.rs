@@ -8,11 +8,11 @@ use super::candidates::{estimate_candidates, estimate_points, score, screen_cand
 use crate::error::{Error, Result};
 use crate::io::basis_file::TrainingData;
 use crate::pipeline::basis_build::build_basis;
-use crate::pipeline::config::{GreedySpec, Pipeline};
+use crate::pipeline::config::{GreedyMeasure, GreedySpec, Pipeline};
 use crate::pipeline::training_record::modes_text;
 use crate::reduction::{ModeRule, Trained};
 use crate::rom::estimator::training::{calibrate, CalibrationPoint, Estimator};
-use crate::rom::estimator::{ByFifth, ErrorMeasure, EstimateMethod, FIFTHS};
+use crate::rom::estimator::{ByFifth, EstimateMethod, FIFTHS};
 use crate::rom::trust::amplifying;
 
 /// Energy tolerances ε tried, loose to tight: 10⁻², 10⁻³, …, 10⁻¹⁴. The tight end is where
@@ -350,7 +350,8 @@ fn level(
     order: &[usize],
 ) -> std::result::Result<Level, (&'static str, String)> {
     let Round { p, data, candidates, points, method, .. } = *r;
-    let (trained, mut estimator) = build_basis(p, data, modes, hyper_tolerance)?;
+    let (trained, mut estimator) =
+        build_basis(p, data, modes, (hyper_tolerance, p.probe_mode_tolerance(Some(energy))))?;
     estimator.calibration = calibrate(points.to_vec());
     // a block whose snapshots span no more than the basis already holds leaves the estimator
     // nothing richer to compare with there; a block with fewer than `k` more (a stiff body:
@@ -455,8 +456,8 @@ fn p_tolerance(p: &Pipeline) -> f64 {
 }
 
 /// The error measure greedy's tolerance is on (`[train] greedy.measure`).
-fn measure_of(p: &Pipeline) -> ErrorMeasure {
-    p.file.train.greedy.as_ref().map_or(ErrorMeasure::Relative, |g| g.measure)
+fn measure_of(p: &Pipeline) -> GreedyMeasure {
+    p.file.train.greedy.as_ref().map_or(GreedyMeasure::Relative, |g| g.measure)
 }
 
 #[cfg(test)]

@@ -115,16 +115,25 @@ pub fn check_loads() -> Vec<f64> {
     loads
 }
 
+/// What a zoo run sets beyond the defaults: an online estimate method (`[online]
+/// estimate`, with the validation loads as its sweep), greedy's `measure`.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Choices<'a> {
+    pub estimate: Option<&'a str>,
+    pub measure: Option<&'a str>,
+}
+
 /// The pipeline a user writes for a model: greedy over [`RANGE`] to `tolerance` with at
-/// most [`MAX_RUNS`] full runs, nothing else set; `estimate` names an online estimate
-/// method (`[online] estimate`, with the validation loads as its sweep) instead of the default.
-pub fn pipeline_toml(model: &str, basis: &str, tolerance: f64, estimate: Option<&str>) -> String {
+/// most [`MAX_RUNS`] full runs, nothing else set but `choices`.
+pub fn pipeline_toml(model: &str, basis: &str, tolerance: f64, choices: Choices) -> String {
+    let Choices { estimate, measure } = choices;
+    let measure = measure.map_or(String::new(), |m| format!(", measure = {m:?}"));
     let loads: Vec<String> = validation_loads().iter().map(|x| format!("{x:?}")).collect();
     let mut s = String::new();
     let _ = writeln!(s, "model = {model:?}\nbasis = {basis:?}\nreport = \"report\"\n");
     let _ = writeln!(
         s,
-        "[train]\ngreedy = {{ range = [{:?}, {:?}], tolerance = {tolerance:e}, max_runs = {MAX_RUNS} }}\n",
+        "[train]\ngreedy = {{ range = [{:?}, {:?}], tolerance = {tolerance:e}, max_runs = {MAX_RUNS}{measure} }}\n",
         RANGE.0, RANGE.1
     );
     if let Some(m) = estimate {
