@@ -299,7 +299,7 @@ fn rung_text(r: &Round, l: &Level, eps: f64, tau: f64, tolerance: f64) -> String
         None => "every element".to_string(),
     };
     let run = l.evaluated.iter().filter(|&&e| e).count();
-    let poor: Vec<String> = (l.estimator.block_modes.iter().zip(&l.trained.block_modes).enumerate())
+    let poor: Vec<String> = (l.estimator.block_modes.iter().zip(&l.trained.block_columns()).enumerate())
         .filter(|(_, (&e, &m))| e <= m)
         .map(|(i, _)| match &r.p.model.file.bodies[..] {
             bodies if l.trained.block_modes.len() > 1 => {
@@ -356,7 +356,7 @@ fn level(
     // a block whose snapshots span no more than the basis already holds leaves the estimator
     // nothing richer to compare with there; a block with fewer than `k` more (a stiff body:
     // its snapshots have low rank) is enriched by all it has
-    let fully_enriched = estimator.block_modes.iter().zip(&trained.block_modes).all(|(&e, &r)| e > r);
+    let fully_enriched = estimator.block_modes.iter().zip(&trained.block_columns()).all(|(&e, &r)| e > r);
     let mut l = Level {
         energy,
         hyper_tolerance,
