@@ -22,7 +22,7 @@ fn model(name: &str) -> String {
 }
 
 /// The tags of `xml`, checked to nest (every open tag closed in order, `<?...?>` and
-/// `<.../>` standing alone); returns (name, attributes text, text after it) per tag.
+/// `<.../>` and `<!-- -->` standing alone); returns (name, attributes text, text after it) per tag.
 fn well_formed(xml: &str) -> Vec<(String, String, String)> {
     let mut stack: Vec<String> = Vec::new();
     let mut tags = Vec::new();
@@ -34,6 +34,8 @@ fn well_formed(xml: &str) -> Vec<(String, String, String)> {
         let text = after[..after.find('<').unwrap_or(after.len())].trim().to_string();
         if tag.starts_with('?') {
             assert!(tag.ends_with('?'));
+        } else if tag.starts_with("!--") {
+            assert!(tag.ends_with("--"), "comment <{tag}>");
         } else if let Some(name) = tag.strip_prefix('/') {
             assert_eq!(stack.pop().as_deref(), Some(name), "closing tag </{name}> out of order");
         } else {
@@ -100,4 +102,67 @@ fn the_xdmf_names_the_datasets_it_describes() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.code() == Some(1) && err.contains("q.xdmf") && err.contains("--paraview"), "{err}");
     assert_eq!(std::fs::read_to_string(dir.path().join("q.xdmf")).unwrap(), "mine");
+}
+
+/// `modes --paraview`: one grid on the configuration linearized at, one vector attribute
+/// per mode named by its number and the frequency of `/frequencies`, every `DataItem` a
+/// dataset of the modes file with the stated shape; the field of mode k is S(ξ) φ_k, so
+/// at the tip sample (ξ = 1 of the last element, S(1) picks the last node's x, y) it is
+/// that node's entries of row k of `/shapes`, and at the pin it is 0 (B φ = 0).
+#[test]
+fn the_modes_xdmf_names_one_field_per_mode() {
+    let dir = tempfile::tempdir().unwrap();
+    let h5 = dir.path().join("m.h5");
+    ok(&["modes", &model("pendulum.toml"), "--count", "3", "-o", h5.to_str().unwrap(), "--paraview", "-q"]);
+    let xml = std::fs::read_to_string(dir.path().join("m.xdmf")).unwrap();
+    let tags = well_formed(&xml);
+    let f = hdf5::File::open(&h5).unwrap();
+    let freq = f.dataset("frequencies").unwrap().read_1d::<f64>().unwrap();
+    let names: Vec<String> = tags.iter().filter(|t| t.0 == "Attribute").map(|t| attr(&t.1, "Name")).collect();
+    let expected: Vec<String> = (0..3).map(|k| format!("mode_{} ({:.6} Hz)", k + 1, freq[k])).collect();
+    assert_eq!(names, expected);
+    assert_eq!(tags.iter().filter(|t| t.0 == "Grid").count(), 1);
+    let mut items = 0;
+    for (_, attrs, text) in tags.iter().filter(|t| t.0 == "DataItem") {
+        let (file, path) = text.split_once(':').unwrap();
+        assert_eq!(file, "m.h5");
+        let dims: Vec<usize> = attr(attrs, "Dimensions").split(' ').map(|d| d.parse().unwrap()).collect();
+        assert_eq!(f.dataset(path).unwrap_or_else(|_| panic!("{path}")).shape(), dims, "{path}");
+        items += 1;
+    }
+    // lines, points and 3 shapes
+    assert_eq!(items, 5);
+    // 50 elements: 4 samples an element and the last node; 51 nodes of 4 coordinates
+    let (n, n_dof) = (4 * 50 + 1, 4 * 51);
+    let shapes = f.dataset("shapes").unwrap().read_2d::<f64>().unwrap();
+    let q = f.dataset("q").unwrap().read_1d::<f64>().unwrap();
+    let p = f.dataset("paraview/points").unwrap().read_2d::<f64>().unwrap();
+    assert_eq!(p.shape(), [n, 3]);
+    assert!((p[[n - 1, 0]] - q[n_dof - 4]).abs() < 1e-14 && (p[[n - 1, 1]] - q[n_dof - 3]).abs() < 1e-14);
+    for k in 0..3 {
+        let u = f.dataset(&format!("paraview/shapes/{k:06}")).unwrap().read_2d::<f64>().unwrap();
+        let scale = shapes.row(k).iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        assert!((u[[n - 1, 0]] - shapes[[k, n_dof - 4]]).abs() <= 1e-12 * scale, "mode {k} tip x");
+        assert!((u[[n - 1, 1]] - shapes[[k, n_dof - 3]]).abs() <= 1e-12 * scale, "mode {k} tip y");
+        assert!(u.row(0).iter().all(|x| x.abs() <= 1e-12 * scale), "mode {k}: the pin does not move");
+        assert!(u.column(2).iter().all(|&z| z == 0.0));
+    }
+    let d = f.dataset("paraview/shapes/000002").unwrap();
+    assert_eq!(d.attr("units").unwrap().read_scalar::<hdf5::types::VarLenUnicode>().unwrap().as_str(), "m/√kg");
+    // without --paraview: no group, no XDMF file
+    let plain = dir.path().join("n.h5");
+    ok(&["modes", &model("pendulum.toml"), "--count", "2", "-o", plain.to_str().unwrap(), "-q"]);
+    assert!(hdf5::File::open(&plain).unwrap().group("paraview").is_err());
+    assert!(!dir.path().join("n.xdmf").exists());
+    // flexrom's own modes XDMF file is replaced, another kept
+    ok(&["modes", &model("pendulum.toml"), "--count", "2", "-o", h5.to_str().unwrap(), "--paraview", "-q"]);
+    assert_eq!(
+        well_formed(&std::fs::read_to_string(dir.path().join("m.xdmf")).unwrap()).len(),
+        tags.len() - 2,
+        "one mode fewer: an Attribute and its DataItem"
+    );
+    std::fs::write(dir.path().join("n.xdmf"), "mine").unwrap();
+    let o = flexrom(&["modes", &model("pendulum.toml"), "-o", plain.to_str().unwrap(), "--paraview", "-q"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.code() == Some(1) && err.contains("n.xdmf") && err.contains("--paraview"), "{err}");
 }

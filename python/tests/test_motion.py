@@ -49,3 +49,22 @@ def test_meshio_reads_the_xdmf(cli, tmp_path):
             assert point_data["velocity"].shape == (n, 3)
             assert point_data["strain"].shape == (n,)
         assert times == pytest.approx([0.0, 0.005, 0.01, 0.015, 0.02])
+
+
+def test_meshio_reads_the_modes_xdmf(cli, tmp_path):
+    """`modes --paraview`: one mesh on the straight pendulum with one displacement field per
+    mode, named by number and frequency; the pin (first point) does not move."""
+    import h5py
+    import meshio
+    out = tmp_path / "m.h5"
+    cli("modes", "data/models/pendulum.toml", "--count", "3", "-o", out, "--paraview")
+    m = meshio.read(tmp_path / "m.xdmf")
+    n = 4 * 50 + 1  # 4 samples an element and the last node (docs/file-formats.md)
+    assert m.points.shape == (n, 3)
+    assert m.cells[0].type == "line" and m.cells[0].data.shape == (n - 1, 2)
+    with h5py.File(out) as f:
+        freq = f["frequencies"][:]
+    assert list(m.point_data) == [f"mode_{k + 1} ({freq[k]:.6f} Hz)" for k in range(3)]
+    for u in m.point_data.values():
+        assert u.shape == (n, 3)
+        assert np.allclose(u[0], 0.0, atol=1e-12 * np.abs(u).max())

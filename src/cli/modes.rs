@@ -4,7 +4,7 @@
 use super::statics::LoadArgs;
 use super::FormatArgs;
 use flexrom::io::attrs::Kind;
-use flexrom::io::modes_file::{write, ModesRecord};
+use flexrom::io::modes_file::{write_with_paraview, ModesRecord};
 use flexrom::io::output::{check_output, Origin};
 use flexrom::limits::Limits;
 use flexrom::linalg::kkt::LinearSolverKind;
@@ -39,6 +39,12 @@ pub struct Args {
     /// modes file (HDF5): frequencies and mode shapes laid out like q, with labels
     #[arg(short, long)]
     output: Option<PathBuf>,
+    /// also write ParaView's view beside the modes file: each mode shape as a displacement
+    /// field on the centre lines of the configuration linearized at (4 points an element),
+    /// in the file's /paraview and an XDMF file of the same stem (out.h5 → out.xdmf); Warp
+    /// By Vector draws a mode
+    #[arg(long, requires = "output")]
+    paraview: bool,
     /// a basis file (`flexrom train`): also the frequencies of its reduced model (the
     /// stiffness and mass projected on its modes, the constraints held), beside the full
     /// ones, to see which modes the POD kept
@@ -53,9 +59,12 @@ pub struct Args {
 
 impl Args {
     pub fn run(self, limits: &Limits) -> flexrom::Result<()> {
-        let Args { model, count, at, loads, output, basis, solver, format } = self;
+        let Args { model, count, at, loads, output, paraview, basis, solver, format } = self;
         if let Some(output) = &output {
             check_output(output, Origin::Flag("-o"), &[(&model, "model file")], &[Kind::Modes])?;
+            if paraview {
+                flexrom::io::paraview::check_xdmf_output(output)?;
+            }
         }
         let model = Model::load_with(&model, limits.clone())?;
         let at = match at {
@@ -94,7 +103,10 @@ impl Args {
             info(&format!("  the basis leaves {} coordinates once its constraint rows hold", r.dimension));
         }
         if let Some(output) = &output {
-            write(output, &ModesRecord { model: &model, modes: &modes, q: &q, at: at.name(), mu: &mu, time: o.time })?;
+            let record = ModesRecord { model: &model, modes: &modes, q: &q, at: at.name(), mu: &mu, time: o.time };
+            if let Some(layout) = write_with_paraview(output, &record, paraview)? {
+                flexrom::io::paraview::write_modes_xdmf(output, &layout)?;
+            }
         }
         match format.format() {
             Format::Json => {

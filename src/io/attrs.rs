@@ -88,12 +88,15 @@ pub const LABELS: [Entry; 7] = [
 /// Mode shapes normalized to unit modal mass, `φᵀMφ = 1 kg·(m or 1)²`.
 pub const MODE_SHAPE_UNITS: &str = "m/√kg (positions x, y), 1/√kg (slopes x', y')";
 
-const MODES: [Entry; 5] = [
+const MODES: [Entry; 8] = [
     ("frequencies", "Hz", "mode"),
     ("omega_squared", "1/s²", "mode"),
     ("rigid", "1", "mode"),
     ("shapes", MODE_SHAPE_UNITS, "mode, dof"),
     ("q", COORDINATE_UNITS, "dof"),
+    ("paraview/lines", "1", "segment, end"),
+    ("paraview/points", "m", "point, xyz"),
+    ("paraview/shapes/*", "m/√kg", "point, xyz"),
 ];
 
 const RESULT: [Entry; 19] = [

@@ -8,6 +8,8 @@
 //! /shapes         (N, n_dof)   row i = mode i laid out like q, φᵀMφ = 1
 //! /q              (n_dof)      the configuration the model was linearized at
 //! /labels/...                  names of the coordinates and constraint rows
+//! /paraview/...                `--paraview` only: the shapes as ParaView's displacement
+//!                              fields ([`crate::io::paraview`])
 //! attributes on /: flexrom_layout, flexrom_file = "modes", model, model_path, at
 //!   ("initial" or "static"), load_scale, parameter:NAME, time, iterations, program_version
 //! ```
@@ -35,6 +37,17 @@ pub struct ModesRecord<'a> {
 
 /// Writes `r` to `path` atomically (a temporary file renamed into place).
 pub fn write(path: &Path, r: &ModesRecord) -> Result<()> {
+    write_with_paraview(path, r, false).map(|_| ())
+}
+
+/// [`write()`], with ParaView's datasets where `paraview` (their layout returned, for the
+/// XDMF file: [`crate::io::paraview::write_modes_xdmf`]).
+pub fn write_with_paraview(
+    path: &Path,
+    r: &ModesRecord,
+    paraview: bool,
+) -> Result<Option<crate::io::paraview::ModesLayout>> {
+    let mut layout = None;
     write_atomically_labelled(path, Kind::Modes, |f, labelled| {
         let e = |err: hdf5::Error| Error::hdf5(path, err);
         let model_path = r.model.path.display().to_string();
@@ -58,6 +71,12 @@ pub fn write(path: &Path, r: &ModesRecord) -> Result<()> {
         write("rigid", ndarray::ArrayView1::from(&rigid).into_dyn()).map_err(e)?;
         write("shapes", r.modes.shapes.view().into_dyn()).map_err(e)?;
         write("q", ndarray::ArrayView1::from(r.q).into_dyn()).map_err(e)?;
+        if paraview {
+            let (bodies, shapes) = (r.model.bodies(), r.modes.shapes.view());
+            let written = crate::io::paraview::write_mode_datasets(f, bodies, r.q, shapes, &r.modes.frequencies);
+            layout = Some(written.map_err(e)?);
+        }
         Ok(())
-    })
+    })?;
+    Ok(layout)
 }
