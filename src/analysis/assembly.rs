@@ -83,9 +83,9 @@ pub fn mass_blocks(sys: &FlexibleSystem, mu: &Parameters) -> Vec<Block> {
     let mut blocks: Vec<Block> =
         (0..sys.n_elements()).map(|e| sys.element(e).mass() * sys.mass_factor(e, mu)).collect();
     blocks.resize(sys.n_blocks(), Block::zeros());
-    // point masses sit on their node's position coordinates, in the block that holds them
-    for (e, i, m) in sys.point_mass_entries() {
-        blocks[e][(i, i)] += m;
+    // point masses sit on their node's coordinates, in the block that holds them
+    for (e, i, j, m) in sys.point_mass_entries() {
+        blocks[e][(i, j)] += m;
     }
     blocks
 }

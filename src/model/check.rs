@@ -297,7 +297,12 @@ impl Model {
             let p = |k: &str| format!("masses[{i}].{k}");
             let node = self.node_id(&p("body"), &p("node"), &m.body, &m.node)?;
             self.positive(&p("mass"), m.mass)?;
-            self.masses.push(PointMass { node, mass: m.mass });
+            let rotary_inertia = m.rotary_inertia.unwrap_or(0.0);
+            if !(rotary_inertia.is_finite() && rotary_inertia >= 0.0) {
+                let msg = format!("must be finite and ≥ 0 (kg m²), got {rotary_inertia}");
+                return Err(self.err(p("rotary_inertia"), msg));
+            }
+            self.masses.push(PointMass { node, mass: m.mass, rotary_inertia });
         }
         self.check_springs(&f.springs)?;
         for (i, pr) in f.probes.iter().enumerate() {

@@ -48,6 +48,10 @@ pub struct MassSpec {
     pub body: String,
     pub node: NodeRef,
     pub mass: f64,
+    /// kg m² about the node, on its slope (absent: none; left out of the serialized file
+    /// then, so that older files keep their fingerprint)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rotary_inertia: Option<f64>,
 }
 
 /// A spring-damper (`[[springs]]`): translational between a node and a node or a ground

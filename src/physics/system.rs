@@ -8,7 +8,7 @@
 use super::element::{BeamElement, Mat8, Vec8};
 use super::joints::{lower, Row};
 use super::loads::{assemble_weight, Gravity, Load, NodalLoad, Weight};
-use super::masses::PointMass;
+use super::masses::{MassEntry, PointMass};
 use crate::linalg::kkt::{make_solver, KktPattern, KktSolver, LinearSolverKind};
 use crate::solver::model::{IterationCoefficients, Parameters, ParametricModel};
 
@@ -53,9 +53,10 @@ pub struct FlexibleSystem {
     symmetric_loads: bool,
     /// whether some nodal load depends on the velocities (a damper)
     load_damping: bool,
-    /// point masses: the node's position coordinates, the mass, and the element whose
-    /// iteration block holds it (its first dof)
-    point_masses: Vec<([usize; 2], f64, (usize, usize))>,
+    /// point masses' mass-matrix entries `(row, column, value)` (the position diagonal and
+    /// any rotary inertia's slope block), each with the element whose iteration block holds
+    /// the node (its first dof)
+    point_masses: Vec<(MassEntry, (usize, usize))>,
     /// the dofs the nodal loads act on, sorted
     load_dofs: Vec<usize>,
     n_dof: usize,
@@ -108,16 +109,15 @@ impl FlexibleSystem {
             loads.iter().filter_map(|l| if let Load::Gravity(g) = l { Some(g) } else { None }).collect();
         let point_masses: Vec<_> = masses
             .iter()
-            .map(|m| {
-                let (dofs, mass) = m.lower(&first);
-                (dofs, mass, {
-                    // a node's position coordinates lie in an element of its
-                    let e = block_holding(&elements, &dofs).expect("a node of the mesh");
-                    (e, elements[e].1[0])
-                })
+            .flat_map(|m| {
+                let d = first(m.node);
+                // a node's four coordinates lie in an element of its
+                let e = block_holding(&elements, &[d, d + 3]).expect("a node of the mesh");
+                let block = (e, elements[e].1[0]);
+                m.entries(&first, bodies[m.node.0].angle).into_iter().map(move |x| (x, block))
             })
             .collect();
-        let lumped: Vec<([usize; 2], f64)> = point_masses.iter().map(|&(d, m, _)| (d, m)).collect();
+        let lumped: Vec<([usize; 2], f64)> = masses.iter().map(|m| m.lower(&first)).collect();
         let weight = assemble_weight(&gravities, &bodies, &elements, &prototypes, &lumped, n_dof);
         let nodal: Vec<Box<dyn NodalLoad>> = loads.iter().filter_map(|l| l.lower(&first)).collect();
         let mut coupling = Vec::new();
@@ -419,10 +419,8 @@ impl FlexibleSystem {
                 }
             }
         }
-        for &(dofs, mass, _) in &self.point_masses {
-            for d in dofs {
-                m[d * n + d] += mass;
-            }
+        for &((i, j, mass), _) in &self.point_masses {
+            m[i * n + j] += mass;
         }
         (m, k)
     }
@@ -521,18 +519,16 @@ impl FlexibleSystem {
 
     /// `out += M_p a`, the point masses' part of the mass matrix.
     fn add_point_mass_product(&self, a: &[f64], out: &mut [f64]) {
-        for &(dofs, mass, _) in &self.point_masses {
-            for d in dofs {
-                out[d] += mass * a[d];
-            }
+        for &((i, j, mass), _) in &self.point_masses {
+            out[i] += mass * a[j];
         }
     }
 
-    /// The point masses as diagonal entries of element blocks: `(element, local index, m)`
-    /// for each position coordinate a point mass sits on (the block that holds it, as the
+    /// The point masses as entries of element blocks: `(element, local row, local column,
+    /// value)` for each entry of their mass matrix (the block that holds the node, as the
     /// iteration matrix's), for callers that assemble their own block matrices.
-    pub fn point_mass_entries(&self) -> impl Iterator<Item = (usize, usize, f64)> + '_ {
-        self.point_masses.iter().flat_map(|&(dofs, mass, (e, d0))| dofs.map(|d| (e, d - d0, mass)))
+    pub fn point_mass_entries(&self) -> impl Iterator<Item = (usize, usize, usize, f64)> + '_ {
+        self.point_masses.iter().map(|&((i, j, mass), (e, d0))| (e, i - d0, j - d0, mass))
     }
 
     /// Whether the model has point masses (mass outside its elements).
@@ -542,10 +538,8 @@ impl FlexibleSystem {
 
     /// Adds `m_c M_p` to the element blocks that hold the point masses.
     fn add_point_mass_blocks(&mut self, coef_mass: f64) {
-        for &(dofs, mass, (e, d0)) in &self.point_masses {
-            for d in dofs {
-                self.blocks[e][(d - d0, d - d0)] += coef_mass * mass;
-            }
+        for &((i, j, mass), (e, d0)) in &self.point_masses {
+            self.blocks[e][(i - d0, j - d0)] += coef_mass * mass;
         }
     }
 
