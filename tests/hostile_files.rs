@@ -408,6 +408,36 @@ fn a_heap_libhdf5_would_loop_on_is_refused() {
     assert_eq!(std::fs::read(tmp.path().join("sweep.h5")).unwrap(), before);
 }
 
+/// Two more cases of scripts/fuzz/heaps.py (`--seed 3`), kept beside the sweep file in
+/// tests/fuzz_cases/heap_free_space/: a snapshot file whose free space claims 8 bytes
+/// (case 14, `train --from-snapshots` never returned) and a part file whose free space
+/// claims 0 (case 192, `merge` never returned). `train` refuses the snapshot file on one
+/// line; the check of global heaps that every text read goes through refuses the part file.
+#[test]
+fn snapshot_and_part_files_libhdf5_would_loop_on_are_refused() {
+    let _one = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let case = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz_cases/heap_free_space");
+    let e = flexrom::io::h5::check_global_heaps(&case.join("part2.h5")).unwrap_err();
+    assert!(e.contains("global heap") && e.contains("damaged"), "{e}");
+    let tmp = tempfile::tempdir().unwrap();
+    for f in ["model.toml", "pipe.toml", "snaps.h5"] {
+        std::fs::copy(case.join(f), tmp.path().join(f)).unwrap();
+    }
+    let o = Command::new("timeout")
+        .arg("60")
+        .arg(env!("CARGO_BIN_EXE_flexrom"))
+        .args(["train", "-q", "pipe.toml", "--from-snapshots", "snaps.h5", "--basis", "new.h5"])
+        .current_dir(tmp.path())
+        .env("HDF5_USE_FILE_LOCKING", "FALSE")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    // its walk ends now that it goes as libhdf5's does; what it reads then is not a snapshot file
+    assert!(err.contains("snaps.h5") && err.trim_end().lines().count() == 1, "{err}");
+    assert!(!tmp.path().join("new.h5").exists());
+}
+
 /// A global heap whose walk would not end in libhdf5 is refused by the check before any
 /// text of the file is read: the free-space object (index 0) claiming 0 bytes (a step of
 /// nothing), at the collection's end or after a free space made shorter than the rest of
