@@ -369,3 +369,156 @@ fn damaged_heap_references_of_text_attributes_are_refused() {
         assert!(e.contains("note") && e.contains("damaged"), "{what}: {e}");
     }
 }
+
+/// A case of scripts/fuzz/heaps.py (`--seed 2`, case 6), kept in
+/// tests/fuzz_cases/heap_free_space/: the free-space object of a sweep file's global heap
+/// made to claim 15 bytes, so that libhdf5's walk of the collection
+/// (`H5HG__cache_heap_deserialize`) went on past it into zeros, an object 0 of 0 bytes it
+/// stepped over by 0 bytes, for ever: `sweep --resume` never returned. Refused now, with
+/// the file left as it was; the basis is trained afresh (the sweep names the model, not
+/// the basis bytes).
+#[test]
+fn a_heap_libhdf5_would_loop_on_is_refused() {
+    let _one = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let case = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz_cases/heap_free_space");
+    let tmp = tempfile::tempdir().unwrap();
+    for f in std::fs::read_dir(&case).unwrap() {
+        let f = f.unwrap().path();
+        std::fs::copy(&f, tmp.path().join(f.file_name().unwrap())).unwrap();
+    }
+    let run = |args: &[&str]| {
+        // a time limit: the loop, if it came back, must fail the test rather than hang it
+        Command::new("timeout")
+            .arg("60")
+            .arg(env!("CARGO_BIN_EXE_flexrom"))
+            .args(args)
+            .current_dir(tmp.path())
+            .env("HDF5_USE_FILE_LOCKING", "FALSE")
+            .output()
+            .unwrap()
+    };
+    let o = run(&["train", "-q", "pipe.toml"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let before = std::fs::read(tmp.path().join("sweep.h5")).unwrap();
+    let o = run(&["sweep", "-q", "pipe.toml", "--load-scales", "0.9:1.1:3", "--resume", "-o", "sweep.h5"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains("sweep.h5") && err.contains("global heap") && err.contains("damaged"), "{err}");
+    assert_eq!(std::fs::read(tmp.path().join("sweep.h5")).unwrap(), before);
+}
+
+/// Two more cases of scripts/fuzz/heaps.py (`--seed 3`), kept beside the sweep file in
+/// tests/fuzz_cases/heap_free_space/: a snapshot file whose free space claims 8 bytes
+/// (case 14, `train --from-snapshots` never returned) and a part file whose free space
+/// claims 0 (case 192, `merge` never returned). `train` refuses the snapshot file on one
+/// line; the check of global heaps that every text read goes through refuses the part file.
+#[test]
+fn snapshot_and_part_files_libhdf5_would_loop_on_are_refused() {
+    let _one = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let case = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz_cases/heap_free_space");
+    let e = flexrom::io::h5::check_global_heaps(&case.join("part2.h5")).unwrap_err();
+    assert!(e.contains("global heap") && e.contains("damaged"), "{e}");
+    let tmp = tempfile::tempdir().unwrap();
+    for f in ["model.toml", "pipe.toml", "snaps.h5"] {
+        std::fs::copy(case.join(f), tmp.path().join(f)).unwrap();
+    }
+    let o = Command::new("timeout")
+        .arg("60")
+        .arg(env!("CARGO_BIN_EXE_flexrom"))
+        .args(["train", "-q", "pipe.toml", "--from-snapshots", "snaps.h5", "--basis", "new.h5"])
+        .current_dir(tmp.path())
+        .env("HDF5_USE_FILE_LOCKING", "FALSE")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    // its walk ends now that it goes as libhdf5's does; what it reads then is not a snapshot file
+    assert!(err.contains("snaps.h5") && err.trim_end().lines().count() == 1, "{err}");
+    assert!(!tmp.path().join("new.h5").exists());
+}
+
+/// A global heap whose walk would not end in libhdf5 is refused by the check before any
+/// text of the file is read: the free-space object (index 0) claiming 0 bytes (a step of
+/// nothing), at the collection's end or after a free space made shorter than the rest of
+/// the collection; an object whose size, rounded up to 8 and plus its 16-byte header,
+/// wraps to 0. The sound file reads.
+#[test]
+fn global_heaps_libhdf5_would_walk_for_ever_are_refused() {
+    let _one = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let tmp = tempfile::tempdir().unwrap();
+    let good = tmp.path().join("good.h5");
+    let text = "a text of some length, stored in a global heap";
+    {
+        let f = hdf5::File::create(&good).unwrap();
+        flexrom::io::h5::attr_str(&f, "note", text).unwrap();
+    }
+    let bytes = std::fs::read(&good).unwrap();
+    let heap = bytes.windows(8).position(|w| w == b"GCOL\x01\0\0\0").expect("a global heap");
+    // object 1 at heap + 16 (16-byte header, the text padded to 8), then the free space
+    let free = heap + 16 + 16 + text.len().div_ceil(8) * 8;
+    assert_eq!(&bytes[free..free + 2], &[0, 0], "object 0, the free space, follows the text");
+    assert!(flexrom::io::h5::check_global_heaps(&good).is_ok());
+    let damages: [(&str, usize, u64); 3] = [
+        ("free space of 0 bytes", free + 8, 0),
+        ("free space of 16 bytes, zeros after it", free + 8, 16),
+        ("an object size wrapping to a step of 0", heap + 16 + 8, u64::MAX - 15),
+    ];
+    for (i, (what, off, with)) in damages.iter().enumerate() {
+        let mut b = bytes.clone();
+        if i == 1 {
+            // what follows the shortened free space: zeros to the collection's end
+            let end = heap + u64::from_le_bytes(b[heap + 8..heap + 16].try_into().unwrap()) as usize;
+            b[free + 16..end].fill(0);
+        }
+        b[*off..*off + 8].copy_from_slice(&with.to_le_bytes());
+        let p = tmp.path().join(format!("damaged{i}.h5"));
+        std::fs::write(&p, &b).unwrap();
+        let e = flexrom::io::h5::check_global_heaps(&p).unwrap_err();
+        assert!(e.contains("global heap") && e.contains("damaged"), "{what}: {e}");
+        let f = hdf5::File::open(&p).unwrap();
+        let e = flexrom::io::h5::read_attr_str(&f, "note").unwrap_err().to_string();
+        assert!(e.contains("damaged"), "{what}: {e}");
+    }
+}
+
+/// A dataset of texts (a sweep's `/message`) is read through the same check as a text
+/// attribute: a damaged heap reference (another index, another collection, a shorter
+/// length) is refused naming the dataset, before libhdf5 follows it; the sound file reads
+/// back equal.
+#[test]
+fn damaged_heap_references_of_text_datasets_are_refused() {
+    use hdf5::types::VarLenUnicode;
+    let _one = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let tmp = tempfile::tempdir().unwrap();
+    let good = tmp.path().join("good.h5");
+    let texts = ["", "a text of some length, stored in a global heap"];
+    {
+        let f = hdf5::File::create(&good).unwrap();
+        let v: Vec<VarLenUnicode> = texts.iter().map(|t| t.parse().unwrap()).collect();
+        flexrom::io::h5_text::write_strings(&f, "message", &v).unwrap();
+    }
+    let f = hdf5::File::open(&good).unwrap();
+    assert_eq!(flexrom::io::h5::read_strings(&f.dataset("message").unwrap()).unwrap(), texts);
+    drop(f);
+    let bytes = std::fs::read(&good).unwrap();
+    let heap = bytes.windows(8).position(|w| w == b"GCOL\x01\0\0\0").expect("a global heap") as u64;
+    // the second text's reference: its length and the collection's address (then its index)
+    let mut stored = (texts[1].len() as u32).to_le_bytes().to_vec();
+    stored.extend(heap.to_le_bytes());
+    let at = bytes.windows(12).position(|w| w == stored.as_slice()).expect("the stored reference");
+    let damages: [(&str, usize, Vec<u8>); 3] = [
+        ("index", at + 12, 7u32.to_le_bytes().to_vec()),
+        ("address", at + 4, (heap + 8).to_le_bytes().to_vec()),
+        ("length", at, 3u32.to_le_bytes().to_vec()),
+    ];
+    for (i, (what, off, with)) in damages.iter().enumerate() {
+        let mut b = bytes.clone();
+        b[*off..*off + with.len()].copy_from_slice(with);
+        let p = tmp.path().join(format!("damaged{i}.h5"));
+        std::fs::write(&p, &b).unwrap();
+        let f = hdf5::File::open(&p).unwrap();
+        let e = flexrom::io::h5::read_strings(&f.dataset("message").unwrap()).unwrap_err().to_string();
+        assert!(e.contains("message") && e.contains("damaged"), "{what}: {e}");
+    }
+}

@@ -188,9 +188,19 @@ unsafe fn scalar_attr(
 pub fn read_attr_str(loc: &hdf5::Location, name: &str) -> hdf5::Result<String> {
     let attr = loc.attr(name)?;
     if let Some(heaps) = heaps_checked(loc)? {
-        check_heap_references(&attr, &heaps).map_err(hdf5::Error::from)?;
+        check_heap_references(&attr, &format!("attribute `{name}`"), &heaps).map_err(hdf5::Error::from)?;
     }
     Ok(attr.read_scalar::<VarLenUnicode>()?.as_str().to_string())
+}
+
+/// Reads the one-dimensional dataset of variable-length strings `ds` (a sweep's
+/// `/message`), its heap references checked first as [`read_attr_str`] checks an
+/// attribute's: libhdf5 would follow a damaged one as it is.
+pub fn read_strings(ds: &hdf5::Dataset) -> hdf5::Result<Vec<String>> {
+    if let Some(heaps) = heaps_checked(ds)? {
+        check_heap_references(ds, &format!("dataset `{}`", ds.name()), &heaps).map_err(hdf5::Error::from)?;
+    }
+    Ok(ds.read_1d::<VarLenUnicode>()?.iter().map(|m| m.as_str().to_string()).collect())
 }
 
 /// The objects of a file's global heap collections, as [`check_global_heaps`] found them:
@@ -253,7 +263,7 @@ extern "C" fn keep_raw_vlen(
     }
 }
 
-/// Refuses the text attribute `attr` if a heap reference stored in it does not name an
+/// Refuses the text attribute or dataset `attr` (`what` in messages) if a heap reference stored in it does not name an
 /// object of `heaps` (the file's global heap collections, checked) whose size is the
 /// stored length: libhdf5 1.10 follows a reference as it is, and a damaged collection
 /// address or object index crashed the process (`H5HG_read`), a length shorter than the
@@ -261,20 +271,32 @@ extern "C" fn keep_raw_vlen(
 /// that keeps them as they are (`keep_raw_vlen`), with no heap dereference. An attribute
 /// that is not a variable-length string is left to the typed read that follows.
 /// `Err(problem)`.
-pub fn check_heap_references(attr: &hdf5::Attribute, heaps: &HeapObjects) -> std::result::Result<(), String> {
+pub fn check_heap_references(
+    attr: &hdf5::Container,
+    what: &str,
+    heaps: &HeapObjects,
+) -> std::result::Result<(), String> {
     use hdf5_sys::h5a::{H5Aget_type, H5Aread};
+    use hdf5_sys::h5d::{H5Dget_type, H5Dread};
+    use hdf5_sys::h5i::{H5I_type_t, H5Iget_type};
+    use hdf5_sys::h5p::H5P_DEFAULT;
+    use hdf5_sys::h5s::H5S_ALL;
     use hdf5_sys::h5t::{H5T_class_t, H5T_pers_t, H5Tclose, H5Tcreate, H5Tis_variable_str, H5Tregister, H5Tset_tag};
     static REGISTERED: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
-    let name = attr.name();
+    // an attribute's or a dataset's texts (`read_attr_str`, `read_strings`): the same
+    // stored layout, read by the matching call
+    // SAFETY: `attr` holds a live id
+    let is_attr = unsafe { H5Iget_type(attr.id()) } == H5I_type_t::H5I_ATTR;
+    let name = what;
     let n = attr.size();
     let raw = hdf5::sync::sync(|| -> std::result::Result<Option<Vec<u8>>, String> {
         // SAFETY: plain calls under the library lock; every type created here is closed
         // here; `H5Aread` writes `n` values of the 16-byte opaque type into a buffer of
         // that size (the conversion keeps the size)
         unsafe {
-            let ft = H5Aget_type(attr.id());
+            let ft = if is_attr { H5Aget_type(attr.id()) } else { H5Dget_type(attr.id()) };
             if ft < 0 {
-                return Err(format!("attribute `{name}`: its type cannot be read"));
+                return Err(format!("{name}: its type cannot be read"));
             }
             let vlen_str = H5Tis_variable_str(ft) > 0;
             H5Tclose(ft);
@@ -309,8 +331,13 @@ pub fn check_heap_references(attr: &hdf5::Attribute, heaps: &HeapObjects) -> std
                     return Err("cannot register the raw reading of texts".to_string());
                 }
                 let mut buf = vec![0u8; n * RAW_VLEN_SIZE];
-                if H5Aread(attr.id(), t, buf.as_mut_ptr().cast()) < 0 {
-                    return Err(format!("attribute `{name}`: its stored text references cannot be read"));
+                let read = if is_attr {
+                    H5Aread(attr.id(), t, buf.as_mut_ptr().cast())
+                } else {
+                    H5Dread(attr.id(), t, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.as_mut_ptr().cast())
+                };
+                if read < 0 {
+                    return Err(format!("{name}: its stored text references cannot be read"));
                 }
                 Ok(Some(buf))
             })();
@@ -323,16 +350,21 @@ pub fn check_heap_references(attr: &hdf5::Attribute, heaps: &HeapObjects) -> std
         let len = u32::from_le_bytes(v[0..4].try_into().expect("4 bytes")) as u64;
         let collection = u64::from_le_bytes(v[4..12].try_into().expect("8 bytes"));
         let index = u32::from_le_bytes(v[12..16].try_into().expect("4 bytes"));
+        if collection == 0 {
+            // the nil reference (a null string, file format "Variable-length data"):
+            // libhdf5 tests the address alone and reads no heap for it
+            continue;
+        }
         match heaps.get(&(collection, index)) {
             Some(&size) if size == len => {}
             Some(&size) => {
                 return Err(format!(
-                    "attribute `{name}` claims a text of {len} bytes where its heap object holds {size}: a damaged file"
+                    "{name} claims a text of {len} bytes where its heap object holds {size}: a damaged file"
                 ))
             }
             None => {
                 return Err(format!(
-                    "attribute `{name}` refers to object {index} of a global heap at address {collection}, which the file does not hold: a damaged file"
+                    "{name} refers to object {index} of a global heap at address {collection}, which the file does not hold: a damaged file"
                 ))
             }
         }
@@ -456,20 +488,23 @@ pub fn check_global_heaps(path: &Path) -> std::result::Result<HeapObjects, Strin
                 "global heap at byte {at} claims {size} bytes, past the end of the file: a damaged file"
             ));
         };
+        // libhdf5's walk (`H5HG__cache_heap_deserialize`), step for step: a tail too short
+        // for an object header is free space; index 0 is free space of its stated size,
+        // header included, and the walk goes on after it
         let mut p = at + 16;
         while p + 16 <= end {
             let (index, object) = (u16::from_le_bytes([b[p], b[p + 1]]), u64_at(p + 8));
-            // index 0: the collection's free space, which ends it
             let need = if index == 0 { object } else { object.saturating_add(16 + 7) / 8 * 8 };
             if need > (end - p) as u64 {
                 return Err(format!(
                     "global heap at byte {at}: object {index} claims {object} bytes, past the end of its collection: a damaged file"
                 ));
             }
-            if index == 0 {
-                break;
+            if need == 0 {
+                // libhdf5 would step by 0 bytes: it never returned
+                return Err(format!("global heap at byte {at}: its free space claims 0 bytes: a damaged file"));
             }
-            if at >= base {
+            if index != 0 && at >= base {
                 objects.insert(((at - base) as u64, u32::from(index)), object);
             }
             p += need as usize;

@@ -20,11 +20,10 @@ use super::sweep::{
     read_sweep, write_sweep, Fallback, Outcome, ScaleResult, Sweep, SweepBasis, STATUS_FAILED, STATUS_OK,
 };
 use crate::error::{show_text, Error, Result};
-use crate::io::h5::{bounded_len, dataset_of_shape, read_attr_f64, read_attr_str};
+use crate::io::h5::{bounded_len, dataset_of_shape, read_attr_f64, read_attr_str, read_strings};
 use crate::limits::Limits;
 use crate::simulate::{Overrides, Settings};
 use crate::solver::parameters::{Parameters, LOAD_SCALE};
-use hdf5::types::VarLenUnicode;
 use ndarray::Array1;
 use std::path::{Path, PathBuf};
 
@@ -133,12 +132,8 @@ fn read_part(path: &Path, limits: &Limits) -> Result<Part> {
         .read_1d::<u8>()
         .map_err(|e| bad("status", format!("cannot be read: {e}")))?
         .to_vec();
-    let message: Vec<String> = shaped(&f, "message", &[n])?
-        .read_1d::<VarLenUnicode>()
-        .map_err(|e| bad("message", format!("cannot be read: {e}")))?
-        .iter()
-        .map(|m| m.as_str().to_string())
-        .collect();
+    let message: Vec<String> =
+        read_strings(&shaped(&f, "message", &[n])?).map_err(|e| bad("message", format!("cannot be read: {e}")))?;
     let noun = if names.len() > 1 { "points" } else { "load scales" };
     if indices.len() != n || status.len() != n || message.len() != n {
         return Err(bad(

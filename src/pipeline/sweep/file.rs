@@ -56,7 +56,7 @@ use super::outcome::{ScaleResult, Sweep, SweepPoint, STATUS_OK, STATUS_PENDING};
 use crate::error::{Error, Result};
 use crate::io::attrs::{check_layout, write_atomically_as, Kind};
 use crate::io::basis_file::StoredBasis;
-use crate::io::h5::{attr_f64, attr_str, attr_u64, bounded_len, dataset_of_shape, read_attr_str};
+use crate::io::h5::{attr_f64, attr_str, attr_u64, bounded_len, dataset_of_shape, read_attr_str, read_strings};
 use crate::model::Model;
 use crate::pipeline::validate::{ProbeQuantityError, Validation};
 use crate::rom::estimator::{Estimate, QuantityEstimate};
@@ -527,14 +527,14 @@ pub fn read_sweep(
     // /message
     let fallback = if f.link_exists("fallback") {
         let flags = flags("fallback")?;
-        let messages = shaped("message", &[n])?.read_1d::<VarLenUnicode>().map_err(|e| read("message", e))?;
+        let messages = read_strings(&shaped("message", &[n])?).map_err(|e| read("message", e))?;
         if flags.len() != n || messages.len() != n {
             return Err(cannot(
                 "fallback",
                 format!("has {} entries (/message {}) for {n} load scales", flags.len(), messages.len()),
             ));
         }
-        flags.iter().zip(&messages).map(|(&x, m)| (x, m.as_str().to_string())).collect()
+        flags.iter().zip(messages).map(|(&x, m)| (x, m)).collect()
     } else {
         vec![(0, String::new()); n]
     };
