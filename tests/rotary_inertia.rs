@@ -15,10 +15,11 @@
 //! * an explicit `rotary_inertia = 0` gives the same bits as none;
 //! * bad input: a negative or NaN rotary inertia, refused naming `masses[0].rotary_inertia`.
 
+mod common;
+
+use common::lowest_frequency;
 use flexrom::model::Model;
 use flexrom::simulate::{simulate, with_energies, Overrides, SimulationResult};
-use std::path::Path;
-use std::process::Command;
 
 const STIFF_STEEL: &str = "density = 7850.0\narea = 1.0e-4\ninertia = 8.33e-10\nyoungs_modulus = 2.1e13";
 /// `J = ρAL³/3` of the 0.5 m bar about its end.
@@ -51,26 +52,6 @@ fn model(text: &str) -> Model {
 
 fn run(text: &str) -> SimulationResult {
     simulate(&model(text), &Overrides::default()).unwrap()
-}
-
-fn write(dir: &Path, name: &str, text: &str) -> std::path::PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
-}
-
-/// `flexrom modes` of a model text: its lowest frequency, Hz.
-fn lowest_frequency(text: &str) -> f64 {
-    let dir = tempfile::tempdir().unwrap();
-    let path = write(dir.path(), "m.toml", text);
-    let out = Command::new(env!("CARGO_BIN_EXE_flexrom"))
-        .args(["modes", path.to_str().unwrap(), "--count", "1", "--json", "-q"])
-        .env("HDF5_USE_FILE_LOCKING", "FALSE")
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    v["frequencies"][0].as_f64().expect("a frequency")
 }
 
 #[test]

@@ -27,10 +27,12 @@
 //! * bad input: negative or NaN stiffness and damping, coincident ends without a free length,
 //!   an unknown body or node, a torsional spring to a point — each refused naming its field.
 
+mod common;
+
+use common::{lowest_frequency, write};
 use flexrom::linalg::kkt::LinearSolverKind;
 use flexrom::model::Model;
 use flexrom::simulate::{simulate, with_energies, Overrides, SimulationResult};
-use std::path::Path;
 use std::process::Command;
 
 const STEEL: &str = "density = 7850.0\narea = 1.0e-4\ninertia = 8.33e-10\nyoungs_modulus = 2.1e11";
@@ -172,26 +174,6 @@ fn a_bar_on_a_torsional_spring_swings_at_the_root_of_k_over_j() {
     let amplitude = w0 / w;
     let dev = max_deviation(&r, &theta, |t| amplitude * (w * t).sin());
     assert!(dev < 3e-3 * amplitude, "deviation {dev:.3e} rad against an amplitude of {amplitude:.3e} rad");
-}
-
-fn write(dir: &Path, name: &str, text: &str) -> std::path::PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
-}
-
-/// `flexrom modes` of a model text: its lowest frequency, Hz.
-fn lowest_frequency(text: &str) -> f64 {
-    let dir = tempfile::tempdir().unwrap();
-    let path = write(dir.path(), "m.toml", text);
-    let out = Command::new(env!("CARGO_BIN_EXE_flexrom"))
-        .args(["modes", path.to_str().unwrap(), "--count", "1", "--json", "-q"])
-        .env("HDF5_USE_FILE_LOCKING", "FALSE")
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    v["frequencies"][0].as_f64().expect("a frequency")
 }
 
 #[test]

@@ -141,3 +141,24 @@ name = "tip"
 body = "lower"
 node = "end"
 "#;
+
+/// Writes `text` to `dir/name` and returns the path.
+pub fn write(dir: &std::path::Path, name: &str, text: &str) -> std::path::PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// `flexrom modes` of a model text: its lowest frequency, Hz.
+pub fn lowest_frequency(text: &str) -> f64 {
+    let dir = tempfile::tempdir().unwrap();
+    let path = write(dir.path(), "m.toml", text);
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_flexrom"))
+        .args(["modes", path.to_str().unwrap(), "--count", "1", "--json", "-q"])
+        .env("HDF5_USE_FILE_LOCKING", "FALSE")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    v["frequencies"][0].as_f64().expect("a frequency")
+}
