@@ -336,14 +336,9 @@ fn the_damaged_reference_of_the_campaign_case_is_refused() {
 fn damaged_heap_references_of_text_attributes_are_refused() {
     let _one = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
     let tmp = tempfile::tempdir().unwrap();
-    let good = tmp.path().join("good.h5");
-    let text = "a text of some length, stored in a global heap";
-    {
-        let f = hdf5::File::create(&good).unwrap();
-        flexrom::io::h5::attr_str(&f, "note", text).unwrap();
-    }
-    let bytes = std::fs::read(&good).unwrap();
-    let heap = bytes.windows(8).position(|w| w == b"GCOL\x01\0\0\0").expect("a global heap") as u64;
+    let (good, text) = (tmp.path().join("good.h5"), HEAP_TEXT);
+    let bytes = file_with_heap_text(&good);
+    let heap = global_heap_at(&bytes) as u64;
     let mut stored = (text.len() as u32).to_le_bytes().to_vec();
     stored.extend(heap.to_le_bytes());
     stored.extend(1u32.to_le_bytes());
@@ -447,14 +442,9 @@ fn snapshot_and_part_files_libhdf5_would_loop_on_are_refused() {
 fn global_heaps_libhdf5_would_walk_for_ever_are_refused() {
     let _one = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
     let tmp = tempfile::tempdir().unwrap();
-    let good = tmp.path().join("good.h5");
-    let text = "a text of some length, stored in a global heap";
-    {
-        let f = hdf5::File::create(&good).unwrap();
-        flexrom::io::h5::attr_str(&f, "note", text).unwrap();
-    }
-    let bytes = std::fs::read(&good).unwrap();
-    let heap = bytes.windows(8).position(|w| w == b"GCOL\x01\0\0\0").expect("a global heap");
+    let (good, text) = (tmp.path().join("good.h5"), HEAP_TEXT);
+    let bytes = file_with_heap_text(&good);
+    let heap = global_heap_at(&bytes);
     // object 1 at heap + 16 (16-byte header, the text padded to 8), then the free space
     let free = heap + 16 + 16 + text.len().div_ceil(8) * 8;
     assert_eq!(&bytes[free..free + 2], &[0, 0], "object 0, the free space, follows the text");
@@ -502,7 +492,7 @@ fn damaged_heap_references_of_text_datasets_are_refused() {
     assert_eq!(flexrom::io::h5::read_strings(&f.dataset("message").unwrap()).unwrap(), texts);
     drop(f);
     let bytes = std::fs::read(&good).unwrap();
-    let heap = bytes.windows(8).position(|w| w == b"GCOL\x01\0\0\0").expect("a global heap") as u64;
+    let heap = global_heap_at(&bytes) as u64;
     // the second text's reference: its length and the collection's address (then its index)
     let mut stored = (texts[1].len() as u32).to_le_bytes().to_vec();
     stored.extend(heap.to_le_bytes());
@@ -521,4 +511,22 @@ fn damaged_heap_references_of_text_datasets_are_refused() {
         let e = flexrom::io::h5::read_strings(&f.dataset("message").unwrap()).unwrap_err().to_string();
         assert!(e.contains("message") && e.contains("damaged"), "{what}: {e}");
     }
+}
+
+/// The text of [`file_with_heap_text`]'s attribute `note`.
+const HEAP_TEXT: &str = "a text of some length, stored in a global heap";
+
+/// Writes an HDF5 file at `path` holding one text attribute, `note` = [`HEAP_TEXT`] (stored
+/// in a global heap), and returns its bytes.
+fn file_with_heap_text(path: &std::path::Path) -> Vec<u8> {
+    {
+        let f = hdf5::File::create(path).unwrap();
+        flexrom::io::h5::attr_str(&f, "note", HEAP_TEXT).unwrap();
+    }
+    std::fs::read(path).unwrap()
+}
+
+/// The byte offset of the first global heap collection ("GCOL", version 1) of a file.
+fn global_heap_at(bytes: &[u8]) -> usize {
+    bytes.windows(8).position(|w| w == b"GCOL\x01\0\0\0").expect("a global heap")
 }

@@ -287,7 +287,6 @@ pub fn check_heap_references(
     // stored layout, read by the matching call
     // SAFETY: `attr` holds a live id
     let is_attr = unsafe { H5Iget_type(attr.id()) } == H5I_type_t::H5I_ATTR;
-    let name = what;
     let n = attr.size();
     let raw = hdf5::sync::sync(|| -> std::result::Result<Option<Vec<u8>>, String> {
         // SAFETY: plain calls under the library lock; every type created here is closed
@@ -296,7 +295,7 @@ pub fn check_heap_references(
         unsafe {
             let ft = if is_attr { H5Aget_type(attr.id()) } else { H5Dget_type(attr.id()) };
             if ft < 0 {
-                return Err(format!("{name}: its type cannot be read"));
+                return Err(format!("{what}: its type cannot be read"));
             }
             let vlen_str = H5Tis_variable_str(ft) > 0;
             H5Tclose(ft);
@@ -337,7 +336,7 @@ pub fn check_heap_references(
                     H5Dread(attr.id(), t, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.as_mut_ptr().cast())
                 };
                 if read < 0 {
-                    return Err(format!("{name}: its stored text references cannot be read"));
+                    return Err(format!("{what}: its stored text references cannot be read"));
                 }
                 Ok(Some(buf))
             })();
@@ -359,12 +358,12 @@ pub fn check_heap_references(
             Some(&size) if size == len => {}
             Some(&size) => {
                 return Err(format!(
-                    "{name} claims a text of {len} bytes where its heap object holds {size}: a damaged file"
+                    "{what} claims a text of {len} bytes where its heap object holds {size}: a damaged file"
                 ))
             }
             None => {
                 return Err(format!(
-                    "{name} refers to object {index} of a global heap at address {collection}, which the file does not hold: a damaged file"
+                    "{what} refers to object {index} of a global heap at address {collection}, which the file does not hold: a damaged file"
                 ))
             }
         }

@@ -545,18 +545,14 @@ fn probes_figure(full: &SimulationResult, reduced: &SimulationResult, title: Str
                 .iter()
                 .zip(&reduced.probes)
                 .flat_map(|((name, a), (_, b))| {
-                    [
+                    let line = |run: &str, v: &ndarray::Array2<f64>, style| {
                         Series::new(
-                            format!("{name}, full"),
-                            t.iter().zip(a.column(c)).map(|(t, v)| (*t, *v)).collect(),
-                            Style::Line,
-                        ),
-                        Series::new(
-                            format!("{name}, reduced"),
-                            t.iter().zip(b.column(c)).map(|(t, v)| (*t, *v)).collect(),
-                            Style::Dashed,
-                        ),
-                    ]
+                            format!("{name}, {run}"),
+                            t.iter().copied().zip(v.column(c).iter().copied()).collect(),
+                            style,
+                        )
+                    };
+                    [line("full", a, Style::Line), line("reduced", b, Style::Dashed)]
                 })
                 .collect(),
         })

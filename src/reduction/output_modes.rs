@@ -87,6 +87,10 @@ pub fn add_output_modes(
     }
     let centred = &x - &trained.basis.reference.view().insert_axis(Axis(1));
     let exact = outputs_at(outputs, &|d, j| x[[d, j]], x.ncols());
+    // the centred snapshots projected on the whole basis, once: a block's new modes change
+    // its own rows only, so each block goes on from what the blocks before it left
+    let modes = &trained.basis.modes;
+    let mut projected = modes.dot(&modes.t().dot(&centred));
     let mut columns: Vec<Array2<f64>> = (0..blocks.len()).map(|b| block_columns(trained, blocks, b)).collect();
     let mut added = vec![0; blocks.len()];
     for (b, rows) in blocks.iter().enumerate() {
@@ -95,7 +99,7 @@ pub fn add_output_modes(
         if reads.is_empty() {
             continue;
         }
-        let mut block = BlockState::new(trained, rows, centred.view(), &columns[b]);
+        let mut block = BlockState::new(rows, centred.view(), &columns[b], &mut projected);
         for s in seed.get(b).map(|a| a.columns().into_iter().map(|c| c.to_owned()).collect()).unwrap_or(Vec::new()) {
             if block.push(s.view()) {
                 added[b] += 1;
@@ -152,9 +156,9 @@ fn outputs_at(outputs: &Outputs, value: &dyn Fn(usize, usize) -> f64, m: usize) 
     y
 }
 
-/// One block during enrichment: its modes on its rows, the snapshots' coefficients in the
-/// whole basis, and the residual of its rows.
-struct BlockState {
+/// One block during enrichment: its modes on its rows, the residual of its rows, and the
+/// snapshots projected on the whole basis.
+struct BlockState<'p> {
     rows: Vec<usize>,
     /// the block's columns on its rows (n_b × k)
     v: Array2<f64>,
@@ -162,17 +166,15 @@ struct BlockState {
     c: Array2<f64>,
     /// (I − V Vᵀ) c on the block's rows
     residual: Array2<f64>,
-    /// the centred snapshots projected on the whole basis (n × m) on every row an output
-    /// reads: the other blocks' and the kept coordinates' parts do not change here
-    projected: Array2<f64>,
+    /// the centred snapshots projected on the whole basis (n × m): the other blocks' and
+    /// the kept coordinates' rows do not change here
+    projected: &'p mut Array2<f64>,
 }
 
-impl BlockState {
-    fn new(trained: &Trained, rows: &[usize], centred: ArrayView2<f64>, v: &Array2<f64>) -> Self {
+impl<'p> BlockState<'p> {
+    fn new(rows: &[usize], centred: ArrayView2<f64>, v: &Array2<f64>, projected: &'p mut Array2<f64>) -> Self {
         let c = centred.select(Axis(0), rows);
         let residual = &c - &v.dot(&v.t().dot(&c));
-        let modes = &trained.basis.modes;
-        let projected = modes.dot(&modes.t().dot(&centred));
         BlockState { rows: rows.to_vec(), v: v.clone(), c, residual, projected }
     }
 

@@ -83,7 +83,10 @@ pub fn held_out_points_within(dir: &std::path::Path, tolerance: f64) -> Vec<serd
 /// with a tip force `(0, −2)` N scaled by the parameter `payload` and a probe `tip`;
 /// `elements` a link, time step `dt`, 1 s.
 pub fn two_link_arm(elements: usize, dt: f64) -> String {
-    TWO_LINK_ARM.replace("ELEMENTS", &elements.to_string()).replace("DT", &dt.to_string())
+    let link = |name: &str, x0: f64| {
+        format!("[[bodies]]\nname = \"{name}\"\nstart = [{x0:?}, 0.0]\nangle = 0.0\nlength = 0.5\nelements = {elements}\ndensity = 2700.0\narea = 1.0e-4\ninertia = 8.3e-10\nyoungs_modulus = 7.0e10\n")
+    };
+    TWO_LINK_ARM.replace("LINKS", &(link("upper", 0.0) + &link("lower", 0.5))).replace("DT", &dt.to_string())
 }
 
 const TWO_LINK_ARM: &str = r#"
@@ -92,27 +95,7 @@ description = "Two aluminium links pinned together, swung by a shoulder moment, 
 t_end = 1.0
 dt = DT
 rho_inf = 0.9
-[[bodies]]
-name = "upper"
-start = [0.0, 0.0]
-angle = 0.0
-length = 0.5
-elements = ELEMENTS
-density = 2700.0
-area = 1.0e-4
-inertia = 8.3e-10
-youngs_modulus = 7.0e10
-[[bodies]]
-name = "lower"
-start = [0.5, 0.0]
-angle = 0.0
-length = 0.5
-elements = ELEMENTS
-density = 2700.0
-area = 1.0e-4
-inertia = 8.3e-10
-youngs_modulus = 7.0e10
-[[joints]]
+LINKS[[joints]]
 type = "ground_pin"
 body = "upper"
 node = "start"
