@@ -32,13 +32,6 @@ impl Property {
         }
     }
 
-    fn noun(self) -> &'static str {
-        match self {
-            Property::YoungsModulus => "Young's modulus",
-            Property::Density => "density",
-        }
-    }
-
     fn other(self) -> Property {
         match self {
             Property::YoungsModulus => Property::Density,
@@ -556,9 +549,7 @@ impl Model {
     /// The parameter that body `i`'s `youngs_modulus` or `density = { value, parameter }`
     /// names, if any: a parameter name that no load scales (a load's parameter is a factor,
     /// a property's its value) and no other kind of property takes, the same value wherever
-    /// bodies share it, and an undamped model (Rayleigh damping `a M + b K` would change
-    /// with the property only in part: the affine split a reduced model relies on holds
-    /// without it).
+    /// bodies share it (Rayleigh damping `a M(ρ) + b K(E)` follows both properties).
     fn checked_property_parameter(&self, f: &ModelFile, i: usize, which: Property) -> Result<Option<String>> {
         let key = which.key();
         let field = format!("bodies[{i}].{key}.parameter");
@@ -597,12 +588,6 @@ impl Model {
             return Err(self.err(
                 field,
                 format!("`{name}` also scales loads[{k}]: a load's parameter multiplies it, a {key} parameter is its value; give them different names"),
-            ));
-        }
-        if f.damping.as_ref().is_some_and(|d| d.mass != 0.0 || d.stiffness != 0.0) {
-            return Err(self.err(
-                field,
-                format!("a {} parameter needs a model without [damping] (Rayleigh damping with a parameter {} is not supported)", which.noun(), which.noun()),
             ));
         }
         Ok(Some(name.to_string()))

@@ -427,17 +427,17 @@ impl FlexibleSystem {
 
     /// `fₑ = Cₑ q̇ₑ + Qₑ(qₑ)` with Rayleigh `Cₑ = a Mₑ + b K_bending,ₑ`, `Qₑ` from the
     /// element prototype `el` (the file's or the bound one).
-    fn element_force_vec(&self, el: &BeamElement, e: usize, qe: &Vec8, ve: &Vec8) -> Vec8 {
+    fn element_force_vec(&self, el: &BeamElement, qe: &Vec8, ve: &Vec8) -> Vec8 {
         let mut f = el.elastic_force(qe);
         if self.damping != Rayleigh::default() {
-            f += self.damping_force(e, ve);
+            f += self.damping_force(el, ve);
         }
         f
     }
 
-    /// The Rayleigh damping force `Cₑ q̇ₑ = (a Mₑ + b K_bending,ₑ) q̇ₑ` of element `e`.
-    fn damping_force(&self, e: usize, ve: &Vec8) -> Vec8 {
-        let el = self.element(e);
+    /// The Rayleigh damping force `Cₑ q̇ₑ = (a Mₑ + b K_bending,ₑ) q̇ₑ` of an element whose
+    /// prototype is `el`: at a bound density and modulus, `a Mₑ(ρ) + b K_bending,ₑ(E)`.
+    fn damping_force(&self, el: &BeamElement, ve: &Vec8) -> Vec8 {
         (el.mass() * self.damping.mass + el.bending_stiffness() * self.damping.stiffness) * ve
     }
 

@@ -30,13 +30,15 @@
 //! ([`crate::solver::model::ElementModel::stiffness_factor`],
 //! Young's modulus) is affine in it: `L_r(μ) = Σ_g s_g(μ) L_r,g`, `l_r(μ)` alike, over the
 //! groups `g` of elements that share a parameter, and each sampled weight becomes
-//! `s_g(μ) wₑ`; both are set again when μ changes (once per run).
+//! `s_g(μ) wₑ`; both are set again when μ changes (once per run). Its damping, where it
+//! has some, is split likewise by mass and stiffness (`super::damping`): `C_r(μ)`.
 
 mod columns;
 mod kernels;
 mod sampled;
 
 use super::basis::Basis;
+use super::damping::DampingSplit;
 use super::projection::{forward_to_projection, impl_reduced, Projection};
 use super::sample::Hyper;
 use crate::linalg::incremental_product::IncrementalProduct;
@@ -74,6 +76,9 @@ pub struct HyperReducedModel<M: InvariantElementModel> {
     runs: Vec<(usize, usize, usize)>,
     /// the affine split in the elements' stiffness parameters; `None` without any
     stiffness: Option<StiffnessSplit>,
+    /// the damping split by mass and stiffness parameters; `None` without damping or
+    /// without such parameters (`C_r` is then constant)
+    damping: Option<DampingSplit>,
 }
 
 /// `L_r,g` and `l_r,g` of the module documentation, with the sampled weights at `s = 1` and
@@ -123,6 +128,7 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
         let (mut le, mut ce) = (vec![0.0; ne * ne], vec![0.0; ne * ne]);
         let mut lv = Array2::zeros((ne, r));
         let mut cv = Array2::zeros((ne, r));
+        let damping = DampingSplit::new(&*full, v.view());
         for e in 0..n_el {
             let dofs = full.element_dofs(e).to_vec();
             full.element_linear(e, &mut le, &mut ce);
@@ -137,7 +143,7 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
             };
             ndarray::linalg::general_mat_mul(1.0, &ve.t(), &lv, 1.0, l_sum);
             // undamped models (both benchmarks) skip half the work of every run's set-up
-            if ce.iter().any(|&x| x != 0.0) {
+            if damping.is_none() && ce.iter().any(|&x| x != 0.0) {
                 ndarray::linalg::general_mat_mul(1.0, &cm, &ve, 0.0, &mut cv);
                 ndarray::linalg::general_mat_mul(1.0, &ve.t(), &cv, 1.0, &mut c_r);
             }
@@ -147,7 +153,10 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
             l_r += lg;
             l0 += l0g;
         }
-        let c_r = if c_r.iter().any(|&x| x != 0.0) { Some(c_r) } else { None };
+        let c_r = match &damping {
+            Some(d) => Some(d.matrix().clone()),
+            None => c_r.iter().any(|&x| x != 0.0).then_some(c_r),
+        };
         let stiffness = (!split.is_empty()).then(|| StiffnessSplit {
             groups: split.iter().zip(group_l).map(|((_, members), (lg, l0g))| (members[0], lg, l0g)).collect(),
             sample_group: hyper.elements.iter().map(|&e| group_of[e]).collect(),
@@ -220,14 +229,20 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
             full,
             p,
             stiffness,
+            damping,
         })
     }
 
     /// Sets the mass to the elements' mass at `mu`, the linear parts and the sampled weights
-    /// to their stiffness (nothing to do for a model without such parameters, or at the
-    /// same factors).
+    /// to their stiffness, the damping to both (nothing to do for a model without such
+    /// parameters, or at the same factors).
     fn bind_parameters(&mut self, mu: &Parameters) {
         self.p.bind(&*self.full, mu);
+        if let Some(c) = self.damping.as_mut().and_then(|d| d.bind(&*self.full, mu)) {
+            self.c_rows = Some(SparseRows::new(c));
+            self.c_v.reset();
+            self.p.set_linear_damping(c.clone());
+        }
         let Some(split) = &mut self.stiffness else { return };
         // the same factors (every evaluation of a run): nothing to do, nothing allocated
         if split.groups.iter().zip(&split.factors).all(|((e, ..), &f)| self.full.stiffness_factor(*e, mu) == f) {

@@ -14,6 +14,7 @@
 
 pub mod basis;
 mod basis_train;
+mod damping;
 pub mod ecsw;
 pub mod estimator;
 pub mod hyper_model;

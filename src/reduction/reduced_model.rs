@@ -12,12 +12,15 @@
 //! touched per iteration except the tangent's `Vᵀ Y` (Y = Σ Aₑᵀ Sₑ Vₑ, n × r): plain Galerkin
 //! costs as much as the mesh. The element weights `wₑ` are 1 for plain Galerkin; an
 //! element whose stiffness is a parameter weighs `sₑ(μ) wₑ`
-//! ([`ElementModel::stiffness_factor`]: such a model is undamped, `fₑ` is elastic alone).
+//! ([`ElementModel::stiffness_factor`]). A damped model with mass or stiffness parameters
+//! keeps its damping apart, `C_r(μ)` over every element (`super::damping`), and evaluates
+//! its elements without velocities: `fₑ(xₑ, 0)`, scaled by `sₑ(μ)`, is elastic alone.
 //!
 //! Joints, mass and nodal loads: see `reduction::projection` (private).
 
 use super::basis::Basis;
-use super::projection::{axpy, expand, forward_to_projection, impl_reduced, project_add, Projection};
+use super::damping::DampingSplit;
+use super::projection::{axpy, expand, forward_to_projection, impl_reduced, mat_vec, project_add, Projection};
 use crate::solver::model::{ElementModel, IterationCoefficients, Parameters, ParametricModel};
 use ndarray::{linalg::general_mat_mul, Array1, Array2, Axis};
 use std::sync::Arc;
@@ -51,6 +54,9 @@ pub struct ReducedModel<M: ElementModel> {
     ve: Vec<f64>,
     fe: Vec<f64>,
     se: Vec<f64>,
+    /// the damping split by mass and stiffness parameters, `C_r(μ)` (`None`: the element
+    /// forces carry the damping)
+    damping: Option<DampingSplit>,
 }
 
 impl<M: ElementModel> ReducedModel<M> {
@@ -72,8 +78,12 @@ impl<M: ElementModel> ReducedModel<M> {
         weights: Vec<f64>,
     ) -> Result<Self, String> {
         let full: Arc<M> = full.into();
-        let p = Projection::new(&*full, basis)?;
+        let mut p = Projection::new(&*full, basis)?;
         let v = &basis.modes;
+        let damping = DampingSplit::new(&*full, v.view());
+        if let Some(d) = &damping {
+            p.set_linear_terms(None, Some(d.matrix().clone()));
+        }
         let (n, r) = (v.nrows(), v.ncols());
         let ne = if full.n_elements() > 0 { full.element_dofs(0).len() } else { 0 };
         let rows: Vec<usize> = elements.iter().flat_map(|&e| full.element_dofs(e).to_vec()).collect();
@@ -94,6 +104,7 @@ impl<M: ElementModel> ReducedModel<M> {
             ve: vec![0.0; ne],
             fe: vec![0.0; ne],
             se: vec![0.0; ne * ne],
+            damping,
             full,
             p,
             ne,
@@ -108,6 +119,9 @@ impl<M: ElementModel> ReducedModel<M> {
     /// the module documentation).
     fn bind_parameters(&mut self, mu: &Parameters) {
         self.p.bind(&*self.full, mu);
+        if let Some(c) = self.damping.as_mut().and_then(|d| d.bind(&*self.full, mu)) {
+            self.p.set_linear_damping(c.clone());
+        }
         match &self.bound {
             Some(at) if at != mu => {}
             _ => return,
@@ -142,11 +156,18 @@ impl<M: ElementModel> ParametricModel for ReducedModel<M> {
         self.p.constant_and_load_force(&*self.full, mu, (q, v), t, out);
         let ne = self.ne;
         self.update_element_coordinates(q);
+        let damping_apart = self.damping.is_some();
         for (k, (&e, &w)) in self.elements.iter().zip(&self.weights).enumerate() {
-            expand(&self.v_el, None, k * ne, v, &mut self.ve);
+            // with the damping apart `ve` stays zero: the elastic force alone
+            if !damping_apart {
+                expand(&self.v_el, None, k * ne, v, &mut self.ve);
+            }
             self.full.element_force(e, &self.x_el[k * ne..(k + 1) * ne], &self.ve, &mut self.fe);
             self.fe.iter_mut().for_each(|f| *f *= w);
             project_add(&self.v_el, k * ne, &self.fe, out);
+        }
+        if let Some(d) = &self.damping {
+            mat_vec(d.matrix(), v, out, true);
         }
     }
 
@@ -163,7 +184,9 @@ impl<M: ElementModel> ParametricModel for ReducedModel<M> {
         self.p.start_matrix(&*self.full, mu, (q, v), t, coef);
         if coef.stiffness != 0.0 || coef.damping != 0.0 {
             self.update_element_coordinates(q);
-            let ecoef = IterationCoefficients { mass: 0.0, ..coef };
+            // the damping kept apart enters with the projection's constant part
+            let damping = if self.damping.is_some() { 0.0 } else { coef.damping };
+            let ecoef = IterationCoefficients { mass: 0.0, damping, ..coef };
             // assemble Y = S V over the global dofs first, then one product Vᵀ Y: about
             // half the flops of projecting every element block separately (shared nodes)
             let vs = self.v_el.as_slice().expect("standard layout");

@@ -223,14 +223,19 @@ impl<M: ParametricModel + ?Sized> DynamicModel for Bound<'_, M> {
 /// `g₀(μ) = g₀,fixed + λ g₀,scaled`, and `g_l` takes μ.
 ///
 /// The element terms are those of the model file's own values. A parameter may scale an
-/// element's stiffness (Young's modulus as a parameter): then the model's force at μ holds
-/// `sₑ(μ) fₑ` and its tangent `sₑ(μ) ∂fₑ/∂qₑ`, with `sₑ` = [`ElementModel::stiffness_factor`];
-/// such a model has no damping (`Cₑ = 0`), so `fₑ` is elastic alone and the model stays
-/// affine in `sₑ`: a reduction sums the elements that share a parameter apart and scales
-/// each sum at μ. A parameter may scale an element's mass likewise (density as a
-/// parameter, [`ElementModel::mass_factor`]): its mass and its share of `g₀` (gravity)
-/// scale by `mₑ(μ)`, and a reduction projects them per group ([`ElementModel::group_mass_mul`],
-/// [`ElementModel::group_constant_forces`]).
+/// element's stiffness (Young's modulus as a parameter): then the model's elastic force at μ
+/// is `sₑ(μ) Qₑ` and its tangent `sₑ(μ) ∂Qₑ/∂qₑ`, with `sₑ` = [`ElementModel::stiffness_factor`],
+/// so the model stays affine in `sₑ`: a reduction sums the elements that share a parameter
+/// apart and scales each sum at μ. A parameter may scale an element's mass likewise
+/// (density as a parameter, [`ElementModel::mass_factor`]): its mass and its share of `g₀`
+/// (gravity) scale by `mₑ(μ)`, and a reduction projects them per group
+/// ([`ElementModel::group_mass_mul`], [`ElementModel::group_constant_forces`]). The damping
+/// of such an element splits into a part that follows its mass and one that follows its
+/// stiffness (Rayleigh `a Mₑ + b Kₑ`, [`ElementModel::element_damping_parts`]):
+///
+/// ```text
+///     fₑ(qₑ, q̇ₑ; μ) = sₑ(μ) Qₑ(qₑ) + (mₑ(μ) Cₑ,m + sₑ(μ) Cₑ,s) q̇ₑ,    Cₑ = Cₑ,m + Cₑ,s.
+/// ```
 pub trait ElementModel: ParametricModel {
     fn n_elements(&self) -> usize;
     /// Global dofs of element `e`; every element has the same number of them.
@@ -272,6 +277,15 @@ pub trait ElementModel: ParametricModel {
     /// `mₑ(μ)`, the factor of element `e`'s mass and weight at μ (1 at the file's values).
     fn mass_factor(&self, _e: usize, _mu: &Parameters) -> f64 {
         1.0
+    }
+    /// `Cₑ` in its two parts at the model file's values (column-major): `by_mass` scales with
+    /// the element's mass factor `mₑ(μ)` (Rayleigh `a Mₑ`), `by_stiffness` with its stiffness
+    /// factor `sₑ(μ)` (`b Kₑ`); their sum is the `Cₑ` of [`Self::element_force`]. A damped
+    /// model gives them, so that a reduction can scale each part at μ; zeros by default (an
+    /// undamped model).
+    fn element_damping_parts(&self, _e: usize, by_mass: &mut [f64], by_stiffness: &mut [f64]) {
+        by_mass.iter_mut().for_each(|x| *x = 0.0);
+        by_stiffness.iter_mut().for_each(|x| *x = 0.0);
     }
     /// `out = M_g a` at the model file's values, `M_g` the mass of the elements whose
     /// [`Self::mass_parameter`] is `group` (`None`: those no parameter scales, every element

@@ -15,7 +15,7 @@ impl ElementModel for FlexibleSystem {
     }
 
     fn element_force(&self, e: usize, qe: &[f64], ve: &[f64], out: &mut [f64]) {
-        let f = self.element_force_vec(self.element(e), e, &Vec8::from_column_slice(qe), &Vec8::from_column_slice(ve));
+        let f = self.element_force_vec(self.element(e), &Vec8::from_column_slice(qe), &Vec8::from_column_slice(ve));
         out.copy_from_slice(f.as_slice());
     }
 
@@ -71,6 +71,13 @@ impl ElementModel for FlexibleSystem {
 
     fn mass_factor(&self, e: usize, mu: &Parameters) -> f64 {
         self.body_mass_factor(self.elements[e].0, mu)
+    }
+
+    /// Rayleigh `a Mₑ` and `b K_bending,ₑ` at the file's values.
+    fn element_damping_parts(&self, e: usize, by_mass: &mut [f64], by_stiffness: &mut [f64]) {
+        let el = self.element(e);
+        by_mass.copy_from_slice((el.mass() * self.damping.mass).as_slice());
+        by_stiffness.copy_from_slice((el.bending_stiffness() * self.damping.stiffness).as_slice());
     }
 
     fn group_mass_mul(&self, group: Option<&str>, a: &[f64], out: &mut [f64]) {
@@ -186,7 +193,7 @@ impl ParametricModel for FlexibleSystem {
         self.gravity_into(mu, out);
         for e in 0..self.elements.len() {
             let el = &self.bound[self.elements[e].0];
-            let f = self.element_force_vec(el, e, &self.gather(e, q), &self.gather(e, v));
+            let f = self.element_force_vec(el, &self.gather(e, q), &self.gather(e, v));
             for (i, &d) in self.elements[e].1.iter().enumerate() {
                 out[d] += f[i];
             }
@@ -219,7 +226,7 @@ impl ParametricModel for FlexibleSystem {
             let (mut f, m) = el.force_and_inertia(qe, ae);
             if damped {
                 // as element_force_vec: the elastic force, then the damping force added
-                f = (Vec8::from(f) + self.damping_force(e, &self.gather(e, v))).into();
+                f = (Vec8::from(f) + self.damping_force(el, &self.gather(e, v))).into();
             }
             for (o, fi) in force[d0..d0 + 8].iter_mut().zip(f) {
                 *o += fi;

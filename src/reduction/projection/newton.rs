@@ -37,6 +37,13 @@ impl Projection {
         self.base_coef = None;
     }
 
+    /// Replaces the constant damping term, keeping the stiffness term (a mass or stiffness
+    /// parameter changed).
+    pub fn set_linear_damping(&mut self, damping: Array2<f64>) {
+        self.linear.1 = Some(damping);
+        self.base_coef = None;
+    }
+
     /// The buffer the iteration matrix is assembled in (column-major) and its leading
     /// dimension: `S` (r × r) when the joints are eliminated, else the KKT matrix.
     fn matrix(&mut self) -> (&mut [f64], usize) {
