@@ -159,7 +159,7 @@ pub fn energies_over(
         out.strain_axial[k] = a;
         out.strain[k] = a + b;
         out.gravity[k] = weight.iter().zip(&qk).map(|(g, q)| g * q).sum();
-        let (stored, rate) = sys.spring_energy(&qk, &vk);
+        let (stored, rate) = sys.spring_energy(mu, &qk, &vk);
         out.springs[k] = stored;
         let power = load_power(sys, mu, (&qk, &vk), t[k], rate);
         if k > 0 {

@@ -13,7 +13,7 @@ use crate::physics::loads::Load;
 use crate::physics::masses::PointMass;
 use crate::physics::system::{BeamBody, FlexibleSystem, Joint, Probe, Rayleigh};
 use crate::solver::generalized_alpha::IntegratorParams;
-use crate::solver::parameters::Parameters;
+use crate::solver::parameters::{Parameters, Scaling};
 use schema::*;
 use std::path::{Path, PathBuf};
 use toml_errors::entry_error;
@@ -128,8 +128,9 @@ impl Model {
     }
 
     /// The model's parameters, each once: those its loads and then its drives are scaled by
-    /// (`scaled = true` is [`crate::solver::parameters::LOAD_SCALE`]) in file order, then the
-    /// bodies' Young's moduli that are parameters, in the order of the bodies.
+    /// (`scaled = true` is [`crate::solver::parameters::LOAD_SCALE`]) in file order, the
+    /// springs' stiffnesses that are parameters among the loads, then the bodies' Young's
+    /// moduli and densities that are parameters, in the order of the bodies.
     pub fn parameter_names(&self) -> Vec<&str> {
         let mut names: Vec<&str> = Vec::new();
         let drives = self.joints.iter().filter_map(|j| j.kind().drive_scaling());
@@ -150,31 +151,39 @@ impl Model {
         names
     }
 
-    /// What `name` sets when it is a body's property, "Young's modulus (Pa)" or "density
-    /// (kg/m³)" (a value, not a factor), or `None`.
-    pub fn property_parameter(&self, name: &str) -> Option<&'static str> {
-        let named = |p: &Option<String>| p.as_deref() == Some(name);
-        if self.bodies.iter().any(|b| named(&b.youngs_modulus_parameter)) {
-            Some("Young's modulus (Pa)")
-        } else if self.bodies.iter().any(|b| named(&b.density_parameter)) {
-            Some("density (kg/m³)")
-        } else {
-            None
-        }
+    /// The properties that are parameters (a value, not a factor), each as (its name, what
+    /// it sets with its unit, the model file's value): bodies' Young's moduli and densities,
+    /// then springs' stiffnesses.
+    fn properties(&self) -> impl Iterator<Item = (&str, &'static str, f64)> {
+        let bodies = self.bodies.iter().flat_map(|b| {
+            let e =
+                b.youngs_modulus_parameter.as_deref().map(|n| (n, "Young's modulus (Pa)", b.section.youngs_modulus));
+            let rho = b.density_parameter.as_deref().map(|n| (n, "density (kg/m³)", b.section.density));
+            e.into_iter().chain(rho)
+        });
+        let springs = self.loads.iter().filter_map(|l| match (l, l.scaling()) {
+            (Load::Spring(_), Scaling::Property { name, file }) => {
+                Some((name.as_str(), "spring stiffness (N/m)", *file))
+            }
+            (Load::TorsionalSpring(_), Scaling::Property { name, file }) => {
+                Some((name.as_str(), "torsional spring stiffness (N m/rad)", *file))
+            }
+            _ => None,
+        });
+        bodies.chain(springs)
     }
 
-    /// The model file's value of the body property the parameter `name` sets (its
-    /// `youngs_modulus` or `density = { value, … }`), or `None` when `name` is no property.
+    /// What `name` sets when it is a property, e.g. "Young's modulus (Pa)", "density
+    /// (kg/m³)" or "spring stiffness (N/m)" (a value, not a factor), or `None`.
+    pub fn property_parameter(&self, name: &str) -> Option<&'static str> {
+        self.properties().find(|p| p.0 == name).map(|p| p.1)
+    }
+
+    /// The model file's value of the property the parameter `name` sets (a body's
+    /// `youngs_modulus` or `density`, a spring's `stiffness = { value, … }`), or `None` when
+    /// `name` is no property.
     pub fn property_value(&self, name: &str) -> Option<f64> {
-        self.bodies.iter().find_map(|b| {
-            if b.youngs_modulus_parameter.as_deref() == Some(name) {
-                Some(b.section.youngs_modulus)
-            } else if b.density_parameter.as_deref() == Some(name) {
-                Some(b.section.density)
-            } else {
-                None
-            }
-        })
+        self.properties().find(|p| p.0 == name).map(|p| p.2)
     }
 
     /// Warnings for body properties set far from the model file's value, more than
@@ -209,17 +218,9 @@ impl Model {
     /// at the model file's value (what a run then uses), so that a check against a box or
     /// its candidates reads the value the run has.
     pub fn with_property_values(&self, mu: &Parameters) -> Parameters {
-        let mut names: Vec<&str> = Vec::new();
-        for b in &self.bodies {
-            names.extend(b.youngs_modulus_parameter.as_deref());
-            names.extend(b.density_parameter.as_deref());
-        }
-        names.into_iter().fold(mu.clone(), |m, name| match m.get(name) {
+        self.properties().fold(mu.clone(), |m, (name, _, value)| match m.get(name) {
             Some(_) => m,
-            None => {
-                let value = self.property_value(name).expect("a property of the model");
-                m.with(name, value)
-            }
+            None => m.with(name, value),
         })
     }
 

@@ -67,8 +67,8 @@ pub struct SpringSpec {
     pub r#type: Option<SpringKind>,
     pub a: NodeSpec,
     pub b: SpringEndSpec,
-    /// N/m (translational) or N m/rad (torsional)
-    pub stiffness: f64,
+    /// N/m (translational) or N m/rad (torsional); or `{ value, parameter = "name" }`
+    pub stiffness: PropertySpec,
     /// N s/m (translational) or N m s/rad (torsional)
     #[serde(default)]
     pub damping: f64,

@@ -494,12 +494,12 @@ impl FlexibleSystem {
         }
     }
 
-    /// The springs' stored energy `Σ ½ k (L − L₀)² + Σ ½ k φ²` at `q` and its rate at `q̇`
-    /// (`loads::NodalLoad::stored_energy`); zeros without springs.
-    pub fn spring_energy(&self, q: &[f64], v: &[f64]) -> (f64, f64) {
+    /// The springs' stored energy `Σ ½ k (L − L₀)² + Σ ½ k φ²` at `q` and its rate at `q̇`,
+    /// their stiffnesses at `mu` (`loads::NodalLoad::stored_energy`); zeros without springs.
+    pub fn spring_energy(&self, mu: &Parameters, q: &[f64], v: &[f64]) -> (f64, f64) {
         self.nodal
             .iter()
-            .filter_map(|l| l.stored_energy(&|d| q[d], &|d| v[d]))
+            .filter_map(|l| l.stored_energy(mu.factor(l.scaling()), &|d| q[d], &|d| v[d]))
             .fold((0.0, 0.0), |(e, r), (le, lr)| (e + le, r + lr))
     }
 

@@ -104,6 +104,7 @@ impl Parameters {
             Scaling::Fixed => 1.0,
             Scaling::LoadScale => self.load_scale,
             Scaling::Named(name) => self.named.get(name).copied().unwrap_or(1.0),
+            Scaling::Property { name, file } => self.named.get(name).map_or(1.0, |value| value / file),
         }
     }
 
@@ -122,7 +123,7 @@ impl Parameters {
 /// Which parameter multiplies a load: `scaled` in the model file (`false`, `true`, or the
 /// name of a parameter). A load is linear in its factor, so a model stays affine in every
 /// parameter that scales loads.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum Scaling {
     /// `scaled = false`: the file's load at every `μ`
     Fixed,
@@ -130,6 +131,9 @@ pub enum Scaling {
     LoadScale,
     /// `scaled = "drive"`: times the parameter `drive`
     Named(String),
+    /// a property the parameter `name` sets, `file` its model file's value (a spring's
+    /// `stiffness = { value, parameter }`): times `μ_name / file`, 1 where μ does not set it
+    Property { name: String, file: f64 },
 }
 
 impl Scaling {
@@ -138,7 +142,7 @@ impl Scaling {
         match self {
             Scaling::Fixed => None,
             Scaling::LoadScale => Some(LOAD_SCALE),
-            Scaling::Named(n) => Some(n),
+            Scaling::Named(n) | Scaling::Property { name: n, .. } => Some(n),
         }
     }
 }
@@ -185,6 +189,9 @@ mod tests {
         assert_eq!(mu.factor(&Scaling::Named("E_lower".into())), 2.5e8);
         // a load named after a parameter the run does not set keeps the file's value
         assert_eq!(mu.factor(&Scaling::Named("drive".into())), 1.0);
+        // a property's factor is its value over the file's, 1 where the run does not set it
+        assert_eq!(mu.factor(&Scaling::Property { name: "E_lower".into(), file: 5e8 }), 0.5);
+        assert_eq!(mu.factor(&Scaling::Property { name: "k".into(), file: 400.0 }), 1.0);
         assert_eq!(mu.scaled_by(2.0).get("E_lower"), Some(2.5e8));
         // messages name a run as they always did; other parameters follow
         assert_eq!(Parameters::load_scale(1.1).to_string(), "load scale 1.1");

@@ -1,6 +1,8 @@
 //! The checks of `[[springs]]`: nodes that exist, a second end that is a node or a ground
 //! point (a node for a torsional spring), stiffness and damping finite and non-negative,
-//! and a free length that gives the spring a direction. A checked spring becomes a load
+//! and a free length that gives the spring a direction; a stiffness that is a parameter
+//! (`{ value, parameter }`) has a positive value and a name no other kind of parameter
+//! takes. A checked spring becomes a load
 //! ([`Load::Spring`], [`Load::TorsionalSpring`]) with its free length or relaxed angle
 //! resolved from the initial configuration.
 
@@ -9,6 +11,7 @@ use crate::model::schema::{SpringEndSpec, SpringKind, SpringSpec};
 use crate::model::Model;
 use crate::physics::loads::{Load, Spring, SpringEnd, TorsionalSpring};
 use crate::physics::system::NodeId;
+use crate::solver::parameters::{is_parameter_name, Scaling, LOAD_SCALE};
 
 /// Below this distance, relative to the longest body, two points coincide.
 const COINCIDENT: f64 = 1e-12;
@@ -22,11 +25,12 @@ impl Model {
                     return Err(self.err(p("name"), "must be non-empty and hold no control character"));
                 }
             }
-            for (key, v) in [("stiffness", s.stiffness), ("damping", s.damping)] {
+            for (key, v) in [("stiffness", s.stiffness.value()), ("damping", s.damping)] {
                 if !(v.is_finite() && v >= 0.0) {
                     return Err(self.err(p(key), format!("must be finite and non-negative, got {v}")));
                 }
             }
+            let scaled = self.stiffness_scaling(i, s)?;
             let a = self.node_id(&p("a.body"), &p("a.node"), &s.a.body, &s.a.node)?;
             let b = self.spring_end(&p("b"), &s.b)?;
             if b == SpringEnd::Node(a) {
@@ -35,12 +39,52 @@ impl Model {
                 );
             }
             let load = match s.r#type.unwrap_or(SpringKind::Translational) {
-                SpringKind::Translational => Load::Spring(self.translational(i, s, a, b)?),
-                SpringKind::Torsional => Load::TorsionalSpring(self.torsional(i, s, a, b)?),
+                SpringKind::Translational => Load::Spring(self.translational(i, s, (a, b), scaled)?),
+                SpringKind::Torsional => Load::TorsionalSpring(self.torsional(i, s, (a, b), scaled)?),
             };
             self.loads.push(load);
         }
         Ok(())
+    }
+
+    /// What scales spring `i`'s stiffness: fixed, or the parameter its `stiffness = { value,
+    /// parameter }` names — a parameter name with a positive value, that neither a load's
+    /// `scaled` nor a body's property takes (a load's parameter multiplies it, a property is
+    /// another quantity), and one value wherever springs share it.
+    fn stiffness_scaling(&self, i: usize, s: &SpringSpec) -> Result<Scaling> {
+        let Some(name) = s.stiffness.parameter() else { return Ok(Scaling::Fixed) };
+        let field = format!("springs[{i}].stiffness.parameter");
+        let value = s.stiffness.value();
+        if !is_parameter_name(name) || name == LOAD_SCALE {
+            return Err(self.err(field, format!("`{name}` is not a parameter name: use letters, digits and `_`, starting with a letter (and not `{LOAD_SCALE}`, the load scale)")));
+        }
+        if !(value > 0.0) {
+            return Err(self.err(
+                format!("springs[{i}].stiffness.value"),
+                format!("must be positive for a parameter (it is the value the parameter replaces), got {value}"),
+            ));
+        }
+        if self
+            .bodies
+            .iter()
+            .any(|b| [&b.youngs_modulus_parameter, &b.density_parameter].into_iter().flatten().any(|n| n == name))
+        {
+            return Err(self.err(field, format!("`{name}` is also a body's Young's modulus or density: give the spring's stiffness a name of its own")));
+        }
+        for (k, load) in self.loads.iter().enumerate() {
+            match load.scaling() {
+                Scaling::Property { name: n, file } if n == name && *file != value => {
+                    return Err(self.err(format!("springs[{i}].stiffness.value"), format!("is {value}, but another spring gives the parameter `{name}` the value {file}: a parameter has one value")));
+                }
+                Scaling::Named(n) | Scaling::Property { name: n, .. }
+                    if n == name && !matches!(load, Load::Spring(_) | Load::TorsionalSpring(_)) =>
+                {
+                    return Err(self.err(field, format!("`{name}` also scales loads[{k}]: a load's parameter multiplies it, a stiffness parameter is its value; give them different names")));
+                }
+                _ => {}
+            }
+        }
+        Ok(Scaling::Property { name: name.to_string(), file: value })
     }
 
     /// `{ body, node }` or `{ point = [x, y] }`.
@@ -65,7 +109,7 @@ impl Model {
     /// A translational spring: its free length `length`, or the initial distance; a spring
     /// whose ends start at one point needs a positive free length (its direction comes from
     /// the stretch).
-    fn translational(&self, i: usize, s: &SpringSpec, a: NodeId, b: SpringEnd) -> Result<Spring> {
+    fn translational(&self, i: usize, s: &SpringSpec, (a, b): (NodeId, SpringEnd), scaled: Scaling) -> Result<Spring> {
         let p = |k: &str| format!("springs[{i}].{k}");
         let ra = self.node_at(a);
         let rb = match b {
@@ -93,11 +137,17 @@ impl Model {
             }
             None => distance,
         };
-        Ok(Spring { a, b, stiffness: s.stiffness, damping: s.damping, length })
+        Ok(Spring { a, b, stiffness: s.stiffness.value(), damping: s.damping, length, scaled })
     }
 
     /// A torsional spring between two nodes' slopes, relaxed at their initial angle.
-    fn torsional(&self, i: usize, s: &SpringSpec, a: NodeId, b: SpringEnd) -> Result<TorsionalSpring> {
+    fn torsional(
+        &self,
+        i: usize,
+        s: &SpringSpec,
+        (a, b): (NodeId, SpringEnd),
+        scaled: Scaling,
+    ) -> Result<TorsionalSpring> {
         let p = |k: &str| format!("springs[{i}].{k}");
         let SpringEnd::Node(b) = b else {
             return Err(self.err(p("b"), "is a point: a torsional spring joins two nodes' slopes; give `b = { body = \"…\", node = … }` (to hold a slope against the ground, clamp a short stub body and join it)"));
@@ -111,6 +161,6 @@ impl Model {
         let (sa, sb) = (self.node_at(a), self.node_at(b));
         // φ₀ as the spring computes φ, so that it starts at exactly 0
         let angle = (sa[2] * sb[3] - sa[3] * sb[2]).atan2(sa[2] * sb[2] + sa[3] * sb[3]);
-        Ok(TorsionalSpring { a, b, stiffness: s.stiffness, damping: s.damping, angle })
+        Ok(TorsionalSpring { a, b, stiffness: s.stiffness.value(), damping: s.damping, angle, scaled })
     }
 }

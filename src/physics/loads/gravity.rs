@@ -43,6 +43,8 @@ impl WeightParts {
                 };
                 &mut self.named[i].1
             }
+            // the model file gives gravity `scaled = true | false | "name"` only
+            Scaling::Property { .. } => unreachable!("gravity scaled by a property"),
         }
     }
 }

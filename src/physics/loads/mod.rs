@@ -36,17 +36,17 @@ pub enum Load {
     TorsionalSpring(TorsionalSpring),
 }
 
-/// A spring is never scaled: neither the load scale nor a parameter stretches it.
-static FIXED: Scaling = Scaling::Fixed;
-
 impl Load {
-    /// What multiplies the load: fixed, the load scale or a named parameter.
+    /// What multiplies the load: fixed, the load scale or a named parameter; for a spring,
+    /// what scales its stiffness (fixed, or the parameter that sets it: the load scale never
+    /// stretches a spring).
     pub fn scaling(&self) -> &Scaling {
         match self {
             Load::Gravity(l) => &l.scaled,
             Load::Moment(l) => &l.scaled,
             Load::Force(l) => &l.scaled,
-            Load::Spring(_) | Load::TorsionalSpring(_) => &FIXED,
+            Load::Spring(l) => &l.scaled,
+            Load::TorsionalSpring(l) => &l.scaled,
         }
     }
 

@@ -36,8 +36,9 @@ pub trait NodalLoad: std::fmt::Debug + Send + Sync {
         true
     }
     /// For a load stored in the system (a spring): its potential energy `V(q)` and rate
-    /// `V̇ = ∇V · q̇`; `None` for an external load, whose power counts as external work.
-    fn stored_energy(&self, _q: Read, _v: Read) -> Option<(f64, f64)> {
+    /// `V̇ = ∇V · q̇` at the factor `factor`; `None` for an external load, whose power counts
+    /// as external work.
+    fn stored_energy(&self, _factor: f64, _q: Read, _v: Read) -> Option<(f64, f64)> {
         None
     }
 }

@@ -9,7 +9,9 @@
 //! ```
 //!
 //! (`∂d/∂r_a = I`, `∂d/∂r_b = −I`): symmetric without damping. Its stored energy is
-//! `½ k (L − L₀)²`; the damper dissipates `c L̇²`. At `L = 0` the direction is undefined
+//! `½ k (L − L₀)²`; the damper dissipates `c L̇²`. A stiffness that is a parameter
+//! (`stiffness = { value, parameter }`) enters as `k = k_file · f`, `f` its factor
+//! ([`Scaling::Property`]); the damping is the file's. At `L = 0` the direction is undefined
 //! and the spring exerts nothing (a model starts its springs between distinct points, or
 //! with a free length, `model::check`).
 
@@ -34,6 +36,8 @@ pub struct Spring {
     pub damping: f64,
     /// `L₀`, m
     pub length: f64,
+    /// what scales `k`: fixed, or the parameter that sets it ([`Scaling::Property`])
+    pub scaled: Scaling,
 }
 
 impl Spring {
@@ -47,7 +51,7 @@ impl Spring {
             }
             SpringEnd::Point(p) => (vec![a, a + 1], Some(p)),
         };
-        NodalSpring { dofs, ground, k: self.stiffness, c: self.damping, l0: self.length, scaled: Scaling::Fixed }
+        NodalSpring { dofs, ground, k: self.stiffness, c: self.damping, l0: self.length, scaled: self.scaled.clone() }
     }
 }
 
@@ -60,7 +64,7 @@ pub struct NodalSpring {
     k: f64,
     c: f64,
     l0: f64,
-    /// always fixed: the load scale does not stretch a spring
+    /// fixed, or the parameter that sets `k` (the load scale never stretches a spring)
     scaled: Scaling,
 }
 
@@ -87,9 +91,9 @@ impl NodalSpring {
         Stretch { len, e, dv, rate: e[0] * dv[0] + e[1] * dv[1] }
     }
 
-    /// The tension `N = k (L − L₀) + c L̇`.
-    fn tension(&self, s: &Stretch) -> f64 {
-        self.k * (s.len - self.l0) + self.c * s.rate
+    /// The tension `N = k (L − L₀) + c L̇` at the stiffness `k`.
+    fn tension(&self, k: f64, s: &Stretch) -> f64 {
+        k * (s.len - self.l0) + self.c * s.rate
     }
 
     /// Adds the 2×2 block `m` over `d` to every pair of ends with the sign `∂d/∂r`.
@@ -117,9 +121,9 @@ impl NodalLoad for NodalSpring {
         &self.scaled
     }
 
-    fn add_force(&self, _factor: f64, _t: f64, q: Read, v: Read, add: &mut dyn FnMut(usize, f64)) {
+    fn add_force(&self, factor: f64, _t: f64, q: Read, v: Read, add: &mut dyn FnMut(usize, f64)) {
         let s = self.stretch(q, v);
-        let n = self.tension(&s);
+        let n = self.tension(self.k * factor, &s);
         add(self.dofs[0], n * s.e[0]);
         add(self.dofs[1], n * s.e[1]);
         if self.ground.is_none() {
@@ -132,12 +136,13 @@ impl NodalLoad for NodalSpring {
         true
     }
 
-    fn add_stiffness(&self, _factor: f64, _t: f64, q: Read, v: Read, add: &mut dyn FnMut(usize, usize, f64)) {
+    fn add_stiffness(&self, factor: f64, _t: f64, q: Read, v: Read, add: &mut dyn FnMut(usize, usize, f64)) {
         let s = self.stretch(q, v);
         if s.len == 0.0 {
             return;
         }
-        let n_l = self.tension(&s) / s.len;
+        let k = self.k * factor;
+        let n_l = self.tension(k, &s) / s.len;
         let c_l = self.c / s.len;
         let e = s.e;
         // P Δv = Δv − e L̇
@@ -148,7 +153,7 @@ impl NodalLoad for NodalSpring {
             std::array::from_fn(|j| {
                 let ee = e[i] * e[j];
                 let p = if i == j { 1.0 - ee } else { -ee };
-                let mut x = self.k * ee + n_l * p;
+                let mut x = k * ee + n_l * p;
                 if self.c != 0.0 {
                     x += c_l * e[i] * pdv[j];
                 }
@@ -172,8 +177,9 @@ impl NodalLoad for NodalSpring {
         self.c == 0.0
     }
 
-    fn stored_energy(&self, q: Read, v: Read) -> Option<(f64, f64)> {
+    fn stored_energy(&self, factor: f64, q: Read, v: Read) -> Option<(f64, f64)> {
         let s = self.stretch(q, v);
+        let k = self.k * factor;
         let stretch = s.len - self.l0;
         // V̇ = k (L − L₀) L̇ needs L̇ even without damping
         let rate = {
@@ -181,7 +187,7 @@ impl NodalLoad for NodalSpring {
             let vb = if self.ground.is_some() { [0.0; 2] } else { [v(d[2]), v(d[3])] };
             s.e[0] * (v(d[0]) - vb[0]) + s.e[1] * (v(d[1]) - vb[1])
         };
-        Some((0.5 * self.k * stretch * stretch, self.k * stretch * rate))
+        Some((0.5 * k * stretch * stretch, k * stretch * rate))
     }
 }
 
@@ -191,8 +197,15 @@ mod tests {
     use crate::physics::loads::nodal::tests::{check_jacobians, Dense};
 
     fn between_nodes(c: f64) -> NodalSpring {
-        Spring { a: (0, 1), b: SpringEnd::Node((1, 0)), stiffness: 400.0, damping: c, length: 0.2 }
-            .lower(&|(b, k)| 4 * (3 * b + k))
+        Spring {
+            a: (0, 1),
+            b: SpringEnd::Node((1, 0)),
+            stiffness: 400.0,
+            damping: c,
+            length: 0.2,
+            scaled: Scaling::Fixed,
+        }
+        .lower(&|(b, k)| 4 * (3 * b + k))
     }
 
     /// A state with the ends 0.3 m apart along (0.6, 0.8) · 0.5: stretched by 0.1 m from
@@ -220,7 +233,7 @@ mod tests {
             assert!((g[d] - want).abs() < 1e-12, "dof {d}: {} vs {want}", g[d]);
         }
         // V = ½ k (L − L₀)² = ½·400·0.01 = 2 J, V̇ = k (L − L₀) L̇ = 400·0.1·0.2 = 8 W
-        let (e, rate) = s.stored_energy(&|d| q[d], &|d| v[d]).unwrap();
+        let (e, rate) = s.stored_energy(1.0, &|d| q[d], &|d| v[d]).unwrap();
         assert!((e - 2.0).abs() < 1e-12 && (rate - 8.0).abs() < 1e-12, "{e} {rate}");
     }
 
@@ -229,8 +242,14 @@ mod tests {
         let (q, v) = state();
         for c in [0.0, 0.5] {
             check_jacobians(&between_nodes(c), &q, &v);
-            let ground =
-                Spring { a: (0, 1), b: SpringEnd::Point([-0.1, 0.05]), stiffness: 400.0, damping: c, length: 0.2 };
+            let ground = Spring {
+                a: (0, 1),
+                b: SpringEnd::Point([-0.1, 0.05]),
+                stiffness: 400.0,
+                damping: c,
+                length: 0.2,
+                scaled: Scaling::Fixed,
+            };
             check_jacobians(&ground.lower(&|(b, k)| 4 * (3 * b + k)), &q, &v);
         }
     }

@@ -34,6 +34,8 @@ pub struct TorsionalSpring {
     pub damping: f64,
     /// `φ₀`, the relative angle at which it is relaxed (the initial one), rad
     pub angle: f64,
+    /// what scales `k`: fixed, or the parameter that sets it ([`Scaling::Property`])
+    pub scaled: Scaling,
 }
 
 impl TorsionalSpring {
@@ -45,7 +47,7 @@ impl TorsionalSpring {
             k: self.stiffness,
             c: self.damping,
             phi0: self.angle,
-            scaled: Scaling::Fixed,
+            scaled: self.scaled.clone(),
         }
     }
 }
@@ -99,9 +101,10 @@ impl NodalLoad for NodalTorsionalSpring {
         &self.scaled
     }
 
-    fn add_force(&self, _factor: f64, _t: f64, q: Read, v: Read, add: &mut dyn FnMut(usize, f64)) {
+    fn add_force(&self, factor: f64, _t: f64, q: Read, v: Read, add: &mut dyn FnMut(usize, f64)) {
         let tw = self.twist(q);
-        let mut n = self.k * tw.phi;
+        let k = self.k * factor;
+        let mut n = k * tw.phi;
         if self.c != 0.0 {
             n += self.c * self.rate(&tw, v);
         }
@@ -114,10 +117,11 @@ impl NodalLoad for NodalTorsionalSpring {
         true
     }
 
-    fn add_stiffness(&self, _factor: f64, _t: f64, q: Read, v: Read, add: &mut dyn FnMut(usize, usize, f64)) {
+    fn add_stiffness(&self, factor: f64, _t: f64, q: Read, v: Read, add: &mut dyn FnMut(usize, usize, f64)) {
         let tw = self.twist(q);
         let h = Self::hessian(&tw);
-        let mut n = self.k * tw.phi;
+        let k = self.k * factor;
+        let mut n = k * tw.phi;
         // H q̇, for the damper's c ∇φ (H q̇)ᵀ
         let mut hv = [0.0; 4];
         if self.c != 0.0 {
@@ -132,7 +136,7 @@ impl NodalLoad for NodalTorsionalSpring {
             for j in 0..4 {
                 // g_i g_j = g_j g_i and H's off-diagonal entries are one value: symmetric
                 // to the bit without damping
-                let mut x = self.k * (tw.grad[i] * tw.grad[j]);
+                let mut x = k * (tw.grad[i] * tw.grad[j]);
                 if i / 2 == j / 2 {
                     x += n * h[i / 2][i % 2][j % 2];
                 }
@@ -161,9 +165,10 @@ impl NodalLoad for NodalTorsionalSpring {
         self.c == 0.0
     }
 
-    fn stored_energy(&self, q: Read, v: Read) -> Option<(f64, f64)> {
+    fn stored_energy(&self, factor: f64, q: Read, v: Read) -> Option<(f64, f64)> {
         let tw = self.twist(q);
-        Some((0.5 * self.k * tw.phi * tw.phi, self.k * tw.phi * self.rate(&tw, v)))
+        let k = self.k * factor;
+        Some((0.5 * k * tw.phi * tw.phi, k * tw.phi * self.rate(&tw, v)))
     }
 }
 
@@ -173,7 +178,7 @@ mod tests {
     use crate::physics::loads::nodal::tests::check_jacobians;
 
     fn spring(c: f64) -> NodalTorsionalSpring {
-        TorsionalSpring { a: (0, 1), b: (1, 0), stiffness: 3.0, damping: c, angle: 0.1 }
+        TorsionalSpring { a: (0, 1), b: (1, 0), stiffness: 3.0, damping: c, angle: 0.1, scaled: Scaling::Fixed }
             .lower(&|(b, k)| 4 * (2 * b + k))
     }
 
@@ -195,7 +200,7 @@ mod tests {
         let (q, v) = state();
         let s = spring(0.4);
         // V = ½·3·0.5² = 0.375 J; V̇ = k φ φ̇ = 3·0.5·(−0.75) = −1.125 W
-        let (e, rate) = s.stored_energy(&|d| q[d], &|d| v[d]).unwrap();
+        let (e, rate) = s.stored_energy(1.0, &|d| q[d], &|d| v[d]).unwrap();
         assert!((e - 0.375).abs() < 1e-14 && (rate + 1.125).abs() < 1e-14, "{e} {rate}");
         // turning b's slope by δ at fixed length does the work N δ, N = kφ + cφ̇ = 1.5 − 0.3
         let mut g = [0.0; 16];

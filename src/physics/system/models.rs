@@ -583,6 +583,7 @@ mod tests {
                     stiffness: 400.0,
                     damping: c,
                     length: 0.4,
+                    scaled: Scaling::Fixed,
                 }),
                 Load::Spring(Spring {
                     a: (1, 2),
@@ -590,6 +591,7 @@ mod tests {
                     stiffness: 90.0,
                     damping: c,
                     length: 0.1,
+                    scaled: Scaling::Fixed,
                 }),
                 Load::Spring(Spring {
                     a: (0, 1),
@@ -597,8 +599,16 @@ mod tests {
                     stiffness: 50.0,
                     damping: c,
                     length: 0.2,
+                    scaled: Scaling::Fixed,
                 }),
-                Load::TorsionalSpring(TorsionalSpring { a: (0, 3), b: (1, 0), stiffness: 7.0, damping: c, angle: 0.2 }),
+                Load::TorsionalSpring(TorsionalSpring {
+                    a: (0, 3),
+                    b: (1, 0),
+                    stiffness: 7.0,
+                    damping: c,
+                    angle: 0.2,
+                    scaled: Scaling::Fixed,
+                }),
             ]
         };
         let mut b = aluminium_body("b", 2);
