@@ -77,7 +77,7 @@ fn every_drawn_model_is_within_the_zoo_ranges() {
                 let sliders = count(|j| matches!(j, JointSpec::Slider { .. }));
                 let welds = count(|j| matches!(j, JointSpec::Weld { .. }));
                 let all = f.joints.len();
-                assert!(f.masses.iter().all(|p| p.mass > 0.0 && p.mass.is_finite()), "{what}: a mass");
+                assert!(f.masses.iter().all(|p| p.mass.value() > 0.0 && p.mass.value().is_finite()), "{what}: a mass");
                 let n = f.bodies.len();
                 match m.kind {
                     // a crank driven by angle or by a moment (then no drive), the rod's end on a slider

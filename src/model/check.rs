@@ -3,6 +3,7 @@
 //! make a run; the validated bodies, joints, loads and probes are kept on the [`Model`].
 
 mod springs;
+mod value_parameters;
 
 use super::schema::*;
 use super::toml_errors::entry_line;
@@ -289,13 +290,19 @@ impl Model {
         for (i, m) in f.masses.iter().enumerate() {
             let p = |k: &str| format!("masses[{i}].{k}");
             let node = self.node_id(&p("body"), &p("node"), &m.body, &m.node)?;
-            self.positive(&p("mass"), m.mass)?;
+            self.positive(&p("mass"), m.mass.value())?;
+            let parameter = self.value_parameter(&p("mass"), &m.mass, value_parameters::ValueKind::PointMass)?;
             let rotary_inertia = m.rotary_inertia.unwrap_or(0.0);
             if !(rotary_inertia.is_finite() && rotary_inertia >= 0.0) {
                 let msg = format!("must be finite and ≥ 0 (kg m²), got {rotary_inertia}");
                 return Err(self.err(p("rotary_inertia"), msg));
             }
-            self.masses.push(PointMass { node, mass: m.mass, rotary_inertia });
+            self.masses.push(PointMass {
+                node,
+                mass: m.mass.value(),
+                rotary_inertia,
+                parameter: parameter.map(|p| p.0),
+            });
         }
         self.check_springs(&f.springs)?;
         for (i, pr) in f.probes.iter().enumerate() {

@@ -130,22 +130,17 @@ impl Model {
     /// The model's parameters, each once: those its loads and then its drives are scaled by
     /// (`scaled = true` is [`crate::solver::parameters::LOAD_SCALE`]) in file order, the
     /// springs' stiffnesses that are parameters among the loads, then the bodies' Young's
-    /// moduli and densities that are parameters, in the order of the bodies.
+    /// moduli and densities that are parameters, in the order of the bodies, then the point
+    /// masses that are.
     pub fn parameter_names(&self) -> Vec<&str> {
-        let mut names: Vec<&str> = Vec::new();
         let drives = self.joints.iter().filter_map(|j| j.kind().drive_scaling());
-        for scaling in self.loads.iter().map(|l| l.scaling()).chain(drives) {
-            if let Some(name) = scaling.parameter() {
-                if !names.contains(&name) {
-                    names.push(name);
-                }
-            }
-        }
-        for body in &self.bodies {
-            for name in [&body.youngs_modulus_parameter, &body.density_parameter].into_iter().flatten() {
-                if !names.contains(&name.as_str()) {
-                    names.push(name);
-                }
+        let scaled = self.loads.iter().map(|l| l.scaling()).chain(drives).filter_map(|s| s.parameter());
+        let bodies = self.bodies.iter().flat_map(|b| [&b.youngs_modulus_parameter, &b.density_parameter]).flatten();
+        let masses = self.masses.iter().filter_map(|m| m.parameter.as_ref());
+        let mut names: Vec<&str> = Vec::new();
+        for name in scaled.chain(bodies.chain(masses).map(String::as_str)) {
+            if !names.contains(&name) {
+                names.push(name);
             }
         }
         names
@@ -153,7 +148,7 @@ impl Model {
 
     /// The properties that are parameters (a value, not a factor), each as (its name, what
     /// it sets with its unit, the model file's value): bodies' Young's moduli and densities,
-    /// then springs' stiffnesses.
+    /// springs' stiffnesses, then point masses.
     fn properties(&self) -> impl Iterator<Item = (&str, &'static str, f64)> {
         let bodies = self.bodies.iter().flat_map(|b| {
             let e =
@@ -170,18 +165,20 @@ impl Model {
             }
             _ => None,
         });
-        bodies.chain(springs)
+        let masses = self.masses.iter().filter_map(|m| m.parameter.as_deref().map(|n| (n, "point mass (kg)", m.mass)));
+        bodies.chain(springs).chain(masses)
     }
 
     /// What `name` sets when it is a property, e.g. "Young's modulus (Pa)", "density
-    /// (kg/m³)" or "spring stiffness (N/m)" (a value, not a factor), or `None`.
+    /// (kg/m³)", "spring stiffness (N/m)" or "point mass (kg)" (a value, not a factor), or
+    /// `None`.
     pub fn property_parameter(&self, name: &str) -> Option<&'static str> {
         self.properties().find(|p| p.0 == name).map(|p| p.1)
     }
 
     /// The model file's value of the property the parameter `name` sets (a body's
-    /// `youngs_modulus` or `density`, a spring's `stiffness = { value, … }`), or `None` when
-    /// `name` is no property.
+    /// `youngs_modulus` or `density`, a spring's `stiffness`, a point's `mass = { value, … }`),
+    /// or `None` when `name` is no property.
     pub fn property_value(&self, name: &str) -> Option<f64> {
         self.properties().find(|p| p.0 == name).map(|p| p.2)
     }

@@ -47,7 +47,8 @@ pub struct InitialSpec {
 pub struct MassSpec {
     pub body: String,
     pub node: NodeRef,
-    pub mass: f64,
+    /// kg; or `{ value, parameter = "name" }`
+    pub mass: PropertySpec,
     /// kg m² about the node, on its slope (absent: none; left out of the serialized file
     /// then, so that older files keep their fingerprint)
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -23,16 +23,22 @@ pub struct PointMass {
     pub mass: f64,
     /// kg m², about the node (0: none)
     pub rotary_inertia: f64,
+    /// the parameter that sets `mass` (kg; `mass` where a run does not set it), if any; the
+    /// rotary inertia stays the file's
+    pub parameter: Option<String>,
 }
 
 /// One entry `(row dof, column dof, value)` of a point mass's part of the mass matrix.
 pub type MassEntry = (usize, usize, f64);
 
+/// A point mass on its position coordinates: `([x, y], kg, the parameter that sets it)`.
+pub type Lumped<'a> = ([usize; 2], f64, Option<&'a str>);
+
 impl PointMass {
-    /// The node's position coordinates `(x, y)` and the mass.
-    pub fn lower(&self, first: NodeIndex) -> ([usize; 2], f64) {
+    /// The node's position coordinates `(x, y)`, the mass and the parameter that sets it.
+    pub fn lower(&self, first: NodeIndex) -> Lumped<'_> {
         let d = first(self.node);
-        ([d, d + 1], self.mass)
+        ([d, d + 1], self.mass, self.parameter.as_deref())
     }
 
     /// The mass-matrix entries: `m` on the two position coordinates, then, with a rotary

@@ -55,8 +55,11 @@ pub struct FlexibleSystem {
     load_damping: bool,
     /// point masses' mass-matrix entries `(row, column, value)` (the position diagonal and
     /// any rotary inertia's slope block), each with the element whose iteration block holds
-    /// the node (its first dof)
+    /// the node (its first dof); the values at the parameters last bound
     point_masses: Vec<(MassEntry, (usize, usize))>,
+    /// the entries a parameter sets (a point mass's `mass = { value, parameter }`): (entry,
+    /// the parameter, the file's kg)
+    point_mass_parameters: Vec<(usize, String, f64)>,
     /// the dofs the nodal loads act on, sorted
     load_dofs: Vec<usize>,
     n_dof: usize,
@@ -107,17 +110,20 @@ impl FlexibleSystem {
 
         let gravities: Vec<&Gravity> =
             loads.iter().filter_map(|l| if let Load::Gravity(g) = l { Some(g) } else { None }).collect();
-        let point_masses: Vec<_> = masses
-            .iter()
-            .flat_map(|m| {
-                let d = first(m.node);
-                // a node's four coordinates lie in an element of its
-                let e = block_holding(&elements, &[d, d + 3]).expect("a node of the mesh");
-                let block = (e, elements[e].1[0]);
-                m.entries(&first, bodies[m.node.0].angle).into_iter().map(move |x| (x, block))
-            })
-            .collect();
-        let lumped: Vec<([usize; 2], f64)> = masses.iter().map(|m| m.lower(&first)).collect();
+        let (mut point_masses, mut point_mass_parameters) = (Vec::new(), Vec::new());
+        for m in masses {
+            let d = first(m.node);
+            // a node's four coordinates lie in an element of its
+            let e = block_holding(&elements, &[d, d + 3]).expect("a node of the mesh");
+            let block = (e, elements[e].1[0]);
+            if let Some(name) = &m.parameter {
+                // the two position entries come first (PointMass::entries)
+                let k = point_masses.len();
+                point_mass_parameters.extend([k, k + 1].map(|k| (k, name.clone(), m.mass)));
+            }
+            point_masses.extend(m.entries(&first, bodies[m.node.0].angle).into_iter().map(|x| (x, block)));
+        }
+        let lumped: Vec<_> = masses.iter().map(|m| m.lower(&first)).collect();
         let weight = assemble_weight(&gravities, &bodies, &elements, &prototypes, &lumped, n_dof);
         let nodal: Vec<Box<dyn NodalLoad>> = loads.iter().filter_map(|l| l.lower(&first)).collect();
         let mut coupling = Vec::new();
@@ -153,6 +159,7 @@ impl FlexibleSystem {
             symmetric_loads,
             load_damping,
             point_masses,
+            point_mass_parameters,
             load_dofs,
             n_dof,
             bound: prototypes.clone(),
@@ -201,8 +208,11 @@ impl FlexibleSystem {
     /// Makes the element prototypes the evaluations use those at `mu`: a body whose Young's
     /// modulus or density is a parameter gets a prototype at `E = μ[name]`, `ρ = μ[name]`
     /// (its elastic force and stiffness scale by `E(μ)/E_file`, its mass by `ρ(μ)/ρ_file`)
-    /// whenever that changes.
+    /// whenever that changes; a point mass a parameter sets is `μ[name]` kg.
     fn bind_parameters(&mut self, mu: &Parameters) {
+        for (k, name, file) in &self.point_mass_parameters {
+            self.point_masses[*k].0 .2 = mu.get(name).unwrap_or(*file);
+        }
         for b in 0..self.bodies.len() {
             let body = &self.bodies[b];
             let mut section = body.section;
@@ -419,8 +429,8 @@ impl FlexibleSystem {
                 }
             }
         }
-        for &((i, j, mass), _) in &self.point_masses {
-            m[i * n + j] += mass;
+        for (entry, &((i, j, mass), _)) in self.point_masses.iter().enumerate() {
+            m[i * n + j] += self.point_mass_file_value(entry).unwrap_or(mass);
         }
         (m, k)
     }
@@ -529,6 +539,26 @@ impl FlexibleSystem {
     /// iteration matrix's), for callers that assemble their own block matrices.
     pub fn point_mass_entries(&self) -> impl Iterator<Item = (usize, usize, usize, f64)> + '_ {
         self.point_masses.iter().map(|&((i, j, mass), (e, d0))| (e, i - d0, j - d0, mass))
+    }
+
+    /// The model file's kg of point-mass entry `entry` when a parameter sets it.
+    fn point_mass_file_value(&self, entry: usize) -> Option<f64> {
+        self.point_mass_parameters.iter().find(|p| p.0 == entry).map(|p| p.2)
+    }
+
+    /// The parameter that sets point-mass entry `entry`, if any.
+    fn point_mass_parameter(&self, entry: usize) -> Option<&str> {
+        self.point_mass_parameters.iter().find(|p| p.0 == entry).map(|p| p.1.as_str())
+    }
+
+    /// `out += M_p,g a` at the model file's values, `M_p,g` the point masses the parameter
+    /// `group` sets (`None`: those no parameter sets).
+    fn add_point_mass_group_product(&self, group: Option<&str>, a: &[f64], out: &mut [f64]) {
+        for (entry, &((i, j, mass), _)) in self.point_masses.iter().enumerate() {
+            if self.point_mass_parameter(entry) == group {
+                out[i] += self.point_mass_file_value(entry).unwrap_or(mass) * a[j];
+            }
+        }
     }
 
     /// Whether the model has point masses (mass outside its elements).

@@ -138,12 +138,38 @@ pub(crate) struct Projection {
     symmetric: bool,
 }
 
-/// The groups of [`Projection::mass_split`]: per group an element of it (to ask its
-/// factor; `None`: no parameter, factor 1), `M_r,g` and its projected constant forces; and
-/// the factors the mass is set to.
+/// The groups of [`Projection::mass_split`]: per group where its factor is read, `M_r,g`
+/// and its projected constant forces; and the factors the mass is set to.
 struct MassSplit {
-    groups: Vec<(Option<usize>, Array2<f64>, ProjectedForces)>,
+    groups: Vec<(FactorOf, Array2<f64>, ProjectedForces)>,
     factors: Vec<f64>,
+}
+
+/// Where a mass group's factor `m_g(μ)` is read: 1 (no parameter), an element of it
+/// ([`ElementModel::mass_factor`]), or the parameter of its lumped mass
+/// ([`ElementModel::lumped_mass_factor`]).
+enum FactorOf {
+    One,
+    Element(usize),
+    Lumped(String),
+}
+
+impl FactorOf {
+    fn new(name: Option<String>, member: Option<usize>) -> Self {
+        match (member, name) {
+            (Some(e), _) => FactorOf::Element(e),
+            (None, Some(name)) => FactorOf::Lumped(name),
+            (None, None) => FactorOf::One,
+        }
+    }
+
+    fn at<M: ElementModel>(&self, full: &M, mu: &Parameters) -> f64 {
+        match self {
+            FactorOf::One => 1.0,
+            FactorOf::Element(e) => full.mass_factor(*e, mu),
+            FactorOf::Lumped(name) => full.lumped_mass_factor(name, mu),
+        }
+    }
 }
 
 /// `Vᵀg₀,fixed`, `Vᵀg₀,scaled` and each `Vᵀg₀,name` ([`ElementModel::group_constant_forces`]):
@@ -190,7 +216,8 @@ impl Projection {
                     full.group_mass_mul(name.as_deref(), &v.column(j).to_vec(), &mut col);
                     mv.column_mut(j).assign(&ArrayView1::from(&col));
                 }
-                (member, v.t().dot(&mv), ProjectedForces::of(v, full.group_constant_forces(name.as_deref())))
+                let forces = ProjectedForces::of(v, full.group_constant_forces(name.as_deref()));
+                (FactorOf::new(name, member), v.t().dot(&mv), forces)
             })
             .collect();
         let mass_split = MassSplit { factors: vec![1.0; groups.len()], groups };
@@ -318,12 +345,11 @@ impl Projection {
     /// parameters, or at the same factors).
     pub fn bind<M: ElementModel>(&mut self, full: &M, mu: &Parameters) {
         let split = &mut self.mass_split;
-        let factor = |e: &Option<usize>| e.map_or(1.0, |e| full.mass_factor(e, mu));
         // the same factors (every evaluation of a run): nothing to do, nothing allocated
-        if split.groups.iter().zip(&split.factors).all(|((e, ..), &f)| factor(e) == f) {
+        if split.groups.iter().zip(&split.factors).all(|((g, ..), &f)| g.at(full, mu) == f) {
             return;
         }
-        let factors: Vec<f64> = split.groups.iter().map(|(e, ..)| factor(e)).collect();
+        let factors: Vec<f64> = split.groups.iter().map(|(g, ..)| g.at(full, mu)).collect();
         let mut mass = Array2::zeros((self.r, self.r));
         for ((_, m, _), &f) in split.groups.iter().zip(&factors) {
             mass.scaled_add(f, m);
@@ -352,8 +378,8 @@ impl Projection {
     ) {
         let x = mu.scale();
         let split = &self.mass_split;
-        for (k, ((e, _, g0), &m)) in split.groups.iter().zip(&split.factors).enumerate() {
-            debug_assert_eq!(m, e.map_or(1.0, |e| full.mass_factor(e, mu)), "bind() before evaluating");
+        for (k, ((g, _, g0), &m)) in split.groups.iter().zip(&split.factors).enumerate() {
+            debug_assert_eq!(m, g.at(full, mu), "bind() before evaluating");
             // the first group is assigned, the others added (one group at factor 1: `f + λ s`
             // to the bit)
             for (o, (f, s)) in out.iter_mut().zip(g0.fixed.iter().zip(&g0.scaled)) {

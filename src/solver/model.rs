@@ -302,6 +302,17 @@ pub trait ElementModel: ParametricModel {
     fn has_lumped_mass(&self) -> bool {
         false
     }
+    /// The parameters that set mass outside the elements (a point mass's kg), each once: a
+    /// group of [`mass_groups`] of its own, with no element, whose factor is
+    /// [`Self::lumped_mass_factor`]. None by default.
+    fn lumped_mass_parameters(&self) -> Vec<String> {
+        Vec::new()
+    }
+    /// The factor `m(μ)/m_file` of the lumped mass the parameter `name` sets (1 where μ does
+    /// not set it).
+    fn lumped_mass_factor(&self, _name: &str, _mu: &Parameters) -> f64 {
+        1.0
+    }
     /// The constraint rows whose coefficients or right-hand side move with time (prescribed
     /// motions), each as (row index, the coordinates of its terms); none by default. A
     /// reduction evaluates these rows through [`Self::moving_row_at`] and projects the
@@ -335,12 +346,22 @@ pub fn stiffness_groups<M: ElementModel + ?Sized>(model: &M) -> Vec<(Option<Stri
 }
 
 /// The elements of `model` by the parameter that scales their mass, as
-/// [`stiffness_groups`] by stiffness.
+/// [`stiffness_groups`] by stiffness; then a group without elements for each parameter that
+/// sets a lumped mass ([`ElementModel::lumped_mass_parameters`]).
 pub fn mass_groups<M: ElementModel + ?Sized>(model: &M) -> Vec<(Option<String>, Vec<usize>)> {
     let mut groups = groups_by(model.n_elements(), |e| model.mass_parameter(e));
+    let lumped = model.lumped_mass_parameters();
+    if groups.is_empty() && !lumped.is_empty() {
+        groups.push((None, (0..model.n_elements()).collect()));
+    }
     // lumped mass belongs to the group `None`, which may then have no element
     if model.has_lumped_mass() && !groups.is_empty() && groups[0].0.is_some() {
         groups.insert(0, (None, Vec::new()));
+    }
+    for name in lumped {
+        if !groups.iter().any(|(g, _)| g.as_deref() == Some(name.as_str())) {
+            groups.push((Some(name), Vec::new()));
+        }
     }
     groups
 }

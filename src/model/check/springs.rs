@@ -1,17 +1,18 @@
 //! The checks of `[[springs]]`: nodes that exist, a second end that is a node or a ground
 //! point (a node for a torsional spring), stiffness and damping finite and non-negative,
 //! and a free length that gives the spring a direction; a stiffness that is a parameter
-//! (`{ value, parameter }`) has a positive value and a name no other kind of parameter
-//! takes. A checked spring becomes a load
+//! (`{ value, parameter }`) is checked as `value_parameters` says. A checked spring becomes
+//! a load
 //! ([`Load::Spring`], [`Load::TorsionalSpring`]) with its free length or relaxed angle
 //! resolved from the initial configuration.
 
+use super::value_parameters::ValueKind;
 use crate::error::Result;
 use crate::model::schema::{SpringEndSpec, SpringKind, SpringSpec};
 use crate::model::Model;
 use crate::physics::loads::{Load, Spring, SpringEnd, TorsionalSpring};
 use crate::physics::system::NodeId;
-use crate::solver::parameters::{is_parameter_name, Scaling, LOAD_SCALE};
+use crate::solver::parameters::Scaling;
 
 /// Below this distance, relative to the longest body, two points coincide.
 const COINCIDENT: f64 = 1e-12;
@@ -48,43 +49,13 @@ impl Model {
     }
 
     /// What scales spring `i`'s stiffness: fixed, or the parameter its `stiffness = { value,
-    /// parameter }` names — a parameter name with a positive value, that neither a load's
-    /// `scaled` nor a body's property takes (a load's parameter multiplies it, a property is
-    /// another quantity), and one value wherever springs share it.
+    /// parameter }` names (`value_parameters`).
     fn stiffness_scaling(&self, i: usize, s: &SpringSpec) -> Result<Scaling> {
-        let Some(name) = s.stiffness.parameter() else { return Ok(Scaling::Fixed) };
-        let field = format!("springs[{i}].stiffness.parameter");
-        let value = s.stiffness.value();
-        if !is_parameter_name(name) || name == LOAD_SCALE {
-            return Err(self.err(field, format!("`{name}` is not a parameter name: use letters, digits and `_`, starting with a letter (and not `{LOAD_SCALE}`, the load scale)")));
-        }
-        if !(value > 0.0) {
-            return Err(self.err(
-                format!("springs[{i}].stiffness.value"),
-                format!("must be positive for a parameter (it is the value the parameter replaces), got {value}"),
-            ));
-        }
-        if self
-            .bodies
-            .iter()
-            .any(|b| [&b.youngs_modulus_parameter, &b.density_parameter].into_iter().flatten().any(|n| n == name))
-        {
-            return Err(self.err(field, format!("`{name}` is also a body's Young's modulus or density: give the spring's stiffness a name of its own")));
-        }
-        for (k, load) in self.loads.iter().enumerate() {
-            match load.scaling() {
-                Scaling::Property { name: n, file } if n == name && *file != value => {
-                    return Err(self.err(format!("springs[{i}].stiffness.value"), format!("is {value}, but another spring gives the parameter `{name}` the value {file}: a parameter has one value")));
-                }
-                Scaling::Named(n) | Scaling::Property { name: n, .. }
-                    if n == name && !matches!(load, Load::Spring(_) | Load::TorsionalSpring(_)) =>
-                {
-                    return Err(self.err(field, format!("`{name}` also scales loads[{k}]: a load's parameter multiplies it, a stiffness parameter is its value; give them different names")));
-                }
-                _ => {}
-            }
-        }
-        Ok(Scaling::Property { name: name.to_string(), file: value })
+        let field = format!("springs[{i}].stiffness");
+        Ok(match self.value_parameter(&field, &s.stiffness, ValueKind::SpringStiffness)? {
+            Some((name, file)) => Scaling::Property { name, file },
+            None => Scaling::Fixed,
+        })
     }
 
     /// `{ body, node }` or `{ point = [x, y] }`.

@@ -4,6 +4,7 @@
 //! parameter as well (their weight scales with their mass).
 
 use crate::physics::element::BeamElement;
+use crate::physics::masses::Lumped;
 use crate::physics::parts::BeamBody;
 use crate::solver::parameters::Scaling;
 
@@ -49,8 +50,9 @@ impl WeightParts {
     }
 }
 
-/// The weight of the bodies whose density is the parameter `parameter` (file value
-/// `density`), at the file's density.
+/// The weight of the bodies whose density is the parameter `parameter`, or of the point
+/// masses it sets, at the file's value `density` (kg/m³, or kg for point masses): at μ it
+/// scales by `μ/density`.
 #[derive(Clone, Debug)]
 pub struct DensityWeight {
     pub parameter: String,
@@ -68,25 +70,26 @@ pub struct Weight {
 
 /// Assembles the weight of `gravities` on the elements `elements` (body, 8 dofs), with one
 /// element prototype per body at the file's values, and on the point masses `lumped`
-/// (position coordinates, kg: `m g`, in the plain group, as no parameter scales them).
+/// (position coordinates, kg: `m g`, in the plain group, or in their parameter's when a
+/// parameter sets the mass).
 pub fn assemble(
     gravities: &[&Gravity],
     bodies: &[BeamBody],
     elements: &[(usize, [usize; 8])],
     prototypes: &[BeamElement],
-    lumped: &[([usize; 2], f64)],
+    lumped: &[Lumped],
     n_dof: usize,
 ) -> Weight {
     let mut by_density: Vec<DensityWeight> = Vec::new();
-    for body in bodies {
-        if let Some(name) = &body.density_parameter {
-            if !by_density.iter().any(|d| &d.parameter == name) {
-                by_density.push(DensityWeight {
-                    parameter: name.clone(),
-                    density: body.section.density,
-                    parts: WeightParts::zeros(n_dof),
-                });
-            }
+    let by_body = bodies.iter().filter_map(|b| b.density_parameter.as_deref().map(|n| (n, b.section.density)));
+    let by_mass = lumped.iter().filter_map(|&(_, m, name)| name.map(|n| (n, m)));
+    for (name, value) in by_body.chain(by_mass) {
+        if !by_density.iter().any(|d| d.parameter == name) {
+            by_density.push(DensityWeight {
+                parameter: name.to_string(),
+                density: value,
+                parts: WeightParts::zeros(n_dof),
+            });
         }
     }
     let mut plain = WeightParts::zeros(n_dof);
@@ -103,8 +106,12 @@ pub fn assemble(
                 target[dofs[i]] += qg[i];
             }
         }
-        let target = plain.part(&gravity.scaled, n_dof);
-        for &([x, y], m) in lumped {
+        for &([x, y], m, name) in lumped {
+            let group = match name {
+                None => &mut plain,
+                Some(name) => &mut by_density.iter_mut().find(|d| d.parameter == name).expect("listed above").parts,
+            };
+            let target = group.part(&gravity.scaled, n_dof);
             target[x] += m * gravity.g[0];
             target[y] += m * gravity.g[1];
         }

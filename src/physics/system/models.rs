@@ -90,10 +90,8 @@ impl ElementModel for FlexibleSystem {
                 }
             }
         }
-        // the point masses: no parameter scales them
-        if group.is_none() {
-            self.add_point_mass_product(a, out);
-        }
+        // the point masses of the group: those its parameter sets, or those none sets
+        self.add_point_mass_group_product(group, a, out);
     }
 
     fn moving_rows(&self) -> Vec<(usize, Vec<usize>)> {
@@ -108,6 +106,23 @@ impl ElementModel for FlexibleSystem {
 
     fn has_lumped_mass(&self) -> bool {
         self.has_point_masses()
+    }
+
+    fn lumped_mass_parameters(&self) -> Vec<String> {
+        let mut names: Vec<String> = Vec::new();
+        for (_, name, _) in &self.point_mass_parameters {
+            if !names.contains(name) {
+                names.push(name.clone());
+            }
+        }
+        names
+    }
+
+    fn lumped_mass_factor(&self, name: &str, mu: &Parameters) -> f64 {
+        match (mu.get(name), self.point_mass_parameters.iter().find(|p| p.1 == name)) {
+            (Some(m), Some((_, _, file))) => m / file,
+            _ => 1.0,
+        }
     }
 
     fn group_constant_forces(&self, group: Option<&str>) -> ConstantForces {

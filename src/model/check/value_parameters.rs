@@ -1,0 +1,102 @@
+//! The parameters that set a part's value rather than multiply a load: a spring's stiffness
+//! and a point mass (`stiffness = { value, parameter }`, `mass = { value, parameter }`). A
+//! checked one has a parameter name, a positive value (the run's factor is `μ/value`), and a
+//! name that no load's `scaled`, no body property and no other kind of part takes; parts of
+//! one kind may share it at one value.
+
+use crate::error::Result;
+use crate::model::schema::PropertySpec;
+use crate::model::Model;
+use crate::physics::loads::Load;
+use crate::solver::parameters::{is_parameter_name, Scaling, LOAD_SCALE};
+
+/// The kind of part a value parameter sets.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum ValueKind {
+    SpringStiffness,
+    PointMass,
+}
+
+impl ValueKind {
+    fn noun(self) -> &'static str {
+        match self {
+            ValueKind::SpringStiffness => "a spring's stiffness",
+            ValueKind::PointMass => "a point mass",
+        }
+    }
+}
+
+impl Model {
+    /// The parameter `spec` (at `field`, e.g. `springs[0].stiffness`) names, with its file
+    /// value, or `None` for a plain number: checked as the module documentation says,
+    /// against the bodies, loads, springs and point masses checked before it.
+    pub(super) fn value_parameter(
+        &self,
+        field: &str,
+        spec: &PropertySpec,
+        kind: ValueKind,
+    ) -> Result<Option<(String, f64)>> {
+        let Some(name) = spec.parameter() else { return Ok(None) };
+        let (at_name, at_value) = (format!("{field}.parameter"), format!("{field}.value"));
+        let value = spec.value();
+        if !is_parameter_name(name) || name == LOAD_SCALE {
+            return Err(self.err(at_name, format!("`{name}` is not a parameter name: use letters, digits and `_`, starting with a letter (and not `{LOAD_SCALE}`, the load scale)")));
+        }
+        if !(value > 0.0 && value.is_finite()) {
+            return Err(self.err(
+                at_value,
+                format!("must be positive for a parameter (it is the value the parameter replaces), got {value}"),
+            ));
+        }
+        let body_property = |n: &Option<String>| n.as_deref() == Some(name);
+        if self.bodies.iter().any(|b| body_property(&b.youngs_modulus_parameter) || body_property(&b.density_parameter))
+        {
+            return Err(self.err(
+                at_name,
+                format!("`{name}` is also a body's Young's modulus or density: give {} a name of its own", kind.noun()),
+            ));
+        }
+        for (k, load) in self.loads.iter().enumerate() {
+            match (load, load.scaling()) {
+                (Load::Spring(_) | Load::TorsionalSpring(_), Scaling::Property { name: n, file }) if n == name => {
+                    self.same_value(kind, ValueKind::SpringStiffness, (&at_name, &at_value), name, (value, *file))?;
+                }
+                (_, Scaling::Named(n)) if n == name => {
+                    return Err(self.err(at_name, format!("`{name}` also scales loads[{k}]: a load's parameter multiplies it, this one is a value; give them different names")));
+                }
+                _ => {}
+            }
+        }
+        for m in self.masses.iter().filter(|m| m.parameter.as_deref() == Some(name)) {
+            self.same_value(kind, ValueKind::PointMass, (&at_name, &at_value), name, (value, m.mass))?;
+        }
+        Ok(Some((name.to_string(), value)))
+    }
+
+    /// Refuses a value parameter that an earlier part of another kind takes, or of the same
+    /// kind at another value.
+    fn same_value(
+        &self,
+        kind: ValueKind,
+        other: ValueKind,
+        (at_name, at_value): (&str, &str),
+        name: &str,
+        (value, theirs): (f64, f64),
+    ) -> Result<()> {
+        if kind != other {
+            return Err(
+                self.err(at_name, format!("`{name}` is also {}: give {} a name of its own", other.noun(), kind.noun()))
+            );
+        }
+        if value != theirs {
+            return Err(self.err(
+                at_value,
+                format!(
+                    "is {value}, but {} gives the parameter `{name}` the value {theirs}: a parameter has one value",
+                    other.noun()
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
