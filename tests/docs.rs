@@ -16,6 +16,9 @@
 //!   copy of the tutorial's model and pipeline files; then the README's Python block runs
 //!   there and writes its figure when python3 has h5py, numpy and matplotlib (otherwise it
 //!   says it skipped). Every command must exit 0 and the files the README names must exist.
+//! - `slider_crank_tutorial_runs_as_written`: the same for docs/tutorial-slider-crank.md's
+//!   blocks (the slider-crank model and its tutorial pipeline); its Python block must print
+//!   the full run's peak midpoint deflection, 3.88 mm (docs/slider-crank.md's converged value).
 //! - `readme_is_at_most_300_lines`: the README stays a page a new user reads whole.
 //! - `the_files_speak_of_the_project_not_of_its_making`: no development bookkeeping (the
 //!   numbered steps and tickets of the work, its sittings, whose measurement it was) in the
@@ -129,11 +132,11 @@ fn every_model_key_has_a_unit() {
     assert!(missing.is_empty(), "model keys without a row in docs/model-format.md's key table: {missing:?}");
 }
 
-/// The fenced block of `lang` that follows the marker `marker` in the README.
-fn readme_block(marker: &str) -> String {
-    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
-    let at = readme.find(marker).unwrap_or_else(|| panic!("README.md has no {marker}"));
-    let rest = &readme[at..];
+/// The fenced block that follows the marker `marker` in the Markdown file `page`.
+fn page_block(page: &str, marker: &str) -> String {
+    let text = std::fs::read_to_string(root().join(page)).unwrap();
+    let at = text.find(marker).unwrap_or_else(|| panic!("{page} has no {marker}"));
+    let rest = &text[at..];
     let open = rest.find("```").unwrap();
     let body = &rest[open..];
     let body = &body[body.find('\n').unwrap() + 1..];
@@ -156,55 +159,88 @@ fn readme_pipeline_snippet_is_the_shipped_file() {
     assert!(n >= 5, "the README's pipeline snippet has only {n} lines");
 }
 
-fn copy_tutorial(dir: &Path) {
-    for f in ["data/models/double_pendulum.toml", "pipelines/double_pendulum.toml"] {
+fn copy_tutorial(dir: &Path, files: &[&str]) {
+    for f in files {
         std::fs::create_dir_all(dir.join(f).parent().unwrap()).unwrap();
         std::fs::copy(root().join(f), dir.join(f)).unwrap();
     }
 }
 
-#[test]
-fn readme_tutorial_runs_as_written() {
-    let dir = tempfile::tempdir().unwrap();
-    copy_tutorial(dir.path());
-    let commands = readme_block("<!-- tutorial:begin -->");
+/// Runs the shell block after `<!-- tutorial:begin -->` of `page` in `dir` (each line starts
+/// with the built binary, and must exit 0); the number of commands.
+fn run_tutorial_commands(page: &str, dir: &Path) -> usize {
+    let commands = page_block(page, "<!-- tutorial:begin -->");
     let mut n = 0;
     for line in commands.lines().map(str::trim).filter(|l| !l.is_empty() && !l.starts_with('#')) {
         let words: Vec<&str> = line.split_whitespace().collect();
         assert_eq!(words[0], "target/release/flexrom", "tutorial line does not start with the built binary: {line}");
         let out = Command::new(env!("CARGO_BIN_EXE_flexrom"))
             .args(&words[1..])
-            .current_dir(dir.path())
+            .current_dir(dir)
             .env("HDF5_USE_FILE_LOCKING", "FALSE")
             .output()
             .unwrap();
         assert!(out.status.success(), "`{line}` failed ({}):\n{}", out.status, String::from_utf8_lossy(&out.stderr));
         n += 1;
     }
-    assert!(n >= 4, "the tutorial has only {n} commands");
-    for f in ["data/bases/double_pendulum.h5", "out/dp_1.3.h5", "out/dp_sweep.h5"] {
-        assert!(dir.path().join(f).is_file(), "the tutorial did not write {f}");
-    }
+    n
+}
 
-    let python = readme_block("<!-- tutorial:python -->");
+/// Runs the Python block after `<!-- tutorial:python -->` of `page` in `dir`: `Some(stdout)`,
+/// or `None` (said) where python3 lacks h5py, numpy or matplotlib.
+fn run_tutorial_python(page: &str, dir: &Path) -> Option<String> {
+    let python = page_block(page, "<!-- tutorial:python -->");
     let has = Command::new("python3")
         .args(["-c", "import h5py, numpy, matplotlib"])
         .status()
         .map(|s| s.success())
         .unwrap_or(false);
     if !has {
-        eprintln!("skipped: the README's Python block (python3 with h5py, numpy and matplotlib not found)");
-        return;
+        eprintln!("skipped: the Python block of {page} (python3 with h5py, numpy and matplotlib not found)");
+        return None;
     }
     let out = Command::new("python3")
         .args(["-c", &python])
-        .current_dir(dir.path())
+        .current_dir(dir)
         .env("MPLBACKEND", "Agg")
         .env("HDF5_USE_FILE_LOCKING", "FALSE")
         .output()
         .unwrap();
-    assert!(out.status.success(), "the README's Python block failed:\n{}", String::from_utf8_lossy(&out.stderr));
-    assert!(dir.path().join("out/dp.png").is_file(), "the README's Python block wrote no figure");
+    assert!(out.status.success(), "the Python block of {page} failed:\n{}", String::from_utf8_lossy(&out.stderr));
+    Some(String::from_utf8_lossy(&out.stdout).into_owned())
+}
+
+#[test]
+fn readme_tutorial_runs_as_written() {
+    let dir = tempfile::tempdir().unwrap();
+    copy_tutorial(dir.path(), &["data/models/double_pendulum.toml", "pipelines/double_pendulum.toml"]);
+    let n = run_tutorial_commands("README.md", dir.path());
+    assert!(n >= 4, "the tutorial has only {n} commands");
+    for f in ["data/bases/double_pendulum.h5", "out/dp_1.3.h5", "out/dp_sweep.h5"] {
+        assert!(dir.path().join(f).is_file(), "the tutorial did not write {f}");
+    }
+    if run_tutorial_python("README.md", dir.path()).is_some() {
+        assert!(dir.path().join("out/dp.png").is_file(), "the README's Python block wrote no figure");
+    }
+}
+
+/// docs/tutorial-slider-crank.md's commands run as written, and its Python block prints
+/// the two runs' peak torque and midpoint deflection: the full run's peak deflection is the
+/// benchmark's 3.88 mm (docs/slider-crank.md, converged in Δt and mesh to 3.88 ± 0.01 mm).
+#[test]
+fn slider_crank_tutorial_runs_as_written() {
+    let page = "docs/tutorial-slider-crank.md";
+    let dir = tempfile::tempdir().unwrap();
+    copy_tutorial(dir.path(), &["data/models/slider_crank.toml", "pipelines/tutorial_slider_crank.toml"]);
+    let n = run_tutorial_commands(page, dir.path());
+    assert!(n >= 4, "the slider-crank tutorial has only {n} commands");
+    for f in ["data/bases/tutorial_slider_crank.h5", "out/sc_full.h5", "out/sc_1.3.h5"] {
+        assert!(dir.path().join(f).is_file(), "the slider-crank tutorial did not write {f}");
+    }
+    if let Some(out) = run_tutorial_python(page, dir.path()) {
+        assert_eq!(out.lines().count(), 2, "{out}");
+        assert!(out.contains("peak midpoint deflection 3.88 mm"), "{out}");
+    }
 }
 
 #[test]

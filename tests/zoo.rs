@@ -2,12 +2,15 @@
 //!
 //! * The generator: a seed names the same models every time (two draws of every slot are
 //!   equal to the byte, another seed draws others); the first eight slots hold the first eight
-//!   kinds and slots 24–27 the four new ones; the first 24 slots are the models they were
-//!   before the new kinds (a fingerprint of their files without the root probes added
-//!   since, and one with them); every clamped or driven root has a probe recording its
+//!   kinds, slots 24–27 the four new ones and slots 32–35 the four with spring-dampers; the
+//!   first 24 slots are the models they were before the new kinds (a fingerprint of their
+//!   files without the root probes added since, and one with them), and slots 24–31 those
+//!   they were before the kinds with springs (a fingerprint of their files, taken from the
+//!   generator before them); every clamped or driven root has a probe recording its
 //!   strain and curvature; every model parses and stays within
 //!   the zoo's ranges (1–4 bodies, 10–60 elements per body, E in [1e6, 1e11] Pa, some load or
-//!   drive follows the load scale, the kinds' joints, positive point masses); the validation
+//!   drive follows the load scale, the kinds' joints and springs, positive point masses and
+//!   rotary inertias, no translational spring stiffer than a body it joins, E A / L); the validation
 //!   loads are neither greedy candidates nor the range's ends.
 //! * The subset (`zoo::SUBSET`, seven models): greedy training at tolerance 1e-2 and
 //!   validation at the 8 held-out loads through the release binary, held to the
@@ -20,13 +23,13 @@
 #[path = "common/zoo/mod.rs"]
 mod zoo;
 
-use flexrom::model::schema::{JointSpec, LoadSpec, NodeRef, ProbeQuantity, ScaledSpec};
+use flexrom::model::schema::{JointSpec, LoadSpec, NodeRef, ProbeQuantity, ScaledSpec, SpringKind};
 use flexrom::model::Model;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use zoo::drive::Flexrom;
-use zoo::mechanisms::{Kind, KINDS, NEW_KINDS};
+use zoo::mechanisms::{Kind, KINDS, NEW_KINDS, SPRING_KINDS};
 use zoo::metrics::{aggregate, model_stats, quantity_cases, quantity_stats, ModelStats};
 
 #[test]
@@ -42,6 +45,8 @@ fn a_seed_names_the_same_models() {
     assert_eq!(kinds, KINDS.to_vec());
     let new: Vec<Kind> = (24..24 + NEW_KINDS.len()).map(|s| zoo::draw(zoo::DEFAULT_SEED, s, 0).kind).collect();
     assert_eq!(new, NEW_KINDS.to_vec());
+    let sprung: Vec<Kind> = (32..32 + SPRING_KINDS.len()).map(|s| zoo::draw(zoo::DEFAULT_SEED, s, 0).kind).collect();
+    assert_eq!(sprung, SPRING_KINDS.to_vec());
 }
 
 #[test]
@@ -78,6 +83,32 @@ fn every_drawn_model_is_within_the_zoo_ranges() {
                 let welds = count(|j| matches!(j, JointSpec::Weld { .. }));
                 let all = f.joints.len();
                 assert!(f.masses.iter().all(|p| p.mass.value() > 0.0 && p.mass.value().is_finite()), "{what}: a mass");
+                assert!(f.masses.iter().all(|p| p.rotary_inertia.is_none_or(|j| j > 0.0)), "{what}: a rotary inertia");
+                // a translational spring no stiffer than the axial stiffness E A / L of a body it joins
+                let axial = |name: &Option<String>| -> Vec<f64> {
+                    f.bodies
+                        .iter()
+                        .filter(|b| Some(&b.name) == name.as_ref())
+                        .map(|b| {
+                            let e = b.end.expect("the zoo writes `end`");
+                            b.youngs_modulus.value() * b.area / (e[0] - b.start[0]).hypot(e[1] - b.start[1])
+                        })
+                        .collect()
+                };
+                for s in &f.springs {
+                    assert!(s.stiffness.value() > 0.0 && s.damping >= 0.0, "{what}: a spring");
+                    if s.r#type != Some(SpringKind::Torsional) {
+                        let a = Some(s.a.body.clone());
+                        let cap = axial(&a).into_iter().chain(axial(&s.b.body)).fold(f64::INFINITY, f64::min);
+                        assert!(
+                            s.stiffness.value() <= cap * 1.01,
+                            "{what}: a spring of {} N/m on a body of E A / L {cap}",
+                            s.stiffness.value()
+                        );
+                    }
+                }
+                let translational = f.springs.iter().filter(|s| s.r#type != Some(SpringKind::Torsional)).count();
+                let torsional = f.springs.len() - translational;
                 let n = f.bodies.len();
                 match m.kind {
                     // a crank driven by angle or by a moment (then no drive), the rod's end on a slider
@@ -96,6 +127,20 @@ fn every_drawn_model_is_within_the_zoo_ranges() {
                         let spins = f.bodies[0].angular_velocity.is_some();
                         assert!(ground == 1 && drives + usize::from(spins) == 1 && all == 1 + drives, "{what}")
                     }
+                    // a bar on a spring to a ground point, no joint
+                    Kind::SpringPendulum => assert_eq!((all, translational, torsional, n), (0, 1, 0, 1), "{what}"),
+                    Kind::SprungBoom => {
+                        assert_eq!((clamps, all, translational, torsional, n), (1, 1, 1, 0, 2), "{what}")
+                    }
+                    // the bracket and 1–2 links: a torsional spring at each pin, a block at the tip
+                    Kind::SpringArm => {
+                        assert!(
+                            (2..=3).contains(&n) && (clamps, pins, all) == (1, n - 1, n) && torsional == n - 1,
+                            "{what}"
+                        );
+                        assert!(f.masses.len() == 1 && f.masses[0].rotary_inertia.is_some(), "{what}");
+                    }
+                    Kind::CoupledPendulums => assert_eq!((ground, all, translational, n), (2, 2, 1, 2), "{what}"),
                     Kind::Pendulum => assert_eq!((ground, clamps, pins), (1, 0, 0), "{what}"),
                     Kind::Cantilever => assert!(clamps == 1 && ground <= 1 && pins == 0, "{what}"),
                     Kind::NPendulum | Kind::DrivenArm => assert_eq!((ground, clamps, pins), (1, 0, n - 1), "{what}"),
@@ -220,12 +265,12 @@ fn without_root_probes(toml: &str) -> &str {
     toml.find("\n[[probes]]\nname = \"root").map_or(toml, |i| &toml[..i])
 }
 
-/// FNV-1a of the model files of slots 0..24, attempts 0..4 of the default seed, each
-/// through `keep`: the zoo's first 24 slots are the models of docs/zoo.md's earlier
-/// results, and growing the zoo must not change them.
-fn fingerprint_of_the_first_24_slots(keep: fn(&str) -> &str) -> u64 {
+/// FNV-1a of the model files of `slots`, attempts 0..4 of the default seed, each through
+/// `keep`: the zoo's slots hold the models of docs/zoo.md's earlier results, and growing
+/// the zoo must not change them.
+fn fingerprint_of_slots(slots: std::ops::Range<usize>, keep: fn(&str) -> &str) -> u64 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for slot in 0..24 {
+    for slot in slots {
         for attempt in 0..4 {
             for b in keep(&zoo::draw(zoo::DEFAULT_SEED, slot, attempt).mechanism.toml).bytes() {
                 h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
@@ -241,8 +286,16 @@ fn fingerprint_of_the_first_24_slots(keep: fn(&str) -> &str) -> u64 {
 /// root probes, the generator since they were added.
 #[test]
 fn growing_the_zoo_keeps_its_first_24_slots() {
-    assert_eq!(fingerprint_of_the_first_24_slots(without_root_probes), 0x509b_750e_da70_7c77);
-    assert_eq!(fingerprint_of_the_first_24_slots(|t| t), 0x6096_1676_0aec_8db2);
+    assert_eq!(fingerprint_of_slots(0..24, without_root_probes), 0x509b_750e_da70_7c77);
+    assert_eq!(fingerprint_of_slots(0..24, |t| t), 0x6096_1676_0aec_8db2);
+}
+
+/// The new kinds' slots 24–31 (sliders, welds, point masses, drives by angle) are the models
+/// of docs/zoo.md's "grown zoo" results: the kinds with springs, drawn in the slots after
+/// them, left their files as they were.
+#[test]
+fn growing_the_zoo_keeps_slots_24_to_31() {
+    assert_eq!(fingerprint_of_slots(24..32, |t| t), 0x9350_1a63_ed3a_bc32);
 }
 
 /// The node of a model file as the zoo writes it: an index, `start` or `end`.

@@ -6,9 +6,10 @@
 //! drawn over the ranges of the zoo's brief (tests/common/zoo/mod.rs).
 
 use super::parts::{
-    ahead, beam, material, model_toml, sig, time, unit_function, Beam, Func, Joint, Load, Material, Parts, Place,
-    Probe, Rng, Time, G,
+    ahead, beam, describe_extras, material, model_toml, sig, time, unit_function, Beam, Func, Joint, Load, Material,
+    Parts, Place, PointMass, Probe, Rng, Spring, Time, G,
 };
+use super::springs;
 use std::f64::consts::PI;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -42,6 +43,18 @@ pub enum Kind {
     /// one beam on a ground pin spun up by angle from rest (the spin-up beam), or released
     /// with an initial angular velocity under gravity; sometimes a tip mass
     SpinningLink,
+    /// one bar hanging from a ground point by a spring-damper at its top node, released
+    /// tilted (an elastic pendulum); sometimes a tip mass
+    SpringPendulum,
+    /// a clamped flexible boom with a bar hanging from its end by a spring-damper, a load's
+    /// point mass at the bar's lower end
+    SprungBoom,
+    /// 1–2 links on a short clamped bracket, a torsional spring-damper at the shoulder and
+    /// the elbow, a tip point mass with rotary inertia, sagging under gravity
+    SpringArm,
+    /// two pendulums on ground pins side by side, joined by a spring-damper, one released
+    /// tilted
+    CoupledPendulums,
 }
 
 pub const KINDS: [Kind; 8] = [
@@ -59,15 +72,26 @@ pub const KINDS: [Kind; 8] = [
 /// `NEW_KINDS[(i − OLD_SLOTS) mod 4]`, so that the first slots keep their models.
 pub const NEW_KINDS: [Kind; 4] = [Kind::SliderCrank, Kind::AngleArm, Kind::WeldedFrame, Kind::SpinningLink];
 
+/// The kinds with spring-dampers and point masses with rotary inertia: slot `i ≥
+/// SPRING_SLOTS` draws `SPRING_KINDS[(i − SPRING_SLOTS) mod 4]`, so that the slots before
+/// keep their models.
+pub const SPRING_KINDS: [Kind; 4] = [Kind::SpringPendulum, Kind::SprungBoom, Kind::SpringArm, Kind::CoupledPendulums];
+
 /// The slots the zoo had before the kinds of [`NEW_KINDS`]: slot `i` below it draws `KINDS[i mod 8]`.
 pub const OLD_SLOTS: usize = 24;
+
+/// The slots the zoo had before the kinds of [`SPRING_KINDS`]: slots `OLD_SLOTS..SPRING_SLOTS`
+/// draw [`NEW_KINDS`].
+pub const SPRING_SLOTS: usize = 32;
 
 /// The kind of slot `slot`.
 pub fn kind_of(slot: usize) -> Kind {
     if slot < OLD_SLOTS {
         KINDS[slot % KINDS.len()]
-    } else {
+    } else if slot < SPRING_SLOTS {
         NEW_KINDS[(slot - OLD_SLOTS) % NEW_KINDS.len()]
+    } else {
+        SPRING_KINDS[(slot - SPRING_SLOTS) % SPRING_KINDS.len()]
     }
 }
 
@@ -86,19 +110,23 @@ impl Kind {
             Kind::AngleArm => "angle-arm",
             Kind::WeldedFrame => "welded-frame",
             Kind::SpinningLink => "spinning-link",
+            Kind::SpringPendulum => "spring-pendulum",
+            Kind::SprungBoom => "sprung-boom",
+            Kind::SpringArm => "spring-arm",
+            Kind::CoupledPendulums => "coupled-pendulums",
         }
     }
 }
 
 /// E over the whole range of the zoo: 1e6 (soft elastomer) to 1e11 Pa (steel-like).
-const E_ALL: (f64, f64) = (1e6, 1e11);
+pub(super) const E_ALL: (f64, f64) = (1e6, 1e11);
 /// Flexibility caps (`Beam::flexibility`): a body hanging or driven from one end, a
 /// cantilever, a body held at both ends.
-const FLEX_FREE: f64 = 1.0;
-const FLEX_CLAMPED: f64 = 0.5;
+pub(super) const FLEX_FREE: f64 = 1.0;
+pub(super) const FLEX_CLAMPED: f64 = 0.5;
 const FLEX_HELD: f64 = 3.0;
 /// How far a drive's peak moment may bend the link it acts on (M L / EI, rad).
-const DRIVE_BEND: f64 = 0.3;
+pub(super) const DRIVE_BEND: f64 = 0.3;
 
 /// A drawn mechanism: the model file and a one-line account of it.
 pub struct Mechanism {
@@ -125,6 +153,10 @@ pub fn build(kind: Kind, rng: &mut Rng) -> Mechanism {
         Kind::AngleArm => angle_arm(rng, t),
         Kind::WeldedFrame => welded_frame(rng, t),
         Kind::SpinningLink => spinning_link(rng, t),
+        Kind::SpringPendulum => springs::spring_pendulum(rng, t),
+        Kind::SprungBoom => springs::sprung_boom(rng, t),
+        Kind::SpringArm => springs::spring_arm(rng, t),
+        Kind::CoupledPendulums => springs::coupled_pendulums(rng, t),
     };
     // a light Rayleigh damping in one model of five, as some users add
     if rng.chance(0.2) {
@@ -148,20 +180,20 @@ pub fn build(kind: Kind, rng: &mut Rng) -> Mechanism {
 }
 
 /// A mechanism being drawn.
-struct Draft {
+pub(super) struct Draft {
     bodies: Vec<Beam>,
     joints: Vec<Joint>,
     loads: Vec<Load>,
     damping: Option<(f64, f64)>,
-    /// point masses: body, node, kg
-    masses: Vec<(String, String, f64)>,
+    pub(super) masses: Vec<PointMass>,
+    pub(super) springs: Vec<Spring>,
     /// what the drive aims at, for the summary
     motion: String,
 }
 
 impl Draft {
-    fn new(bodies: Vec<Beam>, joints: Vec<Joint>, loads: Vec<Load>, motion: String) -> Self {
-        Draft { bodies, joints, loads, damping: None, masses: Vec::new(), motion }
+    pub(super) fn new(bodies: Vec<Beam>, joints: Vec<Joint>, loads: Vec<Load>, motion: String) -> Self {
+        Draft { bodies, joints, loads, damping: None, masses: Vec::new(), springs: Vec::new(), motion }
     }
 
     /// The nodes held against turning by the ground — clamped, driven by angle, or
@@ -224,7 +256,7 @@ impl Draft {
             })
             .collect();
         let mut loads: Vec<String> = self.loads.iter().map(Load::describe).collect();
-        loads.extend(self.masses.iter().map(|(b, n, m)| format!("mass {} kg at {b} {n}", sig(*m, 2))));
+        loads.extend(describe_extras(&self.masses, &self.springs));
         if loads.is_empty() {
             loads.push("no loads".into());
         }
@@ -244,7 +276,13 @@ impl Draft {
             t.rho_inf,
             damping
         );
-        let parts = Parts { bodies: &self.bodies, joints: &self.joints, loads: &self.loads, masses: &self.masses };
+        let parts = Parts {
+            bodies: &self.bodies,
+            joints: &self.joints,
+            loads: &self.loads,
+            masses: &self.masses,
+            springs: &self.springs,
+        };
         let toml = model_toml(&summary, t, self.damping, &parts, &probes);
         let n_elements: usize = self.bodies.iter().map(|b| b.elements).sum();
         Mechanism {
@@ -410,7 +448,7 @@ fn cantilever(rng: &mut Rng, t: Time) -> Draft {
 }
 
 /// Beams end to end from `origin`, each at its own angle; pins between neighbours.
-fn chain(rng: &mut Rng, origin: [f64; 2], specs: &[(f64, f64, Material, f64)]) -> (Vec<Beam>, Vec<Joint>) {
+pub(super) fn chain(rng: &mut Rng, origin: [f64; 2], specs: &[(f64, f64, Material, f64)]) -> (Vec<Beam>, Vec<Joint>) {
     let mut bodies: Vec<Beam> = Vec::new();
     let mut joints = Vec::new();
     let mut p = origin;
@@ -783,7 +821,7 @@ fn slider_crank(rng: &mut Rng, t: Time) -> Draft {
     }
     let mut d = Draft::new(vec![crank, rod], joints, loads, motion);
     if block > 0.0 {
-        d.masses.push(("rod".into(), "end".into(), block));
+        d.masses.push(PointMass::new("rod", "end", block));
     }
     d
 }
@@ -821,7 +859,7 @@ fn angle_arm(rng: &mut Rng, t: Time) -> Draft {
     let what = if matches!(unit, Func::Sum(_)) { "swings" } else { "moves" };
     let mut d = Draft::new(bodies, joints, loads, format!("shoulder {what} by {theta} rad in {duration} s"));
     if tip > 0.0 {
-        d.masses.push((format!("link{n}"), "end".into(), tip));
+        d.masses.push(PointMass::new(&format!("link{n}"), "end", tip));
     }
     d
 }
@@ -859,11 +897,7 @@ fn welded_frame(rng: &mut Rng, t: Time) -> Draft {
         let arm = beam(rng, name, corner, ahead(corner, w, *angle), ma, FLEX_CLAMPED);
         joints.push(Joint::Weld { a: ("column".into(), "end".into()), b: (name.clone(), "start".into()) });
         if rng.chance(0.7) {
-            masses.push((
-                name.clone(),
-                "end".to_string(),
-                sig((frame_mass + arm.mass()) * rng.log_uniform(0.1, 1.0), 3),
-            ));
+            masses.push(PointMass::new(name, "end", sig((frame_mass + arm.mass()) * rng.log_uniform(0.1, 1.0), 3)));
         }
         bodies.push(arm);
     }
@@ -896,7 +930,7 @@ fn welded_frame(rng: &mut Rng, t: Time) -> Draft {
     };
     // each arm sized for its end's load, the column for the arms' moments (M L/EI ≤ 0.3 at λ = 1.5)
     let end_load = |name: &str| -> f64 {
-        let m: f64 = masses.iter().filter(|(b, _, _)| b == name).map(|(_, _, m)| m * G).sum();
+        let m: f64 = masses.iter().filter(|p: &&PointMass| p.body == name).map(|p| p.mass * G).sum();
         let f: f64 = loads
             .iter()
             .filter_map(|l| match l {
@@ -953,7 +987,7 @@ fn spinning_link(rng: &mut Rng, t: Time) -> Draft {
     };
     let mut d = Draft::new(vec![b], joints, loads, motion);
     if tip > 0.0 {
-        d.masses.push(("beam".into(), "end".into(), tip));
+        d.masses.push(PointMass::new("beam", "end", tip));
     }
     d
 }

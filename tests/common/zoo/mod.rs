@@ -6,7 +6,8 @@
 //!
 //! Slot `i` of a zoo draws its kind (`mechanisms::kind_of`: `KINDS[i mod 8]` for the first
 //! 24 slots, the zoo before sliders, welds, point masses and drives by angle; `NEW_KINDS[(i −
-//! 24) mod 4]` after them) from its own stream (seed, slot, attempt), so a slot's model does
+//! 24) mod 4]` after them up to slot 32; `SPRING_KINDS[(i − 32) mod 4]`, the kinds with
+//! spring-dampers, from there) from its own stream (seed, slot, attempt), so a slot's model does
 //! not depend on how many slots are drawn: the subset is the same models as in the whole zoo,
 //! and growing the zoo left its first 24 models as they were. A model whose full run fails at either end of the load range,
 //! or at a load greedy training or the validation would run it at (`check_loads`), is
@@ -18,6 +19,7 @@ pub mod drive;
 pub mod mechanisms;
 pub mod metrics;
 pub mod parts;
+pub mod springs;
 
 use mechanisms::{build, kind_of, Kind, Mechanism};
 use parts::Rng;
@@ -25,8 +27,9 @@ use std::fmt::Write;
 
 /// The zoo of docs/zoo.md.
 pub const DEFAULT_SEED: u64 = 2026;
-/// The slots of the whole zoo: 24 of the first eight kinds, 8 of the four new ones.
-pub const SLOTS: usize = 32;
+/// The slots of the whole zoo: 24 of the first eight kinds, 8 of the four kinds with
+/// sliders, welds, drives by angle and point masses, 8 of the four with spring-dampers.
+pub const SLOTS: usize = 40;
 /// The load range every pipeline trains over; its ends are where a model must run.
 pub const RANGE: (f64, f64) = (0.5, 1.5);
 pub const MAX_RUNS: usize = 10;

@@ -453,12 +453,96 @@ fn node_toml(n: &str) -> String {
     }
 }
 
-/// What a mechanism is made of: its bodies, joints, loads and point masses (body, node, kg).
+/// A point mass of the model file (`[[masses]]`) at a node of a body.
+#[derive(Clone, Debug)]
+pub struct PointMass {
+    pub body: String,
+    pub node: String,
+    /// kg
+    pub mass: f64,
+    /// kg m² about the node (`rotary_inertia`; None leaves the key out, the format's 0)
+    pub rotary_inertia: Option<f64>,
+}
+
+impl PointMass {
+    pub fn new(body: &str, node: &str, mass: f64) -> Self {
+        PointMass { body: body.into(), node: node.into(), mass, rotary_inertia: None }
+    }
+
+    fn describe(&self) -> String {
+        let j = self.rotary_inertia.map_or(String::new(), |j| format!(" (J {} kg m²)", sig(j, 2)));
+        format!("mass {} kg{j} at {} {}", sig(self.mass, 2), self.body, self.node)
+    }
+}
+
+/// A spring's second end: a node of a body, or a ground point.
+#[derive(Clone, Debug)]
+pub enum End {
+    Node(String, String),
+    Point([f64; 2]),
+}
+
+/// A spring-damper of the model file (`[[springs]]`): translational between node `a` and
+/// `b`, or torsional between two nodes' slopes.
+#[derive(Clone, Debug)]
+pub struct Spring {
+    pub name: String,
+    pub torsional: bool,
+    pub a: (String, String),
+    pub b: End,
+    /// N/m, or N m/rad (torsional)
+    pub stiffness: f64,
+    /// N s/m, or N m s/rad (torsional); 0 leaves the key out
+    pub damping: f64,
+    /// the free length, m (None: the initial distance)
+    pub length: Option<f64>,
+}
+
+impl Spring {
+    pub fn describe(&self) -> String {
+        let (what, unit) = if self.torsional { ("torsional spring", "N m/rad") } else { ("spring", "N/m") };
+        let damper = if self.damping > 0.0 { "-damper" } else { "" };
+        format!("{what}{damper} {} {:e} {unit}", self.name, self.stiffness)
+    }
+
+    /// The `[[springs]]` table.
+    fn toml(&self) -> String {
+        let mut s = format!("\n[[springs]]\nname = {:?}\n", self.name);
+        if self.torsional {
+            s.push_str("type = \"torsional\"\n");
+        }
+        let _ = writeln!(s, "a = {{ body = {:?}, node = {} }}", self.a.0, node_toml(&self.a.1));
+        match &self.b {
+            End::Node(body, node) => {
+                let _ = writeln!(s, "b = {{ body = {body:?}, node = {} }}", node_toml(node));
+            }
+            End::Point(p) => {
+                let _ = writeln!(s, "b = {{ point = [{:?}, {:?}] }}", p[0], p[1]);
+            }
+        }
+        let _ = writeln!(s, "stiffness = {:?}", self.stiffness);
+        if self.damping > 0.0 {
+            let _ = writeln!(s, "damping = {:?}", self.damping);
+        }
+        if let Some(l) = self.length {
+            let _ = writeln!(s, "length = {l:?}");
+        }
+        s
+    }
+}
+
+/// What a mechanism is made of: its bodies, joints, loads, point masses and spring-dampers.
 pub struct Parts<'a> {
     pub bodies: &'a [Beam],
     pub joints: &'a [Joint],
     pub loads: &'a [Load],
-    pub masses: &'a [(String, String, f64)],
+    pub masses: &'a [PointMass],
+    pub springs: &'a [Spring],
+}
+
+/// What the summary line says of a mechanism's point masses and springs, after its loads.
+pub fn describe_extras(masses: &[PointMass], springs: &[Spring]) -> Vec<String> {
+    masses.iter().map(PointMass::describe).chain(springs.iter().map(Spring::describe)).collect()
 }
 
 /// Where on its body a probe sits.
@@ -504,7 +588,7 @@ pub fn model_toml(
     parts: &Parts,
     probes: &[Probe],
 ) -> String {
-    let Parts { bodies, joints, loads, masses } = *parts;
+    let Parts { bodies, joints, loads, masses, springs } = *parts;
     let mut s = String::new();
     let _ = writeln!(s, "description = {description:?}\n");
     let _ = writeln!(s, "[time]\nt_end = {:?}\ndt = {:?}\nrho_inf = {:?}", time.t_end, time.dt, time.rho_inf);
@@ -587,8 +671,14 @@ pub fn model_toml(
             }
         }
     }
-    for (body, node, mass) in masses {
-        let _ = writeln!(s, "\n[[masses]]\nbody = {body:?}\nnode = {}\nmass = {mass:?}", node_toml(node));
+    for m in masses {
+        let _ = writeln!(s, "\n[[masses]]\nbody = {:?}\nnode = {}\nmass = {:?}", m.body, node_toml(&m.node), m.mass);
+        if let Some(j) = m.rotary_inertia {
+            let _ = writeln!(s, "rotary_inertia = {j:?}");
+        }
+    }
+    for sp in springs {
+        s.push_str(&sp.toml());
     }
     for p in probes {
         s.push_str(&p.toml());
