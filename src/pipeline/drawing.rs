@@ -2,7 +2,7 @@
 //! ([`crate::physics::centre_line`]), the joints (each kind its mark, a slider with its
 //! rail), point masses, springs (translational: a zig-zag; torsional: a spiral at the
 //! node), probes and body names. One drawing for every use: the frames of `flexrom animate`
-//! ([`super::animate`]),
+//! ([`super::animate`]) and the report's figure of the model ([`super::model_figure`]),
 //! on any plotters backend (GIF, PNG, SVG).
 
 use super::plot::COLORS;

@@ -10,6 +10,7 @@ pub mod dense;
 pub mod drawing;
 pub mod greedy;
 pub mod merge;
+pub mod model_figure;
 pub mod motion;
 pub mod online;
 pub mod plot;
