@@ -90,7 +90,9 @@ pub fn open_sweep_run(path: &Path, pick: SweepPick, limits: &crate::limits::Limi
             format!("is not that of the model the basis {} stores: the sweep ran another model", basis_path.display()),
         ));
     }
-    // a run's coordinates and columns bound how many runs a file this size may hold
+    // the file alone sizes /t: bounded before it is read (8 bytes an instant), and a run's
+    // coordinates and columns bound how many runs the file may hold
+    bounded_len(&f, "t", 8.0, limits).map_err(|p| bad("t", p))?;
     let t: Vec<f64> =
         f.dataset("t").and_then(|d| d.read_raw()).map_err(|e| bad("t", format!("cannot be read: {e}")))?;
     let (nt, r) = (t.len(), basis.n_reduced());
