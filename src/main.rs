@@ -224,19 +224,26 @@ flops) or the memory bound; --dense forces it.
         exit_codes!()
     ))]
     Run(cli::run::Args),
-    /// Draw a result file's motion as an animated GIF (deformed centre lines, joints, probes).
+    /// Draw a result file's motion (or a sweep file's run) as an animated GIF (deformed centre lines, joints, probes).
     #[command(after_help = concat!(
         "Examples:
   flexrom animate out/pendulum.h5 -o out/pendulum.gif
   flexrom animate full.h5 --compare reduced.h5 -o compare.gif --fps 25 --size 800x500
   flexrom animate out/p5000.h5 -o p5000.gif --max-frames 100 --size 480
+  flexrom animate out/sweep.h5 --load-scale 1.2 -o at_1.2.gif
+  flexrom animate out/box_sweep.h5 --point 7 -o point_7.gif --compare full_7.h5
 
 The centre lines are drawn from the elements' cubic interpolation (4 points an element; a
-big mesh evenly subsampled along its bodies), ground joints as triangles, joints between
-bodies as rings, point masses as discs, probes as crosses, on equal axes fitted to the whole
-motion. A long run is shown at --max-frames evenly spaced instants. A reduced result
-(`online`) holds its reconstructed coordinates and is drawn alike. -o must end in .gif; an
-existing file there is replaced only when it is an animation flexrom wrote.
+big mesh evenly subsampled along its bodies), ground pins as triangles, pins as rings,
+clamps as squares, sliders as hollow squares on their rails, welds as diamonds, drives as
+double rings, springs as zig-zags (torsional: spirals), point masses as discs, probes as
+crosses, on equal axes fitted to the whole motion. A long run is shown at --max-frames
+evenly spaced instants. A reduced result (`online`) holds its reconstructed coordinates and
+is drawn alike; a reduced sweep file is drawn at one of its runs (--load-scale L, or --point K
+where several points share a load scale), reconstructed on the basis it names. A full sweep
+keeps probes only: animate `flexrom simulate MODEL --load-scale L -o run.h5` instead. -o
+must end in .gif; an existing file there is replaced only when it is an animation flexrom
+wrote.
 
 ",
         exit_codes!()

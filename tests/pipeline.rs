@@ -297,6 +297,16 @@ fn run_writes_a_report() {
     let summary = std::fs::read_to_string(dir.path().join("report/summary.md")).unwrap();
     assert!(summary.contains("](animation.gif)"), "summary.md does not show the animation");
     assert!(!dir.path().join("report/.animation").exists());
+    // the model drawn at its initial configuration, SVG and PNG, shown before the tables:
+    // the pendulum's body named, its ground pin and its probe in the legend
+    let model_svg = std::fs::read_to_string(dir.path().join("report/model.svg")).unwrap();
+    for word in ["\nbeam\n", "\nground pin\n", "\nprobe\n", "polyline"] {
+        assert!(model_svg.contains(word), "model.svg has no {word}");
+    }
+    let png = std::fs::read(dir.path().join("report/model.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG\r\n\x1a\n"), "model.png is not a PNG");
+    let (figure, tables) = (summary.find("](model.svg)"), summary.find("## Validation"));
+    assert!(figure.is_some() && figure < tables, "summary.md shows the model before its tables");
 }
 
 /// A model without probes: the report has no probe figures and the summary links none (the

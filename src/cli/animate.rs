@@ -2,13 +2,15 @@
 
 use flexrom::limits::Limits;
 use flexrom::output::info;
-use flexrom::pipeline::animate::{animate, check_own_gif, AnimateOptions};
+use flexrom::pipeline::animate::{animate_picked, check_own_gif, AnimateOptions};
+use flexrom::pipeline::sweep::SweepPick;
 use std::path::PathBuf;
 
 /// The arguments of `flexrom animate`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// result file (HDF5) of `simulate`, `online` or `statics`
+    /// result file (HDF5) of `simulate`, `online` or `statics`, or a reduced sweep file of
+    /// `sweep` (with --load-scale or --point)
     result: PathBuf,
     /// the animation to write (must end in .gif)
     #[arg(short, long)]
@@ -26,6 +28,16 @@ pub struct Args {
     /// reduced, or two loads), at the instants nearest the first's
     #[arg(long, value_name = "OTHER.h5")]
     compare: Option<PathBuf>,
+    /// of a sweep file, the run at this load scale (reconstructed on the basis the sweep
+    /// file names; a full sweep keeps no coordinates: animate `flexrom simulate MODEL
+    /// --load-scale L -o run.h5` instead); applies to --compare too when it is a sweep file
+    #[arg(long, value_name = "L", allow_negative_numbers = true, conflicts_with = "point")]
+    load_scale: Option<f64>,
+    /// of a sweep file over named parameters, its point K, where a load scale names several:
+    /// 0-based, row K of its /points and of `flexrom sweep`'s table (the report's plots
+    /// number the points from 1)
+    #[arg(long, value_name = "K")]
+    point: Option<usize>,
 }
 
 fn parse_size(s: &str) -> Result<(u32, Option<u32>), String> {
@@ -39,7 +51,8 @@ fn parse_size(s: &str) -> Result<(u32, Option<u32>), String> {
 
 impl Args {
     pub fn run(self, limits: &Limits) -> flexrom::Result<()> {
-        let Args { result, output, fps, size, max_frames, compare } = self;
+        let Args { result, output, fps, size, max_frames, compare, load_scale, point } = self;
+        let pick = load_scale.map(SweepPick::LoadScale).or(point.map(SweepPick::Point));
         let mut inputs = vec![(result.as_path(), "result file")];
         if let Some(c) = &compare {
             inputs.push((c.as_path(), "compared result file"));
@@ -48,7 +61,7 @@ impl Args {
         let defaults = AnimateOptions::default();
         let opts = AnimateOptions { fps, size: size.unwrap_or(defaults.size), max_frames: max_frames as usize };
         let start = std::time::Instant::now();
-        let a = animate(&result, compare.as_deref(), &output, &opts, limits)?;
+        let a = animate_picked(&result, compare.as_deref(), pick, &output, &opts, limits)?;
         info(&format!(
             "{}: {} frames, {}×{} px, {:.1} KiB in {:.2} s -> {}",
             result.display(),

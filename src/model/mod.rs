@@ -365,6 +365,11 @@ impl Model {
         &self.masses
     }
 
+    /// The validated loads, in file order (springs among them).
+    pub fn loads(&self) -> &[Load] {
+        &self.loads
+    }
+
     pub fn probe_names(&self) -> Vec<String> {
         self.probes.iter().map(|p| p.name.clone()).collect()
     }

@@ -1,18 +1,20 @@
-//! `flexrom animate`: the motion of a result file as an animated GIF (plotters' pure-Rust
-//! GIF backend: plays in any browser and in Markdown, no ffmpeg). Each frame draws the
-//! deformed centre lines from the ANCF interpolation ([`crate::physics::centre_line`]),
-//! the joints, point masses and probes, and the time, on equal axes fitted to the whole
-//! motion; `--compare` overlays a second run, dashed in another colour, at the nearest
-//! instant of its own time grid.
+//! `flexrom animate`: the motion of a result file, or of one run of a reduced sweep file
+//! ([`super::motion`]), as an animated GIF (plotters' pure-Rust GIF backend: plays in any
+//! browser and in Markdown, no ffmpeg). Each frame draws the mechanism as
+//! [`super::drawing`] does (the deformed centre lines from the ANCF interpolation, the
+//! joints, springs, point masses and probes) and the time, on equal axes fitted to the
+//! whole motion; `--compare` overlays a second run, dashed in another colour, at the
+//! nearest instant of its own time grid.
 //!
 //! A long run is subsampled in time (at most `max_frames` evenly spaced instants, the
 //! first and last included) and a big mesh along its bodies ([`MAX_POINTS`] samples a
 //! run), so that a 5000-element model's animation stays small and quick.
 
+use super::drawing::{draw_frame, Bounds, Frame, Style};
+use super::motion::Motion;
 use super::plot::{linear_labels, register_font, COLORS};
+use super::sweep::SweepPick;
 use crate::error::{Error, Result};
-use crate::io::result_read::ResultReader;
-use crate::model::Model;
 use crate::physics::centre_line::CentreLines;
 use plotters::prelude::*;
 use std::path::Path;
@@ -48,64 +50,25 @@ pub struct Animation {
     pub height: u32,
 }
 
-/// One run's drawing at one instant.
-struct Frame {
-    lines: Vec<Vec<(f64, f64)>>,
-    /// joints: position, whether it holds a node to the ground
-    joints: Vec<((f64, f64), bool)>,
-    masses: Vec<(f64, f64)>,
-    probes: Vec<(f64, f64)>,
-}
-
-/// A result file's model and sampling.
+/// A run's motion and its sampling along the bodies.
 struct Run {
-    reader: ResultReader,
-    model: Model,
+    motion: Motion,
     lines: CentreLines,
-    name: String,
 }
 
 impl Run {
-    fn open(path: &Path, limits: &crate::limits::Limits) -> Result<Run> {
-        let reader = ResultReader::open(path, limits)?;
-        let model = Model::from_text_with(&reader.model_text, &reader.model_path, limits.clone())
-            .map_err(|e| Error::input(path, "model", format!("the model text it stores is not valid: {e}")))?;
-        let n_dof = 4 * model.bodies().iter().map(|b| b.n_elements + 1).sum::<usize>();
-        if n_dof != reader.n_dof() {
-            return Err(Error::input(
-                path,
-                "q",
-                format!("has {} coordinates a row; the model it stores has {n_dof}", reader.n_dof()),
-            ));
-        }
-        let lines = CentreLines::new(model.bodies(), MAX_POINTS);
-        let name = path.file_name().map_or(path.display().to_string(), |n| n.to_string_lossy().into_owned());
-        Ok(Run { reader, model, lines, name })
+    fn new(motion: Motion) -> Run {
+        let lines = CentreLines::new(motion.model.bodies(), MAX_POINTS);
+        Run { motion, lines }
     }
 
     fn frame(&self, k: usize) -> Result<Frame> {
-        let q = self.reader.q_row(k)?;
-        let xy = |p: [f64; 2]| (p[0], p[1]);
-        let r = self.lines.interpolate(&q);
-        let lines = self.lines.bodies().map(|range| r[range].iter().map(|&p| xy(p)).collect()).collect();
-        let joints = self
-            .model
-            .joints()
-            .iter()
-            .map(|j| {
-                let kind = j.kind();
-                let node = kind.nodes()[0];
-                (xy(self.lines.node_position(&q, node)), !kind.couples_bodies())
-            })
-            .collect();
-        let masses = self.model.masses().iter().map(|m| xy(self.lines.node_position(&q, m.node))).collect();
-        let probes = self.model.probes().iter().map(|p| xy(self.lines.point_position(&q, p.element, p.xi))).collect();
-        Ok(Frame { lines, joints, masses, probes })
+        Ok(Frame::at(&self.motion.model, &self.lines, &self.motion.q_row(k)?))
     }
 
     /// The instant of this run's time grid nearest `t`.
     fn nearest(&self, t: f64) -> usize {
-        let ts = &self.reader.t;
+        let ts = self.motion.t();
         let i = ts.partition_point(|&x| x < t).min(ts.len() - 1);
         if i > 0 && (t - ts[i - 1]).abs() <= (ts[i] - t).abs() {
             i - 1
@@ -133,20 +96,43 @@ pub fn animate(
     opts: &AnimateOptions,
     limits: &crate::limits::Limits,
 ) -> Result<Animation> {
+    animate_picked(result, compare, None, out, opts, limits)
+}
+
+/// [`animate`] where `result` or `compare` may be a reduced sweep file: `pick` names the
+/// run drawn of each sweep file given ([`Motion::open`]); a `pick` with no sweep file
+/// given is refused.
+pub fn animate_picked(
+    result: &Path,
+    compare: Option<&Path>,
+    pick: Option<SweepPick>,
+    out: &Path,
+    opts: &AnimateOptions,
+    limits: &crate::limits::Limits,
+) -> Result<Animation> {
     if !(opts.fps.is_finite() && opts.fps > 0.0 && opts.fps <= 100.0) {
         return Err(Error::Usage(format!("--fps {} is not in (0, 100] frames per second", opts.fps)));
     }
-    let main = Run::open(result, limits)?;
-    let other = compare.map(|p| Run::open(p, limits)).transpose()?;
-    if main.reader.t.is_empty() {
+    let (main, main_sweep) = Motion::open(result, pick, limits)?;
+    let other = compare.map(|p| Motion::open(p, pick, limits)).transpose()?;
+    if let Some(pick) = pick.filter(|_| !main_sweep && !other.as_ref().is_some_and(|o| o.1)) {
+        return Err(Error::input(
+            result,
+            pick.flag(),
+            "picks a run of a sweep file, and no file given is one: a result file holds one run, animated as it is",
+        ));
+    }
+    let (main, other) = (Run::new(main), other.map(|o| Run::new(o.0)));
+    let ts = main.motion.t();
+    if ts.is_empty() {
         return Err(Error::input(result, "t", "is empty: the run recorded no instant"));
     }
-    let indices = frame_indices(main.reader.t.len(), opts.max_frames);
+    let indices = frame_indices(ts.len(), opts.max_frames);
     let mut frames = Vec::with_capacity(indices.len());
     for &k in &indices {
-        let t = main.reader.t[k];
+        let t = ts[k];
         let second = match &other {
-            Some(o) if !o.reader.t.is_empty() => Some(o.frame(o.nearest(t))?),
+            Some(o) if !o.motion.t().is_empty() => Some(o.frame(o.nearest(t))?),
             _ => None,
         };
         frames.push((t, main.frame(k)?, second));
@@ -155,8 +141,8 @@ pub fn animate(
     let width = opts.size.0.clamp(120, 4000);
     let height = opts.size.1.unwrap_or_else(|| fitted_height(width, &bounds)).clamp(120, 4000);
     let title = match &other {
-        Some(o) => format!("{} (solid) vs {} (dashed)", main.name, o.name),
-        None => main.name.clone(),
+        Some(o) => format!("{} (solid) vs {} (dashed)", main.motion.name, o.motion.name),
+        None => main.motion.name.clone(),
     };
     let delay_ms = (1000.0 / opts.fps).round().max(10.0) as u32;
     crate::io::atomic::write_file_atomically(out, |tmp| {
@@ -166,45 +152,6 @@ pub fn animate(
     })?;
     let bytes = std::fs::metadata(out).map_err(|e| Error::io(out, e))?.len();
     Ok(Animation { frames: frames.len(), bytes, width, height })
-}
-
-/// The data's bounding box over every frame of both runs.
-#[derive(Clone, Copy, Debug)]
-struct Bounds {
-    x: (f64, f64),
-    y: (f64, f64),
-}
-
-impl Bounds {
-    fn of<'a>(frames: impl Iterator<Item = &'a Frame>) -> Bounds {
-        let mut b = Bounds { x: (f64::MAX, f64::MIN), y: (f64::MAX, f64::MIN) };
-        for f in frames {
-            let points =
-                f.lines.iter().flatten().chain(f.joints.iter().map(|j| &j.0)).chain(&f.masses).chain(&f.probes);
-            for &(x, y) in points.filter(|p| p.0.is_finite() && p.1.is_finite()) {
-                b.x = (b.x.0.min(x), b.x.1.max(x));
-                b.y = (b.y.0.min(y), b.y.1.max(y));
-            }
-        }
-        if b.x.0 > b.x.1 {
-            return Bounds { x: (-1.0, 1.0), y: (-1.0, 1.0) };
-        }
-        // a margin of 5 % of the larger extent (never zero: a motion along a line)
-        let pad = 0.05 * (b.x.1 - b.x.0).max(b.y.1 - b.y.0).max(1e-9);
-        Bounds { x: (b.x.0 - pad, b.x.1 + pad), y: (b.y.0 - pad, b.y.1 + pad) }
-    }
-
-    /// The ranges grown (about their centres) to `w : h` pixels, so a metre is as long
-    /// across as up (equal axes).
-    fn equal(&self, w: f64, h: f64) -> Bounds {
-        let (dx, dy) = (self.x.1 - self.x.0, self.y.1 - self.y.0);
-        let per_pixel = (dx / w).max(dy / h);
-        let grow = |(a, b): (f64, f64), span: f64| {
-            let c = 0.5 * (a + b);
-            (c - 0.5 * span, c + 0.5 * span)
-        };
-        Bounds { x: grow(self.x, per_pixel * w), y: grow(self.y, per_pixel * h) }
-    }
 }
 
 /// Margins around the plot: title strip, axis labels.
@@ -258,41 +205,11 @@ fn draw(
             .draw()
             .map_err(|x| e(&x))?;
         if let Some(s) = second {
-            draw_frame(&mut chart, s, COLORS[1], true)?;
+            draw_frame(&mut chart, s, &b, Style { colour: COLORS[1], dashed: true, names: false })?;
         }
-        draw_frame(&mut chart, main, COLORS[0], false)?;
+        draw_frame(&mut chart, main, &b, Style { colour: COLORS[0], dashed: false, names: false })?;
         root.present().map_err(|x| e(&x))?;
     }
-    Ok(())
-}
-
-type Chart<'a, 'b> = ChartContext<
-    'a,
-    BitMapBackend<'b>,
-    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
->;
-
-/// The centre lines (solid or dashed), then the marks: ground joints as triangles,
-/// joints between bodies as rings, point masses as discs, probes as crosses.
-fn draw_frame(chart: &mut Chart<'_, '_>, f: &Frame, colour: RGBColor, dashed: bool) -> std::result::Result<(), String> {
-    let e = |x: DrawingAreaErrorKind<_>| x.to_string();
-    for line in &f.lines {
-        if dashed {
-            chart.draw_series(DashedLineSeries::new(line.iter().copied(), 6, 4, colour.stroke_width(2))).map_err(e)?;
-        } else {
-            chart.draw_series(LineSeries::new(line.iter().copied(), colour.stroke_width(2))).map_err(e)?;
-        }
-    }
-    let ink = if dashed { colour } else { BLACK };
-    for &(p, ground) in &f.joints {
-        if ground {
-            chart.draw_series(std::iter::once(TriangleMarker::new(p, 7, ink.filled()))).map_err(e)?;
-        } else {
-            chart.draw_series(std::iter::once(Circle::new(p, 5, ink.stroke_width(2)))).map_err(e)?;
-        }
-    }
-    chart.draw_series(f.masses.iter().map(|&p| Circle::new(p, 6, COLORS[2].filled()))).map_err(e)?;
-    chart.draw_series(f.probes.iter().map(|&p| Cross::new(p, 5, COLORS[3].stroke_width(2)))).map_err(e)?;
     Ok(())
 }
 
@@ -360,16 +277,5 @@ mod tests {
         let f = frame_indices(1001, 200);
         assert_eq!((f.len(), f[0], f[199]), (200, 0, 1000));
         assert!(f.windows(2).all(|w| (5..=6).contains(&(w[1] - w[0]))), "1000/199 ≈ 5.03 apart");
-    }
-
-    /// Equal axes: the grown box has the pixels' aspect and still holds the data.
-    #[test]
-    fn equal_axes_keep_the_data_and_the_aspect() {
-        let b = Bounds { x: (0.0, 2.0), y: (-0.5, 0.5) };
-        let e = b.equal(400.0, 400.0);
-        assert!(((e.x.1 - e.x.0) - (e.y.1 - e.y.0)).abs() < 1e-12);
-        assert!(e.y.0 <= -0.5 && e.y.1 >= 0.5 && e.x == (0.0, 2.0));
-        let e = b.equal(800.0, 100.0);
-        assert!(((e.x.1 - e.x.0) / 800.0 - (e.y.1 - e.y.0) / 100.0).abs() < 1e-12 && e.y == (-0.5, 0.5));
     }
 }

@@ -285,7 +285,8 @@ impl Figure {
     }
 }
 
-fn write_png(path: &Path, rgb: &[u8], width: u32, height: u32) -> Result<(), String> {
+/// Writes 8-bit RGB pixels `rgb` (row by row) as a PNG file.
+pub fn write_png(path: &Path, rgb: &[u8], width: u32, height: u32) -> Result<(), String> {
     let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut enc = png::Encoder::new(std::io::BufWriter::new(file), width, height);
     enc.set_color(png::ColorType::Rgb);

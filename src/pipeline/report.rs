@@ -1,5 +1,6 @@
 //! `run`: train → online sweep (validated) → validation with timings at chosen points →
-//! a report folder: `summary.md`, `validation.json`, `sweep.h5` and SVG plots. Over a line
+//! a report folder: `summary.md`, `validation.json`, `sweep.h5`, SVG plots (the model's figure
+//! first, [`super::model_figure`]) and the animation. Over a line
 //! of load scales the plots run along λ; over a `[parameters]` box the sweep's points are
 //! numbered in the order of the summary's sweep table and the plots run along that number.
 //! The folder is built beside the target and renamed into place at the end, the basis
@@ -161,6 +162,8 @@ fn build(
     // named by the report's own path: the temporary folder is gone by the time the user reads it
     let plot_err =
         |stem: &str, e: String| Error::io(p.report_dir.join(format!("{stem}.svg")), std::io::Error::other(e));
+    // the model as the user wrote it, at its initial state: it needs none of the runs
+    super::model_figure::save_model_figure(&p.model, &out.join("model"))?;
     let space = p.space();
     let in_box = !space.is_empty();
     // how the report names a run: its load scale, or its point of the box
@@ -413,6 +416,10 @@ fn build(
         sw.threads,
         if sw.threads == 1 { "" } else { "s" },
         sw.wall_seconds
+    );
+    let _ = writeln!(
+        md,
+        "The model at its initial configuration (bodies named; joints, springs, point masses and probes marked):\n\n![the model](model.svg)\n"
     );
     let _ = writeln!(md, "## Validation (time loops only; full and reduced: medians of up to 7 interleaved runs each; full dense: one run)\n");
     let head = if in_box { "point" } else { "load scale" };

@@ -10,17 +10,19 @@
 //! ([`sweep_to_file`]) takes the finished scales from it and runs the rest.
 //!
 //! What each load scale became is in `outcome.rs` ([`Sweep`], [`ScaleResult`]), the sweep
-//! file's layout and its writing and reading (`--resume`) in `file.rs`, the table printed
-//! on stdout in `table.rs`.
+//! file's layout and its writing and reading (`--resume`) in `file.rs`, one run of it with
+//! its basis (for drawing) in `run_at.rs`, the table printed on stdout in `table.rs`.
 
 pub mod fallback;
 pub mod file;
 mod outcome;
+pub mod run_at;
 mod table;
 
 pub use fallback::Fallback;
 pub use file::{point_names, read_sweep, write_sweep, write_sweep_with, Extra, SweepBasis};
 pub use outcome::{Outcome, ScaleResult, Sweep, SweepPoint, STATUS_FAILED, STATUS_OK, STATUS_PENDING};
+pub use run_at::{is_sweep_file, open_sweep_run, SweepPick, SweepRun};
 pub use table::table;
 
 use super::validate::compare;
