@@ -333,6 +333,27 @@ def test_model_from_dict_takes_springs():
         flexrom.Model.from_dict(d)
 
 
+def test_a_spring_stiffness_and_a_point_mass_as_parameters_from_a_dict():
+    """A spring's `stiffness = { value, parameter }` and a point mass's `mass = { value,
+    parameter }` reach Model.from_dict; simulate(k=60, payload=0.02) runs what the dict with
+    those values written in runs, to 1e-12 m (the mass is bound as the value itself, the
+    stiffness as 40 · 60/40, exact; the weight is the file's times 0.02/0.01, a rounding
+    apart)."""
+    tomllib = pytest.importorskip("tomllib")  # Python >= 3.11
+
+    d = tomllib.loads(SPRING_PENDULUM.read_text())
+    d["masses"] = [{"body": "bar", "node": "end", "mass": {"value": 0.01, "parameter": "payload"}}]
+    d["springs"][0]["stiffness"] = {"value": 40.0, "parameter": "k"}
+    model = flexrom.Model.from_dict(d)
+    a = model.simulate(t_end=0.05, k=60.0, payload=0.02)
+    assert a.parameters == {"k": 60.0, "payload": 0.02}
+    d["masses"][0]["mass"], d["springs"][0]["stiffness"] = 0.02, 60.0
+    b = flexrom.Model.from_dict(d).simulate(t_end=0.05)
+    np.testing.assert_allclose(a.q, b.q, rtol=0, atol=1e-12)
+    # at the file's values it is another run
+    assert np.abs(model.simulate(t_end=0.05).q - b.q).max() > 1e-6
+
+
 def test_a_basis_pickles_as_its_file(dp_basis, tmp_path, monkeypatch):
     """A Basis pickles as its file's absolute path and `load`'s arguments (joblib and
     multiprocessing send it so): unpickled in another folder it is the same basis, whose
