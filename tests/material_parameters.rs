@@ -629,6 +629,13 @@ fn a_point_mass_parameter_the_model_cannot_take_is_refused_naming_the_field() {
             "springs[0].stiffness.parameter",
             "is also a point mass",
         ),
+        // a drive scaled by the payload's name, and one by a body property's
+        (base.clone() + DRIVE_BY_PAYLOAD, "masses[0].mass.parameter", "also scales joints[2]'s motion"),
+        (
+            (base.clone() + DRIVE_BY_PAYLOAD).replace("scaled = \"payload\"", "scaled = \"rho\"").replace("density = 2700.0", "density = { value = 2700.0, parameter = \"rho\" }"),
+            "joints[2].scaled",
+            "is a body's Young's modulus or density",
+        ),
     ];
     for (text, field, problem) in cases {
         let e = Model::from_text(&text, "bad.toml").unwrap_err().to_string();
@@ -638,3 +645,6 @@ fn a_point_mass_parameter_the_model_cannot_take_is_refused_naming_the_field() {
         );
     }
 }
+
+/// A motor by angle at the upper link's pin, its rate scaled by the parameter `payload`.
+const DRIVE_BY_PAYLOAD: &str = "\n[[joints]]\ntype = \"driven_angle\"\nbody = \"upper\"\nnode = \"start\"\nscaled = \"payload\"\nfunction = { type = \"polynomial\", coefficients = [0.0, 1.0] }\n";

@@ -640,7 +640,13 @@ impl Model {
                     ),
                 )),
             ScaledSpec::Parameter(name) => {
-                if crate::solver::parameters::is_parameter_name(name) {
+                let property = |p: &Option<String>| p.as_deref() == Some(name.as_str());
+                if self.bodies.iter().any(|b| property(&b.youngs_modulus_parameter) || property(&b.density_parameter)) {
+                    Err(self.err(
+                        field,
+                        format!("`{name}` is a body's Young's modulus or density: a parameter here multiplies, a property's is its value; give them different names"),
+                    ))
+                } else if crate::solver::parameters::is_parameter_name(name) {
                     Ok(Scaling::Named(name.clone()))
                 } else {
                     Err(self.err(

@@ -1,8 +1,8 @@
 //! The parameters that set a part's value rather than multiply a load: a spring's stiffness
 //! and a point mass (`stiffness = { value, parameter }`, `mass = { value, parameter }`). A
 //! checked one has a parameter name, a positive value (the run's factor is `μ/value`), and a
-//! name that no load's `scaled`, no body property and no other kind of part takes; parts of
-//! one kind may share it at one value.
+//! name that no load's or drive's `scaled`, no body property and no other kind of part
+//! takes; parts of one kind may share it at one value.
 
 use crate::error::Result;
 use crate::model::schema::PropertySpec;
@@ -66,6 +66,10 @@ impl Model {
                 }
                 _ => {}
             }
+        }
+        let mut drives = self.joints.iter().enumerate().filter_map(|(k, j)| j.kind().drive_scaling().map(|s| (k, s)));
+        if let Some((k, _)) = drives.find(|(_, s)| matches!(s, Scaling::Named(n) if n == name)) {
+            return Err(self.err(at_name, format!("`{name}` also scales joints[{k}]'s motion: a drive's parameter multiplies it, this one is a value; give them different names")));
         }
         for m in self.masses.iter().filter(|m| m.parameter.as_deref() == Some(name)) {
             self.same_value(kind, ValueKind::PointMass, (&at_name, &at_value), name, (value, m.mass))?;
