@@ -114,8 +114,8 @@ impl Map {
     }
 
     /// The colour bar's ticks over `(lo, hi)` and their labels: on a log scale 1, 2 and 5 of
-    /// each decade (every whole mantissa over less than a decade); on a linear one about
-    /// six steps of 1, 2 or 5 times a power of ten.
+    /// each decade (every whole mantissa over less than a decade); on a linear one at most
+    /// eight steps of 1, 2 or 5 times a power of ten.
     fn ticks(&self, (lo, hi): (f64, f64)) -> Vec<(f64, String)> {
         let inside = |v: &f64| *v >= lo * (1.0 - 1e-9) && *v <= hi * (1.0 + 1e-9);
         if self.log_values {
@@ -133,7 +133,7 @@ impl Map {
             }
             ticks
         } else {
-            let raw = (hi - lo) / 6.0;
+            let raw = (hi - lo) / 8.0;
             let p = 10f64.powf(raw.log10().floor());
             let step = [1.0, 2.0, 5.0, 10.0].iter().map(|m| m * p).find(|s| *s >= raw).unwrap_or(10.0 * p);
             let label = linear_labels(lo, hi);

@@ -533,7 +533,7 @@ fn build(
     motion_section(&mut md, &validations, &labels, head, trust);
     let mut swept = table(&sw);
     if in_box {
-        // a box's points have no order of their own: numbered, to be named in a note
+        // a box's points have no order of their own: numbered, so that a row can be named
         swept = swept
             .lines()
             .enumerate()
