@@ -36,6 +36,9 @@
 //!   "displacement none" on the terminal, no "above the tolerance" warning and `--strict`
 //!   passing — not a ratio of two runs' rounding (before
 //!   2026-11-27 it read 2.1 there, so greedy spent its 6 runs and stopped above T at λ = 0).
+//! - `displacement_error_at_rest_is_none_in_words`: at λ = 0 the pendulum does not move, so
+//!   displacement_error is 0/0: "none" with its reason on `validate`'s text line, and in
+//!   JSON null with `displacement_error_note` (null where the error is a number).
 //! - `bad_measures_and_methods_are_refused`: a greedy `measure` that is not one of the two
 //!   fails `train` naming the pipeline file and `train.greedy.measure`; `[online]
 //!   tolerance_measure` without `[online] tolerance` and with a bad value name
@@ -225,6 +228,36 @@ fn a_range_from_rest_trains_on_the_displacement_measure() {
     let rel: f64 = r.attr("error_estimate").unwrap().read_scalar().unwrap();
     assert!(est.is_nan(), "{est}");
     assert!(rel.is_finite() && rel < 1e-9, "the relative estimate at rest is rounding: {rel}");
+}
+
+/// At λ = 0 the pendulum (its one load, gravity, scaled by λ) does not move: displacement_error
+/// is ‖X_rom − X_full‖ / ‖X_full − X₀‖ = 0/0 to the Newton tolerance. `validate` says so in
+/// words — "none (the full run does not move …)" on its text line, null in JSON with
+/// `displacement_error_note` giving the words (null where the error is a number, at λ = 1)
+/// — and never a ratio of two runs' rounding.
+#[test]
+fn displacement_error_at_rest_is_none_in_words() {
+    let dir = tempfile::tempdir().unwrap();
+    let pipe = setup(
+        dir.path(),
+        "[train]\nload_scales = [0.5, 1.0, 1.5]\nsnapshots = \"reference\"\n[reduction]\nvariant = \"galerkin\"\nmodes = { count = 8 }\n",
+    );
+    let p = pipe.to_str().unwrap();
+    let o = flexrom(&["train", "-q", p]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let o = flexrom(&["validate", p, "--load-scale", "0", "--no-dense"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let line = "displacement_error: none (the full run does not move beyond the Newton tolerance";
+    assert!(text(&o.stdout).contains(line), "{}", text(&o.stdout));
+    let at_rest = json(&flexrom(&["validate", p, "--load-scale", "0", "--no-dense", "--json"]));
+    assert!(at_rest["displacement_error"].is_null(), "{at_rest}");
+    let note = at_rest["displacement_error_note"].as_str().unwrap_or_default();
+    assert!(note.starts_with("none (the full run does not move"), "{at_rest}");
+    // the rel_error there is the runs' rounding over the undeformed geometry: a number
+    assert!(at_rest["rel_error"].as_f64().is_some_and(|e| e < 1e-9), "{at_rest}");
+    let moving = json(&flexrom(&["validate", p, "--load-scale", "1", "--no-dense", "--json"]));
+    assert!(moving["displacement_error"].as_f64().is_some_and(|e| e > 0.0), "{moving}");
+    assert!(moving["displacement_error_note"].is_null(), "{moving}");
 }
 
 #[test]

@@ -307,6 +307,17 @@ fn run_writes_a_report() {
     assert!(png.starts_with(b"\x89PNG\r\n\x1a\n"), "model.png is not a PNG");
     let (figure, tables) = (summary.find("](model.svg)"), summary.find("## Validation"));
     assert!(figure.is_some() && figure < tables, "summary.md shows the model before its tables");
+    // a line of load scales keeps its figures against λ, and no map of a box
+    // (tests/report_box.rs); rel_error and the probe error (m) on axes of their own, a 1×
+    // line on the speedup
+    for stem in ["error_vs_load", "speedup_vs_load", "estimate_vs_load", "error_by_time"] {
+        assert!(summary.contains(&format!("]({stem}.svg)")), "summary.md does not show {stem}");
+    }
+    assert!(!dir.path().join("report/error_map.svg").exists());
+    let errors = std::fs::read_to_string(dir.path().join("report/error_vs_load.svg")).unwrap();
+    assert!(errors.contains("\nrel_error\n") && errors.contains("\nprobe error (m)\n"), "two axes");
+    let speedup = std::fs::read_to_string(dir.path().join("report/speedup_vs_load.svg")).unwrap();
+    assert!(speedup.contains("1× (as fast"), "no 1× line");
 }
 
 /// A model without probes: the report has no probe figures and the summary links none (the

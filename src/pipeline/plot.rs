@@ -20,11 +20,36 @@ pub struct Series {
     pub name: String,
     pub points: Vec<(f64, f64)>,
     pub style: Style,
+    /// its colour; `None`: the palette's colour of its place in the panel
+    pub color: Option<RGBColor>,
 }
 
 impl Series {
     pub fn new(name: impl Into<String>, points: Vec<(f64, f64)>, style: Style) -> Series {
-        Series { name: name.into(), points, style }
+        Series { name: name.into(), points, style, color: None }
+    }
+
+    /// Drawn in the palette's colour `k` (cycling): the series of one run or one quantity
+    /// share a colour (a full run solid, its reduced run dashed).
+    pub fn colored(self, k: usize) -> Series {
+        self.in_color(COLORS[k % COLORS.len()])
+    }
+
+    /// Drawn in the colour `c`.
+    pub fn in_color(mut self, c: RGBColor) -> Series {
+        self.color = Some(c);
+        self
+    }
+
+    /// A horizontal line at `y` over the x range `x` of the other series (a reference
+    /// value, e.g. a speedup of 1×), black: apart from the grey dashed training markers.
+    pub fn level(name: impl Into<String>, y: f64, (x0, x1): (f64, f64)) -> Series {
+        Series::new(name, vec![(x0, y), (x1, y)], Style::Line).in_color(BLACK)
+    }
+
+    /// The colour it is drawn in as the `i`-th series of its panel.
+    fn color_at(&self, i: usize) -> RGBColor {
+        self.color.unwrap_or(COLORS[i % COLORS.len()])
     }
 }
 
@@ -83,7 +108,7 @@ fn log_label(v: &f64) -> String {
 /// such as 9.5e-4, which `log_label` would print as a second "1e-3"), and over more than a
 /// factor of 10 only 1, 2 and 5 of each decade, so that the labels of the crowded top of a
 /// decade do not run into each other.
-fn log_labels(lo: f64, hi: f64) -> impl Fn(&f64) -> String {
+pub fn log_labels(lo: f64, hi: f64) -> impl Fn(&f64) -> String {
     let sparse = hi > 10.0 * lo;
     move |v: &f64| {
         if !(*v > 0.0) {
@@ -218,7 +243,7 @@ impl Figure {
                             .map_err(|x| e(&x))?;
                     }
                     for (i, s) in panel.series.iter().enumerate() {
-                        let c = COLORS[i % COLORS.len()];
+                        let c = s.color_at(i);
                         let data: Vec<(f64, f64)> = s.points.iter().copied().filter(usable(panel.log_y)).collect();
                         match s.style {
                             Style::Line => chart.draw_series(LineSeries::new(data, c.stroke_width(2))).map(|_| ()),
@@ -260,7 +285,7 @@ impl Figure {
         for p in &self.panels {
             for (i, s) in p.series.iter().enumerate() {
                 if !entries.iter().any(|(n, ..)| *n == s.name) {
-                    entries.push((s.name.clone(), s.style, COLORS[i % COLORS.len()]));
+                    entries.push((s.name.clone(), s.style, s.color_at(i)));
                 }
             }
         }
@@ -268,8 +293,8 @@ impl Figure {
             entries.push((self.marker_label.clone(), Style::Dashed, MARKER_COLOR));
         }
         let font = ("sans-serif", 15).into_font();
-        for (k, (name, style, c)) in entries.iter().enumerate() {
-            let y = 30 + 24 * k as i32;
+        let mut y = 30;
+        for (name, style, c) in &entries {
             match style {
                 Style::Markers => area.draw(&Circle::new((18, y), 4, c.filled())),
                 Style::Line => area.draw(&PathElement::new(vec![(6, y), (32, y)], c.stroke_width(2))),
@@ -279,10 +304,44 @@ impl Figure {
                 }
             }
             .map_err(|x| e(&x))?;
-            area.draw(&Text::new(name.clone(), (40, y - 8), font.clone())).map_err(|x| e(&x))?;
+            // a long name on as many lines as the strip needs, never cut off at its edge
+            let style: TextStyle = font.clone().into();
+            for line in wrap(name, LEGEND - 48, &|s| area.estimate_text_size(s, &style).map_or(0, |(w, _)| w)) {
+                area.draw(&Text::new(line, (40, y - 8), font.clone())).map_err(|x| e(&x))?;
+                y += 18;
+            }
+            y += 6;
         }
         Ok(())
     }
+}
+
+/// `text` broken into lines no wider than `width` (as `measure` gives a line's width), at
+/// ", " or else at spaces; a single word wider than `width` keeps a line of its own.
+pub fn wrap(text: &str, width: u32, measure: &dyn Fn(&str) -> u32) -> Vec<String> {
+    let mut lines: Vec<String> = Vec::new();
+    let mut line = String::new();
+    // pieces that end with their separator: "drive = 1.305, " "payload = 0.8"
+    let pieces = text.split_inclusive(", ").flat_map(|p| {
+        if measure(p.trim_end()) <= width {
+            vec![p.to_string()]
+        } else {
+            p.split_inclusive(' ').map(str::to_string).collect()
+        }
+    });
+    for piece in pieces {
+        let joined = format!("{line}{piece}");
+        if !line.is_empty() && measure(joined.trim_end()) > width {
+            lines.push(line.trim_end().to_string());
+            line = piece;
+        } else {
+            line = joined;
+        }
+    }
+    if !line.trim_end().is_empty() || lines.is_empty() {
+        lines.push(line.trim_end().to_string());
+    }
+    lines
 }
 
 /// Writes 8-bit RGB pixels `rgb` (row by row) as a PNG file.
@@ -325,6 +384,20 @@ mod tests {
         assert_eq!(linear_labels(-1e-12, 1e-12)(&3e-29), "0");
         assert_eq!(linear_labels(-1.2, 1.2)(&-2.7e-17), "0");
         assert_eq!(linear_labels(0.0, 1e-4)(&5e-12), "5e-12");
+    }
+
+    /// A legend name wider than its strip wraps at ", " (then at spaces), each line within
+    /// the width (here one unit per character), nothing dropped.
+    #[test]
+    fn long_names_wrap() {
+        let chars = |s: &str| s.chars().count() as u32;
+        let name = "error_estimate, drive = 1.305, payload = 0.8";
+        let lines = wrap(name, 20, &chars);
+        assert_eq!(lines, vec!["error_estimate,", "drive = 1.305,", "payload = 0.8"]);
+        assert_eq!(wrap("rel_error", 20, &chars), vec!["rel_error"]);
+        // a piece wider than the strip breaks at its spaces
+        assert_eq!(wrap("max probe error (m)", 10, &chars), vec!["max probe", "error (m)"]);
+        assert!(lines.iter().all(|l| chars(l) <= 20) && lines.join(" ") == name);
     }
 
     /// A figure writes a valid SVG and a PNG of the stated size (the PNG header's width and

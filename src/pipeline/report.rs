@@ -1,8 +1,8 @@
 //! `run`: train → online sweep (validated) → validation with timings at chosen points →
-//! a report folder: `summary.md`, `validation.json`, `sweep.h5`, SVG plots (the model's figure
-//! first, [`super::model_figure`]) and the animation. Over a line
-//! of load scales the plots run along λ; over a `[parameters]` box the sweep's points are
-//! numbered in the order of the summary's sweep table and the plots run along that number.
+//! a report folder: `summary.md`, `validation.json`, `sweep.h5` and plots (SVG and PNG; the
+//! model's figure first, [`super::model_figure`]). Over a line of load scales the plots run
+//! along λ, over a box of one parameter along it; over a box of two parameters or more they
+//! are maps over the box ([`super::report_maps`]).
 //! The folder is built beside the target and renamed into place at the end, the basis
 //! written under a temporary name and renamed into place only when every stage succeeded.
 //! A current basis (trained from this model with these training keys, passing its checks:
@@ -257,107 +257,151 @@ fn build(
             Series::new(name, sv.by_ref().take(k).enumerate().map(|(i, s)| ((i + 1) as f64, *s)).collect(), Style::Line)
         })
         .collect();
-    let single = |title: &str, x_label: &str, panel: Panel, markers: Vec<f64>, stem: &str| {
-        Figure {
-            title: title.into(),
-            x_label: x_label.into(),
-            panels: vec![panel],
-            markers,
-            marker_label: "training load".into(),
-        }
-        .save(&out.join(stem))
-        .map_err(|e| plot_err(stem, e))
+    // in a box the training runs are points of it: marked by name, not as loads
+    let marker_label = if in_box { "training run" } else { "training load" };
+    let single = |title: &str, x_label: &str, panels: Vec<Panel>, markers: Vec<f64>, stem: &str| {
+        Figure { title: title.into(), x_label: x_label.into(), panels, markers, marker_label: marker_label.into() }
+            .save(&out.join(stem))
+            .map_err(|e| plot_err(stem, e))
     };
+    // the figures summary.md shows after the runs' own, in order: (file stem, what it shows)
+    let mut shown: Vec<(&str, &str)> = vec![("singular_values", "singular values")];
     single(
         "POD singular values",
         "index",
-        Panel { y_label: "σ".into(), log_y: true, series: blocks },
+        vec![Panel { y_label: "σ".into(), log_y: true, series: blocks }],
         vec![],
         "singular_values",
     )?;
-    // along λ, or along the sweep's points numbered 1, 2, … in a box
-    let along = |i: usize, mu: &Parameters| if in_box { (i + 1) as f64 } else { mu.scale() };
-    let x_label = if in_box { "sweep point (summary.md, Sweep)" } else { "load scale" };
-    let pts = |f: &dyn Fn(&Validation) -> f64| -> Vec<(f64, f64)> {
-        (sw.scales.iter().enumerate())
-            .filter_map(|(i, x)| Some((i, x.point()?.validation.as_ref()?)))
-            .map(|(i, v)| (along(i, &v.mu()), f(v)))
-            .collect()
-    };
-    // the loads of the full runs the basis was trained on, marked on the plots against λ
-    let training = if in_box { Vec::new() } else { crate::io::estimator_file::read_training_loads(basis_path)? };
-    single(
-        "Reduced vs full model",
-        x_label,
-        Panel {
-            y_label: "error".into(),
-            log_y: true,
-            series: vec![
-                Series::new("rel_error", pts(&|v| v.rel_error), Style::Line),
-                Series::new("max probe error (m)", pts(&|v| v.max_probe_error), Style::Dashed),
-            ],
-        },
-        training.clone(),
-        "error_vs_load",
-    )?;
-    single(
-        "Speedup of the reduced time loop over the full one",
-        x_label,
-        Panel {
-            y_label: "speedup".into(),
-            log_y: false,
-            series: vec![Series::new("speedup (banded full solver)", pts(&|v| v.speedup), Style::Line)],
-        },
-        training.clone(),
-        "speedup_vs_load",
-    )?;
-    // the estimate over the sweep, the true errors of the sweep and of the validation runs
-    let estimates: Vec<(f64, f64)> = (sw.scales.iter().enumerate())
-        .filter_map(|(i, x)| Some((i, x.point()?)))
-        .filter_map(|(i, q)| q.estimate.as_ref().map(|e| (along(i, &q.run.result.settings.mu), e.error_estimate)))
+    // the estimate over the sweep (no full run), by the sweep's points
+    let estimates: Vec<(Parameters, f64)> = (sw.scales.iter())
+        .filter_map(|x| x.point())
+        .filter_map(|q| q.estimate.as_ref().map(|e| (q.run.result.settings.mu.clone(), e.error_estimate)))
         .collect();
-    let mut errors = pts(&|v| v.rel_error);
-    if !in_box {
-        // the validation's own loads lie on the same axis (in a box they are other points)
-        errors.extend(validations.iter().map(|v| (v.load_scale, v.rel_error)));
-    }
-    if !estimates.is_empty() {
-        single(
-            "Error estimate (no full run) and true error (full runs)",
-            x_label,
-            Panel {
-                y_label: "relative error".into(),
+    let names: Vec<&str> = space.names().collect();
+    // the axis the figures run along: λ on a line, the parameter of a one-parameter box; a
+    // box of two parameters or more is drawn as maps over it instead
+    let axis = match names.as_slice() {
+        [] => Some(crate::solver::parameters::LOAD_SCALE),
+        [one] => Some(*one),
+        _ => None,
+    };
+    match axis {
+        Some(axis) => {
+            let x_of = |mu: &Parameters| mu.get(axis).unwrap_or(1.0);
+            let x_label = if in_box { axis } else { "load scale" };
+            // the sweep's validated runs along the axis, in its order (a box's points are drawn at random)
+            let pts = |f: &dyn Fn(&Validation) -> f64| -> Vec<(f64, f64)> {
+                let mut v: Vec<(f64, f64)> = (sw.scales.iter())
+                    .filter_map(|x| x.point()?.validation.as_ref())
+                    .map(|v| (x_of(&v.mu()), f(v)))
+                    .collect();
+                v.sort_by(|a, b| a.0.total_cmp(&b.0));
+                v
+            };
+            // the full runs the basis was trained on, marked on the plots along the axis
+            let training: Vec<f64> = if in_box {
+                stored_runs(p, basis_path)?.iter().map(x_of).collect()
+            } else {
+                crate::io::estimator_file::read_training_loads(basis_path)?
+            };
+            // rel_error and the probe error (m) on axes of their own: two units, two axes
+            let mut panels = vec![Panel {
+                y_label: "rel_error".into(),
                 log_y: true,
-                series: vec![
-                    Series::new("error_estimate", estimates.clone(), Style::Line),
-                    Series::new("rel_error (validated)", errors, Style::Markers),
-                ],
-            },
-            training.clone(),
-            "estimate_vs_load",
-        )?;
+                series: vec![Series::new("rel_error", pts(&|v| v.rel_error), Style::Line)],
+            }];
+            if !p.model.probe_names().is_empty() {
+                panels.push(Panel {
+                    y_label: "probe error (m)".into(),
+                    log_y: true,
+                    series: vec![Series::new("max probe error", pts(&|v| v.max_probe_error), Style::Line).colored(1)],
+                });
+            }
+            single("Reduced vs full model", x_label, panels, training.clone(), "error_vs_load")?;
+            let speedups = pts(&|v| v.speedup);
+            let span = speedups.iter().fold((f64::MAX, f64::MIN), |(a, b), q| (a.min(q.0), b.max(q.0)));
+            let mut series = vec![Series::new("speedup (banded full solver)", speedups, Style::Line)];
+            if span.0 <= span.1 {
+                series.push(Series::level("1× (as fast as the full run)", 1.0, span));
+            }
+            single(
+                "Speedup of the reduced time loop over the full one",
+                x_label,
+                vec![Panel { y_label: "speedup".into(), log_y: false, series }],
+                training.clone(),
+                "speedup_vs_load",
+            )?;
+            shown.extend([("error_vs_load", "error"), ("speedup_vs_load", "speedup")]);
+            // the validation's own runs lie on the same axis
+            let mut errors = pts(&|v| v.rel_error);
+            errors.extend(validations.iter().map(|v| (x_of(&v.mu()), v.rel_error)));
+            if !estimates.is_empty() {
+                let mut along: Vec<(f64, f64)> = estimates.iter().map(|(mu, e)| (x_of(mu), *e)).collect();
+                along.sort_by(|a, b| a.0.total_cmp(&b.0));
+                single(
+                    "Error estimate (no full run) and true error (full runs)",
+                    x_label,
+                    vec![Panel {
+                        y_label: "relative error".into(),
+                        log_y: true,
+                        series: vec![
+                            Series::new("error_estimate", along, Style::Line),
+                            Series::new("rel_error (validated)", errors, Style::Markers),
+                        ],
+                    }],
+                    training,
+                    "estimate_vs_load",
+                )?;
+                shown.push(("estimate_vs_load", "error estimate"));
+            }
+        }
+        None => {
+            // every validated run, the sweep's and the validation's, at its point
+            let runs: Vec<super::report_maps::MappedRun> = (sw.scales.iter())
+                .filter_map(|x| x.point())
+                .filter_map(|q| {
+                    let estimate = q.estimate.as_ref().map(|e| e.error_estimate);
+                    Some(super::report_maps::MappedRun { validation: q.validation.as_ref()?, estimate })
+                })
+                .chain(
+                    validations
+                        .iter()
+                        .map(|v| super::report_maps::MappedRun { validation: v, estimate: v.error_estimate }),
+                )
+                .collect();
+            let training = stored_runs(p, basis_path)?;
+            let cx = super::report_maps::MapContext {
+                space: &space,
+                training: &training,
+                tolerance: rom.trust().and_then(|t| t.tolerance),
+                probes: !p.model.probe_names().is_empty(),
+            };
+            shown.extend(super::report_maps::write_maps(out, &runs, &cx).map_err(|(stem, e)| plot_err(stem, e))?);
+        }
     }
-    // the true error (solid) and its estimate (dashed) up to each fifth of the run
+    // the true error (solid) and its estimate (dashed) up to each fifth of the run, one
+    // colour a validated run
     let fifths = |v: &[f64]| v.iter().enumerate().map(|(i, e)| ((i + 1) as f64 / 5.0, *e)).collect::<Vec<_>>();
     let by_time: Vec<Series> = validations
         .iter()
-        .flat_map(|v| {
+        .enumerate()
+        .flat_map(|(k, v)| {
+            // one legend entry a run (the two series share its name)
             let at = if in_box { name(&v.mu()) } else { format!("load scale {}", v.load_scale) };
-            let truth = Series::new(format!("rel_error, {at}"), fifths(&v.rel_error_by_time), Style::Line);
-            let est = v
-                .error_estimate_by_time
-                .as_ref()
-                .map(|e| Series::new(format!("error_estimate, {at}"), fifths(e), Style::Dashed));
+            let truth = Series::new(at.clone(), fifths(&v.rel_error_by_time), Style::Line).colored(k);
+            let est = v.error_estimate_by_time.as_ref().map(|e| Series::new(at, fifths(e), Style::Dashed).colored(k));
             std::iter::once(truth).chain(est)
         })
         .collect();
     single(
         "rel_error (solid) and error_estimate (dashed) up to a fraction of the run",
         "fraction of the run",
-        Panel { y_label: "rel_error".into(), log_y: true, series: by_time },
+        vec![Panel { y_label: "relative error".into(), log_y: true, series: by_time }],
         vec![],
         "error_by_time",
     )?;
+    shown.push(("error_by_time", "error by time"));
     let json = serde_json::to_string_pretty(&validations).expect("serializable");
     std::fs::write(out.join("validation.json"), json)
         .map_err(|e| Error::io(p.report_dir.join("validation.json"), e))?;
@@ -496,7 +540,7 @@ fn build(
     motion_section(&mut md, &validations, &labels, head, trust);
     let mut swept = table(&sw);
     if in_box {
-        // the plots run along the sweep's points: number the rows as they do
+        // a box's points have no order of their own: numbered, so that a row can be named
         swept = swept
             .lines()
             .enumerate()
@@ -525,14 +569,9 @@ fn build(
     for (i, x) in labels.iter().enumerate() {
         let _ = writeln!(md, "![energies at {x}](energy_{i}.svg)");
     }
-    let _ = writeln!(
-        md,
-        "![singular values](singular_values.svg)\n![error](error_vs_load.svg)\n![speedup](speedup_vs_load.svg)"
-    );
-    if !estimates.is_empty() {
-        let _ = writeln!(md, "![error estimate](estimate_vs_load.svg)");
+    for (stem, what) in &shown {
+        let _ = writeln!(md, "![{what}]({stem}.svg)");
     }
-    let _ = writeln!(md, "![error by time](error_by_time.svg)");
     std::fs::write(out.join("summary.md"), md).map_err(|e| Error::io(p.report_dir.join("summary.md"), e))?;
     Ok(warnings)
 }
@@ -551,7 +590,9 @@ fn probes_figure(full: &SimulationResult, reduced: &SimulationResult, title: Str
                 .probes
                 .iter()
                 .zip(&reduced.probes)
-                .flat_map(|((name, a), (_, b))| {
+                .enumerate()
+                .flat_map(|(k, ((name, a), (_, b)))| {
+                    // a probe's full and reduced lines in one colour, solid and dashed
                     let line = |run: &str, v: &ndarray::Array2<f64>, style| {
                         Series::new(
                             format!("{name}, {run}"),
@@ -559,7 +600,7 @@ fn probes_figure(full: &SimulationResult, reduced: &SimulationResult, title: Str
                             style,
                         )
                     };
-                    [line("full", a, Style::Line), line("reduced", b, Style::Dashed)]
+                    [line("full", a, Style::Line), line("reduced", b, Style::Dashed)].map(|l| l.colored(k))
                 })
                 .collect(),
         })
@@ -667,20 +708,24 @@ fn energy_figure(rom: &Rom, (full, reduced): (&SimulationResult, &SimulationResu
     let (Some(ef), Some(er)) = (&full.energy, &reduced.energy) else { unreachable!("with_energies sets them") };
     let curve = |t: &ndarray::Array1<f64>, v: &ndarray::Array1<f64>| t.iter().zip(v).map(|(t, v)| (*t, *v)).collect();
     let mut series = Vec::new();
-    for (name, a, b) in [
+    // an energy's full and reduced lines in one colour, solid and dashed
+    for (k, (name, a, b)) in [
         ("kinetic", &ef.kinetic, &er.kinetic),
         ("strain", &ef.strain, &er.strain),
         ("gravity", &ef.gravity, &er.gravity),
         ("springs", &ef.springs, &er.springs),
-    ] {
+    ]
+    .into_iter()
+    .enumerate()
+    {
         if a.iter().chain(b.iter()).any(|x| *x != 0.0) {
-            series.push(Series::new(format!("{name}, full"), curve(&full.t, a), Style::Line));
-            series.push(Series::new(format!("{name}, reduced"), curve(&reduced.t, b), Style::Dashed));
+            series.push(Series::new(format!("{name}, full"), curve(&full.t, a), Style::Line).colored(k));
+            series.push(Series::new(format!("{name}, reduced"), curve(&reduced.t, b), Style::Dashed).colored(k));
         }
     }
     let balance = vec![
-        Series::new("balance, full", curve(&full.t, &ef.total()), Style::Line),
-        Series::new("balance, reduced", curve(&reduced.t, &er.total()), Style::Dashed),
+        Series::new("balance, full", curve(&full.t, &ef.total()), Style::Line).colored(6),
+        Series::new("balance, reduced", curve(&reduced.t, &er.total()), Style::Dashed).colored(6),
     ];
     Ok(Figure {
         title: title.to_string(),

@@ -113,6 +113,9 @@ pub struct Validation {
     /// does not move beyond the Newton tolerance, ∞ where only the reduced one does (JSON
     /// writes both as null; `max_error_over_travel` and the probes tell them apart)
     pub displacement_error: f64,
+    /// why `displacement_error` is not a number, in words (the text output's; JSON writes the
+    /// error itself as null): [`displacement_note`]; null where it is one
+    pub displacement_error_note: Option<String>,
     /// displacement_error up to the end of each fifth of the run (the last is displacement_error)
     pub displacement_error_by_time: Vec<f64>,
     /// the estimate of `displacement_error` (null: the basis has no estimator)
@@ -398,6 +401,8 @@ pub fn compare(
         rel_error_by_time: rel_error_by_time(&r.q, &full.q).to_vec(),
         error_estimate_by_time: None,
         displacement_error: displacement_error_by_time[displacement_error_by_time.len() - 1],
+        displacement_error_note: displacement_note(displacement_error_by_time[displacement_error_by_time.len() - 1])
+            .map(str::to_string),
         displacement_error_by_time,
         error_estimate_displacement: None,
         effectivity_displacement: None,
@@ -411,6 +416,20 @@ pub fn compare(
         estimate_failure: None,
     }
     .with_timings(full.wall_seconds, r.wall_seconds)
+}
+
+/// Why a displacement_error is not a number, in words: NaN where the full run does not move
+/// beyond the Newton tolerance (‖X_full − X₀‖ is zero to it: the ratio is 0/0, at λ = 0
+/// for a model whose loads all scale with λ), ∞ where only the reduced run moves; `None`
+/// for a number.
+pub fn displacement_note(e: f64) -> Option<&'static str> {
+    if e.is_nan() {
+        Some("none (the full run does not move beyond the Newton tolerance: nothing to measure against)")
+    } else if e.is_infinite() {
+        Some("∞ (the reduced run moves where the full one does not beyond the Newton tolerance)")
+    } else {
+        None
+    }
 }
 
 /// The earliest start of a step that one run halved and the other did not, from the two
@@ -646,16 +665,12 @@ impl Validation {
     /// The lines of the errors against the motion: displacement_error (and its estimate),
     /// each probe's error over its travel.
     fn motion_lines(&self) -> String {
-        let mut s = if self.displacement_error.is_nan() {
-            "\n  displacement_error: none (the full run does not move beyond the Newton tolerance)".to_string()
-        } else if self.displacement_error.is_infinite() {
-            "\n  displacement_error: ∞ (the reduced run moves where the full one does not beyond the Newton tolerance)"
-                .to_string()
-        } else {
-            format!(
+        let mut s = match displacement_note(self.displacement_error) {
+            Some(why) => format!("\n  displacement_error: {why}"),
+            None => format!(
                 "\n  displacement_error {:.3e} (against the motion from the initial configuration)",
                 self.displacement_error
-            )
+            ),
         };
         // (no effectivity against an undefined or infinite error)
         if let (Some(e), Some(f), true) = (

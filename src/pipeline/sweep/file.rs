@@ -58,7 +58,7 @@ use crate::io::attrs::{check_layout, write_atomically_as, Kind};
 use crate::io::basis_file::StoredBasis;
 use crate::io::h5::{attr_f64, attr_str, attr_u64, bounded_len, dataset_of_shape, read_attr_str, read_strings};
 use crate::model::Model;
-use crate::pipeline::validate::{ProbeQuantityError, Validation};
+use crate::pipeline::validate::{displacement_note, ProbeQuantityError, Validation};
 use crate::rom::estimator::{Estimate, QuantityEstimate};
 use crate::rom::quantities::Quantity;
 use crate::rom::trust::LoadSensitivity;
@@ -653,6 +653,8 @@ pub fn read_sweep(
             rel_error_by_time: rel_by_time.as_ref().map_or_else(Vec::new, |a| a.row(k).to_vec()),
             error_estimate_by_time: None,
             displacement_error: displacement.as_ref().map_or(f64::NAN, |a| a[k]),
+            // the words for a stored NaN or ∞ (a sweep before the column has none to explain)
+            displacement_error_note: displacement.as_ref().and_then(|a| displacement_note(a[k])).map(str::to_string),
             displacement_error_by_time: Vec::new(),
             error_estimate_displacement: None,
             effectivity_displacement: None,
