@@ -90,10 +90,13 @@ impl Map {
         v.is_finite() && (!self.log_values || v > 0.0)
     }
 
-    /// The colour scale's ends: the values of every layer (a decade, or ±0.5, around a
-    /// single value; 1e-16..1 without any).
+    /// The colour scale's ends: the values of every layer and the marked value, so that the
+    /// mark (the tolerance, 1×) is always on the bar (a decade, or ±0.5, around a single
+    /// value; 1e-16..1 without any).
     fn value_range(&self) -> (f64, f64) {
-        let vs = self.layers.iter().flat_map(|l| l.points.iter().map(|p| p.1)).filter(|v| self.has_value(*v));
+        let marked = self.mark.iter().map(|m| m.0);
+        let vs =
+            self.layers.iter().flat_map(|l| l.points.iter().map(|p| p.1)).chain(marked).filter(|v| self.has_value(*v));
         let (lo, hi) = vs.fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(v), b.max(v)));
         match (lo <= hi, self.log_values) {
             (false, true) => (1e-16, 1.0),
