@@ -10,9 +10,9 @@
 //! first and last included) and a big mesh along its bodies ([`MAX_POINTS`] samples a
 //! run), so that a 5000-element model's animation stays small and quick.
 
-use super::drawing::{draw_frame, Bounds, Frame, Style};
+use super::drawing::{draw_frame, motion_chart, Bounds, Frame, Style, BOTTOM, LEFT, MARGIN, TITLE};
 use super::motion::Motion;
-use super::plot::{linear_labels, register_font, COLORS};
+use super::plot::{register_font, COLORS};
 use super::sweep::SweepPick;
 use crate::error::{Error, Result};
 use crate::physics::centre_line::CentreLines;
@@ -154,12 +154,6 @@ pub fn animate_picked(
     Ok(Animation { frames: frames.len(), bytes, width, height })
 }
 
-/// Margins around the plot: title strip, axis labels.
-const TITLE: u32 = 34;
-const LEFT: u32 = 64;
-const BOTTOM: u32 = 36;
-const MARGIN: u32 = 10;
-
 /// The height at which the motion's box fills the plot's width with equal axes, kept
 /// between 40 % and 100 % of the width.
 fn fitted_height(width: u32, b: &Bounds) -> u32 {
@@ -183,27 +177,10 @@ fn draw(
     let plot_w = size.0.saturating_sub(LEFT + 2 * MARGIN).max(1) as f64;
     let plot_h = size.1.saturating_sub(TITLE + BOTTOM + 2 * MARGIN).max(1) as f64;
     let b = bounds.equal(plot_w, plot_h);
-    let (x_fmt, y_fmt) = (linear_labels(b.x.0, b.x.1), linear_labels(b.y.0, b.y.1));
     for (t, main, second) in frames {
         root.fill(&WHITE).map_err(|x| e(&x))?;
         let area = root.titled(&format!("{title}    t = {t:.4} s"), ("sans-serif", 16)).map_err(|x| e(&x))?;
-        let mut chart = ChartBuilder::on(&area)
-            .margin(MARGIN)
-            .x_label_area_size(BOTTOM)
-            .y_label_area_size(LEFT)
-            .build_cartesian_2d(b.x.0..b.x.1, b.y.0..b.y.1)
-            .map_err(|x| e(&x))?;
-        chart
-            .configure_mesh()
-            .x_desc("x, m")
-            .y_desc("y, m")
-            .x_label_formatter(&x_fmt)
-            .y_label_formatter(&y_fmt)
-            .label_style(("sans-serif", 12))
-            .light_line_style(WHITE.mix(0.0))
-            .bold_line_style(BLACK.mix(0.08))
-            .draw()
-            .map_err(|x| e(&x))?;
+        let mut chart = motion_chart(&area, &b)?;
         if let Some(s) = second {
             draw_frame(&mut chart, s, &b, Style { colour: COLORS[1], dashed: true, names: false })?;
         }

@@ -5,7 +5,7 @@
 //! ([`super::animate`]) and the report's figure of the model ([`super::model_figure`]),
 //! on any plotters backend (GIF, PNG, SVG).
 
-use super::plot::COLORS;
+use super::plot::{linear_labels, COLORS};
 use crate::model::Model;
 use crate::physics::centre_line::CentreLines;
 use crate::physics::joints::Joint;
@@ -171,6 +171,41 @@ const ALL: [Mark; 10] = [
     Mark::Mass,
     Mark::Probe,
 ];
+
+/// Room around a drawing of the motion, px: its title, the y axis's labels, the x axis's
+/// labels, the margin.
+pub const TITLE: u32 = 34;
+pub const LEFT: u32 = 64;
+pub const BOTTOM: u32 = 36;
+pub const MARGIN: u32 = 10;
+
+/// The chart a drawing of the motion is made on (an animation's frame, the report's model):
+/// `b` on `area`, x and y in metres, a faint grid.
+pub fn motion_chart<'a, DB: DrawingBackend + 'a>(
+    area: &'a DrawingArea<DB, plotters::coord::Shift>,
+    b: &Bounds,
+) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, String> {
+    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
+    let (x_fmt, y_fmt) = (linear_labels(b.x.0, b.x.1), linear_labels(b.y.0, b.y.1));
+    let mut chart = ChartBuilder::on(area)
+        .margin(MARGIN)
+        .x_label_area_size(BOTTOM)
+        .y_label_area_size(LEFT)
+        .build_cartesian_2d(b.x.0..b.x.1, b.y.0..b.y.1)
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .x_desc("x, m")
+        .y_desc("y, m")
+        .x_label_formatter(&x_fmt)
+        .y_label_formatter(&y_fmt)
+        .label_style(("sans-serif", 12))
+        .light_line_style(WHITE.mix(0.0))
+        .bold_line_style(BLACK.mix(0.08))
+        .draw()
+        .map_err(e)?;
+    Ok(chart)
+}
 
 /// The data's bounding box over frames, with a margin.
 #[derive(Clone, Copy, Debug)]

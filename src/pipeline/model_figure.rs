@@ -4,8 +4,8 @@
 //! margin, and a legend of the marks it holds in a strip to the right; so that a user sees
 //! at once that the model is the one they meant.
 
-use super::drawing::{draw_frame, Bounds, Frame, Mark, MarkElement, Style};
-use super::plot::{linear_labels, register_font, write_png, COLORS};
+use super::drawing::{draw_frame, motion_chart, Bounds, Frame, Mark, MarkElement, Style, BOTTOM, LEFT, MARGIN, TITLE};
+use super::plot::{register_font, write_png, COLORS};
 use crate::error::Result;
 use crate::model::Model;
 use crate::physics::centre_line::CentreLines;
@@ -15,10 +15,6 @@ use std::path::{Path, PathBuf};
 
 const WIDTH: u32 = 960;
 const LEGEND: u32 = 170;
-const TITLE: u32 = 34;
-const LEFT: u32 = 64;
-const BOTTOM: u32 = 36;
-const MARGIN: u32 = 10;
 
 /// The model at its initial state, and the figure's height fitted to it.
 fn model_frame(model: &Model) -> Result<(Frame, Bounds, u32)> {
@@ -73,24 +69,7 @@ where
     let plot_w = (w.saturating_sub(LEGEND + LEFT + 2 * MARGIN)).max(1) as f64;
     let plot_h = h.saturating_sub(BOTTOM + 2 * MARGIN).max(1) as f64;
     let b = bounds.equal(plot_w, plot_h);
-    let (x_fmt, y_fmt) = (linear_labels(b.x.0, b.x.1), linear_labels(b.y.0, b.y.1));
-    let mut chart = ChartBuilder::on(&plot)
-        .margin(MARGIN)
-        .x_label_area_size(BOTTOM)
-        .y_label_area_size(LEFT)
-        .build_cartesian_2d(b.x.0..b.x.1, b.y.0..b.y.1)
-        .map_err(|x| e(&x))?;
-    chart
-        .configure_mesh()
-        .x_desc("x, m")
-        .y_desc("y, m")
-        .x_label_formatter(&x_fmt)
-        .y_label_formatter(&y_fmt)
-        .label_style(("sans-serif", 12))
-        .light_line_style(WHITE.mix(0.0))
-        .bold_line_style(BLACK.mix(0.08))
-        .draw()
-        .map_err(|x| e(&x))?;
+    let mut chart = motion_chart(&plot, &b)?;
     draw_frame(&mut chart, frame, &b, Style { colour: COLORS[0], dashed: false, names: true })?;
     draw_legend(&legend, frame.kinds())
 }
