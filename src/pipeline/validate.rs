@@ -279,6 +279,23 @@ pub struct ReactionError {
 }
 
 impl ReactionError {
+    /// The force and moment the Newton tolerance `tol` resolves: slopes resolve to `tol`, so
+    /// a body's curvature to `tol / l` over an element of length `l`, which its bending
+    /// stiffness `E I` holds with a moment `E I tol / l` and a shear force `E I tol / l²`; the
+    /// most flexible body's, N and N m.
+    fn floors(model: &Model, tol: f64) -> [f64; 2] {
+        let (force, moment) = model
+            .bodies()
+            .iter()
+            .map(|b| {
+                let l = b.length / b.n_elements as f64;
+                let m = b.section.youngs_modulus * b.section.inertia / l;
+                (m / l, m)
+            })
+            .fold((f64::INFINITY, f64::INFINITY), |(f, m), (bf, bm)| (f.min(bf), m.min(bm)));
+        [tol * force, tol * moment].map(|x| if x.is_finite() { x } else { 0.0 })
+    }
+
     /// Every joint's force and moment of `rom` against `full`, where both runs carry
     /// coordinates and multipliers (a variant that computes none, or a sweep that kept no
     /// coordinates, gives none).
@@ -297,14 +314,17 @@ impl ReactionError {
             map.series((mu, rom.t.as_slice().unwrap_or(&[])), &rom.q, &rom.multipliers),
         );
         let tol = full.settings.params.tolerance;
+        let floors = Self::floors(model, tol);
         let mut out = Vec::new();
         for (p, name) in map.names().into_iter().enumerate() {
             let force = (f.force.index_axis(Axis(1), p), r.force.index_axis(Axis(1), p));
             let moment = (f.moment.column(p).insert_axis(Axis(1)), r.moment.column(p).insert_axis(Axis(1)));
-            for (quantity, (a, b)) in [("force", force), ("moment", moment)] {
-                // the Newton tolerance relative to the reaction's own size
+            for ((quantity, (a, b)), floor) in [("force", force), ("moment", moment)].into_iter().zip(floors) {
+                // the Newton tolerance relative to the reaction's own size, and never below
+                // what the most flexible body's bending resolves (a model at rest has
+                // reactions of round-off, whose range means nothing)
                 let largest = a.outer_iter().map(|v| v.dot(&v).sqrt()).fold(0.0, f64::max);
-                let apart = Apart::of(b, a, tol * largest);
+                let apart = Apart::of(b, a, (tol * largest).max(floor));
                 out.push(ReactionError {
                     reaction: name.to_string(),
                     quantity,
