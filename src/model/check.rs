@@ -561,12 +561,7 @@ impl Model {
         let key = which.key();
         let field = format!("bodies[{i}].{key}.parameter");
         let Some(name) = which.of(&f.bodies[i]).parameter() else { return Ok(None) };
-        if !crate::solver::parameters::is_parameter_name(name) || name == LOAD_SCALE {
-            return Err(self.err(
-                field,
-                format!("`{name}` is not a parameter name: use letters, digits and `_`, starting with a letter (and not `{LOAD_SCALE}`, the load scale)"),
-            ));
-        }
+        self.value_parameter_name(&field, name)?;
         let value = which.of(&f.bodies[i]).value();
         if let Some(other) = f.bodies[..i].iter().find(|o| which.of(o).parameter() == Some(name)) {
             if which.of(other).value() != value {
@@ -640,8 +635,7 @@ impl Model {
                     ),
                 )),
             ScaledSpec::Parameter(name) => {
-                let property = |p: &Option<String>| p.as_deref() == Some(name.as_str());
-                if self.bodies.iter().any(|b| property(&b.youngs_modulus_parameter) || property(&b.density_parameter)) {
+                if self.is_body_property(name) {
                     Err(self.err(
                         field,
                         format!("`{name}` is a body's Young's modulus or density: a parameter here multiplies, a property's is its value; give them different names"),

@@ -135,10 +135,8 @@ impl Model {
     pub fn parameter_names(&self) -> Vec<&str> {
         let drives = self.joints.iter().filter_map(|j| j.kind().drive_scaling());
         let scaled = self.loads.iter().map(|l| l.scaling()).chain(drives).filter_map(|s| s.parameter());
-        let bodies = self.bodies.iter().flat_map(|b| [&b.youngs_modulus_parameter, &b.density_parameter]).flatten();
-        let masses = self.masses.iter().filter_map(|m| m.parameter.as_ref());
         let mut names: Vec<&str> = Vec::new();
-        for name in scaled.chain(bodies.chain(masses).map(String::as_str)) {
+        for name in scaled.chain(self.properties().map(|p| p.0)) {
             if !names.contains(&name) {
                 names.push(name);
             }

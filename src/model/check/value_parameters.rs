@@ -39,18 +39,14 @@ impl Model {
         let Some(name) = spec.parameter() else { return Ok(None) };
         let (at_name, at_value) = (format!("{field}.parameter"), format!("{field}.value"));
         let value = spec.value();
-        if !is_parameter_name(name) || name == LOAD_SCALE {
-            return Err(self.err(at_name, format!("`{name}` is not a parameter name: use letters, digits and `_`, starting with a letter (and not `{LOAD_SCALE}`, the load scale)")));
-        }
+        self.value_parameter_name(&at_name, name)?;
         if !(value > 0.0 && value.is_finite()) {
             return Err(self.err(
                 at_value,
                 format!("must be positive for a parameter (it is the value the parameter replaces), got {value}"),
             ));
         }
-        let body_property = |n: &Option<String>| n.as_deref() == Some(name);
-        if self.bodies.iter().any(|b| body_property(&b.youngs_modulus_parameter) || body_property(&b.density_parameter))
-        {
+        if self.is_body_property(name) {
             return Err(self.err(
                 at_name,
                 format!("`{name}` is also a body's Young's modulus or density: give {} a name of its own", kind.noun()),
@@ -75,6 +71,21 @@ impl Model {
             self.same_value(kind, ValueKind::PointMass, (&at_name, &at_value), name, (value, m.mass))?;
         }
         Ok(Some((name.to_string(), value)))
+    }
+
+    /// Refuses, at `field`, a name that cannot be a value parameter's: not a parameter name,
+    /// or the load scale (a value parameter is a value, the load scale a factor).
+    pub(super) fn value_parameter_name(&self, field: &str, name: &str) -> Result<()> {
+        if is_parameter_name(name) && name != LOAD_SCALE {
+            return Ok(());
+        }
+        Err(self.err(field, format!("`{name}` is not a parameter name: use letters, digits and `_`, starting with a letter (and not `{LOAD_SCALE}`, the load scale)")))
+    }
+
+    /// Whether `name` is a body's Young's modulus or density parameter (bodies checked so far).
+    pub(super) fn is_body_property(&self, name: &str) -> bool {
+        let named = |n: &Option<String>| n.as_deref() == Some(name);
+        self.bodies.iter().any(|b| named(&b.youngs_modulus_parameter) || named(&b.density_parameter))
     }
 
     /// Refuses a value parameter that an earlier part of another kind takes, or of the same
