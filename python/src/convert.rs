@@ -102,7 +102,7 @@ fn sweep_sections<'py>(py: Python<'py>, d: &Bound<'py, PyDict>, s: &Sweep) -> Py
     let mut columns: Vec<((String, &'static str), Vec<f64>)> = Vec::new();
     for (k, sr) in s.scales.iter().enumerate() {
         let Outcome::Done(p) = &sr.outcome else { continue };
-        for q in p.estimate.iter().flat_map(|e| &e.quantities) {
+        for q in p.estimate.iter().flat_map(|e| &e.quantities).filter(|q| !q.quantity.is_reaction()) {
             let key = (q.probe.clone(), q.quantity.name());
             let i = match columns.iter().position(|(c, _)| *c == key) {
                 Some(i) => i,

@@ -659,7 +659,20 @@ impl PyRunResult {
     fn quantity_error_estimates<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
         let Some(e) = self.estimate() else { return Ok(None) };
         let d = PyDict::new(py);
-        for q in &e.quantities {
+        for q in e.quantities.iter().filter(|q| !q.quantity.is_reaction()) {
+            convert::inner_dict(&d, &q.probe)?.set_item(q.quantity.name(), q.estimate)?;
+        }
+        Ok(Some(d))
+    }
+
+    /// reaction point (as `reactions()` names them) → {`force`, `moment` → the estimate of
+    /// its error over its range over the run} (docs/error-estimate.md); None: a full run, or
+    /// no estimator; empty where the reduced run has no physical multipliers
+    #[getter]
+    fn reaction_error_estimates<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(e) = self.estimate() else { return Ok(None) };
+        let d = PyDict::new(py);
+        for q in e.quantities.iter().filter(|q| q.quantity.is_reaction()) {
             convert::inner_dict(&d, &q.probe)?.set_item(q.quantity.name(), q.estimate)?;
         }
         Ok(Some(d))

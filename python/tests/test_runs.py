@@ -130,6 +130,11 @@ def test_sweep_equals_online(dp_basis):
         for name, quantities in r.quantity_error_estimates.items():
             for q, v in quantities.items():
                 same(s["quantity_error_estimates"][name][q][i], v)
+        # each joint's reaction on each node it holds has its own estimate; the pins'
+        # forces swing (their moments are zero: no estimate)
+        reactions = r.reaction_error_estimates
+        assert set(reactions) == set(r.labels["reaction"])
+        assert all(0 < e["force"] < float("inf") for e in reactions.values()), reactions
     assert s["probes"]["tip"].shape == (3, len(s["t"]), 2)
     # no probe records strain or curvature on the double pendulum
     assert s["strains"] == {} and s["curvatures"] == {}

@@ -60,6 +60,24 @@ pub struct Reactions {
     pub moment: Array2<f64>,
 }
 
+/// The force and moment the Newton tolerance `tol` resolves in `model`: slopes resolve to
+/// `tol`, so a body's curvature to `tol / l` over an element of length `l`, which its bending
+/// stiffness `E I` holds with a moment `E I tol / l` and a shear force `E I tol / l²`; the
+/// most flexible body's, `[N, N m]`. A reaction's resolution is never below these (a model
+/// at rest has reactions of round-off, whose range means nothing).
+pub fn resolution_floors(model: &Model, tol: f64) -> [f64; 2] {
+    let (force, moment) = model
+        .bodies()
+        .iter()
+        .map(|b| {
+            let l = b.length / b.n_elements as f64;
+            let m = b.section.youngs_modulus * b.section.inertia / l;
+            (m / l, m)
+        })
+        .fold((f64::INFINITY, f64::INFINITY), |(f, m), (bf, bm)| (f.min(bf), m.min(bm)));
+    [tol * force, tol * moment].map(|x| if x.is_finite() { x } else { 0.0 })
+}
+
 impl ReactionMap {
     /// The reaction points of `model`'s joints, in file order, each joint's nodes in the
     /// order its description names them.
@@ -135,17 +153,35 @@ impl ReactionMap {
     /// The reactions of a run at `mu`: at the instants `t`, `q` (n_dof × n_t) and
     /// `multipliers` (n_c × n_t), one column per instant as the solvers keep them.
     pub fn series(&self, (mu, t): (&Parameters, &[f64]), q: &Array2<f64>, multipliers: &Array2<f64>) -> Reactions {
-        let (nt, np) = (q.ncols(), self.points.len());
+        self.series_by((mu, t), |i, k| q[(i, k)], |c, k| multipliers[(c, k)])
+    }
+
+    /// [`Self::series`] with the coordinates and multipliers read by `(index, instant)`: a
+    /// reduced trajectory gives the few coordinates the moments read (the slopes at the
+    /// joints' nodes) without forming every coordinate.
+    pub fn series_by(
+        &self,
+        (mu, t): (&Parameters, &[f64]),
+        q: impl Fn(usize, usize) -> f64,
+        lambda: impl Fn(usize, usize) -> f64,
+    ) -> Reactions {
+        let (nt, np) = (t.len(), self.points.len());
         let mut force = Array3::zeros((nt, np, 2));
         let mut moment = Array2::zeros((nt, np));
         for k in 0..nt {
-            for (p, r) in self.at((mu, t[k]), |i| q[(i, k)], |c| multipliers[(c, k)]).into_iter().enumerate() {
+            for (p, r) in self.at((mu, t[k]), |i| q(i, k), |c| lambda(c, k)).into_iter().enumerate() {
                 force[(k, p, 0)] = r[0];
                 force[(k, p, 1)] = r[1];
                 moment[(k, p)] = r[2];
             }
         }
         Reactions { force, moment }
+    }
+
+    /// The coordinates the reactions read: the slopes of the joints' nodes (the moments'
+    /// lever), in point order.
+    pub fn read_coordinates(&self) -> Vec<usize> {
+        self.points.iter().flat_map(|p| [p.first + 2, p.first + 3]).collect()
     }
 
     /// The points' names, in order.

@@ -661,7 +661,8 @@ struct TrueError {
     rel_error: f64,
     rel_error_by_time: ByFifth,
     displacement_error_by_time: ByFifth,
-    /// the largest error of a probe quantity over its range (0 without probes)
+    /// the largest error of a probe quantity or a joint reaction over its range (0 without
+    /// probes or joints)
     quantities: f64,
 }
 
@@ -697,7 +698,8 @@ fn true_error(model: &Arc<Model>, basis: &Basis, truth: &SimulationResult, mu: &
     match run {
         Ok(rom) => {
             let v = compare(model, truth, &rom, None, basis.n_reduced(), basis.variant.name());
-            let quantities = v.probe_quantity_errors.iter().map(|q| q.relative.unwrap_or(f64::NAN));
+            let reactions = v.reaction_errors.iter().map(|q| q.relative.unwrap_or(f64::NAN));
+            let quantities = v.probe_quantity_errors.iter().map(|q| q.relative.unwrap_or(f64::NAN)).chain(reactions);
             TrueError {
                 rel_error: v.rel_error,
                 rel_error_by_time: rel_error_by_time(&rom.result.q, &truth.q),

@@ -21,18 +21,18 @@
 //! the error").
 
 use super::timing::{median, repeat_timing};
-use crate::analysis::reactions::ReactionMap;
 use crate::error::Result;
 use crate::linalg::kkt::LinearSolverKind;
 use crate::model::Model;
 use crate::rom::estimator::norms::{against_motion, displacement_error_by_time, distance_and_norm, rel_error_by_time};
 use crate::rom::estimator::Estimate;
 use crate::rom::quantities::{self, Apart, Quantity};
+use crate::rom::reactions::ReactionReader;
 use crate::rom::{Output, ReducedRun, Rom};
 use crate::simulate::{simulate, FullModel, Overrides, SimulationResult};
 use crate::solver::model::Parameters;
 use crate::solver::model::ParametricModel;
-use ndarray::{ArrayView2, Axis};
+use ndarray::ArrayView2;
 
 /// The fixed keys of `validate --json`.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -242,9 +242,7 @@ impl ProbeQuantityError {
 
     /// With its estimate from `e` (matched by probe and quantity).
     fn with_estimate(mut self, e: &Estimate) -> Self {
-        let found = e.quantities.iter().find(|q| q.probe == self.probe && q.quantity == self.quantity);
-        self.estimate = found.map(|q| q.estimate).filter(|x| !x.is_nan());
-        self.effectivity = self.estimate.zip(self.relative).map(|(e, r)| e / r);
+        (self.estimate, self.effectivity) = estimate_for(e, &self.probe, self.quantity, self.relative);
         self
     }
 
@@ -261,81 +259,65 @@ impl ProbeQuantityError {
 
 /// A joint's reaction on one node — its force (both components) or its moment — of the
 /// reduced run against the full run's, relative to the full run's range over the run
-/// (`crate::analysis::reactions`; as [`ProbeQuantityError`] for the probes). Not estimated:
-/// the estimators follow coordinates, not multipliers.
+/// (`crate::rom::reactions`; as [`ProbeQuantityError`] for the probes), with its estimate.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct ReactionError {
     /// the reaction point, "joint 0 (clamp arm node 0) on arm node 0"
     pub reaction: String,
     /// `"force"` (N) or `"moment"` (N m)
-    pub quantity: &'static str,
+    pub quantity: Quantity,
     /// `max_k ‖v_rom(t_k) − v_full(t_k)‖`
     pub max_error: f64,
     /// the full run's range, `‖max_k v_full − min_k v_full‖`
     pub range: f64,
-    /// `max_error / range`; none where the full run's range is within the Newton tolerance
-    /// of its largest value and so is the error
+    /// `max_error / range`; none where the full run's range is within the reaction's
+    /// resolution (`ReactionReader::resolution`) and so is the error
     pub relative: Option<f64>,
+    /// the estimate of `relative` (none: no estimator, or no swing to measure against)
+    pub estimate: Option<f64>,
+    /// `estimate / relative`
+    pub effectivity: Option<f64>,
 }
 
 impl ReactionError {
-    /// The force and moment the Newton tolerance `tol` resolves: slopes resolve to `tol`, so
-    /// a body's curvature to `tol / l` over an element of length `l`, which its bending
-    /// stiffness `E I` holds with a moment `E I tol / l` and a shear force `E I tol / l²`; the
-    /// most flexible body's, N and N m.
-    fn floors(model: &Model, tol: f64) -> [f64; 2] {
-        let (force, moment) = model
-            .bodies()
-            .iter()
-            .map(|b| {
-                let l = b.length / b.n_elements as f64;
-                let m = b.section.youngs_modulus * b.section.inertia / l;
-                (m / l, m)
-            })
-            .fold((f64::INFINITY, f64::INFINITY), |(f, m), (bf, bm)| (f.min(bf), m.min(bm)));
-        [tol * force, tol * moment].map(|x| if x.is_finite() { x } else { 0.0 })
-    }
-
     /// Every joint's force and moment of `rom` against `full`, where both runs carry
     /// coordinates and multipliers (a variant that computes none, or a sweep that kept no
     /// coordinates, gives none).
     fn all(model: &Model, full: &SimulationResult, rom: &SimulationResult) -> Vec<Self> {
-        let same = full.q.dim() == rom.q.dim() && full.multipliers.dim() == rom.multipliers.dim();
-        if !same || full.q.is_empty() || !rom.multipliers.iter().all(|x| x.is_finite()) {
-            return Vec::new();
-        }
-        let map = ReactionMap::of(model);
-        if map.n_rows() != full.multipliers.nrows() {
-            return Vec::new();
-        }
-        let mu = full.settings.parameters();
-        let (f, r) = (
-            map.series((mu, full.t.as_slice().unwrap_or(&[])), &full.q, &full.multipliers),
-            map.series((mu, rom.t.as_slice().unwrap_or(&[])), &rom.q, &rom.multipliers),
-        );
+        let reader = ReactionReader::new(model);
+        let (Some(f), Some(r)) = (reader.of_result(full), reader.of_result(rom)) else { return Vec::new() };
         let tol = full.settings.params.tolerance;
-        let floors = Self::floors(model, tol);
-        let mut out = Vec::new();
-        for (p, name) in map.names().into_iter().enumerate() {
-            let force = (f.force.index_axis(Axis(1), p), r.force.index_axis(Axis(1), p));
-            let moment = (f.moment.column(p).insert_axis(Axis(1)), r.moment.column(p).insert_axis(Axis(1)));
-            for ((quantity, (a, b)), floor) in [("force", force), ("moment", moment)].into_iter().zip(floors) {
-                // the Newton tolerance relative to the reaction's own size, and never below
-                // what the most flexible body's bending resolves (a model at rest has
-                // reactions of round-off, whose range means nothing)
-                let largest = a.outer_iter().map(|v| v.dot(&v).sqrt()).fold(0.0, f64::max);
-                let apart = Apart::of(b, a, (tol * largest).max(floor));
-                out.push(ReactionError {
-                    reaction: name.to_string(),
-                    quantity,
+        f.iter()
+            .zip(&r)
+            .map(|(f, r)| {
+                let apart = reader.apart(r, f, tol);
+                ReactionError {
+                    reaction: f.point.clone(),
+                    quantity: f.quantity,
                     max_error: apart.distance,
                     range: apart.range,
                     relative: (!apart.relative.is_nan()).then_some(apart.relative),
-                });
-            }
-        }
-        out
+                    estimate: None,
+                    effectivity: None,
+                }
+            })
+            .collect()
     }
+
+    /// With its estimate from `e` (matched by reaction point and quantity).
+    fn with_estimate(mut self, e: &Estimate) -> Self {
+        (self.estimate, self.effectivity) = estimate_for(e, &self.reaction, self.quantity, self.relative);
+        self
+    }
+}
+
+/// The estimate `e` gives `quantity` of `name` (a probe or a reaction point) and its
+/// effectivity against the error `relative`; none where `e` has none (NaN: nothing moved to
+/// measure against).
+fn estimate_for(e: &Estimate, name: &str, quantity: Quantity, relative: Option<f64>) -> (Option<f64>, Option<f64>) {
+    let found = e.quantities.iter().find(|q| q.probe == name && q.quantity == quantity);
+    let estimate = found.map(|q| q.estimate).filter(|x| !x.is_nan());
+    (estimate, estimate.zip(relative).map(|(e, r)| e / r))
 }
 
 /// Compares a reduced run with a full run of the same model, load scale and Δt.
@@ -468,6 +450,8 @@ impl Validation {
     pub fn with_quantity_estimates(mut self, e: &Estimate) -> Self {
         let errors = std::mem::take(&mut self.probe_quantity_errors);
         self.probe_quantity_errors = errors.into_iter().map(|q| q.with_estimate(e)).collect();
+        let errors = std::mem::take(&mut self.reaction_errors);
+        self.reaction_errors = errors.into_iter().map(|q| q.with_estimate(e)).collect();
         self
     }
 
@@ -508,8 +492,7 @@ impl Validation {
             self.effectivity_displacement = Some(e.error_estimate_displacement / self.displacement_error);
             self.error_estimate_displacement_by_time = Some(e.displacement_by_time.to_vec());
             self.estimate_failure = e.failure.clone();
-            self.probe_quantity_errors =
-                std::mem::take(&mut self.probe_quantity_errors).into_iter().map(|q| q.with_estimate(e)).collect();
+            self = self.with_quantity_estimates(e);
         }
         if let Some((rom, t)) = rom.and_then(|r| Some((r, r.trust()?))) {
             let mu = self.mu();
@@ -712,15 +695,21 @@ impl Validation {
             ));
         }
         for q in &self.reaction_errors {
-            let unit = if q.quantity == "force" { " N" } else { " N m" };
+            let unit = q.quantity.unit();
+            let estimate = match (q.estimate, q.effectivity) {
+                (Some(e), Some(f)) => format!(", estimate {e:.3e} (effectivity {f:.2})"),
+                (Some(e), None) => format!(", estimate {e:.3e}"),
+                (None, _) if q.relative.is_some() => " (not estimated)".to_string(),
+                (None, _) => String::new(),
+            };
             s.push_str(&format!(
-                "\n  {} {}: max error {:.3e}{unit} over a range of {:.3e}{unit}: {}",
+                "\n  {} {}: max error {:.3e}{unit} over a range of {:.3e}{unit}: {}{estimate}",
                 q.reaction,
-                q.quantity,
+                q.quantity.name(),
                 q.max_error,
                 q.range,
                 q.relative.map_or("none (it stays within the Newton tolerance)".to_string(), |e| {
-                    format!("{e:.3e} of its range (not estimated)")
+                    format!("{e:.3e} of its range")
                 }),
             ));
         }

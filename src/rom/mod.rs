@@ -12,6 +12,7 @@ pub mod estimator;
 pub(crate) mod pool;
 pub mod probes;
 pub mod quantities;
+pub mod reactions;
 pub mod run;
 pub mod trust;
 

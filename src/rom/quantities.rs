@@ -33,6 +33,10 @@ pub enum Quantity {
     Strain,
     /// the centre line's curvature there, 1/m
     Curvature,
+    /// a joint's reaction force on a node it holds, N (two components; [`crate::rom::reactions`])
+    Force,
+    /// a joint's reaction moment on a node it holds, N m
+    Moment,
 }
 
 impl Quantity {
@@ -42,6 +46,8 @@ impl Quantity {
             Quantity::Position => "position",
             Quantity::Strain => "strain",
             Quantity::Curvature => "curvature",
+            Quantity::Force => "force",
+            Quantity::Moment => "moment",
         }
     }
 
@@ -51,19 +57,28 @@ impl Quantity {
             Quantity::Position => " m",
             Quantity::Strain => "",
             Quantity::Curvature => " 1/m",
+            Quantity::Force => " N",
+            Quantity::Moment => " N m",
         }
     }
 
     /// The quantity's resolution at the Newton tolerance `tol` of a model of length scale
     /// `length`: coordinates resolve to `tol · L`, slopes (unit vectors) to `tol`, so a
     /// position to `tol · L`, a strain to `tol`, a curvature (a slope's change over a
-    /// length) to `tol / L`.
+    /// length) to `tol / L`. A reaction's resolution depends on the model's stiffness and
+    /// the reaction's size ([`crate::rom::reactions::ReactionReader::resolution`]): 0 here.
     pub fn resolution(self, tol: f64, length: f64) -> f64 {
         match self {
             Quantity::Position => tol * length,
             Quantity::Strain => tol,
             Quantity::Curvature => tol / length,
+            Quantity::Force | Quantity::Moment => 0.0,
         }
+    }
+
+    /// Whether it is a joint's reaction, not a probe's quantity.
+    pub fn is_reaction(self) -> bool {
+        matches!(self, Quantity::Force | Quantity::Moment)
     }
 }
 

@@ -204,20 +204,17 @@ fn run<R: Reduced<FlexibleSystem>>(
     // reconstruct only what is written out
     let full = rom.full();
     let n_c = full.n_constraints();
-    let (q, qd, multipliers) = match output {
-        Output::Full => {
-            let q = basis.reconstruct_columns(zq.view());
-            // q̇ = V ż: the reference is constant
-            let qd = basis.modes.dot(&zv);
-            let mut multipliers = Array2::from_elem((n_c, nt), f64::NAN);
-            for k in 0..nt {
-                if let Some(l) = rom.multipliers(&zq.column(k).to_vec(), &lam.column(k).to_vec()) {
-                    multipliers.column_mut(k).assign(&l);
-                }
-            }
-            (q, qd, multipliers)
+    // the physical multipliers in either output: the reactions and their estimates read them
+    let mut multipliers = Array2::from_elem((n_c, nt), f64::NAN);
+    for k in 0..nt {
+        if let Some(l) = rom.multipliers(&zq.column(k).to_vec(), &lam.column(k).to_vec()) {
+            multipliers.column_mut(k).assign(&l);
         }
-        Output::ReducedAndProbes => (Array2::zeros((0, nt)), Array2::zeros((0, nt)), Array2::zeros((0, nt))),
+    }
+    let (q, qd) = match output {
+        // q̇ = V ż: the reference is constant
+        Output::Full => (basis.reconstruct_columns(zq.view()), basis.modes.dot(&zv)),
+        Output::ReducedAndProbes => (Array2::zeros((0, nt)), Array2::zeros((0, nt))),
     };
     let values = super::probes::probe_values(full, basis, zq.view());
     Ok(ReducedRun {

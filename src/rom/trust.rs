@@ -236,8 +236,26 @@ pub fn write_run_attributes(
         .create("error_estimate_displacement_by_time")?
         .write(&e.map_or([f64::NAN; FIFTHS], |e| e.displacement_by_time))?;
     attr_f64(f, "sensitivity_near", sensitivity_near.unwrap_or(f64::NAN))?;
-    for q in e.map_or(&[][..], |e| &e.quantities[..]) {
+    let quantities = e.map_or(&[][..], |e| &e.quantities[..]);
+    for q in quantities.iter().filter(|q| !q.quantity.is_reaction()) {
         write_quantity_estimate(f, q)?;
+    }
+    write_reaction_estimates(f, quantities)
+}
+
+/// The estimates of the joints' reactions as the attribute `error_estimate` (one per
+/// reaction point, in `/labels/reaction`'s order) of `/reactions/force` and
+/// `/reactions/moment`, where the file holds them and the estimate has them.
+fn write_reaction_estimates(f: &hdf5::File, quantities: &[QuantityEstimate]) -> hdf5::Result<()> {
+    for (quantity, path) in [(Quantity::Force, "reactions/force"), (Quantity::Moment, "reactions/moment")] {
+        let values: Vec<f64> = quantities.iter().filter(|q| q.quantity == quantity).map(|q| q.estimate).collect();
+        if values.is_empty() || !f.link_exists(path) {
+            continue;
+        }
+        let d = f.dataset(path)?;
+        if d.shape().get(1) == Some(&values.len()) {
+            d.new_attr::<f64>().shape(values.len()).create("error_estimate")?.write(&values)?;
+        }
     }
     Ok(())
 }
@@ -250,6 +268,7 @@ fn write_quantity_estimate(f: &hdf5::File, q: &QuantityEstimate) -> hdf5::Result
         Quantity::Position => "probes",
         Quantity::Strain => "probe_strain",
         Quantity::Curvature => "probe_curvature",
+        Quantity::Force | Quantity::Moment => return Ok(()),
     };
     let path = format!("{group}/{}", q.probe);
     if f.link_exists(&path) {

@@ -270,8 +270,9 @@ pub(super) fn calibrate_defects(
         Ok(true) => Defects::new(model, rom.basis(), &Arc::new(est.clone())).ok(),
         _ => None,
     };
-    // per candidate: the ratio by fifth, and each probe quantity's whole-run ratio
-    let keys: Vec<String> = model.quantity_keys();
+    // per candidate: the ratio by fifth, and each probe quantity's and reaction's whole-run ratio
+    let mut keys: Vec<String> = model.quantity_keys();
+    keys.extend(crate::rom::reactions::ReactionReader::new(model).keys());
     let unusable = || ([f64::NAN; FIFTHS], vec![f64::NAN; keys.len()]);
     let measured: Vec<(ByFifth, Vec<f64>)> = cands
         .points

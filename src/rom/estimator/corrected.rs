@@ -71,12 +71,12 @@ use super::{ErrorEstimator, Estimator, QuantityRaw, Raw};
 use crate::error::{Error, Result};
 use crate::model::Model;
 use crate::physics::system::FlexibleSystem;
-use crate::reduction::{Basis, Hyper, HyperReducedModel, Variant};
+use crate::reduction::{Basis, Hyper, HyperReducedModel, Reduced, Variant};
 use crate::rom::pool::Pool;
 use crate::rom::run::ReducedRun;
 use crate::simulate::{Overrides, Settings};
 use crate::solver::generalized_alpha::{GeneralizedAlpha, State, StepConstants};
-use crate::solver::model::{Bound, DynamicModel};
+use crate::solver::model::{Bound, DynamicModel, ParametricModel};
 use ndarray::{Array2, ArrayView1};
 use std::sync::Arc;
 
@@ -171,6 +171,12 @@ impl CorrectedRunner {
     /// and what the corrections were like. `Err` when a solve fails or the trajectory stops
     /// being finite.
     pub fn trajectory(&mut self, run: &ReducedRun) -> Result<(Array2<f64>, FollowStats)> {
+        self.follow(run, 0).map(|f| (f.q, f.stats))
+    }
+
+    /// [`Self::trajectory`] with the enriched model's physical multipliers along it (n_c × n_t;
+    /// NaN where its variant has none): what its reactions are read from.
+    pub fn trajectory_with_multipliers(&mut self, run: &ReducedRun) -> Result<Followed> {
         self.follow(run, 0)
     }
 
@@ -184,14 +190,23 @@ impl CorrectedRunner {
     /// to in the solve's metric). Cost: one enriched residual, matrix and factorization per
     /// sampled step, plus O(r⁺ r) per step.
     pub fn defects(&mut self, run: &ReducedRun, sample: usize) -> Result<Array2<f64>> {
-        let (mut out, _) = self.follow(run, sample.max(1))?;
+        let mut out = self.follow(run, sample.max(1))?.q;
         out.column_mut(0).fill(0.0);
         Ok(out)
     }
 
+    /// [`Self::defects`] with the enriched model's physical multipliers after each sampled
+    /// correction (n_c × n_t, the other columns NaN): `λ⁺ = β' s Δμ` from multipliers started
+    /// at zero, the enriched step's multipliers at the lifted reduced state.
+    pub fn defects_with_multipliers(&mut self, run: &ReducedRun, sample: usize) -> Result<Followed> {
+        let mut f = self.follow(run, sample.max(1))?;
+        f.q.column_mut(0).fill(0.0);
+        Ok(f)
+    }
+
     /// The loop of both: `sample` 0 corrects the trajectory, `s > 0` records the defects at
     /// every s-th step from the lifted reduced state.
-    fn follow(&mut self, run: &ReducedRun, sample: usize) -> Result<(Array2<f64>, FollowStats)> {
+    fn follow(&mut self, run: &ReducedRun, sample: usize) -> Result<Followed> {
         let s = Settings::resolve(&self.model, &Overrides::at(run.result.settings.parameters()))?;
         let mut bound = Bound::new(self.rom.as_mut(), s.parameters());
         let rom = &mut bound;
@@ -212,6 +227,15 @@ impl CorrectedRunner {
 
         let mut out = Array2::zeros((n, nt));
         out.column_mut(0).assign(&ArrayView1::from(&st.q));
+        let mut lambda = Array2::from_elem((rom.model.full().n_constraints(), nt), f64::NAN);
+        let keep = |lambda: &mut Array2<f64>, col: usize, rom: &Bound<HyperReducedModel<_>>, q: &[f64], l: &[f64]| {
+            if let Some(l) = Reduced::multipliers(&*rom.model, q, l) {
+                lambda.column_mut(col).assign(&l);
+            }
+        };
+        if sample == 0 {
+            keep(&mut lambda, 0, rom, &st.q, &st.lambda);
+        }
         let mut dz = vec![0.0; z.nrows()];
         let mut d = vec![0.0; n];
         for step in 1..nt {
@@ -244,6 +268,8 @@ impl CorrectedRunner {
                         return Err(fail(t, "the defect is not finite".into()));
                     }
                     out.column_mut(step).assign(&ArrayView1::from(&rhs[..n]));
+                    let l: Vec<f64> = rhs[n..].iter().map(|m| k.beta_p * sc * m).collect();
+                    keep(&mut lambda, step, rom, &st.q, &l);
                 } else if !inc.is_finite() {
                     return Err(fail(t, "the corrected trajectory is no longer finite".into()));
                 } else if self.accept.is_finite() {
@@ -251,17 +277,29 @@ impl CorrectedRunner {
                     check_step(rom, &mut st, &c, sc, inc, (&mut rhs, &mut work), &mut stats).map_err(|p| fail(t, p))?;
                     if !stats.followed() {
                         // what follows this step is no reading of the reduced run's error
-                        return Ok((out, stats));
+                        return Ok(Followed { q: out, lambda, stats });
                     }
                 }
             }
             integ.finish_step(&mut st, &k);
             if sample == 0 {
                 out.column_mut(step).assign(&ArrayView1::from(&st.q));
+                keep(&mut lambda, step, rom, &st.q, &st.lambda);
             }
         }
-        Ok((out, stats))
+        Ok(Followed { q: out, lambda, stats })
     }
+}
+
+/// What following a reduced run gives: the enriched coordinates (the corrected trajectory,
+/// or the defects), the enriched model's physical multipliers there, and the corrections'
+/// statistics.
+pub struct Followed {
+    /// r⁺ × n_t
+    pub q: Array2<f64>,
+    /// n_c × n_t, NaN where none was taken
+    pub lambda: Array2<f64>,
+    pub stats: FollowStats,
 }
 
 /// What [`check_step`] holds a step to.
@@ -340,6 +378,8 @@ pub struct Corrected {
     norms: super::norms::NormProjection,
     /// the model's length scale `L` (the displacement measure's resolution is `tol · L`)
     length: f64,
+    /// the model's reaction points
+    reactions: crate::rom::reactions::ReactionReader,
 }
 
 impl Corrected {
@@ -355,6 +395,7 @@ impl Corrected {
         let norms = super::norms::NormProjection::new(basis, &data.enriched, ndarray::ArrayView1::from(&x0[..]));
         Ok(Corrected {
             length,
+            reactions: crate::rom::reactions::ReactionReader::new(model),
             model: Arc::clone(model),
             basis: Arc::clone(basis),
             data: Arc::clone(data),
@@ -374,8 +415,8 @@ impl ErrorEstimator for Corrected {
         &self.data
     }
     fn raw(&self, run: &ReducedRun) -> Result<Raw> {
-        let why = match self.runners.with(|r| r.trajectory(run))? {
-            Ok((qp, stats)) if stats.followed() => {
+        let why = match self.runners.with(|r| r.trajectory_with_multipliers(run))? {
+            Ok(Followed { q: qp, lambda, stats }) if stats.followed() => {
                 let x0 = ndarray::ArrayView1::from(&self.x0[..]);
                 let res = super::norms::resolution(run, self.length);
                 let norms = self.norms.raw_by_time(&self.basis, &self.data.enriched, &run.reduced_q, &qp, x0, res);
@@ -383,10 +424,16 @@ impl ErrorEstimator for Corrected {
                 let enriched = crate::rom::probes::probe_values(sys, &self.data.enriched, qp.view());
                 let reference = crate::rom::quantities::readings_of_probes(&enriched);
                 let tol = run.result.settings.params.tolerance;
-                let quantities = QuantityRaw::between(&run.result, &reference, tol, self.length);
+                let mut quantities = QuantityRaw::between(&run.result, &reference, tol, self.length);
+                let t = run.result.t.as_slice().unwrap_or(&[]);
+                let mu = run.result.settings.parameters();
+                let enriched =
+                    self.reactions.of_trajectory((mu, t), (&self.data.enriched, qp.view()), None, lambda.view());
+                let own = super::run_reactions(&self.reactions, &self.basis, run);
+                quantities.extend(QuantityRaw::between_reactions(&self.reactions, own, enriched, tol));
                 return Ok(Raw { norms, quantities });
             }
-            Ok((_, stats)) if stats.diverged > 0 => {
+            Ok(Followed { stats, .. }) if stats.diverged > 0 => {
                 "left the reduced run's step (a step's first correction was not contracted)".to_string()
             }
             Ok(_) => "did not converge".to_string(),

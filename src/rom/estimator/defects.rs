@@ -24,7 +24,7 @@
 //! [`DEFECT_SAMPLE`], lowered so that a run keeps at least [`MIN_SAMPLES`] samples: fixed
 //! numbers, not fitted.
 
-use super::corrected::CorrectedRunner;
+use super::corrected::{CorrectedRunner, Followed};
 use super::norms::{against_motion, resolution, ConfigurationNorms, RawByFifth};
 use super::{ByFifth, ErrorEstimator, Estimator, QuantityRaw, Raw, FIFTHS};
 use crate::error::Result;
@@ -33,7 +33,8 @@ use crate::physics::element::Vec8;
 use crate::physics::system::FlexibleSystem;
 use crate::reduction::Basis;
 use crate::rom::pool::Pool;
-use crate::rom::quantities::{range, readings, Quantity};
+use crate::rom::quantities::{max_distance, range, readings, Quantity};
+use crate::rom::reactions::ReactionReader;
 use crate::rom::run::ReducedRun;
 use crate::solver::model::Parameters;
 use ndarray::Axis;
@@ -63,6 +64,8 @@ pub struct Defects {
     norms: ConfigurationNorms,
     /// the model's length scale `L` (the displacement measure's resolution is `tol · L`)
     length: f64,
+    /// the model's reaction points
+    reactions: ReactionReader,
 }
 
 impl Defects {
@@ -83,6 +86,7 @@ impl Defects {
             sample: DEFECT_SAMPLE,
             norms,
             length,
+            reactions: ReactionReader::new(model),
         })
     }
 
@@ -139,13 +143,49 @@ impl Defects {
                     Quantity::Position => 0,
                     Quantity::Strain => 1,
                     Quantity::Curvature => 2,
+                    // a run's readings are its probes' ([`Self::reaction_raws`] reads reactions)
+                    Quantity::Force | Quantity::Moment => 3,
                 };
                 let probe = sys.probes.iter().position(|p| p.name == v.probe);
-                let sum = probe.and_then(|i| sums.get(i)).map_or(f64::NAN, |s| s[slot]);
+                let sum = probe.and_then(|i| sums.get(i)).and_then(|s| s.get(slot).copied()).unwrap_or(f64::NAN);
                 let range = range(v.values);
                 let res = v.quantity.resolution(tol, self.length);
                 let raw = against_motion(range > res, sum > res, || sum / range);
                 QuantityRaw { probe: v.probe.to_string(), quantity: v.quantity, raw }
+            })
+            .collect()
+    }
+}
+
+impl Defects {
+    /// The largest change in each joint reaction the enriched correction makes at the
+    /// sampled steps, `max_n ‖R(x_n + V⁺δ_n, λ⁺_n) − R(x_n, λ_n)‖`, over the reduced run's
+    /// range: a reaction is read off each instant's multipliers, so its error is the
+    /// instant's, not a sum over the run as the coordinates' is. On no scale of its own
+    /// (one Newton iteration's multipliers): calibrated per reaction as the probe
+    /// quantities are ([`Self::quantity_factor`]).
+    fn reaction_raws(&self, run: &ReducedRun, followed: &Followed, s: usize) -> Vec<QuantityRaw> {
+        let Some(own) = super::run_reactions(&self.reactions, &self.basis, run) else { return Vec::new() };
+        let (t, nt) = (run.result.t.as_slice().unwrap_or(&[]), run.reduced_q.ncols());
+        let sampled: Vec<usize> = (s..nt).step_by(s).collect();
+        let ts: Vec<f64> = sampled.iter().map(|&k| t[k]).collect();
+        let mu = run.result.settings.parameters();
+        let (z, delta) = (run.reduced_q.select(Axis(1), &sampled), followed.q.select(Axis(1), &sampled));
+        let corrected = self.reactions.of_trajectory(
+            (mu, &ts),
+            (&self.basis, z.view()),
+            Some((&self.data.enriched, delta.view())),
+            followed.lambda.select(Axis(1), &sampled).view(),
+        );
+        let Some(corrected) = corrected else { return Vec::new() };
+        let tol = run.result.settings.params.tolerance;
+        own.iter()
+            .zip(&corrected)
+            .map(|(v, w)| {
+                let change = max_distance(v.values.select(Axis(0), &sampled).view(), w.values.view());
+                let (range, res) = (range(v.values.view()), self.reactions.resolution(v, tol));
+                let raw = against_motion(range > res, change > res, || change / range);
+                QuantityRaw { probe: v.point.clone(), quantity: v.quantity, raw }
             })
             .collect()
     }
@@ -165,7 +205,8 @@ impl ErrorEstimator for Defects {
         let z = &run.reduced_q;
         let nt = z.ncols();
         let s = sample_for(nt.saturating_sub(1), self.sample);
-        let defects = self.runners.with(|r| r.defects(run, s))??;
+        let followed = self.runners.with(|r| r.defects_with_multipliers(run, s))??;
+        let defects = &followed.q;
         // ‖x_ref + V z_k‖² and ‖x_ref + V z_k − x₀‖² from the reduced coordinates (V
         // orthonormal; the corrected runner exists only for such bases): norms.rs
         let (mut err2, mut norm2, mut disp2) = (vec![0.0; nt], vec![0.0; nt], vec![0.0; nt]);
@@ -184,7 +225,9 @@ impl ErrorEstimator for Defects {
             let per_instant = if displacement { &disp2 } else { &norm2 };
             (err2[..end].iter().sum(), per_instant[..end].iter().sum::<f64>().max(0.0))
         });
-        Ok(Raw { norms, quantities: self.quantity_raws(run, &defects, s) })
+        let mut quantities = self.quantity_raws(run, defects, s);
+        quantities.extend(self.reaction_raws(run, &followed, s));
+        Ok(Raw { norms, quantities })
     }
 
     /// The defect sum is a bound by itself: factor 1, raised in the proportion that

@@ -10,6 +10,7 @@ use crate::error::Result;
 use crate::model::Model;
 use crate::reduction::Basis;
 use crate::rom::pool::Pool;
+use crate::rom::reactions::ReactionReader;
 use crate::rom::run::{Output, ReducedRun, ReducedRunner};
 use std::sync::Arc;
 
@@ -24,6 +25,8 @@ pub struct Enriched {
     norms: NormProjection,
     /// the model's length scale `L` (the displacement measure's resolution is `tol · L`)
     length: f64,
+    /// the model's reaction points
+    reactions: ReactionReader,
 }
 
 impl Enriched {
@@ -37,7 +40,8 @@ impl Enriched {
         let x0 = Arc::clone(&physics.x0);
         let length = physics.length_scale();
         let norms = NormProjection::new(basis, &data.enriched, ndarray::ArrayView1::from(&x0[..]));
-        Ok(Enriched { basis: Arc::clone(basis), data: Arc::clone(data), runners, x0, norms, length })
+        let reactions = ReactionReader::new(model);
+        Ok(Enriched { basis: Arc::clone(basis), data: Arc::clone(data), runners, x0, norms, length, reactions })
     }
 }
 
@@ -56,6 +60,16 @@ impl ErrorEstimator for Enriched {
         let norms = self.norms.raw_by_time(&self.basis, &self.data.enriched, &run.reduced_q, &e.reduced_q, x0, res);
         let reference = crate::rom::quantities::readings(&e.result);
         let tol = run.result.settings.params.tolerance;
-        Ok(Raw { norms, quantities: QuantityRaw::between(&run.result, &reference, tol, self.length) })
+        let mut quantities = QuantityRaw::between(&run.result, &reference, tol, self.length);
+        let t = e.result.t.as_slice().unwrap_or(&[]);
+        let enriched = self.reactions.of_trajectory(
+            (mu, t),
+            (&self.data.enriched, e.reduced_q.view()),
+            None,
+            e.result.multipliers.view(),
+        );
+        let own = super::run_reactions(&self.reactions, &self.basis, run);
+        quantities.extend(QuantityRaw::between_reactions(&self.reactions, own, enriched, tol));
+        Ok(Raw { norms, quantities })
     }
 }

@@ -46,6 +46,7 @@ pub use crate::reduction::estimator::{
 };
 use crate::reduction::Basis;
 use crate::rom::quantities::{self, Quantity};
+use crate::rom::reactions::{ReactionReader, ReactionReading};
 use crate::rom::run::ReducedRun;
 use crate::simulate::SimulationResult;
 use crate::solver::model::Parameters;
@@ -81,16 +82,18 @@ impl RawByFifth {
 }
 
 /// What an estimator reads off a run before its factor: `η_raw` by fifth in both measures,
-/// and the distance in each quantity the probes record ([`QuantityRaw`]).
+/// and the distance in each quantity the probes record and each joint reaction
+/// ([`QuantityRaw`]: the probes' in [`quantities::readings`]'s order, then each reaction
+/// point's force, then each one's moment).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Raw {
     pub norms: RawByFifth,
     pub quantities: Vec<QuantityRaw>,
 }
 
-/// A probe quantity's `η_raw`: the reduced run's distance from the enriched model in it
-/// over the enriched model's range ([`crate::rom::quantities`]); NaN where neither moves
-/// beyond the quantity's resolution.
+/// A probe quantity's or a joint reaction's `η_raw`: the reduced run's distance from the
+/// enriched model in it over the enriched model's range ([`crate::rom::quantities`],
+/// [`crate::rom::reactions`]); NaN where neither moves beyond the quantity's resolution.
 #[derive(Clone, Debug, PartialEq)]
 pub struct QuantityRaw {
     pub probe: String,
@@ -116,6 +119,26 @@ impl QuantityRaw {
     /// The quantity's key in calibrations and messages, `quantity:probe`.
     pub fn key(&self) -> String {
         format!("{}:{}", self.quantity.name(), self.probe)
+    }
+
+    /// The raw distance of a run's reactions `run` from the reference's `reference`, over
+    /// the reference's ranges ([`ReactionReader::apart`]); none where either run has no
+    /// reactions (a variant without physical multipliers).
+    pub fn between_reactions(
+        reader: &ReactionReader,
+        run: Option<Vec<ReactionReading>>,
+        reference: Option<Vec<ReactionReading>>,
+        tol: f64,
+    ) -> Vec<Self> {
+        let (Some(run), Some(reference)) = (run, reference) else { return Vec::new() };
+        run.iter()
+            .zip(&reference)
+            .map(|(v, w)| QuantityRaw {
+                probe: v.point.clone(),
+                quantity: v.quantity,
+                raw: reader.apart(v, w, tol).relative,
+            })
+            .collect()
     }
 
     /// ∞ in every quantity of `run`: an estimator whose model failed.
@@ -275,6 +298,14 @@ pub trait ErrorEstimator: Send + Sync {
     fn self_check(&self) -> Option<String> {
         None
     }
+}
+
+/// The reactions of the reduced run `run` of `basis`, from its physical multipliers along its
+/// trajectory; none where its variant has none.
+pub fn run_reactions(reader: &ReactionReader, basis: &Basis, run: &ReducedRun) -> Option<Vec<ReactionReading>> {
+    let t = run.result.t.as_slice()?;
+    let (mu, z) = (run.result.settings.parameters(), run.reduced_q.view());
+    reader.of_trajectory((mu, t), (basis, z), None, run.result.multipliers.view())
 }
 
 /// The estimator of `basis` by `method`: `corrected` and `defects` where the correction can

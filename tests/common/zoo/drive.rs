@@ -72,7 +72,7 @@ pub struct Validation {
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct QuantityError {
     pub probe: String,
-    /// "position", "strain" or "curvature"
+    /// "position", "strain" or "curvature"; a joint reaction's "force" or "moment"
     pub quantity: String,
     /// `relative`: NaN where the JSON has null (no swing to measure against: the full run's
     /// range within the quantity's resolution; ∞ is written as null too, `max_error` and
@@ -84,18 +84,22 @@ pub struct QuantityError {
     pub range: f64,
 }
 
-/// `probe_quantity_errors` of a `validate --json` (none when absent).
+/// `probe_quantity_errors` and `reaction_errors` (a reaction point as the probe) of a
+/// `validate --json` (none when absent).
 fn quantity_errors(v: &Value) -> Vec<QuantityError> {
-    let Some(list) = v.get("probe_quantity_errors").and_then(Value::as_array) else { return Vec::new() };
+    let list = |key: &str| v.get(key).and_then(Value::as_array).cloned().unwrap_or_default();
     let text = |q: &Value, k: &str| q.get(k).and_then(Value::as_str).unwrap_or("").to_string();
-    list.iter()
-        .map(|q| QuantityError {
-            probe: text(q, "probe"),
-            quantity: text(q, "quantity"),
-            relative: number(q, "relative"),
-            estimate: number(q, "estimate"),
-            max_error: number(q, "max_error"),
-            range: number(q, "range"),
+    let probes = list("probe_quantity_errors").into_iter().map(|q| (text(&q, "probe"), q));
+    let reactions = list("reaction_errors").into_iter().map(|q| (text(&q, "reaction"), q));
+    probes
+        .chain(reactions)
+        .map(|(probe, q)| QuantityError {
+            probe,
+            quantity: text(&q, "quantity"),
+            relative: number(&q, "relative"),
+            estimate: number(&q, "estimate"),
+            max_error: number(&q, "max_error"),
+            range: number(&q, "range"),
         })
         .collect()
 }

@@ -293,9 +293,9 @@ pub fn aggregate(models: &[(Option<&Training>, &ModelStats)]) -> Aggregate {
     a
 }
 
-/// The quantities a zoo probe records: the tip's position, the roots' position, strain and
-/// curvature (tests/common/zoo/mechanisms.rs).
-pub const QUANTITIES: [&str; 3] = ["position", "strain", "curvature"];
+/// The quantities a zoo probe records — the tip's position, the roots' position, strain and
+/// curvature (tests/common/zoo/mechanisms.rs) — and the joints' reaction forces and moments.
+pub const QUANTITIES: [&str; 5] = ["position", "strain", "curvature", "force", "moment"];
 
 /// One probe quantity of one validation, with where it comes from.
 #[derive(Clone, Debug, serde::Serialize)]
