@@ -10,6 +10,7 @@
 
 mod convert;
 mod errors;
+mod pickle;
 
 use convert::{dict_of_series, parameters, time_first, warn};
 use errors::{to_py, FlexromWarning};
@@ -26,7 +27,7 @@ use flexrom::simulate::{Overrides, SimulationResult};
 use flexrom::solver::parameters::Parameters;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArrayDyn};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyBytes, PyDict};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -367,6 +368,7 @@ impl PyModel {
 }
 
 /// What a static equilibrium adds to its result: what `statics` writes beside it.
+#[derive(Clone, serde::Serialize, serde::Deserialize)]
 struct StaticsPart {
     /// the time of the loads, s
     time: f64,
@@ -377,6 +379,7 @@ struct StaticsPart {
 }
 
 /// What a reduced run adds to its result: what `online` writes beside the run.
+#[derive(Clone, serde::Serialize, serde::Deserialize)]
 struct ReducedPart {
     /// r × n_t
     reduced_q: ndarray::Array2<f64>,
@@ -385,11 +388,12 @@ struct ReducedPart {
     /// basis stores), which a result must never be written over
     basis_path: PathBuf,
     pipeline_path: Option<PathBuf>,
-    variant: &'static str,
+    variant: String,
     n_modes: usize,
     estimate: Option<Estimate>,
-    method: Option<&'static str>,
+    method: Option<String>,
     trust: Trust,
+    #[serde(with = "pickle::parameters")]
     mu: Parameters,
     extrapolated: bool,
 }
@@ -686,8 +690,8 @@ impl PyRunResult {
 
     /// the estimate's method (`corrected`, `enriched`, `defects`, …)
     #[getter]
-    fn estimate_method(&self) -> Option<&'static str> {
-        self.reduced.as_ref().and_then(|x| x.method)
+    fn estimate_method(&self) -> Option<String> {
+        self.reduced.as_ref().and_then(|x| x.method.clone())
     }
 
     /// whether the run's parameters left those the basis was trained over (False for a
@@ -744,6 +748,15 @@ impl PyRunResult {
         .map_err(to_py)
     }
 
+    /// Pickled as one versioned payload of everything it holds (python/src/pickle.rs):
+    /// unpickling gives a Result equal in every array bit and attribute, in any process of
+    /// the same flexrom version (joblib, multiprocessing), without the files it came from.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyBytes>,))> {
+        let bytes = pickle::to_bytes(self).map_err(pyo3::exceptions::PyValueError::new_err)?;
+        let unpickle = py.import("flexrom._flexrom")?.getattr("_result_from_pickle")?;
+        Ok((unpickle, (PyBytes::new(py, &bytes),)))
+    }
+
     fn __repr__(&self) -> String {
         if self.statics.is_some() {
             return format!(
@@ -791,10 +804,17 @@ impl PyRunResult {
             let Some(x) = &self.reduced else { return Ok(()) };
             flexrom::io::result_file::write_reduced(f, &x.reduced_q).map_err(e)?;
             flexrom::io::h5::attr_str(f, "basis", &x.basis_name).map_err(e)?;
-            flexrom::io::h5::attr_str(f, "variant", x.variant).map_err(e)?;
+            flexrom::io::h5::attr_str(f, "variant", &x.variant).map_err(e)?;
             flexrom::io::h5::attr_u64(f, "n_modes", x.n_modes as u64).map_err(e)?;
-            flexrom::rom::trust::write_run_attributes(f, x.estimate.as_ref(), x.method, &x.trust, &x.mu, x.extrapolated)
-                .map_err(e)
+            flexrom::rom::trust::write_run_attributes(
+                f,
+                x.estimate.as_ref(),
+                x.method.as_deref(),
+                &x.trust,
+                &x.mu,
+                x.extrapolated,
+            )
+            .map_err(e)
         })
     }
 }
@@ -1139,10 +1159,10 @@ impl PyBasis {
             basis_name: flexrom::io::output::resolve(&self.path).display().to_string(),
             basis_path: self.path.clone(),
             pipeline_path: self.pipeline_file.clone(),
-            variant: basis.variant.name(),
+            variant: basis.variant.name().to_string(),
             n_modes: basis.n_reduced(),
             estimate,
-            method: rom.method(),
+            method: rom.method().map(str::to_string),
             trust: rom.trust().cloned().unwrap_or_else(|| Trust::range((f64::NAN, f64::NAN))),
             mu,
             extrapolated,
@@ -1295,6 +1315,13 @@ impl PyBasis {
     }
 }
 
+/// The `Result` of a pickled payload (`Result.__reduce__`); a `ValueError` naming what is
+/// wrong with bytes that are not one, are damaged, or come from another flexrom version.
+#[pyfunction]
+fn _result_from_pickle(payload: &[u8]) -> PyResult<PyRunResult> {
+    pickle::from_bytes(payload).map_err(pyo3::exceptions::PyValueError::new_err)
+}
+
 fn parse_method(name: &str) -> PyResult<EstimateMethod> {
     use clap::ValueEnum;
     EstimateMethod::from_str(name, true).map_err(|_| {
@@ -1415,6 +1442,7 @@ fn _flexrom(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyBasis>()?;
     m.add_function(wrap_pyfunction!(train, m)?)?;
     m.add_function(wrap_pyfunction!(validate, m)?)?;
+    m.add_function(wrap_pyfunction!(_result_from_pickle, m)?)?;
     errors::add(m)?;
     m.add("FlexromWarning", m.py().get_type::<FlexromWarning>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

@@ -22,7 +22,7 @@ use crate::solver::model::{ElementModel, Parameters, ParametricModel};
 use ndarray::Array1;
 
 /// One series per energy, one value per instant, J.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Energies {
     pub kinetic: Array1<f64>,
     pub strain: Array1<f64>,

@@ -24,7 +24,7 @@ use crate::simulate::{Series, SimulationResult};
 use ndarray::{Array2, ArrayView2, Axis};
 
 /// What a probe records.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Quantity {
     /// the point's position, m (two components)

@@ -8,8 +8,9 @@ use crate::error::{Error, Result};
 use crate::solver::parameter_space::ParameterSpace;
 use crate::solver::parameters::Parameters;
 
-/// What the online tools hold a basis's runs to.
-#[derive(Clone, Debug, PartialEq)]
+/// What the online tools hold a basis's runs to. Serde: a Python `Result` carries it when
+/// pickled (python/src/pickle.rs).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Trust {
     /// `[min, max]` of the training load scales
     pub range: (f64, f64),
@@ -24,6 +25,7 @@ pub struct Trust {
     pub sensitivity: Option<LoadSensitivity>,
     /// the box of parameters the basis was trained over (`/parameters`); empty: the load
     /// scale alone, every named parameter at 1
+    #[serde(with = "space_serde")]
     pub space: ParameterSpace,
 }
 
@@ -94,12 +96,57 @@ pub const AMPLIFYING: f64 = 10.0;
 /// interpolate. In a box of parameters (every parameter of the box moved by δ) the
 /// candidates are points, and the largest of those around the point counts (the nearest
 /// in each orthant about it).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct LoadSensitivity {
     candidates: Vec<f64>,
     whole_run: Vec<f64>,
     /// a box's candidates: the box and each candidate in its unit cube
+    #[serde(serialize_with = "space_serde::serialize_points", deserialize_with = "space_serde::deserialize_points")]
     points: Option<(ParameterSpace, Vec<Vec<f64>>)>,
+}
+
+/// The serde form of a box of parameters in [`Trust`] and [`LoadSensitivity`]: its ranges
+/// as `(name, lower, upper, spacing)` (the box itself, a training setting of the solver
+/// layer, has no serde form of its own).
+mod space_serde {
+    use crate::solver::parameter_space::{ParameterRange, ParameterSpace, Spacing};
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    type Ranges = Vec<(String, f64, f64, Spacing)>;
+
+    fn ranges(space: &ParameterSpace) -> Ranges {
+        // every field named: a field added to a range fails to compile here
+        let plain = |r: &ParameterRange| {
+            let ParameterRange { name, lower, upper, spacing } = r;
+            (name.clone(), *lower, *upper, *spacing)
+        };
+        space.ranges.iter().map(plain).collect()
+    }
+
+    fn space(ranges: Ranges) -> ParameterSpace {
+        let ranges =
+            ranges.into_iter().map(|(name, lower, upper, spacing)| ParameterRange { name, lower, upper, spacing });
+        ParameterSpace { ranges: ranges.collect() }
+    }
+
+    pub fn serialize<S: Serializer>(s: &ParameterSpace, to: S) -> Result<S::Ok, S::Error> {
+        ranges(s).serialize(to)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(from: D) -> Result<ParameterSpace, D::Error> {
+        Ranges::deserialize(from).map(space)
+    }
+
+    type Points = Option<(ParameterSpace, Vec<Vec<f64>>)>;
+
+    /// `LoadSensitivity`'s candidate points with their box.
+    pub fn serialize_points<S: Serializer>(p: &Points, to: S) -> Result<S::Ok, S::Error> {
+        p.as_ref().map(|(s, unit)| (ranges(s), unit)).serialize(to)
+    }
+
+    pub fn deserialize_points<'de, D: Deserializer<'de>>(from: D) -> Result<Points, D::Error> {
+        Ok(Option::<(Ranges, Vec<Vec<f64>>)>::deserialize(from)?.map(|(r, unit)| (space(r), unit)))
+    }
 }
 
 impl LoadSensitivity {

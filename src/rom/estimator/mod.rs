@@ -153,7 +153,7 @@ impl QuantityRaw {
 /// The estimate of a probe quantity's error over its range (the `rel_error` of the
 /// quantity `validate` measures, [`crate::rom::quantities`]): `c · η_raw,q`, the factor the
 /// run's estimate has.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct QuantityEstimate {
     pub probe: String,
     pub quantity: Quantity,
@@ -164,7 +164,7 @@ pub struct QuantityEstimate {
 }
 
 /// One estimate.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Estimate {
     /// `c · η_raw`; infinite when the enriched model failed to run
     pub error_estimate: f64,
