@@ -98,11 +98,22 @@ fn sweep_sections<'py>(py: Python<'py>, d: &Bound<'py, PyDict>, s: &Sweep) -> Py
         }
         d.set_item(key, out)?;
     }
+    for (key, reactions) in [("quantity_error_estimates", false), ("reaction_error_estimates", true)] {
+        d.set_item(key, estimate_columns(py, s, reactions)?)?;
+    }
+    Ok(())
+}
+
+/// name → {quantity → (n)}: each point's estimate of each probe quantity (`reactions`
+/// false) or joint reaction (true) over its range; 0 where the full model answered, NaN
+/// where a point has none.
+fn estimate_columns<'py>(py: Python<'py>, s: &Sweep, reactions: bool) -> PyResult<Bound<'py, PyDict>> {
+    let n = s.scales.len();
     let est = PyDict::new(py);
     let mut columns: Vec<((String, &'static str), Vec<f64>)> = Vec::new();
     for (k, sr) in s.scales.iter().enumerate() {
         let Outcome::Done(p) = &sr.outcome else { continue };
-        for q in p.estimate.iter().flat_map(|e| &e.quantities).filter(|q| !q.quantity.is_reaction()) {
+        for q in p.estimate.iter().flat_map(|e| &e.quantities).filter(|q| q.quantity.is_reaction() == reactions) {
             let key = (q.probe.clone(), q.quantity.name());
             let i = match columns.iter().position(|(c, _)| *c == key) {
                 Some(i) => i,
@@ -114,10 +125,10 @@ fn sweep_sections<'py>(py: Python<'py>, d: &Bound<'py, PyDict>, s: &Sweep) -> Py
             columns[i].1[k] = if p.fallback.is_some() { 0.0 } else { q.estimate };
         }
     }
-    for ((probe, quantity), v) in columns {
-        inner_dict(&est, &probe)?.set_item(quantity, v.into_pyarray(py))?;
+    for ((name, quantity), v) in columns {
+        inner_dict(&est, &name)?.set_item(quantity, v.into_pyarray(py))?;
     }
-    d.set_item("quantity_error_estimates", est)
+    Ok(est)
 }
 
 /// A sweep as arrays with the load axis first; a failed point's entries are NaN and its

@@ -135,6 +135,9 @@ def test_sweep_equals_online(dp_basis):
         reactions = r.reaction_error_estimates
         assert set(reactions) == set(r.labels["reaction"])
         assert all(0 < e["force"] < float("inf") for e in reactions.values()), reactions
+        for name, quantities in reactions.items():
+            for q, v in quantities.items():
+                same(s["reaction_error_estimates"][name][q][i], v)
     assert s["probes"]["tip"].shape == (3, len(s["t"]), 2)
     # no probe records strain or curvature on the double pendulum
     assert s["strains"] == {} and s["curvatures"] == {}
