@@ -132,16 +132,88 @@ impl ReactionReader {
         Apart::of(v.values.view(), w.values.view(), self.resolution(w, tol))
     }
 
+    /// Each reaction point's force, then each one's moment: (point, quantity), in the order a
+    /// run's readings come.
+    pub fn points(&self) -> Vec<(String, Quantity)> {
+        let names = self.map.names();
+        let each = |q: Quantity| names.iter().map(move |n| (n.to_string(), q));
+        each(Quantity::Force).chain(each(Quantity::Moment)).collect()
+    }
+
     /// The keys of the reactions' estimates (`QuantityRaw::key`: `force:<point>`, then
     /// `moment:<point>`), in the order a run's readings come.
     pub fn keys(&self) -> Vec<String> {
-        let names = self.map.names();
-        let key = |q: Quantity| names.iter().map(move |n| format!("{}:{n}", q.name()));
-        key(Quantity::Force).chain(key(Quantity::Moment)).collect()
+        self.points().into_iter().map(|(point, q)| format!("{}:{point}", q.name())).collect()
     }
 
     /// The number of constraint rows the reactions read multipliers of.
     pub fn n_rows(&self) -> usize {
         self.map.n_rows()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rom::estimator::QuantityRaw;
+    use crate::simulate::{simulate, Overrides};
+
+    /// A bar clamped at one end and pinned to a link: the clamp and the pin's two nodes are
+    /// three reaction points.
+    const MODEL: &str = "[time]\nt_end = 0.02\ndt = 0.01\nrho_inf = 0.8\n\
+        [[bodies]]\nname = \"bar\"\nstart = [0.0, 0.0]\nangle = 0.0\nlength = 1.0\nelements = 2\n\
+        density = 7800.0\narea = 1e-4\ninertia = 1e-9\nyoungs_modulus = 2e11\n\
+        [[bodies]]\nname = \"link\"\nstart = [1.0, 0.0]\nangle = 0.0\nlength = 1.0\nelements = 2\n\
+        density = 7800.0\narea = 1e-4\ninertia = 1e-9\nyoungs_modulus = 2e11\n\
+        [[joints]]\ntype = \"clamp\"\nbody = \"bar\"\nnode = \"start\"\n\
+        [[joints]]\ntype = \"pin\"\na = { body = \"bar\", node = \"end\" }\nb = { body = \"link\", node = 0 }\n\
+        [[loads]]\ntype = \"gravity\"\ng = [0.0, -9.81]\n";
+
+    /// A full run's reactions read through the reduced trajectory of the identity basis are
+    /// the run's own (`x_ref = 0`, `V = I`): the same coordinates, the same multipliers.
+    #[test]
+    fn a_trajectory_reads_the_reactions_a_result_does() {
+        let model = Model::from_text(MODEL, "m.toml").unwrap();
+        let r = simulate(&model, &Overrides::default()).unwrap();
+        let reader = ReactionReader::new(&model);
+        let full = reader.of_result(&r).unwrap();
+        let n = r.q.nrows();
+        let identity = Basis {
+            variant: crate::reduction::Variant::Galerkin,
+            snapshots: crate::reduction::SnapshotKind::Raw,
+            reference: ndarray::Array1::zeros(n),
+            modes: Array2::eye(n),
+            kept: Vec::new(),
+            multiplier_modes: None,
+            multiplier_scale: 1.0,
+            n_pod_modes: n,
+            hyper: None,
+        };
+        let t = r.t.as_slice().unwrap();
+        let via = reader
+            .of_trajectory((r.settings.parameters(), t), (&identity, r.q.view()), None, r.multipliers.view())
+            .unwrap();
+        assert_eq!(full.len(), 6, "three points, force and moment each");
+        for (a, b) in full.iter().zip(&via) {
+            assert_eq!((&a.point, a.quantity), (&b.point, b.quantity));
+            assert!((&a.values - &b.values).iter().all(|d| d.abs() <= 1e-9 * (1.0 + a.largest())), "{}", a.point);
+        }
+        // the gravity swings both: every force moves (the pin carries no moment)
+        assert!(full[..3].iter().all(|f| f.largest() > 0.0));
+    }
+
+    /// An estimator whose own model failed reads ∞ in every reaction of a run that has
+    /// multipliers, and names none for a run without (a variant that computes none).
+    #[test]
+    fn a_failed_estimator_reads_every_reaction_infinite() {
+        let model = Model::from_text(MODEL, "m.toml").unwrap();
+        let mut r = simulate(&model, &Overrides::default()).unwrap();
+        let reader = ReactionReader::new(&model);
+        let raws = QuantityRaw::infinite(&r, Some(&reader));
+        let reactions: Vec<_> = raws.iter().filter(|q| q.quantity.is_reaction()).collect();
+        assert_eq!(reactions.len(), 6);
+        assert!(reactions.iter().all(|q| q.raw == f64::INFINITY));
+        r.multipliers.fill(f64::NAN);
+        assert!(QuantityRaw::infinite(&r, Some(&reader)).iter().all(|q| !q.quantity.is_reaction()));
     }
 }

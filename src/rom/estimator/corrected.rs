@@ -414,6 +414,9 @@ impl ErrorEstimator for Corrected {
     fn data(&self) -> &Estimator {
         &self.data
     }
+    fn reactions(&self) -> Option<&crate::rom::reactions::ReactionReader> {
+        Some(&self.reactions)
+    }
     fn raw(&self, run: &ReducedRun) -> Result<Raw> {
         let why = match self.runners.with(|r| r.trajectory_with_multipliers(run))? {
             Ok(Followed { q: qp, lambda, stats }) if stats.followed() => {

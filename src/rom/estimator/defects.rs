@@ -198,6 +198,9 @@ impl ErrorEstimator for Defects {
     fn data(&self) -> &Estimator {
         &self.data
     }
+    fn reactions(&self) -> Option<&crate::rom::reactions::ReactionReader> {
+        Some(&self.reactions)
+    }
 
     /// `η_raw` over the instants up to the end of each fifth of `run`, in both measures
     /// (module documentation).

@@ -52,6 +52,9 @@ impl ErrorEstimator for Enriched {
     fn data(&self) -> &Estimator {
         &self.data
     }
+    fn reactions(&self) -> Option<&crate::rom::reactions::ReactionReader> {
+        Some(&self.reactions)
+    }
     fn raw(&self, run: &ReducedRun) -> Result<Raw> {
         let mu = run.result.settings.parameters();
         let e = self.runners.with(|r| r.solve(mu, Output::ReducedAndProbes, &[]))??;

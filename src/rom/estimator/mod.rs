@@ -141,12 +141,15 @@ impl QuantityRaw {
             .collect()
     }
 
-    /// ∞ in every quantity of `run`: an estimator whose model failed.
-    pub fn infinite(run: &SimulationResult) -> Vec<Self> {
-        quantities::readings(run)
-            .iter()
-            .map(|v| QuantityRaw { probe: v.probe.to_string(), quantity: v.quantity, raw: f64::INFINITY })
-            .collect()
+    /// ∞ in every quantity of `run` and, where the run has them, every reaction the reader
+    /// `reactions` names: an estimator whose model failed.
+    pub fn infinite(run: &SimulationResult, reactions: Option<&ReactionReader>) -> Vec<Self> {
+        let infinite = |probe: String, quantity| QuantityRaw { probe, quantity, raw: f64::INFINITY };
+        let probes = quantities::readings(run).into_iter().map(|v| infinite(v.probe.to_string(), v.quantity));
+        let has_reactions = run.multipliers.iter().all(|x| x.is_finite()) && !run.multipliers.is_empty();
+        let fits = |r: &&ReactionReader| has_reactions && run.multipliers.nrows() == r.n_rows();
+        let points = reactions.filter(fits).map(ReactionReader::points).unwrap_or_default();
+        probes.chain(points.into_iter().map(|(point, quantity)| infinite(point, quantity))).collect()
     }
 }
 
@@ -235,6 +238,11 @@ pub trait ErrorEstimator: Send + Sync {
     /// The data training made (enriched basis, calibration).
     fn data(&self) -> &Estimator;
 
+    /// The model's reaction points, whose reactions the method estimates.
+    fn reactions(&self) -> Option<&ReactionReader> {
+        None
+    }
+
     /// `η_raw` of `run` by fifth of the run, in both measures, and in each probe quantity.
     /// `Err` when the estimator's model fails.
     fn raw(&self, run: &ReducedRun) -> Result<Raw>;
@@ -258,7 +266,8 @@ pub trait ErrorEstimator: Send + Sync {
         let (Raw { norms: raw, quantities }, failure) = match self.raw(run) {
             Ok(raw) => (raw, None),
             Err(e) => {
-                let infinite = Raw { norms: RawByFifth::INFINITE, quantities: QuantityRaw::infinite(&run.result) };
+                let quantities = QuantityRaw::infinite(&run.result, self.reactions());
+                let infinite = Raw { norms: RawByFifth::INFINITE, quantities };
                 (infinite, Some(e.to_string()))
             }
         };
