@@ -339,7 +339,7 @@ pub struct OnlineSpec {
     /// its warning, or the failure; the default) or "full" (run the full model there and
     /// keep its exact answer; docs/basis-and-sweep.md)
     #[serde(default)]
-    pub fallback: Option<crate::pipeline::sweep::Fallback>,
+    pub fallback: Option<crate::pipeline::fallback::Fallback>,
 }
 
 #[derive(Clone, Debug, Deserialize)]

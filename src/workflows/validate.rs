@@ -20,8 +20,8 @@
 //! measure the error against the motion itself (docs/error-estimate.md, "Two measures of
 //! the error").
 
-use super::timing::{median, repeat_timing};
 use crate::analysis::reactions::ReactionMap;
+use crate::cost::timing::{median, repeat_timing};
 use crate::error::Result;
 use crate::linalg::kkt::LinearSolverKind;
 use crate::model::Model;
@@ -49,7 +49,7 @@ pub struct Validation {
     pub max_probe_error_t: f64,
     pub max_constraint_violation: f64,
     /// full model, our default (banded) linear solver: time loop only, the median of up to
-    /// seven runs interleaved with the reduced ones ([`super::timing::TIMING_BUDGET`])
+    /// seven runs interleaved with the reduced ones ([`crate::cost::timing::TIMING_BUDGET`])
     pub full_seconds: f64,
     /// full model with dense LAPACK LU; `None` when not measured
     pub full_dense_seconds: Option<f64>,

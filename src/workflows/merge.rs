@@ -1,6 +1,6 @@
-//! `merge`: the part files of a sharded sweep ([`super::shard`]) joined into the file a
+//! `merge`: the part files of a sharded sweep ([`crate::workflows::shard`]) joined into the file a
 //! single `sweep` over the whole list writes: the same datasets with the same values (the
-//! runs' rows are read back and written by the same writer, [`super::sweep::write_sweep`]).
+//! runs' rows are read back and written by the same writer, [`crate::workflows::sweep::write_sweep`]).
 //! Only the whole-sweep attributes differ in meaning: `wall_seconds` is the longest part's
 //! (the parts ran side by side) and `threads` the sum of the parts' threads.
 //!
@@ -13,17 +13,17 @@
 //! which merges what is there and marks the gaps `status` 2 ("not run yet"), so that
 //! `sweep --resume` on the merged file runs exactly the gaps.
 
-use super::config::Pipeline;
-use super::online::load_basis;
-use super::shard::point_list_hash;
-use super::sweep::{
-    read_sweep, write_sweep, Fallback, Outcome, ScaleResult, Sweep, SweepBasis, STATUS_FAILED, STATUS_OK,
-};
 use crate::error::{show_text, Error, Result};
 use crate::io::h5::{bounded_len, dataset_of_shape, read_attr_f64, read_attr_str, read_strings};
 use crate::limits::Limits;
+use crate::pipeline::config::Pipeline;
 use crate::simulate::{Overrides, Settings};
 use crate::solver::parameters::{Parameters, LOAD_SCALE};
+use crate::workflows::online::load_basis;
+use crate::workflows::shard::point_list_hash;
+use crate::workflows::sweep::{
+    read_sweep, write_sweep, Fallback, Outcome, ScaleResult, Sweep, SweepBasis, STATUS_FAILED, STATUS_OK,
+};
 use ndarray::Array1;
 use std::path::{Path, PathBuf};
 
@@ -100,7 +100,7 @@ fn read_part(path: &Path, limits: &Limits) -> Result<Part> {
     // a sweep over named parameters: the points, as /points holds them
     let (all, names): (Vec<Parameters>, Vec<String>) = match g.dataset("all_points") {
         Ok(d) => {
-            let (names, all) = super::sweep::file::read_point_table(&d, scales_all.len())
+            let (names, all) = crate::records::sweep_file::read_point_table(&d, scales_all.len())
                 .map_err(|problem| bad("shard/all_points", problem))?;
             if names.first().map(String::as_str) != Some(LOAD_SCALE) {
                 return Err(bad("shard/all_points", format!("has parameters {names:?}; load_scale comes first")));
@@ -157,7 +157,8 @@ fn read_part(path: &Path, limits: &Limits) -> Result<Part> {
     // over named parameters every parameter of each row, not λ alone
     if names.len() > 1 {
         let d = f.dataset("points").map_err(|e| bad("points", format!("cannot be read: {e}")))?;
-        let (_, rows) = super::sweep::file::read_point_table(&d, n).map_err(|problem| bad("points", problem))?;
+        let (_, rows) =
+            crate::records::sweep_file::read_point_table(&d, n).map_err(|problem| bad("points", problem))?;
         let same = |a: &Parameters, b: &Parameters| {
             names.iter().all(|k| a.get(k).map(f64::to_bits) == b.get(k).map(f64::to_bits))
         };
@@ -231,7 +232,7 @@ fn recorded_in(e: Error, part: &Part, key: &str) -> Error {
 /// A few runs for a message: "load scales 0.5, 0.53, 0.56 and 13 more", or for named
 /// parameters "points (load scale 1, push = 0.5); … and 13 more".
 fn some(xs: &[Parameters]) -> String {
-    let head = super::sweep::runs_noun(xs);
+    let head = crate::workflows::sweep::runs_noun(xs);
     let named = head == "points";
     let shown: Vec<String> =
         xs.iter().take(4).map(|mu| if named { format!("({mu})") } else { mu.scale().to_string() }).collect();
@@ -289,7 +290,8 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool, limits: &Limits) -> R
             return Err(differ("model_fingerprint", "comes from another model"));
         }
         if p.list_hash != first.list_hash {
-            let list = if super::sweep::runs_noun(&first.all) == "points" { "point list" } else { "load list" };
+            let list =
+                if crate::workflows::sweep::runs_noun(&first.all) == "points" { "point list" } else { "load list" };
             return Err(differ("shard/load_list_hash", &format!("comes from another {list}")));
         }
         if p.count != first.count {

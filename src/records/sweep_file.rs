@@ -52,13 +52,12 @@
 //!   were continued from their neighbours), n_failed, n_pending, program_version
 //! ```
 
-use super::outcome::{ScaleResult, Sweep, SweepPoint, STATUS_OK, STATUS_PENDING};
+use super::sweep_outcome::{ScaleResult, Sweep, SweepPoint, STATUS_OK, STATUS_PENDING};
 use crate::error::{Error, Result};
 use crate::io::attrs::{check_layout, write_atomically_as, Kind};
 use crate::io::basis_file::StoredBasis;
 use crate::io::h5::{attr_f64, attr_str, attr_u64, bounded_len, dataset_of_shape, read_attr_str, read_strings};
 use crate::model::Model;
-use crate::pipeline::validate::{displacement_note, ProbeQuantityError, Validation};
 use crate::rom::estimator::{Estimate, QuantityEstimate};
 use crate::rom::quantities::Quantity;
 use crate::rom::trust::LoadSensitivity;
@@ -66,6 +65,7 @@ use crate::rom::ReducedRun;
 use crate::simulate::{Overrides, Settings, SimulationResult};
 use crate::solver::generalized_alpha::Stats;
 use crate::solver::parameters::Parameters;
+use crate::workflows::validate::{displacement_note, ProbeQuantityError, Validation};
 use hdf5::types::VarLenUnicode;
 use ndarray::{Array1, Array2, Array3};
 use std::path::Path;
@@ -386,14 +386,14 @@ pub fn read_point_table(d: &hdf5::Dataset, rows: usize) -> std::result::Result<(
 }
 
 /// The `fallback` a sweep file was written with (files before the attribute: `none`).
-pub fn fallback_of(path: &Path) -> Result<super::Fallback> {
+pub fn fallback_of(path: &Path) -> Result<crate::pipeline::fallback::Fallback> {
     let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
     if f.attr("fallback").is_err() {
-        return Ok(super::Fallback::None);
+        return Ok(crate::pipeline::fallback::Fallback::None);
     }
     match read_attr_str(&f, "fallback").map_err(|e| Error::input(path, "fallback", format!("cannot be read: {e}")))? {
-        s if s == "full" => Ok(super::Fallback::Full),
-        s if s == "none" => Ok(super::Fallback::None),
+        s if s == "full" => Ok(crate::pipeline::fallback::Fallback::Full),
+        s if s == "none" => Ok(crate::pipeline::fallback::Fallback::None),
         s => Err(Error::input(path, "fallback", format!("is \"{s}\", expected \"none\" or \"full\""))),
     }
 }

@@ -1,26 +1,35 @@
 //! `run`: train → online sweep (validated) → validation with timings at chosen points →
 //! a report folder: `summary.md`, `validation.json`, `sweep.h5` and plots (SVG and PNG; the
-//! model's figure first, [`super::model_figure`]). Over a line of load scales the plots run
+//! model's figure first, [`crate::report::model_figure`]). Over a line of load scales the plots run
 //! along λ, over a box of one parameter along it; over a box of two parameters or more they
-//! are maps over the box ([`super::report_maps`]).
+//! are maps over the box ([`crate::report::report_maps`]).
 //! The folder is built beside the target and renamed into place at the end, the basis
 //! written under a temporary name and renamed into place only when every stage succeeded.
 //! A current basis (trained from this model with these training keys, passing its checks:
 //! `current_basis`) is reused as it is: neither trained nor rewritten.
 
-use super::config::{EstimateMethod, Pipeline};
-use super::online::load_rom;
-use super::plot::{Figure, Panel, Series, Style};
-use super::sweep::{sweep, table, write_sweep, SweepBasis, SweepOptions};
-use super::train::train_and_write;
-use super::validate::{validate, Validation};
+pub mod animate;
+pub mod drawing;
+pub mod map;
+pub mod model_figure;
+pub mod motion;
+pub mod plot;
+pub mod report_maps;
+pub mod tables;
+
 use crate::error::{Error, Result};
 use crate::io::atomic::TempPath;
 use crate::io::output::{check_output, check_report_dir, mark_new_report, swap_in_report, Origin};
 use crate::limits::Limits;
+use crate::pipeline::config::{EstimateMethod, Pipeline};
+use crate::report::plot::{Figure, Panel, Series, Style};
 use crate::rom::Rom;
 use crate::simulate::SimulationResult;
 use crate::solver::parameters::Parameters;
+use crate::training::train::train_and_write;
+use crate::workflows::online::load_rom;
+use crate::workflows::sweep::{sweep, table, write_sweep, SweepBasis, SweepOptions};
+use crate::workflows::validate::{validate, Validation};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -49,10 +58,10 @@ pub fn check_outputs(p: &Pipeline) -> Result<()> {
 /// were and the temporary ones removed. Returns the report folder and the training's
 /// warnings.
 pub fn run(p: &Pipeline, progress: bool) -> Result<(PathBuf, Vec<String>)> {
-    run_with(p, progress, super::dense::DenseChoice::Auto, None, true)
+    run_with(p, progress, crate::cost::dense::DenseChoice::Auto, None, true)
 }
 
-/// [`run`] with the choice of the dense-LU comparison ([`super::dense`]), decided before
+/// [`run`] with the choice of the dense-LU comparison ([`crate::cost::dense`]), decided before
 /// any work, the error estimate's method (`--estimate`; `None`: the pipeline's
 /// `[online] estimate`, else the basis's default) and whether to train even where the
 /// pipeline's basis is current (`retrain`; else a current basis, trained from this model with
@@ -60,12 +69,12 @@ pub fn run(p: &Pipeline, progress: bool) -> Result<(PathBuf, Vec<String>)> {
 pub fn run_with(
     p: &Pipeline,
     progress: bool,
-    dense: super::dense::DenseChoice,
+    dense: crate::cost::dense::DenseChoice,
     method: Option<EstimateMethod>,
     retrain: bool,
 ) -> Result<(PathBuf, Vec<String>)> {
     check_outputs(p)?;
-    let dense = super::dense::decide(dense, &p.model)?;
+    let dense = crate::cost::dense::decide(dense, &p.model)?;
     let dir = p.report_dir.clone();
     let report = TempPath::dir_for(&dir)?;
     let reused = if retrain { None } else { current_basis(p, method) };
@@ -163,7 +172,7 @@ fn build(
     let plot_err =
         |stem: &str, e: String| Error::io(p.report_dir.join(format!("{stem}.svg")), std::io::Error::other(e));
     // the model as the user wrote it, at its initial state: it needs none of the runs
-    super::model_figure::save_model_figure(&p.model, &out.join("model"))?;
+    crate::report::model_figure::save_model_figure(&p.model, &out.join("model"))?;
     let space = p.space();
     let in_box = !space.is_empty();
     // how the report names a run: its load scale, or its point of the box
@@ -184,7 +193,7 @@ fn build(
             // the warnings of loading it come with `check_report`'s, once
             let (stored, rom, _) = load_rom(p, basis_path, method, false)?;
             let mut trained = Training::trained(p, summary, &name);
-            trained.warnings.extend(super::route::time_and_store(&rom, basis_path)?);
+            trained.warnings.extend(crate::cost::route::time_and_store(&rom, basis_path)?);
             (stored, rom, trained)
         }
     };
@@ -358,26 +367,28 @@ fn build(
         }
         None => {
             // every validated run, the sweep's and the validation's, at its point
-            let runs: Vec<super::report_maps::MappedRun> = (sw.scales.iter())
+            let runs: Vec<crate::report::report_maps::MappedRun> = (sw.scales.iter())
                 .filter_map(|x| x.point())
                 .filter_map(|q| {
                     let estimate = q.estimate.as_ref().map(|e| e.error_estimate);
-                    Some(super::report_maps::MappedRun { validation: q.validation.as_ref()?, estimate })
+                    Some(crate::report::report_maps::MappedRun { validation: q.validation.as_ref()?, estimate })
                 })
                 .chain(
                     validations
                         .iter()
-                        .map(|v| super::report_maps::MappedRun { validation: v, estimate: v.error_estimate }),
+                        .map(|v| crate::report::report_maps::MappedRun { validation: v, estimate: v.error_estimate }),
                 )
                 .collect();
             let training = stored_runs(p, basis_path)?;
-            let cx = super::report_maps::MapContext {
+            let cx = crate::report::report_maps::MapContext {
                 space: &space,
                 training: &training,
                 tolerance: rom.trust().and_then(|t| t.tolerance),
                 probes: !p.model.probe_names().is_empty(),
             };
-            shown.extend(super::report_maps::write_maps(out, &runs, &cx).map_err(|(stem, e)| plot_err(stem, e))?);
+            shown.extend(
+                crate::report::report_maps::write_maps(out, &runs, &cx).map_err(|(stem, e)| plot_err(stem, e))?,
+            );
         }
     }
     // the true error (solid) and its estimate (dashed) up to each fifth of the run, one
@@ -637,8 +648,8 @@ fn animate_worst(out: &Path, full: &SimulationResult, reduced: &SimulationResult
             .finish(run, |_| Ok(()))
     };
     let made = write(&f, full).and_then(|_| write(&r, reduced)).and_then(|_| {
-        let opts = super::animate::AnimateOptions::default();
-        super::animate::animate(&f, Some(&r), &out.join("animation.gif"), &opts, limits).map(|_| ())
+        let opts = crate::report::animate::AnimateOptions::default();
+        crate::report::animate::animate(&f, Some(&r), &out.join("animation.gif"), &opts, limits).map(|_| ())
     });
     for path in [&f, &r] {
         let _ = std::fs::remove_file(path);
@@ -664,7 +675,11 @@ struct Training {
 }
 
 impl Training {
-    fn trained(p: &Pipeline, t: super::train::TrainSummary, name: &dyn Fn(&Parameters) -> String) -> Training {
+    fn trained(
+        p: &Pipeline,
+        t: crate::training::train::TrainSummary,
+        name: &dyn Fn(&Parameters) -> String,
+    ) -> Training {
         let runs: Vec<String> = match &t.greedy {
             Some(g) => g.runs.iter().map(name).collect(),
             None if !p.space().is_empty() => p.training_points().iter().map(name).collect(),
@@ -844,7 +859,7 @@ fn sweep_warnings(rom: &Rom, path: &Path, strict: bool) -> Result<Vec<String>> {
         crate::rom::estimator::ErrorMeasure::Displacement => "error_estimate_displacement",
     };
     let (scales, est) = (read("load_scales")?, read(estimates)?);
-    let points = super::sweep::file::points_of(&f, &scales.to_vec())
+    let points = crate::records::sweep_file::points_of(&f, &scales.to_vec())
         .map_err(|(field, problem)| Error::input(path, field, problem))?;
     let runs: Vec<_> =
         points.into_iter().zip(&est).map(|(mu, &e)| (mu, if e.is_nan() { None } else { Some(e) })).collect();
@@ -854,12 +869,12 @@ fn sweep_warnings(rom: &Rom, path: &Path, strict: bool) -> Result<Vec<String>> {
 /// The two routes' times per run from the validation's medians (the median over the
 /// validated loads of each; the estimate counts when every validated run has one); `None`
 /// without validated loads.
-fn route_comparison(validations: &[Validation]) -> Option<super::route::Comparison> {
+fn route_comparison(validations: &[Validation]) -> Option<crate::cost::route::Comparison> {
     let mid = |f: &dyn Fn(&Validation) -> Option<f64>| -> Option<f64> {
         let mut x: Vec<f64> = validations.iter().map(f).collect::<Option<_>>()?;
-        (!x.is_empty()).then(|| super::timing::median(&mut x))
+        (!x.is_empty()).then(|| crate::cost::timing::median(&mut x))
     };
-    Some(super::route::Comparison {
+    Some(crate::cost::route::Comparison {
         full: mid(&|v| Some(v.full_seconds))?,
         reduced: mid(&|v| Some(v.rom_seconds))?,
         estimate: mid(&|v| v.estimate_seconds),
