@@ -47,10 +47,7 @@ const LAYERS: &[&[&str]] = &[
 
 /// Edges (from file module, to file module) that still break the layering, in files that
 /// other branches edit at the time of writing; the lead removes them after the merge.
-const KNOWN: &[(&str, &str, &str)] = &[
-    ("records::sweep_file", "workflows::validate", "the validation types move down into records"),
-    ("records::sweep_outcome", "workflows::validate", "the validation types move down into records"),
-];
+const KNOWN: &[(&str, &str, &str)] = &[];
 
 /// One source file: its module path (`a::b`, `main` for the binary, `` for the crate root).
 struct File {

@@ -53,6 +53,7 @@
 //! ```
 
 use super::sweep_outcome::{ScaleResult, Sweep, SweepPoint, STATUS_OK, STATUS_PENDING};
+use super::validation::{displacement_note, ProbeQuantityError, Validation};
 use crate::error::{Error, Result};
 use crate::io::attrs::{check_layout, write_atomically_as, Kind};
 use crate::io::basis_file::StoredBasis;
@@ -65,7 +66,6 @@ use crate::rom::ReducedRun;
 use crate::simulate::{Overrides, Settings, SimulationResult};
 use crate::solver::generalized_alpha::Stats;
 use crate::solver::parameters::Parameters;
-use crate::workflows::validate::{displacement_note, ProbeQuantityError, Validation};
 use hdf5::types::VarLenUnicode;
 use ndarray::{Array1, Array2, Array3};
 use std::path::Path;

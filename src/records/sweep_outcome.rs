@@ -1,10 +1,10 @@
 //! What a sweep produced: the outcome of every load scale (done, failed, not run yet), the
 //! status codes of the sweep file's `/status`, and the one-line summary of the failures.
 
+use super::validation::Validation;
 use crate::rom::estimator::Estimate;
 use crate::rom::ReducedRun;
 use crate::solver::parameters::Parameters;
-use crate::workflows::validate::Validation;
 use ndarray::{Array1, Array2};
 
 /// Status codes of `/status`.
