@@ -169,8 +169,7 @@ pub fn write_sweep(path: &Path, s: &Sweep, basis: Option<SweepBasis>) -> Result<
 
 /// [`write_sweep`] with `extra` written into the file before it is renamed into place.
 pub fn write_sweep_with(path: &Path, s: &Sweep, basis: Option<SweepBasis>, extra: Extra) -> Result<()> {
-    let (n, nt, r) = (s.scales.len(), s.t.len(), s.n_reduced);
-    if n == 0 {
+    if s.scales.is_empty() {
         return Err(Error::Usage("the sweep has no load scales".into()));
     }
     if s.full != basis.is_none() {
@@ -181,172 +180,179 @@ pub fn write_sweep_with(path: &Path, s: &Sweep, basis: Option<SweepBasis>, extra
     }
     write_atomically_as(path, Kind::Sweep, |f| {
         let e = |err: hdf5::Error| Error::hdf5(path, err);
-        // one value per load scale: NaN where it did not run to the end
-        let col =
-            |g: &dyn Fn(&SweepPoint) -> f64| Array1::from_iter(s.scales.iter().map(|x| x.point().map_or(f64::NAN, g)));
-        let count = |g: &dyn Fn(&SweepPoint) -> usize| {
-            Array1::from_iter(s.scales.iter().map(|x| x.point().map_or(0, g) as u64))
-        };
-        f.new_dataset_builder()
-            .with_data(&Array1::from_iter(s.scales.iter().map(|x| x.mu.scale())))
-            .create("load_scales")
-            .map_err(e)?;
-        // the points, where the sweep sets a named parameter (a line of load scales has none)
-        let names = point_names(s.scales.iter().map(|x| &x.mu));
-        if names.len() > 1 {
-            let points = Array2::from_shape_fn((n, names.len()), |(k, j)| s.scales[k].mu.get(&names[j]).unwrap_or(1.0));
-            let d = f.new_dataset_builder().with_data(&points).create("points").map_err(e)?;
-            attr_str(&d, "parameters", &names.join(",")).map_err(e)?;
-        }
-        f.new_dataset_builder()
-            .with_data(&Array1::from_iter(s.scales.iter().map(ScaleResult::status)))
-            .create("status")
-            .map_err(e)?;
-        let messages: Vec<VarLenUnicode> = s
-            .scales
-            .iter()
-            .map(|x| x.message().replace('\0', " ").parse::<VarLenUnicode>().unwrap_or_default())
-            .collect();
-        f.new_dataset_builder().with_data(&Array1::from(messages)).create("message").map_err(e)?;
-        f.new_dataset_builder().with_data(&s.t).create("t").map_err(e)?;
-        // the reduced runs' probes, and beside them with --validate the full runs'
-        type ProbesOf = fn(&SweepPoint) -> Option<&[(String, Array2<f64>)]>;
-        let groups: &[(&str, ProbesOf)] =
-            &[("probes", |p| Some(&p.run.result.probes)), ("full_probes", |p| p.full_probes.as_deref())];
-        for (group, probes) in &groups[..if s.validated { 2 } else { 1 }] {
-            let g = f.create_group(group).map_err(e)?;
-            for (i, name) in s.probe_names.iter().enumerate() {
-                let mut a = Array3::from_elem((n, nt, 2), f64::NAN);
-                for (k, x) in s.scales.iter().enumerate() {
-                    if let Some(xy) = x.point().and_then(probes) {
-                        a.index_axis_mut(ndarray::Axis(0), k).assign(&xy[i].1);
-                    }
-                }
-                g.new_dataset_builder().with_data(&a).create(name.as_str()).map_err(e)?;
-            }
-        }
-        write_sections(f, s).map_err(e)?;
-        write_quantity_errors(f, s).map_err(e)?;
-        if !s.full {
-            // time first: (load, time, mode); the runs keep r × n_t
-            let mut zq = Array3::from_elem((n, nt, r), f64::NAN);
-            // NaN where the full model answered in place of the reduced one (no reduced q)
-            for (k, x) in s.scales.iter().enumerate() {
-                if let Some(p) = x.point().filter(|p| p.fallback.is_none()) {
-                    zq.index_axis_mut(ndarray::Axis(0), k).assign(&p.run.reduced_q.t());
-                }
-            }
-            // one chunk per run, not compressed: deflate took 15 % off the size of these
-            // trajectories for 0.15 s of a 1.5 s four-bar sweep
-            f.new_dataset_builder().chunk((1, nt.max(1), r.max(1))).with_data(&zq).create("reduced_q").map_err(e)?;
-            f.new_dataset_builder().with_data(&col(&|p| p.run.result.wall_seconds)).create("rom_seconds").map_err(e)?;
-            // 1 where the full model answered in place of the reduced one (`--fallback full`;
-            // why: /message; its probes, seconds and iterations are then the full run's), 2
-            // where it was tried and failed and the reduced answer stands
-            f.new_dataset_builder()
-                .with_data(&Array1::from_iter(s.scales.iter().map(|x| x.point().map_or(0, SweepPoint::fallback_code))))
-                .create("fallback")
-                .map_err(e)?;
-        }
-        f.new_dataset_builder()
-            .with_data(&count(&|p| p.run.result.stats.newton_iterations))
-            .create("newton_iterations")
-            .map_err(e)?;
-        f.new_dataset_builder()
-            .with_data(&count(&|p| p.run.result.stats.factorizations))
-            .create("factorizations")
-            .map_err(e)?;
-        f.new_dataset_builder()
-            .with_data(&col(&|p| p.estimate.as_ref().map_or(f64::NAN, |e| e.error_estimate)))
-            .create("error_estimate")
-            .map_err(e)?;
-        // (load, fifth) of an estimate's by-fifth figures; NaN where a load has none
-        let by_fifth = |get: &dyn Fn(&crate::rom::estimator::Estimate) -> crate::rom::estimator::ByFifth| {
-            let mut a = Array2::from_elem((n, 5), f64::NAN);
-            for (k, x) in s.scales.iter().enumerate() {
-                if let Some(est) = x.point().and_then(|p| p.estimate.as_ref()) {
-                    a.row_mut(k).assign(&ndarray::ArrayView1::from(&get(est)));
-                }
-            }
-            a
-        };
-        f.new_dataset_builder().with_data(&by_fifth(&|e| e.by_time)).create("error_estimate_by_time").map_err(e)?;
-        f.new_dataset_builder()
-            .with_data(&col(&|p| p.estimate.as_ref().map_or(f64::NAN, |e| e.error_estimate_displacement)))
-            .create("error_estimate_displacement")
-            .map_err(e)?;
-        f.new_dataset_builder()
-            .with_data(&by_fifth(&|e| e.displacement_by_time))
-            .create("error_estimate_displacement_by_time")
-            .map_err(e)?;
-        f.new_dataset_builder()
-            .with_data(&col(&|p| p.estimate.as_ref().map_or(f64::NAN, |e| e.seconds)))
-            .create("estimate_seconds")
-            .map_err(e)?;
-        f.new_dataset_builder()
-            .with_data(&Array1::from_iter(s.scales.iter().map(|x| x.point().is_some_and(|p| p.extrapolated) as u8)))
-            .create("extrapolated")
-            .map_err(e)?;
-        // training's sensitivity beside each load (NaN: a full sweep, or a basis without it)
-        let sensitivity = basis.as_ref().and_then(|b| b.sensitivity);
-        f.new_dataset_builder()
-            .with_data(&Array1::from_iter(
-                s.scales.iter().map(|x| sensitivity.as_ref().and_then(|t| t.near(&x.mu)).unwrap_or(f64::NAN)),
-            ))
-            .create("sensitivity_near")
-            .map_err(e)?;
+        write_runs(f, s).map_err(e)?;
+        write_estimates(f, s, basis.as_ref().and_then(|b| b.sensitivity)).map_err(e)?;
         if s.validated {
-            let v = |g: &dyn Fn(&Validation) -> f64| col(&|p: &SweepPoint| p.validation.as_ref().map_or(f64::NAN, g));
-            f.new_dataset_builder().with_data(&v(&|x| x.rel_error)).create("rel_error").map_err(e)?;
-            f.new_dataset_builder().with_data(&v(&|x| x.max_probe_error)).create("max_probe_error").map_err(e)?;
-            f.new_dataset_builder()
-                .with_data(&v(&|x| x.max_constraint_violation))
-                .create("max_constraint_violation")
-                .map_err(e)?;
-            f.new_dataset_builder().with_data(&v(&|x| x.full_seconds)).create("full_seconds").map_err(e)?;
-            f.new_dataset_builder().with_data(&v(&|x| x.speedup)).create("speedup").map_err(e)?;
-            f.new_dataset_builder()
-                .with_data(&v(&|x| x.steps_differ_from.unwrap_or(f64::NAN)))
-                .create("steps_differ_from")
-                .map_err(e)?;
-            f.new_dataset_builder().with_data(&v(&|x| x.displacement_error)).create("displacement_error").map_err(e)?;
-            let mut by_time = Array2::from_elem((n, 5), f64::NAN);
-            for (k, x) in s.scales.iter().enumerate() {
-                let r = x.point().and_then(|p| p.validation.as_ref()).map(|v| &v.rel_error_by_time);
-                if let Some(r) = r.filter(|r| r.len() == 5) {
-                    by_time.row_mut(k).assign(&ndarray::ArrayView1::from(&r[..]));
-                }
-            }
-            f.new_dataset_builder().with_data(&by_time).create("rel_error_by_time").map_err(e)?;
+            write_validations(f, s).map_err(e)?;
         }
         if s.full {
             // the full time loops, as a validated sweep's column of the same name
             f.new_dataset_builder()
-                .with_data(&col(&|p| p.run.result.wall_seconds))
+                .with_data(&column(s, &|p| p.run.result.wall_seconds))
                 .create("full_seconds")
                 .map_err(e)?;
         }
-        attr_str(f, "route", route_name(s.full)).map_err(e)?;
-        if let Some(SweepBasis { stored, path: basis_path, .. }) = basis {
-            // absolute, so that the file names its basis wherever it is read from
-            attr_str(f, "basis", &crate::io::output::resolve(basis_path).display().to_string()).map_err(e)?;
-            attr_str(f, "basis_content_hash", &stored.content_hash).map_err(e)?;
-            attr_str(f, "model_fingerprint", &stored.model_fingerprint).map_err(e)?;
-            attr_str(f, "variant", stored.basis.variant.name()).map_err(e)?;
-            attr_u64(f, "n_modes", stored.basis.n_reduced() as u64).map_err(e)?;
-        } else {
-            attr_str(f, "model_fingerprint", &s.model_fingerprint).map_err(e)?;
-        }
-        attr_u64(f, "validated", s.validated as u64).map_err(e)?;
-        attr_str(f, "fallback", s.fallback.name()).map_err(e)?;
-        attr_f64(f, "wall_seconds", s.wall_seconds).map_err(e)?;
-        attr_u64(f, "threads", s.threads as u64).map_err(e)?;
-        attr_u64(f, "continuation", s.continuation as u64).map_err(e)?;
-        attr_u64(f, "n_failed", s.n_failed() as u64).map_err(e)?;
-        attr_u64(f, "n_pending", s.scales.iter().filter(|x| x.status() == STATUS_PENDING).count() as u64).map_err(e)?;
-        attr_str(f, "program_version", env!("CARGO_PKG_VERSION")).map_err(e)?;
+        write_attributes(f, s, basis).map_err(e)?;
         extra(f)
     })
+}
+
+/// One value per point: NaN where it did not run to the end.
+fn column(s: &Sweep, g: &dyn Fn(&SweepPoint) -> f64) -> Array1<f64> {
+    Array1::from_iter(s.scales.iter().map(|x| x.point().map_or(f64::NAN, g)))
+}
+
+/// One count per point: 0 where it did not run to the end.
+fn counts(s: &Sweep, g: &dyn Fn(&SweepPoint) -> usize) -> Array1<u64> {
+    Array1::from_iter(s.scales.iter().map(|x| x.point().map_or(0, g) as u64))
+}
+
+/// The runs: their points, status and messages, the time, the probes (reduced, and the
+/// full runs' of a validated sweep), the section probes and probe quantities, a reduced
+/// sweep's coordinates, seconds and fallbacks, and the solver's counts.
+fn write_runs(f: &hdf5::File, s: &Sweep) -> hdf5::Result<()> {
+    let (n, nt, r) = (s.scales.len(), s.t.len(), s.n_reduced);
+    f.new_dataset_builder()
+        .with_data(&Array1::from_iter(s.scales.iter().map(|x| x.mu.scale())))
+        .create("load_scales")?;
+    // the points, where the sweep sets a named parameter (a line of load scales has none)
+    let names = point_names(s.scales.iter().map(|x| &x.mu));
+    if names.len() > 1 {
+        let points = Array2::from_shape_fn((n, names.len()), |(k, j)| s.scales[k].mu.get(&names[j]).unwrap_or(1.0));
+        let d = f.new_dataset_builder().with_data(&points).create("points")?;
+        attr_str(&d, "parameters", &names.join(","))?;
+    }
+    f.new_dataset_builder().with_data(&Array1::from_iter(s.scales.iter().map(ScaleResult::status))).create("status")?;
+    let messages: Vec<VarLenUnicode> =
+        s.scales.iter().map(|x| x.message().replace('\0', " ").parse::<VarLenUnicode>().unwrap_or_default()).collect();
+    f.new_dataset_builder().with_data(&Array1::from(messages)).create("message")?;
+    f.new_dataset_builder().with_data(&s.t).create("t")?;
+    // the reduced runs' probes, and beside them with --validate the full runs'
+    type ProbesOf = fn(&SweepPoint) -> Option<&[(String, Array2<f64>)]>;
+    let groups: &[(&str, ProbesOf)] =
+        &[("probes", |p| Some(&p.run.result.probes)), ("full_probes", |p| p.full_probes.as_deref())];
+    for (group, probes) in &groups[..if s.validated { 2 } else { 1 }] {
+        let g = f.create_group(group)?;
+        for (i, name) in s.probe_names.iter().enumerate() {
+            let mut a = Array3::from_elem((n, nt, 2), f64::NAN);
+            for (k, x) in s.scales.iter().enumerate() {
+                if let Some(xy) = x.point().and_then(probes) {
+                    a.index_axis_mut(ndarray::Axis(0), k).assign(&xy[i].1);
+                }
+            }
+            g.new_dataset_builder().with_data(&a).create(name.as_str())?;
+        }
+    }
+    write_sections(f, s)?;
+    write_quantity_errors(f, s)?;
+    if !s.full {
+        // time first: (load, time, mode); the runs keep r × n_t
+        let mut zq = Array3::from_elem((n, nt, r), f64::NAN);
+        // NaN where the full model answered in place of the reduced one (no reduced q)
+        for (k, x) in s.scales.iter().enumerate() {
+            if let Some(p) = x.point().filter(|p| p.fallback.is_none()) {
+                zq.index_axis_mut(ndarray::Axis(0), k).assign(&p.run.reduced_q.t());
+            }
+        }
+        // one chunk per run, not compressed: deflate took 15 % off the size of these
+        // trajectories for 0.15 s of a 1.5 s four-bar sweep
+        f.new_dataset_builder().chunk((1, nt.max(1), r.max(1))).with_data(&zq).create("reduced_q")?;
+        f.new_dataset_builder().with_data(&column(s, &|p| p.run.result.wall_seconds)).create("rom_seconds")?;
+        // 1 where the full model answered in place of the reduced one (`--fallback full`;
+        // why: /message; its probes, seconds and iterations are then the full run's), 2
+        // where it was tried and failed and the reduced answer stands
+        f.new_dataset_builder()
+            .with_data(&Array1::from_iter(s.scales.iter().map(|x| x.point().map_or(0, SweepPoint::fallback_code))))
+            .create("fallback")?;
+    }
+    f.new_dataset_builder()
+        .with_data(&counts(s, &|p| p.run.result.stats.newton_iterations))
+        .create("newton_iterations")?;
+    f.new_dataset_builder().with_data(&counts(s, &|p| p.run.result.stats.factorizations)).create("factorizations")?;
+    Ok(())
+}
+
+/// The estimates a point (NaN where it has none), whether it extrapolated, and training's
+/// sensitivity beside it (NaN: a full sweep, or a basis without it).
+fn write_estimates(f: &hdf5::File, s: &Sweep, sensitivity: Option<&LoadSensitivity>) -> hdf5::Result<()> {
+    let n = s.scales.len();
+    f.new_dataset_builder()
+        .with_data(&column(s, &|p| p.estimate.as_ref().map_or(f64::NAN, |e| e.error_estimate)))
+        .create("error_estimate")?;
+    // (load, fifth) of an estimate's by-fifth figures; NaN where a load has none
+    let by_fifth = |get: &dyn Fn(&crate::rom::estimator::Estimate) -> crate::rom::estimator::ByFifth| {
+        let mut a = Array2::from_elem((n, 5), f64::NAN);
+        for (k, x) in s.scales.iter().enumerate() {
+            if let Some(est) = x.point().and_then(|p| p.estimate.as_ref()) {
+                a.row_mut(k).assign(&ndarray::ArrayView1::from(&get(est)));
+            }
+        }
+        a
+    };
+    f.new_dataset_builder().with_data(&by_fifth(&|e| e.by_time)).create("error_estimate_by_time")?;
+    f.new_dataset_builder()
+        .with_data(&column(s, &|p| p.estimate.as_ref().map_or(f64::NAN, |e| e.error_estimate_displacement)))
+        .create("error_estimate_displacement")?;
+    f.new_dataset_builder()
+        .with_data(&by_fifth(&|e| e.displacement_by_time))
+        .create("error_estimate_displacement_by_time")?;
+    f.new_dataset_builder()
+        .with_data(&column(s, &|p| p.estimate.as_ref().map_or(f64::NAN, |e| e.seconds)))
+        .create("estimate_seconds")?;
+    f.new_dataset_builder()
+        .with_data(&Array1::from_iter(s.scales.iter().map(|x| x.point().is_some_and(|p| p.extrapolated) as u8)))
+        .create("extrapolated")?;
+    f.new_dataset_builder()
+        .with_data(&Array1::from_iter(
+            s.scales.iter().map(|x| sensitivity.as_ref().and_then(|t| t.near(&x.mu)).unwrap_or(f64::NAN)),
+        ))
+        .create("sensitivity_near")?;
+    Ok(())
+}
+
+/// A validated sweep's columns: each point's errors, full seconds and speedup, where its
+/// steps first differed, and its rel_error by fifth of the run (NaN where it has none).
+fn write_validations(f: &hdf5::File, s: &Sweep) -> hdf5::Result<()> {
+    let v = |g: &dyn Fn(&Validation) -> f64| column(s, &|p: &SweepPoint| p.validation.as_ref().map_or(f64::NAN, g));
+    f.new_dataset_builder().with_data(&v(&|x| x.rel_error)).create("rel_error")?;
+    f.new_dataset_builder().with_data(&v(&|x| x.max_probe_error)).create("max_probe_error")?;
+    f.new_dataset_builder().with_data(&v(&|x| x.max_constraint_violation)).create("max_constraint_violation")?;
+    f.new_dataset_builder().with_data(&v(&|x| x.full_seconds)).create("full_seconds")?;
+    f.new_dataset_builder().with_data(&v(&|x| x.speedup)).create("speedup")?;
+    f.new_dataset_builder().with_data(&v(&|x| x.steps_differ_from.unwrap_or(f64::NAN))).create("steps_differ_from")?;
+    f.new_dataset_builder().with_data(&v(&|x| x.displacement_error)).create("displacement_error")?;
+    let mut by_time = Array2::from_elem((s.scales.len(), 5), f64::NAN);
+    for (k, x) in s.scales.iter().enumerate() {
+        let r = x.point().and_then(|p| p.validation.as_ref()).map(|v| &v.rel_error_by_time);
+        if let Some(r) = r.filter(|r| r.len() == 5) {
+            by_time.row_mut(k).assign(&ndarray::ArrayView1::from(&r[..]));
+        }
+    }
+    f.new_dataset_builder().with_data(&by_time).create("rel_error_by_time")?;
+    Ok(())
+}
+
+/// The file's attributes: the route, the basis (or the model) it ran, and the sweep's own.
+fn write_attributes(f: &hdf5::File, s: &Sweep, basis: Option<SweepBasis>) -> hdf5::Result<()> {
+    attr_str(f, "route", route_name(s.full))?;
+    if let Some(SweepBasis { stored, path: basis_path, .. }) = basis {
+        // absolute, so that the file names its basis wherever it is read from
+        attr_str(f, "basis", &crate::io::output::resolve(basis_path).display().to_string())?;
+        attr_str(f, "basis_content_hash", &stored.content_hash)?;
+        attr_str(f, "model_fingerprint", &stored.model_fingerprint)?;
+        attr_str(f, "variant", stored.basis.variant.name())?;
+        attr_u64(f, "n_modes", stored.basis.n_reduced() as u64)?;
+    } else {
+        attr_str(f, "model_fingerprint", &s.model_fingerprint)?;
+    }
+    attr_u64(f, "validated", s.validated as u64)?;
+    attr_str(f, "fallback", s.fallback.name())?;
+    attr_f64(f, "wall_seconds", s.wall_seconds)?;
+    attr_u64(f, "threads", s.threads as u64)?;
+    attr_u64(f, "continuation", s.continuation as u64)?;
+    attr_u64(f, "n_failed", s.n_failed() as u64)?;
+    attr_u64(f, "n_pending", s.scales.iter().filter(|x| x.status() == STATUS_PENDING).count() as u64)?;
+    attr_str(f, "program_version", env!("CARGO_PKG_VERSION"))
 }
 
 /// The parameters of `points`: `load_scale` first, then every named one any point sets, in
@@ -408,11 +414,37 @@ pub fn read_sweep(
     stored: Option<&StoredBasis>,
     validate: bool,
 ) -> Result<Vec<(Parameters, Option<SweepPoint>)>> {
-    let cannot = |field: &str, problem: String| {
-        Error::input(path, field, format!("{problem}; cannot resume from it (remove it, or run without --resume)"))
-    };
+    let (f, layout, file_full) = open_to_resume(path, model, stored)?;
+    let s = Settings::resolve(model, &Overrides::default())?;
+    let (nt, r) = (s.n_steps + 1, stored.map_or(0, |b| b.basis.n_reduced()));
+    // the number of runs is the file's own: bounded by what holding them takes (coordinates,
+    // reduced and full probes, the per-run columns) before anything is read, and every
+    // dataset's shape checked against it before that dataset is read
+    let sections: usize = model.section_names().iter().map(Vec::len).sum();
+    let per_run = 8.0 * (nt as f64 * (r + 4 * model.probe_names().len() + sections) as f64 + 32.0);
+    let n =
+        bounded_len(&f, "load_scales", per_run, &model.limits).map_err(|p| cannot_resume(path, "load_scales", p))?;
+    let file = Resumed { f, path, n, nt };
+    let (probe_names, section_names) = (model.probe_names(), model.section_names());
+    let keys = quantity_keys(&probe_names, &section_names);
+    let runs = file.runs(model, &keys, (layout, r), file_full, validate)?;
+    let columns = file.columns(file_full, validate, runs.full_probes.is_some(), runs.rom_seconds.len())?;
+    let read = ReadBack { model, stored, r, nt, keys: &keys, runs, columns, validate };
+    (0..n).map(|k| read.point(k)).collect()
+}
+
+/// The error for a sweep file `--resume` cannot take: the file, the field and the problem.
+fn cannot_resume(path: &Path, field: &str, problem: String) -> Error {
+    Error::input(path, field, format!("{problem}; cannot resume from it (remove it, or run without --resume)"))
+}
+
+/// Opens an earlier sweep file for `--resume` and checks that it is one of this sweep: its
+/// route (reduced with `stored`, else full), basis and model. Returns the file, its layout
+/// version and whether it is a full sweep.
+fn open_to_resume(path: &Path, model: &Model, stored: Option<&StoredBasis>) -> Result<(hdf5::File, u64, bool)> {
+    let cannot = |field: &str, problem: String| cannot_resume(path, field, problem);
     let f = hdf5::File::open(path).map_err(|e| cannot("(file)", crate::io::h5::unreadable(&e)))?;
-    // layout 1 stored /reduced_q as (N, r, n_t): converted below; newer layouts are refused
+    // layout 1 stored /reduced_q as (N, r, n_t): converted on reading; newer layouts are refused
     let layout = check_layout(&f, path, "flexrom sweep")?;
     let text = |name: &str| {
         read_attr_str(&f, name).map_err(|e| cannot(name, format!("cannot be read ({e}): not a flexrom sweep file?")))
@@ -438,263 +470,346 @@ pub fn read_sweep(
     if text("model_fingerprint")? != model.fingerprint() {
         return Err(cannot("model_fingerprint", "comes from another model than the pipeline's".into()));
     }
-    let s = Settings::resolve(model, &Overrides::default())?;
-    let (nt, r) = (s.n_steps + 1, stored.map_or(0, |b| b.basis.n_reduced()));
-    // the number of runs is the file's own: bounded by what holding them takes (coordinates,
-    // reduced and full probes, the per-run columns) before anything is read, and every
-    // dataset's shape checked against it before that dataset is read
-    let sections: usize = model.section_names().iter().map(Vec::len).sum();
-    let per_run = 8.0 * (nt as f64 * (r + 4 * model.probe_names().len() + sections) as f64 + 32.0);
-    let n = bounded_len(&f, "load_scales", per_run, &model.limits).map_err(|p| cannot("load_scales", p))?;
-    let shaped = |name: &str, want: &[usize]| dataset_of_shape(&f, name, want).map_err(|p| cannot(name, p));
-    let read = |name: &str, e: hdf5::Error| cannot(name, format!("cannot be read: {e}"));
-    let vec = |name: &str| shaped(name, &[n])?.read_1d::<f64>().map_err(|e| read(name, e));
-    let ints = |name: &str| shaped(name, &[n])?.read_1d::<u64>().map_err(|e| read(name, e));
-    let flags = |name: &str| shaped(name, &[n])?.read_1d::<u8>().map_err(|e| read(name, e));
-    let scales = vec("load_scales")?;
-    let points = points_of(&f, &scales.to_vec()).map_err(|(field, problem)| cannot(field, problem))?;
-    let status = flags("status")?;
-    let t = shaped("t", &[nt])?.read_1d::<f64>().map_err(|e| read("t", e))?;
-    let zq = if file_full {
-        // a full sweep keeps no coordinates
-        Array3::zeros((n, 0, nt))
-    } else {
-        let want = if layout == 1 { [n, r, nt] } else { [n, nt, r] };
-        shaped("reduced_q", &want)?.read::<f64, ndarray::Ix3>().map_err(|e| read("reduced_q", e))?
-    };
-    let zq = if file_full || layout == 1 {
-        zq
-    } else {
-        // back to the runs' r × n_t
-        zq.permuted_axes([0, 2, 1]).as_standard_layout().to_owned()
-    };
-    let read_probes = |group: &str| -> Result<Vec<(String, Array3<f64>)>> {
+    Ok((f, layout, file_full))
+}
+
+/// An earlier sweep file opened for `--resume`: its datasets, each read with its shape
+/// checked against the file's number of runs `n` and the model's instants `nt`.
+struct Resumed<'a> {
+    f: hdf5::File,
+    path: &'a Path,
+    n: usize,
+    nt: usize,
+}
+
+/// What a sweep file holds of its runs (index 0 of each array: the run).
+struct StoredRuns {
+    points: Vec<Parameters>,
+    status: Array1<u8>,
+    t: Array1<f64>,
+    /// reduced coordinates, run × r × n_t (none for a full sweep)
+    zq: Array3<f64>,
+    probes: Vec<(String, Array3<f64>)>,
+    /// strains and curvatures at the section probes
+    sections: [Option<NamedRuns>; 2],
+    quantity_estimates: Option<Vec<Array1<f64>>>,
+    quantity_errors: Option<Vec<Array1<f64>>>,
+    full_probes: Option<Vec<(String, Array3<f64>)>>,
+    /// the time loops' seconds: the reduced runs', or a full sweep's full runs'
+    rom_seconds: Array1<f64>,
+}
+
+/// A sweep file's per-run columns beside the runs: estimates, fallbacks, solver counts and
+/// validations (each `None` where the file has none).
+struct StoredColumns {
+    estimates: Option<Array1<f64>>,
+    estimate_seconds: Option<Array1<f64>>,
+    extrapolated: Option<Array1<u8>>,
+    /// (code, message) a run
+    fallback: Vec<(u8, String)>,
+    by_time: Option<Array2<f64>>,
+    estimates_displacement: Option<Array1<f64>>,
+    displacement_by_time: Option<Array2<f64>>,
+    displacement: Option<Array1<f64>>,
+    rel_by_time: Option<Array2<f64>>,
+    newton: Array1<u64>,
+    factorizations: Array1<u64>,
+    differ: Option<Array1<f64>>,
+    /// rel_error, max_probe_error, max_constraint_violation, full_seconds, speedup
+    validation: Option<[Array1<f64>; 5]>,
+}
+
+impl Resumed<'_> {
+    fn cannot(&self, field: &str, problem: String) -> Error {
+        cannot_resume(self.path, field, problem)
+    }
+
+    fn shaped(&self, name: &str, want: &[usize]) -> Result<hdf5::Dataset> {
+        dataset_of_shape(&self.f, name, want).map_err(|p| self.cannot(name, p))
+    }
+
+    fn read_err(&self, name: &str, e: hdf5::Error) -> Error {
+        self.cannot(name, format!("cannot be read: {e}"))
+    }
+
+    /// A per-run column of numbers.
+    fn vec(&self, name: &str) -> Result<Array1<f64>> {
+        self.shaped(name, &[self.n])?.read_1d::<f64>().map_err(|e| self.read_err(name, e))
+    }
+
+    /// A per-run column of counts.
+    fn ints(&self, name: &str) -> Result<Array1<u64>> {
+        self.shaped(name, &[self.n])?.read_1d::<u64>().map_err(|e| self.read_err(name, e))
+    }
+
+    /// A per-run column of flags.
+    fn flags(&self, name: &str) -> Result<Array1<u8>> {
+        self.shaped(name, &[self.n])?.read_1d::<u8>().map_err(|e| self.read_err(name, e))
+    }
+
+    /// A per-run column files written before it lack (none then).
+    fn optional(&self, name: &str) -> Result<Option<Array1<f64>>> {
+        if self.f.link_exists(name) {
+            self.vec(name).map(Some)
+        } else {
+            Ok(None)
+        }
+    }
+
+    /// A per-run value by fifth of the run (run × 5), none where the file lacks it.
+    fn by_fifth(&self, name: &str) -> Result<Option<Array2<f64>>> {
+        if !self.f.link_exists(name) {
+            return Ok(None);
+        }
+        self.shaped(name, &[self.n, 5])?.read::<f64, ndarray::Ix2>().map(Some).map_err(|e| self.read_err(name, e))
+    }
+
+    /// `group/<probe>` for every probe of the model: run × time × (x, y).
+    fn probes(&self, model: &Model, group: &str) -> Result<Vec<(String, Array3<f64>)>> {
         let mut probes = Vec::new();
         for name in model.probe_names() {
             let path = format!("{group}/{name}");
-            let a = shaped(&path, &[n, nt, 2])?.read::<f64, ndarray::Ix3>().map_err(|e| read(&path, e))?;
+            let a = self
+                .shaped(&path, &[self.n, self.nt, 2])?
+                .read::<f64, ndarray::Ix3>()
+                .map_err(|e| self.read_err(&path, e))?;
             probes.push((name, a));
         }
         Ok(probes)
-    };
-    let probes = read_probes("probes")?;
-    // each run's strains and curvatures, the probe quantities' estimates and (validated)
-    // errors; files written before them have none, and their points read back without
-    let read_series = |group: &str, names: &[String]| -> Result<Option<NamedRuns>> {
-        if names.is_empty() || !f.link_exists(group) {
+    }
+
+    /// `group/<name>` for each of `names`: run × time; none where the file has no such group.
+    fn series(&self, group: &str, names: &[String]) -> Result<Option<NamedRuns>> {
+        if names.is_empty() || !self.f.link_exists(group) {
             return Ok(None);
         }
         let series = names.iter().map(|name| {
             let path = format!("{group}/{name}");
-            let a = shaped(&path, &[n, nt])?.read::<f64, ndarray::Ix2>().map_err(|e| read(&path, e))?;
+            let a = self
+                .shaped(&path, &[self.n, self.nt])?
+                .read::<f64, ndarray::Ix2>()
+                .map_err(|e| self.read_err(&path, e))?;
             Ok((name.clone(), a))
         });
         series.collect::<Result<Vec<_>>>().map(Some)
-    };
-    let (probe_names, section_names) = (model.probe_names(), model.section_names());
-    let sections =
-        [read_series("probe_strain", &section_names[0])?, read_series("probe_curvature", &section_names[1])?];
-    let keys = quantity_keys(&probe_names, &section_names);
-    let read_quantities = |group: &str| -> Result<Option<Vec<Array1<f64>>>> {
-        if !f.link_exists(group) {
+    }
+
+    /// `group/<quantity>/<probe>` for every probe quantity, none where the file has no such group.
+    fn quantities(&self, group: &str, keys: &[(Quantity, &str)]) -> Result<Option<Vec<Array1<f64>>>> {
+        if !self.f.link_exists(group) {
             return Ok(None);
         }
-        keys.iter().map(|(q, name)| vec(&format!("{group}/{}/{name}", q.name()))).collect::<Result<Vec<_>>>().map(Some)
-    };
-    let quantity_estimates = read_quantities("probe_error_estimate")?;
-    let quantity_errors = if validate { read_quantities("probe_error")? } else { None };
-    let section_at = |i: usize, k: usize| -> crate::simulate::Series {
-        sections[i]
-            .as_ref()
-            .map_or_else(Vec::new, |v| v.iter().map(|(n, a)| (n.clone(), a.row(k).to_owned())).collect())
-    };
-    // files written before /full_probes hold validations without them: run again
-    let full_probes = if validate && f.link_exists("full_probes") { Some(read_probes("full_probes")?) } else { None };
-    let at = |probes: &[(String, Array3<f64>)], k: usize| -> Vec<(String, Array2<f64>)> {
-        probes.iter().map(|(name, a)| (name.clone(), a.index_axis(ndarray::Axis(0), k).to_owned())).collect()
-    };
-    // each run's time loop: the reduced one, or a full sweep's full one
-    let seconds_name = if file_full { "full_seconds" } else { "rom_seconds" };
-    let rom_seconds = vec(seconds_name)?;
-    // the estimate columns of the file (absent in files written before them: no estimate)
-    let optional = |name: &str| if f.link_exists(name) { vec(name).map(Some) } else { Ok(None) };
-    let (estimates, estimate_seconds, extrapolated) = (
-        optional("error_estimate")?,
-        optional("estimate_seconds")?,
-        if f.link_exists("extrapolated") { Some(flags("extrapolated")?) } else { None },
-    );
-    // files written before /fallback hold reduced answers only; a fallback's reason is its
-    // /message
-    let fallback = if f.link_exists("fallback") {
-        let flags = flags("fallback")?;
-        let messages = read_strings(&shaped("message", &[n])?).map_err(|e| read("message", e))?;
+        keys.iter()
+            .map(|(q, name)| self.vec(&format!("{group}/{}/{name}", q.name())))
+            .collect::<Result<Vec<_>>>()
+            .map(Some)
+    }
+
+    /// The runs: points, status, time, reduced coordinates (`layout` 1 stored them as
+    /// (N, r, n_t), newer ones as (N, n_t, r)), probes, section probes, the probe quantities'
+    /// estimates and (validated) errors, the full runs' probes and the time loops' seconds.
+    fn runs(
+        &self,
+        model: &Model,
+        keys: &[(Quantity, &str)],
+        (layout, r): (u64, usize),
+        file_full: bool,
+        validate: bool,
+    ) -> Result<StoredRuns> {
+        let (n, nt) = (self.n, self.nt);
+        let scales = self.vec("load_scales")?;
+        let points = points_of(&self.f, &scales.to_vec()).map_err(|(field, problem)| self.cannot(field, problem))?;
+        let status = self.flags("status")?;
+        let t = self.shaped("t", &[nt])?.read_1d::<f64>().map_err(|e| self.read_err("t", e))?;
+        let zq = if file_full {
+            // a full sweep keeps no coordinates
+            Array3::zeros((n, 0, nt))
+        } else {
+            let want = if layout == 1 { [n, r, nt] } else { [n, nt, r] };
+            self.shaped("reduced_q", &want)?.read::<f64, ndarray::Ix3>().map_err(|e| self.read_err("reduced_q", e))?
+        };
+        let zq = if file_full || layout == 1 {
+            zq
+        } else {
+            // back to the runs' r × n_t
+            zq.permuted_axes([0, 2, 1]).as_standard_layout().to_owned()
+        };
+        let probes = self.probes(model, "probes")?;
+        // each run's strains and curvatures, the probe quantities' estimates and (validated)
+        // errors; files written before them have none, and their points read back without
+        let section_names = model.section_names();
+        let sections =
+            [self.series("probe_strain", &section_names[0])?, self.series("probe_curvature", &section_names[1])?];
+        let quantity_estimates = self.quantities("probe_error_estimate", keys)?;
+        let quantity_errors = if validate { self.quantities("probe_error", keys)? } else { None };
+        // files written before /full_probes hold validations without them: run again
+        let full_probes =
+            if validate && self.f.link_exists("full_probes") { Some(self.probes(model, "full_probes")?) } else { None };
+        // each run's time loop: the reduced one, or a full sweep's full one
+        let seconds_name = if file_full { "full_seconds" } else { "rom_seconds" };
+        let rom_seconds = self.vec(seconds_name)?;
+        Ok(StoredRuns {
+            points,
+            status,
+            t,
+            zq,
+            probes,
+            sections,
+            quantity_estimates,
+            quantity_errors,
+            full_probes,
+            rom_seconds,
+        })
+    }
+
+    /// The per-run columns beside the runs; `validated`: the file has the full runs' probes a
+    /// validation needs. Every column is checked to have a value a run, as the time loops'
+    /// `n_seconds` values are.
+    fn columns(&self, file_full: bool, validate: bool, validated: bool, n_seconds: usize) -> Result<StoredColumns> {
+        let n = self.n;
+        // the estimate columns of the file (absent in files written before them: no estimate)
+        let (estimates, estimate_seconds, extrapolated) = (
+            self.optional("error_estimate")?,
+            self.optional("estimate_seconds")?,
+            if self.f.link_exists("extrapolated") { Some(self.flags("extrapolated")?) } else { None },
+        );
+        let fallback = self.fallback()?;
+        let by_time = self.by_fifth("error_estimate_by_time")?;
+        // files written before the displacement measure have neither: NaN
+        let (estimates_displacement, displacement_by_time) =
+            (self.optional("error_estimate_displacement")?, self.by_fifth("error_estimate_displacement_by_time")?);
+        let displacement = if validate { self.optional("displacement_error")? } else { None };
+        let rel_by_time = if validate { self.by_fifth("rel_error_by_time")? } else { None };
+        let (newton, factorizations) = (self.ints("newton_iterations")?, self.ints("factorizations")?);
+        // files written before it have no /steps_differ_from: unknown, as no halved step
+        let differ = if validate && self.f.link_exists("steps_differ_from") {
+            Some(self.vec("steps_differ_from")?)
+        } else {
+            None
+        };
+        if differ.as_ref().is_some_and(|a| a.len() != n) {
+            return Err(self
+                .cannot("steps_differ_from", format!("has {} entries, expected {n}", differ.map_or(0, |a| a.len()))));
+        }
+        let validation = if validate && self.f.link_exists("rel_error") && validated {
+            Some([
+                self.vec("rel_error")?,
+                self.vec("max_probe_error")?,
+                self.vec("max_constraint_violation")?,
+                self.vec("full_seconds")?,
+                self.vec("speedup")?,
+            ])
+        } else {
+            None
+        };
+        let seconds_name = if file_full { "full_seconds" } else { "rom_seconds" };
+        let lens = std::iter::once(n_seconds).chain(
+            (validation.iter().flatten())
+                .chain(estimates.iter())
+                .chain(estimate_seconds.iter())
+                .chain(estimates_displacement.iter())
+                .chain(displacement.iter())
+                .map(|a| a.len()),
+        );
+        for len in lens {
+            if len != n {
+                return Err(
+                    self.cannot(seconds_name, format!("a per-scale dataset has {len} entries for {n} load scales"))
+                );
+            }
+        }
+        Ok(StoredColumns {
+            estimates,
+            estimate_seconds,
+            extrapolated,
+            fallback,
+            by_time,
+            estimates_displacement,
+            displacement_by_time,
+            displacement,
+            rel_by_time,
+            newton,
+            factorizations,
+            differ,
+            validation,
+        })
+    }
+
+    /// `/fallback` and its reasons (`/message`) a run; files written before /fallback hold
+    /// reduced answers only.
+    fn fallback(&self) -> Result<Vec<(u8, String)>> {
+        let n = self.n;
+        if !self.f.link_exists("fallback") {
+            return Ok(vec![(0, String::new()); n]);
+        }
+        let flags = self.flags("fallback")?;
+        let messages = read_strings(&self.shaped("message", &[n])?).map_err(|e| self.read_err("message", e))?;
         if flags.len() != n || messages.len() != n {
-            return Err(cannot(
+            return Err(self.cannot(
                 "fallback",
                 format!("has {} entries (/message {}) for {n} load scales", flags.len(), messages.len()),
             ));
         }
-        flags.iter().zip(messages).map(|(&x, m)| (x, m)).collect()
-    } else {
-        vec![(0, String::new()); n]
-    };
-    let by_fifth = |name: &str| -> Result<Option<Array2<f64>>> {
-        if !f.link_exists(name) {
-            return Ok(None);
-        }
-        shaped(name, &[n, 5])?.read::<f64, ndarray::Ix2>().map(Some).map_err(|e| read(name, e))
-    };
-    let by_time = by_fifth("error_estimate_by_time")?;
-    // files written before the displacement measure have neither: NaN
-    let (estimates_displacement, displacement_by_time) =
-        (optional("error_estimate_displacement")?, by_fifth("error_estimate_displacement_by_time")?);
-    let displacement = if validate { optional("displacement_error")? } else { None };
-    let rel_by_time = if validate { by_fifth("rel_error_by_time")? } else { None };
-    let (newton, factorizations) = (ints("newton_iterations")?, ints("factorizations")?);
-    // files written before it have no /steps_differ_from: unknown, as no halved step
-    let differ = if validate && f.link_exists("steps_differ_from") { Some(vec("steps_differ_from")?) } else { None };
-    if differ.as_ref().is_some_and(|a| a.len() != n) {
-        return Err(cannot(
-            "steps_differ_from",
-            format!("has {} entries, expected {n}", differ.map_or(0, |a| a.len())),
-        ));
+        Ok(flags.iter().zip(messages).map(|(&x, m)| (x, m)).collect())
     }
-    let validation = if validate && f.link_exists("rel_error") && full_probes.is_some() {
-        Some([
-            vec("rel_error")?,
-            vec("max_probe_error")?,
-            vec("max_constraint_violation")?,
-            vec("full_seconds")?,
-            vec("speedup")?,
-        ])
-    } else {
-        None
-    };
-    for a in [&rom_seconds]
-        .into_iter()
-        .chain(validation.iter().flatten())
-        .chain(estimates.iter())
-        .chain(estimate_seconds.iter())
-        .chain(estimates_displacement.iter())
-        .chain(displacement.iter())
-    {
-        if a.len() != n {
-            return Err(cannot(
-                seconds_name,
-                format!("a per-scale dataset has {} entries for {n} load scales", a.len()),
-            ));
-        }
-    }
-    let mut out = Vec::new();
-    for k in 0..n {
-        let mu = points[k].clone();
+}
+
+/// Run `k` of every probe's series (run × time × (x, y)).
+fn run_row(probes: &[(String, Array3<f64>)], k: usize) -> Vec<(String, Array2<f64>)> {
+    probes.iter().map(|(name, a)| (name.clone(), a.index_axis(ndarray::Axis(0), k).to_owned())).collect()
+}
+
+/// A sweep file read back: what turns each of its runs into a finished point.
+struct ReadBack<'a> {
+    model: &'a Model,
+    stored: Option<&'a StoredBasis>,
+    r: usize,
+    nt: usize,
+    keys: &'a [(Quantity, &'a str)],
+    runs: StoredRuns,
+    columns: StoredColumns,
+    validate: bool,
+}
+
+impl ReadBack<'_> {
+    /// Run `k`: its parameters and, where it finished with what this sweep writes, the point.
+    fn point(&self, k: usize) -> Result<(Parameters, Option<SweepPoint>)> {
+        let (model, nt, runs, c) = (self.model, self.nt, &self.runs, &self.columns);
+        let mu = runs.points[k].clone();
         // a finished run counts only when it has what this sweep writes
-        if status[k] != STATUS_OK || (validate && validation.is_none()) {
-            out.push((mu, None));
-            continue;
+        if runs.status[k] != STATUS_OK || (self.validate && c.validation.is_none()) {
+            return Ok((mu, None));
         }
         let settings = Settings::resolve(model, &Overrides::at(&mu))?;
         let stats = Stats {
             steps: settings.n_steps,
-            newton_iterations: newton[k] as usize,
-            factorizations: factorizations[k] as usize,
+            newton_iterations: c.newton[k] as usize,
+            factorizations: c.factorizations[k] as usize,
             ..Default::default()
+        };
+        let section_at = |i: usize| -> crate::simulate::Series {
+            runs.sections[i]
+                .as_ref()
+                .map_or_else(Vec::new, |v| v.iter().map(|(n, a)| (n.clone(), a.row(k).to_owned())).collect())
         };
         let result = SimulationResult {
             model_text: model.text.clone(),
             model_path: model.path.display().to_string(),
             settings,
-            t: t.clone(),
+            t: runs.t.clone(),
             q: Array2::zeros((0, nt)),
             qd: Array2::zeros((0, nt)),
             multipliers: Array2::zeros((0, nt)),
-            probes: at(&probes, k),
-            strains: section_at(0, k),
-            curvatures: section_at(1, k),
+            probes: run_row(&runs.probes, k),
+            strains: section_at(0),
+            curvatures: section_at(1),
             stats,
-            wall_seconds: rom_seconds[k],
+            wall_seconds: runs.rom_seconds[k],
             energy: None,
         };
-        let v = validation.as_ref().zip(stored).map(|(c, stored)| Validation {
-            load_scale: mu.scale(),
-            parameters: mu.iter().map(|(n, v)| (n.to_string(), v)).collect(),
-            variant: stored.basis.variant.name().to_string(),
-            n_dof: stored.basis.n_dof(),
-            n_modes: r,
-            rel_error: c[0][k],
-            max_probe_error: c[1][k],
-            max_probe_error_probe: String::new(),
-            max_probe_error_t: f64::NAN,
-            max_constraint_violation: c[2][k],
-            full_seconds: c[3][k],
-            full_dense_seconds: None,
-            rom_seconds: rom_seconds[k],
-            speedup: c[4][k],
-            speedup_vs_dense: None,
-            speedup_with_estimate: None,
-            full_newton_iterations: 0,
-            rom_newton_iterations: newton[k] as usize,
-            rom_step_cuts: 0,
-            full_step_cuts: 0,
-            steps_differ_from: differ.as_ref().map(|a| a[k]).filter(|t| !t.is_nan()),
-            full_step_cut_times: Vec::new(),
-            rom_step_cut_times: Vec::new(),
-            // the estimate and the flags are set below from the file's columns
-            error_estimate: None,
-            effectivity: None,
-            estimate_calibrated: None,
-            estimate_seconds: None,
-            extrapolated: false,
-            training_range: None,
-            sensitivity: None,
-            training_box: None,
-            sensitivity_near: None,
-            amplifying: false,
-            rel_error_by_time: rel_by_time.as_ref().map_or_else(Vec::new, |a| a.row(k).to_vec()),
-            error_estimate_by_time: None,
-            displacement_error: displacement.as_ref().map_or(f64::NAN, |a| a[k]),
-            // the words for a stored NaN or ∞ (a sweep before the column has none to explain)
-            displacement_error_note: displacement.as_ref().and_then(|a| displacement_note(a[k])).map(str::to_string),
-            displacement_error_by_time: Vec::new(),
-            error_estimate_displacement: None,
-            effectivity_displacement: None,
-            error_estimate_displacement_by_time: None,
-            max_error_over_travel: None,
-            max_error_over_travel_probe: String::new(),
-            probe_errors_over_travel: Vec::new(),
-            probe_quantity_errors: quantity_errors.as_ref().map_or_else(Vec::new, |cols| {
-                keys.iter().zip(cols).map(|((q, name), c)| ProbeQuantityError::stored(name, *q, c[k])).collect()
-            }),
-            reaction_errors: Vec::new(),
-            error_estimate_method: None,
-            estimate_failure: None,
-        });
-        // the stored estimate: its value and cost (the factor it was made with is the basis's)
-        let estimate = estimates.as_ref().map(|a| a[k]).filter(|e| !e.is_nan()).map(|error_estimate| Estimate {
-            error_estimate,
-            raw: f64::NAN,
-            factor: f64::NAN,
-            calibrated: false,
-            seconds: estimate_seconds.as_ref().map_or(f64::NAN, |a| a[k]),
-            by_time: by_time.as_ref().map_or([f64::NAN; 5], |a| std::array::from_fn(|i| a[[k, i]])),
-            error_estimate_displacement: estimates_displacement.as_ref().map_or(f64::NAN, |a| a[k]),
-            displacement_by_time: displacement_by_time
-                .as_ref()
-                .map_or([f64::NAN; 5], |a| std::array::from_fn(|i| a[[k, i]])),
-            failure: None,
-            quantities: quantity_estimates.as_ref().map_or_else(Vec::new, |cols| {
-                let each = keys.iter().zip(cols);
-                each.map(|((q, name), c)| QuantityEstimate {
-                    probe: name.to_string(),
-                    quantity: *q,
-                    estimate: c[k],
-                    raw: f64::NAN,
-                })
-                .collect()
-            }),
-        });
-        let extrapolated = extrapolated.as_ref().is_some_and(|a| a.get(k).is_some_and(|&v| v != 0));
-        let v = v.map(|mut v| {
+        let estimate = self.estimate(k);
+        let extrapolated = c.extrapolated.as_ref().is_some_and(|a| a.get(k).is_some_and(|&v| v != 0));
+        let v = self.validation(k, &mu).map(|mut v| {
             if let Some(e) = &estimate {
                 v.error_estimate = Some(e.error_estimate);
                 v.effectivity = Some(e.error_estimate / v.rel_error);
@@ -709,10 +824,11 @@ pub fn read_sweep(
             v
         });
         // a fallback's full run has no reduced coordinates (NaN in the file)
-        let (code, message) = &fallback[k];
-        let reduced_q = if *code == 1 { Array2::zeros((0, nt)) } else { zq.index_axis(ndarray::Axis(0), k).to_owned() };
+        let (code, message) = &c.fallback[k];
+        let reduced_q =
+            if *code == 1 { Array2::zeros((0, nt)) } else { runs.zq.index_axis(ndarray::Axis(0), k).to_owned() };
         let run = ReducedRun { result, reduced_q };
-        let full_probes = full_probes.as_deref().map(|p| at(p, k));
+        let full_probes = runs.full_probes.as_deref().map(|p| run_row(p, k));
         // a finished point's message: why the full model answered (1), or why it was tried
         // in place of the reduced answer kept and how it failed (2)
         let (fallback, note) = match code {
@@ -720,7 +836,93 @@ pub fn read_sweep(
             2 => (None, Some(message.clone())),
             _ => (None, None),
         };
-        out.push((mu, Some(SweepPoint { run, validation: v, full_probes, estimate, extrapolated, fallback, note })));
+        Ok((mu, Some(SweepPoint { run, validation: v, full_probes, estimate, extrapolated, fallback, note })))
     }
-    Ok(out)
+
+    /// Run `k`'s stored estimate: its value and cost (the factor it was made with is the
+    /// basis's); `None` where the file has none for it.
+    fn estimate(&self, k: usize) -> Option<Estimate> {
+        let c = &self.columns;
+        let fifths = |a: &Option<Array2<f64>>| a.as_ref().map_or([f64::NAN; 5], |a| std::array::from_fn(|i| a[[k, i]]));
+        c.estimates.as_ref().map(|a| a[k]).filter(|e| !e.is_nan()).map(|error_estimate| Estimate {
+            error_estimate,
+            raw: f64::NAN,
+            factor: f64::NAN,
+            calibrated: false,
+            seconds: c.estimate_seconds.as_ref().map_or(f64::NAN, |a| a[k]),
+            by_time: fifths(&c.by_time),
+            error_estimate_displacement: c.estimates_displacement.as_ref().map_or(f64::NAN, |a| a[k]),
+            displacement_by_time: fifths(&c.displacement_by_time),
+            failure: None,
+            quantities: self.runs.quantity_estimates.as_ref().map_or_else(Vec::new, |cols| {
+                let each = self.keys.iter().zip(cols);
+                each.map(|((q, name), c)| QuantityEstimate {
+                    probe: name.to_string(),
+                    quantity: *q,
+                    estimate: c[k],
+                    raw: f64::NAN,
+                })
+                .collect()
+            }),
+        })
+    }
+
+    /// Run `k`'s stored validation (a validated reduced sweep's), without its estimate.
+    fn validation(&self, k: usize, mu: &Parameters) -> Option<Validation> {
+        let c = &self.columns;
+        c.validation.as_ref().zip(self.stored).map(|(v, stored)| Validation {
+            load_scale: mu.scale(),
+            parameters: mu.iter().map(|(n, v)| (n.to_string(), v)).collect(),
+            variant: stored.basis.variant.name().to_string(),
+            n_dof: stored.basis.n_dof(),
+            n_modes: self.r,
+            rel_error: v[0][k],
+            max_probe_error: v[1][k],
+            max_probe_error_probe: String::new(),
+            max_probe_error_t: f64::NAN,
+            max_constraint_violation: v[2][k],
+            full_seconds: v[3][k],
+            full_dense_seconds: None,
+            rom_seconds: self.runs.rom_seconds[k],
+            speedup: v[4][k],
+            speedup_vs_dense: None,
+            speedup_with_estimate: None,
+            full_newton_iterations: 0,
+            rom_newton_iterations: c.newton[k] as usize,
+            rom_step_cuts: 0,
+            full_step_cuts: 0,
+            steps_differ_from: c.differ.as_ref().map(|a| a[k]).filter(|t| !t.is_nan()),
+            full_step_cut_times: Vec::new(),
+            rom_step_cut_times: Vec::new(),
+            // the estimate and the flags are set by the caller from the file's columns
+            error_estimate: None,
+            effectivity: None,
+            estimate_calibrated: None,
+            estimate_seconds: None,
+            extrapolated: false,
+            training_range: None,
+            sensitivity: None,
+            training_box: None,
+            sensitivity_near: None,
+            amplifying: false,
+            rel_error_by_time: c.rel_by_time.as_ref().map_or_else(Vec::new, |a| a.row(k).to_vec()),
+            error_estimate_by_time: None,
+            displacement_error: c.displacement.as_ref().map_or(f64::NAN, |a| a[k]),
+            // the words for a stored NaN or ∞ (a sweep before the column has none to explain)
+            displacement_error_note: c.displacement.as_ref().and_then(|a| displacement_note(a[k])).map(str::to_string),
+            displacement_error_by_time: Vec::new(),
+            error_estimate_displacement: None,
+            effectivity_displacement: None,
+            error_estimate_displacement_by_time: None,
+            max_error_over_travel: None,
+            max_error_over_travel_probe: String::new(),
+            probe_errors_over_travel: Vec::new(),
+            probe_quantity_errors: self.runs.quantity_errors.as_ref().map_or_else(Vec::new, |cols| {
+                self.keys.iter().zip(cols).map(|((q, name), c)| ProbeQuantityError::stored(name, *q, c[k])).collect()
+            }),
+            reaction_errors: Vec::new(),
+            error_estimate_method: None,
+            estimate_failure: None,
+        })
+    }
 }
