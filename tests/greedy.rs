@@ -1,4 +1,4 @@
-//! Greedy training over a load range (src/pipeline/greedy.rs).
+//! Greedy training over a load range (src/training/greedy.rs).
 //!
 //! Checks, with where each expected number comes from:
 //! - `greedy_pendulum_meets_its_tolerance`: the thesis pendulum (data/models/pendulum.toml),

@@ -9,9 +9,11 @@
 //! killed sweep leaves a valid file of the finished scales at the final path; `--resume`
 //! ([`sweep_to_file`]) takes the finished scales from it and runs the rest.
 //!
-//! What each load scale became is in `outcome.rs` ([`Sweep`], [`ScaleResult`]), the sweep
-//! file's layout and its writing and reading (`--resume`) in `file.rs`, one run of it with
-//! its basis (for drawing) in `run_at.rs`, the table printed on stdout in `table.rs`.
+//! What each load scale became is in `crate::records::sweep_outcome` ([`Sweep`],
+//! [`ScaleResult`]), the sweep file's layout and its writing and reading (`--resume`) in
+//! `crate::records::sweep_file`, one run of it with its basis (for drawing) in
+//! `crate::records::sweep_run`, the table printed on stdout in `sweep/table.rs`; the
+//! fallback policy in `crate::pipeline::fallback`.
 
 mod table;
 

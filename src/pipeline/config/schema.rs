@@ -101,7 +101,7 @@ pub struct TrainSpec {
     /// the training loads; exactly one of `load_scales` and `greedy`
     #[serde(default)]
     pub load_scales: Option<Vec<f64>>,
-    /// greedy training over a load range (src/pipeline/greedy.rs)
+    /// greedy training over a load range (src/training/greedy.rs)
     #[serde(default)]
     pub greedy: Option<GreedySpec>,
     /// training points sampled from the `[parameters]` box
