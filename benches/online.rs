@@ -8,12 +8,12 @@
 //!     cargo bench --bench online            # everything (about two minutes)
 //!     cargo bench --bench online -- quick   # the thesis meshes only
 
-use flexrom::pipeline::train::{train, train_and_write};
-use flexrom::pipeline::validate::compare;
 use flexrom::pipeline::Pipeline;
 use flexrom::rom::Rom;
 use flexrom::simulate::{simulate, Overrides};
 use flexrom::solver::model::Parameters;
+use flexrom::training::train::{train, train_and_write};
+use flexrom::workflows::validate::compare;
 use std::process::Command;
 use std::sync::Arc;
 

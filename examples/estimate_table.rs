@@ -14,7 +14,6 @@
 //! one (docs/error-estimate.md); `ESTIMATE_SAMPLE=s` the defects method's sampling interval.
 
 use flexrom::pipeline::config::parse_range;
-use flexrom::pipeline::train::train;
 use flexrom::pipeline::Pipeline;
 use flexrom::rom::estimator::norms::{distance_and_norm, rel_error_by_time};
 use flexrom::rom::estimator::{self, defects::Defects, ErrorEstimator, EstimateMethod};
@@ -22,6 +21,7 @@ use flexrom::rom::trust::is_extrapolated;
 use flexrom::rom::{Output, Rom};
 use flexrom::simulate::{simulate, Overrides};
 use flexrom::solver::model::Parameters;
+use flexrom::training::train::train;
 use std::sync::Arc;
 
 fn list(s: &str) -> Vec<f64> {

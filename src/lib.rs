@@ -11,6 +11,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
 
 pub mod analysis;
+pub mod cost;
 pub mod error;
 pub mod interrupt;
 pub mod io;
@@ -20,10 +21,14 @@ pub mod model;
 pub mod output;
 pub mod physics;
 pub mod pipeline;
+pub mod records;
 pub mod reduction;
+pub mod report;
 pub mod rom;
 pub mod simulate;
 pub mod solver;
+pub mod training;
+pub mod workflows;
 
 pub use error::{Error, Result};
 

@@ -289,7 +289,7 @@ fn main() -> ExitCode {
         return ExitCode::FAILURE;
     }
     flexrom::single_threaded_blas();
-    if let Err(e) = flexrom::pipeline::shard::configure_threads(cli.threads) {
+    if let Err(e) = flexrom::workflows::shard::configure_threads(cli.threads) {
         note(&format!("error: {e}"));
         return ExitCode::from(e.exit_code());
     }

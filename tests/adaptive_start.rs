@@ -18,7 +18,7 @@
 //!   zero acceleration 41, constant velocity 11, constant position none, the adaptive start
 //!   of 2026-11-27, which chose between the first two only and started a run at zero
 //!   acceleration, 8). A halved step is where a full run and its reduced run part: they
-//!   then solve different discretizations (src/pipeline/validate.rs).
+//!   then solve different discretizations (src/workflows/validate.rs).
 
 #[path = "common/zoo/mod.rs"]
 mod zoo;

@@ -99,8 +99,8 @@ fn pipeline(dir: &Path) -> String {
 /// basis and a damaged one.
 #[test]
 fn a_reduced_sweep_is_animated_at_one_of_its_loads() {
-    use flexrom::pipeline::motion::Motion;
-    use flexrom::pipeline::sweep::SweepPick;
+    use flexrom::report::motion::Motion;
+    use flexrom::workflows::sweep::SweepPick;
     let dir = tempfile::tempdir().unwrap();
     let p = |n: &str| dir.path().join(n).display().to_string();
     let pipe = pipeline(dir.path());

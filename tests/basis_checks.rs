@@ -17,8 +17,8 @@
 //! - whole-system bases (orthonormal only as the stacked [V; V_λ]) pass the library check.
 
 use flexrom::io::basis_check;
-use flexrom::pipeline::train::train_and_write;
 use flexrom::pipeline::Pipeline;
+use flexrom::training::train::train_and_write;
 use ndarray::{Array1, Array2};
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -25,13 +25,13 @@
 //! - `pipelines_may_still_choose_the_corrected_estimate`: `[online] estimate = "corrected"`
 //!   overrides the default for the same basis file.
 
-use flexrom::pipeline::online::load_rom;
-use flexrom::pipeline::train::train_and_write;
-use flexrom::pipeline::validate::validate;
 use flexrom::pipeline::Pipeline;
 use flexrom::rom::estimator::EstimateMethod;
 use flexrom::rom::Output;
 use flexrom::solver::model::Parameters;
+use flexrom::training::train::train_and_write;
+use flexrom::workflows::online::load_rom;
+use flexrom::workflows::validate::validate;
 use std::path::{Path, PathBuf};
 
 fn repo(rel: &str) -> PathBuf {

@@ -291,9 +291,9 @@ fn a_bad_online_tolerance_is_refused() {
 
 #[test]
 fn a_corrected_trajectory_that_blows_up_reads_the_enriched_model() {
-    use flexrom::pipeline::online::load_rom;
     use flexrom::pipeline::Pipeline;
     use flexrom::rom::estimator::EstimateMethod;
+    use flexrom::workflows::online::load_rom;
     let (_dir, p, _) = setup(None);
     let p = Pipeline::load(&p).unwrap();
     let (_, corrected, _) = load_rom(&p, &p.basis_path, Some(EstimateMethod::Corrected), false).unwrap();
@@ -366,9 +366,9 @@ scaled = true
 
 #[test]
 fn a_correction_that_leaves_the_reduced_step_reads_the_enriched_model() {
-    use flexrom::pipeline::online::load_rom;
     use flexrom::pipeline::Pipeline;
     use flexrom::rom::estimator::EstimateMethod;
+    use flexrom::workflows::online::load_rom;
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("boom.toml"), BOOM).unwrap();
     let p = dir.path().join("pipeline.toml");

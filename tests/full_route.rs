@@ -4,7 +4,7 @@
 //! Checks, and where each expectation comes from:
 //! - `a_full_sweep_is_simulate_at_every_load`: `sweep --full` needs no basis file; its
 //!   probes are, bit for bit, those of `flexrom simulate` at each load of the file's
-//!   `/load_scales` (the same full model and integrator: module docs of `pipeline::sweep`),
+//!   `/load_scales` (the same full model and integrator: module docs of `workflows::sweep`),
 //!   and so are the Newton iterations and factorizations; the file says `route = "full"`,
 //!   holds no `/reduced_q`, `/rom_seconds` or basis attributes, a positive `/full_seconds`
 //!   and NaN estimates (docs/file-formats.md); its CSV has the full sweep's columns (docs/cli.md);
@@ -13,8 +13,8 @@
 //! - `train_stores_the_times_of_both_routes`: the basis file's `/timing` holds positive,
 //!   finite medians of the full and reduced time loops and of the estimate, in seconds
 //!   (`units` "s", scalars), timed at 0.9, the lower middle of the training loads
-//!   [0.9, 1.1] (`pipeline::route::timing_load`), `threads` 1, 1 to 7 rounds (the budget
-//!   of `pipeline::timing`), and `estimate_method` the basis's default;
+//!   [0.9, 1.1] (`cost::route::timing_load`), `threads` 1, 1 to 7 rounds (the budget
+//!   of `cost::timing`), and `estimate_method` the basis's default;
 //! - `the_notice_says_once_when_the_full_model_is_faster`: with `/timing` edited to say the
 //!   reduced run takes 10× the full one, `online` and `sweep` print exactly one warning line
 //!   naming the basis, both times and `sweep --full`; with the reduced run at 1/10 and its

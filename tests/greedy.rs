@@ -1,4 +1,4 @@
-//! Greedy training over a load range (src/pipeline/greedy.rs).
+//! Greedy training over a load range (src/training/greedy.rs).
 //!
 //! Checks, with where each expected number comes from:
 //! - `greedy_pendulum_meets_its_tolerance`: the thesis pendulum (data/models/pendulum.toml),
@@ -24,12 +24,12 @@
 //!   bodies, three bodies) gets the constraint-preserving variant and one POD per body, the
 //!   one-body pendulum (a ground pin only) galerkin and one POD (SPEC §3).
 
-use flexrom::pipeline::train::train_and_write;
-use flexrom::pipeline::validate::validate;
 use flexrom::pipeline::Pipeline;
 use flexrom::reduction::Variant;
 use flexrom::rom::Rom;
 use flexrom::solver::parameters::Parameters;
+use flexrom::training::train::train_and_write;
+use flexrom::workflows::validate::validate;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -74,7 +74,7 @@ fn greedy_pendulum_meets_its_tolerance() {
     assert!(last.true_error <= t, "held-out check {}", last.true_error);
     assert_eq!(g.candidates.len(), 33);
     // the basis as written, at loads that are neither training loads nor candidates
-    let stored = flexrom::pipeline::online::load_basis(&p, &p.basis_path).unwrap();
+    let stored = flexrom::workflows::online::load_basis(&p, &p.basis_path).unwrap();
     for x in [0.57, 1.03, 1.41] {
         assert!(g.load_scales().iter().chain(&g.candidate_loads()).all(|&l| (l - x).abs() > 1e-3));
         let (v, _, _) =

@@ -16,8 +16,6 @@
 //! - a basis file whose /hyper data do not fit the model is refused, naming the dataset.
 
 use flexrom::model::Model;
-use flexrom::pipeline::train::train;
-use flexrom::pipeline::validate::validate;
 use flexrom::pipeline::Pipeline;
 use flexrom::reduction::ecsw::training_matrix;
 use flexrom::reduction::{ecsw, Hyper, HyperReducedModel, Reduced, ReducedModel};
@@ -25,6 +23,8 @@ use flexrom::rom::Rom;
 use flexrom::simulate::{prepare, solve, Overrides, Settings};
 use flexrom::solver::model::{InvariantElementModel, IterationCoefficients, ParametricModel};
 use flexrom::solver::parameters::Parameters;
+use flexrom::training::train::train;
+use flexrom::workflows::validate::validate;
 use ndarray::{Array1, Array2, ArrayView1};
 use std::path::{Path, PathBuf};
 use std::process::Command;

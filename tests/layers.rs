@@ -7,12 +7,15 @@
 //! * an import running upward, or sideways between two top-level modules of one layer, in the
 //!   layer order, top to bottom:
 //!
-//!   `main` → `cli` → `pipeline` → `rom` → `io` → `simulate` → `analysis` → `model` → `reduction` | `physics`
+//!   `main` → `cli` → `report` → `training` → `workflows` → `cost` → `records` → `pipeline`
+//!   → `rom` → `io` → `simulate` → `analysis` → `model` → `reduction` | `physics`
 //!   → `solver` → `linalg` → `output` → `limits` | `interrupt` → `error`
 //!
 //!   (`cli` is the binary's command handlers, below `main.rs`'s parsing and dispatch;
 //!   `reduction` and `physics` share a layer and must not see each other: the reduction
-//!   knows the physics only through the traits of `solver::model`).
+//!   knows the physics only through the traits of `solver::model`; the rooms from `report`
+//!   to `pipeline` are the workflow's concerns: presentation, offline training, online
+//!   workflows, the cost model, what runs record and their files, the pipeline file).
 //!
 //! Comments, string literals and `#[cfg(test)]` modules are left out (a unit test may reach
 //! wherever it needs). The expected results are structural, not numbers: no cycle, no
@@ -26,6 +29,11 @@ use std::path::Path;
 const LAYERS: &[&[&str]] = &[
     &["main"],
     &["cli"],
+    &["report"],
+    &["training"],
+    &["workflows"],
+    &["cost"],
+    &["records"],
     &["pipeline"],
     &["rom"],
     &["io"],

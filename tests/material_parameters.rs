@@ -40,13 +40,13 @@
 mod common;
 
 use flexrom::model::Model;
-use flexrom::pipeline::train::train;
 use flexrom::pipeline::Pipeline;
 use flexrom::reduction::ecsw::training_matrix;
 use flexrom::reduction::{ecsw, Basis, Hyper, HyperReducedModel, ReducedModel};
 use flexrom::simulate::{prepare, Overrides, Settings};
 use flexrom::solver::model::{stiffness_groups, ElementModel, IterationCoefficients, ParametricModel};
 use flexrom::solver::parameters::Parameters;
+use flexrom::training::train::train;
 use ndarray::Array2;
 use std::path::{Path, PathBuf};
 use std::process::Command;

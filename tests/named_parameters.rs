@@ -11,11 +11,11 @@
 //! horizontal tip force added.
 
 use flexrom::model::Model;
-use flexrom::pipeline::train::train;
 use flexrom::pipeline::Pipeline;
 use flexrom::rom::{Output, ReducedRunner};
 use flexrom::simulate::{simulate, Overrides};
 use flexrom::solver::model::Parameters;
+use flexrom::training::train::train;
 use ndarray::Array2;
 use std::path::Path;
 use std::process::Command;

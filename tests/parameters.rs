@@ -12,11 +12,11 @@
 
 use flexrom::linalg::kkt::LinearSolverKind;
 use flexrom::model::Model;
-use flexrom::pipeline::train::train;
 use flexrom::pipeline::Pipeline;
 use flexrom::rom::{Output, ReducedRunner};
 use flexrom::simulate::{simulate, FullModel, Overrides};
 use flexrom::solver::model::Parameters;
+use flexrom::training::train::train;
 use ndarray::Array2;
 use std::path::Path;
 use std::sync::Arc;

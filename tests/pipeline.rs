@@ -22,10 +22,10 @@
 use flexrom::io::basis_file::read_basis;
 use flexrom::solver::parameters::Parameters;
 
-use flexrom::pipeline::train::train_and_write;
-use flexrom::pipeline::validate::validate;
 use flexrom::pipeline::Pipeline;
 use flexrom::rom::Rom;
+use flexrom::training::train::train_and_write;
+use flexrom::workflows::validate::validate;
 use ndarray::Array2;
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -28,12 +28,12 @@
 //! held to the bound only.
 
 use flexrom::physics::system::FlexibleSystem;
-use flexrom::pipeline::train::train;
 use flexrom::pipeline::Pipeline;
 use flexrom::reduction::HyperReducedModel;
 use flexrom::simulate::{prepare, Overrides, Settings};
 use flexrom::solver::generalized_alpha::{GeneralizedAlpha, IntegratorParams, JacobianReuse, Predictor, Stats};
 use flexrom::solver::model::{Bound, DynamicModel, Parameters, ParametricModel};
+use flexrom::training::train::train;
 use std::path::{Path, PathBuf};
 
 /// the bound on a step end's distance from the root, in tolerances (see the header)

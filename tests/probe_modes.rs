@@ -23,7 +23,7 @@
 //!   output modes for the root's strain and curvature (the upper link some, the lower none),
 //!   and training's lines name them (the held-out check's error in this measure, the larger
 //!   of rel_error and the worst probe quantity: `the_probes_measure_holds_the_worst_quantity`
-//!   in src/pipeline/greedy.rs).
+//!   in src/training/greedy.rs).
 //! - `probe_modes_are_refused_where_they_cannot_apply`: a model whose probes record neither
 //!   quantity, a tolerance outside (0, 1) — each named as
 //!   `reduction.probe_modes`; `measure = "probes"` on a model without probes, named as

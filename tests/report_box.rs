@@ -1,5 +1,5 @@
 //! `run`'s report over a box of parameters: maps over the box in place of the figures
-//! against the load scale (docs/cli.md, "The report"; src/pipeline/report_maps.rs).
+//! against the load scale (docs/cli.md, "The report"; src/report/report_maps.rs).
 //!
 //! Model: the two-link arm of tests/common (4 elements a link, Δt 5 ms, 1 s: a run in
 //! milliseconds), its shoulder moment scaled by the load scale, its tip force by `payload`

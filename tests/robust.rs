@@ -426,7 +426,7 @@ fn verbose_runs_say_their_largest_axial_strain() {
 /// Worker counts: an absurd one (from the option or either variable) is refused naming where
 /// it came from, before any run, and leaves no file; one above the cores is cut to them. The
 /// cores are what `std::thread::available_parallelism` says here, the figure the program
-/// reads too; 1024 is `pipeline::shard::MOST_THREADS`.
+/// reads too; 1024 is `workflows::shard::MOST_THREADS`.
 #[test]
 fn absurd_thread_counts_are_refused_and_large_ones_cut_to_the_cores() {
     let dir = tempfile::tempdir().unwrap();

@@ -14,11 +14,11 @@
 //! - The full 5000-element pendulum (data/models/pendulum_5000.toml, ~1 s) at λ = 1. Before
 //!   (the elastic terms over absolute coordinates): 123 of 220 steps at the floor.
 
-use flexrom::pipeline::train::train;
 use flexrom::pipeline::Pipeline;
 use flexrom::rom::Rom;
 use flexrom::simulate::{simulate, Overrides};
 use flexrom::solver::model::Parameters;
+use flexrom::training::train::train;
 use std::path::Path;
 use std::sync::Arc;
 

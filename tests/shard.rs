@@ -7,7 +7,7 @@
 //!   `estimate_seconds`), which must only be NaN in the same rows; the same attributes on
 //!   `/`, equal except `wall_seconds` and `threads` (whole-sweep measurements). The
 //!   reference is the single sweep itself: without `--continuation` every load runs on its
-//!   own (module docs of `pipeline::sweep`), so nothing but the run order differs;
+//!   own (module docs of `workflows::sweep`), so nothing but the run order differs;
 //! - `merge` refuses, with one line naming the file: a part of another load list, a part of
 //!   another basis, a file that is no part, two parts of the same shard (naming the
 //!   duplicate loads), a missing shard (naming its loads: shard 4/4 of 9 loads holds loads

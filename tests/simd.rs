@@ -23,11 +23,11 @@
 use flexrom::linalg::dense_lu::DenseLu;
 use flexrom::linalg::simd::set_scalar_only;
 use flexrom::model::Model;
-use flexrom::pipeline::train::train;
 use flexrom::pipeline::Pipeline;
 use flexrom::rom::Rom;
 use flexrom::simulate::{simulate, Overrides};
 use flexrom::solver::model::Parameters;
+use flexrom::training::train::train;
 
 /// Factors and solves the bordered block system; returns the solution.
 fn bordered_solve() -> Vec<f64> {

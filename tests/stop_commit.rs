@@ -2,7 +2,7 @@
 //! SIGTERM and SIGHUP handler before it ends the process) leaves and says, at the moments a
 //! mutation campaign's signals hit:
 //! - during `run`'s commit of its basis and report folder (`swap_in_dir_with`, as
-//!   `pipeline::report::run_with` calls it), before the renames: the previous basis and
+//!   `report::run_with` calls it), before the renames: the previous basis and
 //!   report stay byte for byte, no temporary path is left, and the message says the previous
 //!   outputs were left (7 of 40 SIGINTs during `flexrom run` had left a new basis beside the
 //!   old report, saying the same);

@@ -486,7 +486,7 @@ fn where_the_full_model_fails_too_the_reduced_answer_stands_with_a_note() {
     assert!(f.dataset("reduced_q").unwrap().read_raw::<f64>().unwrap().iter().all(|x| x.is_finite()));
     drop(f);
     let m = &messages(&out)[0];
-    assert!(m.starts_with(flexrom::pipeline::sweep::fallback::FULL_TRIED), "{m}");
+    assert!(m.starts_with(flexrom::pipeline::fallback::FULL_TRIED), "{m}");
     assert!(m.contains("failed: sweep (full run) at load scale 1.34: blow-up"), "{m}");
 }
 

@@ -18,12 +18,12 @@
 
 use flexrom::io::basis_check::INF_SUP_MIN;
 use flexrom::linalg::kkt::LinearSolverKind;
-use flexrom::pipeline::train::train;
-use flexrom::pipeline::validate::validate;
 use flexrom::pipeline::Pipeline;
 use flexrom::reduction::whole_system::{constraint_matrix, inf_sup};
 use flexrom::rom::Rom;
 use flexrom::solver::parameters::Parameters;
+use flexrom::training::train::train;
+use flexrom::workflows::validate::validate;
 use ndarray::Array2;
 use std::path::Path;
 

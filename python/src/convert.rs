@@ -2,8 +2,8 @@
 //! warnings through Python's `warnings`, a sweep as a dict of arrays.
 
 use crate::errors::{model_error, FlexromWarning};
-use flexrom::pipeline::sweep::{Outcome, Sweep};
 use flexrom::solver::parameters::Parameters;
+use flexrom::workflows::sweep::{Outcome, Sweep};
 use numpy::{IntoPyArray, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;

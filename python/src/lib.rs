@@ -19,12 +19,12 @@ use flexrom::io::labels::Labels;
 use flexrom::io::output::{check_output, Origin};
 use flexrom::io::result_file::{ResultFile, RunPlan};
 use flexrom::model::Model;
-use flexrom::pipeline::online::{load_rom, pipeline_of_basis};
 use flexrom::pipeline::Pipeline;
 use flexrom::rom::estimator::{Estimate, EstimateMethod};
 use flexrom::rom::{Rom, Trust};
 use flexrom::simulate::{Overrides, SimulationResult};
 use flexrom::solver::parameters::Parameters;
+use flexrom::workflows::online::{load_rom, pipeline_of_basis};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArrayDyn};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
@@ -735,7 +735,7 @@ impl PyRunResult {
         size: Option<(u32, u32)>,
         max_frames: usize,
     ) -> PyResult<()> {
-        use flexrom::pipeline::animate::{animate, check_own_gif, AnimateOptions};
+        use flexrom::report::animate::{animate, check_own_gif, AnimateOptions};
         check_own_gif(&path, "path", &[(&self.model.path, "model file")]).map_err(to_py)?;
         let defaults = AnimateOptions::default();
         let size = size.map_or(defaults.size, |(w, h)| (w, Some(h)));
@@ -1126,7 +1126,7 @@ impl PyBasis {
         let params = convert::named(params)?;
         let mu = self.point(py, load_scale, params.as_ref())?;
         let rom = &self.rom;
-        let done = interruptible(py, || flexrom::pipeline::online::answer(rom, &mu, fallback))?;
+        let done = interruptible(py, || flexrom::workflows::online::answer(rom, &mu, fallback))?;
         if done.fallback.is_some() {
             // the full model's answer: exact, nothing to warn about
             let r = done.run.result;
@@ -1203,9 +1203,9 @@ impl PyBasis {
             (None, Some(p)) => p.iter().map(|p| self.point(py, None, Some(p))).collect::<PyResult<_>>()?,
             _ => return Err(errors::model_error("sweep: give exactly one of load_scales and points")),
         };
-        let o = flexrom::pipeline::sweep::SweepOptions { continuation, fallback, ..Default::default() };
+        let o = flexrom::workflows::sweep::SweepOptions { continuation, fallback, ..Default::default() };
         let rom = &self.rom;
-        let s = interruptible_with(py, progress.as_ref(), || flexrom::pipeline::sweep::sweep(rom, &mus, o))?;
+        let s = interruptible_with(py, progress.as_ref(), || flexrom::workflows::sweep::sweep(rom, &mus, o))?;
         let measure = rom.tolerance_measure();
         let runs: Vec<(Parameters, Option<f64>)> = s
             .scales
@@ -1239,8 +1239,8 @@ impl PyBasis {
     /// The `fallback` argument of `online` and `sweep` (`what` names the method in
     /// errors): "none" or "full", default the pipeline's `[online] fallback`; "full" needs
     /// the error estimate to judge each reduced answer.
-    fn fallback_choice(&self, given: Option<String>, what: &str) -> PyResult<flexrom::pipeline::sweep::Fallback> {
-        use flexrom::pipeline::sweep::Fallback;
+    fn fallback_choice(&self, given: Option<String>, what: &str) -> PyResult<flexrom::workflows::sweep::Fallback> {
+        use flexrom::workflows::sweep::Fallback;
         let fallback = match given.as_deref() {
             None => self.pipeline.online_fallback().unwrap_or_default(),
             Some("none") => Fallback::None,
@@ -1353,7 +1353,7 @@ fn train<'py>(
             Some(_) => Origin::Flag("output"),
             None => Origin::Key { pipeline: &p.path, key: "basis" },
         };
-        flexrom::pipeline::train::train_to_file(&p, &out, origin, &[])
+        flexrom::training::train::train_to_file(&p, &out, origin, &[])
     })?;
     warn(py, &summary.warnings)?;
     let (b, warnings) =
@@ -1378,7 +1378,7 @@ fn validate<'py>(
     dense: Option<bool>,
     params: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    use flexrom::pipeline::dense::DenseChoice;
+    use flexrom::cost::dense::DenseChoice;
     let params = convert::named(params)?;
     let method = estimate.map(parse_method).transpose()?;
     let p = py.detach(|| Pipeline::load(&pipeline)).map_err(to_py)?;
@@ -1400,11 +1400,11 @@ fn validate<'py>(
         Some(true) => DenseChoice::Always,
         Some(false) => DenseChoice::Never,
     };
-    let with_dense = flexrom::pipeline::dense::decide(choice, &p.model).map_err(to_py)?;
+    let with_dense = flexrom::cost::dense::decide(choice, &p.model).map_err(to_py)?;
     let vs = interruptible(py, || {
         points
             .iter()
-            .map(|mu| flexrom::pipeline::validate::validate(&rom, mu, with_dense).map(|v| v.0))
+            .map(|mu| flexrom::workflows::validate::validate(&rom, mu, with_dense).map(|v| v.0))
             .collect::<flexrom::Result<Vec<_>>>()
     })?;
     // the command's warnings after its runs: estimates over the tolerance, extrapolation,

@@ -2,8 +2,8 @@
 
 use flexrom::limits::Limits;
 use flexrom::output::info;
-use flexrom::pipeline::animate::{animate_picked, check_own_gif, AnimateOptions};
-use flexrom::pipeline::sweep::SweepPick;
+use flexrom::report::animate::{animate_picked, check_own_gif, AnimateOptions};
+use flexrom::workflows::sweep::SweepPick;
 use std::path::PathBuf;
 
 /// The arguments of `flexrom animate`.

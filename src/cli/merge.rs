@@ -29,13 +29,13 @@ impl Args {
         let Args { parts, output, partial, format } = self;
         let inputs: Vec<(&std::path::Path, &str)> = parts.iter().map(|p| (p.as_path(), "part file")).collect();
         check_output(&output, Origin::Flag("-o"), &inputs, &[Kind::Sweep])?;
-        let m = flexrom::pipeline::merge::merge(&parts, &output, partial, limits)?;
-        print_table(&flexrom::pipeline::tables::sweep_table(&m.sweep), format.format(), false)?;
+        let m = flexrom::workflows::merge::merge(&parts, &output, partial, limits)?;
+        print_table(&flexrom::report::tables::sweep_table(&m.sweep), format.format(), false)?;
         info(&format!(
             "{} parts, {} {} ({} not run) -> {}",
             m.parts,
             m.sweep.scales.len(),
-            flexrom::pipeline::sweep::runs_noun(m.sweep.scales.iter().map(|x| &x.mu)),
+            flexrom::workflows::sweep::runs_noun(m.sweep.scales.iter().map(|x| &x.mu)),
             m.gaps,
             output.display()
         ));

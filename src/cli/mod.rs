@@ -14,9 +14,9 @@ pub mod sweep;
 pub mod train;
 pub mod validate;
 
+use flexrom::cost::dense::DenseChoice;
 use flexrom::output::table::{Format, Table};
 use flexrom::output::{self, detail};
-use flexrom::pipeline::dense::DenseChoice;
 use flexrom::solver::parameters::Parameters;
 
 /// `--csv` / `--json`: how a command prints its results on stdout.
@@ -36,7 +36,7 @@ impl FormatArgs {
     }
 }
 
-/// `--dense` / `--no-dense` of `validate` and `run` ([`flexrom::pipeline::dense`]).
+/// `--dense` / `--no-dense` of `validate` and `run` ([`flexrom::cost::dense`]).
 #[derive(clap::Args, Clone, Copy)]
 pub struct DenseArgs {
     /// skip the full run with a dense LU (its time and speedup are then empty)
@@ -166,7 +166,7 @@ pub fn print_table(t: &Table, format: Format, single: bool) -> flexrom::Result<(
     }
 }
 
-/// Prints a run's time series on stdout ([`flexrom::pipeline::tables::series_table`], one
+/// Prints a run's time series on stdout ([`flexrom::report::tables::series_table`], one
 /// row per instant) as CSV or JSON; nothing in text mode. `simulate --csv/--json` and
 /// `online --csv` print it alike.
 pub fn print_series(
@@ -177,7 +177,7 @@ pub fn print_series(
     if format == Format::Text {
         return Ok(());
     }
-    print_table(&flexrom::pipeline::tables::series_table(model, r), format, false)
+    print_table(&flexrom::report::tables::series_table(model, r), format, false)
 }
 
 /// `-v`: the settings and Newton statistics of one run (`reduced`: of a reduced model, whose

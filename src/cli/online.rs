@@ -6,8 +6,8 @@ use flexrom::io::output::{check_output, Origin};
 use flexrom::limits::Limits;
 use flexrom::output::info;
 use flexrom::output::table::{Cell, Format, Table};
-use flexrom::pipeline::online::{load_rom, online_to_file};
 use flexrom::pipeline::Pipeline;
+use flexrom::workflows::online::{load_rom, online_to_file};
 use std::path::PathBuf;
 
 /// The arguments of `flexrom online`.
@@ -35,7 +35,7 @@ pub struct Args {
     /// the full model and write its exact result (attribute `fallback`: why); over the
     /// pipeline's [online] fallback, default none
     #[arg(long, value_enum, value_name = "WHAT")]
-    fallback: Option<flexrom::pipeline::sweep::Fallback>,
+    fallback: Option<flexrom::workflows::sweep::Fallback>,
     /// also write ParaView's view beside the result: the deformed centre lines at every
     /// instant (4 points an element) with strain, curvature and velocity, in the result
     /// file's /paraview and an XDMF file of the same stem (out.h5 → out.xdmf)
@@ -73,7 +73,7 @@ impl Args {
         let (stored, rom, warnings) = load_rom(&p, &path, estimate.method(), false)?;
         warn(&warnings);
         // read before the run (a damaged /timing fails now), said after it
-        let notice = flexrom::pipeline::route::speed_notice_of(&path, &rom)?;
+        let notice = flexrom::cost::route::speed_notice_of(&path, &rom)?;
         let fallback = fallback.or(p.online_fallback()).unwrap_or_default();
         let done = online_to_file(&p, &rom, &path, &mu, &output, fallback, paraview)?;
         let (run, estimate) = (&done.run, &done.estimate);
@@ -96,7 +96,7 @@ impl Args {
         }
         run_details(&run.result, true);
         let mut cols = vec!["load_scale", "n_modes"];
-        cols.extend(flexrom::pipeline::tables::RUN_COLUMNS);
+        cols.extend(flexrom::report::tables::RUN_COLUMNS);
         cols.extend(["error_estimate", "extrapolated", "output", "error_estimate_displacement", "fallback"]);
         // the named parameters last, as a sweep's table has them
         let named: Vec<String> = mu.named().map(|(name, _)| format!("parameter:{name}")).collect();
@@ -105,7 +105,7 @@ impl Args {
         // a full answer has no modes
         let modes = if done.fallback.is_some() { Cell::Null } else { stored.basis.n_reduced().into() };
         let mut row: Vec<Cell> = vec![load_scale.into(), modes];
-        row.extend(flexrom::pipeline::tables::run_cells(&run.result));
+        row.extend(flexrom::report::tables::run_cells(&run.result));
         row.extend([
             estimate.as_ref().map(|e| e.error_estimate).into(),
             done.extrapolated.into(),

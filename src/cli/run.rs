@@ -36,19 +36,14 @@ impl Args {
         let p = Pipeline::load_with(&pipeline, limits.clone())?;
         super::warn(&p.property_warnings());
         super::warn(&super::model_resolution(&p.model));
-        if p.online_fallback() == Some(flexrom::pipeline::sweep::Fallback::Full) {
+        if p.online_fallback() == Some(flexrom::workflows::sweep::Fallback::Full) {
             info(&format!(
                 "{}: [online] fallback = \"full\" applies to `sweep` and `online`; the report's sweep is validated and measures the reduced model at every load",
                 p.path.display()
             ));
         }
-        let (dir, warnings) = flexrom::pipeline::report::run_with(
-            &p,
-            output::show_progress(),
-            dense.choice(),
-            estimate.method(),
-            retrain,
-        )?;
+        let (dir, warnings) =
+            flexrom::report::run_with(&p, output::show_progress(), dense.choice(), estimate.method(), retrain)?;
         super::warn(&warnings);
         let read = |name: &str| {
             let f = dir.join(name);
@@ -59,7 +54,7 @@ impl Args {
             f => print_table(&Table::from_json_records(&read("validation.json")?)?, f, false)?,
         }
         info(&format!("report: {}", dir.display()));
-        super::warn(&flexrom::pipeline::report::check_report(&p, &dir, strict, estimate.method())?);
+        super::warn(&flexrom::report::check_report(&p, &dir, strict, estimate.method())?);
         Ok(())
     }
 }

@@ -106,13 +106,13 @@ impl Args {
             info(&format!("  {name}: ({:.6e}, {:.6e}) m", xy[[k, 0]], xy[[k, 1]]));
         }
         // the probe table with the load factor of each row beside its time
-        let mut table = flexrom::pipeline::tables::probe_table(&r);
+        let mut table = flexrom::report::tables::probe_table(&r);
         table.columns.insert(1, "load_factor".into());
         for (row, step) in table.rows.iter_mut().zip(&solution.steps) {
             row.insert(1, Cell::from(step.load_factor));
         }
         if format.format() != flexrom::output::table::Format::Text {
-            flexrom::pipeline::tables::add_reactions(&mut table, &model, &r);
+            flexrom::report::tables::add_reactions(&mut table, &model, &r);
         }
         print_table(&table, format.format(), false)
     }

@@ -7,10 +7,10 @@ use flexrom::io::output::{check_output, Origin};
 use flexrom::limits::Limits;
 use flexrom::output::table::Format;
 use flexrom::output::{self, info};
-use flexrom::pipeline::online::load_rom;
-use flexrom::pipeline::sweep::{Route, SweepBasis, SweepFile};
 use flexrom::pipeline::Pipeline;
 use flexrom::solver::parameters::{Parameters, LOAD_SCALE};
+use flexrom::workflows::online::load_rom;
+use flexrom::workflows::sweep::{Route, SweepBasis, SweepFile};
 use std::path::PathBuf;
 
 /// The arguments of `flexrom sweep`.
@@ -54,7 +54,7 @@ pub struct Args {
     /// exact answer (`/fallback` 1, why in `/message`); over the pipeline's [online]
     /// fallback, default none
     #[arg(long, value_enum, value_name = "WHAT", conflicts_with_all = ["validate", "full"])]
-    fallback: Option<flexrom::pipeline::sweep::Fallback>,
+    fallback: Option<flexrom::workflows::sweep::Fallback>,
     /// skip the error estimate (about 2× faster; `/error_estimate` is then NaN)
     #[arg(long, conflicts_with = "estimate")]
     no_estimate: bool,
@@ -76,7 +76,7 @@ pub struct Args {
     /// `K/N`: run only the K-th (1-based) of N parts of the load list (loads K, K+N,
     /// K+2N, …) into the part file given by -o; join the parts with `flexrom merge`
     #[arg(long, value_name = "K/N")]
-    shard: Option<flexrom::pipeline::shard::Shard>,
+    shard: Option<flexrom::workflows::shard::Shard>,
     #[command(flatten)]
     estimate: EstimateArgs,
     #[command(flatten)]
@@ -85,7 +85,7 @@ pub struct Args {
 
 /// With `--validate`: the median of the points' speedups, and what they are (one run of each
 /// model, timed while the other threads ran theirs: one point's figure is noisy).
-fn speedup_summary(sw: &flexrom::pipeline::sweep::Sweep) -> Option<String> {
+fn speedup_summary(sw: &flexrom::workflows::sweep::Sweep) -> Option<String> {
     let mut v: Vec<f64> = sw
         .scales
         .iter()
@@ -95,7 +95,7 @@ fn speedup_summary(sw: &flexrom::pipeline::sweep::Sweep) -> Option<String> {
     if v.is_empty() {
         return None;
     }
-    let median = flexrom::pipeline::timing::median(&mut v);
+    let median = flexrom::cost::timing::median(&mut v);
     Some(format!(
         "speedup (reduced run without its estimate): median {median:.2}× over {} points, each from one run of either model{}; `validate` times medians of interleaved runs",
         v.len(),
@@ -147,9 +147,9 @@ impl Args {
         }
         // the fallback this sweep runs with: none for a full or a validated sweep (which
         // measures the reduced model at every point)
-        use flexrom::pipeline::sweep::Fallback;
+        use flexrom::workflows::sweep::Fallback;
         let keyed = fallback.is_none() && p.online_fallback() == Some(Fallback::Full);
-        let options = flexrom::pipeline::sweep::SweepOptions {
+        let options = flexrom::workflows::sweep::SweepOptions {
             validate,
             continuation,
             progress: output::show_progress(),
@@ -179,7 +179,7 @@ impl Args {
         }
         // read before the runs (a damaged /timing fails now), said after them, failed runs or not
         let notice = match &loaded {
-            Some((_, rom, _)) => flexrom::pipeline::route::speed_notice_of(&path, rom)?,
+            Some((_, rom, _)) => flexrom::cost::route::speed_notice_of(&path, rom)?,
             None => None,
         };
         let route = match &loaded {
@@ -202,12 +202,12 @@ impl Args {
         }
         let file = SweepFile { out: &out, resume, extra: &|_| Ok(()) };
         let sw = match shard {
-            Some(k) => flexrom::pipeline::shard::sweep_shard(&p, route, &points, k, options, file)?,
-            None => flexrom::pipeline::sweep::sweep_to_file(route, &points, options, file)?,
+            Some(k) => flexrom::workflows::shard::sweep_shard(&p, route, &points, k, options, file)?,
+            None => flexrom::workflows::sweep::sweep_to_file(route, &points, options, file)?,
         };
         match format.format() {
-            Format::Text => output::print(&flexrom::pipeline::sweep::table(&sw))?,
-            f => print_table(&flexrom::pipeline::tables::sweep_table(&sw), f, false)?,
+            Format::Text => output::print(&flexrom::workflows::sweep::table(&sw))?,
+            f => print_table(&flexrom::report::tables::sweep_table(&sw), f, false)?,
         }
         info(&format!(
             "{}{}{} {} ({} resumed) on {} threads in {:.3} s -> {}",
@@ -283,8 +283,9 @@ impl Args {
 /// One line when the full model answered some points in place of the reduced one, or was
 /// tried and failed: how many, why (by kind), the first few, and that the warnings after it
 /// are about the reduced answers kept.
-fn fallback_summary(sw: &flexrom::pipeline::sweep::Sweep) -> Option<String> {
-    use flexrom::pipeline::sweep::{fallback::kind, runs_noun, ScaleResult};
+fn fallback_summary(sw: &flexrom::workflows::sweep::Sweep) -> Option<String> {
+    use flexrom::pipeline::fallback::kind;
+    use flexrom::workflows::sweep::{runs_noun, ScaleResult};
     let (answered, tried) = (sw.n_fallback(), sw.n_fallback_failed());
     if answered + tried == 0 {
         return None;
@@ -347,7 +348,7 @@ fn sweep_points(
     params: &[String],
     file: Option<&std::path::Path>,
 ) -> flexrom::Result<Vec<Parameters>> {
-    use flexrom::pipeline::points::{grid, parse_axis, read_points_csv};
+    use flexrom::workflows::points::{grid, parse_axis, read_points_csv};
     let points = if let Some(f) = file {
         let points = read_points_csv(f)?;
         // a misspelt column is the CSV's problem: name its header

@@ -28,7 +28,7 @@ pub struct Args {
     load_scale: Option<f64>,
     /// `K/N`: the --snapshots-only runs of loads K, K+N, … of train.load_scales
     #[arg(long, value_name = "K/N", requires = "snapshots_only")]
-    shard: Option<flexrom::pipeline::shard::Shard>,
+    shard: Option<flexrom::workflows::shard::Shard>,
     /// snapshot file of --snapshots-only
     #[arg(short, long, requires = "snapshots_only")]
     output: Option<PathBuf>,
@@ -53,8 +53,8 @@ impl Args {
                 &[(&p.path, "pipeline file"), (&p.model.path, "model file")],
                 &[Kind::Snapshots],
             )?;
-            let points = flexrom::pipeline::snapshots::job_points(&p, load_scale, shard)?;
-            let (n, secs) = flexrom::pipeline::snapshots::write_snapshots(&p, &points, &out)?;
+            let points = flexrom::training::snapshots::job_points(&p, load_scale, shard)?;
+            let (n, secs) = flexrom::training::snapshots::write_snapshots(&p, &points, &out)?;
             let scales: Vec<f64> = points.iter().map(|mu| mu.scale()).collect();
             let at = if p.space().is_empty() {
                 format!("{scales:?}")
@@ -76,7 +76,7 @@ impl Args {
         let origin =
             if basis.is_some() { Origin::Flag("--basis") } else { Origin::Key { pipeline: &p.path, key: "basis" } };
         let out = basis.clone().unwrap_or_else(|| p.basis_path.clone());
-        let s = flexrom::pipeline::train::train_to_file(&p, &out, origin, &from_snapshots)?;
+        let s = flexrom::training::train::train_to_file(&p, &out, origin, &from_snapshots)?;
         super::warn(&s.warnings);
         let b = &s.trained.basis;
         info(&format!(

@@ -4,9 +4,9 @@ use super::{warn, DenseArgs, EstimateArgs, FormatArgs};
 use flexrom::limits::Limits;
 use flexrom::output::table::{Format, Table};
 use flexrom::output::{self};
-use flexrom::pipeline::online::load_rom;
 use flexrom::pipeline::Pipeline;
 use flexrom::solver::parameters::Parameters;
+use flexrom::workflows::online::load_rom;
 use std::path::PathBuf;
 
 /// The arguments of `flexrom validate`.
@@ -53,10 +53,10 @@ impl Args {
         let path = basis.unwrap_or_else(|| p.basis_path.clone());
         let (_, rom, warnings) = load_rom(&p, &path, estimate.method(), false)?;
         warn(&warnings);
-        let with_dense = flexrom::pipeline::dense::decide(dense.choice(), &p.model)?;
+        let with_dense = flexrom::cost::dense::decide(dense.choice(), &p.model)?;
         let mut vs = Vec::with_capacity(points.len());
         for mu in &points {
-            let (v, _, _) = flexrom::pipeline::validate::validate(&rom, mu, with_dense)?;
+            let (v, _, _) = flexrom::workflows::validate::validate(&rom, mu, with_dense)?;
             // text: each load's lines as soon as they are known
             if format.format() == Format::Text {
                 output::println(&v.describe())?;

@@ -495,7 +495,7 @@ impl Pipeline {
     }
 
     /// `[online] fallback`, when given.
-    pub fn online_fallback(&self) -> Option<crate::pipeline::sweep::Fallback> {
+    pub fn online_fallback(&self) -> Option<crate::pipeline::fallback::Fallback> {
         self.file.online.as_ref().and_then(|o| o.fallback)
     }
 

@@ -231,7 +231,7 @@ fn run<R: Reduced<FlexibleSystem>>(
             curvatures: values.curvatures,
             stats,
             wall_seconds,
-            // computed where written (pipeline::online::answer), not in every reduced run
+            // computed where written (workflows::online::answer), not in every reduced run
             energy: None,
         },
         reduced_q: zq,

@@ -101,7 +101,7 @@ pub struct TrainSpec {
     /// the training loads; exactly one of `load_scales` and `greedy`
     #[serde(default)]
     pub load_scales: Option<Vec<f64>>,
-    /// greedy training over a load range (src/pipeline/greedy.rs)
+    /// greedy training over a load range (src/training/greedy.rs)
     #[serde(default)]
     pub greedy: Option<GreedySpec>,
     /// training points sampled from the `[parameters]` box
@@ -339,7 +339,7 @@ pub struct OnlineSpec {
     /// its warning, or the failure; the default) or "full" (run the full model there and
     /// keep its exact answer; docs/basis-and-sweep.md)
     #[serde(default)]
-    pub fallback: Option<crate::pipeline::sweep::Fallback>,
+    pub fallback: Option<crate::pipeline::fallback::Fallback>,
 }
 
 #[derive(Clone, Debug, Deserialize)]

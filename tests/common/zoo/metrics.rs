@@ -139,7 +139,7 @@ pub fn model_stats(runs: &[Result<Validation, String>]) -> ModelStats {
 }
 
 /// Whether `sweep --fallback full` answers a validation's load with the full model (docs/
-/// basis-and-sweep.md), by the rule of `flexrom::pipeline::sweep::fallback`: the reduced
+/// basis-and-sweep.md), by the rule of `flexrom::pipeline::fallback`: the reduced
 /// run failed (the zoo validates only where the full model runs: its models are replaced
 /// otherwise), its estimate is above the tolerance `tol` (the zoo's pipelines hold it to the
 /// training tolerance, relative measure), or training's sensitivity beside the load

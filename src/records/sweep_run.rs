@@ -9,8 +9,8 @@
 //! reduced one (`--fallback full`) no reduced coordinates: both are refused with the command
 //! that draws such a run (`flexrom simulate … --load-scale L`, then `flexrom animate`).
 
-use super::file::points_of;
-use super::outcome::{STATUS_OK, STATUS_PENDING};
+use super::sweep_file::points_of;
+use super::sweep_outcome::{STATUS_OK, STATUS_PENDING};
 use crate::error::{Error, Result};
 use crate::io::attrs::{check_layout, Kind, KIND_ATTR};
 use crate::io::h5::{bounded_len, dataset_of_shape, read_attr_str, read_strings};

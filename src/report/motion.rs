@@ -1,12 +1,12 @@
 //! A run's motion as drawing reads it, an instant at a time: the coordinates `/q` of a
 //! result file (`simulate`, `online`, `statics`: a reduced run's file holds them
 //! reconstructed), or one run of a reduced sweep file reconstructed on its basis
-//! ([`super::sweep::run_at`]), with the model it ran and its time grid.
+//! ([`crate::records::sweep_run`]), with the model it ran and its time grid.
 
-use super::sweep::{is_sweep_file, open_sweep_run, SweepPick, SweepRun};
 use crate::error::{Error, Result};
 use crate::io::result_read::ResultReader;
 use crate::model::Model;
+use crate::workflows::sweep::{is_sweep_file, open_sweep_run, SweepPick, SweepRun};
 use std::path::Path;
 
 /// Where the coordinates come from.

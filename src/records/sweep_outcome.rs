@@ -1,7 +1,7 @@
 //! What a sweep produced: the outcome of every load scale (done, failed, not run yet), the
 //! status codes of the sweep file's `/status`, and the one-line summary of the failures.
 
-use crate::pipeline::validate::Validation;
+use super::validation::Validation;
 use crate::rom::estimator::Estimate;
 use crate::rom::ReducedRun;
 use crate::solver::parameters::Parameters;
@@ -24,11 +24,11 @@ pub struct SweepPoint {
     /// outside the training range
     pub extrapolated: bool,
     /// `Some(why)`: the full model answered this point in place of the reduced one
-    /// ([`super::Fallback::Full`]): `run` is the full run (its probes; no reduced
+    /// ([`crate::pipeline::fallback::Fallback::Full`]): `run` is the full run (its probes; no reduced
     /// coordinates), `estimate` [`Estimate::exact`]
     pub fallback: Option<String>,
     /// a reduced answer's note: the full model was run in its place and failed
-    /// ([`super::fallback::FULL_TRIED`])
+    /// ([`crate::pipeline::fallback::FULL_TRIED`])
     pub note: Option<String>,
 }
 
@@ -103,7 +103,7 @@ pub struct Sweep {
     pub validated: bool,
     /// what the sweep did where it could not stand behind a reduced answer (attribute
     /// `fallback`; always `None` for full and validated sweeps)
-    pub fallback: super::Fallback,
+    pub fallback: crate::pipeline::fallback::Fallback,
     pub wall_seconds: f64,
     pub threads: usize,
     pub continuation: bool,
@@ -152,7 +152,7 @@ impl Sweep {
 }
 
 /// A copy of a finished point (the resumed ones are taken from the file read back).
-pub(super) fn clone_point(p: &SweepPoint) -> SweepPoint {
+pub(crate) fn clone_point(p: &SweepPoint) -> SweepPoint {
     SweepPoint {
         run: p.run.clone(),
         validation: p.validation.clone(),

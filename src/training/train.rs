@@ -1,17 +1,17 @@
 //! `train`: full runs at the training load scales → snapshot matrix → POD basis → HDF5.
 
-use super::basis_build::joint_dofs_of;
-pub use super::basis_build::{build_basis, training_data};
-use super::config::Pipeline;
-pub use super::training_record::TrainSummary;
 use crate::error::{Error, Result};
 use crate::io::atomic::TempPath;
 use crate::io::attrs::Kind;
 use crate::io::basis_file::{write_basis_with, BasisMeta, TrainingData};
 use crate::io::output::{check_output, Origin};
 use crate::linalg::kkt::LinearSolverKind;
+use crate::pipeline::config::Pipeline;
 use crate::simulate::{FullModel, Overrides};
 use crate::solver::parameters::Parameters;
+use crate::training::basis_build::joint_dofs_of;
+pub use crate::training::basis_build::{build_basis, training_data};
+pub use crate::training::training_record::TrainSummary;
 use std::path::{Path, PathBuf};
 
 /// The coordinates that appear in any joint, sorted.
@@ -20,10 +20,10 @@ pub fn joint_dofs(p: &Pipeline) -> Vec<usize> {
 }
 
 /// Runs the training simulations and builds the basis (nothing is written); greedy
-/// training (`train.greedy`) is [`super::greedy::train`].
+/// training (`train.greedy`) is [`crate::training::greedy::train`].
 pub fn train(p: &Pipeline) -> Result<(TrainingData, TrainSummary)> {
     if let Some(g) = &p.file.train.greedy {
-        return super::greedy::train(p, g);
+        return crate::training::greedy::train(p, g);
     }
     // the training runs' parameters: the load scales, or the points of the box
     let points: Vec<Parameters> = match &p.file.train.load_scales {
@@ -50,7 +50,7 @@ pub fn train(p: &Pipeline) -> Result<(TrainingData, TrainSummary)> {
         full_seconds += r.wall_seconds;
         runs.push(r);
     }
-    super::basis_build::basis_from_snapshots(p, training_data(&runs), full_seconds, points.len())
+    crate::training::basis_build::basis_from_snapshots(p, training_data(&runs), full_seconds, points.len())
 }
 
 /// Trains and writes the basis file atomically (a failed run keeps the previous file).
@@ -78,7 +78,7 @@ pub fn write_trained(p: &Pipeline, out: &Path, data: &TrainingData, summary: &Tr
             crate::io::estimator_file::write_estimator(f, est).map_err(|e| Error::hdf5(out, e))?;
         }
         if let Some(g) = &summary.greedy {
-            super::training_record::write_training(f, g).map_err(|e| Error::hdf5(out, e))?;
+            crate::training::training_record::write_training(f, g).map_err(|e| Error::hdf5(out, e))?;
         }
         let space = p.space();
         if !space.is_empty() {
@@ -96,7 +96,7 @@ pub fn write_trained(p: &Pipeline, out: &Path, data: &TrainingData, summary: &Tr
 /// from), trains (from the full runs, or from the snapshot files `from_snapshots` when
 /// given) into a temporary file beside `out`, reads that back and checks it as every
 /// reader of a basis does, times the full and the reduced route at a training load into
-/// its `/timing` ([`super::route::time_and_store`]), and only then renames it over `out`:
+/// its `/timing` ([`crate::cost::route::time_and_store`]), and only then renames it over `out`:
 /// a failure at any stage leaves the previous basis as it was.
 pub fn train_to_file(p: &Pipeline, out: &Path, origin: Origin, from_snapshots: &[PathBuf]) -> Result<TrainSummary> {
     check_output(out, origin, &[(&p.path, "pipeline file"), (&p.model.path, "model file")], &[Kind::Basis])?;
@@ -116,13 +116,13 @@ fn stage(p: &Pipeline, staged: &TempPath, out: &Path, from_snapshots: &[PathBuf]
                 return Err(Error::input(out, "--basis", "is one of the --from-snapshots files"));
             }
         }
-        let (data, s) = super::snapshots::train_from_snapshots(p, from_snapshots)?;
+        let (data, s) = crate::training::snapshots::train_from_snapshots(p, from_snapshots)?;
         write_trained(p, staged.path(), &data, &s)?;
         s
     };
     // read back and checked as every reader does, then both routes timed as users run them
-    let (_, rom, _) = super::online::load_rom(p, staged.path(), None, false)?;
-    s.warnings.extend(super::route::time_and_store(&rom, staged.path())?);
+    let (_, rom, _) = crate::workflows::online::load_rom(p, staged.path(), None, false)?;
+    s.warnings.extend(crate::cost::route::time_and_store(&rom, staged.path())?);
     Ok(s)
 }
 

@@ -3,8 +3,8 @@
 //! list read from a CSV file (`--points FILE`: a header of parameter names, one point per
 //! row).
 
-use super::config::{parse_range, MAX_LOAD_SCALES};
 use crate::error::{Error, Result};
+use crate::pipeline::config::{parse_range, MAX_LOAD_SCALES};
 use crate::solver::parameters::Parameters;
 use std::path::Path;
 

@@ -1,17 +1,17 @@
 //! The basis of training snapshots: the snapshot matrix of full runs, the POD basis of the
 //! pipeline's variant and blocks, its hyper-reduction and its error estimator.
 
-use super::config::{Blocks, Pipeline};
-use super::training_record::TrainSummary;
 use crate::error::{Error, Result};
 use crate::io::basis_file::TrainingData;
 use crate::physics::element::Vec8;
 use crate::physics::system::FlexibleSystem;
+use crate::pipeline::config::{Blocks, Pipeline};
 use crate::reduction::output_modes::{add_output_modes, Output, Outputs, Stop};
 use crate::reduction::{ecsw, train_basis, BasisSpec, ModeRule, Trained};
 use crate::rom::estimator::training::{build_estimator, Estimator, Snapshots, DEFAULT_EXTRA_MODES};
 use crate::rom::quantities::Quantity;
 use crate::simulate::SimulationResult;
+use crate::training::training_record::TrainSummary;
 use ndarray::{concatenate, Array1, Axis};
 
 pub(super) fn joint_dofs_of(sys: &FlexibleSystem) -> Vec<usize> {
@@ -176,7 +176,7 @@ fn within_weight_bound(
 
 /// The basis and estimator of fixed-load training (`train.load_scales`, the pipeline's
 /// `[reduction]` rule) from the snapshots of `n_runs` full runs, on one machine or gathered
-/// from sharded jobs ([`super::snapshots`]).
+/// from sharded jobs ([`crate::training::snapshots`]).
 pub(crate) fn basis_from_snapshots(
     p: &Pipeline,
     data: TrainingData,

@@ -7,13 +7,13 @@ use super::candidate_set::CandidateSet;
 use super::candidates::{estimate_candidates, estimate_points, score, screen_candidates, CandidateRun};
 use crate::error::{Error, Result};
 use crate::io::basis_file::TrainingData;
-use crate::pipeline::basis_build::build_basis;
 use crate::pipeline::config::{GreedyMeasure, GreedySpec, Pipeline};
-use crate::pipeline::training_record::modes_text;
 use crate::reduction::{ModeRule, Trained};
 use crate::rom::estimator::training::{calibrate, CalibrationPoint, Estimator};
 use crate::rom::estimator::{ByFifth, EstimateMethod, FIFTHS};
 use crate::rom::trust::amplifying;
+use crate::training::basis_build::build_basis;
+use crate::training::training_record::modes_text;
 
 /// Energy tolerances ε tried, loose to tight: 10⁻², 10⁻³, …, 10⁻¹⁴. The tight end is where
 /// the captured energy `1 − ε`, a sum of squared singular values, still has two digits in

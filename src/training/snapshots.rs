@@ -3,7 +3,7 @@
 //! from their snapshot files (`train --from-snapshots snaps*.h5`).
 //!
 //! The basis from the files is the one a single `train` builds: the runs are put side by
-//! side in the order of the pipeline's `train.load_scales` (as [`super::train::train`] does),
+//! side in the order of the pipeline's `train.load_scales` (as [`crate::training::train::train`] does),
 //! whatever order the files come in, and the POD, ECSW and estimator that follow are the
 //! same code on the same matrix. A full run does not depend on the process it runs in.
 //!
@@ -30,16 +30,16 @@
 //!   pipeline: [train] and [reduction]), pipeline, full_seconds, program_version
 //! ```
 
-use super::basis_build::{basis_from_snapshots, training_data};
-use super::config::Pipeline;
-use super::shard::Shard;
-use super::training_record::TrainSummary;
 use crate::error::{Error, Result};
 use crate::io::attrs::{check_layout, write_atomically_as, Kind};
 use crate::io::basis_file::TrainingData;
 use crate::io::h5::{attr_f64, attr_str, read_attr_f64, read_attr_str};
+use crate::pipeline::config::Pipeline;
 use crate::simulate::{simulate, Overrides, Settings};
 use crate::solver::parameters::Parameters;
+use crate::training::basis_build::{basis_from_snapshots, training_data};
+use crate::training::training_record::TrainSummary;
+use crate::workflows::shard::Shard;
 use ndarray::{concatenate, s, Array1, Array2, Axis};
 use std::path::{Path, PathBuf};
 

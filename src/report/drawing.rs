@@ -2,14 +2,14 @@
 //! ([`crate::physics::centre_line`]), the joints (each kind its mark, a slider with its
 //! rail), point masses, springs (translational: a zig-zag; torsional: a spiral at the
 //! node), probes and body names. One drawing for every use: the frames of `flexrom animate`
-//! ([`super::animate`]) and the report's figure of the model ([`super::model_figure`]),
+//! ([`crate::report::animate`]) and the report's figure of the model ([`crate::report::model_figure`]),
 //! on any plotters backend (GIF, PNG, SVG).
 
-use super::plot::{linear_labels, COLORS};
 use crate::model::Model;
 use crate::physics::centre_line::CentreLines;
 use crate::physics::joints::Joint;
 use crate::physics::loads::{Load, SpringEnd};
+use crate::report::plot::{linear_labels, COLORS};
 use plotters::coord::types::RangedCoordf64;
 use plotters::element::{Drawable, PointCollection};
 use plotters::prelude::*;

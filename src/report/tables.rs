@@ -2,9 +2,9 @@
 //! scale, per time step or per run; units in the column names' documentation below and in
 //! docs/cli.md).
 
-use super::sweep::Sweep;
 use crate::output::table::{Cell, Table};
 use crate::simulate::SimulationResult;
+use crate::workflows::sweep::Sweep;
 
 /// `sweep`, `merge`: one row per load scale, in the order asked for. `status` is 0 (done),
 /// 1 (failed, `message` says why) or 2 (not run yet), as `/status` of the sweep file;
@@ -82,7 +82,7 @@ pub fn sweep_table(s: &Sweep) -> Table {
 /// The columns `parameter:NAME` of the named parameters the sweep's points set (none for a
 /// line of load scales), appended after the others so that those keep their places.
 fn named_columns(s: &Sweep) -> Vec<(String, String)> {
-    let names = super::sweep::point_names(s.scales.iter().map(|x| &x.mu));
+    let names = crate::workflows::sweep::point_names(s.scales.iter().map(|x| &x.mu));
     names.into_iter().skip(1).map(|n| (format!("parameter:{n}"), n)).collect()
 }
 

@@ -88,14 +88,10 @@ pub use candidate_set::CandidateSet;
 pub use candidates::{score, SENSITIVITY_STEP};
 pub use search::{ENERGY_LADDER, TAU_LADDER};
 
-use super::basis_build::training_data;
-use super::config::{GreedyMeasure, GreedySpec, Pipeline};
-use super::training_record::{modes_text, TrainSummary};
-pub use super::training_record::{write_training, GreedyRecord, Iteration};
-use super::validate::compare;
 use crate::error::Result;
 use crate::io::basis_file::TrainingData;
 use crate::model::Model;
+use crate::pipeline::config::{GreedyMeasure, GreedySpec, Pipeline};
 use crate::reduction::Basis;
 use crate::rom::estimator::norms::rel_error_by_time;
 use crate::rom::estimator::training::{calibrate, CalibrationPoint};
@@ -104,6 +100,10 @@ use crate::rom::trust::amplifying;
 use crate::rom::Rom;
 use crate::simulate::{simulate, Overrides, SimulationResult};
 use crate::solver::model::Parameters;
+use crate::training::basis_build::training_data;
+use crate::training::training_record::{modes_text, TrainSummary};
+pub use crate::training::training_record::{write_training, GreedyRecord, Iteration};
+use crate::workflows::validate::compare;
 use rayon::prelude::*;
 use search::{search, Level, Round};
 use std::sync::Arc;
@@ -111,60 +111,158 @@ use std::sync::Arc;
 /// Greedy training (module documentation); nothing is written.
 pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary)> {
     let candidates = CandidateSet::new(g, &p.space());
-    let full =
-        |mu: &Parameters| simulate(&p.model, &Overrides::at(mu)).map_err(|e| e.at_stage("train (greedy full run)", mu));
-    let first = candidates.first(g, g.max_runs);
-    if candidates.is_box() {
-        log::info!(
-            "greedy training over the box {}, tolerance {:e}, {} candidates: full runs at {}",
-            candidates.space.describe(),
-            g.tolerance,
-            candidates.len(),
-            first.iter().map(|mu| format!("({})", candidates.label(mu))).collect::<Vec<_>>().join(", ")
-        );
-    } else {
-        let range = g.range();
-        log::info!(
-            "greedy training over [{}, {}], tolerance {:e}, {} candidates: full runs at {:?}",
-            range.0,
-            range.1,
-            g.tolerance,
-            candidates.len(),
-            first.iter().map(Parameters::scale).collect::<Vec<_>>()
-        );
-    }
-    let mut runs: Vec<SimulationResult> = first.par_iter().map(full).collect::<Result<_>>()?;
-    // the later full runs, one at a time, on one full model
-    let mut full_model = crate::simulate::FullModel::new(&p.model, crate::linalg::kkt::LinearSolverKind::Banded)?;
-    let mut full_seconds: f64 = runs.iter().map(|r| r.wall_seconds).sum();
-    let mut full_runs = runs.len();
-    let mut points: Vec<CalibrationPoint> = Vec::new();
-    let mut iterations: Vec<Iteration> = Vec::new();
-    let mut warnings = Vec::new();
-    // warnings that the training's method over-reads: moot once the loop switches method
-    let mut over_reading: Vec<String> = Vec::new();
-    // the estimate the loop steers by, until a held-out check finds it off (below)
-    let mut method = EstimateMethod::Corrected;
-    let converged;
-    // what the converged held-out check found above the tolerance, in words (`/training`)
-    let mut held_out_note: Option<String> = None;
-    let chosen = loop {
+    let mut state = Greedy::start(p, g, &candidates)?;
+    let (chosen, converged) = loop {
         crate::interrupt::check()?;
-        let data = training_data(&runs);
-        let previous_energy = iterations.last().map(|i: &Iteration| i.energy);
-        let prior = iterations.last().map(|i: &Iteration| i.estimates.as_slice());
-        let n = iterations.len() + 1;
-        let settled = settled(&candidates, &runs);
-        let round =
-            Round { p, data: &data, candidates: &candidates, points: &points, n, method, prior, settled: &settled };
-        let mut level = search(&round, g, previous_energy)?;
+        let data = training_data(&state.runs);
+        let previous_energy = state.iterations.last().map(|i: &Iteration| i.energy);
+        let prior = state.iterations.last().map(|i: &Iteration| i.estimates.as_slice());
+        let n = state.iterations.len() + 1;
+        let settled = settled(&candidates, &state.runs);
+        let (points, method) = (&state.points, state.method);
+        let round = Round { p, data: &data, candidates: &candidates, points, n, method, prior, settled: &settled };
+        let level = search(&round, g, previous_energy)?;
+        if let Some(stop) = state.step(p, g, &candidates, level)? {
+            break stop;
+        }
+    };
+    state.finish(p, g, candidates, chosen, converged)
+}
+
+/// The greedy loop's state between its iterations.
+struct Greedy<'a> {
+    /// the full runs whose snapshots the next basis is built from
+    runs: Vec<SimulationResult>,
+    /// the later full runs, one at a time, on one full model
+    full_model: crate::simulate::FullModel<'a>,
+    full_seconds: f64,
+    /// full runs made, the held-out checks included
+    full_runs: usize,
+    /// the held-out pairs (raw estimate, true error) the estimator is calibrated with
+    points: Vec<CalibrationPoint>,
+    iterations: Vec<Iteration>,
+    warnings: Vec<String>,
+    /// warnings that the training's method over-reads: moot once the loop switches method
+    over_reading: Vec<String>,
+    /// the estimate the loop steers by, until a held-out check finds it off
+    method: EstimateMethod,
+    /// what the converged held-out check found above the tolerance, in words (`/training`)
+    held_out_note: Option<String>,
+}
+
+impl<'a> Greedy<'a> {
+    /// The first full runs (in parallel), at the candidate set's first points.
+    fn start(p: &'a Pipeline, g: &GreedySpec, candidates: &CandidateSet) -> Result<Self> {
+        let full = |mu: &Parameters| {
+            simulate(&p.model, &Overrides::at(mu)).map_err(|e| e.at_stage("train (greedy full run)", mu))
+        };
+        let first = candidates.first(g, g.max_runs);
+        if candidates.is_box() {
+            log::info!(
+                "greedy training over the box {}, tolerance {:e}, {} candidates: full runs at {}",
+                candidates.space.describe(),
+                g.tolerance,
+                candidates.len(),
+                first.iter().map(|mu| format!("({})", candidates.label(mu))).collect::<Vec<_>>().join(", ")
+            );
+        } else {
+            let range = g.range();
+            log::info!(
+                "greedy training over [{}, {}], tolerance {:e}, {} candidates: full runs at {:?}",
+                range.0,
+                range.1,
+                g.tolerance,
+                candidates.len(),
+                first.iter().map(Parameters::scale).collect::<Vec<_>>()
+            );
+        }
+        let runs: Vec<SimulationResult> = first.par_iter().map(full).collect::<Result<_>>()?;
+        let full_model = crate::simulate::FullModel::new(&p.model, crate::linalg::kkt::LinearSolverKind::Banded)?;
+        let full_seconds: f64 = runs.iter().map(|r| r.wall_seconds).sum();
+        let full_runs = runs.len();
+        Ok(Greedy {
+            runs,
+            full_model,
+            full_seconds,
+            full_runs,
+            points: Vec::new(),
+            iterations: Vec::new(),
+            warnings: Vec::new(),
+            over_reading: Vec::new(),
+            method: EstimateMethod::Corrected,
+            held_out_note: None,
+        })
+    }
+
+    /// One iteration after its search found `level`: the full run at the worst candidate
+    /// without one, the held-out check there and the decision. `Some((basis, converged))`
+    /// ends the loop.
+    fn step(
+        &mut self,
+        p: &Pipeline,
+        g: &GreedySpec,
+        candidates: &CandidateSet,
+        mut level: Level,
+    ) -> Result<Option<(Level, bool)>> {
         let (wi, worst) = level.worst();
         // where to run the full model: the worst candidate without a full run yet (a
         // training point's own run is already in the snapshots)
+        let runs = &self.runs;
         let fresh = |i: usize| runs.iter().all(|r| !candidates.is_at(i, &r.settings.mu));
         let next = level.worst_where(fresh);
+        let mut it = self.iteration_of(p, &level, (wi, worst));
+        let shape = shape_text(&level, &it);
+        let n = self.iterations.len() + 1;
+        let cmp = if worst <= g.tolerance { "≤" } else { ">" };
+        let Some((ni, next_estimate)) = next.filter(|_| self.full_runs < g.max_runs) else {
+            let converged = self.out_of_runs(g, candidates, &it, (wi, worst), &shape);
+            self.iterations.push(it);
+            return Ok(Some((level, converged)));
+        };
+        // the full run at the worst candidate: snapshots for the next basis, and the true
+        // error of this one there (it never saw that point)
+        let mu = candidates.points[ni].clone();
+        let at = candidates.label(&mu);
+        let truth =
+            self.full_model.simulate(&Overrides::at(&mu)).map_err(|e| e.at_stage("train (greedy full run)", &mu))?;
+        let (e_measured, e_score, sens) = self.held_out(p, g, candidates, (&mut level, &mut it), (ni, &at), &truth);
+        // the held-out pair may have raised the calibration factor: the estimates this
+        // basis will report are the candidates' scaled by it (the estimate is linear in c)
+        let rescale = calibrate(self.points.clone()).factor / level.estimator.calibration.factor;
+        let bound = it.bound * rescale.max(1.0);
+        let done = bound <= g.tolerance && e_score <= g.tolerance;
+        if done {
+            let name = g.measure.error_name();
+            self.held_out_note = above_tolerance_note(g.measure, g.tolerance, (&at, e_measured), (e_score, sens));
+            let check = match &self.held_out_note {
+                Some(note) => note.clone(),
+                None => format!("{name} {e_measured:.2e} (score {e_score:.2e}, sensitivity {sens:.1e})"),
+            };
+            log::info!("iteration {n}: worst score {worst:.2e} ≤ {:e}; held-out check at {at} (score {next_estimate:.2e}): {check}; {shape}", g.tolerance);
+        } else {
+            // with every score within T, say what keeps the loop going
+            let why = if worst > g.tolerance {
+                String::new()
+            } else if bound > g.tolerance {
+                format!("; the bound between candidates is {bound:.2e} > {:e}", g.tolerance)
+            } else {
+                format!("; the held-out run's own score is above {:e}", g.tolerance)
+            };
+            log::info!("iteration {n}: full run at {at} (worst score {worst:.2e} {cmp} {:e}; {next_estimate:.2e} there, true error {e_measured:.2e}, its score {e_score:.2e}, sensitivity {sens:.1e}){why}, {shape}", g.tolerance);
+        }
+        self.iterations.push(it);
+        if done {
+            return Ok(Some((level, true)));
+        }
+        self.runs.push(truth);
+        Ok(None)
+    }
+
+    /// The record of this iteration's basis and estimates (`(wi, worst)`: the candidate
+    /// with the largest score), before any held-out run.
+    fn iteration_of(&self, p: &Pipeline, level: &Level, (wi, worst): (usize, f64)) -> Iteration {
         let b = &level.trained.basis;
-        let mut it = Iteration {
+        Iteration {
             energy: level.energy,
             hyper_tolerance: level.hyper_tolerance.unwrap_or(f64::NAN),
             block_modes: level.trained.block_modes.clone(),
@@ -182,57 +280,68 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
             true_error: f64::NAN,
             true_score: f64::NAN,
             held_out_effectivity: f64::NAN,
-            method,
+            method: self.method,
             bound: level.between_candidates(),
             between_points: level.between_points,
-        };
-        let outputs = &level.trained.output_modes;
-        let shape = format!(
-            "{}{}{}, {} elements",
-            modes_text(&it.block_modes),
-            if outputs.iter().all(|&k| k == 0) {
-                String::new()
-            } else {
-                format!(" + {} output modes", outputs.iter().map(|k| k.to_string()).collect::<Vec<_>>().join(" + "))
-            },
-            if b.kept.is_empty() { String::new() } else { format!(" + {} joint coordinates", b.kept.len()) },
-            it.n_elements
-        );
-        let n = iterations.len() + 1;
+        }
+    }
+
+    /// The loop's end where no full run is left to make (`max_runs` reached, or every
+    /// candidate has one): converged when the bound between candidates meets the tolerance,
+    /// with no held-out run to check the basis (a warning says so).
+    fn out_of_runs(
+        &mut self,
+        g: &GreedySpec,
+        candidates: &CandidateSet,
+        it: &Iteration,
+        (wi, worst): (usize, f64),
+        shape: &str,
+    ) -> bool {
+        let n = self.iterations.len() + 1;
         let cmp = if worst <= g.tolerance { "≤" } else { ">" };
-        let Some((ni, next_estimate)) = next.filter(|_| full_runs < g.max_runs) else {
-            let why = if full_runs >= g.max_runs {
-                format!("no full run left (max_runs = {})", g.max_runs)
-            } else {
-                "every candidate has a full run".into()
-            };
-            // the same test as the stop below, without a held-out run to recalibrate with
-            let bound = it.bound;
-            log::info!(
-                "iteration {n}: {why}, worst estimate {worst:.2e} {cmp} {:e} at {} (bound between candidates {bound:.2e}), {shape}",
-                g.tolerance,
-                candidates.label_of(wi)
-            );
-            converged = bound <= g.tolerance;
-            if converged {
-                // the basis kept is built from every run: none is left to hold out against it
-                warnings.push(format!(
-                    "greedy training met its tolerance {:e} with its last basis, which no held-out full run checked ({why}): its estimates alone certify it; `validate` a few loads of the range",
-                    g.tolerance
-                ));
-            }
-            iterations.push(it);
-            break level;
+        let why = if self.full_runs >= g.max_runs {
+            format!("no full run left (max_runs = {})", g.max_runs)
+        } else {
+            "every candidate has a full run".into()
         };
-        // the full run at the worst candidate: snapshots for the next basis, and the true
-        // error of this one there (it never saw that point)
-        let mu = candidates.points[ni].clone();
-        let at = candidates.label(&mu);
-        let truth = full_model.simulate(&Overrides::at(&mu)).map_err(|e| e.at_stage("train (greedy full run)", &mu))?;
-        full_seconds += truth.wall_seconds;
-        full_runs += 1;
+        // the same test as the stop after a held-out run, without a held-out run to
+        // recalibrate with
+        let bound = it.bound;
+        log::info!(
+            "iteration {n}: {why}, worst estimate {worst:.2e} {cmp} {:e} at {} (bound between candidates {bound:.2e}), {shape}",
+            g.tolerance,
+            candidates.label_of(wi)
+        );
+        let converged = bound <= g.tolerance;
+        if converged {
+            // the basis kept is built from every run: none is left to hold out against it
+            self.warnings.push(format!(
+                "greedy training met its tolerance {:e} with its last basis, which no held-out full run checked ({why}): its estimates alone certify it; `validate` a few loads of the range",
+                g.tolerance
+            ));
+        }
+        converged
+    }
+
+    /// The held-out check of this iteration's basis at candidate `ni` (named `at`) against
+    /// the full run `truth` there: its true error (calibrating the estimator), its score,
+    /// and the check of the estimate itself, which may switch the loop to the enriched
+    /// estimate (re-reading the candidates). Returns the true error in the training's
+    /// measure, its score and the model's sensitivity there.
+    fn held_out(
+        &mut self,
+        p: &Pipeline,
+        g: &GreedySpec,
+        candidates: &CandidateSet,
+        (level, it): (&mut Level, &mut Iteration),
+        (ni, at): (usize, &str),
+        truth: &SimulationResult,
+    ) -> (f64, f64, f64) {
+        let mu = &candidates.points[ni];
+        self.full_seconds += truth.wall_seconds;
+        self.full_runs += 1;
         // rel_error `e` calibrates the estimator; the error in the training's measure is held to T
-        let truth_error = true_error(&p.model, &level.trained.basis, &truth, &mu);
+        let truth_error = true_error(&p.model, &level.trained.basis, truth, mu);
         let (e, e_measured) = (truth_error.rel_error, truth_error.in_measure(g.measure));
         let by_time =
             candidates::at_rest_as_relative(&truth_error.by_time_in(g.measure), &truth_error.rel_error_by_time);
@@ -241,7 +350,7 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         (it.run_candidate, it.true_error, it.true_score) = (Some(ni), e_measured, e_score);
         it.held_out_effectivity = c * level.raws[ni] / e;
         if level.raws[ni].is_finite() && e.is_finite() {
-            points.push(CalibrationPoint { load_scale: mu.scale(), raw_estimate: level.raws[ni], rel_error: e });
+            self.points.push(CalibrationPoint { load_scale: mu.scale(), raw_estimate: level.raws[ni], rel_error: e });
         }
         // the held-out check of the estimate itself: off by more than the method assumes, the
         // loop reads the candidates with the enriched model (the reference the correction
@@ -251,80 +360,132 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         let under = it.held_out_effectivity < 1.0;
         let dynamics = if under { dynamics_error(sens, g.tolerance, e_measured) } else { None };
         let found = (e, it.held_out_effectivity, dynamics.map(|s| (s, e_measured)));
-        if let Some(checked) = check_method(p, &level, method, (&mu, &at), found) {
+        if let Some(checked) = check_method(p, level, self.method, (mu, at), found) {
             log::info!("{}", checked.message);
             if !checked.switch && it.held_out_effectivity > MAX_HELD_OUT_OVERESTIMATE {
-                over_reading.push(checked.message);
+                self.over_reading.push(checked.message);
             } else if checked.switch {
-                over_reading.clear();
-                method = EstimateMethod::Enriched;
+                self.over_reading.clear();
+                self.method = EstimateMethod::Enriched;
                 // the earlier pairs were the other method's readings
-                points = vec![CalibrationPoint { load_scale: mu.scale(), raw_estimate: checked.raw, rel_error: e }];
-                level.estimator.calibration = calibrate(points.clone());
+                self.points =
+                    vec![CalibrationPoint { load_scale: mu.scale(), raw_estimate: checked.raw, rel_error: e }];
+                level.estimator.calibration = calibrate(self.points.clone());
                 level.estimate(
                     p,
-                    &candidates,
-                    &format!("iteration {}, enriched estimates", iterations.len() + 1),
-                    method,
+                    candidates,
+                    &format!("iteration {}, enriched estimates", self.iterations.len() + 1),
+                    self.method,
                 );
                 it.estimates = level.estimates.clone();
                 it.whole_run_estimates = level.whole.clone();
-                it.method = method;
+                it.method = self.method;
                 (it.bound, it.between_points) = (level.between_candidates(), level.between_points);
             }
         }
-        // the held-out pair may have raised the calibration factor: the estimates this
-        // basis will report are the candidates' scaled by it (the estimate is linear in c)
-        let rescale = calibrate(points.clone()).factor / level.estimator.calibration.factor;
-        let bound = it.bound * rescale.max(1.0);
-        let done = bound <= g.tolerance && e_score <= g.tolerance;
-        if done {
-            let name = g.measure.error_name();
-            held_out_note = above_tolerance_note(g.measure, g.tolerance, (&at, e_measured), (e_score, sens));
-            let check = match &held_out_note {
-                Some(note) => note.clone(),
-                None => format!("{name} {e_measured:.2e} (score {e_score:.2e}, sensitivity {sens:.1e})"),
-            };
-            log::info!("iteration {n}: worst score {worst:.2e} ≤ {:e}; held-out check at {at} (score {next_estimate:.2e}): {check}; {shape}", g.tolerance);
+        (e_measured, e_score, sens)
+    }
+
+    /// After the loop: the chosen basis's estimator calibrated on every held-out pair, the
+    /// cheap `defects` estimate calibrated against it, the notes and the record.
+    fn finish(
+        mut self,
+        p: &Pipeline,
+        g: &GreedySpec,
+        candidates: CandidateSet,
+        chosen: Level,
+        converged: bool,
+    ) -> Result<(TrainingData, TrainSummary)> {
+        let (method, iterations) = (self.method, &self.iterations);
+        if !converged {
+            self.warnings.push(format!(
+                "greedy training stopped after {} full runs (max_runs = {}) above its tolerance {:e} (worst score {:.2e}, bound between candidates {:.2e}): {}",
+                self.full_runs,
+                g.max_runs,
+                g.tolerance,
+                iterations.last().map_or(f64::NAN, |i| i.worst_estimate),
+                iterations.last().map_or(f64::NAN, |i| i.bound),
+                why_not_converged(g.tolerance, iterations, &candidates, &chosen.failures(), &settled(&candidates, &self.runs))
+            ));
+        }
+        let pair_bounds = chosen.pair_bounds().map(<[f64]>::to_vec);
+        let Level { trained, mut estimator, .. } = chosen;
+        let level_factor = estimator.calibration.factor;
+        estimator.calibration = calibrate(self.points);
+        // the cheap online estimate on the training estimate's scale (`DefectsCalibration`)
+        estimator.defects = candidates::calibrate_defects(&p.model, &trained.basis, &estimator, &candidates, method);
+        if method == EstimateMethod::Enriched && !estimator.defects.as_ref().is_some_and(|d| d.reliable) {
+            // the correction was found off for this basis: its online estimates read the reference
+            estimator.method = Some(EstimateMethod::Enriched);
+        }
+        log::info!("{}", defects_line(&estimator, method));
+        // what the online default reads between the candidates, where training met T with
+        // its own estimate there
+        let estimate_note = match (&estimator.defects, &pair_bounds) {
+            (Some(d), Some(b)) if converged && estimator.default_method() == EstimateMethod::Defects => {
+                let rescale = (estimator.calibration.factor / level_factor).max(1.0);
+                let bounds: Vec<f64> = b.iter().map(|x| x * rescale).collect();
+                defects_note(g.tolerance, method, &candidates.pairs, &bounds, &d.ratios)
+            }
+            _ => None,
+        };
+        if let Some(note) = &estimate_note {
+            log::info!("{note}");
+        }
+        let data = training_data(&self.runs);
+        let record = GreedyRecord {
+            range: if candidates.is_box() { None } else { Some(g.range()) },
+            tolerance: g.tolerance,
+            max_runs: g.max_runs,
+            candidates,
+            runs: self.runs.iter().map(|r| r.settings.mu.clone()).collect(),
+            iterations: self.iterations,
+            converged,
+            full_runs: self.full_runs,
+            method,
+            measure: g.measure.coordinates(),
+            held_out_note: self.held_out_note,
+            estimate_note,
+        };
+        let mut warnings = self.warnings;
+        warnings.splice(0..0, self.over_reading);
+        let n_snapshots = data.x.ncols();
+        Ok((
+            data,
+            TrainSummary {
+                trained,
+                n_snapshots,
+                full_seconds: self.full_seconds,
+                n_runs: self.full_runs,
+                greedy: Some(record),
+                estimator: Some(estimator),
+                warnings,
+            },
+        ))
+    }
+}
+
+/// The basis's shape in words: modes per block, output modes, kept joint coordinates and
+/// elements.
+fn shape_text(level: &Level, it: &Iteration) -> String {
+    let b = &level.trained.basis;
+    let outputs = &level.trained.output_modes;
+    format!(
+        "{}{}{}, {} elements",
+        modes_text(&it.block_modes),
+        if outputs.iter().all(|&k| k == 0) {
+            String::new()
         } else {
-            // with every score within T, say what keeps the loop going
-            let why = if worst > g.tolerance {
-                String::new()
-            } else if bound > g.tolerance {
-                format!("; the bound between candidates is {bound:.2e} > {:e}", g.tolerance)
-            } else {
-                format!("; the held-out run's own score is above {:e}", g.tolerance)
-            };
-            log::info!("iteration {n}: full run at {at} (worst score {worst:.2e} {cmp} {:e}; {next_estimate:.2e} there, true error {e_measured:.2e}, its score {e_score:.2e}, sensitivity {sens:.1e}){why}, {shape}", g.tolerance);
-        }
-        iterations.push(it);
-        if done {
-            converged = true;
-            break level;
-        }
-        runs.push(truth);
-    };
-    if !converged {
-        warnings.push(format!(
-            "greedy training stopped after {full_runs} full runs (max_runs = {}) above its tolerance {:e} (worst score {:.2e}, bound between candidates {:.2e}): {}",
-            g.max_runs,
-            g.tolerance,
-            iterations.last().map_or(f64::NAN, |i| i.worst_estimate),
-            iterations.last().map_or(f64::NAN, |i| i.bound),
-            why_not_converged(g.tolerance, &iterations, &candidates, &chosen.failures(), &settled(&candidates, &runs))
-        ));
-    }
-    let pair_bounds = chosen.pair_bounds().map(<[f64]>::to_vec);
-    let Level { trained, mut estimator, .. } = chosen;
-    let level_factor = estimator.calibration.factor;
-    estimator.calibration = calibrate(points);
-    // the cheap online estimate on the training estimate's scale (`DefectsCalibration`)
-    estimator.defects = candidates::calibrate_defects(&p.model, &trained.basis, &estimator, &candidates, method);
-    if method == EstimateMethod::Enriched && !estimator.defects.as_ref().is_some_and(|d| d.reliable) {
-        // the correction was found off for this basis: its online estimates read the reference
-        estimator.method = Some(EstimateMethod::Enriched);
-    }
-    log::info!("{}", match &estimator.defects {
+            format!(" + {} output modes", outputs.iter().map(|k| k.to_string()).collect::<Vec<_>>().join(" + "))
+        },
+        if b.kept.is_empty() { String::new() } else { format!(" + {} joint coordinates", b.kept.len()) },
+        it.n_elements
+    )
+}
+
+/// The line on the cheap `defects` estimate's calibration against the training's `method`.
+fn defects_line(estimator: &crate::rom::estimator::training::Estimator, method: EstimateMethod) -> String {
+    match &estimator.defects {
         Some(d) if d.reliable => format!(
             "error estimate: the cheap `defects` method calibrated at the {} candidates against the `{}` estimate (factors {}), the online default",
             d.ratios.len(),
@@ -333,49 +494,7 @@ pub fn train(p: &Pipeline, g: &GreedySpec) -> Result<(TrainingData, TrainSummary
         ),
         Some(_) => format!("error estimate: the `defects` method's ratio to the {} estimate jumps between candidates (its leave-one-out check failed): the online default stays `{}`", method.name(), estimator.default_method().name()),
         None => format!("error estimate: the `defects` method could not be calibrated: the online default stays `{}`", estimator.default_method().name()),
-    });
-    // what the online default reads between the candidates, where training met T with
-    // its own estimate there
-    let estimate_note = match (&estimator.defects, &pair_bounds) {
-        (Some(d), Some(b)) if converged && estimator.default_method() == EstimateMethod::Defects => {
-            let rescale = (estimator.calibration.factor / level_factor).max(1.0);
-            let bounds: Vec<f64> = b.iter().map(|x| x * rescale).collect();
-            defects_note(g.tolerance, method, &candidates.pairs, &bounds, &d.ratios)
-        }
-        _ => None,
-    };
-    if let Some(note) = &estimate_note {
-        log::info!("{note}");
     }
-    let data = training_data(&runs);
-    let record = GreedyRecord {
-        range: if candidates.is_box() { None } else { Some(g.range()) },
-        tolerance: g.tolerance,
-        max_runs: g.max_runs,
-        candidates,
-        runs: runs.iter().map(|r| r.settings.mu.clone()).collect(),
-        iterations,
-        converged,
-        full_runs,
-        method,
-        measure: g.measure.coordinates(),
-        held_out_note,
-        estimate_note,
-    };
-    warnings.splice(0..0, over_reading);
-    let n_snapshots = data.x.ncols();
-    Ok((
-        data,
-        TrainSummary {
-            trained,
-            n_snapshots,
-            full_seconds,
-            n_runs: full_runs,
-            greedy: Some(record),
-            estimator: Some(estimator),
-            warnings,
-        },
-    ))
 }
 
 /// The sentence for a converged held-out check whose error (`error`, in `measure`, at `at`)

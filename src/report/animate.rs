@@ -1,7 +1,7 @@
 //! `flexrom animate`: the motion of a result file, or of one run of a reduced sweep file
-//! ([`super::motion`]), as an animated GIF (plotters' pure-Rust GIF backend: plays in any
+//! ([`crate::report::motion`]), as an animated GIF (plotters' pure-Rust GIF backend: plays in any
 //! browser and in Markdown, no ffmpeg). Each frame draws the mechanism as
-//! [`super::drawing`] does (the deformed centre lines from the ANCF interpolation, the
+//! [`crate::report::drawing`] does (the deformed centre lines from the ANCF interpolation, the
 //! joints, springs, point masses and probes) and the time, on equal axes fitted to the
 //! whole motion; `--compare` overlays a second run, dashed in another colour, at the
 //! nearest instant of its own time grid.
@@ -10,12 +10,12 @@
 //! first and last included) and a big mesh along its bodies ([`MAX_POINTS`] samples a
 //! run), so that a 5000-element model's animation stays small and quick.
 
-use super::drawing::{draw_frame, motion_chart, Bounds, Frame, Style, BOTTOM, LEFT, MARGIN, TITLE};
-use super::motion::Motion;
-use super::plot::{register_font, COLORS};
-use super::sweep::SweepPick;
 use crate::error::{Error, Result};
 use crate::physics::centre_line::CentreLines;
+use crate::report::drawing::{draw_frame, motion_chart, Bounds, Frame, Style, BOTTOM, LEFT, MARGIN, TITLE};
+use crate::report::motion::Motion;
+use crate::report::plot::{register_font, COLORS};
+use crate::workflows::sweep::SweepPick;
 use plotters::prelude::*;
 use std::path::Path;
 

@@ -1,5 +1,5 @@
 //! `sweep --shard K/N`: the K-th of N deterministic parts of a sweep's load list, written as
-//! a part file that `flexrom merge` ([`super::merge`]) joins into the file a single sweep
+//! a part file that `flexrom merge` ([`crate::workflows::merge`]) joins into the file a single sweep
 //! writes.
 //!
 //! The parts are strided: load index i (0-based, in the order of the list) belongs to shard
@@ -7,7 +7,7 @@
 //! striding gives every shard a like share of cheap and dear loads; the assignment depends
 //! on the list and N alone, so every job of an array computes the same parts.
 //!
-//! A part file is a sweep file of its own loads ([`super::sweep`]'s layout, rows in list
+//! A part file is a sweep file of its own loads ([`crate::workflows::sweep`]'s layout, rows in list
 //! order) plus the group `/shard`:
 //!
 //! ```text
@@ -21,11 +21,11 @@
 //!   basis (absolute paths, for `merge`)
 //! ```
 
-use super::config::Pipeline;
-use super::sweep::{sweep_to_file, Route, Sweep, SweepFile, SweepOptions};
 use crate::error::{show_text, Error, Result};
 use crate::io::h5::{attr_str, attr_u64};
+use crate::pipeline::config::Pipeline;
 use crate::solver::parameters::Parameters;
+use crate::workflows::sweep::{sweep_to_file, Route, Sweep, SweepFile, SweepOptions};
 use ndarray::Array1;
 use sha2::{Digest, Sha256};
 
@@ -76,7 +76,7 @@ pub fn load_list_hash(scales: &[f64]) -> String {
 }
 
 /// SHA-256 (hex) of a list of points with the parameters `names` (`load_scale` first, as
-/// [`super::sweep::point_names`] gives them): [`load_list_hash`] of their load scales when
+/// [`crate::workflows::sweep::point_names`] gives them): [`load_list_hash`] of their load scales when
 /// they set nothing else (so a part file of a line of loads keeps its hash), else the
 /// count, each name (length, bytes) and each point's values in `names` order (bits,
 /// little-endian).
@@ -125,7 +125,7 @@ pub fn sweep_shard(
     f: SweepFile,
 ) -> Result<Sweep> {
     let out = f.out;
-    let names = super::sweep::point_names(all.iter());
+    let names = crate::workflows::sweep::point_names(all.iter());
     let idx = shard_indices(all.len(), shard, names.len() > 1)?;
     let hash = point_list_hash(all, &names);
     let scales: Vec<f64> = all.iter().map(Parameters::scale).collect();

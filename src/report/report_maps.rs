@@ -1,4 +1,4 @@
-//! The report's figures over a box of two parameters or more ([`super::map`]): where the
+//! The report's figures over a box of two parameters or more ([`crate::report::map`]): where the
 //! runs lie in the box and how each fared, in place of the figures against the load scale
 //! a line of loads has.
 //!
@@ -10,10 +10,10 @@
 //!
 //! The training runs (the full runs whose snapshots the basis holds) are crosses on each.
 
-use super::map::{Layer, Map, MapAxis};
-use super::validate::Validation;
+use crate::report::map::{Layer, Map, MapAxis};
 use crate::solver::parameter_space::{ParameterSpace, Spacing};
 use crate::solver::parameters::Parameters;
+use crate::workflows::validate::Validation;
 use std::path::Path;
 
 /// One validated run: its point, what it measured, and its estimate (`None`: no estimator).

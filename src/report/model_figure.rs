@@ -1,14 +1,16 @@
 //! The report's figure of the model (`model.svg`, `model.png`): its initial configuration
 //! `x₀` (the consistent state every run starts from) drawn as `flexrom animate` draws a
-//! frame ([`super::drawing`]), with the bodies' and probes' names, on equal axes with a
+//! frame ([`crate::report::drawing`]), with the bodies' and probes' names, on equal axes with a
 //! margin, and a legend of the marks it holds in a strip to the right; so that a user sees
 //! at once that the model is the one they meant.
 
-use super::drawing::{draw_frame, motion_chart, Bounds, Frame, Mark, MarkElement, Style, BOTTOM, LEFT, MARGIN, TITLE};
-use super::plot::{register_font, write_png, COLORS};
 use crate::error::Result;
 use crate::model::Model;
 use crate::physics::centre_line::CentreLines;
+use crate::report::drawing::{
+    draw_frame, motion_chart, Bounds, Frame, Mark, MarkElement, Style, BOTTOM, LEFT, MARGIN, TITLE,
+};
+use crate::report::plot::{register_font, write_png, COLORS};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
@@ -19,7 +21,7 @@ const LEGEND: u32 = 170;
 /// The model at its initial state, and the figure's height fitted to it.
 fn model_frame(model: &Model) -> Result<(Frame, Bounds, u32)> {
     let x0 = &model.physics()?.x0;
-    let lines = CentreLines::new(model.bodies(), super::animate::MAX_POINTS);
+    let lines = CentreLines::new(model.bodies(), crate::report::animate::MAX_POINTS);
     let frame = Frame::at(model, &lines, x0);
     let bounds = Bounds::of(std::iter::once(&frame));
     // the plot's height at which the model fills its width on equal axes, between 35 % and

@@ -1,6 +1,6 @@
-//! `merge`: the part files of a sharded sweep ([`super::shard`]) joined into the file a
+//! `merge`: the part files of a sharded sweep ([`crate::workflows::shard`]) joined into the file a
 //! single `sweep` over the whole list writes: the same datasets with the same values (the
-//! runs' rows are read back and written by the same writer, [`super::sweep::write_sweep`]).
+//! runs' rows are read back and written by the same writer, [`crate::workflows::sweep::write_sweep`]).
 //! Only the whole-sweep attributes differ in meaning: `wall_seconds` is the longest part's
 //! (the parts ran side by side) and `threads` the sum of the parts' threads.
 //!
@@ -13,17 +13,17 @@
 //! which merges what is there and marks the gaps `status` 2 ("not run yet"), so that
 //! `sweep --resume` on the merged file runs exactly the gaps.
 
-use super::config::Pipeline;
-use super::online::load_basis;
-use super::shard::point_list_hash;
-use super::sweep::{
-    read_sweep, write_sweep, Fallback, Outcome, ScaleResult, Sweep, SweepBasis, STATUS_FAILED, STATUS_OK,
-};
 use crate::error::{show_text, Error, Result};
 use crate::io::h5::{bounded_len, dataset_of_shape, read_attr_f64, read_attr_str, read_strings};
 use crate::limits::Limits;
+use crate::pipeline::config::Pipeline;
 use crate::simulate::{Overrides, Settings};
 use crate::solver::parameters::{Parameters, LOAD_SCALE};
+use crate::workflows::online::load_basis;
+use crate::workflows::shard::point_list_hash;
+use crate::workflows::sweep::{
+    read_sweep, write_sweep, Fallback, Outcome, ScaleResult, Sweep, SweepBasis, STATUS_FAILED, STATUS_OK,
+};
 use ndarray::Array1;
 use std::path::{Path, PathBuf};
 
@@ -100,7 +100,7 @@ fn read_part(path: &Path, limits: &Limits) -> Result<Part> {
     // a sweep over named parameters: the points, as /points holds them
     let (all, names): (Vec<Parameters>, Vec<String>) = match g.dataset("all_points") {
         Ok(d) => {
-            let (names, all) = super::sweep::file::read_point_table(&d, scales_all.len())
+            let (names, all) = crate::records::sweep_file::read_point_table(&d, scales_all.len())
                 .map_err(|problem| bad("shard/all_points", problem))?;
             if names.first().map(String::as_str) != Some(LOAD_SCALE) {
                 return Err(bad("shard/all_points", format!("has parameters {names:?}; load_scale comes first")));
@@ -157,7 +157,8 @@ fn read_part(path: &Path, limits: &Limits) -> Result<Part> {
     // over named parameters every parameter of each row, not λ alone
     if names.len() > 1 {
         let d = f.dataset("points").map_err(|e| bad("points", format!("cannot be read: {e}")))?;
-        let (_, rows) = super::sweep::file::read_point_table(&d, n).map_err(|problem| bad("points", problem))?;
+        let (_, rows) =
+            crate::records::sweep_file::read_point_table(&d, n).map_err(|problem| bad("points", problem))?;
         let same = |a: &Parameters, b: &Parameters| {
             names.iter().all(|k| a.get(k).map(f64::to_bits) == b.get(k).map(f64::to_bits))
         };
@@ -231,7 +232,7 @@ fn recorded_in(e: Error, part: &Part, key: &str) -> Error {
 /// A few runs for a message: "load scales 0.5, 0.53, 0.56 and 13 more", or for named
 /// parameters "points (load scale 1, push = 0.5); … and 13 more".
 fn some(xs: &[Parameters]) -> String {
-    let head = super::sweep::runs_noun(xs);
+    let head = crate::workflows::sweep::runs_noun(xs);
     let named = head == "points";
     let shown: Vec<String> =
         xs.iter().take(4).map(|mu| if named { format!("({mu})") } else { mu.scale().to_string() }).collect();
@@ -262,128 +263,14 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool, limits: &Limits) -> R
     let parts: Vec<Part> = parts.iter().map(|p| read_part(p, limits)).collect::<Result<_>>()?;
     let first = &parts[0];
     for p in &parts[1..] {
-        let differ = |field: &str, what: &str| {
-            Error::input(
-                &p.path,
-                field,
-                format!("{what} than {}; parts of different sweeps cannot be merged", first.path.display()),
-            )
-        };
-        if p.full != first.full {
-            let kind = |full: bool| if full { "the full model (`sweep --full`)" } else { "a reduced model" };
-            return Err(Error::input(
-                &p.path,
-                "route",
-                format!(
-                    "is a sweep of {} and {} one of {}; parts of different sweeps cannot be merged",
-                    kind(p.full),
-                    first.path.display(),
-                    kind(first.full)
-                ),
-            ));
-        }
-        if p.basis.as_ref().map(|b| &b.hash) != first.basis.as_ref().map(|b| &b.hash) {
-            return Err(differ("basis_content_hash", "comes from another basis"));
-        }
-        if p.model_fingerprint != first.model_fingerprint {
-            return Err(differ("model_fingerprint", "comes from another model"));
-        }
-        if p.list_hash != first.list_hash {
-            let list = if super::sweep::runs_noun(&first.all) == "points" { "point list" } else { "load list" };
-            return Err(differ("shard/load_list_hash", &format!("comes from another {list}")));
-        }
-        if p.count != first.count {
-            return Err(differ(
-                "shard/count",
-                &format!("is one of {} shards, not of {}, (another split)", p.count, first.count),
-            ));
-        }
-        if p.validated != first.validated {
-            return Err(differ("validated", "was run with another --validate"));
-        }
-        if p.continuation != first.continuation {
-            return Err(differ("continuation", "was run with another --continuation"));
-        }
-        if p.fallback != first.fallback {
-            return Err(differ(
-                "fallback",
-                &format!("is \"{}\", not \"{}\" (another --fallback)", p.fallback, first.fallback),
-            ));
-        }
+        same_sweep(first, p)?;
     }
-    // who holds each shard
-    let mut holder: Vec<Option<usize>> = vec![None; first.count];
-    for (j, p) in parts.iter().enumerate() {
-        if let Some(other) = holder[p.index - 1] {
-            let loads: Vec<Parameters> = p.indices.iter().map(|&i| p.all[i].clone()).collect();
-            return Err(Error::input(
-                &p.path,
-                "shard/index",
-                format!(
-                    "is shard {}/{} again, as is {} (duplicate {}); give each shard once",
-                    p.index,
-                    p.count,
-                    parts[other].path.display(),
-                    some(&loads)
-                ),
-            ));
-        }
-        holder[p.index - 1] = Some(j);
-    }
-    let all = &first.all;
-    let missing: Vec<usize> = (0..first.count).filter(|&k| holder[k].is_none()).collect();
-    if !missing.is_empty() && !partial {
-        let loads: Vec<Parameters> =
-            (0..all.len()).filter(|i| missing.contains(&(i % first.count))).map(|i| all[i].clone()).collect();
-        let names: Vec<String> = missing.iter().map(|k| format!("{}/{}", k + 1, first.count)).collect();
-        return Err(Error::Usage(format!(
-            "merge: shard(s) {} missing: {} not in any part; give their parts, or --partial to merge the rest with these marked not run",
-            names.join(", "),
-            some(&loads)
-        )));
-    }
-    if !partial {
-        for p in &parts {
-            let not_run: Vec<Parameters> = (0..p.status.len())
-                .filter(|&j| p.status[j] != STATUS_OK && p.status[j] != STATUS_FAILED)
-                .map(|j| p.all[p.indices[j]].clone())
-                .collect();
-            if !not_run.is_empty() {
-                return Err(Error::input(
-                    &p.path,
-                    "status",
-                    format!(
-                        "{} were not run (the shard did not finish); rerun it with --resume, or merge --partial",
-                        some(&not_run)
-                    ),
-                ));
-            }
-        }
-    }
-    // the model and basis the parts were run with, checked against the parts' basis hash
-    let pipeline =
-        Pipeline::load_with(&first.pipeline, limits.clone()).map_err(|e| recorded_in(e, first, "shard/pipeline"))?;
-    let stored = match &first.basis {
-        None => None,
-        Some(b) => {
-            let stored = load_basis(&pipeline, &b.path).map_err(|e| recorded_in(e, first, "shard/basis"))?;
-            if stored.content_hash != b.hash {
-                return Err(Error::input(
-                    &b.path,
-                    "basis_content_hash",
-                    format!(
-                        "differs from the one the parts were swept with ({}): the basis changed since; rerun the sweep",
-                        first.path.display()
-                    ),
-                ));
-            }
-            Some(stored)
-        }
-    };
+    check_coverage(&parts, partial)?;
+    let (pipeline, stored) = recorded_basis(first, limits)?;
     let model = &pipeline.model;
     let s = Settings::resolve(model, &Overrides::default())?;
     let mut sweep = Sweep {
-        scales: all.iter().map(|mu| ScaleResult { mu: mu.clone(), outcome: Outcome::Pending }).collect(),
+        scales: first.all.iter().map(|mu| ScaleResult { mu: mu.clone(), outcome: Outcome::Pending }).collect(),
         t: Array1::from_iter((0..=s.n_steps).map(|k| k as f64 * s.dt)),
         probe_names: model.probe_names(),
         section_names: model.section_names(),
@@ -424,4 +311,135 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool, limits: &Limits) -> R
     });
     write_sweep(out, &sweep, basis)?;
     Ok(Merged { sweep, gaps, parts: parts.len() })
+}
+
+/// Refuses a part `p` of another sweep than `first`'s: another route, basis, model, point
+/// list, split, `--validate`, `--continuation` or `--fallback`.
+fn same_sweep(first: &Part, p: &Part) -> Result<()> {
+    let differ = |field: &str, what: &str| {
+        Error::input(
+            &p.path,
+            field,
+            format!("{what} than {}; parts of different sweeps cannot be merged", first.path.display()),
+        )
+    };
+    if p.full != first.full {
+        let kind = |full: bool| if full { "the full model (`sweep --full`)" } else { "a reduced model" };
+        return Err(Error::input(
+            &p.path,
+            "route",
+            format!(
+                "is a sweep of {} and {} one of {}; parts of different sweeps cannot be merged",
+                kind(p.full),
+                first.path.display(),
+                kind(first.full)
+            ),
+        ));
+    }
+    if p.basis.as_ref().map(|b| &b.hash) != first.basis.as_ref().map(|b| &b.hash) {
+        return Err(differ("basis_content_hash", "comes from another basis"));
+    }
+    if p.model_fingerprint != first.model_fingerprint {
+        return Err(differ("model_fingerprint", "comes from another model"));
+    }
+    if p.list_hash != first.list_hash {
+        let list = if crate::workflows::sweep::runs_noun(&first.all) == "points" { "point list" } else { "load list" };
+        return Err(differ("shard/load_list_hash", &format!("comes from another {list}")));
+    }
+    if p.count != first.count {
+        return Err(differ(
+            "shard/count",
+            &format!("is one of {} shards, not of {}, (another split)", p.count, first.count),
+        ));
+    }
+    if p.validated != first.validated {
+        return Err(differ("validated", "was run with another --validate"));
+    }
+    if p.continuation != first.continuation {
+        return Err(differ("continuation", "was run with another --continuation"));
+    }
+    if p.fallback != first.fallback {
+        return Err(differ(
+            "fallback",
+            &format!("is \"{}\", not \"{}\" (another --fallback)", p.fallback, first.fallback),
+        ));
+    }
+    Ok(())
+}
+
+/// Refuses a shard given twice; without `partial`, a shard missing or one whose part did
+/// not finish.
+fn check_coverage(parts: &[Part], partial: bool) -> Result<()> {
+    let first = &parts[0];
+    // who holds each shard
+    let mut holder: Vec<Option<usize>> = vec![None; first.count];
+    for (j, p) in parts.iter().enumerate() {
+        if let Some(other) = holder[p.index - 1] {
+            let loads: Vec<Parameters> = p.indices.iter().map(|&i| p.all[i].clone()).collect();
+            return Err(Error::input(
+                &p.path,
+                "shard/index",
+                format!(
+                    "is shard {}/{} again, as is {} (duplicate {}); give each shard once",
+                    p.index,
+                    p.count,
+                    parts[other].path.display(),
+                    some(&loads)
+                ),
+            ));
+        }
+        holder[p.index - 1] = Some(j);
+    }
+    if partial {
+        return Ok(());
+    }
+    let all = &first.all;
+    let missing: Vec<usize> = (0..first.count).filter(|&k| holder[k].is_none()).collect();
+    if !missing.is_empty() {
+        let loads: Vec<Parameters> =
+            (0..all.len()).filter(|i| missing.contains(&(i % first.count))).map(|i| all[i].clone()).collect();
+        let names: Vec<String> = missing.iter().map(|k| format!("{}/{}", k + 1, first.count)).collect();
+        return Err(Error::Usage(format!(
+            "merge: shard(s) {} missing: {} not in any part; give their parts, or --partial to merge the rest with these marked not run",
+            names.join(", "),
+            some(&loads)
+        )));
+    }
+    for p in parts {
+        let not_run: Vec<Parameters> = (0..p.status.len())
+            .filter(|&j| p.status[j] != STATUS_OK && p.status[j] != STATUS_FAILED)
+            .map(|j| p.all[p.indices[j]].clone())
+            .collect();
+        if !not_run.is_empty() {
+            return Err(Error::input(
+                &p.path,
+                "status",
+                format!(
+                    "{} were not run (the shard did not finish); rerun it with --resume, or merge --partial",
+                    some(&not_run)
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The pipeline the parts were run with and, for a reduced sweep, its basis, checked
+/// against the parts' basis hash.
+fn recorded_basis(first: &Part, limits: &Limits) -> Result<(Pipeline, Option<crate::io::basis_file::StoredBasis>)> {
+    let pipeline =
+        Pipeline::load_with(&first.pipeline, limits.clone()).map_err(|e| recorded_in(e, first, "shard/pipeline"))?;
+    let Some(b) = &first.basis else { return Ok((pipeline, None)) };
+    let stored = load_basis(&pipeline, &b.path).map_err(|e| recorded_in(e, first, "shard/basis"))?;
+    if stored.content_hash != b.hash {
+        return Err(Error::input(
+            &b.path,
+            "basis_content_hash",
+            format!(
+                "differs from the one the parts were swept with ({}): the basis changed since; rerun the sweep",
+                first.path.display()
+            ),
+        ));
+    }
+    Ok((pipeline, Some(stored)))
 }

@@ -1,7 +1,7 @@
 //! The table `flexrom sweep` prints on stdout (text form; `--csv`/`--json` use
-//! `pipeline::tables::sweep_table`).
+//! `report::tables::sweep_table`).
 
-use super::outcome::{Sweep, STATUS_FAILED};
+use crate::records::sweep_outcome::{Sweep, STATUS_FAILED};
 
 /// The table printed on stdout.
 pub fn table(s: &Sweep) -> String {
@@ -20,7 +20,8 @@ pub fn table(s: &Sweep) -> String {
         out.push_str("   answer");
     }
     // the named parameters of the points, where there are any, lead each line
-    let named: Vec<String> = super::file::point_names(s.scales.iter().map(|x| &x.mu)).into_iter().skip(1).collect();
+    let named: Vec<String> =
+        crate::records::sweep_file::point_names(s.scales.iter().map(|x| &x.mu)).into_iter().skip(1).collect();
     let lead = |values: Vec<String>| values.into_iter().map(|v| format!("{v}  ")).collect::<String>();
     out.insert_str(0, &lead(named.iter().map(|n| format!("{n:>10}")).collect()));
     out.push('\n');

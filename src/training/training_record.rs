@@ -1,10 +1,10 @@
 //! The record of a training: what `train` returns (`TrainSummary`) and what the greedy loop did
 //! (`GreedyRecord`, written under `/training` in the basis file).
 
-use super::greedy::CandidateSet;
 use crate::reduction::Trained;
 use crate::rom::estimator::{ErrorMeasure, EstimateMethod, Estimator};
 use crate::solver::parameters::Parameters;
+use crate::training::greedy::CandidateSet;
 
 pub struct TrainSummary {
     pub trained: Trained,

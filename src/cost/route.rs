@@ -10,7 +10,7 @@
 //! the medians its validation measured and states the faster route in its report
 //! ([`Comparison`]).
 
-use super::timing::{median, repeat_timing};
+use crate::cost::timing::{median, repeat_timing};
 use crate::error::Result;
 use crate::io::timing_file::RouteTiming;
 use crate::linalg::kkt::LinearSolverKind;
@@ -21,7 +21,7 @@ use std::path::Path;
 
 /// Times the full time loop (banded solver) and the reduced one with its estimate at
 /// the parameters `mu`, interleaved, one run at a time, within the budget of `validate`'s
-/// timing ([`super::timing`]), and returns their medians.
+/// timing ([`crate::cost::timing`]), and returns their medians.
 pub fn time_routes(rom: &Rom, mu: &Parameters) -> Result<RouteTiming> {
     let model = &**rom.model();
     let o = Overrides::at(mu);

@@ -1,11 +1,11 @@
 //! `online`: load a basis, check it against the pipeline, and build its reduced model.
 
-use super::config::Pipeline;
 use crate::error::{Error, Result};
 use crate::io::basis_file::StoredBasis;
 use crate::io::h5::{attr_str, attr_u64, read_attr_str};
 use crate::io::result_file::{begin_alongside, RunPlan};
-use crate::pipeline::sweep::fallback::{settle, Fallback};
+use crate::pipeline::config::Pipeline;
+use crate::pipeline::fallback::{settle, Fallback};
 use crate::rom::estimator::{Estimate, EstimateMethod};
 use crate::rom::trust::write_run_attributes;
 use crate::rom::{check_reduced_memory, settings_at, LoadOptions, Output, ReducedRun, Rom, Trust};
@@ -103,7 +103,7 @@ pub struct OnlineRun {
 
 /// The answer of `online` at `mu`: the reduced run with its estimate, or with
 /// [`Fallback::Full`], where the reduced answer cannot be trusted
-/// ([`crate::pipeline::sweep::fallback::settle`]), the full model's run in its place (no
+/// ([`crate::pipeline::fallback::settle`]), the full model's run in its place (no
 /// reduced coordinates, the estimate of an exact answer); where the full run fails too, the
 /// reduced answer with a note, or both failures when the reduced run had failed.
 pub fn answer(rom: &Rom, mu: &Parameters, fallback: Fallback) -> Result<OnlineRun> {
@@ -139,7 +139,7 @@ pub fn answer(rom: &Rom, mu: &Parameters, fallback: Fallback) -> Result<OnlineRu
 /// when complete) with the reduced coordinates, the basis it came from (`basis_path`) and
 /// the estimate's attributes ([`crate::rom::trust::write_run_attributes`]). With
 /// [`Fallback::Full`], where the reduced answer cannot be trusted
-/// ([`crate::pipeline::sweep::fallback::settle`]) the full
+/// ([`crate::pipeline::fallback::settle`]) the full
 /// model runs and the file is its result (as `simulate` writes it) with the attribute
 /// `fallback` (why), the basis, and the estimate's attributes of an exact answer (0);
 /// where the full run fails too, a reduced answer stands with the attribute

@@ -1,26 +1,35 @@
 //! `run`: train → online sweep (validated) → validation with timings at chosen points →
 //! a report folder: `summary.md`, `validation.json`, `sweep.h5` and plots (SVG and PNG; the
-//! model's figure first, [`super::model_figure`]). Over a line of load scales the plots run
+//! model's figure first, [`crate::report::model_figure`]). Over a line of load scales the plots run
 //! along λ, over a box of one parameter along it; over a box of two parameters or more they
-//! are maps over the box ([`super::report_maps`]).
+//! are maps over the box ([`crate::report::report_maps`]).
 //! The folder is built beside the target and renamed into place at the end, the basis
 //! written under a temporary name and renamed into place only when every stage succeeded.
 //! A current basis (trained from this model with these training keys, passing its checks:
 //! `current_basis`) is reused as it is: neither trained nor rewritten.
 
-use super::config::{EstimateMethod, Pipeline};
-use super::online::load_rom;
-use super::plot::{Figure, Panel, Series, Style};
-use super::sweep::{sweep, table, write_sweep, SweepBasis, SweepOptions};
-use super::train::train_and_write;
-use super::validate::{validate, Validation};
+pub mod animate;
+pub mod drawing;
+pub mod map;
+pub mod model_figure;
+pub mod motion;
+pub mod plot;
+pub mod report_maps;
+pub mod tables;
+
 use crate::error::{Error, Result};
 use crate::io::atomic::TempPath;
 use crate::io::output::{check_output, check_report_dir, mark_new_report, swap_in_report, Origin};
 use crate::limits::Limits;
+use crate::pipeline::config::{EstimateMethod, Pipeline};
+use crate::report::plot::{Figure, Panel, Series, Style};
 use crate::rom::Rom;
 use crate::simulate::SimulationResult;
 use crate::solver::parameters::Parameters;
+use crate::training::train::train_and_write;
+use crate::workflows::online::load_rom;
+use crate::workflows::sweep::{sweep, table, write_sweep, SweepBasis, SweepOptions};
+use crate::workflows::validate::{validate, Validation};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -49,10 +58,10 @@ pub fn check_outputs(p: &Pipeline) -> Result<()> {
 /// were and the temporary ones removed. Returns the report folder and the training's
 /// warnings.
 pub fn run(p: &Pipeline, progress: bool) -> Result<(PathBuf, Vec<String>)> {
-    run_with(p, progress, super::dense::DenseChoice::Auto, None, true)
+    run_with(p, progress, crate::cost::dense::DenseChoice::Auto, None, true)
 }
 
-/// [`run`] with the choice of the dense-LU comparison ([`super::dense`]), decided before
+/// [`run`] with the choice of the dense-LU comparison ([`crate::cost::dense`]), decided before
 /// any work, the error estimate's method (`--estimate`; `None`: the pipeline's
 /// `[online] estimate`, else the basis's default) and whether to train even where the
 /// pipeline's basis is current (`retrain`; else a current basis, trained from this model with
@@ -60,12 +69,12 @@ pub fn run(p: &Pipeline, progress: bool) -> Result<(PathBuf, Vec<String>)> {
 pub fn run_with(
     p: &Pipeline,
     progress: bool,
-    dense: super::dense::DenseChoice,
+    dense: crate::cost::dense::DenseChoice,
     method: Option<EstimateMethod>,
     retrain: bool,
 ) -> Result<(PathBuf, Vec<String>)> {
     check_outputs(p)?;
-    let dense = super::dense::decide(dense, &p.model)?;
+    let dense = crate::cost::dense::decide(dense, &p.model)?;
     let dir = p.report_dir.clone();
     let report = TempPath::dir_for(&dir)?;
     let reused = if retrain { None } else { current_basis(p, method) };
@@ -159,45 +168,145 @@ fn build(
     (dense, method): (bool, Option<EstimateMethod>),
     reused: Option<Reused>,
 ) -> Result<Vec<String>> {
-    // named by the report's own path: the temporary folder is gone by the time the user reads it
-    let plot_err =
-        |stem: &str, e: String| Error::io(p.report_dir.join(format!("{stem}.svg")), std::io::Error::other(e));
     // the model as the user wrote it, at its initial state: it needs none of the runs
-    super::model_figure::save_model_figure(&p.model, &out.join("model"))?;
+    crate::report::model_figure::save_model_figure(&p.model, &out.join("model"))?;
     let space = p.space();
-    let in_box = !space.is_empty();
-    // how the report names a run: its load scale, or its point of the box
-    let name = |mu: &Parameters| if in_box { space.label(mu) } else { mu.scale().to_string() };
-    let (stored, rom, trained) = match reused {
-        Some(r) => {
-            let trained = Training::reused(&r, &name);
-            (r.stored, r.rom, trained)
-        }
-        None => {
-            match &p.file.train.greedy {
-                Some(_) if in_box => log::info!("[1/3] train: greedy over the box {}", space.describe()),
-                Some(g) => log::info!("[1/3] train: greedy over [{}, {}]", g.range().0, g.range().1),
-                None if in_box => log::info!("[1/3] train: {} full run(s)", p.training_points().len()),
-                None => log::info!("[1/3] train: {} full run(s)", p.training_scales().len()),
-            }
-            let summary = train_and_write(p, basis_path)?;
-            // the warnings of loading it come with `check_report`'s, once
-            let (stored, rom, _) = load_rom(p, basis_path, method, false)?;
-            let mut trained = Training::trained(p, summary, &name);
-            trained.warnings.extend(super::route::time_and_store(&rom, basis_path)?);
-            (stored, rom, trained)
-        }
-    };
+    let st = Stage { p, out, in_box: !space.is_empty(), space };
+    let (stored, rom, trained) = train_or_reuse(&st, basis_path, method, reused)?;
+    let sw = sweep_stage(&st, &rom, &stored, progress)?;
+    let (validations, animated) = validation_stage(&st, &rom, dense)?;
+    // the figures summary.md shows after the runs' own, in order: (file stem, what it shows)
+    let mut shown: Vec<(&str, &str)> = vec![("singular_values", "singular values")];
+    st.single(
+        "POD singular values",
+        "index",
+        vec![Panel { y_label: "σ".into(), log_y: true, series: singular_value_series(p, &stored) }],
+        vec![],
+        "singular_values",
+    )?;
+    shown.extend(parameter_figures(&st, basis_path, &rom, &sw, &validations)?);
+    st.single(
+        "rel_error (solid) and error_estimate (dashed) up to a fraction of the run",
+        "fraction of the run",
+        vec![Panel { y_label: "relative error".into(), log_y: true, series: error_by_time_series(&st, &validations) }],
+        vec![],
+        "error_by_time",
+    )?;
+    shown.push(("error_by_time", "error by time"));
+    let json = serde_json::to_string_pretty(&validations).expect("serializable");
+    std::fs::write(out.join("validation.json"), json)
+        .map_err(|e| Error::io(p.report_dir.join("validation.json"), e))?;
+    let run = Done { stored: &stored, rom: &rom, sw: &sw, validations: &validations };
+    write_summary(&st, &run, trained, animated.as_deref(), &shown)
+}
 
-    let points = p.online_points();
+/// What every stage of [`build`] reads: the pipeline, the temporary folder it writes into,
+/// and whether its runs are points of a box (else load scales on a line).
+struct Stage<'a> {
+    p: &'a Pipeline,
+    out: &'a Path,
+    space: crate::solver::parameter_space::ParameterSpace,
+    in_box: bool,
+}
+
+impl Stage<'_> {
+    /// How the report names a run: its load scale, or its point of the box.
+    fn name(&self, mu: &Parameters) -> String {
+        if self.in_box {
+            self.space.label(mu)
+        } else {
+            mu.scale().to_string()
+        }
+    }
+
+    /// A validation's row label in the summary's tables.
+    fn at(&self, v: &Validation) -> String {
+        if self.in_box {
+            self.name(&v.mu())
+        } else {
+            v.load_scale.to_string()
+        }
+    }
+
+    /// The head of the tables' first column.
+    fn head(&self) -> &'static str {
+        if self.in_box {
+            "point"
+        } else {
+            "load scale"
+        }
+    }
+
+    /// A figure that could not be written, named by the report's own path: the temporary
+    /// folder is gone by the time the user reads it.
+    fn plot_err(&self, stem: &str, e: String) -> Error {
+        Error::io(self.p.report_dir.join(format!("{stem}.svg")), std::io::Error::other(e))
+    }
+
+    /// Writes one figure of `panels` as `stem`.svg and .png, the training runs marked at `markers`.
+    fn single(&self, title: &str, x_label: &str, panels: Vec<Panel>, markers: Vec<f64>, stem: &str) -> Result<()> {
+        // in a box the training runs are points of it: marked by name, not as loads
+        let marker_label = if self.in_box { "training run" } else { "training load" };
+        Figure { title: title.into(), x_label: x_label.into(), panels, markers, marker_label: marker_label.into() }
+            .save(&self.out.join(stem))
+            .map(|_| ())
+            .map_err(|e| self.plot_err(stem, e))
+    }
+}
+
+/// What the runs gave, for the summary.
+struct Done<'a> {
+    stored: &'a crate::io::basis_file::StoredBasis,
+    rom: &'a Rom,
+    sw: &'a crate::workflows::sweep::Sweep,
+    validations: &'a [Validation],
+}
+
+/// Stage 1: the reused basis, or one trained now (written to `basis_path`, with the routes'
+/// timing), read back as every reader of a basis reads it.
+fn train_or_reuse(
+    st: &Stage,
+    basis_path: &Path,
+    method: Option<EstimateMethod>,
+    reused: Option<Reused>,
+) -> Result<(crate::io::basis_file::StoredBasis, Rom, Training)> {
+    let p = st.p;
+    let name = |mu: &Parameters| st.name(mu);
+    if let Some(r) = reused {
+        let trained = Training::reused(&r, &name);
+        return Ok((r.stored, r.rom, trained));
+    }
+    match &p.file.train.greedy {
+        Some(_) if st.in_box => log::info!("[1/3] train: greedy over the box {}", st.space.describe()),
+        Some(g) => log::info!("[1/3] train: greedy over [{}, {}]", g.range().0, g.range().1),
+        None if st.in_box => log::info!("[1/3] train: {} full run(s)", p.training_points().len()),
+        None => log::info!("[1/3] train: {} full run(s)", p.training_scales().len()),
+    }
+    let summary = train_and_write(p, basis_path)?;
+    // the warnings of loading it come with `check_report`'s, once
+    let (stored, rom, _) = load_rom(p, basis_path, method, false)?;
+    let mut trained = Training::trained(p, summary, &name);
+    trained.warnings.extend(crate::cost::route::time_and_store(&rom, basis_path)?);
+    Ok((stored, rom, trained))
+}
+
+/// Stage 2: the validated sweep over the online points, written as `sweep.h5`; an error
+/// where any point failed (the plots and tables need every one).
+fn sweep_stage(
+    st: &Stage,
+    rom: &Rom,
+    stored: &crate::io::basis_file::StoredBasis,
+    progress: bool,
+) -> Result<crate::workflows::sweep::Sweep> {
+    let points = st.p.online_points();
     log::info!("[2/3] sweep: {} reduced and full runs", points.len());
-    let sw = sweep(&rom, &points, SweepOptions { validate: true, progress, ..Default::default() })?;
+    let sw = sweep(rom, &points, SweepOptions { validate: true, progress, ..Default::default() })?;
     write_sweep(
-        &out.join("sweep.h5"),
+        &st.out.join("sweep.h5"),
         &sw,
         Some(SweepBasis {
-            stored: &stored,
-            path: &p.basis_path,
+            stored,
+            path: &st.p.basis_path,
             sensitivity: rom.trust().and_then(|t| t.sensitivity.as_ref()),
         }),
     )?;
@@ -205,7 +314,14 @@ fn build(
     if let Some(s) = sw.failure_summary() {
         return Err(Error::PartlyFailed(format!("sweep: {s}; no report written (the basis is)")));
     }
+    Ok(sw)
+}
 
+/// Stage 3: the validations with timings at the validation points, each with its energy
+/// and probe figures, and the one with the largest rel_error animated (its name; `None`
+/// where the animation could not be written, with a warning).
+fn validation_stage(st: &Stage, rom: &Rom, dense: bool) -> Result<(Vec<Validation>, Option<String>)> {
+    let (p, out, in_box) = (st.p, st.out, st.in_box);
     let vpoints = p.validation_points();
     let with = if dense { ", with the dense full solve" } else { "" };
     log::info!("[3/3] validate at {} {}{with}", vpoints.len(), if in_box { "point(s)" } else { "load scale(s)" });
@@ -213,23 +329,23 @@ fn build(
     // the validation with the largest rel_error, animated full against reduced
     let mut worst: Option<(f64, String, SimulationResult, SimulationResult)> = None;
     for (i, mu) in vpoints.iter().enumerate() {
-        let (v, full, reduced) = validate(&rom, mu, dense)?;
+        let (v, full, reduced) = validate(rom, mu, dense)?;
         energy_figure(
-            &rom,
+            rom,
             (&full, &reduced.result),
-            &format!("Energies, full and reduced, {}{}", if in_box { "" } else { "load scale " }, name(mu)),
+            &format!("Energies, full and reduced, {}{}", if in_box { "" } else { "load scale " }, st.name(mu)),
         )?
         .save(&out.join(format!("energy_{i}")))
-        .map_err(|e| plot_err(&format!("energy_{i}"), e))?;
+        .map_err(|e| st.plot_err(&format!("energy_{i}"), e))?;
         // a model without probes has nothing to draw here
         if !full.probes.is_empty() {
-            let title = format!("Probes, full and reduced, {}{}", if in_box { "" } else { "load scale " }, name(mu));
+            let title = format!("Probes, full and reduced, {}{}", if in_box { "" } else { "load scale " }, st.name(mu));
             probes_figure(&full, &reduced.result, title)
                 .save(&out.join(format!("probes_{i}")))
-                .map_err(|e| plot_err(&format!("probes_{i}"), e))?;
+                .map_err(|e| st.plot_err(&format!("probes_{i}"), e))?;
         }
         if worst.as_ref().is_none_or(|w| v.rel_error > w.0) {
-            worst = Some((v.rel_error, name(mu), full, reduced.result));
+            worst = Some((v.rel_error, st.name(mu), full, reduced.result));
         }
         validations.push(v);
     }
@@ -240,15 +356,19 @@ fn build(
             .ok(),
         None => None,
     };
-    // one curve per block of a block basis (one POD per body: named by the body), each
-    // indexed from 1
+    Ok((validations, animated))
+}
+
+/// The POD singular values, one curve per block of a block basis (one POD per body: named
+/// by the body), each indexed from 1.
+fn singular_value_series(p: &Pipeline, stored: &crate::io::basis_file::StoredBasis) -> Vec<Series> {
     let bodies = p.model.bodies();
     let block_name = |b: usize| match bodies.get(b) {
         Some(body) if stored.block_values.len() == bodies.len() => format!("σᵢ, {}", body.name),
         _ => format!("σᵢ, block {}", b + 1),
     };
     let mut sv = stored.singular_values.iter();
-    let blocks: Vec<Series> = stored
+    stored
         .block_values
         .iter()
         .enumerate()
@@ -256,158 +376,193 @@ fn build(
             let name = if stored.block_values.len() == 1 { "σᵢ".into() } else { block_name(b) };
             Series::new(name, sv.by_ref().take(k).enumerate().map(|(i, s)| ((i + 1) as f64, *s)).collect(), Style::Line)
         })
-        .collect();
-    // in a box the training runs are points of it: marked by name, not as loads
-    let marker_label = if in_box { "training run" } else { "training load" };
-    let single = |title: &str, x_label: &str, panels: Vec<Panel>, markers: Vec<f64>, stem: &str| {
-        Figure { title: title.into(), x_label: x_label.into(), panels, markers, marker_label: marker_label.into() }
-            .save(&out.join(stem))
-            .map_err(|e| plot_err(stem, e))
-    };
-    // the figures summary.md shows after the runs' own, in order: (file stem, what it shows)
-    let mut shown: Vec<(&str, &str)> = vec![("singular_values", "singular values")];
-    single(
-        "POD singular values",
-        "index",
-        vec![Panel { y_label: "σ".into(), log_y: true, series: blocks }],
-        vec![],
-        "singular_values",
-    )?;
-    // the estimate over the sweep (no full run), by the sweep's points
-    let estimates: Vec<(Parameters, f64)> = (sw.scales.iter())
-        .filter_map(|x| x.point())
-        .filter_map(|q| q.estimate.as_ref().map(|e| (q.run.result.settings.mu.clone(), e.error_estimate)))
-        .collect();
-    let names: Vec<&str> = space.names().collect();
-    // the axis the figures run along: λ on a line, the parameter of a one-parameter box; a
-    // box of two parameters or more is drawn as maps over it instead
+        .collect()
+}
+
+/// The figures over the parameters: along the axis the runs lie on (λ on a line, the
+/// parameter of a one-parameter box), or maps over a box of two parameters or more; the
+/// (file stem, what it shows) of each, in the order summary.md shows them.
+fn parameter_figures(
+    st: &Stage,
+    basis_path: &Path,
+    rom: &Rom,
+    sw: &crate::workflows::sweep::Sweep,
+    validations: &[Validation],
+) -> Result<Vec<(&'static str, &'static str)>> {
+    let p = st.p;
+    let names: Vec<&str> = st.space.names().collect();
     let axis = match names.as_slice() {
         [] => Some(crate::solver::parameters::LOAD_SCALE),
         [one] => Some(*one),
         _ => None,
     };
-    match axis {
-        Some(axis) => {
-            let x_of = |mu: &Parameters| mu.get(axis).unwrap_or(1.0);
-            let x_label = if in_box { axis } else { "load scale" };
-            // the sweep's validated runs along the axis, in its order (a box's points are drawn at random)
-            let pts = |f: &dyn Fn(&Validation) -> f64| -> Vec<(f64, f64)> {
-                let mut v: Vec<(f64, f64)> = (sw.scales.iter())
-                    .filter_map(|x| x.point()?.validation.as_ref())
-                    .map(|v| (x_of(&v.mu()), f(v)))
-                    .collect();
-                v.sort_by(|a, b| a.0.total_cmp(&b.0));
-                v
-            };
-            // the full runs the basis was trained on, marked on the plots along the axis
-            let training: Vec<f64> = if in_box {
-                stored_runs(p, basis_path)?.iter().map(x_of).collect()
-            } else {
-                crate::io::estimator_file::read_training_loads(basis_path)?
-            };
-            // rel_error and the probe error (m) on axes of their own: two units, two axes
-            let mut panels = vec![Panel {
-                y_label: "rel_error".into(),
-                log_y: true,
-                series: vec![Series::new("rel_error", pts(&|v| v.rel_error), Style::Line)],
-            }];
-            if !p.model.probe_names().is_empty() {
-                panels.push(Panel {
-                    y_label: "probe error (m)".into(),
-                    log_y: true,
-                    series: vec![Series::new("max probe error", pts(&|v| v.max_probe_error), Style::Line).colored(1)],
-                });
-            }
-            single("Reduced vs full model", x_label, panels, training.clone(), "error_vs_load")?;
-            let speedups = pts(&|v| v.speedup);
-            let span = speedups.iter().fold((f64::MAX, f64::MIN), |(a, b), q| (a.min(q.0), b.max(q.0)));
-            let mut series = vec![Series::new("speedup (banded full solver)", speedups, Style::Line)];
-            if span.0 <= span.1 {
-                series.push(Series::level("1× (as fast as the full run)", 1.0, span));
-            }
-            single(
-                "Speedup of the reduced time loop over the full one",
-                x_label,
-                vec![Panel { y_label: "speedup".into(), log_y: false, series }],
-                training.clone(),
-                "speedup_vs_load",
-            )?;
-            shown.extend([("error_vs_load", "error"), ("speedup_vs_load", "speedup")]);
-            // the validation's own runs lie on the same axis
-            let mut errors = pts(&|v| v.rel_error);
-            errors.extend(validations.iter().map(|v| (x_of(&v.mu()), v.rel_error)));
-            if !estimates.is_empty() {
-                let mut along: Vec<(f64, f64)> = estimates.iter().map(|(mu, e)| (x_of(mu), *e)).collect();
-                along.sort_by(|a, b| a.0.total_cmp(&b.0));
-                single(
-                    "Error estimate (no full run) and true error (full runs)",
-                    x_label,
-                    vec![Panel {
-                        y_label: "relative error".into(),
-                        log_y: true,
-                        series: vec![
-                            Series::new("error_estimate", along, Style::Line),
-                            Series::new("rel_error (validated)", errors, Style::Markers),
-                        ],
-                    }],
-                    training,
-                    "estimate_vs_load",
-                )?;
-                shown.push(("estimate_vs_load", "error estimate"));
-            }
-        }
-        None => {
-            // every validated run, the sweep's and the validation's, at its point
-            let runs: Vec<super::report_maps::MappedRun> = (sw.scales.iter())
-                .filter_map(|x| x.point())
-                .filter_map(|q| {
-                    let estimate = q.estimate.as_ref().map(|e| e.error_estimate);
-                    Some(super::report_maps::MappedRun { validation: q.validation.as_ref()?, estimate })
-                })
-                .chain(
-                    validations
-                        .iter()
-                        .map(|v| super::report_maps::MappedRun { validation: v, estimate: v.error_estimate }),
-                )
-                .collect();
-            let training = stored_runs(p, basis_path)?;
-            let cx = super::report_maps::MapContext {
-                space: &space,
-                training: &training,
-                tolerance: rom.trust().and_then(|t| t.tolerance),
-                probes: !p.model.probe_names().is_empty(),
-            };
-            shown.extend(super::report_maps::write_maps(out, &runs, &cx).map_err(|(stem, e)| plot_err(stem, e))?);
-        }
+    let Some(axis) = axis else {
+        // every validated run, the sweep's and the validation's, at its point
+        let runs: Vec<crate::report::report_maps::MappedRun> = (sw.scales.iter())
+            .filter_map(|x| x.point())
+            .filter_map(|q| {
+                let estimate = q.estimate.as_ref().map(|e| e.error_estimate);
+                Some(crate::report::report_maps::MappedRun { validation: q.validation.as_ref()?, estimate })
+            })
+            .chain(
+                validations
+                    .iter()
+                    .map(|v| crate::report::report_maps::MappedRun { validation: v, estimate: v.error_estimate }),
+            )
+            .collect();
+        let training = stored_runs(p, basis_path)?;
+        let cx = crate::report::report_maps::MapContext {
+            space: &st.space,
+            training: &training,
+            tolerance: rom.trust().and_then(|t| t.tolerance),
+            probes: !p.model.probe_names().is_empty(),
+        };
+        return crate::report::report_maps::write_maps(st.out, &runs, &cx).map_err(|(stem, e)| st.plot_err(stem, e));
+    };
+    axis_figures(st, axis, basis_path, sw, validations)
+}
+
+/// The figures along `axis`: the error and the speedup over the sweep, and the estimate
+/// (no full run) against the true errors (full runs) where the sweep has estimates.
+fn axis_figures(
+    st: &Stage,
+    axis: &str,
+    basis_path: &Path,
+    sw: &crate::workflows::sweep::Sweep,
+    validations: &[Validation],
+) -> Result<Vec<(&'static str, &'static str)>> {
+    let p = st.p;
+    // the estimate over the sweep (no full run), by the sweep's points
+    let estimates: Vec<(Parameters, f64)> = (sw.scales.iter())
+        .filter_map(|x| x.point())
+        .filter_map(|q| q.estimate.as_ref().map(|e| (q.run.result.settings.mu.clone(), e.error_estimate)))
+        .collect();
+    let x_of = |mu: &Parameters| mu.get(axis).unwrap_or(1.0);
+    let x_label = if st.in_box { axis } else { "load scale" };
+    // the sweep's validated runs along the axis, in its order (a box's points are drawn at random)
+    let pts = |f: &dyn Fn(&Validation) -> f64| -> Vec<(f64, f64)> {
+        let mut v: Vec<(f64, f64)> =
+            (sw.scales.iter()).filter_map(|x| x.point()?.validation.as_ref()).map(|v| (x_of(&v.mu()), f(v))).collect();
+        v.sort_by(|a, b| a.0.total_cmp(&b.0));
+        v
+    };
+    // the full runs the basis was trained on, marked on the plots along the axis
+    let training: Vec<f64> = if st.in_box {
+        stored_runs(p, basis_path)?.iter().map(x_of).collect()
+    } else {
+        crate::io::estimator_file::read_training_loads(basis_path)?
+    };
+    // rel_error and the probe error (m) on axes of their own: two units, two axes
+    let mut panels = vec![Panel {
+        y_label: "rel_error".into(),
+        log_y: true,
+        series: vec![Series::new("rel_error", pts(&|v| v.rel_error), Style::Line)],
+    }];
+    if !p.model.probe_names().is_empty() {
+        panels.push(Panel {
+            y_label: "probe error (m)".into(),
+            log_y: true,
+            series: vec![Series::new("max probe error", pts(&|v| v.max_probe_error), Style::Line).colored(1)],
+        });
     }
-    // the true error (solid) and its estimate (dashed) up to each fifth of the run, one
-    // colour a validated run
+    st.single("Reduced vs full model", x_label, panels, training.clone(), "error_vs_load")?;
+    let speedups = pts(&|v| v.speedup);
+    let span = speedups.iter().fold((f64::MAX, f64::MIN), |(a, b), q| (a.min(q.0), b.max(q.0)));
+    let mut series = vec![Series::new("speedup (banded full solver)", speedups, Style::Line)];
+    if span.0 <= span.1 {
+        series.push(Series::level("1× (as fast as the full run)", 1.0, span));
+    }
+    st.single(
+        "Speedup of the reduced time loop over the full one",
+        x_label,
+        vec![Panel { y_label: "speedup".into(), log_y: false, series }],
+        training.clone(),
+        "speedup_vs_load",
+    )?;
+    let mut shown = vec![("error_vs_load", "error"), ("speedup_vs_load", "speedup")];
+    // the validation's own runs lie on the same axis
+    let mut errors = pts(&|v| v.rel_error);
+    errors.extend(validations.iter().map(|v| (x_of(&v.mu()), v.rel_error)));
+    if !estimates.is_empty() {
+        let mut along: Vec<(f64, f64)> = estimates.iter().map(|(mu, e)| (x_of(mu), *e)).collect();
+        along.sort_by(|a, b| a.0.total_cmp(&b.0));
+        st.single(
+            "Error estimate (no full run) and true error (full runs)",
+            x_label,
+            vec![Panel {
+                y_label: "relative error".into(),
+                log_y: true,
+                series: vec![
+                    Series::new("error_estimate", along, Style::Line),
+                    Series::new("rel_error (validated)", errors, Style::Markers),
+                ],
+            }],
+            training,
+            "estimate_vs_load",
+        )?;
+        shown.push(("estimate_vs_load", "error estimate"));
+    }
+    Ok(shown)
+}
+
+/// The true error (solid) and its estimate (dashed) up to each fifth of the run, one
+/// colour a validated run.
+fn error_by_time_series(st: &Stage, validations: &[Validation]) -> Vec<Series> {
     let fifths = |v: &[f64]| v.iter().enumerate().map(|(i, e)| ((i + 1) as f64 / 5.0, *e)).collect::<Vec<_>>();
-    let by_time: Vec<Series> = validations
+    validations
         .iter()
         .enumerate()
         .flat_map(|(k, v)| {
             // one legend entry a run (the two series share its name)
-            let at = if in_box { name(&v.mu()) } else { format!("load scale {}", v.load_scale) };
+            let at = if st.in_box { st.name(&v.mu()) } else { format!("load scale {}", v.load_scale) };
             let truth = Series::new(at.clone(), fifths(&v.rel_error_by_time), Style::Line).colored(k);
             let est = v.error_estimate_by_time.as_ref().map(|e| Series::new(at, fifths(e), Style::Dashed).colored(k));
             std::iter::once(truth).chain(est)
         })
-        .collect();
-    single(
-        "rel_error (solid) and error_estimate (dashed) up to a fraction of the run",
-        "fraction of the run",
-        vec![Panel { y_label: "relative error".into(), log_y: true, series: by_time }],
-        vec![],
-        "error_by_time",
-    )?;
-    shown.push(("error_by_time", "error by time"));
-    let json = serde_json::to_string_pretty(&validations).expect("serializable");
-    std::fs::write(out.join("validation.json"), json)
-        .map_err(|e| Error::io(p.report_dir.join("validation.json"), e))?;
+        .collect()
+}
 
-    let b = &*stored.basis;
+/// Writes summary.md: what was trained and run, the validations, the route verdict, the
+/// estimate's section, the sweep's table, its warnings and the plots; returns the
+/// training's and the route's warnings for the caller to print.
+fn write_summary(
+    st: &Stage,
+    run: &Done,
+    trained: Training,
+    animated: Option<&str>,
+    shown: &[(&str, &str)],
+) -> Result<Vec<String>> {
+    let (p, validations) = (st.p, run.validations);
     let mut md = String::new();
+    summary_head(&mut md, st, run, &trained);
+    validation_table(&mut md, st, validations);
+    let mut warnings = trained.warnings;
+    if let Some(speed) = route_comparison(validations) {
+        let _ = writeln!(md, "\n## Full or reduced\n");
+        let _ = writeln!(
+            md,
+            "{} Time loops on one thread: the median over the validated loads of the medians above{}.",
+            speed.verdict(),
+            if speed.estimate.is_some() { " (the estimate: one run at each load)" } else { "" }
+        );
+        let measured = format!("medians of `run`'s validation at {} load(s)", validations.len());
+        warnings.extend(speed.notice(&p.path, &measured));
+    }
+    let trust = run.rom.trust().expect("read from its basis file");
+    estimate_table(&mut md, st, run.rom, validations);
+    let labels: Vec<String> = validations.iter().map(|v| st.at(v)).collect();
+    motion_section(&mut md, validations, &labels, st.head(), trust);
+    sweep_section(&mut md, st, run)?;
+    plots_section(&mut md, st, &labels, animated, shown);
+    std::fs::write(st.out.join("summary.md"), md).map_err(|e| Error::io(p.report_dir.join("summary.md"), e))?;
+    Ok(warnings)
+}
+
+/// The summary's title and its lines on the model, the basis (with its training runs) and
+/// the sweep, and the model's figure.
+fn summary_head(md: &mut String, st: &Stage, run: &Done, trained: &Training) {
+    let (p, in_box, stored, sw) = (st.p, st.in_box, run.stored, run.sw);
+    let b = &*stored.basis;
     let _ = writeln!(md, "# flexrom report: {}\n", p.path.display());
     if !p.file.description.is_empty() {
         let _ = writeln!(md, "{}\n", p.file.description);
@@ -465,16 +620,19 @@ fn build(
         md,
         "The model at its initial configuration (bodies named; joints, springs, point masses and probes marked):\n\n![the model](model.svg)\n"
     );
+}
+
+/// The summary's validation table: errors and the time loops' seconds and speedups.
+fn validation_table(md: &mut String, st: &Stage, validations: &[Validation]) {
     let _ = writeln!(md, "## Validation (time loops only; full and reduced: medians of up to 7 interleaved runs each; full dense: one run)\n");
-    let head = if in_box { "point" } else { "load scale" };
-    let at = |v: &Validation| if in_box { name(&v.mu()) } else { v.load_scale.to_string() };
+    let head = st.head();
     let _ = writeln!(md, "| {head} | rel_error | max probe error (m) | at | max constraint violation | full (s) | full dense (s) | reduced (s) | speedup | vs dense |");
     let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|");
-    for v in &validations {
+    for v in validations {
         let _ = writeln!(
             md,
             "| {} | {:.3e} | {:.3e} | {} t = {:.3} s | {:.2e} | {:.4} | {:.4} | {:.4} | {:.2} | {:.2} |",
-            at(v),
+            st.at(v),
             v.rel_error,
             v.max_probe_error,
             v.max_probe_error_probe,
@@ -487,22 +645,16 @@ fn build(
             v.speedup_vs_dense.unwrap_or(f64::NAN)
         );
     }
-    let mut warnings = trained.warnings;
-    if let Some(speed) = route_comparison(&validations) {
-        let _ = writeln!(md, "\n## Full or reduced\n");
-        let _ = writeln!(
-            md,
-            "{} Time loops on one thread: the median over the validated loads of the medians above{}.",
-            speed.verdict(),
-            if speed.estimate.is_some() { " (the estimate: one run at each load)" } else { "" }
-        );
-        let measured = format!("medians of `run`'s validation at {} load(s)", validations.len());
-        warnings.extend(speed.notice(&p.path, &measured));
-    }
+}
+
+/// The summary's section on the error estimate, extrapolation and sensitivity: the
+/// training range or box, the tolerance, and a row per validation.
+fn estimate_table(md: &mut String, st: &Stage, rom: &Rom, validations: &[Validation]) {
+    let in_box = st.in_box;
     let _ = writeln!(md, "\n## Error estimate, extrapolation, sensitivity\n");
     let trust = rom.trust().expect("read from its basis file");
     let trained_over = if in_box {
-        format!("Training box {}", space.describe())
+        format!("Training box {}", st.space.describe())
     } else {
         format!("Training range [{}, {}]", trust.range.0, trust.range.1)
     };
@@ -513,9 +665,10 @@ fn build(
         rom.method().unwrap_or("no"),
         if in_box { " (every parameter of the box)" } else { "" }
     );
+    let head = st.head();
     let _ = writeln!(md, "| {head} | rel_error | error_estimate | effectivity | calibrated | extrapolated | sensitivity | rel_error by fifth of the run | error_estimate by fifth of the run |");
     let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|");
-    for v in &validations {
+    for v in validations {
         let by: Vec<String> = v.rel_error_by_time.iter().map(|e| format!("{e:.2e}")).collect();
         let est_by = v
             .error_estimate_by_time
@@ -525,7 +678,7 @@ fn build(
         let _ = writeln!(
             md,
             "| {} | {:.3e} | {} | {} | {} | {} | {} | {} | {} |",
-            at(v),
+            st.at(v),
             v.rel_error,
             o(v.error_estimate, &|x| format!("{x:.3e}")),
             o(v.effectivity, &|x| format!("{x:.2}")),
@@ -536,10 +689,12 @@ fn build(
             est_by
         );
     }
-    let labels: Vec<String> = validations.iter().map(at).collect();
-    motion_section(&mut md, &validations, &labels, head, trust);
-    let mut swept = table(&sw);
-    if in_box {
+}
+
+/// The summary's sweep table, and what `run` says in one line each at its end, whole.
+fn sweep_section(md: &mut String, st: &Stage, run: &Done) -> Result<()> {
+    let mut swept = table(run.sw);
+    if st.in_box {
         // a box's points have no order of their own: numbered, so that a row can be named
         swept = swept
             .lines()
@@ -548,8 +703,7 @@ fn build(
             .collect();
     }
     let _ = writeln!(md, "\n## Sweep\n\n```text\n{swept}```\n");
-    // what `run` says in one line each at its end, whole
-    let said = sweep_warnings(&rom, &out.join("sweep.h5"), false)?;
+    let said = sweep_warnings(run.rom, &st.out.join("sweep.h5"), false)?;
     if !said.is_empty() {
         let _ = writeln!(md, "## Warnings\n");
         for w in &said {
@@ -557,23 +711,27 @@ fn build(
         }
         let _ = writeln!(md);
     }
+    Ok(())
+}
+
+/// The summary's plots: the animation, the validations' probe and energy figures (named by
+/// `labels`) and the figures `shown`.
+fn plots_section(md: &mut String, st: &Stage, labels: &[String], animated: Option<&str>, shown: &[(&str, &str)]) {
     let _ = writeln!(md, "## Plots\n");
-    if let Some(at) = &animated {
-        let at = if in_box { at.clone() } else { format!("load scale {at}") };
+    if let Some(at) = animated {
+        let at = if st.in_box { at.to_string() } else { format!("load scale {at}") };
         let _ = writeln!(md, "The motion at {at}, the validation with the largest rel_error: full (solid) against reduced (dashed).\n\n![full against reduced at {at}](animation.gif)\n");
     }
     // a model without probes has no probe figures
-    for (i, x) in labels.iter().enumerate().filter(|_| !p.model.probe_names().is_empty()) {
+    for (i, x) in labels.iter().enumerate().filter(|_| !st.p.model.probe_names().is_empty()) {
         let _ = writeln!(md, "![probes at {x}](probes_{i}.svg)");
     }
     for (i, x) in labels.iter().enumerate() {
         let _ = writeln!(md, "![energies at {x}](energy_{i}.svg)");
     }
-    for (stem, what) in &shown {
+    for (stem, what) in shown {
         let _ = writeln!(md, "![{what}]({stem}.svg)");
     }
-    std::fs::write(out.join("summary.md"), md).map_err(|e| Error::io(p.report_dir.join("summary.md"), e))?;
-    Ok(warnings)
 }
 
 /// The probes' x and y, full (line) and reduced (dashed), and their difference.
@@ -637,8 +795,8 @@ fn animate_worst(out: &Path, full: &SimulationResult, reduced: &SimulationResult
             .finish(run, |_| Ok(()))
     };
     let made = write(&f, full).and_then(|_| write(&r, reduced)).and_then(|_| {
-        let opts = super::animate::AnimateOptions::default();
-        super::animate::animate(&f, Some(&r), &out.join("animation.gif"), &opts, limits).map(|_| ())
+        let opts = crate::report::animate::AnimateOptions::default();
+        crate::report::animate::animate(&f, Some(&r), &out.join("animation.gif"), &opts, limits).map(|_| ())
     });
     for path in [&f, &r] {
         let _ = std::fs::remove_file(path);
@@ -664,7 +822,11 @@ struct Training {
 }
 
 impl Training {
-    fn trained(p: &Pipeline, t: super::train::TrainSummary, name: &dyn Fn(&Parameters) -> String) -> Training {
+    fn trained(
+        p: &Pipeline,
+        t: crate::training::train::TrainSummary,
+        name: &dyn Fn(&Parameters) -> String,
+    ) -> Training {
         let runs: Vec<String> = match &t.greedy {
             Some(g) => g.runs.iter().map(name).collect(),
             None if !p.space().is_empty() => p.training_points().iter().map(name).collect(),
@@ -844,7 +1006,7 @@ fn sweep_warnings(rom: &Rom, path: &Path, strict: bool) -> Result<Vec<String>> {
         crate::rom::estimator::ErrorMeasure::Displacement => "error_estimate_displacement",
     };
     let (scales, est) = (read("load_scales")?, read(estimates)?);
-    let points = super::sweep::file::points_of(&f, &scales.to_vec())
+    let points = crate::records::sweep_file::points_of(&f, &scales.to_vec())
         .map_err(|(field, problem)| Error::input(path, field, problem))?;
     let runs: Vec<_> =
         points.into_iter().zip(&est).map(|(mu, &e)| (mu, if e.is_nan() { None } else { Some(e) })).collect();
@@ -854,12 +1016,12 @@ fn sweep_warnings(rom: &Rom, path: &Path, strict: bool) -> Result<Vec<String>> {
 /// The two routes' times per run from the validation's medians (the median over the
 /// validated loads of each; the estimate counts when every validated run has one); `None`
 /// without validated loads.
-fn route_comparison(validations: &[Validation]) -> Option<super::route::Comparison> {
+fn route_comparison(validations: &[Validation]) -> Option<crate::cost::route::Comparison> {
     let mid = |f: &dyn Fn(&Validation) -> Option<f64>| -> Option<f64> {
         let mut x: Vec<f64> = validations.iter().map(f).collect::<Option<_>>()?;
-        (!x.is_empty()).then(|| super::timing::median(&mut x))
+        (!x.is_empty()).then(|| crate::cost::timing::median(&mut x))
     };
-    Some(super::route::Comparison {
+    Some(crate::cost::route::Comparison {
         full: mid(&|v| Some(v.full_seconds))?,
         reduced: mid(&|v| Some(v.rom_seconds))?,
         estimate: mid(&|v| v.estimate_seconds),

@@ -14,7 +14,7 @@
 //! (largest), in even lightness steps and readable with colour-blindness. A run without a
 //! value there (NaN, ∞, or ≤ 0 on a log scale) is an open grey circle.
 
-use super::plot::{linear_labels, log_labels, register_font, write_png};
+use crate::report::plot::{linear_labels, log_labels, register_font, write_png};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};

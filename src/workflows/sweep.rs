@@ -9,33 +9,33 @@
 //! killed sweep leaves a valid file of the finished scales at the final path; `--resume`
 //! ([`sweep_to_file`]) takes the finished scales from it and runs the rest.
 //!
-//! What each load scale became is in `outcome.rs` ([`Sweep`], [`ScaleResult`]), the sweep
-//! file's layout and its writing and reading (`--resume`) in `file.rs`, one run of it with
-//! its basis (for drawing) in `run_at.rs`, the table printed on stdout in `table.rs`.
+//! What each load scale became is in `crate::records::sweep_outcome` ([`Sweep`],
+//! [`ScaleResult`]), the sweep file's layout and its writing and reading (`--resume`) in
+//! `crate::records::sweep_file`, one run of it with its basis (for drawing) in
+//! `crate::records::sweep_run`, the table printed on stdout in `sweep/table.rs`; the
+//! fallback policy in `crate::pipeline::fallback`.
 
-pub mod fallback;
-pub mod file;
-mod outcome;
-pub mod run_at;
 mod table;
 
-pub use fallback::Fallback;
-pub use file::{point_names, read_sweep, write_sweep, write_sweep_with, Extra, SweepBasis};
-pub use outcome::{Outcome, ScaleResult, Sweep, SweepPoint, STATUS_FAILED, STATUS_OK, STATUS_PENDING};
-pub use run_at::{is_sweep_file, open_sweep_run, SweepPick, SweepRun};
+pub use crate::pipeline::fallback::Fallback;
+pub use crate::records::sweep_file::{point_names, read_sweep, write_sweep, write_sweep_with, Extra, SweepBasis};
+pub use crate::records::sweep_outcome::{
+    Outcome, ScaleResult, Sweep, SweepPoint, STATUS_FAILED, STATUS_OK, STATUS_PENDING,
+};
+pub use crate::records::sweep_run::{is_sweep_file, open_sweep_run, SweepPick, SweepRun};
 pub use table::table;
 
-use super::validate::compare;
 use crate::error::Result;
 use crate::linalg::kkt::LinearSolverKind;
 use crate::model::Model;
+use crate::records::sweep_outcome::clone_point;
 use crate::rom::pool::Pool;
 use crate::rom::{Output, ReducedRun, Rom};
 use crate::simulate::{simulate, FullModel, Overrides, Settings};
 use crate::solver::model::Parameters;
+use crate::workflows::validate::compare;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use ndarray::{Array1, Array2};
-use outcome::clone_point;
 use rayon::prelude::*;
 use std::path::Path;
 use std::sync::Mutex;
@@ -60,7 +60,7 @@ pub struct SweepOptions {
     /// a progress bar on stderr
     pub progress: bool,
     /// what a reduced sweep does at a point whose reduced answer it cannot stand behind
-    /// ([`fallback`]); a full or validated sweep has no such point
+    /// ([`crate::pipeline::fallback`]); a full or validated sweep has no such point
     pub fallback: Fallback,
 }
 
@@ -174,7 +174,11 @@ pub fn sweep_to_file(route: Route, points: &[Parameters], o: SweepOptions, f: Sw
     if resume {
         if out.exists() {
             // its full answers would stand in a file that says it has none
-            if !full && !o.validate && o.fallback == Fallback::None && file::fallback_of(out)? == Fallback::Full {
+            if !full
+                && !o.validate
+                && o.fallback == Fallback::None
+                && crate::records::sweep_file::fallback_of(out)? == Fallback::Full
+            {
                 return Err(crate::error::Error::input(
                     out,
                     "fallback",
@@ -279,7 +283,7 @@ fn falls_back_now(route: &Route, o: SweepOptions, mu: &Parameters, p: &SweepPoin
     o.fallback == Fallback::Full
         && p.fallback.is_none()
         && p.note.is_none()
-        && fallback::reason(rom.trust(), mu, p.estimate.as_ref()).is_some()
+        && crate::pipeline::fallback::reason(rom.trust(), mu, p.estimate.as_ref()).is_some()
 }
 
 /// Every scale pending, with the model's time grid and probe names.
@@ -322,8 +326,8 @@ fn run_reduced(rom: &Rom, state: Sweep, o: SweepOptions, checkpoint: Option<Chec
     let point = |mu: &Parameters, previous: &[&ReducedRun]| -> Result<SweepPoint> {
         let reduced = rom.solve_and_estimate(mu, output, previous).map_err(|e| e.at_stage("sweep (reduced run)", mu));
         let full = || models_run(&full_models, mu);
-        let fallback::Settled { run, estimate, fallback, note } =
-            fallback::settle(reduced, o.fallback, rom.trust(), mu, full)?;
+        let crate::pipeline::fallback::Settled { run, estimate, fallback, note } =
+            crate::pipeline::fallback::settle(reduced, o.fallback, rom.trust(), mu, full)?;
         // a validated sweep does not fall back (`SweepOptions::settled`)
         let (validation, full_probes) = if o.validate {
             let full = simulate(model, &Overrides::at(mu)).map_err(|e| e.at_stage("sweep (full run)", mu))?;
