@@ -213,11 +213,11 @@ pub fn check_own_file(output: &Path, origin: Origin, kinds: &[Kind]) -> Result<(
             format!("exists and {what}; flexrom replaces only its own {names} files: remove it or choose another path"),
         ))
     };
-    let f = match hdf5::File::open(output) {
+    let f = match crate::io::h5_open::open(output) {
         Ok(f) => f,
         // flexrom's own file, perhaps, held open by another handle: say so, not "foreign"
-        Err(e) if super::h5::is_locked(&e) => {
-            return Err(origin.error(output, format!("exists and {}", super::h5::unreadable(&e))))
+        Err(e) if super::h5_open::is_locked(&e) => {
+            return Err(origin.error(output, format!("exists and {}", super::h5_open::unreadable(&e))))
         }
         Err(_) => return refuse("is not an HDF5 file flexrom wrote".into()),
     };

@@ -387,7 +387,8 @@ pub fn read_point_table(d: &hdf5::Dataset, rows: usize) -> std::result::Result<(
 
 /// The `fallback` a sweep file was written with (files before the attribute: `none`).
 pub fn fallback_of(path: &Path) -> Result<super::Fallback> {
-    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
+    let f =
+        crate::io::h5_open::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5_open::unreadable(&e)))?;
     if f.attr("fallback").is_err() {
         return Ok(super::Fallback::None);
     }
@@ -411,7 +412,7 @@ pub fn read_sweep(
     let cannot = |field: &str, problem: String| {
         Error::input(path, field, format!("{problem}; cannot resume from it (remove it, or run without --resume)"))
     };
-    let f = hdf5::File::open(path).map_err(|e| cannot("(file)", crate::io::h5::unreadable(&e)))?;
+    let f = crate::io::h5_open::open(path).map_err(|e| cannot("(file)", crate::io::h5_open::unreadable(&e)))?;
     // layout 1 stored /reduced_q as (N, r, n_t): converted below; newer layouts are refused
     let layout = check_layout(&f, path, "flexrom sweep")?;
     let text = |name: &str| {
