@@ -21,14 +21,14 @@
 //!   reliable follow from load_scale and ratio and are recomputed when read
 //!   attributes on /estimator: method ("enriched": the estimators compare with an enriched
 //!   basis), default_method (the method online estimates use unless the pipeline names one:
-//!   "corrected", "defects" or "enriched"; files written before 2026-11-26 have none, and
+//!   "corrected", "defects" or "enriched"; files of an earlier flexrom have none, and
 //!   the rule of `Estimator::default_method` decides), extra_modes (k), factor (c),
 //!   calibrated (1: c from calibration pairs, 0: the default), n_modes (r⁺)
 //! /training/range             (2)          [min, max] training load scale (greedy training;
 //!                                          otherwise min/max of /snapshot_load_scale)
 //! /training/tolerance or attribute `tolerance` on /training: greedy's tolerance
 //!   attribute `measure` on /training: the error that tolerance is on ("relative" or
-//!   "displacement"; files written before 2026-11-26 have none: relative)
+//!   "displacement"; files of an earlier flexrom have none: relative)
 //!   attributes `held_out_note`, `estimate_note` on /training: the converged held-out check's
 //!   error above the tolerance, the online default reading above it between the candidates,
 //!   in words (each absent when within it)

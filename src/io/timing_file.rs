@@ -13,7 +13,7 @@
 //!   its estimate, interleaved), estimate_method ("none" without an estimator)
 //! ```
 //!
-//! Basis files written before 2026-11-26 have no `/timing`: nothing is known, nothing said.
+//! Basis files of an earlier flexrom have no `/timing`: nothing is known, nothing said.
 //! The content hash does not cover it: it is a measurement of a machine, not the basis.
 
 use super::attrs::{units_of, write_units, Kind};
