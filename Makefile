@@ -33,11 +33,11 @@ run: deps
 	@echo "flexrom is target/release/flexrom; 'cargo install --path .' puts it on PATH"
 
 test: deps
-	# the tests spawn flexrom while they hold HDF5 files open; HDF5's flock() locks travel into
-	# those children with the file descriptors, so a child could keep a test's file locked
-	# one OpenBLAS thread in the test binaries too (the flexrom binary sets it itself): idle
-	# BLAS workers poll with sched_yield and would take CPU from the tests
-	HDF5_USE_FILE_LOCKING=FALSE OPENBLAS_NUM_THREADS=1 cargo test --release
+	# HDF5's file locking stays on: the tests spawn flexrom while they hold HDF5 files open, and
+	# the descriptors flexrom opens are close-on-exec (src/io/h5_open.rs), so no child keeps a
+	# test's file locked. One OpenBLAS thread in the test binaries (the flexrom binary sets it
+	# itself): idle BLAS workers poll with sched_yield and would take CPU from the tests
+	OPENBLAS_NUM_THREADS=1 cargo test --release
 	# the Python package (python/, docs/python.md): built with maturin and installed from this
 	# folder, then its tests against the binary just built and the example script
 	python3 -m pip install --quiet --root-user-action=ignore --no-build-isolation .

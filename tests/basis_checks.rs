@@ -67,7 +67,7 @@ fn trained(dir: &Path, tag: &str, density: f64, pipe: &str) -> PathBuf {
 fn craft(good: &Path, name: &str, edit: impl FnOnce(&hdf5::File)) -> PathBuf {
     let bad = good.with_file_name(name);
     std::fs::copy(good, &bad).unwrap();
-    let f = hdf5::File::open_rw(&bad).unwrap();
+    let f = flexrom::io::h5_open::open_rw(&bad).unwrap();
     edit(&f);
     f.close().unwrap();
     bad
@@ -197,7 +197,8 @@ fn crafted_basis_files_are_refused_naming_file_and_dataset() {
     });
     refused(&pipe, &bad, &["hyper/weights"]);
 
-    let elements = hdf5::File::open(&good).unwrap().dataset("hyper/elements").unwrap().read_1d::<u64>().unwrap();
+    let elements =
+        flexrom::io::h5_open::open(&good).unwrap().dataset("hyper/elements").unwrap().read_1d::<u64>().unwrap();
     assert!(elements.len() >= 2, "the test needs two sampled elements: {elements}");
     let bad = craft(&good, "far_element.h5", |f| {
         let mut e = elements.clone();
@@ -214,8 +215,11 @@ fn crafted_basis_files_are_refused_naming_file_and_dataset() {
 
     // another basis of the same model (5 modes): its content hash does not fit this content
     let other = trained(d, "b", 5540.0, &PIPE.replace("count = 4", "count = 5"));
-    let other_hash =
-        flexrom::io::h5::read_attr_str(&hdf5::File::open(other.with_extension("h5")).unwrap(), "content_hash").unwrap();
+    let other_hash = flexrom::io::h5::read_attr_str(
+        &flexrom::io::h5_open::open(other.with_extension("h5")).unwrap(),
+        "content_hash",
+    )
+    .unwrap();
     let bad = craft(&good, "copied_hash.h5", |f| {
         f.delete_attr("content_hash").unwrap();
         flexrom::io::h5::attr_str(f, "content_hash", &other_hash).unwrap();
@@ -223,7 +227,8 @@ fn crafted_basis_files_are_refused_naming_file_and_dataset() {
     refused(&pipe, &bad, &["content_hash", "copied"]);
     // a basis of another model (denser beam, same sizes) given this model's fingerprint
     trained(d, "c", 6000.0, PIPE);
-    let mine = flexrom::io::h5::read_attr_str(&hdf5::File::open(&good).unwrap(), "model_fingerprint").unwrap();
+    let mine =
+        flexrom::io::h5::read_attr_str(&flexrom::io::h5_open::open(&good).unwrap(), "model_fingerprint").unwrap();
     let bad = craft(&d.join("c.h5"), "copied_fingerprint.h5", |f| {
         f.delete_attr("model_fingerprint").unwrap();
         flexrom::io::h5::attr_str(f, "model_fingerprint", &mine).unwrap();

@@ -66,7 +66,7 @@ fn greedy_calibrates_the_defects_estimate() {
     assert_eq!(candidates.len(), 33);
 
     // the file layout
-    let f = hdf5::File::open(&p.basis_path).unwrap();
+    let f = flexrom::io::h5_open::open(&p.basis_path).unwrap();
     let g = f.group("estimator/defects").expect("/estimator/defects");
     assert_eq!(g.dataset("load_scale").unwrap().read_1d::<f64>().unwrap().to_vec(), candidates);
     assert_eq!(g.dataset("ratio").unwrap().shape(), vec![33, 5]);
@@ -78,7 +78,7 @@ fn greedy_calibrates_the_defects_estimate() {
     let (_, rom, warnings) = load_rom(&p, &p.basis_path, None, false).unwrap();
     assert!(warnings.is_empty(), "{warnings:?}");
     assert_eq!(rom.method(), Some("defects"), "the calibrated cheap method is the default");
-    let default_method: hdf5::types::VarLenUnicode = hdf5::File::open(&p.basis_path)
+    let default_method: hdf5::types::VarLenUnicode = flexrom::io::h5_open::open(&p.basis_path)
         .unwrap()
         .group("estimator")
         .unwrap()
@@ -109,14 +109,14 @@ fn greedy_calibrates_the_defects_estimate() {
         .unwrap();
     assert!(o.status.success(), "online: {}", String::from_utf8_lossy(&o.stderr));
     let method: hdf5::types::VarLenUnicode =
-        hdf5::File::open(&out).unwrap().attr("error_estimate_method").unwrap().read_scalar().unwrap();
+        flexrom::io::h5_open::open(&out).unwrap().attr("error_estimate_method").unwrap().read_scalar().unwrap();
     assert_eq!(method.as_str(), "defects");
 
     // a calibration whose loads are out of order is refused, naming the field
     let bad = dir.path().join("bad.h5");
     std::fs::copy(&p.basis_path, &bad).unwrap();
     {
-        let f = hdf5::File::open_rw(&bad).unwrap();
+        let f = flexrom::io::h5_open::open_rw(&bad).unwrap();
         let g = f.group("estimator/defects").unwrap();
         let mut loads = candidates.clone();
         loads.swap(3, 4);
@@ -153,7 +153,7 @@ fn an_unreliable_calibration_uses_its_largest_ratio_and_warns() {
     train_and_write(&p, &p.basis_path).unwrap();
     // ratios that jump by 10× from one candidate to the next fail the leave-one-out check
     let largest = {
-        let f = hdf5::File::open_rw(&p.basis_path).unwrap();
+        let f = flexrom::io::h5_open::open_rw(&p.basis_path).unwrap();
         let g = f.group("estimator/defects").unwrap();
         let mut ratio = g.dataset("ratio").unwrap().read_2d::<f64>().unwrap();
         for (j, mut row) in ratio.rows_mut().into_iter().enumerate() {
@@ -173,7 +173,8 @@ fn an_unreliable_calibration_uses_its_largest_ratio_and_warns() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{err}");
     assert_eq!(err.matches("defects calibration failed its check").count(), 1, "{err}");
-    let factor: f64 = hdf5::File::open(&out).unwrap().attr("error_estimate_factor").unwrap().read_scalar().unwrap();
+    let factor: f64 =
+        flexrom::io::h5_open::open(&out).unwrap().attr("error_estimate_factor").unwrap().read_scalar().unwrap();
     assert_eq!(factor, largest);
 }
 

@@ -97,10 +97,10 @@ fn a_reduced_run_keeps_its_own_energy() {
     flexrom(&["online", "p.toml", "--load-scale", "1.0", "-o", "reduced.h5", "-q"]);
     flexrom(&["simulate", "m.toml", "-o", "full.h5", "-q"]);
     let energy = |file: &str, name: &str| {
-        let f = hdf5::File::open(dir.path().join(file)).unwrap();
+        let f = flexrom::io::h5_open::open(dir.path().join(file)).unwrap();
         f.dataset(&format!("energy/{name}")).unwrap().read_1d::<f64>().unwrap()
     };
-    let f = hdf5::File::open(dir.path().join("reduced.h5")).unwrap();
+    let f = flexrom::io::h5_open::open(dir.path().join("reduced.h5")).unwrap();
     assert!(f.attr("n_modes").is_ok(), "a reduced run's file");
     let total = ["kinetic", "strain", "gravity", "springs"]
         .iter()

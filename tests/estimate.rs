@@ -188,7 +188,7 @@ fn extrapolation_warns_once_and_is_flagged() {
     let w = warnings(&o);
     assert_eq!(w.len(), 1, "{w:?}");
     assert!(w[0].contains("training range [0.8, 1.2]") && w[0].contains("extrapolated"), "{}", w[0]);
-    let f = hdf5::File::open(&out).unwrap();
+    let f = flexrom::io::h5_open::open(&out).unwrap();
     assert_eq!(f.attr("extrapolated").unwrap().read_scalar::<u64>().unwrap(), 1);
     let e = f.attr("error_estimate").unwrap().read_scalar::<f64>().unwrap();
     assert!(e.is_finite() && e > 0.0, "{e}");
@@ -199,14 +199,14 @@ fn extrapolation_warns_once_and_is_flagged() {
     let o = run(&["online", p.to_str().unwrap(), "--load-scale", "1.0", "-o", out.to_str().unwrap()]);
     assert!(o.status.success());
     assert!(warnings(&o).is_empty(), "{:?}", warnings(&o));
-    let f = hdf5::File::open(&out).unwrap();
+    let f = flexrom::io::h5_open::open(&out).unwrap();
     assert_eq!(f.attr("extrapolated").unwrap().read_scalar::<u64>().unwrap(), 0);
 
     let sw = dir.path().join("s.h5");
     let o = run(&["sweep", p.to_str().unwrap(), "--load-scales", "0.9:1.4:3", "-o", sw.to_str().unwrap()]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(warnings(&o).len(), 1, "{:?}", warnings(&o));
-    let f = hdf5::File::open(&sw).unwrap();
+    let f = flexrom::io::h5_open::open(&sw).unwrap();
     assert_eq!(f.dataset("extrapolated").unwrap().read_1d::<u8>().unwrap().to_vec(), vec![0, 0, 1]);
     let e = f.dataset("error_estimate").unwrap().read_1d::<f64>().unwrap();
     assert!(e.iter().all(|v| v.is_finite() && *v > 0.0), "{e}");
@@ -220,7 +220,7 @@ fn extrapolation_warns_once_and_is_flagged() {
     drop(f);
     let o = run(&["sweep", p.to_str().unwrap(), "--load-scales", "0.9:1.4:3", "-o", sw.to_str().unwrap(), "--resume"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let f = hdf5::File::open(&sw).unwrap();
+    let f = flexrom::io::h5_open::open(&sw).unwrap();
     assert_eq!(f.dataset("error_estimate_by_time").unwrap().read_2d::<f64>().unwrap(), by, "kept by --resume");
 }
 
@@ -261,7 +261,7 @@ fn strict_exits_4_after_writing_its_output() {
 #[test]
 fn basis_file_stores_an_uncalibrated_estimator() {
     let (_dir, _, basis) = setup(None);
-    let f = hdf5::File::open(&basis).unwrap();
+    let f = flexrom::io::h5_open::open(&basis).unwrap();
     let g = f.group("estimator").unwrap();
     assert_eq!(g.dataset("modes").unwrap().shape(), vec![204, 24]);
     assert_eq!(g.attr("factor").unwrap().read_scalar::<f64>().unwrap(), 1.5);

@@ -93,7 +93,7 @@ fn text_attr(loc: &hdf5::Location, name: &str) -> Option<String> {
 /// Every dataset has units and dims that fit its rank; the root has the layout and kind.
 /// Returns the dataset paths seen.
 fn check_units(path: &Path, kind: &str) -> Vec<String> {
-    let f = hdf5::File::open(path).unwrap();
+    let f = flexrom::io::h5_open::open(path).unwrap();
     let layout = f.attr("flexrom_layout").unwrap_or_else(|_| panic!("{}: no flexrom_layout", path.display()));
     assert_eq!(layout.read_scalar::<u64>().unwrap(), 2, "{}", path.display());
     assert_eq!(text_attr(&f, "flexrom_file").as_deref(), Some(kind), "{}", path.display());
@@ -111,15 +111,15 @@ fn check_units(path: &Path, kind: &str) -> Vec<String> {
 }
 
 fn shape(path: &Path, name: &str) -> Vec<usize> {
-    hdf5::File::open(path).unwrap().dataset(name).unwrap_or_else(|_| panic!("{name}")).shape()
+    flexrom::io::h5_open::open(path).unwrap().dataset(name).unwrap_or_else(|_| panic!("{name}")).shape()
 }
 
 fn dims(path: &Path, name: &str) -> String {
-    text_attr(&hdf5::File::open(path).unwrap().dataset(name).unwrap(), "dims").unwrap()
+    text_attr(&flexrom::io::h5_open::open(path).unwrap().dataset(name).unwrap(), "dims").unwrap()
 }
 
 fn texts(path: &Path, name: &str) -> Vec<String> {
-    let d = hdf5::File::open(path).unwrap().dataset(name).unwrap();
+    let d = flexrom::io::h5_open::open(path).unwrap().dataset(name).unwrap();
     d.read_raw::<VarLenUnicode>().unwrap().iter().map(|x| x.as_str().to_string()).collect()
 }
 
@@ -210,20 +210,20 @@ fn every_dataset_of_every_file_has_units_and_time_comes_first() {
     let b = out("basis.h5");
     assert_eq!((shape(&b, "basis/modes"), dims(&b, "basis/modes")), (vec![N_DOF, 6], "dof, mode".to_string()));
     assert_eq!((shape(&b, "snapshots"), dims(&b, "snapshots")), (vec![N_DOF, 2 * N_T], "dof, snapshot".to_string()));
-    let q = hdf5::File::open(&sim).unwrap().dataset("q").unwrap().read_2d::<f64>().unwrap();
-    let snaps = hdf5::File::open(&b).unwrap().dataset("snapshots").unwrap().read_2d::<f64>().unwrap();
+    let q = flexrom::io::h5_open::open(&sim).unwrap().dataset("q").unwrap().read_2d::<f64>().unwrap();
+    let snaps = flexrom::io::h5_open::open(&b).unwrap().dataset("snapshots").unwrap().read_2d::<f64>().unwrap();
     assert_eq!(q.row(0), snaps.column(0), "t = 0 is the same state at every load");
     // x of node 1 at rest: the pendulum starts horizontal along +x (data/models/pendulum.toml)
     assert!(q[[0, 4]] > 0.0 && q[[0, 5]] == 0.0, "{:?}", q.row(0));
     assert_eq!(
-        text_attr(&hdf5::File::open(&sim).unwrap().dataset("q").unwrap(), "units").unwrap(),
+        text_attr(&flexrom::io::h5_open::open(&sim).unwrap().dataset("q").unwrap(), "units").unwrap(),
         "m (positions x, y), 1 (slopes x', y')"
     );
 }
 
 /// Sets `flexrom_layout` of `path` to `v` (or removes it).
 fn set_layout(path: &Path, v: Option<u64>) {
-    let f = hdf5::File::open_rw(path).unwrap();
+    let f = flexrom::io::h5_open::open_rw(path).unwrap();
     if f.attr("flexrom_layout").is_ok() {
         f.delete_attr("flexrom_layout").unwrap();
     }
@@ -251,7 +251,8 @@ fn older_layouts_are_read_and_newer_ones_refused() {
     ok(&["train", s(&p)]);
     let sweep = out("sweep.h5");
     ok(&["sweep", s(&p), "--load-scales", "0.9:1.1:3", "-o", s(&sweep)]);
-    let new = hdf5::File::open(&sweep).unwrap().dataset("reduced_q").unwrap().read::<f64, ndarray::Ix3>().unwrap();
+    let new =
+        flexrom::io::h5_open::open(&sweep).unwrap().dataset("reduced_q").unwrap().read::<f64, ndarray::Ix3>().unwrap();
     assert_eq!(new.dim(), (3, N_T, 6));
     assert!(new.iter().all(|x| x.is_finite()));
 
@@ -259,14 +260,14 @@ fn older_layouts_are_read_and_newer_ones_refused() {
     let old = out("old.h5");
     std::fs::copy(&sweep, &old).unwrap();
     {
-        let f = hdf5::File::open_rw(&old).unwrap();
+        let f = flexrom::io::h5_open::open_rw(&old).unwrap();
         f.unlink("reduced_q").unwrap();
         let zq = new.view().permuted_axes([0, 2, 1]).as_standard_layout().to_owned();
         f.new_dataset_builder().with_data(&zq).create("reduced_q").unwrap();
     }
     set_layout(&old, None);
     ok(&["sweep", s(&p), "--load-scales", "0.9:1.1:3", "--resume", "-o", s(&old)]);
-    let f = hdf5::File::open(&old).unwrap();
+    let f = flexrom::io::h5_open::open(&old).unwrap();
     assert_eq!(f.attr("flexrom_layout").unwrap().read_scalar::<u64>().unwrap(), 2, "rewritten as layout 2");
     let again = f.dataset("reduced_q").unwrap().read::<f64, ndarray::Ix3>().unwrap();
     assert_eq!(again, new, "the runs were taken from the old file and written time first");

@@ -116,7 +116,7 @@ fn a_full_sweep_is_simulate_at_every_load() {
     assert_eq!(csv.lines().next(), Some("load_scale,status,message,full_seconds,newton_iterations,step_cuts"));
     assert_eq!(csv.lines().count(), 4, "{csv}");
 
-    let f = hdf5::File::open(&out).unwrap();
+    let f = flexrom::io::h5_open::open(&out).unwrap();
     let route = f.attr("route").unwrap().read_scalar::<hdf5::types::VarLenUnicode>().unwrap();
     assert_eq!(route.as_str(), "full");
     for absent in ["reduced_q", "rom_seconds"] {
@@ -138,7 +138,7 @@ fn a_full_sweep_is_simulate_at_every_load() {
         // `{x}` is the shortest text that reads back as the same f64
         let r = d.join(format!("sim{k}.h5"));
         ok(&["simulate", s(&m), "--load-scale", &format!("{x}"), "-o", s(&r)]);
-        let g = hdf5::File::open(&r).unwrap();
+        let g = flexrom::io::h5_open::open(&r).unwrap();
         for name in &names {
             let swept = f.dataset(&format!("probes/{name}")).unwrap().read::<f64, ndarray::Ix3>().unwrap();
             let alone = g.dataset(&format!("probes/{name}")).unwrap().read_2d::<f64>().unwrap();
@@ -152,7 +152,7 @@ fn a_full_sweep_is_simulate_at_every_load() {
     // the same loads given as a list, in another order: the same runs, in the list's order
     let listed = d.join("listed.h5");
     ok(&["sweep", s(&p), "--full", "--load-scales", &format!("{},{}", loads[2], loads[0]), "-o", s(&listed)]);
-    let g = hdf5::File::open(&listed).unwrap();
+    let g = flexrom::io::h5_open::open(&listed).unwrap();
     assert_eq!(bits(&g.dataset("load_scales").unwrap().read_raw::<f64>().unwrap()), bits(&[loads[2], loads[0]]));
     let probe = |file: &hdf5::File, k: usize| {
         let p = file.dataset(&format!("probes/{}", names[0])).unwrap().read::<f64, ndarray::Ix3>().unwrap();
@@ -172,14 +172,14 @@ fn a_full_sweep_is_simulate_at_every_load() {
 
 /// The `/timing` group of a basis file: (full, reduced, estimate) seconds.
 fn timing(basis: &Path) -> [f64; 3] {
-    let f = hdf5::File::open(basis).unwrap();
+    let f = flexrom::io::h5_open::open(basis).unwrap();
     ["full_seconds", "reduced_seconds", "estimate_seconds"]
         .map(|n| f.dataset(&format!("timing/{n}")).unwrap().read_scalar::<f64>().unwrap())
 }
 
 /// Overwrites the basis file's stored times (what `train` measured on some machine).
 fn set_timing(basis: &Path, [full, reduced, estimate]: [f64; 3]) {
-    let f = hdf5::File::open_rw(basis).unwrap();
+    let f = flexrom::io::h5_open::open_rw(basis).unwrap();
     for (n, v) in [("full_seconds", full), ("reduced_seconds", reduced), ("estimate_seconds", estimate)] {
         f.dataset(&format!("timing/{n}")).unwrap().write_scalar(&v).unwrap();
     }
@@ -192,7 +192,7 @@ fn train_stores_the_times_of_both_routes() {
     let basis = d.path().join("basis.h5");
     let times = timing(&basis);
     assert!(times.iter().all(|t| *t > 0.0 && t.is_finite()), "{times:?}");
-    let f = hdf5::File::open(&basis).unwrap();
+    let f = flexrom::io::h5_open::open(&basis).unwrap();
     let g = f.group("timing").unwrap();
     assert_eq!(g.attr("load_scale").unwrap().read_scalar::<f64>().unwrap(), 0.9);
     assert_eq!(g.attr("threads").unwrap().read_scalar::<u64>().unwrap(), 1);
@@ -257,7 +257,7 @@ fn the_notice_says_once_when_the_full_model_is_faster() {
     assert!(err.contains("timing/reduced_seconds") && err.contains(s(&basis)), "{err}");
 
     // a basis file from before /timing: runs as before, without a word
-    hdf5::File::open_rw(&basis).unwrap().unlink("timing").unwrap();
+    flexrom::io::h5_open::open_rw(&basis).unwrap().unlink("timing").unwrap();
     for err in [online(&[]), sweep(&[])] {
         assert!(warnings(&err).is_empty(), "{err}");
     }

@@ -83,7 +83,7 @@ fn greedy_pendulum_meets_its_tolerance() {
     }
 
     // /training as the loop reported it
-    let f = hdf5::File::open(&p.basis_path).unwrap();
+    let f = flexrom::io::h5_open::open(&p.basis_path).unwrap();
     let tr = f.group("training").unwrap();
     let v1 = |n: &str| tr.dataset(n).unwrap().read_raw::<f64>().unwrap();
     assert_eq!(v1("range"), vec![0.5, 1.5]);

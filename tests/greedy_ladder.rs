@@ -38,7 +38,7 @@ fn train(dir: &Path, tolerance: &str) -> (u64, Vec<f64>) {
     .unwrap();
     let o = flexrom(&["train", p.to_str().unwrap()]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let f = hdf5::File::open(&basis).unwrap();
+    let f = flexrom::io::h5_open::open(&basis).unwrap();
     let g = f.group("training").unwrap();
     let n = g.dataset("n_modes").unwrap().read_1d::<u64>().unwrap();
     let points = g.dataset("points").unwrap().read_2d::<f64>().unwrap();

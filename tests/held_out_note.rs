@@ -50,7 +50,7 @@ fn the_note_is_recorded_only_when_the_check_was_above_t_and_repeated_once() {
     let notes = |path: &Path| -> Vec<String> {
         flexrom::io::estimator_file::read_training_notes(path).unwrap().into_iter().map(|n| n.1).collect()
     };
-    assert!(hdf5::File::open(&basis).unwrap().group("training").unwrap().attr("held_out_note").is_err());
+    assert!(flexrom::io::h5_open::open(&basis).unwrap().group("training").unwrap().attr("held_out_note").is_err());
     let o = flexrom(&["validate", p, "--no-dense"]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     assert!(!text(&o.stderr).contains("greedy training: held-out"), "{}", text(&o.stderr));
@@ -58,7 +58,7 @@ fn the_note_is_recorded_only_when_the_check_was_above_t_and_repeated_once() {
     let old = dir.path().join("old.h5");
     std::fs::copy(&basis, &old).unwrap();
     {
-        let f = hdf5::File::open_rw(&old).unwrap();
+        let f = flexrom::io::h5_open::open_rw(&old).unwrap();
         let g = f.group("training").unwrap();
         for name in ["held_out_note", "estimate_note"] {
             if g.attr(name).is_ok() {
@@ -71,7 +71,7 @@ fn the_note_is_recorded_only_when_the_check_was_above_t_and_repeated_once() {
     // the attribute as `train` writes it where the held-out error was above T
     let note = "held-out rel_error 2.93e-3 at λ = 1.3 is above the tolerance 3e-3; the model's own sensitivity there is 1.9e-2";
     {
-        let f = hdf5::File::open_rw(&basis).unwrap();
+        let f = flexrom::io::h5_open::open_rw(&basis).unwrap();
         let g = f.group("training").unwrap();
         let v: hdf5::types::VarLenUnicode = note.parse().unwrap();
         g.new_attr::<hdf5::types::VarLenUnicode>().create("held_out_note").unwrap().write_scalar(&v).unwrap();

@@ -66,7 +66,7 @@ fn setup(dir: &Path) -> PathBuf {
 fn craft(good: &Path, name: &str, edit: impl FnOnce(&hdf5::File)) -> PathBuf {
     let bad = good.with_file_name(name);
     std::fs::copy(good, &bad).unwrap();
-    let f = hdf5::File::open_rw(&bad).unwrap();
+    let f = flexrom::io::h5_open::open_rw(&bad).unwrap();
     edit(&f);
     f.close().unwrap();
     bad
@@ -322,7 +322,7 @@ fn an_attribute_with_a_damaged_heap_reference_is_refused() {
 fn the_damaged_reference_of_the_campaign_case_is_refused() {
     let _one = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz_cases/heap_id_unguarded/basis.h5");
-    let f = hdf5::File::open(&path).unwrap();
+    let f = flexrom::io::h5_open::open(&path).unwrap();
     assert_eq!(flexrom::io::h5::read_attr_str(&f, "variant").unwrap(), "galerkin");
     let e = flexrom::io::h5::read_attr_str(&f.group("timing").unwrap(), "estimate_method").unwrap_err().to_string();
     assert!(e.contains("estimate_method") && e.contains("damaged"), "{e}");
@@ -344,7 +344,7 @@ fn damaged_heap_references_of_text_attributes_are_refused() {
     stored.extend(1u32.to_le_bytes());
     let at = bytes.windows(16).position(|w| w == stored.as_slice()).expect("the stored reference");
     // the sound file reads (the check passes what libhdf5 writes)
-    let f = hdf5::File::open(&good).unwrap();
+    let f = flexrom::io::h5_open::open(&good).unwrap();
     assert_eq!(flexrom::io::h5::read_attr_str(&f, "note").unwrap(), text);
     drop(f);
     let damages: [(&str, usize, Vec<u8>); 5] = [
@@ -359,7 +359,7 @@ fn damaged_heap_references_of_text_attributes_are_refused() {
         b[*off..*off + with.len()].copy_from_slice(with);
         let p = tmp.path().join(format!("damaged{i}.h5"));
         std::fs::write(&p, &b).unwrap();
-        let f = hdf5::File::open(&p).unwrap();
+        let f = flexrom::io::h5_open::open(&p).unwrap();
         let e = flexrom::io::h5::read_attr_str(&f, "note").unwrap_err().to_string();
         assert!(e.contains("note") && e.contains("damaged"), "{what}: {e}");
     }
@@ -466,7 +466,7 @@ fn global_heaps_libhdf5_would_walk_for_ever_are_refused() {
         std::fs::write(&p, &b).unwrap();
         let e = flexrom::io::h5::check_global_heaps(&p).unwrap_err();
         assert!(e.contains("global heap") && e.contains("damaged"), "{what}: {e}");
-        let f = hdf5::File::open(&p).unwrap();
+        let f = flexrom::io::h5_open::open(&p).unwrap();
         let e = flexrom::io::h5::read_attr_str(&f, "note").unwrap_err().to_string();
         assert!(e.contains("damaged"), "{what}: {e}");
     }
@@ -484,11 +484,11 @@ fn damaged_heap_references_of_text_datasets_are_refused() {
     let good = tmp.path().join("good.h5");
     let texts = ["", "a text of some length, stored in a global heap"];
     {
-        let f = hdf5::File::create(&good).unwrap();
+        let f = flexrom::io::h5_open::create(&good).unwrap();
         let v: Vec<VarLenUnicode> = texts.iter().map(|t| t.parse().unwrap()).collect();
         flexrom::io::h5_text::write_strings(&f, "message", &v).unwrap();
     }
-    let f = hdf5::File::open(&good).unwrap();
+    let f = flexrom::io::h5_open::open(&good).unwrap();
     assert_eq!(flexrom::io::h5::read_strings(&f.dataset("message").unwrap()).unwrap(), texts);
     drop(f);
     let bytes = std::fs::read(&good).unwrap();
@@ -507,7 +507,7 @@ fn damaged_heap_references_of_text_datasets_are_refused() {
         b[*off..*off + with.len()].copy_from_slice(with);
         let p = tmp.path().join(format!("damaged{i}.h5"));
         std::fs::write(&p, &b).unwrap();
-        let f = hdf5::File::open(&p).unwrap();
+        let f = flexrom::io::h5_open::open(&p).unwrap();
         let e = flexrom::io::h5::read_strings(&f.dataset("message").unwrap()).unwrap_err().to_string();
         assert!(e.contains("message") && e.contains("damaged"), "{what}: {e}");
     }
@@ -520,7 +520,7 @@ const HEAP_TEXT: &str = "a text of some length, stored in a global heap";
 /// in a global heap), and returns its bytes.
 fn file_with_heap_text(path: &std::path::Path) -> Vec<u8> {
     {
-        let f = hdf5::File::create(path).unwrap();
+        let f = flexrom::io::h5_open::create(path).unwrap();
         flexrom::io::h5::attr_str(&f, "note", HEAP_TEXT).unwrap();
     }
     std::fs::read(path).unwrap()

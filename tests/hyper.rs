@@ -247,7 +247,7 @@ fn bad_hyper_data_is_refused_naming_the_dataset() {
     for (dataset, corrupt, needle) in cases {
         std::fs::write(&basis, &good).unwrap();
         {
-            let f = hdf5::File::open_rw(&basis).unwrap();
+            let f = flexrom::io::h5_open::open_rw(&basis).unwrap();
             let g = f.group("hyper").unwrap();
             let name = dataset.trim_start_matches("hyper/");
             if name == "elements" {

@@ -146,7 +146,7 @@ fn greedy_over_gravity_and(
     .unwrap();
     let (ok, err) = flexrom(d, &["train", "p.toml"]);
     assert!(ok, "{err}");
-    let f = hdf5::File::open(d.join("b.h5")).unwrap();
+    let f = flexrom::io::h5_open::open(d.join("b.h5")).unwrap();
     assert_eq!(f.group("training").unwrap().attr("converged").unwrap().read_scalar::<u64>().unwrap(), 1, "{err}");
     drop(f);
     common::held_out_points_within(d, 1e-3)
@@ -222,7 +222,7 @@ fn the_full_model_at_a_modulus_is_the_model_file_with_it() {
         let (ok, err) = flexrom(d, &[&["simulate", model, "-o", &out, "-q"][..], args].concat());
         assert!(ok, "{err}");
     }
-    let q = |f: &str| hdf5::File::open(d.join(f)).unwrap().dataset("q").unwrap().read_raw::<f64>().unwrap();
+    let q = |f: &str| flexrom::io::h5_open::open(d.join(f)).unwrap().dataset("q").unwrap().read_raw::<f64>().unwrap();
     let (a, b) = (q("param.toml.h5"), q("fixed.toml.h5"));
     assert_eq!(a, b, "the parameter at 7e6 and the file's 7e6 must give the same run");
     // and the parameter not set is the file's value, 5e6: another run
@@ -358,7 +358,7 @@ fn greedy_training_over_a_load_and_a_modulus_converges_and_covers_held_out_point
     // result says the value it ran at; validate's neighbouring run moves 7e10, not 1
     let (ok, err) = flexrom(d, &["online", "p.toml", "--param", "g=1", "-o", "o2.h5"]);
     assert!(ok && !err.contains("trained over"), "{err}");
-    let f = hdf5::File::open(d.join("o2.h5")).unwrap();
+    let f = flexrom::io::h5_open::open(d.join("o2.h5")).unwrap();
     assert_eq!(f.attr("parameter:E_lower").unwrap().read_scalar::<f64>().unwrap(), 7e10);
     assert_eq!(f.attr("extrapolated").unwrap().read_scalar::<u64>().unwrap(), 0);
     drop(f);
@@ -390,7 +390,7 @@ fn the_full_model_at_a_density_follows_the_model_file_with_it() {
         let (ok, err) = flexrom(d, &[&["simulate", model, "-o", &out, "-q"][..], args].concat());
         assert!(ok, "{err}");
     }
-    let q = |f: &str| hdf5::File::open(d.join(f)).unwrap().dataset("q").unwrap().read_raw::<f64>().unwrap();
+    let q = |f: &str| flexrom::io::h5_open::open(d.join(f)).unwrap().dataset("q").unwrap().read_raw::<f64>().unwrap();
     let (a, b) = (q("param.toml2.h5"), q("fixed.toml0.h5"));
     assert!(rel(&a, &b) < 1e-10, "density parameter at 2000 vs the file's 2000: {:e}", rel(&a, &b));
     assert!(rel(&q("param.toml0.h5"), &b) > 1e-3, "a 43 % heavier coupler must change the run");
@@ -438,8 +438,9 @@ fn a_property_training_did_not_vary_counts_as_trained_at_the_file_value() {
     .unwrap();
     let (ok, err) = flexrom(d, &["train", "p.toml", "-q"]);
     assert!(ok, "{err}");
-    let extrapolated =
-        |f: &str| hdf5::File::open(d.join(f)).unwrap().attr("extrapolated").unwrap().read_scalar::<u64>().unwrap();
+    let extrapolated = |f: &str| {
+        flexrom::io::h5_open::open(d.join(f)).unwrap().attr("extrapolated").unwrap().read_scalar::<u64>().unwrap()
+    };
     for (out, args) in [("o1.h5", &[][..]), ("o2.h5", &["--param", "E_coupler=5e6"][..])] {
         let (ok, err) = flexrom(d, &[&["online", "p.toml", "--load-scale", "0.95", "-o", out][..], args].concat());
         assert!(ok && !err.contains("trained at"), "{err}");
@@ -537,7 +538,8 @@ fn damped_models_with_a_modulus_or_density_parameter_follow_the_model_file_with_
             let (ok, err) = flexrom(d, &[&["simulate", model, "-o", &format!("{model}.h5"), "-q"][..], args].concat());
             assert!(ok, "{err}");
         }
-        let q = |f: &str| hdf5::File::open(d.join(f)).unwrap().dataset("q").unwrap().read_raw::<f64>().unwrap();
+        let q =
+            |f: &str| flexrom::io::h5_open::open(d.join(f)).unwrap().dataset("q").unwrap().read_raw::<f64>().unwrap();
         let (a, b) = (q("param.toml.h5"), q("fixed.toml.h5"));
         assert!(rel(&a, &b) < 1e-10, "{name}: the damped full runs differ by {:e}", rel(&a, &b));
 
@@ -582,7 +584,7 @@ fn a_point_mass_parameter_follows_the_model_file_with_it() {
         let (ok, err) = flexrom(d, &[&["simulate", model, "-o", &out, "-q"][..], args].concat());
         assert!(ok, "{err}");
     }
-    let q = |f: &str| hdf5::File::open(d.join(f)).unwrap().dataset("q").unwrap().read_raw::<f64>().unwrap();
+    let q = |f: &str| flexrom::io::h5_open::open(d.join(f)).unwrap().dataset("q").unwrap().read_raw::<f64>().unwrap();
     let (a, b) = (q("param.toml2.h5"), q("fixed.toml0.h5"));
     assert!(rel(&a, &b) < 1e-10, "payload 0.5 kg by the parameter and in the file: {:e}", rel(&a, &b));
     assert!(rel(&q("param.toml0.h5"), &b) > 1e-3, "2.5 times the payload must change the run");

@@ -96,12 +96,12 @@ fn greedy_on_the_displacement_measure() {
     let err = text(&o.stderr);
     let row = json(&o);
     let row = row.as_array().map_or(&row, |a| &a[0]);
-    let f = hdf5::File::open(&basis).unwrap();
+    let f = flexrom::io::h5_open::open(&basis).unwrap();
     let g = f.group("training").unwrap();
     let measure: hdf5::types::VarLenUnicode = g.attr("measure").unwrap().read_scalar().unwrap();
     assert_eq!(measure.as_str(), "displacement");
     assert_eq!(
-        flexrom::io::estimator_file::read_training_measure(&basis).unwrap(),
+        flexrom::io::estimator_file::training_measure(&f, &basis).unwrap(),
         flexrom::pipeline::config::ErrorMeasure::Displacement
     );
     let full_runs: u64 = g.attr("full_runs").unwrap().read_scalar().unwrap();
@@ -133,7 +133,7 @@ fn greedy_on_the_displacement_measure() {
     let out = dir.path().join("r.h5");
     let o = flexrom(&["online", p, "--load-scale", "1.1", "-o", out.to_str().unwrap(), "--estimate", "enriched"]);
     assert!(o.status.success(), "{}", text(&o.stderr));
-    let r = hdf5::File::open(&out).unwrap();
+    let r = flexrom::io::h5_open::open(&out).unwrap();
     let attr = |name: &str| -> String {
         let s: hdf5::types::VarLenUnicode = r.attr(name).unwrap().read_scalar().unwrap();
         s.as_str().to_string()
@@ -169,7 +169,7 @@ fn greedy_on_the_displacement_measure() {
         "defects",
     ]);
     assert!(o.status.success(), "{}", text(&o.stderr));
-    let s = hdf5::File::open(&sw).unwrap();
+    let s = flexrom::io::h5_open::open(&sw).unwrap();
     for name in ["displacement_error", "error_estimate_displacement"] {
         let d = s.dataset(name).unwrap().read_1d::<f64>().unwrap();
         assert!(d.len() == 2 && d.iter().all(|x| x.is_finite() && *x > 0.0), "{name}: {d:?}");
@@ -210,7 +210,7 @@ fn a_range_from_rest_trains_on_the_displacement_measure() {
     let o = flexrom(&["train", p]);
     let err = text(&o.stderr);
     assert!(o.status.success(), "{err}");
-    let f = hdf5::File::open(dir.path().join("basis.h5")).unwrap();
+    let f = flexrom::io::h5_open::open(dir.path().join("basis.h5")).unwrap();
     let converged: u64 = f.group("training").unwrap().attr("converged").unwrap().read_scalar().unwrap();
     assert_eq!(converged, 1, "{err}");
 
@@ -223,7 +223,7 @@ fn a_range_from_rest_trains_on_the_displacement_measure() {
     assert!(!err.contains("above the tolerance"), "{err}");
     let o = flexrom(&["online", p, "--load-scale", "0", "-o", out.to_str().unwrap(), "--strict"]);
     assert!(o.status.success(), "{}", text(&o.stderr));
-    let r = hdf5::File::open(&out).unwrap();
+    let r = flexrom::io::h5_open::open(&out).unwrap();
     let est: f64 = r.attr("error_estimate_displacement").unwrap().read_scalar().unwrap();
     let rel: f64 = r.attr("error_estimate").unwrap().read_scalar().unwrap();
     assert!(est.is_nan(), "{est}");
@@ -293,7 +293,7 @@ load_scales = [0.6, 1.3, 1.9]
     let p = pipe.to_str().unwrap();
     let o = flexrom(&["train", p]);
     assert!(o.status.success(), "{}", text(&o.stderr));
-    let f = hdf5::File::open(dir.path().join("basis.h5")).unwrap();
+    let f = flexrom::io::h5_open::open(dir.path().join("basis.h5")).unwrap();
     let g = f.group("training").unwrap();
     let converged: u64 = g.attr("converged").unwrap().read_scalar().unwrap();
     assert_eq!(converged, 1, "{}", text(&o.stderr));

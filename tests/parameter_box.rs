@@ -61,11 +61,11 @@ fn a_basis_trained_over_a_box_holds_it_and_checks_runs_against_it() {
 
     // the basis holds the box and the training points, as the pipeline draws them
     let p = flexrom::pipeline::Pipeline::load(d.join("p.toml")).unwrap();
-    let space = flexrom::io::parameter_space_file::read_parameter_space(&d.join("b.h5")).unwrap().unwrap();
+    let space = flexrom::io::basis_file::read_basis(&d.join("b.h5")).unwrap().training.space;
     assert_eq!(space, p.space());
     let points = p.training_points();
     assert_eq!(points.len(), 6);
-    let f = hdf5::File::open(d.join("b.h5")).unwrap();
+    let f = flexrom::io::h5_open::open(d.join("b.h5")).unwrap();
     for r in &space.ranges {
         let stored = f.dataset(&format!("parameters/{}", r.name)).unwrap().read_raw::<f64>().unwrap();
         let drawn: Vec<f64> = points.iter().map(|mu| mu.get(&r.name).unwrap()).collect();
@@ -96,7 +96,7 @@ fn a_basis_trained_over_a_box_holds_it_and_checks_runs_against_it() {
     assert!(stderr.contains("outside what the basis was trained on: push = 3 (trained over [0.2, 2])"), "{stderr}");
     assert!(stdout.contains("\"extrapolated\":true"), "{stdout}");
     // and the result file says so too, as `validate` does
-    let f = hdf5::File::open(d.join("o.h5")).unwrap();
+    let f = flexrom::io::h5_open::open(d.join("o.h5")).unwrap();
     assert_eq!(f.attr("extrapolated").unwrap().read_scalar::<u64>().unwrap(), 1);
     assert_eq!(f.attr("parameter:push").unwrap().read_scalar::<f64>().unwrap(), 3.0);
     drop(f);
@@ -111,7 +111,7 @@ fn a_basis_trained_over_a_box_holds_it_and_checks_runs_against_it() {
     let summary = std::fs::read_to_string(d.join("r/summary.md")).unwrap();
     assert!(summary.contains("Training box g ∈ [0.8, 1.2], push ∈ [0.2, 2] (log)"), "{summary}");
     assert!(summary.contains("16 random points of the box") && summary.contains("| point | rel_error"), "{summary}");
-    let f = hdf5::File::open(d.join("r/sweep.h5")).unwrap();
+    let f = flexrom::io::h5_open::open(d.join("r/sweep.h5")).unwrap();
     let swept = f.dataset("points").unwrap().read_2d::<f64>().unwrap();
     assert_eq!(swept.nrows(), 16);
     assert!(swept.rows().into_iter().all(|r| (0.8..=1.2).contains(&r[1]) && (0.2..=2.0).contains(&r[2])), "{swept}");
@@ -128,7 +128,7 @@ fn a_basis_trained_over_a_box_holds_it_and_checks_runs_against_it() {
     let out = flexrom(d, &["train", "p.toml", "--basis", "b2.h5", "--from-snapshots", "s2.h5", "s1.h5", "-q"]);
     assert!(out.status.success(), "{}", text(&out).1);
     let read = |file: &str, name: &str| {
-        hdf5::File::open(d.join(file)).unwrap().dataset(name).unwrap().read_raw::<f64>().unwrap()
+        flexrom::io::h5_open::open(d.join(file)).unwrap().dataset(name).unwrap().read_raw::<f64>().unwrap()
     };
     assert_eq!(read("b2.h5", "parameters/push"), read("b.h5", "parameters/push"));
     let (sv, sv2) = (read("b.h5", "basis/singular_values"), read("b2.h5", "basis/singular_values"));
@@ -173,7 +173,7 @@ fn greedy_training_over_a_box_converges_and_its_estimate_covers_held_out_points(
     // one warning expected (src/analysis/resolution.rs); no other
     assert!(!stderr.lines().any(|l| l.contains("warning") && !l.contains("does not resolve")), "{stderr}");
 
-    let f = hdf5::File::open(d.join("b.h5")).unwrap();
+    let f = flexrom::io::h5_open::open(d.join("b.h5")).unwrap();
     let t = f.group("training").unwrap();
     assert_eq!(t.attr("converged").unwrap().read_scalar::<u64>().unwrap(), 1);
     assert!(t.dataset("range").is_err() && t.dataset("candidates").is_err(), "a box has no load range");
@@ -194,7 +194,7 @@ fn greedy_training_over_a_box_converges_and_its_estimate_covers_held_out_points(
     let g = f.dataset("parameters/g").unwrap().read_raw::<f64>().unwrap();
     assert_eq!(g, runs.column(0).to_vec());
     // the routes were timed at the box's centre, which `/timing` names
-    let t = flexrom::io::timing_file::read_timing(&d.join("b.h5")).unwrap().unwrap();
+    let t = flexrom::io::basis_file::read_basis(&d.join("b.h5")).unwrap().training.timing.unwrap();
     assert_eq!(t.named.iter().map(|(n, _)| n.as_str()).collect::<Vec<_>>(), ["g", "push"]);
     assert!((t.named[0].1 - 1.0).abs() < 1e-12 && (t.named[1].1 - (0.2f64 * 2.0).sqrt()).abs() < 1e-12, "{t:?}");
     drop(f);
@@ -208,15 +208,16 @@ fn greedy_training_over_a_box_converges_and_its_estimate_covers_held_out_points(
     }
     assert!(flexrom(d, &[&["sweep", "p.toml", "-o", "q.h5"][..], &grid].concat()).status.success());
     assert!(flexrom(d, &["merge", "q1.h5", "q2.h5", "-o", "qm.h5"]).status.success());
-    let near =
-        |f: &str| hdf5::File::open(d.join(f)).unwrap().dataset("sensitivity_near").unwrap().read_raw::<f64>().unwrap();
+    let near = |f: &str| {
+        flexrom::io::h5_open::open(d.join(f)).unwrap().dataset("sensitivity_near").unwrap().read_raw::<f64>().unwrap()
+    };
     let single = near("q.h5");
     assert!(single.iter().all(|s| s.is_finite()), "{single:?}");
     assert_eq!(near("qm.h5"), single);
     // a part whose own rows are not its points (a named value changed, λ kept) is refused
     std::fs::copy(d.join("q1.h5"), d.join("q1bad.h5")).unwrap();
     {
-        let f = hdf5::File::open_rw(d.join("q1bad.h5")).unwrap();
+        let f = flexrom::io::h5_open::open_rw(d.join("q1bad.h5")).unwrap();
         let pts = f.dataset("points").unwrap();
         let mut a = pts.read_2d::<f64>().unwrap();
         a[[0, 2]] *= 1.5;
@@ -311,7 +312,7 @@ fn a_sweep_over_a_grid_of_points_runs_each_point_as_online_does_and_resumes_by_p
     let (stdout, stderr) = text(&out);
     assert!(out.status.success(), "{stderr}");
     assert!(stdout.lines().next().unwrap().ends_with(",parameter:g,parameter:push"), "{stdout}");
-    let f = hdf5::File::open(d.join("s.h5")).unwrap();
+    let f = flexrom::io::h5_open::open(d.join("s.h5")).unwrap();
     let points = f.dataset("points").unwrap();
     assert_eq!(flexrom::io::h5::read_attr_str(&points, "parameters").unwrap(), "load_scale,g,push");
     let p = points.read_2d::<f64>().unwrap();
@@ -331,7 +332,8 @@ fn a_sweep_over_a_grid_of_points_runs_each_point_as_online_does_and_resumes_by_p
         &["online", "p.toml", "--param", &format!("g={g}"), "--param", &format!("push={push}"), "-o", "o.h5"],
     );
     assert!(out.status.success(), "{}", text(&out).1);
-    let alone = hdf5::File::open(d.join("o.h5")).unwrap().dataset("probes/tip").unwrap().read_2d::<f64>().unwrap();
+    let alone =
+        flexrom::io::h5_open::open(d.join("o.h5")).unwrap().dataset("probes/tip").unwrap().read_2d::<f64>().unwrap();
     assert!(swept.index_axis(ndarray::Axis(0), 5) == alone, "the swept point differs from `online` at it");
 
     // the same grid in two shards, merged: the single sweep's points and probes, to the bit
@@ -342,7 +344,7 @@ fn a_sweep_over_a_grid_of_points_runs_each_point_as_online_does_and_resumes_by_p
     }
     let out = flexrom(d, &["merge", "part_2.h5", "part_1.h5", "-o", "m.h5"]);
     assert!(out.status.success(), "{}", text(&out).1);
-    let m = hdf5::File::open(d.join("m.h5")).unwrap();
+    let m = flexrom::io::h5_open::open(d.join("m.h5")).unwrap();
     assert_eq!(m.dataset("points").unwrap().read_2d::<f64>().unwrap(), p);
     assert!(m.dataset("probes/tip").unwrap().read::<f64, ndarray::Ix3>().unwrap() == swept, "merged ≠ single sweep");
     drop(m);

@@ -68,7 +68,7 @@ fn the_xdmf_names_the_datasets_it_describes() {
     let xml = std::fs::read_to_string(dir.path().join("p.xdmf")).unwrap();
     let tags = well_formed(&xml);
     assert_eq!(tags.iter().filter(|t| t.0 == "Time").count(), 5);
-    let f = hdf5::File::open(&h5).unwrap();
+    let f = flexrom::io::h5_open::open(&h5).unwrap();
     let mut items = 0;
     for (_, attrs, text) in tags.iter().filter(|t| t.0 == "DataItem") {
         let (file, path) = text.split_once(':').unwrap();
@@ -95,7 +95,7 @@ fn the_xdmf_names_the_datasets_it_describes() {
     // without --paraview: no group, no XDMF file; an XDMF file flexrom did not write is kept
     let plain = dir.path().join("q.h5");
     ok(&["simulate", &model("pendulum.toml"), "-o", plain.to_str().unwrap(), "--t-end", "0.01", "-q"]);
-    assert!(hdf5::File::open(&plain).unwrap().group("paraview").is_err());
+    assert!(flexrom::io::h5_open::open(&plain).unwrap().group("paraview").is_err());
     assert!(!Path::new(&dir.path().join("q.xdmf")).exists());
     std::fs::write(dir.path().join("q.xdmf"), "mine").unwrap();
     let o = flexrom(&["simulate", &model("pendulum.toml"), "-o", plain.to_str().unwrap(), "--paraview", "-q"]);
@@ -116,7 +116,7 @@ fn the_modes_xdmf_names_one_field_per_mode() {
     ok(&["modes", &model("pendulum.toml"), "--count", "3", "-o", h5.to_str().unwrap(), "--paraview", "-q"]);
     let xml = std::fs::read_to_string(dir.path().join("m.xdmf")).unwrap();
     let tags = well_formed(&xml);
-    let f = hdf5::File::open(&h5).unwrap();
+    let f = flexrom::io::h5_open::open(&h5).unwrap();
     let freq = f.dataset("frequencies").unwrap().read_1d::<f64>().unwrap();
     let names: Vec<String> = tags.iter().filter(|t| t.0 == "Attribute").map(|t| attr(&t.1, "Name")).collect();
     let expected: Vec<String> = (0..3).map(|k| format!("mode_{} ({:.6} Hz)", k + 1, freq[k])).collect();
@@ -152,7 +152,7 @@ fn the_modes_xdmf_names_one_field_per_mode() {
     // without --paraview: no group, no XDMF file
     let plain = dir.path().join("n.h5");
     ok(&["modes", &model("pendulum.toml"), "--count", "2", "-o", plain.to_str().unwrap(), "-q"]);
-    assert!(hdf5::File::open(&plain).unwrap().group("paraview").is_err());
+    assert!(flexrom::io::h5_open::open(&plain).unwrap().group("paraview").is_err());
     assert!(!dir.path().join("n.xdmf").exists());
     // flexrom's own modes XDMF file is replaced, another kept
     ok(&["modes", &model("pendulum.toml"), "--count", "2", "-o", h5.to_str().unwrap(), "--paraview", "-q"]);

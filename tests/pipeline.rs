@@ -93,7 +93,7 @@ fn pod_basis_is_orthonormal_and_round_trips_through_hdf5() {
     assert_eq!(back.basis.variant, b.variant);
     assert_eq!(back.singular_values, *sv);
     assert_eq!(back.model_fingerprint, p.model.fingerprint());
-    let f = hdf5::File::open(&p.basis_path).unwrap();
+    let f = flexrom::io::h5_open::open(&p.basis_path).unwrap();
     assert_eq!(f.dataset("snapshots").unwrap().shape(), vec![84, 2 * 81], "two runs of 80 steps plus t = 0");
     assert_eq!(f.dataset("snapshot_t").unwrap().shape(), vec![162]);
     let scales = f.dataset("snapshot_load_scale").unwrap().read_1d::<f64>().unwrap();
@@ -148,7 +148,7 @@ fn pendulum_pipeline_end_to_end_within_the_error_bound() {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let f = hdf5::File::open(&out).unwrap();
+    let f = flexrom::io::h5_open::open(&out).unwrap();
     assert_eq!(f.dataset("q").unwrap().shape(), vec![121, 84], "time first");
     assert_eq!(f.dataset("reduced/q").unwrap().shape(), vec![121, 17], "time first");
     assert_eq!(f.dataset("probes/tip").unwrap().shape(), vec![121, 2]);
@@ -205,7 +205,7 @@ fn pendulum_pipeline_end_to_end_within_the_error_bound() {
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(String::from_utf8_lossy(&o.stdout).lines().count(), 4, "header and three rows");
-    let f = hdf5::File::open(&sweep).unwrap();
+    let f = flexrom::io::h5_open::open(&sweep).unwrap();
     // the points' speedups are one run each: their median is said, and how they were timed
     let mut speedups = f.dataset("speedup").unwrap().read_raw::<f64>().unwrap();
     speedups.sort_by(f64::total_cmp);
@@ -237,7 +237,7 @@ fn pendulum_pipeline_end_to_end_within_the_error_bound() {
     let model = dir.path().join("model.toml");
     let o = flexrom().args(["simulate", model.to_str().unwrap(), "-o", sim.to_str().unwrap()]).output().unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let tip = hdf5::File::open(&sim).unwrap().dataset("probes/tip").unwrap().read_2d::<f64>().unwrap();
+    let tip = flexrom::io::h5_open::open(&sim).unwrap().dataset("probes/tip").unwrap().read_2d::<f64>().unwrap();
     assert_eq!(full.index_axis(ndarray::Axis(0), 1), tip);
 
     // continuation in the load scale changes only where Newton starts: the same tips to the
@@ -251,7 +251,7 @@ fn pendulum_pipeline_end_to_end_within_the_error_bound() {
         args.extend_from_slice(extra);
         let o = flexrom().args(&args).output().unwrap();
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        let f = hdf5::File::open(&out).unwrap();
+        let f = flexrom::io::h5_open::open(&out).unwrap();
         let tip = f.dataset("probes/tip").unwrap().read::<f64, ndarray::Ix3>().unwrap();
         let its: u64 = f.dataset("factorizations").unwrap().read_1d::<u64>().unwrap().sum();
         let cont = f.attr("continuation").unwrap().read_scalar::<u64>().unwrap();

@@ -98,10 +98,10 @@ fn output_modes_bring_the_root_curvature_within_the_tolerance() {
     assert!(k1 <= 1e-3 && k1 * 10.0 <= k0, "root curvature over its range: {k0:.2e} without, {k1:.2e} with");
     assert!(s1 < s0, "root strain over its range: {s0:.2e} without, {s1:.2e} with");
     assert!(k1_est >= k1 && s1_est >= s1, "estimates {k1_est:.2e} ≥ {k1:.2e}, {s1_est:.2e} ≥ {s1:.2e}");
-    let f = hdf5::File::open(dir.path().join("enriched.h5")).unwrap();
+    let f = flexrom::io::h5_open::open(dir.path().join("enriched.h5")).unwrap();
     let added = f.dataset("basis/output_modes").unwrap().read_1d::<u64>().unwrap().to_vec();
     assert!(added[0] > 0 && added[1] == 0, "output modes per link: {added:?}");
-    let plain_file = hdf5::File::open(dir.path().join("plain.h5")).unwrap();
+    let plain_file = flexrom::io::h5_open::open(dir.path().join("plain.h5")).unwrap();
     assert!(plain_file.dataset("basis/output_modes").is_err(), "a basis without output modes has no such dataset");
 }
 
@@ -145,7 +145,7 @@ fn greedy_holds_the_probes_with_measure_probes() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{err}");
     assert!(err.lines().any(|l| l.starts_with("iteration 1") && l.contains("output modes")), "{err}");
-    let f = hdf5::File::open(dir.path().join("greedy.h5")).unwrap();
+    let f = flexrom::io::h5_open::open(dir.path().join("greedy.h5")).unwrap();
     let added = f.dataset("basis/output_modes").unwrap().read_1d::<u64>().unwrap().to_vec();
     assert!(added[0] > 0 && added[1] == 0, "output modes per link: {added:?}");
     // the held-out checks hold the worst probe quantity too: at least rel_error's share

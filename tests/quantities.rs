@@ -122,7 +122,7 @@ fn entry<'a>(v: &'a serde_json::Value, probe: &str, quantity: &str) -> &'a serde
 }
 
 fn series(path: &Path, name: &str) -> Vec<f64> {
-    hdf5::File::open(path).unwrap().dataset(name).unwrap().read_raw::<f64>().unwrap()
+    flexrom::io::h5_open::open(path).unwrap().dataset(name).unwrap().read_raw::<f64>().unwrap()
 }
 
 #[test]
@@ -147,7 +147,7 @@ fn validate_measures_each_quantity_over_its_range() {
         let relative = q["relative"].as_f64().unwrap();
         // the same runs, the same arithmetic: to round-off
         assert!((relative - error / range).abs() <= 1e-9 * relative, "{quantity}: {relative} vs {}", error / range);
-        let attr: f64 = hdf5::File::open(dir.join("rom.h5"))
+        let attr: f64 = flexrom::io::h5_open::open(dir.join("rom.h5"))
             .unwrap()
             .dataset(dataset)
             .unwrap()
@@ -170,7 +170,7 @@ fn validate_measures_each_reaction_over_its_range() {
     flexrom(&dir, &["online", "p.toml", "--load-scale", "1.3", "-o", "rom.h5", "--estimate", "corrected"]);
     let v = vs.iter().find(|v| v["load_scale"] == 1.3).unwrap();
     let read = |path: &str, name: &str| -> ndarray::ArrayD<f64> {
-        hdf5::File::open(dir.join(path)).unwrap().dataset(name).unwrap().read_dyn::<f64>().unwrap()
+        flexrom::io::h5_open::open(dir.join(path)).unwrap().dataset(name).unwrap().read_dyn::<f64>().unwrap()
     };
     // the clamp's force (n_t, 1, 2) and moment (n_t, 1): max distance over the full run's range
     let (ff, rf) = (read("full.h5", "reactions/force"), read("rom.h5", "reactions/force"));
@@ -241,7 +241,7 @@ fn a_sweep_carries_strains_curvatures_and_their_estimates() {
     flexrom(&dir, &["online", "p.toml", "--load-scale", "1.3", "--estimate", "corrected", "-o", "rom.h5"]);
     let vs = validations(&dir, "corrected");
     let read2 = |name: &str| {
-        let d = hdf5::File::open(dir.join("s.h5")).unwrap().dataset(name).unwrap();
+        let d = flexrom::io::h5_open::open(dir.join("s.h5")).unwrap().dataset(name).unwrap();
         d.read_2d::<f64>().unwrap()
     };
     let read1 = |name: &str| series(&dir.join("s.h5"), name);

@@ -40,7 +40,7 @@ fn a_reduced_run_starts_from_its_static_equilibrium() {
     flexrom(&["online", "p.toml", "--load-scale", "1.0", "-o", "reduced.h5", "-q"]);
     flexrom(&["simulate", "m.toml", "-o", "full.h5", "-q"]);
     let tip = |name: &str| {
-        let f = hdf5::File::open(dir.path().join(name)).unwrap();
+        let f = flexrom::io::h5_open::open(dir.path().join(name)).unwrap();
         f.dataset("probes/tip").unwrap().read_2d::<f64>().unwrap()
     };
     let (full, reduced) = (tip("full.h5"), tip("reduced.h5"));

@@ -281,7 +281,7 @@ fn existing_files_flexrom_did_not_write_or_wrote_as_another_kind_are_refused() {
     std::fs::write(&empty, "").unwrap();
     // an HDF5 file of another program: no `flexrom_file`, no `program_version` on its root
     let foreign = root.join("theirs.h5");
-    let f = hdf5::File::create(&foreign).unwrap();
+    let f = flexrom::io::h5_open::create(&foreign).unwrap();
     f.new_dataset::<f64>().shape(3).create("data").unwrap().write(&[1.0, 2.0, 3.0]).unwrap();
     drop(f);
     let before = snapshot(root);
@@ -344,7 +344,7 @@ fn every_command_creates_missing_output_folders_and_follows_a_symlink_to_a_regul
     .success());
     assert!(run(&[Path::new("sweep"), &p, Path::new("--basis"), &b, Path::new("-o"), &new("sweep")]).status.success());
     for k in ["basis", "sim", "online", "sweep"] {
-        assert!(hdf5::File::open(new(k)).is_ok(), "{k}");
+        assert!(flexrom::io::h5_open::open(new(k)).is_ok(), "{k}");
     }
     // `run` writes its report; a `sweep` without -o is refused (exit 2, naming -o) and leaves
     // the report's sweep.h5, which its summary.md describes, as it was
@@ -362,7 +362,7 @@ fn every_command_creates_missing_output_folders_and_follows_a_symlink_to_a_regul
         .status
         .success());
     assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
-    let t = hdf5::File::open(new("sim")).unwrap().dataset("t").unwrap().read_1d::<f64>().unwrap();
+    let t = flexrom::io::h5_open::open(new("sim")).unwrap().dataset("t").unwrap().read_1d::<f64>().unwrap();
     assert_eq!(t.len(), 5, "0.02 s in steps of 0.005 s: the new result is behind the link");
     assert!(leftovers(root).is_empty(), "{:?}", leftovers(root));
 }

@@ -118,7 +118,7 @@ fn attrs(f: &hdf5::File) -> Vec<(String, String)> {
 
 /// The two sweep files hold the same datasets and values (times: the same NaN rows only).
 fn assert_same_sweep(a: &Path, b: &Path) {
-    let (fa, fb) = (hdf5::File::open(a).unwrap(), hdf5::File::open(b).unwrap());
+    let (fa, fb) = (flexrom::io::h5_open::open(a).unwrap(), flexrom::io::h5_open::open(b).unwrap());
     let (mut da, mut db) = (Vec::new(), Vec::new());
     datasets(&fa, "", &mut da);
     datasets(&fb, "", &mut db);
@@ -225,7 +225,7 @@ fn four_shards_merged_equal_one_sweep_and_bad_parts_are_refused() {
     let (o, err) =
         run(flexrom().args(["merge", "--partial", s(&parts[0]), s(&parts[1]), s(&parts[2]), "-o", s(&partial)]));
     assert!(o.status.success(), "{err}");
-    let status = hdf5::File::open(&partial).unwrap().dataset("status").unwrap().read_raw::<u8>().unwrap();
+    let status = flexrom::io::h5_open::open(&partial).unwrap().dataset("status").unwrap().read_raw::<u8>().unwrap();
     assert_eq!(status, vec![0, 0, 0, 2, 0, 0, 0, 2, 0]);
     let (o, err) = run(flexrom().args(["sweep", s(&p), "--load-scales", list, "--resume", "-o", s(&partial)]));
     assert!(o.status.success(), "{err}");
@@ -266,7 +266,7 @@ fn full_sweeps_shard_merge_and_resume_and_do_not_mix_with_reduced_ones() {
     let partial = d.join("partial.h5");
     let (o, err) = run(flexrom().args(["merge", "--partial", s(&parts[0]), "-o", s(&partial)]));
     assert!(o.status.success(), "{err}");
-    let status = hdf5::File::open(&partial).unwrap().dataset("status").unwrap().read_raw::<u8>().unwrap();
+    let status = flexrom::io::h5_open::open(&partial).unwrap().dataset("status").unwrap().read_raw::<u8>().unwrap();
     assert_eq!(status, vec![0, 2, 0, 2, 0]);
     let (o, err) = full(&["--resume"], &partial);
     assert!(o.status.success(), "{err}");
@@ -368,7 +368,7 @@ fn slurm_array_sweep_equals_local_sweep() {
     for k in 1..=4 {
         assert!(parts.join(format!("part_{k}.h5")).exists(), "part {k} missing:\n{logs}");
     }
-    let (fl, fm) = (hdf5::File::open(&local).unwrap(), hdf5::File::open(&merged).unwrap());
+    let (fl, fm) = (flexrom::io::h5_open::open(&local).unwrap(), flexrom::io::h5_open::open(&merged).unwrap());
     let names = fl.group("probes").unwrap().member_names().unwrap();
     assert!(!names.is_empty());
     let mut worst = 0.0f64;
@@ -392,7 +392,8 @@ fn slurm_array_sweep_equals_local_sweep() {
 /// The modes (columns of `/basis/modes`) of two basis files: the same shape, and each
 /// column equal up to its sign within `tol`.
 fn max_mode_difference(a: &Path, b: &Path) -> f64 {
-    let read = |p: &Path| hdf5::File::open(p).unwrap().dataset("basis/modes").unwrap().read_2d::<f64>().unwrap();
+    let read =
+        |p: &Path| flexrom::io::h5_open::open(p).unwrap().dataset("basis/modes").unwrap().read_2d::<f64>().unwrap();
     let (va, vb) = (read(a), read(b));
     assert_eq!(va.dim(), vb.dim());
     let mut worst = 0.0f64;
@@ -444,8 +445,9 @@ fn eight_snapshot_jobs_give_the_single_machine_basis() {
     assert!(o.status.success(), "{err}");
     let worst = max_mode_difference(&d.join("single.h5"), &sharded);
     assert!(worst <= 1e-10, "modes differ by {worst:e}");
-    let sv =
-        |f: &Path| hdf5::File::open(f).unwrap().dataset("basis/singular_values").unwrap().read_raw::<f64>().unwrap();
+    let sv = |f: &Path| {
+        flexrom::io::h5_open::open(f).unwrap().dataset("basis/singular_values").unwrap().read_raw::<f64>().unwrap()
+    };
     let (a, b) = (sv(&d.join("single.h5")), sv(&sharded));
     assert_eq!(a.len(), b.len());
     assert!(a.iter().zip(&b).all(|(x, y)| (x - y).abs() <= 1e-10 * a[0]), "{a:?} {b:?}");

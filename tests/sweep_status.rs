@@ -63,11 +63,11 @@ fn run(args: &[&str]) -> (Output, String) {
 }
 
 fn status(f: &Path) -> Vec<u8> {
-    hdf5::File::open(f).unwrap().dataset("status").unwrap().read_raw::<u8>().unwrap()
+    flexrom::io::h5_open::open(f).unwrap().dataset("status").unwrap().read_raw::<u8>().unwrap()
 }
 
 fn column(f: &Path, name: &str) -> Vec<f64> {
-    hdf5::File::open(f).unwrap().dataset(name).unwrap().read_raw::<f64>().unwrap()
+    flexrom::io::h5_open::open(f).unwrap().dataset(name).unwrap().read_raw::<f64>().unwrap()
 }
 
 #[test]
@@ -88,7 +88,7 @@ fn a_failing_load_scale_is_recorded_and_the_others_written() {
     assert_eq!(status(&out), vec![0, 1, 0, 0, 1]);
     // the answers kept are warned about too (0.9 and 1.1 outside the range [1, 1])
     assert!(err.contains("outside the basis's training range [1, 1]"), "{err}");
-    let f = hdf5::File::open(&out).unwrap();
+    let f = flexrom::io::h5_open::open(&out).unwrap();
     let messages: Vec<String> = f
         .dataset("message")
         .unwrap()
@@ -119,7 +119,7 @@ fn a_failing_load_scale_is_recorded_and_the_others_written() {
     let single = d.join("online.h5");
     let (o, err) = run(&["online", p.to_str().unwrap(), "--load-scale", "1.0", "-o", single.to_str().unwrap()]);
     assert!(o.status.success(), "{err}");
-    let alone = hdf5::File::open(&single).unwrap().dataset("probes/tip").unwrap().read_2d::<f64>().unwrap();
+    let alone = flexrom::io::h5_open::open(&single).unwrap().dataset("probes/tip").unwrap().read_2d::<f64>().unwrap();
     assert_eq!(tip.index_axis(ndarray::Axis(0), 2), alone);
 
     // --resume reruns the failed scales only (they fail again: exit 3 again)
@@ -254,13 +254,13 @@ fn an_interrupted_sweep_names_the_file_it_keeps_and_how_to_go_on() {
 }
 
 fn messages(f: &Path) -> Vec<String> {
-    let f = hdf5::File::open(f).unwrap();
+    let f = flexrom::io::h5_open::open(f).unwrap();
     let m = f.dataset("message").unwrap().read_raw::<hdf5::types::VarLenUnicode>().unwrap();
     m.iter().map(|m| m.to_string()).collect()
 }
 
 fn tip(f: &Path) -> ndarray::Array3<f64> {
-    hdf5::File::open(f).unwrap().dataset("probes/tip").unwrap().read::<f64, ndarray::Ix3>().unwrap()
+    flexrom::io::h5_open::open(f).unwrap().dataset("probes/tip").unwrap().read::<f64, ndarray::Ix3>().unwrap()
 }
 
 /// `--fallback full` where every estimate is above the tolerance (an `[online] tolerance`
@@ -291,7 +291,7 @@ fn a_fallback_answers_with_the_full_model_where_the_estimate_exceeds_the_toleran
     let (o, err) = run(&["sweep", ps, "--full", "-o", full.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(0), "{err}");
     assert_eq!(tip(&fb), tip(&full), "the fallback's answers are the full model's");
-    let f = hdf5::File::open(&fb).unwrap();
+    let f = flexrom::io::h5_open::open(&fb).unwrap();
     assert_eq!(f.dataset("fallback").unwrap().read_raw::<u8>().unwrap(), vec![1, 1, 1]);
     assert!(f.dataset("reduced_q").unwrap().read_raw::<f64>().unwrap().iter().all(|x| x.is_nan()));
     drop(f);
@@ -310,9 +310,9 @@ fn a_fallback_answers_with_the_full_model_where_the_estimate_exceeds_the_toleran
     let model = d.join("model.toml");
     let (o, err) = run(&["simulate", model.to_str().unwrap(), "--load-scale", "1.1", "-o", sim.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(0), "{err}");
-    let q = |f: &Path| hdf5::File::open(f).unwrap().dataset("q").unwrap().read_raw::<f64>().unwrap();
+    let q = |f: &Path| flexrom::io::h5_open::open(f).unwrap().dataset("q").unwrap().read_raw::<f64>().unwrap();
     assert_eq!(q(&one), q(&sim));
-    let f = hdf5::File::open(&one).unwrap();
+    let f = flexrom::io::h5_open::open(&one).unwrap();
     let why = f.attr("fallback").unwrap().read_scalar::<hdf5::types::VarLenUnicode>().unwrap().to_string();
     assert!(why.starts_with("full model in place of the reduced one: error estimate "), "{why}");
     assert_eq!(f.attr("error_estimate").unwrap().read_scalar::<f64>().unwrap(), 0.0);
@@ -338,7 +338,7 @@ fn a_fallback_answers_with_the_full_model_where_the_estimate_exceeds_the_toleran
     let (o, err) = run(&["sweep", ps, "--fallback", "none", "-o", plain.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(0), "{err}");
     assert!(err.contains("warning: error estimate above the tolerance 1e-12"), "{err}");
-    let f = hdf5::File::open(&plain).unwrap();
+    let f = flexrom::io::h5_open::open(&plain).unwrap();
     assert_eq!(f.dataset("fallback").unwrap().read_raw::<u8>().unwrap(), vec![0, 0, 0]);
     drop(f);
     assert!(column(&plain, "error_estimate").iter().all(|&e| e > 1e-12));
@@ -391,7 +391,7 @@ fn a_fallback_answers_with_the_full_model_where_the_reduced_run_fails() {
     let (o, err) = run(&[&["sweep", ps, "--full", "-o", full.to_str().unwrap()][..], &loads].concat());
     assert_eq!(o.status.code(), Some(0), "{err}");
     let probes = |f: &Path| {
-        let f = hdf5::File::open(f).unwrap();
+        let f = flexrom::io::h5_open::open(f).unwrap();
         let g = f.group("probes").unwrap();
         let mut names = g.member_names().unwrap();
         names.sort();
@@ -401,7 +401,7 @@ fn a_fallback_answers_with_the_full_model_where_the_reduced_run_fails() {
     assert_eq!(answers.len(), 3, "the model's three probes");
     assert_eq!(answers, probes(&full), "the fallback's answers are the full model's");
     assert_eq!(status(&fb), vec![0, 0, 0]);
-    let f = hdf5::File::open(&fb).unwrap();
+    let f = flexrom::io::h5_open::open(&fb).unwrap();
     assert_eq!(f.dataset("fallback").unwrap().read_raw::<u8>().unwrap(), vec![1, 1, 1]);
     drop(f);
     assert_eq!(column(&fb, "error_estimate"), vec![0.0; 3]);
@@ -437,7 +437,7 @@ fn a_fallback_whose_full_run_fails_too_says_both() {
         m[1].contains("; the full model ran in place of the reduced one, which had failed: sweep (reduced run) at load scale 1e20: Newton failed"),
         "{m:?}"
     );
-    let f = hdf5::File::open(&out).unwrap();
+    let f = flexrom::io::h5_open::open(&out).unwrap();
     assert_eq!(f.dataset("fallback").unwrap().read_raw::<u8>().unwrap(), vec![0, 0]);
 }
 
@@ -481,7 +481,7 @@ fn where_the_full_model_fails_too_the_reduced_answer_stands_with_a_note() {
         "{err}"
     );
     assert_eq!(status(&out), vec![0]);
-    let f = hdf5::File::open(&out).unwrap();
+    let f = flexrom::io::h5_open::open(&out).unwrap();
     assert_eq!(f.dataset("fallback").unwrap().read_raw::<u8>().unwrap(), vec![2]);
     assert!(f.dataset("reduced_q").unwrap().read_raw::<f64>().unwrap().iter().all(|x| x.is_finite()));
     drop(f);
@@ -514,7 +514,7 @@ fn a_fallback_sweep_resumes_merges_and_refuses_what_it_cannot_judge() {
     let (r, err) = run(&["sweep", ps, "--fallback", "full", "--resume", "-o", o]);
     assert_eq!(r.status.code(), Some(0), "{err}");
     assert!(err.contains("0 of 3 load scales already finished, running 3"), "{err}");
-    let fb = |f: &Path| hdf5::File::open(f).unwrap().dataset("fallback").unwrap().read_raw::<u8>().unwrap();
+    let fb = |f: &Path| flexrom::io::h5_open::open(f).unwrap().dataset("fallback").unwrap().read_raw::<u8>().unwrap();
     assert_eq!(fb(&out), vec![1, 1, 1]);
     // and not resumed without it: its full answers would stand in a file that says none
     let (r, err) = run(&["sweep", ps, "--resume", "-o", o]);

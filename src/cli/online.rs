@@ -73,7 +73,7 @@ impl Args {
         let (stored, rom, warnings) = load_rom(&p, &path, estimate.method(), false)?;
         warn(&warnings);
         // read before the run (a damaged /timing fails now), said after it
-        let notice = flexrom::cost::route::speed_notice_of(&path, &rom)?;
+        let notice = flexrom::cost::route::speed_notice_of(&path, &stored, &rom);
         let fallback = fallback.or(p.online_fallback()).unwrap_or_default();
         let done = online_to_file(&p, &rom, &path, &mu, &output, fallback, paraview)?;
         let (run, estimate) = (&done.run, &done.estimate);

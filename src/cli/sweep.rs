@@ -179,7 +179,7 @@ impl Args {
         }
         // read before the runs (a damaged /timing fails now), said after them, failed runs or not
         let notice = match &loaded {
-            Some((_, rom, _)) => flexrom::cost::route::speed_notice_of(&path, rom)?,
+            Some((stored, rom, _)) => flexrom::cost::route::speed_notice_of(&path, stored, rom),
             None => None,
         };
         let route = match &loaded {

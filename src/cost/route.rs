@@ -12,6 +12,7 @@
 
 use crate::cost::timing::{median, repeat_timing};
 use crate::error::Result;
+use crate::io::basis_file::StoredBasis;
 use crate::io::timing_file::RouteTiming;
 use crate::linalg::kkt::LinearSolverKind;
 use crate::rom::{Output, Rom};
@@ -61,11 +62,11 @@ pub fn timing_load(training_loads: &[f64]) -> Option<f64> {
 }
 
 /// Times both routes at the middle training load of the basis file at `path` (just
-/// written, read back as `rom`) and adds `/timing` to it. A run that fails here leaves the
-/// basis without `/timing` and returns the warning that says so.
-pub fn time_and_store(rom: &Rom, path: &Path) -> Result<Option<String>> {
-    let loads = crate::io::estimator_file::read_training_loads(path)?;
-    let Some(x) = timing_load(&loads) else { return Ok(None) };
+/// written, read back as `stored` and `rom`, its handle closed) and adds `/timing` to it. A
+/// run that fails here leaves the basis without `/timing` and returns the warning that
+/// says so.
+pub fn time_and_store(stored: &StoredBasis, rom: &Rom, path: &Path) -> Result<Option<String>> {
+    let Some(x) = timing_load(&stored.training.loads) else { return Ok(None) };
     // a basis of a [parameters] box: its centre (in the unit cube), inside the box
     let mu = match rom.trust().map(|t| &t.space).filter(|s| !s.is_empty()) {
         Some(space) => space.at(&vec![0.5; space.ranges.len()]),
@@ -161,11 +162,11 @@ pub fn speed_notice(basis: &Path, timing: &RouteTiming, with_estimate: bool) -> 
     Comparison::stored(timing, with_estimate).notice(basis, &measured)
 }
 
-/// [`speed_notice`] for the basis file at `path` run by `rom` (with its estimate when it
-/// has an estimator); `None` also for a basis without `/timing`.
-pub fn speed_notice_of(path: &Path, rom: &Rom) -> Result<Option<String>> {
-    let timing = crate::io::timing_file::read_timing(path)?;
-    Ok(timing.and_then(|t| speed_notice(path, &t, rom.estimator().is_some())))
+/// [`speed_notice`] for the basis file at `path`, read as `stored` and run by `rom` (with
+/// its estimate when it has an estimator); `None` also for a basis without `/timing`.
+pub fn speed_notice_of(path: &Path, stored: &StoredBasis, rom: &Rom) -> Option<String> {
+    let timing = stored.training.timing.as_ref()?;
+    speed_notice(path, timing, rom.estimator().is_some())
 }
 
 #[cfg(test)]

@@ -6,7 +6,7 @@
 //! Layout 2 (this one): every time series is time-first, `(n_t, …)` (a sweep's
 //! `(n_loads, n_t, …)`); snapshot and mode matrices keep the POD convention, one column per
 //! snapshot or mode (`dims = "dof, snapshot"`, `"dof, mode"`). Layout 1 (files without the
-//! attribute, flexrom ≤ 0.1 of 2026-11-24) stored `/q`, `/multipliers`, `/reduced/q` as
+//! attribute, flexrom ≤ 0.1) stored `/q`, `/multipliers`, `/reduced/q` as
 //! `(n, n_t)` and a sweep's `/reduced_q` as `(n_loads, r, n_t)`; readers convert them
 //! ([`layout_version`]). A file of a newer layout is refused ([`check_layout`]).
 //!

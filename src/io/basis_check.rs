@@ -27,7 +27,7 @@
 //! (`settings_hash`) is still used, with a one-line warning on stderr.
 
 pub use super::basis_content::{check_content, MIN_WEIGHT, ORTHONORMALITY_TOLERANCE};
-use super::basis_file::{read_basis, StoredBasis};
+use super::basis_file::{open_basis, read_core, read_rest, StoredBasis};
 pub use super::basis_hash::{content_hash, settings_hash, HashInput};
 pub use super::basis_layout::check_file;
 use crate::error::{Error, Result};
@@ -46,9 +46,15 @@ pub const INF_SUP_MIN: f64 = 1e-6;
 /// number of elements, so a single weight above 1e4 × that is not a trained one.
 pub const MAX_WEIGHT_PER_ELEMENT: f64 = 1e4;
 
-/// Reads the basis at `path` and checks it against `model`; `settings_hash` is the
-/// pipeline's [`settings_hash`] (a mismatch only warns). The only way commands read a basis.
+/// Reads the basis at `path` whole (its estimator and training record too, with one open)
+/// and checks it against `model`; `settings_hash` is the pipeline's [`settings_hash`] (a
+/// mismatch only warns). The only way commands read a basis.
 pub fn check(path: &Path, model: &Model, settings_hash: Option<&str>) -> Result<StoredBasis> {
+    check_open(&open_basis(path)?, path, model, settings_hash)
+}
+
+/// [`check`] on the basis file `f`, already open (at `path`, for messages).
+pub fn check_open(f: &hdf5::File, path: &Path, model: &Model, settings_hash: Option<&str>) -> Result<StoredBasis> {
     let bad = |field: &str, problem: String| Error::input(path, field, problem);
     // sizes before anything is read: a crafted shape must not make us allocate terabytes
     // (after the link walk: opening a dataset follows its link)
@@ -57,8 +63,8 @@ pub fn check(path: &Path, model: &Model, settings_hash: Option<&str>) -> Result<
             .and_then(|a| a.read_scalar::<u64>())
             .is_ok_and(|v| v == super::basis_file::SCHEMA_VERSION)
     };
-    if let Some(f) = hdf5::File::open(path).ok().filter(ours) {
-        check_file(&f, path)?;
+    if ours(f) {
+        check_file(f, path)?;
         let sys = &*model.physics()?.sys;
         let (n, nc, ne) = (sys.n_dof(), sys.n_constraints(), sys.n_elements());
         let (cols, values) = (n + nc, n + nc);
@@ -97,9 +103,9 @@ pub fn check(path: &Path, model: &Model, settings_hash: Option<&str>) -> Result<
                 ));
             }
         }
-        bounded_by_memory(&f, path, model)?;
+        bounded_by_memory(f, path, model)?;
     }
-    let mut stored = read_basis(path)?;
+    let stored = read_core(f, path)?;
     // the model first: a basis of another model is the commonest mistake, and the shape
     // checks below would otherwise report its symptoms
     let mine = model.fingerprint();
@@ -128,6 +134,8 @@ pub fn check(path: &Path, model: &Model, settings_hash: Option<&str>) -> Result<
             ),
         ));
     }
+    // the estimator and the training record once the basis is known to be this model's
+    let mut stored = read_rest(f, path, stored)?;
     if let Some(h) = settings_hash {
         if stored.settings_hash != h {
             let w = format!(

@@ -46,8 +46,10 @@
 use super::attrs::{check_layout, write_atomically_as, Kind};
 use super::basis_hash::{content_hash, HashInput};
 use super::basis_layout::check_file;
+use super::basis_training::{read_training, BasisTraining};
 use super::h5::{attr_f64, attr_str, attr_u64, read_attr_f64, read_attr_str};
 use crate::error::{Error, Result};
+use crate::reduction::estimator::Estimator;
 use crate::reduction::{Basis, Hyper, SnapshotKind, Trained, Variant};
 use ndarray::{Array1, Array2};
 use std::path::Path;
@@ -97,6 +99,10 @@ pub struct StoredBasis {
     /// what reading and checking it found worth telling the user (not errors: a basis
     /// trained with other settings than the pipeline has now), one line each
     pub warnings: Vec<String>,
+    /// `/estimator` (`None`: the file has none)
+    pub estimator: Option<std::sync::Arc<Estimator>>,
+    /// what the file says of its training (range, tolerance, notes, timing, …)
+    pub training: BasisTraining,
 }
 
 /// Chunked, shuffled and deflated (when the HDF5 library has zlib): snapshots compress well.
@@ -204,20 +210,41 @@ pub fn write_basis_with(
     })
 }
 
-/// Reads a basis file; every missing or malformed part is reported with the file and the
-/// dataset or attribute it concerns.
+/// Reads a basis file whole (the basis, its estimator and its training record) with one
+/// open; every missing or malformed part is reported with the file and the dataset or
+/// attribute it concerns.
 pub fn read_basis(path: &Path) -> Result<StoredBasis> {
+    let f = open_basis(path)?;
+    let s = read_core(&f, path)?;
+    read_rest(&f, path, s)
+}
+
+/// Opens the basis file at `path` to read: an error naming it when it does not exist or
+/// cannot be read.
+pub fn open_basis(path: &Path) -> Result<hdf5::File> {
     if !path.is_file() {
         return Err(Error::input(path, "(file)", "does not exist; run `flexrom train` first"));
     }
-    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
+    super::h5_open::open_to_read(path)
+}
+
+/// The estimator and the training record of the open basis file `f`, added to its basis
+/// `s` as [`read_core`] read it.
+pub fn read_rest(f: &hdf5::File, path: &Path, s: StoredBasis) -> Result<StoredBasis> {
+    let estimator = super::estimator_file::read_estimator(f, path, &s.basis)?.map(std::sync::Arc::new);
+    Ok(StoredBasis { estimator, training: read_training(f, path)?, ..s })
+}
+
+/// The basis of the open basis file `f` and its provenance, without its estimator and
+/// training record ([`read_rest`] adds them).
+pub fn read_core(f: &hdf5::File, path: &Path) -> Result<StoredBasis> {
     let field = |name: &str, problem: String| Error::input(path, name, problem);
     // layouts 1 and 2 store a basis alike (snapshots and modes one column each); a newer
     // one is refused
-    check_layout(&f, path, "flexrom train")?;
+    check_layout(f, path, "flexrom train")?;
     let version = f.attr("schema_version").and_then(|a| a.read_scalar::<u64>()).map_err(|_| {
         // another flexrom file says what it is (`flexrom_file`): name it
-        let kind = crate::io::h5::read_attr_str(&f, "flexrom_file")
+        let kind = crate::io::h5::read_attr_str(f, "flexrom_file")
             .map_or(String::new(), |k| format!(" (it is a flexrom {k} file)"));
         field("schema_version", format!("is missing: this is not a flexrom basis file{kind}"))
     })?;
@@ -228,9 +255,9 @@ pub fn read_basis(path: &Path) -> Result<StoredBasis> {
         return Err(field("schema_version", format!("is {version}; this program reads version {SCHEMA_VERSION}")));
     }
     // links, external storage and dataset types, before any dataset is read
-    check_file(&f, path)?;
-    let text = |name: &str| read_attr_str(&f, name).map_err(|err| field(name, format!("cannot be read: {err}")));
-    let num = |name: &str| read_attr_f64(&f, name).map_err(|err| field(name, format!("cannot be read: {err}")));
+    check_file(f, path)?;
+    let text = |name: &str| read_attr_str(f, name).map_err(|err| field(name, format!("cannot be read: {err}")));
+    let num = |name: &str| read_attr_f64(f, name).map_err(|err| field(name, format!("cannot be read: {err}")));
     let count = |name: &str| {
         f.attr(name)
             .and_then(|a| a.read_scalar::<u64>())
@@ -271,7 +298,7 @@ pub fn read_basis(path: &Path) -> Result<StoredBasis> {
         multiplier_modes,
         multiplier_scale: num("multiplier_scale")?,
         n_pod_modes: count("n_pod_modes")?,
-        hyper: read_hyper(&f, path)?,
+        hyper: read_hyper(f, path)?,
     };
     let singular_values = vec("basis/singular_values")?;
     let energy = vec("basis/energy")?;
@@ -316,6 +343,8 @@ pub fn read_basis(path: &Path) -> Result<StoredBasis> {
         mode_rule: text("mode_rule")?,
         creation_time: text("creation_time")?,
         warnings: Vec::new(),
+        estimator: None,
+        training: BasisTraining::default(),
     })
 }
 

@@ -21,14 +21,14 @@
 //!   reliable follow from load_scale and ratio and are recomputed when read
 //!   attributes on /estimator: method ("enriched": the estimators compare with an enriched
 //!   basis), default_method (the method online estimates use unless the pipeline names one:
-//!   "corrected", "defects" or "enriched"; files written before 2026-11-26 have none, and
+//!   "corrected", "defects" or "enriched"; files of an earlier flexrom have none, and
 //!   the rule of `Estimator::default_method` decides), extra_modes (k), factor (c),
 //!   calibrated (1: c from calibration pairs, 0: the default), n_modes (r⁺)
 //! /training/range             (2)          [min, max] training load scale (greedy training;
 //!                                          otherwise min/max of /snapshot_load_scale)
 //! /training/tolerance or attribute `tolerance` on /training: greedy's tolerance
 //!   attribute `measure` on /training: the error that tolerance is on ("relative" or
-//!   "displacement"; files written before 2026-11-26 have none: relative)
+//!   "displacement"; files of an earlier flexrom have none: relative)
 //!   attributes `held_out_note`, `estimate_note` on /training: the converged held-out check's
 //!   error above the tolerance, the online default reading above it between the candidates,
 //!   in words (each absent when within it)
@@ -101,11 +101,10 @@ pub fn write_estimator(f: &hdf5::File, est: &Estimator) -> hdf5::Result<()> {
     Ok(())
 }
 
-/// Reads `/estimator` of the basis file at `path`, completing it from `basis` (variant,
-/// reference, kept coordinates are the basis's). `None` when the file has none (trained
-/// before the estimator existed).
-pub fn read_estimator(path: &Path, basis: &Basis) -> Result<Option<Estimator>> {
-    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
+/// Reads `/estimator` of the open basis file `f` (at `path`, for messages), completing it
+/// from `basis` (variant, reference, kept coordinates are the basis's). `None` when the file
+/// has none (trained before the estimator existed).
+pub fn read_estimator(f: &hdf5::File, path: &Path, basis: &Basis) -> Result<Option<Estimator>> {
     let Ok(g) = f.group("estimator") else { return Ok(None) };
     let field = |name: &str, problem: String| Error::input(path, format!("estimator/{name}"), problem);
     let modes = g
@@ -221,7 +220,7 @@ pub fn read_estimator(path: &Path, basis: &Basis) -> Result<Option<Estimator>> {
         ));
     }
     let defects = match g.group("defects") {
-        Ok(dg) => Some(read_defects(path, &dg, &field)?),
+        Ok(dg) => Some(read_defects(f, path, &dg, &field)?),
         Err(_) => None,
     };
     Ok(Some(Estimator {
@@ -236,7 +235,12 @@ pub fn read_estimator(path: &Path, basis: &Basis) -> Result<Option<Estimator>> {
 
 /// `/estimator/defects`: the loads (finite, increasing) and their ratios (N × 5); the
 /// factors and the check's outcome are derived from them, as training derived them.
-fn read_defects(path: &Path, dg: &hdf5::Group, field: &dyn Fn(&str, String) -> Error) -> Result<DefectsCalibration> {
+fn read_defects(
+    f: &hdf5::File,
+    path: &Path,
+    dg: &hdf5::Group,
+    field: &dyn Fn(&str, String) -> Error,
+) -> Result<DefectsCalibration> {
     let load_scales = dg
         .dataset("load_scale")
         .and_then(|d| d.read_1d::<f64>())
@@ -264,7 +268,7 @@ fn read_defects(path: &Path, dg: &hdf5::Group, field: &dyn Fn(&str, String) -> E
     // `factor` and `reliable` follow from the ratios; the file carries them for its readers
     let c = if scattered {
         // where the candidates lie: their unit-cube coordinates in the basis's box
-        let space = crate::io::parameter_space_file::read_parameter_space(path)?.unwrap_or_default();
+        let space = crate::io::parameter_space_file::parameter_space(f, path)?.unwrap_or_default();
         let unit = dg
             .dataset("unit_point")
             .and_then(|d| d.read_2d::<f64>())
@@ -318,8 +322,7 @@ fn read_quantity_ratios(
 
 /// `[min, max]` of the training load scales: `/training/range` when present (greedy
 /// training), else the extremes of `/snapshot_load_scale`.
-pub fn read_training_range(path: &Path) -> Result<(f64, f64)> {
-    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
+pub fn training_range(f: &hdf5::File, path: &Path) -> Result<(f64, f64)> {
     if let Ok(d) = f.dataset("training/range") {
         let r = d.read_1d::<f64>().map_err(|e| Error::input(path, "training/range", format!("cannot be read: {e}")))?;
         if r.len() != 2 || !(r[0].is_finite() && r[1].is_finite() && r[0] <= r[1]) {
@@ -341,8 +344,7 @@ pub fn read_training_range(path: &Path) -> Result<(f64, f64)> {
 
 /// The loads of the full runs whose snapshots the basis holds, sorted, each once:
 /// `/training/load_scales` (greedy training), else the values of `/snapshot_load_scale`.
-pub fn read_training_loads(path: &Path) -> Result<Vec<f64>> {
-    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
+pub fn training_loads(f: &hdf5::File, path: &Path) -> Result<Vec<f64>> {
     let mut l: Vec<f64> = match f.dataset("training/load_scales") {
         Ok(d) => d.read_1d::<f64>().map_err(|e| Error::input(path, "training/load_scales", e.to_string()))?.to_vec(),
         Err(_) => f
@@ -360,8 +362,7 @@ pub fn read_training_loads(path: &Path) -> Result<Vec<f64>> {
 /// its last iteration measured them (`/training/candidates`, the last row of
 /// `/training/sensitivity`); `None` without greedy training or in files written before the
 /// sensitivity was recorded.
-pub fn read_training_sensitivity(path: &Path) -> Result<Option<(Vec<f64>, Vec<f64>)>> {
-    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
+pub fn training_sensitivity(f: &hdf5::File, path: &Path) -> Result<Option<(Vec<f64>, Vec<f64>)>> {
     let Ok(g) = f.group("training") else { return Ok(None) };
     let (Ok(c), Ok(s)) = (g.dataset("candidates"), g.dataset("sensitivity")) else { return Ok(None) };
     let c =
@@ -395,11 +396,11 @@ pub type BoxSensitivity = (Vec<Vec<f64>>, Vec<f64>);
 /// by its attribute `parameters`) in the unit cube of `space`, and the reduced model's
 /// whole-run sensitivity at each (the last row of `/training/sensitivity`); `None` without
 /// them.
-pub fn read_training_box_sensitivity(
+pub fn training_box_sensitivity(
+    f: &hdf5::File,
     path: &Path,
     space: &crate::solver::parameter_space::ParameterSpace,
 ) -> Result<Option<BoxSensitivity>> {
-    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
     let Ok(g) = f.group("training") else { return Ok(None) };
     let (Ok(c), Ok(s)) = (g.dataset("candidate_points"), g.dataset("sensitivity")) else { return Ok(None) };
     let bad = |field: &str, problem: String| Error::input(path, field, problem);
@@ -437,8 +438,7 @@ pub fn read_training_box_sensitivity(
 
 /// Greedy training's tolerance: the dataset `/training/tolerance` or the attribute
 /// `tolerance` on `/training`; `None` without greedy training.
-pub fn read_training_tolerance(path: &Path) -> Result<Option<f64>> {
-    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
+pub fn training_tolerance(f: &hdf5::File, path: &Path) -> Result<Option<f64>> {
     let Ok(g) = f.group("training") else { return Ok(None) };
     let t = if let Ok(d) = g.dataset("tolerance") {
         d.read_scalar::<f64>().or_else(|_| d.read_1d::<f64>().map(|a| a.first().copied().unwrap_or(f64::NAN)))
@@ -459,8 +459,7 @@ pub fn read_training_tolerance(path: &Path) -> Result<Option<f64>> {
 /// tolerance) and `estimate_note` (the online default, `defects`, reading above it between
 /// the candidates) on `/training`, those present; empty without them (within the
 /// tolerance, other training, files written before the attributes).
-pub fn read_training_notes(path: &Path) -> Result<Vec<(&'static str, String)>> {
-    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
+pub fn training_notes(f: &hdf5::File, path: &Path) -> Result<Vec<(&'static str, String)>> {
     let Ok(g) = f.group("training") else { return Ok(Vec::new()) };
     let mut notes = Vec::new();
     for name in ["held_out_note", "estimate_note"] {
@@ -476,8 +475,7 @@ pub fn read_training_notes(path: &Path) -> Result<Vec<(&'static str, String)>> {
 
 /// The error greedy training's tolerance is on: the attribute `measure` on `/training`;
 /// relative without one (files written before the attribute, bases of fixed loads).
-pub fn read_training_measure(path: &Path) -> Result<ErrorMeasure> {
-    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
+pub fn training_measure(f: &hdf5::File, path: &Path) -> Result<ErrorMeasure> {
     let Ok(g) = f.group("training") else { return Ok(ErrorMeasure::Relative) };
     if g.attr("measure").is_err() {
         return Ok(ErrorMeasure::Relative);
@@ -485,4 +483,14 @@ pub fn read_training_measure(path: &Path) -> Result<ErrorMeasure> {
     let m = read_attr_str(&g, "measure")
         .map_err(|e| Error::input(path, "training/measure", format!("cannot be read: {e}")))?;
     ErrorMeasure::parse(&m).map_err(|p| Error::input(path, "training/measure", p))
+}
+
+/// [`training_loads`] of the basis file at `path`, opened for it.
+pub fn read_training_loads(path: &Path) -> Result<Vec<f64>> {
+    training_loads(&crate::io::h5_open::open_to_read(path)?, path)
+}
+
+/// [`training_notes`] of the basis file at `path`, opened for it.
+pub fn read_training_notes(path: &Path) -> Result<Vec<(&'static str, String)>> {
+    training_notes(&crate::io::h5_open::open_to_read(path)?, path)
 }

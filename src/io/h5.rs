@@ -33,7 +33,8 @@ impl StagedFile {
     pub fn create(path: &Path) -> Result<StagedFile> {
         let tmp = super::atomic::TempPath::file_for(path)?;
         // the empty temporary file is flexrom's own (created exclusively): truncated here
-        let file = hdf5::File::create(tmp.path()).map_err(|e| Error::hdf5(path, format!("cannot create: {e}")))?;
+        let file =
+            crate::io::h5_open::create(tmp.path()).map_err(|e| Error::hdf5(path, format!("cannot create: {e}")))?;
         Ok(StagedFile { file, tmp, path: path.to_path_buf() })
     }
 
@@ -510,23 +511,6 @@ pub fn check_global_heaps(path: &Path) -> std::result::Result<HeapObjects, Strin
         }
     }
     Ok(objects)
-}
-
-/// Whether an HDF5 open failed on a lock another handle holds (HDF5's file locking).
-pub fn is_locked(e: &hdf5::Error) -> bool {
-    e.to_string().contains("unable to lock file")
-}
-
-/// Why an HDF5 file could not be opened, for a message that follows the file's name: a lock
-/// held by another open handle (an h5py `File` in the same Python process, another program
-/// writing it) said as such, anything else as a file that is not readable HDF5.
-pub fn unreadable(e: &hdf5::Error) -> String {
-    let text = e.to_string();
-    if is_locked(e) {
-        format!("is locked by another open handle (an h5py File still open, or a program writing it): close it first, or set HDF5_USE_FILE_LOCKING=FALSE to share it read-only ({text})")
-    } else {
-        format!("is not a readable HDF5 file (truncated or of another format?): {text}")
-    }
 }
 
 #[cfg(test)]

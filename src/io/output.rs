@@ -204,7 +204,7 @@ fn check_extension(output: &Path, origin: Origin, kinds: &[Kind]) -> Result<()> 
 /// HDF5 file whose root attribute `flexrom_file` names one of them is replaced (a result by
 /// a result, a basis by a basis, …), so a path mistyped in a pipeline or on the command line
 /// never destroys a user's own file, nor a trained basis by a result. A file of a flexrom
-/// older than that attribute (2026-11-25) is recognised by its root `program_version`.
+/// older than that attribute is recognised by its root `program_version`.
 pub fn check_own_file(output: &Path, origin: Origin, kinds: &[Kind]) -> Result<()> {
     let names = kinds.iter().map(|k| k.name()).collect::<Vec<_>>().join(" or ");
     let refuse = |what: String| {
@@ -213,11 +213,11 @@ pub fn check_own_file(output: &Path, origin: Origin, kinds: &[Kind]) -> Result<(
             format!("exists and {what}; flexrom replaces only its own {names} files: remove it or choose another path"),
         ))
     };
-    let f = match hdf5::File::open(output) {
+    let f = match crate::io::h5_open::open(output) {
         Ok(f) => f,
         // flexrom's own file, perhaps, held open by another handle: say so, not "foreign"
-        Err(e) if super::h5::is_locked(&e) => {
-            return Err(origin.error(output, format!("exists and {}", super::h5::unreadable(&e))))
+        Err(e) if super::h5_open::is_locked(&e) => {
+            return Err(origin.error(output, format!("exists and {}", super::h5_open::unreadable(&e))))
         }
         Err(_) => return refuse("is not an HDF5 file flexrom wrote".into()),
     };

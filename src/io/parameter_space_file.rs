@@ -26,11 +26,11 @@ pub fn write_parameter_space(f: &hdf5::File, space: &ParameterSpace, points: &[P
     Ok(())
 }
 
-/// The box of `/parameters` (`None`: the basis was trained over the load scale alone).
+/// The box of `/parameters` of the open basis file `f` at `path` (`None`: the basis was
+/// trained over the load scale alone).
 /// A range that is not `[lower, upper]` with lower < upper, or an unknown scale, is an
 /// error naming the dataset.
-pub fn read_parameter_space(path: &Path) -> Result<Option<ParameterSpace>> {
-    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
+pub fn parameter_space(f: &hdf5::File, path: &Path) -> Result<Option<ParameterSpace>> {
     let Ok(g) = f.group("parameters") else { return Ok(None) };
     let mut names = g.member_names().map_err(|e| Error::hdf5(path, e))?;
     names.sort();

@@ -27,9 +27,9 @@ impl ResultReader {
     /// flexrom file (a basis, a sweep: named), a newer layout, or a result whose `/t` and
     /// `/q` disagree; every message names the file and what is wrong.
     pub fn open(path: &Path, limits: &crate::limits::Limits) -> Result<ResultReader> {
-        let f = hdf5::File::open(path).map_err(|e| {
-            if super::h5::is_locked(&e) {
-                Error::hdf5(path, super::h5::unreadable(&e))
+        let f = crate::io::h5_open::open(path).map_err(|e| {
+            if super::h5_open::is_locked(&e) {
+                Error::hdf5(path, super::h5_open::unreadable(&e))
             } else if std::fs::metadata(path).is_err() {
                 Error::hdf5(path, "no such file")
             } else {

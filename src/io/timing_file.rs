@@ -13,7 +13,7 @@
 //!   its estimate, interleaved), estimate_method ("none" without an estimator)
 //! ```
 //!
-//! Basis files written before 2026-11-26 have no `/timing`: nothing is known, nothing said.
+//! Basis files of an earlier flexrom have no `/timing`: nothing is known, nothing said.
 //! The content hash does not cover it: it is a measurement of a machine, not the basis.
 
 use super::attrs::{units_of, write_units, Kind};
@@ -44,7 +44,7 @@ const SECONDS: [&str; 3] = ["full_seconds", "reduced_seconds", "estimate_seconds
 /// Adds `/timing` to the basis file at `path` (a staged file, not yet renamed into place).
 pub fn append_timing(path: &Path, t: &RouteTiming) -> Result<()> {
     let e = |err: hdf5::Error| Error::hdf5(path, err);
-    let f = hdf5::File::open_rw(path).map_err(e)?;
+    let f = crate::io::h5_open::open_rw(path).map_err(e)?;
     let g = f.create_group("timing").map_err(e)?;
     for (name, value) in SECONDS.iter().zip([t.full_seconds, t.reduced_seconds, t.estimate_seconds]) {
         let d = g.new_dataset_builder().with_data(&ndarray::arr0(value)).create(*name).map_err(e)?;
@@ -61,10 +61,9 @@ pub fn append_timing(path: &Path, t: &RouteTiming) -> Result<()> {
     f.flush().map_err(e)
 }
 
-/// `/timing` of the basis file at `path`; `None` for a file written before it. A timing
+/// `/timing` of the open basis file `f` at `path`; `None` for a file written before it. A timing
 /// that is there but unreadable, or not positive where it must be, is an error naming it.
-pub fn read_timing(path: &Path) -> Result<Option<RouteTiming>> {
-    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
+pub fn read_timing(f: &hdf5::File, path: &Path) -> Result<Option<RouteTiming>> {
     let Ok(g) = f.group("timing") else { return Ok(None) };
     let bad = |field: &str, problem: String| Error::input(path, format!("timing/{field}"), problem);
     let mut seconds = [f64::NAN; 3];

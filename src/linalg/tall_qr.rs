@@ -45,7 +45,7 @@ pub fn triangular_factor(a: Array2<f64>) -> Array2<f64> {
 /// direct iterations run on: a Householder QR is `2 m n²` flops at the speed of blocked,
 /// cache-resident kernels (on one thread), a direct iteration streams the `m × n` matrix
 /// from memory (the gains `Aᵀr`, on every thread), so the ratio grows with `n` and with the
-/// threads. Measured on the 2-core development host (2026-11-27, random matrices, two
+/// threads. Measured on a 2-core machine (random matrices, two
 /// threads for the gains): the QR took as long as the direct route's set-up and 31
 /// iterations at 321 000 × 146, 99 at 75 000 × 1100 — `n/4.7` and `n/11` on two threads,
 /// `n/9` and `n/22` per thread; at 75 000 × 5000 40 s against 12 s for the direct set-up

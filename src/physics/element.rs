@@ -447,9 +447,8 @@ mod tests {
     /// A 0.24 mm element (the 5000-element pendulum's) a metre from the origin, bent and
     /// stretched a little: moving one node by 1e-13 m changes its elastic force (by 0.74 N)
     /// as the tangent says, to 1e-6 of the change (measured 8e-9). The force summed over the
-    /// absolute coordinates, as computed before 2026-11-27, rounds at a few ε_mach |K_t||x|
-    /// and misses the change by 5e-4 of it: that noise, not the tolerance, decided where
-    /// Newton stopped on fine meshes. The test fails without [`without_translation`].
+    /// absolute coordinates rounds at a few ε_mach |K_t||x| and misses the change by 5e-4 of
+    /// it: that noise, not the tolerance, would decide where Newton stops on fine meshes. The test fails without [`without_translation`].
     #[test]
     fn the_force_of_a_small_element_far_from_the_origin_follows_its_tangent() {
         let (l, angle) = (1.2 / 5000.0, 0.6_f64);

@@ -393,7 +393,8 @@ pub fn read_point_table(d: &hdf5::Dataset, rows: usize) -> std::result::Result<(
 
 /// The `fallback` a sweep file was written with (files before the attribute: `none`).
 pub fn fallback_of(path: &Path) -> Result<crate::pipeline::fallback::Fallback> {
-    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
+    let f =
+        crate::io::h5_open::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5_open::unreadable(&e)))?;
     if f.attr("fallback").is_err() {
         return Ok(crate::pipeline::fallback::Fallback::None);
     }
@@ -443,7 +444,7 @@ fn cannot_resume(path: &Path, field: &str, problem: String) -> Error {
 /// version and whether it is a full sweep.
 fn open_to_resume(path: &Path, model: &Model, stored: Option<&StoredBasis>) -> Result<(hdf5::File, u64, bool)> {
     let cannot = |field: &str, problem: String| cannot_resume(path, field, problem);
-    let f = hdf5::File::open(path).map_err(|e| cannot("(file)", crate::io::h5::unreadable(&e)))?;
+    let f = crate::io::h5_open::open(path).map_err(|e| cannot("(file)", crate::io::h5_open::unreadable(&e)))?;
     // layout 1 stored /reduced_q as (N, r, n_t): converted on reading; newer layouts are refused
     let layout = check_layout(&f, path, "flexrom sweep")?;
     let text = |name: &str| {

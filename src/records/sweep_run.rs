@@ -63,14 +63,14 @@ impl SweepRun {
 /// Whether the HDF5 file at `path` says it is a sweep file (`flexrom_file = "sweep"`);
 /// false for anything else, unreadable files included (their reader says why).
 pub fn is_sweep_file(path: &Path) -> bool {
-    hdf5::File::open(path).is_ok_and(|f| read_attr_str(&f, KIND_ATTR).is_ok_and(|k| k == Kind::Sweep.name()))
+    crate::io::h5_open::open(path).is_ok_and(|f| read_attr_str(&f, KIND_ATTR).is_ok_and(|k| k == Kind::Sweep.name()))
 }
 
 /// Opens the run of the sweep file at `path` that `pick` names, with its basis and model;
 /// every refusal names the file (the sweep's, or the basis's) and what to do instead.
 pub fn open_sweep_run(path: &Path, pick: SweepPick, limits: &crate::limits::Limits) -> Result<SweepRun> {
     let bad = |field: &str, problem: String| Error::input(path, field, problem);
-    let f = hdf5::File::open(path).map_err(|e| bad("(file)", crate::io::h5::unreadable(&e)))?;
+    let f = crate::io::h5_open::open(path).map_err(|e| bad("(file)", crate::io::h5_open::unreadable(&e)))?;
     let layout = check_layout(&f, path, "flexrom sweep")?;
     let text = |name: &str| read_attr_str(&f, name).map_err(|e| bad(name, format!("cannot be read: {e}")));
     // files written before the attribute are reduced sweeps
@@ -154,7 +154,8 @@ fn sweep_basis(
             ),
         ));
     }
-    let f = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
+    // opened once: its model's texts, then the basis checked against that model
+    let f = crate::io::h5_open::open_to_read(path)?;
     let text = |name: &str| {
         read_attr_str(&f, name).map_err(|e| {
             Error::input(
@@ -165,10 +166,9 @@ fn sweep_basis(
         })
     };
     let (model_text, model_path) = (text("model")?, text("model_path")?);
-    drop(f);
     let model = Model::from_text_with(&model_text, &model_path, limits.clone())
         .map_err(|e| Error::input(path, "model", format!("the model text it stores is not valid: {e}")))?;
-    let stored = crate::io::basis_check::check(path, &model, None)?;
+    let stored = crate::io::basis_check::check_open(&f, path, &model, None)?;
     if stored.content_hash != content_hash {
         return Err(Error::input(
             sweep,

@@ -115,7 +115,7 @@ fn current_basis(p: &Pipeline, method: Option<EstimateMethod>) -> Option<Reused>
     if stored.settings_hash != p.settings_hash() || stored.model_fingerprint != p.model.fingerprint() {
         return None;
     }
-    let n_snapshots = hdf5::File::open(&p.basis_path)
+    let n_snapshots = crate::io::h5_open::open(&p.basis_path)
         .and_then(|f| f.dataset("snapshots"))
         .ok()
         .and_then(|d| d.shape().get(1).copied())?;
@@ -142,7 +142,7 @@ fn stored_runs(p: &Pipeline, path: &Path) -> Result<Vec<Parameters>> {
         let loads = crate::io::estimator_file::read_training_loads(path)?;
         return Ok(loads.into_iter().map(Parameters::load_scale).collect());
     }
-    let f = hdf5::File::open(path).map_err(|e| Error::hdf5(path, e))?;
+    let f = crate::io::h5_open::open(path).map_err(|e| Error::hdf5(path, e))?;
     let mut runs: Vec<Parameters> = Vec::new();
     for name in space.names() {
         let field = format!("parameters/{name}");
@@ -286,7 +286,7 @@ fn train_or_reuse(
     // the warnings of loading it come with `check_report`'s, once
     let (stored, rom, _) = load_rom(p, basis_path, method, false)?;
     let mut trained = Training::trained(p, summary, &name);
-    trained.warnings.extend(crate::cost::route::time_and_store(&rom, basis_path)?);
+    trained.warnings.extend(crate::cost::route::time_and_store(&stored, &rom, basis_path)?);
     Ok((stored, rom, trained))
 }
 
@@ -994,7 +994,7 @@ fn headline(w: &str) -> &str {
 /// amplifies changes of the load, estimates above the tolerance; with `strict`, the last is
 /// the error).
 fn sweep_warnings(rom: &Rom, path: &Path, strict: bool) -> Result<Vec<String>> {
-    let f = hdf5::File::open(path).map_err(|e| Error::hdf5(path, e))?;
+    let f = crate::io::h5_open::open(path).map_err(|e| Error::hdf5(path, e))?;
     let read = |name: &str| {
         f.dataset(name)
             .and_then(|d| d.read_1d::<f64>())

@@ -80,15 +80,13 @@ impl Rom {
     }
 
     /// The reduced model of a basis file already read and checked as `stored`
-    /// (`io::basis_check`), with the estimator the file holds, by the method `o` asks for
-    /// (else the one the file names), and its training range and tolerance. Returns the
-    /// warnings a user should see (a method whose own check failed for this basis).
+    /// (`io::basis_check`, at `path`, named in messages), with the estimator the file holds,
+    /// by the method `o` asks for (else the one the file names), and its training range and
+    /// tolerance. Returns the warnings a user should see (a method whose own check failed
+    /// for this basis).
     pub fn load(model: &Arc<Model>, path: &Path, stored: &StoredBasis, o: LoadOptions) -> Result<(Self, Vec<String>)> {
-        use crate::io::estimator_file::{
-            read_estimator, read_training_measure, read_training_range, read_training_tolerance,
-        };
         let mut warnings = Vec::new();
-        let data = if o.no_estimate { None } else { read_estimator(path, &stored.basis)? };
+        let data = if o.no_estimate { None } else { stored.estimator.as_ref() };
         let estimator = match data {
             Some(d) => {
                 let sys = &*model.physics()?.sys;
@@ -99,7 +97,7 @@ impl Rom {
                     h.validate(sys.n_elements()).map_err(err)?;
                 }
                 let method = o.method.unwrap_or(d.default_method());
-                let e = estimator::build(method, model, &stored.basis, &Arc::new(d))?;
+                let e = estimator::build(method, model, &stored.basis, d)?;
                 if let Some(why) = e.self_check() {
                     warnings.push(format!("{}: estimate = \"{}\": {why}", path.display(), e.name()));
                 }
@@ -107,19 +105,14 @@ impl Rom {
             }
             None => None,
         };
-        let trained = read_training_measure(path)?;
+        let t = &stored.training;
         let (tolerance, measure) = match o.tolerance {
-            Some(t) => (Some(t), o.tolerance_measure.unwrap_or(trained)),
-            None => (read_training_tolerance(path)?, trained),
+            Some(tol) => (Some(tol), o.tolerance_measure.unwrap_or(t.measure)),
+            None => (t.tolerance, t.measure),
         };
-        let space = crate::io::parameter_space_file::read_parameter_space(path)?.unwrap_or_default();
-        let sensitivity = trust::LoadSensitivity::read(path, &space)?;
-        // a box that holds λ gives its range; else the training loads' [min, max]
-        let range = match space.range(crate::solver::parameters::LOAD_SCALE) {
-            Some(r) => (r.lower, r.upper),
-            None => read_training_range(path)?,
-        };
-        let trust = Trust { range, tolerance, measure, skipped: o.no_estimate, sensitivity, space };
+        let sensitivity = t.sensitivity.as_ref().map(|s| trust::LoadSensitivity::of_stored(s, &t.space));
+        let trust =
+            Trust { range: t.range, tolerance, measure, skipped: o.no_estimate, sensitivity, space: t.space.clone() };
         Ok((Rom::new(model, &stored.basis, estimator, Some(trust))?, warnings))
     }
 

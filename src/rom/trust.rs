@@ -5,6 +5,7 @@
 use super::estimator::{ErrorMeasure, Estimate, QuantityEstimate};
 use super::quantities::Quantity;
 use crate::error::{Error, Result};
+use crate::io::basis_training::StoredSensitivity;
 use crate::solver::parameter_space::ParameterSpace;
 use crate::solver::parameters::Parameters;
 
@@ -155,15 +156,13 @@ impl LoadSensitivity {
         LoadSensitivity { candidates, whole_run, points: None }
     }
 
-    /// Greedy training's record in the basis file `path` (trained over the box `space`,
-    /// empty for a line): on a line `/training/candidates`, in a box
-    /// `/training/candidate_points`; `None` for other bases.
-    pub fn read(path: &std::path::Path, space: &ParameterSpace) -> Result<Option<Self>> {
-        use crate::io::estimator_file::{read_training_box_sensitivity, read_training_sensitivity};
-        Ok(match read_training_sensitivity(path)? {
-            Some((c, s)) => Some(Self::new(c, s)),
-            None => read_training_box_sensitivity(path, space)?.map(|(unit, s)| Self::in_box(space.clone(), unit, s)),
-        })
+    /// Greedy training's record as the basis file stores it ([`StoredSensitivity`]: on a
+    /// line its candidate loads, in the box `space` its candidate points).
+    pub fn of_stored(s: &StoredSensitivity, space: &ParameterSpace) -> Self {
+        match s {
+            StoredSensitivity::Loads { candidates, whole_run } => Self::new(candidates.clone(), whole_run.clone()),
+            StoredSensitivity::Box { unit, whole_run } => Self::in_box(space.clone(), unit.clone(), whole_run.clone()),
+        }
     }
 
     /// Candidates at the points `unit` of the box `space`'s unit cube, one sensitivity each.

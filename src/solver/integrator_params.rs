@@ -45,7 +45,7 @@ pub enum JacobianReuse {
     WithinStep,
     /// also across steps (`jacobian_reuse = "across-steps"`, opt-in): a fresh matrix is used
     /// at least twice and kept into the next steps until it contracts slowly
-    /// (`slow_contraction`). Measured (2026-11-25): the pendulum needs 257 instead of 441
+    /// (`slow_contraction`). Measured: the pendulum needs 257 instead of 441
     /// factorizations (1110 instead of 660 iterations, about the same time); the four-bar
     /// is much worse (a matrix kept from an earlier step diverges near its stiff
     /// configurations and the step is retried with full Newton), so it is not the default.

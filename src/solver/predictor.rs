@@ -34,7 +34,7 @@
 //!   whose positions stay small: on a stiff arm driven from rest by a moment the velocity
 //!   guess of its second step lands in the cubic range of the axial force (residual 2.6e7,
 //!   Newton crawling at θ = ⅔), the position guess at a residual of 1.4e2.
-//! - [`Predictor::Adaptive`] (`"adaptive"`, the default since 2026-11-27): once a step's
+//! - [`Predictor::Adaptive`] (`"adaptive"`, the default): once a step's
 //!   solution is known, it judges which of the three starts came closest to it (‖·‖∞,
 //!   Newton's own measure; ties to zero acceleration, then constant velocity); the next
 //!   step starts there. A run's first step, with no step before it to judge by, starts from

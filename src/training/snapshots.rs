@@ -160,7 +160,7 @@ struct Run {
 /// The runs of one snapshot file, checked against the pipeline (model, settings, sizes).
 fn read_runs(p: &Pipeline, path: &Path, n_t: usize) -> Result<(Vec<Run>, f64)> {
     let bad = |field: &str, problem: String| Error::input(path, field, problem);
-    let f = hdf5::File::open(path).map_err(|e| bad("(file)", crate::io::h5::unreadable(&e)))?;
+    let f = crate::io::h5_open::open(path).map_err(|e| bad("(file)", crate::io::h5_open::unreadable(&e)))?;
     // layouts 1 and 2 store snapshots alike (one column each)
     check_layout(&f, path, "flexrom train --snapshots-only")?;
     let text = |name: &str| read_attr_str(&f, name).map_err(|e| bad(name, format!("cannot be read: {e}")));

@@ -121,8 +121,8 @@ fn stage(p: &Pipeline, staged: &TempPath, out: &Path, from_snapshots: &[PathBuf]
         s
     };
     // read back and checked as every reader does, then both routes timed as users run them
-    let (_, rom, _) = crate::workflows::online::load_rom(p, staged.path(), None, false)?;
-    s.warnings.extend(crate::cost::route::time_and_store(&rom, staged.path())?);
+    let (stored, rom, _) = crate::workflows::online::load_rom(p, staged.path(), None, false)?;
+    s.warnings.extend(crate::cost::route::time_and_store(&stored, &rom, staged.path())?);
     Ok(s)
 }
 

@@ -65,7 +65,7 @@ struct PartBasis {
 
 fn read_part(path: &Path, limits: &Limits) -> Result<Part> {
     let bad = |field: &str, problem: String| Error::input(path, field, problem);
-    let f = hdf5::File::open(path).map_err(|e| bad("(file)", crate::io::h5::unreadable(&e)))?;
+    let f = crate::io::h5_open::open(path).map_err(|e| bad("(file)", crate::io::h5_open::unreadable(&e)))?;
     let g = f.group("shard").map_err(|_| {
         bad(
             "shard",
@@ -297,13 +297,10 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool, limits: &Limits) -> R
     }
     let gaps = sweep.scales.iter().filter(|x| matches!(x.outcome, Outcome::Pending)).count();
     // the basis file is where the parts say (checked against their hash above)
-    let sensitivity = match &first.basis {
-        Some(b) if stored.is_some() => {
-            let space = crate::io::parameter_space_file::read_parameter_space(&b.path)?.unwrap_or_default();
-            crate::rom::trust::LoadSensitivity::read(&b.path, &space)?
-        }
-        _ => None,
-    };
+    let sensitivity = stored.as_ref().and_then(|s| {
+        let t = &s.training;
+        t.sensitivity.as_ref().map(|x| crate::rom::trust::LoadSensitivity::of_stored(x, &t.space))
+    });
     let basis = stored.as_ref().zip(first.basis.as_ref()).map(|(stored, b)| SweepBasis {
         stored,
         path: Path::new(&b.attr),

@@ -24,7 +24,8 @@ pub fn pipeline_of_basis(path: &Path, limits: crate::limits::Limits) -> Result<P
     if !path.is_file() {
         return Err(Error::input(path, "(file)", "does not exist; run `flexrom train` first"));
     }
-    let file = hdf5::File::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5::unreadable(&e)))?;
+    let file =
+        crate::io::h5_open::open(path).map_err(|e| Error::input(path, "(file)", crate::io::h5_open::unreadable(&e)))?;
     let text = |name: &str| {
         read_attr_str(&file, name).map_err(|e| {
             Error::input(path, name, format!("cannot be read ({e}); is this a basis file of `flexrom train`?"))
@@ -81,8 +82,8 @@ pub fn load_rom(
     warnings.extend(more);
     // what training said beside meeting its tolerance, once per command (of the online
     // default's readings only where the runs read it)
-    for (name, note) in crate::io::estimator_file::read_training_notes(path)? {
-        if name != "estimate_note" || rom.method() == Some(EstimateMethod::Defects.name()) {
+    for (name, note) in &stored.training.notes {
+        if *name != "estimate_note" || rom.method() == Some(EstimateMethod::Defects.name()) {
             warnings.push(format!("{}: greedy training: {note}", path.display()));
         }
     }
