@@ -23,6 +23,7 @@ use crate::io::output::{check_output, check_report_dir, mark_new_report, swap_in
 use crate::limits::Limits;
 use crate::pipeline::config::{EstimateMethod, Pipeline};
 use crate::report::plot::{Figure, Panel, Series, Style};
+use crate::rom::quantities::Quantity;
 use crate::rom::Rom;
 use crate::simulate::SimulationResult;
 use crate::solver::parameters::Parameters;
@@ -941,31 +942,64 @@ fn motion_section(
             probes.join("; ")
         );
     }
-    if validations.iter().all(|v| v.probe_quantity_errors.is_empty()) {
+    let rows: Vec<(&str, Vec<QuantityRow>)> =
+        validations.iter().zip(labels).map(|(v, label)| (label.as_str(), quantity_rows(v))).collect();
+    if rows.iter().all(|(_, r)| r.is_empty()) {
         return;
     }
     let _ = writeln!(
         md,
-        "\nWhat engineers read at the probes — position, and strain and curvature where a probe records them (a bending moment is E I κ: its error is the curvature's) — each against the full run, relative to the full run's range over the run, beside its own estimate (docs/error-estimate.md).\n"
+        "\nWhat engineers read — at the probes position, and strain and curvature where a probe records them (a bending moment is E I κ: its error is the curvature's); at the joints each reaction force and moment that moves — each against the full run, relative to the full run's range over the run, beside its own estimate (docs/error-estimate.md).\n"
     );
-    let _ =
-        writeln!(md, "| {head} | probe | quantity | max error | range (full run) | error over the range | estimate |");
+    let _ = writeln!(
+        md,
+        "| {head} | probe or joint | quantity | max error | range (full run) | error over the range | estimate |"
+    );
     let _ = writeln!(md, "|---|---|---|---|---|---|---|");
-    for (v, label) in validations.iter().zip(labels) {
-        for q in &v.probe_quantity_errors {
+    for (label, rows) in &rows {
+        for q in rows {
             let unit = q.quantity.unit();
             let rel = q.relative.map_or("none".to_string(), |e| format!("{e:.2e}"));
             let est = q.estimate.map_or("—".to_string(), |e| format!("{e:.2e}"));
+            let (name, quantity, error, range) = (q.name, q.quantity.name(), q.max_error, q.range);
             let _ = writeln!(
                 md,
-                "| {label} | {} | {} | {:.2e}{unit} | {:.2e}{unit} | {rel} | {est} |",
-                q.probe,
-                q.quantity.name(),
-                q.max_error,
-                q.range
+                "| {label} | {name} | {quantity} | {error:.2e}{unit} | {range:.2e}{unit} | {rel} | {est} |"
             );
         }
     }
+}
+
+/// One row of the report's table of what engineers read.
+struct QuantityRow<'a> {
+    name: &'a str,
+    quantity: Quantity,
+    max_error: f64,
+    range: f64,
+    relative: Option<f64>,
+    estimate: Option<f64>,
+}
+
+/// Every probe quantity of a validation, then every joint reaction that moves beyond its
+/// resolution (a pin's moment is zero: no row).
+fn quantity_rows(v: &Validation) -> Vec<QuantityRow<'_>> {
+    let probes = v.probe_quantity_errors.iter().map(|q| QuantityRow {
+        name: &q.probe,
+        quantity: q.quantity,
+        max_error: q.max_error,
+        range: q.range,
+        relative: q.relative,
+        estimate: q.estimate,
+    });
+    let reactions = v.reaction_errors.iter().filter(|q| q.relative.is_some()).map(|q| QuantityRow {
+        name: &q.reaction,
+        quantity: q.quantity,
+        max_error: q.max_error,
+        range: q.range,
+        relative: q.relative,
+        estimate: q.estimate,
+    });
+    probes.chain(reactions).collect()
 }
 
 /// After `run`: the warnings of the report's basis and sweep (read back from its
