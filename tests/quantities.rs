@@ -16,7 +16,8 @@
 //!   (which keeps the clamp's multipliers), `reaction_errors` equal the errors recomputed
 //!   from the `/reactions` of `simulate`'s and `online`'s result files; `online`'s file
 //!   carries each reaction's estimate (`error_estimate` of `/reactions/force`, `/moment`),
-//!   `validate`'s value; every method's estimate covers each reaction's error within 3×.
+//!   `validate`'s value, as does a sweep file's `/reaction_error_estimate` (and after
+//!   `--resume`); every method's estimate covers each reaction's error within 3×.
 //! * `a_sweep_carries_strains_curvatures_and_their_estimates`: a validated sweep's
 //!   `/probe_curvature/root` row is the online run's series at that load, its
 //!   `/probe_error_estimate` and `/probe_error` columns are `validate`'s, and `--resume`
@@ -201,6 +202,19 @@ fn validate_measures_each_reaction_over_its_range() {
         let estimate = e["estimate"].as_f64().unwrap();
         assert!((attr[0] - estimate).abs() <= 1e-12 * estimate, "{dataset}: online {attr:?} vs validate {estimate}");
     }
+    // a sweep's file carries each reaction's estimate, validate's at the same load, and
+    // --resume reads them back and writes them again as they were
+    let sweep = ["sweep", "p.toml", "--load-scales", "0.8,1.3", "--estimate", "corrected", "-o", "s.h5"];
+    flexrom(&dir, &sweep);
+    let column = |q: &str| {
+        series(&dir.join("s.h5"), &format!("reaction_error_estimate/{q}/{}", errors[0]["reaction"].as_str().unwrap()))
+    };
+    let before = [column("force"), column("moment")];
+    for (e, stored) in errors.iter().zip(&before) {
+        assert_eq!(Some(stored[1]), e["estimate"].as_f64(), "{e}");
+    }
+    flexrom(&dir, &[&sweep[..], &["--resume"]].concat());
+    assert_eq!([column("force"), column("moment")], before);
     // every method's estimate covers each reaction's error at loads training did not see
     // (measured: effectivity 1.45–1.56 for all three; `defects` on the scale greedy training
     // calibrated per reaction)

@@ -20,6 +20,9 @@
 //!                                    run (crate::rom::quantities; 0 where the full model
 //!                                    answered); with --validate /probe_error/<quantity>/<name>
 //!                                    the error measured against the full run
+//! /reaction_error_estimate/<force|moment>/<point> (N)  the estimate of each joint reaction's
+//!                                    error over its range (crate::rom::reactions; a reduced
+//!                                    sweep of a model with joints)
 //! /reduced_q          (N, n_t, r)    reduced coordinates (time first; layout 1: (N, r, n_t));
 //!                                    not in a full sweep
 //! /rom_seconds        (N)            reduced time loop of each run (not in a full sweep; the
@@ -157,6 +160,31 @@ fn write_quantity_errors(f: &hdf5::File, s: &Sweep) -> hdf5::Result<()> {
             let col = Array1::from_iter(s.scales.iter().map(|x| x.point().map_or(f64::NAN, |p| value(p, q, name))));
             g.new_dataset_builder().with_data(&col).create(name)?;
         }
+    }
+    write_reaction_estimates(f, s)
+}
+
+/// `/reaction_error_estimate/<force|moment>/<point>` (load): each joint reaction's estimated
+/// error over its range (0 where the full model answered; NaN: no estimate, or a variant
+/// without physical multipliers); a reduced sweep of a model with joints.
+fn write_reaction_estimates(f: &hdf5::File, s: &Sweep) -> hdf5::Result<()> {
+    if s.full || s.reactions.is_empty() {
+        return Ok(());
+    }
+    let top = f.create_group("reaction_error_estimate")?;
+    for (name, q) in &s.reactions {
+        let estimate = |p: &SweepPoint| {
+            let e =
+                p.estimate.as_ref().and_then(|e| e.quantities.iter().find(|x| x.quantity == *q && x.probe == *name));
+            if p.fallback.is_some() {
+                0.0
+            } else {
+                e.map_or(f64::NAN, |e| e.estimate)
+            }
+        };
+        let g = if top.link_exists(q.name()) { top.group(q.name())? } else { top.create_group(q.name())? };
+        let col = Array1::from_iter(s.scales.iter().map(|x| x.point().map_or(f64::NAN, estimate)));
+        g.new_dataset_builder().with_data(&col).create(name.as_str())?;
     }
     Ok(())
 }
@@ -428,9 +456,13 @@ pub fn read_sweep(
     let file = Resumed { f, path, n, nt };
     let (probe_names, section_names) = (model.probe_names(), model.section_names());
     let keys = quantity_keys(&probe_names, &section_names);
-    let runs = file.runs(model, &keys, (layout, r), file_full, validate)?;
+    let reactions = crate::rom::reactions::ReactionReader::new(model).points();
+    let reaction_keys: Vec<(Quantity, &str)> = reactions.iter().map(|(n, q)| (*q, n.as_str())).collect();
+    let mut runs = file.runs(model, &keys, (layout, r), file_full, validate)?;
+    // files written before the reactions' estimates have none: their points read back without
+    runs.reaction_estimates = file.quantities("reaction_error_estimate", &reaction_keys)?;
     let columns = file.columns(file_full, validate, runs.full_probes.is_some(), runs.rom_seconds.len())?;
-    let read = ReadBack { model, stored, r, nt, keys: &keys, runs, columns, validate };
+    let read = ReadBack { model, stored, r, nt, keys: &keys, reaction_keys: &reaction_keys, runs, columns, validate };
     (0..n).map(|k| read.point(k)).collect()
 }
 
@@ -495,6 +527,8 @@ struct StoredRuns {
     sections: [Option<NamedRuns>; 2],
     quantity_estimates: Option<Vec<Array1<f64>>>,
     quantity_errors: Option<Vec<Array1<f64>>>,
+    /// the joint reactions' estimates, in the model's reaction order
+    reaction_estimates: Option<Vec<Array1<f64>>>,
     full_probes: Option<Vec<(String, Array3<f64>)>>,
     /// the time loops' seconds: the reduced runs', or a full sweep's full runs'
     rom_seconds: Array1<f64>,
@@ -658,6 +692,7 @@ impl Resumed<'_> {
             sections,
             quantity_estimates,
             quantity_errors,
+            reaction_estimates: None,
             full_probes,
             rom_seconds,
         })
@@ -767,6 +802,7 @@ struct ReadBack<'a> {
     r: usize,
     nt: usize,
     keys: &'a [(Quantity, &'a str)],
+    reaction_keys: &'a [(Quantity, &'a str)],
     runs: StoredRuns,
     columns: StoredColumns,
     validate: bool,
@@ -855,16 +891,20 @@ impl ReadBack<'_> {
             error_estimate_displacement: c.estimates_displacement.as_ref().map_or(f64::NAN, |a| a[k]),
             displacement_by_time: fifths(&c.displacement_by_time),
             failure: None,
-            quantities: self.runs.quantity_estimates.as_ref().map_or_else(Vec::new, |cols| {
-                let each = self.keys.iter().zip(cols);
-                each.map(|((q, name), c)| QuantityEstimate {
-                    probe: name.to_string(),
-                    quantity: *q,
-                    estimate: c[k],
-                    raw: f64::NAN,
-                })
-                .collect()
-            }),
+            quantities: [
+                (self.keys, &self.runs.quantity_estimates),
+                (self.reaction_keys, &self.runs.reaction_estimates),
+            ]
+            .into_iter()
+            .filter_map(|(keys, cols)| Some(keys.iter().zip(cols.as_ref()?)))
+            .flatten()
+            .map(|((q, name), c)| QuantityEstimate {
+                probe: name.to_string(),
+                quantity: *q,
+                estimate: c[k],
+                raw: f64::NAN,
+            })
+            .collect(),
         })
     }
 

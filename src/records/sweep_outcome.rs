@@ -94,6 +94,8 @@ pub struct Sweep {
     pub probe_names: Vec<String>,
     /// the probes that record strain, and those that record curvature (from the model)
     pub section_names: [Vec<String>; 2],
+    /// the joints' reaction points, each one's force then each one's moment (from the model)
+    pub reactions: Vec<(String, crate::rom::quantities::Quantity)>,
     /// reduced coordinates r (0 in a full sweep)
     pub n_reduced: usize,
     /// the full model at every load (`sweep --full`): exact, no estimate, no validation

@@ -274,6 +274,7 @@ pub fn merge(parts: &[PathBuf], out: &Path, partial: bool, limits: &Limits) -> R
         t: Array1::from_iter((0..=s.n_steps).map(|k| k as f64 * s.dt)),
         probe_names: model.probe_names(),
         section_names: model.section_names(),
+        reactions: crate::rom::reactions::ReactionReader::new(model).points(),
         n_reduced: stored.as_ref().map_or(0, |b| b.basis.n_reduced()),
         full: first.full,
         model_fingerprint: model.fingerprint(),

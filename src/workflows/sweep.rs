@@ -295,6 +295,7 @@ fn pending(model: &Model, n_reduced: usize, full: bool, points: &[Parameters], o
         t,
         probe_names: model.probe_names(),
         section_names: model.section_names(),
+        reactions: crate::rom::reactions::ReactionReader::new(model).points(),
         n_reduced,
         full,
         model_fingerprint: model.fingerprint(),
