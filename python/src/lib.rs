@@ -1273,9 +1273,9 @@ impl PyBasis {
             None => pipeline_of_basis(path, flexrom::limits::Limits::from_env_or_defaults())?,
         };
         let (stored, rom, warnings) = load_rom(&p, path, method, no_estimate)?;
-        let training_loads = flexrom::io::estimator_file::read_training_loads(path)?;
-        let training_notes =
-            flexrom::io::estimator_file::read_training_notes(path)?.into_iter().map(|(_, note)| note).collect();
+        // what the one read of the file found of its training
+        let training_loads = stored.training.loads.clone();
+        let training_notes = stored.training.notes.iter().map(|(_, note)| note.clone()).collect();
         let rom = Arc::new(rom);
         let b = PyBasis {
             pipeline: p,

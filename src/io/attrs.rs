@@ -180,7 +180,7 @@ const BASIS: [Entry; 56] = [
     ("timing/estimate_seconds", "s", ""),
 ];
 
-const SWEEP: [Entry; 38] = [
+const SWEEP: [Entry; 40] = [
     ("load_scales", "1", "load"),
     ("points", "1", "load, parameter"),
     ("status", "1", "load"),
@@ -194,6 +194,8 @@ const SWEEP: [Entry; 38] = [
     ("probe_error_estimate/position/*", "1", "load"),
     ("probe_error_estimate/strain/*", "1", "load"),
     ("probe_error_estimate/curvature/*", "1", "load"),
+    ("reaction_error_estimate/force/*", "1", "load"),
+    ("reaction_error_estimate/moment/*", "1", "load"),
     ("probe_error/position/*", "1", "load"),
     ("probe_error/strain/*", "1", "load"),
     ("probe_error/curvature/*", "1", "load"),
