@@ -316,6 +316,12 @@ impl Model {
         )
     }
 
+    /// Whether runs start from the static equilibrium of their loads at t = 0 (`[initial]
+    /// static = true`) rather than from the undeformed state.
+    pub fn starts_static(&self) -> bool {
+        self.file.initial.as_ref().is_some_and(|i| i.r#static)
+    }
+
     /// The sizes of the system this model builds, from the file alone (nothing is
     /// assembled), as floats so that estimates from them cannot overflow.
     pub fn sizes(&self) -> Sizes {

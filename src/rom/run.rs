@@ -130,17 +130,23 @@ pub fn check_reduced_memory(model: &Model, r: usize, n_steps: usize, output: Out
 
 /// The reduced model's own static equilibrium under the run's loads at t = 0 (`[initial]
 /// static = true`, as full runs start from the full model's): Newton on the reduced KKT
-/// system from the undeformed state's reduced coordinates `z0`, the whole load at once
+/// system from the reduced coordinates `z0` (the undeformed state's), the whole load at once
 /// (the reduced model has no load ramp of its own; a load the full model needed steps for
 /// is refused with the reason). Starting at the reduced model's equilibrium, the run starts
-/// at rest without the jolt of the projected full equilibrium's residual.
-fn static_start<R: Reduced<FlexibleSystem>>(rom: &mut R, s: &Settings, z0: Vec<f64>) -> Result<Vec<f64>> {
+/// at rest without the jolt of the projected full equilibrium's residual. `whose` names the
+/// model in the message (the reduced model's, the error estimator's enriched model's).
+pub(crate) fn static_start<R: Reduced<FlexibleSystem>>(
+    rom: &mut R,
+    s: &Settings,
+    z0: Vec<f64>,
+    whose: &str,
+) -> Result<Vec<f64>> {
     use crate::analysis::statics::{MAX_ITERATIONS, TOLERANCE};
     let mut z = z0;
     let mut bound = crate::solver::model::Bound::new(rom, &s.mu);
     crate::solver::statics::solve_static(&mut bound, &mut z, 0.0, TOLERANCE, MAX_ITERATIONS).map_err(|e| {
         if e.is_numerical() {
-            Error::Usage(format!("[initial] static: the reduced model's static equilibrium under the run's loads: {e}"))
+            Error::Usage(format!("[initial] static: {whose} static equilibrium under the run's loads: {e}"))
         } else {
             e
         }
@@ -159,11 +165,8 @@ fn run<R: Reduced<FlexibleSystem>>(
 ) -> Result<ReducedRun> {
     let (r, nt) = (rom.n_dof(), s.n_steps + 1);
     check_reduced_memory(model, r, s.n_steps, output, 1.0)?;
-    let q0 = if model.file.initial.as_ref().is_some_and(|i| i.r#static) {
-        static_start(rom, &s, q0.to_vec())?
-    } else {
-        q0.to_vec()
-    };
+    let q0 =
+        if model.starts_static() { static_start(rom, &s, q0.to_vec(), "the reduced model's")? } else { q0.to_vec() };
     let v0 = v0.to_vec();
     let mut zq = Array2::zeros((r, nt));
     let mut zv = Array2::zeros((r, nt));

@@ -213,10 +213,10 @@ pub fn describe(e: &Estimate, method: &str, rom_seconds: f64) -> String {
         d => format!("{d:.3e}"),
     };
     format!(
-        "error_estimate {:.3e}, displacement {displacement} ({method} method, {}, factor {:.3}), estimator {:.4} s ({:.0} % of the reduced run)",
+        "error_estimate {:.3e}, displacement {displacement} ({method} method, {}, factor {}), estimator {:.4} s ({:.0} % of the reduced run)",
         e.error_estimate,
         if e.calibrated { "calibrated" } else { "uncalibrated" },
-        e.factor,
+        crate::error::show_rounded(e.factor),
         e.seconds,
         100.0 * e.seconds / rom_seconds
     )

@@ -63,7 +63,7 @@ pub fn build_basis(
     // every run starts from the same consistent, undeformed state; with `[initial] static`
     // from the equilibrium of its own loads, and the basis is centred on the undeformed
     // state all the same (what reduced runs and the basis checks take as x₀)
-    let starts_static = p.model.file.initial.as_ref().is_some_and(|i| i.r#static);
+    let starts_static = p.model.starts_static();
     let x_ref = if starts_static { Array1::from(physics.x0.to_vec()) } else { data.x.column(0).to_owned() };
     // whole-system: scale the multipliers so both blocks weigh alike in the POD
     let dx = (&data.x - &x_ref.view().insert_axis(Axis(1))).mapv(|v| v * v).sum().sqrt();

@@ -213,7 +213,6 @@ impl<'a> Greedy<'a> {
         let mut it = self.iteration_of(p, &level, (wi, worst));
         let shape = shape_text(&level, &it);
         let n = self.iterations.len() + 1;
-        let cmp = if worst <= g.tolerance { "≤" } else { ">" };
         let Some((ni, next_estimate)) = next.filter(|_| self.full_runs < g.max_runs) else {
             let converged = self.out_of_runs(g, candidates, &it, (wi, worst), &shape);
             self.iterations.push(it);
@@ -226,6 +225,9 @@ impl<'a> Greedy<'a> {
         let truth =
             self.full_model.simulate(&Overrides::at(&mu)).map_err(|e| e.at_stage("train (greedy full run)", &mu))?;
         let (e_measured, e_score, sens) = self.held_out(p, g, candidates, (&mut level, &mut it), (ni, &at), &truth);
+        // the held-out check may have re-read the candidates with another estimate
+        let worst = it.worst_estimate;
+        let cmp = if worst <= g.tolerance { "≤" } else { ">" };
         // the held-out pair may have raised the calibration factor: the estimates this
         // basis will report are the candidates' scaled by it (the estimate is linear in c)
         let rescale = calibrate(self.points.clone()).factor / level.estimator.calibration.factor;
@@ -379,6 +381,7 @@ impl<'a> Greedy<'a> {
                 );
                 it.estimates = level.estimates.clone();
                 it.whole_run_estimates = level.whole.clone();
+                it.worst_estimate = level.worst().1;
                 it.method = self.method;
                 (it.bound, it.between_points) = (level.between_candidates(), level.between_points);
             }
@@ -490,7 +493,7 @@ fn defects_line(estimator: &crate::rom::estimator::training::Estimator, method: 
             "error estimate: the cheap `defects` method calibrated at the {} candidates against the `{}` estimate (factors {}), the online default",
             d.ratios.len(),
             method.name(),
-            d.factors.iter().map(|f| format!("{f:.3}")).collect::<Vec<_>>().join(", ")
+            d.factors.iter().map(|&f| crate::error::show_rounded(f)).collect::<Vec<_>>().join(", ")
         ),
         Some(_) => format!("error estimate: the `defects` method's ratio to the {} estimate jumps between candidates (its leave-one-out check failed): the online default stays `{}`", method.name(), estimator.default_method().name()),
         None => format!("error estimate: the `defects` method could not be calibrated: the online default stays `{}`", estimator.default_method().name()),

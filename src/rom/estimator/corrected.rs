@@ -77,7 +77,7 @@ use crate::rom::run::ReducedRun;
 use crate::simulate::{Overrides, Settings};
 use crate::solver::generalized_alpha::{GeneralizedAlpha, State, StepConstants};
 use crate::solver::model::{Bound, DynamicModel, ParametricModel};
-use ndarray::{Array2, ArrayView1};
+use ndarray::{Array1, Array2, ArrayView1};
 use std::sync::Arc;
 
 /// What a step's correction may leave uncorrected, relative to the correction itself
@@ -125,6 +125,9 @@ pub struct CorrectedRunner {
     q0: Vec<f64>,
     /// the initial velocities in the enriched coordinates
     v0: Vec<f64>,
+    /// the initial configuration in the basis's coordinates, `Vᵀ(x₀ − x_ref)`: where a
+    /// reduced run starts unless it starts from its own static equilibrium
+    z0: Vec<f64>,
     /// [`ACCEPT`]; ∞ keeps one iteration per step whatever it leaves (experiments)
     accept: f64,
 }
@@ -159,7 +162,8 @@ impl CorrectedRunner {
         let lift = enriched.modes.t().dot(&basis.modes);
         let q0 = enriched.reduce(ArrayView1::from(&physics.x0[..])).to_vec();
         let v0 = enriched.reduce_increment(ArrayView1::from(&physics.v0[..])).to_vec();
-        Ok(CorrectedRunner { model: Arc::clone(model), rom: Box::new(rom), lift, q0, v0, accept: ACCEPT })
+        let z0 = basis.reduce(ArrayView1::from(&physics.x0[..])).to_vec();
+        Ok(CorrectedRunner { model: Arc::clone(model), rom: Box::new(rom), lift, q0, v0, z0, accept: ACCEPT })
     }
 
     /// Another acceptance ratio ([`ACCEPT`]; ∞: one iteration per step, unchecked).
@@ -204,10 +208,30 @@ impl CorrectedRunner {
         Ok(f)
     }
 
+    /// Where the enriched model starts along `run`: the projected initial configuration, or,
+    /// where runs start from the static equilibrium of their loads (`[initial] static`),
+    /// that projection moved by the lifted change the reduced run made to reach its own,
+    /// `q₀⁺ + M (z₀ − Vᵀ(x₀ − x_ref))`, and, when `equilibrium` (the corrected trajectory),
+    /// the enriched model's own static equilibrium from there — as full and reduced runs
+    /// start from theirs, so that the start's difference is the reduced model's static
+    /// error and not the whole static deflection. The defects read the lifted reduced state.
+    fn start(&mut self, run: &ReducedRun, s: &Settings, equilibrium: bool) -> Result<Vec<f64>> {
+        if !self.model.starts_static() {
+            return Ok(self.q0.clone());
+        }
+        let dz: Array1<f64> = run.reduced_q.column(0).iter().zip(&self.z0).map(|(a, b)| a - b).collect();
+        let q: Vec<f64> = self.lift.dot(&dz).iter().zip(&self.q0).map(|(d, q)| q + d).collect();
+        if !equilibrium {
+            return Ok(q);
+        }
+        crate::rom::run::static_start(self.rom.as_mut(), s, q, "the error estimator's enriched model's")
+    }
+
     /// The loop of both: `sample` 0 corrects the trajectory, `s > 0` records the defects at
     /// every s-th step from the lifted reduced state.
     fn follow(&mut self, run: &ReducedRun, sample: usize) -> Result<Followed> {
         let s = Settings::resolve(&self.model, &Overrides::at(run.result.settings.parameters()))?;
+        let q0 = self.start(run, &s, sample == 0)?;
         let mut bound = Bound::new(self.rom.as_mut(), s.parameters());
         let rom = &mut bound;
         let z = &run.reduced_q;
@@ -221,20 +245,19 @@ impl CorrectedRunner {
         let k = integ.step_constants(h);
 
         // consistent start: [M, Bᵀ; B, 0][q̈; λ] = [−g; c]
-        let mut st: State = integ.initialize(rom, self.q0.clone(), self.v0.clone(), 0.0)?;
+        let mut st: State = integ.initialize(rom, q0, self.v0.clone(), 0.0)?;
         let mut rhs = vec![0.0; n + nc];
         let mut work = vec![0.0; n];
 
         let mut out = Array2::zeros((n, nt));
         out.column_mut(0).assign(&ArrayView1::from(&st.q));
-        let mut lambda = Array2::from_elem((rom.model.full().n_constraints(), nt), f64::NAN);
-        let keep = |lambda: &mut Array2<f64>, col: usize, rom: &Bound<HyperReducedModel<_>>, q: &[f64], l: &[f64]| {
-            if let Some(l) = Reduced::multipliers(&*rom.model, q, l) {
-                lambda.column_mut(col).assign(&l);
-            }
-        };
+        let nc_full = rom.model.full().n_constraints();
+        let mut lambda = Array2::from_elem((nc_full, nt), f64::NAN);
+        // following: the model's own multipliers at each step, turned into physical ones
+        // after the loop, so that the loop allocates nothing for them
+        let mut own = Array2::zeros((if sample == 0 { nc } else { 0 }, nt));
         if sample == 0 {
-            keep(&mut lambda, 0, rom, &st.q, &st.lambda);
+            own.column_mut(0).assign(&ArrayView1::from(&st.lambda));
         }
         let mut dz = vec![0.0; z.nrows()];
         let mut d = vec![0.0; n];
@@ -268,8 +291,12 @@ impl CorrectedRunner {
                         return Err(fail(t, "the defect is not finite".into()));
                     }
                     out.column_mut(step).assign(&ArrayView1::from(&rhs[..n]));
-                    let l: Vec<f64> = rhs[n..].iter().map(|m| k.beta_p * sc * m).collect();
-                    keep(&mut lambda, step, rom, &st.q, &l);
+                    // the lifted state's step multipliers λ⁺ = β' s Δμ from zero (at sampled
+                    // steps only, each of which factors a matrix anyway)
+                    rhs[n..].iter_mut().for_each(|m| *m *= k.beta_p * sc);
+                    if let Some(l) = Reduced::multipliers(&*rom.model, &st.q, &rhs[n..]) {
+                        lambda.column_mut(step).assign(&l);
+                    }
                 } else if !inc.is_finite() {
                     return Err(fail(t, "the corrected trajectory is no longer finite".into()));
                 } else if self.accept.is_finite() {
@@ -277,6 +304,9 @@ impl CorrectedRunner {
                     check_step(rom, &mut st, &c, sc, inc, (&mut rhs, &mut work), &mut stats).map_err(|p| fail(t, p))?;
                     if !stats.followed() {
                         // what follows this step is no reading of the reduced run's error
+                        if sample == 0 {
+                            physical_multipliers(&*rom.model, (&out, &own), step, &mut lambda);
+                        }
                         return Ok(Followed { q: out, lambda, stats });
                     }
                 }
@@ -284,10 +314,29 @@ impl CorrectedRunner {
             integ.finish_step(&mut st, &k);
             if sample == 0 {
                 out.column_mut(step).assign(&ArrayView1::from(&st.q));
-                keep(&mut lambda, step, rom, &st.q, &st.lambda);
+                own.column_mut(step).assign(&ArrayView1::from(&st.lambda));
             }
         }
+        if sample == 0 {
+            physical_multipliers(&*rom.model, (&out, &own), nt, &mut lambda);
+        }
         Ok(Followed { q: out, lambda, stats })
+    }
+}
+
+/// Fills the first `taken` columns of `lambda` (n_c × n_t) with the physical multipliers of
+/// the model's own multipliers `own` at the coordinates `q` (r⁺ × n_t), column by column
+/// (none where the variant has none).
+fn physical_multipliers<F, M: Reduced<F>>(
+    model: &M,
+    (q, own): (&Array2<f64>, &Array2<f64>),
+    taken: usize,
+    lambda: &mut Array2<f64>,
+) {
+    for (col, (qc, lc)) in q.columns().into_iter().zip(own.columns()).take(taken).enumerate() {
+        if let Some(l) = model.multipliers(&qc.to_vec(), &lc.to_vec()) {
+            lambda.column_mut(col).assign(&l);
+        }
     }
 }
 
