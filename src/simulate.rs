@@ -1,7 +1,7 @@
 //! Full-order simulation of a model file: the first stage of the flow
 //! model file → full simulation → snapshots → POD basis → reduced runs → validation.
 
-use crate::analysis::energy::{energies, Energies};
+use crate::analysis::energy::{energies, Energies, States};
 use crate::analysis::statics::{StaticOptions, StaticSolution};
 use crate::error::{Error, Result};
 use crate::linalg::kkt::LinearSolverKind;
@@ -378,7 +378,7 @@ fn warn_on_drive_jumps(model: &Model, sys: &FlexibleSystem, s: &Settings, q0: &[
 
 fn run_full(model: &Model, sys: &mut FlexibleSystem, q0: Vec<f64>, s: Settings) -> Result<SimulationResult> {
     model.check_full_run_memory(s.n_steps, s.solver == LinearSolverKind::Dense)?;
-    let q0 = if model.file.initial.as_ref().is_some_and(|i| i.r#static) { static_start(sys, q0, &s)? } else { q0 };
+    let q0 = if model.starts_static() { static_start(sys, q0, &s)? } else { q0 };
     let (n, nc, nt) = (ParametricModel::n_dof(sys), ParametricModel::n_constraints(sys), s.n_steps + 1);
     // column-major: each instant's column is contiguous, so recording a step is one copy
     // and the result file's time-first rows are the memory as it is (no transposition)
@@ -438,9 +438,11 @@ fn run_full(model: &Model, sys: &mut FlexibleSystem, q0: Vec<f64>, s: Settings) 
 /// result files and tables of `simulate` show.
 pub fn with_energies(model: &Model, mut r: SimulationResult) -> Result<SimulationResult> {
     let mut sys = model.system(LinearSolverKind::Banded);
-    let (q, qd) = (&r.q, &r.qd);
+    let (q, v, lambda) = (&r.q, &r.qd, &r.multipliers);
     let t = r.t.to_vec();
-    r.energy = Some(energies(&mut sys, &r.settings.mu, &t, |k| q.column(k).to_vec(), |k| qd.column(k).to_vec()));
+    let states =
+        States { q: |k| q.column(k).to_vec(), v: |k| v.column(k).to_vec(), lambda: |k| lambda.column(k).to_vec() };
+    r.energy = Some(energies(&mut sys, &r.settings.mu, &t, states));
     Ok(r)
 }
 
@@ -453,17 +455,12 @@ pub fn with_reduced_energies(
     hyper: Option<&crate::reduction::Hyper>,
 ) -> Result<SimulationResult> {
     let mut sys = model.system(LinearSolverKind::Banded);
-    let (q, qd) = (&r.q, &r.qd);
+    let (q, v, lambda) = (&r.q, &r.qd, &r.multipliers);
     let t = r.t.to_vec();
     let weights = hyper.map(|h| (&h.elements[..], &h.weights[..]));
-    r.energy = Some(crate::analysis::energy::energies_over(
-        &mut sys,
-        &r.settings.mu,
-        &t,
-        |k| q.column(k).to_vec(),
-        |k| qd.column(k).to_vec(),
-        weights,
-    ));
+    let states =
+        States { q: |k| q.column(k).to_vec(), v: |k| v.column(k).to_vec(), lambda: |k| lambda.column(k).to_vec() };
+    r.energy = Some(crate::analysis::energy::energies_over(&mut sys, &r.settings.mu, &t, states, weights));
     Ok(r)
 }
 
@@ -524,7 +521,9 @@ pub fn statics(model: &Model, o: &StaticOptions) -> Result<(SimulationResult, St
     let (strains, curvatures) =
         probe_sections(&probe_defs, |p| rows.iter().map(|r| sys.probe_section(p, &r.q)).collect());
     // a static state's energies: no motion, no work along a path of equilibria counted
-    let energy = energies(&mut sys, &o.mu, t.as_slice().expect("contiguous"), |k| rows[k].q.clone(), |_| vec![0.0; n]);
+    let states =
+        States { q: |k: usize| rows[k].q.clone(), v: |_| vec![0.0; n], lambda: |k: usize| rows[k].lambda.clone() };
+    let energy = energies(&mut sys, &o.mu, t.as_slice().expect("contiguous"), states);
     let stats = Stats {
         steps: nt,
         newton_iterations: solution.newton_iterations,

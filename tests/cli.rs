@@ -32,7 +32,7 @@ fn simulate_writes_the_documented_layout() {
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let csv = String::from_utf8(o.stdout).unwrap();
-    assert_eq!(csv.lines().next(), Some("t,tip_x,tip_y,energy_kinetic,energy_strain,energy_strain_axial,energy_strain_bending,energy_gravity,energy_springs,energy_external_work,joint 0 (ground_pin beam node 0) on beam node 0: Fx,joint 0 (ground_pin beam node 0) on beam node 0: Fy,joint 0 (ground_pin beam node 0) on beam node 0: M"));
+    assert_eq!(csv.lines().next(), Some("t,tip_x,tip_y,energy_kinetic,energy_strain,energy_strain_axial,energy_strain_bending,energy_gravity,energy_springs,energy_external_work,energy_drive_work,joint 0 (ground_pin beam node 0) on beam node 0: Fx,joint 0 (ground_pin beam node 0) on beam node 0: Fy,joint 0 (ground_pin beam node 0) on beam node 0: M"));
     assert_eq!(csv.lines().count(), 1 + 11, "header + t = 0 and 10 steps");
     let f = flexrom::io::h5_open::open(&out).unwrap();
     let t = f.dataset("t").unwrap().read_1d::<f64>().unwrap();
@@ -85,7 +85,7 @@ fn probes_record_strain_and_curvature_when_asked() {
     let o = flexrom().args(args).args(["-o", out.to_str().unwrap(), "--csv"]).output().unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let csv = String::from_utf8(o.stdout).unwrap();
-    assert_eq!(csv.lines().next(), Some("t,tip_x,tip_y,mid_x,mid_y,mid_strain,mid_curvature,energy_kinetic,energy_strain,energy_strain_axial,energy_strain_bending,energy_gravity,energy_springs,energy_external_work,joint 0 (ground_pin beam node 0) on beam node 0: Fx,joint 0 (ground_pin beam node 0) on beam node 0: Fy,joint 0 (ground_pin beam node 0) on beam node 0: M"));
+    assert_eq!(csv.lines().next(), Some("t,tip_x,tip_y,mid_x,mid_y,mid_strain,mid_curvature,energy_kinetic,energy_strain,energy_strain_axial,energy_strain_bending,energy_gravity,energy_springs,energy_external_work,energy_drive_work,joint 0 (ground_pin beam node 0) on beam node 0: Fx,joint 0 (ground_pin beam node 0) on beam node 0: Fy,joint 0 (ground_pin beam node 0) on beam node 0: M"));
     let f = flexrom::io::h5_open::open(&out).unwrap();
     let m = flexrom::model::Model::from_text(&text, "m.toml").unwrap();
     let sys = m.system(Default::default());

@@ -76,7 +76,8 @@ fn every_result_prints_as_csv_and_json() {
     let out = dir.join("sim/deep/p.h5");
     let o = ok(&["simulate", s(&model), "-o", s(&out), "--t-end", "0.02", "--csv"]);
     let (head, rows) = csv_rows(&o);
-    let energy = ["kinetic", "strain", "strain_axial", "strain_bending", "gravity", "springs", "external_work"];
+    let energy =
+        ["kinetic", "strain", "strain_axial", "strain_bending", "gravity", "springs", "external_work", "drive_work"];
     let expected: Vec<String> = ["t", "tip_x", "tip_y"]
         .iter()
         .map(|s| s.to_string())

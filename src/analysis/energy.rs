@@ -7,14 +7,19 @@
 //! springs          V_s = Σ ½ k (L − L₀)² + Σ ½ k φ²   (translational, torsional)
 //! external work    W(t) = ∫₀ᵗ (Q_ext − Q_s)ᵀ q̇ dt     (forces, moments and the springs'
 //!                                                       dampers, not gravity)
+//! drive work       W_d(t) = −∫₀ᵗ λᵀ (ḃ − Ḃ q) dt      (prescribed motions)
 //! ```
+//!
+//! A prescribed motion's rows `B(t) q = b(t)` hold the system with the force `−Bᵀλ`, whose
+//! power `−λᵀ B q̇ = −λᵀ (ḃ − Ḃ q)` is not zero where the rows move: the work a motor does
+//! to keep the hub on its prescribed angle. Constant joints do no work (`ḃ − Ḃ q = 0`).
 //!
 //! with `Q_s` the springs' elastic forces (`−Q_sᵀ q̇ = V̇_s`): the spring-dampers' dampers
 //! enter `W` as the negative work `−∫ c L̇² dt` (`−∫ c φ̇² dt`) they dissipate, so that
-//! `T + U + V + V_s − W` stays constant with them too. `W` is integrated by the trapezoidal
-//! rule over the recorded instants (second order, as the integrator at `ρ∞ = 1`). Without
-//! Rayleigh damping `T + U + V + V_s − W` stays constant to the integrator's order;
-//! Rayleigh damping makes it decrease (the dissipated energy).
+//! `T + U + V + V_s − W − W_d` stays constant with them too. `W` and `W_d` are integrated by
+//! the trapezoidal rule over the recorded instants (second order, as the integrator at
+//! `ρ∞ = 1`). Without Rayleigh damping `T + U + V + V_s − W − W_d` stays constant to the
+//! integrator's order; Rayleigh damping makes it decrease (the dissipated energy).
 
 use crate::physics::element::Vec8;
 use crate::physics::system::FlexibleSystem;
@@ -31,12 +36,13 @@ pub struct Energies {
     pub gravity: Array1<f64>,
     pub springs: Array1<f64>,
     pub external_work: Array1<f64>,
+    pub drive_work: Array1<f64>,
 }
 
 impl Energies {
     /// The series by name, as the result file's `/energy/<name>` and the CSV columns
     /// `energy_<name>`.
-    pub fn named(&self) -> [(&'static str, &Array1<f64>); 7] {
+    pub fn named(&self) -> [(&'static str, &Array1<f64>); 8] {
         [
             ("kinetic", &self.kinetic),
             ("strain", &self.strain),
@@ -45,12 +51,13 @@ impl Energies {
             ("gravity", &self.gravity),
             ("springs", &self.springs),
             ("external_work", &self.external_work),
+            ("drive_work", &self.drive_work),
         ]
     }
 
-    /// `T + U + V + springs − W` at each instant: constant without damping.
+    /// `T + U + V + springs − W − W_d` at each instant: constant without damping.
     pub fn total(&self) -> Array1<f64> {
-        &self.kinetic + &self.strain + &self.gravity + &self.springs - &self.external_work
+        &self.kinetic + &self.strain + &self.gravity + &self.springs - &self.external_work - &self.drive_work
     }
 }
 
@@ -112,29 +119,47 @@ fn load_power(sys: &FlexibleSystem, mu: &Parameters, (q, v): (&[f64], &[f64]), t
     }
 }
 
-/// The energies of the states `(t_k, q_k, q̇_k)` of a run at `μ` (`q` and `v` give the
-/// state at instant `k`).
-pub fn energies(
-    sys: &mut FlexibleSystem,
-    mu: &Parameters,
-    t: &[f64],
-    q: impl Fn(usize) -> Vec<f64>,
-    v: impl Fn(usize) -> Vec<f64>,
-) -> Energies {
-    energies_over(sys, mu, t, q, v, None)
+/// The power of the prescribed motions at `(q, t)` with the multipliers `lambda`,
+/// `−λᵀ (ḃ − Ḃ q)` over the rows that move (`work`: n_c scratch): exactly 0 without any,
+/// whatever `lambda` holds (a reduced run without physical multipliers keeps NaN).
+fn drive_power(sys: &FlexibleSystem, mu: &Parameters, (q, lambda): (&[f64], &[f64]), t: f64, work: &mut [f64]) -> f64 {
+    ParametricModel::constraint_velocity_rhs(sys, mu, q, t, work);
+    -lambda.iter().zip(work.iter()).filter(|(_, &w)| w != 0.0).map(|(l, w)| l * w).sum::<f64>()
+}
+
+/// A run's states: `(q_k, q̇_k, λ_k)` at instant `k` (λ: the physical multipliers, NaN
+/// where a run kept none).
+pub struct States<Q, V, L> {
+    pub q: Q,
+    pub v: V,
+    pub lambda: L,
+}
+
+/// The energies of the states `(t_k, q_k, q̇_k, λ_k)` of a run at `μ`.
+pub fn energies<Q, V, L>(sys: &mut FlexibleSystem, mu: &Parameters, t: &[f64], states: States<Q, V, L>) -> Energies
+where
+    Q: Fn(usize) -> Vec<f64>,
+    V: Fn(usize) -> Vec<f64>,
+    L: Fn(usize) -> Vec<f64>,
+{
+    energies_over(sys, mu, t, states, None)
 }
 
 /// [`energies`] with the strain summed over the elements `weights` names: a reduced run's
 /// energies from its reconstructed states `x_ref + V z`, `V ż` (the kinetic energy
 /// `½ żᵀ VᵀMV ż`, the gravity's `−g₀ᵀ(x_ref + V z)`, the strain of its own sampled elements).
-pub fn energies_over(
+pub fn energies_over<Q, V, L>(
     sys: &mut FlexibleSystem,
     mu: &Parameters,
     t: &[f64],
-    q: impl Fn(usize) -> Vec<f64>,
-    v: impl Fn(usize) -> Vec<f64>,
+    States { q, v, lambda }: States<Q, V, L>,
     weights: ElementWeights,
-) -> Energies {
+) -> Energies
+where
+    Q: Fn(usize) -> Vec<f64>,
+    V: Fn(usize) -> Vec<f64>,
+    L: Fn(usize) -> Vec<f64>,
+{
     let nt = t.len();
     sys.bind(mu);
     let mut out = Energies {
@@ -145,8 +170,10 @@ pub fn energies_over(
         gravity: Array1::zeros(nt),
         springs: Array1::zeros(nt),
         external_work: Array1::zeros(nt),
+        drive_work: Array1::zeros(nt),
     };
-    let mut last_power = 0.0;
+    let (mut last_power, mut last_drive) = (0.0, 0.0);
+    let mut rows = vec![0.0; ParametricModel::n_constraints(sys)];
     // gravity's potential −g₀(μ)ᵀ q: its gradient is constant, taken once
     let weight = sys.gravity_potential_gradient(mu);
     let mut mv = vec![0.0; weight.len()];
@@ -162,10 +189,13 @@ pub fn energies_over(
         let (stored, rate) = sys.spring_energy(mu, &qk, &vk);
         out.springs[k] = stored;
         let power = load_power(sys, mu, (&qk, &vk), t[k], rate);
+        let drive = drive_power(sys, mu, (&qk, &lambda(k)), t[k], &mut rows);
         if k > 0 {
-            out.external_work[k] = out.external_work[k - 1] + 0.5 * (t[k] - t[k - 1]) * (power + last_power);
+            let h = 0.5 * (t[k] - t[k - 1]);
+            out.external_work[k] = out.external_work[k - 1] + h * (power + last_power);
+            out.drive_work[k] = out.drive_work[k - 1] + h * (drive + last_drive);
         }
-        last_power = power;
+        (last_power, last_drive) = (power, drive);
     }
     out
 }

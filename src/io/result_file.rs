@@ -13,7 +13,8 @@
 //!                                        attribute error_estimate, the estimate of its error
 //!                                        over its range over the run, crate::rom::quantities)
 //! /energy/<name>          (n_t)          energies, J: kinetic, strain, strain_axial,
-//!                                        strain_bending, gravity, springs, external_work
+//!                                        strain_bending, gravity, springs, external_work,
+//!                                        drive_work
 //!                                        (simulate, statics, online)
 //! /reactions/force        (n_t, n_r, 2)  force each joint applies on the body at each of
 //!                                        its nodes, x and y, N (models with joints)

@@ -863,7 +863,7 @@ impl Training {
 /// under the column `head`).
 /// The energies of a validated load, full (lines) and reduced (dashed, from its own reduced
 /// quantities: [`crate::simulate::with_reduced_energies`]): kinetic, strain, gravity and
-/// springs, and the balance `T + U + V + V_s − W` (constant without damping at ρ∞ = 1, else
+/// springs, and the balance `T + U + V + V_s − W − W_d` (constant without damping at ρ∞ = 1, else
 /// falling by what the damping and the numerical damping take).
 fn energy_figure(rom: &Rom, (full, reduced): (&SimulationResult, &SimulationResult), title: &str) -> Result<Figure> {
     let full = crate::simulate::with_energies(rom.model(), full.clone())?;
@@ -895,7 +895,7 @@ fn energy_figure(rom: &Rom, (full, reduced): (&SimulationResult, &SimulationResu
         x_label: "t (s)".into(),
         panels: vec![
             Panel { y_label: "energy (J)".into(), log_y: false, series },
-            Panel { y_label: "T + U + V − W (J)".into(), log_y: false, series: balance },
+            Panel { y_label: "T + U + V − W − W_d (J)".into(), log_y: false, series: balance },
         ],
         markers: vec![],
         marker_label: String::new(),

@@ -113,7 +113,7 @@ fn full_sweep_table(s: &Sweep) -> Table {
 /// `NAME_y` (m), then `NAME_strain` (1) and `NAME_curvature` (1/m) of the probes that
 /// record them, then a full run's energies `energy_kinetic`, `energy_strain`,
 /// `energy_strain_axial`, `energy_strain_bending`, `energy_gravity`, `energy_springs`,
-/// `energy_external_work` (J).
+/// `energy_external_work`, `energy_drive_work` (J).
 pub fn probe_table(r: &SimulationResult) -> Table {
     let mut cols = vec!["t".to_string()];
     for (n, _) in &r.probes {
