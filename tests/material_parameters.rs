@@ -317,7 +317,7 @@ fn a_material_parameter_the_model_cannot_take_is_refused_naming_the_field() {
 
     // a factor meant for a value (two orders of magnitude or more from the file's 5e6) is
     // warned about, on the command line and in a box; a value near the file's is not
-    let far = "E_coupler = 0.5 is far from the model file's value 5e6: it sets the body's Young's modulus (Pa) itself, not a factor of it";
+    let far = "E_coupler = 0.5 is far from the model file's value 5e6: it sets the Young's modulus (Pa) itself, not a factor of it";
     let (_, err) = flexrom(d, &["simulate", "m.toml", "-o", "far.h5", "--param", "E_coupler=0.5", "--t-end", "0.007"]);
     assert!(err.contains(far), "{err}");
     let (ok, err) =
@@ -614,6 +614,9 @@ fn greedy_training_over_a_load_and_a_payload_converges_and_covers_held_out_point
     common::held_out_points_within(d, 1e-3);
     let (ok, err) = flexrom(d, &["online", "p.toml", "--param", "payload=0", "-o", "o.h5"]);
     assert!(!ok && err.contains("parameter payload is a point mass (kg) and must be positive, got 0"), "{err}");
+    // refused with its error alone: no warning that 0 is far from the file's value first
+    let (ok, err) = flexrom(d, &["simulate", "m.toml", "--param", "payload=0", "--csv"]);
+    assert!(!ok && err.contains("must be positive") && !err.contains("far from"), "{err}");
 }
 
 #[test]

@@ -71,12 +71,14 @@ impl EstimateArgs {
 }
 
 /// `--param NAME=VALUE` (repeatable): the model's named parameters (`scaled = "drive"` on a
-/// load, a body's modulus or density), beside `--load-scale`.
+/// load; a body's modulus or density, a spring's stiffness, a point mass), beside
+/// `--load-scale`.
 #[derive(clap::Args, Clone, Default)]
 pub struct ParamArgs {
     /// a named parameter of the model: a load's factor (`scaled = "NAME"`), e.g. `--param
-    /// drive=1.1`, or a body's Young's modulus in Pa or density in kg/m³ (`youngs_modulus =
-    /// { value, parameter = "NAME" }`), e.g. `--param E_lower=2.5e8`; repeat it for several;
+    /// drive=1.1`, or a value the model file names (`{ value, parameter = "NAME" }`): a body's
+    /// Young's modulus in Pa or density in kg/m³, a spring's stiffness in N/m (N·m/rad), a
+    /// point mass in kg, e.g. `--param E_lower=2.5e8`, `--param payload=2`; repeat it for several;
     /// `--param load_scale=X` is `--load-scale X`; parameters not given keep the model file's
     /// loads and values
     #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_param, allow_negative_numbers = true)]

@@ -92,10 +92,11 @@ impl Args {
         }
         let written = output.as_ref().map_or("no result file (-o not given)".to_string(), |o| o.display().to_string());
         info(&format!(
-            "{}: static equilibrium at t = {} s in {} load steps ({} Newton iterations, {} step cuts, {:.3} s) -> {}",
+            "{}: static equilibrium at t = {} s in {} load step{} ({} Newton iterations, {} step cuts, {:.3} s) -> {}",
             model.path.display(),
             o.t,
             steps,
+            if steps == 1 { "" } else { "s" },
             r.stats.newton_iterations,
             r.stats.step_cuts,
             r.wall_seconds,

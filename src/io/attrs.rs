@@ -32,15 +32,15 @@ pub const COORDINATE_UNITS: &str = "m (positions x, y), 1 (slopes x', y')";
 /// Velocities `q̇`: of positions in m/s, of slopes in 1/s.
 pub const VELOCITY_UNITS: &str = "m/s (positions x, y), 1/s (slopes x', y')";
 /// Lagrange multipliers: forces on position rows, moments (N·m, conjugate to a
-/// dimensionless slope) on the slope rows of clamps.
-pub const MULTIPLIER_UNITS: &str = "N (position rows), N·m (slope rows of clamps)";
+/// dimensionless slope) on the slope rows (clamps, welds, driven angles, locked sliders).
+pub const MULTIPLIER_UNITS: &str = "N (position rows), N·m (slope rows: clamps, welds, driven angles, locked sliders)";
 /// Reduced coordinates `z = Vᵀ(q − x_ref)` with orthonormal, dimensionless modes: each mixes
 /// the units of `q` in proportion to the mode's entries.
 pub const REDUCED_UNITS: &str = "m (positions) and 1 (slopes), mixed by the modes: z = Vᵀ(q − x_ref)";
 /// Singular values of a snapshot matrix with rows in m and in 1.
 pub const SINGULAR_VALUE_UNITS: &str = "m (positions) and 1 (slopes), mixed: singular values of /snapshots";
-/// Constraint residuals: position rows in m, clamp slope rows dimensionless.
-pub const VIOLATION_UNITS: &str = "m (position rows), 1 (slope rows of clamps)";
+/// Constraint residuals: position rows in m, slope rows dimensionless.
+pub const VIOLATION_UNITS: &str = "m (position rows), 1 (slope rows: clamps, welds, driven angles, locked sliders)";
 /// Text datasets.
 pub const TEXT: &str = "none (text)";
 

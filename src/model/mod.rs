@@ -184,13 +184,14 @@ impl Model {
     /// Warnings for body properties set far from the model file's value, more than
     /// [`FACTOR_LIKE`] times above or below it: such a value is most often a factor meant
     /// (`--param E=0.5` for half the modulus), while the parameter is the value itself. One
-    /// warning per parameter, at the first of `points` where it is far.
+    /// warning per parameter, at the first of `points` where it is far; none for a value that
+    /// is not positive, which [`Self::check_parameters`] refuses with its own error.
     pub fn property_warnings<'a>(&self, points: impl IntoIterator<Item = &'a Parameters>) -> Vec<String> {
         let (mut out, mut warned) = (Vec::new(), Vec::new());
         for mu in points {
             for (name, x) in mu.named() {
                 let Some(file) = self.property_value(name) else { continue };
-                if far_from(x / file) && !warned.contains(&name) {
+                if x > 0.0 && far_from(x / file) && !warned.contains(&name) {
                     warned.push(name);
                     out.push(self.factor_like(name, &crate::error::show_number(x), file));
                 }
@@ -203,7 +204,7 @@ impl Model {
     pub fn factor_like(&self, name: &str, given: &str, file: f64) -> String {
         let what = self.property_parameter(name).unwrap_or("property");
         format!(
-            "{}: {name} = {given} is far from the model file's value {}: it sets the body's {what} itself, not a factor of it",
+            "{}: {name} = {given} is far from the model file's value {}: it sets the {what} itself, not a factor of it",
             self.path.display(),
             crate::error::show_number(file)
         )

@@ -518,7 +518,8 @@ impl Validation {
                 })
             ));
         }
-        for q in &self.reaction_errors {
+        // a reaction the joint never carries (a pin's moment) is 0 in both runs: no line
+        for q in self.reaction_errors.iter().filter(|q| q.range != 0.0 || q.max_error != 0.0) {
             let unit = q.quantity.unit();
             let estimate = match (q.estimate, q.effectivity) {
                 (Some(e), Some(f)) => format!(", estimate {e:.3e} (effectivity {f:.2})"),
