@@ -102,15 +102,15 @@ fn every_result_prints_as_csv_and_json() {
     assert_eq!(rows.len(), 1);
     assert_eq!(rows[0][head.iter().position(|h| h == "n_pod_modes").unwrap()], j["n_pod_modes"].to_string());
 
-    // online: one record
+    // online: one record, at λ = 1 where no load is given (as `simulate`)
     let on = dir.join("online/deep/o.h5");
-    let j = json(&ok(&["online", &p, "--load-scale", "1.0", "-o", s(&on), "--json"]));
+    let j = json(&ok(&["online", &p, "-o", s(&on), "--json"]));
     assert_eq!(j["load_scale"].as_f64(), Some(1.0));
     assert_eq!(j["steps"].as_u64(), Some(220), "t_end 1.1 s / dt 0.005 s");
     assert!(j["error_estimate"].as_f64().unwrap() > 0.0);
     // online --csv: the time series, as simulate --csv prints it (one shared writer): every
     // column of the reduced run is one of the full run's, under the same name, at the same
-    // instants (a reduced run has no energies)
+    // instants
     let (head, rows) = csv_rows(&ok(&["online", &p, "--load-scale", "1.0", "-o", s(&on), "--csv"]));
     assert_eq!(head[..3], ["t", "tip_x", "tip_y"]);
     assert_eq!(rows.len(), 221, "t = 0 and 220 steps of 0.005 s");
@@ -194,7 +194,10 @@ fn parse_errors_show_the_whole_clap_message() {
             &["simulate", s(&model)],
             &["required arguments were not provided", "--output <OUTPUT>", "Usage: flexrom simulate"],
         ),
-        (&["online", s(&pipeline)], &["--load-scale <LOAD_SCALE>", "--output <OUTPUT>", "Usage: flexrom online"]),
+        (
+            &["online", s(&pipeline)],
+            &["required arguments were not provided", "--output <OUTPUT>", "Usage: flexrom online"],
+        ),
         (
             &["sweep", s(&pipeline), "--loadscales", "1:2:3"],
             &["'--loadscales'", "tip: a similar argument exists: '--load-scales'", "Usage: flexrom sweep"],

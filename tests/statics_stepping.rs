@@ -113,6 +113,58 @@ fn a_free_motion_under_load_has_no_equilibrium_and_is_named() {
     assert!(e.contains("singular") && e.contains("body 'beam' translates and rotates freely"), "{e}");
 }
 
+/// A stiff clamped link carrying a soft one on a pin, at an angle under gravity and a
+/// moment on the pinned link's slope (a model of the test zoo, `04-clamped-chain`): the
+/// moment's Jacobian lifts the pinned link's swing off zero, so no mode is rigid to name; the error is Newton's failure, not an empty
+/// list of free motions ("0 free motions: ").
+#[test]
+fn a_failure_without_a_rigid_mode_names_none() {
+    let text = r#"
+        [time]
+        t_end = 0.5
+        dt = 0.001
+        rho_inf = 0.8
+        [[bodies]]
+        name = "link1"
+        start = [0.0, 0.0]
+        end = [0.21, 0.0]
+        elements = 13
+        density = 5300.0
+        area = 3.43e-5
+        inertia = 6.65e-11
+        youngs_modulus = 7.3e10
+        [[bodies]]
+        name = "link2"
+        start = [0.21, 0.0]
+        end = [0.555, -0.134]
+        elements = 13
+        density = 1200.0
+        area = 2.32e-4
+        inertia = 3.52e-9
+        youngs_modulus = 9.3e8
+        [[joints]]
+        type = "clamp"
+        body = "link1"
+        node = "start"
+        [[joints]]
+        type = "pin"
+        a = { body = "link1", node = "end" }
+        b = { body = "link2", node = "start" }
+        [[loads]]
+        type = "gravity"
+        g = [0.0, -9.81]
+        [[loads]]
+        type = "moment"
+        body = "link2"
+        node = "start"
+        function = { type = "exponential", amplitude = 0.0446, rate = 2.3 }
+        "#;
+    let model = Model::from_text(text, "chain.toml").unwrap();
+    let e = statics(&model, &StaticOptions::default()).unwrap_err().to_string();
+    assert!(!e.contains("0 free motions") && !e.contains("()"), "{e}");
+    assert!(e.contains("no equilibrium found") || e.contains("link2"), "{e}");
+}
+
 #[test]
 fn time_and_steps_outside_their_range_are_refused() {
     let (a, i) = (1e-4, 1e-8 / 12.0);

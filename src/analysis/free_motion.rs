@@ -40,6 +40,11 @@ pub fn free_motions(model: &mut Ramped, q: &[f64], t: f64) -> Result<Vec<FreeMot
     }
     let found = modes::compute(sys, model.parameters(), q, t, count, model.solver_kind())?;
     let shapes: Vec<Vec<f64>> = (0..found.len()).filter(|&i| found.rigid[i]).map(|i| found.shape(i)).collect();
+    if shapes.is_empty() {
+        // none at this configuration (the loads' geometric stiffness can lift a pendulum's
+        // swing off zero): nothing to name
+        return Ok(Vec::new());
+    }
     let load = model.external_force(q, t);
     let load_norm = norm(&load);
     let sys = model.system();

@@ -15,8 +15,9 @@ use std::path::PathBuf;
 pub struct Args {
     /// pipeline file (TOML)
     pipeline: PathBuf,
-    /// multiplies every load marked `scaled` in the model file (negative: the load reversed)
-    #[arg(long, allow_negative_numbers = true, required_unless_present = "params")]
+    /// multiplies every load marked `scaled` in the model file (negative: the load reversed;
+    /// default 1, as `simulate` and Python's `Basis.online`)
+    #[arg(long, allow_negative_numbers = true)]
     load_scale: Option<f64>,
     #[command(flatten)]
     params: super::ParamArgs,
