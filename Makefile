@@ -35,9 +35,9 @@ run: deps
 test: deps
 	# HDF5's file locking stays on: the tests spawn flexrom while they hold HDF5 files open, and
 	# the descriptors flexrom opens are close-on-exec (src/io/h5_open.rs), so no child keeps a
-	# test's file locked. One OpenBLAS thread in the test binaries (the flexrom binary sets it
-	# itself): idle BLAS workers poll with sched_yield and would take CPU from the tests
-	OPENBLAS_NUM_THREADS=1 cargo test --release
+	# test's file locked. No OPENBLAS_NUM_THREADS: the library sets its OpenBLAS to one thread
+	# before its first LAPACK call (src/linalg/lapack.rs), in the test binaries as in flexrom
+	cargo test --release
 	# the Python package (python/, docs/python.md): built with maturin and installed from this
 	# folder, then its tests against the binary just built and the example script
 	python3 -m pip install --quiet --root-user-action=ignore --no-build-isolation .

@@ -28,6 +28,8 @@ fn bench(model: &Model, solver: LinearSolverKind, runs: usize) -> (f64, usize, u
 }
 
 fn main() {
+    // joins the OpenBLAS workers this binary's constructor started before any timing (the
+    // library would at its first LAPACK call)
     flexrom::single_threaded_blas();
     // `cargo bench` passes `--bench`; anything else named `quick` shortens the run
     let quick = std::env::args().any(|a| a == "quick");

@@ -23,6 +23,8 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 fn main() {
+    // joins the OpenBLAS workers this binary's constructor started before any timing (the
+    // library would at its first LAPACK call)
     flexrom::single_threaded_blas();
     let quick = std::env::args().any(|a| a == "quick");
     let root = env!("CARGO_MANIFEST_DIR");

@@ -42,7 +42,6 @@ fn median(v: &mut [f64]) -> f64 {
 }
 
 fn main() -> flexrom::Result<()> {
-    flexrom::single_threaded_blas();
     let args: Vec<String> = std::env::args().collect();
     if args.len() != 4 {
         eprintln!("usage: estimate_table PIPELINE TRAIN_LOADS(a,b,c) TEST_LOADS(a,b,.. or A:B:N)");

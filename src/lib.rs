@@ -31,28 +31,4 @@ pub mod training;
 pub mod workflows;
 
 pub use error::{Error, Result};
-
-extern "C" {
-    fn openblas_set_num_threads(n: std::os::raw::c_int);
-    fn blas_thread_shutdown_() -> std::os::raw::c_int;
-}
-
-/// Keeps OpenBLAS on one thread: the dense reference solver then measures one core, like
-/// everything else, and parallel sweeps do not oversubscribe the machine.
-///
-/// In the `flexrom` binary OpenBLAS has usually started no worker at all (its
-/// `BLAS_ONE_THREAD_AT_START` sets `OPENBLAS_NUM_THREADS=1` before OpenBLAS's constructor
-/// runs). When the user's `OPENBLAS_NUM_THREADS` asked for more, or in another program
-/// linking this library, the constructor has started them before `main`;
-/// setting the count to 1 only stops handing them work, and each keeps polling its queue with
-/// `sched_yield` (about a third of a pendulum run's CPU time). `blas_thread_shutdown_` joins
-/// them; with one thread no call starts them again (OpenBLAS's `exec_blas` is reached only
-/// for more than one thread).
-pub fn single_threaded_blas() {
-    // SAFETY: plain calls into OpenBLAS's thread server, which is idle here (nothing has
-    // called BLAS yet, and with one thread nothing will hand work to a worker afterwards).
-    unsafe {
-        openblas_set_num_threads(1);
-        blas_thread_shutdown_();
-    }
-}
+pub use linalg::lapack::single_threaded_blas;

@@ -288,6 +288,9 @@ fn main() -> ExitCode {
         note(&format!("error: {e}"));
         return ExitCode::FAILURE;
     }
+    // the library sets OpenBLAS to one thread at its first LAPACK call; called here too, it
+    // joins at once the workers a user's OPENBLAS_NUM_THREADS=N started, in commands that
+    // never reach LAPACK as well
     flexrom::single_threaded_blas();
     if let Err(e) = flexrom::workflows::shard::configure_threads(cli.threads) {
         note(&format!("error: {e}"));

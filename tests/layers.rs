@@ -593,3 +593,36 @@ fn checker_finds_cycles_and_upward_imports() {
     assert!(p.iter().any(|s| s.contains("known exception model -> io no longer occurs")), "{p:?}");
     assert_eq!(p.len(), 3, "{p:?}");
 }
+
+/// Every LAPACK call passes through `linalg::lapack`, whose traits keep OpenBLAS on one
+/// thread before the first call (concurrent callers crash a multi-threaded OpenBLAS): no
+/// other file under src/ (test modules included) names `ndarray_linalg`, nor do the
+/// integration tests, benches, examples or the Python bindings, which link the same OpenBLAS.
+#[test]
+fn lapack_is_reached_through_linalg_lapack_only() {
+    let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut offenders = Vec::new();
+    for dir in ["src", "tests", "benches", "examples", "python/src"] {
+        for path in rust_files(&manifest.join(dir)) {
+            let text = std::fs::read_to_string(&path).expect("readable source");
+            let code_names_it =
+                text.lines().any(|l| !l.trim_start().starts_with("//") && l.contains(concat!("ndarray", "_linalg")));
+            if code_names_it && !path.ends_with("src/linalg/lapack.rs") {
+                offenders.push(path.strip_prefix(manifest).unwrap_or(&path).display().to_string());
+            }
+        }
+    }
+    assert!(offenders.is_empty(), "LAPACK reached around src/linalg/lapack.rs in: {offenders:?}");
+}
+
+fn rust_files(dir: &Path) -> Vec<std::path::PathBuf> {
+    let mut out = Vec::new();
+    for p in std::fs::read_dir(dir).into_iter().flatten().map(|e| e.expect("entry").path()) {
+        if p.is_dir() {
+            out.extend(rust_files(&p));
+        } else if p.extension().is_some_and(|e| e == "rs") {
+            out.push(p);
+        }
+    }
+    out
+}

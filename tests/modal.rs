@@ -6,8 +6,8 @@
 
 mod common;
 
+use flexrom::linalg::lapack::{Eigh, UPLO};
 use ndarray::Array2;
-use ndarray_linalg::{Eigh, UPLO};
 
 #[test]
 fn clamped_free_bending_frequencies_match_euler_bernoulli() {

@@ -105,8 +105,8 @@ fn pinned_free_beam_has_one_rigid_mode_then_euler_bernoulli() {
 /// iteration resolves at once.
 #[test]
 fn subspace_iteration_matches_the_dense_eigensolver() {
+    use flexrom::linalg::lapack::{Eigh, UPLO};
     use ndarray::Array2;
-    use ndarray_linalg::{Eigh, UPLO};
     let m = beam(12, "clamp");
     let sys = m.system(Default::default());
     let q = sys.initial_state();

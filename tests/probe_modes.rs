@@ -35,12 +35,7 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 fn flexrom(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_flexrom"))
-        .args(args)
-        .env("HDF5_USE_FILE_LOCKING", "FALSE")
-        .env("OPENBLAS_NUM_THREADS", "1")
-        .output()
-        .unwrap()
+    Command::new(env!("CARGO_BIN_EXE_flexrom")).args(args).env("HDF5_USE_FILE_LOCKING", "FALSE").output().unwrap()
 }
 
 /// The arm of `common::two_link_arm` (30 elements a link, Δt 1 ms) with a probe at the

@@ -86,7 +86,6 @@ fn flexrom(dir: &Path, args: &[&str]) -> Output {
         .args(args)
         .current_dir(dir)
         .env("HDF5_USE_FILE_LOCKING", "FALSE")
-        .env("OPENBLAS_NUM_THREADS", "1")
         .output()
         .unwrap();
     assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));

@@ -1434,7 +1434,8 @@ fn _flexrom(m: &Bound<'_, PyModule>) -> PyResult<()> {
     if let Ok(h) = pyo3_log::try_init() {
         let _ = LOG_RESET.set(h);
     }
-    // one OpenBLAS thread, as in the command line: parallel sweeps run a thread per point
+    // one OpenBLAS thread, as in the command line (the library sets it at its first LAPACK
+    // call anyway): joins now the workers OpenBLAS's constructor started when the module loaded
     flexrom::single_threaded_blas();
     m.add_class::<PyModel>()?;
     m.add_class::<PyRunResult>()?;

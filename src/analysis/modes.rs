@@ -33,10 +33,10 @@
 use super::assembly::{self, block_mul};
 use crate::error::{Error, Result};
 use crate::linalg::kkt::{Block, LinearSolverKind};
+use crate::linalg::lapack::{Eigh, UPLO};
 use crate::physics::system::FlexibleSystem;
 use crate::solver::model::{Parameters, ParametricModel};
 use ndarray::Array2;
-use ndarray_linalg::{Eigh, UPLO};
 
 /// A mode is rigid when `|ω²| ≤ RIGID · |σ|` (a rigid mode's `ω²` from
 /// [`inverse_quotient`] is round-off, about `10⁻⁵ |σ|`).

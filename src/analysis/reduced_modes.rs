@@ -16,10 +16,10 @@
 
 use super::assembly::{self, block_mul};
 use crate::error::{Error, Result};
+use crate::linalg::lapack::{Eigh, SVD, UPLO};
 use crate::physics::system::FlexibleSystem;
 use crate::solver::model::{Parameters, ParametricModel};
 use ndarray::{Array2, ArrayView2};
-use ndarray_linalg::{Eigh, SVD, UPLO};
 
 /// A singular value of `B V` counts toward its rank above `RANK · max(σ_max, ‖B‖ ‖V‖)`
 /// (POD modes satisfy `B φ = 0` to the training's Newton tolerance, the kept unit columns

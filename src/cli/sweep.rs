@@ -10,7 +10,7 @@ use flexrom::output::{self, info};
 use flexrom::pipeline::Pipeline;
 use flexrom::solver::parameters::{Parameters, LOAD_SCALE};
 use flexrom::workflows::online::load_rom;
-use flexrom::workflows::sweep::{Route, SweepBasis, SweepFile};
+use flexrom::workflows::sweep::{Fallback, Route, SweepBasis, SweepFile, SweepOptions};
 use std::path::PathBuf;
 
 /// The arguments of `flexrom sweep`.
@@ -145,34 +145,8 @@ impl Args {
         if no_estimate && strict {
             return Err(flexrom::Error::Usage("--strict needs the error estimate; drop --no-estimate".into()));
         }
-        // the fallback this sweep runs with: none for a full or a validated sweep (which
-        // measures the reduced model at every point)
-        use flexrom::workflows::sweep::Fallback;
-        let keyed = fallback.is_none() && p.online_fallback() == Some(Fallback::Full);
-        let options = flexrom::workflows::sweep::SweepOptions {
-            validate,
-            continuation,
-            progress: output::show_progress(),
-            fallback: fallback.or(p.online_fallback()).unwrap_or_default(),
-        }
-        .settled(full);
+        let options = sweep_options(&p, fallback, validate, continuation, full, no_estimate)?;
         let fallback = options.fallback;
-        if keyed && validate {
-            info(&format!(
-                "{}: [online] fallback = \"full\" does not apply to a validated sweep, which measures the reduced model at every point",
-                p.path.display()
-            ));
-        }
-        if fallback == Fallback::Full && no_estimate {
-            let given = if keyed {
-                format!("{}'s [online] fallback = \"full\"", p.path.display())
-            } else {
-                "--fallback full".into()
-            };
-            return Err(flexrom::Error::Usage(format!(
-                "{given} needs the error estimate to judge each reduced answer; drop --no-estimate (or pass --fallback none)"
-            )));
-        }
         let loaded = if full { None } else { Some(load_rom(&p, &path, estimate.method(), no_estimate)?) };
         if let Some((_, _, warnings)) = &loaded {
             warn(warnings);
@@ -194,35 +168,14 @@ impl Args {
             None => Route::Full(&p.model),
         };
         if let (Fallback::Full, Some((_, rom, _))) = (fallback, &loaded) {
-            if rom.estimator().is_none() {
-                warn(&["the basis has no error estimator: --fallback full acts only where a reduced run fails or the model amplifies load changes (train again for an estimator)".to_string()]);
-            } else if rom.trust().and_then(|t| t.tolerance).is_none() {
-                warn(&["no tolerance to hold the estimates to (a basis trained at fixed loads, and no [online] tolerance in the pipeline): --fallback full acts only where a reduced run fails".to_string()]);
-            }
+            warn_what_the_fallback_lacks(rom);
         }
         let file = SweepFile { out: &out, resume, extra: &|_| Ok(()) };
         let sw = match shard {
             Some(k) => flexrom::workflows::shard::sweep_shard(&p, route, &points, k, options, file)?,
             None => flexrom::workflows::sweep::sweep_to_file(route, &points, options, file)?,
         };
-        match format.format() {
-            Format::Text => output::print(&flexrom::workflows::sweep::table(&sw))?,
-            f => print_table(&flexrom::report::tables::sweep_table(&sw), f, false)?,
-        }
-        info(&format!(
-            "{}{}{} {} ({} resumed) on {} threads in {:.3} s -> {}",
-            shard.map(|k| format!("shard {k}: ")).unwrap_or_default(),
-            if full { "full model, " } else { "" },
-            sw.scales.len(),
-            if named { "points" } else { "load scales" },
-            sw.resumed,
-            sw.threads,
-            sw.wall_seconds,
-            out.display()
-        ));
-        if let Some(line) = speedup_summary(&sw) {
-            info(&line);
-        }
+        show_sweep(&sw, format.format(), shard, full, named, &out)?;
         warn(notice.as_slice());
         if let Some(line) = fallback_summary(&sw) {
             info(&line);
@@ -230,54 +183,140 @@ impl Args {
         // the answers kept are warned about also when some points failed (exit 3 below)
         let failure = sw.failure_summary();
         let checked = match &loaded {
-            Some((_, rom, _)) => {
-                // of the reduced answers: the full model's do not extrapolate
-                let outside: Vec<Vec<String>> = sw
-                    .scales
-                    .iter()
-                    .filter(|x| x.point().is_some_and(|p| p.fallback.is_none()))
-                    .map(|x| rom.named_outside(&x.mu))
-                    .filter(|w| !w.is_empty())
-                    .collect();
-                if let Some(first) = outside.first() {
-                    warn(&[format!(
-                        "{} of {} points lie outside what the basis was trained on (the first: {}); the reduced model extrapolates there",
-                        outside.len(),
-                        sw.scales.len(),
-                        first.join(", ")
-                    )]);
-                }
-                // a point the full model answered is exact: nothing to warn about
-                let runs: Vec<_> = sw
-                    .scales
-                    .iter()
-                    .filter_map(|x| x.point())
-                    .filter(|q| q.fallback.is_none())
-                    .map(|q| {
-                        let e = q.estimate.as_ref().map(|e| e.in_measure(rom.tolerance_measure()));
-                        (q.run.result.settings.mu.clone(), e)
-                    })
-                    .collect();
-                super::check_runs(rom, &runs, strict && failure.is_none())
-            }
+            Some((_, rom, _)) => check_reduced_answers(rom, &sw, strict && failure.is_none()),
             None => Ok(()),
         };
         // the good runs are written; the exit code (3) says that some failed
         if let Some(s) = failure {
-            // the way on after failed reduced runs, once for all of them (with the fallback a
-            // failed point is one where the full model failed too)
-            let hint = if loaded.is_some() && fallback == Fallback::None {
-                format!("\n{}", flexrom::error::REDUCED_RUN_FAILED)
-            } else {
-                String::new()
-            };
-            return Err(flexrom::Error::PartlyFailed(format!(
-                "{s} (the others are in {}; /status and /message say which){hint}",
-                out.display()
-            )));
+            return Err(partly_failed(&s, loaded.is_some() && fallback == Fallback::None, &out));
         }
         checked
     }
+}
+
+/// The sweep's options: the fallback it runs with (none for a full or a validated sweep,
+/// which measures the reduced model at every point; else `--fallback`, else the pipeline's
+/// [online] fallback), refusing a full fallback without the estimate that judges each answer.
+fn sweep_options(
+    p: &Pipeline,
+    fallback: Option<Fallback>,
+    validate: bool,
+    continuation: bool,
+    full: bool,
+    no_estimate: bool,
+) -> flexrom::Result<SweepOptions> {
+    let keyed = fallback.is_none() && p.online_fallback() == Some(Fallback::Full);
+    let options = SweepOptions {
+        validate,
+        continuation,
+        progress: output::show_progress(),
+        fallback: fallback.or(p.online_fallback()).unwrap_or_default(),
+    }
+    .settled(full);
+    if keyed && validate {
+        info(&format!(
+            "{}: [online] fallback = \"full\" does not apply to a validated sweep, which measures the reduced model at every point",
+            p.path.display()
+        ));
+    }
+    if options.fallback == Fallback::Full && no_estimate {
+        let given = if keyed {
+            format!("{}'s [online] fallback = \"full\"", p.path.display())
+        } else {
+            "--fallback full".into()
+        };
+        return Err(flexrom::Error::Usage(format!(
+            "{given} needs the error estimate to judge each reduced answer; drop --no-estimate (or pass --fallback none)"
+        )));
+    }
+    Ok(options)
+}
+
+/// The error of a sweep some of whose points failed (exit 3), the good ones written to `out`;
+/// `reduced_failed` (reduced runs without a fallback) adds the way on, once for all of them
+/// (with the fallback a failed point is one where the full model failed too).
+fn partly_failed(summary: &str, reduced_failed: bool, out: &std::path::Path) -> flexrom::Error {
+    let hint = if reduced_failed { format!("\n{}", flexrom::error::REDUCED_RUN_FAILED) } else { String::new() };
+    flexrom::Error::PartlyFailed(format!(
+        "{summary} (the others are in {}; /status and /message say which){hint}",
+        out.display()
+    ))
+}
+
+/// Where `--fallback full` can act less than asked: a basis without an error estimator, or no
+/// tolerance to hold the estimates to.
+fn warn_what_the_fallback_lacks(rom: &flexrom::rom::Rom) {
+    if rom.estimator().is_none() {
+        warn(&["the basis has no error estimator: --fallback full acts only where a reduced run fails or the model amplifies load changes (train again for an estimator)".to_string()]);
+    } else if rom.trust().and_then(|t| t.tolerance).is_none() {
+        warn(&["no tolerance to hold the estimates to (a basis trained at fixed loads, and no [online] tolerance in the pipeline): --fallback full acts only where a reduced run fails".to_string()]);
+    }
+}
+
+/// The sweep's table on stdout, then its summary line and the speed-up line on stderr.
+fn show_sweep(
+    sw: &flexrom::workflows::sweep::Sweep,
+    format: Format,
+    shard: Option<flexrom::workflows::shard::Shard>,
+    full: bool,
+    named: bool,
+    out: &std::path::Path,
+) -> flexrom::Result<()> {
+    match format {
+        Format::Text => output::print(&flexrom::workflows::sweep::table(sw))?,
+        f => print_table(&flexrom::report::tables::sweep_table(sw), f, false)?,
+    }
+    info(&format!(
+        "{}{}{} {} ({} resumed) on {} threads in {:.3} s -> {}",
+        shard.map(|k| format!("shard {k}: ")).unwrap_or_default(),
+        if full { "full model, " } else { "" },
+        sw.scales.len(),
+        if named { "points" } else { "load scales" },
+        sw.resumed,
+        sw.threads,
+        sw.wall_seconds,
+        out.display()
+    ));
+    if let Some(line) = speedup_summary(sw) {
+        info(&line);
+    }
+    Ok(())
+}
+
+/// The warnings on the reduced answers kept (the full model's are exact and do not
+/// extrapolate): points outside what the basis was trained on, then the estimates held to the
+/// tolerance (an error with `strict`).
+fn check_reduced_answers(
+    rom: &flexrom::rom::Rom,
+    sw: &flexrom::workflows::sweep::Sweep,
+    strict: bool,
+) -> flexrom::Result<()> {
+    let outside: Vec<Vec<String>> = sw
+        .scales
+        .iter()
+        .filter(|x| x.point().is_some_and(|p| p.fallback.is_none()))
+        .map(|x| rom.named_outside(&x.mu))
+        .filter(|w| !w.is_empty())
+        .collect();
+    if let Some(first) = outside.first() {
+        warn(&[format!(
+            "{} of {} points lie outside what the basis was trained on (the first: {}); the reduced model extrapolates there",
+            outside.len(),
+            sw.scales.len(),
+            first.join(", ")
+        )]);
+    }
+    let runs: Vec<_> = sw
+        .scales
+        .iter()
+        .filter_map(|x| x.point())
+        .filter(|q| q.fallback.is_none())
+        .map(|q| {
+            let e = q.estimate.as_ref().map(|e| e.in_measure(rom.tolerance_measure()));
+            (q.run.result.settings.mu.clone(), e)
+        })
+        .collect();
+    super::check_runs(rom, &runs, strict)
 }
 
 /// One line when the full model answered some points in place of the reduced one, or was

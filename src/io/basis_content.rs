@@ -3,7 +3,7 @@
 //! in [0, 1], kept coordinates with their unit columns, a consistent ECSW set.
 
 use super::basis_file::StoredBasis;
-use crate::reduction::Variant;
+use crate::reduction::{Basis, Variant};
 use ndarray::{s, Array2};
 
 /// ‖VᵀV − I‖_max allowed: LAPACK's SVD gives orthonormal columns to ~1e-14; 1e-8 leaves
@@ -14,14 +14,35 @@ pub const ORTHONORMALITY_TOLERANCE: f64 = 1e-8;
 /// so 1e-8 and below is an edited or corrupted file.
 pub const MIN_WEIGHT: f64 = 1e-8;
 
+/// What a check finds wrong: `Err((dataset, problem))`.
+type Found = std::result::Result<(), (String, String)>;
+
+fn bad(dataset: &str, problem: String) -> Found {
+    Err((dataset.to_string(), problem))
+}
+
+/// The first entry that is not finite, with its index in iteration order.
+fn first_non_finite<'a>(values: impl Iterator<Item = &'a f64>) -> Option<(usize, f64)> {
+    values.enumerate().find(|(_, v)| !v.is_finite()).map(|(i, v)| (i, *v))
+}
+
 /// Checks that need no model: values, orthonormality, the spectrum, the ECSW set's own
-/// consistency. `Err((dataset, problem))`.
-pub fn check_content(s: &StoredBasis) -> std::result::Result<(), (String, String)> {
+/// consistency, in that order (the first problem found is the one reported).
+/// `Err((dataset, problem))`.
+pub fn check_content(s: &StoredBasis) -> Found {
     let b = &s.basis;
-    let bad = |f: &str, p: String| Err((f.to_string(), p));
-    let first_bad =
-        |a: &mut dyn Iterator<Item = &f64>| a.enumerate().find(|(_, v)| !v.is_finite()).map(|(i, v)| (i, *v));
-    if let Some((i, v)) = first_bad(&mut b.modes.iter()) {
+    check_finite(b)?;
+    check_multiplier_modes(b)?;
+    check_column_counts(b)?;
+    check_spectrum(s)?;
+    check_kept_columns(b)?;
+    check_orthonormal(s)?;
+    check_hyper(s)
+}
+
+/// Every entry of the modes and the reference finite.
+fn check_finite(b: &Basis) -> Found {
+    if let Some((i, v)) = first_non_finite(b.modes.iter()) {
         return bad(
             "basis/modes",
             format!(
@@ -31,11 +52,17 @@ pub fn check_content(s: &StoredBasis) -> std::result::Result<(), (String, String
             ),
         );
     }
-    if let Some((i, v)) = first_bad(&mut b.reference.iter()) {
+    if let Some((i, v)) = first_non_finite(b.reference.iter()) {
         return bad("basis/reference", format!("entry {i} is {v}; every entry must be finite"));
     }
+    Ok(())
+}
+
+/// The multiplier modes: finite; whole-system-stabilized's supremizers orthonormal and of a
+/// count that fits; whole-system's as many columns as the modes.
+fn check_multiplier_modes(b: &Basis) -> Found {
     if let Some(vl) = &b.multiplier_modes {
-        if let Some((i, v)) = first_bad(&mut vl.iter()) {
+        if let Some((i, v)) = first_non_finite(vl.iter()) {
             return bad("basis/multiplier_modes", format!("entry {i} is {v}; every entry must be finite"));
         }
         if b.variant == Variant::WholeSystemStabilized {
@@ -65,6 +92,12 @@ pub fn check_content(s: &StoredBasis) -> std::result::Result<(), (String, String
             );
         }
     }
+    Ok(())
+}
+
+/// The multiplier scale, and the columns of the modes: at least one, as many as the POD modes,
+/// supremizers and kept coordinates together.
+fn check_column_counts(b: &Basis) -> Found {
     if b.variant == Variant::WholeSystem && !(b.multiplier_scale.is_finite() && b.multiplier_scale > 0.0) {
         return bad("multiplier_scale", format!("is {}; it must be positive and finite", b.multiplier_scale));
     }
@@ -87,6 +120,12 @@ pub fn check_content(s: &StoredBasis) -> std::result::Result<(), (String, String
             ),
         );
     }
+    Ok(())
+}
+
+/// Singular values finite, non-negative and non-increasing within each block; energies one
+/// per singular value, in [0, 1].
+fn check_spectrum(s: &StoredBasis) -> Found {
     // singular values: finite, non-negative, non-increasing within each block
     let mut at = 0;
     for (blk, &k) in s.block_values.iter().enumerate() {
@@ -122,6 +161,11 @@ pub fn check_content(s: &StoredBasis) -> std::result::Result<(), (String, String
     {
         return bad("basis/energy", format!("entry {i} is {v}; captured energy fractions lie in [0, 1]"));
     }
+    Ok(())
+}
+
+/// Each kept coordinate exists and has its unit column.
+fn check_kept_columns(b: &Basis) -> Found {
     // the kept coordinates' unit columns
     for (k, &d) in b.kept.iter().enumerate() {
         if d >= b.modes.nrows() {
@@ -141,7 +185,12 @@ pub fn check_content(s: &StoredBasis) -> std::result::Result<(), (String, String
             );
         }
     }
-    // VᵀV = I (whole-system: the stacked [V; V_λ])
+    Ok(())
+}
+
+/// VᵀV = I (whole-system: the stacked [V; V_λ]), the worst entry named with its block.
+fn check_orthonormal(s: &StoredBasis) -> Found {
+    let b = &s.basis;
     let mut gram = b.modes.t().dot(&b.modes);
     if let (Variant::WholeSystem, Some(vl)) = (b.variant, &b.multiplier_modes) {
         gram += &vl.t().dot(vl);
@@ -153,6 +202,11 @@ pub fn check_content(s: &StoredBasis) -> std::result::Result<(), (String, String
             if b.variant == Variant::WholeSystem { "basis/modes, basis/multiplier_modes" } else { "basis/modes" };
         return bad(dataset, format!("are not orthonormal: {name} − I is {:.3e} at columns ({i}, {j}) ({}); the limit is {ORTHONORMALITY_TOLERANCE:e}", gram[[i, j]] - if i == j { 1.0 } else { 0.0 }, block_of(s, i, j)));
     }
+    Ok(())
+}
+
+/// The ECSW set: its own consistency, trained weights, a finite non-negative residual.
+fn check_hyper(s: &StoredBasis) -> Found {
     if let Some(h) = &s.basis.hyper {
         h.validate(usize::MAX)?;
         if let Some((k, w)) = h.weights.iter().enumerate().find(|(_, w)| **w < MIN_WEIGHT) {

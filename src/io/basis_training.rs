@@ -1,6 +1,7 @@
 //! What a basis file says of the training that made it, beside the basis: the training
 //! range and loads, greedy's tolerance and its measure, its notes, the sensitivity it
-//! measured, the box of parameters, and `train`'s timing of both routes. Read from the
+//! measured, the box of parameters and its training points, the snapshot count, and `train`'s
+//! timing of both routes. Read from the
 //! open file with the basis itself ([`super::basis_file::read_basis`]), so that a command
 //! opens its basis file once.
 
@@ -12,7 +13,7 @@ use super::timing_file::{read_timing, RouteTiming};
 use crate::error::Result;
 use crate::reduction::estimator::ErrorMeasure;
 use crate::solver::parameter_space::ParameterSpace;
-use crate::solver::parameters::LOAD_SCALE;
+use crate::solver::parameters::{Parameters, LOAD_SCALE};
 use std::path::Path;
 
 /// Greedy training's whole-run sensitivity at its candidates, as the file stores it.
@@ -42,6 +43,11 @@ pub struct BasisTraining {
     pub notes: Vec<(&'static str, String)>,
     /// the box of parameters the basis was trained over; empty: the load scale alone
     pub space: ParameterSpace,
+    /// the points of the full runs in that box, in run order (`/parameters/<name>`); empty
+    /// for a basis trained over the load scale alone
+    pub points: Vec<Parameters>,
+    /// columns of `/snapshots` (`None`: the file has none)
+    pub snapshot_count: Option<usize>,
     /// greedy training's sensitivity at its candidates; `None` for other bases
     pub sensitivity: Option<StoredSensitivity>,
     /// `train`'s timing of the full and the reduced route; `None` for a file without it
@@ -68,7 +74,9 @@ pub fn read_training(f: &hdf5::File, path: &Path) -> Result<BasisTraining> {
         tolerance: training_tolerance(f, path)?,
         measure: training_measure(f, path)?,
         notes: training_notes(f, path)?,
+        points: super::parameter_space_file::training_points(f, path, &space)?,
         space,
+        snapshot_count: f.dataset("snapshots").ok().and_then(|d| d.shape().get(1).copied()),
         sensitivity,
         timing: read_timing(f, path)?,
     })

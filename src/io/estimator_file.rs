@@ -485,11 +485,6 @@ pub fn training_measure(f: &hdf5::File, path: &Path) -> Result<ErrorMeasure> {
     ErrorMeasure::parse(&m).map_err(|p| Error::input(path, "training/measure", p))
 }
 
-/// [`training_loads`] of the basis file at `path`, opened for it.
-pub fn read_training_loads(path: &Path) -> Result<Vec<f64>> {
-    training_loads(&crate::io::h5_open::open_to_read(path)?, path)
-}
-
 /// [`training_notes`] of the basis file at `path`, opened for it.
 pub fn read_training_notes(path: &Path) -> Result<Vec<(&'static str, String)>> {
     training_notes(&crate::io::h5_open::open_to_read(path)?, path)

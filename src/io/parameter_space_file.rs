@@ -26,6 +26,25 @@ pub fn write_parameter_space(f: &hdf5::File, space: &ParameterSpace, points: &[P
     Ok(())
 }
 
+/// The points of the training runs in the box `space` of the open basis file `f` at `path`:
+/// each parameter's `/parameters/<name>` values, in run order (empty for a basis trained over
+/// the load scale alone).
+pub fn training_points(f: &hdf5::File, path: &Path, space: &ParameterSpace) -> Result<Vec<Parameters>> {
+    let mut runs: Vec<Parameters> = Vec::new();
+    for name in space.names() {
+        let field = format!("parameters/{name}");
+        let values = f
+            .dataset(&field)
+            .and_then(|d| d.read_1d::<f64>())
+            .map_err(|e| Error::input(path, &field, format!("cannot be read: {e}")))?;
+        runs.resize(values.len(), Parameters::default());
+        for (mu, v) in runs.iter_mut().zip(values.iter()) {
+            *mu = std::mem::take(mu).with(name, *v);
+        }
+    }
+    Ok(runs)
+}
+
 /// The box of `/parameters` of the open basis file `f` at `path` (`None`: the basis was
 /// trained over the load scale alone).
 /// A range that is not `[lower, upper]` with lower < upper, or an unknown scale, is an

@@ -135,10 +135,10 @@ impl KktSolver for SparseKkt {
     }
 }
 
-/// Dense KKT solver through LAPACK (getrf/getrs via ndarray-linalg).
+/// Dense KKT solver through LAPACK (getrf/getrs via ndarray-linalg, through `linalg::lapack`).
 pub struct DenseKkt {
     pattern: KktPattern,
-    lu: Option<ndarray_linalg::LUFactorized<ndarray::OwnedRepr<f64>>>,
+    lu: Option<crate::linalg::lapack::LUFactorized<ndarray::OwnedRepr<f64>>>,
 }
 
 impl DenseKkt {
@@ -149,7 +149,7 @@ impl DenseKkt {
 
 impl KktSolver for DenseKkt {
     fn factor(&mut self, blocks: &[Block], scale: f64) -> Result<(), String> {
-        use ndarray_linalg::FactorizeInto;
+        use crate::linalg::lapack::FactorizeInto;
         let n = self.pattern.size();
         let nd = self.pattern.n_dof;
         let mut a = ndarray::Array2::<f64>::zeros((n, n));
@@ -182,10 +182,10 @@ impl KktSolver for DenseKkt {
 /// Solves in place with a LAPACK LU factorization (getrs); a non-finite solution means the
 /// matrix was singular. Shared by the dense KKT solver and the reduced models.
 pub fn dense_lu_solve(
-    lu: Option<&ndarray_linalg::LUFactorized<ndarray::OwnedRepr<f64>>>,
+    lu: Option<&crate::linalg::lapack::LUFactorized<ndarray::OwnedRepr<f64>>>,
     rhs: &mut [f64],
 ) -> Result<(), String> {
-    use ndarray_linalg::Solve;
+    use crate::linalg::lapack::Solve;
     let lu = lu.ok_or("solve called without a valid factorization")?;
     let mut b = ndarray::ArrayViewMut1::from(rhs);
     let x = lu.solve(&b.view()).map_err(|e| format!("dense solve failed: {e}"))?;

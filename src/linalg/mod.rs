@@ -8,6 +8,7 @@ pub mod dense_lu;
 pub(crate) mod incremental_product;
 pub mod kkt;
 pub mod kkt_pattern;
+pub mod lapack;
 pub mod nnls;
 pub mod simd;
 pub(crate) mod sparse_rows;

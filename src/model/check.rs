@@ -51,9 +51,49 @@ impl Property {
 /// Relative tolerance for a joint to count as closed in the initial configuration.
 const CLOSURE_TOL: f64 = 1e-6;
 
+/// A node's position in the undeformed configuration.
+fn node_position(bodies: &[BeamBody], (b, k): NodeId) -> [f64; 2] {
+    let r = bodies[b].undeformed_node(k);
+    [r[0], r[1]]
+}
+
 impl Model {
     pub(super) fn check(&mut self) -> Result<()> {
         let f = self.file.clone();
+        self.check_time(&f)?;
+        if f.bodies.is_empty() {
+            return Err(self.err("bodies", "a model needs at least one body"));
+        }
+        for i in 0..f.bodies.len() {
+            let body = self.checked_body(&f, i)?;
+            self.bodies.push(body);
+        }
+        let lmax = self.bodies.iter().map(|b| b.length).fold(0.0, f64::max);
+        for (i, j) in f.joints.iter().enumerate() {
+            let joint = self.checked_joint(i, j, lmax)?;
+            self.joints.push(joint);
+        }
+        self.check_joint_rank()?;
+        self.check_initial_velocities()?;
+        for (i, l) in f.loads.iter().enumerate() {
+            let load = self.checked_load(i, l)?;
+            self.loads.push(load);
+        }
+        for (i, m) in f.masses.iter().enumerate() {
+            let mass = self.checked_mass(i, m)?;
+            self.masses.push(mass);
+        }
+        self.check_springs(&f.springs)?;
+        for i in 0..f.probes.len() {
+            let probe = self.checked_probe(&f, i)?;
+            self.probes.push(probe);
+        }
+        Ok(())
+    }
+
+    /// The `[time]` settings (step within the end time, the integrator's parameters) and
+    /// the Rayleigh damping's coefficients.
+    fn check_time(&self, f: &ModelFile) -> Result<()> {
         let t = &f.time;
         self.positive("time.t_end", t.t_end)?;
         self.positive("time.dt", t.dt)?;
@@ -68,287 +108,293 @@ impl Model {
                 }
             }
         }
-        if f.bodies.is_empty() {
-            return Err(self.err("bodies", "a model needs at least one body"));
-        }
-        for (i, b) in f.bodies.iter().enumerate() {
-            let p = |k: &str| format!("bodies[{i}].{k}");
-            if b.name.trim().is_empty() {
-                return Err(self.err(p("name"), "must not be empty"));
-            }
-            if b.name.chars().any(char::is_control) {
-                // the result files' labels store it as HDF5 text, which ends at a NUL
-                return Err(self.err(
-                    p("name"),
-                    format!("`{}` holds a control character (a NUL, a newline, …): names are written into the result files' labels", crate::error::show_text(&b.name)),
-                ));
-            }
-            if f.bodies[..i].iter().any(|o| o.name == b.name) {
-                return Err(self.err(p("name"), format!("body `{}` is defined twice", b.name)));
-            }
-            self.finite2(&p("start"), b.start)?;
-            if b.elements <= 0 {
-                return Err(self.err(p("elements"), format!("must be a positive integer, got {}", b.elements)));
-            }
-            let total: f64 = f.bodies[..=i].iter().map(|b| b.elements.max(0) as f64).sum();
-            self.limits.check_elements(total).map_err(|e| self.err(p("elements"), e))?;
-            // a property given as `{ value, parameter }` names its `value`
-            let property = |k: &str, spec: &PropertySpec| match spec {
-                PropertySpec::Value(v) => (k.to_string(), *v),
-                PropertySpec::Parameter(x) => (format!("{k}.value"), x.value),
-            };
-            for (k, v) in [
-                property("density", &b.density),
-                ("area".into(), b.area),
-                ("inertia".into(), b.inertia),
-                property("youngs_modulus", &b.youngs_modulus),
-            ] {
-                self.positive(&p(&k), v)?;
-            }
-            let youngs_modulus_parameter = self.checked_property_parameter(&f, i, Property::YoungsModulus)?;
-            let density_parameter = self.checked_property_parameter(&f, i, Property::Density)?;
-            let (angle, length) = match (b.angle, b.end) {
-                (Some(_), Some(_)) => return Err(self.err(p("end"), "give either `angle` or `end`, not both")),
-                (None, None) => return Err(self.err(p("angle"), "missing: give `angle` (rad) with `length`, or `end`")),
-                (Some(a), None) => {
-                    self.finite(&p("angle"), a)?;
-                    let l = b.length.ok_or_else(|| self.err(p("length"), "missing (required with `angle`)"))?;
-                    self.positive(&p("length"), l)?;
-                    (a, l)
-                }
-                (None, Some(end)) => {
-                    self.finite2(&p("end"), end)?;
-                    let (dx, dy) = (end[0] - b.start[0], end[1] - b.start[1]);
-                    let dist = dx.hypot(dy);
-                    if dist <= 0.0 {
-                        return Err(self.err(p("end"), "coincides with `start`: the body has zero length"));
-                    }
-                    let l = match b.length {
-                        Some(l) => {
-                            self.positive(&p("length"), l)?;
-                            if (l - dist).abs() > CLOSURE_TOL * l {
-                                return Err(self.err(p("length"), format!("{l} disagrees with |end − start| = {dist}")));
-                            }
-                            l
-                        }
-                        None => dist,
-                    };
-                    (dy.atan2(dx), l)
-                }
-            };
-            self.bodies.push(BeamBody {
-                name: b.name.clone(),
-                start: b.start,
-                angle,
-                length,
-                n_elements: b.elements as usize,
-                section: Section {
-                    density: b.density.value(),
-                    area: b.area,
-                    inertia: b.inertia,
-                    youngs_modulus: b.youngs_modulus.value(),
-                },
-                youngs_modulus_parameter,
-                density_parameter,
-                velocity: match b.velocity {
-                    Some(v) => {
-                        self.finite2(&p("velocity"), v)?;
-                        v
-                    }
-                    None => [0.0; 2],
-                },
-                angular_velocity: match b.angular_velocity {
-                    Some(w) => {
-                        self.finite(&p("angular_velocity"), w)?;
-                        w
-                    }
-                    None => 0.0,
-                },
-            });
-        }
-        let lmax = self.bodies.iter().map(|b| b.length).fold(0.0, f64::max);
-        let node_pos = |(b, k): NodeId, bodies: &[BeamBody]| -> [f64; 2] {
-            let r = bodies[b].undeformed_node(k);
-            [r[0], r[1]]
-        };
-        for (i, j) in f.joints.iter().enumerate() {
-            let p = |k: &str| format!("joints[{i}].{k}");
-            let joint = match j {
-                JointSpec::GroundPin { body, node, point } => {
-                    let id = self.node_id(&p("body"), &p("node"), body, node)?;
-                    let at = node_pos(id, &self.bodies);
-                    let point = match point {
-                        Some(pt) => {
-                            self.finite2(&p("point"), *pt)?;
-                            let gap = (pt[0] - at[0]).hypot(pt[1] - at[1]);
-                            if gap > CLOSURE_TOL * lmax {
-                                return Err(self.err(p("point"), format!("{pt:?} is {gap:.3e} m from the node's initial position {at:?}; the initial configuration must satisfy every joint")));
-                            }
-                            *pt
-                        }
-                        None => at,
-                    };
-                    Joint::GroundPin(GroundPin { node: id, point })
-                }
-                JointSpec::Pin { a, b } => {
-                    let ia = self.node_id(&p("a.body"), &p("a.node"), &a.body, &a.node)?;
-                    let ib = self.node_id(&p("b.body"), &p("b.node"), &b.body, &b.node)?;
-                    if ia.0 == ib.0 {
-                        return Err(self.err(p("b.body"), "a pin joins two different bodies"));
-                    }
-                    let (pa, pb) = (node_pos(ia, &self.bodies), node_pos(ib, &self.bodies));
-                    let gap = (pa[0] - pb[0]).hypot(pa[1] - pb[1]);
-                    if gap > CLOSURE_TOL * lmax {
-                        return Err(self.err(p("b"), format!("the two nodes start {gap:.3e} m apart ({pa:?} and {pb:?}); the initial configuration must satisfy every joint")));
-                    }
-                    Joint::Pin(Pin { a: ia, b: ib })
-                }
-                JointSpec::Clamp { body, node } => {
-                    let id = self.node_id(&p("body"), &p("node"), body, node)?;
-                    let bd = &self.bodies[id.0];
-                    Joint::Clamp(Clamp {
-                        node: id,
-                        point: node_pos(id, &self.bodies),
-                        slope: [bd.angle.cos(), bd.angle.sin()],
-                    })
-                }
-                JointSpec::Slider { body, node, direction, lock_rotation } => {
-                    let id = self.node_id(&p("body"), &p("node"), body, node)?;
-                    self.finite2(&p("direction"), *direction)?;
-                    if direction[0].hypot(direction[1]) == 0.0 {
-                        return Err(
-                            self.err(p("direction"), "has zero length; give the line's direction, e.g. [1.0, 0.0]")
-                        );
-                    }
-                    let angle = self.bodies[id.0].angle;
-                    Joint::Slider(Slider {
-                        node: id,
-                        point: node_pos(id, &self.bodies),
-                        direction: *direction,
-                        locked_slope: lock_rotation.then(|| [angle.cos(), angle.sin()]),
-                    })
-                }
-                JointSpec::Weld { a, b } => {
-                    let ia = self.node_id(&p("a.body"), &p("a.node"), &a.body, &a.node)?;
-                    let ib = self.node_id(&p("b.body"), &p("b.node"), &b.body, &b.node)?;
-                    if ia.0 == ib.0 {
-                        return Err(self.err(p("b.body"), "a weld joins two different bodies"));
-                    }
-                    let (pa, pb) = (node_pos(ia, &self.bodies), node_pos(ib, &self.bodies));
-                    let gap = (pa[0] - pb[0]).hypot(pa[1] - pb[1]);
-                    if gap > CLOSURE_TOL * lmax {
-                        return Err(self.err(p("b"), format!("the two nodes start {gap:.3e} m apart ({pa:?} and {pb:?}); the initial configuration must satisfy every joint")));
-                    }
-                    Joint::Weld(Weld { a: ia, b: ib, angle: self.bodies[ib.0].angle - self.bodies[ia.0].angle })
-                }
-                JointSpec::DrivenAngle { body, node, function, scaled } => {
-                    let id = self.node_id(&p("body"), &p("node"), body, node)?;
-                    let drive = self.drive(&p("function"), Some(function), &p("scaled"), scaled)?;
-                    Joint::DrivenAngle(DrivenAngle { node: id, theta0: self.bodies[id.0].angle, drive })
-                }
-                JointSpec::DrivenPoint { body, node, x, y, scaled } => {
-                    let id = self.node_id(&p("body"), &p("node"), body, node)?;
-                    let path = [
-                        self.drive(&p("x"), x.as_ref(), &p("scaled"), scaled)?,
-                        self.drive(&p("y"), y.as_ref(), &p("scaled"), scaled)?,
-                    ];
-                    Joint::DrivenPoint(DrivenPoint { node: id, point: node_pos(id, &self.bodies), path })
-                }
-            };
-            self.joints.push(joint);
-        }
-        self.check_joint_rank()?;
-        self.check_initial_velocities()?;
-        for (i, l) in f.loads.iter().enumerate() {
-            let p = |k: &str| format!("loads[{i}].{k}");
-            let load = match l {
-                LoadSpec::Gravity { g, scaled } => {
-                    self.finite2(&p("g"), *g)?;
-                    Load::Gravity(Gravity { g: *g, scaled: self.scaling(&p("scaled"), scaled)? })
-                }
-                LoadSpec::Moment { body, node, function, scaled } => {
-                    let id = self.node_id(&p("body"), &p("node"), body, node)?;
-                    function.check().map_err(|e| self.err(p("function"), e))?;
-                    Load::Moment(Moment {
-                        node: id,
-                        function: function.clone(),
-                        scaled: self.scaling(&p("scaled"), scaled)?,
-                    })
-                }
-                LoadSpec::Force { body, node, value, function, scaled } => {
-                    let id = self.node_id(&p("body"), &p("node"), body, node)?;
-                    self.finite2(&p("value"), *value)?;
-                    if let Some(func) = function {
-                        func.check().map_err(|e| self.err(p("function"), e))?;
-                    }
-                    let scaled = self.scaling(&p("scaled"), scaled)?;
-                    Load::Force(Force { node: id, value: *value, function: function.clone(), scaled })
-                }
-            };
-            self.loads.push(load);
-        }
-        for (i, m) in f.masses.iter().enumerate() {
-            let p = |k: &str| format!("masses[{i}].{k}");
-            let node = self.node_id(&p("body"), &p("node"), &m.body, &m.node)?;
-            self.positive(&p("mass"), m.mass.value())?;
-            let parameter = self.value_parameter(&p("mass"), &m.mass, value_parameters::ValueKind::PointMass)?;
-            let rotary_inertia = m.rotary_inertia.unwrap_or(0.0);
-            if !(rotary_inertia.is_finite() && rotary_inertia >= 0.0) {
-                let msg = format!("must be finite and ≥ 0 (kg m²), got {rotary_inertia}");
-                return Err(self.err(p("rotary_inertia"), msg));
-            }
-            self.masses.push(PointMass {
-                node,
-                mass: m.mass.value(),
-                rotary_inertia,
-                parameter: parameter.map(|p| p.0),
-            });
-        }
-        self.check_springs(&f.springs)?;
-        for (i, pr) in f.probes.iter().enumerate() {
-            let p = |k: &str| format!("probes[{i}].{k}");
-            if f.probes[..i].iter().any(|o| o.name == pr.name) {
-                return Err(self.err(p("name"), format!("probe `{}` is defined twice", pr.name)));
-            }
-            if pr.name.is_empty() || pr.name.contains('/') || pr.name.chars().any(char::is_control) {
-                return Err(self.err(
-                    p("name"),
-                    "must be non-empty and contain no `/` and no control character (a NUL, a newline, …): it names an HDF5 dataset",
-                ));
-            }
-            let b = self.body_index(&p("body"), &pr.body)?;
-            let n_el = self.bodies[b].n_elements;
-            let first_el: usize = self.bodies[..b].iter().map(|x| x.n_elements).sum();
-            let (element, xi) = match (&pr.node, pr.at) {
-                (Some(_), Some(_)) => return Err(self.err(p("at"), "give either `node` or `at`, not both")),
-                (None, None) => return Err(self.err(p("node"), "missing: give `node` or `at`")),
-                (Some(node), None) => {
-                    let (_, k) = self.node_id(&p("body"), &p("node"), &pr.body, node)?;
-                    if k < n_el {
-                        (first_el + k, 0.0)
-                    } else {
-                        (first_el + n_el - 1, 1.0)
-                    }
-                }
-                (None, Some(at)) => {
-                    if !(at.is_finite() && (0.0..=1.0).contains(&at)) {
-                        return Err(self.err(p("at"), format!("{at} lies outside the body (must be in [0, 1])")));
-                    }
-                    let s = at * n_el as f64;
-                    let k = (s.floor() as usize).min(n_el - 1);
-                    (first_el + k, s - k as f64)
-                }
-            };
-            let asks = |q: ProbeQuantity| pr.quantities.as_ref().is_some_and(|l| l.contains(&q));
-            self.probes.push(Probe {
-                name: pr.name.clone(),
-                element,
-                xi,
-                strain: asks(ProbeQuantity::Strain),
-                curvature: asks(ProbeQuantity::Curvature),
-            });
-        }
         Ok(())
+    }
+
+    /// `bodies[i]`, checked against the bodies before it (its name unique, the element count
+    /// within the limits): the beam body it gives.
+    fn checked_body(&self, f: &ModelFile, i: usize) -> Result<BeamBody> {
+        let b = &f.bodies[i];
+        let p = |k: &str| format!("bodies[{i}].{k}");
+        if b.name.trim().is_empty() {
+            return Err(self.err(p("name"), "must not be empty"));
+        }
+        if b.name.chars().any(char::is_control) {
+            // the result files' labels store it as HDF5 text, which ends at a NUL
+            return Err(self.err(
+                p("name"),
+                format!("`{}` holds a control character (a NUL, a newline, …): names are written into the result files' labels", crate::error::show_text(&b.name)),
+            ));
+        }
+        if f.bodies[..i].iter().any(|o| o.name == b.name) {
+            return Err(self.err(p("name"), format!("body `{}` is defined twice", b.name)));
+        }
+        self.finite2(&p("start"), b.start)?;
+        if b.elements <= 0 {
+            return Err(self.err(p("elements"), format!("must be a positive integer, got {}", b.elements)));
+        }
+        let total: f64 = f.bodies[..=i].iter().map(|b| b.elements.max(0) as f64).sum();
+        self.limits.check_elements(total).map_err(|e| self.err(p("elements"), e))?;
+        // a property given as `{ value, parameter }` names its `value`
+        let property = |k: &str, spec: &PropertySpec| match spec {
+            PropertySpec::Value(v) => (k.to_string(), *v),
+            PropertySpec::Parameter(x) => (format!("{k}.value"), x.value),
+        };
+        for (k, v) in [
+            property("density", &b.density),
+            ("area".into(), b.area),
+            ("inertia".into(), b.inertia),
+            property("youngs_modulus", &b.youngs_modulus),
+        ] {
+            self.positive(&p(&k), v)?;
+        }
+        let youngs_modulus_parameter = self.checked_property_parameter(f, i, Property::YoungsModulus)?;
+        let density_parameter = self.checked_property_parameter(f, i, Property::Density)?;
+        let (angle, length) = self.body_angle_and_length(b, i)?;
+        Ok(BeamBody {
+            name: b.name.clone(),
+            start: b.start,
+            angle,
+            length,
+            n_elements: b.elements as usize,
+            section: Section {
+                density: b.density.value(),
+                area: b.area,
+                inertia: b.inertia,
+                youngs_modulus: b.youngs_modulus.value(),
+            },
+            youngs_modulus_parameter,
+            density_parameter,
+            velocity: match b.velocity {
+                Some(v) => {
+                    self.finite2(&p("velocity"), v)?;
+                    v
+                }
+                None => [0.0; 2],
+            },
+            angular_velocity: match b.angular_velocity {
+                Some(w) => {
+                    self.finite(&p("angular_velocity"), w)?;
+                    w
+                }
+                None => 0.0,
+            },
+        })
+    }
+
+    /// A body's direction and length, from `angle` and `length` or from `end` (a `length`
+    /// given beside `end` must agree with it).
+    fn body_angle_and_length(&self, b: &BodySpec, i: usize) -> Result<(f64, f64)> {
+        let p = |k: &str| format!("bodies[{i}].{k}");
+        match (b.angle, b.end) {
+            (Some(_), Some(_)) => Err(self.err(p("end"), "give either `angle` or `end`, not both")),
+            (None, None) => Err(self.err(p("angle"), "missing: give `angle` (rad) with `length`, or `end`")),
+            (Some(a), None) => {
+                self.finite(&p("angle"), a)?;
+                let l = b.length.ok_or_else(|| self.err(p("length"), "missing (required with `angle`)"))?;
+                self.positive(&p("length"), l)?;
+                Ok((a, l))
+            }
+            (None, Some(end)) => {
+                self.finite2(&p("end"), end)?;
+                let (dx, dy) = (end[0] - b.start[0], end[1] - b.start[1]);
+                let dist = dx.hypot(dy);
+                if dist <= 0.0 {
+                    return Err(self.err(p("end"), "coincides with `start`: the body has zero length"));
+                }
+                let l = match b.length {
+                    Some(l) => {
+                        self.positive(&p("length"), l)?;
+                        if (l - dist).abs() > CLOSURE_TOL * l {
+                            return Err(self.err(p("length"), format!("{l} disagrees with |end − start| = {dist}")));
+                        }
+                        l
+                    }
+                    None => dist,
+                };
+                Ok((dy.atan2(dx), l))
+            }
+        }
+    }
+
+    /// `joints[i]` on the checked bodies: its nodes exist and, for the joints that hold two
+    /// points together, start closed (within `CLOSURE_TOL` of the longest body `lmax`).
+    fn checked_joint(&self, i: usize, j: &JointSpec, lmax: f64) -> Result<Joint> {
+        let p = |k: &str| format!("joints[{i}].{k}");
+        let node_pos = |id: NodeId| node_position(&self.bodies, id);
+        Ok(match j {
+            JointSpec::GroundPin { body, node, point } => {
+                let id = self.node_id(&p("body"), &p("node"), body, node)?;
+                let at = node_pos(id);
+                let point = match point {
+                    Some(pt) => {
+                        self.finite2(&p("point"), *pt)?;
+                        let gap = (pt[0] - at[0]).hypot(pt[1] - at[1]);
+                        if gap > CLOSURE_TOL * lmax {
+                            return Err(self.err(p("point"), format!("{pt:?} is {gap:.3e} m from the node's initial position {at:?}; the initial configuration must satisfy every joint")));
+                        }
+                        *pt
+                    }
+                    None => at,
+                };
+                Joint::GroundPin(GroundPin { node: id, point })
+            }
+            JointSpec::Pin { a, b } => {
+                let (ia, ib) = self.closed_node_pair(i, a, b, "pin", lmax)?;
+                Joint::Pin(Pin { a: ia, b: ib })
+            }
+            JointSpec::Clamp { body, node } => {
+                let id = self.node_id(&p("body"), &p("node"), body, node)?;
+                let bd = &self.bodies[id.0];
+                Joint::Clamp(Clamp { node: id, point: node_pos(id), slope: [bd.angle.cos(), bd.angle.sin()] })
+            }
+            JointSpec::Slider { body, node, direction, lock_rotation } => {
+                let id = self.node_id(&p("body"), &p("node"), body, node)?;
+                self.finite2(&p("direction"), *direction)?;
+                if direction[0].hypot(direction[1]) == 0.0 {
+                    return Err(self.err(p("direction"), "has zero length; give the line's direction, e.g. [1.0, 0.0]"));
+                }
+                let angle = self.bodies[id.0].angle;
+                Joint::Slider(Slider {
+                    node: id,
+                    point: node_pos(id),
+                    direction: *direction,
+                    locked_slope: lock_rotation.then(|| [angle.cos(), angle.sin()]),
+                })
+            }
+            JointSpec::Weld { a, b } => {
+                let (ia, ib) = self.closed_node_pair(i, a, b, "weld", lmax)?;
+                Joint::Weld(Weld { a: ia, b: ib, angle: self.bodies[ib.0].angle - self.bodies[ia.0].angle })
+            }
+            JointSpec::DrivenAngle { body, node, function, scaled } => {
+                let id = self.node_id(&p("body"), &p("node"), body, node)?;
+                let drive = self.drive(&p("function"), Some(function), &p("scaled"), scaled)?;
+                Joint::DrivenAngle(DrivenAngle { node: id, theta0: self.bodies[id.0].angle, drive })
+            }
+            JointSpec::DrivenPoint { body, node, x, y, scaled } => {
+                let id = self.node_id(&p("body"), &p("node"), body, node)?;
+                let path = [
+                    self.drive(&p("x"), x.as_ref(), &p("scaled"), scaled)?,
+                    self.drive(&p("y"), y.as_ref(), &p("scaled"), scaled)?,
+                ];
+                Joint::DrivenPoint(DrivenPoint { node: id, point: node_pos(id), path })
+            }
+        })
+    }
+
+    /// The nodes `a` and `b` of the pin or weld `joints[i]` (`kind`): on two different bodies,
+    /// and starting at one point.
+    fn closed_node_pair(
+        &self,
+        i: usize,
+        a: &NodeSpec,
+        b: &NodeSpec,
+        kind: &str,
+        lmax: f64,
+    ) -> Result<(NodeId, NodeId)> {
+        let p = |k: &str| format!("joints[{i}].{k}");
+        let ia = self.node_id(&p("a.body"), &p("a.node"), &a.body, &a.node)?;
+        let ib = self.node_id(&p("b.body"), &p("b.node"), &b.body, &b.node)?;
+        if ia.0 == ib.0 {
+            return Err(self.err(p("b.body"), format!("a {kind} joins two different bodies")));
+        }
+        let (pa, pb) = (node_position(&self.bodies, ia), node_position(&self.bodies, ib));
+        let gap = (pa[0] - pb[0]).hypot(pa[1] - pb[1]);
+        if gap > CLOSURE_TOL * lmax {
+            return Err(self.err(p("b"), format!("the two nodes start {gap:.3e} m apart ({pa:?} and {pb:?}); the initial configuration must satisfy every joint")));
+        }
+        Ok((ia, ib))
+    }
+
+    /// `loads[i]` on the checked bodies.
+    fn checked_load(&self, i: usize, l: &LoadSpec) -> Result<Load> {
+        let p = |k: &str| format!("loads[{i}].{k}");
+        Ok(match l {
+            LoadSpec::Gravity { g, scaled } => {
+                self.finite2(&p("g"), *g)?;
+                Load::Gravity(Gravity { g: *g, scaled: self.scaling(&p("scaled"), scaled)? })
+            }
+            LoadSpec::Moment { body, node, function, scaled } => {
+                let id = self.node_id(&p("body"), &p("node"), body, node)?;
+                function.check().map_err(|e| self.err(p("function"), e))?;
+                Load::Moment(Moment {
+                    node: id,
+                    function: function.clone(),
+                    scaled: self.scaling(&p("scaled"), scaled)?,
+                })
+            }
+            LoadSpec::Force { body, node, value, function, scaled } => {
+                let id = self.node_id(&p("body"), &p("node"), body, node)?;
+                self.finite2(&p("value"), *value)?;
+                if let Some(func) = function {
+                    func.check().map_err(|e| self.err(p("function"), e))?;
+                }
+                let scaled = self.scaling(&p("scaled"), scaled)?;
+                Load::Force(Force { node: id, value: *value, function: function.clone(), scaled })
+            }
+        })
+    }
+
+    /// `masses[i]`: a point mass on a node, its mass (maybe a parameter) positive, its rotary
+    /// inertia finite and non-negative.
+    fn checked_mass(&self, i: usize, m: &MassSpec) -> Result<PointMass> {
+        let p = |k: &str| format!("masses[{i}].{k}");
+        let node = self.node_id(&p("body"), &p("node"), &m.body, &m.node)?;
+        self.positive(&p("mass"), m.mass.value())?;
+        let parameter = self.value_parameter(&p("mass"), &m.mass, value_parameters::ValueKind::PointMass)?;
+        let rotary_inertia = m.rotary_inertia.unwrap_or(0.0);
+        if !(rotary_inertia.is_finite() && rotary_inertia >= 0.0) {
+            let msg = format!("must be finite and ≥ 0 (kg m²), got {rotary_inertia}");
+            return Err(self.err(p("rotary_inertia"), msg));
+        }
+        Ok(PointMass { node, mass: m.mass.value(), rotary_inertia, parameter: parameter.map(|p| p.0) })
+    }
+
+    /// `probes[i]`: a unique name fit for an HDF5 dataset, and the element and local
+    /// coordinate ξ of its point (a node, or a fraction `at` of its body's length).
+    fn checked_probe(&self, f: &ModelFile, i: usize) -> Result<Probe> {
+        let pr = &f.probes[i];
+        let p = |k: &str| format!("probes[{i}].{k}");
+        if f.probes[..i].iter().any(|o| o.name == pr.name) {
+            return Err(self.err(p("name"), format!("probe `{}` is defined twice", pr.name)));
+        }
+        if pr.name.is_empty() || pr.name.contains('/') || pr.name.chars().any(char::is_control) {
+            return Err(self.err(
+                p("name"),
+                "must be non-empty and contain no `/` and no control character (a NUL, a newline, …): it names an HDF5 dataset",
+            ));
+        }
+        let b = self.body_index(&p("body"), &pr.body)?;
+        let n_el = self.bodies[b].n_elements;
+        let first_el: usize = self.bodies[..b].iter().map(|x| x.n_elements).sum();
+        let (element, xi) = match (&pr.node, pr.at) {
+            (Some(_), Some(_)) => return Err(self.err(p("at"), "give either `node` or `at`, not both")),
+            (None, None) => return Err(self.err(p("node"), "missing: give `node` or `at`")),
+            (Some(node), None) => {
+                let (_, k) = self.node_id(&p("body"), &p("node"), &pr.body, node)?;
+                if k < n_el {
+                    (first_el + k, 0.0)
+                } else {
+                    (first_el + n_el - 1, 1.0)
+                }
+            }
+            (None, Some(at)) => {
+                if !(at.is_finite() && (0.0..=1.0).contains(&at)) {
+                    return Err(self.err(p("at"), format!("{at} lies outside the body (must be in [0, 1])")));
+                }
+                let s = at * n_el as f64;
+                let k = (s.floor() as usize).min(n_el - 1);
+                (first_el + k, s - k as f64)
+            }
+        };
+        let asks = |q: ProbeQuantity| pr.quantities.as_ref().is_some_and(|l| l.contains(&q));
+        Ok(Probe {
+            name: pr.name.clone(),
+            element,
+            xi,
+            strain: asks(ProbeQuantity::Strain),
+            curvature: asks(ProbeQuantity::Curvature),
+        })
     }
 
     /// Refuses joints whose constraint rows `B` (as each joint kind builds them) are

@@ -173,7 +173,7 @@ impl Basis {
         let vtd = self.modes.t().dot(&dx);
         match self.variant {
             Variant::WholeSystem => {
-                use ndarray_linalg::Solve;
+                use crate::linalg::lapack::Solve;
                 let gram = self.modes.t().dot(&self.modes);
                 gram.solve_into(vtd.clone()).unwrap_or(vtd)
             }

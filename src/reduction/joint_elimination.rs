@@ -24,9 +24,9 @@
 //! `j` joint rows and columns of `S`. The multipliers stay exact.
 
 use crate::linalg::dense_lu::DenseLu;
+use crate::linalg::lapack::SVD;
 use crate::linalg::vec_ops::{axpy, dot};
 use ndarray::Array2;
-use ndarray_linalg::SVD;
 
 pub(crate) struct JointElimination {
     r: usize,

@@ -5,8 +5,8 @@
 //!     energy(r) = Σ_{i≤r} σᵢ² / Σ_i σᵢ²
 //! ```
 
+use crate::linalg::lapack::{JobSvd, SVDDC};
 use ndarray::{s, Array1, Array2, ArrayView2};
-use ndarray_linalg::{JobSvd, SVDDC};
 
 /// How many POD modes to keep.
 #[derive(Clone, Debug, PartialEq, serde::Deserialize, serde::Serialize)]

@@ -30,11 +30,11 @@ mod newton;
 use super::basis::{Basis, Variant};
 use super::joint_elimination::JointElimination;
 use crate::linalg::dense_lu::DenseLu;
+use crate::linalg::lapack::SVD;
 use crate::linalg::sparse_rows::SparseRows;
 pub(crate) use crate::linalg::vec_ops::{axpy, dot, mat_vec};
 use crate::solver::model::{mass_groups, ConstantForces, ElementModel, IterationCoefficients, Parameters};
 use ndarray::{s, Array1, Array2, ArrayView1, Axis};
-use ndarray_linalg::SVD;
 
 /// The [`crate::solver::model::ParametricModel`] methods a reduced model with fields
 /// `p: Projection` and `full: M` forwards unchanged (mass, joints, Newton solve, length

@@ -162,7 +162,7 @@ pub fn explain_failure(
 /// orthonormal `Ψ`, `V` (the reduced constraint block's smallest singular value): zero
 /// means some reduced multiplier acts on nothing and the reduced Newton matrix is singular.
 pub fn inf_sup(b: &Array2<f64>, psi: &Array2<f64>, v: &Array2<f64>) -> f64 {
-    use ndarray_linalg::SVD;
+    use crate::linalg::lapack::SVD;
     let c = psi.t().dot(&b.dot(v));
     if c.is_empty() {
         return 0.0;

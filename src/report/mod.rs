@@ -116,11 +116,8 @@ fn current_basis(p: &Pipeline, method: Option<EstimateMethod>) -> Option<Reused>
     if stored.settings_hash != p.settings_hash() || stored.model_fingerprint != p.model.fingerprint() {
         return None;
     }
-    let n_snapshots = crate::io::h5_open::open(&p.basis_path)
-        .and_then(|f| f.dataset("snapshots"))
-        .ok()
-        .and_then(|d| d.shape().get(1).copied())?;
-    let runs = stored_runs(p, &p.basis_path).ok()?;
+    let n_snapshots = stored.training.snapshot_count?;
+    let runs = stored_runs(p, &stored);
     Some(Reused { stored, rom, n_snapshots, runs })
 }
 
@@ -136,27 +133,13 @@ struct Reused {
 }
 
 /// The points of the full runs a basis holds the snapshots of: in a box, `/parameters`
-/// (their values in run order); on a line, its training loads.
-fn stored_runs(p: &Pipeline, path: &Path) -> Result<Vec<Parameters>> {
-    let space = p.space();
-    if space.is_empty() {
-        let loads = crate::io::estimator_file::read_training_loads(path)?;
-        return Ok(loads.into_iter().map(Parameters::load_scale).collect());
+/// (their values in run order); on a line, its training loads. Both as the one read of the
+/// basis file gave them ([`crate::io::basis_training`]).
+fn stored_runs(p: &Pipeline, stored: &crate::io::basis_file::StoredBasis) -> Vec<Parameters> {
+    if p.space().is_empty() {
+        return stored.training.loads.iter().map(|&l| Parameters::load_scale(l)).collect();
     }
-    let f = crate::io::h5_open::open(path).map_err(|e| Error::hdf5(path, e))?;
-    let mut runs: Vec<Parameters> = Vec::new();
-    for name in space.names() {
-        let field = format!("parameters/{name}");
-        let values = f
-            .dataset(&field)
-            .and_then(|d| d.read_1d::<f64>())
-            .map_err(|e| Error::input(path, &field, format!("cannot be read: {e}")))?;
-        runs.resize(values.len(), Parameters::default());
-        for (mu, v) in runs.iter_mut().zip(values.iter()) {
-            *mu = std::mem::take(mu).with(name, *v);
-        }
-    }
-    Ok(runs)
+    stored.training.points.clone()
 }
 
 /// Every stage, writing the basis to `basis_path` (a temporary name) and the report files
@@ -185,7 +168,7 @@ fn build(
         vec![],
         "singular_values",
     )?;
-    shown.extend(parameter_figures(&st, basis_path, &rom, &sw, &validations)?);
+    shown.extend(parameter_figures(&st, &stored, &rom, &sw, &validations)?);
     st.single(
         "rel_error (solid) and error_estimate (dashed) up to a fraction of the run",
         "fraction of the run",
@@ -385,7 +368,7 @@ fn singular_value_series(p: &Pipeline, stored: &crate::io::basis_file::StoredBas
 /// (file stem, what it shows) of each, in the order summary.md shows them.
 fn parameter_figures(
     st: &Stage,
-    basis_path: &Path,
+    stored: &crate::io::basis_file::StoredBasis,
     rom: &Rom,
     sw: &crate::workflows::sweep::Sweep,
     validations: &[Validation],
@@ -411,7 +394,7 @@ fn parameter_figures(
                     .map(|v| crate::report::report_maps::MappedRun { validation: v, estimate: v.error_estimate }),
             )
             .collect();
-        let training = stored_runs(p, basis_path)?;
+        let training = stored_runs(p, stored);
         let cx = crate::report::report_maps::MapContext {
             space: &st.space,
             training: &training,
@@ -420,7 +403,7 @@ fn parameter_figures(
         };
         return crate::report::report_maps::write_maps(st.out, &runs, &cx).map_err(|(stem, e)| st.plot_err(stem, e));
     };
-    axis_figures(st, axis, basis_path, sw, validations)
+    axis_figures(st, axis, stored, sw, validations)
 }
 
 /// The figures along `axis`: the error and the speedup over the sweep, and the estimate
@@ -428,7 +411,7 @@ fn parameter_figures(
 fn axis_figures(
     st: &Stage,
     axis: &str,
-    basis_path: &Path,
+    stored: &crate::io::basis_file::StoredBasis,
     sw: &crate::workflows::sweep::Sweep,
     validations: &[Validation],
 ) -> Result<Vec<(&'static str, &'static str)>> {
@@ -448,11 +431,8 @@ fn axis_figures(
         v
     };
     // the full runs the basis was trained on, marked on the plots along the axis
-    let training: Vec<f64> = if st.in_box {
-        stored_runs(p, basis_path)?.iter().map(x_of).collect()
-    } else {
-        crate::io::estimator_file::read_training_loads(basis_path)?
-    };
+    let training: Vec<f64> =
+        if st.in_box { stored_runs(p, stored).iter().map(x_of).collect() } else { stored.training.loads.clone() };
     // rel_error and the probe error (m) on axes of their own: two units, two axes
     let mut panels = vec![Panel {
         y_label: "rel_error".into(),

@@ -296,7 +296,7 @@ mod tests {
         let nt = 4;
         let a =
             Array2::from_shape_fn((n, 5), |(i, j)| ((i * 5 + j) as f64 * 0.37).sin() + if i == j { 2.0 } else { 0.0 });
-        let (qf, _) = ndarray_linalg::QR::qr(&a).unwrap();
+        let (qf, _) = crate::linalg::lapack::QR::qr(&a).unwrap();
         let vp = qf.slice(ndarray::s![.., ..5]).to_owned();
         let reference = Array1::from_shape_fn(n, |i| 0.1 * i as f64 + 1.0);
         let mk = |modes: Array2<f64>| galerkin(modes, reference.clone());
@@ -305,9 +305,10 @@ mod tests {
         // nested (first 3 columns) and not nested (mixing columns 2..5)
         let nested = vp.slice(ndarray::s![.., ..3]).to_owned();
         let mixed = {
-            let (q, _) =
-                ndarray_linalg::QR::qr(&(&vp.slice(ndarray::s![.., 1..4]) + &(0.3 * &qf.slice(ndarray::s![.., 4..5]))))
-                    .unwrap();
+            let (q, _) = crate::linalg::lapack::QR::qr(
+                &(&vp.slice(ndarray::s![.., 1..4]) + &(0.3 * &qf.slice(ndarray::s![.., 4..5]))),
+            )
+            .unwrap();
             q
         };
         for small in [nested, mixed] {
