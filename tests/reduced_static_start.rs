@@ -24,6 +24,13 @@ const MODEL: &str = "[time]\nt_end = 0.05\ndt = 0.001\nrho_inf = 0.8\n\
     [[loads]]\ntype = \"gravity\"\ng = [0.0, -9.81]\nscaled = true\n\
     [[probes]]\nname = \"tip\"\nbody = \"beam\"\nnode = \"end\"\n";
 
+/// `flexrom ARGS` in `dir`, which must succeed: its standard output.
+fn run(dir: &std::path::Path, args: &[&str]) -> String {
+    let out = Command::new(env!("CARGO_BIN_EXE_flexrom")).args(args).current_dir(dir).output().unwrap();
+    assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    String::from_utf8(out.stdout).unwrap()
+}
+
 #[test]
 fn a_reduced_run_starts_from_its_static_equilibrium() {
     let dir = tempfile::tempdir().unwrap();
@@ -34,15 +41,7 @@ fn a_reduced_run_starts_from_its_static_equilibrium() {
          [reduction]\nmodes = { count = 2 }\n",
     )
     .unwrap();
-    let flexrom = |args: &[&str]| {
-        let out = Command::new(env!("CARGO_BIN_EXE_flexrom"))
-            .args(args)
-            .current_dir(dir.path())
-            .env("HDF5_USE_FILE_LOCKING", "FALSE")
-            .output()
-            .unwrap();
-        assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
-    };
+    let flexrom = |args: &[&str]| run(dir.path(), args);
     flexrom(&["train", "p.toml", "-q"]);
     flexrom(&["online", "p.toml", "--load-scale", "1.0", "-o", "reduced.h5", "-q"]);
     flexrom(&["simulate", "m.toml", "-o", "full.h5", "-q"]);
@@ -83,11 +82,7 @@ fn the_estimate_of_a_run_from_its_static_equilibrium_follows_its_error() {
         "model = \"m.toml\"\nbasis = \"b.h5\"\n[train]\ngreedy = { range = [0.5, 1.5], tolerance = 1e-3, max_runs = 8 }\n",
     )
     .unwrap();
-    let flexrom = |args: &[&str]| {
-        let out = Command::new(env!("CARGO_BIN_EXE_flexrom")).args(args).current_dir(dir.path()).output().unwrap();
-        assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
-        String::from_utf8(out.stdout).unwrap()
-    };
+    let flexrom = |args: &[&str]| run(dir.path(), args);
     flexrom(&["train", "p.toml", "-q"]);
     for method in ["corrected", "defects", "enriched"] {
         for load in ["0.7", "1.3"] {
