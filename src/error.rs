@@ -34,6 +34,22 @@ pub enum Error {
     #[error("linear solve failed at t = {t:.6} s: {problem}")]
     LinearSolve { t: f64, problem: String },
 
+    /// A numerical step failed where no time is known: a linear system's factorization or
+    /// solve, a POD, an NNLS fit. `what` names the step (`linear solve`, `POD`, `NNLS`); a
+    /// caller that knows the time makes a linear solve's failure an [`Error::LinearSolve`]
+    /// ([`Error::at_time`]).
+    #[error("{what}: {problem}")]
+    Numerical { what: &'static str, problem: String },
+
+    /// What a failed numerical step was for (`enriched basis`, `block 2`), before the
+    /// step's own failure ([`Error::context`]).
+    #[error("{context}: {source}")]
+    Context {
+        context: String,
+        #[source]
+        source: Box<Error>,
+    },
+
     /// `--strict`: a run's error estimate exceeds the tolerance (its output is written;
     /// the program exits with code 4).
     #[error("{0}")]
@@ -111,6 +127,9 @@ pub fn show_text(s: &str) -> String {
     s.chars().map(|c| if c.is_control() { c.escape_default().to_string() } else { c.to_string() }).collect()
 }
 
+/// The step [`Error::Numerical`] names for a linear system's factorization or solve.
+pub const LINEAR_SOLVE: &str = "linear solve";
+
 /// What to do after a reduced run failed ([`Error::at_reduced_stage`]; a sweep says it once
 /// after its failures).
 pub const REDUCED_RUN_FAILED: &str =
@@ -147,7 +166,9 @@ impl Error {
     pub fn is_numerical(&self) -> bool {
         match self {
             Error::NewtonFailed { .. } | Error::LinearSolve { .. } | Error::BlowUp { .. } => true,
-            Error::Stage { source, .. } | Error::Hinted { source, .. } => source.is_numerical(),
+            Error::Stage { source, .. } | Error::Hinted { source, .. } | Error::Context { source, .. } => {
+                source.is_numerical()
+            }
             _ => false,
         }
     }
@@ -174,6 +195,67 @@ impl Error {
                 Error::Hinted { source: Box::new(self.at_stage(stage, mu)), hint: hint.to_string() }
             }
             other => other,
+        }
+    }
+
+    /// A linear system's factorization or solve failed ([`Error::Numerical`] with
+    /// [`LINEAR_SOLVE`]).
+    pub fn linear_solve(problem: impl Into<String>) -> Self {
+        Error::Numerical { what: LINEAR_SOLVE, problem: problem.into() }
+    }
+
+    /// A numerical step's failure ([`Error::Numerical`]).
+    pub fn numerical(what: &'static str, problem: impl Into<String>) -> Self {
+        Error::Numerical { what, problem: problem.into() }
+    }
+
+    /// A failed linear solve placed at time `t` ([`Error::LinearSolve`]; another numerical
+    /// step keeps its name in the problem); every other error passes unchanged.
+    pub fn at_time(self, t: f64) -> Self {
+        match self {
+            Error::Numerical { what: LINEAR_SOLVE, problem } => Error::LinearSolve { t, problem },
+            Error::Numerical { what, problem } => Error::LinearSolve { t, problem: format!("{what}: {problem}") },
+            Error::Context { context, source } => source.at_time_in(t, &context),
+            other => other,
+        }
+    }
+
+    /// [`Self::at_time`] with what the solve was for put before its problem (`initial joint
+    /// projection: …`).
+    pub fn at_time_in(self, t: f64, context: &str) -> Self {
+        match self.at_time(t) {
+            Error::LinearSolve { t, problem } => Error::LinearSolve { t, problem: format!("{context}: {problem}") },
+            other => other,
+        }
+    }
+
+    /// What the failing step was for (`enriched basis`, `block 2`) put before the problem of
+    /// a bad value, a bound, a linear solve or an HDF5 finding (the variant stays, so does
+    /// what it tells the caller), or before a numerical step's failure
+    /// ([`Error::Context`]). Other errors name their file and field already and pass
+    /// unchanged.
+    pub fn context(self, c: impl std::fmt::Display) -> Self {
+        match self {
+            Error::Usage(p) => Error::Usage(format!("{c}: {p}")),
+            Error::Resource(p) => Error::Resource(format!("{c}: {p}")),
+            e @ (Error::Numerical { .. } | Error::Context { .. }) => {
+                Error::Context { context: c.to_string(), source: Box::new(e) }
+            }
+            Error::LinearSolve { t, problem } => Error::LinearSolve { t, problem: format!("{c}: {problem}") },
+            Error::Hdf5 { file, problem } => Error::Hdf5 { file, problem: format!("{c}: {problem}") },
+            other => other,
+        }
+    }
+
+    /// The problem a lower layer found, without the file or the step it names: what a caller
+    /// that knows the file and the field puts after them ([`Error::input`]). A bad value
+    /// ([`Error::Usage`]), a bound ([`Error::Resource`]) and what an HDF5 check found
+    /// ([`Error::Hdf5`]) give their text; another error gives its whole message.
+    pub fn problem(self) -> String {
+        match self {
+            Error::Usage(p) | Error::Resource(p) | Error::Hdf5 { problem: p, .. } => p,
+            Error::Numerical { what: LINEAR_SOLVE, problem } => problem,
+            other => other.to_string(),
         }
     }
 

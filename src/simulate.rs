@@ -175,7 +175,7 @@ pub fn integrate_guided<M: DynamicModel>(
     mut record: impl FnMut(usize, &State),
 ) -> Result<Stats> {
     let (params, dt, n_steps) = (&s.params, s.dt, s.n_steps);
-    let mut integ = GeneralizedAlpha::new(params.clone()).map_err(Error::Usage)?;
+    let mut integ = GeneralizedAlpha::new(params.clone())?;
     let mut state = integ.initialize(model, q0, v0, 0.0)?;
     let mut increment = vec![0.0; state.q.len()];
     let mut watch = BlowUpWatch::new(params, s.allow_blowup);
@@ -282,8 +282,7 @@ impl BlowUpWatch {
 pub fn prepare(model: &Model, s: &Settings) -> Result<(FlexibleSystem, Vec<f64>)> {
     let mut sys = model.system(s.solver);
     let mut q0 = sys.initial_state();
-    sys.make_consistent(&mut q0)
-        .map_err(|p| Error::LinearSolve { t: 0.0, problem: format!("initial joint projection: {p}") })?;
+    sys.make_consistent(&mut q0).map_err(|e| e.at_time_in(0.0, "initial joint projection"))?;
     Ok((sys, q0))
 }
 
@@ -611,7 +610,8 @@ pub fn modes(model: &Model, o: &ModesOptions) -> Result<ModesAnalysis> {
             model.path.display(),
             q0.len(),
             q0.len() - n_free
-        )));
+        ),
+        ));
     }
     let start = std::time::Instant::now();
     let q = match o.at {

@@ -44,7 +44,9 @@ pub fn to_py(e: Error) -> PyErr {
     }
     match root(&e) {
         Error::Interrupted => pyo3::exceptions::PyKeyboardInterrupt::new_err(msg),
-        Error::NewtonFailed { .. } | Error::LinearSolve { .. } | Error::BlowUp { .. } => SolverError::new_err(msg),
+        Error::NewtonFailed { .. } | Error::LinearSolve { .. } | Error::BlowUp { .. } | Error::Numerical { .. } => {
+            SolverError::new_err(msg)
+        }
         Error::Input { .. } | Error::Io { .. } | Error::Usage(_) | Error::Resource(_) => ModelError::new_err(msg),
         _ => FlexromError::new_err(msg),
     }
@@ -67,7 +69,7 @@ pub fn model_error(msg: &str) -> PyErr {
 /// The error under a stage's context (the kind decides the exception).
 fn root(e: &Error) -> &Error {
     match e {
-        Error::Stage { source, .. } | Error::Hinted { source, .. } => root(source),
+        Error::Stage { source, .. } | Error::Hinted { source, .. } | Error::Context { source, .. } => root(source),
         other => other,
     }
 }

@@ -9,6 +9,7 @@
 //! How it is built, calibrated and run is `crate::rom::estimator`'s.
 
 use super::basis::Basis;
+use crate::error::{Error, Result};
 use crate::solver::parameter_space::ParameterSpace;
 use crate::solver::parameters::Parameters;
 
@@ -319,12 +320,14 @@ impl EstimateMethod {
         }
     }
 
-    pub fn parse(s: &str) -> std::result::Result<Self, String> {
+    pub fn parse(s: &str) -> Result<Self> {
         match s {
             "corrected" => Ok(EstimateMethod::Corrected),
             "enriched" => Ok(EstimateMethod::Enriched),
             "defects" => Ok(EstimateMethod::Defects),
-            _ => Err(format!("is \"{s}\"; expected \"corrected\" (default), \"defects\" or \"enriched\"")),
+            _ => {
+                Err(Error::Usage(format!("is \"{s}\"; expected \"corrected\" (default), \"defects\" or \"enriched\"")))
+            }
         }
     }
 }
@@ -358,11 +361,11 @@ impl ErrorMeasure {
         }
     }
 
-    pub fn parse(s: &str) -> std::result::Result<Self, String> {
+    pub fn parse(s: &str) -> Result<Self> {
         match s {
             "relative" => Ok(ErrorMeasure::Relative),
             "displacement" => Ok(ErrorMeasure::Displacement),
-            _ => Err(format!("is \"{s}\"; expected \"relative\" (default) or \"displacement\"")),
+            _ => Err(Error::Usage(format!("is \"{s}\"; expected \"relative\" (default) or \"displacement\""))),
         }
     }
 
