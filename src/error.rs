@@ -59,6 +59,13 @@ pub enum Error {
     #[error("{0}")]
     Usage(String),
 
+    /// A bad value of a run's option, named by its key (`load_scale`, `shard`, `dt`,
+    /// `max_memory`) and not as a front end spells it: the command line renders it as
+    /// `--load-scale`, Python as the keyword `load_scale=` ([`Error::render`]). `value`: the
+    /// value given, where the message shows it.
+    #[error("{}", option_message(key, value.as_deref(), problem, &plain_option))]
+    Option { key: &'static str, value: Option<String>, problem: String },
+
     /// A run or an allocation would exceed a resource bound (memory, step count): names
     /// the estimated figure, the bound and the option or key that raises it.
     #[error("{0}")]
@@ -125,6 +132,24 @@ pub fn show_number(x: f64) -> String {
 /// one line and a file cannot write to the terminal through it; everything else as it is.
 pub fn show_text(s: &str) -> String {
     s.chars().map(|c| if c.is_control() { c.escape_default().to_string() } else { c.to_string() }).collect()
+}
+
+/// How a front end writes an option and its value (`--load-scale 2`, `load_scale=2`; the
+/// value is `None` where the message does not show it).
+pub type OptionSpelling = dyn Fn(&str, Option<&str>) -> String;
+
+/// An option's message with the option as `spell` writes it: `OPTION VALUE: problem`, or
+/// `OPTION problem` without a value (`--load-scale must be finite, got NaN`).
+fn option_message(key: &str, value: Option<&str>, problem: &str, spell: &OptionSpelling) -> String {
+    match value {
+        Some(_) => format!("{}: {problem}", spell(key, value)),
+        None => format!("{} {problem}", spell(key, None)),
+    }
+}
+
+/// The library's own spelling of an option: its key, and ` = value` (`load_scale = NaN`).
+fn plain_option(key: &str, value: Option<&str>) -> String {
+    value.map_or(key.to_string(), |v| format!("{key} = {v}"))
 }
 
 /// The step [`Error::Numerical`] names for a linear system's factorization or solve.
@@ -195,6 +220,24 @@ impl Error {
                 Error::Hinted { source: Box::new(self.at_stage(stage, mu)), hint: hint.to_string() }
             }
             other => other,
+        }
+    }
+
+    /// A bad value of the option `key` ([`Error::Option`]).
+    pub fn option(key: &'static str, value: Option<String>, problem: impl Into<String>) -> Self {
+        Error::Option { key, value, problem: problem.into() }
+    }
+
+    /// The message with each option written as a front end's users write it (`spell`:
+    /// `--load-scale 2` on the command line, `load_scale=2` in Python), also under a stage,
+    /// a hint or a context; every other text as [`std::fmt::Display`] gives it.
+    pub fn render(&self, spell: &OptionSpelling) -> String {
+        match self {
+            Error::Option { key, value, problem } => option_message(key, value.as_deref(), problem, spell),
+            Error::Stage { stage, parameters, source } => format!("{stage} at {parameters}: {}", source.render(spell)),
+            Error::Hinted { source, hint } => format!("{}; {hint}", source.render(spell)),
+            Error::Context { context, source } => format!("{context}: {}", source.render(spell)),
+            other => other.to_string(),
         }
     }
 

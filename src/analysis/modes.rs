@@ -96,12 +96,16 @@ pub fn compute(
 ) -> Result<Modes> {
     let n_free = unconstrained(sys);
     if count == 0 || count > n_free {
-        return Err(Error::Usage(format!(
-            "--count {count}: the model has {n_free} unconstrained coordinates ({} coordinates, {} constraint rows); \
-             ask for 1 to {n_free} modes",
-            ParametricModel::n_dof(sys),
-            ParametricModel::n_constraints(sys)
-        )));
+        return Err(Error::option(
+            "count",
+            Some(count.to_string()),
+            format!(
+                "the model has {n_free} unconstrained coordinates ({} coordinates, {} constraint rows); \
+                 ask for 1 to {n_free} modes",
+                ParametricModel::n_dof(sys),
+                ParametricModel::n_constraints(sys)
+            ),
+        ));
     }
     let k = assembly::tangent_blocks(sys, mu, q, t, 1.0);
     let m = assembly::mass_blocks(sys, mu);

@@ -127,6 +127,18 @@ impl ParamArgs {
     }
 }
 
+/// How the command line writes an option the library names by its key
+/// ([`flexrom::Error::render`]): `load_scale` is `--load-scale`, its value after a space.
+pub fn flag(key: &str, value: Option<&str>) -> String {
+    let name = format!("--{}", key.replace('_', "-"));
+    value.map_or_else(|| name.clone(), |v| format!("{name} {v}"))
+}
+
+/// An error's one line as the command line shows it: its options as flags.
+pub fn message(e: &flexrom::Error) -> String {
+    e.render(&flag)
+}
+
 /// Prints the library's warnings on stderr, one `warning: ` line each (every verbosity).
 pub fn warn(warnings: &[String]) {
     for w in warnings {
