@@ -13,6 +13,7 @@ pub mod statics;
 pub mod sweep;
 pub mod train;
 pub mod validate;
+pub mod values;
 
 use flexrom::cost::dense::DenseChoice;
 use flexrom::output::table::{Format, Table};
@@ -61,12 +62,12 @@ pub struct EstimateArgs {
     /// how the error estimate is computed, over the pipeline's [online] estimate (default:
     /// that, else "defects" where greedy training calibrated it, else "corrected")
     #[arg(long, value_enum, value_name = "METHOD")]
-    estimate: Option<flexrom::pipeline::config::EstimateMethod>,
+    estimate: Option<values::Method>,
 }
 
 impl EstimateArgs {
     pub fn method(self) -> Option<flexrom::pipeline::config::EstimateMethod> {
-        self.estimate
+        self.estimate.map(Into::into)
     }
 }
 

@@ -42,7 +42,7 @@ impl KktPattern {
 }
 
 /// Which linear solver the full-order model uses.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum LinearSolverKind {
     /// Symmetric band LDLᵀ after reverse Cuthill–McKee ordering (each constraint row behind

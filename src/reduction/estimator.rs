@@ -284,7 +284,7 @@ impl Default for Calibration {
 }
 
 /// How the enriched model's trajectory `X⁺` is obtained (docs/error-estimate.md).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum EstimateMethod {
     /// one Newton iteration of the enriched model per step, from the reduced run's
@@ -293,25 +293,21 @@ pub enum EstimateMethod {
     /// online estimate reads on the scale of the training tolerance. The default online
     /// estimate unless greedy training calibrated `Defects` reliably (`DefectsCalibration`)
     #[default]
-    #[value(
-        help = "one Newton iteration of the enriched model per step along the reduced run (about 1.5× the error; 45–130 % of the reduced run)"
-    )]
     Corrected,
     /// the enriched model integrated on its own to convergence (about 2× the reduced run)
-    #[value(help = "the enriched model integrated on its own (about 2× the reduced run)")]
     Enriched,
     /// the cheap method: the reduced run's local defects against the enriched model at
     /// every 10th step, summed (`rom::estimator::defects`), 7–16 % of the reduced run.
     /// Uncalibrated a loose bound (1.2–46× the error measured); calibrated by greedy training
     /// ([`DefectsCalibration`]) the corrected estimate's reading at its candidates, and
     /// then the online default where its leave-one-out check passed (docs/error-estimate.md)
-    #[value(
-        help = "the enriched model's local defects at every 10th step (7–16 % of the reduced run; calibrated by greedy training)"
-    )]
     Defects,
 }
 
 impl EstimateMethod {
+    /// Every method, in the order the front ends list them.
+    pub const ALL: [EstimateMethod; 3] = [EstimateMethod::Corrected, EstimateMethod::Enriched, EstimateMethod::Defects];
+
     pub fn name(self) -> &'static str {
         match self {
             EstimateMethod::Corrected => "corrected",
