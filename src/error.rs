@@ -306,3 +306,42 @@ impl Error {
         Error::Hdf5 { file: file.as_ref().display().to_string(), problem: problem.to_string() }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A factorization's failure reads as before once the integrator places it at its time;
+    /// the context a caller adds keeps the variant and comes first.
+    #[test]
+    fn a_numerical_failure_gets_its_time_and_its_context() {
+        let e = Error::linear_solve("the iteration matrix is singular (zero pivot 3 of 8)");
+        assert_eq!(e.to_string(), "linear solve: the iteration matrix is singular (zero pivot 3 of 8)");
+        let at = Error::linear_solve("singular").at_time_in(0.5, "modes");
+        assert_eq!(at.to_string(), "linear solve failed at t = 0.500000 s: modes: singular");
+        assert!(at.is_numerical());
+        let pod = Error::numerical("POD", "empty").context("block 2");
+        assert_eq!(pod.to_string(), "block 2: POD: empty");
+        assert_eq!(pod.at_time(1.0).to_string(), "linear solve failed at t = 1.000000 s: block 2: POD: empty");
+        let usage = Error::Usage("count must be at least 1".into()).context("reduction.multiplier_modes");
+        assert!(matches!(&usage, Error::Usage(p) if p == "reduction.multiplier_modes: count must be at least 1"));
+        assert_eq!(usage.problem(), "reduction.multiplier_modes: count must be at least 1");
+    }
+
+    /// An option is named by its key, and each front end spells it its own way, also under
+    /// a stage.
+    #[test]
+    fn an_option_is_spelt_by_the_front_end() {
+        let e = Error::option("time", Some("1.5".into()), "outside the model's run");
+        assert_eq!(e.to_string(), "time = 1.5: outside the model's run");
+        let flag = |k: &str, v: Option<&str>| {
+            format!("--{}{}", k.replace('_', "-"), v.map_or(String::new(), |v| format!(" {v}")))
+        };
+        assert_eq!(e.render(&flag), "--time 1.5: outside the model's run");
+        let e = Error::option("load_scale", None, "must be finite, got NaN");
+        assert_eq!(e.render(&flag), "--load-scale must be finite, got NaN");
+        assert_eq!(e.render(&|k, v| format!("{k}={}", v.unwrap_or(""))), "load_scale= must be finite, got NaN");
+        let hinted = Error::Hinted { source: Box::new(e), hint: "a hint".into() };
+        assert_eq!(hinted.render(&flag), "--load-scale must be finite, got NaN; a hint");
+    }
+}
