@@ -34,6 +34,22 @@ pub enum Error {
     #[error("linear solve failed at t = {t:.6} s: {problem}")]
     LinearSolve { t: f64, problem: String },
 
+    /// A numerical step failed where no time is known: a linear system's factorization or
+    /// solve, a POD, an NNLS fit. `what` names the step (`linear solve`, `POD`, `NNLS`); a
+    /// caller that knows the time makes a linear solve's failure an [`Error::LinearSolve`]
+    /// ([`Error::at_time`]).
+    #[error("{what}: {problem}")]
+    Numerical { what: &'static str, problem: String },
+
+    /// What a failed numerical step was for (`enriched basis`, `block 2`), before the
+    /// step's own failure ([`Error::context`]).
+    #[error("{context}: {source}")]
+    Context {
+        context: String,
+        #[source]
+        source: Box<Error>,
+    },
+
     /// `--strict`: a run's error estimate exceeds the tolerance (its output is written;
     /// the program exits with code 4).
     #[error("{0}")]
@@ -42,6 +58,13 @@ pub enum Error {
     /// Anything else that is a usage error of the program (bad command-line values).
     #[error("{0}")]
     Usage(String),
+
+    /// A bad value of a run's option, named by its key (`load_scale`, `shard`, `dt`,
+    /// `max_memory`) and not as a front end spells it: the command line renders it as
+    /// `--load-scale`, Python as the keyword `load_scale=` ([`Error::render`]). `value`: the
+    /// value given, where the message shows it.
+    #[error("{}", option_message(key, value.as_deref(), problem, &plain_option))]
+    Option { key: &'static str, value: Option<String>, problem: String },
 
     /// A run or an allocation would exceed a resource bound (memory, step count): names
     /// the estimated figure, the bound and the option or key that raises it.
@@ -122,6 +145,27 @@ pub fn show_text(s: &str) -> String {
     s.chars().map(|c| if c.is_control() { c.escape_default().to_string() } else { c.to_string() }).collect()
 }
 
+/// How a front end writes an option and its value (`--load-scale 2`, `load_scale=2`; the
+/// value is `None` where the message does not show it).
+pub type OptionSpelling = dyn Fn(&str, Option<&str>) -> String;
+
+/// An option's message with the option as `spell` writes it: `OPTION VALUE: problem`, or
+/// `OPTION problem` without a value (`--load-scale must be finite, got NaN`).
+fn option_message(key: &str, value: Option<&str>, problem: &str, spell: &OptionSpelling) -> String {
+    match value {
+        Some(_) => format!("{}: {problem}", spell(key, value)),
+        None => format!("{} {problem}", spell(key, None)),
+    }
+}
+
+/// The library's own spelling of an option: its key, and ` = value` (`load_scale = NaN`).
+fn plain_option(key: &str, value: Option<&str>) -> String {
+    value.map_or(key.to_string(), |v| format!("{key} = {v}"))
+}
+
+/// The step [`Error::Numerical`] names for a linear system's factorization or solve.
+pub const LINEAR_SOLVE: &str = "linear solve";
+
 /// What to do after a reduced run failed ([`Error::at_reduced_stage`]; a sweep says it once
 /// after its failures).
 pub const REDUCED_RUN_FAILED: &str =
@@ -158,7 +202,9 @@ impl Error {
     pub fn is_numerical(&self) -> bool {
         match self {
             Error::NewtonFailed { .. } | Error::LinearSolve { .. } | Error::BlowUp { .. } => true,
-            Error::Stage { source, .. } | Error::Hinted { source, .. } => source.is_numerical(),
+            Error::Stage { source, .. } | Error::Hinted { source, .. } | Error::Context { source, .. } => {
+                source.is_numerical()
+            }
             _ => false,
         }
     }
@@ -188,6 +234,85 @@ impl Error {
         }
     }
 
+    /// A bad value of the option `key` ([`Error::Option`]).
+    pub fn option(key: &'static str, value: Option<String>, problem: impl Into<String>) -> Self {
+        Error::Option { key, value, problem: problem.into() }
+    }
+
+    /// The message with each option written as a front end's users write it (`spell`:
+    /// `--load-scale 2` on the command line, `load_scale=2` in Python), also under a stage,
+    /// a hint or a context; every other text as [`std::fmt::Display`] gives it.
+    pub fn render(&self, spell: &OptionSpelling) -> String {
+        match self {
+            Error::Option { key, value, problem } => option_message(key, value.as_deref(), problem, spell),
+            Error::Stage { stage, parameters, source } => format!("{stage} at {parameters}: {}", source.render(spell)),
+            Error::Hinted { source, hint } => format!("{}; {hint}", source.render(spell)),
+            Error::Context { context, source } => format!("{context}: {}", source.render(spell)),
+            other => other.to_string(),
+        }
+    }
+
+    /// A linear system's factorization or solve failed ([`Error::Numerical`] with
+    /// [`LINEAR_SOLVE`]).
+    pub fn linear_solve(problem: impl Into<String>) -> Self {
+        Error::Numerical { what: LINEAR_SOLVE, problem: problem.into() }
+    }
+
+    /// A numerical step's failure ([`Error::Numerical`]).
+    pub fn numerical(what: &'static str, problem: impl Into<String>) -> Self {
+        Error::Numerical { what, problem: problem.into() }
+    }
+
+    /// A failed linear solve placed at time `t` ([`Error::LinearSolve`]; another numerical
+    /// step keeps its name in the problem); every other error passes unchanged.
+    pub fn at_time(self, t: f64) -> Self {
+        match self {
+            Error::Numerical { what: LINEAR_SOLVE, problem } => Error::LinearSolve { t, problem },
+            Error::Numerical { what, problem } => Error::LinearSolve { t, problem: format!("{what}: {problem}") },
+            Error::Context { context, source } => source.at_time_in(t, &context),
+            other => other,
+        }
+    }
+
+    /// [`Self::at_time`] with what the solve was for put before its problem (`initial joint
+    /// projection: …`).
+    pub fn at_time_in(self, t: f64, context: &str) -> Self {
+        match self.at_time(t) {
+            Error::LinearSolve { t, problem } => Error::LinearSolve { t, problem: format!("{context}: {problem}") },
+            other => other,
+        }
+    }
+
+    /// What the failing step was for (`enriched basis`, `block 2`) put before the problem of
+    /// a bad value, a bound, a linear solve or an HDF5 finding (the variant stays, so does
+    /// what it tells the caller), or before a numerical step's failure
+    /// ([`Error::Context`]). Other errors name their file and field already and pass
+    /// unchanged.
+    pub fn context(self, c: impl std::fmt::Display) -> Self {
+        match self {
+            Error::Usage(p) => Error::Usage(format!("{c}: {p}")),
+            Error::Resource(p) => Error::Resource(format!("{c}: {p}")),
+            e @ (Error::Numerical { .. } | Error::Context { .. }) => {
+                Error::Context { context: c.to_string(), source: Box::new(e) }
+            }
+            Error::LinearSolve { t, problem } => Error::LinearSolve { t, problem: format!("{c}: {problem}") },
+            Error::Hdf5 { file, problem } => Error::Hdf5 { file, problem: format!("{c}: {problem}") },
+            other => other,
+        }
+    }
+
+    /// The problem a lower layer found, without the file or the step it names: what a caller
+    /// that knows the file and the field puts after them ([`Error::input`]). A bad value
+    /// ([`Error::Usage`]), a bound ([`Error::Resource`]) and what an HDF5 check found
+    /// ([`Error::Hdf5`]) give their text; another error gives its whole message.
+    pub fn problem(self) -> String {
+        match self {
+            Error::Usage(p) | Error::Resource(p) | Error::Hdf5 { problem: p, .. } => p,
+            Error::Numerical { what: LINEAR_SOLVE, problem } => problem,
+            other => other.to_string(),
+        }
+    }
+
     pub fn hdf5(file: impl AsRef<Path>, problem: impl std::fmt::Display) -> Self {
         Error::Hdf5 { file: file.as_ref().display().to_string(), problem: problem.to_string() }
     }
@@ -195,7 +320,7 @@ impl Error {
 
 #[cfg(test)]
 mod tests {
-    use super::show_rounded;
+    use super::*;
 
     /// Three decimals from 0.01 up; below, the exponent form keeps the digits a fixed
     /// three decimals would round away (2.9e-6 → 0.000).
@@ -206,5 +331,39 @@ mod tests {
         assert_eq!(show_rounded(2.9e-6), "2.90e-6");
         assert_eq!(show_rounded(0.0), "0.000");
         assert_eq!(show_rounded(12.0), "12.000");
+    }
+
+    /// A factorization's failure reads as before once the integrator places it at its time;
+    /// the context a caller adds keeps the variant and comes first.
+    #[test]
+    fn a_numerical_failure_gets_its_time_and_its_context() {
+        let e = Error::linear_solve("the iteration matrix is singular (zero pivot 3 of 8)");
+        assert_eq!(e.to_string(), "linear solve: the iteration matrix is singular (zero pivot 3 of 8)");
+        let at = Error::linear_solve("singular").at_time_in(0.5, "modes");
+        assert_eq!(at.to_string(), "linear solve failed at t = 0.500000 s: modes: singular");
+        assert!(at.is_numerical());
+        let pod = Error::numerical("POD", "empty").context("block 2");
+        assert_eq!(pod.to_string(), "block 2: POD: empty");
+        assert_eq!(pod.at_time(1.0).to_string(), "linear solve failed at t = 1.000000 s: block 2: POD: empty");
+        let usage = Error::Usage("count must be at least 1".into()).context("reduction.multiplier_modes");
+        assert!(matches!(&usage, Error::Usage(p) if p == "reduction.multiplier_modes: count must be at least 1"));
+        assert_eq!(usage.problem(), "reduction.multiplier_modes: count must be at least 1");
+    }
+
+    /// An option is named by its key, and each front end spells it its own way, also under
+    /// a stage.
+    #[test]
+    fn an_option_is_spelt_by_the_front_end() {
+        let e = Error::option("time", Some("1.5".into()), "outside the model's run");
+        assert_eq!(e.to_string(), "time = 1.5: outside the model's run");
+        let flag = |k: &str, v: Option<&str>| {
+            format!("--{}{}", k.replace('_', "-"), v.map_or(String::new(), |v| format!(" {v}")))
+        };
+        assert_eq!(e.render(&flag), "--time 1.5: outside the model's run");
+        let e = Error::option("load_scale", None, "must be finite, got NaN");
+        assert_eq!(e.render(&flag), "--load-scale must be finite, got NaN");
+        assert_eq!(e.render(&|k, v| format!("{k}={}", v.unwrap_or(""))), "load_scale= must be finite, got NaN");
+        let hinted = Error::Hinted { source: Box::new(e), hint: "a hint".into() };
+        assert_eq!(hinted.render(&flag), "--load-scale must be finite, got NaN; a hint");
     }
 }

@@ -110,22 +110,23 @@ fn positive_count(v: &str, name: &str) -> Result<u64> {
 }
 
 /// `"8G"`, `"512M"`, `"1.5GiB"`, `"1000000"` → bytes (K, M, G, T are powers of 1024).
-pub fn parse_bytes(s: &str) -> std::result::Result<u64, String> {
+pub fn parse_bytes(s: &str) -> Result<u64> {
     let t = s.trim();
     let split = t.find(|c: char| c.is_ascii_alphabetic()).unwrap_or(t.len());
     let (num, unit) = t.split_at(split);
-    let x: f64 = num.trim().parse().map_err(|_| format!("`{s}` is not a size (e.g. 8G, 512M, 1000000)"))?;
+    let x: f64 =
+        num.trim().parse().map_err(|_| Error::Usage(format!("`{s}` is not a size (e.g. 8G, 512M, 1000000)")))?;
     let mult = match unit.trim().to_ascii_uppercase().as_str() {
         "" | "B" => 1.0,
         "K" | "KB" | "KIB" => 1024.0,
         "M" | "MB" | "MIB" => 1024.0 * 1024.0,
         "G" | "GB" | "GIB" => 1024.0 * 1024.0 * 1024.0,
         "T" | "TB" | "TIB" => 1024.0_f64.powi(4),
-        u => return Err(format!("unknown unit `{u}` in `{s}` (use K, M, G or T)")),
+        u => return Err(Error::Usage(format!("unknown unit `{u}` in `{s}` (use K, M, G or T)"))),
     };
     let b = x * mult;
     if !(b.is_finite() && (1.0..1.8e19).contains(&b)) {
-        return Err(format!("`{s}` is not a positive size below 16 EiB"));
+        return Err(Error::Usage(format!("`{s}` is not a positive size below 16 EiB")));
     }
     Ok(b as u64)
 }
@@ -163,15 +164,15 @@ impl Limits {
     }
 
     /// Refuses a model of `n` elements above the element bound.
-    pub fn check_elements(&self, n: f64) -> std::result::Result<(), String> {
+    pub fn check_elements(&self, n: f64) -> Result<()> {
         let l = self;
         if n <= l.max_elements as f64 {
             return Ok(());
         }
-        Err(format!(
+        Err(Error::Resource(format!(
             "{n:.0} elements in all, over the limit of {} (raise it with --max-elements or FLEXROM_MAX_ELEMENTS)",
             l.max_elements
-        ))
+        )))
     }
 
     /// Refuses a run of `steps` (a float, so 1e300 / 1e-300 cannot overflow) above the step bound.

@@ -293,7 +293,7 @@ fn main() -> ExitCode {
     // never reach LAPACK as well
     flexrom::single_threaded_blas();
     if let Err(e) = flexrom::workflows::shard::configure_threads(cli.threads) {
-        note(&format!("error: {e}"));
+        note(&format!("error: {}", cli::message(&e)));
         return ExitCode::from(e.exit_code());
     }
     let limits = flexrom::limits::from_env(
@@ -332,7 +332,7 @@ fn main() -> ExitCode {
             let e = flexrom::model::with_field_line_from_file(e);
             // one line whatever a file's text put into it (an attribute's newline, an
             // escape sequence)
-            note(&format!("error: {}", flexrom::error::show_text(&e.to_string())));
+            note(&format!("error: {}", flexrom::error::show_text(&cli::message(&e))));
             ExitCode::from(e.exit_code())
         }
     }

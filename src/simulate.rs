@@ -3,7 +3,7 @@
 
 use crate::analysis::energy::{energies, Energies, States};
 use crate::analysis::statics::{StaticOptions, StaticSolution};
-use crate::error::{Error, Result};
+use crate::error::{show_number, Error, Result};
 use crate::linalg::kkt::LinearSolverKind;
 use crate::model::Model;
 use crate::physics::joints::RowKind;
@@ -52,19 +52,19 @@ impl Settings {
         let t_end = o.t_end.unwrap_or(t.t_end);
         let rho_inf = o.rho_inf.unwrap_or(t.rho_inf);
         let mu = o.mu.clone().unwrap_or_default();
-        let bad = |name: &str, v: f64| Error::Usage(format!("--{name} must be positive and finite, got {v}"));
+        let bad = |key: &'static str, v: f64| Error::option(key, None, format!("must be positive and finite, got {v}"));
         if !(dt.is_finite() && dt > 0.0) {
             return Err(bad("dt", dt));
         }
         if !(t_end.is_finite() && t_end > 0.0) {
-            return Err(bad("t-end", t_end));
+            return Err(bad("t_end", t_end));
         }
         mu.validate()?;
         model.check_parameters(&mu)?;
         // a body property the run does not set is the file's value: say so in the result
         let mu = model.with_property_values(&mu);
         let params = IntegratorParams { rho_inf, ..model.integrator_params() };
-        params.validate().map_err(|e| Error::Usage(format!("--rho-inf: {e}")))?;
+        params.validate().map_err(|e| Error::option("rho_inf", Some(show_number(rho_inf)), e.problem()))?;
         // the number of whole steps that fit (SPEC §4: 1.1 s at 0.007 s is 157 steps),
         // bounded in floating point before the cast (t_end = 1e300 or dt = 1e-300 would
         // saturate it and overflow n_t = n_steps + 1)
@@ -175,7 +175,7 @@ pub fn integrate_guided<M: DynamicModel>(
     mut record: impl FnMut(usize, &State),
 ) -> Result<Stats> {
     let (params, dt, n_steps) = (&s.params, s.dt, s.n_steps);
-    let mut integ = GeneralizedAlpha::new(params.clone()).map_err(Error::Usage)?;
+    let mut integ = GeneralizedAlpha::new(params.clone())?;
     let mut state = integ.initialize(model, q0, v0, 0.0)?;
     let mut increment = vec![0.0; state.q.len()];
     let mut watch = BlowUpWatch::new(params, s.allow_blowup);
@@ -282,8 +282,7 @@ impl BlowUpWatch {
 pub fn prepare(model: &Model, s: &Settings) -> Result<(FlexibleSystem, Vec<f64>)> {
     let mut sys = model.system(s.solver);
     let mut q0 = sys.initial_state();
-    sys.make_consistent(&mut q0)
-        .map_err(|p| Error::LinearSolve { t: 0.0, problem: format!("initial joint projection: {p}") })?;
+    sys.make_consistent(&mut q0).map_err(|e| e.at_time_in(0.0, "initial joint projection"))?;
     Ok((sys, q0))
 }
 
@@ -484,15 +483,18 @@ fn static_start(sys: &mut FlexibleSystem, q0: Vec<f64>, s: &Settings) -> Result<
 pub fn statics(model: &Model, o: &StaticOptions) -> Result<(SimulationResult, StaticSolution)> {
     let t_end = model.file.time.t_end;
     if !(o.t >= 0.0 && o.t <= t_end) {
-        return Err(Error::Usage(format!(
-            "--time {}: outside the model's run, [0, {}] s ({}: time.t_end)",
-            crate::error::show_number(o.t),
-            crate::error::show_number(t_end),
-            model.path.display()
-        )));
+        return Err(Error::option(
+            "time",
+            Some(show_number(o.t)),
+            format!("outside the model's run, [0, {}] s ({}: time.t_end)", show_number(t_end), model.path.display()),
+        ));
     }
     if o.steps == 0 || o.steps as u64 > model.limits.max_steps {
-        return Err(Error::Usage(format!("--steps {}: give 1 to {} load steps", o.steps, model.limits.max_steps)));
+        return Err(Error::option(
+            "steps",
+            Some(o.steps.to_string()),
+            format!("give 1 to {} load steps", model.limits.max_steps),
+        ));
     }
     o.mu.validate()?;
     model.check_parameters(&o.mu)?;
@@ -604,13 +606,16 @@ pub fn modes(model: &Model, o: &ModesOptions) -> Result<ModesAnalysis> {
     let (sys, q0) = prepare(model, &settings)?;
     let n_free = crate::analysis::modes::unconstrained(&sys);
     if o.count == 0 || o.count > n_free {
-        return Err(Error::Usage(format!(
-            "--count {}: {} has {n_free} unconstrained coordinates ({} coordinates less {} constraint rows); ask for 1 to {n_free}",
-            o.count,
+        return Err(Error::option(
+            "count",
+            Some(o.count.to_string()),
+            format!(
+            "{} has {n_free} unconstrained coordinates ({} coordinates less {} constraint rows); ask for 1 to {n_free}",
             model.path.display(),
             q0.len(),
             q0.len() - n_free
-        )));
+        ),
+        ));
     }
     let start = std::time::Instant::now();
     let q = match o.at {

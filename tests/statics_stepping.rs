@@ -169,8 +169,13 @@ fn a_failure_without_a_rigid_mode_names_none() {
 fn time_and_steps_outside_their_range_are_refused() {
     let (a, i) = (1e-4, 1e-8 / 12.0);
     let model = beam(2, a, i, CLAMP, "");
-    let e = statics(&model, &StaticOptions { t: 1.5, ..Default::default() }).unwrap_err().to_string();
+    // the library names the option by its key; the command line writes it as its flag
+    let flag =
+        |k: &str, v: Option<&str>| format!("--{}{}", k.replace('_', "-"), v.map_or(String::new(), |v| format!(" {v}")));
+    let e = statics(&model, &StaticOptions { t: 1.5, ..Default::default() }).unwrap_err();
+    assert!(e.to_string().starts_with("time = 1.5: outside"), "{e}");
+    let e = e.render(&flag);
     assert!(e.contains("--time 1.5") && e.contains("[0, 1] s") && e.contains("beam.toml: time.t_end"), "{e}");
-    let e = statics(&model, &StaticOptions { steps: 0, ..Default::default() }).unwrap_err().to_string();
+    let e = statics(&model, &StaticOptions { steps: 0, ..Default::default() }).unwrap_err().render(&flag);
     assert!(e.contains("--steps 0"), "{e}");
 }

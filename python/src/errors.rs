@@ -30,22 +30,23 @@ create_exception!(
     "A run outside the training range, an estimate over the tolerance, a value that looks like a factor."
 );
 
-/// The command line's option names in the library's messages, as a Python call names them.
-const OPTION_NAMES: [(&str, &str); 5] =
-    [("--load-scale", "load_scale"), ("--t-end", "t_end"), ("--rho-inf", "rho_inf"), ("--dt", "dt"), ("--param ", "")];
+/// How a Python call writes an option the library names by its key ([`Error::render`]): as
+/// its keyword argument, `load_scale=`, with the value after the `=`.
+fn keyword(key: &str, value: Option<&str>) -> String {
+    format!("{key}={}", value.unwrap_or(""))
+}
 
 /// The exception of a library error.
 pub fn to_py(e: Error) -> PyErr {
-    let mut msg = e.to_string();
-    if matches!(root(&e), Error::Usage(_)) {
-        for (option, keyword) in OPTION_NAMES {
-            msg = msg.replace(option, keyword);
-        }
-    }
+    let msg = e.render(&keyword);
     match root(&e) {
         Error::Interrupted => pyo3::exceptions::PyKeyboardInterrupt::new_err(msg),
-        Error::NewtonFailed { .. } | Error::LinearSolve { .. } | Error::BlowUp { .. } => SolverError::new_err(msg),
-        Error::Input { .. } | Error::Io { .. } | Error::Usage(_) | Error::Resource(_) => ModelError::new_err(msg),
+        Error::NewtonFailed { .. } | Error::LinearSolve { .. } | Error::BlowUp { .. } | Error::Numerical { .. } => {
+            SolverError::new_err(msg)
+        }
+        Error::Input { .. } | Error::Io { .. } | Error::Usage(_) | Error::Option { .. } | Error::Resource(_) => {
+            ModelError::new_err(msg)
+        }
         _ => FlexromError::new_err(msg),
     }
 }
@@ -67,7 +68,7 @@ pub fn model_error(msg: &str) -> PyErr {
 /// The error under a stage's context (the kind decides the exception).
 fn root(e: &Error) -> &Error {
     match e {
-        Error::Stage { source, .. } | Error::Hinted { source, .. } => root(source),
+        Error::Stage { source, .. } | Error::Hinted { source, .. } | Error::Context { source, .. } => root(source),
         other => other,
     }
 }

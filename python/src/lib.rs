@@ -1323,13 +1323,8 @@ fn _result_from_pickle(payload: &[u8]) -> PyResult<PyRunResult> {
 }
 
 fn parse_method(name: &str) -> PyResult<EstimateMethod> {
-    use clap::ValueEnum;
-    EstimateMethod::from_str(name, true).map_err(|_| {
-        let names: Vec<String> = EstimateMethod::value_variants()
-            .iter()
-            .filter_map(|m| m.to_possible_value())
-            .map(|v| v.get_name().to_string())
-            .collect();
+    EstimateMethod::ALL.into_iter().find(|m| m.name().eq_ignore_ascii_case(name)).ok_or_else(|| {
+        let names: Vec<&str> = EstimateMethod::ALL.iter().map(|m| m.name()).collect();
         errors::model_error(&format!("estimate: `{name}` is not a method; one of {}", names.join(", ")))
     })
 }

@@ -96,12 +96,16 @@ pub fn compute(
 ) -> Result<Modes> {
     let n_free = unconstrained(sys);
     if count == 0 || count > n_free {
-        return Err(Error::Usage(format!(
-            "--count {count}: the model has {n_free} unconstrained coordinates ({} coordinates, {} constraint rows); \
-             ask for 1 to {n_free} modes",
-            ParametricModel::n_dof(sys),
-            ParametricModel::n_constraints(sys)
-        )));
+        return Err(Error::option(
+            "count",
+            Some(count.to_string()),
+            format!(
+                "the model has {n_free} unconstrained coordinates ({} coordinates, {} constraint rows); \
+                 ask for 1 to {n_free} modes",
+                ParametricModel::n_dof(sys),
+                ParametricModel::n_constraints(sys)
+            ),
+        ));
     }
     let k = assembly::tangent_blocks(sys, mu, q, t, 1.0);
     let m = assembly::mass_blocks(sys, mu);
@@ -110,14 +114,14 @@ pub fn compute(
     let shifted: Vec<Block> = k.iter().zip(&m).map(|(k, m)| k - m * sigma).collect();
     let mut kkt = assembly::solver(sys, kind);
     kkt.factor(&shifted, super::ramp::diagonal_scale(&shifted))
-        .map_err(|p| Error::LinearSolve { t, problem: format!("modes: factoring K_T − σM: {p}") })?;
+        .map_err(|e| e.at_time_in(t, "modes: factoring K_T − σM"))?;
     let n = ParametricModel::n_dof(sys);
     let nc = ParametricModel::n_constraints(sys);
     let p = n_free.min((2 * count).max(count + 8));
     let mut solve = |x: &[f64]| -> Result<Vec<f64>> {
         let mut rhs = vec![0.0; n + nc];
         block_mul(sys, &m, x, &mut rhs[..n]);
-        kkt.solve(&mut rhs).map_err(|p| Error::LinearSolve { t, problem: format!("modes: {p}") })?;
+        kkt.solve(&mut rhs).map_err(|e| e.at_time_in(t, "modes"))?;
         rhs.truncate(n);
         Ok(rhs)
     };

@@ -11,6 +11,7 @@
 //! matrix `[K_s, σBᵀ; σB, 0]` is factored by a solver of its own ([`super::assembly`]).
 
 use super::assembly;
+use crate::error::Result;
 use crate::linalg::kkt::{Block, KktSolver, LinearSolverKind};
 use crate::physics::system::FlexibleSystem;
 use crate::solver::model::{DynamicModel, ElementModel, IterationCoefficients, Parameters, ParametricModel};
@@ -106,7 +107,7 @@ impl DynamicModel for Ramped<'_> {
 
     /// `c_k K_s(q) + c_m M` (statics asks for `c_k = 1`, `c_m = 0`); the constraint rows are
     /// scaled by the largest diagonal entry, as the integrator's.
-    fn factor(&mut self, q: &[f64], _v: &[f64], t: f64, coef: IterationCoefficients) -> Result<f64, String> {
+    fn factor(&mut self, q: &[f64], _v: &[f64], t: f64, coef: IterationCoefficients) -> Result<f64> {
         let mut blocks = assembly::tangent_blocks(self.sys, &self.mu, q, t, self.factor);
         if coef.stiffness != 1.0 {
             blocks.iter_mut().for_each(|b| *b *= coef.stiffness);
@@ -122,7 +123,7 @@ impl DynamicModel for Ramped<'_> {
         Ok(scale)
     }
 
-    fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+    fn solve(&mut self, rhs: &mut [f64]) -> Result<()> {
         self.kkt.solve(rhs)
     }
 

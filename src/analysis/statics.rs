@@ -73,15 +73,15 @@ impl StaticSolution {
 }
 
 /// The static equilibrium of `sys` under `o`'s loads, from `q0` (a consistent state, at
-/// rest under no load: the undeformed one). Fails with [`Error::Usage`] for `N = 0` or a
+/// rest under no load: the undeformed one). Fails with [`Error::Option`] for `N = 0` or a
 /// time that is not finite, and with a numerical error naming the load reached and the
 /// free motions of the tangent when a step cannot be taken.
 pub fn solve(sys: &mut FlexibleSystem, q0: Vec<f64>, o: &StaticOptions) -> Result<StaticSolution> {
     if o.steps == 0 {
-        return Err(Error::Usage("--steps must be at least 1".into()));
+        return Err(Error::option("steps", None, "must be at least 1"));
     }
     if !o.t.is_finite() {
-        return Err(Error::Usage(format!("--time must be finite, got {}", o.t)));
+        return Err(Error::option("time", None, format!("must be finite, got {}", o.t)));
     }
     o.mu.validate()?;
     let nominal = 1.0 / o.steps as f64;

@@ -13,6 +13,7 @@ pub mod statics;
 pub mod sweep;
 pub mod train;
 pub mod validate;
+pub mod values;
 
 use flexrom::cost::dense::DenseChoice;
 use flexrom::output::table::{Format, Table};
@@ -61,12 +62,12 @@ pub struct EstimateArgs {
     /// how the error estimate is computed, over the pipeline's [online] estimate (default:
     /// that, else "defects" where greedy training calibrated it, else "corrected")
     #[arg(long, value_enum, value_name = "METHOD")]
-    estimate: Option<flexrom::pipeline::config::EstimateMethod>,
+    estimate: Option<values::Method>,
 }
 
 impl EstimateArgs {
     pub fn method(self) -> Option<flexrom::pipeline::config::EstimateMethod> {
-        self.estimate
+        self.estimate.map(Into::into)
     }
 }
 
@@ -127,6 +128,18 @@ impl ParamArgs {
         mu.validate()?;
         Ok(mu)
     }
+}
+
+/// How the command line writes an option the library names by its key
+/// ([`flexrom::Error::render`]): `load_scale` is `--load-scale`, its value after a space.
+pub fn flag(key: &str, value: Option<&str>) -> String {
+    let name = format!("--{}", key.replace('_', "-"));
+    value.map_or_else(|| name.clone(), |v| format!("{name} {v}"))
+}
+
+/// An error's one line as the command line shows it: its options as flags.
+pub fn message(e: &flexrom::Error) -> String {
+    e.render(&flag)
 }
 
 /// Prints the library's warnings on stderr, one `warning: ` line each (every verbosity).

@@ -7,7 +7,6 @@ use flexrom::io::attrs::Kind;
 use flexrom::io::modes_file::{write_with_paraview, ModesRecord};
 use flexrom::io::output::{check_output, Origin};
 use flexrom::limits::Limits;
-use flexrom::linalg::kkt::LinearSolverKind;
 use flexrom::model::Model;
 use flexrom::output::info;
 use flexrom::output::table::{Cell, Format, Table};
@@ -51,8 +50,8 @@ pub struct Args {
     #[arg(long)]
     basis: Option<PathBuf>,
     /// linear solver of the shift-invert factorization
-    #[arg(long, value_enum, default_value_t = LinearSolverKind::Banded)]
-    solver: LinearSolverKind,
+    #[arg(long, value_enum, default_value_t = super::values::Solver::Banded)]
+    solver: super::values::Solver,
     #[command(flatten)]
     format: FormatArgs,
 }
@@ -71,7 +70,7 @@ impl Args {
             At::Initial => ModesAt::Initial,
             At::Static => ModesAt::Static,
         };
-        let o = ModesOptions { count, at, mu: loads.parameters()?, time: loads.time(), solver };
+        let o = ModesOptions { count, at, mu: loads.parameters()?, time: loads.time(), solver: solver.into() };
         let analysis = flexrom::simulate::modes(&model, &o)?;
         let reduced = match &basis {
             Some(path) => Some(reduced_frequencies(&model, path, &analysis, &o)?),

@@ -128,8 +128,8 @@ struct RunArgs {
     #[command(flatten)]
     params: super::ParamArgs,
     /// linear solver of the full model
-    #[arg(long, value_enum, default_value_t = LinearSolverKind::Banded)]
-    solver: LinearSolverKind,
+    #[arg(long, value_enum, default_value_t = super::values::Solver::Banded)]
+    solver: super::values::Solver,
 }
 
 impl RunArgs {
@@ -139,6 +139,6 @@ impl RunArgs {
         } else {
             self.load_scale.map(Parameters::load_scale)
         };
-        Ok(Overrides { dt: self.dt, t_end: self.t_end, rho_inf: self.rho_inf, mu, solver: self.solver })
+        Ok(Overrides { dt: self.dt, t_end: self.t_end, rho_inf: self.rho_inf, mu, solver: self.solver.into() })
     }
 }

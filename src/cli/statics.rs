@@ -7,7 +7,6 @@ use flexrom::io::attrs::Kind;
 use flexrom::io::output::{check_output, Origin};
 use flexrom::io::result_file::{write_statics, ResultFile, RunPlan};
 use flexrom::limits::Limits;
-use flexrom::linalg::kkt::LinearSolverKind;
 use flexrom::model::Model;
 use flexrom::output::info;
 use flexrom::output::table::Cell;
@@ -27,8 +26,8 @@ pub struct Args {
     #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     steps: usize,
     /// linear solver
-    #[arg(long, value_enum, default_value_t = LinearSolverKind::Banded)]
-    solver: LinearSolverKind,
+    #[arg(long, value_enum, default_value_t = super::values::Solver::Banded)]
+    solver: super::values::Solver,
     /// also write ParaView's view beside the result: the deformed centre lines at every
     /// instant (4 points an element) with strain, curvature and velocity, in the result
     /// file's /paraview and an XDMF file of the same stem (out.h5 → out.xdmf)
@@ -73,7 +72,7 @@ impl Args {
         let model = Model::load_with(&model, limits.clone())?;
         let mu = loads.parameters()?;
         super::warn(&model.property_warnings([&mu]));
-        let o = StaticOptions { mu: mu.clone(), t: loads.time, steps, solver };
+        let o = StaticOptions { mu: mu.clone(), t: loads.time, steps, solver: solver.into() };
         let (r, solution) = flexrom::simulate::statics(&model, &o).map_err(|e| e.at_stage("statics", &mu))?;
         if let Some(output) = &output {
             let file =

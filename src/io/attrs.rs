@@ -355,10 +355,12 @@ pub fn write_atomically_labelled(
 
 /// The layout version of an open file: [`LAYOUT_ATTR`], or 1 when the file has none (files
 /// written before layouts had a version).
-pub fn layout_version(f: &hdf5::File) -> std::result::Result<u64, String> {
+pub fn layout_version(f: &hdf5::File) -> Result<u64> {
     match f.attr(LAYOUT_ATTR) {
         Err(_) => Ok(1),
-        Ok(a) => a.read_scalar::<u64>().map_err(|e| format!("cannot be read as a whole number: {e}")),
+        Ok(a) => a
+            .read_scalar::<u64>()
+            .map_err(|e| Error::hdf5(f.filename(), format!("cannot be read as a whole number: {e}"))),
     }
 }
 
@@ -366,7 +368,7 @@ pub fn layout_version(f: &hdf5::File) -> std::result::Result<u64, String> {
 /// (or unreadable) with a message naming the file, both versions and what to do; `stage` is
 /// the command that writes such a file (`flexrom train`, …).
 pub fn check_layout(f: &hdf5::File, path: &Path, stage: &str) -> Result<u64> {
-    let v = layout_version(f).map_err(|p| Error::input(path, LAYOUT_ATTR, p))?;
+    let v = layout_version(f).map_err(|p| Error::input(path, LAYOUT_ATTR, p.problem()))?;
     if v > LAYOUT_VERSION {
         return Err(Error::input(
             path,

@@ -138,7 +138,7 @@ pub fn read_estimator(f: &hdf5::File, path: &Path, basis: &Basis) -> Result<Opti
         Ok(_) => {
             let m = read_attr_str(&g, "default_method")
                 .map_err(|e| field("default_method", format!("cannot be read: {e}")))?;
-            Some(EstimateMethod::parse(&m).map_err(|p| field("default_method", p))?)
+            Some(EstimateMethod::parse(&m).map_err(|p| field("default_method", p.problem()))?)
         }
         Err(_) => None,
     };
@@ -482,7 +482,7 @@ pub fn training_measure(f: &hdf5::File, path: &Path) -> Result<ErrorMeasure> {
     }
     let m = read_attr_str(&g, "measure")
         .map_err(|e| Error::input(path, "training/measure", format!("cannot be read: {e}")))?;
-    ErrorMeasure::parse(&m).map_err(|p| Error::input(path, "training/measure", p))
+    ErrorMeasure::parse(&m).map_err(|p| Error::input(path, "training/measure", p.problem()))
 }
 
 /// [`training_notes`] of the basis file at `path`, opened for it.

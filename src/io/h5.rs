@@ -398,12 +398,14 @@ pub fn read_attr_f64(loc: &hdf5::Location, name: &str) -> hdf5::Result<f64> {
 
 /// Opens dataset `name` of `loc` with its shape checked before anything is read: a crafted
 /// or damaged shape must neither size an allocation nor leave an index out of bounds later.
-/// `Err(problem)`, for a message after the file and the dataset.
-pub fn dataset_of_shape(loc: &hdf5::Group, name: &str, want: &[usize]) -> std::result::Result<hdf5::Dataset, String> {
-    let d = loc.dataset(name).map_err(|e| format!("cannot be read: {e}"))?;
+/// An [`Error::Hdf5`] whose [`Error::problem`] is for a message after the file and the
+/// dataset.
+pub fn dataset_of_shape(loc: &hdf5::Group, name: &str, want: &[usize]) -> Result<hdf5::Dataset> {
+    let d = loc.dataset(name).map_err(|e| Error::hdf5(loc.filename(), format!("cannot be read: {e}")))?;
     let shape = d.shape();
     if shape != want {
-        return Err(format!("has shape {} where {} is expected", show_shape(&shape), show_shape(want)));
+        let problem = format!("has shape {} where {} is expected", show_shape(&shape), show_shape(want));
+        return Err(Error::hdf5(loc.filename(), problem));
     }
     Ok(d)
 }
@@ -411,18 +413,20 @@ pub fn dataset_of_shape(loc: &hdf5::Group, name: &str, want: &[usize]) -> std::r
 /// The length of the one-dimensional dataset `name` of `loc`, refused before anything is
 /// read when what reading it brings along, `bytes_per_entry` for each entry, would exceed
 /// the memory bound: the file alone sizes it, so a flipped bit must not size an allocation.
+/// An [`Error::Hdf5`] or [`Error::Resource`] whose [`Error::problem`] is for a message after
+/// the file and the dataset.
 pub fn bounded_len(
     loc: &hdf5::Group,
     name: &str,
     bytes_per_entry: f64,
     limits: &crate::limits::Limits,
-) -> std::result::Result<usize, String> {
-    let d = loc.dataset(name).map_err(|e| format!("cannot be read: {e}"))?;
+) -> Result<usize> {
+    let d = loc.dataset(name).map_err(|e| Error::hdf5(loc.filename(), format!("cannot be read: {e}")))?;
     let shape = d.shape();
     let &[n] = shape.as_slice() else {
-        return Err(format!("has shape {}, expected one dimension", show_shape(&shape)));
+        return Err(Error::hdf5(loc.filename(), format!("has shape {}, expected one dimension", show_shape(&shape))));
     };
-    limits.check_memory(&format!("its {n} entries"), n as f64 * bytes_per_entry).map_err(|e| e.to_string())?;
+    limits.check_memory(&format!("its {n} entries"), n as f64 * bytes_per_entry)?;
     Ok(n)
 }
 

@@ -70,7 +70,7 @@ pub fn parameter_space(f: &hdf5::File, path: &Path) -> Result<Option<ParameterSp
         };
         let [lower, upper] = r[..] else { return Err(bad(format!("has a range of {} values; expected 2", r.len()))) };
         let range = ParameterRange { name, lower, upper, spacing };
-        range.validate().map_err(&bad)?;
+        range.validate().map_err(|e| bad(e.problem()))?;
         ranges.push(range);
     }
     Ok(Some(ParameterSpace { ranges }))

@@ -9,6 +9,7 @@
 //! ~350k instructions per 206-row factorization against ~60k here).
 
 use super::kkt_pattern::{Block, KktPattern, KktSolver, SlotMap};
+use crate::error::{Error, Result};
 use std::collections::VecDeque;
 
 /// The graph of the KKT matrix `[S Bᵀ; B 0]`: coordinates coupled through an element, and
@@ -43,7 +44,7 @@ pub fn solve_permuted(
     work: &mut [f64],
     rhs: &mut [f64],
     solve_band: impl FnOnce(&mut [f64]),
-) -> Result<(), String> {
+) -> Result<()> {
     for (old, &new) in new_of.iter().enumerate() {
         work[new] = rhs[old];
     }
@@ -54,7 +55,7 @@ pub fn solve_permuted(
     if rhs.iter().all(|v| v.is_finite()) {
         Ok(())
     } else {
-        Err("the iteration matrix is singular (non-finite solution)".into())
+        Err(Error::linear_solve("the iteration matrix is singular (non-finite solution)"))
     }
 }
 
@@ -158,7 +159,7 @@ impl BandedKkt {
 }
 
 impl KktSolver for BandedKkt {
-    fn factor(&mut self, blocks: &[Block], scale: f64) -> Result<(), String> {
+    fn factor(&mut self, blocks: &[Block], scale: f64) -> Result<()> {
         self.slots.scatter(&mut self.ab, blocks, scale);
         self.factored = false;
         self.ubw = band_lu(&mut self.ab, self.n, self.band, self.ldab, &mut self.ipiv)?;
@@ -166,9 +167,9 @@ impl KktSolver for BandedKkt {
         Ok(())
     }
 
-    fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+    fn solve(&mut self, rhs: &mut [f64]) -> Result<()> {
         if !self.factored {
-            return Err("solve called without a valid factorization".into());
+            return Err(Error::linear_solve("solve called without a valid factorization"));
         }
         let (ab, n, band, ldab, ipiv, ubw) = (&self.ab, self.n, self.band, self.ldab, &self.ipiv, self.ubw);
         solve_permuted(&self.new_of, &mut self.work, rhs, |w| band_lu_solve(ab, n, band, ldab, ipiv, ubw, w))
@@ -189,7 +190,7 @@ const PIVOT_THRESHOLD: f64 = 0.1;
 /// in LAPACK band storage: `A(i, j)` at `ab[2b + i − j + j·ldab]`, `ldab ≥ 3b + 1`, rows
 /// `0..b` of each column zero on entry (room for fill from row interchanges). LAPACK
 /// `dgbtf2`'s algorithm and storage. Returns the upper bandwidth of U actually reached.
-pub fn band_lu(ab: &mut [f64], n: usize, b: usize, ldab: usize, ipiv: &mut [usize]) -> Result<usize, String> {
+pub fn band_lu(ab: &mut [f64], n: usize, b: usize, ldab: usize, ipiv: &mut [usize]) -> Result<usize> {
     // Monomorphized for the common half-bandwidths, so the length-b inner loops have a
     // compile-time length (unrolled, no bounds checks); measured 2× faster at b = 7.
     macro_rules! dispatch {
@@ -204,13 +205,7 @@ pub fn band_lu(ab: &mut [f64], n: usize, b: usize, ldab: usize, ipiv: &mut [usiz
 }
 
 /// [`band_lu`] with `B = b` known at compile time (`B = 0`: any `b`).
-fn band_lu_impl<const B: usize>(
-    ab: &mut [f64],
-    n: usize,
-    b: usize,
-    ldab: usize,
-    ipiv: &mut [usize],
-) -> Result<usize, String> {
+fn band_lu_impl<const B: usize>(ab: &mut [f64], n: usize, b: usize, ldab: usize, ipiv: &mut [usize]) -> Result<usize> {
     let kv = 2 * b;
     let mut ju = 0; // last column touched by the interchanges so far
     let mut ubw = 0;
@@ -230,7 +225,9 @@ fn band_lu_impl<const B: usize>(
         }
         ipiv[j] = j + jp;
         if best == 0.0 || !best.is_finite() {
-            return Err(format!("band LU: zero or non-finite pivot in column {j} (singular iteration matrix)"));
+            return Err(Error::linear_solve(format!(
+                "band LU: zero or non-finite pivot in column {j} (singular iteration matrix)"
+            )));
         }
         ju = ju.max((j + b + jp).min(n - 1));
         ubw = ubw.max(ju - j);

@@ -30,6 +30,7 @@ mod kernels;
 use super::banded::{solve_permuted, BandedKkt};
 pub use super::banded_order::quasi_definite_order;
 use super::kkt_pattern::{Block, KktPattern, KktSolver};
+use crate::error::{Error, Result};
 use kernels::PIVOT_RATIO;
 pub use kernels::{band_ldlt, band_ldlt_solve};
 
@@ -156,7 +157,7 @@ impl BandedLdlt {
     /// Assembles and factors; with `check`, blocks that are not symmetric (to the bit, or
     /// else within [`SYMMETRY_TOL`]) go to the LU, without it they are taken as symmetric
     /// ([`KktSolver::factor_symmetric`]).
-    fn factor_checked(&mut self, blocks: &[Block], scale: f64, check: bool) -> Result<(), String> {
+    fn factor_checked(&mut self, blocks: &[Block], scale: f64, check: bool) -> Result<()> {
         self.state = Factored::No;
         // assembled first: the bit-exact symmetry check comes with it, the tolerant one only
         // when some block fails that
@@ -225,11 +226,11 @@ fn symmetric(blocks: &[Block]) -> bool {
 }
 
 impl KktSolver for BandedLdlt {
-    fn factor(&mut self, blocks: &[Block], scale: f64) -> Result<(), String> {
+    fn factor(&mut self, blocks: &[Block], scale: f64) -> Result<()> {
         self.factor_checked(blocks, scale, true)
     }
 
-    fn factor_symmetric(&mut self, blocks: &[Block], scale: f64) -> Result<(), String> {
+    fn factor_symmetric(&mut self, blocks: &[Block], scale: f64) -> Result<()> {
         // to the bit, NaN included (a diverging state gives NaN entries, built alike)
         debug_assert!(
             blocks.iter().all(|b| (0..8).all(|j| (j + 1..8).all(|i| b[(i, j)].to_bits() == b[(j, i)].to_bits()))),
@@ -238,11 +239,14 @@ impl KktSolver for BandedLdlt {
         self.factor_checked(blocks, scale, false)
     }
 
-    fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+    fn solve(&mut self, rhs: &mut [f64]) -> Result<()> {
         match self.state {
-            Factored::No => return Err("solve called without a valid factorization".into()),
+            Factored::No => return Err(Error::linear_solve("solve called without a valid factorization")),
             Factored::Lu => {
-                return self.fallback.as_mut().map_or(Err("the LU fallback was never built".into()), |f| f.solve(rhs))
+                return self
+                    .fallback
+                    .as_mut()
+                    .map_or(Err(Error::linear_solve("the LU fallback was never built")), |f| f.solve(rhs))
             }
             Factored::Ldlt => {}
         }

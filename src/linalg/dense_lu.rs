@@ -12,6 +12,7 @@
 //! outside the blocks and the border, so the blocks cost what they would on their own.
 
 use super::simd::{dispatch, Kernel};
+use crate::error::{Error, Result};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt;
 use faer::linalg::lu::partial_pivoting::{factor, solve};
@@ -138,7 +139,7 @@ impl DenseLu {
     /// matrices are indefinite, one at a time, so going on with LU after a failure (16 in
     /// a row was tried) cost more than the failed attempts. A dense attempt works on a
     /// copy: faer's Cholesky may write the upper triangle too.
-    pub fn factor_symmetric(&mut self) -> Result<(), String> {
+    pub fn factor_symmetric(&mut self) -> Result<()> {
         self.check_finite()?;
         let n = self.n;
         if self.find_blocks() {
@@ -188,12 +189,12 @@ impl DenseLu {
     }
 
     /// Factors the matrix in place; refuses non-finite entries and exact zero pivots.
-    pub fn factor(&mut self) -> Result<(), String> {
+    pub fn factor(&mut self) -> Result<()> {
         self.check_finite()?;
         self.factor_lu()
     }
 
-    fn factor_lu(&mut self) -> Result<(), String> {
+    fn factor_lu(&mut self) -> Result<()> {
         let n = self.n;
         let a = MatMut::from_column_major_slice_mut(&mut self.a, n, n);
         factor::lu_in_place(
@@ -205,13 +206,13 @@ impl DenseLu {
             Default::default(),
         );
         if let Some(i) = (0..n).find(|&i| self.a[i + n * i] == 0.0) {
-            return Err(format!("the iteration matrix is singular (zero pivot {i} of {n})"));
+            return Err(Error::linear_solve(format!("the iteration matrix is singular (zero pivot {i} of {n})")));
         }
         self.factored = Some(Factors::Lu);
         Ok(())
     }
 
-    fn check_finite(&self) -> Result<(), String> {
+    fn check_finite(&self) -> Result<()> {
         let n = self.n;
         // x·0 is NaN exactly for infinite or NaN x; eight independent sums vectorize (a
         // position() scan with early exit does not), and the column is found only on failure
@@ -225,19 +226,22 @@ impl DenseLu {
         }
         if (acc.iter().sum::<f64>() + tail).is_nan() {
             let k = self.a.iter().position(|x| !x.is_finite()).unwrap_or(0);
-            return Err(format!("the iteration matrix holds non-finite values (column {})", k / n.max(1)));
+            return Err(Error::linear_solve(format!(
+                "the iteration matrix holds non-finite values (column {})",
+                k / n.max(1)
+            )));
         }
         Ok(())
     }
 
     /// Solves `A x = b` in place with the last factorization.
-    pub fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+    pub fn solve(&mut self, rhs: &mut [f64]) -> Result<()> {
         let Some(kind) = self.factored else {
-            return Err("no valid factorization to solve with".into());
+            return Err(Error::linear_solve("no valid factorization to solve with"));
         };
         let n = self.dim();
         if rhs.len() != n {
-            return Err(format!("right-hand side has {} entries, the matrix {n} rows", rhs.len()));
+            return Err(Error::linear_solve(format!("right-hand side has {} entries, the matrix {n} rows", rhs.len())));
         }
         if kind == Factors::Bordered {
             self.bordered_solve(rhs);
@@ -425,9 +429,9 @@ mod tests {
     fn refuses_singular_and_non_finite_matrices() {
         let mut lu = DenseLu::new(2);
         lu.matrix_mut()[0] = 1.0; // second row and column stay zero
-        assert!(lu.factor().unwrap_err().contains("singular"));
+        assert!(lu.factor().unwrap_err().to_string().contains("singular"));
         lu.matrix_mut()[3] = f64::NAN;
-        assert!(lu.factor().unwrap_err().contains("non-finite"));
+        assert!(lu.factor().unwrap_err().to_string().contains("non-finite"));
         assert!(lu.solve(&mut [1.0, 1.0]).is_err());
     }
 }

@@ -11,6 +11,7 @@
 //! symbolic analysis (COLAMD ordering) is done once and every Newton iteration only scatters
 //! values and refactors numerically: cost linear in the number of elements.
 
+use crate::error::{Error, Result};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::lu::{factorize_symbolic_lu, NumericLu, SymbolicLu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
@@ -94,7 +95,7 @@ impl SparseKkt {
 }
 
 impl KktSolver for SparseKkt {
-    fn factor(&mut self, blocks: &[Block], scale: f64) -> Result<(), String> {
+    fn factor(&mut self, blocks: &[Block], scale: f64) -> Result<()> {
         debug_assert_eq!(blocks.len(), self.pattern.element_dofs.len());
         self.slots.scatter(&mut self.values, blocks, scale);
         let n = self.pattern.size();
@@ -109,7 +110,7 @@ impl KktSolver for SparseKkt {
                 MemStack::new(&mut self.factor_mem),
                 Default::default(),
             )
-            .map_err(|e| format!("sparse LU failed: {e:?}"))?;
+            .map_err(|e| Error::linear_solve(format!("sparse LU failed: {e:?}")))?;
         self.factored = true;
         Ok(())
     }
@@ -119,9 +120,9 @@ impl KktSolver for SparseKkt {
         self.slots.set_row(c, coefs);
     }
 
-    fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+    fn solve(&mut self, rhs: &mut [f64]) -> Result<()> {
         if !self.factored {
-            return Err("solve called without a valid factorization".into());
+            return Err(Error::linear_solve("solve called without a valid factorization"));
         }
         let n = rhs.len();
         let lu = faer::sparse::linalg::lu::LuRef::new_unchecked(&self.symbolic, &self.numeric);
@@ -130,7 +131,7 @@ impl KktSolver for SparseKkt {
         if rhs.iter().all(|v| v.is_finite()) {
             Ok(())
         } else {
-            Err("the iteration matrix is singular (non-finite solution)".into())
+            Err(Error::linear_solve("the iteration matrix is singular (non-finite solution)"))
         }
     }
 }
@@ -148,7 +149,7 @@ impl DenseKkt {
 }
 
 impl KktSolver for DenseKkt {
-    fn factor(&mut self, blocks: &[Block], scale: f64) -> Result<(), String> {
+    fn factor(&mut self, blocks: &[Block], scale: f64) -> Result<()> {
         use crate::linalg::lapack::FactorizeInto;
         let n = self.pattern.size();
         let nd = self.pattern.n_dof;
@@ -166,11 +167,11 @@ impl KktSolver for DenseKkt {
                 a[[dof, nd + c]] += scale * coef;
             }
         }
-        self.lu = Some(a.factorize_into().map_err(|e| format!("dense LU failed: {e}"))?);
+        self.lu = Some(a.factorize_into().map_err(|e| Error::linear_solve(format!("dense LU failed: {e}")))?);
         Ok(())
     }
 
-    fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+    fn solve(&mut self, rhs: &mut [f64]) -> Result<()> {
         dense_lu_solve(self.lu.as_ref(), rhs)
     }
 
@@ -184,13 +185,13 @@ impl KktSolver for DenseKkt {
 pub fn dense_lu_solve(
     lu: Option<&crate::linalg::lapack::LUFactorized<ndarray::OwnedRepr<f64>>>,
     rhs: &mut [f64],
-) -> Result<(), String> {
+) -> Result<()> {
     use crate::linalg::lapack::Solve;
-    let lu = lu.ok_or("solve called without a valid factorization")?;
+    let lu = lu.ok_or_else(|| Error::linear_solve("solve called without a valid factorization"))?;
     let mut b = ndarray::ArrayViewMut1::from(rhs);
-    let x = lu.solve(&b.view()).map_err(|e| format!("dense solve failed: {e}"))?;
+    let x = lu.solve(&b.view()).map_err(|e| Error::linear_solve(format!("dense solve failed: {e}")))?;
     if x.iter().any(|v| !v.is_finite()) {
-        return Err("the iteration matrix is singular (non-finite solution)".into());
+        return Err(Error::linear_solve("the iteration matrix is singular (non-finite solution)"));
     }
     b.assign(&x);
     Ok(())

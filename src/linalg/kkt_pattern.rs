@@ -2,6 +2,7 @@
 //! pattern (element dof maps and constraint rows), where each entry lands in a solver's
 //! storage (`SlotMap`), the choice of solver and the interface every solver implements.
 
+use crate::error::Result;
 use nalgebra::SMatrix;
 
 pub type Block = SMatrix<f64, 8, 8>;
@@ -41,7 +42,7 @@ impl KktPattern {
 }
 
 /// Which linear solver the full-order model uses.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum LinearSolverKind {
     /// Symmetric band LDLᵀ after reverse Cuthill–McKee ordering (each constraint row behind
@@ -113,15 +114,15 @@ impl SlotMap {
 
 pub trait KktSolver: Send + Sync {
     /// Assembles `[Σ P_eᵀ blocks[e] P_e, s Bᵀ; s B, 0]` and factors it.
-    fn factor(&mut self, blocks: &[Block], scale: f64) -> Result<(), String>;
+    fn factor(&mut self, blocks: &[Block], scale: f64) -> Result<()>;
     /// [`Self::factor`] of blocks their builder made symmetric to the bit (each entry and
     /// its mirror computed by the same operations), so that a solver that would check the
     /// symmetry need not; the default is [`Self::factor`].
-    fn factor_symmetric(&mut self, blocks: &[Block], scale: f64) -> Result<(), String> {
+    fn factor_symmetric(&mut self, blocks: &[Block], scale: f64) -> Result<()> {
         self.factor(blocks, scale)
     }
     /// Solves in place with the last factorization; `rhs` has `n_dof + n_c` entries.
-    fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String>;
+    fn solve(&mut self, rhs: &mut [f64]) -> Result<()>;
     /// Sets constraint row `c`'s coefficients for the next factorization, its coordinates
     /// unchanged (rows that move with time, `B(t)`): the pattern and ordering stay.
     fn set_constraint_row(&mut self, c: usize, coefs: &[f64]);

@@ -12,6 +12,7 @@
 //! updated by one column per entry, on unit-norm columns (the sizes here: thousands of
 //! rows, a few hundred passive columns at most).
 
+use crate::error::{Error, Result};
 use nalgebra::{DMatrix, DVector};
 use ndarray::{Array1, Array2, ArrayView1, ArrayView2, ShapeBuilder};
 use rayon::prelude::*;
@@ -32,12 +33,12 @@ impl Default for NnlsParams {
 }
 
 impl NnlsParams {
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<()> {
         if !(self.tolerance.is_finite() && (0.0..1.0).contains(&self.tolerance)) {
-            return Err(format!("the NNLS tolerance must lie in [0, 1), got {}", self.tolerance));
+            return Err(Error::Usage(format!("the NNLS tolerance must lie in [0, 1), got {}", self.tolerance)));
         }
         if self.max_iterations == 0 {
-            return Err("max_iterations must be at least 1".into());
+            return Err(Error::Usage("max_iterations must be at least 1".into()));
         }
         Ok(())
     }
@@ -53,7 +54,7 @@ pub struct NnlsSolution {
 }
 
 /// Solves `min ‖A x − b‖, x ≥ 0` (see the module documentation).
-pub fn nnls(a: ArrayView2<f64>, b: ArrayView1<f64>, params: &NnlsParams) -> Result<NnlsSolution, String> {
+pub fn nnls(a: ArrayView2<f64>, b: ArrayView1<f64>, params: &NnlsParams) -> Result<NnlsSolution> {
     check(a, b, params)?;
     // unit-norm columns, copied once into column-major storage: every iteration reads whole
     // columns (the gains, the new column's products with the passive ones, the residual),
@@ -78,7 +79,7 @@ pub fn nnls_scaling(
     a: Array2<f64>,
     b: ArrayView1<f64>,
     params: &NnlsParams,
-) -> Result<(NnlsSolution, Array2<f64>, Vec<f64>), String> {
+) -> Result<(NnlsSolution, Array2<f64>, Vec<f64>)> {
     check(a.view(), b, params)?;
     let mut a = if a.t().is_standard_layout() { a } else { column_major(a.view()) };
     let norms = column_norms(a.view());
@@ -110,13 +111,13 @@ fn scale_columns(a: &mut Array2<f64>, norms: &[f64]) {
     }
 }
 
-fn check(a: ArrayView2<f64>, b: ArrayView1<f64>, params: &NnlsParams) -> Result<(), String> {
+fn check(a: ArrayView2<f64>, b: ArrayView1<f64>, params: &NnlsParams) -> Result<()> {
     params.validate()?;
     if b.len() != a.nrows() {
-        return Err(format!("A has {} rows but b has {} entries", a.nrows(), b.len()));
+        return Err(Error::numerical("NNLS", format!("A has {} rows but b has {} entries", a.nrows(), b.len())));
     }
     if a.iter().chain(b.iter()).any(|v| !v.is_finite()) {
-        return Err("A or b holds non-finite values".into());
+        return Err(Error::numerical("NNLS", "A or b holds non-finite values"));
     }
     Ok(())
 }
@@ -129,7 +130,7 @@ fn solve_unit(
     norms: &[f64],
     b: ArrayView1<f64>,
     params: &NnlsParams,
-) -> Result<(Array1<f64>, Array1<f64>, usize), String> {
+) -> Result<(Array1<f64>, Array1<f64>, usize)> {
     let n = unit.ncols();
     let b_norm = b.dot(&b).sqrt();
     let mut x = Array1::<f64>::zeros(n);
@@ -153,7 +154,7 @@ fn solve_unit(
     loop {
         // a fit of a refined mesh takes seconds: a stop asked for ends it ([`crate::interrupt`])
         if crate::interrupt::requested() {
-            return Err("interrupted".into());
+            return Err(Error::Interrupted);
         }
         let res_norm = residual.dot(&residual).sqrt();
         if res_norm <= tol || iterations >= params.max_iterations {

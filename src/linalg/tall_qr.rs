@@ -13,6 +13,7 @@
 //! thousands of rows (snapshots × modes), where every NNLS iteration otherwise streams the
 //! whole matrix from memory.
 
+use crate::error::Result;
 use crate::linalg::nnls::{column_major, nnls, nnls_scaling, NnlsParams, NnlsSolution};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::qr::no_pivoting::factor::{qr_in_place, qr_in_place_scratch, recommended_block_size};
@@ -61,7 +62,7 @@ pub const FACTOR_ITERATIONS_PER_COLUMN: f64 = 1.0 / 16.0;
 /// problem needs, the time is at most about twice that of the better of the two routes
 /// chosen in hindsight — the direct one wins where few columns enter (a refined mesh with
 /// few sampled elements), the factored one where many do (a coarse mesh sampled densely).
-pub fn nnls_of_column_sum(a: Array2<f64>, params: &NnlsParams) -> Result<NnlsSolution, String> {
+pub fn nnls_of_column_sum(a: Array2<f64>, params: &NnlsParams) -> Result<NnlsSolution> {
     let (m, n) = a.dim();
     let threads = rayon::current_num_threads().max(1) as f64;
     let rent = (FACTOR_ITERATIONS_PER_COLUMN * n as f64 * threads).ceil() as usize;

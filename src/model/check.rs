@@ -134,7 +134,7 @@ impl Model {
             return Err(self.err(p("elements"), format!("must be a positive integer, got {}", b.elements)));
         }
         let total: f64 = f.bodies[..=i].iter().map(|b| b.elements.max(0) as f64).sum();
-        self.limits.check_elements(total).map_err(|e| self.err(p("elements"), e))?;
+        self.limits.check_elements(total).map_err(|e| self.err(p("elements"), e.problem()))?;
         // a property given as `{ value, parameter }` names its `value`
         let property = |k: &str, spec: &PropertySpec| match spec {
             PropertySpec::Value(v) => (k.to_string(), *v),
@@ -316,7 +316,7 @@ impl Model {
             }
             LoadSpec::Moment { body, node, function, scaled } => {
                 let id = self.node_id(&p("body"), &p("node"), body, node)?;
-                function.check().map_err(|e| self.err(p("function"), e))?;
+                function.check().map_err(|e| self.err(p("function"), e.problem()))?;
                 Load::Moment(Moment {
                     node: id,
                     function: function.clone(),
@@ -327,7 +327,7 @@ impl Model {
                 let id = self.node_id(&p("body"), &p("node"), body, node)?;
                 self.finite2(&p("value"), *value)?;
                 if let Some(func) = function {
-                    func.check().map_err(|e| self.err(p("function"), e))?;
+                    func.check().map_err(|e| self.err(p("function"), e.problem()))?;
                 }
                 let scaled = self.scaling(&p("scaled"), scaled)?;
                 Load::Force(Force { node: id, value: *value, function: function.clone(), scaled })
@@ -653,7 +653,7 @@ impl Model {
         scaled: &ScaledSpec,
     ) -> Result<Drive> {
         let function = function.cloned().unwrap_or(TimeFunction::Constant { value: 0.0 });
-        function.check().map_err(|e| self.err(field, e))?;
+        function.check().map_err(|e| self.err(field, e.problem()))?;
         let start = function.eval(0.0);
         if start != 0.0 {
             return Err(self.err(

@@ -2,7 +2,7 @@
 //! shared, read only, by every reduced model and check that needs it, on any thread.
 
 use super::{Model, SharedPhysics};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::linalg::kkt::LinearSolverKind;
 use std::sync::Arc;
 
@@ -17,8 +17,7 @@ impl SharedPhysics {
     pub fn assemble(model: &Model) -> Result<Self> {
         let mut sys = model.system(LinearSolverKind::Banded);
         let mut x0 = sys.initial_state();
-        sys.make_consistent(&mut x0)
-            .map_err(|p| Error::LinearSolve { t: 0.0, problem: format!("initial joint projection: {p}") })?;
+        sys.make_consistent(&mut x0).map_err(|e| e.at_time_in(0.0, "initial joint projection"))?;
         let v0 = sys.initial_velocity(&x0);
         Ok(SharedPhysics { sys: Arc::new(sys), x0: Arc::new(x0), v0: Arc::new(v0) })
     }

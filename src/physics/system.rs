@@ -9,6 +9,7 @@ use super::element::{BeamElement, Mat8, Vec8};
 use super::joints::{lower, Row};
 use super::loads::{assemble_weight, Gravity, Load, NodalLoad, Weight};
 use super::masses::{MassEntry, PointMass};
+use crate::error::{Error, Result};
 use crate::linalg::kkt::{make_solver, KktPattern, KktSolver, LinearSolverKind};
 use crate::solver::model::{IterationCoefficients, Parameters, ParametricModel};
 
@@ -283,7 +284,7 @@ impl FlexibleSystem {
     /// motion closes) by the smallest change of the joint coordinates. Moving the joint
     /// nodes alone would bend the end elements: a gap `g` costs ~12 EI g / l³, 10 N for
     /// g = 2e-10 m on the four-bar refined 10×. Returns the largest change of a coordinate.
-    pub fn make_consistent(&mut self, q: &mut [f64]) -> Result<f64, String> {
+    pub fn make_consistent(&mut self, q: &mut [f64]) -> Result<f64> {
         use nalgebra::{DMatrix, DVector};
         let (n, nb, nc) = (self.n_dof, self.bodies.len(), self.constraints.len());
         let mut res = vec![0.0; nc];
@@ -316,7 +317,10 @@ impl FlexibleSystem {
             }
             let rhs = DVector::from_iterator(nc, res.iter().map(|r| -r));
             // least-squares solution of least norm (a body may be held by several joints)
-            let p = a.svd(true, true).solve(&rhs, 1e-12).map_err(|e| format!("rigid joint closure: {e}"))?;
+            let p = a
+                .svd(true, true)
+                .solve(&rhs, 1e-12)
+                .map_err(|e| Error::linear_solve(format!("rigid joint closure: {e}")))?;
             let old = q.to_vec();
             for d in 0..n {
                 let (b, t) = motion(d, &old);

@@ -1,5 +1,6 @@
 //! Scalar functions of time that drive loads (model files name them with `type = ...`).
 
+use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
@@ -110,9 +111,14 @@ impl TimeFunction {
     }
 
     /// Checks that every number is finite and the pieces are ordered; returns the problem.
-    pub fn check(&self) -> Result<(), String> {
-        let finite =
-            |name: &str, v: f64| if v.is_finite() { Ok(()) } else { Err(format!("{name} must be finite, got {v}")) };
+    pub fn check(&self) -> Result<()> {
+        let finite = |name: &str, v: f64| {
+            if v.is_finite() {
+                Ok(())
+            } else {
+                Err(Error::Usage(format!("{name} must be finite, got {v}")))
+            }
+        };
         match self {
             TimeFunction::Constant { value } => finite("value", *value),
             TimeFunction::Sine { amplitude, frequency, phase } => {
@@ -127,42 +133,44 @@ impl TimeFunction {
             TimeFunction::Ramp { amplitude, duration } => {
                 finite("amplitude", *amplitude)?;
                 if !(duration.is_finite() && *duration > 0.0) {
-                    return Err(format!("duration must be positive and finite, got {duration}"));
+                    return Err(Error::Usage(format!("duration must be positive and finite, got {duration}")));
                 }
                 Ok(())
             }
             TimeFunction::Piecewise { pieces } => {
                 if pieces.is_empty() {
-                    return Err("pieces must not be empty".into());
+                    return Err(Error::Usage("pieces must not be empty".into()));
                 }
                 let mut last = f64::NEG_INFINITY;
                 for (i, p) in pieces.iter().enumerate() {
                     match p.until {
                         Some(u) if !u.is_finite() || u <= last => {
-                            return Err(format!("pieces[{i}].until must be finite and increasing, got {u}"))
+                            return Err(Error::Usage(format!(
+                                "pieces[{i}].until must be finite and increasing, got {u}"
+                            )))
                         }
                         Some(u) => last = u,
                         None if i + 1 != pieces.len() => {
-                            return Err(format!("pieces[{i}] has no `until` but is not the last piece"))
+                            return Err(Error::Usage(format!("pieces[{i}] has no `until` but is not the last piece")))
                         }
                         None => {}
                     }
-                    p.function.check().map_err(|e| format!("pieces[{i}].function: {e}"))?;
+                    p.function.check().map_err(|e| Error::Usage(format!("pieces[{i}].function: {e}")))?;
                 }
                 Ok(())
             }
             TimeFunction::Polynomial { coefficients } => {
                 if coefficients.is_empty() {
-                    return Err("coefficients must not be empty (give [c0, c1, ...])".into());
+                    return Err(Error::Usage("coefficients must not be empty (give [c0, c1, ...])".into()));
                 }
                 coefficients.iter().enumerate().try_for_each(|(i, c)| finite(&format!("coefficients[{i}]"), *c))
             }
             TimeFunction::Sum { terms } => {
                 if terms.is_empty() {
-                    return Err("terms must not be empty".into());
+                    return Err(Error::Usage("terms must not be empty".into()));
                 }
                 for (i, f) in terms.iter().enumerate() {
-                    f.check().map_err(|e| format!("terms[{i}]: {e}"))?;
+                    f.check().map_err(|e| Error::Usage(format!("terms[{i}]: {e}")))?;
                 }
                 Ok(())
             }
@@ -285,16 +293,16 @@ mod tests {
     #[test]
     fn empty_polynomials_and_sums_are_refused() {
         let p: TimeFunction = toml::from_str("type = \"polynomial\"\ncoefficients = []").unwrap();
-        assert!(p.check().unwrap_err().contains("coefficients"));
+        assert!(p.check().unwrap_err().to_string().contains("coefficients"));
         let s: TimeFunction = toml::from_str("type = \"sum\"\nterms = []").unwrap();
-        assert!(s.check().unwrap_err().contains("terms"));
+        assert!(s.check().unwrap_err().to_string().contains("terms"));
         let bad: TimeFunction = toml::from_str("type = \"polynomial\"\ncoefficients = [1.0, nan]").unwrap();
-        assert!(bad.check().unwrap_err().contains("coefficients[1]"));
+        assert!(bad.check().unwrap_err().to_string().contains("coefficients[1]"));
     }
 
     #[test]
     fn unknown_keys_are_refused() {
-        let r: Result<TimeFunction, _> = toml::from_str("type = \"constant\"\nvalue = 1.0\nvalu = 2.0");
+        let r: std::result::Result<TimeFunction, _> = toml::from_str("type = \"constant\"\nvalue = 1.0\nvalu = 2.0");
         assert!(r.is_err());
     }
 }

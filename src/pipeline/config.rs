@@ -153,18 +153,18 @@ impl Pipeline {
 
     /// `[reduction] probe_modes`: a tolerance in (0, 1), a variant that has blocks of modes,
     /// and a probe that records what the modes are for.
-    fn check_probe_modes(&self, tolerance: f64) -> std::result::Result<(), String> {
+    fn check_probe_modes(&self, tolerance: f64) -> Result<()> {
         if !(tolerance.is_finite() && tolerance > 0.0 && tolerance < 1.0) {
-            return Err(format!("has tolerance {tolerance}; it must lie strictly between 0 and 1"));
+            return Err(Error::Usage(format!("has tolerance {tolerance}; it must lie strictly between 0 and 1")));
         }
         if matches!(self.variant(), Variant::WholeSystem | Variant::WholeSystemStabilized) {
-            return Err(format!(
+            return Err(Error::Usage(format!(
                 "needs the galerkin or the constraint-preserving variant, not {}",
                 self.variant().name()
-            ));
+            )));
         }
         if !self.model.probes().iter().any(|p| p.strain || p.curvature) {
-            return Err("is set, but no probe of the model records a strain or a curvature (`quantities = [\"strain\", \"curvature\"]` in a [[probes]] entry)".into());
+            return Err(Error::Usage("is set, but no probe of the model records a strain or a curvature (`quantities = [\"strain\", \"curvature\"]` in a [[probes]] entry)".into()));
         }
         Ok(())
     }
@@ -210,7 +210,7 @@ impl Pipeline {
             }
         }
         if let Err(e) = red.modes.as_ref().map_or(Ok(()), |m| m.validate()) {
-            return bad("reduction.modes", e);
+            return bad("reduction.modes", e.problem());
         }
         match (&red.modes, self.blocks()) {
             (Some(ModeRule::Counts(_)), None) => {
@@ -251,11 +251,11 @@ impl Pipeline {
                 );
             }
             if let Err(e) = m.validate().and(if matches!(m, ModeRule::Counts(_)) {
-                Err("gives counts per block; use count, ratio or energy".to_string())
+                Err(Error::Usage("gives counts per block; use count, ratio or energy".into()))
             } else {
                 Ok(())
             }) {
-                return bad("reduction.multiplier_modes", e);
+                return bad("reduction.multiplier_modes", e.problem());
             }
         }
         if let Some(h) = &self.file.reduction.hyper {
@@ -273,7 +273,8 @@ impl Pipeline {
             );
         }
         if let Some(m) = &self.file.reduction.probe_modes {
-            self.check_probe_modes(m.tolerance).map_err(|e| Error::input(&self.path, "reduction.probe_modes", e))?;
+            self.check_probe_modes(m.tolerance)
+                .map_err(|e| Error::input(&self.path, "reduction.probe_modes", e.problem()))?;
         }
         for (name, scales) in [
             ("online", self.file.online.as_ref().and_then(|o| o.load_scales.as_ref())),
@@ -338,7 +339,7 @@ impl Pipeline {
             }
             let range = spec.range(name);
             if let Err(e) = range.validate() {
-                return bad(&field, e);
+                return bad(&field, e.problem());
             }
             if let Some(what) = self.model.property_parameter(name).filter(|_| !(range.lower > 0.0)) {
                 return bad(

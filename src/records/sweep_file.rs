@@ -451,8 +451,8 @@ pub fn read_sweep(
     // dataset's shape checked against it before that dataset is read
     let sections: usize = model.section_names().iter().map(Vec::len).sum();
     let per_run = 8.0 * (nt as f64 * (r + 4 * model.probe_names().len() + sections) as f64 + 32.0);
-    let n =
-        bounded_len(&f, "load_scales", per_run, &model.limits).map_err(|p| cannot_resume(path, "load_scales", p))?;
+    let n = bounded_len(&f, "load_scales", per_run, &model.limits)
+        .map_err(|p| cannot_resume(path, "load_scales", p.problem()))?;
     let file = Resumed { f, path, n, nt };
     let (probe_names, section_names) = (model.probe_names(), model.section_names());
     let keys = quantity_keys(&probe_names, &section_names);
@@ -560,7 +560,7 @@ impl Resumed<'_> {
     }
 
     fn shaped(&self, name: &str, want: &[usize]) -> Result<hdf5::Dataset> {
-        dataset_of_shape(&self.f, name, want).map_err(|p| self.cannot(name, p))
+        dataset_of_shape(&self.f, name, want).map_err(|p| self.cannot(name, p.problem()))
     }
 
     fn read_err(&self, name: &str, e: hdf5::Error) -> Error {

@@ -92,12 +92,13 @@ pub fn open_sweep_run(path: &Path, pick: SweepPick, limits: &crate::limits::Limi
     }
     // the file alone sizes /t: bounded before it is read (8 bytes an instant), and a run's
     // coordinates and columns bound how many runs the file may hold
-    bounded_len(&f, "t", 8.0, limits).map_err(|p| bad("t", p))?;
+    bounded_len(&f, "t", 8.0, limits).map_err(|p| bad("t", p.problem()))?;
     let t: Vec<f64> =
         f.dataset("t").and_then(|d| d.read_raw()).map_err(|e| bad("t", format!("cannot be read: {e}")))?;
     let (nt, r) = (t.len(), basis.n_reduced());
-    let n = bounded_len(&f, "load_scales", 8.0 * (nt * r + 32) as f64, limits).map_err(|p| bad("load_scales", p))?;
-    let shaped = |name: &str, want: &[usize]| dataset_of_shape(&f, name, want).map_err(|p| bad(name, p));
+    let n = bounded_len(&f, "load_scales", 8.0 * (nt * r + 32) as f64, limits)
+        .map_err(|p| bad("load_scales", p.problem()))?;
+    let shaped = |name: &str, want: &[usize]| dataset_of_shape(&f, name, want).map_err(|p| bad(name, p.problem()));
     let scales = shaped("load_scales", &[n])?.read_raw::<f64>().map_err(|e| bad("load_scales", e.to_string()))?;
     let points = points_of(&f, &scales).map_err(|(field, p)| bad(field, p))?;
     let index = pick_index(path, &points, pick)?;

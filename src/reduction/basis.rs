@@ -13,7 +13,7 @@ use super::sample::Hyper;
 use ndarray::{Array1, Array2, ArrayView1, ArrayView2};
 
 /// Which reduction (SPEC §3).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Variant {
     /// project all coordinates; the joint equations are projected too, and those the

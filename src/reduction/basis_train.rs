@@ -5,6 +5,7 @@
 
 use super::basis::{Basis, BasisSpec, SnapshotKind, Trained, Variant};
 use super::pod::{pod, ModeRule};
+use crate::error::{Error, Result};
 use ndarray::{s, Array1, Array2, ArrayView1, ArrayView2, Axis};
 
 /// Builds a basis from snapshots `x` (n × m) and, for whole-system, multipliers `λ`
@@ -20,11 +21,11 @@ pub(crate) fn train_plain(
     joint_dofs: &[usize],
     x_ref: ArrayView1<f64>,
     spec: &BasisSpec,
-) -> Result<Trained, String> {
+) -> Result<Trained> {
     let (variant, multiplier_scale) = (spec.variant, spec.multiplier_scale);
     let n = x.nrows();
     if x.ncols() == 0 {
-        return Err("the training set is empty (no snapshots)".into());
+        return Err(Error::Usage("the training set is empty (no snapshots)".into()));
     }
     let reference = match spec.snapshots {
         SnapshotKind::Raw => Array1::zeros(n),
@@ -36,21 +37,21 @@ pub(crate) fn train_plain(
         _ => (0..n).collect(),
     };
     if variant == Variant::WholeSystemStabilized {
-        return Err("the stabilized variant is trained by reduction::train_basis".into());
+        return Err(Error::Usage("the stabilized variant is trained by reduction::train_basis".into()));
     }
     if !spec.blocks.is_empty() {
         return train_blocks(centred, reference, joint_dofs, reduced_dofs, spec);
     }
     if let ModeRule::Counts(_) = spec.modes {
-        return Err(format!("{} gives one count per block, and the basis has no blocks", spec.modes));
+        return Err(Error::Usage(format!("{} gives one count per block, and the basis has no blocks", spec.modes)));
     }
     let rows = match variant {
         Variant::WholeSystem => {
             if !(multiplier_scale.is_finite() && multiplier_scale > 0.0) {
-                return Err(format!("the multiplier scale must be positive, got {multiplier_scale}"));
+                return Err(Error::Usage(format!("the multiplier scale must be positive, got {multiplier_scale}")));
             }
             ndarray::concatenate(Axis(0), &[centred.view(), (&lambda / multiplier_scale).view()])
-                .map_err(|e| e.to_string())?
+                .map_err(|e| Error::numerical("POD", e.to_string()))?
         }
         _ => centred.select(Axis(0), &reduced_dofs),
     };
@@ -62,7 +63,9 @@ pub(crate) fn train_plain(
         Variant::WholeSystem => {
             (lead.slice(s![..n, ..]).to_owned(), Vec::new(), Some(lead.slice(s![n.., ..]).to_owned()))
         }
-        Variant::WholeSystemStabilized => return Err("the stabilized variant is trained by whole_system".into()),
+        Variant::WholeSystemStabilized => {
+            return Err(Error::Usage("the stabilized variant is trained by whole_system".into()))
+        }
         Variant::ConstraintPreserving => {
             let mut v = Array2::zeros((n, r + joint_dofs.len()));
             for (i, &d) in reduced_dofs.iter().enumerate() {
@@ -93,38 +96,45 @@ fn train_blocks(
     joint_dofs: &[usize],
     reduced_dofs: Vec<usize>,
     spec: &BasisSpec,
-) -> Result<Trained, String> {
+) -> Result<Trained> {
     let n = centred.nrows();
     if matches!(spec.variant, Variant::WholeSystem | Variant::WholeSystemStabilized) {
-        return Err("a basis with blocks needs the galerkin or the constraint-preserving variant".into());
+        return Err(Error::Usage("a basis with blocks needs the galerkin or the constraint-preserving variant".into()));
     }
     if let ModeRule::Counts(c) = &spec.modes {
         if c.len() != spec.blocks.len() {
-            return Err(format!("{} gives {} counts for {} blocks", spec.modes, c.len(), spec.blocks.len()));
+            return Err(Error::Usage(format!(
+                "{} gives {} counts for {} blocks",
+                spec.modes,
+                c.len(),
+                spec.blocks.len()
+            )));
         }
     }
     let mut owner = vec![None; n];
     for (b, block) in spec.blocks.iter().enumerate() {
         for &d in block {
             match owner.get(d) {
-                None => return Err(format!("block {} holds coordinate {d}, the model has {n}", b + 1)),
-                Some(Some(o)) => return Err(format!("coordinate {d} is in blocks {} and {}", o + 1, b + 1)),
+                None => return Err(Error::Usage(format!("block {} holds coordinate {d}, the model has {n}", b + 1))),
+                Some(Some(o)) => {
+                    return Err(Error::Usage(format!("coordinate {d} is in blocks {} and {}", o + 1, b + 1)))
+                }
                 Some(None) => owner[d] = Some(b),
             }
         }
     }
     if let Some(d) = reduced_dofs.iter().find(|&&d| owner[d].is_none()) {
-        return Err(format!("coordinate {d} is in no block"));
+        return Err(Error::Usage(format!("coordinate {d} is in no block")));
     }
     let kept = if spec.variant == Variant::ConstraintPreserving { joint_dofs.to_vec() } else { Vec::new() };
     let (mut pods, mut block_modes, mut columns) = (Vec::new(), Vec::new(), Vec::new());
     for (b, block) in spec.blocks.iter().enumerate() {
         let rows: Vec<usize> = block.iter().copied().filter(|d| !kept.contains(d)).collect();
-        let p = pod(centred.select(Axis(0), &rows).view()).map_err(|e| format!("block {}: {e}", b + 1))?;
+        let p = pod(centred.select(Axis(0), &rows).view()).map_err(|e| e.context(format_args!("block {}", b + 1)))?;
         let r = spec
             .modes
             .count_in_block(b, block.len(), p.energy.as_slice().expect("contiguous"))
-            .map_err(|e| format!("block {}: {e}", b + 1))?;
+            .map_err(|e| e.context(format_args!("block {}", b + 1)))?;
         columns.push((rows, p.leading(r)));
         pods.push(p);
         block_modes.push(r);
@@ -243,7 +253,7 @@ mod tests {
             (BasisSpec { blocks: vec![(0..5).collect()], ..spec.clone() }, "in no block"),
             (BasisSpec { blocks: vec![], ..counts.clone() }, "no blocks"),
         ] {
-            let err = train_basis(x.view(), lam.view(), &[4, 5], xref.view(), &bad).err().expect("refused");
+            let err = train_basis(x.view(), lam.view(), &[4, 5], xref.view(), &bad).err().expect("refused").to_string();
             assert!(err.contains(needle), "{err}");
         }
     }

@@ -26,6 +26,7 @@
 
 use super::basis::Basis;
 use super::sample::Hyper;
+use crate::error::{Error, Result};
 use crate::linalg::nnls::NnlsParams;
 use crate::linalg::tall_qr::nnls_of_column_sum;
 use crate::solver::model::{stiffness_groups, InvariantElementModel};
@@ -83,9 +84,9 @@ pub fn ecsw<M: InvariantElementModel>(
     basis: &Basis,
     snapshots: ArrayView2<f64>,
     tolerance: f64,
-) -> Result<Hyper, String> {
+) -> Result<Hyper> {
     if snapshots.ncols() == 0 {
-        return Err("no training snapshots".into());
+        return Err(Error::Usage("no training snapshots".into()));
     }
     // b = C 1 lies in C's range: once NNLS has taken as long as factoring C would, it goes
     // on in C's triangular factor R (n_elements², not rows × n_elements, per iteration)

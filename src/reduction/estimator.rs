@@ -9,6 +9,7 @@
 //! How it is built, calibrated and run is `crate::rom::estimator`'s.
 
 use super::basis::Basis;
+use crate::error::{Error, Result};
 use crate::solver::parameter_space::ParameterSpace;
 use crate::solver::parameters::Parameters;
 
@@ -283,7 +284,7 @@ impl Default for Calibration {
 }
 
 /// How the enriched model's trajectory `X⁺` is obtained (docs/error-estimate.md).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum EstimateMethod {
     /// one Newton iteration of the enriched model per step, from the reduced run's
@@ -292,25 +293,21 @@ pub enum EstimateMethod {
     /// online estimate reads on the scale of the training tolerance. The default online
     /// estimate unless greedy training calibrated `Defects` reliably (`DefectsCalibration`)
     #[default]
-    #[value(
-        help = "one Newton iteration of the enriched model per step along the reduced run (about 1.5× the error; 45–130 % of the reduced run)"
-    )]
     Corrected,
     /// the enriched model integrated on its own to convergence (about 2× the reduced run)
-    #[value(help = "the enriched model integrated on its own (about 2× the reduced run)")]
     Enriched,
     /// the cheap method: the reduced run's local defects against the enriched model at
     /// every 10th step, summed (`rom::estimator::defects`), 7–16 % of the reduced run.
     /// Uncalibrated a loose bound (1.2–46× the error measured); calibrated by greedy training
     /// ([`DefectsCalibration`]) the corrected estimate's reading at its candidates, and
     /// then the online default where its leave-one-out check passed (docs/error-estimate.md)
-    #[value(
-        help = "the enriched model's local defects at every 10th step (7–16 % of the reduced run; calibrated by greedy training)"
-    )]
     Defects,
 }
 
 impl EstimateMethod {
+    /// Every method, in the order the front ends list them.
+    pub const ALL: [EstimateMethod; 3] = [EstimateMethod::Corrected, EstimateMethod::Enriched, EstimateMethod::Defects];
+
     pub fn name(self) -> &'static str {
         match self {
             EstimateMethod::Corrected => "corrected",
@@ -319,12 +316,14 @@ impl EstimateMethod {
         }
     }
 
-    pub fn parse(s: &str) -> std::result::Result<Self, String> {
+    pub fn parse(s: &str) -> Result<Self> {
         match s {
             "corrected" => Ok(EstimateMethod::Corrected),
             "enriched" => Ok(EstimateMethod::Enriched),
             "defects" => Ok(EstimateMethod::Defects),
-            _ => Err(format!("is \"{s}\"; expected \"corrected\" (default), \"defects\" or \"enriched\"")),
+            _ => {
+                Err(Error::Usage(format!("is \"{s}\"; expected \"corrected\" (default), \"defects\" or \"enriched\"")))
+            }
         }
     }
 }
@@ -358,11 +357,11 @@ impl ErrorMeasure {
         }
     }
 
-    pub fn parse(s: &str) -> std::result::Result<Self, String> {
+    pub fn parse(s: &str) -> Result<Self> {
         match s {
             "relative" => Ok(ErrorMeasure::Relative),
             "displacement" => Ok(ErrorMeasure::Displacement),
-            _ => Err(format!("is \"{s}\"; expected \"relative\" (default) or \"displacement\"")),
+            _ => Err(Error::Usage(format!("is \"{s}\"; expected \"relative\" (default) or \"displacement\""))),
         }
     }
 

@@ -41,6 +41,7 @@ use super::basis::Basis;
 use super::damping::DampingSplit;
 use super::projection::{forward_to_projection, impl_reduced, Projection};
 use super::sample::Hyper;
+use crate::error::{Error, Result};
 use crate::linalg::incremental_product::IncrementalProduct;
 use crate::linalg::sparse_rows::SparseRows;
 use crate::solver::model::{
@@ -100,9 +101,9 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
 
     /// Projects `full` (a model, or an `Arc` of one shared with other reduced models) on
     /// `basis`, summing the element terms over the sample `hyper`.
-    pub fn new(full: impl Into<Arc<M>>, basis: &Basis, hyper: &Hyper) -> Result<Self, String> {
+    pub fn new(full: impl Into<Arc<M>>, basis: &Basis, hyper: &Hyper) -> Result<Self> {
         let full: Arc<M> = full.into();
-        hyper.validate(full.n_elements()).map_err(|(f, p)| format!("{f} {p}"))?;
+        hyper.validate(full.n_elements()).map_err(|(f, p)| Error::Usage(format!("{f} {p}")))?;
         let mut p = Projection::new(&*full, basis)?;
         let v = basis.modes.as_standard_layout();
         let r = v.ncols();
@@ -110,7 +111,7 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
         let ne = if n_el > 0 { full.element_dofs(0).len() } else { 0 };
         let nj = full.n_invariants();
         if ![4, 6, 8, 12].contains(&ne) {
-            return Err(format!("hyper-reduction supports elements of 4, 6, 8 or 12 dofs, not {ne}"));
+            return Err(Error::Usage(format!("hyper-reduction supports elements of 4, 6, 8 or 12 dofs, not {ne}")));
         }
 
         // the elements by stiffness parameter, each group's linear part summed apart
@@ -290,14 +291,7 @@ impl<M: InvariantElementModel> ParametricModel for HyperReducedModel<M> {
         self.add_force(out);
     }
 
-    fn factor(
-        &mut self,
-        mu: &Parameters,
-        q: &[f64],
-        v: &[f64],
-        t: f64,
-        coef: IterationCoefficients,
-    ) -> Result<f64, String> {
+    fn factor(&mut self, mu: &Parameters, q: &[f64], v: &[f64], t: f64, coef: IterationCoefficients) -> Result<f64> {
         // m M_r + k (L_r + J_l,r) + c C_r
         self.bind_parameters(mu);
         self.p.start_matrix(&*self.full, mu, (q, v), t, coef);

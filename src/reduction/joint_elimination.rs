@@ -23,6 +23,7 @@
 //! thesis four-bar: 54 instead of 70, an LU 40 % as costly), and forming it touches only the
 //! `j` joint rows and columns of `S`. The multipliers stay exact.
 
+use crate::error::{Error, Result};
 use crate::linalg::dense_lu::DenseLu;
 use crate::linalg::lapack::SVD;
 use crate::linalg::vec_ops::{axpy, dot};
@@ -129,11 +130,15 @@ impl JointElimination {
 
     /// Solves the KKT system in place (`rhs = [r_q; r_c]` → `[Δq; Δμ]`) with `lu` holding
     /// the factorized `Pᵀ S P` of the last [`Self::reduce`].
-    pub fn solve(&mut self, lu: &mut DenseLu, rhs: &mut [f64]) -> Result<(), String> {
+    pub fn solve(&mut self, lu: &mut DenseLu, rhs: &mut [f64]) -> Result<()> {
         let (r, nc, f) = (self.r, self.nc, self.f);
         let (j, k) = (r - f, self.dim() - f);
         if rhs.len() != r + nc {
-            return Err(format!("right-hand side has {} entries, the system {}", rhs.len(), r + nc));
+            return Err(Error::linear_solve(format!(
+                "right-hand side has {} entries, the system {}",
+                rhs.len(),
+                r + nc
+            )));
         }
         let (rq, rc) = rhs.split_at_mut(r);
         let s = &self.s;

@@ -27,6 +27,7 @@ pub mod reduced_model;
 pub mod sample;
 pub mod whole_system;
 
+use crate::error::{Error, Result};
 pub use basis::{Basis, BasisSpec, SnapshotKind, Stabilization, Trained, Variant};
 pub use ecsw::ecsw;
 pub use hyper_model::HyperReducedModel;
@@ -44,15 +45,15 @@ pub fn train_basis(
     joint_dofs: &[usize],
     x_ref: ndarray::ArrayView1<f64>,
     spec: &BasisSpec,
-) -> Result<Trained, String> {
+) -> Result<Trained> {
     if spec.variant != Variant::WholeSystemStabilized {
         return basis_train::train_plain(x, lambda, joint_dofs, x_ref, spec);
     }
     if !spec.blocks.is_empty() {
-        return Err("a basis with blocks needs the galerkin or the constraint-preserving variant".into());
+        return Err(Error::Usage("a basis with blocks needs the galerkin or the constraint-preserving variant".into()));
     }
     if x.ncols() == 0 {
-        return Err("the training set is empty (no snapshots)".into());
+        return Err(Error::Usage("the training set is empty (no snapshots)".into()));
     }
     let reference = match spec.snapshots {
         SnapshotKind::Raw => ndarray::Array1::zeros(x.nrows()),

@@ -27,6 +27,7 @@
 //! reads and a function of them.
 
 use super::basis::Trained;
+use crate::error::{Error, Result};
 use ndarray::{s, Array1, Array2, ArrayView1, ArrayView2, Axis};
 
 /// One scalar output of the coordinates: it reads the coordinates `dofs` (in this order).
@@ -76,14 +77,18 @@ pub fn add_output_modes(
     outputs: &Outputs,
     seed: &[Array2<f64>],
     stop: Stop,
-) -> Result<Vec<usize>, String> {
+) -> Result<Vec<usize>> {
     if let Stop::Tolerance(t) = stop {
         if !(t.is_finite() && t > 0.0 && t < 1.0) {
-            return Err(format!("the probe-mode tolerance must lie in (0, 1), got {t}"));
+            return Err(Error::Usage(format!("the probe-mode tolerance must lie in (0, 1), got {t}")));
         }
     }
     if blocks.len() != trained.block_modes.len() {
-        return Err(format!("{} row sets for a basis of {} blocks", blocks.len(), trained.block_modes.len()));
+        return Err(Error::Usage(format!(
+            "{} row sets for a basis of {} blocks",
+            blocks.len(),
+            trained.block_modes.len()
+        )));
     }
     let centred = &x - &trained.basis.reference.view().insert_axis(Axis(1));
     let exact = outputs_at(outputs, &|d, j| x[[d, j]], x.ncols());

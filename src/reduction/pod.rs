@@ -6,6 +6,7 @@
 //! ```
 
 use crate::linalg::lapack::{JobSvd, SVDDC};
+use crate::error::{Error, Result};
 use ndarray::{s, Array1, Array2, ArrayView2};
 
 /// How many POD modes to keep.
@@ -24,17 +25,17 @@ pub enum ModeRule {
 }
 
 impl ModeRule {
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<()> {
         match *self {
-            ModeRule::Count(0) => Err("count must be at least 1".into()),
+            ModeRule::Count(0) => Err(Error::Usage("count must be at least 1".into())),
             ModeRule::Counts(ref c) if c.is_empty() || c.contains(&0) => {
-                Err(format!("counts must be at least 1 each, got {c:?}"))
+                Err(Error::Usage(format!("counts must be at least 1 each, got {c:?}")))
             }
             ModeRule::Ratio(x) if !(x.is_finite() && x > 0.0 && x <= 1.0) => {
-                Err(format!("ratio must lie in (0, 1], got {x}"))
+                Err(Error::Usage(format!("ratio must lie in (0, 1], got {x}")))
             }
             ModeRule::Energy(t) if !(t.is_finite() && t > 0.0 && t < 1.0) => {
-                Err(format!("energy tolerance must lie in (0, 1), got {t}"))
+                Err(Error::Usage(format!("energy tolerance must lie in (0, 1), got {t}")))
             }
             _ => Ok(()),
         }
@@ -42,23 +43,25 @@ impl ModeRule {
 
     /// The number of modes this rule keeps, given the full model's dof count and the
     /// captured-energy curve; an error when it asks for more modes than the snapshots hold.
-    pub fn count(&self, n_dof: usize, energy: &[f64]) -> Result<usize, String> {
+    pub fn count(&self, n_dof: usize, energy: &[f64]) -> Result<usize> {
         self.count_in_block(0, n_dof, energy)
     }
 
     /// [`Self::count`] for block `b` of a block basis whose block has `n_dof` coordinates
     /// (`counts` gives each block its own number).
-    pub fn count_in_block(&self, b: usize, n_dof: usize, energy: &[f64]) -> Result<usize, String> {
+    pub fn count_in_block(&self, b: usize, n_dof: usize, energy: &[f64]) -> Result<usize> {
         self.validate()?;
         let available = energy.len();
         let r = match *self {
             ModeRule::Count(n) => n,
-            ModeRule::Counts(ref c) => *c.get(b).ok_or_else(|| format!("{self} has no count for block {}", b + 1))?,
+            ModeRule::Counts(ref c) => {
+                *c.get(b).ok_or_else(|| Error::Usage(format!("{self} has no count for block {}", b + 1)))?
+            }
             ModeRule::Ratio(x) => ((x * n_dof as f64).round() as usize).max(1),
             ModeRule::Energy(tol) => energy.iter().position(|&e| e >= 1.0 - tol).map_or(available, |i| i + 1),
         };
         if r > available {
-            return Err(format!("{self} asks for {r} modes but the snapshots span at most {available}"));
+            return Err(Error::Usage(format!("{self} asks for {r} modes but the snapshots span at most {available}")));
         }
         Ok(r)
     }
@@ -94,17 +97,21 @@ impl Pod {
 }
 
 /// Thin SVD of `snapshots` (n × m) by LAPACK's divide-and-conquer `gesdd`.
-pub fn pod(snapshots: ArrayView2<f64>) -> Result<Pod, String> {
+pub fn pod(snapshots: ArrayView2<f64>) -> Result<Pod> {
     let (n, m) = snapshots.dim();
     if n == 0 || m == 0 {
-        return Err(format!("the snapshot matrix is empty ({n} × {m})"));
+        return Err(Error::numerical("POD", format!("the snapshot matrix is empty ({n} × {m})")));
     }
     if snapshots.iter().any(|x| !x.is_finite()) {
-        return Err("the snapshot matrix holds non-finite values".into());
+        return Err(Error::numerical("POD", "the snapshot matrix holds non-finite values"));
     }
-    let (u, sigma, _) = snapshots.svddc(JobSvd::Some).map_err(|e| format!("SVD failed: {e}"))?;
+    let (u, sigma, _) =
+        snapshots.svddc(JobSvd::Some).map_err(|e| Error::numerical("POD", format!("SVD failed: {e}")))?;
     // LAPACK hands back column-major storage; keep everything downstream row-major
-    let u = u.ok_or("SVD returned no left singular vectors")?.as_standard_layout().into_owned();
+    let u = u
+        .ok_or_else(|| Error::numerical("POD", "SVD returned no left singular vectors"))?
+        .as_standard_layout()
+        .into_owned();
     let total: f64 = sigma.iter().map(|s| s * s).sum();
     let mut acc = 0.0;
     let energy = sigma
@@ -143,9 +150,9 @@ mod tests {
         assert!((p.energy[0] - 0.9).abs() < 1e-12);
         assert!((p.modes.column(0).dot(&u1).abs() - 1.0).abs() < 1e-12);
         assert!((p.modes.column(1).dot(&u2).abs() - 1.0).abs() < 1e-12);
-        assert_eq!(ModeRule::Energy(0.15).count(3, p.energy.as_slice().unwrap()), Ok(1));
-        assert_eq!(ModeRule::Energy(0.05).count(3, p.energy.as_slice().unwrap()), Ok(2));
-        assert_eq!(ModeRule::Ratio(0.5).count(3, p.energy.as_slice().unwrap()), Ok(2));
+        assert_eq!(ModeRule::Energy(0.15).count(3, p.energy.as_slice().unwrap()).ok(), Some(1));
+        assert_eq!(ModeRule::Energy(0.05).count(3, p.energy.as_slice().unwrap()).ok(), Some(2));
+        assert_eq!(ModeRule::Ratio(0.5).count(3, p.energy.as_slice().unwrap()).ok(), Some(2));
         assert!(ModeRule::Count(4).count(3, p.energy.as_slice().unwrap()).is_err());
         assert!(ModeRule::Count(0).validate().is_err());
     }

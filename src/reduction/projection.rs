@@ -29,6 +29,7 @@ mod newton;
 
 use super::basis::{Basis, Variant};
 use super::joint_elimination::JointElimination;
+use crate::error::{Error, Result};
 use crate::linalg::dense_lu::DenseLu;
 use crate::linalg::lapack::SVD;
 use crate::linalg::sparse_rows::SparseRows;
@@ -64,7 +65,7 @@ macro_rules! forward_to_projection {
         fn add_constraint_force(&self, mu: &Parameters, lambda: &[f64], t: f64, out: &mut [f64]) {
             self.p.add_constraint_force_at(&*self.full, mu, lambda, t, out);
         }
-        fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+        fn solve(&mut self, rhs: &mut [f64]) -> Result<()> {
             self.p.solve(rhs)
         }
         fn length_scale(&self) -> f64 {
@@ -192,9 +193,9 @@ impl ProjectedForces {
 }
 
 impl Projection {
-    pub fn new<M: ElementModel>(full: &M, basis: &Basis) -> Result<Self, String> {
+    pub fn new<M: ElementModel>(full: &M, basis: &Basis) -> Result<Self> {
         let (n, nc_full) = (full.n_dof(), full.n_constraints());
-        basis.validate(n, nc_full).map_err(|(field, problem)| format!("{field} {problem}"))?;
+        basis.validate(n, nc_full).map_err(|(field, problem)| Error::Usage(format!("{field} {problem}")))?;
         let v = &basis.modes;
         let r = v.ncols();
         let load_dofs = full.load_dofs();
@@ -243,11 +244,11 @@ impl Projection {
         full.constraint_residual(&mu0, basis.reference.as_slice().expect("contiguous"), 0.0, &mut res);
         let moving = moving::MovingRows::new(full, v, &basis.reference, nc_full)?;
         if !moving.is_empty() && basis.variant != Variant::ConstraintPreserving {
-            return Err(format!(
+            return Err(Error::Usage(format!(
                 "the model prescribes motions (driven joints), whose rows move with time; the {} variant projects \
                  the joint rows once: train with variant = \"constraint-preserving\"",
                 basis.variant.name()
-            ));
+            )));
         }
         let mut c_ref = Array1::from(res);
 
@@ -258,7 +259,7 @@ impl Projection {
                 // rows Uₖᵀ(B V q + B x_ref − b) for σ > 1e-8 (B has unit entries, V is
                 // orthonormal, so σ ≤ √2); the rest hold as well as the basis represents them
                 let (u, sigma, _) = if nc_full > 0 {
-                    bv.svd(true, false).map_err(|e| format!("SVD of B V failed: {e}"))?
+                    bv.svd(true, false).map_err(|e| Error::numerical("SVD of B V", e.to_string()))?
                 } else {
                     (None, Array1::zeros(0), None)
                 };

@@ -21,6 +21,7 @@
 use super::basis::Basis;
 use super::damping::DampingSplit;
 use super::projection::{axpy, expand, forward_to_projection, impl_reduced, mat_vec, project_add, Projection};
+use crate::error::Result;
 use crate::solver::model::{ElementModel, IterationCoefficients, Parameters, ParametricModel};
 use ndarray::{linalg::general_mat_mul, Array1, Array2, Axis};
 use std::sync::Arc;
@@ -62,7 +63,7 @@ pub struct ReducedModel<M: ElementModel> {
 impl<M: ElementModel> ReducedModel<M> {
     /// Projects `full` (a model, or an `Arc` of one shared with other reduced models) on
     /// `basis`, visiting every element with weight 1.
-    pub fn new(full: impl Into<Arc<M>>, basis: &Basis) -> Result<Self, String> {
+    pub fn new(full: impl Into<Arc<M>>, basis: &Basis) -> Result<Self> {
         let full = full.into();
         let all: Vec<usize> = (0..full.n_elements()).collect();
         let ones = vec![1.0; all.len()];
@@ -76,7 +77,7 @@ impl<M: ElementModel> ReducedModel<M> {
         basis: &Basis,
         elements: Vec<usize>,
         weights: Vec<f64>,
-    ) -> Result<Self, String> {
+    ) -> Result<Self> {
         let full: Arc<M> = full.into();
         let mut p = Projection::new(&*full, basis)?;
         let v = &basis.modes;
@@ -171,14 +172,7 @@ impl<M: ElementModel> ParametricModel for ReducedModel<M> {
         }
     }
 
-    fn factor(
-        &mut self,
-        mu: &Parameters,
-        q: &[f64],
-        v: &[f64],
-        t: f64,
-        coef: IterationCoefficients,
-    ) -> Result<f64, String> {
+    fn factor(&mut self, mu: &Parameters, q: &[f64], v: &[f64], t: f64, coef: IterationCoefficients) -> Result<f64> {
         let (r, ne) = (self.p.r, self.ne);
         self.bind_parameters(mu);
         self.p.start_matrix(&*self.full, mu, (q, v), t, coef);

@@ -26,6 +26,7 @@
 pub use super::basis::Stabilization;
 use super::basis::{Basis, BasisSpec, Trained};
 use super::pod::{pod, ModeRule};
+use crate::error::{Error, Result};
 use ndarray::{s, Array1, Array2, ArrayView2};
 
 /// Default multiplier mode rule: all modes above 1e-12 of the energy (the multiplier
@@ -46,7 +47,7 @@ pub fn constraint_matrix(n: usize, rows: &[Vec<(usize, f64)>]) -> Array2<f64> {
 /// Orthonormalizes the columns of `a` against the orthonormal `q` and each other
 /// (modified Gram–Schmidt, two passes for round-off); `Err(j)` when column `j` lies
 /// (to 1e-10 of its length) in the span of what precedes it.
-pub fn orthonormalize_against(q: &Array2<f64>, a: &Array2<f64>) -> Result<Array2<f64>, usize> {
+pub fn orthonormalize_against(q: &Array2<f64>, a: &Array2<f64>) -> std::result::Result<Array2<f64>, usize> {
     let mut out = Array2::<f64>::zeros(a.dim());
     for j in 0..a.ncols() {
         let mut v = a.column(j).to_owned();
@@ -77,45 +78,50 @@ pub(crate) fn train_stabilized(
     lambda: ArrayView2<f64>,
     reference: Array1<f64>,
     spec: &BasisSpec,
-) -> Result<Trained, String> {
+) -> Result<Trained> {
     let n = centred.nrows();
-    let stab = spec
-        .stabilization
-        .as_ref()
-        .ok_or("the whole-system-stabilized variant needs the joint equations B (none were given)")?;
+    let stab = spec.stabilization.as_ref().ok_or_else(|| {
+        Error::Usage("the whole-system-stabilized variant needs the joint equations B (none were given)".into())
+    })?;
     let b = &stab.constraints;
     let nc = b.nrows();
     if nc == 0 {
-        return Err(
+        return Err(Error::Usage(
             "the model has no joints: the whole-system-stabilized variant has no multipliers to reduce; use galerkin"
                 .into(),
-        );
+        ));
     }
     if b.ncols() != n || lambda.nrows() != nc || lambda.ncols() != centred.ncols() {
-        return Err(format!(
+        return Err(Error::Usage(format!(
             "B is {:?}, the snapshots are {:?} and the multiplier snapshots {:?}: they do not fit",
             b.dim(),
             centred.dim(),
             lambda.dim()
-        ));
+        )));
     }
     if let ModeRule::Counts(_) = spec.modes {
-        return Err(format!("{} gives one count per block, and the basis has no blocks", spec.modes));
+        return Err(Error::Usage(format!("{} gives one count per block, and the basis has no blocks", spec.modes)));
     }
     let p = pod(centred.view())?;
     let r = spec.modes.count(n, p.energy.as_slice().expect("contiguous"))?;
     if lambda.iter().all(|&v| v == 0.0) {
-        return Err("the multiplier snapshots are all zero (the joints carry no load): nothing to reduce".into());
+        return Err(Error::Usage(
+            "the multiplier snapshots are all zero (the joints carry no load): nothing to reduce".into(),
+        ));
     }
-    let pl = pod(lambda).map_err(|e| format!("multiplier POD: {e}"))?;
+    let pl = pod(lambda).map_err(|e| e.context("multiplier POD"))?;
     let k = stab
         .multiplier_modes
         .count(nc, pl.energy.as_slice().expect("contiguous"))
-        .map_err(|e| format!("reduction.multiplier_modes: {e}"))?;
+        .map_err(|e| e.context("reduction.multiplier_modes"))?;
     let phi = p.leading(r);
     let psi = pl.leading(k);
     let supremizers = orthonormalize_against(&phi, &b.t().dot(&psi)).map_err(|j| {
-        format!("supremizer {} (Bᵀ of multiplier mode {}) lies in the span of the coordinate modes", j + 1, j + 1)
+        Error::Usage(format!(
+            "supremizer {} (Bᵀ of multiplier mode {}) lies in the span of the coordinate modes",
+            j + 1,
+            j + 1
+        ))
     })?;
     let mut modes = Array2::zeros((n, r + k));
     modes.slice_mut(s![.., ..r]).assign(&phi);
@@ -221,6 +227,7 @@ mod tests {
         assert!(train_basis(x.view(), lam.view(), &[0, 2], x0.view(), &none)
             .err()
             .expect("refused")
+            .to_string()
             .contains("joint equations"));
     }
 }

@@ -63,7 +63,7 @@ impl ReducedRunner {
         let q0 = basis.reduce(ArrayView1::from(&physics.x0[..])).to_vec();
         let v0 = basis.reduce_increment(ArrayView1::from(&physics.v0[..])).to_vec();
         let (model, basis) = (Arc::clone(model), Arc::clone(basis));
-        let cannot = |e: String| Error::Usage(format!("cannot build the reduced model: {e}"));
+        let cannot = |e: Error| e.context("cannot build the reduced model");
         let rom = match &basis.hyper {
             Some(h) => Kind::Invariant(Box::new(HyperReducedModel::new(sys, &basis, h).map_err(cannot)?)),
             None if HyperReducedModel::<FlexibleSystem>::supports(&sys) => {

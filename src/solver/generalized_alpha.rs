@@ -126,7 +126,7 @@ pub struct GeneralizedAlpha {
 }
 
 impl GeneralizedAlpha {
-    pub fn new(params: IntegratorParams) -> std::result::Result<Self, String> {
+    pub fn new(params: IntegratorParams) -> Result<Self> {
         params.validate()?;
         let r = params.rho_inf;
         let alpha_m = (2.0 * r - 1.0) / (r + 1.0);
@@ -262,7 +262,7 @@ impl GeneralizedAlpha {
         s: f64,
         rhs: &mut [f64],
         apply: bool,
-    ) -> std::result::Result<f64, String> {
+    ) -> Result<f64> {
         let n = st.q.len();
         let (rq, rc) = rhs.split_at_mut(n);
         rq.iter_mut().for_each(|x| *x *= -1.0 / k.beta_p);
@@ -305,7 +305,7 @@ impl GeneralizedAlpha {
         // slender glass-fibre arm put that guess 10² m off, its residual 4e11 against 1.5e2)
         self.next_start = Predictor::ConstantVelocity;
         let coef = IterationCoefficients { mass: 1.0, damping: 0.0, stiffness: 0.0 };
-        let s = model.factor(&q0, &v0, t0, coef).map_err(|p| Error::LinearSolve { t: t0, problem: p })?;
+        let s = model.factor(&q0, &v0, t0, coef).map_err(|e| e.at_time(t0))?;
         self.factored = None;
         self.stats.factorizations += 1;
         model.force(&q0, &v0, t0, &mut self.work);
@@ -315,7 +315,7 @@ impl GeneralizedAlpha {
         // the constraint rows are factored as s B: their right-hand side is s c
         model.constraint_acceleration_rhs(&q0, &v0, t0, &mut self.rhs[n..]);
         self.rhs[n..].iter_mut().for_each(|x| *x *= s);
-        model.solve(&mut self.rhs).map_err(|p| Error::LinearSolve { t: t0, problem: p })?;
+        model.solve(&mut self.rhs).map_err(|e| e.at_time(t0))?;
         let qdd = self.rhs[..n].to_vec();
         let lambda = self.rhs[n..].iter().map(|m| m * s).collect();
         Ok(State { t: t0, q: q0, v: v0, a: qdd.clone(), qdd, lambda })
@@ -620,18 +620,12 @@ mod tests {
         }
         fn constraint_residual(&self, _q: &[f64], _t: f64, _out: &mut [f64]) {}
         fn add_constraint_force(&self, _lambda: &[f64], _t: f64, _out: &mut [f64]) {}
-        fn factor(
-            &mut self,
-            q: &[f64],
-            _v: &[f64],
-            _t: f64,
-            c: IterationCoefficients,
-        ) -> std::result::Result<f64, String> {
+        fn factor(&mut self, q: &[f64], _v: &[f64], _t: f64, c: IterationCoefficients) -> Result<f64> {
             self.s = c.mass + c.stiffness * (self.k + 3.0 * self.c * q[0] * q[0]);
             self.fresh = true;
             Ok(1.0)
         }
-        fn solve(&mut self, rhs: &mut [f64]) -> std::result::Result<(), String> {
+        fn solve(&mut self, rhs: &mut [f64]) -> Result<()> {
             rhs[0] /= if std::mem::take(&mut self.fresh) { self.s } else { self.stale * self.s };
             Ok(())
         }
@@ -755,17 +749,11 @@ mod tests {
         fn add_constraint_force(&self, lambda: &[f64], _t: f64, out: &mut [f64]) {
             out[0] += lambda[0];
         }
-        fn factor(
-            &mut self,
-            _q: &[f64],
-            _v: &[f64],
-            _t: f64,
-            c: IterationCoefficients,
-        ) -> std::result::Result<f64, String> {
+        fn factor(&mut self, _q: &[f64], _v: &[f64], _t: f64, c: IterationCoefficients) -> Result<f64> {
             self.diag = c.mass * self.m + c.stiffness * self.k;
             Ok(self.s)
         }
-        fn solve(&mut self, rhs: &mut [f64]) -> std::result::Result<(), String> {
+        fn solve(&mut self, rhs: &mut [f64]) -> Result<()> {
             // [d, s; s, 0] [x; y] = [f; g]: x = g/s, y = (f − d x)/s
             let (f, g) = (rhs[0], rhs[1]);
             let x = g / self.s;

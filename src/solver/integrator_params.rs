@@ -3,6 +3,7 @@
 //! set from a model's `[time]` table (docs/model-format.md).
 
 use super::predictor::Predictor;
+use crate::error::{Error, Result};
 
 /// Parameters of the integrator; `validate()` checks them.
 #[derive(Clone, Debug, PartialEq)]
@@ -71,21 +72,24 @@ impl Default for IntegratorParams {
 }
 
 impl IntegratorParams {
-    pub fn validate(&self) -> std::result::Result<(), String> {
+    pub fn validate(&self) -> Result<()> {
         if !(self.rho_inf.is_finite() && (0.0..=1.0).contains(&self.rho_inf)) {
-            return Err(format!("rho_inf must lie in [0, 1], got {}", self.rho_inf));
+            return Err(Error::Usage(format!("rho_inf must lie in [0, 1], got {}", self.rho_inf)));
         }
         if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
-            return Err(format!("Newton tolerance must be positive, got {}", self.tolerance));
+            return Err(Error::Usage(format!("Newton tolerance must be positive, got {}", self.tolerance)));
         }
         if !(self.stagnation.is_finite() && self.stagnation >= 0.0) {
-            return Err(format!("the Newton stagnation bound must be zero or positive, got {}", self.stagnation));
+            return Err(Error::Usage(format!(
+                "the Newton stagnation bound must be zero or positive, got {}",
+                self.stagnation
+            )));
         }
         if !(self.max_strain > 0.0) {
-            return Err(format!("max_strain must be positive, got {}", self.max_strain));
+            return Err(Error::Usage(format!("max_strain must be positive, got {}", self.max_strain)));
         }
         if self.max_iterations == 0 {
-            return Err("max_iterations must be at least 1".into());
+            return Err(Error::Usage("max_iterations must be at least 1".into()));
         }
         Ok(())
     }

@@ -21,6 +21,7 @@
 //! [`ParametricModel`], and the integrator sees one bound to a run's μ.
 
 pub use super::parameters::Parameters;
+use crate::error::Result;
 
 /// Coefficients of the iteration matrix `S = m·M + c·C_t + k·K_t`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -61,9 +62,9 @@ pub trait DynamicModel {
     /// Assembles and factors `[S, s Bᵀ; s B, 0]` with `S = m M + c ∂g/∂q̇ + k ∂g/∂q`
     /// at `(q, q̇, t)`, choosing the constraint scale `s` so that both block rows are of the
     /// same magnitude; returns `s`.
-    fn factor(&mut self, q: &[f64], v: &[f64], t: f64, coef: IterationCoefficients) -> Result<f64, String>;
+    fn factor(&mut self, q: &[f64], v: &[f64], t: f64, coef: IterationCoefficients) -> Result<f64>;
     /// Solves in place with the last factorization; `rhs` has `n_dof + n_constraints` entries.
-    fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String>;
+    fn solve(&mut self, rhs: &mut [f64]) -> Result<()>;
     /// A length that sets the absolute scale of coordinate increments (for convergence tests).
     fn length_scale(&self) -> f64;
     /// The largest mean axial strain `max_e |ε̄ₑ|` (SPEC §1) at `q` and its element, over
@@ -126,16 +127,9 @@ pub trait ParametricModel {
     /// `out += B(t)ᵀ λ`
     fn add_constraint_force(&self, mu: &Parameters, lambda: &[f64], t: f64, out: &mut [f64]);
     /// [`DynamicModel::factor`] at the parameters `mu`.
-    fn factor(
-        &mut self,
-        mu: &Parameters,
-        q: &[f64],
-        v: &[f64],
-        t: f64,
-        coef: IterationCoefficients,
-    ) -> std::result::Result<f64, String>;
+    fn factor(&mut self, mu: &Parameters, q: &[f64], v: &[f64], t: f64, coef: IterationCoefficients) -> Result<f64>;
     /// [`DynamicModel::solve`]
-    fn solve(&mut self, rhs: &mut [f64]) -> std::result::Result<(), String>;
+    fn solve(&mut self, rhs: &mut [f64]) -> Result<()>;
     fn length_scale(&self) -> f64;
     /// [`DynamicModel::max_strain`]
     fn max_strain(&self, _q: &[f64]) -> Option<(f64, usize)> {
@@ -188,16 +182,10 @@ impl<M: ParametricModel + ?Sized> DynamicModel for Bound<'_, M> {
     fn add_constraint_force(&self, lambda: &[f64], t: f64, out: &mut [f64]) {
         self.model.add_constraint_force(&self.mu, lambda, t, out)
     }
-    fn factor(
-        &mut self,
-        q: &[f64],
-        v: &[f64],
-        t: f64,
-        coef: IterationCoefficients,
-    ) -> std::result::Result<f64, String> {
+    fn factor(&mut self, q: &[f64], v: &[f64], t: f64, coef: IterationCoefficients) -> Result<f64> {
         self.model.factor(&self.mu, q, v, t, coef)
     }
-    fn solve(&mut self, rhs: &mut [f64]) -> std::result::Result<(), String> {
+    fn solve(&mut self, rhs: &mut [f64]) -> Result<()> {
         self.model.solve(rhs)
     }
     fn length_scale(&self) -> f64 {

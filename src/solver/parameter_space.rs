@@ -15,7 +15,7 @@
 //! uniform. The random streams are ChaCha8 from the seed, the same on every platform.
 
 use super::parameters::{Parameters, LOAD_SCALE};
-use crate::error::show_number;
+use crate::error::{show_number, Error, Result};
 use rand_chacha::rand_core::{RngCore, SeedableRng};
 
 /// How a parameter's range is spanned.
@@ -50,13 +50,13 @@ pub struct ParameterRange {
 impl ParameterRange {
     /// Refuses a range no sample can be drawn from: non-finite ends, `lower ≥ upper`, or a
     /// logarithmic range that does not lie above zero.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<()> {
         let (a, b) = (self.lower, self.upper);
         if !(a.is_finite() && b.is_finite() && a < b) {
-            return Err(format!("range [{a}, {b}] must be finite with lower < upper"));
+            return Err(Error::Usage(format!("range [{a}, {b}] must be finite with lower < upper")));
         }
         if self.spacing == Spacing::Log && a <= 0.0 {
-            return Err(format!("range [{a}, {b}] with scale = \"log\" must lie above zero"));
+            return Err(Error::Usage(format!("range [{a}, {b}] with scale = \"log\" must lie above zero")));
         }
         Ok(())
     }

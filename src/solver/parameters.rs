@@ -88,8 +88,12 @@ impl Parameters {
     pub fn validate(&self) -> Result<()> {
         for (name, value) in self.iter() {
             if !value.is_finite() {
-                let option = if name == LOAD_SCALE { "--load-scale".to_string() } else { format!("parameter {name}") };
-                return Err(Error::Usage(format!("{option} must be finite, got {value}")));
+                let problem = format!("must be finite, got {value}");
+                return Err(if name == LOAD_SCALE {
+                    Error::option(LOAD_SCALE, None, problem)
+                } else {
+                    Error::Usage(format!("parameter {name} {problem}"))
+                });
             }
         }
         Ok(())
@@ -170,8 +174,11 @@ mod tests {
         assert_eq!(Parameters::default(), Parameters::load_scale(1.0));
         assert!(Parameters::load_scale(-2.5).validate().is_ok());
         for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
-            let e = Parameters::load_scale(bad).validate().expect_err("non-finite load scale accepted").to_string();
-            assert!(e.contains("--load-scale must be finite"), "{e}");
+            // the library names the option by its key; a front end spells it its own way
+            let e = Parameters::load_scale(bad).validate().expect_err("non-finite load scale accepted");
+            assert!(e.to_string().starts_with("load_scale must be finite"), "{e}");
+            let flag = e.render(&|k, _| format!("--{}", k.replace('_', "-")));
+            assert!(flag.starts_with("--load-scale must be finite"), "{flag}");
             let e = Parameters::default().with("E_lower", bad).validate().expect_err("non-finite value accepted");
             assert!(e.to_string().contains("parameter E_lower must be finite"), "{e}");
         }

@@ -29,12 +29,12 @@ pub fn solve_static<M: DynamicModel>(
             // diverged: no matrix to factor at a NaN or infinite state
             break;
         }
-        let s = model.factor(q, &zero, t, coef).map_err(|p| Error::LinearSolve { t, problem: p })?;
+        let s = model.factor(q, &zero, t, coef).map_err(|e| e.at_time(t))?;
         let (rq, rc) = rhs.split_at_mut(n);
         rq.iter_mut().for_each(|x| *x = -*x);
         model.constraint_residual(q, t, rc);
         rc.iter_mut().for_each(|x| *x *= -s);
-        model.solve(&mut rhs).map_err(|p| Error::LinearSolve { t, problem: p })?;
+        model.solve(&mut rhs).map_err(|e| e.at_time(t))?;
         inc = crate::linalg::vec_ops::max_abs(&rhs[..n]);
         if !inc.is_finite() {
             break;

@@ -84,14 +84,14 @@ pub fn build_basis(
     };
     let joints = joint_dofs_of(sys);
     let mut trained = train_basis(data.x.view(), data.multipliers.view(), &joints, x_ref.view(), &spec)
-        .map_err(|e| ("reduction.modes", e))?;
+        .map_err(|e| ("reduction.modes", e.problem()))?;
     let eval = |o: usize, v: &[f64]| probe_output(sys, o, v);
     let outputs =
         probe_tolerance.map(|_| Outputs { outputs: probe_outputs(p, sys, physics.length_scale()), eval: &eval });
     let rows = block_rows(&spec, &trained);
     if let (Some(tol), Some(outputs)) = (probe_tolerance, &outputs) {
         add_output_modes(&mut trained, &rows, data.x.view(), outputs, &[], Stop::Tolerance(tol))
-            .map_err(|e| ("reduction.probe_modes", e))?;
+            .map_err(|e| ("reduction.probe_modes", e.problem()))?;
     }
     if let Some(tol) = hyper_tolerance {
         let hyper = ecsw(sys, &trained.basis, data.x.view(), tol)

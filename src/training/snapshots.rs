@@ -56,18 +56,17 @@ pub fn job_points(p: &Pipeline, x: Option<f64>, shard: Option<Shard>) -> Result<
             "trains at the points of its box: split them with --shard K/N, not --load-scale",
         )),
         (Some(x), None) if x.is_finite() => Ok(vec![Parameters::load_scale(x)]),
-        (Some(x), None) => Err(Error::Usage(format!("--load-scale must be finite, got {x}"))),
+        (Some(x), None) => Err(Error::option("load_scale", None, format!("must be finite, got {x}"))),
         (None, Some(k)) => {
             let all = fixed_points(p)?;
             let idx = k.indices(all.len());
             if idx.is_empty() {
                 let what = if p.file.parameters.is_empty() { "train.load_scales has" } else { "train.points has" };
-                return Err(Error::Usage(format!(
-                    "--shard {k}: {what} {} runs, none for shard {}; use at most {} shards",
-                    all.len(),
-                    k.index,
-                    all.len()
-                )));
+                return Err(Error::option(
+                    "shard",
+                    Some(k.to_string()),
+                    format!("{what} {} runs, none for shard {}; use at most {} shards", all.len(), k.index, all.len()),
+                ));
             }
             Ok(idx.iter().map(|&i| all[i].clone()).collect())
         }

@@ -88,10 +88,10 @@ fn read_part(path: &Path, limits: &Limits) -> Result<Part> {
     // becomes a `Parameters` and a row of the merged sweep), every other shape checked
     // against them
     let n_all = bounded_len(&g, "all_load_scales", BYTES_PER_LISTED_POINT, limits)
-        .map_err(|p| bad("shard/all_load_scales", p))?;
+        .map_err(|p| bad("shard/all_load_scales", p.problem()))?;
     let shaped = |loc: &hdf5::Group, name: &str, want: &[usize]| {
         let field = if loc.name() == "/shard" { format!("shard/{name}") } else { name.to_string() };
-        dataset_of_shape(loc, name, want).map_err(|p| bad(&field, p))
+        dataset_of_shape(loc, name, want).map_err(|p| bad(&field, p.problem()))
     };
     let scales_all = shaped(&g, "all_load_scales", &[n_all])?
         .read_1d::<f64>()
@@ -118,7 +118,8 @@ fn read_part(path: &Path, limits: &Limits) -> Result<Part> {
             "does not match shard/all_load_scales and shard/all_points (a damaged file)".into(),
         ));
     }
-    let n = bounded_len(&f, "load_scales", BYTES_PER_LISTED_POINT, limits).map_err(|p| bad("load_scales", p))?;
+    let n =
+        bounded_len(&f, "load_scales", BYTES_PER_LISTED_POINT, limits).map_err(|p| bad("load_scales", p.problem()))?;
     let indices: Vec<usize> = shaped(&g, "indices", &[n])?
         .read_1d::<u64>()
         .map_err(|e| bad("shard/indices", format!("cannot be read: {e}")))?
@@ -182,7 +183,7 @@ fn read_part(path: &Path, limits: &Limits) -> Result<Part> {
     } else {
         Some(PartBasis {
             hash: s(&f, "basis_content_hash")?,
-            path: recorded_path(&g, "basis").map_err(|p| bad("shard/basis", p))?,
+            path: recorded_path(&g, "basis").map_err(|p| bad("shard/basis", p.problem()))?,
             attr: s(&f, "basis")?,
         })
     };
@@ -203,16 +204,18 @@ fn read_part(path: &Path, limits: &Limits) -> Result<Part> {
         fallback: if f.attr("fallback").is_ok() { s(&f, "fallback")? } else { "none".into() },
         wall_seconds: read_attr_f64(&f, "wall_seconds").unwrap_or(f64::NAN),
         threads: f.attr("threads").and_then(|a| a.read_scalar::<u64>()).unwrap_or(1),
-        pipeline: recorded_path(&g, "pipeline").map_err(|p| bad("shard/pipeline", p))?,
+        pipeline: recorded_path(&g, "pipeline").map_err(|p| bad("shard/pipeline", p.problem()))?,
     })
 }
 
 /// A path a part records for `merge` (attribute `name` on `/shard`; `sweep --shard` writes
 /// it absolute). `Err(problem)`.
-fn recorded_path(g: &hdf5::Group, name: &str) -> std::result::Result<PathBuf, String> {
-    let v = read_attr_str(g, name).map_err(|e| format!("cannot be read ({e}): not a flexrom part file?"))?;
+fn recorded_path(g: &hdf5::Group, name: &str) -> Result<PathBuf> {
+    let v = read_attr_str(g, name)
+        .map_err(|e| Error::hdf5(g.filename(), format!("cannot be read ({e}): not a flexrom part file?")))?;
     if v.trim().is_empty() {
-        return Err(format!("is `{}`, not a path (`sweep --shard` records one): a damaged part file", show_text(&v)));
+        let problem = format!("is `{}`, not a path (`sweep --shard` records one): a damaged part file", show_text(&v));
+        return Err(Error::hdf5(g.filename(), problem));
     }
     Ok(PathBuf::from(v))
 }

@@ -49,12 +49,11 @@ pub fn parse_axis(spec: &str) -> std::result::Result<(String, Vec<f64>), String>
 pub fn grid(axes: &[(String, Vec<f64>)]) -> Result<Vec<Parameters>> {
     for (i, (name, _)) in axes.iter().enumerate() {
         if axes[..i].iter().any(|(n, _)| n == name) {
-            let what = if name == crate::solver::parameters::LOAD_SCALE {
-                "load_scale given twice (--load-scales and --param load_scale)".to_string()
+            return Err(if name == crate::solver::parameters::LOAD_SCALE {
+                Error::option("load_scales", None, "and the parameter load_scale both give the load scales")
             } else {
-                format!("--param {name} given twice")
-            };
-            return Err(Error::Usage(what));
+                Error::option("param", Some(name.clone()), "given twice")
+            });
         }
     }
     let total = axes.iter().map(|(_, v)| v.len() as f64).product::<f64>();

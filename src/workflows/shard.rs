@@ -104,10 +104,11 @@ pub fn shard_indices(n: usize, shard: Shard, points: bool) -> Result<Vec<usize>>
     let idx = shard.indices(n);
     if idx.is_empty() {
         let (many, one) = if points { ("points", "point") } else { ("load scales", "load") };
-        return Err(Error::Usage(format!(
-            "--shard {shard}: a list of {n} {many} has no {one} for shard {}; use at most {n} shards",
-            shard.index
-        )));
+        return Err(Error::option(
+            "shard",
+            Some(shard.to_string()),
+            format!("a list of {n} {many} has no {one} for shard {}; use at most {n} shards", shard.index),
+        ));
     }
     Ok(idx)
 }
@@ -171,7 +172,7 @@ pub const MOST_THREADS: usize = 1024;
 /// whole number is a usage error naming the option or variable.
 pub fn configure_threads(flag: Option<usize>) -> Result<()> {
     let asked = match flag {
-        Some(0) => return Err(Error::Usage("--threads must be at least 1".into())),
+        Some(0) => return Err(Error::option("threads", None, "must be at least 1")),
         Some(n) if n > MOST_THREADS => return Err(too_many_threads("--threads", &n.to_string())),
         Some(n) => Some(("--threads", n)),
         None if std::env::var_os("RAYON_NUM_THREADS").is_some() => threads_from_env("RAYON_NUM_THREADS", true)?,

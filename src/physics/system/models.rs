@@ -299,14 +299,7 @@ impl ParametricModel for FlexibleSystem {
         }
     }
 
-    fn factor(
-        &mut self,
-        mu: &Parameters,
-        q: &[f64],
-        v: &[f64],
-        t: f64,
-        coef: IterationCoefficients,
-    ) -> Result<f64, String> {
+    fn factor(&mut self, mu: &Parameters, q: &[f64], v: &[f64], t: f64, coef: IterationCoefficients) -> Result<f64> {
         self.bind_parameters(mu);
         if self.iteration_coef != Some(coef) {
             let damped = coef.damping != 0.0 && self.damping != Rayleigh::default();
@@ -359,7 +352,7 @@ impl ParametricModel for FlexibleSystem {
         Ok(scale)
     }
 
-    fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+    fn solve(&mut self, rhs: &mut [f64]) -> Result<()> {
         self.kkt.solve(rhs)
     }
 

@@ -11,6 +11,7 @@
 //! coordinate a joint touches unreduced, so the reduced rows hold the motion exactly.
 
 use super::{dot, Projection};
+use crate::error::{Error, Result};
 use crate::solver::model::{ElementModel, Parameters};
 use ndarray::{Array1, Array2, Axis};
 
@@ -26,12 +27,15 @@ pub(crate) struct MovingRows {
 
 impl MovingRows {
     /// The full model's moving rows under the basis `(V, x_ref)`; `nc` rows in all.
-    pub fn new<M: ElementModel>(full: &M, v: &Array2<f64>, x_ref: &Array1<f64>, nc: usize) -> Result<Self, String> {
+    pub fn new<M: ElementModel>(full: &M, v: &Array2<f64>, x_ref: &Array1<f64>, nc: usize) -> Result<Self> {
         let mut is_moving = vec![false; nc];
         let mut rows = Vec::new();
         for (c, dofs) in full.moving_rows() {
             if dofs.len() > MAX_TERMS {
-                return Err(format!("constraint row {c} moves with {} terms; at most {MAX_TERMS}", dofs.len()));
+                return Err(Error::Usage(format!(
+                    "constraint row {c} moves with {} terms; at most {MAX_TERMS}",
+                    dofs.len()
+                )));
             }
             is_moving[c] = true;
             rows.push((c, v.select(Axis(0), &dofs), x_ref.select(Axis(0), &dofs)));

@@ -4,6 +4,7 @@
 //! by Cholesky or LU; [`Projection::solve`] solves with the last factorization.
 
 use super::{expand, Projection};
+use crate::error::Result;
 use crate::linalg::dense_lu::DenseLu;
 use crate::linalg::vec_ops::axpy;
 use crate::reduction::joint_elimination::JointElimination;
@@ -52,7 +53,7 @@ impl Projection {
 
     /// Solves the Newton system `[S, s Bᵀ; s B, 0] [Δq; Δμ] = rhs` in place with the last
     /// factorization (in the joints' null space when they are eliminated).
-    pub fn solve(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+    pub fn solve(&mut self, rhs: &mut [f64]) -> Result<()> {
         match &mut self.elim {
             Some(e) => e.solve(&mut self.lu, rhs),
             None => self.lu.solve(rhs),
@@ -158,7 +159,7 @@ impl Projection {
     /// Completes the matrix with the scaled constraint rows `s B_r`, `s B_rᵀ` (s = the largest
     /// diagonal entry, so both block rows are of one magnitude) and factors it; returns `s`.
     /// With the joints eliminated it factors `Pᵀ S P` instead.
-    pub fn finish_matrix(&mut self) -> Result<f64, String> {
+    pub fn finish_matrix(&mut self) -> Result<f64> {
         let (r, nc) = (self.r, self.nc);
         let (a, n) = self.matrix();
         let scale = (0..r).map(|i| a[i + n * i].abs()).fold(0.0, f64::max);
@@ -180,9 +181,9 @@ impl Projection {
         Ok(scale)
     }
 
-    fn factor_matrix(&mut self) -> Result<(), String> {
+    fn factor_matrix(&mut self) -> Result<()> {
         let done = if self.symmetric { self.lu.factor_symmetric() } else { self.lu.factor() };
-        done.map_err(|e| format!("reduced Newton matrix: {e}"))
+        done.map_err(|e| e.context("reduced Newton matrix"))
     }
 }
 

@@ -237,7 +237,7 @@ impl CorrectedRunner {
         let z = &run.reduced_q;
         let nt = z.ncols();
         let (n, nc) = (rom.n_dof(), rom.n_constraints());
-        let fail = |t: f64, p: String| Error::LinearSolve { t, problem: format!("error estimator: {p}") };
+        let fail = |t: f64, e: Error| e.at_time_in(t, "error estimator");
         let (tol, max_iterations) = (s.params.tolerance * rom.length_scale(), s.params.max_iterations);
         let mut integ = GeneralizedAlpha::new(s.params).map_err(|p| fail(0.0, p))?;
         let mut stats = FollowStats::default();
@@ -288,7 +288,7 @@ impl CorrectedRunner {
                     .map_err(|p| fail(t, p))?;
                 if record {
                     if !rhs[..n].iter().all(|x| x.is_finite()) {
-                        return Err(fail(t, "the defect is not finite".into()));
+                        return Err(fail(t, Error::linear_solve("the defect is not finite")));
                     }
                     out.column_mut(step).assign(&ArrayView1::from(&rhs[..n]));
                     // the lifted state's step multipliers λ⁺ = β' s Δμ from zero (at sampled
@@ -298,7 +298,7 @@ impl CorrectedRunner {
                         lambda.column_mut(step).assign(&l);
                     }
                 } else if !inc.is_finite() {
-                    return Err(fail(t, "the corrected trajectory is no longer finite".into()));
+                    return Err(fail(t, Error::linear_solve("the corrected trajectory is no longer finite")));
                 } else if self.accept.is_finite() {
                     let c = Check { k, t, tol, max_iterations, accept: self.accept };
                     check_step(rom, &mut st, &c, sc, inc, (&mut rhs, &mut work), &mut stats).map_err(|p| fail(t, p))?;
@@ -373,7 +373,7 @@ fn check_step<M: DynamicModel>(
     first: f64,
     (rhs, work): (&mut [f64], &mut [f64]),
     stats: &mut FollowStats,
-) -> std::result::Result<(), String> {
+) -> Result<()> {
     stats.steps += 1;
     let limit = (c.accept * first).max(c.tol);
     let mut last = first;
@@ -381,7 +381,7 @@ fn check_step<M: DynamicModel>(
         GeneralizedAlpha::residual(rom, st, c.t, rhs, work);
         let next = GeneralizedAlpha::correction(rom, st, c.t, &c.k, s, rhs, false)?;
         if !next.is_finite() {
-            return Err("the corrected trajectory is no longer finite".into());
+            return Err(Error::linear_solve("the corrected trajectory is no longer finite"));
         }
         if it == 2 && first > 0.0 {
             stats.worst_ratio = stats.worst_ratio.max(next / first);

@@ -2,6 +2,7 @@
 //! `k` more modes per block, its own ECSW set) and the calibration constant `c` of
 //! `error_estimate = c · η_raw` from held-out full runs.
 
+use crate::error::Result;
 use crate::physics::system::FlexibleSystem;
 pub use crate::reduction::estimator::{Calibration, CalibrationPoint, EstimateMethod, Estimator, DEFAULT_FACTOR};
 use crate::reduction::output_modes::{add_output_modes, output_columns, Outputs, Stop};
@@ -91,20 +92,19 @@ pub fn build_estimator(
     snapshots: &Snapshots,
     hyper_tolerance: Option<f64>,
     extra: usize,
-) -> std::result::Result<Estimator, String> {
+) -> Result<Estimator> {
     let Snapshots { x, multipliers, joint_dofs, x_ref, outputs } = *snapshots;
     let spec = BasisSpec { modes: enriched_rule(trained, !spec.blocks.is_empty(), extra), ..spec.clone() };
-    let mut richer =
-        train_basis(x, multipliers, joint_dofs, x_ref, &spec).map_err(|e| format!("enriched basis: {e}"))?;
+    let mut richer = train_basis(x, multipliers, joint_dofs, x_ref, &spec).map_err(|e| e.context("enriched basis"))?;
     if let Some((outputs, blocks)) = outputs {
         let seed: Vec<_> = (0..blocks.len()).map(|b| output_columns(trained, blocks, b)).collect();
         add_output_modes(&mut richer, blocks, x, outputs, &seed, Stop::More(extra))
-            .map_err(|e| format!("output modes of the enriched basis: {e}"))?;
+            .map_err(|e| e.context("output modes of the enriched basis"))?;
     }
     if let Some(tol) = hyper_tolerance {
         richer.basis.hyper = Some(
             ecsw(sys, &richer.basis, x, ENRICHED_HYPER_FACTOR * tol)
-                .map_err(|e| format!("ECSW of the enriched basis: {e}"))?,
+                .map_err(|e| e.context("ECSW of the enriched basis"))?,
         );
     }
     Ok(Estimator {
