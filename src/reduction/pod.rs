@@ -5,8 +5,8 @@
 //!     energy(r) = Σ_{i≤r} σᵢ² / Σ_i σᵢ²
 //! ```
 
-use crate::linalg::lapack::{JobSvd, SVDDC};
 use crate::error::{Error, Result};
+use crate::linalg::lapack::{JobSvd, SVDDC};
 use ndarray::{s, Array1, Array2, ArrayView2};
 
 /// How many POD modes to keep.
