@@ -18,7 +18,7 @@ use flexrom::io::attrs::Kind;
 use flexrom::io::labels::Labels;
 use flexrom::io::output::{check_output, Origin};
 use flexrom::io::result_file::{ResultFile, RunPlan};
-use flexrom::model::Model;
+use flexrom::model::{Model, Runs};
 use flexrom::pipeline::Pipeline;
 use flexrom::rom::estimator::{Estimate, EstimateMethod};
 use flexrom::rom::{Rom, Trust};
@@ -280,10 +280,7 @@ impl PyModel {
             _ => None,
         };
         let shown = mu.clone().unwrap_or_default();
-        model.check_parameters(&shown).map_err(to_py)?;
-        let mut warnings: Vec<String> = model.load_scale_warning(std::iter::once(shown.scale())).into_iter().collect();
-        warnings.extend(model.property_warnings([&shown]));
-        warn(py, &warnings)?;
+        warn(py, &model.admit(std::slice::from_ref(&shown), Runs::Full).map_err(to_py)?)?;
         let overrides = Overrides { dt, t_end, rho_inf, mu, ..Default::default() };
         let r = interruptible(py, || {
             // with its energies, as `simulate`'s result file (to_hdf5 writes that layout)
@@ -317,7 +314,7 @@ impl PyModel {
         let params = convert::named(params)?.unwrap_or_default();
         let mu = parameters(load_scale, &params)?;
         let model = &self.model;
-        warn(py, &model.property_warnings([&mu]))?;
+        warn(py, &model.admit(std::slice::from_ref(&mu), Runs::Full).map_err(to_py)?)?;
         let o = flexrom::analysis::statics::StaticOptions { mu: mu.clone(), t: time, steps, ..Default::default() };
         let (r, solution) =
             interruptible(py, || flexrom::simulate::statics(model, &o).map_err(|e| e.at_stage("statics", &mu)))?;
@@ -355,7 +352,7 @@ impl PyModel {
         let params = convert::named(params)?.unwrap_or_default();
         let mu = parameters(load_scale, &params)?;
         let model = &self.model;
-        warn(py, &model.property_warnings([&mu]))?;
+        warn(py, &model.admit(std::slice::from_ref(&mu), Runs::Full).map_err(to_py)?)?;
         let o = flexrom::simulate::ModesOptions { count, at, mu, time, solver: Default::default() };
         let a = interruptible(py, || flexrom::simulate::modes(model, &o))?;
         Ok(PyModes { model: Arc::clone(model), a, at, time })
@@ -1301,9 +1298,7 @@ impl PyBasis {
     ) -> PyResult<Parameters> {
         let model = &self.pipeline.model;
         let mu = parameters(load_scale, params.unwrap_or(&HashMap::new()))?;
-        model.check_parameters(&mu).map_err(to_py)?;
-        model.refuse_load_scale(std::iter::once(mu.scale())).map_err(to_py)?;
-        warn(py, &model.property_warnings([&mu]))?;
+        warn(py, &model.admit(std::slice::from_ref(&mu), Runs::Reduced).map_err(to_py)?)?;
         Ok(model.with_property_values(&mu))
     }
 
@@ -1381,12 +1376,8 @@ fn validate<'py>(
     let named = !params.is_empty();
     let sets_load_scale = params.contains_key(flexrom::solver::parameters::LOAD_SCALE);
     let points = p.validation_points_given(load_scale, (named, sets_load_scale), |x| parameters(x, &params))?;
-    if let Some(mu) = points.first() {
-        p.model.check_parameters(mu).map_err(to_py)?;
-    }
-    warn(py, &p.model.property_warnings(&points))?;
+    warn(py, &p.model.admit(&points, Runs::Reduced).map_err(to_py)?)?;
     let points: Vec<Parameters> = points.iter().map(|mu| p.model.with_property_values(mu)).collect();
-    p.model.refuse_load_scale(points.iter().map(|mu| mu.scale())).map_err(to_py)?;
     let path = basis.unwrap_or_else(|| p.basis_path.clone());
     let (_, rom, warnings) = py.detach(|| load_rom(&p, &path, method, false)).map_err(errors::basis_error)?;
     warn(py, &warnings)?;

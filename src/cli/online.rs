@@ -4,6 +4,7 @@ use super::{print_table, run_details, warn, EstimateArgs, FormatArgs};
 use flexrom::io::attrs::Kind;
 use flexrom::io::output::{check_output, Origin};
 use flexrom::limits::Limits;
+use flexrom::model::Runs;
 use flexrom::output::info;
 use flexrom::output::table::{Cell, Format, Table};
 use flexrom::pipeline::Pipeline;
@@ -54,9 +55,7 @@ impl Args {
         let p = Pipeline::load_with(&pipeline, limits.clone())?;
         // λ checked finite with the named values
         let mu = params.parameters(load_scale, 1.0)?;
-        p.model.check_parameters(&mu)?;
-        p.model.refuse_load_scale(std::iter::once(mu.scale()))?;
-        warn(&p.model.property_warnings([&mu]));
+        warn(&p.model.admit(std::slice::from_ref(&mu), Runs::Reduced)?);
         // a body property not given is the file's value, which the checks against the
         // training box must read too
         let mu = p.model.with_property_values(&mu);

@@ -44,8 +44,7 @@ impl Args {
         let model = Model::load_with(&model, limits.clone())?;
         let overrides = run.overrides()?;
         let mu = overrides.mu.clone().unwrap_or_default();
-        super::warn(model.load_scale_warning(std::iter::once(mu.scale())).as_slice());
-        super::warn(&model.property_warnings([&mu]));
+        super::warn(&model.admit(std::slice::from_ref(&mu), flexrom::model::Runs::Full)?);
         // whether dt resolves the model, looked at on a second thread while the run computes
         // (a modes analysis: the run's own time is not to grow by it), said after the run
         let (r, resolution) = std::thread::scope(|s| {

@@ -71,7 +71,7 @@ impl Args {
         }
         let model = Model::load_with(&model, limits.clone())?;
         let mu = loads.parameters()?;
-        super::warn(&model.property_warnings([&mu]));
+        super::warn(&model.admit(std::slice::from_ref(&mu), flexrom::model::Runs::Full)?);
         let o = StaticOptions { mu: mu.clone(), t: loads.time, steps, solver: solver.into() };
         let (r, solution) = flexrom::simulate::statics(&model, &o).map_err(|e| e.at_stage("statics", &mu))?;
         if let Some(output) = &output {

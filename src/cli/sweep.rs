@@ -426,10 +426,8 @@ fn sweep_points(
     };
     for mu in &points {
         mu.validate()?;
-        p.model.check_parameters(mu)?;
     }
-    super::warn(&p.model.property_warnings(&points));
-    p.model.refuse_load_scale(points.iter().map(Parameters::scale))?;
+    super::warn(&p.model.admit(&points, flexrom::model::Runs::Reduced)?);
     // a body property not given is the file's value (online's reason)
     Ok(points.iter().map(|mu| p.model.with_property_values(mu)).collect())
 }

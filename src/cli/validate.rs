@@ -43,13 +43,9 @@ impl Args {
         let points = p.validation_points_given(load_scale, (params.any(), params.sets_load_scale()), |x| {
             params.parameters(x, 1.0)
         })?;
-        if let Some(mu) = points.first() {
-            p.model.check_parameters(mu)?;
-        }
-        warn(&p.model.property_warnings(&points));
+        warn(&p.model.admit(&points, flexrom::model::Runs::Reduced)?);
         // a body property not given is the file's value (online's reason)
         let points: Vec<Parameters> = points.iter().map(|mu| p.model.with_property_values(mu)).collect();
-        p.model.refuse_load_scale(points.iter().map(|mu| mu.scale()))?;
         let path = basis.unwrap_or_else(|| p.basis_path.clone());
         let (_, rom, warnings) = load_rom(&p, &path, estimate.method(), false)?;
         warn(&warnings);

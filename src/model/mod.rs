@@ -32,6 +32,14 @@ pub struct Sizes {
     pub n_probe_values: f64,
 }
 
+/// Which runs [`Model::admit`] checks parameters for: full runs (`simulate`, `statics`,
+/// `modes`) or reduced ones (`online`, `sweep`, `validate`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Runs {
+    Full,
+    Reduced,
+}
+
 /// How far from the model file's value a body property's parameter may lie before a run
 /// warns that a factor may have been meant ([`Model::property_warnings`]): two orders of
 /// magnitude, beyond what a study of a material around its nominal value spans, and below
@@ -246,6 +254,26 @@ impl Model {
         Some(format!("{}: the load scale {x} is given, but {why}", self.path.display()))
     }
 
+    /// What every front end (the command line, Python) checks of the parameters of the runs
+    /// it is about to make, and what it warns of, in one place: each point's parameters are
+    /// the model's and its properties positive ([`Self::check_parameters`]); a load scale the
+    /// model's loads do not take is refused for reduced runs ([`Self::refuse_load_scale`])
+    /// and warned of for full ones ([`Self::load_scale_warning`]); properties far from the
+    /// file's values are warned of ([`Self::property_warnings`]). Returns the warnings.
+    pub fn admit(&self, points: &[Parameters], runs: Runs) -> Result<Vec<String>> {
+        for mu in points {
+            self.check_parameters(mu)?;
+        }
+        let scales = points.iter().map(Parameters::scale);
+        let mut warnings = Vec::new();
+        match runs {
+            Runs::Reduced => self.refuse_load_scale(scales)?,
+            Runs::Full => warnings.extend(self.load_scale_warning(scales)),
+        }
+        warnings.extend(self.property_warnings(points));
+        Ok(warnings)
+    }
+
     /// [`Self::load_scale_warning`] as an error: a reduced run at a load scale that changes
     /// nothing would read as outside its basis's training (λ = 1) though it is not.
     pub fn refuse_load_scale(&self, scales: impl Iterator<Item = f64>) -> Result<()> {
@@ -414,5 +442,37 @@ pub struct SharedPhysics {
 impl std::fmt::Debug for SharedPhysics {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "SharedPhysics({} coordinates)", self.x0.len())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Model, Runs};
+    use crate::solver::parameters::Parameters;
+
+    /// A pendulum under gravity that is not `scaled`: a load scale changes nothing.
+    const UNSCALED: &str = "[time]\nt_end = 0.1\ndt = 0.01\nrho_inf = 1.0\n\
+        [[bodies]]\nname = \"beam\"\nstart = [0.0, 0.0]\nangle = 0.0\nlength = 1.0\nelements = 2\n\
+        density = 7800.0\narea = 1e-4\ninertia = 1e-9\nyoungs_modulus = { value = 2e11, parameter = \"E\" }\n\
+        [[joints]]\ntype = \"ground_pin\"\nbody = \"beam\"\nnode = \"start\"\n\
+        [[loads]]\ntype = \"gravity\"\ng = [0.0, -9.81]\nscaled = false\n";
+
+    /// The front ends' one check: λ ≠ 1 on a model without scaled loads is refused for
+    /// reduced runs and a warning for full ones; a property far from the file's value warns;
+    /// a parameter the model lacks, or a property not positive, is refused for both.
+    #[test]
+    fn admit_refuses_what_every_front_end_refuses_and_warns_alike() {
+        let model = Model::from_text(UNSCALED, "m.toml").unwrap();
+        let scaled = [Parameters::load_scale(2.0)];
+        assert!(model.admit(&scaled, Runs::Reduced).is_err());
+        let w = model.admit(&scaled, Runs::Full).unwrap();
+        assert!(w.len() == 1 && w[0].contains("the load scale 2 is given"), "{w:?}");
+        // 0.5 is 4e11 times below the file's 2e11 (more than FACTOR_LIKE): a factor meant
+        let far = [Parameters::load_scale(1.0).with("E", 0.5)];
+        let w = model.admit(&far, Runs::Reduced).unwrap();
+        assert!(w.len() == 1 && w[0].contains("far from the model file's value"), "{w:?}");
+        for bad in [Parameters::load_scale(1.0).with("F", 1.0), Parameters::load_scale(1.0).with("E", 0.0)] {
+            assert!(model.admit(std::slice::from_ref(&bad), Runs::Full).is_err(), "{bad:?}");
+        }
     }
 }
