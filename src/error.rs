@@ -127,17 +127,6 @@ pub fn show_number(x: f64) -> String {
     }
 }
 
-/// A computed number in a message: to three decimals where that keeps two significant
-/// digits or more (|x| ≥ 0.01, or 0), else in exponent form, so that a factor of 2.9e-6
-/// does not print as 0.000.
-pub fn show_rounded(x: f64) -> String {
-    if x == 0.0 || !x.is_finite() || x.abs() >= 0.01 {
-        format!("{x:.3}")
-    } else {
-        format!("{x:.2e}")
-    }
-}
-
 /// A text from a file or the environment as a message shows it: control characters (a
 /// newline, a NUL, an escape sequence) escaped as `\n`, `\0`, `\u{1b}`, so an error stays
 /// one line and a file cannot write to the terminal through it; everything else as it is.
@@ -321,17 +310,6 @@ impl Error {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Three decimals from 0.01 up; below, the exponent form keeps the digits a fixed
-    /// three decimals would round away (2.9e-6 → 0.000).
-    #[test]
-    fn rounded_numbers_keep_their_digits() {
-        assert_eq!(show_rounded(0.1073), "0.107");
-        assert_eq!(show_rounded(0.0374), "0.037");
-        assert_eq!(show_rounded(2.9e-6), "2.90e-6");
-        assert_eq!(show_rounded(0.0), "0.000");
-        assert_eq!(show_rounded(12.0), "12.000");
-    }
 
     /// A factorization's failure reads as before once the integrator places it at its time;
     /// the context a caller adds keeps the variant and comes first.

@@ -7,7 +7,7 @@ use crate::physics::system::FlexibleSystem;
 use crate::reduction::{Basis, Hyper, HyperReducedModel, Reduced, ReducedModel};
 use crate::simulate::{Overrides, Settings, SimulationResult};
 use crate::solver::model::{Parameters, ParametricModel};
-use ndarray::{Array1, Array2, ArrayView1};
+use ndarray::{Array1, Array2, ArrayView1, ArrayView2};
 use std::sync::Arc;
 
 /// A reduced run: the full-coordinate result (same layout as `simulate`) and the reduced
@@ -154,6 +154,25 @@ pub(crate) fn static_start<R: Reduced<FlexibleSystem>>(
     Ok(z)
 }
 
+/// The physical multipliers (n_c × n_t, `n_c` the full model's constraints) of a reduced
+/// model's own multipliers `own` at its coordinates `q` (columns: instants), over the first
+/// `taken` columns; NaN after them and where the variant has none. Made after a time loop,
+/// so that the loop allocates nothing for them.
+pub(crate) fn physical_multipliers<F, R: Reduced<F>>(
+    rom: &R,
+    n_c: usize,
+    (q, own): (ArrayView2<f64>, ArrayView2<f64>),
+    taken: usize,
+) -> Array2<f64> {
+    let mut out = Array2::from_elem((n_c, q.ncols()), f64::NAN);
+    for (k, (qk, lk)) in q.columns().into_iter().zip(own.columns()).take(taken).enumerate() {
+        if let Some(l) = rom.multipliers(&qk.to_vec(), &lk.to_vec()) {
+            out.column_mut(k).assign(&l);
+        }
+    }
+    out
+}
+
 fn run<R: Reduced<FlexibleSystem>>(
     rom: &mut R,
     model: &Model,
@@ -208,12 +227,7 @@ fn run<R: Reduced<FlexibleSystem>>(
     let full = rom.full();
     let n_c = full.n_constraints();
     // the physical multipliers in either output: the reactions and their estimates read them
-    let mut multipliers = Array2::from_elem((n_c, nt), f64::NAN);
-    for k in 0..nt {
-        if let Some(l) = rom.multipliers(&zq.column(k).to_vec(), &lam.column(k).to_vec()) {
-            multipliers.column_mut(k).assign(&l);
-        }
-    }
+    let multipliers = physical_multipliers(rom, n_c, (zq.view(), lam.view()), nt);
     let (q, qd) = match output {
         // q̇ = V ż: the reference is constant
         Output::Full => (basis.reconstruct_columns(zq.view()), basis.modes.dot(&zv)),

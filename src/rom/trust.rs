@@ -216,7 +216,7 @@ pub fn describe(e: &Estimate, method: &str, rom_seconds: f64) -> String {
         "error_estimate {:.3e}, displacement {displacement} ({method} method, {}, factor {}), estimator {:.4} s ({:.0} % of the reduced run)",
         e.error_estimate,
         if e.calibrated { "calibrated" } else { "uncalibrated" },
-        crate::error::show_rounded(e.factor),
+        crate::solver::parameter_space::short_number(e.factor),
         e.seconds,
         100.0 * e.seconds / rom_seconds
     )

@@ -493,7 +493,7 @@ fn defects_line(estimator: &crate::rom::estimator::training::Estimator, method: 
             "error estimate: the cheap `defects` method calibrated at the {} candidates against the `{}` estimate (factors {}), the online default",
             d.ratios.len(),
             method.name(),
-            d.factors.iter().map(|&f| crate::error::show_rounded(f)).collect::<Vec<_>>().join(", ")
+            d.factors.iter().map(|&f| crate::solver::parameter_space::short_number(f)).collect::<Vec<_>>().join(", ")
         ),
         Some(_) => format!("error estimate: the `defects` method's ratio to the {} estimate jumps between candidates (its leave-one-out check failed): the online default stays `{}`", method.name(), estimator.default_method().name()),
         None => format!("error estimate: the `defects` method could not be calibrated: the online default stays `{}`", estimator.default_method().name()),

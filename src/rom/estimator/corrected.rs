@@ -73,7 +73,7 @@ use crate::model::Model;
 use crate::physics::system::FlexibleSystem;
 use crate::reduction::{Basis, Hyper, HyperReducedModel, Reduced, Variant};
 use crate::rom::pool::Pool;
-use crate::rom::run::ReducedRun;
+use crate::rom::run::{physical_multipliers, ReducedRun};
 use crate::simulate::{Overrides, Settings};
 use crate::solver::generalized_alpha::{GeneralizedAlpha, State, StepConstants};
 use crate::solver::model::{Bound, DynamicModel, ParametricModel};
@@ -305,7 +305,7 @@ impl CorrectedRunner {
                     if !stats.followed() {
                         // what follows this step is no reading of the reduced run's error
                         if sample == 0 {
-                            physical_multipliers(&*rom.model, (&out, &own), step, &mut lambda);
+                            lambda = physical_multipliers(&*rom.model, nc_full, (out.view(), own.view()), step);
                         }
                         return Ok(Followed { q: out, lambda, stats });
                     }
@@ -318,25 +318,9 @@ impl CorrectedRunner {
             }
         }
         if sample == 0 {
-            physical_multipliers(&*rom.model, (&out, &own), nt, &mut lambda);
+            lambda = physical_multipliers(&*rom.model, nc_full, (out.view(), own.view()), nt);
         }
         Ok(Followed { q: out, lambda, stats })
-    }
-}
-
-/// Fills the first `taken` columns of `lambda` (n_c × n_t) with the physical multipliers of
-/// the model's own multipliers `own` at the coordinates `q` (r⁺ × n_t), column by column
-/// (none where the variant has none).
-fn physical_multipliers<F, M: Reduced<F>>(
-    model: &M,
-    (q, own): (&Array2<f64>, &Array2<f64>),
-    taken: usize,
-    lambda: &mut Array2<f64>,
-) {
-    for (col, (qc, lc)) in q.columns().into_iter().zip(own.columns()).take(taken).enumerate() {
-        if let Some(l) = model.multipliers(&qc.to_vec(), &lc.to_vec()) {
-            lambda.column_mut(col).assign(&l);
-        }
     }
 }
 
