@@ -152,6 +152,41 @@ fn a_basis_trained_over_a_box_holds_it_and_checks_runs_against_it() {
     assert!(stderr.contains("b.h5: parameters: the basis was trained over g [0.8, 1.2] linear"), "{stderr}");
     assert!(stderr.contains("names g [0.7, 1.2] linear"), "{stderr}");
     assert!(!d.join("o2.h5").exists());
+
+    // a basis whose training points are damaged — a NaN, a parameter one run short — is
+    // refused naming the file and the dataset, before anything runs
+    type Damage = fn(&hdf5::File);
+    let damages: [(&str, Damage, &str); 2] = [
+        (
+            "nan.h5",
+            |f| f.dataset("parameters/push").unwrap().write(&[f64::NAN; 6]).unwrap(),
+            "parameters/push: holds NaN",
+        ),
+        (
+            "short.h5",
+            |f| {
+                let g = f.group("parameters").unwrap();
+                let d = g.dataset("g").unwrap();
+                let (range, scale): (Vec<f64>, String) = (
+                    d.attr("range").unwrap().read_raw().unwrap(),
+                    flexrom::io::h5::read_attr_str(&d, "scale").unwrap(),
+                );
+                g.unlink("g").unwrap();
+                let d = g.new_dataset_builder().with_data(&[1.0; 5]).create("g").unwrap();
+                d.new_attr::<f64>().shape(2).create("range").unwrap().write(&range).unwrap();
+                flexrom::io::h5::attr_str(&d, "scale", &scale).unwrap();
+            },
+            "parameters/push: has shape (6) where (5) is expected",
+        ),
+    ];
+    for (name, damage, needle) in damages {
+        std::fs::copy(d.join("b.h5"), d.join(name)).unwrap();
+        damage(&hdf5::File::open_rw(d.join(name)).unwrap());
+        let out = flexrom(d, &["online", "p.toml", "--basis", name, "--param", "g=1.0", "-o", "o3.h5"]);
+        assert_eq!(out.status.code(), Some(1), "{name}");
+        assert!(text(&out).1.contains(&format!("{name}: {needle}")), "{name}: {}", text(&out).1);
+        assert!(!d.join("o3.h5").exists());
+    }
 }
 
 /// Greedy training over the box (no range: `[parameters]` is the range): it converges at

@@ -8,7 +8,7 @@
 //! Written by `train` for a pipeline with a `[parameters]` table; a basis without the group
 //! was trained over the load scale alone (every named parameter at 1).
 
-use super::h5::{attr_str, read_attr_str};
+use super::h5::{attr_str, bounded_len, dataset_of_shape, read_attr_str};
 use crate::error::{Error, Result};
 use crate::solver::parameter_space::{ParameterRange, ParameterSpace, Spacing};
 use crate::solver::parameters::Parameters;
@@ -30,14 +30,26 @@ pub fn write_parameter_space(f: &hdf5::File, space: &ParameterSpace, points: &[P
 /// each parameter's `/parameters/<name>` values, in run order (empty for a basis trained over
 /// the load scale alone).
 pub fn training_points(f: &hdf5::File, path: &Path, space: &ParameterSpace) -> Result<Vec<Parameters>> {
-    let mut runs: Vec<Parameters> = Vec::new();
-    for name in space.names() {
-        let field = format!("parameters/{name}");
-        let values = f
-            .dataset(&field)
-            .and_then(|d| d.read_1d::<f64>())
-            .map_err(|e| Error::input(path, &field, format!("cannot be read: {e}")))?;
-        runs.resize(values.len(), Parameters::default());
+    let names: Vec<&str> = space.names().collect();
+    let Some(first) = names.first() else { return Ok(Vec::new()) };
+    let g = f.group("parameters").map_err(|e| Error::input(path, "parameters", format!("cannot be read: {e}")))?;
+    let refused = |name: &str, e: Error| Error::input(path, format!("parameters/{name}"), e.problem());
+    // the file's header sizes the runs: bounded before anything is read (a point holds a
+    // value per name), then every name's dataset must have that length
+    let limits = crate::limits::Limits::from_env_or_defaults();
+    let n = bounded_len(&g, first, 64.0 * names.len() as f64, &limits).map_err(|e| refused(first, e))?;
+    let mut runs = vec![Parameters::default(); n];
+    for name in names {
+        let values = dataset_of_shape(&g, name, &[n])
+            .and_then(|d| d.read_1d::<f64>().map_err(|e| Error::hdf5(path, format!("cannot be read: {e}"))))
+            .map_err(|e| refused(name, e))?;
+        if let Some(v) = values.iter().find(|v| !v.is_finite()) {
+            return Err(Error::input(
+                path,
+                format!("parameters/{name}"),
+                format!("holds {v} where a training run's value belongs"),
+            ));
+        }
         for (mu, v) in runs.iter_mut().zip(values.iter()) {
             *mu = std::mem::take(mu).with(name, *v);
         }
