@@ -50,10 +50,11 @@ pub enum Error {
         source: Box<Error>,
     },
 
-    /// `--strict`: a run's error estimate exceeds the tolerance (its output is written;
-    /// the program exits with code 4).
-    #[error("{0}")]
-    Strict(String),
+    /// Strict checking (`--strict`): a run's error estimate exceeds the tolerance (its output
+    /// is written; the program exits with code 4). `warnings`: what the front end says
+    /// before the error (extrapolation, amplification), as it would without strict.
+    #[error("{}: {message}", plain_option("strict", None))]
+    Strict { message: String, warnings: Vec<String> },
 
     /// Anything else that is a usage error of the program (bad command-line values).
     #[error("{0}")]
@@ -172,7 +173,7 @@ impl Error {
     pub fn exit_code(&self) -> u8 {
         match self {
             Error::PartlyFailed(_) => 3,
-            Error::Strict(_) => STRICT_EXIT_CODE,
+            Error::Strict { .. } => STRICT_EXIT_CODE,
             _ => 1,
         }
     }
@@ -234,6 +235,7 @@ impl Error {
     pub fn render(&self, spell: &OptionSpelling) -> String {
         match self {
             Error::Option { key, value, problem } => option_message(key, value.as_deref(), problem, spell),
+            Error::Strict { message, .. } => format!("{}: {message}", spell("strict", None)),
             Error::Stage { stage, parameters, source } => format!("{stage} at {parameters}: {}", source.render(spell)),
             Error::Hinted { source, hint } => format!("{}; {hint}", source.render(spell)),
             Error::Context { context, source } => format!("{context}: {}", source.render(spell)),

@@ -327,6 +327,10 @@ fn main() -> ExitCode {
             ExitCode::from((128 + sig) as u8)
         }
         Err(e) => {
+            // strict checking: what would have been warned of is said before the error
+            if let flexrom::Error::Strict { warnings, .. } = &e {
+                cli::warn(warnings);
+            }
             // a check made while a stage ran names its field without the line load-time
             // checks give: the line from the file
             let e = flexrom::model::with_field_line_from_file(e);

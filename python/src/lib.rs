@@ -1137,19 +1137,9 @@ impl PyBasis {
                 exact: done.estimate.map(|e| (e, done.extrapolated)),
             });
         }
+        warn(py, &done.warnings(rom, &mu, false).map_err(to_py)?)?;
         let (run, estimate) = (done.run, done.estimate);
         let extrapolated = rom.is_extrapolated(&mu);
-        let mut warnings: Vec<String> = estimate
-            .as_ref()
-            .and_then(|e| flexrom::rom::trust::estimate_failed(&format!("{mu}"), e.failure.as_deref()))
-            .into_iter()
-            .collect();
-        warnings.extend(
-            self.run_warnings(&[(mu.clone(), estimate.as_ref().map(|e| e.in_measure(rom.tolerance_measure())))])?,
-        );
-        warnings.extend(rom.untrained_parameters(&mu));
-        warnings.extend(done.note.clone());
-        warn(py, &warnings)?;
         let basis = rom.basis();
         let reduced = ReducedPart {
             reduced_q: run.reduced_q,
@@ -1203,26 +1193,7 @@ impl PyBasis {
         let o = flexrom::workflows::sweep::SweepOptions { continuation, fallback, ..Default::default() };
         let rom = &self.rom;
         let s = interruptible_with(py, progress.as_ref(), || flexrom::workflows::sweep::sweep(rom, &mus, o))?;
-        let measure = rom.tolerance_measure();
-        let runs: Vec<(Parameters, Option<f64>)> = s
-            .scales
-            .iter()
-            .filter_map(|x| {
-                x.point()
-                    .filter(|p| p.fallback.is_none())
-                    .map(|p| (x.mu.clone(), p.estimate.as_ref().map(|e| e.in_measure(measure))))
-            })
-            .collect();
-        let mut warnings = self.run_warnings(&runs)?;
-        // the full model's answers extrapolate nothing
-        let mut outside: Vec<String> = s
-            .scales
-            .iter()
-            .filter(|x| x.point().is_some_and(|p| p.fallback.is_none()))
-            .flat_map(|x| rom.untrained_parameters(&x.mu))
-            .collect();
-        outside.dedup();
-        warnings.extend(outside);
+        let warnings = rom.warnings_after(&s.answered(rom), false).map_err(to_py)?;
         warn(py, &warnings)?;
         convert::sweep_dict(py, &s, &mus)
     }
@@ -1300,13 +1271,6 @@ impl PyBasis {
         let mu = parameters(load_scale, params.unwrap_or(&HashMap::new()))?;
         warn(py, &model.admit(std::slice::from_ref(&mu), Runs::Reduced).map_err(to_py)?)?;
         Ok(model.with_property_values(&mu))
-    }
-
-    /// The command line's warnings about finished runs (extrapolation, estimates above the
-    /// tolerance): `(parameters, estimate in the tolerance's measure)` each.
-    fn run_warnings(&self, runs: &[(Parameters, Option<f64>)]) -> PyResult<Vec<String>> {
-        let Some(trust) = self.rom.trust() else { return Ok(Vec::new()) };
-        flexrom::rom::trust::check_runs(trust, self.rom.estimator().is_some(), runs, false).map_err(to_py)
     }
 }
 
@@ -1395,16 +1359,8 @@ fn validate<'py>(
     })?;
     // the command's warnings after its runs: estimates over the tolerance, extrapolation,
     // parameters the basis was not trained over
-    let measure = rom.tolerance_measure();
-    if let Some(trust) = rom.trust() {
-        let runs: Vec<(Parameters, Option<f64>)> =
-            points.iter().cloned().zip(vs.iter().map(|v| v.estimate_in(measure))).collect();
-        let lines = flexrom::rom::trust::check_runs(trust, rom.estimator().is_some(), &runs, false).map_err(to_py)?;
-        warn(py, &lines)?;
-    }
-    let mut outside: Vec<String> = points.iter().flat_map(|mu| rom.untrained_parameters(mu)).collect();
-    outside.dedup();
-    warn(py, &outside)?;
+    let answered: Vec<_> = points.iter().zip(&vs).map(|(mu, v)| v.answered(&rom, mu)).collect();
+    warn(py, &rom.warnings_after(&answered, false).map_err(to_py)?)?;
     let text = match vs.as_slice() {
         [v] if load_scale.is_some() || named => serde_json::to_string(v),
         _ => serde_json::to_string(&vs),

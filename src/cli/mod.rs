@@ -157,15 +157,21 @@ pub fn model_resolution(model: &flexrom::model::Model) -> Vec<String> {
         .map_or_else(|_| Vec::new(), |s| flexrom::simulate::resolution_warnings(model, &s))
 }
 
-/// The warnings about finished runs of `rom` (extrapolation, estimates above the
-/// tolerance), printed; with `strict`, an estimate above the tolerance is the error.
-pub fn check_runs(
+/// Says the warnings after reduced answers ([`flexrom::rom::Rom::warnings_after`]); with
+/// `strict`, an estimate above the tolerance is the error (exit code 4) and a basis without a
+/// tolerance is warned of.
+pub fn warn_after(
+    warnings: flexrom::Result<Vec<String>>,
     rom: &flexrom::rom::Rom,
-    runs: &[(flexrom::solver::parameters::Parameters, Option<f64>)],
     strict: bool,
 ) -> flexrom::Result<()> {
-    let Some(trust) = rom.trust() else { return Ok(()) };
-    warn(&flexrom::rom::trust::check_runs(trust, rom.estimator().is_some(), runs, strict)?);
+    warn(&warnings?);
+    if strict && rom.trust().is_some_and(|t| t.held_tolerance().is_none()) {
+        warn(&[format!(
+            "{}: no tolerance to hold the estimates to (set [online] tolerance in the pipeline)",
+            flag("strict", None)
+        )]);
+    }
     Ok(())
 }
 

@@ -121,20 +121,6 @@ impl Args {
             f => print_table(&t, f, true)?,
         }
         warn(notice.as_slice());
-        if let Some(note) = &done.note {
-            warn(std::slice::from_ref(note));
-        }
-        // the full model's answer is exact: nothing to hold to the tolerance
-        if done.fallback.is_some() {
-            return Ok(());
-        }
-        let measure = rom.tolerance_measure();
-        warn(&rom.untrained_parameters(&mu));
-        if let Some(w) =
-            estimate.as_ref().and_then(|e| flexrom::rom::trust::estimate_failed(&format!("{mu}"), e.failure.as_deref()))
-        {
-            warn(&[w]);
-        }
-        super::check_runs(&rom, &[(mu.clone(), estimate.as_ref().map(|e| e.in_measure(measure)))], strict)
+        super::warn_after(done.warnings(&rom, &mu, strict), &rom, strict && done.fallback.is_none())
     }
 }

@@ -183,7 +183,10 @@ impl Args {
         // the answers kept are warned about also when some points failed (exit 3 below)
         let failure = sw.failure_summary();
         let checked = match &loaded {
-            Some((_, rom, _)) => check_reduced_answers(rom, &sw, strict && failure.is_none()),
+            Some((_, rom, _)) => {
+                let strict = strict && failure.is_none();
+                super::warn_after(rom.warnings_after(&sw.answered(rom), strict), rom, strict)
+            }
             None => Ok(()),
         };
         // the good runs are written; the exit code (3) says that some failed
@@ -281,42 +284,6 @@ fn show_sweep(
         info(&line);
     }
     Ok(())
-}
-
-/// The warnings on the reduced answers kept (the full model's are exact and do not
-/// extrapolate): points outside what the basis was trained on, then the estimates held to the
-/// tolerance (an error with `strict`).
-fn check_reduced_answers(
-    rom: &flexrom::rom::Rom,
-    sw: &flexrom::workflows::sweep::Sweep,
-    strict: bool,
-) -> flexrom::Result<()> {
-    let outside: Vec<Vec<String>> = sw
-        .scales
-        .iter()
-        .filter(|x| x.point().is_some_and(|p| p.fallback.is_none()))
-        .map(|x| rom.named_outside(&x.mu))
-        .filter(|w| !w.is_empty())
-        .collect();
-    if let Some(first) = outside.first() {
-        warn(&[format!(
-            "{} of {} points lie outside what the basis was trained on (the first: {}); the reduced model extrapolates there",
-            outside.len(),
-            sw.scales.len(),
-            first.join(", ")
-        )]);
-    }
-    let runs: Vec<_> = sw
-        .scales
-        .iter()
-        .filter_map(|x| x.point())
-        .filter(|q| q.fallback.is_none())
-        .map(|q| {
-            let e = q.estimate.as_ref().map(|e| e.in_measure(rom.tolerance_measure()));
-            (q.run.result.settings.mu.clone(), e)
-        })
-        .collect();
-    super::check_runs(rom, &runs, strict)
 }
 
 /// One line when the full model answered some points in place of the reduced one, or was

@@ -5,6 +5,7 @@ use flexrom::limits::Limits;
 use flexrom::output::table::{Format, Table};
 use flexrom::output::{self};
 use flexrom::pipeline::Pipeline;
+use flexrom::rom::Answered;
 use flexrom::solver::parameters::Parameters;
 use flexrom::workflows::online::load_rom;
 use std::path::PathBuf;
@@ -76,15 +77,7 @@ impl Args {
             }
             Format::Text => {}
         }
-        let measure = rom.tolerance_measure();
-        let runs: Vec<_> = points.iter().cloned().zip(vs.iter().map(|v| v.estimate_in(measure))).collect();
-        let failed: Vec<String> = (points.iter().zip(&vs))
-            .filter_map(|(mu, v)| flexrom::rom::trust::estimate_failed(&format!("{mu}"), v.estimate_failure.as_deref()))
-            .collect();
-        warn(&failed);
-        let mut outside: Vec<String> = points.iter().flat_map(|mu| rom.untrained_parameters(mu)).collect();
-        outside.dedup();
-        warn(&outside);
-        super::check_runs(&rom, &runs, strict)
+        let answered: Vec<Answered> = points.iter().zip(&vs).map(|(mu, v)| v.answered(&rom, mu)).collect();
+        super::warn_after(rom.warnings_after(&answered, strict), &rom, strict)
     }
 }

@@ -3,7 +3,7 @@
 
 use super::validation::Validation;
 use crate::rom::estimator::Estimate;
-use crate::rom::ReducedRun;
+use crate::rom::{Answered, ReducedRun, Rom};
 use crate::solver::parameters::Parameters;
 use ndarray::{Array1, Array2};
 
@@ -111,6 +111,16 @@ pub struct Sweep {
     pub continuation: bool,
     /// scales taken from an earlier sweep file (`--resume`)
     pub resumed: usize,
+}
+
+impl Sweep {
+    /// The reduced answers the sweep kept — not the failed points, nor those the full model
+    /// answered, which are exact — as the warnings after a sweep read them
+    /// ([`Rom::warnings_after`]).
+    pub fn answered<'a>(&'a self, rom: &Rom) -> Vec<Answered<'a>> {
+        let kept = self.scales.iter().filter_map(|x| Some((&x.mu, x.point()?)));
+        kept.filter(|(_, p)| p.fallback.is_none()).map(|(mu, p)| Answered::new(rom, mu, p.estimate.as_ref())).collect()
+    }
 }
 
 impl Sweep {

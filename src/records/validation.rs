@@ -333,6 +333,16 @@ impl Validation {
         }
     }
 
+    /// This validation's reduced answer at `mu` as the warnings after it read it
+    /// ([`crate::rom::Rom::warnings_after`]).
+    pub fn answered<'a>(&'a self, rom: &Rom, mu: &'a Parameters) -> crate::rom::Answered<'a> {
+        crate::rom::Answered {
+            mu,
+            estimate: self.estimate_in(rom.tolerance_measure()),
+            failure: self.estimate_failure.as_deref(),
+        }
+    }
+
     /// The time loops' seconds and the speedups derived from them (against the dense run
     /// too, when it was timed).
     pub fn with_timings(mut self, full_seconds: f64, rom_seconds: f64) -> Self {

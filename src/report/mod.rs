@@ -1004,7 +1004,7 @@ fn headline(w: &str) -> &str {
 }
 
 /// The warnings about the runs of the sweep file at `path` (a report's `sweep.h5`) that
-/// `online` and `sweep` give ([`crate::rom::trust::check_runs`]: extrapolation, a model that
+/// `online` and `sweep` give ([`Rom::warnings_after`]: extrapolation, a model that
 /// amplifies changes of the load, estimates above the tolerance; with `strict`, the last is
 /// the error).
 fn sweep_warnings(rom: &Rom, path: &Path, strict: bool) -> Result<Vec<String>> {
@@ -1022,9 +1022,10 @@ fn sweep_warnings(rom: &Rom, path: &Path, strict: bool) -> Result<Vec<String>> {
     let (scales, est) = (read("load_scales")?, read(estimates)?);
     let points = crate::records::sweep_file::points_of(&f, &scales.to_vec())
         .map_err(|(field, problem)| Error::input(path, field, problem))?;
-    let runs: Vec<_> =
-        points.into_iter().zip(&est).map(|(mu, &e)| (mu, if e.is_nan() { None } else { Some(e) })).collect();
-    crate::rom::trust::check_runs(trust, rom.estimator().is_some(), &runs, strict)
+    let answered: Vec<_> = (points.iter().zip(&est))
+        .map(|(mu, &e)| crate::rom::Answered { mu, estimate: Some(e).filter(|e| !e.is_nan()), failure: None })
+        .collect();
+    rom.warnings_after(&answered, strict)
 }
 
 /// The two routes' times per run from the validation's medians (the median over the

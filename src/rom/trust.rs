@@ -43,6 +43,12 @@ impl Trust {
         }
     }
 
+    /// The tolerance the estimates are held to: none without one, or when the estimate is
+    /// skipped (`--no-estimate`).
+    pub fn held_tolerance(&self) -> Option<f64> {
+        self.tolerance.filter(|_| !self.skipped)
+    }
+
     /// The sensitivity near `mu` when the model amplifies changes of the load
     /// there beyond what `estimate` (in the trust's measure; `None`: no estimate) can see:
     /// above the tolerance, above [`AMPLIFYING`]` · δ` and above the estimate
@@ -362,16 +368,19 @@ fn few(v: &[String]) -> String {
 /// load scales outside the training range, a basis without an estimator, load scales where
 /// the model is sensitive beyond the tolerance and the estimate below that sensitivity
 /// ([`LoadSensitivity`]), and estimates above the tolerance; `runs` are `(parameters, the estimate in the trust's measure)`
-/// ([`Estimate::in_measure`]) and `has_estimator` says whether the basis has one. With `strict`, an estimate above the tolerance (or none at
-/// all when a tolerance is set) is an [`Error::Strict`] instead, for after the output is
-/// written.
+/// ([`Estimate::in_measure`]) and `has_estimator` says whether the basis has one; they
+/// follow the warnings `before`. With `strict`, an estimate above the tolerance (or none at
+/// all when a tolerance is set) is an [`Error::Strict`] instead, carrying the other
+/// warnings, for after the output is written (without a tolerance there is nothing to
+/// hold them to: [`Trust::held_tolerance`]).
 pub fn check_runs(
     trust: &Trust,
     has_estimator: bool,
     runs: &[(Parameters, Option<f64>)],
     strict: bool,
+    before: Vec<String>,
 ) -> Result<Vec<String>> {
-    let mut warnings = Vec::new();
+    let mut warnings = before;
     let (a, b) = trust.range;
     // λ outside its range (a box's other parameters are the caller's to name)
     let out: Vec<String> =
@@ -401,14 +410,7 @@ pub fn check_runs(
     if !has_estimator && runs.iter().all(|r| r.1.is_none()) && !trust.skipped {
         warnings.push("the basis file has no error estimator (/estimator; written by `flexrom train` since this version): no error_estimate; train again".into());
     }
-    let Some(tol) = trust.tolerance.filter(|_| !trust.skipped) else {
-        if strict {
-            warnings.push(
-                "--strict: no tolerance to hold the estimates to (set [online] tolerance in the pipeline)".into(),
-            );
-        }
-        return Ok(warnings);
-    };
+    let Some(tol) = trust.held_tolerance() else { return Ok(warnings) };
     let over: Vec<String> = runs
         .iter()
         // NaN: a displacement estimate where nothing moved beyond the Newton tolerance
@@ -441,11 +443,8 @@ pub fn check_runs(
     let msg = format!("{kind} above the tolerance {tol:e} at {what}");
     if strict {
         // the error ends the command: the other warnings (extrapolation, amplification)
-        // are said first, as without --strict
-        for w in &warnings {
-            crate::output::note(&format!("warning: {w}"));
-        }
-        return Err(Error::Strict(format!("--strict: {msg}")));
+        // travel with it, to be said first, as without strict
+        return Err(Error::Strict { message: msg, warnings });
     }
     warnings.push(msg);
     Ok(warnings)
@@ -479,15 +478,24 @@ mod tests {
             sensitivity: None,
             space: ParameterSpace::default(),
         };
-        let w = check_runs(&t, true, &[(l(1.7), Some(1e-4)), (l(1.0), Some(2e-3))], false).unwrap();
+        let w = check_runs(&t, true, &[(l(1.7), Some(1e-4)), (l(1.0), Some(2e-3))], false, Vec::new()).unwrap();
         assert_eq!(w.len(), 2, "{w:?}");
         assert!(w[0].contains("1 of 2 load scales (1.7)") && w[1].contains("above the tolerance 1e-3"), "{w:?}");
         let d = Trust { measure: ErrorMeasure::Displacement, ..t.clone() };
-        let w = check_runs(&d, true, &[(l(1.0), Some(2e-3))], false).unwrap();
+        let w = check_runs(&d, true, &[(l(1.0), Some(2e-3))], false, Vec::new()).unwrap();
         assert!(w.len() == 1 && w[0].starts_with("displacement error estimate above the tolerance 1e-3"), "{w:?}");
-        assert!(matches!(check_runs(&t, true, &[(l(1.0), Some(2e-3))], true), Err(Error::Strict(_))));
-        assert!(check_runs(&t, true, &[(l(1.0), Some(1e-4))], true).unwrap().is_empty());
-        let none = check_runs(&Trust::range((0.5, 1.5)), false, &[(l(1.0), None)], false).unwrap();
+        assert!(matches!(check_runs(&t, true, &[(l(1.0), Some(2e-3))], true, Vec::new()), Err(Error::Strict { .. })));
+        // strict: the error carries the warnings said before it, those given and its own
+        let runs = [(l(1.7), Some(1e-4)), (l(1.0), Some(2e-3))];
+        match check_runs(&t, true, &runs, true, vec!["given".into()]) {
+            Err(Error::Strict { message, warnings }) => {
+                assert!(message.starts_with("error estimate above the tolerance 1e-3 at 1 of 2"), "{message}");
+                assert!(warnings.len() == 2 && warnings[0] == "given" && warnings[1].contains("(1.7)"), "{warnings:?}");
+            }
+            other => panic!("expected the strict error, got {other:?}"),
+        }
+        assert!(check_runs(&t, true, &[(l(1.0), Some(1e-4))], true, Vec::new()).unwrap().is_empty());
+        let none = check_runs(&Trust::range((0.5, 1.5)), false, &[(l(1.0), None)], false, Vec::new()).unwrap();
         assert!(none.len() == 1 && none[0].contains("no error estimator"), "{none:?}");
     }
 }
@@ -539,15 +547,22 @@ mod sensitivity_tests {
             sensitivity: Some(LoadSensitivity::new(vec![0.5, 1.0, 1.5], vec![1e-3, 3e-2, 1e-3])),
             space: ParameterSpace::default(),
         };
-        let w = check_runs(&t, true, &[(l(1.2), Some(1e-4))], false).unwrap();
+        let w = check_runs(&t, true, &[(l(1.2), Some(1e-4))], false, Vec::new()).unwrap();
         assert_eq!(w.len(), 1, "{w:?}");
         assert!(w[0].contains("amplifies changes of the load at load scale 1.2 (3.0e-2)"), "{}", w[0]);
         // below the first candidate only its own, calm value counts
-        assert!(check_runs(&t, true, &[(l(0.4), Some(1e-4))], false).unwrap().iter().all(|w| !w.contains("amplifies")));
+        assert!(check_runs(&t, true, &[(l(0.4), Some(1e-4))], false, Vec::new())
+            .unwrap()
+            .iter()
+            .all(|w| !w.contains("amplifies")));
         // an estimate already as large as the sensitivity (but within T) covers it
         let t2 = Trust { tolerance: Some(5e-2), ..t.clone() };
-        assert!(check_runs(&t2, true, &[(l(1.2), Some(1e-4))], false).unwrap().is_empty(), "s below T: calm enough");
-        let w = check_runs(&t, true, &[(l(1.2), Some(4e-2)), (l(0.7), None), (l(0.3), Some(1e-4))], false).unwrap();
+        assert!(
+            check_runs(&t2, true, &[(l(1.2), Some(1e-4))], false, Vec::new()).unwrap().is_empty(),
+            "s below T: calm enough"
+        );
+        let w = check_runs(&t, true, &[(l(1.2), Some(4e-2)), (l(0.7), None), (l(0.3), Some(1e-4))], false, Vec::new())
+            .unwrap();
         let sens: Vec<_> = w.iter().filter(|w| w.contains("amplifies")).collect();
         assert_eq!(sens.len(), 1);
         assert!(sens[0].contains("1 of 3 load scales: 0.7 (3.0e-2)"), "{}", sens[0]);
@@ -558,8 +573,8 @@ mod sensitivity_tests {
             sensitivity: Some(LoadSensitivity::new(vec![0.5, 1.5], vec![5e-3, 5e-3])),
             ..t.clone()
         };
-        assert!(check_runs(&calm, true, &[(l(1.2), Some(1e-4))], false).unwrap().is_empty());
+        assert!(check_runs(&calm, true, &[(l(1.2), Some(1e-4))], false, Vec::new()).unwrap().is_empty());
         // not an error under --strict: the estimates themselves are within the tolerance
-        assert!(check_runs(&t, true, &[(l(1.2), Some(1e-4))], true).is_ok());
+        assert!(check_runs(&t, true, &[(l(1.2), Some(1e-4))], true, Vec::new()).is_ok());
     }
 }

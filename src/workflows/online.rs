@@ -8,7 +8,7 @@ use crate::pipeline::config::Pipeline;
 use crate::pipeline::fallback::{settle, Fallback};
 use crate::rom::estimator::{Estimate, EstimateMethod};
 use crate::rom::trust::write_run_attributes;
-use crate::rom::{check_reduced_memory, settings_at, LoadOptions, Output, ReducedRun, Rom, Trust};
+use crate::rom::{check_reduced_memory, settings_at, Answered, LoadOptions, Output, ReducedRun, Rom, Trust};
 use crate::solver::model::Parameters;
 use std::path::Path;
 
@@ -100,6 +100,26 @@ pub struct OnlineRun {
     pub fallback: Option<String>,
     /// the full model was run in place of this reduced answer and failed
     pub note: Option<String>,
+}
+
+impl OnlineRun {
+    /// The warnings after this answer at `mu`, as the command line and Python say them:
+    /// [`Rom::warnings_after`], then the note of a full run tried in its place that failed.
+    /// The full model's answer is exact: nothing to warn about. With `strict`, an estimate
+    /// above the tolerance is the [`crate::Error::Strict`] carrying the others.
+    pub fn warnings(&self, rom: &Rom, mu: &Parameters, strict: bool) -> Result<Vec<String>> {
+        if self.fallback.is_some() {
+            return Ok(Vec::new());
+        }
+        let note = self.note.iter().cloned();
+        match rom.warnings_after(&[Answered::new(rom, mu, self.estimate.as_ref())], strict) {
+            Ok(w) => Ok(w.into_iter().chain(note).collect()),
+            Err(Error::Strict { message, warnings }) => {
+                Err(Error::Strict { message, warnings: warnings.into_iter().chain(note).collect() })
+            }
+            Err(e) => Err(e),
+        }
+    }
 }
 
 /// The answer of `online` at `mu`: the reduced run with its estimate, or with
