@@ -229,6 +229,64 @@ fn validate_measures_each_reaction_over_its_range() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// The held-out full run calibrates each quantity as it calibrates the coordinates
+/// (`/estimator/calibration/quantity_factor`, src/rom/estimator/training.rs): the keys are
+/// quantities the arm measures that move (the root's position and a clamped root's strain
+/// have no swing: no pair), no factor is below the coordinates' `c`, and the corrected
+/// estimate of each quantity is its raw estimate times that factor (`c_q · η_q`). A
+/// factor that is not finite is refused, naming the dataset, before any output is begun.
+#[test]
+fn held_out_runs_calibrate_each_quantity() {
+    let dir = trained("held-out");
+    let basis = dir.join("arm.h5");
+    let (keys, factors, c) = {
+        let f = flexrom::io::h5_open::open(&basis).unwrap();
+        assert_eq!(series(&basis, "estimator/calibration/load_scale").len(), 1, "one held-out check");
+        let ds = f.dataset("estimator/calibration/quantity_factor").unwrap();
+        let keys: hdf5::types::VarLenUnicode = ds.attr("quantities").unwrap().read_scalar().unwrap();
+        let keys: Vec<String> = keys.as_str().lines().map(str::to_string).collect();
+        let c = f.group("estimator").unwrap().attr("factor").unwrap().read_scalar::<f64>().unwrap();
+        (keys, ds.read_raw::<f64>().unwrap(), c)
+    };
+    let measured = ["position:tip", "position:mid", "strain:mid", "curvature:root", "curvature:mid"];
+    assert_eq!(
+        keys, measured,
+        "the quantities that move, in the model's order, then no reaction (a Galerkin basis keeps no multipliers)"
+    );
+    assert!(factors.iter().all(|&f| f >= c), "{factors:?} against c = {c}");
+
+    let p = flexrom::pipeline::Pipeline::load(dir.join("p.toml")).unwrap();
+    let method = Some(flexrom::rom::estimator::EstimateMethod::Corrected);
+    let (_, rom, _) = flexrom::workflows::online::load_rom(&p, &basis, method, false).unwrap();
+    let mu = flexrom::solver::model::Parameters::load_scale(1.2);
+    let (_, e) = rom.solve_and_estimate(&mu, flexrom::rom::Output::Full, &[]).unwrap();
+    let e = e.unwrap();
+    for (key, factor) in keys.iter().zip(&factors) {
+        let q = e.quantities.iter().find(|q| &q.key() == key).unwrap();
+        assert!((q.estimate - factor * q.raw).abs() <= 1e-12 * q.estimate.abs(), "{key}: {q:?} against c_q = {factor}");
+    }
+
+    let bad = dir.join("bad.h5");
+    std::fs::copy(&basis, &bad).unwrap();
+    {
+        let f = flexrom::io::h5_open::open_rw(&bad).unwrap();
+        let ds = f.dataset("estimator/calibration/quantity_factor").unwrap();
+        let mut v = factors.clone();
+        v[0] = f64::NAN;
+        ds.write_raw(&v).unwrap();
+    }
+    let o = Command::new(env!("CARGO_BIN_EXE_flexrom"))
+        .args(["online", "p.toml", "--basis", "bad.h5", "-o", "bad_run.h5"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("estimator/calibration/quantity_factor") && err.contains("NaN"), "{err}");
+    assert!(!dir.join("bad_run.h5").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn every_method_covers_every_quantity() {
     let dir = trained("cover");

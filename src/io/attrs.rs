@@ -121,7 +121,7 @@ const RESULT: [Entry; 19] = [
     ("labels/reaction_joint", "1", "reaction"),
 ];
 
-const BASIS: [Entry; 56] = [
+const BASIS: [Entry; 57] = [
     ("snapshots", COORDINATE_UNITS, "dof, snapshot"),
     ("snapshot_multipliers", MULTIPLIER_UNITS, "constraint, snapshot"),
     ("snapshot_load_scale", "1", "snapshot"),
@@ -146,6 +146,7 @@ const BASIS: [Entry; 56] = [
     ("estimator/calibration/load_scale", "1", "pair"),
     ("estimator/calibration/raw_estimate", "1", "pair"),
     ("estimator/calibration/rel_error", "1", "pair"),
+    ("estimator/calibration/quantity_factor", "1", "quantity"),
     ("estimator/defects/load_scale", "1", "load"),
     ("estimator/defects/ratio", "1", "load, fifth"),
     ("estimator/defects/factor", "1", "fifth"),

@@ -67,6 +67,12 @@ pub fn write_estimator(f: &hdf5::File, est: &Estimator) -> hdf5::Result<()> {
     cg.new_dataset_builder().with_data(&col(&|p| p.load_scale)).create("load_scale")?;
     cg.new_dataset_builder().with_data(&col(&|p| p.raw_estimate)).create("raw_estimate")?;
     cg.new_dataset_builder().with_data(&col(&|p| p.rel_error)).create("rel_error")?;
+    if !c.quantities.is_empty() {
+        let factors = Array1::from_iter(c.quantities.iter().map(|(_, f)| *f));
+        let ds = cg.new_dataset_builder().with_data(&factors).create("quantity_factor")?;
+        let keys: Vec<&str> = c.quantities.iter().map(|(k, _)| k.as_str()).collect();
+        attr_str(&ds, "quantities", &keys.join("\n"))?;
+    }
     if let Some(d) = &est.defects {
         let dg = g.create_group("defects")?;
         dg.new_dataset_builder().with_data(&Array1::from(d.load_scales.clone())).create("load_scale")?;
@@ -227,7 +233,12 @@ pub fn read_estimator(f: &hdf5::File, path: &Path, basis: &Basis) -> Result<Opti
         enriched,
         block_modes,
         extra_modes: count("extra_modes")? as usize,
-        calibration: Calibration { factor, calibrated: count("calibrated")? != 0, points },
+        calibration: Calibration {
+            factor,
+            calibrated: count("calibrated")? != 0,
+            points,
+            quantities: read_quantity_factors(&cg, &field)?,
+        },
         defects,
         method: chosen,
     }))
@@ -292,6 +303,25 @@ fn read_defects(
     let c =
         c.ok_or_else(|| field("defects/ratio", "has a fifth of the run without one positive, finite ratio".into()))?;
     read_quantity_ratios(dg, c, field)
+}
+
+/// `/estimator/calibration/quantity_factor` (n_q) and its attribute `quantities` (the keys
+/// `quantity:probe`, one a line): each probe quantity's and reaction's `c_q`, positive and
+/// finite; files written before it have none (every quantity reads `c`).
+fn read_quantity_factors(cg: &hdf5::Group, field: &dyn Fn(&str, String) -> Error) -> Result<Vec<(String, f64)>> {
+    let Ok(ds) = cg.dataset("quantity_factor") else { return Ok(Vec::new()) };
+    let name = "calibration/quantity_factor";
+    let keys = crate::io::h5::read_attr_str(&ds, "quantities")
+        .map_err(|e| field(name, format!("has no readable attribute quantities ({e})")))?;
+    let keys: Vec<&str> = keys.lines().collect();
+    if ds.shape() != [keys.len()] {
+        return Err(field(name, format!("is {:?}; expected ({}), one factor per quantity", ds.shape(), keys.len())));
+    }
+    let f = ds.read_1d::<f64>().map_err(|e| field(name, format!("cannot be read: {e}")))?;
+    if let Some(bad) = f.iter().find(|x| !(x.is_finite() && **x > 0.0)) {
+        return Err(field(name, format!("holds {bad}; every factor must be positive and finite")));
+    }
+    Ok(keys.into_iter().map(str::to_string).zip(f.iter().copied()).collect())
 }
 
 /// `/estimator/defects/quantity_ratio` (N, n_q) and its attribute `quantities` (the keys

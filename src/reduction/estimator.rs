@@ -268,6 +268,16 @@ pub struct CalibrationPoint {
     pub rel_error: f64,
 }
 
+/// One held-out load's reading of one probe quantity or joint reaction (its key
+/// `quantity:probe`): the raw estimate of a basis there and the true error over the
+/// quantity's range.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct QuantityPoint {
+    pub key: String,
+    pub raw_estimate: f64,
+    pub error: f64,
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Calibration {
     /// `c`
@@ -275,11 +285,22 @@ pub struct Calibration {
     /// false: [`DEFAULT_FACTOR`], no usable held-out data
     pub calibrated: bool,
     pub points: Vec<CalibrationPoint>,
+    /// `c_q` of each probe quantity and reaction the held-out runs measured (key
+    /// `quantity:probe`), never below `c`; a quantity not listed reads `c`
+    pub quantities: Vec<(String, f64)>,
 }
 
 impl Default for Calibration {
     fn default() -> Self {
-        Calibration { factor: DEFAULT_FACTOR, calibrated: false, points: Vec::new() }
+        Calibration { factor: DEFAULT_FACTOR, calibrated: false, points: Vec::new(), quantities: Vec::new() }
+    }
+}
+
+impl Calibration {
+    /// `c_q / c` of the quantity `key`: how much more than the coordinates' factor its raw
+    /// estimate is multiplied by; 1 for a quantity without its own calibration.
+    pub fn quantity_scale(&self, key: &str) -> f64 {
+        self.quantities.iter().find(|(k, _)| k == key).map_or(1.0, |(_, c)| c / self.factor)
     }
 }
 

@@ -69,9 +69,9 @@
 //!   runs spent there do not make the basis better. The whole-run estimate is still what
 //!   every reduced run reports; `/training/whole_run_estimates` keeps it. A response
 //!   proportional to the load moves by about δ (in the displacement measure by δ exactly):
-//!   that is no amplification, and a tolerance below it is held as given (until
-//!   2026-11-27 any `s_i > T` relaxed it, and a clamped beam held to 1e-4 in the
-//!   displacement measure "converged" with a held-out error of 3.0e-4).
+//!   that is no amplification, and a tolerance below it is held as given (relaxed by any
+//!   `s_i > T`, a clamped beam held to 1e-4 in the displacement measure "converged" with a
+//!   held-out error of 3.0e-4).
 //!
 //! Nothing here is fitted to a model: the ladder, √ε and the bound B are the same for
 //! every model; a reduced run that fails (Newton diverges) counts as an infinite estimate.
@@ -94,8 +94,8 @@ use crate::model::Model;
 use crate::pipeline::config::{GreedyMeasure, GreedySpec, Pipeline};
 use crate::reduction::Basis;
 use crate::rom::estimator::norms::rel_error_by_time;
-use crate::rom::estimator::training::{calibrate, CalibrationPoint};
-use crate::rom::estimator::{ByFifth, ErrorMeasure, EstimateMethod, FIFTHS};
+use crate::rom::estimator::training::{calibrate, calibrate_quantities, CalibrationPoint, QuantityPoint};
+use crate::rom::estimator::{quantity_key, ByFifth, ErrorMeasure, EstimateMethod, FIFTHS};
 use crate::rom::trust::amplifying;
 use crate::rom::Rom;
 use crate::simulate::{simulate, Overrides, SimulationResult};
@@ -140,6 +140,8 @@ struct Greedy<'a> {
     full_runs: usize,
     /// the held-out pairs (raw estimate, true error) the estimator is calibrated with
     points: Vec<CalibrationPoint>,
+    /// the same pairs for each probe quantity and joint reaction (`c_q`)
+    quantity_points: Vec<QuantityPoint>,
     iterations: Vec<Iteration>,
     warnings: Vec<String>,
     /// warnings that the training's method over-reads: moot once the loop switches method
@@ -186,6 +188,7 @@ impl<'a> Greedy<'a> {
             full_seconds,
             full_runs,
             points: Vec::new(),
+            quantity_points: Vec::new(),
             iterations: Vec::new(),
             warnings: Vec::new(),
             over_reading: Vec::new(),
@@ -354,6 +357,10 @@ impl<'a> Greedy<'a> {
         if level.raws[ni].is_finite() && e.is_finite() {
             self.points.push(CalibrationPoint { load_scale: mu.scale(), raw_estimate: level.raws[ni], rel_error: e });
         }
+        self.quantity_points.extend(level.quantity_raws(ni).iter().filter_map(|(key, raw)| {
+            let error = truth_error.by_quantity.iter().find(|(k, _)| k == key)?.1;
+            Some(QuantityPoint { key: key.clone(), raw_estimate: *raw, error })
+        }));
         // the held-out check of the estimate itself: off by more than the method assumes, the
         // loop reads the candidates with the enriched model (the reference the correction
         // approximates) from here on, when that reads closer at this point; not for an
@@ -369,9 +376,11 @@ impl<'a> Greedy<'a> {
             } else if checked.switch {
                 self.over_reading.clear();
                 self.method = EstimateMethod::Enriched;
-                // the earlier pairs were the other method's readings
+                // the earlier pairs were the other method's readings (and its quantities'
+                // readings at this point are not known)
                 self.points =
                     vec![CalibrationPoint { load_scale: mu.scale(), raw_estimate: checked.raw, rel_error: e }];
+                self.quantity_points.clear();
                 level.estimator.calibration = calibrate(self.points.clone());
                 level.estimate(
                     p,
@@ -414,7 +423,7 @@ impl<'a> Greedy<'a> {
         let pair_bounds = chosen.pair_bounds().map(<[f64]>::to_vec);
         let Level { trained, mut estimator, .. } = chosen;
         let level_factor = estimator.calibration.factor;
-        estimator.calibration = calibrate(self.points);
+        estimator.calibration = calibrate_quantities(calibrate(self.points), &self.quantity_points);
         // the cheap online estimate on the training estimate's scale (`DefectsCalibration`)
         estimator.defects = candidates::calibrate_defects(&p.model, &trained.basis, &estimator, &candidates, method);
         if method == EstimateMethod::Enriched && !estimator.defects.as_ref().is_some_and(|d| d.reliable) {
@@ -786,6 +795,9 @@ struct TrueError {
     /// the largest error of a probe quantity or a joint reaction over its range (0 without
     /// probes or joints)
     quantities: f64,
+    /// each probe quantity's and reaction's error over its range, by key `quantity:probe`
+    /// (none where it has no swing to measure against)
+    by_quantity: Vec<(String, f64)>,
 }
 
 impl TrueError {
@@ -820,13 +832,17 @@ fn true_error(model: &Arc<Model>, basis: &Basis, truth: &SimulationResult, mu: &
     match run {
         Ok(rom) => {
             let v = compare(model, truth, &rom, None, basis.n_reduced(), basis.variant.name());
-            let reactions = v.reaction_errors.iter().map(|q| q.relative.unwrap_or(f64::NAN));
-            let quantities = v.probe_quantity_errors.iter().map(|q| q.relative.unwrap_or(f64::NAN)).chain(reactions);
+            let reactions = v.reaction_errors.iter().map(|q| (q.quantity, &q.reaction, q.relative));
+            let all: Vec<_> =
+                v.probe_quantity_errors.iter().map(|q| (q.quantity, &q.probe, q.relative)).chain(reactions).collect();
+            let quantities = all.iter().map(|q| q.2.unwrap_or(f64::NAN));
+            let by_quantity = all.iter().filter_map(|(q, name, e)| Some((quantity_key(*q, name), (*e)?)));
             TrueError {
                 rel_error: v.rel_error,
                 rel_error_by_time: rel_error_by_time(&rom.result.q, &truth.q),
                 displacement_error_by_time: std::array::from_fn(|i| v.displacement_error_by_time[i]),
                 quantities: candidates::worst_quantity(quantities),
+                by_quantity: by_quantity.collect(),
             }
         }
         Err(_) => TrueError {
@@ -834,6 +850,7 @@ fn true_error(model: &Arc<Model>, basis: &Basis, truth: &SimulationResult, mu: &
             rel_error_by_time: [f64::INFINITY; FIFTHS],
             displacement_error_by_time: [f64::INFINITY; FIFTHS],
             quantities: f64::INFINITY,
+            by_quantity: Vec::new(),
         },
     }
 }
@@ -869,6 +886,7 @@ mod tests {
             rel_error_by_time: [1e-5, 1e-5, 2e-5, 2e-5, 2.1e-5],
             displacement_error_by_time: [3e-4; FIFTHS],
             quantities: 1.2e-2,
+            by_quantity: Vec::new(),
         };
         assert_eq!(t.in_measure(GreedyMeasure::Probes), 1.2e-2);
         assert_eq!(t.in_measure(GreedyMeasure::Relative), 2e-5);

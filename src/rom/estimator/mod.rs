@@ -116,9 +116,9 @@ impl QuantityRaw {
             .collect()
     }
 
-    /// The quantity's key in calibrations and messages, `quantity:probe`.
+    /// The quantity's key in calibrations and messages ([`quantity_key`]).
     pub fn key(&self) -> String {
-        format!("{}:{}", self.quantity.name(), self.probe)
+        quantity_key(self.quantity, &self.probe)
     }
 
     /// The raw distance of a run's reactions `run` from the reference's `reference`, over
@@ -164,6 +164,19 @@ pub struct QuantityEstimate {
     /// move beyond its resolution in either run
     pub estimate: f64,
     pub raw: f64,
+}
+
+impl QuantityEstimate {
+    /// The quantity's key in calibrations ([`quantity_key`]).
+    pub fn key(&self) -> String {
+        quantity_key(self.quantity, &self.probe)
+    }
+}
+
+/// A probe quantity's or joint reaction's key in calibrations and messages,
+/// `quantity:probe` (`curvature:root`, `force:joint 0 … on arm node 0`).
+pub fn quantity_key(quantity: Quantity, name: &str) -> String {
+    format!("{}:{name}", quantity.name())
 }
 
 /// One estimate.
@@ -254,9 +267,10 @@ pub trait ErrorEstimator: Send + Sync {
     }
 
     /// The factor a probe quantity's `η_raw` is multiplied by at `mu`: the run's whole-run
-    /// factor `whole`, unless the method calibrated the quantity on its own.
-    fn quantity_factor(&self, _mu: &Parameters, _q: &QuantityRaw, whole: f64) -> f64 {
-        whole
+    /// factor `whole`, raised as the held-out runs raised the quantity's `c_q` above `c`
+    /// ([`Calibration::quantity_scale`]), unless the method calibrated the quantity on its own.
+    fn quantity_factor(&self, _mu: &Parameters, q: &QuantityRaw, whole: f64) -> f64 {
+        whole * self.data().calibration.quantity_scale(&q.key())
     }
 
     /// The estimate of `run` at its parameters `mu`. A failure of the estimator's model gives

@@ -4,7 +4,9 @@
 
 use crate::error::Result;
 use crate::physics::system::FlexibleSystem;
-pub use crate::reduction::estimator::{Calibration, CalibrationPoint, EstimateMethod, Estimator, DEFAULT_FACTOR};
+pub use crate::reduction::estimator::{
+    Calibration, CalibrationPoint, EstimateMethod, Estimator, QuantityPoint, DEFAULT_FACTOR,
+};
 use crate::reduction::output_modes::{add_output_modes, output_columns, Outputs, Stop};
 use crate::reduction::{ecsw, train_basis, BasisSpec, ModeRule, Trained};
 use ndarray::{ArrayView1, ArrayView2};
@@ -43,7 +45,39 @@ pub fn calibrate(points: Vec<CalibrationPoint>) -> Calibration {
         return Calibration { points, ..Calibration::default() };
     }
     let worst = ratios.iter().copied().fold(0.0, f64::max);
-    Calibration { factor: (CALIBRATION_MARGIN * worst).max(DEFAULT_FACTOR), calibrated: true, points }
+    Calibration {
+        factor: (CALIBRATION_MARGIN * worst).max(DEFAULT_FACTOR),
+        calibrated: true,
+        points,
+        quantities: Vec::new(),
+    }
+}
+
+/// The factors `c_q` of the probe quantities and reactions from their held-out pairs
+/// `(η_q,i, e_q,i)`, as `c` is calibrated and never below it:
+///
+/// ```text
+///     c_q = max(c, CALIBRATION_MARGIN · max_i e_q,i / η_q,i)
+/// ```
+///
+/// A quantity's raw estimate reads its own scale: the correction sees a tip's position
+/// better than a stiff root's strain, whose error a rotation of the modes can stretch
+/// beyond what the enriched basis resolves (docs/error-estimate.md). Pairs with a
+/// non-finite or non-positive value are ignored; a quantity with none left keeps `c`.
+pub fn calibrate_quantities(mut c: Calibration, points: &[QuantityPoint]) -> Calibration {
+    let mut factors: Vec<(String, f64)> = Vec::new();
+    for p in points.iter().filter(|p| p.raw_estimate.is_finite() && p.error.is_finite()) {
+        if !(p.raw_estimate > 0.0 && p.error > 0.0) {
+            continue;
+        }
+        let need = (CALIBRATION_MARGIN * p.error / p.raw_estimate).max(c.factor);
+        match factors.iter_mut().find(|(k, _)| *k == p.key) {
+            Some((_, f)) => *f = f.max(need),
+            None => factors.push((p.key.clone(), need)),
+        }
+    }
+    c.quantities = factors;
+    c
 }
 
 /// The mode rule of the enriched basis: each block's count plus `extra`, capped by the
@@ -137,5 +171,30 @@ mod tests {
         let none = calibrate(vec![p(0.0, 0.0)]);
         assert!(!none.calibrated);
         assert_eq!(none.factor, DEFAULT_FACTOR);
+    }
+
+    /// Each quantity's `c_q` = max(c, 1.25 · its largest e_q/η_q): the root strain read
+    /// 4× under its raw estimate at one held-out load and 1× at another, so c_q = 1.25 · 4 = 5;
+    /// the tip read below c / 1.25 and keeps c (2.5 here); a quantity with only unusable
+    /// pairs has no factor of its own and reads c (scale 1), as does one never measured.
+    #[test]
+    fn quantity_factors_cover_their_own_pairs_and_never_fall_below_c() {
+        let p = |raw, err| CalibrationPoint { load_scale: 1.0, raw_estimate: raw, rel_error: err };
+        let q = |key: &str, raw, error| QuantityPoint { key: key.into(), raw_estimate: raw, error };
+        let c = calibrate(vec![p(1e-3, 2e-3)]);
+        let points = [
+            q("strain:root", 1e-3, 4e-3),
+            q("strain:root", 1e-3, 1e-3),
+            q("position:tip", 1e-3, 1e-3),
+            q("curvature:root", 0.0, 1e-3),
+            q("curvature:root", f64::INFINITY, 1e-3),
+        ];
+        let c = calibrate_quantities(c, &points);
+        assert_eq!(c.quantities.len(), 2, "{:?}", c.quantities);
+        assert!((c.quantity_scale("strain:root") - 5.0 / 2.5).abs() < 1e-12);
+        assert_eq!(c.quantity_scale("position:tip"), 1.0);
+        assert_eq!(c.quantity_scale("curvature:root"), 1.0);
+        assert_eq!(c.quantity_scale("moment:never measured"), 1.0);
+        assert_eq!(c.factor, 2.5, "the coordinates' c is untouched");
     }
 }

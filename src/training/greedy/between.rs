@@ -40,9 +40,9 @@
 /// run is in the snapshots, so that its estimate measures only what the basis truncates
 /// there, not a trend — counts with its larger value too: between a point the basis holds
 /// and its neighbour the error rises from about nothing towards the neighbour's, and a
-/// ratio against that nothing says nothing. (Until 2026-11-27 only in a box; on a line the
-/// zoo's `18-n-pendulum` then stayed unconverged at scores within T because a training
-/// load's 2.3e-6 stood beside a neighbour's 7.8e-3.)
+/// ratio against that nothing says nothing. (Held only in a box, on a line the zoo's
+/// `18-n-pendulum` stayed unconverged at scores within T because a training load's 2.3e-6
+/// stood beside a neighbour's 7.8e-3.)
 pub(crate) fn pair_bound(a: f64, b: f64, both_sensitive: bool, settled: bool) -> f64 {
     if !(a.is_finite() && a > 0.0 && b.is_finite() && b > 0.0) {
         return f64::INFINITY;

@@ -45,6 +45,9 @@ pub(super) struct CandidateRun {
     pub(super) sensitivity: ByFifth,
     /// why no estimate could be computed, when none could (the estimates are then ∞)
     pub(super) failure: Option<String>,
+    /// each probe quantity's and reaction's raw estimate, by key `quantity:probe` (what
+    /// `c_q` is calibrated with)
+    pub(super) quantity_raws: Vec<(String, f64)>,
 }
 
 /// The reduced model training steers by: `basis` with the estimator of `est` by `method`
@@ -63,8 +66,8 @@ fn training_setup<'m>(
     basis: &Basis,
     est: &Estimator,
     method: EstimateMethod,
-) -> std::result::Result<(Rom, &'m crate::model::SharedPhysics), CandidateRun> {
-    let cannot = |e: crate::error::Error| failed(format!("the reduced model cannot be built: {e}"));
+) -> std::result::Result<(Rom, &'m crate::model::SharedPhysics), Box<CandidateRun>> {
+    let cannot = |e: crate::error::Error| Box::new(failed(format!("the reduced model cannot be built: {e}")));
     Ok((training_rom(model, basis, est, method).map_err(cannot)?, model.physics().map_err(cannot)?))
 }
 
@@ -97,7 +100,7 @@ pub(super) fn estimate_candidates(
     let (rom, physics) = match training_setup(model, basis, est, method) {
         Ok(s) => s,
         Err(f) => {
-            which.iter().for_each(|&i| out[i] = Some(f.clone()));
+            which.iter().for_each(|&i| out[i] = Some((*f).clone()));
             return out;
         }
     };
@@ -125,6 +128,7 @@ fn failed(why: String) -> CandidateRun {
         raw: f64::INFINITY,
         sensitivity: [0.0; FIFTHS],
         failure: Some(why),
+        quantity_raws: Vec::new(),
     }
 }
 
@@ -164,7 +168,8 @@ fn point_run(
             if measure.probes() {
                 by_time[FIFTHS - 1] = by_time[FIFTHS - 1].max(worst_quantity(e.quantities.iter().map(|q| q.estimate)));
             }
-            CandidateRun { by_time, raw: e.raw, sensitivity, failure }
+            let quantity_raws = e.quantities.iter().map(|q| (q.key(), q.raw)).collect();
+            CandidateRun { by_time, raw: e.raw, sensitivity, failure, quantity_raws }
         }
         Ok((_, None)) => failed("the reduced model has no estimator".into()),
         Err(e) => failed(format!("the reduced run failed: {e}")),
@@ -202,7 +207,7 @@ pub(super) fn estimate_points(
 ) -> Vec<CandidateRun> {
     let (rom, physics) = match training_setup(model, basis, est, method) {
         Ok(s) => s,
-        Err(f) => return vec![f; units.len()],
+        Err(f) => return vec![*f; units.len()],
     };
     let x0 = ndarray::ArrayView1::from(&physics.x0[..]);
     units
@@ -233,7 +238,7 @@ pub(super) fn screen_candidates(
         Ok(s) => s,
         Err(f) => {
             // like a failed run at every candidate: one is enough to reject
-            out[order[0]] = Some(f);
+            out[order[0]] = Some(*f);
             return out;
         }
     };

@@ -19,8 +19,8 @@ use crate::training::training_record::modes_text;
 /// the captured energy `1 − ε`, a sum of squared singular values, still has two digits in
 /// double precision; a tolerance far below the relative error measure's (a displacement
 /// of a few per cent of the coordinates held to 1e-4) needs it: a clamped beam in the
-/// displacement measure at 1e-4 needs 25 modes, ε = 1.2e-13 (until 2026-11-27 the ladder
-/// ended at 10⁻¹⁰, 15 modes, and training spent its runs at a 2e-4 error).
+/// displacement measure at 1e-4 needs 25 modes, ε = 1.2e-13 (a ladder ending at 10⁻¹⁰
+/// gives it 15 modes, and training spent its runs at a 2e-4 error).
 pub const ENERGY_LADDER: [f64; 13] =
     [1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13, 1e-14];
 /// ECSW tolerances τ tried with the chosen modes, loose to tight: 10^(−1 − i/2), down to 10⁻⁶
@@ -435,6 +435,12 @@ impl Level {
             &mut look,
         );
         (self.pair_bounds, self.between_points) = (Some(bounds), used);
+    }
+
+    /// The raw estimates of candidate `i`'s probe quantities and reactions, by key (none
+    /// where it was not run).
+    pub(super) fn quantity_raws(&self, i: usize) -> &[(String, f64)] {
+        self.runs.get(i).and_then(Option::as_ref).map_or(&[], |r| &r.quantity_raws)
     }
 
     fn record(&mut self, p: &Pipeline, runs: Vec<Option<CandidateRun>>) {
