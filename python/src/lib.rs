@@ -481,6 +481,22 @@ impl PyRunResult {
         dict_of_series(py, &self.r.curvatures)
     }
 
+    /// name → (n_t) energy, J, as a result file's `/energy/<name>`: `kinetic`, `strain`
+    /// (`strain_axial` + `strain_bending`), `gravity`, `springs`, `external_work`,
+    /// `drive_work`, and `total` = kinetic + strain + gravity + springs − external_work −
+    /// drive_work (constant without damping; its drift measures the integrator's); None for a
+    /// run without them (a reduced run's are over its sampled elements)
+    #[getter]
+    fn energies<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(e) = &self.r.energy else { return Ok(None) };
+        let d = PyDict::new(py);
+        for (name, series) in e.named() {
+            d.set_item(name, series.clone().into_pyarray(py))?;
+        }
+        d.set_item("total", e.total().into_pyarray(py))?;
+        Ok(Some(d))
+    }
+
     /// names of the coordinates (`dof`), constraint rows (`multiplier`) and bodies, as a
     /// result file's `/labels`
     #[getter]
