@@ -111,7 +111,7 @@ pub fn animate_picked(
     limits: &crate::limits::Limits,
 ) -> Result<Animation> {
     if !(opts.fps.is_finite() && opts.fps > 0.0 && opts.fps <= 100.0) {
-        return Err(Error::Usage(format!("--fps {} is not in (0, 100] frames per second", opts.fps)));
+        return Err(Error::option("fps", None, format!("{} is not in (0, 100] frames per second", opts.fps)));
     }
     let (main, main_sweep) = Motion::open(result, pick, limits)?;
     let other = compare.map(|p| Motion::open(p, pick, limits)).transpose()?;
