@@ -417,7 +417,7 @@ pub fn dataset_of_shape(loc: &hdf5::Group, name: &str, want: &[usize]) -> Result
 /// The length of the one-dimensional dataset `name` of `loc`, refused before anything is
 /// read when what reading it brings along, `bytes_per_entry` for each entry, would exceed
 /// the memory bound: the file alone sizes it, so a flipped bit must not size an allocation.
-/// An [`Error::Hdf5`] or [`Error::Resource`] whose [`Error::problem`] is for a message after
+/// An [`Error::Hdf5`] or [`Error::Resource`] whose [`Error::problem_text`] is for a message after
 /// the file and the dataset.
 pub fn bounded_len(
     loc: &hdf5::Group,
