@@ -2,6 +2,7 @@
 //! act on it: the file and field for bad input, the time, iteration and residual for a
 //! failed solve.
 
+use std::fmt;
 use std::path::Path;
 
 #[derive(Debug, thiserror::Error)]
@@ -9,7 +10,7 @@ pub enum Error {
     /// Bad input: names the file, the field (a dotted path such as `bodies[1].length`) and
     /// the problem.
     #[error("{file}: {field}: {problem}")]
-    Input { file: String, field: String, problem: String },
+    Input { file: String, field: String, problem: Text },
 
     /// Reading or writing a file failed at the operating-system level.
     #[error("{file}: {source}")]
@@ -64,18 +65,18 @@ pub enum Error {
     /// `max_memory`) and not as a front end spells it: the command line renders it as
     /// `--load-scale`, Python as the keyword `load_scale=` ([`Error::render`]). `value`: the
     /// value given, where the message shows it.
-    #[error("{}", option_message(key, value.as_deref(), problem, &plain_option))]
-    Option { key: &'static str, value: Option<String>, problem: String },
+    #[error("{}", option_message(key, value.as_deref(), &problem.to_string(), &plain_option))]
+    Option { key: &'static str, value: Option<String>, problem: Text },
 
     /// A run or an allocation would exceed a resource bound (memory, step count): names
     /// the estimated figure, the bound and the option or key that raises it.
     #[error("{0}")]
-    Resource(String),
+    Resource(Text),
 
     /// A run left plausible bounds (strain, step cuts): names what, when, and the key or
     /// option that relaxes the check.
     #[error("blow-up at t = {t:.6} s: {problem}")]
-    BlowUp { t: f64, problem: String },
+    BlowUp { t: f64, problem: Text },
 
     /// A numerical failure with the stage (simulate, train, online, validate, sweep) and
     /// the parameters it happened at (as `Parameters` print them: `load scale 1.1`); the
@@ -93,7 +94,7 @@ pub enum Error {
     Hinted {
         #[source]
         source: Box<Error>,
-        hint: String,
+        hint: Text,
     },
 
     /// The host program asked the computation to stop ([`crate::interrupt`]: Ctrl-C in
@@ -135,16 +136,125 @@ pub fn show_text(s: &str) -> String {
     s.chars().map(|c| if c.is_control() { c.escape_default().to_string() } else { c.to_string() }).collect()
 }
 
-/// How a front end writes an option and its value (`--load-scale 2`, `load_scale=2`; the
-/// value is `None` where the message does not show it).
-pub type OptionSpelling = dyn Fn(&str, Option<&str>) -> String;
+/// How a front end writes an option the library names by its key: the command line as its
+/// flag (`--load-scale 2`), Python as its keyword (`load_scale=2`), the library's own text as
+/// the key (`load_scale = 2`). `value` is `None` where the message does not show it.
+pub trait Spelling {
+    /// The option `key` (with `value`) as this front end's users write it, or `None` where
+    /// they have no such option: a [`Text`] then leaves out the clause that names it.
+    fn option(&self, key: &str, value: Option<&str>) -> Option<String>;
+}
+
+/// A front end that has every option: a function from the key and the value to its spelling.
+impl<F: Fn(&str, Option<&str>) -> String> Spelling for F {
+    fn option(&self, key: &str, value: Option<&str>) -> Option<String> {
+        Some(self(key, value))
+    }
+}
+
+/// How a front end writes an option ([`Spelling`]; the name [`Error::render`] takes).
+pub type OptionSpelling = dyn Spelling;
+
+/// A message's text that names options by their keys, for each front end to spell
+/// ([`Spelling`]): words, and options each in the clause that goes with it (`; ` `--allow-blowup`
+/// ` only warns`), which a front end without the option leaves out whole. Displayed, it is
+/// the library's own text, the options as their keys (`allow_blowup only warns`); a front
+/// end renders it with [`Text::render`] (through [`Error::render`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Text(Vec<Piece>);
+
+#[derive(Clone, Debug, PartialEq)]
+enum Piece {
+    Words(String),
+    /// `before`, the option as spelt, `after`; nothing where the front end lacks the option.
+    Clause {
+        before: String,
+        key: &'static str,
+        value: Option<String>,
+        after: String,
+    },
+}
+
+impl Text {
+    /// `words`, then what is added after them.
+    pub fn new(words: impl Into<String>) -> Text {
+        Text(vec![Piece::Words(words.into())])
+    }
+
+    /// `words` added at the end.
+    pub fn then(mut self, words: impl Into<String>) -> Text {
+        self.0.push(Piece::Words(words.into()));
+        self
+    }
+
+    /// The option `key` (with `value`) added at the end, as each front end spells it.
+    pub fn option(self, key: &'static str, value: Option<&str>) -> Text {
+        self.clause("", key, value, "")
+    }
+
+    /// The clause `before OPTION after` added at the end; a front end without the option
+    /// leaves the clause out (`; --allow-blowup only warns` is nothing in Python).
+    pub fn clause(
+        mut self,
+        before: impl Into<String>,
+        key: &'static str,
+        value: Option<&str>,
+        after: impl Into<String>,
+    ) -> Text {
+        let value = value.map(str::to_string);
+        self.0.push(Piece::Clause { before: before.into(), key, value, after: after.into() });
+        self
+    }
+
+    /// The text with each option as `spell` writes it.
+    pub fn render(&self, spell: &OptionSpelling) -> String {
+        let mut out = String::new();
+        for piece in &self.0 {
+            match piece {
+                Piece::Words(w) => out.push_str(w),
+                Piece::Clause { before, key, value, after } => {
+                    if let Some(o) = spell.option(key, value.as_deref()) {
+                        out.push_str(&format!("{before}{o}{after}"));
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// `c: ` put before the text ([`Error::context`]).
+    fn prefixed(mut self, c: impl fmt::Display) -> Text {
+        self.0.insert(0, Piece::Words(format!("{c}: ")));
+        self
+    }
+}
+
+impl fmt::Display for Text {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.render(&plain_option))
+    }
+}
+
+impl From<String> for Text {
+    fn from(words: String) -> Text {
+        Text::new(words)
+    }
+}
+
+impl From<&str> for Text {
+    fn from(words: &str) -> Text {
+        Text::new(words)
+    }
+}
 
 /// An option's message with the option as `spell` writes it: `OPTION VALUE: problem`, or
-/// `OPTION problem` without a value (`--load-scale must be finite, got NaN`).
+/// `OPTION problem` without a value (`--load-scale must be finite, got NaN`); the key where
+/// the front end has no such option.
 fn option_message(key: &str, value: Option<&str>, problem: &str, spell: &OptionSpelling) -> String {
+    let option = spell.option(key, value).unwrap_or_else(|| plain_option(key, value));
     match value {
-        Some(_) => format!("{}: {problem}", spell(key, value)),
-        None => format!("{} {problem}", spell(key, None)),
+        Some(_) => format!("{option}: {problem}"),
+        None => format!("{option} {problem}"),
     }
 }
 
@@ -178,7 +288,7 @@ impl Error {
         }
     }
 
-    pub fn input(file: impl AsRef<Path>, field: impl Into<String>, problem: impl Into<String>) -> Self {
+    pub fn input(file: impl AsRef<Path>, field: impl Into<String>, problem: impl Into<Text>) -> Self {
         Error::Input { file: file.as_ref().display().to_string(), field: field.into(), problem: problem.into() }
     }
 
@@ -218,14 +328,14 @@ impl Error {
         match self {
             Error::NewtonFailed { .. } | Error::LinearSolve { .. } | Error::BlowUp { .. } => {
                 let hint = if full_ran { REDUCED_RUN_FAILED_FULL_RAN } else { REDUCED_RUN_FAILED };
-                Error::Hinted { source: Box::new(self.at_stage(stage, mu)), hint: hint.to_string() }
+                Error::Hinted { source: Box::new(self.at_stage(stage, mu)), hint: hint.into() }
             }
             other => other,
         }
     }
 
     /// A bad value of the option `key` ([`Error::Option`]).
-    pub fn option(key: &'static str, value: Option<String>, problem: impl Into<String>) -> Self {
+    pub fn option(key: &'static str, value: Option<String>, problem: impl Into<Text>) -> Self {
         Error::Option { key, value, problem: problem.into() }
     }
 
@@ -234,10 +344,18 @@ impl Error {
     /// a hint or a context; every other text as [`std::fmt::Display`] gives it.
     pub fn render(&self, spell: &OptionSpelling) -> String {
         match self {
-            Error::Option { key, value, problem } => option_message(key, value.as_deref(), problem, spell),
-            Error::Strict { message, .. } => format!("{}: {message}", spell("strict", None)),
+            Error::Input { file, field, problem } => format!("{file}: {field}: {}", problem.render(spell)),
+            Error::Option { key, value, problem } => {
+                option_message(key, value.as_deref(), &problem.render(spell), spell)
+            }
+            Error::Strict { message, .. } => {
+                let option = spell.option("strict", None).unwrap_or_else(|| plain_option("strict", None));
+                format!("{option}: {message}")
+            }
+            Error::Resource(text) => text.render(spell),
+            Error::BlowUp { t, problem } => format!("blow-up at t = {t:.6} s: {}", problem.render(spell)),
             Error::Stage { stage, parameters, source } => format!("{stage} at {parameters}: {}", source.render(spell)),
-            Error::Hinted { source, hint } => format!("{}; {hint}", source.render(spell)),
+            Error::Hinted { source, hint } => format!("{}; {}", source.render(spell), hint.render(spell)),
             Error::Context { context, source } => format!("{context}: {}", source.render(spell)),
             other => other.to_string(),
         }
@@ -282,7 +400,7 @@ impl Error {
     pub fn context(self, c: impl std::fmt::Display) -> Self {
         match self {
             Error::Usage(p) => Error::Usage(format!("{c}: {p}")),
-            Error::Resource(p) => Error::Resource(format!("{c}: {p}")),
+            Error::Resource(p) => Error::Resource(p.prefixed(c)),
             e @ (Error::Numerical { .. } | Error::Context { .. }) => {
                 Error::Context { context: c.to_string(), source: Box::new(e) }
             }
@@ -298,15 +416,34 @@ impl Error {
     /// ([`Error::Hdf5`]) give their text; another error gives its whole message.
     pub fn problem(self) -> String {
         match self {
-            Error::Usage(p) | Error::Resource(p) | Error::Hdf5 { problem: p, .. } => p,
+            Error::Usage(p) | Error::Hdf5 { problem: p, .. } => p,
+            Error::Resource(p) => p.to_string(),
             Error::Numerical { what: LINEAR_SOLVE, problem } => problem,
             other => other.to_string(),
+        }
+    }
+
+    /// [`Self::problem`] with the options a bound's text names kept for each front end to
+    /// spell ([`Text`]): what a caller puts after the file and the field where the problem
+    /// may be a bound ([`Error::Resource`]).
+    pub fn problem_text(self) -> Text {
+        match self {
+            Error::Resource(text) => text,
+            other => other.problem().into(),
         }
     }
 
     pub fn hdf5(file: impl AsRef<Path>, problem: impl std::fmt::Display) -> Self {
         Error::Hdf5 { file: file.as_ref().display().to_string(), problem: problem.to_string() }
     }
+}
+
+/// The command line's spelling of an option (src/cli/mod.rs `flag`: `--load-scale 2`), for
+/// the library's tests of the texts it shows.
+#[cfg(test)]
+pub(crate) fn cli_flag(key: &str, value: Option<&str>) -> String {
+    let name = format!("--{}", key.replace('_', "-"));
+    value.map_or_else(|| name.clone(), |v| format!("{name} {v}"))
 }
 
 #[cfg(test)]
@@ -336,14 +473,50 @@ mod tests {
     fn an_option_is_spelt_by_the_front_end() {
         let e = Error::option("time", Some("1.5".into()), "outside the model's run");
         assert_eq!(e.to_string(), "time = 1.5: outside the model's run");
-        let flag = |k: &str, v: Option<&str>| {
-            format!("--{}{}", k.replace('_', "-"), v.map_or(String::new(), |v| format!(" {v}")))
-        };
-        assert_eq!(e.render(&flag), "--time 1.5: outside the model's run");
+        assert_eq!(e.render(&cli_flag), "--time 1.5: outside the model's run");
         let e = Error::option("load_scale", None, "must be finite, got NaN");
-        assert_eq!(e.render(&flag), "--load-scale must be finite, got NaN");
-        assert_eq!(e.render(&|k, v| format!("{k}={}", v.unwrap_or(""))), "load_scale= must be finite, got NaN");
+        assert_eq!(e.render(&cli_flag), "--load-scale must be finite, got NaN");
+        assert_eq!(e.render(&Python), "load_scale= must be finite, got NaN");
         let hinted = Error::Hinted { source: Box::new(e), hint: "a hint".into() };
-        assert_eq!(hinted.render(&flag), "--load-scale must be finite, got NaN; a hint");
+        assert_eq!(hinted.render(&cli_flag), "--load-scale must be finite, got NaN; a hint");
+    }
+
+    /// Python's spelling as python/src/errors.rs `Keywords` writes it: the keyword, and no
+    /// `allow_blowup` (no Python call takes it).
+    struct Python;
+
+    impl Spelling for Python {
+        fn option(&self, key: &str, value: Option<&str>) -> Option<String> {
+            (key != "allow_blowup").then(|| format!("{key}={}", value.unwrap_or("")))
+        }
+    }
+
+    /// One message whose text names options, three ways: the library's own text (the keys,
+    /// no control or invisible character: it is also written into files), the command
+    /// line's (the flags, as the message read before it named the keys:
+    /// src/simulate.rs's blow-up check), Python's (the keyword; the clause naming an option
+    /// Python lacks left out), also under a stage and in a bound's problem after a file.
+    #[test]
+    fn a_text_names_its_options_for_each_front_end() {
+        let problem = Text::new("strain 2 over the bound 0.5 (`[time] max_strain` raises it")
+            .clause("; ", "allow_blowup", None, " only warns")
+            .then(")");
+        let e = Error::BlowUp { t: 0.5, problem }.at_stage("simulate", &"load scale 2");
+        let head = "simulate at load scale 2: blow-up at t = 0.500000 s: strain 2 over the bound 0.5 (`[time] max_strain` raises it";
+        assert_eq!(e.to_string(), format!("{head}; allow_blowup only warns)"));
+        assert!(!e.to_string().chars().any(|c| c.is_control() || c == '\u{200b}' || c == '\u{feff}'));
+        assert_eq!(e.render(&cli_flag), format!("{head}; --allow-blowup only warns)"));
+        assert_eq!(e.render(&Python), format!("{head})"));
+        let text = Text::new("pick one with ").option("point", Some("K"));
+        let e = Error::input("s.h5", "load_scale", text).context("ignored: an input error names its file");
+        assert_eq!(e.to_string(), "s.h5: load_scale: pick one with point = K");
+        assert_eq!(e.render(&cli_flag), "s.h5: load_scale: pick one with --point K");
+        assert_eq!(e.render(&Python), "s.h5: load_scale: pick one with point=K");
+        let bound = Error::Resource(
+            Text::new("over the limit; raise it with ").clause("", "max_memory", None, " or ").then("ENV"),
+        );
+        let e = Error::input("r.h5", "t", bound.context("its 9 entries").problem_text());
+        assert_eq!(e.render(&cli_flag), "r.h5: t: its 9 entries: over the limit; raise it with --max-memory or ENV");
+        assert_eq!(e.to_string(), "r.h5: t: its 9 entries: over the limit; raise it with max_memory or ENV");
     }
 }

@@ -16,7 +16,7 @@
 //!     sweep         N · n_t · (r + n_pv) · 8  (+ N · n_t · n_dof · 8 with --validate)
 //! ```
 
-use crate::error::{show_number, Error, Result};
+use crate::error::{show_number, Error, Result, Text};
 
 /// The bounds in force.
 #[derive(Clone, Debug, PartialEq)]
@@ -155,12 +155,15 @@ impl Limits {
         if bytes.is_finite() && bytes <= l.max_memory as f64 {
             return Ok(());
         }
-        Err(Error::Resource(format!(
-        "{what} would need about {} of memory, over the limit of {} ({}); raise it with --max-memory or FLEXROM_MAX_MEMORY, or use fewer steps, elements or load scales",
-        show_bytes(bytes),
-        show_bytes(l.max_memory as f64),
-        l.memory_source
-    )))
+        let over = format!(
+            "{what} would need about {} of memory, over the limit of {} ({}); raise it with ",
+            show_bytes(bytes),
+            show_bytes(l.max_memory as f64),
+            l.memory_source
+        );
+        Err(Error::Resource(
+            raise_with(over, "max_memory", "FLEXROM_MAX_MEMORY").then(", or use fewer steps, elements or load scales"),
+        ))
     }
 
     /// Refuses a model of `n` elements above the element bound.
@@ -169,10 +172,8 @@ impl Limits {
         if n <= l.max_elements as f64 {
             return Ok(());
         }
-        Err(Error::Resource(format!(
-            "{n:.0} elements in all, over the limit of {} (raise it with --max-elements or FLEXROM_MAX_ELEMENTS)",
-            l.max_elements
-        )))
+        let over = format!("{n:.0} elements in all, over the limit of {} (raise it with ", l.max_elements);
+        Err(Error::Resource(raise_with(over, "max_elements", "FLEXROM_MAX_ELEMENTS").then(")")))
     }
 
     /// Refuses a run of `steps` (a float, so 1e300 / 1e-300 cannot overflow) above the step bound.
@@ -181,18 +182,71 @@ impl Limits {
         if steps.is_finite() && steps <= l.max_steps as f64 {
             return Ok(());
         }
-        Err(Error::Resource(format!(
-        "t_end = {} s at dt = {} s is {steps:.3e} steps, over the limit of {} steps; raise it with --max-steps or FLEXROM_MAX_STEPS, or use a larger dt",
-        show_number(t_end),
-        show_number(dt),
-        l.max_steps
-    )))
+        let over = format!(
+            "t_end = {} s at dt = {} s is {steps:.3e} steps, over the limit of {} steps; raise it with ",
+            show_number(t_end),
+            show_number(dt),
+            l.max_steps
+        );
+        Err(Error::Resource(raise_with(over, "max_steps", "FLEXROM_MAX_STEPS").then(", or use a larger dt")))
     }
+}
+
+/// `over`, then the option `key` or the environment variable `env` that raises the bound
+/// (`--max-memory or FLEXROM_MAX_MEMORY` on the command line; a front end without the
+/// option names the variable alone).
+fn raise_with(over: String, key: &'static str, env: &str) -> Text {
+    Text::new(over).clause("", key, None, " or ").then(env)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::error::{cli_flag, Spelling};
+
+    /// A front end without the bounds' options (Python reads the environment variables).
+    struct NoBoundOptions;
+
+    impl Spelling for NoBoundOptions {
+        fn option(&self, _: &str, _: Option<&str>) -> Option<String> {
+            None
+        }
+    }
+
+    /// Each bound names the option that raises it by its key; the command line's text is
+    /// byte for byte the one it showed when these messages wrote its flags (the literals
+    /// below are those messages' earlier format strings filled in; docs/guarantees-robust.md
+    /// quotes the memory one), and a front end without the options names the variable alone.
+    #[test]
+    fn a_bound_names_the_option_and_the_variable_that_raise_it() {
+        let l = Limits {
+            max_memory: 1024,
+            memory_source: "FLEXROM_MAX_MEMORY".into(),
+            max_steps: 10,
+            max_elements: 5,
+            allow_blowup: false,
+        };
+        let e = l.check_memory("a full run", 2048.0).unwrap_err();
+        let head = "a full run would need about 2.0 KiB of memory, over the limit of 1.0 KiB (FLEXROM_MAX_MEMORY); raise it with";
+        let tail = "FLEXROM_MAX_MEMORY, or use fewer steps, elements or load scales";
+        assert_eq!(e.render(&cli_flag), format!("{head} --max-memory or {tail}"));
+        assert_eq!(e.to_string(), format!("{head} max_memory or {tail}"));
+        assert_eq!(e.render(&NoBoundOptions), format!("{head} {tail}"));
+        let e = l.check_steps(100.0, 0.01, 1.0).unwrap_err();
+        assert_eq!(
+            e.render(&cli_flag),
+            "t_end = 1 s at dt = 0.01 s is 1.000e2 steps, over the limit of 10 steps; raise it with --max-steps or FLEXROM_MAX_STEPS, or use a larger dt"
+        );
+        let e = l.check_elements(6.0).unwrap_err();
+        assert_eq!(
+            e.render(&cli_flag),
+            "6 elements in all, over the limit of 5 (raise it with --max-elements or FLEXROM_MAX_ELEMENTS)"
+        );
+        assert_eq!(
+            e.render(&NoBoundOptions),
+            "6 elements in all, over the limit of 5 (raise it with FLEXROM_MAX_ELEMENTS)"
+        );
+    }
 
     #[test]
     fn sizes_parse_with_binary_units_and_refuse_nonsense() {

@@ -3,7 +3,7 @@
 
 use crate::analysis::energy::{energies, Energies, States};
 use crate::analysis::statics::{StaticOptions, StaticSolution};
-use crate::error::{show_number, Error, Result};
+use crate::error::{show_number, Error, Result, Text};
 use crate::linalg::kkt::LinearSolverKind;
 use crate::model::Model;
 use crate::physics::joints::RowKind;
@@ -240,7 +240,7 @@ impl BlowUpWatch {
     fn check<M: DynamicModel>(&mut self, model: &M, st: &State, stats: &mut Stats, strain_now: bool) -> Result<()> {
         if stats.step_cuts > self.max_cuts && !self.warned_cuts {
             let problem = format!(
-                "{} step halvings so far, over the budget of {} per run (`[time] max_total_step_cuts` in the model file raises it; --allow-blowup only warns)",
+                "{} step halvings so far, over the budget of {} per run (`[time] max_total_step_cuts` in the model file raises it",
                 stats.step_cuts, self.max_cuts
             );
             self.report(st.t, problem, true)?;
@@ -253,7 +253,7 @@ impl BlowUpWatch {
                 }
                 if !(eps <= self.max_strain) && !self.warned_strain {
                     let problem = format!(
-                        "mean axial strain |ε̄| = {eps:.3e} in element {e}, over the plausible bound {} (`[time] max_strain` in the model file raises it; --allow-blowup only warns)",
+                        "mean axial strain |ε̄| = {eps:.3e} in element {e}, over the plausible bound {} (`[time] max_strain` in the model file raises it",
                         self.max_strain
                     );
                     self.report(st.t, problem, false)?;
@@ -263,11 +263,14 @@ impl BlowUpWatch {
         Ok(())
     }
 
+    /// `problem` (what and the key that relaxes it, up to its closing parenthesis) as an
+    /// error that names the option warning instead, or, where that option is on, as a warning.
     fn report(&mut self, t: f64, problem: String, cuts: bool) -> Result<()> {
         if !self.warn_only {
+            let problem = Text::new(problem).clause("; ", "allow_blowup", None, " only warns").then(")");
             return Err(Error::BlowUp { t, problem });
         }
-        log::warn!("warning: blow-up at t = {t:.6} s: {problem}");
+        log::warn!("warning: blow-up at t = {t:.6} s: {problem})");
         if cuts {
             self.warned_cuts = true
         } else {

@@ -132,7 +132,7 @@ fn count_above_the_unconstrained_coordinates_is_refused() {
     // the library names the option by its key; the command line writes it as its flag
     let e = compute(&sys, &Parameters::default(), &q, 0.0, 9, Default::default()).unwrap_err();
     assert!(e.to_string().starts_with("count = 9: "), "{e}");
-    let e = e.render(&|k, v| format!("--{k} {}", v.unwrap_or_default()));
+    let e = e.render(&|k: &str, v: Option<&str>| format!("--{k} {}", v.unwrap_or_default()));
     assert!(e.contains("--count 9") && e.contains("8 unconstrained coordinates"), "{e}");
     let all = compute(&sys, &Parameters::default(), &q, 0.0, 8, Default::default()).unwrap();
     assert_eq!(all.len(), 8);

@@ -9,6 +9,7 @@
 //!
 //! Ctrl-C is `KeyboardInterrupt`, as everywhere in Python.
 
+use flexrom::error::Spelling;
 use flexrom::Error;
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyUserWarning};
@@ -30,15 +31,25 @@ create_exception!(
     "A run outside the training range, an estimate over the tolerance, a value that looks like a factor."
 );
 
+/// The command line's options that no Python call takes: the bounds come from the
+/// `FLEXROM_MAX_*` environment variables (which the messages name beside them), and a
+/// blow-up always fails.
+const NOT_KEYWORDS: [&str; 4] = ["max_memory", "max_steps", "max_elements", "allow_blowup"];
+
 /// How a Python call writes an option the library names by its key ([`Error::render`]): as
-/// its keyword argument, `load_scale=`, with the value after the `=`.
-fn keyword(key: &str, value: Option<&str>) -> String {
-    format!("{key}={}", value.unwrap_or(""))
+/// its keyword argument, `load_scale=`, with the value after the `=`; a clause naming an
+/// option Python does not have is left out.
+struct Keywords;
+
+impl Spelling for Keywords {
+    fn option(&self, key: &str, value: Option<&str>) -> Option<String> {
+        (!NOT_KEYWORDS.contains(&key)).then(|| format!("{key}={}", value.unwrap_or("")))
+    }
 }
 
 /// The exception of a library error.
 pub fn to_py(e: Error) -> PyErr {
-    let msg = e.render(&keyword);
+    let msg = e.render(&Keywords);
     match root(&e) {
         Error::Interrupted => pyo3::exceptions::PyKeyboardInterrupt::new_err(msg),
         Error::NewtonFailed { .. } | Error::LinearSolve { .. } | Error::BlowUp { .. } | Error::Numerical { .. } => {

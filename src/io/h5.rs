@@ -189,9 +189,15 @@ unsafe fn scalar_attr(
 pub fn read_attr_str(loc: &hdf5::Location, name: &str) -> hdf5::Result<String> {
     let attr = loc.attr(name)?;
     if let Some(heaps) = heaps_checked(loc)? {
-        check_heap_references(&attr, &format!("attribute `{name}`"), &heaps).map_err(hdf5::Error::from)?;
+        check_heap_references(&attr, &format!("attribute `{name}`"), &heaps).map_err(as_hdf5)?;
     }
     Ok(attr.read_scalar::<VarLenUnicode>()?.as_str().to_string())
+}
+
+/// A check's finding as the hdf5 crate's error of the read it stops: its problem alone, as
+/// the caller names the file.
+fn as_hdf5(e: Error) -> hdf5::Error {
+    hdf5::Error::from(e.problem())
 }
 
 /// Reads the one-dimensional dataset of variable-length strings `ds` (a sweep's
@@ -199,7 +205,7 @@ pub fn read_attr_str(loc: &hdf5::Location, name: &str) -> hdf5::Result<String> {
 /// attribute's: libhdf5 would follow a damaged one as it is.
 pub fn read_strings(ds: &hdf5::Dataset) -> hdf5::Result<Vec<String>> {
     if let Some(heaps) = heaps_checked(ds)? {
-        check_heap_references(ds, &format!("dataset `{}`", ds.name()), &heaps).map_err(hdf5::Error::from)?;
+        check_heap_references(ds, &format!("dataset `{}`", ds.name()), &heaps).map_err(as_hdf5)?;
     }
     Ok(ds.read_1d::<VarLenUnicode>()?.iter().map(|m| m.as_str().to_string()).collect())
 }
@@ -271,12 +277,10 @@ extern "C" fn keep_raw_vlen(
 /// object overran the buffer sized by it. The stored bytes are read through a conversion
 /// that keeps them as they are (`keep_raw_vlen`), with no heap dereference. An attribute
 /// that is not a variable-length string is left to the typed read that follows.
-/// `Err(problem)`.
-pub fn check_heap_references(
-    attr: &hdf5::Container,
-    what: &str,
-    heaps: &HeapObjects,
-) -> std::result::Result<(), String> {
+/// An [`Error::Hdf5`] naming the file.
+pub fn check_heap_references(attr: &hdf5::Container, what: &str, heaps: &HeapObjects) -> Result<()> {
+    let file = attr.filename();
+    let bad = |problem: String| Error::hdf5(&file, problem);
     use hdf5_sys::h5a::{H5Aget_type, H5Aread};
     use hdf5_sys::h5d::{H5Dget_type, H5Dread};
     use hdf5_sys::h5i::{H5I_type_t, H5Iget_type};
@@ -289,14 +293,14 @@ pub fn check_heap_references(
     // SAFETY: `attr` holds a live id
     let is_attr = unsafe { H5Iget_type(attr.id()) } == H5I_type_t::H5I_ATTR;
     let n = attr.size();
-    let raw = hdf5::sync::sync(|| -> std::result::Result<Option<Vec<u8>>, String> {
+    let raw = hdf5::sync::sync(|| -> Result<Option<Vec<u8>>> {
         // SAFETY: plain calls under the library lock; every type created here is closed
         // here; `H5Aread` writes `n` values of the 16-byte opaque type into a buffer of
         // that size (the conversion keeps the size)
         unsafe {
             let ft = if is_attr { H5Aget_type(attr.id()) } else { H5Dget_type(attr.id()) };
             if ft < 0 {
-                return Err(format!("{what}: its type cannot be read"));
+                return Err(bad(format!("{what}: its type cannot be read")));
             }
             let vlen_str = H5Tis_variable_str(ft) > 0;
             H5Tclose(ft);
@@ -305,11 +309,11 @@ pub fn check_heap_references(
             }
             let t = H5Tcreate(H5T_class_t::H5T_OPAQUE, RAW_VLEN_SIZE);
             if t < 0 {
-                return Err("cannot create a memory type".into());
+                return Err(bad("cannot create a memory type".into()));
             }
             let r = (|| {
                 if H5Tset_tag(t, RAW_VLEN_TAG.as_ptr()) < 0 {
-                    return Err("cannot tag a memory type".to_string());
+                    return Err(bad("cannot tag a memory type".to_string()));
                 }
                 let registered = *REGISTERED.get_or_init(|| {
                     let src = H5Tcopy(*hdf5::globals::H5T_C_S1);
@@ -328,7 +332,7 @@ pub fn check_heap_references(
                     ok
                 });
                 if !registered {
-                    return Err("cannot register the raw reading of texts".to_string());
+                    return Err(bad("cannot register the raw reading of texts".to_string()));
                 }
                 let mut buf = vec![0u8; n * RAW_VLEN_SIZE];
                 let read = if is_attr {
@@ -337,7 +341,7 @@ pub fn check_heap_references(
                     H5Dread(attr.id(), t, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.as_mut_ptr().cast())
                 };
                 if read < 0 {
-                    return Err(format!("{what}: its stored text references cannot be read"));
+                    return Err(bad(format!("{what}: its stored text references cannot be read")));
                 }
                 Ok(Some(buf))
             })();
@@ -358,14 +362,14 @@ pub fn check_heap_references(
         match heaps.get(&(collection, index)) {
             Some(&size) if size == len => {}
             Some(&size) => {
-                return Err(format!(
+                return Err(bad(format!(
                     "{what} claims a text of {len} bytes where its heap object holds {size}: a damaged file"
-                ))
+                )))
             }
             None => {
-                return Err(format!(
+                return Err(bad(format!(
                     "{what} refers to object {index} of a global heap at address {collection}, which the file does not hold: a damaged file"
-                ))
+                )))
             }
         }
     }
@@ -387,7 +391,7 @@ pub fn heaps_checked(loc: &hdf5::Location) -> hdf5::Result<Option<std::sync::Arc
     if let Some((_, h)) = CHECKED.lock().unwrap_or_else(|e| e.into_inner()).iter().find(|(k, _)| *k == key) {
         return Ok(Some(h.clone()));
     }
-    let heaps = std::sync::Arc::new(check_global_heaps(Path::new(&name)).map_err(hdf5::Error::from)?);
+    let heaps = std::sync::Arc::new(check_global_heaps(Path::new(&name)).map_err(as_hdf5)?);
     CHECKED.lock().unwrap_or_else(|e| e.into_inner()).push((key, heaps.clone()));
     Ok(Some(heaps))
 }
@@ -413,7 +417,7 @@ pub fn dataset_of_shape(loc: &hdf5::Group, name: &str, want: &[usize]) -> Result
 /// The length of the one-dimensional dataset `name` of `loc`, refused before anything is
 /// read when what reading it brings along, `bytes_per_entry` for each entry, would exceed
 /// the memory bound: the file alone sizes it, so a flipped bit must not size an allocation.
-/// An [`Error::Hdf5`] or [`Error::Resource`] whose [`Error::problem`] is for a message after
+/// An [`Error::Hdf5`] or [`Error::Resource`] whose [`Error::problem_text`] is for a message after
 /// the file and the dataset.
 pub fn bounded_len(
     loc: &hdf5::Group,
@@ -468,9 +472,10 @@ fn show_shape(s: &[usize]) -> String {
 /// format, "Global Heap"); its size and each object's are 8-byte lengths, as in every file
 /// flexrom and h5py write. A collection's address is its byte offset less the base address,
 /// taken as where the superblock's signature is (0, or 512, 1024, … after a user block).
-/// The objects found, for [`check_heap_references`]; `Err(problem)`.
-pub fn check_global_heaps(path: &Path) -> std::result::Result<HeapObjects, String> {
-    let b = std::fs::read(path).map_err(|e| format!("cannot be read: {e}"))?;
+/// The objects found, for [`check_heap_references`]; an [`Error::Hdf5`] naming the file.
+pub fn check_global_heaps(path: &Path) -> Result<HeapObjects> {
+    let bad = |problem: String| Error::hdf5(path, problem);
+    let b = std::fs::read(path).map_err(|e| bad(format!("cannot be read: {e}")))?;
     let base = std::iter::once(0)
         .chain((9..63).map(|k| 1usize << k))
         .take_while(|&o| o + 8 <= b.len())
@@ -483,14 +488,14 @@ pub fn check_global_heaps(path: &Path) -> std::result::Result<HeapObjects, Strin
         let at = from + k;
         from = at + 8;
         if at + 16 > b.len() {
-            return Err(format!("global heap at byte {at} is cut off by the end of the file: a damaged file"));
+            return Err(bad(format!("global heap at byte {at} is cut off by the end of the file: a damaged file")));
         }
         let size = u64_at(at + 8);
         let end = (at as u64).checked_add(size).filter(|&e| e <= b.len() as u64 && size >= 16);
         let Some(end) = end.map(|e| e as usize) else {
-            return Err(format!(
+            return Err(bad(format!(
                 "global heap at byte {at} claims {size} bytes, past the end of the file: a damaged file"
-            ));
+            )));
         };
         // libhdf5's walk (`H5HG__cache_heap_deserialize`), step for step: a tail too short
         // for an object header is free space; index 0 is free space of its stated size,
@@ -500,13 +505,13 @@ pub fn check_global_heaps(path: &Path) -> std::result::Result<HeapObjects, Strin
             let (index, object) = (u16::from_le_bytes([b[p], b[p + 1]]), u64_at(p + 8));
             let need = if index == 0 { object } else { object.saturating_add(16 + 7) / 8 * 8 };
             if need > (end - p) as u64 {
-                return Err(format!(
+                return Err(bad(format!(
                     "global heap at byte {at}: object {index} claims {object} bytes, past the end of its collection: a damaged file"
-                ));
+                )));
             }
             if need == 0 {
                 // libhdf5 would step by 0 bytes: it never returned
-                return Err(format!("global heap at byte {at}: its free space claims 0 bytes: a damaged file"));
+                return Err(bad(format!("global heap at byte {at}: its free space claims 0 bytes: a damaged file")));
             }
             if index != 0 && at >= base {
                 objects.insert(((at - base) as u64, u32::from(index)), object);

@@ -33,7 +33,7 @@ pub fn training_points(f: &hdf5::File, path: &Path, space: &ParameterSpace) -> R
     let names: Vec<&str> = space.names().collect();
     let Some(first) = names.first() else { return Ok(Vec::new()) };
     let g = f.group("parameters").map_err(|e| Error::input(path, "parameters", format!("cannot be read: {e}")))?;
-    let refused = |name: &str, e: Error| Error::input(path, format!("parameters/{name}"), e.problem());
+    let refused = |name: &str, e: Error| Error::input(path, format!("parameters/{name}"), e.problem_text());
     // the file's header sizes the runs: bounded before anything is read (a point holds a
     // value per name), then every name's dataset must have that length
     let limits = crate::limits::Limits::from_env_or_defaults();

@@ -60,7 +60,7 @@ impl ResultReader {
             |name: &str| read_attr_str(&f, name).map_err(|e| Error::input(path, name, format!("cannot be read: {e}")));
         let (model_text, model_path) = (text("model")?, text("model_path")?);
         // the file alone sizes /t: bounded before it is read (8 bytes an instant)
-        super::h5::bounded_len(&f, "t", 8.0, limits).map_err(|e| Error::input(path, "t", e.problem()))?;
+        super::h5::bounded_len(&f, "t", 8.0, limits).map_err(|e| Error::input(path, "t", e.problem_text()))?;
         let t: Vec<f64> = f
             .dataset("t")
             .and_then(|d| d.read_raw::<f64>())

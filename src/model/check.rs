@@ -134,7 +134,7 @@ impl Model {
             return Err(self.err(p("elements"), format!("must be a positive integer, got {}", b.elements)));
         }
         let total: f64 = f.bodies[..=i].iter().map(|b| b.elements.max(0) as f64).sum();
-        self.limits.check_elements(total).map_err(|e| self.err(p("elements"), e.problem()))?;
+        self.limits.check_elements(total).map_err(|e| self.err(p("elements"), e.problem_text()))?;
         // a property given as `{ value, parameter }` names its `value`
         let property = |k: &str, spec: &PropertySpec| match spec {
             PropertySpec::Value(v) => (k.to_string(), *v),

@@ -107,7 +107,7 @@ impl Model {
         Ok(model)
     }
 
-    fn err(&self, field: impl Into<String>, problem: impl Into<String>) -> Error {
+    fn err(&self, field: impl Into<String>, problem: impl Into<crate::error::Text>) -> Error {
         Error::input(&self.path, toml_errors::field_with_line(&self.text, &field.into()), problem)
     }
 

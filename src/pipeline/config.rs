@@ -185,7 +185,7 @@ impl Pipeline {
             }
             (Some(s), None) => {
                 if let Err(e) = check_scales(s) {
-                    return bad("train.load_scales", e);
+                    return bad("train.load_scales", e.problem());
                 }
                 if red.modes.is_none() {
                     return bad("reduction.modes", "is missing: with train.load_scales the mode count must be given (or train greedily, which chooses it)".into());

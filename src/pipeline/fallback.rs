@@ -104,7 +104,7 @@ pub fn settle(
         }
         (Err(e), Err(r)) => Err(Error::Hinted {
             source: Box::new(e),
-            hint: format!("the full model ran in place of the reduced one, which had failed: {r}"),
+            hint: format!("the full model ran in place of the reduced one, which had failed: {r}").into(),
         }),
     }
 }

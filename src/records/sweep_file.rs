@@ -57,7 +57,7 @@
 
 use super::sweep_outcome::{ScaleResult, Sweep, SweepPoint, STATUS_OK, STATUS_PENDING};
 use super::validation::{displacement_note, ProbeQuantityError, Validation};
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, Text};
 use crate::io::attrs::{check_layout, write_atomically_as, Kind};
 use crate::io::basis_file::StoredBasis;
 use crate::io::h5::{attr_f64, attr_str, attr_u64, bounded_len, dataset_of_shape, read_attr_str, read_strings};
@@ -452,7 +452,7 @@ pub fn read_sweep(
     let sections: usize = model.section_names().iter().map(Vec::len).sum();
     let per_run = 8.0 * (nt as f64 * (r + 4 * model.probe_names().len() + sections) as f64 + 32.0);
     let n = bounded_len(&f, "load_scales", per_run, &model.limits)
-        .map_err(|p| cannot_resume(path, "load_scales", p.problem()))?;
+        .map_err(|p| cannot_resume(path, "load_scales", p.problem_text()))?;
     let file = Resumed { f, path, n, nt };
     let (probe_names, section_names) = (model.probe_names(), model.section_names());
     let keys = quantity_keys(&probe_names, &section_names);
@@ -467,8 +467,9 @@ pub fn read_sweep(
 }
 
 /// The error for a sweep file `--resume` cannot take: the file, the field and the problem.
-fn cannot_resume(path: &Path, field: &str, problem: String) -> Error {
-    Error::input(path, field, format!("{problem}; cannot resume from it (remove it, or run without --resume)"))
+fn cannot_resume(path: &Path, field: &str, problem: impl Into<Text>) -> Error {
+    let problem = problem.into().then("; cannot resume from it (remove it, or run without ");
+    Error::input(path, field, problem.option("resume", None).then(")"))
 }
 
 /// Opens an earlier sweep file for `--resume` and checks that it is one of this sweep: its

@@ -11,7 +11,7 @@
 
 use super::sweep_file::points_of;
 use super::sweep_outcome::{STATUS_OK, STATUS_PENDING};
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, Text};
 use crate::io::attrs::{check_layout, Kind, KIND_ATTR};
 use crate::io::h5::{bounded_len, dataset_of_shape, read_attr_str, read_strings};
 use crate::model::Model;
@@ -92,12 +92,12 @@ pub fn open_sweep_run(path: &Path, pick: SweepPick, limits: &crate::limits::Limi
     }
     // the file alone sizes /t: bounded before it is read (8 bytes an instant), and a run's
     // coordinates and columns bound how many runs the file may hold
-    bounded_len(&f, "t", 8.0, limits).map_err(|p| bad("t", p.problem()))?;
+    bounded_len(&f, "t", 8.0, limits).map_err(|p| Error::input(path, "t", p.problem_text()))?;
     let t: Vec<f64> =
         f.dataset("t").and_then(|d| d.read_raw()).map_err(|e| bad("t", format!("cannot be read: {e}")))?;
     let (nt, r) = (t.len(), basis.n_reduced());
     let n = bounded_len(&f, "load_scales", 8.0 * (nt * r + 32) as f64, limits)
-        .map_err(|p| bad("load_scales", p.problem()))?;
+        .map_err(|p| Error::input(path, "load_scales", p.problem_text()))?;
     let shaped = |name: &str, want: &[usize]| dataset_of_shape(&f, name, want).map_err(|p| bad(name, p.problem()));
     let scales = shaped("load_scales", &[n])?.read_raw::<f64>().map_err(|e| bad("load_scales", e.to_string()))?;
     let points = points_of(&f, &scales).map_err(|(field, p)| bad(field, p))?;
@@ -205,11 +205,12 @@ fn pick_index(path: &Path, points: &[Parameters], pick: SweepPick) -> Result<usi
                 many => Err(Error::input(
                     path,
                     "--load-scale",
-                    format!(
-                        "{x} is the load scale of {} points of the sweep ({}): pick one with --point K",
+                    Text::new(format!(
+                        "{x} is the load scale of {} points of the sweep ({}): pick one with ",
                         many.len(),
                         many.iter().map(|&k| format!("{k}: {}", points[k])).collect::<Vec<_>>().join("; ")
-                    ),
+                    ))
+                    .option("point", Some("K")),
                 )),
             }
         }
@@ -252,7 +253,8 @@ mod tests {
     #[test]
     fn a_load_shared_by_points_asks_for_the_point() {
         let points = vec![Parameters::load_scale(1.0).with("e", 1.0), Parameters::load_scale(1.0).with("e", 2.0)];
-        let e = pick_index(Path::new("s.h5"), &points, SweepPick::LoadScale(1.0)).unwrap_err().to_string();
-        assert!(e.contains("--point K") && e.contains("0: load scale 1, e = 1"), "{e}");
+        let e = pick_index(Path::new("s.h5"), &points, SweepPick::LoadScale(1.0)).unwrap_err();
+        let e = e.render(&crate::error::cli_flag);
+        assert!(e.contains("pick one with --point K") && e.contains("0: load scale 1, e = 1"), "{e}");
     }
 }

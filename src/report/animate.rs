@@ -14,7 +14,7 @@ use crate::error::{Error, Result};
 use crate::physics::centre_line::CentreLines;
 use crate::report::drawing::{draw_frame, motion_chart, Bounds, Frame, Style, BOTTOM, LEFT, MARGIN, TITLE};
 use crate::report::motion::Motion;
-use crate::report::plot::{register_font, COLORS};
+use crate::report::plot::{not_drawn, register_font, COLORS};
 use crate::workflows::sweep::SweepPick;
 use plotters::prelude::*;
 use std::path::Path;
@@ -111,7 +111,7 @@ pub fn animate_picked(
     limits: &crate::limits::Limits,
 ) -> Result<Animation> {
     if !(opts.fps.is_finite() && opts.fps > 0.0 && opts.fps <= 100.0) {
-        return Err(Error::Usage(format!("--fps {} is not in (0, 100] frames per second", opts.fps)));
+        return Err(Error::option("fps", None, format!("{} is not in (0, 100] frames per second", opts.fps)));
     }
     let (main, main_sweep) = Motion::open(result, pick, limits)?;
     let other = compare.map(|p| Motion::open(p, pick, limits)).transpose()?;
@@ -146,8 +146,7 @@ pub fn animate_picked(
     };
     let delay_ms = (1000.0 / opts.fps).round().max(10.0) as u32;
     crate::io::atomic::write_file_atomically(out, |tmp| {
-        draw(tmp, (width, height), delay_ms, &title, &bounds, &frames)
-            .map_err(|e| Error::io(out, std::io::Error::other(e)))?;
+        draw((tmp, out), (width, height), delay_ms, &title, &bounds, &frames)?;
         mark_gif(tmp)
     })?;
     let bytes = std::fs::metadata(out).map_err(|e| Error::io(out, e))?.len();
@@ -163,15 +162,16 @@ fn fitted_height(width: u32, b: &Bounds) -> u32 {
     h + TITLE + BOTTOM + 2 * MARGIN
 }
 
+/// Draws `frames` as a GIF at `path`; a failure is one to write `out`, the file the user named.
 fn draw(
-    path: &Path,
+    (path, out): (&Path, &Path),
     size: (u32, u32),
     delay_ms: u32,
     title: &str,
     bounds: &Bounds,
     frames: &[(f64, Frame, Option<Frame>)],
-) -> std::result::Result<(), String> {
-    let e = |x: &dyn std::fmt::Display| x.to_string();
+) -> Result<()> {
+    let e = |x: &dyn std::fmt::Display| not_drawn(out, x);
     register_font();
     let root = BitMapBackend::gif(path, size, delay_ms).map_err(|x| e(&x))?.into_drawing_area();
     let plot_w = size.0.saturating_sub(LEFT + 2 * MARGIN).max(1) as f64;
@@ -180,11 +180,11 @@ fn draw(
     for (t, main, second) in frames {
         root.fill(&WHITE).map_err(|x| e(&x))?;
         let area = root.titled(&format!("{title}    t = {t:.4} s"), ("sans-serif", 16)).map_err(|x| e(&x))?;
-        let mut chart = motion_chart(&area, &b)?;
+        let mut chart = motion_chart(&area, &b, out)?;
         if let Some(s) = second {
-            draw_frame(&mut chart, s, &b, Style { colour: COLORS[1], dashed: true, names: false })?;
+            draw_frame(&mut chart, s, &b, Style { colour: COLORS[1], dashed: true, names: false }, out)?;
         }
-        draw_frame(&mut chart, main, &b, Style { colour: COLORS[0], dashed: false, names: false })?;
+        draw_frame(&mut chart, main, &b, Style { colour: COLORS[0], dashed: false, names: false }, out)?;
         root.present().map_err(|x| e(&x))?;
     }
     Ok(())

@@ -9,7 +9,7 @@ use crate::model::Model;
 use crate::physics::centre_line::CentreLines;
 use crate::physics::joints::Joint;
 use crate::physics::loads::{Load, SpringEnd};
-use crate::report::plot::{linear_labels, COLORS};
+use crate::report::plot::{linear_labels, not_drawn, COLORS};
 use plotters::coord::types::RangedCoordf64;
 use plotters::element::{Drawable, PointCollection};
 use plotters::prelude::*;
@@ -180,12 +180,13 @@ pub const BOTTOM: u32 = 36;
 pub const MARGIN: u32 = 10;
 
 /// The chart a drawing of the motion is made on (an animation's frame, the report's model):
-/// `b` on `area`, x and y in metres, a faint grid.
+/// `b` on `area`, x and y in metres, a faint grid; a failure is one to write `file`.
 pub fn motion_chart<'a, DB: DrawingBackend + 'a>(
     area: &'a DrawingArea<DB, plotters::coord::Shift>,
     b: &Bounds,
-) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, String> {
-    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
+    file: &std::path::Path,
+) -> crate::error::Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>> {
+    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| not_drawn(file, x);
     let (x_fmt, y_fmt) = (linear_labels(b.x.0, b.x.1), linear_labels(b.y.0, b.y.1));
     let mut chart = ChartBuilder::on(area)
         .margin(MARGIN)
@@ -391,17 +392,18 @@ fn zigzag(a: Point, b: Point) -> Vec<Point> {
 }
 
 /// Draws `f` on `chart` (clipped rails first, then springs, centre lines, marks, probes,
-/// names).
+/// names); a failure is one to write `file`.
 pub fn draw_frame<DB: DrawingBackend>(
     chart: &mut Chart<'_, DB>,
     f: &Frame,
     bounds: &Bounds,
     style: Style,
-) -> Result<(), String>
+    file: &std::path::Path,
+) -> crate::error::Result<()>
 where
     DB::ErrorType: 'static,
 {
-    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
+    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| not_drawn(file, x);
     let colour = style.colour;
     for r in &f.rails {
         if let Some((p, q)) = bounds.clip(r.point, r.direction) {

@@ -14,7 +14,8 @@
 //! (largest), in even lightness steps and readable with colour-blindness. A run without a
 //! value there (NaN, ∞, or ≤ 0 on a log scale) is an open grey circle.
 
-use crate::report::plot::{linear_labels, log_labels, register_font, write_png};
+use crate::error::{Error, Result};
+use crate::report::plot::{linear_labels, log_labels, not_drawn, register_font, write_png};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
@@ -153,33 +154,34 @@ impl Map {
     }
 
     /// Writes `<stem>.svg` and `<stem>.png`; returns their paths.
-    pub fn save(&self, stem: &Path) -> Result<Vec<PathBuf>, String> {
+    pub fn save(&self, stem: &Path) -> Result<Vec<PathBuf>> {
         if self.axes.len() < 2 {
-            return Err("a map needs two parameters or more".into());
+            return Err(Error::Usage("a map needs two parameters or more".into()));
         }
         let (svg, png) = (stem.with_extension("svg"), stem.with_extension("png"));
         let (w, h) = self.size();
         register_font();
         {
             let root = SVGBackend::new(&svg, (w, h)).into_drawing_area();
-            self.draw(&root).map_err(|e| format!("{}: {e}", svg.display()))?;
-            root.present().map_err(|e| format!("{}: {e}", svg.display()))?;
+            self.draw(&root, &svg)?;
+            root.present().map_err(|e| not_drawn(&svg, e))?;
         }
         let mut buf = vec![0u8; (w * h * 3) as usize];
         {
             let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
-            self.draw(&root).map_err(|e| format!("{}: {e}", png.display()))?;
-            root.present().map_err(|e| format!("{}: {e}", png.display()))?;
+            self.draw(&root, &png)?;
+            root.present().map_err(|e| not_drawn(&png, e))?;
         }
         write_png(&png, &buf, w, h)?;
         Ok(vec![svg, png])
     }
 
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String>
+    /// Draws the map on `root`; a failure is one to write `file`.
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, file: &Path) -> Result<()>
     where
         DB::ErrorType: 'static,
     {
-        let e = |x: &dyn std::fmt::Display| x.to_string();
+        let e = |x: &dyn std::fmt::Display| not_drawn(file, x);
         root.fill(&WHITE).map_err(|x| e(&x))?;
         let area = root.titled(&self.title, ("sans-serif", 22)).map_err(|x| e(&x))?;
         let (w, _) = self.size();
@@ -190,10 +192,10 @@ impl Map {
         let scale = self.value_range();
         for (r, &(i, j)) in pairs.iter().enumerate() {
             for (c, layer) in self.layers.iter().enumerate() {
-                self.draw_cell(&grid[r * cols + c], layer, (i, j), scale)?;
+                self.draw_cell(&grid[r * cols + c], layer, (i, j), scale, file)?;
             }
         }
-        self.draw_strip(&strip, scale)
+        self.draw_strip(&strip, scale, file)
     }
 
     /// The map of `layer` over the axes `i` (x) and `j` (y).
@@ -203,11 +205,12 @@ impl Map {
         layer: &Layer,
         (i, j): (usize, usize),
         scale: (f64, f64),
-    ) -> Result<(), String>
+        file: &Path,
+    ) -> Result<()>
     where
         DB::ErrorType: 'static,
     {
-        let e = |x: &dyn std::fmt::Display| x.to_string();
+        let e = |x: &dyn std::fmt::Display| not_drawn(file, x);
         let (ax, ay) = (&self.axes[i], &self.axes[j]);
         // a margin of 4 % of each axis (in its own scale) so that points at the box's edge show
         let pad = |a: &MapAxis| {
@@ -273,11 +276,16 @@ impl Map {
     }
 
     /// The strip right of the maps: the key of the markers, then the colour bar.
-    fn draw_strip<DB: DrawingBackend>(&self, strip: &DrawingArea<DB, Shift>, (lo, hi): (f64, f64)) -> Result<(), String>
+    fn draw_strip<DB: DrawingBackend>(
+        &self,
+        strip: &DrawingArea<DB, Shift>,
+        (lo, hi): (f64, f64),
+        file: &Path,
+    ) -> Result<()>
     where
         DB::ErrorType: 'static,
     {
-        let e = |x: &dyn std::fmt::Display| x.to_string();
+        let e = |x: &dyn std::fmt::Display| not_drawn(file, x);
         let font = ("sans-serif", 15).into_font();
         let (key, bar) = strip.split_vertically(110);
         let mid = viridis(0.5);

@@ -223,8 +223,14 @@ impl Stage<'_> {
 
     /// A figure that could not be written, named by the report's own path: the temporary
     /// folder is gone by the time the user reads it.
-    fn plot_err(&self, stem: &str, e: String) -> Error {
-        Error::io(self.p.report_dir.join(format!("{stem}.svg")), std::io::Error::other(e))
+    fn plot_err(&self, e: Error) -> Error {
+        match e {
+            Error::Io { file, source } => {
+                let name = Path::new(&file).file_name().unwrap_or_default();
+                Error::io(self.p.report_dir.join(name), source)
+            }
+            other => other,
+        }
     }
 
     /// Writes one figure of `panels` as `stem`.svg and .png, the training runs marked at `markers`.
@@ -234,7 +240,7 @@ impl Stage<'_> {
         Figure { title: title.into(), x_label: x_label.into(), panels, markers, marker_label: marker_label.into() }
             .save(&self.out.join(stem))
             .map(|_| ())
-            .map_err(|e| self.plot_err(stem, e))
+            .map_err(|e| self.plot_err(e))
     }
 }
 
@@ -320,13 +326,13 @@ fn validation_stage(st: &Stage, rom: &Rom, dense: bool) -> Result<(Vec<Validatio
             &format!("Energies, full and reduced, {}{}", if in_box { "" } else { "load scale " }, st.name(mu)),
         )?
         .save(&out.join(format!("energy_{i}")))
-        .map_err(|e| st.plot_err(&format!("energy_{i}"), e))?;
+        .map_err(|e| st.plot_err(e))?;
         // a model without probes has nothing to draw here
         if !full.probes.is_empty() {
             let title = format!("Probes, full and reduced, {}{}", if in_box { "" } else { "load scale " }, st.name(mu));
             probes_figure(&full, &reduced.result, title)
                 .save(&out.join(format!("probes_{i}")))
-                .map_err(|e| st.plot_err(&format!("probes_{i}"), e))?;
+                .map_err(|e| st.plot_err(e))?;
         }
         if worst.as_ref().is_none_or(|w| v.rel_error > w.0) {
             worst = Some((v.rel_error, st.name(mu), full, reduced.result));
@@ -401,7 +407,7 @@ fn parameter_figures(
             tolerance: rom.trust().and_then(|t| t.tolerance),
             probes: !p.model.probe_names().is_empty(),
         };
-        return crate::report::report_maps::write_maps(st.out, &runs, &cx).map_err(|(stem, e)| st.plot_err(stem, e));
+        return crate::report::report_maps::write_maps(st.out, &runs, &cx).map_err(|e| st.plot_err(e));
     };
     axis_figures(st, axis, stored, sw, validations)
 }

@@ -10,7 +10,7 @@ use crate::physics::centre_line::CentreLines;
 use crate::report::drawing::{
     draw_frame, motion_chart, Bounds, Frame, Mark, MarkElement, Style, BOTTOM, LEFT, MARGIN, TITLE,
 };
-use crate::report::plot::{register_font, write_png, COLORS};
+use crate::report::plot::{not_drawn, register_font, write_png, COLORS};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
@@ -37,20 +37,19 @@ pub fn save_model_figure(model: &Model, stem: &Path) -> Result<Vec<PathBuf>> {
     let file = model.path.file_name().map_or(model.path.display().to_string(), |n| n.to_string_lossy().into_owned());
     let title = format!("The model: {file}, initial configuration");
     let (svg, png) = (stem.with_extension("svg"), stem.with_extension("png"));
-    let failed = |path: &Path, e: String| crate::error::Error::io(path, std::io::Error::other(e));
     register_font();
     {
         let root = SVGBackend::new(&svg, (WIDTH, height)).into_drawing_area();
-        draw(&root, &frame, &bounds, &title).map_err(|e| failed(&svg, e))?;
-        root.present().map_err(|e| failed(&svg, e.to_string()))?;
+        draw(&root, &frame, &bounds, &title, &svg)?;
+        root.present().map_err(|e| not_drawn(&svg, e))?;
     }
     let mut buf = vec![0u8; (WIDTH * height * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buf, (WIDTH, height)).into_drawing_area();
-        draw(&root, &frame, &bounds, &title).map_err(|e| failed(&png, e))?;
-        root.present().map_err(|e| failed(&png, e.to_string()))?;
+        draw(&root, &frame, &bounds, &title, &png)?;
+        root.present().map_err(|e| not_drawn(&png, e))?;
     }
-    write_png(&png, &buf, WIDTH, height).map_err(|e| failed(&png, e))?;
+    write_png(&png, &buf, WIDTH, height)?;
     Ok(vec![svg, png])
 }
 
@@ -59,11 +58,12 @@ fn draw<DB: DrawingBackend>(
     frame: &Frame,
     bounds: &Bounds,
     title: &str,
-) -> std::result::Result<(), String>
+    file: &Path,
+) -> Result<()>
 where
     DB::ErrorType: 'static,
 {
-    let e = |x: &dyn std::fmt::Display| x.to_string();
+    let e = |x: &dyn std::fmt::Display| not_drawn(file, x);
     root.fill(&WHITE).map_err(|x| e(&x))?;
     let area = root.titled(title, ("sans-serif", 18)).map_err(|x| e(&x))?;
     let (w, h) = area.dim_in_pixel();
@@ -71,17 +71,17 @@ where
     let plot_w = (w.saturating_sub(LEGEND + LEFT + 2 * MARGIN)).max(1) as f64;
     let plot_h = h.saturating_sub(BOTTOM + 2 * MARGIN).max(1) as f64;
     let b = bounds.equal(plot_w, plot_h);
-    let mut chart = motion_chart(&plot, &b)?;
-    draw_frame(&mut chart, frame, &b, Style { colour: COLORS[0], dashed: false, names: true })?;
-    draw_legend(&legend, frame.kinds())
+    let mut chart = motion_chart(&plot, &b, file)?;
+    draw_frame(&mut chart, frame, &b, Style { colour: COLORS[0], dashed: false, names: true }, file)?;
+    draw_legend(&legend, frame.kinds(), file)
 }
 
 /// One line per kind of mark: the mark, and its name.
-fn draw_legend<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, kinds: Vec<Mark>) -> std::result::Result<(), String>
+fn draw_legend<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, kinds: Vec<Mark>, file: &Path) -> Result<()>
 where
     DB::ErrorType: 'static,
 {
-    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
+    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| not_drawn(file, x);
     let font = ("sans-serif", 13).into_font().color(&BLACK);
     let body = PathElement::new(vec![(8, 24), (32, 24)], COLORS[0].stroke_width(2));
     area.draw(&body).map_err(e)?;

@@ -3,7 +3,7 @@
 //! reconstructed), or one run of a reduced sweep file reconstructed on its basis
 //! ([`crate::records::sweep_run`]), with the model it ran and its time grid.
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, Text};
 use crate::io::result_read::ResultReader;
 use crate::model::Model;
 use crate::workflows::sweep::{is_sweep_file, open_sweep_run, SweepPick, SweepRun};
@@ -35,7 +35,11 @@ impl Motion {
                 return Err(Error::input(
                     path,
                     "(file)",
-                    "is a sweep file: pick the run to draw with --load-scale L (or --point K in a sweep over named parameters)",
+                    Text::new("is a sweep file: pick the run to draw with ")
+                        .option("load_scale", Some("L"))
+                        .then(" (or ")
+                        .option("point", Some("K"))
+                        .then(" in a sweep over named parameters)"),
                 ));
             };
             let run = open_sweep_run(path, pick, limits)?;

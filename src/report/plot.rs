@@ -3,6 +3,7 @@
 //! the legend in a strip to the right of the data (never over it), log axes labelled in
 //! powers of ten, and optional vertical markers (the training loads).
 
+use crate::error::{Error, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
@@ -172,32 +173,33 @@ impl Figure {
     }
 
     /// Writes `<stem>.svg` and `<stem>.png`; returns their paths.
-    pub fn save(&self, stem: &Path) -> Result<Vec<PathBuf>, String> {
+    pub fn save(&self, stem: &Path) -> Result<Vec<PathBuf>> {
         let svg = stem.with_extension("svg");
         let png = stem.with_extension("png");
         let height = 70 + PANEL_HEIGHT * self.panels.len().max(1) as u32;
         register_font();
         {
             let root = SVGBackend::new(&svg, (WIDTH, height)).into_drawing_area();
-            self.draw(&root).map_err(|e| format!("{}: {e}", svg.display()))?;
-            root.present().map_err(|e| format!("{}: {e}", svg.display()))?;
+            self.draw(&root, &svg)?;
+            root.present().map_err(|e| not_drawn(&svg, e))?;
         }
         let mut buf = vec![0u8; (WIDTH * height * 3) as usize];
         {
             let root = BitMapBackend::with_buffer(&mut buf, (WIDTH, height)).into_drawing_area();
-            self.draw(&root).map_err(|e| format!("{}: {e}", png.display()))?;
-            root.present().map_err(|e| format!("{}: {e}", png.display()))?;
+            self.draw(&root, &png)?;
+            root.present().map_err(|e| not_drawn(&png, e))?;
         }
         write_png(&png, &buf, WIDTH, height)?;
         Ok(vec![svg, png])
     }
 
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String>
+    /// Draws the figure on `root`; a failure is one to write `file`.
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, file: &Path) -> Result<()>
     where
         DB::ErrorType: 'static,
     {
-        let e = |x: &dyn std::fmt::Display| x.to_string();
-        let (x0, x1) = self.x_range().ok_or("nothing to plot")?;
+        let e = |x: &dyn std::fmt::Display| not_drawn(file, x);
+        let (x0, x1) = self.x_range().ok_or_else(|| not_drawn(file, "nothing to plot"))?;
         let pad = 0.02 * (x1 - x0);
         let (x0, x1) = (x0 - pad, x1 + pad);
         let x_fmt = linear_labels(x0, x1);
@@ -271,16 +273,16 @@ impl Figure {
                 finish!(chart, y0, y1, y_fmt);
             }
         }
-        self.draw_legend(&legend)
+        self.draw_legend(&legend, file)
     }
 
     /// The legend, in its own strip right of the panels: one entry per series name (the
     /// colour of its first use), then the markers.
-    fn draw_legend<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<(), String>
+    fn draw_legend<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>, file: &Path) -> Result<()>
     where
         DB::ErrorType: 'static,
     {
-        let e = |x: &dyn std::fmt::Display| x.to_string();
+        let e = |x: &dyn std::fmt::Display| not_drawn(file, x);
         let mut entries: Vec<(String, Style, RGBColor)> = Vec::new();
         for p in &self.panels {
             for (i, s) in p.series.iter().enumerate() {
@@ -345,14 +347,20 @@ pub fn wrap(text: &str, width: u32, measure: &dyn Fn(&str) -> u32) -> Vec<String
 }
 
 /// Writes 8-bit RGB pixels `rgb` (row by row) as a PNG file.
-pub fn write_png(path: &Path, rgb: &[u8], width: u32, height: u32) -> Result<(), String> {
-    let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
+pub fn write_png(path: &Path, rgb: &[u8], width: u32, height: u32) -> Result<()> {
+    let file = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
     let mut enc = png::Encoder::new(std::io::BufWriter::new(file), width, height);
     enc.set_color(png::ColorType::Rgb);
     enc.set_depth(png::BitDepth::Eight);
-    let mut w = enc.write_header().map_err(|e| format!("{}: {e}", path.display()))?;
-    w.write_image_data(rgb).map_err(|e| format!("{}: {e}", path.display()))?;
-    w.finish().map_err(|e| format!("{}: {e}", path.display()))
+    let mut w = enc.write_header().map_err(|e| not_drawn(path, e))?;
+    w.write_image_data(rgb).map_err(|e| not_drawn(path, e))?;
+    w.finish().map_err(|e| not_drawn(path, e))
+}
+
+/// A figure that could not be drawn or encoded as the failure to write its `file` (plotters
+/// and the PNG encoder report their backends' and fonts' errors as text).
+pub fn not_drawn(file: &Path, e: impl std::fmt::Display) -> Error {
+    Error::io(file, std::io::Error::other(e.to_string()))
 }
 
 #[cfg(test)]

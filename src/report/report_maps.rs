@@ -10,6 +10,7 @@
 //!
 //! The training runs (the full runs whose snapshots the basis holds) are crosses on each.
 
+use crate::error::Result;
 use crate::report::map::{Layer, Map, MapAxis};
 use crate::solver::parameter_space::{ParameterSpace, Spacing};
 use crate::solver::parameters::Parameters;
@@ -34,12 +35,8 @@ pub struct MapContext<'a> {
 }
 
 /// Writes the maps into `out`; returns, for the summary, each figure's file stem and what
-/// it shows, in order. `Err((stem, problem))` where a figure could not be drawn.
-pub fn write_maps(
-    out: &Path,
-    runs: &[MappedRun],
-    cx: &MapContext,
-) -> Result<Vec<(&'static str, &'static str)>, (&'static str, String)> {
+/// it shows, in order.
+pub fn write_maps(out: &Path, runs: &[MappedRun], cx: &MapContext) -> Result<Vec<(&'static str, &'static str)>> {
     let axes: Vec<MapAxis> = cx
         .space
         .names()
@@ -63,9 +60,9 @@ pub fn write_maps(
     };
     let mut written = Vec::new();
     let mut save = |m: Map, stem: &'static str, what: &'static str| {
-        m.save(&out.join(stem)).map_err(|e| (stem, e))?;
+        m.save(&out.join(stem))?;
         written.push((stem, what));
-        Ok::<(), (&'static str, String)>(())
+        Ok::<(), crate::error::Error>(())
     };
     let mut errors = vec![layer("rel_error (full runs)", &|r| Some(r.validation.rel_error))];
     if runs.iter().any(|r| r.estimate.is_some()) {

@@ -177,7 +177,7 @@ mod tests {
             // the library names the option by its key; a front end spells it its own way
             let e = Parameters::load_scale(bad).validate().expect_err("non-finite load scale accepted");
             assert!(e.to_string().starts_with("load_scale must be finite"), "{e}");
-            let flag = e.render(&|k, _| format!("--{}", k.replace('_', "-")));
+            let flag = e.render(&crate::error::cli_flag);
             assert!(flag.starts_with("--load-scale must be finite"), "{flag}");
             let e = Parameters::default().with("E_lower", bad).validate().expect_err("non-finite value accepted");
             assert!(e.to_string().contains("parameter E_lower must be finite"), "{e}");

@@ -30,7 +30,7 @@
 //!   pipeline: [train] and [reduction]), pipeline, full_seconds, program_version
 //! ```
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, Text};
 use crate::io::attrs::{check_layout, write_atomically_as, Kind};
 use crate::io::basis_file::TrainingData;
 use crate::io::h5::{attr_f64, attr_str, read_attr_f64, read_attr_str};
@@ -53,7 +53,10 @@ pub fn job_points(p: &Pipeline, x: Option<f64>, shard: Option<Shard>) -> Result<
         (Some(_), None) if !p.file.parameters.is_empty() => Err(Error::input(
             &p.path,
             "parameters",
-            "trains at the points of its box: split them with --shard K/N, not --load-scale",
+            Text::new("trains at the points of its box: split them with ")
+                .option("shard", Some("K/N"))
+                .then(", not ")
+                .option("load_scale", None),
         )),
         (Some(x), None) if x.is_finite() => Ok(vec![Parameters::load_scale(x)]),
         (Some(x), None) => Err(Error::option("load_scale", None, format!("must be finite, got {x}"))),
@@ -70,7 +73,11 @@ pub fn job_points(p: &Pipeline, x: Option<f64>, shard: Option<Shard>) -> Result<
             }
             Ok(idx.iter().map(|&i| all[i].clone()).collect())
         }
-        _ => Err(Error::Usage("--snapshots-only needs either --load-scale X or --shard K/N".into())),
+        _ => Err(Error::option(
+            "snapshots_only",
+            None,
+            Text::new("needs either ").option("load_scale", Some("X")).then(" or ").option("shard", Some("K/N")),
+        )),
     }
 }
 
@@ -81,8 +88,12 @@ fn fixed_points(p: &Pipeline) -> Result<Vec<Parameters>> {
         return Err(Error::input(
             &p.path,
             "train.greedy",
-            "greedy training is sequential (each full run is chosen from the basis of the runs before it); \
-             shard it by --load-scale runs only with train.load_scales",
+            Text::new(
+                "greedy training is sequential (each full run is chosen from the basis of the runs before it); \
+                 shard it by ",
+            )
+            .option("load_scale", None)
+            .then(" runs only with train.load_scales"),
         ));
     }
     if !p.file.parameters.is_empty() {

@@ -13,7 +13,7 @@
 //! which merges what is there and marks the gaps `status` 2 ("not run yet"), so that
 //! `sweep --resume` on the merged file runs exactly the gaps.
 
-use crate::error::{show_text, Error, Result};
+use crate::error::{show_text, Error, Result, Text};
 use crate::io::h5::{bounded_len, dataset_of_shape, read_attr_f64, read_attr_str, read_strings};
 use crate::limits::Limits;
 use crate::pipeline::config::Pipeline;
@@ -88,7 +88,7 @@ fn read_part(path: &Path, limits: &Limits) -> Result<Part> {
     // becomes a `Parameters` and a row of the merged sweep), every other shape checked
     // against them
     let n_all = bounded_len(&g, "all_load_scales", BYTES_PER_LISTED_POINT, limits)
-        .map_err(|p| bad("shard/all_load_scales", p.problem()))?;
+        .map_err(|p| Error::input(path, "shard/all_load_scales", p.problem_text()))?;
     let shaped = |loc: &hdf5::Group, name: &str, want: &[usize]| {
         let field = if loc.name() == "/shard" { format!("shard/{name}") } else { name.to_string() };
         dataset_of_shape(loc, name, want).map_err(|p| bad(&field, p.problem()))
@@ -118,8 +118,8 @@ fn read_part(path: &Path, limits: &Limits) -> Result<Part> {
             "does not match shard/all_load_scales and shard/all_points (a damaged file)".into(),
         ));
     }
-    let n =
-        bounded_len(&f, "load_scales", BYTES_PER_LISTED_POINT, limits).map_err(|p| bad("load_scales", p.problem()))?;
+    let n = bounded_len(&f, "load_scales", BYTES_PER_LISTED_POINT, limits)
+        .map_err(|p| Error::input(path, "load_scales", p.problem_text()))?;
     let indices: Vec<usize> = shaped(&g, "indices", &[n])?
         .read_1d::<u64>()
         .map_err(|e| bad("shard/indices", format!("cannot be read: {e}")))?
@@ -228,7 +228,8 @@ fn recorded_in(e: Error, part: &Part, key: &str) -> Error {
         hint: format!(
             "that path is the one {} records in `{key}` (moved since the sweep? put it back there, or sweep again)",
             part.path.display()
-        ),
+        )
+        .into(),
     }
 }
 
@@ -415,10 +416,10 @@ fn check_coverage(parts: &[Part], partial: bool) -> Result<()> {
             return Err(Error::input(
                 &p.path,
                 "status",
-                format!(
-                    "{} were not run (the shard did not finish); rerun it with --resume, or merge --partial",
-                    some(&not_run)
-                ),
+                Text::new(format!("{} were not run (the shard did not finish); rerun it with ", some(&not_run)))
+                    .option("resume", None)
+                    .then(", or merge ")
+                    .option("partial", None),
             ));
         }
     }

@@ -173,7 +173,7 @@ pub const MOST_THREADS: usize = 1024;
 pub fn configure_threads(flag: Option<usize>) -> Result<()> {
     let asked = match flag {
         Some(0) => return Err(Error::option("threads", None, "must be at least 1")),
-        Some(n) if n > MOST_THREADS => return Err(too_many_threads("--threads", &n.to_string())),
+        Some(n) if n > MOST_THREADS => return Err(Error::option("threads", Some(n.to_string()), too_many_threads())),
         Some(n) => Some(("--threads", n)),
         None if std::env::var_os("RAYON_NUM_THREADS").is_some() => threads_from_env("RAYON_NUM_THREADS", true)?,
         None => threads_from_env("SLURM_CPUS_PER_TASK", false)?,
@@ -201,17 +201,17 @@ fn threads_from_env(name: &'static str, zero_is_default: bool) -> Result<Option<
         Ok(0) if zero_is_default => Ok(None),
         Ok(n) if n > 0 && n <= MOST_THREADS as u64 => Ok(Some((name, n as usize))),
         // a row of digits too large for u64 is as absurd as 100000
-        Ok(n) if n > 0 => Err(too_many_threads(&shown, "")),
-        Err(_) if v.bytes().all(|b| b.is_ascii_digit()) => Err(too_many_threads(&shown, "")),
+        Ok(n) if n > 0 => Err(Error::Usage(format!("{shown}: {}", too_many_threads()))),
+        Err(_) if v.bytes().all(|b| b.is_ascii_digit()) => {
+            Err(Error::Usage(format!("{shown}: {}", too_many_threads())))
+        }
         _ => Err(Error::Usage(format!("{shown} is not a positive whole number"))),
     }
 }
 
-fn too_many_threads(what: &str, value: &str) -> Error {
-    let what = if value.is_empty() { what.to_string() } else { format!("{what} {value}") };
-    Error::Usage(format!(
-        "{what}: more worker threads than flexrom starts (at most {MOST_THREADS}; the default is one per core)"
-    ))
+/// What a thread count above [`MOST_THREADS`] is told, after the option or the variable.
+fn too_many_threads() -> String {
+    format!("more worker threads than flexrom starts (at most {MOST_THREADS}; the default is one per core)")
 }
 
 /// `asked` cut to the cores, with a detail line saying so.
@@ -258,5 +258,16 @@ mod tests {
         assert_eq!(h, point_list_hash(&pts(2.0), &names));
         assert_ne!(h, point_list_hash(&pts(2.5), &names));
         assert_ne!(h, point_list_hash(&pts(2.0), &["load_scale".into(), "pull".into()]));
+    }
+
+    /// A thread count above the most is refused before any pool starts, named by the option's
+    /// key; on the command line it reads as the message did when it wrote the flag
+    /// (`"{what} {value}: more worker threads …"` with `--threads`).
+    #[test]
+    fn too_many_threads_name_the_option() {
+        let e = configure_threads(Some(MOST_THREADS + 1)).unwrap_err();
+        let tail = "more worker threads than flexrom starts (at most 1024; the default is one per core)";
+        assert_eq!(e.render(&crate::error::cli_flag), format!("--threads 1025: {tail}"));
+        assert_eq!(e.to_string(), format!("threads = 1025: {tail}"));
     }
 }

@@ -25,7 +25,7 @@ pub use crate::records::sweep_outcome::{
 pub use crate::records::sweep_run::{is_sweep_file, open_sweep_run, SweepPick, SweepRun};
 pub use table::table;
 
-use crate::error::Result;
+use crate::error::{Result, Text};
 use crate::linalg::kkt::LinearSolverKind;
 use crate::model::Model;
 use crate::records::sweep_outcome::clone_point;
@@ -182,7 +182,11 @@ pub fn sweep_to_file(route: Route, points: &[Parameters], o: SweepOptions, f: Sw
                 return Err(crate::error::Error::input(
                     out,
                     "fallback",
-                    "is \"full\": the sweep was written with --fallback full; resume it with --fallback full (or the pipeline's [online] fallback), or write another file",
+                    Text::new("is \"full\": the sweep was written with ")
+                        .option("fallback", Some("full"))
+                        .then("; resume it with ")
+                        .option("fallback", Some("full"))
+                        .then(" (or the pipeline's [online] fallback), or write another file"),
                 ));
             }
             let old = read_sweep(out, model, route.basis().map(|b| b.stored), o.validate)?;

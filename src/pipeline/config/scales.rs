@@ -1,6 +1,7 @@
 //! Lists of load scales in a pipeline file: a list, or `"A:B:N"` (also the CLI's form, which
 //! takes a list as `X,Y,Z` too).
 
+use crate::error::{Error, Result};
 use serde::Deserialize;
 
 /// A list of load scales, or `"A:B:N"`: N evenly spaced values from A to B.
@@ -17,7 +18,7 @@ impl Scales {
             Scales::List(v) => v.clone(),
             Scales::Range(s) => parse_range(s)?,
         };
-        check_scales(&v)?;
+        check_scales(&v).map_err(Error::problem)?;
         Ok(v)
     }
 }
@@ -42,7 +43,7 @@ pub fn parse_range(s: &str) -> std::result::Result<Vec<f64>, String> {
         return Err(format!("`{s}` asks for {n} load scales, more than the {MAX_LOAD_SCALES} one sweep takes; split the range into several sweeps"));
     }
     let v = if n == 1 { vec![a] } else { (0..n).map(|i| a + (b - a) * i as f64 / (n - 1) as f64).collect() };
-    check_scales(&v)?;
+    check_scales(&v).map_err(Error::problem)?;
     Ok(v)
 }
 
@@ -63,16 +64,19 @@ pub fn parse_scales(s: &str) -> std::result::Result<Vec<f64>, String> {
     if v.len() > MAX_LOAD_SCALES {
         return Err(format!("`{s}` lists {} load scales, more than the {MAX_LOAD_SCALES} one sweep takes", v.len()));
     }
-    check_scales(&v)?;
+    check_scales(&v).map_err(Error::problem)?;
     Ok(v)
 }
 
-pub(super) fn check_scales(v: &[f64]) -> std::result::Result<(), String> {
+/// Refuses an empty list of load scales and one that is not finite (a usage error the
+/// caller puts after the field or the option; the parsers here, which `clap` and serde call
+/// with `String` errors, take its [`Error::problem`]).
+pub(super) fn check_scales(v: &[f64]) -> Result<()> {
     if v.is_empty() {
-        return Err("the list of load scales is empty".into());
+        return Err(Error::Usage("the list of load scales is empty".into()));
     }
     if let Some(x) = v.iter().find(|x| !x.is_finite()) {
-        return Err(format!("load scale {x} is not finite"));
+        return Err(Error::Usage(format!("load scale {x} is not finite")));
     }
     Ok(())
 }
