@@ -59,7 +59,7 @@ pub enum Error {
 
     /// Anything else that is a usage error of the program (bad command-line values).
     #[error("{0}")]
-    Usage(String),
+    Usage(Text),
 
     /// A bad value of a run's option, named by its key (`load_scale`, `shard`, `dt`,
     /// `max_memory`) and not as a front end spells it: the command line renders it as
@@ -187,6 +187,12 @@ impl Text {
         self
     }
 
+    /// `other` added at the end.
+    pub fn append(mut self, other: Text) -> Text {
+        self.0.extend(other.0);
+        self
+    }
+
     /// The option `key` (with `value`) added at the end, as each front end spells it.
     pub fn option(self, key: &'static str, value: Option<&str>) -> Text {
         self.clause("", key, value, "")
@@ -232,6 +238,24 @@ impl Text {
 impl fmt::Display for Text {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(&self.render(&plain_option))
+    }
+}
+
+/// A line the library hands a front end to say — a warning, a note: plain words, or a
+/// [`Text`] that names options, as the front end's `spell` writes them.
+pub trait Said {
+    fn said(&self, spell: &OptionSpelling) -> String;
+}
+
+impl Said for String {
+    fn said(&self, _spell: &OptionSpelling) -> String {
+        self.clone()
+    }
+}
+
+impl Said for Text {
+    fn said(&self, spell: &OptionSpelling) -> String {
+        self.render(spell)
     }
 }
 
@@ -334,6 +358,12 @@ impl Error {
         }
     }
 
+    /// A usage error ([`Error::Usage`]) with the text `t`, whose options each front end
+    /// spells ([`Text`]).
+    pub fn usage(t: impl Into<Text>) -> Self {
+        Error::Usage(t.into())
+    }
+
     /// A bad value of the option `key` ([`Error::Option`]).
     pub fn option(key: &'static str, value: Option<String>, problem: impl Into<Text>) -> Self {
         Error::Option { key, value, problem: problem.into() }
@@ -352,7 +382,7 @@ impl Error {
                 let option = spell.option("strict", None).unwrap_or_else(|| plain_option("strict", None));
                 format!("{option}: {message}")
             }
-            Error::Resource(text) => text.render(spell),
+            Error::Resource(text) | Error::Usage(text) => text.render(spell),
             Error::BlowUp { t, problem } => format!("blow-up at t = {t:.6} s: {}", problem.render(spell)),
             Error::Stage { stage, parameters, source } => format!("{stage} at {parameters}: {}", source.render(spell)),
             Error::Hinted { source, hint } => format!("{}; {}", source.render(spell), hint.render(spell)),
@@ -399,7 +429,7 @@ impl Error {
     /// unchanged.
     pub fn context(self, c: impl std::fmt::Display) -> Self {
         match self {
-            Error::Usage(p) => Error::Usage(format!("{c}: {p}")),
+            Error::Usage(p) => Error::Usage(p.prefixed(c)),
             Error::Resource(p) => Error::Resource(p.prefixed(c)),
             e @ (Error::Numerical { .. } | Error::Context { .. }) => {
                 Error::Context { context: c.to_string(), source: Box::new(e) }
@@ -416,7 +446,8 @@ impl Error {
     /// ([`Error::Hdf5`]) give their text; another error gives its whole message.
     pub fn problem(self) -> String {
         match self {
-            Error::Usage(p) | Error::Hdf5 { problem: p, .. } => p,
+            Error::Hdf5 { problem: p, .. } => p,
+            Error::Usage(p) => p.to_string(),
             Error::Resource(p) => p.to_string(),
             Error::Numerical { what: LINEAR_SOLVE, problem } => problem,
             other => other.to_string(),
@@ -428,7 +459,7 @@ impl Error {
     /// may be a bound ([`Error::Resource`]).
     pub fn problem_text(self) -> Text {
         match self {
-            Error::Resource(text) => text,
+            Error::Resource(text) | Error::Usage(text) => text,
             other => other.problem().into(),
         }
     }
@@ -462,8 +493,10 @@ mod tests {
         let pod = Error::numerical("POD", "empty").context("block 2");
         assert_eq!(pod.to_string(), "block 2: POD: empty");
         assert_eq!(pod.at_time(1.0).to_string(), "linear solve failed at t = 1.000000 s: block 2: POD: empty");
-        let usage = Error::Usage("count must be at least 1".into()).context("reduction.multiplier_modes");
-        assert!(matches!(&usage, Error::Usage(p) if p == "reduction.multiplier_modes: count must be at least 1"));
+        let usage = Error::usage("count must be at least 1").context("reduction.multiplier_modes");
+        assert!(
+            matches!(&usage, Error::Usage(p) if p.to_string() == "reduction.multiplier_modes: count must be at least 1")
+        );
         assert_eq!(usage.problem(), "reduction.multiplier_modes: count must be at least 1");
     }
 

@@ -83,7 +83,7 @@ pub fn from_env(
     if let Some((v, name)) =
         max_memory.map(|v| (v.to_string(), "--max-memory")).or(env_mem.map(|v| (v, "FLEXROM_MAX_MEMORY")))
     {
-        l.max_memory = parse_bytes(&v).map_err(|e| Error::Usage(format!("{name}: {e}")))?;
+        l.max_memory = parse_bytes(&v).map_err(|e| Error::usage(format!("{name}: {e}")))?;
         l.memory_source = name.to_string();
     }
     let env_steps = std::env::var("FLEXROM_MAX_STEPS").ok();
@@ -106,7 +106,7 @@ fn positive_count(v: &str, name: &str) -> Result<u64> {
         .parse::<u64>()
         .ok()
         .filter(|&n| n > 0)
-        .ok_or_else(|| Error::Usage(format!("{name}: `{v}` is not a positive whole number")))
+        .ok_or_else(|| Error::usage(format!("{name}: `{v}` is not a positive whole number")))
 }
 
 /// `"8G"`, `"512M"`, `"1.5GiB"`, `"1000000"` → bytes (K, M, G, T are powers of 1024).
@@ -115,18 +115,18 @@ pub fn parse_bytes(s: &str) -> Result<u64> {
     let split = t.find(|c: char| c.is_ascii_alphabetic()).unwrap_or(t.len());
     let (num, unit) = t.split_at(split);
     let x: f64 =
-        num.trim().parse().map_err(|_| Error::Usage(format!("`{s}` is not a size (e.g. 8G, 512M, 1000000)")))?;
+        num.trim().parse().map_err(|_| Error::usage(format!("`{s}` is not a size (e.g. 8G, 512M, 1000000)")))?;
     let mult = match unit.trim().to_ascii_uppercase().as_str() {
         "" | "B" => 1.0,
         "K" | "KB" | "KIB" => 1024.0,
         "M" | "MB" | "MIB" => 1024.0 * 1024.0,
         "G" | "GB" | "GIB" => 1024.0 * 1024.0 * 1024.0,
         "T" | "TB" | "TIB" => 1024.0_f64.powi(4),
-        u => return Err(Error::Usage(format!("unknown unit `{u}` in `{s}` (use K, M, G or T)"))),
+        u => return Err(Error::usage(format!("unknown unit `{u}` in `{s}` (use K, M, G or T)"))),
     };
     let b = x * mult;
     if !(b.is_finite() && (1.0..1.8e19).contains(&b)) {
-        return Err(Error::Usage(format!("`{s}` is not a positive size below 16 EiB")));
+        return Err(Error::usage(format!("`{s}` is not a positive size below 16 EiB")));
     }
     Ok(b as u64)
 }

@@ -80,7 +80,7 @@ impl Settings {
                     format!("{}: time.{key}", model.path.display())
                 }
             };
-            return Err(Error::Usage(format!(
+            return Err(Error::usage(format!(
                 "the time step ({} = {dt}) is longer than the run ({} = {t_end}): no step fits",
                 from(o.dt.is_some(), "dt", "dt"),
                 from(o.t_end.is_some(), "t-end", "t_end"),

@@ -59,9 +59,9 @@ pub fn dict_of_series<'py>(py: Python<'py>, s: &flexrom::simulate::Series) -> Py
 
 /// Each line through `warnings.warn` as a `FlexromWarning` (shown once per place by
 /// Python's default filter; an error under `-W error`).
-pub fn warn(py: Python<'_>, lines: &[String]) -> PyResult<()> {
+pub fn warn<W: flexrom::error::Said>(py: Python<'_>, lines: &[W]) -> PyResult<()> {
     for line in lines {
-        let msg = std::ffi::CString::new(line.replace('\0', " ")).expect("NULs replaced");
+        let msg = std::ffi::CString::new(crate::errors::said(line).replace('\0', " ")).expect("NULs replaced");
         PyErr::warn(py, &py.get_type::<FlexromWarning>(), &msg, 1)?;
     }
     Ok(())

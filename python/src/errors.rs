@@ -37,14 +37,23 @@ create_exception!(
 const NOT_KEYWORDS: [&str; 4] = ["max_memory", "max_steps", "max_elements", "allow_blowup"];
 
 /// How a Python call writes an option the library names by its key ([`Error::render`]): as
-/// its keyword argument, `load_scale=`, with the value after the `=`; a clause naming an
-/// option Python does not have is left out.
+/// its keyword argument, `load_scale=`, with the value after the `=`; a named parameter
+/// (`param`, `NAME=VALUE`) is a keyword argument of its own name; a clause naming an option
+/// Python does not have is left out.
 struct Keywords;
 
 impl Spelling for Keywords {
     fn option(&self, key: &str, value: Option<&str>) -> Option<String> {
-        (!NOT_KEYWORDS.contains(&key)).then(|| format!("{key}={}", value.unwrap_or("")))
+        match (key, value) {
+            ("param", Some(assignment)) => Some(assignment.to_string()),
+            _ => (!NOT_KEYWORDS.contains(&key)).then(|| format!("{key}={}", value.unwrap_or(""))),
+        }
     }
+}
+
+/// A library line (a warning, a text that names options) as a Python call's user reads it.
+pub fn said(line: &impl flexrom::error::Said) -> String {
+    line.said(&Keywords)
 }
 
 /// The exception of a library error.

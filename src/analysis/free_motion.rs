@@ -169,20 +169,20 @@ pub fn describe_failure(reached: f64, next: f64, cuts: u32, motions: &[FreeMotio
     let loaded: Vec<&FreeMotion> = motions.iter().filter(|m| m.loaded()).collect();
     let free: Vec<&FreeMotion> = motions.iter().collect();
     if !loaded.is_empty() {
-        return Error::Usage(format!(
+        return Error::usage(format!(
             "statics: no static equilibrium: the loads drive a free motion of the mechanism ({}); \
              add a joint that holds it, or run `simulate`",
             told(&loaded)
         ));
     }
     if !free.is_empty() {
-        return Error::Usage(format!(
+        return Error::usage(format!(
             "statics: the tangent stiffness is singular at {} of the load: free motion ({}) that no joint holds",
             crate::error::show_number(reached),
             told(&free)
         ));
     }
-    Error::Usage(format!(
+    Error::usage(format!(
         "statics: no equilibrium found past {} of the load (the step to {} failed after {} halvings): {e}",
         crate::error::show_number(reached),
         crate::error::show_number(next),

@@ -154,7 +154,7 @@ pub fn compute(
         // X = Y Z: the Ritz vectors, ascending
         x = (0..p).map(|j| combine(&y, &z.column(j).to_vec())).collect();
     }
-    Err(Error::Usage(format!(
+    Err(Error::usage(format!(
         "modes: the lowest {count} modes did not converge in {MAX_ITERATIONS} subspace iterations"
     )))
 }
@@ -241,9 +241,7 @@ fn m_orthonormalize(
                 break;
             }
             if attempt == 2 {
-                return Err(Error::Usage(
-                    "modes: the subspace lost its rank (fewer independent motions than asked)".into(),
-                ));
+                return Err(Error::usage("modes: the subspace lost its rank (fewer independent motions than asked)"));
             }
             y[j] = solve(&random_vector(n, seed))?;
         }
@@ -272,7 +270,7 @@ fn ritz(sys: &FlexibleSystem, k: &[Block], y: &[Vec<f64>]) -> Result<Array2<f64>
             kr[(j, i)] = v;
         }
     }
-    let (_, z) = kr.eigh(UPLO::Lower).map_err(|e| Error::Usage(format!("modes: Rayleigh–Ritz eigenproblem: {e}")))?;
+    let (_, z) = kr.eigh(UPLO::Lower).map_err(|e| Error::usage(format!("modes: Rayleigh–Ritz eigenproblem: {e}")))?;
     Ok(z)
 }
 

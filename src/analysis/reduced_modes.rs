@@ -54,7 +54,7 @@ pub fn compute(
 ) -> Result<ReducedModes> {
     let n = v.nrows();
     if n != ParametricModel::n_dof(sys) {
-        return Err(Error::Usage(format!("the basis has {n} coordinates, the model {}", ParametricModel::n_dof(sys))));
+        return Err(Error::usage(format!("the basis has {n} coordinates, the model {}", ParametricModel::n_dof(sys))));
     }
     let kr = project(sys, &assembly::tangent_blocks(sys, mu, q, t, 1.0), v);
     let mr = project(sys, &assembly::mass_blocks(sys, mu), v);

@@ -120,7 +120,7 @@ impl ParamArgs {
                 } else {
                     format!("--param {name}")
                 };
-                return Err(flexrom::Error::Usage(format!("{twice} given twice")));
+                return Err(flexrom::Error::usage(format!("{twice} given twice")));
             }
             seen.push(name);
             mu = mu.with(name, *value);
@@ -142,10 +142,11 @@ pub fn message(e: &flexrom::Error) -> String {
     e.render(&flag)
 }
 
-/// Prints the library's warnings on stderr, one `warning: ` line each (every verbosity).
-pub fn warn(warnings: &[String]) {
+/// Prints the library's warnings on stderr, one `warning: ` line each (every verbosity),
+/// their options as flags.
+pub fn warn<W: flexrom::error::Said>(warnings: &[W]) {
     for w in warnings {
-        flexrom::output::note(&format!("warning: {w}"));
+        flexrom::output::note(&format!("warning: {}", w.said(&flag)));
     }
 }
 

@@ -143,7 +143,7 @@ impl Args {
         let out = output;
         check_output(&out, Origin::Flag("-o"), &inputs, &[Kind::Sweep])?;
         if no_estimate && strict {
-            return Err(flexrom::Error::Usage("--strict needs the error estimate; drop --no-estimate".into()));
+            return Err(flexrom::Error::usage("--strict needs the error estimate; drop --no-estimate"));
         }
         let options = sweep_options(&p, fallback, validate, continuation, full, no_estimate)?;
         let fallback = options.fallback;
@@ -228,7 +228,7 @@ fn sweep_options(
         } else {
             "--fallback full".into()
         };
-        return Err(flexrom::Error::Usage(format!(
+        return Err(flexrom::Error::usage(format!(
             "{given} needs the error estimate to judge each reduced answer; drop --no-estimate (or pass --fallback none)"
         )));
     }
@@ -373,7 +373,7 @@ fn sweep_points(
     } else {
         let named = params
             .iter()
-            .map(|spec| parse_axis(spec).map_err(|e| flexrom::Error::Usage(format!("--param: {e}"))))
+            .map(|spec| parse_axis(spec).map_err(|e| flexrom::Error::usage(format!("--param: {e}"))))
             .collect::<flexrom::Result<Vec<_>>>()?;
         let first = match load_scales {
             Some(v) => Some(v),
@@ -384,7 +384,7 @@ fn sweep_points(
         let axes: Vec<(String, Vec<f64>)> =
             first.map(|v| (LOAD_SCALE.to_string(), v)).into_iter().chain(named).collect();
         if axes.is_empty() {
-            return Err(flexrom::Error::Usage(format!(
+            return Err(flexrom::Error::usage(format!(
                 "{}: a pipeline with a [parameters] box sweeps the points of `--param NAME=A:B:N` (one per parameter) or `--points FILE`",
                 p.path.display()
             )));

@@ -5,7 +5,7 @@ use flexrom::limits::Limits;
 use flexrom::output::table::{Format, Table};
 use flexrom::output::{self};
 use flexrom::pipeline::Pipeline;
-use flexrom::rom::Answered;
+use flexrom::rom::warnings::Answered;
 use flexrom::solver::parameters::Parameters;
 use flexrom::workflows::online::load_rom;
 use std::path::PathBuf;
@@ -60,7 +60,7 @@ impl Args {
             }
             vs.push(v);
         }
-        let json_err = |e: serde_json::Error| flexrom::Error::Usage(format!("cannot write the JSON: {e}"));
+        let json_err = |e: serde_json::Error| flexrom::Error::usage(format!("cannot write the JSON: {e}"));
         match format.format() {
             // the record as serde writes it (arrays stay arrays): the keys scripts read; one
             // object for --load-scale, else an array as the report's validation.json

@@ -100,7 +100,7 @@ mod tests {
         assert_eq!(std::fs::read_dir(d.path().join("sub")).unwrap().count(), 1);
         let r = write_file_atomically(&target, |tmp| {
             std::fs::write(tmp, b"three").map_err(|e| Error::io(tmp, e))?;
-            Err(Error::Usage("later stage failed".into()))
+            Err(Error::usage("later stage failed"))
         });
         assert!(r.is_err());
         assert_eq!(std::fs::read(&target).unwrap(), b"two");

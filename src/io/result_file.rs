@@ -434,9 +434,9 @@ mod tests {
         let plan = super::RunPlan::of_result(&r);
         assert_eq!((plan.n_t, plan.n_dof, plan.n_c, plan.dt), (1, 8, 0, 0.1));
         let failed = super::begin_alongside(&out, "text = 1", "m.toml", &plan, || -> crate::Result<()> {
-            Err(Error::Usage("the run failed".into()))
+            Err(Error::usage("the run failed"))
         });
-        assert!(matches!(failed, Err(Error::Usage(m)) if m == "the run failed"));
+        assert!(matches!(failed, Err(Error::Usage(m)) if m.to_string() == "the run failed"));
         assert_eq!(entries(dir.path()), ["r.h5"]);
         assert_eq!(std::fs::read(&out).unwrap(), b"previous");
 

@@ -35,10 +35,10 @@ impl Default for NnlsParams {
 impl NnlsParams {
     pub fn validate(&self) -> Result<()> {
         if !(self.tolerance.is_finite() && (0.0..1.0).contains(&self.tolerance)) {
-            return Err(Error::Usage(format!("the NNLS tolerance must lie in [0, 1), got {}", self.tolerance)));
+            return Err(Error::usage(format!("the NNLS tolerance must lie in [0, 1), got {}", self.tolerance)));
         }
         if self.max_iterations == 0 {
-            return Err(Error::Usage("max_iterations must be at least 1".into()));
+            return Err(Error::usage("max_iterations must be at least 1"));
         }
         Ok(())
     }

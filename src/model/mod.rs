@@ -6,7 +6,7 @@ pub mod schema;
 pub mod shared;
 mod toml_errors;
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, Text};
 use crate::limits::Limits;
 use crate::linalg::kkt::LinearSolverKind;
 use crate::physics::loads::Load;
@@ -233,11 +233,11 @@ impl Model {
     /// and the parameters it has.
     pub fn check_parameters(&self, mu: &Parameters) -> Result<()> {
         if let Some(problem) = mu.named().find_map(|(name, _)| self.unknown_parameter(name)) {
-            return Err(Error::Usage(format!("{}: {problem}", self.path.display())));
+            return Err(Error::usage(format!("{}: {problem}", self.path.display())));
         }
         for (name, value) in mu.named() {
             if let Some(what) = self.property_parameter(name).filter(|_| !(value > 0.0)) {
-                return Err(Error::Usage(format!(
+                return Err(Error::usage(format!(
                     "{}: parameter {name} is a {what} and must be positive, got {value}",
                     self.path.display()
                 )));
@@ -248,10 +248,10 @@ impl Model {
 
     /// The warning for load scales other than 1 on a model none of whose loads is `scaled =
     /// true`: they change nothing, and a run would read as at another load.
-    pub fn load_scale_warning(&self, mut scales: impl Iterator<Item = f64>) -> Option<String> {
+    pub fn load_scale_warning(&self, mut scales: impl Iterator<Item = f64>) -> Option<Text> {
         let why = self.unscaled_load_scale()?;
         let x = scales.find(|&x| x != 1.0)?;
-        Some(format!("{}: the load scale {x} is given, but {why}", self.path.display()))
+        Some(Text::new(format!("{}: the load scale {x} is given, but ", self.path.display())).append(why))
     }
 
     /// What every front end (the command line, Python) checks of the parameters of the runs
@@ -260,7 +260,7 @@ impl Model {
     /// model's loads do not take is refused for reduced runs ([`Self::refuse_load_scale`])
     /// and warned of for full ones ([`Self::load_scale_warning`]); properties far from the
     /// file's values are warned of ([`Self::property_warnings`]). Returns the warnings.
-    pub fn admit(&self, points: &[Parameters], runs: Runs) -> Result<Vec<String>> {
+    pub fn admit(&self, points: &[Parameters], runs: Runs) -> Result<Vec<Text>> {
         for mu in points {
             self.check_parameters(mu)?;
         }
@@ -270,7 +270,7 @@ impl Model {
             Runs::Reduced => self.refuse_load_scale(scales)?,
             Runs::Full => warnings.extend(self.load_scale_warning(scales)),
         }
-        warnings.extend(self.property_warnings(points));
+        warnings.extend(self.property_warnings(points).into_iter().map(Text::from));
         Ok(warnings)
     }
 
@@ -285,17 +285,20 @@ impl Model {
 
     /// Why a load scale λ means nothing to this model (no load is `scaled = true`), or
     /// `None` when some load is.
-    pub fn unscaled_load_scale(&self) -> Option<String> {
+    pub fn unscaled_load_scale(&self) -> Option<Text> {
         let names = self.parameter_names();
         if names.contains(&crate::solver::parameters::LOAD_SCALE) {
             return None;
         }
         Some(if names.is_empty() {
-            "no load of the model is scaled (`scaled = true`), so it would change nothing".to_string()
+            Text::new("no load of the model is scaled (`scaled = true`), so it would change nothing")
         } else {
-            format!(
-                "no load of the model is `scaled = true`, so it would change nothing; its parameters are {} (set them with --param NAME=VALUE)",
-                names.join(", ")
+            let why = "no load of the model is `scaled = true`, so it would change nothing; its parameters are";
+            Text::new(format!("{why} {}", names.join(", "))).clause(
+                " (set them with ",
+                "param",
+                Some("NAME=VALUE"),
+                ")",
             )
         })
     }
@@ -466,11 +469,15 @@ mod tests {
         let scaled = [Parameters::load_scale(2.0)];
         assert!(model.admit(&scaled, Runs::Reduced).is_err());
         let w = model.admit(&scaled, Runs::Full).unwrap();
-        assert!(w.len() == 1 && w[0].contains("the load scale 2 is given"), "{w:?}");
+        assert!(w.len() == 1 && w[0].to_string().contains("the load scale 2 is given"), "{w:?}");
+        // the named parameters' option as the command line spells it, and as the library's text
+        let cli = w[0].render(&crate::error::cli_flag);
+        assert!(cli.ends_with("its parameters are E (set them with --param NAME=VALUE)"), "{cli}");
+        assert!(w[0].to_string().ends_with("(set them with param = NAME=VALUE)"), "{}", w[0]);
         // 0.5 is 4e11 times below the file's 2e11 (more than FACTOR_LIKE): a factor meant
         let far = [Parameters::load_scale(1.0).with("E", 0.5)];
         let w = model.admit(&far, Runs::Reduced).unwrap();
-        assert!(w.len() == 1 && w[0].contains("far from the model file's value"), "{w:?}");
+        assert!(w.len() == 1 && w[0].to_string().contains("far from the model file's value"), "{w:?}");
         for bad in [Parameters::load_scale(1.0).with("F", 1.0), Parameters::load_scale(1.0).with("E", 0.0)] {
             assert!(model.admit(std::slice::from_ref(&bad), Runs::Full).is_err(), "{bad:?}");
         }

@@ -318,7 +318,7 @@ mod tests {
         assert!(shown(Error::input(&h5, "train.greedy", "no")).ends_with("train.greedy: no"));
         let gone = dir.path().join("gone.toml");
         assert!(shown(Error::input(&gone, "train.greedy", "no")).ends_with("train.greedy: no"));
-        assert_eq!(shown(Error::Usage("x".into())), "x");
+        assert_eq!(shown(Error::usage("x")), "x");
     }
 
     /// A checked field's line: a key of a table, a key of an array-of-tables entry, a key

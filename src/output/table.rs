@@ -124,7 +124,7 @@ impl Table {
     /// result): arrays become one column per element, `name_1`, `name_2`, … (1-based, as
     /// "fifth 1 … 5" reads), nested objects `outer.inner`.
     pub fn from_record(record: &impl serde::Serialize) -> Result<Table> {
-        let err = |e: serde_json::Error| Error::Usage(format!("cannot write the record: {e}"));
+        let err = |e: serde_json::Error| Error::usage(format!("cannot write the record: {e}"));
         // through the text, read back field by field: a `serde_json::Map` would sort the keys
         let text = serde_json::to_string(record).map_err(err)?;
         Table::from_json_records(&format!("[{text}]"))
@@ -135,7 +135,7 @@ impl Table {
     /// in their written order, and a key another object lacks is an empty cell.
     pub fn from_json_records(text: &str) -> Result<Table> {
         let records: Vec<Ordered> = serde_json::from_str(text)
-            .map_err(|e| Error::Usage(format!("cannot read the records as a JSON array of objects: {e}")))?;
+            .map_err(|e| Error::usage(format!("cannot read the records as a JSON array of objects: {e}")))?;
         let mut t = Table::default();
         for (i, rec) in records.iter().enumerate() {
             let (mut cols, mut row) = (Vec::new(), Vec::new());
@@ -156,14 +156,14 @@ impl Table {
 
     /// CSV: a header line and one line per row.
     pub fn to_csv(&self) -> Result<String> {
-        let err = |e: csv::Error| Error::Usage(format!("cannot write the CSV: {e}"));
+        let err = |e: csv::Error| Error::usage(format!("cannot write the CSV: {e}"));
         let mut w = csv::Writer::from_writer(Vec::new());
         w.write_record(&self.columns).map_err(err)?;
         for r in &self.rows {
             w.write_record(r.iter().map(Cell::text)).map_err(err)?;
         }
-        let bytes = w.into_inner().map_err(|e| Error::Usage(format!("cannot write the CSV: {e}")))?;
-        String::from_utf8(bytes).map_err(|e| Error::Usage(format!("cannot write the CSV: {e}")))
+        let bytes = w.into_inner().map_err(|e| Error::usage(format!("cannot write the CSV: {e}")))?;
+        String::from_utf8(bytes).map_err(|e| Error::usage(format!("cannot write the CSV: {e}")))
     }
 
     /// JSON: an array of objects, one per row, keys in column order.

@@ -116,7 +116,7 @@ impl TimeFunction {
             if v.is_finite() {
                 Ok(())
             } else {
-                Err(Error::Usage(format!("{name} must be finite, got {v}")))
+                Err(Error::usage(format!("{name} must be finite, got {v}")))
             }
         };
         match self {
@@ -133,44 +133,44 @@ impl TimeFunction {
             TimeFunction::Ramp { amplitude, duration } => {
                 finite("amplitude", *amplitude)?;
                 if !(duration.is_finite() && *duration > 0.0) {
-                    return Err(Error::Usage(format!("duration must be positive and finite, got {duration}")));
+                    return Err(Error::usage(format!("duration must be positive and finite, got {duration}")));
                 }
                 Ok(())
             }
             TimeFunction::Piecewise { pieces } => {
                 if pieces.is_empty() {
-                    return Err(Error::Usage("pieces must not be empty".into()));
+                    return Err(Error::usage("pieces must not be empty"));
                 }
                 let mut last = f64::NEG_INFINITY;
                 for (i, p) in pieces.iter().enumerate() {
                     match p.until {
                         Some(u) if !u.is_finite() || u <= last => {
-                            return Err(Error::Usage(format!(
+                            return Err(Error::usage(format!(
                                 "pieces[{i}].until must be finite and increasing, got {u}"
                             )))
                         }
                         Some(u) => last = u,
                         None if i + 1 != pieces.len() => {
-                            return Err(Error::Usage(format!("pieces[{i}] has no `until` but is not the last piece")))
+                            return Err(Error::usage(format!("pieces[{i}] has no `until` but is not the last piece")))
                         }
                         None => {}
                     }
-                    p.function.check().map_err(|e| Error::Usage(format!("pieces[{i}].function: {e}")))?;
+                    p.function.check().map_err(|e| Error::usage(format!("pieces[{i}].function: {e}")))?;
                 }
                 Ok(())
             }
             TimeFunction::Polynomial { coefficients } => {
                 if coefficients.is_empty() {
-                    return Err(Error::Usage("coefficients must not be empty (give [c0, c1, ...])".into()));
+                    return Err(Error::usage("coefficients must not be empty (give [c0, c1, ...])"));
                 }
                 coefficients.iter().enumerate().try_for_each(|(i, c)| finite(&format!("coefficients[{i}]"), *c))
             }
             TimeFunction::Sum { terms } => {
                 if terms.is_empty() {
-                    return Err(Error::Usage("terms must not be empty".into()));
+                    return Err(Error::usage("terms must not be empty"));
                 }
                 for (i, f) in terms.iter().enumerate() {
-                    f.check().map_err(|e| Error::Usage(format!("terms[{i}]: {e}")))?;
+                    f.check().map_err(|e| Error::usage(format!("terms[{i}]: {e}")))?;
                 }
                 Ok(())
             }

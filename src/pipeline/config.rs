@@ -33,7 +33,7 @@
 mod scales;
 mod schema;
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, Text};
 use crate::io::output::tidy;
 use crate::limits::Limits;
 use crate::model::Model;
@@ -155,16 +155,16 @@ impl Pipeline {
     /// and a probe that records what the modes are for.
     fn check_probe_modes(&self, tolerance: f64) -> Result<()> {
         if !(tolerance.is_finite() && tolerance > 0.0 && tolerance < 1.0) {
-            return Err(Error::Usage(format!("has tolerance {tolerance}; it must lie strictly between 0 and 1")));
+            return Err(Error::usage(format!("has tolerance {tolerance}; it must lie strictly between 0 and 1")));
         }
         if matches!(self.variant(), Variant::WholeSystem | Variant::WholeSystemStabilized) {
-            return Err(Error::Usage(format!(
+            return Err(Error::usage(format!(
                 "needs the galerkin or the constraint-preserving variant, not {}",
                 self.variant().name()
             )));
         }
         if !self.model.probes().iter().any(|p| p.strain || p.curvature) {
-            return Err(Error::Usage("is set, but no probe of the model records a strain or a curvature (`quantities = [\"strain\", \"curvature\"]` in a [[probes]] entry)".into()));
+            return Err(Error::usage("is set, but no probe of the model records a strain or a curvature (`quantities = [\"strain\", \"curvature\"]` in a [[probes]] entry)"));
         }
         Ok(())
     }
@@ -203,10 +203,10 @@ impl Pipeline {
             let varies = t.greedy.is_some() || t.load_scales.as_ref().is_some_and(|s| s.iter().any(|&x| x != 1.0));
             if let Some(why) = self.model.unscaled_load_scale().filter(|_| varies) {
                 let field = if t.greedy.is_some() { "train.greedy.range" } else { "train.load_scales" };
-                return bad(
-                    field,
-                    format!("trains over load scales, but {why}; a [parameters] box trains over named parameters"),
-                );
+                let problem = Text::new("trains over load scales, but ")
+                    .append(why)
+                    .then("; a [parameters] box trains over named parameters");
+                return Err(Error::input(&self.path, field, problem));
             }
         }
         if let Err(e) = red.modes.as_ref().map_or(Ok(()), |m| m.validate()) {
@@ -251,7 +251,7 @@ impl Pipeline {
                 );
             }
             if let Err(e) = m.validate().and(if matches!(m, ModeRule::Counts(_)) {
-                Err(Error::Usage("gives counts per block; use count, ratio or energy".into()))
+                Err(Error::usage("gives counts per block; use count, ratio or energy"))
             } else {
                 Ok(())
             }) {

@@ -198,10 +198,10 @@ pub fn write_sweep(path: &Path, s: &Sweep, basis: Option<SweepBasis>) -> Result<
 /// [`write_sweep`] with `extra` written into the file before it is renamed into place.
 pub fn write_sweep_with(path: &Path, s: &Sweep, basis: Option<SweepBasis>, extra: Extra) -> Result<()> {
     if s.scales.is_empty() {
-        return Err(Error::Usage("the sweep has no load scales".into()));
+        return Err(Error::usage("the sweep has no load scales"));
     }
     if s.full != basis.is_none() {
-        return Err(Error::Usage(format!(
+        return Err(Error::usage(format!(
             "{}: a reduced sweep is written with its basis, a full one without",
             path.display()
         )));

@@ -3,7 +3,8 @@
 
 use super::validation::Validation;
 use crate::rom::estimator::Estimate;
-use crate::rom::{Answered, ReducedRun, Rom};
+use crate::rom::warnings::Answered;
+use crate::rom::{ReducedRun, Rom};
 use crate::solver::parameters::Parameters;
 use ndarray::{Array1, Array2};
 

@@ -335,8 +335,8 @@ impl Validation {
 
     /// This validation's reduced answer at `mu` as the warnings after it read it
     /// ([`crate::rom::Rom::warnings_after`]).
-    pub fn answered<'a>(&'a self, rom: &Rom, mu: &'a Parameters) -> crate::rom::Answered<'a> {
-        crate::rom::Answered {
+    pub fn answered<'a>(&'a self, rom: &Rom, mu: &'a Parameters) -> crate::rom::warnings::Answered<'a> {
+        crate::rom::warnings::Answered {
             mu,
             estimate: self.estimate_in(rom.tolerance_measure()),
             failure: self.estimate_failure.as_deref(),

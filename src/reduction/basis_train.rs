@@ -25,7 +25,7 @@ pub(crate) fn train_plain(
     let (variant, multiplier_scale) = (spec.variant, spec.multiplier_scale);
     let n = x.nrows();
     if x.ncols() == 0 {
-        return Err(Error::Usage("the training set is empty (no snapshots)".into()));
+        return Err(Error::usage("the training set is empty (no snapshots)"));
     }
     let reference = match spec.snapshots {
         SnapshotKind::Raw => Array1::zeros(n),
@@ -37,18 +37,18 @@ pub(crate) fn train_plain(
         _ => (0..n).collect(),
     };
     if variant == Variant::WholeSystemStabilized {
-        return Err(Error::Usage("the stabilized variant is trained by reduction::train_basis".into()));
+        return Err(Error::usage("the stabilized variant is trained by reduction::train_basis"));
     }
     if !spec.blocks.is_empty() {
         return train_blocks(centred, reference, joint_dofs, reduced_dofs, spec);
     }
     if let ModeRule::Counts(_) = spec.modes {
-        return Err(Error::Usage(format!("{} gives one count per block, and the basis has no blocks", spec.modes)));
+        return Err(Error::usage(format!("{} gives one count per block, and the basis has no blocks", spec.modes)));
     }
     let rows = match variant {
         Variant::WholeSystem => {
             if !(multiplier_scale.is_finite() && multiplier_scale > 0.0) {
-                return Err(Error::Usage(format!("the multiplier scale must be positive, got {multiplier_scale}")));
+                return Err(Error::usage(format!("the multiplier scale must be positive, got {multiplier_scale}")));
             }
             ndarray::concatenate(Axis(0), &[centred.view(), (&lambda / multiplier_scale).view()])
                 .map_err(|e| Error::numerical("POD", e.to_string()))?
@@ -64,7 +64,7 @@ pub(crate) fn train_plain(
             (lead.slice(s![..n, ..]).to_owned(), Vec::new(), Some(lead.slice(s![n.., ..]).to_owned()))
         }
         Variant::WholeSystemStabilized => {
-            return Err(Error::Usage("the stabilized variant is trained by whole_system".into()))
+            return Err(Error::usage("the stabilized variant is trained by whole_system"))
         }
         Variant::ConstraintPreserving => {
             let mut v = Array2::zeros((n, r + joint_dofs.len()));
@@ -99,11 +99,11 @@ fn train_blocks(
 ) -> Result<Trained> {
     let n = centred.nrows();
     if matches!(spec.variant, Variant::WholeSystem | Variant::WholeSystemStabilized) {
-        return Err(Error::Usage("a basis with blocks needs the galerkin or the constraint-preserving variant".into()));
+        return Err(Error::usage("a basis with blocks needs the galerkin or the constraint-preserving variant"));
     }
     if let ModeRule::Counts(c) = &spec.modes {
         if c.len() != spec.blocks.len() {
-            return Err(Error::Usage(format!(
+            return Err(Error::usage(format!(
                 "{} gives {} counts for {} blocks",
                 spec.modes,
                 c.len(),
@@ -115,16 +115,16 @@ fn train_blocks(
     for (b, block) in spec.blocks.iter().enumerate() {
         for &d in block {
             match owner.get(d) {
-                None => return Err(Error::Usage(format!("block {} holds coordinate {d}, the model has {n}", b + 1))),
+                None => return Err(Error::usage(format!("block {} holds coordinate {d}, the model has {n}", b + 1))),
                 Some(Some(o)) => {
-                    return Err(Error::Usage(format!("coordinate {d} is in blocks {} and {}", o + 1, b + 1)))
+                    return Err(Error::usage(format!("coordinate {d} is in blocks {} and {}", o + 1, b + 1)))
                 }
                 Some(None) => owner[d] = Some(b),
             }
         }
     }
     if let Some(d) = reduced_dofs.iter().find(|&&d| owner[d].is_none()) {
-        return Err(Error::Usage(format!("coordinate {d} is in no block")));
+        return Err(Error::usage(format!("coordinate {d} is in no block")));
     }
     let kept = if spec.variant == Variant::ConstraintPreserving { joint_dofs.to_vec() } else { Vec::new() };
     let (mut pods, mut block_modes, mut columns) = (Vec::new(), Vec::new(), Vec::new());

@@ -86,7 +86,7 @@ pub fn ecsw<M: InvariantElementModel>(
     tolerance: f64,
 ) -> Result<Hyper> {
     if snapshots.ncols() == 0 {
-        return Err(Error::Usage("no training snapshots".into()));
+        return Err(Error::usage("no training snapshots"));
     }
     // b = C 1 lies in C's range: once NNLS has taken as long as factoring C would, it goes
     // on in C's triangular factor R (n_elements², not rows × n_elements, per iteration)

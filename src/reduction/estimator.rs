@@ -343,7 +343,7 @@ impl EstimateMethod {
             "enriched" => Ok(EstimateMethod::Enriched),
             "defects" => Ok(EstimateMethod::Defects),
             _ => {
-                Err(Error::Usage(format!("is \"{s}\"; expected \"corrected\" (default), \"defects\" or \"enriched\"")))
+                Err(Error::usage(format!("is \"{s}\"; expected \"corrected\" (default), \"defects\" or \"enriched\"")))
             }
         }
     }
@@ -382,7 +382,7 @@ impl ErrorMeasure {
         match s {
             "relative" => Ok(ErrorMeasure::Relative),
             "displacement" => Ok(ErrorMeasure::Displacement),
-            _ => Err(Error::Usage(format!("is \"{s}\"; expected \"relative\" (default) or \"displacement\""))),
+            _ => Err(Error::usage(format!("is \"{s}\"; expected \"relative\" (default) or \"displacement\""))),
         }
     }
 

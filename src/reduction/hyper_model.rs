@@ -103,7 +103,7 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
     /// `basis`, summing the element terms over the sample `hyper`.
     pub fn new(full: impl Into<Arc<M>>, basis: &Basis, hyper: &Hyper) -> Result<Self> {
         let full: Arc<M> = full.into();
-        hyper.validate(full.n_elements()).map_err(|(f, p)| Error::Usage(format!("{f} {p}")))?;
+        hyper.validate(full.n_elements()).map_err(|(f, p)| Error::usage(format!("{f} {p}")))?;
         let mut p = Projection::new(&*full, basis)?;
         let v = basis.modes.as_standard_layout();
         let r = v.ncols();
@@ -111,7 +111,7 @@ impl<M: InvariantElementModel> HyperReducedModel<M> {
         let ne = if n_el > 0 { full.element_dofs(0).len() } else { 0 };
         let nj = full.n_invariants();
         if ![4, 6, 8, 12].contains(&ne) {
-            return Err(Error::Usage(format!("hyper-reduction supports elements of 4, 6, 8 or 12 dofs, not {ne}")));
+            return Err(Error::usage(format!("hyper-reduction supports elements of 4, 6, 8 or 12 dofs, not {ne}")));
         }
 
         // the elements by stiffness parameter, each group's linear part summed apart

@@ -50,10 +50,10 @@ pub fn train_basis(
         return basis_train::train_plain(x, lambda, joint_dofs, x_ref, spec);
     }
     if !spec.blocks.is_empty() {
-        return Err(Error::Usage("a basis with blocks needs the galerkin or the constraint-preserving variant".into()));
+        return Err(Error::usage("a basis with blocks needs the galerkin or the constraint-preserving variant"));
     }
     if x.ncols() == 0 {
-        return Err(Error::Usage("the training set is empty (no snapshots)".into()));
+        return Err(Error::usage("the training set is empty (no snapshots)"));
     }
     let reference = match spec.snapshots {
         SnapshotKind::Raw => ndarray::Array1::zeros(x.nrows()),

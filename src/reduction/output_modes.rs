@@ -80,11 +80,11 @@ pub fn add_output_modes(
 ) -> Result<Vec<usize>> {
     if let Stop::Tolerance(t) = stop {
         if !(t.is_finite() && t > 0.0 && t < 1.0) {
-            return Err(Error::Usage(format!("the probe-mode tolerance must lie in (0, 1), got {t}")));
+            return Err(Error::usage(format!("the probe-mode tolerance must lie in (0, 1), got {t}")));
         }
     }
     if blocks.len() != trained.block_modes.len() {
-        return Err(Error::Usage(format!(
+        return Err(Error::usage(format!(
             "{} row sets for a basis of {} blocks",
             blocks.len(),
             trained.block_modes.len()

@@ -27,15 +27,15 @@ pub enum ModeRule {
 impl ModeRule {
     pub fn validate(&self) -> Result<()> {
         match *self {
-            ModeRule::Count(0) => Err(Error::Usage("count must be at least 1".into())),
+            ModeRule::Count(0) => Err(Error::usage("count must be at least 1")),
             ModeRule::Counts(ref c) if c.is_empty() || c.contains(&0) => {
-                Err(Error::Usage(format!("counts must be at least 1 each, got {c:?}")))
+                Err(Error::usage(format!("counts must be at least 1 each, got {c:?}")))
             }
             ModeRule::Ratio(x) if !(x.is_finite() && x > 0.0 && x <= 1.0) => {
-                Err(Error::Usage(format!("ratio must lie in (0, 1], got {x}")))
+                Err(Error::usage(format!("ratio must lie in (0, 1], got {x}")))
             }
             ModeRule::Energy(t) if !(t.is_finite() && t > 0.0 && t < 1.0) => {
-                Err(Error::Usage(format!("energy tolerance must lie in (0, 1), got {t}")))
+                Err(Error::usage(format!("energy tolerance must lie in (0, 1), got {t}")))
             }
             _ => Ok(()),
         }
@@ -55,13 +55,13 @@ impl ModeRule {
         let r = match *self {
             ModeRule::Count(n) => n,
             ModeRule::Counts(ref c) => {
-                *c.get(b).ok_or_else(|| Error::Usage(format!("{self} has no count for block {}", b + 1)))?
+                *c.get(b).ok_or_else(|| Error::usage(format!("{self} has no count for block {}", b + 1)))?
             }
             ModeRule::Ratio(x) => ((x * n_dof as f64).round() as usize).max(1),
             ModeRule::Energy(tol) => energy.iter().position(|&e| e >= 1.0 - tol).map_or(available, |i| i + 1),
         };
         if r > available {
-            return Err(Error::Usage(format!("{self} asks for {r} modes but the snapshots span at most {available}")));
+            return Err(Error::usage(format!("{self} asks for {r} modes but the snapshots span at most {available}")));
         }
         Ok(r)
     }

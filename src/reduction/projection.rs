@@ -195,7 +195,7 @@ impl ProjectedForces {
 impl Projection {
     pub fn new<M: ElementModel>(full: &M, basis: &Basis) -> Result<Self> {
         let (n, nc_full) = (full.n_dof(), full.n_constraints());
-        basis.validate(n, nc_full).map_err(|(field, problem)| Error::Usage(format!("{field} {problem}")))?;
+        basis.validate(n, nc_full).map_err(|(field, problem)| Error::usage(format!("{field} {problem}")))?;
         let v = &basis.modes;
         let r = v.ncols();
         let load_dofs = full.load_dofs();
@@ -244,7 +244,7 @@ impl Projection {
         full.constraint_residual(&mu0, basis.reference.as_slice().expect("contiguous"), 0.0, &mut res);
         let moving = moving::MovingRows::new(full, v, &basis.reference, nc_full)?;
         if !moving.is_empty() && basis.variant != Variant::ConstraintPreserving {
-            return Err(Error::Usage(format!(
+            return Err(Error::usage(format!(
                 "the model prescribes motions (driven joints), whose rows move with time; the {} variant projects \
                  the joint rows once: train with variant = \"constraint-preserving\"",
                 basis.variant.name()

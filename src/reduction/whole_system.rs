@@ -81,18 +81,17 @@ pub(crate) fn train_stabilized(
 ) -> Result<Trained> {
     let n = centred.nrows();
     let stab = spec.stabilization.as_ref().ok_or_else(|| {
-        Error::Usage("the whole-system-stabilized variant needs the joint equations B (none were given)".into())
+        Error::usage("the whole-system-stabilized variant needs the joint equations B (none were given)")
     })?;
     let b = &stab.constraints;
     let nc = b.nrows();
     if nc == 0 {
-        return Err(Error::Usage(
-            "the model has no joints: the whole-system-stabilized variant has no multipliers to reduce; use galerkin"
-                .into(),
+        return Err(Error::usage(
+            "the model has no joints: the whole-system-stabilized variant has no multipliers to reduce; use galerkin",
         ));
     }
     if b.ncols() != n || lambda.nrows() != nc || lambda.ncols() != centred.ncols() {
-        return Err(Error::Usage(format!(
+        return Err(Error::usage(format!(
             "B is {:?}, the snapshots are {:?} and the multiplier snapshots {:?}: they do not fit",
             b.dim(),
             centred.dim(),
@@ -100,13 +99,13 @@ pub(crate) fn train_stabilized(
         )));
     }
     if let ModeRule::Counts(_) = spec.modes {
-        return Err(Error::Usage(format!("{} gives one count per block, and the basis has no blocks", spec.modes)));
+        return Err(Error::usage(format!("{} gives one count per block, and the basis has no blocks", spec.modes)));
     }
     let p = pod(centred.view())?;
     let r = spec.modes.count(n, p.energy.as_slice().expect("contiguous"))?;
     if lambda.iter().all(|&v| v == 0.0) {
-        return Err(Error::Usage(
-            "the multiplier snapshots are all zero (the joints carry no load): nothing to reduce".into(),
+        return Err(Error::usage(
+            "the multiplier snapshots are all zero (the joints carry no load): nothing to reduce",
         ));
     }
     let pl = pod(lambda).map_err(|e| e.context("multiplier POD"))?;
@@ -117,7 +116,7 @@ pub(crate) fn train_stabilized(
     let phi = p.leading(r);
     let psi = pl.leading(k);
     let supremizers = orthonormalize_against(&phi, &b.t().dot(&psi)).map_err(|j| {
-        Error::Usage(format!(
+        Error::usage(format!(
             "supremizer {} (Bᵀ of multiplier mode {}) lies in the span of the coordinate modes",
             j + 1,
             j + 1

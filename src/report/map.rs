@@ -156,7 +156,7 @@ impl Map {
     /// Writes `<stem>.svg` and `<stem>.png`; returns their paths.
     pub fn save(&self, stem: &Path) -> Result<Vec<PathBuf>> {
         if self.axes.len() < 2 {
-            return Err(Error::Usage("a map needs two parameters or more".into()));
+            return Err(Error::usage("a map needs two parameters or more"));
         }
         let (svg, png) = (stem.with_extension("svg"), stem.with_extension("png"));
         let (w, h) = self.size();

@@ -19,7 +19,6 @@ pub mod warnings;
 
 pub use run::{check_reduced_memory, settings_at, Output, ReducedRun, ReducedRunner};
 pub use trust::Trust;
-pub use warnings::Answered;
 
 use crate::error::{Error, Result};
 use crate::io::basis_file::StoredBasis;

@@ -59,7 +59,7 @@ mod tests {
             assert_eq!(pool.with(|w| *w).unwrap(), 0);
         }
         assert_eq!(made.load(Ordering::SeqCst), 1);
-        let bad: Pool<'_, u8> = Pool::new(|| Err(crate::Error::Usage("no".into())));
+        let bad: Pool<'_, u8> = Pool::new(|| Err(crate::Error::usage("no")));
         assert!(bad.with(|_| ()).is_err());
     }
 

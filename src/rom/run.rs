@@ -146,7 +146,7 @@ pub(crate) fn static_start<R: Reduced<FlexibleSystem>>(
     let mut bound = crate::solver::model::Bound::new(rom, &s.mu);
     crate::solver::statics::solve_static(&mut bound, &mut z, 0.0, TOLERANCE, MAX_ITERATIONS).map_err(|e| {
         if e.is_numerical() {
-            Error::Usage(format!("[initial] static: {whose} static equilibrium under the run's loads: {e}"))
+            Error::usage(format!("[initial] static: {whose} static equilibrium under the run's loads: {e}"))
         } else {
             e
         }

@@ -74,22 +74,22 @@ impl Default for IntegratorParams {
 impl IntegratorParams {
     pub fn validate(&self) -> Result<()> {
         if !(self.rho_inf.is_finite() && (0.0..=1.0).contains(&self.rho_inf)) {
-            return Err(Error::Usage(format!("rho_inf must lie in [0, 1], got {}", self.rho_inf)));
+            return Err(Error::usage(format!("rho_inf must lie in [0, 1], got {}", self.rho_inf)));
         }
         if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
-            return Err(Error::Usage(format!("Newton tolerance must be positive, got {}", self.tolerance)));
+            return Err(Error::usage(format!("Newton tolerance must be positive, got {}", self.tolerance)));
         }
         if !(self.stagnation.is_finite() && self.stagnation >= 0.0) {
-            return Err(Error::Usage(format!(
+            return Err(Error::usage(format!(
                 "the Newton stagnation bound must be zero or positive, got {}",
                 self.stagnation
             )));
         }
         if !(self.max_strain > 0.0) {
-            return Err(Error::Usage(format!("max_strain must be positive, got {}", self.max_strain)));
+            return Err(Error::usage(format!("max_strain must be positive, got {}", self.max_strain)));
         }
         if self.max_iterations == 0 {
-            return Err(Error::Usage("max_iterations must be at least 1".into()));
+            return Err(Error::usage("max_iterations must be at least 1"));
         }
         Ok(())
     }

@@ -53,10 +53,10 @@ impl ParameterRange {
     pub fn validate(&self) -> Result<()> {
         let (a, b) = (self.lower, self.upper);
         if !(a.is_finite() && b.is_finite() && a < b) {
-            return Err(Error::Usage(format!("range [{a}, {b}] must be finite with lower < upper")));
+            return Err(Error::usage(format!("range [{a}, {b}] must be finite with lower < upper")));
         }
         if self.spacing == Spacing::Log && a <= 0.0 {
-            return Err(Error::Usage(format!("range [{a}, {b}] with scale = \"log\" must lie above zero")));
+            return Err(Error::usage(format!("range [{a}, {b}] with scale = \"log\" must lie above zero")));
         }
         Ok(())
     }

@@ -92,7 +92,7 @@ impl Parameters {
                 return Err(if name == LOAD_SCALE {
                     Error::option(LOAD_SCALE, None, problem)
                 } else {
-                    Error::Usage(format!("parameter {name} {problem}"))
+                    Error::usage(format!("parameter {name} {problem}"))
                 });
             }
         }

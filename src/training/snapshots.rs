@@ -116,9 +116,11 @@ pub fn write_snapshots(p: &Pipeline, points: &[Parameters], out: &Path) -> Resul
         Vec::new()
     } else {
         let all = p.training_points();
-        points.iter().map(|mu| all.iter().position(|a| a == mu).map(|i| i as u64)).collect::<Option<_>>().ok_or_else(
-            || Error::Usage("--snapshots-only: a point is not among the pipeline's training points".into()),
-        )?
+        points
+            .iter()
+            .map(|mu| all.iter().position(|a| a == mu).map(|i| i as u64))
+            .collect::<Option<_>>()
+            .ok_or_else(|| Error::usage("--snapshots-only: a point is not among the pipeline's training points"))?
     };
     let mut runs = Vec::new();
     let mut seconds = 0.0;
@@ -343,7 +345,7 @@ pub fn train_from_snapshots(p: &Pipeline, files: &[PathBuf]) -> Result<(Training
         } else {
             format!("training load(s) {:?}", missing.iter().map(|&k| points[k].scale()).collect::<Vec<_>>())
         };
-        return Err(Error::Usage(format!("--from-snapshots: no file holds the {what} of {}", p.path.display())));
+        return Err(Error::usage(format!("--from-snapshots: no file holds the {what} of {}", p.path.display())));
     }
     // the pipeline's order, as a single `train` concatenates its runs
     let ordered: Vec<&Run> = held.iter().map(|r| r.as_ref().expect("checked above")).collect();

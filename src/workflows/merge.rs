@@ -262,7 +262,7 @@ pub struct Merged {
 /// Joins `parts` into `out` (atomically; the caller has checked that `out` may be written).
 pub fn merge(parts: &[PathBuf], out: &Path, partial: bool, limits: &Limits) -> Result<Merged> {
     if parts.is_empty() {
-        return Err(Error::Usage("merge: no part files given".into()));
+        return Err(Error::usage("merge: no part files given"));
     }
     let parts: Vec<Part> = parts.iter().map(|p| read_part(p, limits)).collect::<Result<_>>()?;
     let first = &parts[0];
@@ -401,7 +401,7 @@ fn check_coverage(parts: &[Part], partial: bool) -> Result<()> {
         let loads: Vec<Parameters> =
             (0..all.len()).filter(|i| missing.contains(&(i % first.count))).map(|i| all[i].clone()).collect();
         let names: Vec<String> = missing.iter().map(|k| format!("{}/{}", k + 1, first.count)).collect();
-        return Err(Error::Usage(format!(
+        return Err(Error::usage(format!(
             "merge: shard(s) {} missing: {} not in any part; give their parts, or --partial to merge the rest with these marked not run",
             names.join(", "),
             some(&loads)

@@ -8,7 +8,8 @@ use crate::pipeline::config::Pipeline;
 use crate::pipeline::fallback::{settle, Fallback};
 use crate::rom::estimator::{Estimate, EstimateMethod};
 use crate::rom::trust::write_run_attributes;
-use crate::rom::{check_reduced_memory, settings_at, Answered, LoadOptions, Output, ReducedRun, Rom, Trust};
+use crate::rom::warnings::Answered;
+use crate::rom::{check_reduced_memory, settings_at, LoadOptions, Output, ReducedRun, Rom, Trust};
 use crate::solver::model::Parameters;
 use std::path::Path;
 

@@ -58,7 +58,7 @@ pub fn grid(axes: &[(String, Vec<f64>)]) -> Result<Vec<Parameters>> {
     }
     let total = axes.iter().map(|(_, v)| v.len() as f64).product::<f64>();
     if total > MAX_LOAD_SCALES as f64 {
-        return Err(Error::Usage(format!(
+        return Err(Error::usage(format!(
             "the grid has {total} points, more than the {MAX_LOAD_SCALES} one sweep takes; split it into several sweeps"
         )));
     }

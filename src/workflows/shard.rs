@@ -186,7 +186,7 @@ pub fn configure_threads(flag: Option<usize>) -> Result<()> {
     rayon::ThreadPoolBuilder::new()
         .num_threads(n)
         .build_global()
-        .map_err(|e| Error::Usage(format!("{source}: could not start {n} worker threads: {e}")))
+        .map_err(|e| Error::usage(format!("{source}: could not start {n} worker threads: {e}")))
 }
 
 /// The count an environment variable asks for; `None` when unset or empty (and for 0 where
@@ -201,11 +201,11 @@ fn threads_from_env(name: &'static str, zero_is_default: bool) -> Result<Option<
         Ok(0) if zero_is_default => Ok(None),
         Ok(n) if n > 0 && n <= MOST_THREADS as u64 => Ok(Some((name, n as usize))),
         // a row of digits too large for u64 is as absurd as 100000
-        Ok(n) if n > 0 => Err(Error::Usage(format!("{shown}: {}", too_many_threads()))),
+        Ok(n) if n > 0 => Err(Error::usage(format!("{shown}: {}", too_many_threads()))),
         Err(_) if v.bytes().all(|b| b.is_ascii_digit()) => {
-            Err(Error::Usage(format!("{shown}: {}", too_many_threads())))
+            Err(Error::usage(format!("{shown}: {}", too_many_threads())))
         }
-        _ => Err(Error::Usage(format!("{shown} is not a positive whole number"))),
+        _ => Err(Error::usage(format!("{shown} is not a positive whole number"))),
     }
 }
 

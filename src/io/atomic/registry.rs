@@ -189,7 +189,7 @@ pub fn live_paths() -> Vec<PathBuf> {
 pub fn install_signal_handler() -> Result<()> {
     use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
     let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP])
-        .map_err(|e| Error::Usage(format!("cannot install the SIGINT/SIGTERM/SIGHUP handler: {e}")))?;
+        .map_err(|e| Error::usage(format!("cannot install the SIGINT/SIGTERM/SIGHUP handler: {e}")))?;
     std::thread::Builder::new()
         .name("flexrom-signals".into())
         .spawn(move || {
@@ -221,7 +221,7 @@ pub fn install_signal_handler() -> Result<()> {
                 signal_hook::low_level::exit(128 + sig);
             }
         })
-        .map_err(|e| Error::Usage(format!("cannot start the signal thread: {e}")))?;
+        .map_err(|e| Error::usage(format!("cannot start the signal thread: {e}")))?;
     Ok(())
 }
 

@@ -30,7 +30,7 @@ pub fn swap_in_dir_with(
 ) -> Result<()> {
     let (src, target) = match &tmp.live {
         Live::Dir(p) => (p.clone(), tmp.target.clone()),
-        _ => return Err(Error::Usage("internal: swap_in_dir needs a temporary folder".into())),
+        _ => return Err(Error::usage("internal: swap_in_dir needs a temporary folder")),
     };
     let (parent, name) = split(&target)?;
     // a stop asked for: the folder's contents may come from runs the stop cut short

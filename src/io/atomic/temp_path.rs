@@ -59,7 +59,7 @@ impl TempPath {
                 Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
                 // the output named, not the temporary name the user never gave
                 Err(e) => {
-                    return Err(Error::Usage(format!(
+                    return Err(Error::usage(format!(
                         "{}: cannot write there: creating its temporary sibling {} failed: {e}",
                         target.display(),
                         tmp.display()
@@ -104,7 +104,7 @@ impl TempPath {
         crate::interrupt::check()?;
         let tmp = self.path().to_path_buf();
         if matches!(self.live, Live::Dir(_)) {
-            return Err(Error::Usage(format!(
+            return Err(Error::usage(format!(
                 "internal: {} is a folder; it is swapped in, not committed",
                 tmp.display()
             )));

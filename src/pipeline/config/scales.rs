@@ -73,10 +73,10 @@ pub fn parse_scales(s: &str) -> std::result::Result<Vec<f64>, String> {
 /// with `String` errors, take its [`Error::problem`]).
 pub(super) fn check_scales(v: &[f64]) -> Result<()> {
     if v.is_empty() {
-        return Err(Error::Usage("the list of load scales is empty".into()));
+        return Err(Error::usage("the list of load scales is empty"));
     }
     if let Some(x) = v.iter().find(|x| !x.is_finite()) {
-        return Err(Error::Usage(format!("load scale {x} is not finite")));
+        return Err(Error::usage(format!("load scale {x} is not finite")));
     }
     Ok(())
 }

@@ -32,7 +32,7 @@ impl MovingRows {
         let mut rows = Vec::new();
         for (c, dofs) in full.moving_rows() {
             if dofs.len() > MAX_TERMS {
-                return Err(Error::Usage(format!(
+                return Err(Error::usage(format!(
                     "constraint row {c} moves with {} terms; at most {MAX_TERMS}",
                     dofs.len()
                 )));

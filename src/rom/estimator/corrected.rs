@@ -158,7 +158,7 @@ impl CorrectedRunner {
             }
         };
         let rom = HyperReducedModel::new(sys, enriched, h)
-            .map_err(|e| Error::Usage(format!("cannot build the estimator's reduced model: {e}")))?;
+            .map_err(|e| Error::usage(format!("cannot build the estimator's reduced model: {e}")))?;
         let lift = enriched.modes.t().dot(&basis.modes);
         let q0 = enriched.reduce(ArrayView1::from(&physics.x0[..])).to_vec();
         let v0 = enriched.reduce_increment(ArrayView1::from(&physics.v0[..])).to_vec();
@@ -479,11 +479,11 @@ impl ErrorEstimator for Corrected {
             self.fallback.get_or_init(|| super::enriched::Enriched::new(&self.model, &self.basis, &self.data).ok());
         match fallback {
             Some(e) => e.raw(run).map_err(|e| {
-                crate::error::Error::Usage(format!(
+                crate::error::Error::usage(format!(
                     "the corrected estimate {why}, and the enriched model run instead failed too ({e})"
                 ))
             }),
-            None => Err(crate::error::Error::Usage(format!(
+            None => Err(crate::error::Error::usage(format!(
                 "the corrected estimate {why} and the enriched model cannot be built"
             ))),
         }
