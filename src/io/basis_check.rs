@@ -30,7 +30,7 @@ pub use super::basis_content::{check_content, MIN_WEIGHT, ORTHONORMALITY_TOLERAN
 use super::basis_file::{open_basis, read_core, read_rest, StoredBasis};
 pub use super::basis_hash::{content_hash, settings_hash, HashInput};
 pub use super::basis_layout::check_file;
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, Text};
 use crate::model::Model;
 use crate::reduction::{SnapshotKind, Variant};
 use crate::solver::model::ParametricModel;
@@ -160,7 +160,10 @@ fn bounded_by_memory(f: &hdf5::File, path: &Path, model: &Model) -> Result<()> {
         model
             .limits
             .check_memory(&format!("its shape {shape:?}"), bytes)
-            .map_err(|e| Error::input(path, &name, e.to_string()))?;
+            // a bound, not a damaged file: the options that raise it stay the front end's to spell
+            .map_err(|e| {
+                Error::Resource(Text::new(format!("{}: {name}: ", path.display())).append(e.problem_text()))
+            })?;
     }
     Ok(())
 }

@@ -336,10 +336,14 @@ impl Validation {
     /// This validation's reduced answer at `mu` as the warnings after it read it
     /// ([`crate::rom::Rom::warnings_after`]).
     pub fn answered<'a>(&'a self, rom: &Rom, mu: &'a Parameters) -> crate::rom::warnings::Answered<'a> {
+        use crate::rom::warnings::reading;
+        let probes = self.probe_quantity_errors.iter().map(|q| (reading(q.quantity.name(), &q.probe), q.estimate));
+        let reactions = self.reaction_errors.iter().map(|q| (reading(q.quantity.name(), &q.reaction), q.estimate));
         crate::rom::warnings::Answered {
             mu,
             estimate: self.estimate_in(rom.tolerance_measure()),
             failure: self.estimate_failure.as_deref(),
+            quantities: probes.chain(reactions).filter_map(|(name, e)| Some((name, e?))).collect(),
         }
     }
 

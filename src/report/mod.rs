@@ -1029,7 +1029,12 @@ fn sweep_warnings(rom: &Rom, path: &Path, strict: bool) -> Result<Vec<String>> {
     let points = crate::records::sweep_file::points_of(&f, &scales.to_vec())
         .map_err(|(field, problem)| Error::input(path, field, problem))?;
     let answered: Vec<_> = (points.iter().zip(&est))
-        .map(|(mu, &e)| crate::rom::warnings::Answered { mu, estimate: Some(e).filter(|e| !e.is_nan()), failure: None })
+        .map(|(mu, &e)| crate::rom::warnings::Answered {
+            mu,
+            estimate: Some(e).filter(|e| !e.is_nan()),
+            failure: None,
+            quantities: Vec::new(),
+        })
         .collect();
     rom.warnings_after(&answered, strict)
 }

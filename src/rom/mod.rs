@@ -173,7 +173,7 @@ impl Rom {
             return Vec::new();
         }
         vec![format!(
-            "outside what the basis was trained on: {}; the reduced model extrapolates there (check it with `flexrom validate`)",
+            "outside what the basis was trained on: {}; the reduced model extrapolates there (`validate` measures it against the full model)",
             away.join(", ")
         )]
     }

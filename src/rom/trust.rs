@@ -346,13 +346,18 @@ fn which(named: &[String], of: usize, sep: (&str, &str), in_box: bool) -> String
     }
 }
 
-/// A run's parameters in a list of a message: its load scale ([`short`]), or in a box the
-/// box's parameters, `(g = 1.1, push = 0.3)`.
-fn label(trust: &Trust, mu: &Parameters) -> String {
-    if trust.space.is_empty() {
-        return short(mu.scale());
+/// A run's parameters in a list of a message: its load scale ([`short`]), in a box the
+/// box's parameters, `(g = 1.1, push = 0.3)`, and with named parameters outside a box all
+/// of them, `(load scale 1, payload = 1)`.
+/// `whole`: some run of the list has named parameters outside a box (each is then named by
+/// all its parameters, λ alone as `(load scale 3)`).
+fn label(trust: &Trust, mu: &Parameters, whole: bool) -> String {
+    match (trust.space.is_empty(), whole) {
+        (true, false) => short(mu.scale()),
+        // named parameters the basis was not trained over: they are part of where it ran
+        (true, true) => format!("({mu})"),
+        (false, _) => format!("({})", trust.space.label(mu)),
     }
-    format!("({})", trust.space.label(mu))
 }
 
 /// At most five entries of a list for a one-line message, then "…".
@@ -382,11 +387,16 @@ pub fn check_runs(
 ) -> Result<Vec<String>> {
     let mut warnings = before;
     let (a, b) = trust.range;
-    // λ outside its range (a box's other parameters are the caller's to name)
+    // runs named by their points where they have parameters besides λ
+    let named = !trust.space.is_empty() || runs.iter().any(|r| r.0.named().next().is_some());
+    // λ outside its range (a box's other parameters are the caller's to name; named
+    // parameters outside a box are part of where it ran)
+    let whole = trust.space.is_empty() && named;
+    let outside = runs.iter().filter(|r| is_extrapolated(trust.range, r.0.scale()));
     let out: Vec<String> =
-        runs.iter().filter(|r| is_extrapolated(trust.range, r.0.scale())).map(|r| short(r.0.scale())).collect();
+        outside.map(|r| if whole { label(trust, &r.0, whole) } else { short(r.0.scale()) }).collect();
     if !out.is_empty() {
-        let what = which(&out, runs.len(), (" (", ")"), false);
+        let what = which(&out, runs.len(), (" (", ")"), whole);
         warnings.push(format!(
             "{what} outside the basis's training range [{a}, {b}]: extrapolated, the reduced model was never trained there"
         ));
@@ -394,10 +404,12 @@ pub fn check_runs(
     if let Some(tol) = trust.tolerance {
         let sensitive: Vec<String> = runs
             .iter()
-            .filter_map(|r| trust.amplifying_near(&r.0, r.1).map(|s| format!("{} ({s:.1e})", label(trust, &r.0))))
+            .filter_map(|r| {
+                trust.amplifying_near(&r.0, r.1).map(|s| format!("{} ({s:.1e})", label(trust, &r.0, whole)))
+            })
             .collect();
         if !sensitive.is_empty() {
-            let what = which(&sensitive, runs.len(), (": ", ""), !trust.space.is_empty());
+            let what = which(&sensitive, runs.len(), (": ", ""), named);
             let load = if trust.space.is_empty() { "the load" } else { "the parameters" };
             warnings.push(format!(
                 "the model amplifies changes of {load} at {what}: near there a 0.1 % change of {load} moved \
@@ -417,7 +429,7 @@ pub fn check_runs(
         // (norms::against_motion): nothing to hold to the tolerance
         .filter(|r| r.1.is_none_or(|e| !e.is_nan() && !(e <= tol)))
         .map(|r| {
-            let at = label(trust, &r.0);
+            let at = label(trust, &r.0, whole);
             match r.1 {
                 Some(e) if e.is_infinite() => format!(
                     "{at} (∞: the estimator's own run failed{})",
@@ -435,7 +447,7 @@ pub fn check_runs(
     if over.is_empty() {
         return Ok(warnings);
     }
-    let what = which(&over, runs.len(), (": ", ""), !trust.space.is_empty());
+    let what = which(&over, runs.len(), (": ", ""), named);
     let kind = match trust.measure {
         ErrorMeasure::Relative => "error estimate",
         ErrorMeasure::Displacement => "displacement error estimate",
@@ -495,6 +507,13 @@ mod tests {
             other => panic!("expected the strict error, got {other:?}"),
         }
         assert!(check_runs(&t, true, &[(l(1.0), Some(1e-4))], true, Vec::new()).unwrap().is_empty());
+        // a named parameter the basis was not trained over is part of where the run was
+        let named = [(l(1.0).with("payload", 1.0), Some(3.9e-3))];
+        let w = check_runs(&t, true, &named, false, Vec::new()).unwrap();
+        assert_eq!(w, ["error estimate above the tolerance 1e-3 at point (load scale 1, payload = 1) (3.90e-3)"]);
+        let twice = [(l(3.0), Some(1e-4)), (l(3.0).with("payload", 1.0), Some(1e-4))];
+        let w = check_runs(&t, true, &twice, false, Vec::new()).unwrap();
+        assert!(w[0].starts_with("2 of 2 points ((load scale 3), (load scale 3, payload = 1)) outside"), "{w:?}");
         let none = check_runs(&Trust::range((0.5, 1.5)), false, &[(l(1.0), None)], false, Vec::new()).unwrap();
         assert!(none.len() == 1 && none[0].contains("no error estimator"), "{none:?}");
     }

@@ -16,6 +16,10 @@ pub struct Answered<'a> {
     pub estimate: Option<f64>,
     /// why the estimator's own run failed, when it did (the estimate then reads ∞)
     pub failure: Option<&'a str>,
+    /// the estimates of what engineers read — each probe quantity and joint reaction,
+    /// relative to its range over the run — named as a message names them (`strain at
+    /// tip`)
+    pub quantities: Vec<(String, f64)>,
 }
 
 impl<'a> Answered<'a> {
@@ -25,8 +29,16 @@ impl<'a> Answered<'a> {
             mu,
             estimate: estimate.map(|e| e.in_measure(rom.tolerance_measure())),
             failure: estimate.and_then(|e| e.failure.as_deref()),
+            quantities: estimate.map_or_else(Vec::new, |e| {
+                e.quantities.iter().map(|q| (reading(q.quantity.name(), &q.probe), q.estimate)).collect()
+            }),
         }
     }
+}
+
+/// A probe quantity or reaction as a message names it: `strain at tip`.
+pub fn reading(quantity: &str, name: &str) -> String {
+    format!("{quantity} at {name}")
 }
 
 impl Rom {
@@ -38,7 +50,9 @@ impl Rom {
     /// 2. parameters other than the load scale outside what the basis was trained on
     ///    ([`Rom::untrained_parameters`] for one answer; for more, how many points and the
     ///    first's);
-    /// 3. [`trust::check_runs`]: the load scale outside its training range, a model that
+    /// 3. readings whose estimate exceeds their whole range over the run
+    ///    ([`unreadable_quantities`]): the reduced model cannot tell them;
+    /// 4. [`trust::check_runs`]: the load scale outside its training range, a model that
     ///    amplifies load changes, no estimator, estimates above the tolerance.
     ///
     /// With `strict`, an estimate above the tolerance is an [`crate::Error::Strict`]
@@ -46,6 +60,7 @@ impl Rom {
     pub fn warnings_after(&self, answers: &[Answered<'_>], strict: bool) -> Result<Vec<String>> {
         let mut warnings = failed_estimates(answers);
         warnings.extend(self.outside_training(answers));
+        warnings.extend(unreadable_quantities(answers));
         let Some(trust) = self.trust() else { return Ok(warnings) };
         let runs: Vec<(Parameters, Option<f64>)> = answers.iter().map(|a| (a.mu.clone(), a.estimate)).collect();
         trust::check_runs(trust, self.estimator().is_some(), &runs, strict, warnings)
@@ -66,6 +81,42 @@ impl Rom {
             answers.len(),
             first.join(", ")
         )]
+    }
+}
+
+/// The warning about probe quantities and reactions whose estimate exceeds 1 — their whole
+/// range over the run — at some answers: the reduced answer may be off by more than the
+/// reading moves, so nothing of it can be read off (a stiff link's axial strain, which a
+/// rotation by a combination of modes stretches). One line: how many readings, at how many
+/// points, and the largest. Estimates that could not be computed (∞) are said apart.
+pub fn unreadable_quantities(answers: &[Answered<'_>]) -> Option<String> {
+    let mut names: Vec<&str> = Vec::new();
+    let (mut points, mut largest) = (0, None::<(f64, &str, &Parameters)>);
+    for a in answers {
+        let over: Vec<&(String, f64)> = a.quantities.iter().filter(|(_, e)| e.is_finite() && *e > 1.0).collect();
+        points += usize::from(!over.is_empty());
+        for (name, e) in over {
+            if !names.contains(&name.as_str()) {
+                names.push(name);
+            }
+            if largest.is_none_or(|(l, _, _)| *e > l) {
+                largest = Some((*e, name, a.mu));
+            }
+        }
+    }
+    let (e, name, mu) = largest?;
+    let at = if answers.len() == 1 { format!("{mu}") } else { format!("{points} of {} points", answers.len()) };
+    Some(format!(
+        "at {at} the error estimates of {} exceed their whole range over the run (the largest, {name}: {e:.2e} times its range, at {mu}): the reduced model cannot tell those readings; the full model gives them (`validate`), and greedy training with measure = \"probes\" holds them to the tolerance",
+        few_names(&names)
+    ))
+}
+
+/// Up to four names and how many more.
+fn few_names(names: &[&str]) -> String {
+    match names.len() {
+        0..=4 => names.join(", "),
+        n => format!("{} and {} more", names[..3].join(", "), n - 3),
     }
 }
 
@@ -99,8 +150,10 @@ mod tests {
     fn failed_estimates_are_listed_or_counted() {
         let runs: Vec<_> =
             [1.0, 1.1, 1.2].iter().map(|&x| at(&Parameters::load_scale(x), Some("Newton failed"))).collect();
-        let answers: Vec<Answered> =
-            runs.iter().map(|(mu, f)| Answered { mu, estimate: Some(f64::INFINITY), failure: *f }).collect();
+        let answers: Vec<Answered> = runs
+            .iter()
+            .map(|(mu, f)| Answered { mu, estimate: Some(f64::INFINITY), failure: *f, quantities: Vec::new() })
+            .collect();
         let two = failed_estimates(&answers[..2]);
         assert_eq!(two.len(), 2);
         assert!(
@@ -113,7 +166,37 @@ mod tests {
             three[0].starts_with("3 of 3 estimates could not be computed") && three[0].contains("load scale 1:"),
             "{three:?}"
         );
-        let fine = Answered { mu: &runs[0].0, estimate: Some(1e-3), failure: None };
+        let fine = Answered { mu: &runs[0].0, estimate: Some(1e-3), failure: None, quantities: Vec::new() };
         assert!(failed_estimates(&[fine]).is_empty());
+    }
+
+    /// A reading whose estimate exceeds its range is named, with the largest and where; one
+    /// line for all points; within the range (≤ 1), NaN (no swing) and ∞ (said apart) are not.
+    #[test]
+    fn readings_estimated_beyond_their_range_are_named_once() {
+        let (a, b) = (Parameters::load_scale(0.7), Parameters::load_scale(1.2));
+        let q = |v: &[(&str, f64)]| v.iter().map(|(n, e)| (n.to_string(), *e)).collect::<Vec<_>>();
+        let one = Answered {
+            mu: &a,
+            estimate: Some(1e-4),
+            failure: None,
+            quantities: q(&[("strain at tip", 388.0), ("curvature at tip", 0.5), ("strain at root", 8.7)]),
+        };
+        let w = unreadable_quantities(std::slice::from_ref(&one)).unwrap();
+        assert!(w.starts_with("at load scale 0.7 the error estimates of strain at tip, strain at root exceed"), "{w}");
+        assert!(w.contains("the largest, strain at tip: 3.88e2 times its range, at load scale 0.7"), "{w}");
+        let calm = Answered {
+            mu: &b,
+            estimate: Some(1e-4),
+            failure: None,
+            quantities: q(&[
+                ("strain at tip", 0.9),
+                ("position at tip", f64::NAN),
+                ("curvature at root", f64::INFINITY),
+            ]),
+        };
+        assert_eq!(unreadable_quantities(std::slice::from_ref(&calm)), None);
+        let w = unreadable_quantities(&[calm, one]).unwrap();
+        assert!(w.starts_with("at 1 of 2 points the error estimates of strain at tip, strain at root"), "{w}");
     }
 }
