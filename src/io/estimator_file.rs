@@ -311,9 +311,7 @@ fn read_defects(
 fn read_quantity_factors(cg: &hdf5::Group, field: &dyn Fn(&str, String) -> Error) -> Result<Vec<(String, f64)>> {
     let Ok(ds) = cg.dataset("quantity_factor") else { return Ok(Vec::new()) };
     let name = "calibration/quantity_factor";
-    let keys = crate::io::h5::read_attr_str(&ds, "quantities")
-        .map_err(|e| field(name, format!("has no readable attribute quantities ({e})")))?;
-    let keys: Vec<&str> = keys.lines().collect();
+    let keys = quantity_keys(&ds, name, field)?;
     if ds.shape() != [keys.len()] {
         return Err(field(name, format!("is {:?}; expected ({}), one factor per quantity", ds.shape(), keys.len())));
     }
@@ -321,7 +319,15 @@ fn read_quantity_factors(cg: &hdf5::Group, field: &dyn Fn(&str, String) -> Error
     if let Some(bad) = f.iter().find(|x| !(x.is_finite() && **x > 0.0)) {
         return Err(field(name, format!("holds {bad}; every factor must be positive and finite")));
     }
-    Ok(keys.into_iter().map(str::to_string).zip(f.iter().copied()).collect())
+    Ok(keys.into_iter().zip(f.iter().copied()).collect())
+}
+
+/// The attribute `quantities` of the dataset `name`: the keys `quantity:probe` of its
+/// columns, one a line.
+fn quantity_keys(ds: &hdf5::Dataset, name: &str, field: &dyn Fn(&str, String) -> Error) -> Result<Vec<String>> {
+    let keys = crate::io::h5::read_attr_str(ds, "quantities")
+        .map_err(|e| field(name, format!("has no readable attribute quantities ({e})")))?;
+    Ok(keys.lines().map(str::to_string).collect())
 }
 
 /// `/estimator/defects/quantity_ratio` (N, n_q) and its attribute `quantities` (the keys
@@ -334,9 +340,7 @@ fn read_quantity_ratios(
 ) -> Result<DefectsCalibration> {
     let Ok(ds) = dg.dataset("quantity_ratio") else { return Ok(c) };
     let name = "defects/quantity_ratio";
-    let keys = crate::io::h5::read_attr_str(&ds, "quantities")
-        .map_err(|e| field(name, format!("has no readable attribute quantities ({e})")))?;
-    let keys: Vec<String> = keys.lines().map(str::to_string).collect();
+    let keys = quantity_keys(&ds, name, field)?;
     let want = (c.ratios.len(), keys.len());
     let shape = ds.shape();
     if shape != [want.0, want.1] {

@@ -361,7 +361,7 @@ fn label(trust: &Trust, mu: &Parameters, whole: bool) -> String {
 }
 
 /// At most five entries of a list for a one-line message, then "…".
-fn few(v: &[String]) -> String {
+pub(crate) fn few(v: &[String]) -> String {
     if v.len() <= 5 {
         v.join(", ")
     } else {

@@ -90,14 +90,14 @@ impl Rom {
 /// rotation by a combination of modes stretches). One line: how many readings, at how many
 /// points, and the largest. Estimates that could not be computed (∞) are said apart.
 pub fn unreadable_quantities(answers: &[Answered<'_>]) -> Option<String> {
-    let mut names: Vec<&str> = Vec::new();
+    let mut names: Vec<String> = Vec::new();
     let (mut points, mut largest) = (0, None::<(f64, &str, &Parameters)>);
     for a in answers {
         let over: Vec<&(String, f64)> = a.quantities.iter().filter(|(_, e)| e.is_finite() && *e > 1.0).collect();
         points += usize::from(!over.is_empty());
         for (name, e) in over {
-            if !names.contains(&name.as_str()) {
-                names.push(name);
+            if !names.contains(name) {
+                names.push(name.clone());
             }
             if largest.is_none_or(|(l, _, _)| *e > l) {
                 largest = Some((*e, name, a.mu));
@@ -108,16 +108,8 @@ pub fn unreadable_quantities(answers: &[Answered<'_>]) -> Option<String> {
     let at = if answers.len() == 1 { format!("{mu}") } else { format!("{points} of {} points", answers.len()) };
     Some(format!(
         "at {at} the error estimates of {} exceed their whole range over the run (the largest, {name}: {e:.2e} times its range, at {mu}): the reduced model cannot tell those readings; the full model gives them (`validate`), and greedy training with measure = \"probes\" holds them to the tolerance",
-        few_names(&names)
+        trust::few(&names)
     ))
-}
-
-/// Up to four names and how many more.
-fn few_names(names: &[&str]) -> String {
-    match names.len() {
-        0..=4 => names.join(", "),
-        n => format!("{} and {} more", names[..3].join(", "), n - 3),
-    }
 }
 
 /// The warnings of estimates whose estimator's run failed: each for up to two answers (a

@@ -36,21 +36,21 @@ pub const CALIBRATION_MARGIN: f64 = 1.25;
 /// a non-finite or non-positive value are ignored (an exact reduced run says nothing about
 /// `c`); with none left, `c` = [`DEFAULT_FACTOR`], uncalibrated. The points are kept either way.
 pub fn calibrate(points: Vec<CalibrationPoint>) -> Calibration {
-    let ratios: Vec<f64> = points
-        .iter()
-        .filter(|p| p.raw_estimate.is_finite() && p.rel_error.is_finite() && p.raw_estimate > 0.0 && p.rel_error > 0.0)
-        .map(|p| p.rel_error / p.raw_estimate)
-        .collect();
-    if ratios.is_empty() {
+    let Some(worst) = points.iter().filter_map(|p| usable_ratio(p.raw_estimate, p.rel_error)).reduce(f64::max) else {
         return Calibration { points, ..Calibration::default() };
-    }
-    let worst = ratios.iter().copied().fold(0.0, f64::max);
+    };
     Calibration {
         factor: (CALIBRATION_MARGIN * worst).max(DEFAULT_FACTOR),
         calibrated: true,
         points,
         quantities: Vec::new(),
     }
+}
+
+/// `error / raw` of a held-out pair, where both are finite and positive (an exact reduced
+/// run, or an estimator that failed, says nothing about a factor).
+fn usable_ratio(raw: f64, error: f64) -> Option<f64> {
+    (raw.is_finite() && error.is_finite() && raw > 0.0 && error > 0.0).then(|| error / raw)
 }
 
 /// The factors `c_q` of the probe quantities and reactions from their held-out pairs
@@ -66,11 +66,9 @@ pub fn calibrate(points: Vec<CalibrationPoint>) -> Calibration {
 /// non-finite or non-positive value are ignored; a quantity with none left keeps `c`.
 pub fn calibrate_quantities(mut c: Calibration, points: &[QuantityPoint]) -> Calibration {
     let mut factors: Vec<(String, f64)> = Vec::new();
-    for p in points.iter().filter(|p| p.raw_estimate.is_finite() && p.error.is_finite()) {
-        if !(p.raw_estimate > 0.0 && p.error > 0.0) {
-            continue;
-        }
-        let need = (CALIBRATION_MARGIN * p.error / p.raw_estimate).max(c.factor);
+    for p in points {
+        let Some(ratio) = usable_ratio(p.raw_estimate, p.error) else { continue };
+        let need = (CALIBRATION_MARGIN * ratio).max(c.factor);
         match factors.iter_mut().find(|(k, _)| *k == p.key) {
             Some((_, f)) => *f = f.max(need),
             None => factors.push((p.key.clone(), need)),
