@@ -67,24 +67,38 @@ fn run(args: &[&Path]) -> Output {
 }
 
 /// Every entry below `root`: path → bytes (files), `<dir>` / `<link …>` / `<other>`.
+/// An entry that vanishes between its listing and its reading is left out: `kill_run` polls
+/// while flexrom renames its temporary paths, and a rename there is not a fault.
 fn snapshot(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
-    let mut m = BTreeMap::new();
+    fn present<T>(r: std::io::Result<T>) -> Option<T> {
+        match r {
+            Ok(v) => Some(v),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
+            Err(e) => panic!("{e}"),
+        }
+    }
     fn walk(d: &Path, m: &mut BTreeMap<PathBuf, Vec<u8>>) {
-        for e in std::fs::read_dir(d).unwrap() {
-            let p = e.unwrap().path();
-            let t = std::fs::symlink_metadata(&p).unwrap().file_type();
-            if t.is_symlink() {
-                m.insert(p.clone(), format!("<link {}>", std::fs::read_link(&p).unwrap().display()).into_bytes());
+        let Some(entries) = present(std::fs::read_dir(d)) else { return };
+        for e in entries {
+            let Some(e) = present(e) else { continue };
+            let p = e.path();
+            let Some(t) = present(std::fs::symlink_metadata(&p)).map(|m| m.file_type()) else { continue };
+            let bytes = if t.is_symlink() {
+                present(std::fs::read_link(&p)).map(|l| format!("<link {}>", l.display()).into_bytes())
             } else if t.is_dir() {
-                m.insert(p.clone(), b"<dir>".to_vec());
                 walk(&p, m);
+                Some(b"<dir>".to_vec())
             } else if t.is_file() {
-                m.insert(p.clone(), std::fs::read(&p).unwrap());
+                present(std::fs::read(&p))
             } else {
-                m.insert(p.clone(), b"<other>".to_vec());
+                Some(b"<other>".to_vec())
+            };
+            if let Some(b) = bytes {
+                m.insert(p, b);
             }
         }
     }
+    let mut m = BTreeMap::new();
     walk(root, &mut m);
     m
 }
