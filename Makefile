@@ -34,7 +34,7 @@ run: deps
 
 test: deps
 	# HDF5's file locking stays on: the tests spawn flexrom while they hold HDF5 files open, and
-	# the descriptors flexrom opens are close-on-exec (src/io/h5_open.rs), so no child keeps a
+	# the descriptors libhdf5 opens are close-on-exec (src/io/h5_open.rs), so no child keeps a
 	# test's file locked. No OPENBLAS_NUM_THREADS: the library sets its OpenBLAS to one thread
 	# before its first LAPACK call (src/linalg/lapack.rs), in the test binaries as in flexrom
 	cargo test --release

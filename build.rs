@@ -27,6 +27,11 @@ fn main() {
 
 /// Emits the link arguments above (also called by the Python module's build script,
 /// python/build.rs, which links HDF5 itself).
+///
+/// With them goes `--wrap=open`: the `open(2)` calls of the objects linked statically —
+/// libhdf5's file drivers among them — go to `__wrap_open` (src/io/open_cloexec.c, compiled
+/// here and linked into every program), which adds `O_CLOEXEC`, so that no child process
+/// started at any moment inherits a descriptor of an HDF5 file with its lock.
 pub fn link_native_libraries() {
     let target = std::env::var("TARGET").unwrap_or_default();
     if target != "x86_64-unknown-linux-gnu" {
@@ -63,8 +68,27 @@ pub fn link_native_libraries() {
         args.push("-l:libgfortran.so.5".into());
     }
     args.extend(["-lm", "-lpthread", "-ldl"].map(String::from));
+    args.push(open_cloexec());
+    args.push("-Wl,--wrap=open".into());
     for arg in args {
         println!("cargo::rustc-link-arg={arg}");
+    }
+}
+
+/// src/io/open_cloexec.c compiled into `OUT_DIR`: the object file's path (the package's
+/// own source, or the root package's for the Python module in python/).
+fn open_cloexec() -> String {
+    let dir = std::env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR");
+    let source = ["src/io/open_cloexec.c", "../src/io/open_cloexec.c"]
+        .map(|p| Path::new(&dir).join(p))
+        .into_iter()
+        .find(|p| p.exists())
+        .expect("src/io/open_cloexec.c is in the source tree");
+    let object = Path::new(&std::env::var("OUT_DIR").expect("cargo sets OUT_DIR")).join("open_cloexec.o");
+    println!("cargo::rerun-if-changed={}", source.display());
+    match Command::new("cc").args(["-c", "-O2", "-fPIC", "-o"]).arg(&object).arg(&source).status() {
+        Ok(s) if s.success() => object.display().to_string(),
+        other => panic!("cannot compile {} with `cc` (gcc): {other:?}", source.display()),
     }
 }
 

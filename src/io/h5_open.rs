@@ -10,8 +10,12 @@
 //! for as long as the child ran: a basis read right after it was written failed with
 //! "unable to lock file", the writer's exclusive lock still held by an unrelated child.
 //! Marking the descriptor close-on-exec as soon as the file is open closes it in every
-//! program a child `exec`s. (A child forked in the microseconds between libhdf5's `open`
-//! and the mark still inherits it; only `O_CLOEXEC` inside libhdf5 would close that gap.)
+//! program a child `exec`s. A child started in the microseconds between libhdf5's `open`
+//! and the mark would still inherit it (a test harness met it): where libhdf5 is linked
+//! statically (flexrom's programs and tests, build.rs), the linker sends its `open` calls to
+//! `__wrap_open` (src/io/open_cloexec.c), which opens with `O_CLOEXEC`, and no such moment is
+//! left. The Python
+//! module links the shared libhdf5, whose descriptors only the mark closes.
 
 use crate::error::{Error, Result};
 use std::path::Path;
