@@ -483,8 +483,9 @@ pub fn check_global_heaps(path: &Path) -> Result<HeapObjects> {
         .unwrap_or(0);
     let mut objects = HeapObjects::new();
     let u64_at = |i: usize| u64::from_le_bytes(b[i..i + 8].try_into().expect("8 bytes"));
+    let signature = memchr::memmem::Finder::new(b"GCOL\x01\0\0\0");
     let mut from = 0;
-    while let Some(k) = b[from..].windows(8).position(|w| w == b"GCOL\x01\0\0\0") {
+    while let Some(k) = signature.find(&b[from..]) {
         let at = from + k;
         from = at + 8;
         if at + 16 > b.len() {
