@@ -145,6 +145,23 @@ pub struct Stabilization {
 }
 
 impl Basis {
+    /// The identity basis of `n` coordinates (`x_ref = 0`, `V = I`): a reduced model of it is
+    /// the full model, which tests compare against.
+    #[cfg(test)]
+    pub(crate) fn identity(n: usize, variant: Variant) -> Self {
+        Basis {
+            variant,
+            snapshots: super::SnapshotKind::Raw,
+            reference: ndarray::Array1::zeros(n),
+            modes: ndarray::Array2::eye(n),
+            kept: Vec::new(),
+            multiplier_modes: None,
+            multiplier_scale: 1.0,
+            n_pod_modes: n,
+            hyper: None,
+        }
+    }
+
     /// Writes the unit columns of the kept coordinates (the last `kept.len()` columns).
     pub(super) fn set_kept_columns(&mut self) {
         for (k, &d) in self.kept.iter().enumerate() {

@@ -24,6 +24,7 @@
 //! `λ = w V_λ q` and the projected saddle point adds `Vᵀ Bᵀ λ + w V_λᵀ (B x − b)`, i.e.
 //! `(P + Pᵀ) q + c₀` with `P = w V_λᵀ B V`, `c₀ = w V_λᵀ (B x_ref − b)`.
 
+mod balance;
 mod moving;
 mod newton;
 
@@ -35,7 +36,7 @@ use crate::linalg::lapack::SVD;
 use crate::linalg::sparse_rows::SparseRows;
 pub(crate) use crate::linalg::vec_ops::{axpy, dot, mat_vec};
 use crate::solver::model::{mass_groups, ConstantForces, ElementModel, IterationCoefficients, Parameters};
-use ndarray::{s, Array1, Array2, ArrayView1, Axis};
+use ndarray::{s, Array1, Array2, ArrayView1, ArrayView2, ArrayViewMut2, Axis};
 
 /// The [`crate::solver::model::ParametricModel`] methods a reduced model with fields
 /// `p: Projection` and `full: M` forwards unchanged (mass, joints, Newton solve, length
@@ -85,6 +86,22 @@ macro_rules! impl_reduced {
             }
             fn multipliers(&self, q: &[f64], lambda: &[f64]) -> Option<ndarray::Array1<f64>> {
                 self.p.multipliers(q, lambda)
+            }
+            fn multipliers_along(
+                &self,
+                q: ndarray::ArrayView2<f64>,
+                own: ndarray::ArrayView2<f64>,
+            ) -> Option<ndarray::Array2<f64>> {
+                self.p.multipliers_along(q, own)
+            }
+            fn balance(
+                &self,
+                mu: &crate::solver::model::Parameters,
+                t: &[f64],
+                states: [ndarray::ArrayView2<f64>; 3],
+                lambda: ndarray::ArrayViewMut2<f64>,
+            ) {
+                self.p.balance(&*self.full, mu, t, states, lambda)
             }
         }
     };
@@ -137,6 +154,8 @@ pub(crate) struct Projection {
     /// the model's Newton matrix is symmetric apart from the load Jacobian: factor by
     /// Cholesky (see [`Projection::symmetric_newton_matrix`])
     symmetric: bool,
+    /// every body's balance of momentum, which the physical multipliers are moved to hold
+    balance: Option<balance::Balance>,
 }
 
 /// The groups of [`Projection::mass_split`]: per group where its factor is read, `M_r,g`
@@ -149,6 +168,7 @@ struct MassSplit {
 /// Where a mass group's factor `m_g(μ)` is read: 1 (no parameter), an element of it
 /// ([`ElementModel::mass_factor`]), or the parameter of its lumped mass
 /// ([`ElementModel::lumped_mass_factor`]).
+#[derive(Clone)]
 enum FactorOf {
     One,
     Element(usize),
@@ -182,7 +202,7 @@ struct ProjectedForces {
 }
 
 impl ProjectedForces {
-    fn of(v: &Array2<f64>, g: ConstantForces) -> Self {
+    fn of(v: &Array2<f64>, g: &ConstantForces) -> Self {
         let project = |x: &[f64]| v.t().dot(&ArrayView1::from(x));
         ProjectedForces {
             fixed: project(&g.fixed),
@@ -209,7 +229,7 @@ impl Projection {
             groups.push((None, None));
         }
         let mut col = vec![0.0; n];
-        let groups: Vec<_> = groups
+        let unprojected: Vec<_> = groups
             .into_iter()
             .map(|(name, member)| {
                 let mut mv = Array2::zeros((n, r));
@@ -217,10 +237,13 @@ impl Projection {
                     full.group_mass_mul(name.as_deref(), &v.column(j).to_vec(), &mut col);
                     mv.column_mut(j).assign(&ArrayView1::from(&col));
                 }
-                let forces = ProjectedForces::of(v, full.group_constant_forces(name.as_deref()));
-                (FactorOf::new(name, member), v.t().dot(&mv), forces)
+                let forces = full.group_constant_forces(name.as_deref());
+                (FactorOf::new(name, member), mv, forces)
             })
             .collect();
+        let groups: Vec<_> =
+            unprojected.iter().map(|(f, mv, g)| (f.clone(), v.t().dot(mv), ProjectedForces::of(v, g))).collect();
+        let balance = balance::Balance::new(full, (v, &basis.reference), unprojected);
         let mass_split = MassSplit { factors: vec![1.0; groups.len()], groups };
         // the file's values, whatever the model was last bound to (one group: its own mass)
         let mass = match &mass_split.groups[..] {
@@ -327,6 +350,7 @@ impl Projection {
             elim,
             lu: DenseLu::new(dim),
             symmetric: false,
+            balance,
         })
     }
 
@@ -339,6 +363,33 @@ impl Projection {
             Variant::Galerkin | Variant::WholeSystemStabilized => {
                 self.multiplier_map.as_ref().map(|uk| uk.dot(&ArrayView1::from(lambda)))
             }
+        }
+    }
+
+    /// [`Self::multipliers`] at every instant of a run: `q` by instant (n_t × r), `own` the
+    /// model's own multipliers (its n_c × n_t), in one product.
+    pub fn multipliers_along(&self, q: ArrayView2<f64>, own: ArrayView2<f64>) -> Option<Array2<f64>> {
+        match self.variant {
+            Variant::ConstraintPreserving => Some(own.to_owned()),
+            Variant::WholeSystem => Some(self.multiplier_map.as_ref().expect("set").dot(&q.t())),
+            Variant::Galerkin | Variant::WholeSystemStabilized => self.multiplier_map.as_ref().map(|uk| uk.dot(&own)),
+        }
+    }
+
+    /// Moves the physical multipliers `lambda` (n_c × n_t) along the reduced trajectory
+    /// `[q, q̇, q̈]` by instant (n_t × r each, at the times `t`) to the nearest that hold every
+    /// body's balance of momentum ([`balance`]); unchanged for a model without bodies or
+    /// joints.
+    pub fn balance<M: ElementModel>(
+        &self,
+        full: &M,
+        mu: &Parameters,
+        t: &[f64],
+        states: [ArrayView2<f64>; 3],
+        lambda: ArrayViewMut2<f64>,
+    ) {
+        if let Some(b) = &self.balance {
+            b.correct(full, mu, t, states, lambda);
         }
     }
 

@@ -178,17 +178,7 @@ mod tests {
         let reader = ReactionReader::new(&model);
         let full = reader.of_result(&r).unwrap();
         let n = r.q.nrows();
-        let identity = Basis {
-            variant: crate::reduction::Variant::Galerkin,
-            snapshots: crate::reduction::SnapshotKind::Raw,
-            reference: ndarray::Array1::zeros(n),
-            modes: Array2::eye(n),
-            kept: Vec::new(),
-            multiplier_modes: None,
-            multiplier_scale: 1.0,
-            n_pod_modes: n,
-            hyper: None,
-        };
+        let identity = Basis::identity(n, crate::reduction::Variant::Galerkin);
         let t = r.t.as_slice().unwrap();
         let via = reader
             .of_trajectory((r.settings.parameters(), t), (&identity, r.q.view()), None, r.multipliers.view())

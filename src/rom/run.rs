@@ -109,14 +109,15 @@ pub fn settings_at(model: &Model, mu: &Parameters) -> Result<Settings> {
 }
 
 /// Refuses `runs` reduced runs of `r` coordinates over `n_steps` whose kept arrays would
-/// not fit the memory bound: `8 n_t (2 r + n_c + n_pv + 1)` each (z and ż, the reduced
-/// multipliers, the probes' values, t), plus the full coordinates and velocities and the
-/// multipliers `8 n_t (2 n_dof + n_c)` when they are reconstructed ([`crate::limits`]).
+/// not fit the memory bound: `8 n_t (4 r + n_c + n_pv + 1)` each (z, ż and z̈ by instant and
+/// z by mode, the reduced multipliers, the probes' values, t), plus the full coordinates
+/// and velocities and the multipliers `8 n_t (2 n_dof + n_c)` when they are reconstructed
+/// ([`crate::limits`]).
 pub fn check_reduced_memory(model: &Model, r: usize, n_steps: usize, output: Output, runs: f64) -> Result<()> {
     let z = model.sizes();
     let nt = n_steps as f64 + 1.0;
     let full = if output == Output::Full { 2.0 * z.n_dof + z.n_constraints } else { 0.0 };
-    let bytes = runs * 8.0 * nt * (2.0 * r as f64 + z.n_constraints + z.n_probe_values + 1.0 + full);
+    let bytes = runs * 8.0 * nt * (4.0 * r as f64 + z.n_constraints + z.n_probe_values + 1.0 + full);
     let what = if runs > 1.0 {
         format!(
             "{runs} reduced runs of {n_steps} steps × {r} modes{}",
@@ -155,20 +156,25 @@ pub(crate) fn static_start<R: Reduced<FlexibleSystem>>(
 }
 
 /// The physical multipliers (n_c × n_t, `n_c` the full model's constraints) of a reduced
-/// model's own multipliers `own` at its coordinates `q` (columns: instants), over the first
-/// `taken` columns; NaN after them and where the variant has none. Made after a time loop,
-/// so that the loop allocates nothing for them.
+/// model's own multipliers `own` (columns: instants at `t`) along its trajectory, given by
+/// instant (`[q, q̇, q̈]`, n_t × r each), over the first `taken` instants, moved to hold every
+/// body's balance of momentum ([`Reduced::balance`]); NaN after them and where the variant
+/// has none. Made after a time loop, so that the loop allocates nothing for them.
 pub(crate) fn physical_multipliers<F, R: Reduced<F>>(
     rom: &R,
     n_c: usize,
-    (q, own): (ArrayView2<f64>, ArrayView2<f64>),
+    (mu, t): (&Parameters, &[f64]),
+    states: [ArrayView2<f64>; 3],
+    own: ArrayView2<f64>,
     taken: usize,
 ) -> Array2<f64> {
-    let mut out = Array2::from_elem((n_c, q.ncols()), f64::NAN);
-    for (k, (qk, lk)) in q.columns().into_iter().zip(own.columns()).take(taken).enumerate() {
-        if let Some(l) = rom.multipliers(&qk.to_vec(), &lk.to_vec()) {
-            out.column_mut(k).assign(&l);
-        }
+    let mut out = Array2::from_elem((n_c, own.ncols()), f64::NAN);
+    let taken = taken.min(own.ncols());
+    let along = states.map(|x| x.slice_move(ndarray::s![..taken, ..]));
+    if let Some(l) = rom.multipliers_along(along[0], own.slice(ndarray::s![.., ..taken])) {
+        let mut kept = out.slice_mut(ndarray::s![.., ..taken]);
+        kept.assign(&l);
+        rom.balance(mu, &t[..taken], along, kept);
     }
     out
 }
@@ -187,8 +193,9 @@ fn run<R: Reduced<FlexibleSystem>>(
     let q0 =
         if model.starts_static() { static_start(rom, &s, q0.to_vec(), "the reduced model's")? } else { q0.to_vec() };
     let v0 = v0.to_vec();
-    let mut zq = Array2::zeros((r, nt));
-    let mut zv = Array2::zeros((r, nt));
+    // the state by instant (z, ż, z̈: n_t × r), rows written whole: the multipliers'
+    // balance reads it so, and `z` is laid out by mode after the loop
+    let mut by_instant = [Array2::zeros((nt, r)), Array2::zeros((nt, r)), Array2::zeros((nt, r))];
     let mut lam = Array2::<f64>::zeros((rom.n_constraints(), nt));
     let mut t = Array1::zeros(nt);
     // (λᵢ, trajectory) of the earlier runs that fit this one, nearest last
@@ -218,8 +225,9 @@ fn run<R: Reduced<FlexibleSystem>>(
     let start = std::time::Instant::now();
     let stats = crate::simulate::solve(rom, &s, (q0, v0), guess, |k, st| {
         t[k] = st.t;
-        zq.column_mut(k).assign(&ArrayView1::from(&st.q));
-        zv.column_mut(k).assign(&ArrayView1::from(&st.v));
+        for (to, from) in by_instant.iter_mut().zip([&st.q, &st.v, &st.qdd]) {
+            to.row_mut(k).assign(&ArrayView1::from(from));
+        }
         lam.column_mut(k).assign(&ArrayView1::from(&st.lambda));
     })?;
     let wall_seconds = start.elapsed().as_secs_f64();
@@ -227,10 +235,18 @@ fn run<R: Reduced<FlexibleSystem>>(
     let full = rom.full();
     let n_c = full.n_constraints();
     // the physical multipliers in either output: the reactions and their estimates read them
-    let multipliers = physical_multipliers(rom, n_c, (zq.view(), lam.view()), nt);
+    let multipliers = physical_multipliers(
+        rom,
+        n_c,
+        (&s.mu, t.as_slice().expect("contiguous")),
+        by_instant.each_ref().map(|x| x.view()),
+        lam.view(),
+        nt,
+    );
+    let zq = by_instant[0].t().as_standard_layout().into_owned();
     let (q, qd) = match output {
         // q̇ = V ż: the reference is constant
-        Output::Full => (basis.reconstruct_columns(zq.view()), basis.modes.dot(&zv)),
+        Output::Full => (basis.reconstruct_columns(zq.view()), basis.modes.dot(&by_instant[1].t())),
         Output::ReducedAndProbes => (Array2::zeros((0, nt)), Array2::zeros((0, nt))),
     };
     let values = super::probes::probe_values(full, basis, zq.view());

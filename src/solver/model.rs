@@ -315,6 +315,24 @@ pub trait ElementModel: ParametricModel {
         coefs.iter_mut().for_each(|c| *c = 0.0);
         0.0
     }
+    /// Each body's coordinates as a rigid motion moves them ([`RigidBody`]), for the balance
+    /// of each body's momentum that reduced models read their joint reactions from; none by
+    /// default (the reduced models' multipliers are then given as they come).
+    fn rigid_bodies(&self) -> Vec<RigidBody> {
+        Vec::new()
+    }
+}
+
+/// A body's coordinates in `(x, y)` pairs as a rigid motion of the plane moves them: its
+/// positions translate and turn, its slopes (directions) only turn. The body's elements must
+/// be objective — their elastic forces do no work in such a motion — so that its balance of
+/// momentum holds the joints' forces on it without them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RigidBody {
+    pub positions: Vec<[usize; 2]>,
+    pub slopes: Vec<[usize; 2]>,
+    /// the body's length (m): its turn is read per unit length, in N as its forces
+    pub length: f64,
 }
 
 /// The constant forces `g₀` of a model, or of a group of its elements, in parts:

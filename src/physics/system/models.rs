@@ -94,6 +94,20 @@ impl ElementModel for FlexibleSystem {
         self.add_point_mass_group_product(group, a, out);
     }
 
+    /// Each beam: its nodes' positions and slopes (the Berzeri–Shabana element is objective:
+    /// its strain invariant and bending curvature do not change in a rigid motion).
+    fn rigid_bodies(&self) -> Vec<crate::solver::model::RigidBody> {
+        let pairs =
+            |b: usize, offset: usize| self.body_dofs(b).step_by(4).map(|d| [d + offset, d + offset + 1]).collect();
+        (0..self.bodies.len())
+            .map(|b| crate::solver::model::RigidBody {
+                positions: pairs(b, 0),
+                slopes: pairs(b, 2),
+                length: self.bodies[b].length,
+            })
+            .collect()
+    }
+
     fn moving_rows(&self) -> Vec<(usize, Vec<usize>)> {
         self.moving.iter().map(|(c, row)| (*c, row.terms.iter().map(|t| t.0).collect())).collect()
     }

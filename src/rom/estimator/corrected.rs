@@ -77,7 +77,7 @@ use crate::rom::run::{physical_multipliers, ReducedRun};
 use crate::simulate::{Overrides, Settings};
 use crate::solver::generalized_alpha::{GeneralizedAlpha, State, StepConstants};
 use crate::solver::model::{Bound, DynamicModel, ParametricModel};
-use ndarray::{Array1, Array2, ArrayView1};
+use ndarray::{Array1, Array2, ArrayView1, ArrayView2};
 use std::sync::Arc;
 
 /// What a step's correction may leave uncorrected, relative to the correction itself
@@ -239,7 +239,7 @@ impl CorrectedRunner {
         let (n, nc) = (rom.n_dof(), rom.n_constraints());
         let fail = |t: f64, e: Error| e.at_time_in(t, "error estimator");
         let (tol, max_iterations) = (s.params.tolerance * rom.length_scale(), s.params.max_iterations);
-        let mut integ = GeneralizedAlpha::new(s.params).map_err(|p| fail(0.0, p))?;
+        let mut integ = GeneralizedAlpha::new(s.params.clone()).map_err(|p| fail(0.0, p))?;
         let mut stats = FollowStats::default();
         let h = s.dt;
         let k = integ.step_constants(h);
@@ -256,9 +256,16 @@ impl CorrectedRunner {
         // following: the model's own multipliers at each step, turned into physical ones
         // after the loop, so that the loop allocates nothing for them
         let mut own = Array2::zeros((if sample == 0 { nc } else { 0 }, nt));
+        // the corrected trajectory by instant (q, q̇, q̈), which the multipliers' balance reads
+        let rows = if sample == 0 { nt } else { 0 };
+        let mut by_instant = [Array2::zeros((rows, n)), Array2::zeros((rows, n)), Array2::zeros((rows, n))];
         if sample == 0 {
             own.column_mut(0).assign(&ArrayView1::from(&st.lambda));
+            keep_state(&mut by_instant, 0, &st);
         }
+        let mu = s.parameters();
+        let times: Vec<f64> = (0..nt).map(|k| k as f64 * h).collect();
+        let mut corrected = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
         let mut dz = vec![0.0; z.nrows()];
         let mut d = vec![0.0; n];
         for step in 1..nt {
@@ -294,7 +301,12 @@ impl CorrectedRunner {
                     // the lifted state's step multipliers λ⁺ = β' s Δμ from zero (at sampled
                     // steps only, each of which factors a matrix anyway)
                     rhs[n..].iter_mut().for_each(|m| *m *= k.beta_p * sc);
-                    if let Some(l) = Reduced::multipliers(&*rom.model, &st.q, &rhs[n..]) {
+                    if let Some(mut l) = Reduced::multipliers(&*rom.model, &st.q, &rhs[n..]) {
+                        // balanced at the corrected state, where λ⁺ belongs
+                        corrected_state(&st, &k, &rhs[..n], &mut corrected);
+                        let state = corrected.each_ref().map(|x| ArrayView2::from_shape((1, n), x).expect("n"));
+                        let l_mut = l.view_mut().insert_axis(ndarray::Axis(1));
+                        Reduced::balance(&*rom.model, mu, &[t], state, l_mut);
                         lambda.column_mut(step).assign(&l);
                     }
                 } else if !inc.is_finite() {
@@ -305,7 +317,8 @@ impl CorrectedRunner {
                     if !stats.followed() {
                         // what follows this step is no reading of the reduced run's error
                         if sample == 0 {
-                            lambda = physical_multipliers(&*rom.model, nc_full, (out.view(), own.view()), step);
+                            let along = by_instant.each_ref().map(|x| x.view());
+                            lambda = physical_multipliers(&*rom.model, nc_full, (mu, &times), along, own.view(), step);
                         }
                         return Ok(Followed { q: out, lambda, stats });
                     }
@@ -315,12 +328,32 @@ impl CorrectedRunner {
             if sample == 0 {
                 out.column_mut(step).assign(&ArrayView1::from(&st.q));
                 own.column_mut(step).assign(&ArrayView1::from(&st.lambda));
+                keep_state(&mut by_instant, step, &st);
             }
         }
         if sample == 0 {
-            lambda = physical_multipliers(&*rom.model, nc_full, (out.view(), own.view()), nt);
+            let along = by_instant.each_ref().map(|x| x.view());
+            lambda = physical_multipliers(&*rom.model, nc_full, (mu, &times), along, own.view(), nt);
         }
         Ok(Followed { q: out, lambda, stats })
+    }
+}
+
+/// Row `k` of the trajectory by instant: the state's `q`, `q̇`, `q̈`.
+fn keep_state(by_instant: &mut [Array2<f64>; 3], k: usize, st: &State) {
+    for (to, from) in by_instant.iter_mut().zip([&st.q, &st.v, &st.qdd]) {
+        to.row_mut(k).assign(&ArrayView1::from(from));
+    }
+}
+
+/// The state a Newton correction `dq` (not applied) would give:
+/// `(q + dq, q̇ + γ' dq, q̈ + β' dq)` ([`GeneralizedAlpha::apply_correction`]).
+fn corrected_state(st: &State, k: &StepConstants, dq: &[f64], out: &mut [Vec<f64>; 3]) {
+    let [q, v, a] = out;
+    for (i, d) in dq.iter().enumerate() {
+        q[i] = st.q[i] + d;
+        v[i] = st.v[i] + k.gamma_p * d;
+        a[i] = st.qdd[i] + k.beta_p * d;
     }
 }
 
