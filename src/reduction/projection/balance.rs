@@ -26,7 +26,8 @@
 //! reading costs `O(r²)` a body and no full vector.
 
 use super::{dot, expand, FactorOf};
-use crate::solver::model::{mass_groups, stiffness_groups, ConstantForces, ElementModel, Parameters, RigidBody};
+use crate::reduction::damping::{damping_parts, part_factor};
+use crate::solver::model::{ConstantForces, ElementModel, Parameters, RigidBody};
 use ndarray::{Array1, Array2, ArrayView1, ArrayView2, ArrayViewMut2, Axis};
 
 /// One body's coordinate pairs, the point it turns about and its length's inverse.
@@ -150,9 +151,7 @@ impl Factor {
     fn at<M: ElementModel>(&self, full: &M, mu: &Parameters) -> f64 {
         match self {
             Factor::Mass(f) => f.at(full, mu),
-            Factor::Damping { member: None, .. } => 1.0,
-            Factor::Damping { member: Some(e), follows_mass: true } => full.mass_factor(*e, mu),
-            Factor::Damping { member: Some(e), follows_mass: false } => full.stiffness_factor(*e, mu),
+            Factor::Damping { member, follows_mass } => part_factor(full, (*member, *follows_mass), mu),
         }
     }
 }
@@ -255,7 +254,7 @@ impl Balance {
             })
             .collect();
         let damping =
-            damping_parts(full, v).into_iter().map(|(f, cv)| (f, Tested::of(&bodies, cv.view(), basis))).collect();
+            damping_products(full, v).into_iter().map(|(f, cv)| (f, Tested::of(&bodies, cv.view(), basis))).collect();
         let rows: Vec<JointTests> = bodies.iter().map(|b| constant_rows(full, b, v, x_ref)).collect();
         let moving = full.moving_rows();
         let pattern =
@@ -537,38 +536,20 @@ fn constant_rows<M: ElementModel>(full: &M, b: &Body, v: &Array2<f64>, x_ref: &A
     JointTests { x: times_b(&tx), y: times_b(&ty), turn: times_b(&d), moving }
 }
 
-/// `C_part V` per damping part (Rayleigh's mass and stiffness parts, per group of elements
-/// one parameter scales), each with where its factor is read; none for an undamped model.
-fn damping_parts<M: ElementModel>(full: &M, v: &Array2<f64>) -> Vec<(Factor, Array2<f64>)> {
-    let ne = full.n_elements();
-    if ne == 0 {
-        return Vec::new();
-    }
-    let size = full.element_dofs(0).len();
-    let (mut cm, mut cs) = (vec![0.0; size * size], vec![0.0; size * size]);
-    let whole = |g: Vec<(Option<String>, Vec<usize>)>| if g.is_empty() { vec![(None, (0..ne).collect())] } else { g };
-    let mut parts = Vec::new();
-    for (follows_mass, groups) in [(true, whole(mass_groups(full))), (false, whole(stiffness_groups(full)))] {
-        for (name, members) in groups {
-            let mut cv = Array2::zeros((full.n_dof(), v.ncols()));
-            for &e in &members {
-                full.element_damping_parts(e, &mut cm, &mut cs);
-                let ce = ArrayView2::from_shape((size, size), if follows_mass { &cm } else { &cs }).expect("square");
-                let dofs = full.element_dofs(e);
-                // column-major Cₑ read row-major is Cₑᵀ = Cₑ
-                let part = ce.dot(&v.select(Axis(0), dofs));
-                for (row, &d) in dofs.iter().enumerate() {
-                    let mut target = cv.row_mut(d);
-                    target += &part.row(row);
-                }
+/// `C_part V` per damping part ([`damping_parts`]), each with where its factor is read;
+/// none for an undamped model.
+fn damping_products<M: ElementModel>(full: &M, v: &Array2<f64>) -> Vec<(Factor, Array2<f64>)> {
+    let parts = damping_parts(full).into_iter().map(|part| {
+        let mut cv = Array2::zeros((full.n_dof(), v.ncols()));
+        part.each_element(full, |dofs, ce| {
+            for (row, &d) in ce.dot(&v.select(Axis(0), dofs)).outer_iter().zip(dofs) {
+                let mut target = cv.row_mut(d);
+                target += &row;
             }
-            if cv.iter().any(|x| *x != 0.0) {
-                let member = name.as_ref().and(members.first().copied());
-                parts.push((Factor::Damping { member, follows_mass }, cv));
-            }
-        }
-    }
-    parts
+        });
+        (Factor::Damping { member: part.member, follows_mass: part.follows_mass }, cv)
+    });
+    parts.filter(|(_, cv)| cv.iter().any(|x| *x != 0.0)).collect()
 }
 
 #[cfg(test)]
